@@ -1,0 +1,196 @@
+// The one runtime every fploc process uses. A node is a small class that wires a transport-free
+// library to typed ports; the runtime does options, LCM, telemetry, timers and shutdown.
+//
+//   class SegmenterNode : public fploc::rt::Node {
+//    public:
+//     static fploc::rt::NodeSpec spec() {
+//       return {"segmenter", "segmenter", "ceiling/ground planes -> roll, pitch, z; wall points",
+//               {fploc::rt::input<fploc::scan_t>("scan", "OS1_SCAN"),
+//                fploc::rt::output<fploc::segments_t>("segments", "FPLOC_SEGMENTS")}};
+//     }
+//     void setup(fploc::rt::Context& ctx) override {
+//       const auto& opt = ctx.options<fploc::SegmenterOptions>();
+//       out_ = ctx.advertise<fploc::segments_t>("segments");
+//       ctx.subscribe<fploc::scan_t>("scan", [this](const fploc::scan_t& m) { ... out_.publish(seg); });
+//     }
+//    private:
+//     fploc::rt::Publisher<fploc::segments_t> out_;
+//   };
+//   FPLOC_REGISTER_NODE(SegmenterNode)
+//
+// Build with fploc_add_node(segmenter SOURCES segmenter_node.cpp DEPS fploc_segmentation): that gives
+// the executable fploc-segmenter (standalone or under `fploc launch`) and lets `fploc replay` compose it.
+#pragma once
+#include <google/protobuf/message.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fploc/runtime/telemetry.h"
+
+namespace fploc::rt {
+
+struct PortSpec {
+  std::string name;
+  std::string lcm_type;          // e.g. "fploc.scan_t"
+  std::string default_channel;   // used when the graph does not map the port
+  bool output = false;
+};
+
+struct NodeSpec {
+  std::string type;              // registry key; the executable is fploc-<type>
+  std::string options_field;     // field of Node.options in graph.proto ("" = takes no options)
+  std::string description;
+  std::vector<PortSpec> ports;
+};
+
+template <class Msg>
+PortSpec input(std::string name, std::string default_channel) {
+  return {std::move(name), std::string("fploc.") + Msg::getTypeName(), std::move(default_channel), false};
+}
+template <class Msg>
+PortSpec output(std::string name, std::string default_channel) {
+  return {std::move(name), std::string("fploc.") + Msg::getTypeName(), std::move(default_channel), true};
+}
+
+class Context;
+
+class Node {
+ public:
+  virtual ~Node() = default;
+  virtual void setup(Context& ctx) = 0;
+  // Called once before the process exits (after the last message); flush files here.
+  virtual void shutdown() {}
+};
+
+// A typed output port. Cheap to copy; publishing counts messages for telemetry.
+template <class Msg>
+class Publisher {
+ public:
+  Publisher() = default;
+  void publish(const Msg& m) const;
+  bool valid() const { return ctx_ != nullptr; }
+  const std::string& channel() const { return channel_; }
+
+ private:
+  friend class Context;
+  Context* ctx_ = nullptr;
+  std::string channel_;
+  PortCounters* counters_ = nullptr;
+};
+
+class Bus;  // LCM instance shared by all nodes of a process
+
+class Context {
+ public:
+  Context(Bus& bus, const NodeSpec& spec, std::string instance_name,
+          std::unique_ptr<google::protobuf::Message> options, std::vector<std::pair<std::string, std::string>> port_map,
+          std::string base_dir, bool composed);
+  ~Context();
+
+  const std::string& name() const { return name_; }
+  const NodeSpec& spec() const { return spec_; }
+  // The node's typed options from the graph (default values when the graph gives none).
+  template <class Opt>
+  const Opt& options() const {
+    static const Opt kDefault;
+    const auto* o = dynamic_cast<const Opt*>(options_.get());
+    return o ? *o : kDefault;
+  }
+  // Resolves a path from the options: absolute, or relative to the graph file's folder.
+  std::string resolve_path(const std::string& p) const;
+  // True inside `fploc replay` (one process, lock-step): no wall-clock timers or sockets.
+  bool composed() const { return composed_; }
+  const std::string& channel(const std::string& port) const;
+
+  template <class Msg>
+  Publisher<Msg> advertise(const std::string& port);
+  template <class Msg>
+  void subscribe(const std::string& port, std::function<void(const Msg&)> fn);
+
+  // Periodic work (drivers, simulator); not allowed in composed mode.
+  void every(double period_s, std::function<void()> fn);
+  // Calls fn whenever fd is readable (sockets).
+  void watch_fd(int fd, std::function<void()> fn);
+  // Records an error for telemetry (last_error, count) and prints it to stderr the first few times.
+  void error(const std::string& msg);
+  // Asks the process to stop after the current message (e.g. a pcap source reached its end).
+  void request_stop();
+
+  // Internal (used by the runtime).
+  NodeStats& stats() { return stats_; }
+  void publish_raw(const std::string& channel, const void* data, int size, PortCounters* c);
+  Bus& bus() { return bus_; }
+
+ private:
+  void subscribe_raw(const std::string& port, std::function<bool(const void*, int)> fn);
+  Bus& bus_;
+  NodeSpec spec_;
+  std::string name_;
+  std::unique_ptr<google::protobuf::Message> options_;
+  std::vector<std::pair<std::string, std::string>> port_map_;
+  std::string base_dir_;
+  bool composed_;
+  NodeStats stats_;
+};
+
+// ---- registry -------------------------------------------------------------------------------
+using NodeFactory = std::function<std::unique_ptr<Node>()>;
+struct Registration {
+  NodeSpec spec;
+  NodeFactory make;
+};
+std::vector<Registration>& registry();
+const Registration* find_registration(const std::string& type);
+// `fploc-segmenter` -> "segmenter".
+std::string type_from_executable(const std::string& executable);
+
+template <class N>
+struct Registrar {
+  Registrar() { registry().push_back({N::spec(), [] { return std::unique_ptr<Node>(new N()); }}); }
+};
+
+#define FPLOC_CONCAT_(a, b) a##b
+#define FPLOC_CONCAT(a, b) FPLOC_CONCAT_(a, b)
+#define FPLOC_REGISTER_NODE(Class) static ::fploc::rt::Registrar<Class> FPLOC_CONCAT(fploc_registrar_, __LINE__);
+
+// Entry point of every node executable (runtime/src/node_main.cpp calls it).
+int node_main(int argc, char** argv);
+
+// ---- template implementation ----------------------------------------------------------------
+template <class Msg>
+void Publisher<Msg>::publish(const Msg& m) const {
+  if (!ctx_) return;
+  const int n = m.getEncodedSize();
+  thread_local std::vector<uint8_t> buf;
+  buf.resize(size_t(n));
+  m.encode(buf.data(), 0, n);
+  ctx_->publish_raw(channel_, buf.data(), n, counters_);
+}
+
+template <class Msg>
+Publisher<Msg> Context::advertise(const std::string& port) {
+  Publisher<Msg> p;
+  p.ctx_ = this;
+  p.channel_ = channel(port);
+  p.counters_ = &stats_.port(port, p.channel_, true);
+  return p;
+}
+
+template <class Msg>
+void Context::subscribe(const std::string& port, std::function<void(const Msg&)> fn) {
+  auto* counters = &stats_.port(port, channel(port), false);
+  subscribe_raw(port, [fn = std::move(fn), counters](const void* data, int size) {
+    Msg m;
+    if (m.decode(data, 0, size) < 0) return false;
+    if constexpr (requires { m.seq; }) counters->observe_seq(m.seq);
+    fn(m);
+    return true;
+  });
+}
+
+}  // namespace fploc::rt

@@ -1,0 +1,64 @@
+// Telemetry statistics kept by the runtime for each node (no LCM here; unit-tested on its own).
+#pragma once
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <vector>
+
+namespace fploc::rt {
+
+struct PortCounters {
+  std::string port, channel;
+  bool output = false;
+  int64_t messages = 0;        // since start
+  int64_t period_messages = 0; // since the last heartbeat
+  int64_t dropped = 0;
+  int64_t undecodable = 0;
+  int64_t last_seq = -1;
+  // Sequence gaps on an input are counted as drops; a restart of the publisher (seq going back) is not.
+  void observe_seq(int64_t seq) {
+    if (last_seq >= 0 && seq > last_seq + 1) dropped += seq - last_seq - 1;
+    last_seq = seq;
+  }
+};
+
+// Exact percentiles of the samples since the last reset.
+class LatencyWindow {
+ public:
+  void add(double ms) { samples_.push_back(ms); }
+  // q in [0, 1]; nearest-rank percentile; 0 when empty.
+  double percentile(double q) const;
+  size_t size() const { return samples_.size(); }
+  void reset() { samples_.clear(); }
+  double sum() const;
+
+ private:
+  std::vector<double> samples_;
+};
+
+// CPU time of this process as a percentage of one core between two calls.
+class CpuMeter {
+ public:
+  CpuMeter();
+  double sample_percent();
+
+ private:
+  double last_cpu_s_, last_wall_s_;
+};
+
+struct NodeStats {
+  std::deque<PortCounters> ports;  // deque: stable addresses for publishers/subscribers
+  LatencyWindow latency;           // handler latency this period
+  LatencyWindow latency_total;     // every handler call (replay breakdown)
+  int64_t errors = 0;
+  std::string last_error;
+  double busy_s_period = 0;        // time spent in handlers this period
+
+  PortCounters& port(const std::string& name, const std::string& channel, bool output);
+  int64_t messages(bool output) const;
+  int64_t dropped() const;
+  int64_t undecodable() const;
+  void end_period();               // resets per-period counters
+};
+
+}  // namespace fploc::rt

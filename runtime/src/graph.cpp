@@ -1,0 +1,184 @@
+#include "fploc/runtime/graph.h"
+
+#include <google/protobuf/descriptor.h>
+#include <google/protobuf/io/tokenizer.h>
+#include <google/protobuf/io/zero_copy_stream_impl_lite.h>
+#include <google/protobuf/util/json_util.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace fploc::rt {
+
+using google::protobuf::Descriptor;
+using google::protobuf::FieldDescriptor;
+using google::protobuf::Message;
+using google::protobuf::TextFormat;
+
+std::string GraphError::str() const {
+  std::ostringstream s;
+  s << file;
+  if (line > 0) s << ":" << line;
+  s << ": " << message;
+  return s.str();
+}
+
+namespace {
+
+class Collector : public google::protobuf::io::ErrorCollector {
+ public:
+  Collector(std::string file, std::vector<GraphError>& errors) : file_(std::move(file)), errors_(errors) {}
+  void AddError(int line, google::protobuf::io::ColumnNumber col, const std::string& msg) override {
+    errors_.push_back({file_, line + 1, msg});
+    ++count;
+  }
+  void AddWarning(int line, google::protobuf::io::ColumnNumber col, const std::string& msg) override {
+    // With AllowUnknownField(true) the parser reports unknown fields as warnings and carries on; for a
+    // graph they are errors (a misspelt option must never be silently ignored).
+    if (msg.find("no field named") != std::string::npos || msg.find("unknown") != std::string::npos) {
+      errors_.push_back({file_, line + 1, msg + " (misspelt or unknown field)"});
+      ++count;
+    }
+  }
+  int count = 0;
+
+ private:
+  std::string file_;
+  std::vector<GraphError>& errors_;
+};
+
+}  // namespace
+
+bool parse_graph_text(const std::string& text, const std::string& name, LoadedGraph& out,
+                      std::vector<GraphError>& errors) {
+  out.path = name;
+  out.dir = std::filesystem::absolute(std::filesystem::path(name)).parent_path().string();
+  out.tree = std::make_shared<TextFormat::ParseInfoTree>();
+  Collector collector(name, errors);
+  TextFormat::Parser parser;
+  parser.RecordErrorsTo(&collector);
+  parser.WriteLocationsTo(out.tree.get());
+  parser.AllowUnknownField(true);
+  const bool ok = parser.ParseFromString(text, &out.graph);
+  return ok && collector.count == 0;
+}
+
+bool load_graph(const std::string& path, LoadedGraph& out, std::vector<GraphError>& errors) {
+  std::ifstream in(path);
+  if (!in) {
+    errors.push_back({path, 0, "cannot open graph file"});
+    return false;
+  }
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_graph_text(ss.str(), path, out, errors);
+}
+
+int LoadedGraph::node_line(int node_index, const std::string& field, int field_index) const {
+  const auto* gd = fploc::Graph::descriptor();
+  const auto* node_field = gd->FindFieldByName("node");
+  const auto loc = tree->GetLocation(node_field, node_index);
+  if (field.empty()) return loc.line + 1;
+  auto* sub = tree->GetTreeForNested(node_field, node_index);
+  if (!sub) return loc.line + 1;
+  const auto* f = fploc::Node::descriptor()->FindFieldByName(field);
+  if (!f) return loc.line + 1;
+  const auto l = sub->GetLocation(f, f->is_repeated() ? std::max(field_index, 0) : -1);
+  return l.line >= 0 ? l.line + 1 : loc.line + 1;
+}
+
+std::string node_options_field(const fploc::Node& node) {
+  const auto* oneof = fploc::Node::descriptor()->FindOneofByName("options");
+  const auto* f = node.GetReflection()->GetOneofFieldDescriptor(node, oneof);
+  return f ? f->name() : "";
+}
+
+std::unique_ptr<Message> node_options(const fploc::Node& node) {
+  const auto* oneof = fploc::Node::descriptor()->FindOneofByName("options");
+  const auto* f = node.GetReflection()->GetOneofFieldDescriptor(node, oneof);
+  if (!f) return nullptr;
+  const Message& m = node.GetReflection()->GetMessage(node, f);
+  std::unique_ptr<Message> copy(m.New());
+  copy->CopyFrom(m);
+  return copy;
+}
+
+std::unique_ptr<Message> default_options(const std::string& field) {
+  const auto* f = fploc::Node::descriptor()->FindFieldByName(field);
+  if (!f || !f->containing_oneof() || f->type() != FieldDescriptor::TYPE_MESSAGE) return nullptr;
+  fploc::Node n;
+  const Message& m = n.GetReflection()->GetMessage(n, f);
+  return std::unique_ptr<Message>(m.New());
+}
+
+bool apply_overrides(Message& opts, const std::vector<std::string>& overrides, std::string& error) {
+  for (const auto& kv : overrides) {
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos) {
+      error = "override '" + kv + "': expected field=value";
+      return false;
+    }
+    const std::string path = kv.substr(0, eq), value = kv.substr(eq + 1);
+    // Walk "a.b.c" to build nested text: a { b { c: value } }.
+    std::vector<std::string> parts;
+    std::stringstream ps(path);
+    for (std::string p; std::getline(ps, p, '.');) parts.push_back(p);
+    const Descriptor* d = opts.GetDescriptor();
+    const FieldDescriptor* f = nullptr;
+    for (size_t i = 0; i < parts.size(); ++i) {
+      f = d ? d->FindFieldByName(parts[i]) : nullptr;
+      if (!f) {
+        error = "override '" + kv + "': " + opts.GetDescriptor()->full_name() + " has no field '" + path + "'";
+        return false;
+      }
+      if (i + 1 < parts.size()) d = f->message_type();
+    }
+    std::string v = value;
+    if (f->type() == FieldDescriptor::TYPE_STRING && (v.empty() || v.front() != '"')) {
+      std::string q = "\"";
+      for (char c : v) {
+        if (c == '"' || c == '\\') q += '\\';
+        q += c;
+      }
+      v = q + "\"";
+    }
+    std::string text;
+    for (size_t i = 0; i + 1 < parts.size(); ++i) text += parts[i] + " { ";
+    text += parts.back() + ": " + v;
+    for (size_t i = 0; i + 1 < parts.size(); ++i) text += " }";
+    std::vector<GraphError> errs;
+    Collector c("--set", errs);
+    TextFormat::Parser parser;
+    parser.RecordErrorsTo(&c);
+    if (!parser.MergeFromString(text, &opts) || c.count) {
+      error = "override '" + kv + "': " + (errs.empty() ? std::string("cannot parse value") : errs.front().message);
+      return false;
+    }
+  }
+  return true;
+}
+
+namespace {
+nlohmann::json describe(const Descriptor* d, int depth) {
+  nlohmann::json j;
+  j["type"] = d->full_name();
+  auto& fields = j["fields"] = nlohmann::json::array();
+  for (int i = 0; i < d->field_count(); ++i) {
+    const auto* f = d->field(i);
+    nlohmann::json fj{{"name", f->name()}, {"type", f->type_name()}, {"repeated", f->is_repeated()}};
+    if (f->message_type() && depth < 4) fj["message"] = describe(f->message_type(), depth + 1);
+    if (f->enum_type()) {
+      auto& vals = fj["values"] = nlohmann::json::array();
+      for (int k = 0; k < f->enum_type()->value_count(); ++k) vals.push_back(f->enum_type()->value(k)->name());
+    }
+    fields.push_back(fj);
+  }
+  return j;
+}
+}  // namespace
+
+std::string describe_message_json(const Descriptor* d) { return describe(d, 0).dump(); }
+
+}  // namespace fploc::rt

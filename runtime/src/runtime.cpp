@@ -1,0 +1,442 @@
+#include <fploc/node_command_t.hpp>
+#include <fploc/node_status_t.hpp>
+#include <poll.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <stdexcept>
+
+#include "fploc/runtime/bus.h"
+#include "fploc/runtime/compose.h"
+#include "fploc/runtime/graph.h"
+#include "fploc/runtime/node.h"
+
+namespace fploc::rt {
+
+namespace {
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+int64_t wall_utime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+}  // namespace
+
+Bus::Bus(const std::string& url) : url_(url.empty() ? kDefaultLcmUrl : url) {
+  lcm_ = std::make_unique<lcm::LCM>(url_);
+  if (!lcm_->good()) throw std::runtime_error("cannot open LCM provider '" + url_ + "'");
+}
+
+// ---- registry ---------------------------------------------------------------------------------
+std::vector<Registration>& registry() {
+  static std::vector<Registration> r;
+  return r;
+}
+const Registration* find_registration(const std::string& type) {
+  for (const auto& r : registry())
+    if (r.spec.type == type) return &r;
+  return nullptr;
+}
+std::string type_from_executable(const std::string& executable) {
+  std::string base = std::filesystem::path(executable).filename().string();
+  if (base.rfind("fploc-", 0) == 0) base = base.substr(6);
+  std::replace(base.begin(), base.end(), '-', '_');
+  return base;
+}
+
+// ---- context ----------------------------------------------------------------------------------
+struct TimerEntry {
+  double period, next;
+  std::function<void()> fn;
+};
+struct FdEntry {
+  int fd;
+  std::function<void()> fn;
+};
+struct HandlerEntry {
+  Context* ctx;
+  PortCounters* counters;
+  std::function<bool(const void*, int)> fn;
+};
+
+// Per-process loop state that nodes register timers and fds into.
+struct LoopState {
+  std::vector<std::pair<Context*, TimerEntry>> timers;
+  std::vector<std::pair<Context*, FdEntry>> fds;
+  std::vector<std::unique_ptr<HandlerEntry>> handlers;
+  std::atomic<bool> stop{false};
+};
+static LoopState& loop() {
+  static LoopState s;
+  return s;
+}
+
+Context::Context(Bus& bus, const NodeSpec& spec, std::string instance_name,
+                 std::unique_ptr<google::protobuf::Message> options,
+                 std::vector<std::pair<std::string, std::string>> port_map, std::string base_dir, bool composed)
+    : bus_(bus),
+      spec_(spec),
+      name_(std::move(instance_name)),
+      options_(std::move(options)),
+      port_map_(std::move(port_map)),
+      base_dir_(std::move(base_dir)),
+      composed_(composed) {}
+
+Context::~Context() = default;
+
+std::string Context::resolve_path(const std::string& p) const {
+  if (p.empty()) return p;
+  std::filesystem::path path(p);
+  if (path.is_absolute() || base_dir_.empty()) return p;
+  return (std::filesystem::path(base_dir_) / path).lexically_normal().string();
+}
+
+const std::string& Context::channel(const std::string& port) const {
+  for (const auto& [p, c] : port_map_)
+    if (p == port) return c;
+  for (const auto& ps : spec_.ports)
+    if (ps.name == port) return ps.default_channel;
+  throw std::runtime_error("node '" + name_ + "': no port named '" + port + "' in its spec");
+}
+
+void Context::publish_raw(const std::string& channel, const void* data, int size, PortCounters* c) {
+  if (bus_.lcm().publish(channel, data, unsigned(size)) != 0) {
+    if (c) ++c->dropped;
+    return;
+  }
+  if (c) {
+    ++c->messages;
+    ++c->period_messages;
+  }
+}
+
+static void raw_handler(const lcm::ReceiveBuffer* rbuf, const std::string&, HandlerEntry* h) {
+  const double t0 = now_s();
+  bool ok = false;
+  try {
+    ok = h->fn(rbuf->data, int(rbuf->data_size));
+  } catch (const std::exception& e) {
+    h->ctx->error(std::string("handler on ") + h->counters->channel + ": " + e.what());
+    ok = true;  // decoded, but the node failed on it
+  }
+  if (!ok) {
+    ++h->counters->undecodable;
+    h->ctx->error("undecodable message on " + h->counters->channel + " (" + std::to_string(rbuf->data_size) +
+                  " bytes)");
+    return;
+  }
+  ++h->counters->messages;
+  ++h->counters->period_messages;
+  const double dt = now_s() - t0;
+  h->ctx->stats().latency.add(dt * 1e3);
+  h->ctx->stats().latency_total.add(dt * 1e3);
+  h->ctx->stats().busy_s_period += dt;
+}
+
+void Context::subscribe_raw(const std::string& port, std::function<bool(const void*, int)> fn) {
+  const std::string& ch = channel(port);
+  auto h = std::make_unique<HandlerEntry>();
+  h->ctx = this;
+  h->counters = &stats_.port(port, ch, false);
+  h->fn = std::move(fn);
+  auto* sub = bus_.lcm().subscribeFunction(ch, &raw_handler, h.get());
+  // Composed replay drains after every event; live nodes get room for bursts.
+  if (sub) sub->setQueueCapacity(composed_ ? 10000 : 100);
+  loop().handlers.push_back(std::move(h));
+}
+
+void Context::every(double period_s, std::function<void()> fn) {
+  if (composed_) throw std::runtime_error("node '" + name_ + "': timers are not available in composed replay");
+  loop().timers.push_back({this, TimerEntry{period_s, now_s() + period_s, std::move(fn)}});
+}
+
+void Context::watch_fd(int fd, std::function<void()> fn) {
+  if (composed_) throw std::runtime_error("node '" + name_ + "': sockets are not available in composed replay");
+  loop().fds.push_back({this, FdEntry{fd, std::move(fn)}});
+}
+
+void Context::error(const std::string& msg) {
+  ++stats_.errors;
+  stats_.last_error = msg;
+  if (stats_.errors <= 5 || (stats_.errors % 1000) == 0) {
+    std::cerr << "[" << name_ << "] error: " << msg;
+    if (stats_.errors == 5) std::cerr << " (further errors are counted in telemetry)";
+    std::cerr << std::endl;
+  }
+}
+
+void Context::request_stop() { loop().stop = true; }
+
+// ---- composition --------------------------------------------------------------------------------
+static std::vector<std::pair<std::string, std::string>> port_map_of(const fploc::Node& n) {
+  std::vector<std::pair<std::string, std::string>> m;
+  for (const auto& p : n.input()) m.emplace_back(p.port(), p.channel());
+  for (const auto& p : n.output()) m.emplace_back(p.port(), p.channel());
+  return m;
+}
+
+Composition::Composition(const LoadedGraph& graph, Bus& bus, const std::vector<std::string>& skip) : bus_(bus) {
+  for (const auto& n : graph.graph.node()) {
+    if (n.disabled() || std::find(skip.begin(), skip.end(), n.name()) != skip.end()) continue;
+    const auto* reg = find_registration(type_from_executable(n.executable()));
+    if (!reg) continue;  // not linked into this process (e.g. drivers, dashboard)
+    auto opts = node_options(n);
+    ComposedNode cn;
+    cn.name = n.name();
+    cn.ctx = std::make_unique<Context>(bus, reg->spec, n.name(), std::move(opts), port_map_of(n), graph.dir, true);
+    cn.node = reg->make();
+    try {
+      cn.node->setup(*cn.ctx);
+    } catch (const std::exception& e) {
+      throw std::runtime_error("node '" + n.name() + "': setup failed: " + e.what());
+    }
+    nodes_.push_back(std::move(cn));
+  }
+}
+
+void Composition::drain() {
+  while (bus_.lcm().handleTimeout(0) > 0) {
+  }
+}
+
+void Composition::shutdown() {
+  drain();
+  for (auto& n : nodes_) n.node->shutdown();
+}
+
+std::vector<std::string> Composition::external_inputs() const {
+  std::vector<std::string> produced, needed;
+  for (const auto& n : nodes_)
+    for (const auto& p : n.ctx->stats().ports) (p.output ? produced : needed).push_back(p.channel);
+  std::vector<std::string> out;
+  for (const auto& c : needed)
+    if (std::find(produced.begin(), produced.end(), c) == produced.end() &&
+        std::find(out.begin(), out.end(), c) == out.end())
+      out.push_back(c);
+  return out;
+}
+
+// ---- process main -------------------------------------------------------------------------------
+static void on_signal(int) { loop().stop = true; }
+
+static fploc::node_status_t make_status(Context& ctx, const std::string& executable, const std::string& state,
+                                        double cpu, double uptime, int restarts) {
+  auto& st = ctx.stats();
+  fploc::node_status_t s;
+  s.utime = wall_utime();
+  s.node = ctx.name();
+  s.executable = executable;
+  s.pid = getpid();
+  s.state = state;
+  s.reporter = "node";
+  s.restarts = restarts;
+  s.cpu_percent = cpu;
+  s.latency_p50_ms = st.latency.percentile(0.5);
+  s.latency_p99_ms = st.latency.percentile(0.99);
+  s.messages_in = st.messages(false);
+  s.messages_out = st.messages(true);
+  s.dropped = st.dropped();
+  s.undecodable = st.undecodable();
+  s.last_error = st.last_error;
+  s.uptime_s = uptime;
+  for (const auto& p : st.ports) {
+    fploc::port_stats_t ps;
+    ps.port = p.port;
+    ps.channel = p.channel;
+    ps.output = p.output;
+    ps.messages = p.messages;
+    ps.rate_hz = double(p.period_messages);  // per 1 s period, corrected by the caller
+    ps.dropped = p.dropped;
+    ps.undecodable = p.undecodable;
+    s.ports.push_back(ps);
+  }
+  s.num_ports = int32_t(s.ports.size());
+  return s;
+}
+
+static void usage(const Registration& r) {
+  std::cerr << "usage: fploc-" << r.spec.type
+            << " [--graph FILE --node NAME] [--lcm-url URL] [--set field=value ...] [--describe]\n  "
+            << r.spec.description << "\n";
+}
+
+int node_main(int argc, char** argv) {
+  if (registry().size() != 1) {
+    std::cerr << "internal error: a node executable must link exactly one node (has " << registry().size() << ")\n";
+    return 2;
+  }
+  const Registration& reg = registry().front();
+  std::string graph_path, node_name, url;
+  std::vector<std::string> sets;
+  bool describe = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) throw std::runtime_error(a + " needs a value");
+      return argv[++i];
+    };
+    try {
+      if (a == "--graph") graph_path = next();
+      else if (a == "--node") node_name = next();
+      else if (a == "--lcm-url") url = next();
+      else if (a == "--set") sets.push_back(next());
+      else if (a == "--describe") describe = true;
+      else if (a == "-h" || a == "--help") { usage(reg); return 0; }
+      else { std::cerr << "fploc-" << reg.spec.type << ": unknown argument '" << a << "'\n"; usage(reg); return 2; }
+    } catch (const std::exception& e) {
+      std::cerr << "fploc-" << reg.spec.type << ": " << e.what() << "\n";
+      return 2;
+    }
+  }
+
+  if (describe) {
+    std::cout << "{\"type\":\"" << reg.spec.type << "\",\"description\":\"" << reg.spec.description
+              << "\",\"options_field\":\"" << reg.spec.options_field << "\",\"ports\":[";
+    for (size_t i = 0; i < reg.spec.ports.size(); ++i) {
+      const auto& p = reg.spec.ports[i];
+      std::cout << (i ? "," : "") << "{\"name\":\"" << p.name << "\",\"direction\":\"" << (p.output ? "output" : "input")
+                << "\",\"lcm_type\":\"" << p.lcm_type << "\",\"default_channel\":\"" << p.default_channel << "\"}";
+    }
+    std::cout << "],\"options\":";
+    auto d = default_options(reg.spec.options_field);
+    std::cout << (d ? describe_message_json(d->GetDescriptor()) : std::string("null")) << "}\n";
+    return 0;
+  }
+
+  // Options and ports from the graph (or defaults when run standalone).
+  std::unique_ptr<google::protobuf::Message> options = default_options(reg.spec.options_field);
+  std::vector<std::pair<std::string, std::string>> port_map;
+  std::string base_dir = std::filesystem::current_path().string();
+  std::string instance = reg.spec.type;
+  if (!graph_path.empty()) {
+    LoadedGraph g;
+    std::vector<GraphError> errors;
+    if (!load_graph(graph_path, g, errors)) {
+      for (const auto& e : errors) std::cerr << e.str() << "\n";
+      return 2;
+    }
+    const fploc::Node* found = nullptr;
+    for (const auto& n : g.graph.node())
+      if (n.name() == node_name) found = &n;
+    if (!found) {
+      std::cerr << graph_path << ": no node named '" << node_name << "'\n";
+      return 2;
+    }
+    if (auto o = node_options(*found)) options = std::move(o);
+    port_map = port_map_of(*found);
+    base_dir = g.dir;
+    instance = node_name;
+    if (url.empty()) url = g.graph.lcm_url();
+  }
+  if (!sets.empty()) {
+    std::string err;
+    if (!options) {
+      std::cerr << "fploc-" << reg.spec.type << ": --set given but this node takes no options\n";
+      return 2;
+    }
+    if (!apply_overrides(*options, sets, err)) {
+      std::cerr << "fploc-" << reg.spec.type << ": " << err << "\n";
+      return 2;
+    }
+  }
+
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+
+  const int restarts = getenv("FPLOC_RESTARTS") ? atoi(getenv("FPLOC_RESTARTS")) : 0;
+  const std::string executable = std::string("fploc-") + reg.spec.type;
+  try {
+    Bus bus(url);
+    Context ctx(bus, reg.spec, instance, std::move(options), port_map, base_dir, false);
+    auto node = reg.make();
+    try {
+      node->setup(ctx);
+    } catch (const std::exception& e) {
+      std::cerr << "[" << instance << "] setup failed: " << e.what() << std::endl;
+      auto s = make_status(ctx, executable, "dead", 0, 0, restarts);
+      s.last_error = std::string("setup failed: ") + e.what();
+      bus.lcm().publish(kTelemetryChannel, &s);
+      return 1;
+    }
+    CpuMeter cpu;
+    const double t_start = now_s();
+    double next_beat = t_start;  // first heartbeat at once, then 1 Hz
+    const int lcm_fd = bus.lcm().getFileno();
+    auto beat = [&](const std::string& state) {
+      auto s = make_status(ctx, executable, state, cpu.sample_percent(), now_s() - t_start, restarts);
+      bus.lcm().publish(kTelemetryChannel, &s);
+      ctx.stats().end_period();
+    };
+    auto& L = loop();
+    while (!L.stop) {
+      double t = now_s();
+      double wake = next_beat;
+      for (auto& [c, te] : L.timers) wake = std::min(wake, te.next);
+      std::vector<pollfd> pfds;
+      pfds.push_back({lcm_fd, POLLIN, 0});
+      for (auto& [c, fe] : L.fds) pfds.push_back({fe.fd, POLLIN, 0});
+      const int timeout_ms = std::max(0, int((wake - t) * 1000.0));
+      const int r = poll(pfds.data(), pfds.size(), std::min(timeout_ms, 100));
+      if (r < 0 && errno != EINTR) {
+        ctx.error(std::string("poll: ") + strerror(errno));
+        break;
+      }
+      if (r > 0) {
+        if (pfds[0].revents & POLLIN) bus.lcm().handleTimeout(0);
+        for (size_t i = 1; i < pfds.size(); ++i) {
+          if (pfds[i].revents & (POLLIN | POLLERR | POLLHUP)) {
+            auto& [c, fe] = L.fds[i - 1];
+            const double t0 = now_s();
+            try {
+              fe.fn();
+            } catch (const std::exception& e) {
+              c->error(e.what());
+            }
+            c->stats().busy_s_period += now_s() - t0;
+          }
+        }
+      }
+      t = now_s();
+      for (auto& [c, te] : L.timers) {
+        if (t >= te.next) {
+          const double t0 = now_s();
+          try {
+            te.fn();
+          } catch (const std::exception& e) {
+            c->error(e.what());
+          }
+          const double dt = now_s() - t0;
+          c->stats().latency.add(dt * 1e3);
+          c->stats().busy_s_period += dt;
+          te.next = std::max(te.next + te.period, t);
+        }
+      }
+      if (now_s() >= next_beat) {
+        beat("running");
+        next_beat += 1.0;
+        if (next_beat < now_s()) next_beat = now_s() + 1.0;
+      }
+    }
+    // Deliver what is already queued, then stop.
+    while (bus.lcm().handleTimeout(0) > 0) {
+    }
+    node->shutdown();
+    beat("stopped");
+  } catch (const std::exception& e) {
+    std::cerr << "[" << instance << "] fatal: " << e.what() << std::endl;
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace fploc::rt

@@ -1,0 +1,77 @@
+#include <gtest/gtest.h>
+
+#include "fploc/runtime/graph.h"
+
+using namespace fploc::rt;
+
+TEST(Graph, ParsesNodesWithLines) {
+  const std::string text = R"pb(name: "t"
+lcm_url: "memq://"
+node {
+  name: "seg"
+  executable: "fploc-segmenter"
+  input { port: "scan" channel: "OS1_SCAN" }
+  segmenter { seed_rings: 3 }
+}
+node {
+  name: "log"
+  executable: "fploc-pose-logger"
+  pose_logger { file: "out.tum" }
+}
+)pb";
+  LoadedGraph g;
+  std::vector<GraphError> errors;
+  ASSERT_TRUE(parse_graph_text(text, "t.pbtxt", g, errors)) << (errors.empty() ? "" : errors[0].str());
+  ASSERT_EQ(g.graph.node_size(), 2);
+  EXPECT_EQ(g.node_line(0), 3);
+  EXPECT_EQ(g.node_line(1), 9);
+  EXPECT_EQ(g.node_line(0, "executable"), 5);
+  EXPECT_EQ(g.node_line(0, "input", 0), 6);
+  EXPECT_EQ(node_options_field(g.graph.node(0)), "segmenter");
+  auto o = node_options(g.graph.node(0));
+  ASSERT_TRUE(o);
+  EXPECT_NE(o->DebugString().find("seed_rings: 3"), std::string::npos);
+}
+
+TEST(Graph, EveryUnknownFieldIsReportedWithItsLine) {
+  const std::string text = R"pb(name: "t"
+node {
+  name: "seg"
+  executable: "fploc-segmenter"
+  segmenter { seed_ringz: 3 }
+}
+node {
+  name: "log"
+  exekutable: "x"
+}
+)pb";
+  LoadedGraph g;
+  std::vector<GraphError> errors;
+  EXPECT_FALSE(parse_graph_text(text, "t.pbtxt", g, errors));
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[0].line, 5);
+  EXPECT_NE(errors[0].message.find("seed_ringz"), std::string::npos);
+  EXPECT_EQ(errors[1].line, 9);
+  EXPECT_EQ(errors[0].str().rfind("t.pbtxt:5: ", 0), 0u);
+}
+
+TEST(Graph, WrongValueTypeIsAnError) {
+  LoadedGraph g;
+  std::vector<GraphError> errors;
+  EXPECT_FALSE(parse_graph_text("node {\n name: \"a\"\n segmenter { seed_rings: \"many\" }\n}\n", "x.pbtxt", g, errors));
+  ASSERT_FALSE(errors.empty());
+  EXPECT_EQ(errors[0].line, 3);
+}
+
+TEST(Overrides, SetsNestedAndRejectsUnknown) {
+  auto o = default_options("matcher");
+  ASSERT_TRUE(o);
+  std::string err;
+  EXPECT_TRUE(apply_overrides(*o, {"lookup=kdtree", "initial_pose.x=1.5", "max_iterations=7"}, err)) << err;
+  const auto s = o->ShortDebugString();
+  EXPECT_NE(s.find("lookup: \"kdtree\""), std::string::npos) << s;
+  EXPECT_NE(s.find("x: 1.5"), std::string::npos) << s;
+  EXPECT_FALSE(apply_overrides(*o, {"lokup=kdtree"}, err));
+  EXPECT_NE(err.find("lokup"), std::string::npos);
+  EXPECT_FALSE(apply_overrides(*o, {"max_iterations=lots"}, err));
+}

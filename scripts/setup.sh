@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Installs everything fploc needs on a fresh Debian 12 machine (idempotent; quick when all is present).
+set -euo pipefail
+PKGS=(
+  build-essential cmake ninja-build ccache pkg-config git iproute2 util-linux procps ca-certificates
+  libeigen3-dev libceres-dev libpcl-dev
+  liblcm-dev liblcm-bin liblcm-java default-jre-headless default-jdk-headless libjchart2d-java libglib2.0-dev
+  libprotobuf-dev protobuf-compiler
+  libgtest-dev libgmock-dev libbenchmark-dev
+  nlohmann-json3-dev libcli11-dev libcpp-httplib-dev libpcap-dev libnanoflann-dev
+  python3
+)
+missing=()
+for p in "${PKGS[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  echo "fploc setup: installing ${missing[*]}" >&2
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
+fi
