@@ -43,3 +43,18 @@ function(fploc_add_node NAME)
 endfunction()
 
 set(FPLOC_SHARED_DIR "${PROJECT_SOURCE_DIR}/../shared" CACHE PATH "Shared data folder (tests skip when absent)")
+
+# fploc_add_netns_test(NAME COMMAND cmd args...) -> a ctest that runs inside its own network namespace
+# (scripts/netns-run: loopback only, multicast routed to lo), so processes talking LCM are isolated.
+function(fploc_add_netns_test NAME)
+  cmake_parse_arguments(A "" "TIMEOUT" "COMMAND;LABELS" ${ARGN})
+  add_test(NAME ${NAME} COMMAND ${PROJECT_SOURCE_DIR}/scripts/netns-run ${A_COMMAND})
+  if(NOT A_TIMEOUT)
+    set(A_TIMEOUT 300)
+  endif()
+  set_tests_properties(${NAME} PROPERTIES TIMEOUT ${A_TIMEOUT}
+    ENVIRONMENT "FPLOC_BUILD_DIR=${CMAKE_BINARY_DIR};FPLOC_ROOT=${PROJECT_SOURCE_DIR};FPLOC_SHARED_DIR=${FPLOC_SHARED_DIR};PATH=${CMAKE_BINARY_DIR}/bin:$ENV{PATH}")
+  if(A_LABELS)
+    set_tests_properties(${NAME} PROPERTIES LABELS "${A_LABELS}")
+  endif()
+endfunction()

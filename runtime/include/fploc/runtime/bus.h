@@ -9,7 +9,7 @@ namespace fploc::rt {
 
 // Default URL: multicast on the loopback-friendly group with TTL 0 and a receive buffer large
 // enough for full scans (LCM 1.3.1 drops a fragmented message when one fragment is lost).
-inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216";
+inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304";
 inline constexpr const char* kTelemetryChannel = "FPLOC_TELEMETRY";
 inline constexpr const char* kControlChannel = "FPLOC_CONTROL";
 
