@@ -1,0 +1,110 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "fploc/floorplan/io.h"
+
+using namespace fploc;
+
+namespace {
+std::string shared(const std::string& rel) { return std::string(FPLOC_SHARED_DIR) + "/data/" + rel; }
+bool have_shared() { return std::filesystem::exists(std::string(FPLOC_SHARED_DIR) + "/data/floorplans"); }
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(PlanIo, CsvWithHeaderAndUnits) {
+  std::istringstream in("x1,y1,x2,y2\n0,0,100,0\n\n# comment\n100,0,100,250\n");
+  PlanLoadOptions o;
+  o.units_override = "cm";
+  auto plan = read_plan_csv(in, "t.csv", o);
+  ASSERT_EQ(plan.elements.size(), 2u);
+  EXPECT_NEAR(plan.elements[1].b.y(), 2.5, 1e-12);
+  EXPECT_NEAR(plan.elements[0].b.x(), 1.0, 1e-12);
+}
+
+TEST(PlanIo, CsvBadRowNamesFileAndLine) {
+  std::istringstream in("x1,y1,x2,y2\n0,0,1,0\n0,0,abc,1\n");
+  const std::string err = error_of([&] { read_plan_csv(in, "bad.csv", {}); });
+  EXPECT_NE(err.find("bad.csv:3:"), std::string::npos) << err;
+}
+
+TEST(PlanIo, CsvNanIsAnError) {
+  std::istringstream in("0,0,1,0\n0,nan,1,1\n");
+  const std::string err = error_of([&] { read_plan_csv(in, "nan.csv", {}); });
+  EXPECT_NE(err.find("nan.csv:2:"), std::string::npos) << err;
+}
+
+TEST(PlanIo, JsonRoundTripKeepsKindsIdsAndLayers) {
+  FloorPlan p;
+  p.source = "mem";
+  p.elements.push_back(Element::segment({0, 0}, {1, 2}, p.layer_index("walls")));
+  p.elements.push_back(Element::circle({3, 3}, 0.25, p.layer_index("cols")));
+  p.elements.push_back(Element::arc({1, 1}, 2.0, 0.5, 2.0, p.layer_index("walls")));
+  std::stringstream ss;
+  write_plan_json(p, ss);
+  auto q = read_plan_json(ss, "mem.json");
+  ASSERT_EQ(q.elements.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(q.elements[i].kind, p.elements[i].kind);
+    EXPECT_EQ(q.layers[q.elements[i].layer], p.layers[p.elements[i].layer]);
+    for (Eigen::Vector2d x : {Eigen::Vector2d(0.3, 0.7), Eigen::Vector2d(-2, 5)})
+      EXPECT_NEAR(distance(q.elements[i], x), distance(p.elements[i], x), 1e-9);
+  }
+}
+
+TEST(PlanIo, JsonUnitsAndLayerGlobs) {
+  std::istringstream in(R"({"units":"mm","elements":[{"type":"segment","a":[0,0],"b":[1000,0],"layer":"A-WALL"},
+    {"type":"circle","c":[0,0],"r":300,"layer":"S-COLS"}]})");
+  PlanLoadOptions o;
+  o.layer_globs = {"*wall*"};
+  auto plan = read_plan_json(in, "u.json", o);
+  ASSERT_EQ(plan.elements.size(), 1u);
+  EXPECT_NEAR(plan.elements[0].b.x(), 1.0, 1e-12);
+}
+
+TEST(PlanIo, EmptyLayerSelectionIsAnError) {
+  std::istringstream in(R"({"elements":[{"type":"segment","a":[0,0],"b":[1,0],"layer":"walls"}]})");
+  PlanLoadOptions o;
+  o.layer_globs = {"nothing*"};
+  const std::string err = error_of([&] { read_plan_json(in, "e.json", o); });
+  EXPECT_NE(err.find("e.json: no elements on layers matching 'nothing*'"), std::string::npos) << err;
+  EXPECT_NE(err.find("walls"), std::string::npos) << err;
+}
+
+TEST(PlanIo, JsonBadElementNamesIndex) {
+  std::istringstream in(R"({"elements":[{"type":"segment","a":[0,0],"b":[1,0]},{"type":"circle","c":[0,0]}]})");
+  const std::string err = error_of([&] { read_plan_json(in, "b.json", {}); });
+  EXPECT_NE(err.find("b.json: elements[1]"), std::string::npos) << err;
+}
+
+TEST(PlanIo, GlobMatchesRealLayerNames) {
+  EXPECT_TRUE(glob_match("*$A-WALL", "E1-RI-1F$0$A-WALL"));
+  EXPECT_TRUE(glob_match("e-cols-f4*", "E-COLS-F4$0$0S-COLS-I"));
+  EXPECT_FALSE(glob_match("*WALL", "A-WALL-PATT"));
+}
+
+TEST(PlanIo, CorridorCsvInCentimetres) {
+  if (!have_shared()) GTEST_SKIP() << "no ../shared/data";
+  auto plan = load_floor_plan(shared("floorplans/annf-demo-corridor-lines.csv"), {}, "cm");
+  EXPECT_EQ(plan.elements.size(), 416u);
+  const auto b = plan.bounds();
+  EXPECT_GT(b.size().x(), 10.0);
+  EXPECT_LT(b.size().x(), 500.0);
+}
+
+TEST(PlanIo, UnknownExtensionAndMissingFile) {
+  EXPECT_NE(error_of([] { load_floor_plan("x.txt"); }).find("x.txt"), std::string::npos);
+  EXPECT_NE(error_of([] { load_floor_plan("/nonexistent/p.csv"); }).find("/nonexistent/p.csv: cannot open"),
+            std::string::npos);
+}
