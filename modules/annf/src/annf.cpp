@@ -1,0 +1,468 @@
+#include "fploc/annf/annf.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "fploc/floorplan/io.h"
+
+namespace fploc {
+namespace {
+
+[[noreturn]] void fail(const std::string& m) { throw std::runtime_error(m); }
+
+// Candidates provably containing the k nearest elements of every point of `box`: elements whose
+// minimum distance to the box is <= the k-th smallest maximum distance. `eps` absorbs rounding.
+void filter_candidates(const FloorPlan& plan, const std::vector<uint32_t>& in, const Box2& box, int k,
+                       std::vector<uint32_t>* out, std::vector<double>* scratch_max, std::vector<double>* scratch_min) {
+  out->clear();
+  const size_t n = in.size();
+  scratch_max->resize(n);
+  scratch_min->resize(n);
+  for (size_t i = 0; i < n; ++i) (*scratch_max)[i] = max_distance(plan.elements[in[i]], box);
+  double bound;
+  if (n <= size_t(k)) {
+    bound = std::numeric_limits<double>::infinity();
+  } else {
+    std::vector<double> tmp(scratch_max->begin(), scratch_max->end());
+    std::nth_element(tmp.begin(), tmp.begin() + (k - 1), tmp.end());
+    bound = tmp[k - 1];
+  }
+  const double eps = 1e-9 * (1.0 + box.size().norm()) + 1e-9;
+  for (size_t i = 0; i < n; ++i) {
+    const double lo = min_distance(plan.elements[in[i]], box);
+    if (lo <= bound + eps) out->push_back(in[i]);
+  }
+}
+
+struct Pair {
+  int first = -1, second = -1;
+};
+
+// The two elements nearest to p among `cand` (ties by id).
+Pair two_nearest(const FloorPlan& plan, const std::vector<uint32_t>& cand, const Eigen::Vector2d& p) {
+  Pair out;
+  double d1 = std::numeric_limits<double>::infinity(), d2 = d1;
+  for (uint32_t id : cand) {
+    const double d = distance(plan.elements[id], p);
+    if (d < d1 || (d == d1 && int(id) < out.first)) {
+      d2 = d1;
+      out.second = out.first;
+      d1 = d;
+      out.first = int(id);
+    } else if (d < d2 || (d == d2 && int(id) < out.second)) {
+      d2 = d;
+      out.second = int(id);
+    }
+  }
+  return out;
+}
+
+bool same_pair(const Pair& a, const Pair& b, bool ordered) {
+  if (ordered) return a.first == b.first && a.second == b.second;
+  return (a.first == b.first && a.second == b.second) || (a.first == b.second && a.second == b.first);
+}
+
+Box2 child_box(const Box2& b, int q) {
+  const Eigen::Vector2d h = b.size() / 2;
+  Box2 c;
+  c.min = b.min + Eigen::Vector2d((q & 1) * h.x(), (q >> 1) * h.y());
+  c.max = c.min + h;
+  return c;
+}
+
+Eigen::Vector2d centre(const Box2& b) { return (b.min + b.max) / 2; }
+
+struct Builder {
+  const FloorPlan& plan;
+  const AnnfOptions& o;
+  std::vector<uint32_t>& nodes;
+  std::vector<uint32_t>& pool;
+  std::unordered_map<std::string, uint32_t> dedupe;
+  std::vector<double> smax, smin;
+  static constexpr uint32_t kLeafBit = 0x80000000u;
+
+  uint32_t leaf(const std::vector<uint32_t>& ids) {
+    std::string key(reinterpret_cast<const char*>(ids.data()), ids.size() * sizeof(uint32_t));
+    auto it = dedupe.find(key);
+    if (it != dedupe.end()) return it->second;
+    const size_t off = pool.size();
+    if (off >= kLeafBit) fail("ANNF too large (leaf pool exceeds 2^31 entries)");
+    pool.push_back(uint32_t(ids.size()));
+    pool.insert(pool.end(), ids.begin(), ids.end());
+    const uint32_t w = kLeafBit | uint32_t(off);
+    dedupe.emplace(std::move(key), w);
+    return w;
+  }
+  uint32_t leaf(const Pair& p) {
+    std::vector<uint32_t> ids;
+    if (p.first >= 0) ids.push_back(uint32_t(p.first));
+    if (p.second >= 0) ids.push_back(uint32_t(p.second));
+    return leaf(ids);
+  }
+
+  uint32_t alloc4() {
+    const size_t idx = nodes.size();
+    if (idx + 4 >= kLeafBit) fail("ANNF too large (more than 2^31 nodes)");
+    nodes.resize(idx + 4, 0);
+    return uint32_t(idx);
+  }
+
+  // Paper mode: `pair` is this field's two nearest elements to its centre, K its 2-candidates.
+  uint32_t paper(const Box2& box, int depth, const std::vector<uint32_t>& K, const Pair& pair) {
+    if (depth >= o.max_depth) return leaf(pair);
+    std::vector<uint32_t> Kc[4];
+    Pair pc[4];
+    bool all_same = true;
+    const bool ordered = o.paper_rule == PaperRule::kChildLeafOrdered;
+    for (int q = 0; q < 4; ++q) {
+      const Box2 cb = child_box(box, q);
+      filter_candidates(plan, K, cb, 2, &Kc[q], &smax, &smin);
+      pc[q] = two_nearest(plan, Kc[q], centre(cb));
+      all_same = all_same && same_pair(pc[q], pair, ordered);
+    }
+    if (o.paper_rule != PaperRule::kFull && all_same) return leaf(pair);  // withdraw the division
+    const uint32_t base = alloc4();
+    for (int q = 0; q < 4; ++q) {
+      uint32_t w;
+      const bool child_leaf = (o.paper_rule == PaperRule::kChildLeaf || o.paper_rule == PaperRule::kChildLeafOrdered) &&
+                              same_pair(pc[q], pair, ordered);
+      if (child_leaf)
+        w = leaf(pc[q]);
+      else
+        w = paper(child_box(box, q), depth + 1, Kc[q], pc[q]);
+      nodes[base + q] = w;
+    }
+    return base;
+  }
+
+  // Exact mode: K = 1-candidates of box.
+  uint32_t exact(const Box2& box, int depth, const std::vector<uint32_t>& K) {
+    if (depth >= o.max_depth || int(K.size()) <= o.exact_max_candidates) {
+      // Order by distance to the centre: the first candidate is the likely nearest.
+      std::vector<std::pair<double, uint32_t>> order;
+      const Eigen::Vector2d c = centre(box);
+      for (uint32_t id : K) order.push_back({distance(plan.elements[id], c), id});
+      std::sort(order.begin(), order.end());
+      std::vector<uint32_t> ids;
+      for (auto& x : order) ids.push_back(x.second);
+      return leaf(ids);
+    }
+    std::vector<uint32_t> Kc[4];
+    for (int q = 0; q < 4; ++q) filter_candidates(plan, K, child_box(box, q), 1, &Kc[q], &smax, &smin);
+    const uint32_t base = alloc4();
+    for (int q = 0; q < 4; ++q) {
+      const uint32_t w = exact(child_box(box, q), depth + 1, Kc[q]);
+      nodes[base + q] = w;
+    }
+    return base;
+  }
+};
+
+uint64_t fnv1a(const void* data, size_t n, uint64_t h = 1469598103934665603ull) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (size_t i = 0; i < n; ++i) {
+    h ^= p[i];
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+template <typename T>
+void put(std::ostream& out, const T& v) {
+  out.write(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+template <typename T>
+T get(std::istream& in, const std::string& source) {
+  T v{};
+  in.read(reinterpret_cast<char*>(&v), sizeof(T));
+  if (!in) fail(source + ": truncated map file");
+  return v;
+}
+
+}  // namespace
+
+const char* to_string(AnnfMode m) { return m == AnnfMode::kExact ? "exact" : "paper"; }
+const char* to_string(PaperRule r) {
+  switch (r) {
+    case PaperRule::kChildLeaf: return "child-leaf";
+    case PaperRule::kUndoOnly: return "undo-only";
+    case PaperRule::kChildLeafOrdered: return "child-leaf-ordered";
+    case PaperRule::kFull: return "full";
+  }
+  return "?";
+}
+AnnfMode parse_annf_mode(const std::string& s) {
+  if (s == "paper") return AnnfMode::kPaper;
+  if (s == "exact") return AnnfMode::kExact;
+  fail("unknown ANNF mode '" + s + "' (paper or exact)");
+}
+PaperRule parse_paper_rule(const std::string& s) {
+  for (PaperRule r : {PaperRule::kChildLeaf, PaperRule::kUndoOnly, PaperRule::kChildLeafOrdered, PaperRule::kFull})
+    if (s == to_string(r)) return r;
+  fail("unknown paper stopping rule '" + s + "' (child-leaf, undo-only, child-leaf-ordered, full)");
+}
+
+void Annf::prepare() {
+  leaf_ = options_.root_length / double(1u << (max_depth_ - 1));
+  inv_leaf_ = 1.0 / leaf_;
+  extent_x_ = double(nx_) * double(1u << (max_depth_ - 1));
+  extent_y_ = double(ny_) * double(1u << (max_depth_ - 1));
+  prims_.clear();
+  for (const auto& e : plan_.elements) {
+    Prim p{};
+    p.kind = int(e.kind);
+    if (e.kind == ElementKind::kSegment) {
+      p.ax = e.a.x();
+      p.ay = e.a.y();
+      p.dx = e.b.x() - e.a.x();
+      p.dy = e.b.y() - e.a.y();
+      const double l2 = p.dx * p.dx + p.dy * p.dy;
+      p.inv_l2 = l2 > 0 ? 1.0 / l2 : 0.0;
+    }
+    prims_.push_back(p);
+  }
+}
+
+Annf Annf::build(const FloorPlan& plan, const AnnfOptions& options) {
+  if (plan.elements.empty()) fail(plan.source + ": cannot build an ANNF over an empty plan");
+  if (!(options.root_length > 0) || !std::isfinite(options.root_length)) fail("ANNF root length must be > 0");
+  if (options.max_depth < 1 || options.max_depth > 20) fail("ANNF max depth must be in 1..20");
+  if (options.exact_max_candidates < 1) fail("ANNF exact_max_candidates must be >= 1");
+  Annf a;
+  a.plan_ = plan;
+  a.options_ = options;
+  a.max_depth_ = options.max_depth;
+  const Box2 bb = plan.bounds();
+  const double L = options.root_length;
+  a.origin_ = bb.min - Eigen::Vector2d(options.margin, options.margin);
+  const Eigen::Vector2d size = bb.size() + Eigen::Vector2d(2 * options.margin, 2 * options.margin);
+  const double nxd = std::max(1.0, std::ceil(size.x() / L)), nyd = std::max(1.0, std::ceil(size.y() / L));
+  // Finest-leaf indices must fit in 31 bits.
+  if (nxd * double(1u << (a.max_depth_ - 1)) > 2e9 || nyd * double(1u << (a.max_depth_ - 1)) > 2e9 ||
+      nxd * nyd > 5e7)
+    fail(plan.source + ": plan too large for root fields of " + std::to_string(L) + " m at depth " +
+         std::to_string(a.max_depth_) + " (check the units)");
+  a.nx_ = uint32_t(nxd);
+  a.ny_ = uint32_t(nyd);
+  // Size exactly: the last root field may overhang (that is fine, the extents are in leaf units).
+  a.prepare();
+  a.roots_.assign(size_t(a.nx_) * a.ny_, 0);
+  Builder b{a.plan_, a.options_, a.nodes_, a.pool_, {}, {}, {}};
+  std::vector<uint32_t> all(plan.elements.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = uint32_t(i);
+  std::vector<uint32_t> K;
+  for (uint32_t j = 0; j < a.ny_; ++j)
+    for (uint32_t i = 0; i < a.nx_; ++i) {
+      Box2 box;
+      box.min = a.origin_ + Eigen::Vector2d(i * L, j * L);
+      box.max = box.min + Eigen::Vector2d(L, L);
+      uint32_t w;
+      if (options.mode == AnnfMode::kPaper) {
+        filter_candidates(a.plan_, all, box, 2, &K, &b.smax, &b.smin);
+        w = b.paper(box, 1, K, two_nearest(a.plan_, K, centre(box)));
+      } else {
+        filter_candidates(a.plan_, all, box, 1, &K, &b.smax, &b.smin);
+        w = b.exact(box, 1, K);
+      }
+      a.roots_[size_t(j) * a.nx_ + i] = w;
+    }
+  a.nodes_.shrink_to_fit();
+  a.pool_.shrink_to_fit();
+  return a;
+}
+
+int Annf::best_of(const uint32_t* ids, int n, const Eigen::Vector2d& p, double* dist, Eigen::Vector2d* closest) const {
+  int best = -1;
+  double bd2 = std::numeric_limits<double>::infinity();
+  double bx = 0, by = 0;
+  for (int k = 0; k < n; ++k) {
+    const uint32_t id = ids[k];
+    const Prim& s = prims_[id];
+    double qx, qy;
+    if (s.kind == 0) {
+      double t = ((p.x() - s.ax) * s.dx + (p.y() - s.ay) * s.dy) * s.inv_l2;
+      t = t < 0 ? 0 : (t > 1 ? 1 : t);
+      qx = s.ax + t * s.dx;
+      qy = s.ay + t * s.dy;
+    } else {
+      const ClosestPoint cp = closest_point(plan_.elements[id], p);
+      qx = cp.point.x();
+      qy = cp.point.y();
+    }
+    const double d2 = (qx - p.x()) * (qx - p.x()) + (qy - p.y()) * (qy - p.y());
+    if (d2 < bd2) {
+      bd2 = d2;
+      best = int(id);
+      bx = qx;
+      by = qy;
+    }
+  }
+  if (dist) *dist = std::sqrt(bd2);
+  if (closest) *closest = Eigen::Vector2d(bx, by);
+  return best;
+}
+
+int Annf::nearest(const Eigen::Vector2d& p, double* dist, Eigen::Vector2d* closest) const {
+  int n;
+  const uint32_t* ids = lookup(p, &n);
+  if (ids) return best_of(ids, n, p, dist, closest);
+  // Outside the covered area: brute force (exact).
+  double d;
+  const int id = nearest_element_brute_force(plan_, p, &d);
+  if (dist) *dist = d;
+  if (closest && id >= 0) *closest = closest_point(plan_.elements[id], p).point;
+  return id;
+}
+
+bool Annf::leaf_box(const Eigen::Vector2d& p, Box2* box, int* depth) const {
+  const double fx = (p.x() - origin_.x()) * inv_leaf_, fy = (p.y() - origin_.y()) * inv_leaf_;
+  if (!(fx >= 0 && fy >= 0 && fx < extent_x_ && fy < extent_y_)) return false;
+  const uint32_t ix = uint32_t(fx), iy = uint32_t(fy);
+  const int shift = max_depth_ - 1;
+  uint32_t node = roots_[(iy >> shift) * nx_ + (ix >> shift)];
+  int s = shift, d = 1;
+  while (!(node & kLeafBit)) {
+    --s;
+    ++d;
+    node = nodes_[node + (((iy >> s) & 1u) << 1 | ((ix >> s) & 1u))];
+  }
+  const double len = leaf_ * double(1u << s);
+  box->min = origin_ + Eigen::Vector2d(double(ix >> s) * len, double(iy >> s) * len);
+  box->max = box->min + Eigen::Vector2d(len, len);
+  if (depth) *depth = d;
+  return true;
+}
+
+Box2 Annf::covered() const {
+  Box2 b;
+  b.min = origin_;
+  b.max = origin_ + Eigen::Vector2d(nx_, ny_) * options_.root_length;
+  return b;
+}
+
+AnnfStats Annf::stats() const {
+  AnnfStats s;
+  s.nodes = roots_.size() + nodes_.size();
+  s.pool_ids = pool_.size();
+  s.bytes = (roots_.size() + nodes_.size() + pool_.size()) * sizeof(uint32_t);
+  size_t total = 0;
+  for_each_leaf([&](const Box2&, int depth, const uint32_t*, int n) {
+    ++s.leaves;
+    total += size_t(n);
+    s.max_leaf_candidates = std::max(s.max_leaf_candidates, n);
+    s.deepest = std::max(s.deepest, depth);
+  });
+  s.mean_leaf_candidates = s.leaves ? double(total) / double(s.leaves) : 0;
+  return s;
+}
+
+void Annf::write(std::ostream& out) const {
+  put<uint8_t>(out, uint8_t(options_.mode));
+  put<uint8_t>(out, uint8_t(options_.paper_rule));
+  put<double>(out, options_.root_length);
+  put<int32_t>(out, options_.max_depth);
+  put<int32_t>(out, options_.exact_max_candidates);
+  put<double>(out, options_.margin);
+  put<double>(out, origin_.x());
+  put<double>(out, origin_.y());
+  put<uint32_t>(out, nx_);
+  put<uint32_t>(out, ny_);
+  uint64_t h = 1469598103934665603ull;
+  for (const auto* v : {&roots_, &nodes_, &pool_}) {
+    put<uint64_t>(out, uint64_t(v->size()));
+    out.write(reinterpret_cast<const char*>(v->data()), std::streamsize(v->size() * sizeof(uint32_t)));
+    h = fnv1a(v->data(), v->size() * sizeof(uint32_t), h);
+  }
+  put<uint64_t>(out, h);
+}
+
+Annf Annf::read(std::istream& in, FloorPlan plan, const std::string& source) {
+  Annf a;
+  a.plan_ = std::move(plan);
+  const uint8_t mode = get<uint8_t>(in, source), rule = get<uint8_t>(in, source);
+  if (mode > 1 || rule > 3) fail(source + ": corrupt map file (mode/rule)");
+  a.options_.mode = AnnfMode(mode);
+  a.options_.paper_rule = PaperRule(rule);
+  a.options_.root_length = get<double>(in, source);
+  a.options_.max_depth = get<int32_t>(in, source);
+  a.options_.exact_max_candidates = get<int32_t>(in, source);
+  a.options_.margin = get<double>(in, source);
+  a.origin_.x() = get<double>(in, source);
+  a.origin_.y() = get<double>(in, source);
+  a.nx_ = get<uint32_t>(in, source);
+  a.ny_ = get<uint32_t>(in, source);
+  if (!(a.options_.root_length > 0) || !std::isfinite(a.options_.root_length) || a.options_.max_depth < 1 ||
+      a.options_.max_depth > 20 || !a.origin_.allFinite() || a.nx_ == 0 || a.ny_ == 0 ||
+      double(a.nx_) * double(a.ny_) > 5e7 || double(a.nx_) * double(1u << (a.options_.max_depth - 1)) > 2e9 ||
+      double(a.ny_) * double(1u << (a.options_.max_depth - 1)) > 2e9)
+    fail(source + ": corrupt map file (header values)");
+  a.max_depth_ = a.options_.max_depth;
+  uint64_t h = 1469598103934665603ull;
+  for (auto* v : {&a.roots_, &a.nodes_, &a.pool_}) {
+    const uint64_t n = get<uint64_t>(in, source);
+    if (n > (1ull << 31)) fail(source + ": corrupt map file (array size)");
+    v->resize(n);
+    in.read(reinterpret_cast<char*>(v->data()), std::streamsize(n * sizeof(uint32_t)));
+    if (!in) fail(source + ": truncated map file");
+    h = fnv1a(v->data(), v->size() * sizeof(uint32_t), h);
+  }
+  if (get<uint64_t>(in, source) != h) fail(source + ": map file checksum mismatch (corrupt file)");
+  if (a.roots_.size() != size_t(a.nx_) * a.ny_ || a.nodes_.size() % 4 != 0)
+    fail(source + ": corrupt map file (tree sizes)");
+  // Validate every word reachable from the roots, with a depth limit (no cycles, no bad index).
+  const size_t ne = a.plan_.elements.size();
+  auto check_leaf = [&](uint32_t w) {
+    const uint32_t off = w & ~kLeafBit;
+    if (off >= a.pool_.size() || size_t(off) + 1 + a.pool_[off] > a.pool_.size() || a.pool_[off] == 0)
+      fail(source + ": corrupt map file (leaf)");
+    for (uint32_t k = 0; k < a.pool_[off]; ++k)
+      if (a.pool_[off + 1 + k] >= ne) fail(source + ": corrupt map file (element id)");
+  };
+  std::vector<std::pair<uint32_t, int>> stack;
+  for (uint32_t w : a.roots_) {
+    stack.push_back({w, 1});
+    while (!stack.empty()) {
+      auto [x, d] = stack.back();
+      stack.pop_back();
+      if (x & kLeafBit) {
+        check_leaf(x);
+        continue;
+      }
+      if (d >= a.max_depth_ || size_t(x) + 4 > a.nodes_.size() || x % 4 != 0)
+        fail(source + ": corrupt map file (node)");
+      for (int q = 0; q < 4; ++q) stack.push_back({a.nodes_[x + q], d + 1});
+    }
+  }
+  a.prepare();
+  return a;
+}
+
+void Annf::save(const std::string& path) const {
+  std::ofstream f(path, std::ios::binary);
+  if (!f) fail(path + ": cannot write (" + std::strerror(errno) + ")");
+  f.write(kFpmapMagic, 8);
+  put<uint32_t>(f, kFpmapVersion);
+  write_plan_binary(plan_, f);
+  write(f);
+  f.flush();
+  if (!f) fail(path + ": write error");
+}
+
+Annf Annf::load(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) fail(path + ": cannot open (" + std::strerror(errno) + ")");
+  read_fpmap_header(f, path);
+  FloorPlan plan = read_plan_binary(f, path);
+  plan.source = path;
+  Annf a = read(f, std::move(plan), path);
+  f.peek();
+  if (!f.eof()) fail(path + ": trailing data after the map (corrupt file)");
+  return a;
+}
+
+}  // namespace fploc

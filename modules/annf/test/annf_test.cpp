@@ -1,0 +1,149 @@
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "fploc/annf/annf.h"
+#include "fploc/floorplan/io.h"
+
+using namespace fploc;
+
+namespace {
+bool have_shared() { return std::filesystem::exists(std::string(FPLOC_SHARED_DIR) + "/data/floorplans"); }
+
+// A small synthetic plan with every element kind, corners, a pillar and a curved wall.
+FloorPlan synthetic() {
+  FloorPlan p;
+  p.source = "synthetic";
+  const int w = p.layer_index("walls"), c = p.layer_index("cols");
+  p.elements.push_back(Element::segment({0, 0}, {12, 0}, w));
+  p.elements.push_back(Element::segment({12, 0}, {12, 8}, w));
+  p.elements.push_back(Element::segment({12, 8}, {0, 8}, w));
+  p.elements.push_back(Element::segment({0, 8}, {0, 0}, w));
+  p.elements.push_back(Element::segment({5, 0}, {5, 3.5}, w));
+  p.elements.push_back(Element::circle({8, 4}, 0.3, c));
+  p.elements.push_back(Element::circle({3, 5}, 0.25, c));
+  p.elements.push_back(Element::arc({9, 8}, 1.5, M_PI, 2 * M_PI, w));
+  p.elements.push_back(Element::arc({2, 2}, 1.0, 0.2, 1.5, w));
+  return p;
+}
+
+double exact_rate(const Annf& a, const FloorPlan& plan, int n, uint32_t seed) {
+  std::mt19937 rng(seed);
+  const Box2 b = plan.bounds();
+  std::uniform_real_distribution<double> ux(b.min.x(), b.max.x()), uy(b.min.y(), b.max.y());
+  int hits = 0;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector2d p(ux(rng), uy(rng));
+    double d_true, d;
+    nearest_element_brute_force(plan, p, &d_true);
+    a.nearest(p, &d);
+    hits += std::abs(d - d_true) <= 1e-9;
+  }
+  return double(hits) / n;
+}
+}  // namespace
+
+TEST(Annf, ExactModeIsExactOnSynthetic) {
+  const auto plan = synthetic();
+  AnnfOptions o;
+  o.mode = AnnfMode::kExact;
+  o.root_length = 4;
+  o.max_depth = 8;
+  const Annf a = Annf::build(plan, o);
+  EXPECT_EQ(exact_rate(a, plan, 100000, 1), 1.0);
+  // Distance and closest point agree with the model.
+  double d;
+  Eigen::Vector2d q;
+  const int id = a.nearest({6, 2}, &d, &q);
+  EXPECT_EQ(id, 4);
+  EXPECT_NEAR(d, 1.0, 1e-12);
+  EXPECT_NEAR(q.x(), 5.0, 1e-12);
+}
+
+TEST(Annf, PaperModeDepthImprovesAndLookupIsConsistent) {
+  const auto plan = synthetic();
+  AnnfOptions o;
+  o.root_length = 4;
+  o.max_depth = 2;
+  const double coarse = exact_rate(Annf::build(plan, o), plan, 20000, 2);
+  o.max_depth = 8;
+  const Annf fine = Annf::build(plan, o);
+  const double r = exact_rate(fine, plan, 20000, 2);
+  EXPECT_GT(r, coarse);
+  EXPECT_GT(r, 0.9);
+  int n;
+  const uint32_t* ids = fine.lookup({6, 1}, &n);
+  ASSERT_NE(ids, nullptr);
+  EXPECT_GE(n, 1);
+  EXPECT_LE(n, 2);
+  EXPECT_EQ(fine.lookup({-100, 0}, &n), nullptr);
+  EXPECT_EQ(n, 0);
+  // Outside: nearest falls back to brute force.
+  double d;
+  EXPECT_EQ(fine.nearest({-100, 4}, &d), 3);
+  EXPECT_NEAR(d, 100.0, 1e-9);
+}
+
+TEST(Annf, SaveLoadRoundTrip) {
+  const auto plan = synthetic();
+  AnnfOptions o;
+  o.mode = AnnfMode::kExact;
+  o.root_length = 4;
+  o.max_depth = 7;
+  const Annf a = Annf::build(plan, o);
+  const std::string path = testing::TempDir() + "/annf_roundtrip.fpmap";
+  a.save(path);
+  const Annf b = Annf::load(path);
+  EXPECT_EQ(b.plan().elements.size(), plan.elements.size());
+  EXPECT_EQ(b.stats().bytes, a.stats().bytes);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> U(-1, 13);
+  for (int i = 0; i < 2000; ++i) {
+    const Eigen::Vector2d p(U(rng), U(rng) * 0.7);
+    int n1, n2;
+    const uint32_t* c1 = a.lookup(p, &n1);
+    const uint32_t* c2 = b.lookup(p, &n2);
+    ASSERT_EQ(n1, n2);
+    for (int k = 0; k < n1; ++k) EXPECT_EQ(c1[k], c2[k]);
+  }
+  // The plan inside the map loads through the generic loader.
+  EXPECT_EQ(load_floor_plan(path).elements.size(), plan.elements.size());
+  // A corrupted file is a clear error, not a crash.
+  std::string bytes;
+  {
+    std::ifstream f(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(f), {});
+  }
+  for (size_t cut : {size_t(4), size_t(20), bytes.size() / 2, bytes.size() - 3}) {
+    const std::string bad = testing::TempDir() + "/annf_bad.fpmap";
+    std::ofstream(bad, std::ios::binary).write(bytes.data(), std::streamsize(cut));
+    EXPECT_THROW(Annf::load(bad), std::runtime_error) << cut;
+  }
+  std::string flipped = bytes;
+  flipped[bytes.size() - 20] ^= 0x5a;
+  const std::string bad = testing::TempDir() + "/annf_flip.fpmap";
+  std::ofstream(bad, std::ios::binary).write(flipped.data(), std::streamsize(flipped.size()));
+  EXPECT_THROW(Annf::load(bad), std::runtime_error);
+  std::string old = bytes;
+  old[8] = 99;  // version
+  std::ofstream(bad, std::ios::binary).write(old.data(), std::streamsize(old.size()));
+  try {
+    Annf::load(bad);
+    FAIL() << "old version accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("version 99"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Annf, ExactOnCorridorPlan) {
+  if (!have_shared()) GTEST_SKIP() << "no ../shared/data";
+  const auto plan = load_floor_plan(std::string(FPLOC_SHARED_DIR) + "/data/floorplans/annf-demo-corridor-lines.csv", {}, "cm");
+  AnnfOptions o;
+  o.mode = AnnfMode::kExact;
+  o.max_depth = 9;
+  const Annf a = Annf::build(plan, o);
+  EXPECT_EQ(exact_rate(a, plan, 50000, 4), 1.0);
+}
