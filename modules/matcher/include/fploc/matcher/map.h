@@ -1,0 +1,36 @@
+// The localization map a node loads: the floor plan, the ANNF when the look-up needs one, and the
+// selected correspondence look-up. Look-up names: "annf-exact" (default), "annf-paper" (the leaf's two
+// stored candidates, the closer one used), "annf-paper-first" (only the leaf's first element),
+// "kdtree" (points sampled on the plan), "brute-force".
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fploc/floorplan/plan.h"
+#include "fploc/matcher/lookup.h"
+
+namespace fploc {
+
+class Annf;
+
+struct LocalizationMap {
+  std::shared_ptr<const FloorPlan> plan;
+  std::shared_ptr<const Annf> annf;  // null unless an ANNF look-up is used
+  std::unique_ptr<NearestLookup> lookup;
+  std::string note;                  // what was loaded/built (for logs)
+};
+
+// Known look-up names.
+const std::vector<std::string>& lookup_names();
+bool have_annf();  // false when built without modules/annf
+
+// From a plan already in memory. The ANNF (if needed) is built with its default options (depth 7,
+// 6 m root fields). Throws std::runtime_error on an unknown name or an empty plan.
+LocalizationMap make_localization_map(FloorPlan plan, const std::string& lookup = "annf-exact");
+// From a file: a plan (.dxf/.csv/.json, layers/units as fploc/floorplan/io.h) or a built .fpmap (its
+// ANNF is used when its mode matches the look-up, else one is built from its plan).
+LocalizationMap load_localization_map(const std::string& path, const std::vector<std::string>& layers,
+                                      const std::string& units, const std::string& lookup = "annf-exact");
+
+}  // namespace fploc

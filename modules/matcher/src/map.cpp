@@ -1,0 +1,125 @@
+#include "fploc/matcher/map.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "fploc/floorplan/io.h"
+#ifdef FPLOC_HAVE_ANNF
+#include "fploc/annf/annf.h"
+#endif
+
+namespace fploc {
+
+#ifdef FPLOC_HAVE_ANNF
+namespace {
+
+// Candidates from the ANNF leaf. Leaves with more candidates than the caller takes (exact mode at
+// max depth) and points outside the covered area use Annf::nearest (exact).
+class AnnfLookup : public NearestLookup {
+ public:
+  AnnfLookup(std::shared_ptr<const Annf> annf, bool first_only, std::string name)
+      : annf_(std::move(annf)), first_only_(first_only), name_(std::move(name)) {}
+  const std::vector<Element>& targets() const override { return annf_->plan().elements; }
+  int candidates(const Eigen::Vector2d& p, int* out, int max) const override {
+    if (max <= 0) return 0;
+    int n = 0;
+    const uint32_t* ids = annf_->lookup(p, &n);
+    if (n > 0 && (first_only_ || n <= max)) {
+      const int k = first_only_ ? 1 : n;
+      for (int i = 0; i < k; ++i) out[i] = int(ids[i]);
+      return k;
+    }
+    const int id = annf_->nearest(p);
+    if (id < 0) return 0;
+    out[0] = id;
+    return 1;
+  }
+  std::string name() const override { return name_; }
+
+ private:
+  std::shared_ptr<const Annf> annf_;
+  bool first_only_;
+  std::string name_;
+};
+
+}  // namespace
+#endif
+
+const std::vector<std::string>& lookup_names() {
+  static const std::vector<std::string> n = {"annf-exact", "annf-paper", "annf-paper-first", "kdtree", "brute-force"};
+  return n;
+}
+
+bool have_annf() {
+#ifdef FPLOC_HAVE_ANNF
+  return true;
+#else
+  return false;
+#endif
+}
+
+namespace {
+
+LocalizationMap finish(LocalizationMap m, const std::string& lookup, std::shared_ptr<const void> annf_in) {
+  if (std::find(lookup_names().begin(), lookup_names().end(), lookup) == lookup_names().end())
+    throw std::runtime_error("unknown look-up '" + lookup + "' (annf-exact, annf-paper, annf-paper-first, kdtree, brute-force)");
+  if (m.plan->elements.empty()) throw std::runtime_error(m.plan->source + ": the floor plan has no elements");
+  if (lookup == "kdtree") {
+    m.lookup = std::make_unique<KdTreeLookup>(*m.plan);
+    return m;
+  }
+  if (lookup == "brute-force") {
+    m.lookup = std::make_unique<BruteForceLookup>(*m.plan);
+    return m;
+  }
+#ifdef FPLOC_HAVE_ANNF
+  const AnnfMode mode = lookup == "annf-exact" ? AnnfMode::kExact : AnnfMode::kPaper;
+  auto annf = std::static_pointer_cast<const Annf>(annf_in);
+  if (!annf || annf->options().mode != mode) {
+    AnnfOptions o;
+    o.mode = mode;
+    annf = std::make_shared<const Annf>(Annf::build(*m.plan, o));
+    m.note += std::string(m.note.empty() ? "" : "; ") + "built ANNF (" + to_string(mode) + ", depth " +
+              std::to_string(o.max_depth) + ")";
+  }
+  m.annf = annf;
+  m.lookup = std::make_unique<AnnfLookup>(annf, lookup == "annf-paper-first", lookup);
+  return m;
+#else
+  (void)annf_in;
+  throw std::runtime_error("look-up '" + lookup + "' needs modules/annf, which this build does not have");
+#endif
+}
+
+bool ends_with(std::string s, const std::string& suf) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s.size() >= suf.size() && s.compare(s.size() - suf.size(), suf.size(), suf) == 0;
+}
+
+}  // namespace
+
+LocalizationMap make_localization_map(FloorPlan plan, const std::string& lookup) {
+  LocalizationMap m;
+  m.plan = std::make_shared<const FloorPlan>(std::move(plan));
+  return finish(std::move(m), lookup, nullptr);
+}
+
+LocalizationMap load_localization_map(const std::string& path, const std::vector<std::string>& layers,
+                                      const std::string& units, const std::string& lookup) {
+  LocalizationMap m;
+  std::shared_ptr<const void> annf;
+#ifdef FPLOC_HAVE_ANNF
+  if (ends_with(path, ".fpmap")) {
+    auto a = std::make_shared<const Annf>(Annf::load(path));
+    m.plan = std::make_shared<const FloorPlan>(a->plan());
+    m.note = "loaded " + path;
+    annf = a;
+    return finish(std::move(m), lookup, annf);
+  }
+#endif
+  m.plan = std::make_shared<const FloorPlan>(load_floor_plan(path, layers, units));
+  m.note = "loaded " + path;
+  return finish(std::move(m), lookup, annf);
+}
+
+}  // namespace fploc

@@ -1,0 +1,34 @@
+// Synthetic plans and 2D feature frames for the localization tests and benchmarks: a room with
+// pillars and a ray-casting "sensor" that produces features from a known pose, with range noise,
+// clutter that is not in the plan, and PCA group ids (consecutive hits on one wall).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "fploc/floorplan/plan.h"
+#include "fploc/matcher/types.h"
+
+namespace fploc::testing {
+
+// ~20 x 10 m room, door gaps on two opposite walls, a square and two round pillars.
+FloorPlan room_with_pillars();
+// Four bended, self-similar corridors (~2 m wide) around a block.
+FloorPlan corridor_loop();
+
+struct SynthOptions {
+  int beams = 360;             // rays over 360 degrees
+  double max_range = 25.0;
+  double noise_sigma = 0.0;    // range noise [m]
+  double clutter_fraction = 0; // extra points not on the plan, as a fraction of the hits
+  double clutter_radius = 4.0; // clutter points lie within this distance of the sensor
+  bool groups = true;          // group ids for runs of >= 5 hits on one segment
+  uint32_t seed = 1;
+};
+
+// Features as the sensor at `pose` would see them (sensor frame).
+FeatureFrame synth_frame(const FloorPlan& plan, const Pose2& pose, const SynthOptions& o, int64_t utime = 0);
+
+// Random points unrelated to the plan (a frame that cannot match).
+FeatureFrame random_frame(int n, double radius, uint32_t seed);
+
+}  // namespace fploc::testing
