@@ -15,6 +15,7 @@
 #include "fploc/runtime/compose.h"
 #include "fploc/runtime/graph.h"
 #include "fploc/runtime/node.h"
+#include "fploc/runtime/validate.h"
 
 namespace fploc::rt {
 
@@ -296,16 +297,7 @@ int node_main(int argc, char** argv) {
   }
 
   if (describe) {
-    std::cout << "{\"type\":\"" << reg.spec.type << "\",\"description\":\"" << reg.spec.description
-              << "\",\"options_field\":\"" << reg.spec.options_field << "\",\"ports\":[";
-    for (size_t i = 0; i < reg.spec.ports.size(); ++i) {
-      const auto& p = reg.spec.ports[i];
-      std::cout << (i ? "," : "") << "{\"name\":\"" << p.name << "\",\"direction\":\"" << (p.output ? "output" : "input")
-                << "\",\"lcm_type\":\"" << p.lcm_type << "\",\"default_channel\":\"" << p.default_channel << "\"}";
-    }
-    std::cout << "],\"options\":";
-    auto d = default_options(reg.spec.options_field);
-    std::cout << (d ? describe_message_json(d->GetDescriptor()) : std::string("null")) << "}\n";
+    std::cout << spec_json(reg.spec) << "\n";
     return 0;
   }
 
@@ -354,7 +346,8 @@ int node_main(int argc, char** argv) {
   signal(SIGPIPE, SIG_IGN);
 
   const int restarts = getenv("FPLOC_RESTARTS") ? atoi(getenv("FPLOC_RESTARTS")) : 0;
-  const std::string executable = std::string("fploc-") + reg.spec.type;
+  std::string executable = std::string("fploc-") + reg.spec.type;
+  std::replace(executable.begin(), executable.end(), '_', '-');
   try {
     Bus bus(url);
     Context ctx(bus, reg.spec, instance, std::move(options), port_map, base_dir, false);

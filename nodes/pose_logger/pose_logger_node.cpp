@@ -1,0 +1,79 @@
+// Pose logger: every fploc.pose_t on its `pose` port becomes one TUM line (core `tum_line`, so the
+// formatting is deterministic). Each line is handed to the kernel with a single write(2) as soon as the
+// pose arrives: nothing is buffered in the process, so no processed pose is lost on SIGINT or a crash.
+#include <fcntl.h>
+#include <fploc/pose_t.hpp>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+#include "fploc/core/pose.h"
+#include "fploc/runtime/node.h"
+#include "options/tools.pb.h"
+
+namespace {
+
+class PoseLoggerNode : public fploc::rt::Node {
+ public:
+  static fploc::rt::NodeSpec spec() {
+    return {"pose_logger", "pose_logger", "writes FPLOC_POSE to a TUM trajectory file (one flushed line per pose)",
+            {fploc::rt::input<fploc::pose_t>("pose", "FPLOC_POSE")}};
+  }
+
+  void setup(fploc::rt::Context& ctx) override {
+    const auto& opt = ctx.options<fploc::PoseLoggerOptions>();
+    path_ = opt.file().empty() ? std::string("poses.tum") : opt.file();
+    final_only_ = opt.final_only();
+    fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw std::runtime_error("cannot write '" + path_ + "': " + std::strerror(errno));
+    ctx_ = &ctx;
+    ctx.subscribe<fploc::pose_t>("pose", [this](const fploc::pose_t& m) { on_pose(m); });
+  }
+
+  void shutdown() override {
+    if (fd_ >= 0) {
+      ::fsync(fd_);
+      ::close(fd_);
+      fd_ = -1;
+    }
+  }
+  ~PoseLoggerNode() override { shutdown(); }
+
+ private:
+  void on_pose(const fploc::pose_t& m) {
+    if (final_only_ && !m.final_estimate) return;
+    fploc::StampedPose p;
+    p.t = double(m.utime) * 1e-6;
+    p.p = Eigen::Vector3d(m.position[0], m.position[1], m.position[2]);
+    const double n2 = m.orientation[0] * m.orientation[0] + m.orientation[1] * m.orientation[1] +
+                      m.orientation[2] * m.orientation[2] + m.orientation[3] * m.orientation[3];
+    if (!p.p.allFinite() || !std::isfinite(n2) || n2 < 1e-12) {
+      ctx_->error("pose seq " + std::to_string(m.seq) + ": non-finite position or zero quaternion (skipped)");
+      return;
+    }
+    p.q = Eigen::Quaterniond(m.orientation[3], m.orientation[0], m.orientation[1], m.orientation[2]);
+    const std::string line = fploc::tum_line(p) + "\n";
+    size_t off = 0;
+    while (off < line.size()) {
+      const ssize_t w = ::write(fd_, line.data() + off, line.size() - off);
+      if (w < 0) {
+        if (errno == EINTR) continue;
+        ctx_->error("write '" + path_ + "': " + std::strerror(errno));
+        return;
+      }
+      off += size_t(w);
+    }
+  }
+
+  fploc::rt::Context* ctx_ = nullptr;
+  std::string path_;
+  bool final_only_ = false;
+  int fd_ = -1;
+};
+
+}  // namespace
+
+FPLOC_REGISTER_NODE(PoseLoggerNode)

@@ -1,0 +1,539 @@
+// fploc launch: validates a graph (every error as file:line), then runs and supervises its nodes.
+//   fploc launch GRAPH [--check] [--duration S] [--lcm-url URL]
+// Each node is its own process (own process group, PR_SET_PDEATHSIG=SIGKILL) started as
+//   EXE --graph GRAPH --node NAME [--set k=v ...] [args...]   with FPLOC_RESTARTS=<restarts so far>.
+// Supervision: restart policy (never/on-failure/always, max restarts in a window, exponential backoff),
+// heartbeat timeout on FPLOC_TELEMETRY (a silent node is killed and restarted), control requests on
+// FPLOC_CONTROL (node_command_t from `fploc node restart`). Events go to stderr and, as node_status_t
+// with reporter "launcher", to FPLOC_TELEMETRY. SIGINT/SIGTERM (or --duration): SIGINT to every node,
+// then SIGTERM, then SIGKILL.
+#include <fcntl.h>
+#include <fploc/node_command_t.hpp>
+#include <fploc/node_status_t.hpp>
+#include <poll.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/syscall.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <deque>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fploc/runtime/bus.h"
+#include "fploc/runtime/graph.h"
+#include "fploc/runtime/validate.h"
+
+using namespace fploc::rt;
+
+namespace {
+
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+int64_t wall_utime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+double g_t0 = now_s();
+void log(const std::string& msg) {
+  char ts[32];
+  std::snprintf(ts, sizeof ts, "%8.3f", now_s() - g_t0);
+  std::cerr << "[launch " << ts << "] " << msg << std::endl;
+}
+
+int g_sig_pipe[2] = {-1, -1};
+void on_signal(int sig) {
+  const char c = char(sig);
+  [[maybe_unused]] auto r = ::write(g_sig_pipe[1], &c, 1);
+}
+
+enum class State { Starting, Running, Backoff, Stopping, Stopped, Dead };
+const char* state_name(State s) {
+  switch (s) {
+    case State::Starting: return "starting";
+    case State::Running: return "running";
+    case State::Backoff: return "restarting";
+    case State::Stopping: return "stopping";
+    case State::Stopped: return "stopped";
+    case State::Dead: return "dead";
+  }
+  return "?";
+}
+
+struct Child {
+  std::string name;
+  std::string exe_name;               // as in the graph (or the control request)
+  std::string exe_path;               // resolved
+  bool fploc_node = false;            // speaks the runtime protocol (--graph/--node, telemetry)
+  std::string options_field;          // declared by the executable
+  std::vector<std::string> sets;      // overrides from control requests
+  std::vector<std::string> args;
+  fploc::RestartPolicy policy;
+  double heartbeat_timeout = 3.0;
+
+  pid_t pid = -1;
+  State state = State::Stopped;
+  int restarts = 0;                   // FPLOC_RESTARTS of the next start - 1
+  std::deque<double> restart_times;   // within the policy window
+  double backoff = 0;                 // current backoff
+  double next_start = 0;
+  double started_at = 0;
+  double last_beat = 0;               // 0 = none from this pid yet
+  double stop_deadline = 0;           // Stopping: next escalation time
+  int stop_stage = 0;                 // 0 SIGINT sent, 1 SIGTERM sent, 2 SIGKILL sent
+  bool restart_after_stop = false;    // control request: start again once stopped
+  bool hung = false;
+};
+
+double policy_or(double v, double d) { return v > 0 ? v : d; }
+
+class Launcher {
+ public:
+  Launcher(LoadedGraph g, std::vector<ResolvedNode> resolved, std::string url, std::string bin_dir)
+      : g_(std::move(g)), bin_dir_(std::move(bin_dir)), bus_(url) {
+    for (const auto& rn : resolved) {
+      const auto& n = g_.graph.node(rn.index);
+      if (n.disabled()) continue;
+      Child c;
+      c.name = n.name();
+      c.exe_name = n.executable();
+      c.exe_path = rn.executable;
+      c.fploc_node = rn.desc.describable;
+      c.options_field = rn.desc.spec.options_field;
+      c.args.assign(n.args().begin(), n.args().end());
+      c.policy = n.restart();
+      c.heartbeat_timeout = policy_or(n.heartbeat_timeout_s(), 3.0);
+      c.backoff = policy_or(c.policy.backoff_initial_s(), 0.1);
+      children_.push_back(std::move(c));
+    }
+    shutdown_timeout_ = policy_or(g_.graph.shutdown_timeout_s(), 2.0);
+    graph_abs_ = std::filesystem::absolute(g_.path).string();
+    bus_.lcm().subscribe(kTelemetryChannel, &Launcher::on_telemetry, this);
+    control_channel_ = g_.graph.control_channel().empty() ? kControlChannel : g_.graph.control_channel();
+    bus_.lcm().subscribe(control_channel_, &Launcher::on_control, this);
+  }
+
+  int run(double duration) {
+    const double t_start = now_s();
+    for (auto& c : children_) start(c);
+    log("graph '" + g_.graph.name() + "' running: " + std::to_string(children_.size()) + " nodes on " + bus_.url() +
+        (duration > 0 ? ", for " + fmt(duration) + " s" : "") + "; control on " + control_channel_);
+    bool shutting_down = false;
+    double last_report = now_s();
+    const int lcm_fd = bus_.lcm().getFileno();
+    for (;;) {
+      pollfd p[2] = {{lcm_fd, POLLIN, 0}, {g_sig_pipe[0], POLLIN, 0}};
+      ::poll(p, 2, 20);
+      if (p[0].revents & POLLIN) bus_.lcm().handleTimeout(0);
+      if (p[1].revents & POLLIN) {
+        char buf[16];
+        const ssize_t n = ::read(g_sig_pipe[0], buf, sizeof buf);
+        for (ssize_t k = 0; k < n; ++k) {
+          if (buf[k] == SIGCHLD) continue;
+          if (!shutting_down) {
+            log(std::string("received ") + strsignal(buf[k]) + ": stopping every node");
+            shutting_down = true;
+            for (auto& c : children_) begin_stop(c, false);
+          } else {
+            log("second signal: killing every node now");
+            for (auto& c : children_)
+              if (c.pid > 0) ::kill(-c.pid, SIGKILL);
+          }
+        }
+      }
+      if (!shutting_down && duration > 0 && now_s() - t_start >= duration) {
+        log("duration of " + fmt(duration) + " s reached: stopping every node");
+        shutting_down = true;
+        for (auto& c : children_) begin_stop(c, false);
+      }
+      reap();
+      const double t = now_s();
+      for (auto& c : children_) {
+        if (c.state == State::Stopping) escalate(c, t);
+        if (shutting_down) continue;
+        if (c.state == State::Backoff && t >= c.next_start) start(c);
+        if (c.state == State::Running && c.fploc_node) check_heartbeat(c, t);
+      }
+      if (t - last_report >= 1.0) {
+        last_report = t;
+        for (auto& c : children_)
+          if (c.state == State::Dead || c.state == State::Backoff) publish(c, state_name(c.state), "");
+      }
+      if (shutting_down &&
+          std::all_of(children_.begin(), children_.end(), [](const Child& c) { return c.pid <= 0; })) {
+        log("all nodes stopped");
+        for (auto& c : children_) publish(c, "stopped", "");
+        return 0;
+      }
+    }
+  }
+
+ private:
+  void start(Child& c) {
+    std::vector<std::string> args{c.exe_path};
+    if (c.fploc_node) {
+      args.insert(args.end(), {"--graph", graph_abs_, "--node", c.name});
+      for (const auto& s : c.sets) args.insert(args.end(), {"--set", s});
+    }
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    std::vector<std::string> env_s;
+    for (char** e = environ; *e; ++e)
+      if (std::strncmp(*e, "FPLOC_RESTARTS=", 15) != 0) env_s.push_back(*e);
+    env_s.push_back("FPLOC_RESTARTS=" + std::to_string(c.restarts));
+    std::vector<char*> envp;
+    for (auto& e : env_s) envp.push_back(e.data());
+    envp.push_back(nullptr);
+    const pid_t parent = ::getpid();
+    const pid_t pid = ::fork();
+    if (pid < 0) {
+      log("node '" + c.name + "': fork failed: " + strerror(errno));
+      schedule_restart(c, "fork failed");
+      return;
+    }
+    if (pid == 0) {
+      ::setpgid(0, 0);
+      ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+      if (::getppid() != parent) ::_exit(127);  // the launcher died before prctl
+      sigset_t none;
+      sigemptyset(&none);
+      ::sigprocmask(SIG_SETMASK, &none, nullptr);
+      for (int s : {SIGINT, SIGTERM, SIGCHLD, SIGPIPE}) ::signal(s, SIG_DFL);
+      ::syscall(SYS_close_range, 3u, ~0u, 0u);
+      ::execve(argv[0], argv.data(), envp.data());
+      const char msg[] = "fploc launch: exec failed\n";
+      [[maybe_unused]] auto r = ::write(2, msg, sizeof msg - 1);
+      ::_exit(127);
+    }
+    ::setpgid(pid, pid);  // also from the parent: no race with kill(-pid)
+    c.pid = pid;
+    c.state = State::Running;
+    c.started_at = now_s();
+    c.last_beat = 0;
+    c.hung = false;
+    log("node '" + c.name + "' started: pid " + std::to_string(pid) + ", " + c.exe_name +
+        (c.sets.empty() ? "" : " (overrides: " + join(c.sets) + ")") +
+        (c.restarts ? ", restart " + std::to_string(c.restarts) : ""));
+  }
+
+  static std::string join(const std::vector<std::string>& v) {
+    std::string s;
+    for (const auto& x : v) s += (s.empty() ? "" : " ") + x;
+    return s;
+  }
+
+  void begin_stop(Child& c, bool restart_after) {
+    c.restart_after_stop = restart_after;
+    if (c.pid <= 0) {
+      if (!restart_after) c.state = State::Stopped;
+      return;
+    }
+    if (c.state == State::Stopping) return;
+    c.state = State::Stopping;
+    c.stop_stage = 0;
+    c.stop_deadline = now_s() + shutdown_timeout_;
+    ::kill(-c.pid, SIGINT);
+  }
+
+  void escalate(Child& c, double t) {
+    if (c.pid <= 0 || t < c.stop_deadline) return;
+    if (c.stop_stage == 0) {
+      log("node '" + c.name + "' still running " + fmt(shutdown_timeout_) + " s after SIGINT: SIGTERM");
+      ::kill(-c.pid, SIGTERM);
+      c.stop_stage = 1;
+      c.stop_deadline = t + 1.0;
+    } else if (c.stop_stage == 1) {
+      log("node '" + c.name + "' ignores SIGTERM: SIGKILL");
+      ::kill(-c.pid, SIGKILL);
+      c.stop_stage = 2;
+      c.stop_deadline = t + 1e9;
+    }
+  }
+
+  void check_heartbeat(Child& c, double t) {
+    // Until the first heartbeat the node may still be loading (maps): allow a longer grace period.
+    const double since = c.last_beat > 0 ? t - c.last_beat : t - c.started_at;
+    const double limit = c.last_beat > 0 ? c.heartbeat_timeout : std::max(c.heartbeat_timeout, 10.0);
+    if (since <= limit) return;
+    log("node '" + c.name + "' (pid " + std::to_string(c.pid) + ") hung: no heartbeat for " + fmt(since) +
+        " s; killing it");
+    c.hung = true;
+    publish(c, "hung", "no heartbeat for " + fmt(since) + " s");
+    ::kill(-c.pid, SIGKILL);
+    c.state = State::Stopping;
+    c.stop_stage = 2;
+    c.stop_deadline = t + 1e9;
+  }
+
+  static std::string fmt(double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.2f", v);
+    return b;
+  }
+
+  void reap() {
+    for (;;) {
+      int status = 0;
+      const pid_t pid = ::waitpid(-1, &status, WNOHANG);
+      if (pid <= 0) return;
+      for (auto& c : children_) {
+        if (c.pid != pid) continue;
+        // Anything left in the node's process group goes with it.
+        ::kill(-pid, SIGKILL);
+        c.pid = -1;
+        std::string how = WIFEXITED(status) ? "exited with code " + std::to_string(WEXITSTATUS(status))
+                                            : "killed by signal " + std::to_string(WTERMSIG(status)) + " (" + strsignal(WTERMSIG(status)) + ")";
+        const bool failed = c.hung || !WIFEXITED(status) || WEXITSTATUS(status) != 0;
+        if (c.state == State::Stopping && !c.hung) {
+          log("node '" + c.name + "' stopped (" + how + ")");
+          if (c.restart_after_stop) {
+            c.restart_after_stop = false;
+            ++c.restarts;
+            start(c);
+          } else {
+            c.state = State::Stopped;
+          }
+          break;
+        }
+        const auto mode = c.policy.mode();
+        const bool restart = mode == fploc::RestartPolicy::ALWAYS ||
+                             (mode == fploc::RestartPolicy::ON_FAILURE && failed);
+        if (!restart) {
+          log("node '" + c.name + "' " + how + (failed ? " (restart policy: not restarted)" : ""));
+          c.state = failed ? State::Dead : State::Stopped;
+          publish(c, failed ? "dead" : "stopped", how);
+        } else {
+          schedule_restart(c, (c.hung ? "hung, " : "") + how);
+        }
+        break;
+      }
+    }
+  }
+
+  void schedule_restart(Child& c, const std::string& why) {
+    const double t = now_s();
+    const double window = policy_or(c.policy.window_s(), 60.0);
+    const int max_restarts = c.policy.max_restarts() > 0 ? c.policy.max_restarts() : 5;
+    while (!c.restart_times.empty() && t - c.restart_times.front() > window) c.restart_times.pop_front();
+    if (int(c.restart_times.size()) >= max_restarts) {
+      log("node '" + c.name + "' " + why + ": " + std::to_string(max_restarts) + " restarts within " + fmt(window) +
+          " s already, giving up (dead)");
+      c.state = State::Dead;
+      publish(c, "dead", why + "; too many restarts");
+      return;
+    }
+    // Backoff grows with consecutive quick failures and resets after a run longer than the window.
+    const double initial = policy_or(c.policy.backoff_initial_s(), 0.1);
+    if (t - c.started_at > window) c.backoff = initial;
+    const double delay = c.backoff;
+    c.backoff = std::min(c.backoff * policy_or(c.policy.backoff_factor(), 2.0), policy_or(c.policy.backoff_max_s(), 5.0));
+    c.restart_times.push_back(t);
+    ++c.restarts;
+    c.next_start = t + delay;
+    c.state = State::Backoff;
+    log("node '" + c.name + "' " + why + "; restarting in " + fmt(delay) + " s (restart " +
+        std::to_string(c.restarts) + ", " + std::to_string(c.restart_times.size()) + "/" +
+        std::to_string(max_restarts) + " within " + fmt(window) + " s)");
+    publish(c, "restarting", why);
+  }
+
+  void publish(const Child& c, const std::string& state, const std::string& error) {
+    fploc::node_status_t s{};
+    s.utime = wall_utime();
+    s.node = c.name;
+    s.executable = c.exe_name;
+    s.pid = c.pid;
+    s.state = state;
+    s.reporter = "launcher";
+    s.restarts = c.restarts;
+    s.last_error = error;
+    s.num_ports = 0;
+    bus_.lcm().publish(kTelemetryChannel, &s);
+  }
+
+  Child* find(const std::string& name) {
+    for (auto& c : children_)
+      if (c.name == name) return &c;
+    return nullptr;
+  }
+
+  void on_telemetry(const lcm::ReceiveBuffer*, const std::string&, const fploc::node_status_t* m) {
+    if (m->reporter == "launcher") return;
+    Child* c = find(m->node);
+    if (c && c->pid > 0 && m->pid == c->pid) c->last_beat = now_s();
+  }
+
+  void reject(const std::string& node, const std::string& why) {
+    log("control request for '" + node + "' rejected: " + why);
+    fploc::node_status_t s{};
+    s.utime = wall_utime();
+    s.node = node;
+    s.state = "rejected";
+    s.reporter = "launcher";
+    s.last_error = "control: " + why;
+    bus_.lcm().publish(kTelemetryChannel, &s);
+  }
+
+  void on_control(const lcm::ReceiveBuffer*, const std::string&, const fploc::node_command_t* m) {
+    if (!g_.graph.control_token().empty() && m->token != g_.graph.control_token()) {
+      reject(m->node, "wrong control token");
+      return;
+    }
+    Child* c = find(m->node);
+    if (!c) {
+      reject(m->node, "no running node named '" + m->node + "'");
+      return;
+    }
+    if (m->action == "stop") {
+      log("control: stop node '" + c->name + "'");
+      begin_stop(*c, false);
+      publish(*c, "stopping", "");
+      return;
+    }
+    if (m->action != "restart" && m->action != "start") {
+      reject(m->node, "unknown action '" + m->action + "' (restart, stop, start)");
+      return;
+    }
+    // A new executable / overrides must pass the same checks as the graph before the old one stops.
+    std::string exe_name = c->exe_name, exe_path = c->exe_path, field = c->options_field;
+    bool fploc_node = c->fploc_node;
+    if (!m->executable.empty() && m->executable != c->exe_name) {
+      exe_path = resolve_executable(m->executable, bin_dir_);
+      if (exe_path.empty()) return reject(m->node, "executable '" + m->executable + "' not found");
+      auto d = describe_executable(exe_path);
+      if (!d.error.empty()) return reject(m->node, d.error);
+      const auto& n = graph_node(c->name);
+      const std::string graph_field = node_options_field(n);
+      if (d.describable && !graph_field.empty() && graph_field != d.spec.options_field)
+        return reject(m->node, "'" + m->executable + "' takes options '" + d.spec.options_field +
+                                   "' but the graph gives '" + graph_field + "'");
+      exe_name = m->executable;
+      fploc_node = d.describable;
+      field = d.spec.options_field;
+    }
+    std::vector<std::string> sets(m->set.begin(), m->set.end());
+    if (!sets.empty()) {
+      if (!fploc_node) return reject(m->node, "--set needs an fploc node");
+      auto opts = node_options(graph_node(c->name));
+      if (!opts) opts = default_options(field);
+      if (!opts) return reject(m->node, "node takes no options");
+      std::string err;
+      auto all = c->sets;
+      all.insert(all.end(), sets.begin(), sets.end());
+      if (!apply_overrides(*opts, all, err)) return reject(m->node, err);
+      sets = all;
+    } else {
+      sets = c->sets;
+    }
+    if (exe_name != c->exe_name) sets = std::vector<std::string>(m->set.begin(), m->set.end());
+    c->exe_name = exe_name;
+    c->exe_path = exe_path;
+    c->fploc_node = fploc_node;
+    c->options_field = field;
+    c->sets = sets;
+    c->restart_times.clear();
+    c->backoff = policy_or(c->policy.backoff_initial_s(), 0.1);
+    log("control: " + m->action + " node '" + c->name + "' with " + exe_name +
+        (sets.empty() ? "" : " (overrides: " + join(sets) + ")"));
+    publish(*c, "restarting", "control: " + m->action);
+    if (c->pid > 0) {
+      begin_stop(*c, true);
+    } else {
+      if (c->started_at > 0) ++c->restarts;
+      start(*c);
+    }
+  }
+
+  const fploc::Node& graph_node(const std::string& name) const {
+    for (const auto& n : g_.graph.node())
+      if (n.name() == name) return n;
+    static const fploc::Node empty;
+    return empty;
+  }
+
+  LoadedGraph g_;
+  std::string bin_dir_;
+  Bus bus_;
+  std::vector<Child> children_;
+  double shutdown_timeout_ = 2.0;
+  std::string graph_abs_, control_channel_;
+};
+
+void usage() {
+  std::cerr << "usage: fploc launch GRAPH.pbtxt [--check] [--duration SECONDS] [--lcm-url URL]\n"
+               "  --check      validate the graph (fields, executables, ports, channel types) and exit\n"
+               "  --duration   stop every node cleanly after SECONDS\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string graph_path, url;
+  bool check = false;
+  double duration = 0;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--check") check = true;
+    else if (a == "--duration" && i + 1 < argc) duration = std::atof(argv[++i]);
+    else if (a == "--lcm-url" && i + 1 < argc) url = argv[++i];
+    else if (a == "-h" || a == "--help") { usage(); return 0; }
+    else if (!a.empty() && a[0] != '-' && graph_path.empty()) graph_path = a;
+    else { std::cerr << "fploc launch: unexpected argument '" << a << "'\n"; usage(); return 2; }
+  }
+  if (graph_path.empty()) { usage(); return 2; }
+
+  LoadedGraph g;
+  std::vector<GraphError> errors;
+  load_graph(graph_path, g, errors);
+  std::vector<ResolvedNode> resolved;
+  if (g.tree) validate_graph(g, default_hooks(self_bin_dir()), errors, &resolved);
+  if (url.empty()) url = g.graph.lcm_url();
+  if (!check && url.rfind("memq://", 0) == 0)
+    errors.push_back({graph_path, 0, "lcm_url memq:// only works inside one process (use fploc replay)"});
+  std::stable_sort(errors.begin(), errors.end(), [](const GraphError& a, const GraphError& b) {
+    return a.file == b.file ? a.line < b.line : a.file < b.file;
+  });
+  for (const auto& e : errors) std::cerr << e.str() << "\n";
+  if (!errors.empty()) {
+    std::cerr << graph_path << ": " << errors.size() << " error" << (errors.size() > 1 ? "s" : "") << "\n";
+    return 1;
+  }
+  if (check) {
+    int enabled = 0;
+    for (const auto& n : g.graph.node()) enabled += !n.disabled();
+    std::cerr << graph_path << ": OK (" << enabled << " nodes)\n";
+    return 0;
+  }
+
+  if (::pipe2(g_sig_pipe, O_CLOEXEC | O_NONBLOCK) != 0) return 1;
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  sigaction(SIGHUP, &sa, nullptr);
+  sigaction(SIGCHLD, &sa, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+  try {
+    Launcher l(std::move(g), std::move(resolved), url, self_bin_dir());
+    return l.run(duration);
+  } catch (const std::exception& e) {
+    std::cerr << "fploc launch: " << e.what() << "\n";
+    return 1;
+  }
+}
