@@ -1,0 +1,139 @@
+// fploc node restart NAME [--exe EXE] [--set field=value ...] [--graph G | --lcm-url URL] [--token T]
+//                                                             [--timeout S] [--no-wait]
+// fploc node stop NAME / fploc node start NAME
+// Publishes a node_command_t on the launcher's control channel and waits until the node reports back
+// from its new process (or the launcher rejects the request, naming why).
+#include <fploc/node_command_t.hpp>
+#include <fploc/node_status_t.hpp>
+
+#include <chrono>
+#include <cstdlib>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "fploc/runtime/bus.h"
+#include "fploc/runtime/graph.h"
+
+using namespace fploc::rt;
+
+namespace {
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+void usage() {
+  std::cerr << "usage: fploc node restart|stop|start NAME [--exe EXECUTABLE] [--set field=value ...]\n"
+               "                  [--graph GRAPH | --lcm-url URL] [--token T] [--timeout S] [--no-wait]\n";
+}
+struct Watch {
+  std::string node;
+  bool learning = true;
+  int old_pid = -1;
+  int new_pid = -1;
+  std::string rejected, state;
+  void on(const lcm::ReceiveBuffer*, const std::string&, const fploc::node_status_t* m) {
+    if (m->node != node) return;
+    if (m->reporter == "launcher") {
+      if (m->state == "rejected") rejected = m->last_error;
+      state = m->state;
+      return;
+    }
+    if (learning) {
+      if (m->state == "running") old_pid = m->pid;
+      return;
+    }
+    if (m->pid != old_pid && m->state == "running") new_pid = m->pid;
+    if (m->state == "stopped") state = "stopped";
+  }
+};
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 3) {
+    usage();
+    return 2;
+  }
+  fploc::node_command_t cmd{};
+  cmd.action = argv[1];
+  cmd.node = argv[2];
+  std::string url = getenv("FPLOC_LCM_URL") ? getenv("FPLOC_LCM_URL") : "";
+  std::string channel = kControlChannel;
+  double timeout = 10;
+  bool wait = true;
+  for (int i = 3; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::cerr << "fploc node: " << a << " needs a value\n";
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--exe") cmd.executable = next();
+    else if (a == "--set") cmd.set.push_back(next());
+    else if (a == "--lcm-url") url = next();
+    else if (a == "--token") cmd.token = next();
+    else if (a == "--timeout") timeout = std::atof(next().c_str());
+    else if (a == "--no-wait") wait = false;
+    else if (a == "--graph") {
+      LoadedGraph g;
+      std::vector<GraphError> errors;
+      const std::string path = next();
+      if (!load_graph(path, g, errors)) {
+        for (const auto& e : errors) std::cerr << e.str() << "\n";
+        return 2;
+      }
+      if (url.empty()) url = g.graph.lcm_url();
+      if (!g.graph.control_channel().empty()) channel = g.graph.control_channel();
+      if (cmd.token.empty()) cmd.token = g.graph.control_token();
+    } else {
+      std::cerr << "fploc node: unexpected argument '" << a << "'\n";
+      usage();
+      return 2;
+    }
+  }
+  if (cmd.action != "restart" && cmd.action != "stop" && cmd.action != "start") {
+    usage();
+    return 2;
+  }
+  cmd.num_set = int32_t(cmd.set.size());
+  try {
+    Bus bus(url);
+    Watch w;
+    w.node = cmd.node;
+    bus.lcm().subscribe(kTelemetryChannel, &Watch::on, &w);
+    // Learn the current process from its heartbeat (1 Hz) so that its successor can be recognised.
+    const double t_learn = now_s();
+    while (wait && w.old_pid < 0 && now_s() - t_learn < 1.5) bus.lcm().handleTimeout(100);
+    w.learning = false;
+    const auto sent = std::chrono::system_clock::now();
+    cmd.utime = std::chrono::duration_cast<std::chrono::microseconds>(sent.time_since_epoch()).count();
+    bus.lcm().publish(channel, &cmd);
+    std::cerr << "fploc node: " << cmd.action << " '" << cmd.node << "' sent on " << channel << "\n";
+    if (!wait) return 0;
+    const double t0 = now_s();
+    while (now_s() - t0 < timeout) {
+      bus.lcm().handleTimeout(50);
+      if (!w.rejected.empty()) {
+        std::cerr << "fploc node: rejected by the launcher: " << w.rejected << "\n";
+        return 1;
+      }
+      if (cmd.action == "stop" && w.state == "stopped") {
+        std::cerr << "fploc node: '" << cmd.node << "' stopped\n";
+        return 0;
+      }
+      if (cmd.action != "stop" && w.new_pid > 0) {
+        std::cerr << "fploc node: '" << cmd.node << "' running again as pid " << w.new_pid
+                  << (w.old_pid > 0 ? " (was " + std::to_string(w.old_pid) + ")" : std::string()) << " after "
+                  << int((now_s() - t0) * 1000) << " ms\n";
+        return 0;
+      }
+    }
+    std::cerr << "fploc node: no answer within " << timeout << " s (is `fploc launch` running on " << bus.url()
+              << "?)\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "fploc node: " << e.what() << "\n";
+    return 1;
+  }
+}
