@@ -1,0 +1,97 @@
+// Windowed optimisation (paper Section IV-C, second stage). Keyframes are selected by distance/angle
+// from the last key pose (single-frame poses); a window of the W most recent keyframes is optimised
+// jointly with Ceres: the floor-plan terms of every keyframe (as in single-frame registration) plus the
+// regularisation of consecutive linear and angular velocities, alpha ||v^{m+1} - v^m||^2 and
+// beta ||w^{m+1} - w^m||^2. Each key pose is optimised W times and becomes final when it leaves the
+// window. Non-keyframes are passed on with the correction (final - single-frame) of the surrounding
+// keyframes interpolated in time, so the final trajectory has every frame.
+#pragma once
+#include <Eigen/Core>
+#include <cmath>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "fploc/matcher/lookup.h"
+#include "fploc/matcher/types.h"
+
+namespace fploc {
+
+struct OptimizerConfig {
+  int window = 10;                     // W
+  double alpha = 1.1;                  // linear velocity regularisation
+  double beta = 0.9;                   // angular velocity regularisation
+  double keyframe_distance_m = 0.1;
+  double keyframe_angle_rad = 5.0 * M_PI / 180;
+  double gate_m = 0.3;                 // correspondence gate around the current estimate
+  double loss_scale_m = 0.05;
+  std::string loss = "huber";
+  int max_iterations = 10;             // Ceres iterations per outer round
+  int outer = 2;                       // look-up + solve rounds per new keyframe
+  bool group_rule = true;
+  int stride = 1;                      // use every stride-th feature point of a keyframe
+  bool anchor_final = false;           // also regularise against the last two final key poses (held fixed)
+  double max_keyframe_gap_s = 2.0;     // a longer gap (e.g. lost frames) restarts the window
+};
+
+struct FrameInput {
+  FeatureFrame features;
+  Pose2 sfr;                           // single-frame registration result
+  FitStatus status = FitStatus::kOk;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+};
+
+struct PoseOut {
+  int64_t utime = 0;
+  int64_t scan_seq = 0;
+  Pose2 pose;
+  double roll = 0, pitch = 0, z = 0;
+  bool keyframe = false;
+  bool final_estimate = false;
+  FitStatus status = FitStatus::kOk;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+  int optimised = 0;                   // how many window solves this pose took part in
+};
+
+class WindowOptimizer {
+ public:
+  WindowOptimizer(const NearestLookup& lookup, OptimizerConfig cfg);
+  ~WindowOptimizer();
+  // Feeds one frame (in time order). Appends the poses that became final (time order) to `finals` and
+  // returns the current estimate of this frame (final_estimate = false).
+  PoseOut add(FrameInput in, std::vector<PoseOut>* finals);
+  // Makes everything still in the window final (end of a sequence).
+  void flush(std::vector<PoseOut>* finals);
+  size_t window_size() const { return window_.size(); }
+  int solves() const { return solves_; }
+  const OptimizerConfig& config() const { return cfg_; }
+
+ private:
+  struct Key {
+    FrameInput in;
+    double x[3];
+    int optimised = 0;
+  };
+  struct Final {
+    int64_t utime;
+    Pose2 pose;
+    Eigen::Vector3d correction;
+  };
+  void solve();
+  void finalize_front(std::vector<PoseOut>* finals);
+  void emit_pending_until(int64_t utime, const Eigen::Vector3d& corr_next, std::vector<PoseOut>* finals);
+  PoseOut make_out(const FrameInput& in, const Pose2& p, bool key) const;
+  Eigen::Vector3d newest_correction() const;
+
+  const NearestLookup& lookup_;
+  OptimizerConfig cfg_;
+  std::deque<Key> window_;
+  std::deque<FrameInput> pending_;     // non-keyframes waiting for their surrounding keyframes to be final
+  std::deque<Final> finals_;           // last two final key poses
+  bool have_last_key_ = false;
+  Pose2 last_key_sfr_;
+  int64_t last_key_utime_ = 0;
+  int solves_ = 0;
+};
+
+}  // namespace fploc

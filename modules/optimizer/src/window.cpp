@@ -1,0 +1,190 @@
+#include "fploc/optimizer/window.h"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "fploc/matcher/plan_terms.h"
+
+namespace fploc {
+namespace {
+
+// sqrt(alpha) (v^{m+1} - v^m), sqrt(beta) (w^{m+1} - w^m) for three consecutive key poses.
+struct VelocityReg {
+  double dt0, dt1, sa, sb;
+  template <typename T>
+  bool operator()(const T* p0, const T* p1, const T* p2, T* r) const {
+    using std::atan2;
+    using std::cos;
+    using std::sin;
+    const T d0 = p1[2] - p0[2], d1 = p2[2] - p1[2];
+    const T w0 = atan2(sin(d0), cos(d0)) / dt0, w1 = atan2(sin(d1), cos(d1)) / dt1;
+    r[0] = sa * ((p2[0] - p1[0]) / dt1 - (p1[0] - p0[0]) / dt0);
+    r[1] = sa * ((p2[1] - p1[1]) / dt1 - (p1[1] - p0[1]) / dt0);
+    r[2] = sb * (w1 - w0);
+    return true;
+  }
+};
+
+Eigen::Vector3d diff(const Pose2& a, const Pose2& b) { return {a.x - b.x, a.y - b.y, wrap_angle(a.yaw - b.yaw)}; }
+Pose2 plus(const Pose2& a, const Eigen::Vector3d& c) { return {a.x + c[0], a.y + c[1], wrap_angle(a.yaw + c[2])}; }
+
+}  // namespace
+
+WindowOptimizer::WindowOptimizer(const NearestLookup& lookup, OptimizerConfig cfg) : lookup_(lookup), cfg_(std::move(cfg)) {
+  cfg_.window = std::max(1, cfg_.window);
+}
+WindowOptimizer::~WindowOptimizer() = default;
+
+Eigen::Vector3d WindowOptimizer::newest_correction() const {
+  if (!window_.empty()) {
+    const Key& k = window_.back();
+    return diff(Pose2{k.x[0], k.x[1], k.x[2]}, k.in.sfr);
+  }
+  if (!finals_.empty()) return finals_.back().correction;
+  return Eigen::Vector3d::Zero();
+}
+
+PoseOut WindowOptimizer::make_out(const FrameInput& in, const Pose2& p, bool key) const {
+  PoseOut o;
+  o.utime = in.features.utime;
+  o.scan_seq = in.features.scan_seq;
+  o.pose = p;
+  o.roll = in.features.roll;
+  o.pitch = in.features.pitch;
+  o.z = in.features.z;
+  o.keyframe = key;
+  o.status = in.status;
+  o.covariance = in.covariance;
+  return o;
+}
+
+PoseOut WindowOptimizer::add(FrameInput in, std::vector<PoseOut>* finals) {
+  const int64_t t = in.features.utime;
+  bool key = in.status == FitStatus::kOk;
+  if (key && have_last_key_) {
+    const double d = std::hypot(in.sfr.x - last_key_sfr_.x, in.sfr.y - last_key_sfr_.y);
+    const double a = std::abs(wrap_angle(in.sfr.yaw - last_key_sfr_.yaw));
+    key = d >= cfg_.keyframe_distance_m || a >= cfg_.keyframe_angle_rad;
+    if (key && (t - last_key_utime_) * 1e-6 > cfg_.max_keyframe_gap_s) {
+      flush(finals);  // a long gap: the velocities across it mean nothing
+      finals_.clear();
+    }
+  }
+  if (!key) {
+    PoseOut o = make_out(in, plus(in.sfr, newest_correction()), false);
+    pending_.push_back(std::move(in));
+    return o;
+  }
+  Key k;
+  k.in = std::move(in);
+  const Pose2 init = plus(k.in.sfr, newest_correction());
+  k.x[0] = init.x;
+  k.x[1] = init.y;
+  k.x[2] = init.yaw;
+  last_key_sfr_ = k.in.sfr;
+  last_key_utime_ = t;
+  have_last_key_ = true;
+  window_.push_back(std::move(k));
+  while (int(window_.size()) > cfg_.window) finalize_front(finals);
+  solve();
+  const Key& nk = window_.back();
+  PoseOut o = make_out(nk.in, Pose2{nk.x[0], nk.x[1], wrap_angle(nk.x[2])}, true);
+  o.optimised = nk.optimised;
+  return o;
+}
+
+void WindowOptimizer::solve() {
+  auto loss = make_loss(cfg_.loss, cfg_.loss_scale_m);
+  ceres::Problem::Options po;
+  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  so.num_threads = 1;
+  so.max_num_iterations = std::max(1, cfg_.max_iterations);
+  so.logging_type = ceres::SILENT;
+  AssignOptions ao;
+  ao.gate_m = cfg_.gate_m;
+  ao.group_rule = cfg_.group_rule;
+  ao.stride = cfg_.stride;
+  std::vector<std::vector<Assignment>> as(window_.size());
+  // Anchors: the last final key poses, held fixed (optional).
+  double anchors[2][3];
+  std::vector<std::pair<double*, int64_t>> chain;  // pose block, utime
+  if (cfg_.anchor_final) {
+    for (size_t i = 0; i < finals_.size(); ++i) {
+      anchors[i][0] = finals_[i].pose.x;
+      anchors[i][1] = finals_[i].pose.y;
+      anchors[i][2] = finals_[i].pose.yaw;
+      chain.push_back({anchors[i], finals_[i].utime});
+    }
+  }
+  for (auto& k : window_) chain.push_back({k.x, k.in.features.utime});
+  for (int outer = 0; outer < std::max(1, cfg_.outer); ++outer) {
+    ceres::Problem problem(po);
+    for (size_t i = 0; i < window_.size(); ++i) {
+      Key& k = window_[i];
+      assign(lookup_, k.in.features, Pose2{k.x[0], k.x[1], k.x[2]}, ao, &as[i]);
+      problem.AddParameterBlock(k.x, 3);
+      add_plan_terms(&problem, k.x, lookup_, k.in.features, as[i], loss.get());
+    }
+    for (size_t i = 0; i + 2 < chain.size(); ++i) {
+      const double dt0 = (chain[i + 1].second - chain[i].second) * 1e-6;
+      const double dt1 = (chain[i + 2].second - chain[i + 1].second) * 1e-6;
+      if (!(dt0 > 1e-4 && dt1 > 1e-4)) continue;
+      auto* cost = new ceres::AutoDiffCostFunction<VelocityReg, 3, 3, 3, 3>(
+          new VelocityReg{dt0, dt1, std::sqrt(std::max(cfg_.alpha, 0.0)), std::sqrt(std::max(cfg_.beta, 0.0))});
+      problem.AddResidualBlock(cost, nullptr, chain[i].first, chain[i + 1].first, chain[i + 2].first);
+    }
+    if (cfg_.anchor_final)
+      for (size_t i = 0; i < finals_.size(); ++i)
+        if (problem.HasParameterBlock(anchors[i])) problem.SetParameterBlockConstant(anchors[i]);
+    ceres::Solver::Summary sum;
+    ceres::Solve(so, &problem, &sum);
+  }
+  for (auto& k : window_) ++k.optimised;
+  ++solves_;
+}
+
+void WindowOptimizer::emit_pending_until(int64_t utime, const Eigen::Vector3d& corr_next, std::vector<PoseOut>* finals) {
+  while (!pending_.empty() && pending_.front().features.utime < utime) {
+    const FrameInput& in = pending_.front();
+    Eigen::Vector3d c = corr_next;
+    if (!finals_.empty()) {
+      const Final& prev = finals_.back();
+      const double span = double(utime - prev.utime);
+      const double s = span > 0 ? std::clamp(double(in.features.utime - prev.utime) / span, 0.0, 1.0) : 1.0;
+      Eigen::Vector3d d = corr_next - prev.correction;
+      d[2] = wrap_angle(d[2]);
+      c = prev.correction + s * d;
+    }
+    PoseOut o = make_out(in, plus(in.sfr, c), false);
+    o.final_estimate = true;
+    if (finals) finals->push_back(o);
+    pending_.pop_front();
+  }
+}
+
+void WindowOptimizer::finalize_front(std::vector<PoseOut>* finals) {
+  Key k = std::move(window_.front());
+  window_.pop_front();
+  const Pose2 p{k.x[0], k.x[1], wrap_angle(k.x[2])};
+  const Eigen::Vector3d corr = diff(p, k.in.sfr);
+  emit_pending_until(k.in.features.utime, corr, finals);
+  PoseOut o = make_out(k.in, p, true);
+  o.final_estimate = true;
+  o.optimised = k.optimised;
+  if (finals) finals->push_back(o);
+  finals_.push_back({k.in.features.utime, p, corr});
+  while (finals_.size() > 2) finals_.pop_front();
+}
+
+void WindowOptimizer::flush(std::vector<PoseOut>* finals) {
+  while (!window_.empty()) finalize_front(finals);
+  const Eigen::Vector3d c = finals_.empty() ? Eigen::Vector3d::Zero() : finals_.back().correction;
+  emit_pending_until(std::numeric_limits<int64_t>::max(), c, finals);
+}
+
+}  // namespace fploc

@@ -1,0 +1,152 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "fploc/matcher/map.h"
+#include "fploc/matcher/matcher.h"
+#include "fploc/optimizer/window.h"
+#include "synthetic.h"
+
+using namespace fploc;
+using fploc::testing::room_with_pillars;
+using fploc::testing::synth_frame;
+using fploc::testing::SynthOptions;
+
+namespace {
+
+// A smooth path through the room at ~0.6 m/s, 10 Hz.
+Pose2 truth_at(double t) { return {3.0 + 0.6 * t, 3.0 + 1.5 * std::sin(0.25 * t), 0.2 * std::sin(0.3 * t) + 0.1 * t}; }
+
+struct SeqRun {
+  std::vector<Pose2> truth;
+  std::vector<MatchResult> sfr;
+  std::vector<FeatureFrame> frames;
+};
+
+SeqRun make_run(const NearestLookup& lookup, const FloorPlan& plan, int n, const SynthOptions& base) {
+  SeqRun run;
+  Matcher m(lookup, MatcherConfig{});
+  m.set_pose(truth_at(0));
+  for (int k = 0; k < n; ++k) {
+    const double t = 0.1 * k;
+    SynthOptions so = base;
+    so.seed = base.seed + uint32_t(k);
+    run.truth.push_back(truth_at(t));
+    run.frames.push_back(synth_frame(plan, run.truth.back(), so, int64_t(std::llround(t * 1e6))));
+    run.frames.back().scan_seq = k;
+    run.sfr.push_back(m.process(run.frames.back()));
+  }
+  return run;
+}
+
+double rms_err(const std::vector<Pose2>& est, const std::vector<Pose2>& truth) {
+  double s = 0;
+  for (size_t i = 0; i < est.size(); ++i) s += std::pow(est[i].x - truth[i].x, 2) + std::pow(est[i].y - truth[i].y, 2);
+  return std::sqrt(s / double(est.size()));
+}
+
+std::vector<PoseOut> optimise(const NearestLookup& lookup, const SeqRun& run, OptimizerConfig cfg) {
+  WindowOptimizer opt(lookup, cfg);
+  std::vector<PoseOut> finals;
+  for (size_t k = 0; k < run.frames.size(); ++k) {
+    FrameInput in;
+    in.features = run.frames[k];
+    in.sfr = run.sfr[k].pose;
+    in.status = run.sfr[k].status;
+    const PoseOut latest = opt.add(in, &finals);
+    EXPECT_FALSE(latest.final_estimate);
+    EXPECT_EQ(latest.utime, run.frames[k].utime);
+  }
+  opt.flush(&finals);
+  return finals;
+}
+
+}  // namespace
+
+TEST(WindowOptimizer, EveryFrameBecomesFinalOnceInOrderAndKeysAreOptimisedWTimes) {
+  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  SynthOptions so;
+  so.noise_sigma = 0.02;
+  const SeqRun run = make_run(*map.lookup, *map.plan, 60, so);
+  OptimizerConfig cfg;
+  const auto finals = optimise(*map.lookup, run, cfg);
+  ASSERT_EQ(finals.size(), run.frames.size());
+  int keys = 0, keys_w = 0;
+  for (size_t i = 0; i < finals.size(); ++i) {
+    EXPECT_EQ(finals[i].utime, run.frames[i].utime);
+    EXPECT_TRUE(finals[i].final_estimate);
+    if (finals[i].keyframe) {
+      ++keys;
+      keys_w += finals[i].optimised == cfg.window;
+      EXPECT_LE(finals[i].optimised, cfg.window);
+    }
+  }
+  EXPECT_GT(keys, 20);                 // 0.6 m/s at 10 Hz, 0.1 m threshold: most frames are keys
+  EXPECT_GE(keys_w, keys - cfg.window);  // all but the last W (flushed) were optimised W times
+}
+
+TEST(WindowOptimizer, ExactWithoutNoise) {
+  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  const SeqRun run = make_run(*map.lookup, *map.plan, 40, SynthOptions{});
+  const auto finals = optimise(*map.lookup, run, OptimizerConfig{});
+  std::vector<Pose2> est;
+  for (const auto& f : finals) est.push_back(f.pose);
+  EXPECT_LT(rms_err(est, run.truth), 1e-3);
+}
+
+TEST(WindowOptimizer, RegularisationSmoothsANoisySequence) {
+  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  SynthOptions so;
+  so.beams = 60;            // few, noisy features: single-frame poses scatter by centimetres
+  so.noise_sigma = 0.08;
+  so.clutter_fraction = 0.1;
+  so.seed = 11;
+  const SeqRun run = make_run(*map.lookup, *map.plan, 100, so);
+  std::vector<Pose2> sfr;
+  for (const auto& r : run.sfr) sfr.push_back(r.pose);
+  OptimizerConfig cfg;
+  const auto finals = optimise(*map.lookup, run, cfg);
+  ASSERT_EQ(finals.size(), run.frames.size());
+  std::vector<Pose2> wo;
+  for (const auto& f : finals) wo.push_back(f.pose);
+  const double e_sfr = rms_err(sfr, run.truth), e_wo = rms_err(wo, run.truth);
+  std::printf("rms position error: single-frame %.4f m, windowed %.4f m\n", e_sfr, e_wo);
+  EXPECT_LT(e_wo, e_sfr);
+  // Without the velocity terms the window is just W independent single-frame problems.
+  cfg.alpha = cfg.beta = 0;
+  const auto plain = optimise(*map.lookup, run, cfg);
+  std::vector<Pose2> pl;
+  for (const auto& f : plain) pl.push_back(f.pose);
+  EXPECT_LT(e_wo, rms_err(pl, run.truth));
+}
+
+TEST(WindowOptimizer, StationarySensorMakesOneKeyframe) {
+  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  WindowOptimizer opt(*map.lookup, OptimizerConfig{});
+  std::vector<PoseOut> finals;
+  int keys = 0;
+  for (int k = 0; k < 20; ++k) {
+    FrameInput in;
+    in.features = synth_frame(*map.plan, {8, 3, 0.5}, SynthOptions{}, k * 100000);
+    in.sfr = {8, 3, 0.5};
+    keys += opt.add(in, &finals).keyframe;
+  }
+  opt.flush(&finals);
+  EXPECT_EQ(keys, 1);
+  EXPECT_EQ(finals.size(), 20u);
+}
+
+TEST(WindowOptimizer, PoorFramesAreNeverKeyframes) {
+  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  WindowOptimizer opt(*map.lookup, OptimizerConfig{});
+  std::vector<PoseOut> finals;
+  for (int k = 0; k < 10; ++k) {
+    FrameInput in;
+    in.features = synth_frame(*map.plan, {4.0 + 0.2 * k, 3, 0}, SynthOptions{}, k * 100000);
+    in.sfr = {4.0 + 0.2 * k, 3, 0};
+    in.status = k % 2 ? FitStatus::kPoor : FitStatus::kOk;
+    const PoseOut o = opt.add(in, &finals);
+    EXPECT_EQ(o.keyframe, k % 2 == 0);
+    EXPECT_EQ(o.status, in.status);
+  }
+}
