@@ -38,8 +38,11 @@ TEST_P(LookupTest, ExactRecoveryWithoutNoise) {
   MatcherConfig cfg;
   cfg.max_iterations = 30;
   cfg.max_outer = 8;
-  // Point-to-point against 5 cm samples cannot be exact: its floor is the sampling error.
-  const double tol = GetParam() == "kdtree" ? 0.02 : 1e-4;
+  // Point-to-point against 5 cm samples cannot be exact: its floor is the sampling error. The paper's
+  // ANNF (two candidates per leaf, depth 7 = 9.4 cm leaves) gives a wrong element near some element
+  // ends, which costs millimetres: measured 0.1-1.8 mm here.
+  const bool paper = GetParam().find("paper") != std::string::npos;
+  const double tol = GetParam() == "kdtree" ? 0.02 : paper ? 0.005 : 1e-4;
   for (const auto& truth : kPoses) {
     SynthOptions so;
     const FeatureFrame f = synth_frame(*map.plan, truth, so);
@@ -48,7 +51,7 @@ TEST_P(LookupTest, ExactRecoveryWithoutNoise) {
     EXPECT_EQ(r.status, FitStatus::kOk) << GetParam() << " " << r.text;
     EXPECT_LT(pos_err(r.pose, truth), tol) << GetParam() << " at " << truth.x << "," << truth.y;
     EXPECT_LT(yaw_err(r.pose, truth), tol) << GetParam();
-    EXPECT_GT(r.fit.inlier_ratio, 0.95);
+    EXPECT_GT(r.fit.inlier_ratio, paper ? 0.9 : 0.95);
   }
 }
 
