@@ -16,6 +16,22 @@ namespace {
 
 [[noreturn]] void fail(const std::string& m) { throw std::runtime_error(m); }
 
+// Double -> int without undefined behaviour (clamped; NaN -> lo).
+int to_int(double v, int lo, int hi) {
+  if (!(v >= lo)) return lo;
+  if (v >= hi) return hi;
+  return int(v);
+}
+constexpr int kBig = 1 << 30;
+
+// Sweep in (0, 2 pi] (no loops: angles in a fuzzed file can be huge).
+double norm_sweep(double s) {
+  if (!std::isfinite(s)) return 2 * M_PI;
+  s = std::fmod(s, 2 * M_PI);
+  if (s <= 0) s += 2 * M_PI;
+  return s;
+}
+
 struct Group {
   int code;
   std::string value;
@@ -407,7 +423,7 @@ class DxfLoader {
   int steps_for(double radius, double sweep) const {
     const double r = std::max(radius, 1e-12);
     const double step = tol_ < r ? 2 * std::acos(1 - tol_ / r) : M_PI / 2;
-    return std::clamp(int(std::ceil(std::abs(sweep) / std::max(step, 1e-4))), 1, 4096);
+    return to_int(std::ceil(std::abs(sweep) / std::max(step, 1e-4)), 1, 4096);
   }
   // Counter-clockwise arc (local frame) from a0 to a1 (radians); a full circle when full.
   void arc(const Xf& x, const Eigen::Vector2d& c, double r, double a0, double a1, bool full, int layer, const Entity& top) {
@@ -429,16 +445,12 @@ class DxfLoader {
       if (det < 0) std::swap(b0, b1);
       Element e = Element::arc(cc, r * s0, b0, b1, layer);
       // Keep the sweep (a full-turn arc stays a full turn).
-      double sweep = a1 - a0;
-      while (sweep <= 0) sweep += 2 * M_PI;
-      if (sweep > 2 * M_PI) sweep = 2 * M_PI;
-      e.a1 = e.a0 + sweep;
+      e.a1 = e.a0 + norm_sweep(a1 - a0);
       add(e, top);
       return;
     }
     // Non-uniform scale: the image is an elliptical arc; approximate by chords.
-    double sweep = full ? 2 * M_PI : a1 - a0;
-    while (sweep <= 0) sweep += 2 * M_PI;
+    const double sweep = full ? 2 * M_PI : norm_sweep(a1 - a0);
     const int n = steps_for(r * std::max(s0, s1), sweep);
     std::vector<Eigen::Vector2d> pts;
     for (int k = 0; k <= n; ++k) {
@@ -474,6 +486,7 @@ class DxfLoader {
   }
 
   void emit_entity(const Entity& e, const Xf& xf, const std::string& inherited, int depth, const Entity& top) {
+    if (++visits_ > kMaxVisits) fail(where(top) + ": more than " + std::to_string(kMaxVisits) + " block entity expansions (runaway INSERT arrays?)");
     if (num(e, 67, 0) != 0) return;  // paper space
     std::string lname = decode_unicode(str(e, 8, "0"));
     if (lname == "0" && !inherited.empty()) lname = inherited;
@@ -517,10 +530,10 @@ class DxfLoader {
           bulge.back() = parse_num(g, t);
         }
       }
-      const bool closed = (int(num(e, 70, 0)) & 1) != 0;
+      const bool closed = (to_int(num(e, 70, 0), -kBig, kBig) & 1) != 0;
       bulged(x, v, bulge, closed, layer, top);
     } else if (t == "POLYLINE") {
-      const int flags = int(num(e, 70, 0));
+      const int flags = to_int(num(e, 70, 0), -kBig, kBig);
       if (flags & (16 | 64)) {  // polygon / polyface mesh
         ++unsupported_["POLYLINE(mesh)"];
         return;
@@ -530,7 +543,7 @@ class DxfLoader {
       std::vector<Eigen::Vector2d> v;
       std::vector<double> bulge;
       for (const auto& c : e.children) {
-        const int vf = int(num(c, 70, 0));
+        const int vf = to_int(num(c, 70, 0), -kBig, kBig);
         if (vf & 16) continue;  // spline frame control point
         v.push_back({num(c, 10, 0), num(c, 20, 0)});
         bulge.push_back(is3d ? 0.0 : num(c, 42, 0));
@@ -544,9 +557,7 @@ class DxfLoader {
       if (!(M.norm() > 0) || !(ratio > 0) || ratio > 1 + 1e-9) fail(where(e) + ": bad major axis or ratio");
       const Eigen::Vector3d mi = n.cross(M) * ratio;
       double t0 = num(e, 41, 0), t1 = num(e, 42, 2 * M_PI);
-      double sweep = t1 - t0;
-      while (sweep <= 0) sweep += 2 * M_PI;
-      if (sweep > 2 * M_PI + 1e-9) sweep = std::fmod(sweep, 2 * M_PI);
+      const double sweep = norm_sweep(t1 - t0);
       const int steps = steps_for(M.norm(), sweep);
       std::vector<Eigen::Vector2d> pts;
       for (int k = 0; k <= steps; ++k) {
@@ -561,7 +572,7 @@ class DxfLoader {
   }
 
   void spline(const Entity& e, const Xf& xf, int layer, const Entity& top) {
-    const int degree = int(num(e, 71, 3));
+    const int degree = to_int(num(e, 71, 3), -kBig, kBig);
     std::vector<double> knots, weights;
     std::vector<Eigen::Vector2d> ctrl, fit;
     for (const auto& g : e.groups) {
@@ -583,7 +594,7 @@ class DxfLoader {
     if (int(weights.size()) != n) weights.assign(n, 1.0);
     double len = 0;
     for (int i = 1; i < n; ++i) len += (ctrl[i] - ctrl[i - 1]).norm();
-    const int samples = std::clamp(int(std::ceil(len / std::max(tol_ * 20, 1e-12))), 8 * n, std::min(4096, 64 * n + 64));
+    const int samples = std::clamp(to_int(std::ceil(len / std::max(tol_ * 20, 1e-12)), 0, kBig), std::min(8 * n, 4096), 4096);
     std::vector<Eigen::Vector2d> pts;
     const double u0 = knots[degree], u1 = knots[n];
     std::vector<Eigen::Vector3d> d(degree + 1);
@@ -621,7 +632,7 @@ class DxfLoader {
     const Block& b = it->second;
     const double sx = num(e, 41, 1), sy = num(e, 42, 1);
     const double rot = num(e, 50, 0) * M_PI / 180;
-    const int cols = std::clamp(int(num(e, 70, 1)), 1, 1000), rows = std::clamp(int(num(e, 71, 1)), 1, 1000);
+    const int cols = to_int(num(e, 70, 1), 1, 1000), rows = to_int(num(e, 71, 1), 1, 1000);
     const double cs = num(e, 44, 0), rs = num(e, 45, 0);
     const Eigen::Vector2d ins(num(e, 10, 0), num(e, 20, 0));
     const Xf o = ocs(extrusion(e));
@@ -697,7 +708,9 @@ class DxfLoader {
     plan_ = std::move(kept);
   }
 
-  static constexpr size_t kMaxElements = 5'000'000;
+  static constexpr size_t kMaxElements = 2'000'000;
+  static constexpr long kMaxVisits = 5'000'000;
+  long visits_ = 0;
   std::string source_;
   const PlanLoadOptions& o_;
   int insunits_ = -1;
