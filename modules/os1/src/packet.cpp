@@ -277,8 +277,7 @@ PacketError FrameAssembler::add_packet(const uint8_t* data, size_t size, std::ve
       const size_t o = size_t(b) * W;
       rng[o] = rd<uint32_t>(px) & mask;
       sig[o] = rd<uint16_t>(px + 6);
-      const uint16_t r = legacy ? rd<uint16_t>(px + 4) : px[4];
-      refl[o] = uint8_t(std::min<uint16_t>(r, 255));
+      refl[o] = px[4];  // legacy: low 8 bits of the 16-bit field, as the Ouster SDK reads it
     }
   }
   if (received_ >= info_.window_columns()) publish(out);
