@@ -1,0 +1,577 @@
+#include "fploc/segmentation/segmenter.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace fploc::seg {
+
+namespace {
+constexpr double kDeg = M_PI / 180.0;
+
+bool same_beams(const BeamIntrinsics& a, const BeamIntrinsics& b) {
+  return a.altitude_deg == b.altitude_deg && a.azimuth_deg == b.azimuth_deg &&
+         a.beam_offset_mm == b.beam_offset_mm && a.lidar_to_sensor == b.lidar_to_sensor;
+}
+
+// Orthonormal basis (e1, e2) of the plane orthogonal to `u`.
+void basis(const Eigen::Vector3d& u, Eigen::Vector3d& e1, Eigen::Vector3d& e2) {
+  const Eigen::Vector3d a = std::abs(u.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  e1 = (a - a.dot(u) * u).normalized();
+  e2 = u.cross(e1);
+}
+
+// Weighted least-squares plane through accumulated moments; normal oriented against `up`.
+struct Moments {
+  double w = 0;
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d ss = Eigen::Matrix3d::Zero();
+  void add(const Eigen::Vector3d& p, double wi) {
+    w += wi;
+    s += wi * p;
+    ss.noalias() += wi * p * p.transpose();
+  }
+  bool plane(const Eigen::Vector3d& ref, const Eigen::Vector3d& up, Eigen::Vector4d& out,
+             Eigen::Vector3d* eigenvalues = nullptr) const {
+    if (w <= 0) return false;
+    const Eigen::Vector3d c = s / w;
+    const Eigen::Matrix3d cov = ss / w - c * c.transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+    es.computeDirect(cov);
+    Eigen::Vector3d n = es.eigenvectors().col(0);
+    if (!n.allFinite()) return false;
+    if (n.dot(up) > 0) n = -n;
+    const Eigen::Vector3d cw = c + ref;
+    out << n, -n.dot(cw);
+    if (eigenvalues) *eigenvalues = es.eigenvalues() * w;
+    return true;
+  }
+};
+
+double median_inplace(std::vector<float>& v) {
+  if (v.empty()) return 0.0;
+  auto mid = v.begin() + v.size() / 2;
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+}  // namespace
+
+const char* to_string(SegStatus s) {
+  switch (s) {
+    case SegStatus::kOk: return "OK";
+    case SegStatus::kNoCeiling: return "NO_CEILING";
+    case SegStatus::kBadInput: return "BAD_INPUT";
+    case SegStatus::kEmpty: return "EMPTY";
+  }
+  return "?";
+}
+
+Eigen::Vector3d up_from_roll_pitch(double roll, double pitch) {
+  // up_sensor = R^T e_z with R = Rz(yaw) Ry(pitch) Rx(roll).
+  return {-std::sin(pitch), std::sin(roll) * std::cos(pitch), std::cos(roll) * std::cos(pitch)};
+}
+
+void roll_pitch_from_up(const Eigen::Vector3d& u, double& roll, double& pitch) {
+  roll = std::atan2(u.y(), u.z());
+  pitch = std::atan2(-u.x(), std::hypot(u.y(), u.z()));
+}
+
+Segmenter::Segmenter(SegmenterConfig cfg) : cfg_(cfg) {}
+Segmenter::~Segmenter() = default;
+
+void Segmenter::add_accel(const Eigen::Vector3d& a) {
+  if (!a.allFinite() || a.norm() < 1.0) return;
+  accel_sum_ += a;
+  ++accel_n_;
+}
+
+bool Segmenter::prepare(const Scan& scan) {
+  out_.height = scan.height;
+  out_.width = scan.width;
+  auto fail = [&](SegStatus st, std::string why) {
+    out_.status = st;
+    out_.status_text = std::move(why);
+    return false;
+  };
+  if (scan.height <= 0 || scan.width <= 0) return fail(SegStatus::kEmpty, "empty scan (no rows/columns)");
+  const size_t n = size_t(scan.height) * scan.width;
+  if (scan.range_mm.size() != n)
+    return fail(SegStatus::kBadInput, "range_mm has " + std::to_string(scan.range_mm.size()) + " pixels, expected " +
+                                          std::to_string(scan.height) + "x" + std::to_string(scan.width));
+  if (scan.beams.beams() != scan.height || int(scan.beams.azimuth_deg.size()) != scan.height)
+    return fail(SegStatus::kBadInput, "beam intrinsics have " + std::to_string(scan.beams.beams()) +
+                                          " beams but the scan has " + std::to_string(scan.height) + " rows");
+  if (scan.height < 4) return fail(SegStatus::kBadInput, "too few beams (" + std::to_string(scan.height) + ")");
+  for (double a : scan.beams.altitude_deg)
+    if (!std::isfinite(a) || std::abs(a) > 90) return fail(SegStatus::kBadInput, "beam altitude not finite or > 90 deg");
+  for (double a : scan.beams.azimuth_deg)
+    if (!std::isfinite(a)) return fail(SegStatus::kBadInput, "beam azimuth not finite");
+
+  if (lut_width_ != scan.width || !same_beams(lut_beams_, scan.beams)) {
+    lut_ = make_xyz_lut(scan.beams, scan.width);
+    lut_beams_ = scan.beams;
+    lut_width_ = scan.width;
+    ring_order_.resize(scan.height);
+    std::iota(ring_order_.begin(), ring_order_.end(), 0);
+    std::stable_sort(ring_order_.begin(), ring_order_.end(),
+                     [&](int a, int b) { return scan.beams.altitude_deg[a] > scan.beams.altitude_deg[b]; });
+  }
+  xyz_.resize(n);
+  range_.resize(n);
+  const float rmin = float(cfg_.min_range_m * 1000.0), rmax = float(cfg_.max_range_m * 1000.0);
+  const bool mids = int(scan.measurement_id.size()) == scan.width;
+  const bool cvalid = int(scan.column_valid.size()) == scan.width;
+  size_t valid = 0;
+  for (int u = 0; u < scan.height; ++u) {
+    for (int c = 0; c < scan.width; ++c) {
+      const size_t i = size_t(u) * scan.width + c;
+      const uint32_t r = scan.range_mm[i];
+      int mid = mids ? scan.measurement_id[c] : c;
+      if (mid < 0 || mid >= scan.width) mid = c;
+      if (r == 0 || float(r) < rmin || float(r) > rmax || (cvalid && !scan.column_valid[c])) {
+        range_[i] = 0.f;
+        continue;
+      }
+      const size_t k = size_t(u) * scan.width + mid;
+      xyz_[i] = lut_.direction.row(k).transpose() * float(r) + lut_.offset.row(k).transpose();
+      range_[i] = float(r) * 1e-3f;
+      ++valid;
+    }
+  }
+  if (valid == 0) return fail(SegStatus::kEmpty, "no valid returns in the scan");
+
+  // Candidate sets: upper half rings (top first) and lower half rings (bottom first).
+  auto fill = [&](Candidates& cs, bool upper) {
+    cs.p.clear();
+    cs.range.clear();
+    cs.pixel.clear();
+    cs.ring_start.assign(1, 0);
+    cs.width = scan.width;
+    const int half = scan.height / 2;
+    for (int k = 0; k < half; ++k) {
+      const int u = upper ? ring_order_[k] : ring_order_[scan.height - 1 - k];
+      for (int c = 0; c < scan.width; ++c) {
+        const size_t i = size_t(u) * scan.width + c;
+        if (range_[i] <= 0.f) continue;
+        cs.p.push_back(xyz_[i]);
+        cs.range.push_back(range_[i]);
+        cs.pixel.push_back(int32_t(i));
+      }
+      cs.ring_start.push_back(int32_t(cs.p.size()));
+    }
+  };
+  fill(upper_, true);
+  fill(lower_, false);
+  return true;
+}
+
+void Segmenter::quality(const Candidates& c, Plane& pl) const {
+  const Eigen::Vector3f n = pl.coeffs.head<3>().cast<float>();
+  const float d = float(pl.coeffs[3]);
+  const float thr = float(cfg_.inlier_threshold_m);
+  Moments m;
+  double r2 = 0;
+  int cnt = 0;
+  Eigen::Vector3d ref = Eigen::Vector3d::Zero();
+  bool have_ref = false;
+  for (size_t i = 0; i < c.p.size(); ++i) {
+    const float r = n.dot(c.p[i]) + d;
+    if (std::abs(r) >= thr) continue;
+    if (!have_ref) {
+      ref = c.p[i].cast<double>();
+      have_ref = true;
+    }
+    m.add(c.p[i].cast<double>() - ref, 1.0);
+    r2 += double(r) * r;
+    ++cnt;
+  }
+  pl.inliers = cnt;
+  pl.rms_m = cnt ? std::sqrt(r2 / cnt) : 0.0;
+  if (cnt < 3) return;
+  Eigen::Vector4d tmp;
+  Eigen::Vector3d ev;
+  m.plane(ref, -pl.coeffs.head<3>(), tmp, &ev);
+  // Normal uncertainty ~ sigma / sqrt(smallest in-plane scatter); distance ~ sigma / sqrt(N) plus the lever
+  // arm from the inlier centroid to the sensor.
+  const double sig = std::max(pl.rms_m, 1e-4);
+  pl.tilt_sigma = sig / std::sqrt(std::max(ev[1], 1e-9));
+  const Eigen::Vector3d cen = m.s / m.w + ref;
+  const Eigen::Vector3d nn = pl.coeffs.head<3>();
+  const double lever = (cen - nn.dot(cen) * nn).norm();
+  pl.d_sigma = std::hypot(sig / std::sqrt(double(cnt)), lever * pl.tilt_sigma);
+}
+
+void Segmenter::update_room_height(double h) {
+  heights_.push_back(h);
+  while (int(heights_.size()) > std::max(1, cfg_.room_height_window)) heights_.pop_front();
+  std::vector<double> v(heights_.begin(), heights_.end());
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  room_height_ = v[v.size() / 2];
+}
+
+const Segmentation& Segmenter::process(const Scan& scan) {
+  out_.utime = scan.utime;
+  out_.seq = scan.seq;
+  out_.status = SegStatus::kOk;
+  out_.status_text.clear();
+  out_.ceiling = Plane{};
+  out_.ground = Plane{};
+  out_.wall.clear();
+  out_.label.clear();
+
+  // Gravity prior: IMU (when enabled and available), else the sensor's z axis.
+  bool imu_now = false;
+  if (accel_n_ > 0) {
+    imu_up_ = (accel_sum_ / accel_n_).normalized();
+    have_imu_ = true;
+    accel_sum_.setZero();
+    accel_n_ = 0;
+  }
+  if (cfg_.use_imu_prior && have_imu_) imu_now = true;
+  const Eigen::Vector3d gate_up = imu_now ? imu_up_ : Eigen::Vector3d::UnitZ();
+
+  auto fallback_attitude = [&]() {
+    if (imu_now) {
+      roll_pitch_from_up(imu_up_, out_.roll, out_.pitch);
+      out_.roll_pitch_sigma = 0.5 * kDeg;
+      out_.attitude_source = AttitudeSource::kImu;
+    } else if (have_prev_attitude_) {
+      out_.roll = prev_roll_;
+      out_.pitch = prev_pitch_;
+      out_.roll_pitch_sigma = std::max(prev_rp_sigma_ * 2.0, 0.2 * kDeg);
+      out_.attitude_source = AttitudeSource::kPrevious;
+    } else {
+      out_.roll = out_.pitch = 0;
+      out_.roll_pitch_sigma = M_PI;
+      out_.attitude_source = AttitudeSource::kNone;
+    }
+    if (have_prev_attitude_) {
+      out_.z = prev_z_;
+      out_.z_sigma = std::max(prev_z_sigma_ * 2.0, 0.05);
+    } else {
+      out_.z = 0;
+      out_.z_sigma = 1e3;
+    }
+  };
+
+  if (!prepare(scan)) {
+    fallback_attitude();
+    return out_;
+  }
+  if (scan.status == ScanStatus::kBadInput) {
+    out_.status = SegStatus::kBadInput;
+    out_.status_text = "scan marked bad by the driver";
+    fallback_attitude();
+    return out_;
+  }
+  if (keep_labels_) out_.label.assign(size_t(scan.height) * scan.width, 0);
+
+  const double max_tilt = cfg_.max_tilt_deg * kDeg;
+  const Eigen::Vector3d init_up =
+      imu_now ? imu_up_ : (have_prev_ceiling_ ? Eigen::Vector3d(-prev_ceiling_.head<3>()) : gate_up);
+
+  // Ceiling.
+  {
+    Eigen::Vector4d pl;
+    std::string why;
+    if (!fit_plane(upper_, init_up, have_prev_ceiling_ ? &prev_ceiling_ : nullptr, pl)) {
+      why = "no plane fit on the upper rings";
+    } else {
+      out_.ceiling.coeffs = pl;
+      quality(upper_, out_.ceiling);
+      const double tilt = std::acos(std::clamp(-pl.head<3>().dot(gate_up), -1.0, 1.0));
+      if (tilt > max_tilt)
+        why = "ceiling tilted " + std::to_string(tilt / kDeg) + " deg > max_tilt_deg";
+      else if (pl[3] < 0.2)
+        why = "ceiling plane not above the sensor";
+      else if (out_.ceiling.inliers < cfg_.min_plane_inliers)
+        why = "ceiling has " + std::to_string(out_.ceiling.inliers) + " inliers < " +
+              std::to_string(cfg_.min_plane_inliers);
+      else if (out_.ceiling.inliers < cfg_.min_inlier_fraction * double(upper_.p.size()))
+        why = "ceiling inliers are only " + std::to_string(100.0 * out_.ceiling.inliers / upper_.p.size()) +
+              " % of the upper-ring returns";
+    }
+    out_.ceiling.found = why.empty();
+    if (!why.empty()) {
+      out_.status = SegStatus::kNoCeiling;
+      out_.status_text = why;
+    }
+  }
+  const Eigen::Vector3d up =
+      out_.ceiling.found ? Eigen::Vector3d(-out_.ceiling.coeffs.head<3>()) : init_up.normalized();
+
+  // Ground: the same fit on the lower rings, flipped.
+  {
+    Eigen::Vector4d pl;
+    if (fit_plane(lower_, -up, have_prev_ground_ ? &prev_ground_ : nullptr, pl)) {
+      out_.ground.coeffs = pl;
+      quality(lower_, out_.ground);
+      const double tilt = std::acos(std::clamp(pl.head<3>().dot(up), -1.0, 1.0));
+      out_.ground.found = tilt < std::min(max_tilt, 5 * kDeg) && pl[3] > 0.1 &&
+                          out_.ground.inliers >= cfg_.min_plane_inliers;
+    }
+  }
+
+  // Height: sensor height above the floor = room height - distance to the ceiling.
+  if (out_.ceiling.found && out_.ground.found && cfg_.ceiling_height_m <= 0)
+    update_room_height(out_.ceiling.distance() + out_.ground.distance());
+  const double H = cfg_.ceiling_height_m > 0 ? cfg_.ceiling_height_m : room_height_;
+
+  if (out_.ceiling.found) {
+    roll_pitch_from_up(up, out_.roll, out_.pitch);
+    out_.roll_pitch_sigma = out_.ceiling.tilt_sigma;
+    out_.attitude_source = AttitudeSource::kCeiling;
+    if (H > 0) {
+      out_.z = H - out_.ceiling.distance();
+      out_.z_sigma = out_.ceiling.d_sigma + (cfg_.ceiling_height_m > 0 ? 0.0 : out_.ground.d_sigma / std::sqrt(double(heights_.size())));
+    } else if (out_.ground.found) {
+      out_.z = out_.ground.distance();
+      out_.z_sigma = out_.ground.d_sigma;
+    } else {
+      out_.z = have_prev_attitude_ ? prev_z_ : 0.0;
+      out_.z_sigma = have_prev_attitude_ ? std::max(prev_z_sigma_ * 2.0, 0.05) : 1e3;
+    }
+    have_prev_attitude_ = true;
+    prev_roll_ = out_.roll;
+    prev_pitch_ = out_.pitch;
+    prev_z_ = out_.z;
+    prev_rp_sigma_ = out_.roll_pitch_sigma;
+    prev_z_sigma_ = out_.z_sigma;
+    have_prev_ceiling_ = true;
+    prev_ceiling_ = out_.ceiling.coeffs;
+  } else {
+    fallback_attitude();
+    if (out_.ground.found) {
+      out_.z = out_.ground.distance();
+      out_.z_sigma = out_.ground.d_sigma;
+    }
+  }
+  if (out_.ground.found) {
+    have_prev_ground_ = true;
+    prev_ground_ = out_.ground.coeffs;
+  }
+
+  select_walls(scan, up);
+  return out_;
+}
+
+void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
+  // Upper bound: the ceiling (this frame's or last known); lower bound: the ground plane, else a plane
+  // parallel to the ceiling one room height below, else last known ground.
+  Eigen::Vector4d ceil, floor;
+  double mc = cfg_.wall_margin_m, mf = cfg_.wall_margin_m;
+  if (out_.ceiling.found) {
+    ceil = out_.ceiling.coeffs;
+    mc = std::max(mc, 3.0 * out_.ceiling.rms_m);
+  } else if (have_prev_ceiling_) {
+    ceil = prev_ceiling_;
+    mc *= 1.5;
+  } else {
+    if (!out_.status_text.empty()) out_.status_text += "; ";
+    out_.status_text += "no ceiling known: no wall points";
+    return;
+  }
+  const double H = cfg_.ceiling_height_m > 0 ? cfg_.ceiling_height_m : room_height_;
+  if (out_.ground.found) {
+    floor = out_.ground.coeffs;
+    mf = std::max(mf, 3.0 * out_.ground.rms_m);
+  } else if (H > 0) {
+    floor << -ceil.head<3>(), H - ceil[3];
+  } else if (have_prev_ground_) {
+    floor = prev_ground_;
+    mf *= 1.5;
+  } else {
+    floor << up, ceil[3];  // last resort: assume the sensor at mid height
+  }
+  const Eigen::Vector3f nc = ceil.head<3>().cast<float>(), nf = floor.head<3>().cast<float>();
+  const float dc = float(ceil[3] - mc), df = float(floor[3] - mf);
+  const float cin = float(ceil[3] - cfg_.inlier_threshold_m), fin = float(floor[3] - cfg_.inlier_threshold_m);
+  const int W = scan.width;
+  auto& w = out_.wall;
+  w.x.reserve(size_t(scan.height) * W / 2);
+  for (int u = 0; u < scan.height; ++u) {
+    const int shift = u < int(scan.beams.pixel_shift_by_row.size()) ? scan.beams.pixel_shift_by_row[u] : 0;
+    for (int cd = 0; cd < W; ++cd) {
+      const int v = ((cd - shift) % W + W) % W;
+      const size_t i = size_t(u) * W + v;
+      const float r = range_[i];
+      if (r <= 0.f) continue;
+      const Eigen::Vector3f& p = xyz_[i];
+      const float sc = nc.dot(p), sf = nf.dot(p);
+      if (sc > -dc && sf > -df) {
+        w.push(p, r, u, cd);
+        if (keep_labels_) out_.label[i] = 3;
+      } else if (keep_labels_) {
+        if (sc <= -cin) out_.label[i] = 1;
+        else if (sf <= -fin) out_.label[i] = 2;
+      }
+    }
+  }
+}
+
+// ---- the paper's ring-based robust fit ---------------------------------------------------------------
+bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in, const Eigen::Vector4d* previous,
+                              Eigen::Vector4d& plane) {
+  if (c.p.size() < 10 || c.rings() < 1) return false;
+  const Eigen::Vector3d up = up_in.normalized();
+  const Eigen::Vector3f upf = up.cast<float>();
+  Eigen::Vector3d e1, e2;
+  basis(up, e1, e2);
+
+  // 1. Seeds: on each of the K_r outermost rings, the largest-range point of every azimuth sector, keeping
+  //    the largest fraction of those (obstructed rays are shorter), and only points above the sensor.
+  const int S = std::max(4, cfg_.seed_sectors);
+  seeds_.clear();
+  const int kr = std::min(std::max(1, cfg_.seed_rings), c.rings());
+  for (int k = 0; k < kr; ++k) {
+    sector_best_.assign(S, -1.f);
+    sector_idx_.assign(S, -1);
+    for (int i = c.ring_start[k]; i < c.ring_start[k + 1]; ++i) {
+      if (upf.dot(c.p[i]) < 0.2f) continue;
+      const int col = c.pixel[i] % c.width;
+      const int s = col * S / c.width;
+      if (c.range[i] > sector_best_[s]) {
+        sector_best_[s] = c.range[i];
+        sector_idx_[s] = i;
+      }
+    }
+    std::vector<int> cand;
+    for (int s = 0; s < S; ++s)
+      if (sector_idx_[s] >= 0) cand.push_back(sector_idx_[s]);
+    std::sort(cand.begin(), cand.end(), [&](int a, int b) { return c.range[a] > c.range[b]; });
+    const size_t keep = std::min(cand.size(), std::max<size_t>(3, size_t(std::ceil(cfg_.seed_fraction * S))));
+    seeds_.insert(seeds_.end(), cand.begin(), cand.begin() + keep);
+  }
+
+  // 2. Initial plane by linear regression h = a*x1 + b*x2 + g in the prior's frame, trimmed twice.
+  bool have_seed_plane = false;
+  Eigen::Vector4d seed_plane;
+  std::vector<float> res;
+  for (int round = 0; round < 3 && seeds_.size() >= 3; ++round) {
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    for (int i : seeds_) {
+      const Eigen::Vector3d p = c.p[i].cast<double>();
+      const Eigen::Vector3d x(p.dot(e1), p.dot(e2), 1.0);
+      A.noalias() += x * x.transpose();
+      b += x * p.dot(up);
+    }
+    const Eigen::Vector3d sol = A.ldlt().solve(b);
+    if (!sol.allFinite()) break;
+    const Eigen::Vector3d m = up - sol[0] * e1 - sol[1] * e2;
+    const double nm = m.norm();
+    seed_plane << -m / nm, sol[2] / nm;
+    have_seed_plane = true;
+    if (round == 2) break;
+    res.clear();
+    for (int i : seeds_) res.push_back(std::abs(float(seed_plane.head<3>().dot(c.p[i].cast<double>()) + seed_plane[3])));
+    std::vector<float> tmp = res;
+    const double thr = std::max(0.05, 3.0 * 1.4826 * median_inplace(tmp));
+    std::vector<int> kept;
+    for (size_t j = 0; j < seeds_.size(); ++j)
+      if (res[j] <= thr) kept.push_back(seeds_[j]);
+    if (kept.size() < 3 || kept.size() == seeds_.size()) break;
+    seeds_.swap(kept);
+  }
+
+  // Choose the start with the most support (inliers on a subsample of all half-ring points): the seed
+  // regression, last frame's plane, or planes through seed triplets (deterministic sampling). The
+  // triplets make the start robust when a tilted sensor's longest rays hit far walls, not the ceiling.
+  const double max_tilt = cfg_.max_tilt_deg * M_PI / 180.0;
+  auto score = [&](const Eigen::Vector4d& pl) {
+    const Eigen::Vector3f n = pl.head<3>().cast<float>();
+    const float d = float(pl[3]);
+    int cnt = 0;
+    for (size_t i = 0; i < c.p.size(); i += 8) cnt += std::abs(n.dot(c.p[i]) + d) < 0.05f;
+    return cnt;
+  };
+  Eigen::Vector4d cur;
+  int best = -1;
+  auto consider = [&](const Eigen::Vector4d& pl) {
+    if (!pl.allFinite() || -pl.head<3>().dot(up) < std::cos(max_tilt) || pl[3] <= 0) return;
+    const int sc = score(pl);
+    if (sc > best) {
+      best = sc;
+      cur = pl;
+    }
+  };
+  if (have_seed_plane) consider(seed_plane);
+  if (previous) consider(*previous);
+  if (seeds_.size() >= 3 && cfg_.seed_triplets > 0) {
+    uint32_t state = 12345u;
+    auto next = [&]() {
+      state = state * 1664525u + 1013904223u;
+      return state >> 8;
+    };
+    for (int t = 0; t < cfg_.seed_triplets; ++t) {
+      const Eigen::Vector3d a = c.p[seeds_[next() % seeds_.size()]].cast<double>();
+      const Eigen::Vector3d b = c.p[seeds_[next() % seeds_.size()]].cast<double>();
+      const Eigen::Vector3d q = c.p[seeds_[next() % seeds_.size()]].cast<double>();
+      Eigen::Vector3d nn = (b - a).cross(q - a);
+      if (nn.norm() < 1e-3) continue;
+      nn.normalize();
+      if (nn.dot(up) > 0) nn = -nn;
+      Eigen::Vector4d pl;
+      pl << nn, -nn.dot(a);
+      consider(pl);
+    }
+  }
+  if (best < 0) return false;
+
+  // 3. M-estimator (IRLS, Tukey biweight) over all points of the half rings, cut-off shrinking from
+  //    irls_initial_scale_m to ~4.7 robust sigmas of the inliers.
+  const Eigen::Vector3d ref = -cur[3] * cur.head<3>();  // a point of the plane (numerics)
+  const Eigen::Vector3f reff = ref.cast<float>();
+  double cut = cfg_.irls_initial_scale_m;
+  band_.clear();
+  {
+    const Eigen::Vector3f n = cur.head<3>().cast<float>();
+    const float d = float(cur[3]), cb = float(cut);
+    for (size_t i = 0; i < c.p.size(); ++i)
+      if (std::abs(n.dot(c.p[i]) + d) < cb) band_.push_back(int(i));
+  }
+  if (band_.size() < 3) return false;
+  for (int it = 0; it < std::max(1, cfg_.irls_iterations); ++it) {
+    const Eigen::Vector3f n = cur.head<3>().cast<float>();
+    const float d = float(cur[3]);
+    // Robust scale of the residuals inside the current cut-off.
+    res_.clear();
+    for (int i : band_) {
+      const float r = n.dot(c.p[i]) + d;
+      if (std::abs(r) < cut) res_.push_back(std::abs(r));
+    }
+    if (res_.size() < 3) return false;
+    const double sigma = 1.4826 * median_inplace(res_);
+    const double next_cut = std::max({cut * 0.5, 4.685 * sigma, 0.02});
+    cut = std::min(cut, next_cut);
+    const float inv_c2 = float(1.0 / (cut * cut));
+    // Accumulate in float around `ref` per block, in double overall.
+    Moments m;
+    double sw = 0;
+    Eigen::Vector3d s1 = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d s2 = Eigen::Matrix3d::Zero();
+    for (int i : band_) {
+      const float r = n.dot(c.p[i]) + d;
+      const float t = r * r * inv_c2;
+      if (t >= 1.f) continue;
+      const float w = (1.f - t) * (1.f - t);
+      const Eigen::Vector3d q = (c.p[i] - reff).cast<double>();
+      sw += w;
+      s1 += w * q;
+      s2.noalias() += double(w) * q * q.transpose();
+    }
+    m.w = sw;
+    m.s = s1;
+    m.ss = s2;
+    Eigen::Vector4d next;
+    if (!m.plane(ref, up, next)) return false;
+    const double dn = (next.head<3>() - cur.head<3>()).norm(), dd = std::abs(next[3] - cur[3]);
+    cur = next;
+    if (dn < 1e-7 && dd < 1e-6 && cut <= next_cut) break;
+  }
+  plane = cur;
+  return true;
+}
+
+}  // namespace fploc::seg
