@@ -1,0 +1,67 @@
+// LOAM-style wall features (paper section IV-B): smoothness along each ring of the wall points, corner and
+// surface features with LOAM's neighbour/occlusion rules and per-sector limits, roll/pitch compensation,
+// projection to the horizontal plane, and PCA line groups of surface points between corner anchors.
+// Transport-free; nodes/features wraps it.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "fploc/segmentation/segmenter.h"
+
+namespace fploc::feat {
+
+struct FeatureConfig {
+  int sectors = 6;                  // per-ring sectors for the feature limits
+  int max_corners_per_sector = 2;
+  int max_surfaces_per_sector = 12;
+  double corner_threshold = 0.002;  // smoothness c (dimensionless, see below) above which a point is a corner
+  double surface_threshold = 0.0005;// smoothness below which a point is a surface point
+  double max_range_m = 60.0;
+  double min_range_m = 0.5;
+  int half_window = 5;              // neighbours each side for the smoothness (LOAM: 5)
+  int max_column_gap = 1;           // a larger column step breaks the neighbourhood (uneven spacing fakes curvature)
+  double occlusion_ratio = 0.1;     // |r_i - r_j| > ratio * r_i between neighbours = occlusion boundary
+  double parallel_ratio = 0.02;     // both-side range jumps > ratio * r_i = surface parallel to the beam
+  int surface_spacing = 2;          // picked surface points suppress +-this many neighbours
+  // PCA line groups.
+  int min_group_points = 4;
+  double line_max_rms_m = 0.03;     // sqrt(smallest eigenvalue) of the group's 2D covariance
+  double line_min_ratio = 20.0;     // largest / smallest eigenvalue
+  double group_max_gap_m = 1.0;     // consecutive surface points farther apart end a run
+};
+
+enum class FeatStatus : int8_t { kOk = 0, kFewFeatures = 1, kBadInput = 2 };
+enum Kind : int8_t { kCorner = 0, kSurface = 1 };
+
+struct Features2D {
+  int64_t utime = 0, seq = 0;
+  FeatStatus status = FeatStatus::kOk;
+  double roll = 0, pitch = 0, z = 0, roll_pitch_sigma = 0, z_sigma = 0;
+  std::vector<float> x, y;          // gravity-aligned, sensor-centred [m]
+  std::vector<int8_t> kind;
+  std::vector<int32_t> group;       // -1 = unclassified
+  int32_t num_groups = 0;
+  // Index of each feature in the input wall points (diagnostics, bench).
+  std::vector<int32_t> source;
+  size_t size() const { return x.size(); }
+};
+
+class FeatureExtractor {
+ public:
+  explicit FeatureExtractor(FeatureConfig cfg = {});
+  // Uses seg.wall (ring-major, increasing column per ring) and seg.roll/pitch.
+  const Features2D& process(const seg::Segmentation& seg);
+  const FeatureConfig& config() const { return cfg_; }
+
+ private:
+  void ring(const seg::Segmentation& seg, size_t begin, size_t end);
+  FeatureConfig cfg_;
+  Features2D out_;
+  std::vector<float> curv_;
+  std::vector<uint8_t> ok_, picked_;
+  std::vector<int> order_;
+  std::vector<float> gx_, gy_;
+  std::vector<int> sel_;
+};
+
+}  // namespace fploc::feat

@@ -1,0 +1,177 @@
+#include "fploc/features/features.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace fploc::feat {
+
+FeatureExtractor::FeatureExtractor(FeatureConfig cfg) : cfg_(cfg) {}
+
+const Features2D& FeatureExtractor::process(const seg::Segmentation& seg) {
+  out_ = Features2D{};
+  out_.utime = seg.utime;
+  out_.seq = seg.seq;
+  out_.roll = seg.roll;
+  out_.pitch = seg.pitch;
+  out_.z = seg.z;
+  out_.roll_pitch_sigma = seg.roll_pitch_sigma;
+  out_.z_sigma = seg.z_sigma;
+  const auto& w = seg.wall;
+  const size_t n = w.x.size();
+  if (w.y.size() != n || w.z.size() != n || w.range.size() != n || w.ring.size() != n || w.column.size() != n ||
+      !std::isfinite(seg.roll) || !std::isfinite(seg.pitch)) {
+    out_.status = FeatStatus::kBadInput;
+    return out_;
+  }
+  // Gravity compensation: p_level = Ry(pitch) Rx(roll) p_sensor (yaw stays in the sensor frame).
+  const Eigen::Matrix3f R = (Eigen::AngleAxisf(float(seg.pitch), Eigen::Vector3f::UnitY()) *
+                             Eigen::AngleAxisf(float(seg.roll), Eigen::Vector3f::UnitX()))
+                                .toRotationMatrix();
+  gx_.resize(n);
+  gy_.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3f q = R * Eigen::Vector3f(w.x[i], w.y[i], w.z[i]);
+    gx_[i] = q.x();
+    gy_[i] = q.y();
+  }
+  size_t b = 0;
+  for (size_t i = 1; i <= n; ++i) {
+    if (i == n || w.ring[i] != w.ring[b]) {
+      ring(seg, b, i);
+      b = i;
+    }
+  }
+  if (out_.x.size() < 30) out_.status = FeatStatus::kFewFeatures;
+  return out_;
+}
+
+void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t end) {
+  const auto& w = seg.wall;
+  const int n = int(end - begin);
+  const int hw = std::max(1, cfg_.half_window);
+  if (n < 2 * hw + 1) return;
+  auto P = [&](int j) { return Eigen::Vector3f(w.x[begin + j], w.y[begin + j], w.z[begin + j]); };
+  auto r = [&](int j) { return w.range[begin + j]; };
+  auto col = [&](int j) { return int(w.column[begin + j]); };
+
+  curv_.assign(n, 0.f);
+  ok_.assign(n, 0);
+  picked_.assign(n, 0);
+  // breaks[j] = 1 when points j and j+1 are not neighbours (column gap); prefix sums for window tests.
+  std::vector<int> brk_prefix(n + 1, 0);
+  for (int j = 0; j < n; ++j) {
+    const int br = j + 1 < n ? (col(j + 1) - col(j) > cfg_.max_column_gap) : 1;
+    brk_prefix[j + 1] = brk_prefix[j] + br;
+  }
+  const float rmin = float(cfg_.min_range_m), rmax = float(cfg_.max_range_m);
+  for (int i = hw; i < n - hw; ++i) {
+    // All of i-hw .. i+hw connected: no break between i-hw and i+hw-1.
+    if (brk_prefix[i + hw] - brk_prefix[i - hw] != 0) continue;
+    const float ri = r(i);
+    if (ri < rmin || ri > rmax) continue;
+    Eigen::Vector3f diff = -float(2 * hw) * P(i);
+    for (int k = 1; k <= hw; ++k) diff += P(i - k) + P(i + k);
+    curv_[i] = diff.norm() / (float(2 * hw) * ri);  // LOAM's c = |sum(X_j - X_i)| / (|S| |X_i|)
+    ok_[i] = 1;
+  }
+  // LOAM's unreliable points: the far side of an occlusion boundary, and surfaces parallel to the beam.
+  const float occ = float(cfg_.occlusion_ratio), par = float(cfg_.parallel_ratio);
+  for (int j = 0; j + 1 < n; ++j) {
+    if (col(j + 1) - col(j) > cfg_.max_column_gap) continue;
+    const float a = r(j), c = r(j + 1);
+    if (std::abs(a - c) > occ * std::min(a, c)) {
+      if (a > c) {
+        for (int k = std::max(0, j - hw + 1); k <= j; ++k) ok_[k] = 0;
+      } else {
+        for (int k = j + 1; k <= std::min(n - 1, j + hw); ++k) ok_[k] = 0;
+      }
+    }
+  }
+  for (int i = 1; i + 1 < n; ++i) {
+    const float ri = r(i);
+    if (std::abs(r(i - 1) - ri) > par * ri && std::abs(r(i + 1) - ri) > par * ri) ok_[i] = 0;
+  }
+
+  // Per-sector selection (sectors split the ring's points evenly, as LOAM does).
+  sel_.clear();
+  std::vector<int8_t> kind_of(n, -1);
+  const int S = std::max(1, cfg_.sectors);
+  const float cthr = float(cfg_.corner_threshold), sthr = float(cfg_.surface_threshold);
+  for (int s = 0; s < S; ++s) {
+    const int sb = hw + (n - 2 * hw) * s / S, se = hw + (n - 2 * hw) * (s + 1) / S;
+    if (se <= sb) continue;
+    order_.resize(se - sb);
+    std::iota(order_.begin(), order_.end(), sb);
+    std::sort(order_.begin(), order_.end(), [&](int a, int b) { return curv_[a] < curv_[b] || (curv_[a] == curv_[b] && a < b); });
+    int corners = 0;
+    for (auto it = order_.rbegin(); it != order_.rend() && corners < cfg_.max_corners_per_sector; ++it) {
+      const int i = *it;
+      if (curv_[i] <= cthr) break;
+      if (!ok_[i] || picked_[i]) continue;
+      kind_of[i] = kCorner;
+      ++corners;
+      for (int k = std::max(0, i - hw); k <= std::min(n - 1, i + hw); ++k) picked_[k] = 1;
+    }
+    int surfaces = 0;
+    for (int i : order_) {
+      if (surfaces >= cfg_.max_surfaces_per_sector) break;
+      if (curv_[i] >= sthr) break;
+      if (!ok_[i] || picked_[i]) continue;
+      kind_of[i] = kSurface;
+      ++surfaces;
+      for (int k = std::max(0, i - cfg_.surface_spacing); k <= std::min(n - 1, i + cfg_.surface_spacing); ++k)
+        picked_[k] = 1;
+    }
+  }
+
+  // Emit in column order and group surface runs between corner anchors (or gaps) by PCA.
+  std::vector<int> run;
+  const size_t first_out = out_.x.size();
+  auto close_run = [&]() {
+    if (int(run.size()) >= cfg_.min_group_points) {
+      Eigen::Vector2d m = Eigen::Vector2d::Zero();
+      for (int o : run) m += Eigen::Vector2d(out_.x[o], out_.y[o]);
+      m /= double(run.size());
+      Eigen::Matrix2d C = Eigen::Matrix2d::Zero();
+      for (int o : run) {
+        const Eigen::Vector2d d = Eigen::Vector2d(out_.x[o], out_.y[o]) - m;
+        C += d * d.transpose();
+      }
+      C /= double(run.size());
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(C);
+      const double l0 = std::max(es.eigenvalues()[0], 0.0), l1 = es.eigenvalues()[1];
+      if (std::sqrt(l0) <= cfg_.line_max_rms_m && l1 >= cfg_.line_min_ratio * std::max(l0, 1e-12)) {
+        const int32_t g = out_.num_groups++;
+        for (int o : run) out_.group[o] = g;
+      }
+    }
+    run.clear();
+  };
+  for (int i = 0; i < n; ++i) {
+    if (kind_of[i] < 0) continue;
+    const size_t src = begin + i;
+    const int o = int(out_.x.size());
+    out_.x.push_back(gx_[src]);
+    out_.y.push_back(gy_[src]);
+    out_.kind.push_back(kind_of[i]);
+    out_.group.push_back(-1);
+    out_.source.push_back(int32_t(src));
+    if (kind_of[i] == kCorner) {
+      close_run();
+      continue;
+    }
+    if (!run.empty()) {
+      const int p = run.back();
+      const float dx = out_.x[o] - out_.x[p], dy = out_.y[o] - out_.y[p];
+      if (dx * dx + dy * dy > float(cfg_.group_max_gap_m * cfg_.group_max_gap_m)) close_run();
+    }
+    run.push_back(o);
+  }
+  close_run();
+  (void)first_out;
+}
+
+}  // namespace fploc::feat
