@@ -1,0 +1,139 @@
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "model.h"
+#include "web_path.h"
+
+using namespace fploc::dashboard;
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+static fploc::pose_t pose(int64_t t, double x, double y) {
+  fploc::pose_t p{};
+  p.utime = t;
+  p.position[0] = x;
+  p.position[1] = y;
+  p.orientation[3] = 1;
+  return p;
+}
+static fploc::ground_truth_t gt(int64_t t, double x, double y) {
+  fploc::ground_truth_t g{};
+  g.utime = t;
+  g.position[0] = x;
+  g.position[1] = y;
+  g.orientation[3] = 1;
+  return g;
+}
+
+TEST(DashboardModel, AteMatchesByUtimeInEitherOrder) {
+  Model m;
+  m.on_ground_truth(gt(1000000, 0, 0), 0, 0);
+  m.on_pose(pose(1000000, 3, 4), 0, 0);   // error 5
+  m.on_pose(pose(2000000, 1, 0), 0, 0);   // no GT yet
+  EXPECT_EQ(m.ate_count(), 1u);
+  m.on_ground_truth(gt(2000000, 0, 0), 0, 0);  // error 1 -> rmse sqrt((25+1)/2)
+  EXPECT_EQ(m.ate_count(), 2u);
+  EXPECT_NEAR(m.ate_rmse(), std::sqrt(13.0), 1e-9);
+  m.on_pose(pose(1000000, 0, 0), 0, 0);  // the optimiser refines the first pose: error 0
+  EXPECT_NEAR(m.ate_rmse(), std::sqrt(0.5), 1e-9);
+  m.on_pose(pose(5000000, 0, 0), 0, 0);  // no GT within tolerance
+  EXPECT_EQ(m.ate_count(), 2u);
+  auto h = json::parse(m.history_json());
+  EXPECT_EQ(h["est"].size(), 3u);  // the refined pose replaced its entry
+  EXPECT_EQ(h["gt"].size(), 2u);
+}
+
+TEST(DashboardModel, NodeTurnsRedWhenSilentOrRestartingAndGreenAgain) {
+  ModelConfig cfg;
+  cfg.silent_after_s = 2.0;
+  Model m(cfg);
+  fploc::node_status_t s{};
+  s.node = "matcher";
+  s.state = "running";
+  s.reporter = "node";
+  m.on_status(s, 10.0);
+  auto health = [&] { return json::parse(m.state_json())["nodes"]["nodes"][0]["health"].get<std::string>(); };
+  EXPECT_EQ(health(), "ok");
+  m.tick(11.9, 0);
+  EXPECT_EQ(health(), "ok");
+  m.tick(12.5, 0);
+  EXPECT_EQ(health(), "bad");
+  m.on_status(s, 13.0);
+  EXPECT_EQ(health(), "ok");
+  s.state = "restarting";
+  s.reporter = "launcher";
+  m.on_status(s, 13.5);
+  EXPECT_EQ(health(), "bad");
+}
+
+TEST(DashboardModel, FeaturesJsonIsValidAndDecimated) {
+  fploc::features_t f{};
+  f.scan_seq = 7;
+  for (int i = 0; i < 1000; ++i) {
+    f.x.push_back(float(i) * 0.01f);
+    f.y.push_back(i == 3 ? NAN : 1.0f);
+    f.kind.push_back(int8_t(i % 2));
+    f.group.push_back(-1);
+  }
+  f.num_points = 1000;
+  auto j = json::parse(Model::features_json(f, 100, "null"));
+  EXPECT_EQ(j["n"], 1000);
+  EXPECT_LE(j["xy"].size() / 2, 100u);
+  EXPECT_EQ(j["xy"].size() / 2, j["kind"].get<std::string>().size());
+  // Inconsistent array sizes never read out of bounds.
+  f.num_points = 5000;
+  EXPECT_NO_THROW(json::parse(Model::features_json(f, 0, "null")));
+}
+
+TEST(DashboardModel, PushesAreRateCappedAndCarryOnlyTheLatestValue) {
+  Model m;
+  ClientCursor c;
+  std::string out;
+  ASSERT_TRUE(m.next_push(c, 20, 1.0, out));  // greeting
+  std::atomic<bool> done{false};
+  std::thread producer([&] {
+    for (int i = 0; i < 300 && !done; ++i) {
+      m.on_pose(pose(i, i, 0), 0, 0);
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  });
+  int pushes = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(500)) {
+    ASSERT_TRUE(m.next_push(c, 20, 0.2, out));
+    if (!out.empty()) {
+      ++pushes;
+      EXPECT_EQ(out.find("event: pose"), out.rfind("event: pose"));  // one pose per push, never a queue
+    }
+  }
+  done = true;
+  producer.join();
+  EXPECT_LE(pushes, 11);  // 20 Hz for 0.5 s (+1 at the start)
+  EXPECT_GE(pushes, 5);
+  m.stop();
+  EXPECT_FALSE(m.next_push(c, 20, 0.2, out));
+}
+
+TEST(DashboardWebPath, RejectsTraversal) {
+  const fs::path dir = fs::temp_directory_path() / ("fploc_web_" + std::to_string(getpid()));
+  fs::create_directories(dir / "web" / "sub");
+  std::ofstream(dir / "web" / "index.html") << "x";
+  std::ofstream(dir / "web" / "sub" / "a.js") << "x";
+  std::ofstream(dir / "web" / ".hidden") << "x";
+  std::ofstream(dir / "secret.txt") << "x";
+  fs::create_symlink(dir / "secret.txt", dir / "web" / "link.txt");
+  const fs::path root = fs::canonical(dir / "web");
+  EXPECT_EQ(resolve_web_path(root, "/"), (root / "index.html").string());
+  EXPECT_EQ(resolve_web_path(root, "/sub/a.js"), (root / "sub" / "a.js").string());
+  for (const char* bad : {"/../secret.txt", "/sub/../../secret.txt", "/sub/../index.html", "/./index.html",
+                          "/.hidden", "/link.txt", "/sub", "/nope.js", "", "index.html", "/..\\secret.txt",
+                          "//etc/passwd", "/sub//../../secret.txt"})
+    EXPECT_EQ(resolve_web_path(root, bad), "") << bad;
+  fs::remove_all(dir);
+}

@@ -1,0 +1,213 @@
+// The dashboard over HTTP, fed by fake publishers over LCM (run inside a network namespace by ctest):
+// endpoints, SSE rate cap and latest-value pushes, path traversal, read-only, loopback-only default bind.
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <httplib.h>
+
+using nlohmann::json;
+using namespace std::chrono_literals;
+
+namespace {
+std::string build_dir() { return getenv("FPLOC_BUILD_DIR") ? getenv("FPLOC_BUILD_DIR") : FPLOC_BUILD_DIR_DEFAULT; }
+
+pid_t spawn(std::vector<std::string> args) {
+  pid_t pid = fork();
+  if (pid == 0) {
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+void stop(pid_t pid) {
+  if (pid <= 0) return;
+  kill(pid, SIGTERM);
+  int st = 0;
+  for (int i = 0; i < 50; ++i) {
+    if (waitpid(pid, &st, WNOHANG) == pid) return;
+    std::this_thread::sleep_for(50ms);
+  }
+  kill(pid, SIGKILL);
+  waitpid(pid, &st, 0);
+}
+
+// One raw HTTP/1.0 request exactly as written (no client-side path normalisation).
+std::string raw_request(const std::string& request_line) {
+  int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(8080);
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+    close(fd);
+    return "";
+  }
+  const std::string req = request_line + "\r\nHost: 127.0.0.1:8080\r\nConnection: close\r\n\r\n";
+  (void)!write(fd, req.data(), req.size());
+  std::string out;
+  char buf[4096];
+  ssize_t n;
+  while ((n = read(fd, buf, sizeof buf)) > 0) out.append(buf, size_t(n));
+  close(fd);
+  return out;
+}
+int status_of(const std::string& response) {
+  return response.size() > 12 ? std::atoi(response.substr(9, 3).c_str()) : 0;
+}
+
+class DashboardHttp : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    const std::string bin = build_dir() + "/bin/";
+    const std::string plan = std::string(FPLOC_SOURCE_DIR) + "/tests/dashboard/room.json";
+    dash_ = spawn({bin + "fploc-dashboard", "--set", "plan.file=" + plan});
+    sim_ = spawn({bin + "fploc-dashboard-fake", "--name", "sim", "--sim", "--rate", "100"});
+    seg_ = spawn({bin + "fploc-dashboard-fake", "--name", "segmenter"});
+    httplib::Client c("127.0.0.1", 8080);
+    for (int i = 0; i < 100; ++i) {
+      if (auto r = c.Get("/api/info"); r && r->status == 200) break;
+      std::this_thread::sleep_for(100ms);
+    }
+    std::this_thread::sleep_for(1500ms);  // a heartbeat from every fake, poses for a while
+  }
+  static void TearDownTestSuite() {
+    stop(sim_);
+    stop(seg_);
+    stop(dash_);
+  }
+  static pid_t dash_, sim_, seg_;
+  httplib::Client client_{"127.0.0.1", 8080};
+};
+pid_t DashboardHttp::dash_ = -1, DashboardHttp::sim_ = -1, DashboardHttp::seg_ = -1;
+
+TEST_F(DashboardHttp, ServesThePageAndItsModules) {
+  auto r = client_.Get("/");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200);
+  EXPECT_NE(r->get_header_value("Content-Type").find("text/html"), std::string::npos);
+  EXPECT_NE(r->body.find("<title>"), std::string::npos);
+  r = client_.Get("/app.js");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200);
+  EXPECT_NE(r->get_header_value("Content-Type").find("javascript"), std::string::npos);
+  EXPECT_EQ(r->get_header_value("X-Content-Type-Options"), "nosniff");
+}
+
+TEST_F(DashboardHttp, PlanStateAndHistory) {
+  auto r = client_.Get("/api/plan");
+  ASSERT_TRUE(r);
+  auto plan = json::parse(r->body);
+  EXPECT_EQ(plan["elements"].size(), 6u);
+  EXPECT_NEAR(plan["bounds"][2].get<double>(), 12.0, 1e-6);
+  r = client_.Get("/api/state");
+  ASSERT_TRUE(r);
+  auto st = json::parse(r->body);
+  for (const char* k : {"pose", "gt", "frame_pose", "features", "nodes"}) EXPECT_TRUE(st.contains(k)) << k;
+  std::vector<std::string> names;
+  for (const auto& n : st["nodes"]["nodes"]) names.push_back(n["node"]);
+  EXPECT_NE(std::find(names.begin(), names.end(), "sim"), names.end());
+  EXPECT_NE(std::find(names.begin(), names.end(), "segmenter"), names.end());
+  EXPECT_NE(std::find(names.begin(), names.end(), "dashboard"), names.end());  // its own heartbeat
+  EXPECT_GT(st["pose"]["ate_n"].get<int>(), 10);
+  EXPECT_LT(st["pose"]["ate_rmse"].get<double>(), 0.1);  // the fake estimate is within 7 cm of truth
+  EXPECT_GT(st["features"]["xy"].size(), 100u);
+  r = client_.Get("/api/history");
+  ASSERT_TRUE(r);
+  auto h = json::parse(r->body);
+  EXPECT_GT(h["est"].size(), 50u);
+  EXPECT_GT(h["gt"].size(), 50u);
+}
+
+TEST_F(DashboardHttp, EventsAreRateCappedLatestValues) {
+  // Poses come at 100 Hz; the stream must carry at most 20 pushes per second, each with the newest pose.
+  int pose_events = 0, keepalives = 0;
+  int64_t last_seq = -1, max_gap = 0;
+  std::string buffer;
+  const auto t0 = std::chrono::steady_clock::now();
+  httplib::Client c("127.0.0.1", 8080);
+  c.set_read_timeout(5, 0);
+  c.Get("/api/events", [&](const char* data, size_t n) {
+    buffer.append(data, n);
+    size_t pos;
+    while ((pos = buffer.find("\n\n")) != std::string::npos) {
+      const std::string ev = buffer.substr(0, pos);
+      buffer.erase(0, pos + 2);
+      if (ev.rfind("event: pose\n", 0) == 0) {
+        auto j = json::parse(ev.substr(ev.find("data: ") + 6));
+        const int64_t seq = j["seq"];
+        if (last_seq >= 0) max_gap = std::max(max_gap, seq - last_seq);
+        last_seq = seq;
+        ++pose_events;
+      } else if (ev.rfind(":", 0) == 0) {
+        ++keepalives;
+      }
+    }
+    return std::chrono::steady_clock::now() - t0 < 3s;
+  });
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::cout << "SSE: " << pose_events << " pose events in " << secs << " s (" << pose_events / secs
+            << " Hz) with poses at 100 Hz; largest seq step " << max_gap << "\n";
+  EXPECT_LE(pose_events, int(20 * secs) + 2);
+  EXPECT_GE(pose_events, int(12 * secs));
+  EXPECT_GE(max_gap, 3);  // intermediate poses were skipped, not queued
+}
+
+TEST_F(DashboardHttp, NoFileOutsideWebIsServed) {
+  for (const std::string path :
+       {"/../CMakeLists.txt", "/%2e%2e/CMakeLists.txt", "/..%2fCMakeLists.txt", "/%2E%2E%2F%2E%2E%2Fetc%2Fpasswd",
+        "/../../../../../../etc/passwd", "/web/../../etc/passwd", "//etc/passwd", "/.%2e/CMakeLists.txt",
+        "/..%5cCMakeLists.txt", "/%00index.html", "/../nodes/dashboard/dashboard_node.cpp",
+        "http://127.0.0.1:8080/../CMakeLists.txt", "/.git/config"}) {
+    const std::string res = raw_request("GET " + path + " HTTP/1.0");
+    const int status = status_of(res);
+    EXPECT_TRUE(status == 404 || status == 400 || status == 403) << path << " -> " << res.substr(0, 40);
+    EXPECT_EQ(res.find("cmake_minimum_required"), std::string::npos) << path;
+    EXPECT_EQ(res.find("root:"), std::string::npos) << path;
+    EXPECT_EQ(res.find("FPLOC_REGISTER_NODE"), std::string::npos) << path;
+  }
+  EXPECT_EQ(status_of(raw_request("GET /index.html HTTP/1.0")), 200);  // the same socket path works for a real file
+}
+
+TEST_F(DashboardHttp, ReadOnlyByDefault) {
+  auto r = client_.Post("/api/command", R"({"node":"segmenter","action":"stop"})", "application/json");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 403);
+  r = client_.Post("/api/plan", "{}", "application/json");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 405);
+}
+
+TEST_F(DashboardHttp, ListensOnLoopbackOnlyByDefault) {
+  std::ifstream in("/proc/net/tcp");
+  std::string line;
+  bool found = false;
+  while (std::getline(in, line)) {
+    std::istringstream ss(line);
+    std::string sl, local, remote, state;
+    ss >> sl >> local >> remote >> state;
+    if (state == "0A" && local.size() > 5 && local.substr(local.size() - 4) == "1F90") {  // LISTEN on 8080
+      found = true;
+      EXPECT_EQ(local, "0100007F:1F90");
+    }
+  }
+  EXPECT_TRUE(found);
+}
+
+}  // namespace

@@ -1,0 +1,224 @@
+// fploc dashboard page: plan + poses + features on a map, plots, node health. Data: GET /api/plan,
+// /api/history once (and after every reconnect), then Server-Sent Events from /api/events.
+import { MapView } from './map.js';
+import { Plot } from './plot.js';
+
+const $ = (id) => document.getElementById(id);
+const DEG = 180 / Math.PI;
+const css = getComputedStyle(document.documentElement);
+const color = (n) => css.getPropertyValue(n).trim();
+const COL = { est: color('--est'), gt: color('--gt'), fp: color('--fp'), corner: color('--corner'), surface: color('--surface') };
+
+// Visible to tests (playwright reads it) and handy in the console.
+const S = window.__fploc = {
+  connected: false, reconnects: 0, events: {}, latencies: [], trail: [], gtTrail: [],
+  pose: null, gt: null, frame: null, features: null, nodes: [], stats: null,
+};
+const MAX_TRAIL = 50000;
+
+const map = new MapView($('map'));
+const plots = {
+  ate: new Plot($('plot-ate'), [{ label: 'ATE', color: '#dc2626' }, { label: 'error', color: '#9ca3af' }], { digits: 3, zero: true, minSpan: 0.02 }),
+  rp: new Plot($('plot-rp'), [{ label: 'roll', color: COL.est }, { label: 'pitch', color: '#ea580c' },
+    { label: 'gt roll', color: COL.est, dash: [3, 3] }, { label: 'gt pitch', color: '#ea580c', dash: [3, 3] }], { digits: 2, minSpan: 0.5 }),
+  z: new Plot($('plot-z'), [{ label: 'z', color: COL.est }, { label: 'gt z', color: COL.gt, dash: [3, 3] }], { digits: 3, minSpan: 0.05 }),
+  rate: new Plot($('plot-rate'), [{ label: 'frames', color: COL.fp }, { label: 'poses', color: COL.est }], { digits: 1, zero: true, minSpan: 1 }),
+};
+
+// ---- map layers ------------------------------------------------------------------------------
+map.layers.push((c, v) => {
+  v.polyline(c, S.gtTrail, COL.gt, 2);
+  v.polyline(c, S.trail, COL.est, 2);
+  const f = S.features;
+  if (f && f.pose && $('showfeat').checked) {
+    const cs = Math.cos(f.pose.yaw), sn = Math.sin(f.pose.yaw), r = 2;
+    for (const kind of ['s', 'c']) {
+      c.fillStyle = kind === 'c' ? COL.corner : COL.surface;
+      c.beginPath();
+      for (let i = 0, k = 0; k < f.kind.length; i += 2, k++) {
+        if (f.kind[k] !== kind) continue;
+        const px = f.xy[i], py = f.xy[i + 1];
+        const [sx, sy] = v.toScreen(f.pose.x + cs * px - sn * py, f.pose.y + sn * px + cs * py);
+        c.moveTo(sx + r, sy); c.arc(sx, sy, kind === 'c' ? r + 1 : r, 0, 2 * Math.PI);
+      }
+      c.fill();
+    }
+  }
+  if (S.gt) v.arrow(c, S.gt.x, S.gt.y, S.gt.yaw, COL.gt, false);
+  if (S.frame && S.frame.x !== null) v.arrow(c, S.frame.x, S.frame.y, S.frame.yaw, COL.fp, false, 9);
+  if (S.pose) {
+    const p = S.pose;
+    if (p.sigma_xy > 0) {
+      const [sx, sy] = v.toScreen(p.x, p.y);
+      c.strokeStyle = 'rgba(31,111,235,.35)'; c.lineWidth = 1;
+      c.beginPath(); c.arc(sx, sy, Math.max(3, 2 * p.sigma_xy * v.scale), 0, 2 * Math.PI); c.stroke();
+    }
+    v.arrow(c, p.x, p.y, p.yaw, p.status === 0 ? COL.est : '#dc2626', true);
+  }
+});
+
+// ---- trail handling (the optimiser re-publishes poses of its window: replace by utime) --------
+function addToTrail(trail, utime, x, y) {
+  if (x === null || y === null) return;
+  for (let k = trail.length - 1; k >= 0 && k >= trail.length - 200; k--) {
+    if (trail[k][2] === utime) { trail[k] = [x, y, utime]; return; }
+    if (trail[k][2] < utime) break;
+  }
+  if (trail.length && trail[trail.length - 1][2] > utime) return;  // late and outside the window: ignore
+  trail.push([x, y, utime]);
+  if (trail.length > MAX_TRAIL) trail.splice(0, trail.length - MAX_TRAIL);
+}
+
+// ---- readouts ---------------------------------------------------------------------------------
+const fmt = (v, d = 3) => (v === null || v === undefined || !Number.isFinite(v) ? '–' : v.toFixed(d));
+function renderPoseBox() {
+  const p = S.pose, g = S.gt, f = S.frame;
+  const rows = [
+    ['x, y, z [m]', p ? `${fmt(p.x)}, ${fmt(p.y)}, ${fmt(p.z)}` : '–'],
+    ['roll, pitch, yaw [°]', p ? `${fmt(p.roll * DEG, 2)}, ${fmt(p.pitch * DEG, 2)}, ${fmt(p.yaw * DEG, 1)}` : '–'],
+    ['status', p ? ['OK', 'POOR', 'LOST'][p.status] ?? p.status : '–'],
+    ['ATE so far', p && p.ate_n ? `${fmt(p.ate_rmse)} m (${p.ate_n} poses)` : (g ? 'waiting for matches' : 'no ground truth')],
+    ['frame pose', f ? `${f.status_text || f.status} · inliers ${fmt(100 * f.inlier_ratio, 0)} % · ${fmt(f.solve_ms, 1)} ms` : '–'],
+    ['features', S.features ? `${S.features.n} (shown ${S.features.shown})` : '–'],
+  ];
+  $('posebox').tBodies[0].replaceChildren(...rows.map(([k, v]) => {
+    const tr = document.createElement('tr');
+    const a = document.createElement('td'); a.textContent = k;
+    const b = document.createElement('td'); b.textContent = v;
+    tr.append(a, b); return tr;
+  }));
+}
+let poseBoxPending = false;
+function schedulePoseBox() {
+  if (poseBoxPending) return;
+  poseBoxPending = true;
+  setTimeout(() => { poseBoxPending = false; renderPoseBox(); }, 100);
+}
+
+function renderNodes(msg) {
+  S.nodes = msg.nodes;
+  const body = $('nodes').tBodies[0];
+  const rows = msg.nodes.map((n) => {
+    const tr = document.createElement('tr');
+    tr.className = n.health;
+    tr.dataset.node = n.node;
+    tr.dataset.health = n.health;
+    const state = n.health === 'bad' ? (n.reason || n.state) : n.state + (n.reporter === 'launcher' ? ' (launcher)' : '');
+    const cells = [n.node, state, fmt(n.rate_hz, 1), fmt(n.latency_p50_ms, 2), fmt(n.latency_p99_ms, 2), fmt(n.cpu_percent, 1),
+      String(n.dropped), String(n.restarts), `${fmt(n.age_s, 1)} s ago`, n.last_error || ''];
+    for (const [i, text] of cells.entries()) {
+      const td = document.createElement('td');
+      td.textContent = text;
+      if (i === 0) td.title = `${n.executable} pid ${n.pid}`;
+      if (i === cells.length - 1) td.title = text;
+      tr.append(td);
+    }
+    return tr;
+  });
+  body.replaceChildren(...rows);
+  const bad = msg.nodes.filter((n) => n.health === 'bad').length;
+  $('summary').textContent = `${msg.nodes.length} nodes${bad ? `, ${bad} down` : ''}`;
+}
+
+// ---- data ---------------------------------------------------------------------------------------
+let t0 = null;  // plot time origin (s)
+const tsec = (utime) => { const t = utime / 1e6; if (t0 === null) t0 = t; return t - t0; };
+
+function onPose(p) {
+  S.pose = p;
+  addToTrail(S.trail, p.utime, p.x, p.y);
+  const lat = Date.now() - p.utime / 1000;
+  if (lat > -50 && lat < 10000) {  // only when the stamp is this machine's wall clock (live runs)
+    S.latencies.push(lat);
+    if (S.latencies.length > 10000) S.latencies.splice(0, 5000);
+    S.lastLatency = lat;
+  }
+  const t = tsec(p.utime);
+  plots.ate.push(t, [p.ate_n ? p.ate_rmse : null, p.err]);
+  plots.rp.push(t, [p.roll * DEG, p.pitch * DEG, null, null]);
+  plots.z.push(t, [p.z, null]);
+  if ($('follow').checked) map.centerOn(p.x, p.y);
+  map.invalidate();
+  schedulePoseBox();
+}
+function onGt(g) {
+  S.gt = g;
+  addToTrail(S.gtTrail, g.utime, g.x, g.y);
+  const t = tsec(g.utime);
+  plots.rp.push(t, [null, null, g.roll * DEG, g.pitch * DEG]);
+  plots.z.push(t, [null, g.z]);
+  map.invalidate();
+}
+
+async function loadStatic() {
+  const [plan, hist] = await Promise.all([
+    fetch('/api/plan', { cache: 'no-store' }).then((r) => r.json()),
+    fetch('/api/history', { cache: 'no-store' }).then((r) => r.json()),
+  ]);
+  if (plan) map.setPlan(plan);
+  S.trail = []; S.gtTrail = []; t0 = null;
+  Object.values(plots).forEach((p) => p.clear());
+  let sq = 0, n = 0;
+  for (const [utime, x, y, z, roll, pitch, , err] of hist.est) {
+    addToTrail(S.trail, utime, x, y);
+    const t = tsec(utime);
+    if (err !== null) { sq += err * err; n++; }
+    plots.ate.push(t, [n ? Math.sqrt(sq / n) : null, err]);
+    plots.rp.push(t, [roll * DEG, pitch * DEG, null, null]);
+    plots.z.push(t, [z, null]);
+  }
+  for (const [utime, x, y, z] of hist.gt) { addToTrail(S.gtTrail, utime, x, y); plots.z.push(tsec(utime), [null, z]); }
+  map.invalidate();
+}
+
+function setConnected(ok) {
+  S.connected = ok;
+  $('conn').textContent = ok ? 'live' : 'disconnected';
+  $('conn').className = 'badge ' + (ok ? 'ok' : 'bad');
+  $('banner').classList.toggle('hidden', ok);
+}
+
+function connect() {
+  const es = new EventSource('/api/events');
+  let everOpen = false;
+  es.addEventListener('open', async () => {
+    if (S.wasDisconnected) {  // the server may have restarted: trails and plan start again
+      S.reconnects++;
+      try { await loadStatic(); } catch (e) { console.warn('reload after reconnect failed', e); }
+    }
+    everOpen = true;
+    S.wasDisconnected = false;
+    setConnected(true);
+  });
+  es.addEventListener('error', () => {
+    if (everOpen || !S.connected) S.wasDisconnected = true;
+    setConnected(false);
+  });
+  const on = (name, fn) => es.addEventListener(name, (ev) => {
+    S.events[name] = (S.events[name] || 0) + 1;
+    let msg;
+    try { msg = JSON.parse(ev.data); } catch (e) { console.warn('bad event', name, e); return; }
+    fn(msg);
+  });
+  on('pose', onPose);
+  on('gt', onGt);
+  on('frame_pose', (f) => { S.frame = f; map.invalidate(); schedulePoseBox(); });
+  on('features', (f) => { S.features = f; map.invalidate(); });
+  on('nodes', renderNodes);
+  on('stats', (s) => {
+    S.stats = s;
+    const t = S.pose ? tsec(S.pose.utime) : null;
+    if (t !== null) plots.rate.push(t, [s.frame_rate_hz, s.pose_rate_hz]);
+    const l = S.latencies.slice(-50).sort((a, b) => a - b);
+    $('latency').textContent = l.length ? `latency p50 ${l[l.length >> 1].toFixed(0)} ms · ${s.clients} viewer(s)` : `${s.clients} viewer(s)`;
+  });
+  on('plan_changed', async () => { try { map.setPlan(await (await fetch('/api/plan')).json()); } catch (e) { /* next reconnect */ } });
+}
+
+$('fit').addEventListener('click', () => map.fit());
+$('showfeat').addEventListener('change', () => map.invalidate());
+$('follow').addEventListener('change', () => map.invalidate());
+setConnected(false);
+$('banner').classList.add('hidden');  // no banner before the first attempt
+loadStatic().catch((e) => console.warn('initial load failed', e)).finally(connect);
+renderPoseBox();
