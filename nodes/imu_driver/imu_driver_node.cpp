@@ -1,0 +1,113 @@
+// IMU driver: publishes imu_t (SI units) on OS1_IMU. A source turns raw input into ImuSamples; the only
+// one implemented is "os1" (Ouster 48-byte IMU packets over UDP, default port 7503, or from a pcap,
+// including captures where lidar and IMU share a port: IMU packets are told apart by their size).
+// An Xsens MTi-30 (MTData2 over a serial port) would be another ImuSource reading `serial_device`.
+#include <fploc/imu_t.hpp>
+
+#include <memory>
+#include <stdexcept>
+
+#include "fploc/os1/packet.h"
+#include "fploc/os1/source.h"
+#include "fploc/runtime/node.h"
+#include "options/sensors.pb.h"
+
+namespace {
+
+using namespace fploc::os1;
+
+struct Sample {
+  ImuSample s;
+  std::string source;
+};
+using SampleFn = std::function<void(const Sample&)>;
+
+// One IMU input. setup() registers fds / timers with the context and calls `emit` per sample.
+class ImuSource {
+ public:
+  virtual ~ImuSource() = default;
+  virtual void setup(fploc::rt::Context& ctx, const fploc::ImuDriverOptions& opt, SampleFn emit) = 0;
+};
+
+class Os1ImuSource : public ImuSource {
+ public:
+  void setup(fploc::rt::Context& ctx, const fploc::ImuDriverOptions& opt, SampleFn emit) override {
+    ctx_ = &ctx;
+    emit_ = std::move(emit);
+    const int port = opt.imu_port() > 0 ? opt.imu_port() : 7503;
+    if (!opt.pcap().empty()) {
+      pcap_port_ = opt.imu_port();  // 0: any port, IMU packets recognised by size
+      std::string err;
+      const double rate = opt.pcap_rate() == 0 ? 1.0 : opt.pcap_rate();
+      if (!replay_.open(ctx.resolve_path(opt.pcap()), rate, opt.pcap_loop(), &err)) throw std::runtime_error("imu_driver: " + err);
+      ctx.every(0.002, [this] {
+        const bool more = replay_.poll([this](uint16_t p, const uint8_t* d, size_t n) {
+          if (pcap_port_ == 0 || p == pcap_port_) on_datagram(d, n, pcap_port_ == 0);
+        });
+        for (const auto& e : replay_.take_errors()) ctx_->error("pcap: " + e);
+        if (!more) ctx_->request_stop();
+      });
+    } else {
+      std::string err;
+      if (!udp_.open(opt.bind_address(), port, 1 << 20, &err)) throw std::runtime_error("imu_driver: " + err);
+      ctx.watch_fd(udp_.fd(), [this] {
+        udp_.drain([this](uint16_t, const uint8_t* d, size_t n) { on_datagram(d, n, false); });
+      });
+    }
+  }
+
+ private:
+  void on_datagram(const uint8_t* d, size_t n, bool any_port) {
+    if (n != kImuPacketSize) {
+      if (!any_port) ctx_->error("imu packet: " + std::to_string(n) + " B, expected 48");
+      return;  // other traffic in a capture (lidar packets)
+    }
+    Sample s{{}, "os1"};
+    if (!parse_imu_packet(d, n, s.s)) {
+      ctx_->error("imu packet: non-finite accel/gyro value");
+      return;
+    }
+    emit_(s);
+  }
+  fploc::rt::Context* ctx_ = nullptr;
+  SampleFn emit_;
+  UdpReceiver udp_;
+  PcapReplay replay_;
+  int pcap_port_ = 0;
+};
+
+class ImuDriverNode : public fploc::rt::Node {
+ public:
+  static fploc::rt::NodeSpec spec() {
+    return {"imu_driver", "imu_driver", "IMU samples (Ouster IMU packets over UDP or pcap) in SI units -> OS1_IMU",
+            {fploc::rt::output<fploc::imu_t>("imu", "OS1_IMU")}};
+  }
+
+  void setup(fploc::rt::Context& ctx) override {
+    const auto& opt = ctx.options<fploc::ImuDriverOptions>();
+    const std::string kind = opt.source().empty() ? "os1" : opt.source();
+    if (kind == "os1") source_ = std::make_unique<Os1ImuSource>();
+    else throw std::runtime_error("imu_driver: option 'source': '" + kind + "' is not implemented (os1)");
+    out_ = ctx.advertise<fploc::imu_t>("imu");
+    source_->setup(ctx, opt, [this](const Sample& s) { publish(s); });
+  }
+
+ private:
+  void publish(const Sample& s) {
+    fploc::imu_t m;
+    m.utime = int64_t(s.s.accel_ts_ns / 1000);
+    m.accel_utime = int64_t(s.s.accel_ts_ns / 1000);
+    m.gyro_utime = int64_t(s.s.gyro_ts_ns / 1000);
+    m.seq = seq_++;
+    for (int i = 0; i < 3; ++i) m.accel[i] = s.s.accel_mps2[i], m.gyro[i] = s.s.gyro_radps[i];
+    m.source = s.source;
+    out_.publish(m);
+  }
+  std::unique_ptr<ImuSource> source_;
+  fploc::rt::Publisher<fploc::imu_t> out_;
+  int64_t seq_ = 0;
+};
+
+FPLOC_REGISTER_NODE(ImuDriverNode)
+
+}  // namespace

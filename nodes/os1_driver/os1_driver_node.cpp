@@ -1,0 +1,123 @@
+// OS-1 lidar driver: Ouster lidar packets from UDP (default port 7502) or a pcap -> FrameAssembler ->
+// OS1_SCAN (scan_t: staggered range image, signal, reflectivity, column times, beam intrinsics).
+// Bad input (wrong sizes, garbage columns, late packets, missing columns) is counted with ctx.error and
+// never stops the node. Output times are sensor times from the packets (deterministic for a pcap).
+#include <fploc/scan_t.hpp>
+
+#include <memory>
+#include <stdexcept>
+
+#include "fploc/nodes/convert.h"
+#include "fploc/os1/metadata.h"
+#include "fploc/os1/packet.h"
+#include "fploc/os1/source.h"
+#include "fploc/runtime/node.h"
+#include "options/sensors.pb.h"
+
+namespace {
+
+using namespace fploc::os1;
+
+class Os1DriverNode : public fploc::rt::Node {
+ public:
+  static fploc::rt::NodeSpec spec() {
+    return {"os1_driver", "os1_driver", "Ouster OS-1 lidar packets (UDP or pcap) -> full frames on OS1_SCAN",
+            {fploc::rt::output<fploc::scan_t>("scan", "OS1_SCAN")}};
+  }
+
+  void setup(fploc::rt::Context& ctx) override {
+    ctx_ = &ctx;
+    const auto& opt = ctx.options<fploc::Os1DriverOptions>();
+    if (opt.metadata().empty()) throw std::runtime_error("os1_driver: option 'metadata' (sensor JSON) is required");
+    info_ = load_metadata(ctx.resolve_path(opt.metadata()));  // MetadataError names file and field
+    for (const auto& f : info_.defaulted)
+      if (f == "pixel_shift_by_row" || f == "lidar_origin_to_beam_origin_mm")
+        std::cerr << "[" << ctx.name() << "] metadata: '" << f << "' absent, using the Ouster default\n";
+    assembler_ = std::make_unique<FrameAssembler>(info_);
+    out_ = ctx.advertise<fploc::scan_t>("scan");
+    const int port = opt.lidar_port() > 0 ? opt.lidar_port() : 7502;
+    classifier_ = PacketClassifier{opt.pcap().empty() ? port : opt.lidar_port(), -1, assembler_->format().lidar_packet_size()};
+    if (!opt.pcap().empty()) {
+      std::string err;
+      const double rate = opt.pcap_rate() == 0 ? 1.0 : opt.pcap_rate();
+      if (!replay_.open(ctx.resolve_path(opt.pcap()), rate, opt.pcap_loop(), &err)) throw std::runtime_error("os1_driver: " + err);
+      ctx.every(rate > 0 ? 0.002 : 0.001, [this] { poll_pcap(); });
+    } else {
+      const int buf = opt.recv_buffer_bytes() > 0 ? opt.recv_buffer_bytes() : 8 << 20;
+      std::string err;
+      if (!udp_.open(opt.bind_address(), port, buf, &err)) throw std::runtime_error("os1_driver: " + err);
+      if (udp_.actual_buffer_bytes() < buf)
+        ctx.error("SO_RCVBUF is " + std::to_string(udp_.actual_buffer_bytes()) + " B, asked " + std::to_string(buf) +
+                  " (raise net.core.rmem_max); packets may be dropped at 10 Hz");
+      ctx.watch_fd(udp_.fd(), [this] {
+        udp_.drain([this](uint16_t p, const uint8_t* d, size_t n) { on_datagram(p, d, n); });
+      });
+    }
+  }
+
+  void shutdown() override {
+    if (assembler_) {
+      assembler_->flush(frames_);
+      publish_frames();
+    }
+  }
+
+ private:
+  void poll_pcap() {
+    const bool more = replay_.poll([this](uint16_t p, const uint8_t* d, size_t n) { on_datagram(p, d, n); },
+                                   [this] { return published_in_poll_; });
+    published_in_poll_ = false;
+    for (const auto& e : replay_.take_errors()) ctx_->error("pcap: " + e);
+    if (!more) {
+      assembler_->flush(frames_);
+      publish_frames();
+      ctx_->request_stop();
+    }
+  }
+
+  void on_datagram(uint16_t port, const uint8_t* d, size_t n) {
+    if (n == kImuPacketSize) return;  // IMU on the lidar port (same-port setups): the imu driver's job
+    if (classifier_.classify(port, n) != PacketKind::kLidar) {
+      if (classifier_.lidar_port == 0 || port == classifier_.lidar_port) report(PacketError::kWrongSize, n);
+      return;  // another port in a pcap: not ours
+    }
+    const PacketError e = assembler_->add_packet(d, n, frames_);
+    if (e != PacketError::kNone) report(e, n);
+    publish_frames();
+  }
+
+  void report(PacketError e, size_t n) {
+    std::string msg = std::string("lidar packet: ") + to_string(e);
+    if (e == PacketError::kWrongSize)
+      msg += " (" + std::to_string(n) + " B, expected " + std::to_string(assembler_->format().lidar_packet_size()) + ")";
+    ctx_->error(msg);
+  }
+
+  void publish_frames() {
+    for (auto& s : frames_) {
+      if (s.missing_columns > 0)
+        ctx_->error("frame " + std::to_string(s.frame_id) + ": " + std::to_string(s.missing_columns) +
+                    " columns missing (published as invalid)");
+      fploc::to_msg(s, msg_);
+      out_.publish(msg_);
+      published_in_poll_ = true;
+      assembler_->recycle(std::move(s));
+    }
+    frames_.clear();
+  }
+
+  fploc::rt::Context* ctx_ = nullptr;
+  SensorInfo info_;
+  std::unique_ptr<FrameAssembler> assembler_;
+  PacketClassifier classifier_;
+  UdpReceiver udp_;
+  PcapReplay replay_;
+  std::vector<fploc::Scan> frames_;
+  fploc::scan_t msg_;
+  fploc::rt::Publisher<fploc::scan_t> out_;
+  bool published_in_poll_ = false;
+};
+
+FPLOC_REGISTER_NODE(Os1DriverNode)
+
+}  // namespace
