@@ -1,0 +1,56 @@
+// fploc-features: FPLOC_SEGMENTS -> LOAM corner/surface features, gravity-compensated, projected to 2D,
+// PCA line groups -> FPLOC_FEATURES (paper IV-B).
+#include <fploc/features_t.hpp>
+#include <fploc/segments_t.hpp>
+
+#include "fploc/features/features.h"
+#include "fploc/nodes/perception_convert.h"
+#include "fploc/runtime/node.h"
+
+namespace {
+
+class FeaturesNode : public fploc::rt::Node {
+ public:
+  static fploc::rt::NodeSpec spec() {
+    return {"features", "features", "LOAM corner/surface wall features projected to 2D with PCA line groups",
+            {fploc::rt::input<fploc::segments_t>("segments", "FPLOC_SEGMENTS"),
+             fploc::rt::output<fploc::features_t>("features", "FPLOC_FEATURES")}};
+  }
+
+  void setup(fploc::rt::Context& ctx) override {
+    ctx_ = &ctx;
+    fx_ = std::make_unique<fploc::feat::FeatureExtractor>(fploc::config_of(ctx.options<fploc::FeatureOptions>()));
+    out_ = ctx.advertise<fploc::features_t>("features");
+    ctx.subscribe<fploc::segments_t>("segments", [this](const fploc::segments_t& m) { on_segments(m); });
+  }
+
+ private:
+  void on_segments(const fploc::segments_t& m) {
+    fploc::features_t msg;
+    try {
+      fploc::from_msg(m, seg_);
+    } catch (const std::exception& e) {
+      ctx_->error(std::string("segments: ") + e.what());
+      fploc::feat::Features2D bad;
+      bad.utime = m.utime;
+      bad.status = fploc::feat::FeatStatus::kBadInput;
+      fploc::to_msg(bad, seq_++, m.scan_seq, msg);
+      out_.publish(msg);
+      return;
+    }
+    const auto& f = fx_->process(seg_);
+    if (f.status == fploc::feat::FeatStatus::kBadInput)
+      ctx_->error("segments seq " + std::to_string(m.seq) + ": bad input (non-finite roll/pitch)");
+    fploc::to_msg(f, seq_++, m.scan_seq, msg);
+    out_.publish(msg);
+  }
+
+  fploc::rt::Context* ctx_ = nullptr;
+  std::unique_ptr<fploc::feat::FeatureExtractor> fx_;
+  fploc::rt::Publisher<fploc::features_t> out_;
+  fploc::seg::Segmentation seg_;
+  int64_t seq_ = 0;
+};
+
+}  // namespace
+FPLOC_REGISTER_NODE(FeaturesNode)

@@ -1,0 +1,135 @@
+#include "fploc/nodes/perception_convert.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace fploc {
+
+void to_msg(const seg::Segmentation& s, int64_t seq, segments_t& m) {
+  m.utime = s.utime;
+  m.seq = seq;
+  m.scan_seq = s.seq;
+  m.status = int8_t(s.status);
+  m.status_text = s.status_text;
+  m.ceiling_found = s.ceiling.found;
+  m.ground_found = s.ground.found;
+  for (int k = 0; k < 4; ++k) {
+    m.ceiling_plane[k] = s.ceiling.coeffs[k];
+    m.ground_plane[k] = s.ground.coeffs[k];
+  }
+  m.ceiling_inliers = s.ceiling.inliers;
+  m.ceiling_rms_m = s.ceiling.rms_m;
+  m.ground_inliers = s.ground.inliers;
+  m.ground_rms_m = s.ground.rms_m;
+  m.roll = s.roll;
+  m.pitch = s.pitch;
+  m.z = s.z;
+  m.roll_pitch_sigma = s.roll_pitch_sigma;
+  m.z_sigma = s.z_sigma;
+  m.attitude_source = int8_t(s.attitude_source);  // 3 = none (no ceiling, no history, no IMU)
+  m.height = int16_t(s.height);
+  m.width = int16_t(s.width);
+  const auto& w = s.wall;
+  m.num_points = int32_t(w.size());
+  m.x = w.x;
+  m.y = w.y;
+  m.z_pts = w.z;
+  m.ring = w.ring;
+  m.column = w.column;
+  m.range_m = w.range;
+}
+
+void from_msg(const segments_t& m, seg::Segmentation& s) {
+  const size_t n = size_t(std::max(0, m.num_points));
+  auto bad = [&](const std::string& what) {
+    throw std::runtime_error("segments_t seq " + std::to_string(m.seq) + ": " + what);
+  };
+  if (m.num_points < 0) bad("num_points < 0");
+  if (m.x.size() != n || m.y.size() != n || m.z_pts.size() != n || m.ring.size() != n || m.column.size() != n ||
+      m.range_m.size() != n)
+    bad("x/y/z_pts/ring/column/range_m sizes disagree with num_points " + std::to_string(n));
+  s.utime = m.utime;
+  s.seq = m.scan_seq;
+  s.status = seg::SegStatus(m.status);
+  s.status_text = m.status_text;
+  s.ceiling.found = m.ceiling_found;
+  s.ground.found = m.ground_found;
+  for (int k = 0; k < 4; ++k) {
+    s.ceiling.coeffs[k] = m.ceiling_plane[k];
+    s.ground.coeffs[k] = m.ground_plane[k];
+  }
+  s.ceiling.inliers = m.ceiling_inliers;
+  s.ceiling.rms_m = m.ceiling_rms_m;
+  s.ground.inliers = m.ground_inliers;
+  s.ground.rms_m = m.ground_rms_m;
+  s.roll = m.roll;
+  s.pitch = m.pitch;
+  s.z = m.z;
+  s.roll_pitch_sigma = m.roll_pitch_sigma;
+  s.z_sigma = m.z_sigma;
+  s.attitude_source = seg::AttitudeSource(m.attitude_source);
+  s.height = m.height;
+  s.width = m.width;
+  auto& w = s.wall;
+  w.x = m.x;
+  w.y = m.y;
+  w.z = m.z_pts;
+  w.ring = m.ring;
+  w.column = m.column;
+  w.range = m.range_m;
+  // The feature extractor needs ring-major, increasing columns; check instead of trusting.
+  for (size_t i = 1; i < n; ++i)
+    if (w.ring[i] < w.ring[i - 1] || (w.ring[i] == w.ring[i - 1] && w.column[i] <= w.column[i - 1]))
+      bad("wall points not ring-major with increasing column at index " + std::to_string(i));
+}
+
+void to_msg(const feat::Features2D& f, int64_t seq, int64_t scan_seq, features_t& m) {
+  m.utime = f.utime;
+  m.seq = seq;
+  m.scan_seq = scan_seq;
+  m.status = int8_t(f.status);
+  m.roll = f.roll;
+  m.pitch = f.pitch;
+  m.z = f.z;
+  m.roll_pitch_sigma = f.roll_pitch_sigma;
+  m.z_sigma = f.z_sigma;
+  m.num_points = int32_t(f.size());
+  m.x = f.x;
+  m.y = f.y;
+  m.kind = f.kind;
+  m.group = f.group;
+  m.num_groups = f.num_groups;
+}
+
+seg::SegmenterConfig config_of(const SegmenterOptions& o) {
+  seg::SegmenterConfig c;
+  if (o.seed_rings() > 0) c.seed_rings = o.seed_rings();
+  if (o.max_tilt_deg() > 0) c.max_tilt_deg = o.max_tilt_deg();
+  if (o.wall_margin_m() > 0) c.wall_margin_m = o.wall_margin_m();
+  c.use_imu_prior = o.use_imu_prior();
+  if (o.ceiling_height_m() > 0) c.ceiling_height_m = o.ceiling_height_m();
+  if (o.min_range_m() > 0) c.min_range_m = o.min_range_m();
+  if (o.inlier_threshold_m() > 0) c.inlier_threshold_m = o.inlier_threshold_m();
+  if (o.min_plane_inliers() > 0) c.min_plane_inliers = o.min_plane_inliers();
+  if (o.irls_iterations() > 0) c.irls_iterations = o.irls_iterations();
+  if (o.seed_triplets() > 0) c.seed_triplets = o.seed_triplets();
+  return c;
+}
+
+feat::FeatureConfig config_of(const FeatureOptions& o) {
+  feat::FeatureConfig c;
+  if (o.sectors() > 0) c.sectors = o.sectors();
+  if (o.max_corners_per_sector() > 0) c.max_corners_per_sector = o.max_corners_per_sector();
+  if (o.max_surfaces_per_sector() > 0) c.max_surfaces_per_sector = o.max_surfaces_per_sector();
+  if (o.corner_threshold() > 0) c.corner_threshold = o.corner_threshold();
+  if (o.surface_threshold() > 0) c.surface_threshold = o.surface_threshold();
+  if (o.max_range_m() > 0) c.max_range_m = o.max_range_m();
+  if (o.min_range_m() > 0) c.min_range_m = o.min_range_m();
+  if (o.half_window() > 0) c.half_window = o.half_window();
+  if (o.min_group_points() > 0) c.min_group_points = o.min_group_points();
+  if (o.line_max_rms_m() > 0) c.line_max_rms_m = o.line_max_rms_m();
+  return c;
+}
+
+}  // namespace fploc
