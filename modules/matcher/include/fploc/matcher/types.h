@@ -23,6 +23,7 @@ struct FeatureFrame {
   int64_t utime = 0;
   int64_t scan_seq = 0;
   double roll = 0, pitch = 0, z = 0;
+  double roll_pitch_sigma = 0, z_sigma = 0;
   std::vector<Feature2> points;
 };
 

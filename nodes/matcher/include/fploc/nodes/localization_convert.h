@@ -1,0 +1,28 @@
+// LCM <-> localization types (features_t -> FeatureFrame, results -> frame_pose_t / pose_t), shared by
+// the matcher, optimizer and odometry nodes.
+#pragma once
+#include <fploc/features_t.hpp>
+#include <fploc/frame_pose_t.hpp>
+#include <fploc/pose_t.hpp>
+
+#include <Eigen/Core>
+#include <string>
+
+#include "fploc/matcher/types.h"
+
+namespace fploc {
+
+// Non-finite points are dropped (counted in *dropped). Throws std::runtime_error naming the field when
+// the arrays disagree with num_points.
+FeatureFrame from_msg(const features_t& m, int* dropped = nullptr);
+
+// 6-DoF pose message from (x, y, yaw) + (roll, pitch, z); covariance: the 3x3 (x, y, yaw) block is
+// placed in the 6x6 (x y z roll pitch yaw), z/roll/pitch get the given sigmas.
+pose_t make_pose_msg(int64_t utime, int64_t seq, const Pose2& p, double roll, double pitch, double z,
+                     const Eigen::Matrix3d& cov_xy_yaw, double z_sigma, double rp_sigma, int8_t status,
+                     bool keyframe, bool final_estimate);
+
+// Pose2 from a pose_t (yaw of its quaternion).
+Pose2 pose2_of(const pose_t& m);
+
+}  // namespace fploc

@@ -1,0 +1,157 @@
+// fploc-matcher: FPLOC_FEATURES (+ OS1_IMU yaw rate) -> single-frame registration -> FPLOC_FRAME_POSE
+// for every scan. The map (plan or .fpmap) and the look-up come from the `matcher` options.
+#include <fploc/features_t.hpp>
+#include <fploc/frame_pose_t.hpp>
+#include <fploc/imu_t.hpp>
+#include <fploc/pose_t.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <memory>
+#include <optional>
+
+#include "fploc/matcher/map.h"
+#include "fploc/matcher/matcher.h"
+#include "fploc/nodes/localization_convert.h"
+#include "fploc/runtime/node.h"
+#include "options/localization.pb.h"
+
+namespace {
+
+using fploc::FitStatus;
+
+fploc::MatcherConfig config_of(const fploc::MatcherOptions& o) {
+  fploc::MatcherConfig c;
+  if (o.max_correspondence_m() > 0) c.gate_initial_m = o.max_correspondence_m();
+  if (o.min_correspondence_m() > 0) c.gate_final_m = o.min_correspondence_m();
+  if (o.huber_m() > 0) c.loss_scale_m = o.huber_m();
+  if (!o.loss().empty()) c.loss = o.loss();
+  if (o.max_iterations() > 0) c.max_iterations = o.max_iterations();
+  if (o.max_rounds() > 0) c.max_outer = o.max_rounds();
+  if (o.inlier_m() > 0) c.inlier_m = o.inlier_m();
+  if (o.min_inlier_ratio() > 0) c.min_inlier_ratio = o.min_inlier_ratio();
+  if (o.min_inliers() > 0) c.min_inliers = o.min_inliers();
+  if (o.lost_after() > 0) c.lost_after = o.lost_after();
+  if (o.max_jump_m() > 0) c.max_jump_m = o.max_jump_m();
+  c.max_jump_rad = (o.max_jump_deg() > 0 ? o.max_jump_deg() : 30.0) * M_PI / 180;
+  c.group_rule = !o.disable_group_rule();
+  c.motion_model = !o.disable_motion_model();
+  if (o.stride() > 0) c.stride = o.stride();
+  return c;
+}
+
+class MatcherNode : public fploc::rt::Node {
+ public:
+  static fploc::rt::NodeSpec spec() {
+    return {"matcher", "matcher", "single-frame (x, y, yaw) registration of 2D features against the floor plan",
+            {fploc::rt::input<fploc::features_t>("features", "FPLOC_FEATURES"),
+             fploc::rt::input<fploc::imu_t>("imu", "OS1_IMU"),
+             fploc::rt::input<fploc::pose_t>("initial_pose", "FPLOC_INITIAL_POSE"),
+             fploc::rt::output<fploc::frame_pose_t>("frame_pose", "FPLOC_FRAME_POSE")}};
+  }
+
+  void setup(fploc::rt::Context& ctx) override {
+    ctx_ = &ctx;
+    const auto& o = ctx.options<fploc::MatcherOptions>();
+    if (o.plan().file().empty()) throw std::runtime_error("matcher.plan.file: no floor plan given");
+    const std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
+    map_ = fploc::load_localization_map(ctx.resolve_path(o.plan().file()), layers, o.plan().units(),
+                                        o.lookup().empty() ? "annf-exact" : o.lookup());
+    matcher_ = std::make_unique<fploc::Matcher>(*map_.lookup, config_of(o));
+    use_imu_ = !o.ignore_imu();
+    if (!o.wait_for_initial_pose()) matcher_->set_pose({o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()});
+    out_ = ctx.advertise<fploc::frame_pose_t>("frame_pose");
+    ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) { on_features(m); });
+    ctx.subscribe<fploc::imu_t>("imu", [this](const fploc::imu_t& m) { on_imu(m); });
+    ctx.subscribe<fploc::pose_t>("initial_pose", [this](const fploc::pose_t& m) {
+      const fploc::Pose2 p = fploc::pose2_of(m);
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.yaw)) {
+        ctx_->error("initial_pose seq " + std::to_string(m.seq) + ": non-finite pose (ignored)");
+        return;
+      }
+      matcher_->set_pose(p);
+    });
+  }
+
+ private:
+  void on_imu(const fploc::imu_t& m) {
+    if (!use_imu_ || !std::isfinite(m.gyro[2])) return;
+    if (!imu_.empty() && m.utime <= imu_.back().first) return;  // out of order / duplicate
+    imu_.emplace_back(m.utime, m.gyro[2]);
+    while (imu_.size() > 4000) imu_.pop_front();
+  }
+
+  // Integrated gyro z over (t0, t1] (trapezoid over the samples inside, held at the ends); nullopt when
+  // the samples do not cover the interval.
+  std::optional<double> yaw_delta(int64_t t0, int64_t t1) {
+    if (imu_.size() < 2 || t1 <= t0 || imu_.front().first > t0 || imu_.back().first < t1 - 20000) return std::nullopt;
+    double sum = 0;
+    for (size_t i = 1; i < imu_.size(); ++i) {
+      const int64_t a = std::max(imu_[i - 1].first, t0), b = std::min(imu_[i].first, t1);
+      if (b <= a) continue;
+      sum += 0.5 * (imu_[i - 1].second + imu_[i].second) * (b - a) * 1e-6;
+    }
+    while (imu_.size() > 2 && imu_[1].first < t0) imu_.pop_front();
+    return sum;
+  }
+
+  void on_features(const fploc::features_t& m) {
+    const auto t_start = std::chrono::steady_clock::now();
+    fploc::FeatureFrame f;
+    int dropped = 0;
+    try {
+      f = fploc::from_msg(m, &dropped);
+    } catch (const std::exception& e) {
+      ctx_->error(std::string("features: ") + e.what());
+      return;
+    }
+    if (dropped) ctx_->error("features seq " + std::to_string(m.seq) + ": " + std::to_string(dropped) + " non-finite points dropped");
+    std::optional<double> dyaw;
+    if (use_imu_ && have_prev_) dyaw = yaw_delta(prev_utime_, f.utime);
+    const fploc::MatchResult r = matcher_->process(f, dyaw);
+    if (r.status != FitStatus::kNotInitialised) {
+      prev_utime_ = f.utime;
+      have_prev_ = true;
+    }
+    fploc::frame_pose_t o;
+    o.utime = m.utime;
+    o.seq = seq_++;
+    o.scan_seq = m.scan_seq;
+    o.status = int8_t(r.status);
+    o.status_text = r.status == FitStatus::kOk ? "" : std::string(fploc::to_string(r.status)) + ": " + r.text;
+    o.x = r.pose.x;
+    o.y = r.pose.y;
+    o.yaw = r.pose.yaw;
+    for (int i = 0; i < 9; ++i) o.covariance[i] = r.covariance(i / 3, i % 3);
+    o.roll = f.roll;
+    o.pitch = f.pitch;
+    o.z = f.z;
+    o.num_points = r.fit.num_points;
+    o.num_inliers = r.fit.num_inliers;
+    o.inlier_ratio = r.fit.inlier_ratio;
+    o.rms_residual_m = r.fit.rms_m;
+    o.iterations = r.iterations;
+    // Wall-clock only outside replay (outputs must be reproducible there).
+    o.solve_ms = ctx_->composed() ? 0.0
+                                  : std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
+    if (r.status == FitStatus::kLost && last_status_ != FitStatus::kLost) ctx_->error("LOST at scan " + std::to_string(m.scan_seq) + ": " + r.text);
+    last_status_ = r.status;
+    out_.publish(o);
+  }
+
+  fploc::rt::Context* ctx_ = nullptr;
+  fploc::LocalizationMap map_;
+  std::unique_ptr<fploc::Matcher> matcher_;
+  fploc::rt::Publisher<fploc::frame_pose_t> out_;
+  std::deque<std::pair<int64_t, double>> imu_;
+  bool use_imu_ = true;
+  bool have_prev_ = false;
+  int64_t prev_utime_ = 0;
+  int64_t seq_ = 0;
+  FitStatus last_status_ = FitStatus::kOk;
+};
+
+}  // namespace
+
+FPLOC_REGISTER_NODE(MatcherNode)

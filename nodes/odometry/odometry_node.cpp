@@ -1,0 +1,61 @@
+// fploc-odometry: the no-floor-plan baseline. FPLOC_FEATURES -> frame-to-local-map 2D ICP ->
+// FPLOC_ODOM_POSE (6-DoF with the segmenter's roll/pitch/z, every frame, final_estimate = true), from
+// the same initial pose as the matcher.
+#include <fploc/features_t.hpp>
+#include <fploc/pose_t.hpp>
+
+#include <cmath>
+#include <memory>
+
+#include "fploc/nodes/localization_convert.h"
+#include "fploc/odometry/odometry.h"
+#include "fploc/runtime/node.h"
+#include "options/localization.pb.h"
+
+namespace {
+
+class OdometryNode : public fploc::rt::Node {
+ public:
+  static fploc::rt::NodeSpec spec() {
+    return {"odometry", "odometry", "no-floor-plan baseline: frame-to-local-map 2D ICP on the features",
+            {fploc::rt::input<fploc::features_t>("features", "FPLOC_FEATURES"),
+             fploc::rt::output<fploc::pose_t>("pose", "FPLOC_ODOM_POSE")}};
+  }
+
+  void setup(fploc::rt::Context& ctx) override {
+    ctx_ = &ctx;
+    const auto& o = ctx.options<fploc::OdometryOptions>();
+    fploc::OdometryConfig c;
+    if (o.max_correspondence_m() > 0) c.max_correspondence_m = o.max_correspondence_m();
+    if (o.keyframe_distance_m() > 0) c.keyframe_distance_m = o.keyframe_distance_m();
+    if (o.keyframe_angle_deg() > 0) c.keyframe_angle_rad = o.keyframe_angle_deg() * M_PI / 180;
+    if (o.map_keyframes() > 0) c.map_keyframes = o.map_keyframes();
+    if (o.max_iterations() > 0) c.max_iterations = o.max_iterations();
+    odo_ = std::make_unique<fploc::Odometry2D>(c);
+    odo_->set_pose({o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()});
+    out_ = ctx.advertise<fploc::pose_t>("pose");
+    ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) {
+      fploc::FeatureFrame f;
+      try {
+        f = fploc::from_msg(m);
+      } catch (const std::exception& e) {
+        ctx_->error(std::string("features: ") + e.what());
+        return;
+      }
+      const fploc::OdometryResult r = odo_->process(f);
+      Eigen::Matrix3d cov = Eigen::Matrix3d::Identity() * (r.ok ? r.rms_m * r.rms_m : 1e6);
+      out_.publish(fploc::make_pose_msg(f.utime, seq_++, r.pose, f.roll, f.pitch, f.z, cov, f.z_sigma,
+                                        f.roll_pitch_sigma, r.ok ? 0 : 1, r.keyframe, true));
+    });
+  }
+
+ private:
+  fploc::rt::Context* ctx_ = nullptr;
+  std::unique_ptr<fploc::Odometry2D> odo_;
+  fploc::rt::Publisher<fploc::pose_t> out_;
+  int64_t seq_ = 0;
+};
+
+}  // namespace
+
+FPLOC_REGISTER_NODE(OdometryNode)
