@@ -24,6 +24,7 @@ static void BM_RegisterFrame(benchmark::State& st, std::string lookup) {
   const Pose2 truth{10, 5, 0.7};
   const FeatureFrame f = fploc::testing::synth_frame(*map.plan, truth, so);
   MatcherConfig cfg;
+  cfg.gate_initial_m = cfg.gate_tracking_m;  // as while tracking (Matcher::process)
   double err = 0;
   int iters = 0;
   for (auto _ : st) {

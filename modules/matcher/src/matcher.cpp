@@ -51,9 +51,9 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
   std::vector<Assignment> as;
   ceres::Problem::Options po;
   po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  po.enable_fast_removal = false;
+  po.disable_all_safety_checks = true;
   ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
+  so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   so.num_threads = 1;
   so.max_num_iterations = std::max(1, cfg.max_iterations);
   so.logging_type = ceres::SILENT;
@@ -69,7 +69,7 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
     assign(lookup, f, Pose2{x[0], x[1], x[2]}, ao, &as);
     if (as.size() < 3) break;
     problem = std::make_unique<ceres::Problem>(po);
-    add_plan_terms(problem.get(), x, lookup, f, as, loss.get());
+    add_frame_term(problem.get(), x, lookup, f, as, cfg.loss, cfg.loss_scale_m);
     const double before[3] = {x[0], x[1], x[2]};
     ceres::Solver::Summary sum;
     ceres::Solve(so, problem.get(), &sum);
@@ -129,6 +129,9 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
   MatcherConfig cfg = cfg_;
   const bool lost = poor_count_ >= cfg_.lost_after;
   if (lost) cfg.gate_initial_m *= 2;  // search wider while lost
+  // Tracking (the previous frame was registered): the motion model is good to centimetres, so start
+  // with the tracking gate (fewer look-up rounds).
+  else if (have_last_ && poor_count_ == 0) cfg.gate_initial_m = std::min(cfg.gate_initial_m, cfg.gate_tracking_m);
   MatchResult r = register_frame(lookup_, f, pred, cfg);
   r.predicted = pred;
   const double jump = std::hypot(r.solved.x - pred.x, r.solved.y - pred.y);

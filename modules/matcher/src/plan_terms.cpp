@@ -8,6 +8,8 @@
 namespace fploc {
 namespace {
 
+enum class LossKind { kNone, kHuber, kCauchy };
+
 // Closest point on one element with d(p - q)/dp.
 double closest_one(const Element& e, const Eigen::Vector2d& p, Eigen::Vector2d* q, Eigen::Matrix2d* J) {
   switch (e.kind) {
@@ -85,6 +87,70 @@ class PointCost : public ceres::SizedCostFunction<2, 3> {
   Assignment a_;
   Eigen::Vector2d p_;
   double w_;
+};
+
+// All points of one frame in one residual block (Ceres' per-block overhead dominates per-point
+// blocks). The robust loss is folded into the residuals exactly: r~ = g(s) r with g = sqrt(rho(s)/s),
+// s = |r|^2, so |r~|^2 = rho(s), and the Jacobian is the exact derivative of r~.
+class FrameCost : public ceres::CostFunction {
+ public:
+  FrameCost(const std::vector<Element>* targets, std::vector<Assignment> as, std::vector<Eigen::Vector2d> pts,
+            LossKind loss, double scale, double w)
+      : targets_(targets), as_(std::move(as)), pts_(std::move(pts)), loss_(loss), a_(scale), w_(w) {
+    set_num_residuals(int(2 * as_.size()));
+    mutable_parameter_block_sizes()->push_back(3);
+  }
+  bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
+    const double* x = params[0];
+    const double c = std::cos(x[2]), s = std::sin(x[2]);
+    double* jac = jacobians ? jacobians[0] : nullptr;
+    Eigen::Vector2d q;
+    Eigen::Matrix2d J;
+    for (size_t i = 0; i < as_.size(); ++i) {
+      const Eigen::Vector2d& p = pts_[i];
+      const Eigen::Vector2d pw(c * p.x() - s * p.y() + x[0], s * p.x() + c * p.y() + x[1]);
+      closest_of(*targets_, as_[i].cand, as_[i].n, pw, &q, jac ? &J : nullptr);
+      const Eigen::Vector2d r = w_ * (pw - q);
+      const double sq = r.squaredNorm();
+      double g = 1, dg = 0;
+      robust_scale(sq, &g, &dg);
+      residuals[2 * i] = g * r.x();
+      residuals[2 * i + 1] = g * r.y();
+      if (jac) {
+        Eigen::Matrix<double, 2, 3> dp;
+        dp << 1, 0, -s * p.x() - c * p.y(), 0, 1, c * p.x() - s * p.y();
+        const Eigen::Matrix<double, 2, 3> Jr = w_ * J * dp;
+        Eigen::Matrix<double, 2, 3> Jt = g * Jr;
+        if (dg != 0) Jt += (2 * dg) * r * (r.transpose() * Jr);
+        Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>>(jac + 6 * i) = Jt;
+      }
+    }
+    return true;
+  }
+
+ private:
+  // g = sqrt(rho(s)/s) and dg/ds.
+  void robust_scale(double s, double* g, double* dg) const {
+    const double a2 = a_ * a_;
+    if (loss_ == LossKind::kNone || s < 1e-18) return;
+    double rho, rho1;
+    if (loss_ == LossKind::kHuber) {
+      if (s <= a2) return;
+      const double r = std::sqrt(s);
+      rho = 2 * a_ * r - a2;
+      rho1 = a_ / r;
+    } else {  // Cauchy
+      rho = a2 * std::log1p(s / a2);
+      rho1 = 1.0 / (1.0 + s / a2);
+    }
+    *g = std::sqrt(rho / s);
+    *dg = (rho1 * s - rho) / (2 * (*g) * s * s);
+  }
+  const std::vector<Element>* targets_;
+  std::vector<Assignment> as_;
+  std::vector<Eigen::Vector2d> pts_;
+  LossKind loss_;
+  double a_, w_;
 };
 
 }  // namespace
@@ -169,6 +235,16 @@ void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, 
 ceres::CostFunction* make_point_cost(const std::vector<Element>* targets, const Assignment& a,
                                      const Eigen::Vector2d& p_sensor, double weight) {
   return new PointCost(targets, a, p_sensor, weight);
+}
+
+void add_frame_term(ceres::Problem* problem, double* pose, const NearestLookup& lookup, const FeatureFrame& f,
+                    const std::vector<Assignment>& as, const std::string& loss, double scale, double weight) {
+  if (as.empty()) return;
+  std::vector<Eigen::Vector2d> pts;
+  pts.reserve(as.size());
+  for (const auto& a : as) pts.push_back(f.points[size_t(a.point)].p);
+  const LossKind k = (loss == "none" || scale <= 0) ? LossKind::kNone : loss == "cauchy" ? LossKind::kCauchy : LossKind::kHuber;
+  problem->AddResidualBlock(new FrameCost(&lookup.targets(), as, std::move(pts), k, scale, weight), nullptr, pose);
 }
 
 void add_plan_terms(ceres::Problem* problem, double* pose, const NearestLookup& lookup, const FeatureFrame& f,

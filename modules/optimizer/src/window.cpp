@@ -97,9 +97,8 @@ PoseOut WindowOptimizer::add(FrameInput in, std::vector<PoseOut>* finals) {
 }
 
 void WindowOptimizer::solve() {
-  auto loss = make_loss(cfg_.loss, cfg_.loss_scale_m);
   ceres::Problem::Options po;
-  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.disable_all_safety_checks = true;
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   so.num_threads = 1;
@@ -128,7 +127,7 @@ void WindowOptimizer::solve() {
       Key& k = window_[i];
       assign(lookup_, k.in.features, Pose2{k.x[0], k.x[1], k.x[2]}, ao, &as[i]);
       problem.AddParameterBlock(k.x, 3);
-      add_plan_terms(&problem, k.x, lookup_, k.in.features, as[i], loss.get());
+      add_frame_term(&problem, k.x, lookup_, k.in.features, as[i], cfg_.loss, cfg_.loss_scale_m);
     }
     for (size_t i = 0; i + 2 < chain.size(); ++i) {
       const double dt0 = (chain[i + 1].second - chain[i].second) * 1e-6;

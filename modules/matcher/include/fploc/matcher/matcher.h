@@ -14,6 +14,7 @@ namespace fploc {
 struct MatcherConfig {
   double gate_initial_m = 1.5;    // correspondence gate of the first outer iteration
   double gate_final_m = 0.3;      // ... halved each outer iteration down to this
+  double gate_tracking_m = 0.6;   // first gate while tracking (previous frame OK)
   double loss_scale_m = 0.05;     // robust (Huber) loss scale
   std::string loss = "huber";     // "huber", "cauchy", "none"
   int max_iterations = 10;        // Ceres iterations per outer iteration

@@ -54,6 +54,12 @@ void add_plan_terms(ceres::Problem* problem, double* pose, const NearestLookup& 
 // Robust loss by name ("huber", "cauchy", "none" = nullptr) with scale [m].
 std::unique_ptr<ceres::LossFunction> make_loss(const std::string& name, double scale);
 
+// The same terms as ONE residual block for the whole frame (2 residuals per assignment) with the robust
+// loss ("huber", "cauchy", "none", scale [m]) folded exactly into the residuals: much less Ceres
+// overhead than a block per point. Used by the matcher and the optimizer.
+void add_frame_term(ceres::Problem* problem, double* pose, const NearestLookup& lookup, const FeatureFrame& f,
+                    const std::vector<Assignment>& a, const std::string& loss, double scale, double weight = 1.0);
+
 // Inlier ratio and rms against the nearest candidate at pose x (no gating other than inlier_m).
 FitQuality evaluate_fit(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, double inlier_m);
 
