@@ -44,11 +44,16 @@ struct Pair {
 };
 
 // The two elements nearest to p among `cand` (ties by id).
-Pair two_nearest(const FloorPlan& plan, const std::vector<uint32_t>& cand, const Eigen::Vector2d& p) {
+Pair two_nearest(const FloorPlan& plan, const std::vector<uint32_t>& cand, const Eigen::Vector2d& p,
+                 bool distinct = false) {
   Pair out;
   double d1 = std::numeric_limits<double>::infinity(), d2 = d1;
   for (uint32_t id : cand) {
     const double d = distance(plan.elements[id], p);
+    if (distinct && d == d1) {  // keep the lower id as first, never a tie as second
+      if (int(id) < out.first) out.first = int(id);
+      continue;
+    }
     if (d < d1 || (d == d1 && int(id) < out.first)) {
       d2 = d1;
       out.second = out.first;
@@ -122,7 +127,7 @@ struct Builder {
     for (int q = 0; q < 4; ++q) {
       const Box2 cb = child_box(box, q);
       filter_candidates(plan, K, cb, 2, &Kc[q], &smax, &smin);
-      pc[q] = two_nearest(plan, Kc[q], centre(cb));
+      pc[q] = two_nearest(plan, Kc[q], centre(cb), o.paper_distinct_distances);
       all_same = all_same && same_pair(pc[q], pair, ordered);
     }
     if (o.paper_rule != PaperRule::kFull && all_same) return leaf(pair);  // withdraw the division
@@ -212,20 +217,59 @@ void Annf::prepare() {
   inv_leaf_ = 1.0 / leaf_;
   extent_x_ = double(nx_) * double(1u << (max_depth_ - 1));
   extent_y_ = double(ny_) * double(1u << (max_depth_ - 1));
-  prims_.clear();
-  for (const auto& e : plan_.elements) {
-    Prim p{};
-    p.kind = int(e.kind);
-    if (e.kind == ElementKind::kSegment) {
-      p.ax = e.a.x();
-      p.ay = e.a.y();
-      p.dx = e.b.x() - e.a.x();
-      p.dy = e.b.y() - e.a.y();
-      const double l2 = p.dx * p.dx + p.dy * p.dy;
-      p.inv_l2 = l2 > 0 ? 1.0 / l2 : 0.0;
+  // Fast leaf records with geometry copies; map pool offsets to fast offsets.
+  fast_.clear();
+  fast_.push_back(0);  // records start at odd offsets
+  std::unordered_map<uint32_t, uint32_t> remap;
+  auto leaf_word = [&](uint32_t w) -> uint32_t {
+    const uint32_t off = w & ~kLeafBit;
+    auto it = remap.find(off);
+    if (it != remap.end()) return kLeafBit | it->second;
+    if (fast_.size() % 2 == 0) fast_.push_back(0);
+    const uint32_t at = uint32_t(fast_.size());
+    const uint32_t n = pool_[off];
+    fast_.push_back(n);
+    for (uint32_t k = 0; k < n; ++k) fast_.push_back(pool_[off + 1 + k]);
+    if (fast_.size() % 2 == 1) fast_.push_back(0);
+    for (uint32_t k = 0; k < n; ++k) {
+      const Element& e = plan_.elements[pool_[off + 1 + k]];
+      FastPrim f{};
+      if (e.kind == ElementKind::kSegment) {
+        f.ax = e.a.x();
+        f.ay = e.a.y();
+        f.dx = e.b.x() - e.a.x();
+        f.dy = e.b.y() - e.a.y();
+        const double l2 = f.dx * f.dx + f.dy * f.dy;
+        f.inv_l2 = l2 > 0 ? 1.0 / l2 : 0.0;
+      } else {
+        f.inv_l2 = -1;
+      }
+      uint32_t words[10];
+      std::memcpy(words, &f, sizeof f);
+      fast_.insert(fast_.end(), words, words + 10);
     }
-    prims_.push_back(p);
-  }
+    if (fast_.size() >= kLeafBit) fail("ANNF too large (fast leaf pool)");
+    remap.emplace(off, at);
+    return kLeafBit | at;
+  };
+  fnodes_ = nodes_;
+  for (auto& w : fnodes_)
+    if (w & kLeafBit) w = leaf_word(w);
+  // Dense index at the deepest level whose cell count fits the budget.
+  int g = 1;
+  while (g < max_depth_ && double(nx_) * ny_ * double(1ull << (2 * g)) <= double(options_.index_cells)) ++g;
+  index_shift_ = max_depth_ - g;
+  const uint32_t per = 1u << (g - 1);
+  index_nx_ = nx_ * per;
+  index_.assign(size_t(index_nx_) * ny_ * per, 0);
+  for (uint32_t j = 0; j < ny_ * per; ++j)
+    for (uint32_t i = 0; i < index_nx_; ++i) {
+      uint32_t node = roots_[size_t(j / per) * nx_ + i / per];
+      for (int level = g - 2; level >= 0 && !(node & kLeafBit); --level)
+        node = nodes_[node + (((j >> level) & 1u) << 1 | ((i >> level) & 1u))];
+      index_[size_t(j) * index_nx_ + i] = (node & kLeafBit) ? leaf_word(node) : node;
+    }
+  fast_.shrink_to_fit();
 }
 
 Annf Annf::build(const FloorPlan& plan, const AnnfOptions& options) {
@@ -249,8 +293,6 @@ Annf Annf::build(const FloorPlan& plan, const AnnfOptions& options) {
          std::to_string(a.max_depth_) + " (check the units)");
   a.nx_ = uint32_t(nxd);
   a.ny_ = uint32_t(nyd);
-  // Size exactly: the last root field may overhang (that is fine, the extents are in leaf units).
-  a.prepare();
   a.roots_.assign(size_t(a.nx_) * a.ny_, 0);
   Builder b{a.plan_, a.options_, a.nodes_, a.pool_, {}, {}, {}};
   std::vector<uint32_t> all(plan.elements.size());
@@ -264,7 +306,7 @@ Annf Annf::build(const FloorPlan& plan, const AnnfOptions& options) {
       uint32_t w;
       if (options.mode == AnnfMode::kPaper) {
         filter_candidates(a.plan_, all, box, 2, &K, &b.smax, &b.smin);
-        w = b.paper(box, 1, K, two_nearest(a.plan_, K, centre(box)));
+        w = b.paper(box, 1, K, two_nearest(a.plan_, K, centre(box), options.paper_distinct_distances));
       } else {
         filter_candidates(a.plan_, all, box, 1, &K, &b.smax, &b.smin);
         w = b.exact(box, 1, K);
@@ -273,45 +315,11 @@ Annf Annf::build(const FloorPlan& plan, const AnnfOptions& options) {
     }
   a.nodes_.shrink_to_fit();
   a.pool_.shrink_to_fit();
+  a.prepare();
   return a;
 }
 
-int Annf::best_of(const uint32_t* ids, int n, const Eigen::Vector2d& p, double* dist, Eigen::Vector2d* closest) const {
-  int best = -1;
-  double bd2 = std::numeric_limits<double>::infinity();
-  double bx = 0, by = 0;
-  for (int k = 0; k < n; ++k) {
-    const uint32_t id = ids[k];
-    const Prim& s = prims_[id];
-    double qx, qy;
-    if (s.kind == 0) {
-      double t = ((p.x() - s.ax) * s.dx + (p.y() - s.ay) * s.dy) * s.inv_l2;
-      t = t < 0 ? 0 : (t > 1 ? 1 : t);
-      qx = s.ax + t * s.dx;
-      qy = s.ay + t * s.dy;
-    } else {
-      const ClosestPoint cp = closest_point(plan_.elements[id], p);
-      qx = cp.point.x();
-      qy = cp.point.y();
-    }
-    const double d2 = (qx - p.x()) * (qx - p.x()) + (qy - p.y()) * (qy - p.y());
-    if (d2 < bd2) {
-      bd2 = d2;
-      best = int(id);
-      bx = qx;
-      by = qy;
-    }
-  }
-  if (dist) *dist = std::sqrt(bd2);
-  if (closest) *closest = Eigen::Vector2d(bx, by);
-  return best;
-}
-
-int Annf::nearest(const Eigen::Vector2d& p, double* dist, Eigen::Vector2d* closest) const {
-  int n;
-  const uint32_t* ids = lookup(p, &n);
-  if (ids) return best_of(ids, n, p, dist, closest);
-  // Outside the covered area: brute force (exact).
+int Annf::nearest_outside(const Eigen::Vector2d& p, double* dist, Eigen::Vector2d* closest) const {
   double d;
   const int id = nearest_element_brute_force(plan_, p, &d);
   if (dist) *dist = d;
@@ -349,7 +357,8 @@ AnnfStats Annf::stats() const {
   AnnfStats s;
   s.nodes = roots_.size() + nodes_.size();
   s.pool_ids = pool_.size();
-  s.bytes = (roots_.size() + nodes_.size() + pool_.size()) * sizeof(uint32_t);
+  s.bytes = (index_.size() + fnodes_.size() + fast_.size()) * sizeof(uint32_t);
+  s.file_bytes = (roots_.size() + nodes_.size() + pool_.size()) * sizeof(uint32_t);
   size_t total = 0;
   for_each_leaf([&](const Box2&, int depth, const uint32_t*, int n) {
     ++s.leaves;
@@ -363,7 +372,7 @@ AnnfStats Annf::stats() const {
 
 void Annf::write(std::ostream& out) const {
   put<uint8_t>(out, uint8_t(options_.mode));
-  put<uint8_t>(out, uint8_t(options_.paper_rule));
+  put<uint8_t>(out, uint8_t(uint8_t(options_.paper_rule) | (options_.paper_distinct_distances ? 0x80 : 0)));
   put<double>(out, options_.root_length);
   put<int32_t>(out, options_.max_depth);
   put<int32_t>(out, options_.exact_max_candidates);
@@ -384,8 +393,10 @@ void Annf::write(std::ostream& out) const {
 Annf Annf::read(std::istream& in, FloorPlan plan, const std::string& source) {
   Annf a;
   a.plan_ = std::move(plan);
-  const uint8_t mode = get<uint8_t>(in, source), rule = get<uint8_t>(in, source);
+  const uint8_t mode = get<uint8_t>(in, source), rule_byte = get<uint8_t>(in, source);
+  const uint8_t rule = rule_byte & 0x7f;
   if (mode > 1 || rule > 3) fail(source + ": corrupt map file (mode/rule)");
+  a.options_.paper_distinct_distances = (rule_byte & 0x80) != 0;
   a.options_.mode = AnnfMode(mode);
   a.options_.paper_rule = PaperRule(rule);
   a.options_.root_length = get<double>(in, source);

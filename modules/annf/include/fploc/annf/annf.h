@@ -24,7 +24,9 @@
 // on a bad, truncated or old file.
 #pragma once
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -53,6 +55,13 @@ struct AnnfOptions {
   PaperRule paper_rule = PaperRule::kChildLeaf;
   int exact_max_candidates = 2;  // exact mode: subdivide while a leaf holds more candidates
   double margin = 0.0;           // metres added around the plan's bounding box
+  // Paper mode: "two nearest" keeps two elements at *different* distances from the field centre
+  // (an element tied with the first, e.g. the other wall at a shared corner, is skipped), as the
+  // authors' public ANNF demo does (its leaf table shows this).
+  bool paper_distinct_distances = false;
+  // Speed only (not saved, no effect on results): the top levels of the trees are flattened into a
+  // dense index of at most this many cells so a look-up starts near the leaf.
+  uint32_t index_cells = 1u << 18;
 };
 
 const char* to_string(AnnfMode m);
@@ -62,7 +71,8 @@ PaperRule parse_paper_rule(const std::string& s);  // "child-leaf" | "undo-only"
 
 struct AnnfStats {
   size_t nodes = 0, leaves = 0, pool_ids = 0;
-  size_t bytes = 0;  // memory of the look-up structure (nodes + pool + root grid)
+  size_t bytes = 0;       // memory of the look-up structure (index + nodes + leaf records with geometry)
+  size_t file_bytes = 0;  // compact tree as saved (roots + nodes + id pool), without the plan
   int max_leaf_candidates = 0;
   double mean_leaf_candidates = 0;
   int deepest = 0;
@@ -85,21 +95,55 @@ class Annf {
       return nullptr;
     }
     const uint32_t ix = uint32_t(fx), iy = uint32_t(fy);
-    const int shift = max_depth_ - 1;
-    uint32_t node = roots_[(iy >> shift) * nx_ + (ix >> shift)];
-    int s = shift;
+    // Root field by rounding (through a dense index of the tree's top levels), then descend.
+    int s = index_shift_;
+    uint32_t node = index_[size_t(iy >> s) * index_nx_ + (ix >> s)];
     while (!(node & kLeafBit)) {
       --s;
-      node = nodes_[node + (((iy >> s) & 1u) << 1 | ((ix >> s) & 1u))];
+      node = fnodes_[node + (((iy >> s) & 1u) << 1 | ((ix >> s) & 1u))];
     }
-    const uint32_t* leaf = pool_.data() + (node & ~kLeafBit);
+    const uint32_t* leaf = fast_.data() + (node & ~kLeafBit);
     *count = int(leaf[0]);
     return leaf + 1;
   }
 
   // Best element among the leaf's candidates (exact in exact mode; the better of the two in paper
   // mode). Outside the covered area: brute force. Returns -1 only for an empty field.
-  int nearest(const Eigen::Vector2d& p, double* dist = nullptr, Eigen::Vector2d* closest = nullptr) const;
+  int nearest(const Eigen::Vector2d& p, double* dist = nullptr, Eigen::Vector2d* closest = nullptr) const {
+    int n;
+    const uint32_t* ids = lookup(p, &n);
+    if (!ids) return nearest_outside(p, dist, closest);
+    // The leaf record holds a copy of its candidates' geometry right after the ids (one cache
+    // line or two): no further dependent memory access.
+    const uint32_t* g = ids + ((n + 1) & ~1);
+    int best = -1;
+    double bd2 = 1e300, bx = 0, by = 0;
+    for (int k = 0; k < n; ++k, g += 10) {
+      FastPrim s;
+      std::memcpy(&s, g, sizeof s);
+      double qx, qy;
+      if (s.inv_l2 >= 0) {
+        double t = ((p.x() - s.ax) * s.dx + (p.y() - s.ay) * s.dy) * s.inv_l2;
+        t = t < 0 ? 0 : (t > 1 ? 1 : t);
+        qx = s.ax + t * s.dx;
+        qy = s.ay + t * s.dy;
+      } else {
+        const ClosestPoint cp = closest_point(plan_.elements[ids[k]], p);
+        qx = cp.point.x();
+        qy = cp.point.y();
+      }
+      const double d2 = (qx - p.x()) * (qx - p.x()) + (qy - p.y()) * (qy - p.y());
+      if (d2 < bd2) {
+        bd2 = d2;
+        best = int(ids[k]);
+        bx = qx;
+        by = qy;
+      }
+    }
+    if (dist) *dist = std::sqrt(bd2);
+    if (closest) *closest = Eigen::Vector2d(bx, by);
+    return best;
+  }
 
   // Like nearest() but also returns the first candidate (paper mode: the leaf's "1st element").
   int first_candidate(const Eigen::Vector2d& p) const {
@@ -127,13 +171,13 @@ class Annf {
 
  private:
   static constexpr uint32_t kLeafBit = 0x80000000u;
-  // Compact element for fast distance evaluation (segments: a, b-a, 1/|b-a|^2).
-  struct Prim {
+  // Geometry copy in a leaf record (segments: a, b-a, 1/|b-a|^2; inv_l2 < 0: other kinds).
+  struct FastPrim {
     double ax, ay, dx, dy, inv_l2;
-    int kind;  // 0 segment, otherwise use plan_.elements
   };
+  static_assert(sizeof(FastPrim) == 40);
+  int nearest_outside(const Eigen::Vector2d& p, double* dist, Eigen::Vector2d* closest) const;
   void prepare();
-  int best_of(const uint32_t* ids, int n, const Eigen::Vector2d& p, double* dist, Eigen::Vector2d* closest) const;
 
   FloorPlan plan_;
   AnnfOptions options_;
@@ -145,7 +189,14 @@ class Annf {
   std::vector<uint32_t> roots_;  // nx*ny, node word: leaf bit | pool offset, or index of 4 children
   std::vector<uint32_t> nodes_;  // groups of 4 child words
   std::vector<uint32_t> pool_;   // [count, ids...] per leaf
-  std::vector<Prim> prims_;
+  // Derived in prepare() (not saved): dense top-level index, nodes with leaf words pointing into
+  // fast_, and fast_ = per leaf [count, ids..., pad, FastPrim x count] (record at an odd offset so
+  // the geometry is 8-byte aligned).
+  std::vector<uint32_t> index_;
+  std::vector<uint32_t> fnodes_;
+  std::vector<uint32_t> fast_;
+  uint32_t index_nx_ = 0;
+  int index_shift_ = 0;
 };
 
 template <typename F>

@@ -1,0 +1,165 @@
+// fploc map build|validate|render|export-pgm  (contracts in docs/DESIGN.md)
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
+
+#include "fploc/annf/annf.h"
+#include "fploc/annf/baselines.h"
+#include "fploc/floorplan/io.h"
+#include "map_tool.h"
+
+using nlohmann::json;
+using namespace fploc;
+
+namespace {
+
+struct PlanArgs {
+  std::string plan, layers, units;
+  void add(CLI::App* app) {
+    app->add_option("--plan", plan, "floor plan (.dxf, .csv, .json, .fpmap)")->required();
+    app->add_option("--layers", layers, "layer globs, comma-separated (e.g. '*WALL*,*COLS*')");
+    app->add_option("--units", units, "drawing units override: m, cm, mm, in, ft");
+  }
+  FloorPlan load() const {
+    PlanLoadOptions o;
+    std::stringstream ss(layers);
+    std::string g;
+    while (std::getline(ss, g, ','))
+      if (!g.empty()) o.layer_globs.push_back(g);
+    o.units_override = units;
+    return load_floor_plan(plan, o);
+  }
+};
+
+struct AnnfArgs {
+  std::string mode = "paper", rule = "child-leaf";
+  int depth = 7, max_candidates = 2;
+  double root = 6.0;
+  void add(CLI::App* app, bool with_depth = true) {
+    app->add_option("--mode", mode, "paper | exact")->check(CLI::IsMember({"paper", "exact"}));
+    if (with_depth) app->add_option("--depth", depth, "maximum depth (1 = root fields only)");
+    app->add_option("--root", root, "root field length in metres (default 6)");
+    app->add_option("--rule", rule, "paper stopping rule: child-leaf | undo-only | child-leaf-ordered | full");
+    app->add_option("--max-candidates", max_candidates, "exact mode: subdivide while a leaf has more candidates");
+  }
+  AnnfOptions options() const {
+    AnnfOptions o;
+    o.mode = parse_annf_mode(mode);
+    o.paper_rule = parse_paper_rule(rule);
+    o.max_depth = depth;
+    o.root_length = root;
+    o.exact_max_candidates = max_candidates;
+    return o;
+  }
+};
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+json stats_json(const Annf& a, double build_ms) {
+  const AnnfStats s = a.stats();
+  return {{"mode", to_string(a.options().mode)},
+          {"rule", to_string(a.options().paper_rule)},
+          {"depth", a.options().max_depth},
+          {"root_length_m", a.options().root_length},
+          {"leaf_length_m", a.leaf_length()},
+          {"elements", a.plan().elements.size()},
+          {"nodes", s.nodes},
+          {"leaves", s.leaves},
+          {"bytes", s.bytes},
+          {"mean_candidates", s.mean_leaf_candidates},
+          {"max_candidates", s.max_leaf_candidates},
+          {"deepest", s.deepest},
+          {"build_ms", build_ms}};
+}
+
+int cmd_build(const PlanArgs& pa, const AnnfArgs& aa, const std::string& out, bool as_json) {
+  const FloorPlan plan = pa.load();
+  const auto t0 = std::chrono::steady_clock::now();
+  const Annf a = Annf::build(plan, aa.options());
+  const double ms = ms_since(t0);
+  a.save(out);
+  json j = stats_json(a, ms);
+  j["out"] = out;
+  j["file_bytes"] = std::filesystem::file_size(out);
+  std::cerr << "fploc map build: " << plan.elements.size() << " elements, mode " << aa.mode << ", depth " << aa.depth
+            << ", leaf " << a.leaf_length() << " m, " << j["leaves"] << " leaves, " << j["bytes"] << " bytes, "
+            << ms << " ms -> " << out << "\n";
+  if (as_json) std::cout << j.dump(1) << "\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"fploc map: floor plans and the ANNF"};
+  app.require_subcommand(1);
+  bool as_json = false;
+
+  PlanArgs b_plan;
+  AnnfArgs b_annf;
+  std::string b_out;
+  auto* build = app.add_subcommand("build", "build an ANNF and save it as .fpmap");
+  b_plan.add(build);
+  b_annf.add(build);
+  build->add_option("--out", b_out, "output .fpmap")->required();
+  build->add_flag("--json", as_json, "JSON summary on stdout");
+
+  PlanArgs v_plan;
+  ValidateArgs v;
+  auto* validate = app.add_subcommand("validate", "accuracy/speed table (paper's Table III) with baselines");
+  v_plan.add(validate);
+  validate->add_option("--depths", v.depths, "depth range, e.g. 3-8");
+  validate->add_option("--samples", v.samples, "uniform samples in the plan's bounding box (default 1000000)");
+  validate->add_option("--mode", v.mode, "paper | exact | both (default both)")->check(CLI::IsMember({"paper", "exact", "both"}));
+  validate->add_option("--rule", v.rule, "paper stopping rule (default child-leaf)");
+  validate->add_flag("--distinct", v.distinct, "paper mode: two nearest at distinct distances (the authors' demo)");
+  validate->add_flag("--all-rules", v.all_rules, "measure every reading of the paper's stopping rules");
+  validate->add_option("--root", v.root, "root field length in metres (default 6)");
+  validate->add_option("--max-candidates", v.max_candidates, "exact mode: subdivide while a leaf has more candidates");
+  validate->add_option("--exact-depth", v.exact_depth, "exact mode rows: extra depth added (default 0)");
+  validate->add_option("--baseline-depth", v.baseline_depth, "KD-tree spacing / grid resolution = leaf length at this depth (default 7)");
+  validate->add_option("--seed", v.seed, "random seed");
+  validate->add_flag("--no-baselines", v.no_baselines, "skip the baselines");
+  validate->add_flag("--json", as_json, "JSON on stdout");
+
+  PlanArgs r_plan;
+  RenderArgs r;
+  auto* render = app.add_subcommand("render", "SVG/PNG of the plan and the leaf fields coloured by nearest element");
+  r_plan.add(render);
+  render->add_option("--map", r.map, "a built .fpmap (default: build a paper-mode field)");
+  render->add_option("--depth", r.depth, "depth when building (default 5, like the paper's Fig. 2)");
+  render->add_option("--out", r.out, "output .svg or .png")->required();
+  render->add_option("--width", r.width, "image width in pixels (PNG) / user units (SVG)");
+
+  PlanArgs p_plan;
+  PgmArgs p;
+  auto* pgm = app.add_subcommand("export-pgm", "ROS map_server occupancy map (PGM + YAML)");
+  p_plan.add(pgm);
+  pgm->add_option("--resolution", p.resolution, "metres per pixel")->required();
+  pgm->add_option("--out", p.out, "output directory")->required();
+  pgm->add_option("--name", p.name, "file name stem (default map)");
+  pgm->add_option("--margin", p.margin, "free border around the plan in metres (default 1)");
+  pgm->add_option("--thickness", p.thickness, "wall thickness drawn in metres (default: one pixel)");
+  pgm->add_flag("--json", as_json, "JSON summary on stdout");
+
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (*build) return cmd_build(b_plan, b_annf, b_out, as_json);
+    if (*validate) return cmd_validate(v_plan.load(), v, as_json);
+    if (*render) return cmd_render(r_plan.load(), r);
+    if (*pgm) return cmd_export_pgm(p_plan.load(), p, as_json);
+  } catch (const std::exception& e) {
+    std::cerr << "fploc map: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 2;
+}

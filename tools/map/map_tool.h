@@ -1,0 +1,40 @@
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include "fploc/floorplan/plan.h"
+
+namespace fploc {
+
+struct ValidateArgs {
+  std::string depths = "3-8";
+  long samples = 1000000;
+  std::string mode = "both";
+  std::string rule = "child-leaf";
+  bool all_rules = false;
+  bool distinct = false;
+  double root = 6.0;
+  int max_candidates = 2;
+  int exact_depth = 0;
+  int baseline_depth = 7;
+  uint32_t seed = 1;
+  bool no_baselines = false;
+};
+int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json);
+
+struct RenderArgs {
+  std::string map, out;
+  int depth = 5;
+  int width = 1600;
+};
+int cmd_render(const FloorPlan& plan, const RenderArgs& a);
+
+struct PgmArgs {
+  double resolution = 0.05;
+  std::string out, name = "map";
+  double margin = 1.0;
+  double thickness = 0;
+};
+int cmd_export_pgm(const FloorPlan& plan, const PgmArgs& a, bool as_json);
+
+}  // namespace fploc

@@ -1,0 +1,217 @@
+// fploc map validate: the paper's Table III (per depth: leaf length, hit by 1st, hit by 1st or 2nd,
+// ns per query) over uniform samples in the plan's bounding box, ground truth by brute force, plus
+// exact-mode rows and the baselines (brute force, KD-tree over sampled points, distance grid).
+#include <chrono>
+#include <ctime>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <stdexcept>
+
+#include "fploc/annf/annf.h"
+#include "fploc/annf/baselines.h"
+#include "map_tool.h"
+
+using nlohmann::json;
+
+namespace fploc {
+namespace {
+
+// A hit: the returned element is at the true nearest distance (ties and duplicate elements count).
+constexpr double kTol = 1e-9;
+
+// Thread CPU time: the machine is shared, wall time would count other processes' slices.
+double now_ns() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) * 1e9 + double(ts.tv_nsec);
+}
+
+template <typename F>
+double time_per_query(const std::vector<Eigen::Vector2d>& pts, size_t n, F&& f) {
+  n = std::min(n, pts.size());
+  volatile double sink = 0;
+  double acc = 0;
+  const double t0 = now_ns();
+  for (size_t i = 0; i < n; ++i) acc += f(pts[i]);
+  const double t1 = now_ns();
+  sink = acc;
+  (void)sink;
+  return (t1 - t0) / double(n);
+}
+
+const std::map<int, std::array<double, 3>> kPaper = {{3, {61.61, 76.10, 0.24}}, {4, {76.08, 87.85, 0.16}},
+                                                     {5, {86.29, 93.61, 0.24}}, {6, {91.96, 96.24, 0.18}},
+                                                     {7, {94.90, 97.28, 0.25}}, {8, {96.46, 98.84, 0.35}}};
+
+}  // namespace
+
+int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
+  int d0 = 0, d1 = 0;
+  if (std::sscanf(a.depths.c_str(), "%d-%d", &d0, &d1) != 2) {
+    if (std::sscanf(a.depths.c_str(), "%d", &d0) != 1) throw std::runtime_error("--depths: expected A-B, e.g. 3-8");
+    d1 = d0;
+  }
+  if (d0 < 1 || d1 < d0 || d1 > 16) throw std::runtime_error("--depths: expected 1 <= A <= B <= 16");
+  if (a.samples < 1) throw std::runtime_error("--samples must be >= 1");
+  const Box2 bb = plan.bounds();
+  std::mt19937_64 rng(a.seed);
+  std::uniform_real_distribution<double> ux(bb.min.x(), bb.max.x()), uy(bb.min.y(), bb.max.y());
+  std::vector<Eigen::Vector2d> pts(size_t(a.samples));
+  for (auto& p : pts) p = {ux(rng), uy(rng)};
+
+  std::cerr << "fploc map validate: " << plan.elements.size() << " elements, " << pts.size()
+            << " uniform samples in " << bb.size().x() << " x " << bb.size().y() << " m; brute-force ground truth...\n";
+  std::vector<double> truth(pts.size());
+  const double tb0 = now_ns();
+  for (size_t i = 0; i < pts.size(); ++i) nearest_element_brute_force(plan, pts[i], &truth[i]);
+  const double brute_ns = (now_ns() - tb0) / double(pts.size());
+
+  json rows = json::array();
+  struct Config {
+    AnnfMode mode;
+    PaperRule rule;
+    bool distinct;
+  };
+  std::vector<Config> configs;
+  if (a.mode != "exact") {
+    if (a.all_rules) {
+      for (bool distinct : {false, true})
+        for (PaperRule r : {PaperRule::kChildLeaf, PaperRule::kUndoOnly, PaperRule::kChildLeafOrdered, PaperRule::kFull})
+          configs.push_back({AnnfMode::kPaper, r, distinct});
+    } else {
+      configs.push_back({AnnfMode::kPaper, parse_paper_rule(a.rule), a.distinct});
+    }
+  }
+  if (a.mode != "paper") configs.push_back({AnnfMode::kExact, PaperRule::kChildLeaf, false});
+  const size_t timed = std::min<size_t>(pts.size(), 2000000);
+
+  std::fprintf(stderr, "%-6s %-28s %5s %9s %8s %8s %8s %8s %10s %9s | paper: %6s %6s\n", "mode", "rule", "depth",
+               "leaf[cm]", "hit1", "hit1|2", "exact", "ns/q", "bytes", "build[ms]", "hit1", "hit1|2");
+  for (const auto& [mode, rule, distinct] : configs) {
+    for (int depth = d0; depth <= d1; ++depth) {
+      AnnfOptions o;
+      o.mode = mode;
+      o.paper_rule = rule;
+      o.root_length = a.root;
+      o.max_depth = depth + (mode == AnnfMode::kExact ? a.exact_depth : 0);
+      o.exact_max_candidates = a.max_candidates;
+      o.paper_distinct_distances = distinct;
+      const double t0 = now_ns();
+      const Annf f = Annf::build(plan, o);
+      const double build_ms = (now_ns() - t0) / 1e6;
+      size_t h1 = 0, h12 = 0, hx = 0;
+      for (size_t i = 0; i < pts.size(); ++i) {
+        int n;
+        const uint32_t* c = f.lookup(pts[i], &n);
+        const double t = truth[i] + kTol;
+        if (c && n >= 1 && distance(plan.elements[c[0]], pts[i]) <= t) {
+          ++h1;
+          ++h12;
+        } else if (c && n >= 2 && distance(plan.elements[c[1]], pts[i]) <= t) {
+          ++h12;
+        }
+        double d;
+        f.nearest(pts[i], &d);
+        hx += d <= t;
+      }
+      const double ns = time_per_query(pts, timed, [&](const Eigen::Vector2d& p) {
+        double d;
+        return f.nearest(p, &d) + d;
+      });
+      const double lookup_ns = time_per_query(pts, timed, [&](const Eigen::Vector2d& p) {
+        int n;
+        const uint32_t* c = f.lookup(p, &n);
+        return c ? double(c[0] + n) : 0.0;
+      });
+      const AnnfStats s = f.stats();
+      const double N = double(pts.size());
+      json row = {{"mode", to_string(mode)},
+                  {"rule", mode == AnnfMode::kPaper ? to_string(rule) : "-"},
+                  {"distinct_distances", distinct},
+                  {"depth", o.max_depth},
+                  {"leaf_length_m", f.leaf_length()},
+                  {"hit_first", h1 / N},
+                  {"hit_first_or_second", h12 / N},
+                  {"hit_exact", hx / N},
+                  {"ns_per_query", ns},
+                  {"lookup_ns", lookup_ns},
+                  {"bytes", s.bytes},
+                  {"nodes", s.nodes},
+                  {"leaves", s.leaves},
+                  {"mean_candidates", s.mean_leaf_candidates},
+                  {"max_candidates", s.max_leaf_candidates},
+                  {"build_ms", build_ms}};
+      auto it = kPaper.find(o.max_depth);
+      if (mode == AnnfMode::kPaper && it != kPaper.end()) {
+        row["paper_hit_first"] = it->second[0] / 100;
+        row["paper_hit_first_or_second"] = it->second[1] / 100;
+      }
+      rows.push_back(row);
+      const std::string rname = mode == AnnfMode::kPaper ? std::string(to_string(rule)) + (distinct ? "+distinct" : "") : "-";
+      std::fprintf(stderr, "%-6s %-28s %5d %9.2f %7.2f%% %7.2f%% %7.3f%% %8.2f %10zu %9.0f", to_string(mode),
+                   rname.c_str(), o.max_depth, f.leaf_length() * 100, 100 * h1 / N,
+                   100 * h12 / N, 100 * hx / N, ns, s.bytes, build_ms);
+      if (mode == AnnfMode::kPaper && it != kPaper.end())
+        std::fprintf(stderr, " | paper: %5.2f%% %5.2f%%\n", it->second[0], it->second[1]);
+      else
+        std::fprintf(stderr, "\n");
+    }
+  }
+
+  json out = {{"elements", plan.elements.size()}, {"samples", pts.size()}, {"rows", rows}};
+  out["bbox_m"] = {bb.min.x(), bb.min.y(), bb.max.x(), bb.max.y()};
+  json base = {{"brute_force_ns", brute_ns}};
+  if (!a.no_baselines) {
+    const double spacing = a.root / double(1u << (a.baseline_depth - 1));
+    const SampledKdTree kd(plan, spacing);
+    size_t kh = 0;
+    for (size_t i = 0; i < pts.size(); ++i) {
+      const int id = kd.nearest(pts[i]);
+      kh += distance(plan.elements[id], pts[i]) <= truth[i] + kTol;
+    }
+    const double kd_ns = time_per_query(pts, timed, [&](const Eigen::Vector2d& p) {
+      double d;
+      return kd.nearest(p, &d) + d;
+    });
+    AnnfOptions xo;
+    xo.mode = AnnfMode::kExact;
+    xo.root_length = a.root;
+    xo.max_depth = a.baseline_depth + 2;
+    const Annf ex = Annf::build(plan, xo);
+    const DistanceGrid grid(ex, spacing);
+    size_t gh = 0;
+    for (size_t i = 0; i < pts.size(); ++i) {
+      const int id = grid.read(pts[i]);
+      gh += id >= 0 && distance(plan.elements[id], pts[i]) <= truth[i] + kTol;
+    }
+    const double grid_ns = time_per_query(pts, timed, [&](const Eigen::Vector2d& p) {
+      float d = 0;
+      return grid.read(p, &d) + double(d);
+    });
+    base["kdtree_ns"] = kd_ns;
+    base["kdtree_hit"] = kh / double(pts.size());
+    base["kdtree_points"] = kd.points();
+    base["kdtree_bytes"] = kd.bytes();
+    base["kdtree_spacing_m"] = spacing;
+    base["grid_ns"] = grid_ns;
+    base["grid_hit"] = gh / double(pts.size());
+    base["grid_bytes"] = grid.bytes();
+    base["grid_resolution_m"] = spacing;
+    std::fprintf(stderr,
+                 "baselines: brute force %.1f ns/q; KD-tree (%zu points every %.2f cm) %.1f ns/q, hit %.2f%%, %zu B; "
+                 "distance grid (%.2f cm) %.2f ns/q, hit %.2f%%, %zu B\n",
+                 brute_ns, kd.points(), spacing * 100, kd_ns, 100.0 * kh / double(pts.size()), kd.bytes(), spacing * 100,
+                 grid_ns, 100.0 * gh / double(pts.size()), grid.bytes());
+  } else {
+    std::fprintf(stderr, "baselines: brute force %.1f ns/q\n", brute_ns);
+  }
+  out["baselines"] = base;
+  if (as_json) std::cout << out.dump(1) << "\n";
+  return 0;
+}
+
+}  // namespace fploc
