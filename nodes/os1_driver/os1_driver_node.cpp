@@ -41,6 +41,11 @@ class Os1DriverNode : public fploc::rt::Node {
       std::string err;
       const double rate = opt.pcap_rate() == 0 ? 1.0 : opt.pcap_rate();
       if (!replay_.open(ctx.resolve_path(opt.pcap()), rate, opt.pcap_loop(), &err)) throw std::runtime_error("os1_driver: " + err);
+      // Looping: the capture starts over with the same frame ids; never treat them as late packets.
+      replay_.set_on_restart([this] {
+        assembler_->resync(frames_);
+        publish_frames();
+      });
       ctx.every(rate > 0 ? 0.002 : 0.001, [this] { poll_pcap(); });
     } else {
       const int buf = opt.recv_buffer_bytes() > 0 ? opt.recv_buffer_bytes() : 8 << 20;

@@ -118,6 +118,7 @@ bool PcapReplay::fetch() {
     }
     ++passes_;
     started_ = false;
+    if (on_restart_) on_restart_();
   }
   return false;
 }

@@ -125,6 +125,12 @@ class FrameAssembler {
   const AssemblerStats& stats() const { return stats_; }
   const PacketFormat& format() const { return fmt_; }
   const SensorInfo& info() const { return info_; }
+  // Publishes the frame in progress and forgets the last frame id (a replayed capture starting over, a
+  // sensor restart): the next packets start a new frame whatever their id.
+  void resync(std::vector<Scan>& out) {
+    publish(out);
+    have_last_ = false;
+  }
   // Reuse a published Scan's buffers (optional; avoids allocation at 10 Hz).
   void recycle(Scan&& s) { spare_ = std::move(s); }
 

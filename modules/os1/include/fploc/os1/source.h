@@ -44,6 +44,8 @@ class PcapReplay {
   // Read errors seen so far (one per pass), for the node's error reporting.
   std::vector<std::string> take_errors();
   int passes() const { return passes_; }
+  // Called when a looping replay starts the file over (before its first datagram is handed out).
+  void set_on_restart(std::function<void()> fn) { on_restart_ = std::move(fn); }
 
  private:
   bool fetch();
@@ -59,6 +61,7 @@ class PcapReplay {
   std::chrono::steady_clock::time_point t0_;
   int passes_ = 0;
   std::vector<std::string> errors_;
+  std::function<void()> on_restart_;
 };
 
 }  // namespace fploc::os1

@@ -1,0 +1,72 @@
+#!/usr/bin/env python3
+"""Checks an LCM log of the OS-1 drivers against `fploc os1 decode --json` of the same capture."""
+import hashlib
+import json
+import struct
+import sys
+
+
+def events(path):
+    d = open(path, 'rb').read()
+    o = 0
+    while o + 28 <= len(d):
+        sync, _, _, cl, dl = struct.unpack('>IQQII', d[o:o + 28])
+        assert sync == 0xEDA1DA01, f"{path}: bad sync at {o}"
+        o += 28
+        ch = d[o:o + cl].decode()
+        o += cl
+        yield ch, d[o:o + dl]
+        o += dl
+
+
+def scan(b):
+    o = 8  # fingerprint
+    utime, seq, frame_id = struct.unpack('>qqi', b[o:o + 20]); o += 20
+    (n,) = struct.unpack('>i', b[o:o + 4]); o += 4
+    sensor = b[o:o + n - 1].decode(); o += n
+    h, w, npx = struct.unpack('>hhi', b[o:o + 8]); o += 8
+    rng = struct.unpack(f'>{npx}i', b[o:o + 4 * npx])
+    missing, status = struct.unpack('>ib', b[-5:])
+    md5 = hashlib.md5(struct.pack(f'<{npx}I', *rng)).hexdigest()
+    return dict(frame_id=frame_id, sensor=sensor, h=h, w=w, missing=missing, status=status, md5=md5,
+                valid=sum(1 for r in rng if r))
+
+
+def imu(b):
+    utime, seq, au, gu = struct.unpack('>qqqq', b[8:40])
+    acc = struct.unpack('>3d', b[40:64])
+    gyr = struct.unpack('>3d', b[64:88])
+    return dict(utime=utime, seq=seq, acc=acc, gyr=gyr)
+
+
+def main():
+    log, ref_path = sys.argv[1], sys.argv[2]
+    ref = json.load(open(ref_path))
+    scans, imus = [], []
+    for ch, data in events(log):
+        if ch == 'OS1_SCAN':
+            scans.append(scan(data))
+        elif ch == 'OS1_IMU':
+            imus.append(imu(data))
+    errors = []
+    if len(scans) != ref['complete_frames']:
+        errors.append(f"OS1_SCAN: {len(scans)} messages, expected {ref['complete_frames']} (late repeat must be dropped)")
+    for s in scans:
+        if (s['h'], s['w']) != (ref['pixels_per_column'], ref['columns_per_frame']):
+            errors.append(f"scan size {s['h']}x{s['w']}")
+        if s['missing'] != 0 or s['status'] != 0:
+            errors.append(f"scan {s['frame_id']}: missing {s['missing']} status {s['status']}")
+        if s['md5'] != ref['range_md5'][0]:
+            errors.append(f"scan {s['frame_id']}: range md5 {s['md5']} != decode {ref['range_md5'][0]}")
+    if len(imus) != 2 * ref['imu_packets']:
+        errors.append(f"OS1_IMU: {len(imus)} messages, expected {2 * ref['imu_packets']} (capture sent twice)")
+    for m in imus:
+        if not 9.0 < m['acc'][2] < 10.6:
+            errors.append(f"imu accel z {m['acc'][2]} m/s^2 not ~g")
+    print(json.dumps({'scans': scans, 'imu': len(imus)}, indent=1))
+    for e in errors:
+        print("FAIL:", e)
+    sys.exit(1 if errors else 0)
+
+
+main()
