@@ -39,7 +39,27 @@ def imu(b):
     return dict(utime=utime, seq=seq, acc=acc, gyr=gyr)
 
 
+def sdk_digest_mode(log, digest_path, imu_expected):
+    """Pcap-mode run: one OS1_SCAN whose range image hashes to the SDK's scan RANGE digest."""
+    ref = json.load(open(digest_path))['scans']
+    scans = [scan(d) for ch, d in events(log) if ch == 'OS1_SCAN']
+    imus = [imu(d) for ch, d in events(log) if ch == 'OS1_IMU']
+    errors = []
+    if [s['md5'] for s in scans] != [r['RANGE'] for r in ref]:
+        errors.append(f"scan RANGE md5 {[s['md5'] for s in scans]} != SDK digest {[r['RANGE'] for r in ref]}")
+    if [str(s['frame_id']) for s in scans] != [r['FRAME_ID'] for r in ref]:
+        errors.append("frame ids differ from the SDK digest")
+    if len(imus) != imu_expected:
+        errors.append(f"OS1_IMU: {len(imus)} messages, expected {imu_expected}")
+    print(json.dumps({'scans': scans, 'imu': len(imus)}, indent=1))
+    for e in errors:
+        print("FAIL:", e)
+    sys.exit(1 if errors else 0)
+
+
 def main():
+    if sys.argv[1] == '--sdk-digest':
+        sdk_digest_mode(sys.argv[2], sys.argv[3], int(sys.argv[4]))
     log, ref_path = sys.argv[1], sys.argv[2]
     ref = json.load(open(ref_path))
     scans, imus = [], []

@@ -38,3 +38,15 @@ sleep 0.3
 "$B/fploc-os1-decode" --pcap "$PCAP" --metadata "$META" --json > "$T/decode.json" 2>/dev/null
 cat "$T/os1.txt" "$T/imu.txt"
 python3 "$(dirname "$0")/check_log.py" "$T/log.lcm" "$T/decode.json"
+
+# Pcap mode (as fast as possible): the drivers stop by themselves at the end of the file; the scan that
+# went through LCM must still match the Ouster SDK's RANGE digest of OS-1-32-G.
+G="$D/OS-1-32-G_v2.1.1_1024x10"
+lcm-logger --lcm-url="$URL" "$T/log2.lcm" > "$T/logger2.txt" 2>&1 & pids+=($!)
+sleep 0.5
+timeout 20 "$B/fploc-os1-driver" --lcm-url "$URL" --set metadata="$G.json" --set pcap="$G.pcap" --set pcap_rate=-1
+timeout 20 "$B/fploc-imu-driver" --lcm-url "$URL" --set pcap="$PCAP" --set pcap_rate=-1
+sleep 1
+kill -INT "${pids[3]}"
+sleep 0.3
+python3 "$(dirname "$0")/check_log.py" --sdk-digest "$T/log2.lcm" "$G""_digest.json" 11
