@@ -1,0 +1,137 @@
+#include "fploc/sim/simulator.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "fploc/sim/rng.h"
+
+namespace fploc::sim {
+namespace {
+
+double dist_to_path(const std::vector<Eigen::Vector2d>& path, const Eigen::Vector2d& p) {
+  double d = std::numeric_limits<double>::infinity();
+  for (const auto& q : path) d = std::min(d, (q - p).squaredNorm());
+  return std::sqrt(d);
+}
+
+}  // namespace
+
+Simulator::Simulator(FloorPlan plan, SimulatorOptions opt) : opt_(std::move(opt)) {
+  std::string err;
+  if (!scenario_spec(opt_.scenario, spec_, &err)) throw std::runtime_error(err);
+  if (plan.elements.empty()) {
+    if (spec_.plan_kind == "room") plan = demo_room_plan();
+    else if (spec_.plan_kind == "corridor") plan = demo_corridor_plan();
+    else throw std::runtime_error("scenario " + spec_.name + " needs a floor plan (--plan FILE)");
+  }
+  if (spec_.plan_kind == "any") {
+    const AutoLoopResult r = plan_auto_loop(plan);
+    spec_.control = r.control;
+    spec_.closed = true;
+    spec_.length = 0;
+    info_ += r.info + "\n";
+  }
+  WorldConfig wc;
+  wc.ceiling_height_m = opt_.ceiling_height_m > 0 ? opt_.ceiling_height_m : spec_.ceiling_m;
+  world_ = std::make_unique<World>(plan, wc);
+  motion_ = std::make_unique<Motion>(spec_.control, spec_.closed, spec_.speed, spec_.length, opt_.seed);
+  if (opt_.ceiling_patches && spec_.plan_kind != "corridor") {
+    // A sloped patch in one corner of the building (rising 0.15 m per metre) and a missing patch (an
+    // opening, 2.0 x 1.5 m) at the centre of the plan.
+    const Box2 b = world_->bounds();
+    CeilingPatch slope;
+    slope.box.min = b.min + 0.75 * b.size();
+    slope.box.max = b.max;
+    slope.h0 = wc.ceiling_height_m;
+    slope.slope = Eigen::Vector2d(0.15, 0.0);
+    world_->add_ceiling_patch(slope);
+    CeilingPatch open;
+    const Eigen::Vector2d c = 0.5 * (b.min + b.max);
+    open.box.min = c - Eigen::Vector2d(1.0, 0.75);
+    open.box.max = c + Eigen::Vector2d(1.0, 0.75);
+    open.open = true;
+    world_->add_ceiling_patch(open);
+  }
+  if (opt_.clutter) add_clutter();
+  SensorConfig sc;
+  if (!opt_.metadata.empty()) {
+    if (!load_beam_intrinsics_json(opt_.metadata, sc.beams, &err)) throw std::runtime_error(err);
+    beam_source_ = opt_.metadata;
+  } else {
+    sc.beams = default_beams(opt_.shared_dir, &beam_source_);
+  }
+  sc.width = opt_.width;
+  sc.rate_hz = opt_.rate_hz;
+  sc.range_noise_m = opt_.range_noise_m;
+  sc.dropout = opt_.dropout;
+  lidar_ = std::make_unique<LidarSim>(sc);
+  ImuConfig ic;
+  ic.rate_hz = opt_.imu_rate_hz;
+  imu_ = simulate_imu(*motion_, ic, opt_.seed);
+  num_frames_ = int(std::floor(motion_->duration() * opt_.rate_hz));
+}
+
+void Simulator::add_clutter() {
+  Rng rng(mix_seed(opt_.seed, 0xC1u));
+  const auto path = motion_->sample_path(0.1);
+  struct Kind {
+    double hx, hy, h;
+    uint8_t refl;
+  };
+  const Kind kinds[] = {{0.8, 0.4, 0.75, 30}, {0.5, 0.25, 1.9, 50}, {0.25, 0.25, 0.9, 20}, {0.6, 0.3, 1.1, 40}};
+  const int want_boxes = std::clamp(int(motion_->length() / 6.0), 4, 12);
+  int boxes = 0;
+  for (int attempt = 0; attempt < 400 && boxes < want_boxes; ++attempt) {
+    const auto& base = path[size_t(rng.uniform() * path.size()) % path.size()];
+    const double a = rng.uniform(0, 2 * M_PI), r = rng.uniform(1.0, 4.0);
+    const Kind& k = kinds[size_t(rng.uniform() * 4) % 4];
+    Furniture f;
+    f.center = base + r * Eigen::Vector2d(std::cos(a), std::sin(a));
+    f.yaw = rng.uniform(0, M_PI);
+    f.half = Eigen::Vector2d(k.hx, k.hy);
+    f.z0 = 0;
+    f.z1 = k.h;
+    f.reflectivity = k.refl;
+    const double rad = f.half.norm();
+    if (std::isnan(world_->ceiling_at(f.center.x(), f.center.y()))) continue;
+    if (world_->static_clearance(f.center) < rad + 0.05) continue;
+    if (dist_to_path(path, f.center) < rad + 0.6) continue;
+    world_->add_furniture(f);
+    ++boxes;
+  }
+  int people = 0;
+  for (int attempt = 0; attempt < 400 && people < 2; ++attempt) {
+    const auto& base = path[size_t(rng.uniform() * path.size()) % path.size()];
+    const double a = rng.uniform(0, 2 * M_PI), r = rng.uniform(1.5, 4.0);
+    const Eigen::Vector2d p0 = base + r * Eigen::Vector2d(std::cos(a), std::sin(a));
+    const double b = rng.uniform(0, 2 * M_PI), len = rng.uniform(3.0, 6.0);
+    const Eigen::Vector2d p1 = p0 + len * Eigen::Vector2d(std::cos(b), std::sin(b));
+    bool ok = true;
+    for (int i = 0; i <= 20 && ok; ++i) {
+      const Eigen::Vector2d q = p0 + (p1 - p0) * (i / 20.0);
+      if (std::isnan(world_->ceiling_at(q.x(), q.y())) || world_->static_clearance(q) < 0.45 ||
+          dist_to_path(path, q) < 1.0)
+        ok = false;
+    }
+    if (!ok) continue;
+    Person p;
+    p.path = {p0, p1};
+    p.speed = rng.uniform(0.6, 1.3);
+    p.phase_s = rng.uniform(0, 10);
+    world_->add_person(p);
+    ++people;
+  }
+  info_ += "clutter: " + std::to_string(boxes) + " furniture boxes, " + std::to_string(people) + " people\n";
+}
+
+void Simulator::frame(int k, SimScan& out) {
+  const double t0 = frame_time(k);
+  const Motion& m = *motion_;
+  const double base = opt_.t0_s;
+  lidar_->simulate(*world_, [&m, base](double t) { return m.pose(t - base); }, t0, k, opt_.seed, out);
+}
+
+StampedPose Simulator::ground_truth(double t) const { return StampedPose::from(t, motion_->pose(t - opt_.t0_s)); }
+
+}  // namespace fploc::sim
