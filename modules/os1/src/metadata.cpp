@@ -163,7 +163,7 @@ SensorInfo parse_metadata(const std::string& text, const std::string& source) {
   json root;
   try {
     root = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse_error, and out_of_range for numbers like 1e999
     throw MetadataError(source + ": not valid JSON (" + e.what() + ")");
   }
   if (!root.is_object()) throw MetadataError(source + ": top level is not a JSON object");
