@@ -61,20 +61,24 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   ok_.assign(n, 0);
   picked_.assign(n, 0);
   // breaks[j] = 1 when points j and j+1 are not neighbours (column gap); prefix sums for window tests.
-  std::vector<int> brk_prefix(n + 1, 0);
+  auto& brk_prefix = brk_;
+  brk_prefix.assign(n + 1, 0);
   for (int j = 0; j < n; ++j) {
     const int br = j + 1 < n ? (col(j + 1) - col(j) > cfg_.max_column_gap) : 1;
     brk_prefix[j + 1] = brk_prefix[j] + br;
   }
   const float rmin = float(cfg_.min_range_m), rmax = float(cfg_.max_range_m);
+  // Window sums by prefix sums (double: ring coordinates reach ~100 m): sum(X_j - X_i) = S - (2hw+1) X_i.
+  pre_.resize(size_t(n) + 1);
+  pre_[0].setZero();
+  for (int j = 0; j < n; ++j) pre_[j + 1] = pre_[j] + P(j).cast<double>();
   for (int i = hw; i < n - hw; ++i) {
     // All of i-hw .. i+hw connected: no break between i-hw and i+hw-1.
     if (brk_prefix[i + hw] - brk_prefix[i - hw] != 0) continue;
     const float ri = r(i);
     if (ri < rmin || ri > rmax) continue;
-    Eigen::Vector3f diff = -float(2 * hw) * P(i);
-    for (int k = 1; k <= hw; ++k) diff += P(i - k) + P(i + k);
-    curv_[i] = diff.norm() / (float(2 * hw) * ri);  // LOAM's c = |sum(X_j - X_i)| / (|S| |X_i|)
+    const Eigen::Vector3d diff = (pre_[i + hw + 1] - pre_[i - hw]) - double(2 * hw + 1) * P(i).cast<double>();
+    curv_[i] = float(diff.norm()) / (float(2 * hw) * ri);  // LOAM's c = |sum(X_j - X_i)| / (|S| |X_i|)
     ok_[i] = 1;
   }
   // LOAM's unreliable points: the far side of an occlusion boundary, and surfaces parallel to the beam.
@@ -97,29 +101,48 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
 
   // Per-sector selection (sectors split the ring's points evenly, as LOAM does).
   sel_.clear();
-  std::vector<int8_t> kind_of(n, -1);
+  auto& kind_of = kind_;
+  kind_of.assign(n, -1);
   const int S = std::max(1, cfg_.sectors);
   const float cthr = float(cfg_.corner_threshold), sthr = float(cfg_.surface_threshold);
   for (int s = 0; s < S; ++s) {
     const int sb = hw + (n - 2 * hw) * s / S, se = hw + (n - 2 * hw) * (s + 1) / S;
     if (se <= sb) continue;
-    order_.resize(se - sb);
-    std::iota(order_.begin(), order_.end(), sb);
-    std::sort(order_.begin(), order_.end(), [&](int a, int b) { return curv_[a] < curv_[b] || (curv_[a] == curv_[b] && a < b); });
+    // Corner candidates (few): sorted by decreasing smoothness.
+    order_.clear();
+    for (int i = sb; i < se; ++i)
+      if (ok_[i] && curv_[i] > cthr) order_.push_back(i);
+    auto more = [&](int a, int b) { return curv_[a] > curv_[b] || (curv_[a] == curv_[b] && a < b); };
+    size_t csorted = 0;
     int corners = 0;
-    for (auto it = order_.rbegin(); it != order_.rend() && corners < cfg_.max_corners_per_sector; ++it) {
-      const int i = *it;
-      if (curv_[i] <= cthr) break;
-      if (!ok_[i] || picked_[i]) continue;
+    for (size_t j = 0; j < order_.size() && corners < cfg_.max_corners_per_sector; ++j) {
+      if (j == csorted) {
+        const size_t k = std::min(order_.size(), std::max<size_t>(csorted * 2, size_t(8 * cfg_.max_corners_per_sector)));
+        std::partial_sort(order_.begin() + csorted, order_.begin() + k, order_.end(), more);
+        csorted = k;
+      }
+      const int i = order_[j];
+      if (picked_[i]) continue;
       kind_of[i] = kCorner;
       ++corners;
       for (int k = std::max(0, i - hw); k <= std::min(n - 1, i + hw); ++k) picked_[k] = 1;
     }
+    // Surface candidates: only the smoothest few need ordering (partial sort, widened if the spacing
+    // rule rejects too many).
+    order_.clear();
+    for (int i = sb; i < se; ++i)
+      if (ok_[i] && curv_[i] < sthr && !picked_[i]) order_.push_back(i);
+    auto less = [&](int a, int b) { return curv_[a] < curv_[b] || (curv_[a] == curv_[b] && a < b); };
+    size_t sorted = 0;
     int surfaces = 0;
-    for (int i : order_) {
-      if (surfaces >= cfg_.max_surfaces_per_sector) break;
-      if (curv_[i] >= sthr) break;
-      if (!ok_[i] || picked_[i]) continue;
+    for (size_t j = 0; j < order_.size() && surfaces < cfg_.max_surfaces_per_sector; ++j) {
+      if (j == sorted) {
+        const size_t k = std::min(order_.size(), std::max<size_t>(sorted * 2, size_t(4 * cfg_.max_surfaces_per_sector)));
+        std::partial_sort(order_.begin() + sorted, order_.begin() + k, order_.end(), less);
+        sorted = k;
+      }
+      const int i = order_[j];
+      if (picked_[i]) continue;
       kind_of[i] = kSurface;
       ++surfaces;
       for (int k = std::max(0, i - cfg_.surface_spacing); k <= std::min(n - 1, i + cfg_.surface_spacing); ++k)

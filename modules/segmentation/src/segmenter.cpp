@@ -393,7 +393,8 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
   for (int u = 0; u < scan.height; ++u) {
     const int shift = u < int(scan.beams.pixel_shift_by_row.size()) ? scan.beams.pixel_shift_by_row[u] : 0;
     for (int cd = 0; cd < W; ++cd) {
-      const int v = ((cd - shift) % W + W) % W;
+      int v = (cd - shift) % W;
+      if (v < 0) v += W;
       const size_t i = size_t(u) * W + v;
       const float r = range_[i];
       if (r <= 0.f) continue;
@@ -483,7 +484,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
     const Eigen::Vector3f n = pl.head<3>().cast<float>();
     const float d = float(pl[3]);
     int cnt = 0;
-    for (size_t i = 0; i < c.p.size(); i += 8) cnt += std::abs(n.dot(c.p[i]) + d) < 0.05f;
+    for (size_t i = 0; i < c.p.size(); i += 16) cnt += std::abs(n.dot(c.p[i]) + d) < 0.05f;
     return cnt;
   };
   Eigen::Vector4d cur;
@@ -535,40 +536,56 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
   for (int it = 0; it < std::max(1, cfg_.irls_iterations); ++it) {
     const Eigen::Vector3f n = cur.head<3>().cast<float>();
     const float d = float(cur[3]);
-    // Robust scale of the residuals inside the current cut-off.
-    res_.clear();
-    for (int i : band_) {
-      const float r = n.dot(c.p[i]) + d;
-      if (std::abs(r) < cut) res_.push_back(std::abs(r));
+    // Residuals once per iteration; robust scale (1.4826 * median |r| inside the cut-off) from a histogram.
+    res_.resize(band_.size());
+    constexpr int kBins = 256;
+    int hist[kBins] = {0};
+    const float inv_bin = float(kBins / cut);
+    int inside = 0;
+    for (size_t j = 0; j < band_.size(); ++j) {
+      const float r = n.dot(c.p[band_[j]]) + d;
+      res_[j] = r;
+      const float a = std::abs(r);
+      if (a < cut) {
+        ++hist[std::min(kBins - 1, int(a * inv_bin))];
+        ++inside;
+      }
     }
-    if (res_.size() < 3) return false;
-    const double sigma = 1.4826 * median_inplace(res_);
+    if (inside < 3) return false;
+    int acc = 0, bin = 0;
+    for (; bin < kBins; ++bin) {
+      acc += hist[bin];
+      if (2 * acc >= inside) break;
+    }
+    const double sigma = 1.4826 * (bin + 0.5) / inv_bin;
     const double next_cut = std::max({cut * 0.5, 4.685 * sigma, 0.02});
+    const bool final_scale = next_cut >= cut;
     cut = std::min(cut, next_cut);
     const float inv_c2 = float(1.0 / (cut * cut));
-    // Accumulate in float around `ref` per block, in double overall.
-    Moments m;
-    double sw = 0;
-    Eigen::Vector3d s1 = Eigen::Vector3d::Zero();
-    Eigen::Matrix3d s2 = Eigen::Matrix3d::Zero();
-    for (int i : band_) {
-      const float r = n.dot(c.p[i]) + d;
+    // While the cut-off still shrinks a subsample is enough; at the final scale use every point.
+    const size_t step = final_scale ? 1 : 3;
+    double sw = 0, sx = 0, sy = 0, sz = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
+    for (size_t j = 0; j < band_.size(); j += step) {
+      const float r = res_[j];
       const float t = r * r * inv_c2;
       if (t >= 1.f) continue;
-      const float w = (1.f - t) * (1.f - t);
-      const Eigen::Vector3d q = (c.p[i] - reff).cast<double>();
+      const double w = (1.f - t) * (1.f - t);
+      const Eigen::Vector3f& pf = c.p[band_[j]];
+      const double x = pf.x() - reff.x(), y = pf.y() - reff.y(), z = pf.z() - reff.z();
       sw += w;
-      s1 += w * q;
-      s2.noalias() += double(w) * q * q.transpose();
+      sx += w * x; sy += w * y; sz += w * z;
+      sxx += w * x * x; sxy += w * x * y; sxz += w * x * z;
+      syy += w * y * y; syz += w * y * z; szz += w * z * z;
     }
+    Moments m;
     m.w = sw;
-    m.s = s1;
-    m.ss = s2;
+    m.s << sx, sy, sz;
+    m.ss << sxx, sxy, sxz, sxy, syy, syz, sxz, syz, szz;
     Eigen::Vector4d next;
     if (!m.plane(ref, up, next)) return false;
     const double dn = (next.head<3>() - cur.head<3>()).norm(), dd = std::abs(next[3] - cur[3]);
     cur = next;
-    if (dn < 1e-7 && dd < 1e-6 && cut <= next_cut) break;
+    if (final_scale && dn < 1e-6 && dd < 1e-5) break;
   }
   plane = cur;
   return true;

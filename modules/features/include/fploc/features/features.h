@@ -3,6 +3,7 @@
 // projection to the horizontal plane, and PCA line groups of surface points between corner anchors.
 // Transport-free; nodes/features wraps it.
 #pragma once
+#include <Eigen/Core>
 #include <cstdint>
 #include <vector>
 
@@ -61,7 +62,9 @@ class FeatureExtractor {
   std::vector<uint8_t> ok_, picked_;
   std::vector<int> order_;
   std::vector<float> gx_, gy_;
-  std::vector<int> sel_;
+  std::vector<int> sel_, brk_;
+  std::vector<int8_t> kind_;
+  std::vector<Eigen::Vector3d> pre_;
 };
 
 }  // namespace fploc::feat
