@@ -254,6 +254,28 @@ SensorInfo load_metadata(const std::string& path) {
   return parse_metadata(ss.str(), path);
 }
 
+std::string metadata_to_json(const SensorInfo& info) {
+  json j;
+  j["beam_altitude_angles"] = info.beams.altitude_deg;
+  j["beam_azimuth_angles"] = info.beams.azimuth_deg;
+  j["lidar_origin_to_beam_origin_mm"] = info.beams.beam_offset_mm;
+  j["lidar_to_sensor_transform"] = info.beams.lidar_to_sensor;
+  j["imu_to_sensor_transform"] = info.imu_to_sensor;
+  j["lidar_mode"] = info.lidar_mode;
+  if (!info.prod_line.empty()) j["prod_line"] = info.prod_line;
+  if (!info.serial.empty()) j["prod_sn"] = info.serial;
+  if (!info.firmware.empty()) j["build_rev"] = info.firmware;
+  j["udp_profile_lidar"] = to_string(info.profile);
+  j["udp_port_lidar"] = info.udp_port_lidar;
+  j["udp_port_imu"] = info.udp_port_imu;
+  j["data_format"] = {{"pixels_per_column", info.pixels_per_column},
+                      {"columns_per_packet", info.columns_per_packet},
+                      {"columns_per_frame", info.columns_per_frame},
+                      {"pixel_shift_by_row", info.beams.pixel_shift_by_row},
+                      {"column_window", {info.column_window_first, info.column_window_last}}};
+  return j.dump(4);
+}
+
 SensorInfo make_sensor_info(const std::vector<double>& altitude_deg, const std::vector<double>& azimuth_deg,
                             const std::string& lidar_mode, UdpProfile profile) {
   if (altitude_deg.size() != azimuth_deg.size() || altitude_deg.empty())

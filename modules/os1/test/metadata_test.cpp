@@ -107,3 +107,31 @@ TEST(Metadata, DefaultPixelShift) {
   EXPECT_EQ(default_pixel_shift(4, 512), (std::vector<int>{9, 6, 3, 0}));
   EXPECT_EQ(default_pixel_shift(8, 2048), (std::vector<int>{36, 24, 12, 0, 36, 24, 12, 0}));
 }
+
+TEST(Metadata, WriteReadRoundTrip) {
+  SensorInfo a = make_sensor_info({10.5, 0.25, -3.0, -12.125}, {3.1, -1.0, 0.5, -3.1}, "2048x10",
+                                  UdpProfile::kRng19Rfl8Sig16Nir16);
+  a.prod_line = "OS-1-4-test";
+  a.serial = "42";
+  a.beams.beam_offset_mm = 15.806;
+  a.beams.lidar_to_sensor[11] = 38.195;
+  a.imu_to_sensor[3] = 1.5;
+  a.column_window_first = 100, a.column_window_last = 50;
+  a.udp_port_lidar = 17502;
+  const SensorInfo b = parse_metadata(metadata_to_json(a), "roundtrip");
+  EXPECT_EQ(b.beams.altitude_deg, a.beams.altitude_deg);
+  EXPECT_EQ(b.beams.azimuth_deg, a.beams.azimuth_deg);
+  EXPECT_EQ(b.beams.pixel_shift_by_row, a.beams.pixel_shift_by_row);
+  EXPECT_EQ(b.beams.lidar_to_sensor, a.beams.lidar_to_sensor);
+  EXPECT_EQ(b.imu_to_sensor, a.imu_to_sensor);
+  EXPECT_DOUBLE_EQ(b.beams.beam_offset_mm, 15.806);
+  EXPECT_EQ(b.columns_per_frame, 2048);
+  EXPECT_EQ(b.profile, UdpProfile::kRng19Rfl8Sig16Nir16);
+  EXPECT_EQ(b.column_window_first, 100);
+  EXPECT_EQ(b.column_window_last, 50);
+  EXPECT_EQ(b.window_columns(), 2048 - 100 + 51);
+  EXPECT_TRUE(b.in_window(2000) && b.in_window(0) && !b.in_window(75));
+  EXPECT_EQ(b.udp_port_lidar, 17502);
+  EXPECT_EQ(b.sensor_name(), "OS-1-4-test sn 42");
+  EXPECT_TRUE(b.defaulted.empty()) << b.defaulted.front();
+}

@@ -184,3 +184,24 @@ TEST(Imu, RoundTripSi) {
   std::memcpy(b.data() + 40, &nan, 4);
   EXPECT_FALSE(parse_imu_packet(b.data(), b.size(), r));
 }
+
+TEST(Packet, AzimuthWindowWrappingZero) {
+  SensorInfo info = info_for(16);
+  info.column_window_first = 1000, info.column_window_last = 15;  // 40 columns around 0
+  const PacketFormat f = PacketFormat::from(info);
+  Scan a = random_scan(info, 9);
+  std::vector<std::vector<uint8_t>> pa;
+  encode_frame(a, 77, f, pa);
+  FrameAssembler fa(info);
+  std::vector<Scan> out;
+  fa.add_packet(pa[0].data(), pa[0].size(), out);
+  fa.add_packet(pa[62].data(), pa[62].size(), out);
+  EXPECT_TRUE(out.empty());
+  fa.add_packet(pa[63].data(), pa[63].size(), out);  // all 40 window columns in: published now
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].missing_columns, 0);
+  EXPECT_EQ(out[0].status, ScanStatus::kOk);
+  EXPECT_EQ(out[0].column_valid[500], 0);  // outside the window: invalid but not "missing"
+  EXPECT_EQ(out[0].range(5, 1010), a.range(5, 1010));
+  EXPECT_EQ(out[0].utime, a.column_utime[0]);
+}

@@ -60,6 +60,10 @@ double default_beam_offset_mm(const std::string& prod_line);
 // Parses "WxF"; throws MetadataError for anything else.
 void parse_lidar_mode(const std::string& mode, int& columns, double& hz, const std::string& source);
 
+// Writes `info` as a legacy flat metadata file (plus udp_profile_lidar and the ports) that
+// parse_metadata reads back to the same SensorInfo (the simulator ships this next to its captures).
+std::string metadata_to_json(const SensorInfo& info);
+
 // A synthetic SensorInfo (simulator, tests): beams with the given angles, lidar_mode, SDK defaults.
 SensorInfo make_sensor_info(const std::vector<double>& altitude_deg, const std::vector<double>& azimuth_deg,
                             const std::string& lidar_mode = "1024x10", UdpProfile profile = UdpProfile::kLegacy);
