@@ -171,6 +171,14 @@ class Launcher {
         for (auto& c : children_)
           if (c.state == State::Dead || c.state == State::Backoff) publish(c, state_name(c.state), "");
       }
+      if (!shutting_down && std::all_of(children_.begin(), children_.end(), [](const Child& c) {
+            return c.state == State::Stopped || c.state == State::Dead;
+          })) {
+        const bool dead = std::any_of(children_.begin(), children_.end(),
+                                      [](const Child& c) { return c.state == State::Dead; });
+        log(std::string("no node left running (") + (dead ? "some failed" : "all finished") + "): exiting");
+        return dead ? 1 : 0;
+      }
       if (shutting_down &&
           std::all_of(children_.begin(), children_.end(), [](const Child& c) { return c.pid <= 0; })) {
         log("all nodes stopped");
@@ -225,6 +233,7 @@ class Launcher {
     c.started_at = now_s();
     c.last_beat = 0;
     c.hung = false;
+    publish(c, "starting", "");
     log("node '" + c.name + "' started: pid " + std::to_string(pid) + ", " + c.exe_name +
         (c.sets.empty() ? "" : " (overrides: " + join(c.sets) + ")") +
         (c.restarts ? ", restart " + std::to_string(c.restarts) : ""));
@@ -269,6 +278,13 @@ class Launcher {
     const double since = c.last_beat > 0 ? t - c.last_beat : t - c.started_at;
     const double limit = c.last_beat > 0 ? c.heartbeat_timeout : std::max(c.heartbeat_timeout, 10.0);
     if (since <= limit) return;
+    if (c.last_beat == 0 && !transport_ok_) {
+      if (!transport_warned_)
+        log("warning: no telemetry arrives on " + bus_.url() +
+            " (not even the launcher's own): heartbeat supervision is off until the first heartbeat");
+      transport_warned_ = true;
+      return;
+    }
     log("node '" + c.name + "' (pid " + std::to_string(c.pid) + ") hung: no heartbeat for " + fmt(since) +
         " s; killing it");
     c.hung = true;
@@ -372,6 +388,7 @@ class Launcher {
   }
 
   void on_telemetry(const lcm::ReceiveBuffer*, const std::string&, const fploc::node_status_t* m) {
+    transport_ok_ = true;  // our own "starting" reports come back too when the LCM URL works here
     if (m->reporter == "launcher") return;
     Child* c = find(m->node);
     if (c && c->pid > 0 && m->pid == c->pid) c->last_beat = now_s();
@@ -470,6 +487,7 @@ class Launcher {
   Bus bus_;
   std::vector<Child> children_;
   double shutdown_timeout_ = 2.0;
+  bool transport_ok_ = false, transport_warned_ = false;
   std::string graph_abs_, control_channel_;
 };
 
