@@ -11,7 +11,7 @@ const COL = { est: color('--est'), gt: color('--gt'), fp: color('--fp'), corner:
 
 // Visible to tests (playwright reads it) and handy in the console.
 const S = window.__fploc = {
-  connected: false, reconnects: 0, events: {}, latencies: [], trail: [], gtTrail: [],
+  connected: false, reconnects: 0, events: {}, latencies: [], rxLatencies: [], trail: [], gtTrail: [],
   pose: null, gt: null, frame: null, features: null, nodes: [], stats: null,
 };
 const MAX_TRAIL = 50000;
@@ -130,7 +130,9 @@ function onPose(p) {
   const lat = Date.now() - p.utime / 1000;
   if (lat > -50 && lat < 10000) {  // only when the stamp is this machine's wall clock (live runs)
     S.latencies.push(lat);
-    if (S.latencies.length > 10000) S.latencies.splice(0, 5000);
+    // Part of it spent before the dashboard received the message (LCM + publisher), same clock.
+    if (p.rx_us) S.rxLatencies.push((p.rx_us - p.utime) / 1000);
+    if (S.latencies.length > 10000) { S.latencies.splice(0, 5000); S.rxLatencies.splice(0, 5000); }
     S.lastLatency = lat;
   }
   const t = tsec(p.utime);

@@ -33,7 +33,11 @@ export class Plot {
     for (const d of this.data) if (d.length) tmax = Math.max(tmax, d[d.length - 1][0]);
     c.font = '10px "DejaVu Sans", sans-serif';
     if (!Number.isFinite(tmax)) { c.fillStyle = '#9ca3af'; c.fillText('no data', 6, h / 2 + 3); return; }
-    const tmin = tmax - this.window;
+    // The window starts at the first sample until the data spans the whole window.
+    let first = Infinity;
+    for (const d of this.data) if (d.length) first = Math.min(first, d[0][0]);
+    const span = Math.max(5, Math.min(this.window, tmax - first));
+    const tmin = tmax - span;
     let lo = Infinity, hi = -Infinity;
     for (const d of this.data) for (const [t, v] of d) if (t >= tmin) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
     if (this.zero) lo = Math.min(lo, 0);
@@ -41,7 +45,7 @@ export class Plot {
     if (hi === lo) { hi += 1e-3; lo -= 1e-3; }
     const pad = (hi - lo) * 0.08; lo -= pad; hi += pad;
     const L = 44, R = 4, T = 4, B = 4;
-    const X = (t) => L + (t - tmin) / this.window * (w - L - R), Y = (v) => T + (hi - v) / (hi - lo) * (h - T - B);
+    const X = (t) => L + (t - tmin) / span * (w - L - R), Y = (v) => T + (hi - v) / (hi - lo) * (h - T - B);
     c.strokeStyle = '#e5e7eb'; c.lineWidth = 1; c.beginPath(); c.moveTo(L, T); c.lineTo(L, h - B); c.lineTo(w - R, h - B); c.stroke();
     c.fillStyle = '#6b7280'; c.textAlign = 'right';
     c.fillText(hi.toFixed(this.digits), L - 3, T + 8); c.fillText(lo.toFixed(this.digits), L - 3, h - B - 1);

@@ -145,6 +145,7 @@ class DashboardNode : public fploc::rt::Node {
   void setup_routes() {
     auto& s = server_;
     s.new_task_queue = [] { return new httplib::ThreadPool(16); };
+    s.set_tcp_nodelay(true);  // small SSE events must not wait for delayed ACKs (Nagle)
     s.set_keep_alive_max_count(100);
     s.set_read_timeout(5, 0);
     s.set_write_timeout(5, 0);

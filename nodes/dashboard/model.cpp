@@ -414,30 +414,37 @@ bool Model::next_push(ClientCursor& c, double max_hz, double keepalive_s, std::s
   if (!c.greeted) {
     c.greeted = true;
     out = "retry: 1000\n\n";
-  } else {
-    // Wait for anything new, then respect the rate cap (the newest values are taken after the wait,
-    // so intermediate ones are skipped, never queued).
-    const auto deadline = clock::now() + std::chrono::duration<double>(keepalive_s);
-    if (!cv_.wait_until(lk, deadline, [&] { return stopping_ || global_version_ > c.seen_global; })) return true;
+  }
+  // Each stream is capped on its own (at most max_hz events per second per stream), so a burst of
+  // different streams from one scan goes out at once. Values are read when they are sent: whatever
+  // arrived in between is skipped, never queued.
+  const double period = max_hz > 0 ? 1.0 / max_hz : 0.0;
+  const double keepalive_at = secs() + keepalive_s;
+  for (;;) {
+    const double now = secs();
+    double next_due = keepalive_at;
+    c.seen_global = global_version_;
+    for (const auto& [name, s] : slots_) {
+      auto& sent = c.sent[name];
+      if (s.version <= sent) continue;
+      double& last = c.last_sent_s[name];
+      if (last + period <= now) {
+        out += "event: " + name + "\ndata: " + s.json + "\n\n";
+        sent = s.version;
+        last = now;
+      } else {
+        next_due = std::min(next_due, last + period);
+      }
+    }
+    if (!out.empty()) {
+      ++pushes_;
+      return true;
+    }
+    if (now >= keepalive_at) return true;  // nothing new: the caller sends a keep-alive comment
+    cv_.wait_for(lk, std::chrono::duration<double>(std::max(0.0, next_due - now)),
+                 [&] { return stopping_ || global_version_ > c.seen_global; });
     if (stopping_) return false;
-    const double period = max_hz > 0 ? 1.0 / max_hz : 0.0;
-    const double wait_s = c.last_push_s + period - secs();
-    if (wait_s > 0) {
-      cv_.wait_for(lk, std::chrono::duration<double>(wait_s), [&] { return stopping_; });
-      if (stopping_) return false;
-    }
   }
-  for (const auto& [name, s] : slots_) {
-    auto& sent = c.sent[name];
-    if (s.version > sent) {
-      out += "event: " + name + "\ndata: " + s.json + "\n\n";
-      sent = s.version;
-    }
-  }
-  c.seen_global = global_version_;
-  c.last_push_s = secs();
-  ++pushes_;
-  return true;
 }
 
 }  // namespace fploc::dashboard

@@ -28,8 +28,8 @@ struct Slot {
 // What one SSE client has already received (per stream version).
 struct ClientCursor {
   std::map<std::string, uint64_t> sent;
+  std::map<std::string, double> last_sent_s;  // steady clock [s] of the last event per stream
   uint64_t seen_global = 0;
-  double last_push_s = -1e9;
   bool greeted = false;
 };
 
@@ -61,8 +61,9 @@ class Model {
   std::string state_json() const;    // {"pose":..., "nodes":..., ...} latest of every stream
   std::string history_json() const;  // trails and plot series since start
   std::string info_json() const;
-  // Blocks until something the client has not seen exists (and at most `max_hz` pushes per second),
-  // then returns the SSE text to send ("" on timeout -> send a keep-alive comment). Returns false when
+  // Blocks until a stream has a value the client has not seen and that stream's rate cap (max_hz
+  // events per second per stream) allows it, then returns the SSE text to send ("" after keepalive_s
+  // without anything -> send a keep-alive comment). Returns false when
   // the model is shutting down.
   bool next_push(ClientCursor& c, double max_hz, double keepalive_s, std::string& out);
   void stop();

@@ -1,0 +1,177 @@
+// Browser test of the dashboard: Debian's chromium driven headless by playwright-core, against
+// fploc-dashboard fed by fake publishers over LCM (inside the network namespace ctest gives us).
+// Checks: the page loads, the trail grows, every node is in the table, a killed node turns red and
+// green again after restart, a launcher "restarting" report turns a node red, the page reconnects by
+// itself after a server restart. Measures pose->browser latency, the dashboard's CPU with two
+// browsers attached at 10 Hz and the push rate. Writes dashboard.png + dashboard_browser.json.
+import { chromium } from 'playwright-core';
+import { spawn } from 'node:child_process';
+import { readFileSync, mkdirSync, writeFileSync, copyFileSync } from 'node:fs';
+import { dirname, join } from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const HERE = dirname(fileURLToPath(import.meta.url));
+const ROOT = process.env.FPLOC_ROOT || join(HERE, '../..');
+const BUILD = process.env.FPLOC_BUILD_DIR || join(ROOT, 'build');
+const BIN = join(BUILD, 'bin');
+const OUT = process.env.FPLOC_ARTIFACTS || join(BUILD, 'tests/dashboard');
+const URL = 'http://127.0.0.1:8080/';
+const NODES = ['sim', 'segmenter', 'feature_extractor', 'matcher', 'optimizer'];
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+const procs = new Set();
+let failures = 0;
+
+function start(exe, args, name) {
+  const p = spawn(join(BIN, exe), args, { stdio: ['ignore', 'ignore', 'pipe'] });
+  p.stderr.on('data', (d) => { if (process.env.FPLOC_VERBOSE) process.stderr.write(`[${name}] ${d}`); });
+  procs.add(p);
+  p.on('exit', () => procs.delete(p));
+  return p;
+}
+const startDashboard = () => start('fploc-dashboard', ['--set', `plan.file=${join(ROOT, 'tests/dashboard/room.json')}`], 'dashboard');
+const startFake = (name, extra = []) => start('fploc-dashboard-fake', ['--name', name, ...extra], name);
+async function stop(p, signal = 'SIGTERM') {
+  if (p.exitCode !== null || p.signalCode !== null) return;
+  const done = new Promise((r) => p.once('exit', r));
+  p.kill(signal);
+  await Promise.race([done, sleep(3000)]);
+  if (p.exitCode === null && p.signalCode === null) { p.kill('SIGKILL'); await done; }
+}
+function check(ok, what) {
+  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
+  if (!ok) failures++;
+}
+async function waitFor(fn, timeoutMs, stepMs = 50) {
+  const t0 = Date.now();
+  for (;;) {
+    const v = await fn();
+    if (v) return Date.now() - t0;
+    if (Date.now() - t0 > timeoutMs) return -1;
+    await sleep(stepMs);
+  }
+}
+async function serverUp() {
+  return waitFor(async () => { try { return (await fetch(URL + 'api/info')).ok; } catch { return false; } }, 10000, 100);
+}
+const cpuTicks = (pid) => { const f = readFileSync(`/proc/${pid}/stat`, 'utf8').split(') ')[1].split(' '); return Number(f[11]) + Number(f[12]); };
+const pct = (a, q) => { const s = [...a].sort((x, y) => x - y); return s.length ? s[Math.min(s.length - 1, Math.floor(q * s.length))] : NaN; };
+const health = (page, node) => page.evaluate((n) => document.querySelector(`#nodes tr[data-node="${n}"]`)?.dataset.health ?? null, node);
+
+let browser;
+try {
+  mkdirSync(OUT, { recursive: true });
+  let dash = startDashboard();
+  const fakes = {};
+  fakes.sim = startFake('sim', ['--sim', '--rate', '10']);
+  for (const n of NODES.slice(1)) fakes[n] = startFake(n);
+  check((await serverUp()) >= 0, 'dashboard answers on 127.0.0.1:8080');
+
+  browser = await chromium.launch({
+    executablePath: process.env.FPLOC_CHROMIUM || '/usr/bin/chromium',
+    headless: true,
+    args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
+      '--disable-component-update', '--disable-sync'],
+  });
+  const pages = [];
+  const pageErrors = [];
+  for (let i = 0; i < 2; i++) {
+    const ctx = await browser.newContext({ viewport: { width: 1440, height: 900 } });
+    const page = await ctx.newPage();
+    page.on('pageerror', (e) => pageErrors.push(String(e)));
+    // Refused connections are expected while the server is restarted on purpose below.
+    page.on('console', (m) => { if (m.type() === 'error' && !m.text().includes('ERR_CONNECTION_REFUSED')) pageErrors.push(m.text()); });
+    await page.goto(URL);
+    pages.push(page);
+  }
+  const [page] = pages;
+  check((await waitFor(() => page.evaluate(() => window.__fploc?.connected), 5000)) >= 0, 'page loads and connects (SSE)');
+  check(await page.evaluate(() => document.title === 'fploc dashboard'), 'title');
+
+  // Trail grows.
+  const trail0 = await page.evaluate(() => window.__fploc.trail.length);
+  await sleep(2000);
+  const trail1 = await page.evaluate(() => window.__fploc.trail.length);
+  check(trail1 >= trail0 + 10, `trail grows (${trail0} -> ${trail1} poses in 2 s at 10 Hz)`);
+  check(await page.evaluate(() => window.__fploc.gtTrail.length > 10), 'ground-truth trail present');
+  check(await page.evaluate(() => (window.__fploc.features?.xy.length ?? 0) > 100), 'features received');
+
+  // Every node in the table, all green.
+  const everyNode = [...NODES, 'dashboard'];
+  const allOk = await waitFor(async () => {
+    const h = await Promise.all(everyNode.map((n) => health(page, n)));
+    return h.every((x) => x === 'ok');
+  }, 4000);
+  check(allOk >= 0, `node table shows every node green: ${everyNode.join(', ')}`);
+
+  // Measurement window: two browsers attached, 10 Hz poses.
+  await Promise.all(pages.map((p) => p.evaluate(() => { window.__fploc.latencies = []; window.__fploc.rxLatencies = []; window.__fploc.mark = { ...window.__fploc.events, t: performance.now() }; })));
+  const cpu0 = cpuTicks(dash.pid), w0 = Date.now();
+  await sleep(10000);
+  const cpu1 = cpuTicks(dash.pid), w1 = Date.now();
+  const cpuPercent = 100 * ((cpu1 - cpu0) / 100) / ((w1 - w0) / 1000);  // USER_HZ = 100
+  const perPage = await Promise.all(pages.map((p) => p.evaluate(() => {
+    const S = window.__fploc, dt = (performance.now() - S.mark.t) / 1000;
+    const rate = (k) => ((S.events[k] || 0) - (S.mark[k] || 0)) / dt;
+    return { latencies: S.latencies, rx: S.rxLatencies, pose_hz: rate('pose'), features_hz: rate('features'), nodes_hz: rate('nodes') };
+  })));
+  const lat = perPage.flatMap((p) => p.latencies), rx = perPage.flatMap((p) => p.rx);
+  const loadavg = readFileSync('/proc/loadavg', 'utf8').split(' ').slice(0, 3).map(Number);
+  const results = {
+    browsers: 2,
+    input_rate_hz: 10,
+    window_s: (w1 - w0) / 1000,
+    dashboard_cpu_percent_of_one_core: Number(cpuPercent.toFixed(2)),
+    latency_ms: { n: lat.length, p50: pct(lat, 0.5), p95: pct(lat, 0.95), p99: pct(lat, 0.99), max: Math.max(...lat) },
+    // Stamp -> dashboard receive (publisher + LCM + the dashboard's handler queue): the rest is HTTP + browser.
+    to_dashboard_ms: { p50: pct(rx, 0.5), p95: pct(rx, 0.95), p99: pct(rx, 0.99) },
+    loadavg_1_5_15: loadavg,
+    push_rate_hz_per_browser: perPage.map((p) => ({ pose: +p.pose_hz.toFixed(2), features: +p.features_hz.toFixed(2), nodes: +p.nodes_hz.toFixed(2) })),
+  };
+  console.log(JSON.stringify(results));
+  check(lat.length >= 150, `latency samples from both browsers (${lat.length})`);
+  // Reported, not asserted (speed is measured, never asserted in tests): the target is p50 <= 100 ms.
+  console.log(`note pose -> browser latency p50 ${results.latency_ms.p50.toFixed(1)} ms, p95 ${results.latency_ms.p95.toFixed(1)} ms ` +
+    `(target <= 100; load average ${loadavg[0]}); dashboard CPU ${results.dashboard_cpu_percent_of_one_core} % of one core`);
+
+  // A node that stops heartbeating turns red, and green again when it comes back.
+  await stop(fakes.matcher, 'SIGKILL');
+  const tRed = await waitFor(async () => (await health(page, 'matcher')) === 'bad', 6000);
+  check(tRed >= 0, `killed node turns red (after ${tRed} ms; threshold 2 s without heartbeat)`);
+  check(await page.evaluate(() => document.querySelector('#nodes tr[data-node="matcher"]').classList.contains('bad')), 'red row style');
+  fakes.matcher = startFake('matcher');
+  const tGreen = await waitFor(async () => (await health(page, 'matcher')) === 'ok', 4000);
+  check(tGreen >= 0, `restarted node turns green again (after ${tGreen} ms)`);
+
+  // The launcher reports a node as restarting: red at once.
+  startFake('feature_extractor', ['--state', 'restarting', '--reporter', 'launcher', '--once']);
+  const tLaunch = await waitFor(async () => (await health(page, 'feature_extractor')) === 'bad', 1500, 20);
+  check(tLaunch >= 0, `launcher-reported "restarting" turns the node red (after ${tLaunch} ms)`);
+
+  await sleep(2500);  // let the trail get longer for the picture
+  await page.screenshot({ path: join(OUT, 'dashboard.png') });
+  if (process.env.FPLOC_SCREENSHOT) copyFileSync(join(OUT, 'dashboard.png'), process.env.FPLOC_SCREENSHOT);
+
+  // Server restart: banner while down, reconnect by itself, trail grows again.
+  await stop(dash);
+  const tBanner = await waitFor(() => page.evaluate(() => !document.getElementById('banner').classList.contains('hidden')), 4000);
+  check(tBanner >= 0, `disconnected banner shown (after ${tBanner} ms)`);
+  dash = startDashboard();
+  const tBack = await waitFor(() => page.evaluate(() => window.__fploc.connected && window.__fploc.reconnects > 0), 8000);
+  check(tBack >= 0, `page reconnects by itself after a server restart (after ${tBack} ms)`);
+  const r0 = await page.evaluate(() => window.__fploc.trail.length);
+  await sleep(1500);
+  const r1 = await page.evaluate(() => window.__fploc.trail.length);
+  check(r1 > r0 && (await page.evaluate(() => document.getElementById('banner').classList.contains('hidden'))), `trail grows again, banner gone (${r0} -> ${r1})`);
+
+  check(pageErrors.length === 0, `no errors in the page${pageErrors.length ? ': ' + pageErrors.slice(0, 3).join(' | ') : ''}`);
+  writeFileSync(join(OUT, 'dashboard_browser.json'), JSON.stringify({ ...results, failures }, null, 2));
+  console.log(`screenshot: ${join(OUT, 'dashboard.png')}`);
+} catch (e) {
+  console.log(`FAIL ${e.stack || e}`);
+  failures++;
+} finally {
+  if (browser) await browser.close().catch(() => {});
+  await Promise.all([...procs].map((p) => stop(p)));
+}
+console.log(failures ? `${failures} check(s) failed` : 'all checks passed');
+process.exit(failures ? 1 : 0);
