@@ -26,17 +26,11 @@ const Features2D& FeatureExtractor::process(const seg::Segmentation& seg) {
     out_.status = FeatStatus::kBadInput;
     return out_;
   }
-  // Gravity compensation: p_level = Ry(pitch) Rx(roll) p_sensor (yaw stays in the sensor frame).
-  const Eigen::Matrix3f R = (Eigen::AngleAxisf(float(seg.pitch), Eigen::Vector3f::UnitY()) *
-                             Eigen::AngleAxisf(float(seg.roll), Eigen::Vector3f::UnitX()))
-                                .toRotationMatrix();
-  gx_.resize(n);
-  gy_.resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3f q = R * Eigen::Vector3f(w.x[i], w.y[i], w.z[i]);
-    gx_[i] = q.x();
-    gy_[i] = q.y();
-  }
+  // Gravity compensation: p_level = Ry(pitch) Rx(roll) p_sensor (yaw stays in the sensor frame); applied
+  // to the selected features only.
+  R_ = (Eigen::AngleAxisf(float(seg.pitch), Eigen::Vector3f::UnitY()) *
+        Eigen::AngleAxisf(float(seg.roll), Eigen::Vector3f::UnitX()))
+           .toRotationMatrix();
   size_t b = 0;
   for (size_t i = 1; i <= n; ++i) {
     if (i == n || w.ring[i] != w.ring[b]) {
@@ -177,8 +171,9 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     if (kind_of[i] < 0) continue;
     const size_t src = begin + i;
     const int o = int(out_.x.size());
-    out_.x.push_back(gx_[src]);
-    out_.y.push_back(gy_[src]);
+    const Eigen::Vector3f q = R_ * Eigen::Vector3f(w.x[src], w.y[src], w.z[src]);
+    out_.x.push_back(q.x());
+    out_.y.push_back(q.y());
     out_.kind.push_back(kind_of[i]);
     out_.group.push_back(-1);
     out_.source.push_back(int32_t(src));

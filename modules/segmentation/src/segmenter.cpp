@@ -170,22 +170,29 @@ void Segmenter::quality(const Candidates& c, Plane& pl) const {
   const Eigen::Vector3f n = pl.coeffs.head<3>().cast<float>();
   const float d = float(pl.coeffs[3]);
   const float thr = float(cfg_.inlier_threshold_m);
-  Moments m;
   double r2 = 0;
   int cnt = 0;
-  Eigen::Vector3d ref = Eigen::Vector3d::Zero();
+  Eigen::Vector3f reff = Eigen::Vector3f::Zero();
   bool have_ref = false;
+  double sx = 0, sy = 0, sz = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
   for (size_t i = 0; i < c.p.size(); ++i) {
     const float r = n.dot(c.p[i]) + d;
     if (std::abs(r) >= thr) continue;
     if (!have_ref) {
-      ref = c.p[i].cast<double>();
+      reff = c.p[i];
       have_ref = true;
     }
-    m.add(c.p[i].cast<double>() - ref, 1.0);
+    const double x = c.p[i].x() - reff.x(), y = c.p[i].y() - reff.y(), z = c.p[i].z() - reff.z();
+    sx += x; sy += y; sz += z;
+    sxx += x * x; sxy += x * y; sxz += x * z; syy += y * y; syz += y * z; szz += z * z;
     r2 += double(r) * r;
     ++cnt;
   }
+  Moments m;
+  m.w = cnt;
+  m.s << sx, sy, sz;
+  m.ss << sxx, sxy, sxz, sxy, syy, syz, sxz, syz, szz;
+  const Eigen::Vector3d ref = reff.cast<double>();
   pl.inliers = cnt;
   pl.rms_m = cnt ? std::sqrt(r2 / cnt) : 0.0;
   if (cnt < 3) return;
@@ -389,7 +396,8 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
   const float cin = float(ceil[3] - cfg_.inlier_threshold_m), fin = float(floor[3] - cfg_.inlier_threshold_m);
   const int W = scan.width;
   auto& w = out_.wall;
-  w.x.reserve(size_t(scan.height) * W / 2);
+  const size_t cap = size_t(scan.height) * W;
+  w.x.reserve(cap); w.y.reserve(cap); w.z.reserve(cap); w.range.reserve(cap); w.ring.reserve(cap); w.column.reserve(cap);
   for (int u = 0; u < scan.height; ++u) {
     const int shift = u < int(scan.beams.pixel_shift_by_row.size()) ? scan.beams.pixel_shift_by_row[u] : 0;
     for (int cd = 0; cd < W; ++cd) {

@@ -61,7 +61,7 @@ class FeatureExtractor {
   std::vector<float> curv_;
   std::vector<uint8_t> ok_, picked_;
   std::vector<int> order_;
-  std::vector<float> gx_, gy_;
+  Eigen::Matrix3f R_ = Eigen::Matrix3f::Identity();
   std::vector<int> sel_, brk_;
   std::vector<int8_t> kind_;
   std::vector<Eigen::Vector3d> pre_;
