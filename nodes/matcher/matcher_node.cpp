@@ -38,6 +38,7 @@ fploc::MatcherConfig config_of(const fploc::MatcherOptions& o) {
   c.group_rule = !o.disable_group_rule();
   c.motion_model = !o.disable_motion_model();
   if (o.stride() > 0) c.stride = o.stride();
+  if (o.max_points() != 0) c.max_points = o.max_points() < 0 ? 0 : o.max_points();
   return c;
 }
 

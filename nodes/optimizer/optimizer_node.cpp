@@ -33,6 +33,7 @@ fploc::OptimizerConfig config_of(const fploc::OptimizerOptions& o) {
   if (o.max_iterations() > 0) c.max_iterations = o.max_iterations();
   if (o.rounds() > 0) c.outer = o.rounds();
   if (o.stride() > 0) c.stride = o.stride();
+  if (o.max_points() != 0) c.max_points = o.max_points() < 0 ? 0 : o.max_points();
   if (o.max_keyframe_gap_s() > 0) c.max_keyframe_gap_s = o.max_keyframe_gap_s();
   c.anchor_final = o.anchor_final();
   c.group_rule = !o.disable_group_rule();

@@ -47,7 +47,9 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
   AssignOptions ao;
   ao.gate_m = std::max(cfg.gate_initial_m, cfg.gate_final_m);
   ao.group_rule = cfg.group_rule;
-  ao.stride = cfg.stride;
+  ao.stride = std::max(1, cfg.stride);
+  if (cfg.max_points > 0 && int(f.points.size()) > cfg.max_points * ao.stride)
+    ao.stride = int((f.points.size() + size_t(cfg.max_points) - 1) / size_t(cfg.max_points));
   std::vector<Assignment> as;
   ceres::Problem::Options po;
   po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;

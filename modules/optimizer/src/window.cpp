@@ -125,7 +125,12 @@ void WindowOptimizer::solve() {
     ceres::Problem problem(po);
     for (size_t i = 0; i < window_.size(); ++i) {
       Key& k = window_[i];
-      assign(lookup_, k.in.features, Pose2{k.x[0], k.x[1], k.x[2]}, ao, &as[i]);
+      AssignOptions aok = ao;
+      const size_t np = k.in.features.points.size();
+      aok.stride = std::max(1, cfg_.stride);
+      if (cfg_.max_points > 0 && np > size_t(cfg_.max_points) * size_t(aok.stride))
+        aok.stride = int((np + size_t(cfg_.max_points) - 1) / size_t(cfg_.max_points));
+      assign(lookup_, k.in.features, Pose2{k.x[0], k.x[1], k.x[2]}, aok, &as[i]);
       problem.AddParameterBlock(k.x, 3);
       add_frame_term(&problem, k.x, lookup_, k.in.features, as[i], cfg_.loss, cfg_.loss_scale_m);
     }

@@ -28,6 +28,7 @@ struct MatcherConfig {
   bool group_rule = true;
   bool motion_model = true;       // constant velocity (else: previous pose)
   int stride = 1;                 // use every stride-th point
+  int max_points = 800;           // more features than this: the stride grows to keep about this many (0 = all)
 };
 
 struct MatchResult {

@@ -30,6 +30,7 @@ struct OptimizerConfig {
   int outer = 2;                       // look-up + solve rounds per new keyframe
   bool group_rule = true;
   int stride = 1;                      // use every stride-th feature point of a keyframe
+  int max_points = 400;                // per keyframe: the stride grows to keep about this many (0 = all)
   bool anchor_final = false;           // also regularise against the last two final key poses (held fixed)
   double max_keyframe_gap_s = 2.0;     // a longer gap (e.g. lost frames) restarts the window
 };

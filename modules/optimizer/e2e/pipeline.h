@@ -1,0 +1,39 @@
+// Library-level end-to-end run (no LCM): simulator -> ring segmenter -> features -> matcher ->
+// windowed optimizer, plus the no-plan odometry baseline on the same features. Used by the e2e test and
+// by the localization_e2e tool (numbers in docs/notes/localization.md). Built only when modules/sim,
+// modules/segmentation and modules/features exist.
+#pragma once
+#include <string>
+
+#include "fploc/core/pose.h"
+#include "fploc/floorplan/plan.h"
+
+namespace fploc::e2e {
+
+struct Options {
+  std::string scenario = "room-small-loop-medium";
+  uint64_t seed = 1;
+  int max_frames = 0;            // 0 = whole sequence
+  std::string lookup = "annf-exact";
+  bool imu = true;
+  std::string shared_dir;        // beams from ../shared when present
+  double gt_offset_s = 0.05;     // ground truth at scan start + this (mid-scan at 10 Hz)
+  int window = 10;
+  double alpha = 1.1, beta = 0.9;
+  bool clutter = true;
+  double drop_fraction = 0;      // drop this fraction of scans (deterministic)
+  double init_dx = 0, init_dy = 0, init_dyaw = 0;  // error of the initial pose
+};
+
+struct Result {
+  int frames = 0, ok_frames = 0, lost_frames = 0;
+  double length_m = 0, avg_speed = 0, max_speed = 0;
+  double ate_sfr = 0, rpe_sfr = 0, ate_wo = 0, rpe_wo = 0, ate_odo = 0, rpe_odo = 0;  // rmse ATE, mean RPE (1 s)
+  double us_segment = 0, us_features = 0, us_matcher = 0, us_optimizer = 0, us_odometry = 0;  // per scan
+  double features_per_scan = 0;
+  Trajectory gt, sfr, wo, odo;
+};
+
+Result run(const FloorPlan& plan, const Options& o);
+
+}  // namespace fploc::e2e
