@@ -1,14 +1,22 @@
 // IMU driver: publishes imu_t (SI units) on OS1_IMU. A source turns raw input into ImuSamples; the only
 // one implemented is "os1" (Ouster 48-byte IMU packets over UDP, default port 7503, or from a pcap,
 // including captures where lidar and IMU share a port: IMU packets are told apart by their size).
-// An Xsens MTi-30 (MTData2 over a serial port) would be another ImuSource reading `serial_device`.
+// "xsens" is an Xsens MTi (MTData2 over a serial port or from a recorded stream).
 #include <fploc/imu_t.hpp>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <memory>
 #include <stdexcept>
 
 #include "fploc/os1/packet.h"
 #include "fploc/os1/source.h"
+#include "fploc/os1/xsens.h"
 #include "fploc/runtime/node.h"
 #include "options/sensors.pb.h"
 
@@ -76,10 +84,83 @@ class Os1ImuSource : public ImuSource {
   int pcap_port_ = 0;
 };
 
+// Xsens MTi (MTi-30 in the paper): Xbus MTData2 with Acceleration, RateOfTurn and SampleTimeFine
+// enabled (configure the device with MT Manager). `serial_device` is a tty (raw 8N1 at serial_baud) or a
+// file holding a recorded byte stream (read as fast as possible; the node stops at its end). Times are
+// the device's SampleTimeFine (10 kHz) so a recording replays deterministically.
+class XsensSource : public ImuSource {
+ public:
+  ~XsensSource() override {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  void setup(fploc::rt::Context& ctx, const fploc::ImuDriverOptions& opt, SampleFn emit) override {
+    ctx_ = &ctx;
+    emit_ = std::move(emit);
+    if (opt.serial_device().empty()) throw std::runtime_error("imu_driver: source 'xsens' needs option 'serial_device'");
+    const std::string dev = ctx.resolve_path(opt.serial_device());
+    fd_ = ::open(dev.c_str(), O_RDONLY | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+    if (fd_ < 0) throw std::runtime_error("imu_driver: " + dev + ": " + std::strerror(errno));
+    struct stat st {};
+    ::fstat(fd_, &st);
+    if (S_ISREG(st.st_mode)) {
+      ctx.every(0.001, [this] {
+        if (!read_some()) ctx_->request_stop();
+      });
+      return;
+    }
+    termios t{};
+    if (::tcgetattr(fd_, &t) != 0) throw std::runtime_error("imu_driver: " + dev + ": not a tty: " + std::strerror(errno));
+    ::cfmakeraw(&t);
+    const int baud = opt.serial_baud() > 0 ? opt.serial_baud() : 115200;
+    speed_t sp;
+    switch (baud) {
+      case 115200: sp = B115200; break;
+      case 230400: sp = B230400; break;
+      case 460800: sp = B460800; break;
+      case 921600: sp = B921600; break;
+      default: throw std::runtime_error("imu_driver: option 'serial_baud': unsupported " + std::to_string(baud));
+    }
+    ::cfsetispeed(&t, sp);
+    ::cfsetospeed(&t, sp);
+    t.c_cflag |= CLOCAL | CREAD;
+    if (::tcsetattr(fd_, TCSANOW, &t) != 0) throw std::runtime_error("imu_driver: " + dev + ": " + std::strerror(errno));
+    ctx.watch_fd(fd_, [this] { read_some(); });
+  }
+
+ private:
+  // Returns false at the end of a file.
+  bool read_some() {
+    uint8_t buf[4096];
+    const ssize_t n = ::read(fd_, buf, sizeof(buf));
+    if (n <= 0) return n < 0 && (errno == EAGAIN || errno == EINTR);
+    const auto before = parser_.stats();
+    parser_.feed(buf, size_t(n), [this](const XsensSample& x) {
+      if (!x.has_time || !x.has_accel || !x.has_gyro) {
+        ctx_->error("xsens MTData2 without SampleTimeFine/Acceleration/RateOfTurn (enable them on the device)");
+        return;
+      }
+      Sample s{{}, "xsens"};
+      const uint64_t ns = uint64_t(x.sample_time_fine) * 100000u;  // 10 kHz ticks
+      s.s.sys_ts_ns = s.s.accel_ts_ns = s.s.gyro_ts_ns = ns;
+      s.s.accel_mps2 = x.accel;
+      s.s.gyro_radps = x.gyro;
+      emit_(s);
+    });
+    const auto& after = parser_.stats();
+    if (after.checksum_errors > before.checksum_errors) ctx_->error("xsens: Xbus checksum error");
+    if (after.bad_payloads > before.bad_payloads) ctx_->error("xsens: malformed MTData2 payload");
+    return true;
+  }
+  fploc::rt::Context* ctx_ = nullptr;
+  SampleFn emit_;
+  XbusParser parser_;
+  int fd_ = -1;
+};
+
 class ImuDriverNode : public fploc::rt::Node {
  public:
   static fploc::rt::NodeSpec spec() {
-    return {"imu_driver", "imu_driver", "IMU samples (Ouster IMU packets over UDP or pcap) in SI units -> OS1_IMU",
+    return {"imu_driver", "imu_driver", "IMU samples (Ouster IMU packets over UDP/pcap, or Xsens MTi MTData2 over serial) in SI units -> OS1_IMU",
             {fploc::rt::output<fploc::imu_t>("imu", "OS1_IMU")}};
   }
 
@@ -87,7 +168,8 @@ class ImuDriverNode : public fploc::rt::Node {
     const auto& opt = ctx.options<fploc::ImuDriverOptions>();
     const std::string kind = opt.source().empty() ? "os1" : opt.source();
     if (kind == "os1") source_ = std::make_unique<Os1ImuSource>();
-    else throw std::runtime_error("imu_driver: option 'source': '" + kind + "' is not implemented (os1)");
+    else if (kind == "xsens") source_ = std::make_unique<XsensSource>();
+    else throw std::runtime_error("imu_driver: option 'source': unknown '" + kind + "' (os1, xsens)");
     out_ = ctx.advertise<fploc::imu_t>("imu");
     source_->setup(ctx, opt, [this](const Sample& s) { publish(s); });
   }

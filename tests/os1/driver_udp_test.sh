@@ -50,3 +50,38 @@ sleep 1
 kill -INT "${pids[3]}"
 sleep 0.3
 python3 "$(dirname "$0")/check_log.py" --sdk-digest "$T/log2.lcm" "$G""_digest.json" 11
+
+# Xsens source from a recorded serial byte stream: 5 MTData2 messages (a real MTi payload) with garbage
+# and one corrupted message in between -> 5 OS1_IMU samples with source "xsens".
+python3 - "$T/mti.bin" <<'PY'
+import sys
+p = bytes.fromhex("10 20 02 8D 90 10 60 04 00 54 DB F1 20 10 10 3F 7F 89 11 BC 11 1D FA 3B A0 CE F0 BD 73 25 73 40 20 0C BD DC "
+    "F9 D0 BE 3C 86 19 41 1D 0B 47 40 10 0C B9 8D B0 00 B9 F1 48 00 3C C9 04 30 40 30 0C BC B9 89 2E BB 09 8C 00 "
+    "3C A7 08 00 80 20 0C BA 63 BC 01 BC 04 D6 3F BB 6D E3 FE 80 30 10 3F 80 00 01 B5 91 C0 00 B7 2A 08 00 B6 98 "
+    "40 00 E0 20 04 00 40 00 03".replace(" ", ""))
+m = bytes([0xFA, 0xFF, 0x36, len(p)]) + p
+m += bytes([(-sum(m[1:])) & 0xFF])
+bad = bytearray(m); bad[40] ^= 1
+open(sys.argv[1], "wb").write(b"\x00\xfa\x13" + m + m + bytes(bad) + b"junk" + m + m + m)
+PY
+lcm-logger --lcm-url="$URL" "$T/log3.lcm" > "$T/logger3.txt" 2>&1 & pids+=($!)
+sleep 0.5
+timeout 20 "$B/fploc-imu-driver" --lcm-url "$URL" --set source=xsens --set serial_device="$T/mti.bin"
+sleep 1
+kill -INT "${pids[4]}"
+sleep 0.3
+python3 - "$T/log3.lcm" <<'PY'
+import struct, sys
+d = open(sys.argv[1], "rb").read(); o = 0; got = []
+while o + 28 <= len(d):
+    _, _, _, cl, dl = struct.unpack(">IQQII", d[o:o + 28]); o += 28
+    ch = d[o:o + cl].decode(); o += cl; b = d[o:o + dl]; o += dl
+    if ch == "OS1_IMU":
+        utime = struct.unpack(">q", b[8:16])[0]
+        acc = struct.unpack(">3d", b[40:64]); gyr = struct.unpack(">3d", b[64:88])
+        n = struct.unpack(">i", b[88:92])[0]; src = b[92:92 + n - 1].decode()
+        got.append((utime, acc, gyr, src))
+print("xsens samples:", len(got), got[:1])
+ok = len(got) == 5 and all(g[3] == "xsens" and abs(g[1][2] - 9.81525326) < 1e-5 and g[0] == 556132900 for g in got)
+sys.exit(0 if ok else 1)
+PY
