@@ -39,7 +39,7 @@ struct PlanArgs {
 };
 
 struct AnnfArgs {
-  std::string mode = "paper", rule = "child-leaf";
+  std::string mode = "paper", rule = "child-leaf-ordered";
   int depth = 7, max_candidates = 2;
   double root = 6.0;
   void add(CLI::App* app, bool with_depth = true) {
@@ -120,8 +120,9 @@ int main(int argc, char** argv) {
   validate->add_option("--depths", v.depths, "depth range, e.g. 3-8");
   validate->add_option("--samples", v.samples, "uniform samples in the plan's bounding box (default 1000000)");
   validate->add_option("--mode", v.mode, "paper | exact | both (default both)")->check(CLI::IsMember({"paper", "exact", "both"}));
-  validate->add_option("--rule", v.rule, "paper stopping rule (default child-leaf)");
+  validate->add_option("--rule", v.rule, "paper stopping rule (default child-leaf-ordered)");
   validate->add_flag("--distinct", v.distinct, "paper mode: two nearest at distinct distances (the authors' demo)");
+  validate->add_option("--sample-area", v.sample_area, "bbox (plan's bounding box, default) | fields (area of the root fields)");
   validate->add_flag("--all-rules", v.all_rules, "measure every reading of the paper's stopping rules");
   validate->add_option("--root", v.root, "root field length in metres (default 6)");
   validate->add_option("--max-candidates", v.max_candidates, "exact mode: subdivide while a leaf has more candidates");

@@ -10,9 +10,10 @@ struct ValidateArgs {
   std::string depths = "3-8";
   long samples = 1000000;
   std::string mode = "both";
-  std::string rule = "child-leaf";
+  std::string rule = "child-leaf-ordered";
   bool all_rules = false;
   bool distinct = false;
+  std::string sample_area = "bbox";
   double root = 6.0;
   int max_candidates = 2;
   int exact_depth = 0;

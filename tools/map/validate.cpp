@@ -57,7 +57,15 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
   }
   if (d0 < 1 || d1 < d0 || d1 > 16) throw std::runtime_error("--depths: expected 1 <= A <= B <= 16");
   if (a.samples < 1) throw std::runtime_error("--samples must be >= 1");
-  const Box2 bb = plan.bounds();
+  Box2 bb = plan.bounds();
+  if (a.sample_area == "fields") {  // the area covered by the root fields (extends past the plan)
+    AnnfOptions ro;
+    ro.root_length = a.root;
+    ro.max_depth = 1;
+    bb = Annf::build(plan, ro).covered();
+  } else if (a.sample_area != "bbox") {
+    throw std::runtime_error("--sample-area: bbox or fields");
+  }
   std::mt19937_64 rng(a.seed);
   std::uniform_real_distribution<double> ux(bb.min.x(), bb.max.x()), uy(bb.min.y(), bb.max.y());
   std::vector<Eigen::Vector2d> pts(size_t(a.samples));
@@ -137,6 +145,7 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
                   {"hit_first", h1 / N},
                   {"hit_first_or_second", h12 / N},
                   {"hit_exact", hx / N},
+                  {"exact_misses", pts.size() - hx},
                   {"ns_per_query", ns},
                   {"lookup_ns", lookup_ns},
                   {"bytes", s.bytes},
@@ -163,7 +172,8 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
   }
 
   json out = {{"elements", plan.elements.size()}, {"samples", pts.size()}, {"rows", rows}};
-  out["bbox_m"] = {bb.min.x(), bb.min.y(), bb.max.x(), bb.max.y()};
+  out["sample_box_m"] = {bb.min.x(), bb.min.y(), bb.max.x(), bb.max.y()};
+  out["sample_area"] = a.sample_area;
   json base = {{"brute_force_ns", brute_ns}};
   if (!a.no_baselines) {
     const double spacing = a.root / double(1u << (a.baseline_depth - 1));

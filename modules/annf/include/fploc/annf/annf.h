@@ -24,6 +24,7 @@
 // on a bad, truncated or old file.
 #pragma once
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -52,7 +53,7 @@ struct AnnfOptions {
   AnnfMode mode = AnnfMode::kPaper;
   double root_length = 6.0;  // metres
   int max_depth = 7;         // 1 = root fields only
-  PaperRule paper_rule = PaperRule::kChildLeaf;
+  PaperRule paper_rule = PaperRule::kChildLeafOrdered;  // closest to Table III (docs/notes/annf.md)
   int exact_max_candidates = 2;  // exact mode: subdivide while a leaf holds more candidates
   double margin = 0.0;           // metres added around the plan's bounding box
   // Paper mode: "two nearest" keeps two elements at *different* distances from the field centre
@@ -122,9 +123,8 @@ class Annf {
       FastPrim s;
       std::memcpy(&s, g, sizeof s);
       double qx, qy;
-      if (s.inv_l2 >= 0) {
-        double t = ((p.x() - s.ax) * s.dx + (p.y() - s.ay) * s.dy) * s.inv_l2;
-        t = t < 0 ? 0 : (t > 1 ? 1 : t);
+      if (__builtin_expect(s.inv_l2 >= 0, 1)) {
+        const double t = std::min(1.0, std::max(0.0, ((p.x() - s.ax) * s.dx + (p.y() - s.ay) * s.dy) * s.inv_l2));
         qx = s.ax + t * s.dx;
         qy = s.ay + t * s.dy;
       } else {
@@ -133,12 +133,12 @@ class Annf {
         qy = cp.point.y();
       }
       const double d2 = (qx - p.x()) * (qx - p.x()) + (qy - p.y()) * (qy - p.y());
-      if (d2 < bd2) {
-        bd2 = d2;
-        best = int(ids[k]);
-        bx = qx;
-        by = qy;
-      }
+      // Branch-free selection (mispredictions would flush the next queries' memory loads).
+      const bool better = d2 < bd2;
+      bd2 = better ? d2 : bd2;
+      best = better ? int(ids[k]) : best;
+      bx = better ? qx : bx;
+      by = better ? qy : by;
     }
     if (dist) *dist = std::sqrt(bd2);
     if (closest) *closest = Eigen::Vector2d(bx, by);
