@@ -1,0 +1,31 @@
+#!/bin/sh
+# CLI contract checks for fploc-map: errors name file:line and exit non-zero; validate emits the JSON keys.
+set -u
+MAP="$1"
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+printf 'x1,y1,x2,y2\n0,0,1,0\n0,0,zz,1\n' > "$T/bad.csv"
+if "$MAP" build --plan "$T/bad.csv" --out "$T/x.fpmap" 2> "$T/err"; then fail "bad CSV accepted"; fi
+grep -q "bad.csv:3:" "$T/err" || fail "error does not name bad.csv:3: $(cat "$T/err")"
+printf '  0\nSECTION\n  2\nENTITIES\n  0\nLINE\n  8\nw\n 10\n0\n' > "$T/trunc.dxf"
+if "$MAP" build --plan "$T/trunc.dxf" --out "$T/x.fpmap" 2> "$T/err"; then fail "truncated DXF accepted"; fi
+grep -q "trunc.dxf:" "$T/err" || fail "error does not name trunc.dxf: $(cat "$T/err")"
+cat > "$T/p.json" <<'J'
+{"units":"m","elements":[{"type":"segment","a":[0,0],"b":[10,0],"layer":"walls"},{"type":"segment","a":[10,0],"b":[10,8],"layer":"walls"},
+ {"type":"circle","c":[4,4],"r":0.3,"layer":"cols"},{"type":"arc","c":[2,6],"r":1,"start_deg":0,"end_deg":180,"layer":"walls"}]}
+J
+if "$MAP" build --plan "$T/p.json" --layers 'nothing*' --out "$T/x.fpmap" 2> "$T/err"; then fail "empty layer selection accepted"; fi
+grep -q "no elements on layers" "$T/err" || fail "empty selection message: $(cat "$T/err")"
+"$MAP" build --plan "$T/p.json" --mode exact --depth 8 --out "$T/p.fpmap" --json > "$T/build.json" 2>/dev/null || fail "build"
+grep -q '"leaves"' "$T/build.json" || fail "build JSON"
+"$MAP" validate --plan "$T/p.json" --samples 20000 --depths 4-6 --json > "$T/v.json" 2>/dev/null || fail "validate"
+for k in elements rows depth leaf_length_m hit_first hit_first_or_second hit_exact ns_per_query bytes baselines brute_force_ns kdtree_ns kdtree_hit; do
+  grep -q "\"$k\"" "$T/v.json" || fail "validate JSON lacks $k"
+done
+"$MAP" render --plan "$T/p.json" --map "$T/p.fpmap" --out "$T/r.svg" 2>/dev/null || fail "render"
+grep -q "<svg" "$T/r.svg" || fail "svg"
+"$MAP" export-pgm --plan "$T/p.json" --resolution 0.1 --out "$T/pgm" 2>/dev/null || fail "export-pgm"
+head -c 2 "$T/pgm/map.pgm" | grep -q P5 || fail "pgm header"
+grep -q "resolution: 0.1" "$T/pgm/map.yaml" || fail "yaml"
+echo "fploc-map CLI checks passed"
