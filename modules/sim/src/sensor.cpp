@@ -25,50 +25,41 @@ BeamIntrinsics nominal_os1_64() {
 }
 
 bool load_beam_intrinsics_json(const std::string& path, BeamIntrinsics& out, std::string* error) {
-  auto fail = [&](const std::string& m) {
-    if (error) *error = path + ": " + m;
+  // The OS-1 driver's metadata reader (legacy flat, nested and reduced layouts; SDK defaults).
+  try {
+    out = os1::load_metadata(path).beams;
+    return true;
+  } catch (const std::exception& e) {
+    if (error) *error = e.what();
     return false;
-  };
-  std::ifstream in(path);
-  if (!in) return fail("cannot open");
+  }
+}
+
+os1::SensorInfo sensor_info_for(const BeamIntrinsics& beams, int width, double rate_hz) {
+  std::vector<double> alt = beams.altitude_deg, az = beams.azimuth_deg;
+  os1::SensorInfo info = os1::make_sensor_info(alt, az, std::to_string(width) + "x" + std::to_string(int(std::lround(rate_hz))));
+  info.beams = beams;
+  info.prod_line = "OS-1-" + std::to_string(beams.beams());
+  info.serial = "sim";
+  return info;
+}
+
+std::string metadata_json(const os1::SensorInfo& info) {
   nlohmann::json j;
-  try {
-    in >> j;
-  } catch (const std::exception& e) {
-    return fail(std::string("not JSON: ") + e.what());
-  }
-  auto find = [&](const char* key, const char* nested) -> const nlohmann::json* {
-    if (j.contains(key)) return &j[key];
-    if (nested && j.contains(nested) && j[nested].contains(key)) return &j[nested][key];
-    return nullptr;
-  };
-  BeamIntrinsics b;
-  const auto* alt = find("beam_altitude_angles", "beam_intrinsics");
-  const auto* az = find("beam_azimuth_angles", "beam_intrinsics");
-  if (!alt || !alt->is_array()) return fail("missing field beam_altitude_angles");
-  if (!az || !az->is_array()) return fail("missing field beam_azimuth_angles");
-  if (alt->size() != az->size() || alt->empty()) return fail("beam_altitude_angles and beam_azimuth_angles differ in size");
-  try {
-    for (const auto& v : *alt) b.altitude_deg.push_back(v.get<double>());
-    for (const auto& v : *az) b.azimuth_deg.push_back(v.get<double>());
-    if (const auto* off = find("lidar_origin_to_beam_origin_mm", "beam_intrinsics")) b.beam_offset_mm = off->get<double>();
-    else b.beam_offset_mm = 12.163;
-    if (const auto* t = find("lidar_to_sensor_transform", "lidar_intrinsics"); t && t->is_array() && t->size() == 16)
-      for (int i = 0; i < 16; ++i) b.lidar_to_sensor[size_t(i)] = (*t)[size_t(i)].get<double>();
-    const nlohmann::json* df = find("data_format", nullptr);
-    if (!df) df = find("lidar_data_format", nullptr);
-    if (df && df->contains("pixel_shift_by_row"))
-      for (const auto& v : (*df)["pixel_shift_by_row"]) b.pixel_shift_by_row.push_back(v.get<int>());
-  } catch (const std::exception& e) {
-    return fail(std::string("bad value: ") + e.what());
-  }
-  if (b.pixel_shift_by_row.size() != b.altitude_deg.size()) {
-    b.pixel_shift_by_row.clear();
-    const int s4[4] = {18, 12, 6, 0};
-    for (size_t u = 0; u < b.altitude_deg.size(); ++u) b.pixel_shift_by_row.push_back(s4[u % 4]);
-  }
-  out = std::move(b);
-  return true;
+  j["beam_altitude_angles"] = info.beams.altitude_deg;
+  j["beam_azimuth_angles"] = info.beams.azimuth_deg;
+  j["lidar_origin_to_beam_origin_mm"] = info.beams.beam_offset_mm;
+  j["lidar_to_sensor_transform"] = std::vector<double>(info.beams.lidar_to_sensor.begin(), info.beams.lidar_to_sensor.end());
+  j["imu_to_sensor_transform"] = std::vector<double>(info.imu_to_sensor.begin(), info.imu_to_sensor.end());
+  j["lidar_mode"] = info.lidar_mode;
+  j["prod_line"] = info.prod_line;
+  j["prod_sn"] = info.serial;
+  j["data_format"] = {{"pixels_per_column", info.pixels_per_column},
+                      {"columns_per_packet", info.columns_per_packet},
+                      {"columns_per_frame", info.columns_per_frame},
+                      {"pixel_shift_by_row", info.beams.pixel_shift_by_row},
+                      {"column_window", {info.column_window_first, info.column_window_last}}};
+  return j.dump(1);
 }
 
 BeamIntrinsics default_beams(const std::string& shared_dir, std::string* source) {

@@ -11,6 +11,7 @@
 #include "fploc/core/pose.h"
 #include "fploc/core/scan.h"
 #include "fploc/core/xyz.h"
+#include "fploc/os1/metadata.h"
 #include "fploc/sim/world.h"
 
 namespace fploc::sim {
@@ -19,9 +20,15 @@ namespace fploc::sim {
 // four-fold azimuth stagger +3.1/+0.9/-1.3/-3.4 deg, pixel shifts 19/13/6/0 for 1024 columns).
 BeamIntrinsics nominal_os1_64();
 
-// Reads beam angles, beam offset, lidar_to_sensor and pixel shifts from an Ouster metadata JSON (legacy flat
-// or nested layout). Returns false with a message naming the file and field on failure.
+// Reads beam angles, beam offset, lidar_to_sensor and pixel shifts from an Ouster metadata JSON with the
+// OS-1 driver's reader (fploc/os1/metadata.h). Returns false with a message naming the file and field.
 bool load_beam_intrinsics_json(const std::string& path, BeamIntrinsics& out, std::string* error);
+
+// The SensorInfo the OS-1 driver needs to decode the simulator's packets (legacy profile, 16 columns per
+// packet, lidar_mode "<width>x<rate>", the simulator's beams), and the metadata JSON (legacy flat layout)
+// that describes it, for `fploc-os1-driver --metadata`.
+os1::SensorInfo sensor_info_for(const BeamIntrinsics& beams, int width = 1024, double rate_hz = 10);
+std::string metadata_json(const os1::SensorInfo& info);
 
 // The beams the simulator uses by default: the real OS-1-64 calibration from
 // <shared>/data/ouster/metadata/ when that folder is present, otherwise nominal_os1_64().

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Runs inside scripts/netns-run (FPLOC_BUILD_DIR set by fploc_add_netns_test).
+set -euo pipefail
+B="${FPLOC_BUILD_DIR:?}/bin"
+for exe in fploc-sim-sensor fploc-os1-driver fploc-imu-driver fploc-sim; do
+  [ -x "$B/$exe" ] || { echo "missing $B/$exe (build it first)"; exit 1; }
+done
+T="$(mktemp -d)"
+pids=()
+cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; rm -rf "$T"; }
+trap cleanup EXIT
+URL="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608"
+SCEN=room-small-loop-fast
+SEED=3
+
+lcm-logger --lcm-url="$URL" "$T/drv.lcm" > "$T/logger.txt" 2>&1 & pids+=($!)
+"$B/fploc-sim-sensor" --lcm-url "$URL" --set scenario=$SCEN --set seed=$SEED --set lidar_port=17502 \
+  --set imu_port=17503 --set metadata_out="$T/meta.json" > "$T/sim.txt" 2>&1 & pids+=($!)
+for _ in $(seq 100); do [ -s "$T/meta.json" ] && break; sleep 0.1; done
+[ -s "$T/meta.json" ] || { echo "sim-sensor wrote no metadata"; cat "$T/sim.txt"; exit 1; }
+sleep 0.2
+"$B/fploc-os1-driver" --lcm-url "$URL" --set metadata="$T/meta.json" --set lidar_port=17502 > "$T/os1.txt" 2>&1 & pids+=($!)
+"$B/fploc-imu-driver" --lcm-url "$URL" --set imu_port=17503 > "$T/imu.txt" 2>&1 & pids+=($!)
+sleep 6
+kill -INT "${pids[2]}" "${pids[3]}" "${pids[1]}"
+sleep 0.5
+kill -INT "${pids[0]}"
+wait "${pids[2]}" "${pids[3]}" || { echo "driver exited non-zero"; cat "$T/os1.txt" "$T/imu.txt"; exit 1; }
+sleep 0.3
+cat "$T/sim.txt" "$T/os1.txt" "$T/imu.txt"
+# The reference: the same scenario and seed written directly as an LCM log.
+"$B/fploc-sim" --scenario $SCEN --seed $SEED --out "$T/ref.lcm" --gt "$T/ref.tum" --duration 15 2> "$T/ref.txt"
+python3 "$(dirname "$0")/check_sim_log.py" "$T/drv.lcm" "$T/ref.lcm"
