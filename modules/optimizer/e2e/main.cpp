@@ -53,6 +53,8 @@ int main(int argc, char** argv) {
                         {"avg_speed_mps", r.avg_speed}, {"max_speed_mps", r.max_speed}, {"ate_sfr_m", r.ate_sfr},
                         {"rpe_sfr_m", r.rpe_sfr}, {"ate_wo_m", r.ate_wo}, {"rpe_wo_m", r.rpe_wo},
                         {"ate_odometry_m", r.ate_odo}, {"rpe_odometry_m", r.rpe_odo},
+                        {"ate_sfr_xy_m", r.ate_sfr_xy}, {"rpe_sfr_xy_m", r.rpe_sfr_xy}, {"ate_wo_xy_m", r.ate_wo_xy},
+                        {"rpe_wo_xy_m", r.rpe_wo_xy}, {"ate_odometry_xy_m", r.ate_odo_xy}, {"rpe_odometry_xy_m", r.rpe_odo_xy},
                         {"features_per_scan", r.features_per_scan},
                         {"us_per_scan", {{"segmenter", r.us_segment}, {"features", r.us_features}, {"matcher", r.us_matcher},
                                          {"optimizer", r.us_optimizer}, {"odometry", r.us_odometry}}},

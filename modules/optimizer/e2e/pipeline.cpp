@@ -151,6 +151,14 @@ Result run(const FloorPlan& plan_in, const Options& o) {
   score(r.gt, r.sfr, &r.ate_sfr, &r.rpe_sfr);
   score(r.gt, r.wo, &r.ate_wo, &r.rpe_wo);
   score(r.gt, r.odo, &r.ate_odo, &r.rpe_odo);
+  auto flat = [](Trajectory t) {
+    for (auto& p : t) p.p.z() = 0;
+    return t;
+  };
+  const Trajectory gt_xy = flat(r.gt);
+  score(gt_xy, flat(r.sfr), &r.ate_sfr_xy, &r.rpe_sfr_xy);
+  score(gt_xy, flat(r.wo), &r.ate_wo_xy, &r.rpe_wo_xy);
+  score(gt_xy, flat(r.odo), &r.ate_odo_xy, &r.rpe_odo_xy);
   return r;
 }
 

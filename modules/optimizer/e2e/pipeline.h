@@ -28,7 +28,9 @@ struct Options {
 struct Result {
   int frames = 0, ok_frames = 0, lost_frames = 0;
   double length_m = 0, avg_speed = 0, max_speed = 0;
-  double ate_sfr = 0, rpe_sfr = 0, ate_wo = 0, rpe_wo = 0, ate_odo = 0, rpe_odo = 0;  // rmse ATE, mean RPE (1 s)
+  double ate_sfr = 0, rpe_sfr = 0, ate_wo = 0, rpe_wo = 0, ate_odo = 0, rpe_odo = 0;  // rmse ATE, mean RPE (1 s), 3D
+  // The same in the horizontal plane only (x, y: what the matcher and optimizer estimate; z is the segmenter's).
+  double ate_sfr_xy = 0, rpe_sfr_xy = 0, ate_wo_xy = 0, rpe_wo_xy = 0, ate_odo_xy = 0, rpe_odo_xy = 0;
   double us_segment = 0, us_features = 0, us_matcher = 0, us_optimizer = 0, us_odometry = 0;  // per scan
   double features_per_scan = 0;
   Trajectory gt, sfr, wo, odo;
