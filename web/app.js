@@ -124,7 +124,33 @@ function renderNodes(msg) {
 let t0 = null;  // plot time origin (s)
 const tsec = (utime) => { const t = utime / 1e6; if (t0 === null) t0 = t; return t - t0; };
 
+// Poses skipped by the rate cap or a stalled browser leave gaps: fetch them from /api/history.
+function mergeTrail(trail, pts) {
+  const all = trail.concat(pts).sort((a, b) => a[2] - b[2]);
+  const out = [];
+  for (const q of all) { if (out.length && out[out.length - 1][2] === q[2]) out[out.length - 1] = q; else out.push(q); }
+  return out.slice(-MAX_TRAIL);
+}
+let fillSince = null, fillTimer = null;
+function fillGap(since) {
+  fillSince = fillSince === null ? since : Math.min(fillSince, since);
+  if (fillTimer) return;
+  fillTimer = setTimeout(async () => {
+    const from = fillSince; fillSince = null;
+    try {
+      const h = await (await fetch(`/api/history?since=${from}`, { cache: 'no-store' })).json();
+      S.trail = mergeTrail(S.trail, h.est.map(([u, x, y]) => [x, y, u]));
+      S.gtTrail = mergeTrail(S.gtTrail, h.gt.map(([u, x, y]) => [x, y, u]));
+      S.gapFills = (S.gapFills || 0) + 1;
+      map.invalidate();
+    } catch (e) { /* next gap tries again */ }
+    fillTimer = setTimeout(() => { fillTimer = null; if (fillSince !== null) fillGap(fillSince); }, 1000);
+  }, 200);
+}
+
 function onPose(p) {
+  if (S.lastPoseSeq !== undefined && p.seq > S.lastPoseSeq + 1 && S.trail.length) fillGap(S.trail[S.trail.length - 1][2]);
+  S.lastPoseSeq = p.seq;
   S.pose = p;
   addToTrail(S.trail, p.utime, p.x, p.y);
   const lat = Date.now() - p.utime / 1000;
@@ -144,6 +170,8 @@ function onPose(p) {
   schedulePoseBox();
 }
 function onGt(g) {
+  if (S.lastGtSeq !== undefined && g.seq > S.lastGtSeq + 1 && S.gtTrail.length) fillGap(S.gtTrail[S.gtTrail.length - 1][2]);
+  S.lastGtSeq = g.seq;
   S.gt = g;
   addToTrail(S.gtTrail, g.utime, g.x, g.y);
   const t = tsec(g.utime);
@@ -158,7 +186,7 @@ async function loadStatic() {
     fetch('/api/history', { cache: 'no-store' }).then((r) => r.json()),
   ]);
   if (plan) map.setPlan(plan);
-  S.trail = []; S.gtTrail = []; t0 = null;
+  S.trail = []; S.gtTrail = []; t0 = null; S.lastPoseSeq = undefined; S.lastGtSeq = undefined;
   Object.values(plots).forEach((p) => p.clear());
   let sq = 0, n = 0;
   for (const [utime, x, y, z, roll, pitch, , err] of hist.est) {

@@ -44,11 +44,11 @@ export class Plot {
     if (hi - lo < this.minSpan) { const m = (hi + lo) / 2; lo = m - this.minSpan / 2; hi = m + this.minSpan / 2; }
     if (hi === lo) { hi += 1e-3; lo -= 1e-3; }
     const pad = (hi - lo) * 0.08; lo -= pad; hi += pad;
-    const L = 44, R = 4, T = 4, B = 4;
+    const L = 44, R = 4, T = 15, B = 4;  // legend above the plot area
     const X = (t) => L + (t - tmin) / span * (w - L - R), Y = (v) => T + (hi - v) / (hi - lo) * (h - T - B);
     c.strokeStyle = '#e5e7eb'; c.lineWidth = 1; c.beginPath(); c.moveTo(L, T); c.lineTo(L, h - B); c.lineTo(w - R, h - B); c.stroke();
     c.fillStyle = '#6b7280'; c.textAlign = 'right';
-    c.fillText(hi.toFixed(this.digits), L - 3, T + 8); c.fillText(lo.toFixed(this.digits), L - 3, h - B - 1);
+    c.fillText(hi.toFixed(this.digits), L - 3, T + 4); c.fillText(lo.toFixed(this.digits), L - 3, h - B - 1);
     this.series.forEach((s, i) => {
       const d = this.data[i];
       c.strokeStyle = s.color; c.lineWidth = 1.5; c.setLineDash(s.dash || []);
@@ -62,7 +62,7 @@ export class Plot {
     this.series.forEach((s, i) => {
       const d = this.data[i];
       const last = d.length ? d[d.length - 1][1].toFixed(this.digits) : '–';
-      c.fillStyle = s.color; const txt = `${s.label} ${last}`; c.fillText(txt, x, T + 9); x += c.measureText(txt).width + 10;
+      c.fillStyle = s.color; const txt = `${s.label} ${last}`; c.fillText(txt, x, 10); x += c.measureText(txt).width + 10;
     });
   }
 }

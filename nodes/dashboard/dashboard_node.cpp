@@ -162,7 +162,19 @@ class DashboardNode : public fploc::rt::Node {
     };
     s.Get("/api/plan", [this, json_reply](const httplib::Request&, httplib::Response& res) { json_reply(res, model_->plan_json()); });
     s.Get("/api/state", [this, json_reply](const httplib::Request&, httplib::Response& res) { json_reply(res, model_->state_json()); });
-    s.Get("/api/history", [this, json_reply](const httplib::Request&, httplib::Response& res) { json_reply(res, model_->history_json()); });
+    s.Get("/api/history", [this, json_reply](const httplib::Request& req, httplib::Response& res) {
+      int64_t since = INT64_MIN;
+      if (req.has_param("since")) {
+        try {
+          since = std::stoll(req.get_param_value("since"));
+        } catch (const std::exception&) {
+          res.status = 400;
+          res.set_content("since: expected an integer utime\n", "text/plain");
+          return;
+        }
+      }
+      json_reply(res, model_->history_json(since));
+    });
     s.Get("/api/info", [this, json_reply](const httplib::Request&, httplib::Response& res) { json_reply(res, model_->info_json()); });
     s.Get("/api/events", [this](const httplib::Request&, httplib::Response& res) {
       res.set_header("Cache-Control", "no-store");

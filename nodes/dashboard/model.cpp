@@ -362,13 +362,14 @@ std::string Model::state_json() const {
   return out + "}";
 }
 
-std::string Model::history_json() const {
+std::string Model::history_json(int64_t since) const {
   std::lock_guard<std::mutex> lk(mu_);
   json est = json::array(), gt = json::array();
   for (const auto& p : est_)
-    est.push_back({p.utime, num(r6(p.x)), num(r6(p.y)), num(r6(p.z)), num(r6(p.roll)), num(r6(p.pitch)),
+    if (p.utime > since) est.push_back({p.utime, num(r6(p.x)), num(r6(p.y)), num(r6(p.z)), num(r6(p.roll)), num(r6(p.pitch)),
                    num(r6(p.yaw)), p.has_err ? num(r6(p.err)) : json(nullptr)});
-  for (const auto& p : gt_) gt.push_back({p.utime, num(r6(p.x)), num(r6(p.y)), num(r6(p.z))});
+  for (const auto& p : gt_)
+    if (p.utime > since) gt.push_back({p.utime, num(r6(p.x)), num(r6(p.y)), num(r6(p.z))});
   json j = {{"fields_est", {"utime", "x", "y", "z", "roll", "pitch", "yaw", "err"}},
             {"fields_gt", {"utime", "x", "y", "z"}},
             {"est", est},

@@ -10,6 +10,7 @@
 
 #include <array>
 #include <condition_variable>
+#include <climits>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -59,7 +60,8 @@ class Model {
   // ---- outputs (HTTP threads)
   std::string plan_json() const;
   std::string state_json() const;    // {"pose":..., "nodes":..., ...} latest of every stream
-  std::string history_json() const;  // trails and plot series since start
+  // Trails and plot series (entries with utime > since_utime; all by default).
+  std::string history_json(int64_t since_utime = INT64_MIN) const;
   std::string info_json() const;
   // Blocks until a stream has a value the client has not seen and that stream's rate cap (max_hz
   // events per second per stream) allows it, then returns the SSE text to send ("" after keepalive_s

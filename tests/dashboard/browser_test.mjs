@@ -148,6 +148,13 @@ try {
   check(tLaunch >= 0, `launcher-reported "restarting" turns the node red (after ${tLaunch} ms)`);
 
   await sleep(2500);  // let the trail get longer for the picture
+  // Poses the page missed (rate cap, stalls) are filled in from /api/history: no hole in the trail.
+  const maxStep = await page.evaluate(() => {
+    const t = window.__fploc.trail; let m = 0;
+    for (let i = 1; i < t.length; i++) m = Math.max(m, t[i][2] - t[i - 1][2]);
+    return m / 1000;
+  });
+  check(maxStep < 1000, `trail has no holes (largest step ${maxStep.toFixed(0)} ms at 10 Hz; ${await page.evaluate(() => window.__fploc.gapFills || 0)} gap fills)`);
   await page.screenshot({ path: join(OUT, 'dashboard.png') });
   if (process.env.FPLOC_SCREENSHOT) copyFileSync(join(OUT, 'dashboard.png'), process.env.FPLOC_SCREENSHOT);
 

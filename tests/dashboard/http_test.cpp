@@ -133,6 +133,16 @@ TEST_F(DashboardHttp, PlanStateAndHistory) {
   auto h = json::parse(r->body);
   EXPECT_GT(h["est"].size(), 50u);
   EXPECT_GT(h["gt"].size(), 50u);
+  // Gap filling: only entries after `since`.
+  const int64_t since = h["est"][h["est"].size() - 5][0];
+  r = client_.Get(("/api/history?since=" + std::to_string(since)).c_str());
+  ASSERT_TRUE(r);
+  auto tail = json::parse(r->body);
+  ASSERT_GE(tail["est"].size(), 4u);
+  for (const auto& e : tail["est"]) EXPECT_GT(e[0].get<int64_t>(), since);
+  r = client_.Get("/api/history?since=abc");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 400);
 }
 
 TEST_F(DashboardHttp, EventsAreRateCappedLatestValues) {
