@@ -30,15 +30,17 @@ map.layers.push((c, v) => {
   v.polyline(c, S.gtTrail, COL.gt, 2);
   v.polyline(c, S.trail, COL.est, 2);
   const f = S.features;
-  if (f && f.pose && $('showfeat').checked) {
-    const cs = Math.cos(f.pose.yaw), sn = Math.sin(f.pose.yaw), r = 2;
+  // Project with the frame pose of the same scan when it is here (it arrives just after the features).
+  const fpose = f && (S.frame && S.frame.scan_seq === f.scan_seq && S.frame.x !== null ? S.frame : f.pose);
+  if (f && fpose && $('showfeat').checked) {
+    const cs = Math.cos(fpose.yaw), sn = Math.sin(fpose.yaw), r = 2;
     for (const kind of ['s', 'c']) {
       c.fillStyle = kind === 'c' ? COL.corner : COL.surface;
       c.beginPath();
       for (let i = 0, k = 0; k < f.kind.length; i += 2, k++) {
         if (f.kind[k] !== kind) continue;
         const px = f.xy[i], py = f.xy[i + 1];
-        const [sx, sy] = v.toScreen(f.pose.x + cs * px - sn * py, f.pose.y + sn * px + cs * py);
+        const [sx, sy] = v.toScreen(fpose.x + cs * px - sn * py, fpose.y + sn * px + cs * py);
         c.moveTo(sx + r, sy); c.arc(sx, sy, kind === 'c' ? r + 1 : r, 0, 2 * Math.PI);
       }
       c.fill();
