@@ -87,6 +87,7 @@ struct SdkScan {
 };
 
 struct SdkDigester {
+  explicit SdkDigester(const PacketFormat& fmt) : f(fmt) {}
   PacketFormat f;
   SdkScan cur;
   std::vector<json> scans;
@@ -195,7 +196,7 @@ int main(int argc, char** argv) {
   if (!pcd_dir.empty()) std::filesystem::create_directories(pcd_dir);
 
   FrameAssembler fa(info);
-  SdkDigester sdk{fa.format()};
+  SdkDigester sdk(fa.format());
   PacketClassifier cls{lidar_port, imu_port, fa.format().lidar_packet_size()};
   const XyzLut lut = make_xyz_lut(info.beams, info.columns_per_frame);
   uint64_t lidar_packets = 0, imu_packets = 0, imu_bad = 0, other = 0, valid_returns = 0;
