@@ -43,8 +43,9 @@ Fixture& fixture() {
     f.paper = std::make_unique<Annf>(Annf::build(f.plan, po));
     AnnfOptions xo;
     xo.mode = AnnfMode::kExact;
-    xo.max_depth = 9;
-    xo.exact_max_candidates = 4;
+    // FPLOC_EXACT_DEPTH / FPLOC_EXACT_MC: exact-mode depth and leaf candidate threshold.
+    xo.max_depth = std::getenv("FPLOC_EXACT_DEPTH") ? std::atoi(std::getenv("FPLOC_EXACT_DEPTH")) : 9;
+    xo.exact_max_candidates = std::getenv("FPLOC_EXACT_MC") ? std::atoi(std::getenv("FPLOC_EXACT_MC")) : 4;
     xo.index_cells = cells;
     f.exact = std::make_unique<Annf>(Annf::build(f.plan, xo));
     const double res = 6.0 / 64;  // the leaf length at depth 7 (9.375 cm)
@@ -109,10 +110,40 @@ void BM_AnnfExact(benchmark::State& st) {
   });
   st.counters["bytes"] = double(fixture().ok ? fixture().exact->stats().bytes : 0);
 }
+// Batch look-ups of 1024 points (a scan), with software prefetching; time per point.
+void batch(benchmark::State& st, const Annf& a) {
+  Fixture& f = fixture();
+  const auto& pts = points(f, int(st.range(0)));
+  const size_t B = 1024;
+  std::vector<int> ids(B);
+  std::vector<double> d(B);
+  size_t off = 0;
+  for (auto _ : st) {
+    a.nearest_batch(pts.data() + off, B, ids.data(), d.data());
+    benchmark::DoNotOptimize(d.data());
+    off = (off + B) & (pts.size() - 1);
+  }
+  st.SetItemsProcessed(int64_t(st.iterations() * B));
+}
+void BM_AnnfPaperBatch(benchmark::State& st) {
+  if (!fixture().ok) return st.SkipWithError("no ../shared/data");
+  batch(st, *fixture().paper);
+}
+void BM_AnnfExactBatch(benchmark::State& st) {
+  if (!fixture().ok) return st.SkipWithError("no ../shared/data");
+  batch(st, *fixture().exact);
+}
 void BM_AnnfExactLookupOnly(benchmark::State& st) {
   run(st, [](Fixture& f, const Eigen::Vector2d& p) {
     int n;
     const uint32_t* c = f.exact->lookup(p, &n);
+    return c ? double(c[0] + n) : 0.0;
+  });
+}
+void BM_AnnfPaperLookupOnly(benchmark::State& st) {
+  run(st, [](Fixture& f, const Eigen::Vector2d& p) {
+    int n;
+    const uint32_t* c = f.paper->lookup(p, &n);
     return c ? double(c[0] + n) : 0.0;
   });
 }
@@ -142,7 +173,10 @@ void BM_BruteForce(benchmark::State& st) {
 // Arg 0: random points in the bounding box; 1: points within ~5 cm of walls/columns.
 BENCHMARK(BM_AnnfPaper)->Arg(0)->Arg(1);
 BENCHMARK(BM_AnnfExact)->Arg(0)->Arg(1);
+BENCHMARK(BM_AnnfPaperBatch)->Arg(0)->Arg(1);
+BENCHMARK(BM_AnnfExactBatch)->Arg(0)->Arg(1);
 BENCHMARK(BM_AnnfExactLookupOnly)->Arg(0)->Arg(1);
+BENCHMARK(BM_AnnfPaperLookupOnly)->Arg(0)->Arg(1);
 BENCHMARK(BM_DistanceGrid)->Arg(0)->Arg(1);
 BENCHMARK(BM_KdTree)->Arg(0)->Arg(1);
 BENCHMARK(BM_BruteForce)->Arg(0)->Arg(1);

@@ -219,18 +219,20 @@ void Annf::prepare() {
   extent_y_ = double(ny_) * double(1u << (max_depth_ - 1));
   // Fast leaf records with geometry copies; map pool offsets to fast offsets.
   fast_.clear();
-  fast_.push_back(0);  // records start at odd offsets
   std::unordered_map<uint32_t, uint32_t> remap;
   auto leaf_word = [&](uint32_t w) -> uint32_t {
     const uint32_t off = w & ~kLeafBit;
     auto it = remap.find(off);
     if (it != remap.end()) return kLeafBit | it->second;
-    if (fast_.size() % 2 == 0) fast_.push_back(0);
-    const uint32_t at = uint32_t(fast_.size());
     const uint32_t n = pool_[off];
+    const uint32_t geom = (n + 2) & ~1u;          // geometry offset inside the record (8-byte aligned)
+    const uint32_t size = geom + 10 * n;
+    const uint32_t align = size <= 16 ? 16 : 32;  // 64 B or 128 B
+    while (fast_.size() % align) fast_.push_back(0);
+    const uint32_t at = uint32_t(fast_.size());
     fast_.push_back(n);
     for (uint32_t k = 0; k < n; ++k) fast_.push_back(pool_[off + 1 + k]);
-    if (fast_.size() % 2 == 1) fast_.push_back(0);
+    while (fast_.size() < size_t(at) + geom) fast_.push_back(0);
     for (uint32_t k = 0; k < n; ++k) {
       const Element& e = plan_.elements[pool_[off + 1 + k]];
       FastPrim f{};
@@ -325,6 +327,81 @@ int Annf::nearest_outside(const Eigen::Vector2d& p, double* dist, Eigen::Vector2
   if (dist) *dist = d;
   if (closest && id >= 0) *closest = closest_point(plan_.elements[id], p).point;
   return id;
+}
+
+void Annf::nearest_batch(const Eigen::Vector2d* pts, size_t n, int* ids, double* dists,
+                         Eigen::Vector2d* closest) const {
+  // Three-stage software pipeline: prefetch the index cell of point i+2D, resolve the leaf of point
+  // i+D (descending, then prefetching its record), compute point i.
+  constexpr size_t D = 8;
+  uint32_t words[D];
+  auto index_ptr = [&](const Eigen::Vector2d& p) -> const uint32_t* {
+    const double fx = (p.x() - origin_.x()) * inv_leaf_, fy = (p.y() - origin_.y()) * inv_leaf_;
+    if (!(fx >= 0 && fy >= 0 && fx < extent_x_ && fy < extent_y_)) return nullptr;
+    return &index_[size_t(uint32_t(fy) >> index_shift_) * index_nx_ + (uint32_t(fx) >> index_shift_)];
+  };
+  auto resolve = [&](const Eigen::Vector2d& p) -> uint32_t {
+    const double fx = (p.x() - origin_.x()) * inv_leaf_, fy = (p.y() - origin_.y()) * inv_leaf_;
+    if (!(fx >= 0 && fy >= 0 && fx < extent_x_ && fy < extent_y_)) return 0;  // 0: outside
+    const uint32_t ix = uint32_t(fx), iy = uint32_t(fy);
+    int sh = index_shift_;
+    uint32_t node = index_[size_t(iy >> sh) * index_nx_ + (ix >> sh)];
+    while (!(node & kLeafBit)) {
+      --sh;
+      node = fnodes_[node + (((iy >> sh) & 1u) << 1 | ((ix >> sh) & 1u))];
+    }
+    const uint32_t* rec = fast_.data() + (node & ~kLeafBit);
+    __builtin_prefetch(rec);
+    __builtin_prefetch(rec + 16);
+    return node;
+  };
+  for (size_t i = 0; i < std::min(n, 2 * D); ++i)
+    if (const uint32_t* q = index_ptr(pts[i])) __builtin_prefetch(q);
+  for (size_t i = 0; i < std::min(n, D); ++i) words[i % D] = resolve(pts[i]);
+  for (size_t i = 0; i < n; ++i) {
+    if (i + 2 * D < n)
+      if (const uint32_t* q = index_ptr(pts[i + 2 * D])) __builtin_prefetch(q);
+    const uint32_t w = words[i % D];
+    if (i + D < n) words[i % D] = resolve(pts[i + D]);
+    const Eigen::Vector2d& p = pts[i];
+    if (w == 0) {
+      double d;
+      Eigen::Vector2d c;
+      ids[i] = nearest_outside(p, &d, &c);
+      dists[i] = d;
+      if (closest) closest[i] = c;
+      continue;
+    }
+    const uint32_t* rec = fast_.data() + (w & ~kLeafBit);
+    const int cnt = int(rec[0]);
+    const uint32_t* cid = rec + 1;
+    const uint32_t* g = rec + ((cnt + 2) & ~1);
+    int best = -1;
+    double bd2 = 1e300, bx = 0, by = 0;
+    for (int k = 0; k < cnt; ++k, g += 10) {
+      FastPrim sp;
+      std::memcpy(&sp, g, sizeof sp);
+      double qx, qy;
+      if (__builtin_expect(sp.inv_l2 >= 0, 1)) {
+        const double t = std::min(1.0, std::max(0.0, ((p.x() - sp.ax) * sp.dx + (p.y() - sp.ay) * sp.dy) * sp.inv_l2));
+        qx = sp.ax + t * sp.dx;
+        qy = sp.ay + t * sp.dy;
+      } else {
+        const ClosestPoint cp = closest_point(plan_.elements[cid[k]], p);
+        qx = cp.point.x();
+        qy = cp.point.y();
+      }
+      const double d2 = (qx - p.x()) * (qx - p.x()) + (qy - p.y()) * (qy - p.y());
+      const bool better = d2 < bd2;
+      bd2 = better ? d2 : bd2;
+      best = better ? int(cid[k]) : best;
+      bx = better ? qx : bx;
+      by = better ? qy : by;
+    }
+    ids[i] = best;
+    dists[i] = std::sqrt(bd2);
+    if (closest) closest[i] = Eigen::Vector2d(bx, by);
+  }
 }
 
 bool Annf::leaf_box(const Eigen::Vector2d& p, Box2* box, int* depth) const {

@@ -147,3 +147,28 @@ TEST(Annf, ExactOnCorridorPlan) {
   const Annf a = Annf::build(plan, o);
   EXPECT_EQ(exact_rate(a, plan, 50000, 4), 1.0);
 }
+
+TEST(Annf, BatchEqualsSingle) {
+  const auto plan = synthetic();
+  for (AnnfMode mode : {AnnfMode::kPaper, AnnfMode::kExact}) {
+    AnnfOptions o;
+    o.mode = mode;
+    o.root_length = 4;
+    o.max_depth = 7;
+    const Annf a = Annf::build(plan, o);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> U(-3, 15);  // includes points outside the field
+    std::vector<Eigen::Vector2d> pts(1000), closest(1000);
+    for (auto& p : pts) p = {U(rng), U(rng) * 0.7};
+    std::vector<int> ids(pts.size());
+    std::vector<double> d(pts.size());
+    a.nearest_batch(pts.data(), pts.size(), ids.data(), d.data(), closest.data());
+    for (size_t i = 0; i < pts.size(); ++i) {
+      double d1;
+      Eigen::Vector2d c1;
+      ASSERT_EQ(a.nearest(pts[i], &d1, &c1), ids[i]) << i;
+      EXPECT_EQ(d1, d[i]);
+      EXPECT_EQ(c1, closest[i]);
+    }
+  }
+}

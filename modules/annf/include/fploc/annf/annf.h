@@ -29,6 +29,7 @@
 #include <cstdint>
 #include <cstring>
 #include <iosfwd>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -116,7 +117,7 @@ class Annf {
     if (!ids) return nearest_outside(p, dist, closest);
     // The leaf record holds a copy of its candidates' geometry right after the ids (one cache
     // line or two): no further dependent memory access.
-    const uint32_t* g = ids + ((n + 1) & ~1);
+    const uint32_t* g = ids - 1 + ((n + 2) & ~1);
     int best = -1;
     double bd2 = 1e300, bx = 0, by = 0;
     for (int k = 0; k < n; ++k, g += 10) {
@@ -144,6 +145,12 @@ class Annf {
     if (closest) *closest = Eigen::Vector2d(bx, by);
     return best;
   }
+
+  // Batch form of nearest() for a whole scan: the same results as calling nearest() for each point,
+  // but memory accesses of later points are prefetched while earlier ones are computed (a look-up
+  // is memory-latency bound on large plans). ids/dists may not alias pts. closest may be nullptr.
+  void nearest_batch(const Eigen::Vector2d* pts, size_t n, int* ids, double* dists,
+                     Eigen::Vector2d* closest = nullptr) const;
 
   // Like nearest() but also returns the first candidate (paper mode: the leaf's "1st element").
   int first_candidate(const Eigen::Vector2d& p) const {
@@ -190,11 +197,24 @@ class Annf {
   std::vector<uint32_t> nodes_;  // groups of 4 child words
   std::vector<uint32_t> pool_;   // [count, ids...] per leaf
   // Derived in prepare() (not saved): dense top-level index, nodes with leaf words pointing into
-  // fast_, and fast_ = per leaf [count, ids..., pad, FastPrim x count] (record at an odd offset so
-  // the geometry is 8-byte aligned).
+  // fast_, and fast_ = per leaf [count, ids..., pad, FastPrim x count], each record aligned to 64 B
+  // (128 B when longer than 64 B) so the whole record arrives with one memory round trip.
+  template <typename T>
+  struct Aligned128 {
+    using value_type = T;
+    Aligned128() = default;
+    template <typename U>
+    Aligned128(const Aligned128<U>&) {}
+    T* allocate(size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(128))); }
+    void deallocate(T* p, size_t) { ::operator delete(p, std::align_val_t(128)); }
+    template <typename U>
+    bool operator==(const Aligned128<U>&) const { return true; }
+    template <typename U>
+    bool operator!=(const Aligned128<U>&) const { return false; }
+  };
   std::vector<uint32_t> index_;
   std::vector<uint32_t> fnodes_;
-  std::vector<uint32_t> fast_;
+  std::vector<uint32_t, Aligned128<uint32_t>> fast_;
   uint32_t index_nx_ = 0;
   int index_shift_ = 0;
 };
