@@ -171,19 +171,21 @@ AutoLoopResult plan_auto_loop(const FloorPlan& plan, const AutoLoopConfig& cfg) 
     double D;
     std::vector<std::pair<int, int>> boundary;
     double perimeter;
+    double R;
   };
   std::vector<Candidate> cands;
   std::vector<int> lab(g.dist.size());
-  for (const double D : offsets) {
+  for (const double D : offsets)
+  for (const double R : {kOpenR, 0.0}) {
     // Morphological opening of {dist >= D} by a disc of radius R (removes passages narrower than 2R, so the
     // traced boundary has no thin spikes): dilate {dist >= D + R} by R.
     std::vector<uint8_t> region(g.dist.size(), 0);
     {
       std::vector<double> f(g.dist.size(), kBig);
       for (size_t i = 0; i < f.size(); ++i)
-        if (g.dist[i] >= D + kOpenR) f[i] = 0;
+        if (g.dist[i] >= D + R) f[i] = 0;
       const std::vector<double> d2 = edt(f, g.nx, g.ny);
-      for (size_t i = 0; i < f.size(); ++i) region[i] = std::sqrt(d2[i]) * res <= kOpenR + 1e-9 && g.dist[i] >= D;
+      for (size_t i = 0; i < f.size(); ++i) region[i] = std::sqrt(d2[i]) * res <= R + 1e-9 && g.dist[i] >= D;
     }
     // Components of the region that do not touch the border.
     std::fill(lab.begin(), lab.end(), -1);
@@ -223,7 +225,7 @@ AutoLoopResult plan_auto_loop(const FloorPlan& plan, const AutoLoopConfig& cfg) 
           const auto& q = bnd[(k + 1) % bnd.size()];
           per += std::hypot(p.first - q.first, p.second - q.second) * res;
         }
-        cands.push_back({D, std::move(bnd), per});
+        cands.push_back({D, std::move(bnd), per, R});
       }
   }
   if (cands.empty())
@@ -236,6 +238,7 @@ AutoLoopResult plan_auto_loop(const FloorPlan& plan, const AutoLoopConfig& cfg) 
     const bool ga = a.perimeter >= 0.85 * best_per, gc = c.perimeter >= 0.85 * best_per;
     if (ga != gc) return ga;
     if (ga && a.D != c.D) return a.D > c.D;
+    if (ga && a.R != c.R) return a.R > c.R;  // the opened (smoother) region first
     return a.perimeter > c.perimeter;
   });
   std::string tried;

@@ -138,6 +138,11 @@ void World::add_ceiling_patch(const CeilingPatch& p) {
   }
 }
 
+void World::add_furniture(const Furniture& f) {
+  furniture_.push_back(f);
+  furn_cs_.emplace_back(std::cos(f.yaw), std::sin(f.yaw), f.half.norm());
+}
+
 void World::set_time(double t) {
   people_pos_.resize(people_.size());
   for (size_t i = 0; i < people_.size(); ++i) people_pos_[i] = people_[i].position(t);
@@ -267,8 +272,16 @@ Hit World::cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_max
   const Eigen::Vector2d o2 = o.head<2>(), d2 = d.head<2>();
   for (size_t i = 0; i < furniture_.size(); ++i) {
     const Furniture& f = furniture_[i];
-    const double c = std::cos(f.yaw), s = std::sin(f.yaw);
+    const double c = furn_cs_[i].x(), s = furn_cs_[i].y();
     const Eigen::Vector2d rel = o2 - f.center;
+    // Bounding-circle rejection in 2D.
+    {
+      const double a2 = d2.squaredNorm();
+      if (a2 > 1e-18) {
+        const double tc = std::max(0.0, -rel.dot(d2) / a2);
+        if ((rel + tc * d2).squaredNorm() > furn_cs_[i].z() * furn_cs_[i].z()) continue;
+      }
+    }
     const double lo[3] = {c * rel.x() + s * rel.y(), -s * rel.x() + c * rel.y(), o.z()};
     const double ld[3] = {c * d2.x() + s * d2.y(), -s * d2.x() + c * d2.y(), d.z()};
     const double bmin[3] = {-f.half.x(), -f.half.y(), f.z0}, bmax[3] = {f.half.x(), f.half.y(), f.z1};

@@ -33,7 +33,7 @@ void check_loop(const FloorPlan& plan, double min_len) {
 
 TEST(AutoLoop, DemoPlans) {
   check_loop(demo_room_plan(), 30);
-  check_loop(demo_corridor_plan(), 60);
+  check_loop(demo_corridor_plan(), 75);  // the corridor ring (~84 m), not the enclosed inner block (~65 m)
 }
 
 TEST(AutoLoop, SharedCadPlans) {

@@ -1,8 +1,9 @@
 // auto-loop: plans a smooth, collision-free closed loop through the free space of any floor plan.
 //
 // The plan is rasterised, an exact Euclidean distance transform gives the clearance of every cell, and for a
-// few offsets D (1.0 m down to clearance + 0.15 m) the connected regions {clearance >= D} that do not touch
-// the grid border (the outside of a closed building) are found. The outer boundary of the region with the
+// few offsets D (1.0 m down to clearance + 0.15 m) the connected regions {clearance >= D} (as they are, and
+// morphologically opened by a 0.5 m disc to drop thin spurs) that do not touch the grid border (the outside
+// of a closed building) are found. The outer boundary of the region with the
 // longest boundary (preferring larger D when the lengths are close) is traced, smoothed and used as the
 // control polygon of a closed cubic B-spline; the final path is checked against the exact distance to every
 // plan element and D is raised when it comes closer than `clearance_m`.

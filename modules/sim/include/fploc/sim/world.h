@@ -71,10 +71,14 @@ class World {
  public:
   explicit World(const FloorPlan& plan, WorldConfig cfg = {});
 
-  void add_furniture(const Furniture& f) { furniture_.push_back(f); }
+  void add_furniture(const Furniture& f);
   void add_person(const Person& p) { people_.push_back(p); }
   void add_ceiling_patch(const CeilingPatch& p);
-  void clear_clutter() { furniture_.clear(); people_.clear(); }
+  void clear_clutter() {
+    furniture_.clear();
+    furn_cs_.clear();
+    people_.clear();
+  }
 
   // Moves the people to time t (call before casting rays for that time).
   void set_time(double t);
@@ -121,6 +125,7 @@ class World {
 
   std::vector<CeilingPatch> patches_;
   std::vector<Furniture> furniture_;
+  std::vector<Eigen::Vector3d> furn_cs_;  // cos(yaw), sin(yaw), bounding radius
   std::vector<Person> people_;
   std::vector<Eigen::Vector2d> people_pos_;
 };
