@@ -107,7 +107,7 @@ function renderNodes(msg) {
     tr.dataset.health = n.health;
     const state = n.health === 'bad' ? (n.reason || n.state) : n.state + (n.reporter === 'launcher' ? ' (launcher)' : '');
     const cells = [n.node, state, fmt(n.rate_hz, 1), fmt(n.latency_p50_ms, 2), fmt(n.latency_p99_ms, 2), fmt(n.cpu_percent, 1),
-      String(n.dropped), String(n.restarts), `${fmt(n.age_s, 1)} s ago`, n.last_error || ''];
+      String(n.dropped), String(n.restarts), n.age_s === null ? 'never' : `${fmt(n.age_s, 1)} s ago`, n.last_error || ''];
     for (const [i, text] of cells.entries()) {
       const td = document.createElement('td');
       td.textContent = text;
@@ -133,25 +133,31 @@ function mergeTrail(trail, pts) {
   for (const q of all) { if (out.length && out[out.length - 1][2] === q[2]) out[out.length - 1] = q; else out.push(q); }
   return out.slice(-MAX_TRAIL);
 }
-let fillSince = null, fillTimer = null;
+let fillSince = null, fillBusy = false;
 function fillGap(since) {
   fillSince = fillSince === null ? since : Math.min(fillSince, since);
-  if (fillTimer) return;
-  fillTimer = setTimeout(async () => {
-    const from = fillSince; fillSince = null;
-    try {
-      const h = await (await fetch(`/api/history?since=${from}`, { cache: 'no-store' })).json();
-      S.trail = mergeTrail(S.trail, h.est.map(([u, x, y]) => [x, y, u]));
-      S.gtTrail = mergeTrail(S.gtTrail, h.gt.map(([u, x, y]) => [x, y, u]));
-      S.gapFills = (S.gapFills || 0) + 1;
-      map.invalidate();
-    } catch (e) { /* next gap tries again */ }
-    fillTimer = setTimeout(() => { fillTimer = null; if (fillSince !== null) fillGap(fillSince); }, 1000);
-  }, 200);
+  S.fillPending = true;
+  if (fillBusy) return;  // the running fill picks it up when done
+  fillBusy = true;
+  setTimeout(async () => {
+    while (fillSince !== null) {
+      const from = fillSince; fillSince = null;
+      try {
+        const h = await (await fetch(`/api/history?since=${from}`, { cache: 'no-store' })).json();
+        S.trail = mergeTrail(S.trail, h.est.map(([u, x, y]) => [x, y, u]));
+        S.gtTrail = mergeTrail(S.gtTrail, h.gt.map(([u, x, y]) => [x, y, u]));
+        S.gapFills = (S.gapFills || 0) + 1;
+        map.invalidate();
+      } catch (e) { await new Promise((r) => setTimeout(r, 1000)); if (fillSince === null) fillSince = from; }
+    }
+    fillBusy = false;
+    S.fillPending = false;
+  }, 100);
 }
 
 function onPose(p) {
-  if (S.lastPoseSeq !== undefined && p.seq > S.lastPoseSeq + 1 && S.trail.length) fillGap(S.trail[S.trail.length - 1][2]);
+  // A seq gap, or the first event after loading the history (poses may have come in between).
+  if (S.trail.length && (S.lastPoseSeq === undefined || p.seq > S.lastPoseSeq + 1)) fillGap(S.trail[S.trail.length - 1][2]);
   S.lastPoseSeq = p.seq;
   S.pose = p;
   addToTrail(S.trail, p.utime, p.x, p.y);
@@ -172,7 +178,7 @@ function onPose(p) {
   schedulePoseBox();
 }
 function onGt(g) {
-  if (S.lastGtSeq !== undefined && g.seq > S.lastGtSeq + 1 && S.gtTrail.length) fillGap(S.gtTrail[S.gtTrail.length - 1][2]);
+  if (S.gtTrail.length && (S.lastGtSeq === undefined || g.seq > S.lastGtSeq + 1)) fillGap(S.gtTrail[S.gtTrail.length - 1][2]);
   S.lastGtSeq = g.seq;
   S.gt = g;
   addToTrail(S.gtTrail, g.utime, g.x, g.y);

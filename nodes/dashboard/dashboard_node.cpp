@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "fploc/runtime/bus.h"
+#include "fploc/runtime/graph.h"
 #include "fploc/runtime/node.h"
 #include "model.h"
 #include "options/tools.pb.h"
@@ -98,6 +99,17 @@ class DashboardNode : public fploc::rt::Node {
     if (ec || !fs::is_directory(web_root_)) ctx.error("dashboard.web_root: '" + root + "' is not a folder; no page will be served");
 
     load_plan(o);
+    if (!o.graph().empty()) {
+      const std::string gpath = ctx.resolve_path(o.graph());
+      fploc::rt::LoadedGraph g;
+      std::vector<fploc::rt::GraphError> errors;
+      if (fploc::rt::load_graph(gpath, g, errors)) {
+        for (const auto& n : g.graph.node())
+          if (!n.disabled()) model_->expect_node(n.name(), n.executable(), steady_s());
+      } else {
+        ctx.error("dashboard.graph: " + (errors.empty() ? gpath : errors.front().str()));
+      }
+    }
     model_->set_info("bind", json(bind_).dump());
     model_->set_info("port", std::to_string(port_));
     model_->set_info("max_push_hz", json(max_hz_).dump());

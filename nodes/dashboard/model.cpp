@@ -263,9 +263,21 @@ void Model::on_status(const fploc::node_status_t& m, double now_s) {
   // says the node is gone (restarting/dead/stopped/hung).
   e.status = m;
   e.received_s = now_s;
+  e.seen = true;
   const int64_t wall = std::chrono::duration_cast<std::chrono::microseconds>(
                            std::chrono::system_clock::now().time_since_epoch()).count();
   rebuild_nodes(now_s, wall);
+}
+
+void Model::expect_node(const std::string& name, const std::string& executable, double now_s) {
+  std::lock_guard<std::mutex> lk(mu_);
+  if (nodes_.count(name)) return;
+  auto& e = nodes_[name];
+  e.status.node = name;
+  e.status.executable = executable;
+  e.status.state = "not seen";
+  e.status.reporter = "graph";
+  e.received_s = now_s;
 }
 
 void Model::tick(double now_s, int64_t wall_us) {
@@ -288,7 +300,10 @@ void Model::rebuild_nodes(double now_s, int64_t wall_us) {
     const auto& s = e.status;
     const double age = now_s - e.received_s;
     std::string health = "ok", reason;
-    if (age > cfg_.silent_after_s) {
+    if (!e.seen) {
+      health = age > cfg_.silent_after_s ? "bad" : "warn";
+      reason = "no heartbeat yet";
+    } else if (age > cfg_.silent_after_s) {
       health = "bad";
       char b[64];
       std::snprintf(b, sizeof b, "silent for %.1f s", age);
@@ -333,7 +348,7 @@ void Model::rebuild_nodes(double now_s, int64_t wall_us) {
                    {"undecodable", s.undecodable},
                    {"last_error", s.last_error},
                    {"uptime_s", num(r6(s.uptime_s))},
-                   {"age_s", num(std::round(age * 10) / 10)},
+                   {"age_s", e.seen ? num(std::round(age * 10) / 10) : json(nullptr)},
                    {"health", health},
                    {"reason", reason},
                    {"ports", ports}});

@@ -51,6 +51,8 @@ class Model {
   void on_features(const fploc::features_t& m, double now_s, int64_t wall_us);
   void on_ground_truth(const fploc::ground_truth_t& m, double now_s, int64_t wall_us);
   void on_status(const fploc::node_status_t& m, double now_s);
+  // A node of the graph that must be listed even before its first heartbeat (red after silent_after_s).
+  void expect_node(const std::string& name, const std::string& executable, double now_s);
   // Re-evaluates node health (silence) and stream rates; call at a few Hz.
   void tick(double now_s, int64_t wall_us);
   // The plan as JSON (served at /api/plan and not pushed).
@@ -108,6 +110,7 @@ class Model {
   struct NodeEntry {
     fploc::node_status_t status;
     double received_s = 0;
+    bool seen = false;
   };
   std::map<std::string, NodeEntry> nodes_;
   std::deque<double> frame_times_, pose_times_, feature_times_;

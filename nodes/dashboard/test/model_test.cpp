@@ -72,6 +72,22 @@ TEST(DashboardModel, NodeTurnsRedWhenSilentOrRestartingAndGreenAgain) {
   EXPECT_EQ(health(), "bad");
 }
 
+TEST(DashboardModel, ExpectedNodeIsListedBeforeItsFirstHeartbeat) {
+  Model m;  // silent_after_s = 2
+  m.expect_node("optimizer", "fploc-optimizer", 0.0);
+  auto node = [&] { return json::parse(m.state_json())["nodes"]["nodes"][0]; };
+  m.tick(1.0, 0);
+  EXPECT_EQ(node()["health"], "warn");
+  m.tick(2.5, 0);
+  EXPECT_EQ(node()["health"], "bad");
+  EXPECT_TRUE(node()["age_s"].is_null());
+  fploc::node_status_t s{};
+  s.node = "optimizer";
+  s.state = "running";
+  m.on_status(s, 3.0);
+  EXPECT_EQ(node()["health"], "ok");
+}
+
 TEST(DashboardModel, FeaturesJsonIsValidAndDecimated) {
   fploc::features_t f{};
   f.scan_seq = 7;
