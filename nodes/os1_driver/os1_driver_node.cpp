@@ -28,16 +28,14 @@ class Os1DriverNode : public fploc::rt::Node {
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
     const auto& opt = ctx.options<fploc::Os1DriverOptions>();
-    if (opt.metadata().empty()) throw std::runtime_error("os1_driver: option 'metadata' (sensor JSON) is required");
-    info_ = load_metadata(ctx.resolve_path(opt.metadata()));  // MetadataError names file and field
-    for (const auto& f : info_.defaulted)
-      if (f == "pixel_shift_by_row" || f == "lidar_origin_to_beam_origin_mm")
-        std::cerr << "[" << ctx.name() << "] metadata: '" << f << "' absent, using the Ouster default\n";
-    assembler_ = std::make_unique<FrameAssembler>(info_);
     out_ = ctx.advertise<fploc::scan_t>("scan");
-    const int port = opt.lidar_port() > 0 ? opt.lidar_port() : 7502;
-    classifier_ = PacketClassifier{opt.pcap().empty() ? port : opt.lidar_port(), -1, assembler_->format().lidar_packet_size()};
-    if (!opt.pcap().empty()) {
+    port_ = opt.lidar_port() > 0 ? opt.lidar_port() : 7502;
+    pcap_mode_ = !opt.pcap().empty();
+    metadata_path_ = opt.metadata().empty() ? std::string() : ctx.resolve_path(opt.metadata());
+    // A missing or broken metadata file is bad input, not a reason to die: it is reported (stderr and
+    // telemetry), packets are dropped and counted, and the file is read again every 5 s until it loads.
+    if (!load()) ctx.every(5.0, [this] { if (!assembler_) load(); });
+    if (pcap_mode_) {
       std::string err;
       const double rate = opt.pcap_rate() == 0 ? 1.0 : opt.pcap_rate();
       if (!replay_.open(ctx.resolve_path(opt.pcap()), rate, opt.pcap_loop(), &err)) throw std::runtime_error("os1_driver: " + err);
@@ -46,11 +44,13 @@ class Os1DriverNode : public fploc::rt::Node {
         assembler_->resync(frames_);
         publish_frames();
       });
-      ctx.every(rate > 0 ? 0.002 : 0.001, [this] { poll_pcap(); });
+      ctx.every(rate > 0 ? 0.002 : 0.001, [this] {
+        if (assembler_) poll_pcap();  // a capture waits for its metadata
+      });
     } else {
       const int buf = opt.recv_buffer_bytes() > 0 ? opt.recv_buffer_bytes() : 8 << 20;
       std::string err;
-      if (!udp_.open(opt.bind_address(), port, buf, &err)) throw std::runtime_error("os1_driver: " + err);
+      if (!udp_.open(opt.bind_address(), port_, buf, &err)) throw std::runtime_error("os1_driver: " + err);
       if (udp_.actual_buffer_bytes() < buf)
         ctx.error("SO_RCVBUF is " + std::to_string(udp_.actual_buffer_bytes()) + " B, asked " + std::to_string(buf) +
                   " (raise net.core.rmem_max); packets may be dropped at 10 Hz");
@@ -68,6 +68,26 @@ class Os1DriverNode : public fploc::rt::Node {
   }
 
  private:
+  bool load() {
+    if (metadata_path_.empty()) {
+      ctx_->error("option 'metadata' (sensor metadata JSON) is not set: lidar packets are dropped");
+      return false;
+    }
+    try {
+      info_ = load_metadata(metadata_path_);
+    } catch (const MetadataError& e) {
+      ctx_->error(std::string(e.what()) + " (lidar packets are dropped; retrying every 5 s)");
+      return false;
+    }
+    for (const auto& f : info_.defaulted)
+      if (f == "pixel_shift_by_row" || f == "lidar_origin_to_beam_origin_mm")
+        std::cerr << "[" << ctx_->name() << "] metadata: '" << f << "' absent, using the Ouster default\n";
+    assembler_ = std::make_unique<FrameAssembler>(info_);
+    classifier_ = PacketClassifier{pcap_mode_ ? ctx_->options<fploc::Os1DriverOptions>().lidar_port() : port_, -1,
+                                   assembler_->format().lidar_packet_size()};
+    return true;
+  }
+
   void poll_pcap() {
     const bool more = replay_.poll([this](uint16_t p, const uint8_t* d, size_t n) { on_datagram(p, d, n); },
                                    [this] { return published_in_poll_; });
@@ -81,6 +101,10 @@ class Os1DriverNode : public fploc::rt::Node {
   }
 
   void on_datagram(uint16_t port, const uint8_t* d, size_t n) {
+    if (!assembler_) {
+      if (++dropped_without_metadata_ % 6400 == 1) ctx_->error("lidar packets dropped: no valid metadata");
+      return;
+    }
     if (n == kImuPacketSize) return;  // IMU on the lidar port (same-port setups): the imu driver's job
     if (classifier_.classify(port, n) != PacketKind::kLidar) {
       if (classifier_.lidar_port == 0 || port == classifier_.lidar_port) report(PacketError::kWrongSize, n);
@@ -121,6 +145,10 @@ class Os1DriverNode : public fploc::rt::Node {
   fploc::scan_t msg_;
   fploc::rt::Publisher<fploc::scan_t> out_;
   bool published_in_poll_ = false;
+  bool pcap_mode_ = false;
+  int port_ = 7502;
+  std::string metadata_path_;
+  uint64_t dropped_without_metadata_ = 0;
 };
 
 FPLOC_REGISTER_NODE(Os1DriverNode)

@@ -85,3 +85,17 @@ print("xsens samples:", len(got), got[:1])
 ok = len(got) == 5 and all(g[3] == "xsens" and abs(g[1][2] - 9.81525326) < 1e-5 and g[0] == 556132900 for g in got)
 sys.exit(0 if ok else 1)
 PY
+
+# Broken metadata is bad input too: the driver reports it, drops packets, stays alive and exits cleanly.
+echo '{"beam_altitude_angles": [1, 2], "beam_azimuth_angles": [0]}' > "$T/bad.json"
+"$B/fploc-os1-driver" --lcm-url "$URL" --set metadata="$T/bad.json" --set lidar_port=17502 > "$T/bad.txt" 2>&1 & bad=$!
+pids+=($bad)
+sleep 1
+"$B/fploc-os1-send" --pcap "$PCAP" --lidar-port 17502 --imu-port 17503 --rate -1
+sleep 0.5
+kill -0 "$bad" || { echo "FAIL: driver died on bad metadata"; cat "$T/bad.txt"; exit 1; }
+kill -INT "$bad"
+wait "$bad" || { echo "FAIL: driver exit status after bad metadata"; cat "$T/bad.txt"; exit 1; }
+grep -q "beam_azimuth_angles" "$T/bad.txt" || { echo "FAIL: metadata error not reported"; cat "$T/bad.txt"; exit 1; }
+grep -q "dropped: no valid metadata" "$T/bad.txt" || { echo "FAIL: dropped packets not reported"; cat "$T/bad.txt"; exit 1; }
+echo "os1 driver tests passed"
