@@ -106,7 +106,8 @@ function renderNodes(msg) {
     tr.dataset.node = n.node;
     tr.dataset.health = n.health;
     const state = n.health === 'bad' ? (n.reason || n.state) : n.state + (n.reporter === 'launcher' ? ' (launcher)' : '');
-    const cells = [n.node, state, fmt(n.rate_hz, 1), fmt(n.latency_p50_ms, 2), fmt(n.latency_p99_ms, 2), fmt(n.cpu_percent, 1),
+    const seen = n.age_s !== null, num = (v, d) => (seen ? fmt(v, d) : '–');
+    const cells = [n.node, state, num(n.rate_hz, 1), num(n.latency_p50_ms, 2), num(n.latency_p99_ms, 2), num(n.cpu_percent, 1),
       String(n.dropped), String(n.restarts), n.age_s === null ? 'never' : `${fmt(n.age_s, 1)} s ago`, n.last_error || ''];
     for (const [i, text] of cells.entries()) {
       const td = document.createElement('td');

@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
@@ -149,6 +150,7 @@ TEST_F(DashboardHttp, EventsAreRateCappedLatestValues) {
   // Poses come at 100 Hz; the stream must carry at most 20 pushes per second, each with the newest pose.
   int pose_events = 0, keepalives = 0;
   int64_t last_seq = -1, max_gap = 0;
+  std::vector<double> lat_ms;  // pose stamp -> this client (no browser), same clock
   std::string buffer;
   const auto t0 = std::chrono::steady_clock::now();
   httplib::Client c("127.0.0.1", 8080);
@@ -162,6 +164,9 @@ TEST_F(DashboardHttp, EventsAreRateCappedLatestValues) {
       if (ev.rfind("event: pose\n", 0) == 0) {
         auto j = json::parse(ev.substr(ev.find("data: ") + 6));
         const int64_t seq = j["seq"];
+        const int64_t now_us = std::chrono::duration_cast<std::chrono::microseconds>(
+                                   std::chrono::system_clock::now().time_since_epoch()).count();
+        lat_ms.push_back(double(now_us - j["utime"].get<int64_t>()) / 1e3);
         if (last_seq >= 0) max_gap = std::max(max_gap, seq - last_seq);
         last_seq = seq;
         ++pose_events;
@@ -174,6 +179,10 @@ TEST_F(DashboardHttp, EventsAreRateCappedLatestValues) {
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::cout << "SSE: " << pose_events << " pose events in " << secs << " s (" << pose_events / secs
             << " Hz) with poses at 100 Hz; largest seq step " << max_gap << "\n";
+  std::sort(lat_ms.begin(), lat_ms.end());
+  if (!lat_ms.empty())
+    std::cout << "SSE latency pose stamp -> HTTP client: p50 " << lat_ms[lat_ms.size() / 2] << " ms, p95 "
+              << lat_ms[lat_ms.size() * 95 / 100] << " ms, max " << lat_ms.back() << " ms\n";
   EXPECT_LE(pose_events, int(20 * secs) + 2);
   EXPECT_GE(pose_events, int(12 * secs));
   EXPECT_GE(max_gap, 3);  // intermediate poses were skipped, not queued
