@@ -230,3 +230,19 @@ TEST_F(DashboardHttp, ListensOnLoopbackOnlyByDefault) {
 }
 
 }  // namespace
+
+namespace {
+TEST(DashboardFlags, BindAndPortFlags) {
+  const std::string bin = build_dir() + "/bin/";
+  pid_t d = spawn({bin + "fploc-dashboard", "--bind", "127.0.0.1", "--port", "18081"});
+  httplib::Client c("127.0.0.1", 18081);
+  bool up = false;
+  for (int i = 0; i < 100 && !up; ++i) {
+    auto r = c.Get("/api/info");
+    up = r && r->status == 200 && json::parse(r->body)["port"] == 18081;
+    if (!up) std::this_thread::sleep_for(100ms);
+  }
+  stop(d);
+  EXPECT_TRUE(up);
+}
+}  // namespace
