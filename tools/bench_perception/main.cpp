@@ -83,7 +83,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> layers;
   uint64_t seed = 0;
   int max_frames = 0, stride = 1;
-  bool json = false, no_clutter = false, no_patches = false;
+  bool json = false, no_clutter = false, no_patches = false, verbose = false;
   double noise = 0.02;
   app.add_option("--plan", plan_file, "floor plan (.dxf/.csv/.json/.fpmap); default: the scenario's demo plan");
   app.add_option("--layers", layers, "layer globs")->delimiter(',');
@@ -96,6 +96,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-clutter", no_clutter, "no furniture or people");
   app.add_flag("--no-ceiling-patches", no_patches, "flat ceiling everywhere");
   app.add_flag("--json", json, "JSON on stdout");
+  app.add_flag("--verbose", verbose, "one line per frame on stderr");
   CLI11_PARSE(app, argc, argv);
   try {
     fploc::FloorPlan plan;
@@ -141,6 +142,14 @@ int main(int argc, char** argv) {
       const auto& r = ransac.process(f.scan);
       acc_ransac.add(r, f, gt, us_since(t0));
       ++done;
+      if (verbose) {
+        const Eigen::Vector3d rpy = gt.rpy();
+        std::cerr << "frame " << k << " gt z " << gt.p.z() << " roll " << rpy[0] / kDeg << " pitch " << rpy[1] / kDeg
+                  << " | rings " << fploc::seg::to_string(s.status) << " c " << s.ceiling.found << " d "
+                  << s.ceiling.distance() << " inl " << s.ceiling.inliers << " g " << s.ground.found << " d "
+                  << s.ground.distance() << " inl " << s.ground.inliers << " H " << rings.room_height() << " z " << s.z
+                  << " roll " << s.roll / kDeg << " pitch " << s.pitch / kDeg << " '" << s.status_text << "'\n";
+      }
       if (!json && done % 50 == 0) std::cerr << "  frame " << k << "\n";
     }
     nlohmann::json out = acc_rings.json();

@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 namespace fploc::seg {
@@ -171,12 +172,14 @@ void Segmenter::quality(const Candidates& c, Plane& pl) const {
   const float d = float(pl.coeffs[3]);
   const float thr = float(cfg_.inlier_threshold_m);
   double r2 = 0;
-  int cnt = 0;
+  int cnt = 0, beyond = 0;
+  const float beyond_thr = 2 * thr;
   Eigen::Vector3f reff = Eigen::Vector3f::Zero();
   bool have_ref = false;
   double sx = 0, sy = 0, sz = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
   for (size_t i = 0; i < c.p.size(); ++i) {
     const float r = n.dot(c.p[i]) + d;
+    if (r < -beyond_thr) ++beyond;
     if (std::abs(r) >= thr) continue;
     if (!have_ref) {
       reff = c.p[i];
@@ -194,6 +197,7 @@ void Segmenter::quality(const Candidates& c, Plane& pl) const {
   m.ss << sxx, sxy, sxz, sxy, syy, syz, sxz, syz, szz;
   const Eigen::Vector3d ref = reff.cast<double>();
   pl.inliers = cnt;
+  pl.beyond = beyond;
   pl.rms_m = cnt ? std::sqrt(r2 / cnt) : 0.0;
   if (cnt < 3) return;
   Eigen::Vector4d tmp;
@@ -295,6 +299,9 @@ const Segmentation& Segmenter::process(const Scan& scan) {
       else if (out_.ceiling.inliers < cfg_.min_plane_inliers)
         why = "ceiling has " + std::to_string(out_.ceiling.inliers) + " inliers < " +
               std::to_string(cfg_.min_plane_inliers);
+      else if (out_.ceiling.beyond > cfg_.max_beyond_ratio * out_.ceiling.inliers)
+        why = "ceiling not where the rays end: " + std::to_string(out_.ceiling.beyond) + " returns beyond it vs " +
+              std::to_string(out_.ceiling.inliers) + " inliers";
       else if (out_.ceiling.inliers < cfg_.min_inlier_fraction * double(upper_.p.size()))
         why = "ceiling inliers are only " + std::to_string(100.0 * out_.ceiling.inliers / upper_.p.size()) +
               " % of the upper-ring returns";
@@ -316,7 +323,8 @@ const Segmentation& Segmenter::process(const Scan& scan) {
       quality(lower_, out_.ground);
       const double tilt = std::acos(std::clamp(pl.head<3>().dot(up), -1.0, 1.0));
       out_.ground.found = tilt < std::min(max_tilt, 5 * kDeg) && pl[3] > 0.1 &&
-                          out_.ground.inliers >= cfg_.min_plane_inliers;
+                          out_.ground.inliers >= cfg_.min_plane_inliers &&
+                          out_.ground.beyond <= cfg_.max_beyond_ratio * out_.ground.inliers;
     }
   }
 
@@ -432,6 +440,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
   //    the largest fraction of those (obstructed rays are shorter), and only points above the sensor.
   const int S = std::max(4, cfg_.seed_sectors);
   seeds_.clear();
+  all_seeds_.clear();
   const int kr = std::min(std::max(1, cfg_.seed_rings), c.rings());
   for (int k = 0; k < kr; ++k) {
     sector_best_.assign(S, -1.f);
@@ -451,6 +460,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
     std::sort(cand.begin(), cand.end(), [&](int a, int b) { return c.range[a] > c.range[b]; });
     const size_t keep = std::min(cand.size(), std::max<size_t>(3, size_t(std::ceil(cfg_.seed_fraction * S))));
     seeds_.insert(seeds_.end(), cand.begin(), cand.begin() + keep);
+    all_seeds_.insert(all_seeds_.end(), cand.begin(), cand.end());
   }
 
   // 2. Initial plane by linear regression h = a*x1 + b*x2 + g in the prior's frame, trimmed twice.
@@ -491,12 +501,18 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
   auto score = [&](const Eigen::Vector4d& pl) {
     const Eigen::Vector3f n = pl.head<3>().cast<float>();
     const float d = float(pl[3]);
+    // A ceiling is where the rays end: returns beyond the plane (above a ceiling) count against it, so a
+    // horizontal plane cutting through near walls (many "inliers" at one height) loses.
     int cnt = 0;
-    for (size_t i = 0; i < c.p.size(); i += 16) cnt += std::abs(n.dot(c.p[i]) + d) < 0.05f;
+    for (size_t i = 0; i < c.p.size(); i += 16) {
+      const float r = n.dot(c.p[i]) + d;
+      cnt += std::abs(r) < 0.05f;
+      cnt -= 2 * (r < -0.1f);
+    }
     return cnt;
   };
   Eigen::Vector4d cur;
-  int best = -1;
+  int best = std::numeric_limits<int>::min();
   auto consider = [&](const Eigen::Vector4d& pl) {
     if (!pl.allFinite() || -pl.head<3>().dot(up) < std::cos(max_tilt) || pl[3] <= 0) return;
     const int sc = score(pl);
@@ -507,16 +523,19 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
   };
   if (have_seed_plane) consider(seed_plane);
   if (previous) consider(*previous);
-  if (seeds_.size() >= 3 && cfg_.seed_triplets > 0) {
-    uint32_t state = 12345u;
-    auto next = [&]() {
-      state = state * 1664525u + 1013904223u;
-      return state >> 8;
-    };
-    for (int t = 0; t < cfg_.seed_triplets; ++t) {
-      const Eigen::Vector3d a = c.p[seeds_[next() % seeds_.size()]].cast<double>();
-      const Eigen::Vector3d b = c.p[seeds_[next() % seeds_.size()]].cast<double>();
-      const Eigen::Vector3d q = c.p[seeds_[next() % seeds_.size()]].cast<double>();
+  uint32_t state = 12345u;
+  auto next = [&]() {
+    state = state * 1664525u + 1013904223u;
+    return state >> 8;
+  };
+  for (int t = 0; t < cfg_.seed_triplets; ++t) {
+    // Alternate between the longest-range seeds (the paper's) and all sector maxima (tilted sensor).
+    const std::vector<int>& pool = (t % 2 == 0) ? seeds_ : all_seeds_;
+    if (pool.size() < 3) continue;
+    {
+      const Eigen::Vector3d a = c.p[pool[next() % pool.size()]].cast<double>();
+      const Eigen::Vector3d b = c.p[pool[next() % pool.size()]].cast<double>();
+      const Eigen::Vector3d q = c.p[pool[next() % pool.size()]].cast<double>();
       Eigen::Vector3d nn = (b - a).cross(q - a);
       if (nn.norm() < 1e-3) continue;
       nn.normalize();
@@ -526,7 +545,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
       consider(pl);
     }
   }
-  if (best < 0) return false;
+  if (best == std::numeric_limits<int>::min()) return false;
 
   // 3. M-estimator (IRLS, Tukey biweight) over all points of the half rings, cut-off shrinking from
   //    irls_initial_scale_m to ~4.7 robust sigmas of the inliers.

@@ -17,7 +17,7 @@ namespace fploc::seg {
 struct SegmenterConfig {
   int seed_rings = 4;              // K_r: top (bottom) rings giving the seed points
   int seed_sectors = 64;           // azimuth sectors per seed ring (one max-range candidate each)
-  double seed_fraction = 1.0;      // keep this fraction of the sector maxima (largest ranges) per ring
+  double seed_fraction = 0.25;     // keep this fraction of the sector maxima (largest ranges) per ring
   int seed_triplets = 40;          // planes through seed triplets also tried as the IRLS start
   double max_tilt_deg = 10.0;      // reject planes tilted more than this from the gravity prior
   double wall_margin_m = 0.10;     // points closer than this to ceiling/floor are not wall points
@@ -26,7 +26,8 @@ struct SegmenterConfig {
   double min_range_m = 0.4;        // ignore returns closer than this (platform, tripod)
   double max_range_m = 120.0;
   int min_plane_inliers = 200;     // fewer inliers -> plane not found
-  double min_inlier_fraction = 0.05;  // of the upper (lower) half-ring returns
+  double min_inlier_fraction = 0.02;  // of the upper (lower) half-ring returns (a corridor ceiling: ~3 %)
+  double max_beyond_ratio = 0.25;     // reject a plane with more returns beyond it than this x inliers
   double inlier_threshold_m = 0.05;// inlier band for counting / rms
   int irls_iterations = 8;
   double irls_initial_scale_m = 0.5;  // first Tukey cut-off; halves every iteration down to ~4.7 sigma
@@ -40,6 +41,7 @@ struct Plane {
   Eigen::Vector4d coeffs = Eigen::Vector4d::Zero();  // n.x n.y n.z d, n.p + d = 0, n into the room
   bool found = false;
   int inliers = 0;
+  int beyond = 0;           // returns behind the plane (above a ceiling / below a floor), 2x the inlier band
   double rms_m = 0.0;
   double tilt_sigma = 0.0;  // 1-sigma of the normal direction [rad] (from the inlier spread)
   double d_sigma = 0.0;     // 1-sigma of the distance [m]
@@ -155,7 +157,7 @@ class RingSegmenter : public Segmenter {
                  Eigen::Vector4d& plane) override;
 
  private:
-  std::vector<int> seeds_;
+  std::vector<int> seeds_, all_seeds_;
   std::vector<float> sector_best_;
   std::vector<int> sector_idx_;
   std::vector<int> band_;
