@@ -291,7 +291,11 @@ class DashboardNode : public fploc::rt::Node {
     if (stopping_) return;
     stopping_ = true;
     if (model_) model_->stop();
-    if (listening_) server_.stop();
+    if (listening_) {
+      // stop() is a no-op before listen_after_bind() has started: wait for it (at most 1 s).
+      for (int i = 0; i < 100 && !server_.is_running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      server_.stop();
+    }
     if (thread_.joinable()) thread_.join();
   }
 
