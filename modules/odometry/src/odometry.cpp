@@ -77,7 +77,16 @@ void Odometry2D::add_keyframe(const FeatureFrame& f, const Pose2& p) {
   last_key_ = p;
 }
 
-OdometryResult Odometry2D::process(const FeatureFrame& f) {
+OdometryResult Odometry2D::process(const FeatureFrame& f_in) {
+  FeatureFrame sub;
+  const FeatureFrame* fp_ = &f_in;
+  if (cfg_.max_points > 0 && f_in.points.size() > size_t(cfg_.max_points)) {
+    const size_t stride = (f_in.points.size() + size_t(cfg_.max_points) - 1) / size_t(cfg_.max_points);
+    sub.utime = f_in.utime;
+    for (size_t i = 0; i < f_in.points.size(); i += stride) sub.points.push_back(f_in.points[i]);
+    fp_ = &sub;
+  }
+  const FeatureFrame& f = *fp_;
   OdometryResult r;
   r.num_points = int(f.points.size());
   if (!have_pose_) return r;
@@ -136,7 +145,10 @@ OdometryResult Odometry2D::process(const FeatureFrame& f) {
   r.num_inliers = inliers;
   r.rms_m = inliers > 0 ? std::sqrt(sum2 / inliers) : 0;
   r.ok = inliers >= 10 && double(inliers) >= cfg_.min_inlier_ratio * double(std::max(1, r.num_points));
-  if (!r.ok) x = pred;
+  if (!r.ok) {
+    x = pred;
+    have_velocity_ = false;  // hold the pose instead of extrapolating into nowhere
+  }
   if (r.ok && dt > 0 && dt < 1.0) {
     velocity_ = Eigen::Vector3d((x.x - pose_.x) / dt, (x.y - pose_.y) / dt, wrap_angle(x.yaw - pose_.yaw) / dt);
     have_velocity_ = true;

@@ -26,6 +26,9 @@ int main(int argc, char** argv) {
   app.add_option("--window", o.window);
   app.add_option("--alpha", o.alpha);
   app.add_option("--beta", o.beta);
+  app.add_option("--kf-distance", o.keyframe_distance_m);
+  app.add_option("--matcher-points", o.matcher_points);
+  app.add_option("--optimizer-points", o.optimizer_points);
   app.add_option("--drop", o.drop_fraction, "fraction of scans dropped");
   app.add_option("--gt-offset", o.gt_offset_s, "ground truth time = scan start + this [s]");
   app.add_option("--init-error", [&](const std::vector<std::string>& v) {

@@ -57,12 +57,16 @@ Result run(const FloorPlan& plan_in, const Options& o) {
   Result r;
   const StampedPose g0 = sim.ground_truth(sim.frame_time(0) + o.gt_offset_s);
   const Pose2 init{g0.p.x() + o.init_dx, g0.p.y() + o.init_dy, g0.rpy()[2] + o.init_dyaw};
-  Matcher matcher(*map.lookup, MatcherConfig{});
+  MatcherConfig mcfg;
+  mcfg.max_points = o.matcher_points;
+  Matcher matcher(*map.lookup, mcfg);
   matcher.set_pose(init);
   OptimizerConfig ocfg;
   ocfg.window = o.window;
   ocfg.alpha = o.alpha;
   ocfg.beta = o.beta;
+  ocfg.keyframe_distance_m = o.keyframe_distance_m;
+  ocfg.max_points = o.optimizer_points;
   WindowOptimizer opt(*map.lookup, ocfg);
   Odometry2D odo;
   odo.set_pose(init);

@@ -22,6 +22,8 @@ struct Options {
   double alpha = 1.1, beta = 0.9;
   bool clutter = true;
   double drop_fraction = 0;      // drop this fraction of scans (deterministic)
+  double keyframe_distance_m = 0.1;
+  int matcher_points = 800, optimizer_points = 400;
   double init_dx = 0, init_dy = 0, init_dyaw = 0;  // error of the initial pose
 };
 

@@ -22,6 +22,7 @@ struct OdometryConfig {
   double huber_m = 0.05;
   int normal_neighbours = 6;
   double min_inlier_ratio = 0.3;
+  int max_points = 800;  // per frame: every k-th feature so that about this many are used (0 = all)
 };
 
 struct OdometryResult {
