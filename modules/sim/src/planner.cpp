@@ -175,8 +175,13 @@ AutoLoopResult plan_auto_loop(const FloorPlan& plan, const AutoLoopConfig& cfg) 
   };
   std::vector<Candidate> cands;
   std::vector<int> lab(g.dist.size());
+  // First the enclosed free space; when there is none (an open plan such as a pavilion), the free space
+  // inside the plan's bounding box.
+  bool bounded = false;
+  for (int pass = 0; pass < 2 && cands.empty(); ++pass)
   for (const double D : offsets)
   for (const double R : {kOpenR, 0.0}) {
+    bounded = pass == 1;
     // Morphological opening of {dist >= D} by a disc of radius R (removes passages narrower than 2R, so the
     // traced boundary has no thin spikes): dilate {dist >= D + R} by R.
     std::vector<uint8_t> region(g.dist.size(), 0);
@@ -186,6 +191,13 @@ AutoLoopResult plan_auto_loop(const FloorPlan& plan, const AutoLoopConfig& cfg) 
         if (g.dist[i] >= D + R) f[i] = 0;
       const std::vector<double> d2 = edt(f, g.nx, g.ny);
       for (size_t i = 0; i < f.size(); ++i) region[i] = std::sqrt(d2[i]) * res <= R + 1e-9 && g.dist[i] >= D;
+      if (bounded)
+        for (int y = 0; y < g.ny; ++y)
+          for (int x = 0; x < g.nx; ++x) {
+            const V c = g.center(x, y);
+            if (c.x() < b.min.x() + D || c.y() < b.min.y() + D || c.x() > b.max.x() - D || c.y() > b.max.y() - D)
+              region[size_t(y) * g.nx + x] = 0;
+          }
     }
     // Components of the region that do not touch the border.
     std::fill(lab.begin(), lab.end(), -1);
@@ -229,7 +241,7 @@ AutoLoopResult plan_auto_loop(const FloorPlan& plan, const AutoLoopConfig& cfg) 
       }
   }
   if (cands.empty())
-    throw std::runtime_error("auto-loop: no enclosed free space with clearance >= " + std::to_string(dmin) +
+    throw std::runtime_error("auto-loop: no free space with clearance >= " + std::to_string(dmin) +
                              " m in plan " + plan.source);
   double best_per = 0;
   for (const auto& c : cands) best_per = std::max(best_per, c.perimeter);
@@ -297,7 +309,8 @@ AutoLoopResult plan_auto_loop(const FloorPlan& plan, const AutoLoopConfig& cfg) 
       r.offset_m = c.D;
       r.min_clearance_m = clr;
       r.length_m = m.length();
-      r.info = "auto-loop:" + os.str() + " grid " + std::to_string(res) + " m";
+      r.info = "auto-loop:" + os.str() + " grid " + std::to_string(res) + " m" +
+               (bounded ? " (no enclosed free space: loop inside the plan's bounding box)" : "");
       return r;
     }
   }

@@ -44,7 +44,8 @@ TEST(AutoLoop, SharedCadPlans) {
     std::vector<std::string> layers;
   };
   const P plans[] = {{"shanghaitech_SIST-F4-filtered.dxf", {"*WALL*", "*COLS*"}},
-                     {"annf-demo-corridor-lines.csv", {}}};
+                     {"annf-demo-corridor-lines.csv", {}},
+                     {"barcelona_pavilion_plan.dxf", {"Walls", "Columns"}}};  // open plan: bounding-box fallback
   int tested = 0;
   for (const auto& p : plans) {
     FloorPlan plan;
