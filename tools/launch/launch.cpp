@@ -32,6 +32,7 @@
 
 #include "fploc/runtime/bus.h"
 #include "fploc/runtime/graph.h"
+#include "fploc/runtime/restart.h"
 #include "fploc/runtime/validate.h"
 
 using namespace fploc::rt;
@@ -86,8 +87,7 @@ struct Child {
   pid_t pid = -1;
   State state = State::Stopped;
   int restarts = 0;                   // FPLOC_RESTARTS of the next start - 1
-  std::deque<double> restart_times;   // within the policy window
-  double backoff = 0;                 // current backoff
+  RestartTracker tracker;             // window and backoff
   double next_start = 0;
   double started_at = 0;
   double last_beat = 0;               // 0 = none from this pid yet
@@ -115,7 +115,7 @@ class Launcher {
       c.args.assign(n.args().begin(), n.args().end());
       c.policy = n.restart();
       c.heartbeat_timeout = policy_or(n.heartbeat_timeout_s(), 3.0);
-      c.backoff = policy_or(c.policy.backoff_initial_s(), 0.1);
+      c.tracker = RestartTracker(c.policy);
       children_.push_back(std::move(c));
     }
     shutdown_timeout_ = policy_or(g_.graph.shutdown_timeout_s(), 2.0);
@@ -325,15 +325,13 @@ class Launcher {
           }
           break;
         }
-        const auto mode = c.policy.mode();
-        const bool restart = mode == fploc::RestartPolicy::ALWAYS ||
-                             (mode == fploc::RestartPolicy::ON_FAILURE && failed);
-        if (!restart) {
+        const auto d = c.tracker.on_exit(now_s(), now_s() - c.started_at, failed);
+        if (!d.restart && !d.give_up) {
           log("node '" + c.name + "' " + how + (failed ? " (restart policy: not restarted)" : ""));
           c.state = failed ? State::Dead : State::Stopped;
           publish(c, failed ? "dead" : "stopped", how);
         } else {
-          schedule_restart(c, (c.hung ? "hung, " : "") + how);
+          apply_restart(c, d, (c.hung ? "hung, " : "") + how);
         }
         break;
       }
@@ -341,29 +339,23 @@ class Launcher {
   }
 
   void schedule_restart(Child& c, const std::string& why) {
-    const double t = now_s();
-    const double window = policy_or(c.policy.window_s(), 60.0);
-    const int max_restarts = c.policy.max_restarts() > 0 ? c.policy.max_restarts() : 5;
-    while (!c.restart_times.empty() && t - c.restart_times.front() > window) c.restart_times.pop_front();
-    if (int(c.restart_times.size()) >= max_restarts) {
-      log("node '" + c.name + "' " + why + ": " + std::to_string(max_restarts) + " restarts within " + fmt(window) +
-          " s already, giving up (dead)");
+    apply_restart(c, c.tracker.on_exit(now_s(), now_s() - c.started_at, true), why);
+  }
+
+  void apply_restart(Child& c, const RestartDecision& d, const std::string& why) {
+    if (!d.restart) {
+      log("node '" + c.name + "' " + why + ": " + std::to_string(d.max_restarts) + " restarts within " +
+          fmt(d.window_s) + " s already, giving up (dead)");
       c.state = State::Dead;
       publish(c, "dead", why + "; too many restarts");
       return;
     }
-    // Backoff grows with consecutive quick failures and resets after a run longer than the window.
-    const double initial = policy_or(c.policy.backoff_initial_s(), 0.1);
-    if (t - c.started_at > window) c.backoff = initial;
-    const double delay = c.backoff;
-    c.backoff = std::min(c.backoff * policy_or(c.policy.backoff_factor(), 2.0), policy_or(c.policy.backoff_max_s(), 5.0));
-    c.restart_times.push_back(t);
     ++c.restarts;
-    c.next_start = t + delay;
+    c.next_start = now_s() + d.delay;
     c.state = State::Backoff;
-    log("node '" + c.name + "' " + why + "; restarting in " + fmt(delay) + " s (restart " +
-        std::to_string(c.restarts) + ", " + std::to_string(c.restart_times.size()) + "/" +
-        std::to_string(max_restarts) + " within " + fmt(window) + " s)");
+    log("node '" + c.name + "' " + why + "; restarting in " + fmt(d.delay) + " s (restart " +
+        std::to_string(c.restarts) + ", " + std::to_string(d.in_window) + "/" + std::to_string(d.max_restarts) +
+        " within " + fmt(d.window_s) + " s)");
     publish(c, "restarting", why);
   }
 
@@ -462,8 +454,7 @@ class Launcher {
     c->fploc_node = fploc_node;
     c->options_field = field;
     c->sets = sets;
-    c->restart_times.clear();
-    c->backoff = policy_or(c->policy.backoff_initial_s(), 0.1);
+    c->tracker.reset();
     log("control: " + m->action + " node '" + c->name + "' with " + exe_name +
         (sets.empty() ? "" : " (overrides: " + join(sets) + ")"));
     publish(*c, "restarting", "control: " + m->action);

@@ -49,7 +49,7 @@ class CpuMeter {
 struct NodeStats {
   std::deque<PortCounters> ports;  // deque: stable addresses for publishers/subscribers
   LatencyWindow latency;           // handler latency this period
-  LatencyWindow latency_total;     // every handler call (replay breakdown)
+  LatencyWindow latency_total;     // every handler call, composed replay only (its --json breakdown)
   int64_t errors = 0;
   std::string last_error;
   double busy_s_period = 0;        // time spent in handlers this period
