@@ -79,6 +79,7 @@ struct Child {
   std::string exe_path;               // resolved
   bool fploc_node = false;            // speaks the runtime protocol (--graph/--node, telemetry)
   std::string options_field;          // declared by the executable
+  NodeSpec spec;                      // its --describe (fploc nodes)
   std::vector<std::string> sets;      // overrides from control requests
   std::vector<std::string> args;
   fploc::RestartPolicy policy;
@@ -112,6 +113,7 @@ class Launcher {
       c.exe_path = rn.executable;
       c.fploc_node = rn.desc.describable;
       c.options_field = rn.desc.spec.options_field;
+      c.spec = rn.desc.spec;
       c.args.assign(n.args().begin(), n.args().end());
       c.policy = n.restart();
       c.heartbeat_timeout = policy_or(n.heartbeat_timeout_s(), 3.0);
@@ -420,6 +422,7 @@ class Launcher {
     // A new executable / overrides must pass the same checks as the graph before the old one stops.
     std::string exe_name = c->exe_name, exe_path = c->exe_path, field = c->options_field;
     bool fploc_node = c->fploc_node;
+    NodeSpec spec = c->spec;
     if (!m->executable.empty() && m->executable != c->exe_name) {
       exe_path = resolve_executable(m->executable, bin_dir_);
       if (exe_path.empty()) return reject(m->node, "executable '" + m->executable + "' not found");
@@ -430,7 +433,22 @@ class Launcher {
       if (d.describable && !graph_field.empty() && graph_field != d.spec.options_field)
         return reject(m->node, "'" + m->executable + "' takes options '" + d.spec.options_field +
                                    "' but the graph gives '" + graph_field + "'");
+      // The swapped-in module must offer the ports the graph maps, with the same LCM types as before.
+      if (d.describable && c->fploc_node) {
+        for (const auto& old_p : c->spec.ports) {
+          const PortSpec* np = nullptr;
+          for (const auto& p : d.spec.ports)
+            if (p.name == old_p.name && p.output == old_p.output) np = &p;
+          if (!np)
+            return reject(m->node, "'" + m->executable + "' has no " + (old_p.output ? "output" : "input") +
+                                       " port '" + old_p.name + "' (the running " + c->exe_name + " has)");
+          if (np->lcm_type != old_p.lcm_type)
+            return reject(m->node, "'" + m->executable + "' port '" + np->name + "' is " + np->lcm_type +
+                                       ", the graph's channel carries " + old_p.lcm_type);
+        }
+      }
       exe_name = m->executable;
+      spec = d.spec;
       fploc_node = d.describable;
       field = d.spec.options_field;
     }
@@ -453,6 +471,7 @@ class Launcher {
     c->exe_path = exe_path;
     c->fploc_node = fploc_node;
     c->options_field = field;
+    c->spec = spec;
     c->sets = sets;
     c->tracker.reset();
     log("control: " + m->action + " node '" + c->name + "' with " + exe_name +
