@@ -20,6 +20,7 @@ double dist_to_path(const std::vector<Eigen::Vector2d>& path, const Eigen::Vecto
 Simulator::Simulator(FloorPlan plan, SimulatorOptions opt) : opt_(std::move(opt)) {
   std::string err;
   if (!scenario_spec(opt_.scenario, spec_, &err)) throw std::runtime_error(err);
+  const bool own_plan = !plan.elements.empty();
   if (plan.elements.empty()) {
     if (spec_.plan_kind == "room") plan = demo_room_plan();
     else if (spec_.plan_kind == "corridor") plan = demo_corridor_plan();
@@ -31,6 +32,15 @@ Simulator::Simulator(FloorPlan plan, SimulatorOptions opt) : opt_(std::move(opt)
     spec_.closed = true;
     spec_.length = 0;
     info_ += r.info + "\n";
+  }
+  if (own_plan && spec_.plan_kind != "any") {
+    // The paper scenarios are drawn for the demo plans: refuse a plan they would drive through.
+    const Motion probe(spec_.control, spec_.closed, spec_.speed, spec_.length, 0);
+    const double clr = min_clearance(plan, probe.sample_path(0.05));
+    if (clr < 0.4)
+      throw std::runtime_error("scenario " + spec_.name + " is drawn for the demo " + spec_.plan_kind +
+                               " plan; its path comes within " + std::to_string(clr) + " m of an element of " +
+                               plan.source + " (use auto-loop-" + spec_.speed_name + " for other plans)");
   }
   WorldConfig wc;
   wc.ceiling_height_m = opt_.ceiling_height_m > 0 ? opt_.ceiling_height_m : spec_.ceiling_m;

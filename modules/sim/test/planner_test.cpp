@@ -69,6 +69,13 @@ TEST(AutoLoop, SimulatorRunsOnAnyPlan) {
   EXPECT_NEAR(sim.motion().avg_speed(), 0.65, 0.03);
 }
 
+TEST(AutoLoop, PaperScenarioRefusesAnotherPlan) {
+  SimulatorOptions o;
+  o.scenario = "room-large-loop-fast";
+  EXPECT_THROW(Simulator(demo_corridor_plan(), o), std::runtime_error);
+  EXPECT_NO_THROW(Simulator(load_floor_plan(std::string(FPLOC_SOURCE_DIR) + "/data/plans/room.json"), o));
+}
+
 TEST(DemoPlans, ShippedFilesMatchCode) {
   for (const auto& [file, plan] : {std::make_pair("room.json", demo_room_plan()), std::make_pair("corridor.json", demo_corridor_plan())}) {
     const std::string path = std::string(FPLOC_SOURCE_DIR) + "/data/plans/" + file;
