@@ -2,6 +2,7 @@
 // /api/history once (and after every reconnect), then Server-Sent Events from /api/events.
 import { MapView } from './map.js';
 import { Plot } from './plot.js';
+import { PlanIndex } from './nearest.js';
 
 const $ = (id) => document.getElementById(id);
 const DEG = 180 / Math.PI;
@@ -15,6 +16,8 @@ const S = window.__fploc = {
   pose: null, gt: null, frame: null, features: null, nodes: [], stats: null,
 };
 const MAX_TRAIL = 50000;
+const MATCH_M = 0.15;  // a projected feature this close to a plan element counts as matched
+let planIndex = null;
 
 const map = new MapView($('map'));
 const plots = {
@@ -33,17 +36,28 @@ map.layers.push((c, v) => {
   // Project with the frame pose of the same scan when it is here (it arrives just after the features).
   const fpose = f && (S.frame && S.frame.scan_seq === f.scan_seq && S.frame.x !== null ? S.frame : f.pose);
   if (f && fpose && $('showfeat').checked) {
-    const cs = Math.cos(fpose.yaw), sn = Math.sin(fpose.yaw), r = 2;
+    // Points within MATCH_M of a plan element are drawn filled ("matched"), the others hollow.
+    const cs = Math.cos(fpose.yaw), sn = Math.sin(fpose.yaw), r = 2, n = f.kind.length;
+    const wx = new Float64Array(n), wy = new Float64Array(n), near = new Uint8Array(n);
+    let matched = 0;
+    for (let k = 0; k < n; k++) {
+      const px = f.xy[2 * k], py = f.xy[2 * k + 1];
+      wx[k] = fpose.x + cs * px - sn * py; wy[k] = fpose.y + sn * px + cs * py;
+      near[k] = planIndex && planIndex.distance(wx[k], wy[k]) <= MATCH_M ? 1 : 0;
+      matched += near[k];
+    }
+    S.featuresMatched = n ? matched / n : null;
     for (const kind of ['s', 'c']) {
-      c.fillStyle = kind === 'c' ? COL.corner : COL.surface;
-      c.beginPath();
-      for (let i = 0, k = 0; k < f.kind.length; i += 2, k++) {
-        if (f.kind[k] !== kind) continue;
-        const px = f.xy[i], py = f.xy[i + 1];
-        const [sx, sy] = v.toScreen(fpose.x + cs * px - sn * py, fpose.y + sn * px + cs * py);
-        c.moveTo(sx + r, sy); c.arc(sx, sy, kind === 'c' ? r + 1 : r, 0, 2 * Math.PI);
+      for (const m of [1, 0]) {
+        c.beginPath();
+        for (let k = 0; k < n; k++) {
+          if (f.kind[k] !== kind || near[k] !== m) continue;
+          const [sx, sy] = v.toScreen(wx[k], wy[k]);
+          c.moveTo(sx + r + 1, sy); c.arc(sx, sy, kind === 'c' ? r + 1 : r, 0, 2 * Math.PI);
+        }
+        const col = kind === 'c' ? COL.corner : COL.surface;
+        if (m) { c.fillStyle = col; c.fill(); } else { c.strokeStyle = col; c.lineWidth = 1; c.stroke(); }
       }
-      c.fill();
     }
   }
   if (S.gt) v.arrow(c, S.gt.x, S.gt.y, S.gt.yaw, COL.gt, false);
@@ -81,7 +95,8 @@ function renderPoseBox() {
     ['status', p ? ['OK', 'POOR', 'LOST'][p.status] ?? p.status : '–'],
     ['ATE so far', p && p.ate_n ? `${fmt(p.ate_rmse)} m (${p.ate_n} poses)` : (g ? 'waiting for matches' : 'no ground truth')],
     ['frame pose', f ? `${f.status_text || f.status} · inliers ${fmt(100 * f.inlier_ratio, 0)} % · ${fmt(f.solve_ms, 1)} ms` : '–'],
-    ['features', S.features ? `${S.features.n} (shown ${S.features.shown})` : '–'],
+    ['features', S.features ? `${S.features.n} (shown ${S.features.shown})` +
+      (S.featuresMatched !== null && S.featuresMatched !== undefined ? ` · ${(100 * S.featuresMatched).toFixed(0)} % on the plan` : '') : '–'],
   ];
   $('posebox').tBodies[0].replaceChildren(...rows.map(([k, v]) => {
     const tr = document.createElement('tr');
@@ -156,6 +171,9 @@ function fillGap(since) {
   }, 100);
 }
 
+// Belt and braces: every 5 s re-read the last 10 s of history (poses lost in ways a seq gap does not show).
+setInterval(() => { if (S.connected && S.trail.length) fillGap(S.trail[S.trail.length - 1][2] - 10e6); }, 5000);
+
 function onPose(p) {
   // A seq gap, or the first event after loading the history (poses may have come in between).
   if (S.trail.length && (S.lastPoseSeq === undefined || p.seq > S.lastPoseSeq + 1)) fillGap(S.trail[S.trail.length - 1][2]);
@@ -194,7 +212,7 @@ async function loadStatic() {
     fetch('/api/plan', { cache: 'no-store' }).then((r) => r.json()),
     fetch('/api/history', { cache: 'no-store' }).then((r) => r.json()),
   ]);
-  if (plan) map.setPlan(plan);
+  if (plan) { map.setPlan(plan); planIndex = new PlanIndex(plan); }
   S.trail = []; S.gtTrail = []; t0 = null; S.lastPoseSeq = undefined; S.lastGtSeq = undefined;
   Object.values(plots).forEach((p) => p.clear());
   let sq = 0, n = 0;
@@ -251,7 +269,7 @@ function connect() {
     const l = S.latencies.slice(-50).sort((a, b) => a - b);
     $('latency').textContent = l.length ? `latency p50 ${l[l.length >> 1].toFixed(0)} ms · ${s.clients} viewer(s)` : `${s.clients} viewer(s)`;
   });
-  on('plan_changed', async () => { try { map.setPlan(await (await fetch('/api/plan')).json()); } catch (e) { /* next reconnect */ } });
+  on('plan_changed', async () => { try { const plan = await (await fetch('/api/plan')).json(); map.setPlan(plan); planIndex = new PlanIndex(plan); } catch (e) { /* next reconnect */ } });
 }
 
 $('fit').addEventListener('click', () => map.fit());

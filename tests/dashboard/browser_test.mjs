@@ -99,6 +99,9 @@ try {
   check(trail1 >= trail0 + 10, `trail grows (${trail0} -> ${trail1} poses in 2 s at 10 Hz)`);
   check(await page.evaluate(() => window.__fploc.gtTrail.length > 10), 'ground-truth trail present');
   check(await page.evaluate(() => (window.__fploc.features?.xy.length ?? 0) > 100), 'features received');
+  // Most features lie on the plan; the cabinet (not in the plan) gives some off the plan.
+  const onPlan = await page.evaluate(() => window.__fploc.featuresMatched);
+  check(onPlan > 0.6 && onPlan < 0.995, `features on the plan vs off it (${(100 * onPlan).toFixed(1)} % on the plan)`);
 
   // Every node in the table, all green.
   const everyNode = [...NODES, 'dashboard'];
@@ -164,6 +167,7 @@ try {
   await sleep(2500);  // let the trail get longer for the picture
   // Poses the page missed (rate cap, stalls) are filled in from /api/history: the page's trail holds
   // every pose the server has in the same time range.
+  await sleep(5200);  // one periodic history re-read
   await waitFor(() => page.evaluate(() => !window.__fploc.fillPending), 3000);
   const trailCheck = await page.evaluate(async () => {
     const t = window.__fploc.trail, have = new Set(t.map((p) => p[2]));

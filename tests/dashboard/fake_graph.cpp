@@ -1,5 +1,6 @@
 // Test-only publisher for the dashboard tests: heartbeats of a named node and, with --sim, a simulated
-// robot driving an ellipse in a 12 m x 8 m room with a round pillar (tests/dashboard/room.json):
+// robot driving an ellipse in a 12 m x 8 m room with a round pillar (tests/dashboard/room.json) and a
+// cabinet that is not in the plan:
 // ground truth, 6-DoF poses, frame poses and ray-cast 2D features. Message times are the wall clock so
 // the browser can measure end-to-end latency.
 //   fploc-dashboard-fake --name NAME [--sim] [--rate HZ] [--duration S] [--state S --reporter R --once]
@@ -52,6 +53,21 @@ double cast(double px, double py, double dx, double dy) {
     const double tc = -b - std::sqrt(disc);
     if (tc > 0) t = std::min(t, tc);
   }
+  // Clutter that is not in the plan: a 1 m x 0.6 m cabinet at (9.5, 1.5).
+  const double bx0 = 9.0, bx1 = 10.0, by0 = 1.2, by1 = 1.8;
+  double tmin = 0, tmax = 1e9;
+  for (int a = 0; a < 2; ++a) {
+    const double p = a ? py : px, d = a ? dy : dx, lo = a ? by0 : bx0, hi = a ? by1 : bx1;
+    if (std::abs(d) < 1e-12) {
+      if (p < lo || p > hi) tmax = -1;
+    } else {
+      double t1 = (lo - p) / d, t2 = (hi - p) / d;
+      if (t1 > t2) std::swap(t1, t2);
+      tmin = std::max(tmin, t1);
+      tmax = std::min(tmax, t2);
+    }
+  }
+  if (tmax >= tmin && tmin > 0) t = std::min(t, tmin);
   return t;
 }
 }  // namespace
