@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <numeric>
 
 namespace fploc::seg {
@@ -507,7 +508,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
     for (size_t i = 0; i < c.p.size(); i += 16) {
       const float r = n.dot(c.p[i]) + d;
       cnt += std::abs(r) < 0.05f;
-      cnt -= 2 * (r < -0.1f);
+      cnt -= (r < -0.2f);
     }
     return cnt;
   };
@@ -549,6 +550,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
 
   // 3. M-estimator (IRLS, Tukey biweight) over all points of the half rings, cut-off shrinking from
   //    irls_initial_scale_m to ~4.7 robust sigmas of the inliers.
+  auto refine = [&](Eigen::Vector4d cur) -> std::optional<Eigen::Vector4d> {
   const Eigen::Vector3d ref = -cur[3] * cur.head<3>();  // a point of the plane (numerics)
   const Eigen::Vector3f reff = ref.cast<float>();
   double cut = cfg_.irls_initial_scale_m;
@@ -559,7 +561,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
     for (size_t i = 0; i < c.p.size(); ++i)
       if (std::abs(n.dot(c.p[i]) + d) < cb) band_.push_back(int(i));
   }
-  if (band_.size() < 3) return false;
+  if (band_.size() < 3) return std::nullopt;
   for (int it = 0; it < std::max(1, cfg_.irls_iterations); ++it) {
     const Eigen::Vector3f n = cur.head<3>().cast<float>();
     const float d = float(cur[3]);
@@ -578,7 +580,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
         ++inside;
       }
     }
-    if (inside < 3) return false;
+    if (inside < 3) return std::nullopt;
     int acc = 0, bin = 0;
     for (; bin < kBins; ++bin) {
       acc += hist[bin];
@@ -609,11 +611,22 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
     m.s << sx, sy, sz;
     m.ss << sxx, sxy, sxz, sxy, syy, syz, sxz, syz, szz;
     Eigen::Vector4d next;
-    if (!m.plane(ref, up, next)) return false;
+    if (!m.plane(ref, up, next)) return std::nullopt;
     const double dn = (next.head<3>() - cur.head<3>()).norm(), dd = std::abs(next[3] - cur[3]);
     cur = next;
     if (final_scale && dn < 1e-6 && dd < 1e-5) break;
   }
+  return cur;
+  };
+  // Refine the best start; when last frame's plane was not that start, refine it too and keep the result
+  // with more support (a lowered/sloped patch must not capture the fit when the main ceiling is known).
+  auto res1 = refine(cur);
+  if (previous && (cur - *previous).norm() > 1e-9) {
+    auto res2 = refine(*previous);
+    if (res2 && (!res1 || score(*res2) > score(*res1))) res1 = res2;
+  }
+  if (!res1) return false;
+  cur = *res1;
   plane = cur;
   return true;
 }
