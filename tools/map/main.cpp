@@ -40,12 +40,13 @@ struct PlanArgs {
 
 struct AnnfArgs {
   std::string mode = "paper", rule = "child-leaf-ordered";
-  int depth = 7, max_candidates = 2;
-  double root = 6.0;
+  int depth = 7, max_candidates = 4;
+  double root = 6.0, margin = 2.0;
   void add(CLI::App* app, bool with_depth = true) {
     app->add_option("--mode", mode, "paper | exact")->check(CLI::IsMember({"paper", "exact"}));
     if (with_depth) app->add_option("--depth", depth, "maximum depth (1 = root fields only)");
     app->add_option("--root", root, "root field length in metres (default 6)");
+    app->add_option("--margin", margin, "metres of field around the plan's bounding box (default 2)");
     app->add_option("--rule", rule, "paper stopping rule: child-leaf | undo-only | child-leaf-ordered | full");
     app->add_option("--max-candidates", max_candidates, "exact mode: subdivide while a leaf has more candidates");
   }
@@ -56,6 +57,7 @@ struct AnnfArgs {
     o.max_depth = depth;
     o.root_length = root;
     o.exact_max_candidates = max_candidates;
+    o.margin = margin;
     return o;
   }
 };
@@ -125,6 +127,7 @@ int main(int argc, char** argv) {
   validate->add_option("--sample-area", v.sample_area, "bbox (plan's bounding box, default) | fields (area of the root fields)");
   validate->add_flag("--all-rules", v.all_rules, "measure every reading of the paper's stopping rules");
   validate->add_option("--root", v.root, "root field length in metres (default 6)");
+  validate->add_option("--margin", v.margin, "metres of field around the plan's bounding box (default 2)");
   validate->add_option("--max-candidates", v.max_candidates, "exact mode: subdivide while a leaf has more candidates");
   validate->add_option("--exact-depth", v.exact_depth, "exact mode rows: extra depth added (default 0)");
   validate->add_option("--baseline-depth", v.baseline_depth, "KD-tree spacing / grid resolution = leaf length at this depth (default 7)");

@@ -15,7 +15,8 @@ struct ValidateArgs {
   bool distinct = false;
   std::string sample_area = "bbox";
   double root = 6.0;
-  int max_candidates = 2;
+  double margin = 2.0;
+  int max_candidates = 4;
   int exact_depth = 0;
   int baseline_depth = 7;
   uint32_t seed = 1;

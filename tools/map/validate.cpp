@@ -61,6 +61,7 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
   if (a.sample_area == "fields") {  // the area covered by the root fields (extends past the plan)
     AnnfOptions ro;
     ro.root_length = a.root;
+    ro.margin = a.margin;
     ro.max_depth = 1;
     bb = Annf::build(plan, ro).covered();
   } else if (a.sample_area != "bbox") {
@@ -105,6 +106,7 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
       o.mode = mode;
       o.paper_rule = rule;
       o.root_length = a.root;
+      o.margin = a.margin;
       o.max_depth = depth + (mode == AnnfMode::kExact ? a.exact_depth : 0);
       o.exact_max_candidates = a.max_candidates;
       o.paper_distinct_distances = distinct;
@@ -190,6 +192,7 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
     AnnfOptions xo;
     xo.mode = AnnfMode::kExact;
     xo.root_length = a.root;
+    xo.margin = a.margin;
     xo.max_depth = a.baseline_depth + 2;
     const Annf ex = Annf::build(plan, xo);
     const DistanceGrid grid(ex, spacing);

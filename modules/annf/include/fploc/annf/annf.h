@@ -55,8 +55,10 @@ struct AnnfOptions {
   double root_length = 6.0;  // metres
   int max_depth = 7;         // 1 = root fields only
   PaperRule paper_rule = PaperRule::kChildLeafOrdered;  // closest to Table III (docs/notes/annf.md)
-  int exact_max_candidates = 2;  // exact mode: subdivide while a leaf holds more candidates
-  double margin = 0.0;           // metres added around the plan's bounding box
+  int exact_max_candidates = 4;  // exact mode: subdivide while a leaf holds more candidates
+  // Metres added around the plan's bounding box: scan points just outside the outer walls stay
+  // inside the field (outside it nearest() falls back to brute force).
+  double margin = 2.0;
   // Paper mode: "two nearest" keeps two elements at *different* distances from the field centre
   // (an element tied with the first, e.g. the other wall at a shared corner, is skipped), as the
   // authors' public ANNF demo does (its leaf table shows this).
