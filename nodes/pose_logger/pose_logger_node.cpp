@@ -1,7 +1,9 @@
-// Pose logger: every fploc.pose_t on its `pose` port becomes one TUM line (core `tum_line`, so the
+// Pose logger: every fploc.pose_t on its `pose` port (or fploc.frame_pose_t on its optional `frame_pose`
+// port: single-frame registration results, 6-DoF from x, y, yaw + roll, pitch, z) becomes one TUM line (core `tum_line`, so the
 // formatting is deterministic). Each line is handed to the kernel with a single write(2) as soon as the
 // pose arrives: nothing is buffered in the process, so no processed pose is lost on SIGINT or a crash.
 #include <fcntl.h>
+#include <fploc/frame_pose_t.hpp>
 #include <fploc/pose_t.hpp>
 #include <unistd.h>
 
@@ -20,7 +22,9 @@ class PoseLoggerNode : public fploc::rt::Node {
  public:
   static fploc::rt::NodeSpec spec() {
     return {"pose_logger", "pose_logger", "writes FPLOC_POSE to a TUM trajectory file (one flushed line per pose)",
-            {fploc::rt::input<fploc::pose_t>("pose", "FPLOC_POSE")}};
+            {fploc::rt::input<fploc::pose_t>("pose", "FPLOC_POSE"),
+             // Not connected unless the graph maps it (e.g. to FPLOC_FRAME_POSE); map `pose` to "" then.
+             fploc::rt::input<fploc::frame_pose_t>("frame_pose", "")}};
   }
 
   void setup(fploc::rt::Context& ctx) override {
@@ -30,7 +34,10 @@ class PoseLoggerNode : public fploc::rt::Node {
     fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd_ < 0) throw std::runtime_error("cannot write '" + path_ + "': " + std::strerror(errno));
     ctx_ = &ctx;
-    ctx.subscribe<fploc::pose_t>("pose", [this](const fploc::pose_t& m) { on_pose(m); });
+    if (!ctx.channel("pose").empty())
+      ctx.subscribe<fploc::pose_t>("pose", [this](const fploc::pose_t& m) { on_pose(m); });
+    if (!ctx.channel("frame_pose").empty())
+      ctx.subscribe<fploc::frame_pose_t>("frame_pose", [this](const fploc::frame_pose_t& m) { on_frame_pose(m); });
   }
 
   void shutdown() override {
@@ -43,6 +50,17 @@ class PoseLoggerNode : public fploc::rt::Node {
   ~PoseLoggerNode() override { shutdown(); }
 
  private:
+  void on_frame_pose(const fploc::frame_pose_t& m) {
+    if (m.status == 3) return;  // NOT_INITIALISED: no pose yet
+    const auto p = fploc::StampedPose::from_rpy(double(m.utime) * 1e-6, Eigen::Vector3d(m.x, m.y, m.z), m.roll,
+                                                m.pitch, m.yaw);
+    if (!p.p.allFinite() || !p.q.coeffs().allFinite()) {
+      ctx_->error("frame_pose seq " + std::to_string(m.seq) + ": non-finite pose (skipped)");
+      return;
+    }
+    write_line(fploc::tum_line(p) + "\n");
+  }
+
   void on_pose(const fploc::pose_t& m) {
     if (final_only_ && !m.final_estimate) return;
     fploc::StampedPose p;
@@ -55,7 +73,10 @@ class PoseLoggerNode : public fploc::rt::Node {
       return;
     }
     p.q = Eigen::Quaterniond(m.orientation[3], m.orientation[0], m.orientation[1], m.orientation[2]);
-    const std::string line = fploc::tum_line(p) + "\n";
+    write_line(fploc::tum_line(p) + "\n");
+  }
+
+  void write_line(const std::string& line) {
     size_t off = 0;
     while (off < line.size()) {
       const ssize_t w = ::write(fd_, line.data() + off, line.size() - off);

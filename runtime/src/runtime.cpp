@@ -107,6 +107,7 @@ const std::string& Context::channel(const std::string& port) const {
 }
 
 void Context::publish_raw(const std::string& channel, const void* data, int size, PortCounters* c) {
+  if (channel.empty()) return;  // output port not connected
   if (bus_.lcm().publish(channel, data, unsigned(size)) != 0) {
     if (c) ++c->dropped;
     return;
@@ -144,6 +145,7 @@ static void raw_handler(const lcm::ReceiveBuffer* rbuf, const std::string&, Hand
 
 void Context::subscribe_raw(const std::string& port, std::function<bool(const void*, int)> fn) {
   const std::string& ch = channel(port);
+  if (ch.empty()) return;  // not connected
   auto h = std::make_unique<HandlerEntry>();
   h->ctx = this;
   h->counters = &stats_.port(port, ch, false);
@@ -209,8 +211,13 @@ void Composition::drain() {
 }
 
 void Composition::shutdown() {
+  // In graph order, delivering what each node publishes while it shuts down (e.g. the optimizer's last
+  // window) before the next node shuts down: sinks such as pose loggers belong at the end of a graph.
   drain();
-  for (auto& n : nodes_) n.node->shutdown();
+  for (auto& n : nodes_) {
+    n.node->shutdown();
+    drain();
+  }
 }
 
 std::vector<std::string> Composition::external_inputs() const {
@@ -219,7 +226,7 @@ std::vector<std::string> Composition::external_inputs() const {
     for (const auto& p : n.ctx->stats().ports) (p.output ? produced : needed).push_back(p.channel);
   std::vector<std::string> out;
   for (const auto& c : needed)
-    if (std::find(produced.begin(), produced.end(), c) == produced.end() &&
+    if (!c.empty() && std::find(produced.begin(), produced.end(), c) == produced.end() &&
         std::find(out.begin(), out.end(), c) == out.end())
       out.push_back(c);
   return out;

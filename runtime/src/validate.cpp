@@ -204,6 +204,7 @@ bool validate_graph(const LoadedGraph& g, const ValidateHooks& hooks, std::vecto
   const std::string control = g.graph.control_channel().empty() ? kControlChannel : g.graph.control_channel();
   producers[control].push_back({"(fploc node)", "control", "fploc.node_command_t", 0});
 
+  bool unknown_ports = false;  // an enabled fploc node could not be described: it may be a missing producer
   for (int i = 0; i < g.graph.node_size(); ++i) {
     const auto& n = g.graph.node(i);
     const int line = g.node_line(i);
@@ -235,6 +236,8 @@ bool validate_graph(const LoadedGraph& g, const ValidateHooks& hooks, std::vecto
       }
     }
     const bool typed = rn.desc.describable && rn.desc.error.empty();
+    if (!n.disabled() && !n.executable().empty() && (rn.executable.empty() || !rn.desc.error.empty()))
+      unknown_ports = true;
     const std::string opt_field = node_options_field(n);
     if (typed && !opt_field.empty() && opt_field != rn.desc.spec.options_field) {
       err(g.node_line(i, opt_field),
@@ -256,8 +259,8 @@ bool validate_graph(const LoadedGraph& g, const ValidateHooks& hooks, std::vecto
         const auto& p = ports[k];
         const int pl = g.node_line(i, field, k);
         auto& seen = output ? mapped_out : mapped_in;
-        if (p.port().empty() || p.channel().empty()) {
-          err(pl, who + ": " + field + " needs both port and channel");
+        if (p.port().empty()) {
+          err(pl, who + ": " + field + " needs a port name");
           continue;
         }
         if (!seen.insert(p.port()).second) err(pl, who + ": port '" + p.port() + "' mapped twice");
@@ -276,7 +279,7 @@ bool validate_graph(const LoadedGraph& g, const ValidateHooks& hooks, std::vecto
           }
           type = ps->lcm_type;
         }
-        if (n.disabled() && !output) continue;
+        if ((n.disabled() && !output) || p.channel().empty()) continue;  // "" = not connected
         (output ? producers : consumers)[p.channel()].push_back({n.name(), p.port(), type, pl});
       }
     };
@@ -285,7 +288,7 @@ bool validate_graph(const LoadedGraph& g, const ValidateHooks& hooks, std::vecto
     if (typed) {
       for (const auto& s : rn.desc.spec.ports) {
         if ((s.output ? mapped_out : mapped_in).count(s.name)) continue;
-        if (n.disabled() && !s.output) continue;
+        if ((n.disabled() && !s.output) || s.default_channel.empty()) continue;
         (s.output ? producers : consumers)[s.default_channel].push_back({n.name(), s.name, s.lcm_type, line});
       }
     }
@@ -297,6 +300,7 @@ bool validate_graph(const LoadedGraph& g, const ValidateHooks& hooks, std::vecto
     auto pit = producers.find(channel);
     for (const auto& c : cons) {
       if (pit == producers.end()) {
+        if (unknown_ports) continue;  // reported once every executable is there (no cascades)
         err(c.line, "node '" + c.node + "' input '" + c.port + "' on channel '" + channel +
                         "' has no producer (no node of the graph publishes it)");
         continue;

@@ -49,7 +49,7 @@ node { name: "l" executable: "fploc-log"
   input { port: "pose" channel: "OS1_SCAN" }
 }
 node { name: "seg" executable: "fploc-seg" }
-node { name: "s" executable: "fploc-missing" }
+node { name: "s" executable: "fploc-src" }
 node { name: "l2" executable: "fploc-log"
   segmenter { seed_rings: 2 }
   input { port: "poze" channel: "P" }
@@ -57,12 +57,11 @@ node { name: "l2" executable: "fploc-log"
 node { name: "l3" executable: "fploc-log" }
 )");
   const std::string s = all(e);
-  ASSERT_EQ(e.size(), 8u) << s;  // + l2's unmapped "pose" on its default FPLOC_POSE
+  ASSERT_EQ(e.size(), 7u) << s;  // + l2's unmapped "pose" on its default FPLOC_POSE
   // l's input on OS1_SCAN: no producer (seg also consumes OS1_SCAN: no producer either).
   EXPECT_NE(s.find("g.pbtxt:3: node 'l' input 'pose' on channel 'OS1_SCAN' has no producer"), std::string::npos) << s;
   EXPECT_NE(s.find("g.pbtxt:5: node 'seg' input 'scan' on channel 'OS1_SCAN' has no producer"), std::string::npos) << s;
   EXPECT_NE(s.find("g.pbtxt:6: duplicate node name 's' (first defined at line 1)"), std::string::npos) << s;
-  EXPECT_NE(s.find("g.pbtxt:6: node 's': executable 'fploc-missing' not found"), std::string::npos) << s;
   EXPECT_NE(s.find("g.pbtxt:8: node 'l2': options field 'segmenter' does not match"), std::string::npos) << s;
   EXPECT_NE(s.find("g.pbtxt:9: node 'l2': fploc-log has no input port 'poze'"), std::string::npos) << s;
   // l3 is not mapped: its default channel FPLOC_POSE has no producer, reported at the node's line.
@@ -104,4 +103,18 @@ TEST(Validate, ResolvesFromBinDirThenPath) {
   EXPECT_FALSE(resolve_executable("sh", "").empty());
   EXPECT_EQ(resolve_executable("fploc-definitely-missing", "/usr/bin"), "");
   EXPECT_EQ(resolve_executable("sh", "/bin"), "/bin/sh");
+}
+
+TEST(Validate, EmptyChannelMeansNotConnected) {
+  const auto e = check(R"(node { name: "l" executable: "fploc-log" input { port: "pose" channel: "" } }
+)");
+  EXPECT_TRUE(e.empty()) << all(e);
+}
+
+TEST(Validate, MissingExecutableDoesNotCascadeIntoNoProducer) {
+  const auto e = check(R"(node { name: "s" executable: "fploc-missing" }
+node { name: "l" executable: "fploc-log" }
+)");
+  ASSERT_EQ(e.size(), 1u) << all(e);
+  EXPECT_NE(e[0].str().find("g.pbtxt:1: node 's': executable 'fploc-missing' not found"), std::string::npos) << all(e);
 }

@@ -37,7 +37,7 @@ namespace fploc::rt {
 struct PortSpec {
   std::string name;
   std::string lcm_type;          // e.g. "fploc.scan_t"
-  std::string default_channel;   // used when the graph does not map the port
+  std::string default_channel;   // used when the graph does not map the port ("" = not connected)
   bool output = false;
 };
 
@@ -183,6 +183,7 @@ Publisher<Msg> Context::advertise(const std::string& port) {
 
 template <class Msg>
 void Context::subscribe(const std::string& port, std::function<void(const Msg&)> fn) {
+  if (channel(port).empty()) return;  // port mapped to "" (or no default channel): not connected
   auto* counters = &stats_.port(port, channel(port), false);
   subscribe_raw(port, [fn = std::move(fn), counters](const void* data, int size) {
     Msg m;
