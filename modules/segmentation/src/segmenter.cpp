@@ -621,7 +621,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
   // Refine the best start; when last frame's plane was not that start, refine it too and keep the result
   // with more support (a lowered/sloped patch must not capture the fit when the main ceiling is known).
   auto res1 = refine(cur);
-  if (previous && (cur - *previous).norm() > 1e-9) {
+  if (previous && (cur - *previous).norm() > 1e-9 && (!res1 || score(*res1) < score(*previous))) {
     auto res2 = refine(*previous);
     if (res2 && (!res1 || score(*res2) > score(*res1))) res1 = res2;
   }
