@@ -505,7 +505,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
     // A ceiling is where the rays end: returns beyond the plane (above a ceiling) count against it, so a
     // horizontal plane cutting through near walls (many "inliers" at one height) loses.
     int cnt = 0;
-    for (size_t i = 0; i < c.p.size(); i += 16) {
+    for (size_t i = 0; i < c.p.size(); i += 24) {
       const float r = n.dot(c.p[i]) + d;
       cnt += std::abs(r) < 0.05f;
       cnt -= (r < -0.2f);
@@ -614,7 +614,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
     if (!m.plane(ref, up, next)) return std::nullopt;
     const double dn = (next.head<3>() - cur.head<3>()).norm(), dd = std::abs(next[3] - cur[3]);
     cur = next;
-    if (final_scale && dn < 1e-6 && dd < 1e-5) break;
+    if (final_scale && dn < 1e-5 && dd < 1e-4) break;  // 0.0006 deg, 0.1 mm
   }
   return cur;
   };
