@@ -243,6 +243,11 @@ void Annf::prepare() {
         f.dy = e.b.y() - e.a.y();
         const double l2 = f.dx * f.dx + f.dy * f.dy;
         f.inv_l2 = l2 > 0 ? 1.0 / l2 : 0.0;
+      } else if (e.kind == ElementKind::kCircle) {
+        f.ax = e.c.x();
+        f.ay = e.c.y();
+        f.dx = e.r;
+        f.inv_l2 = -2;
       } else {
         f.inv_l2 = -1;
       }
@@ -386,6 +391,11 @@ void Annf::nearest_batch(const Eigen::Vector2d* pts, size_t n, int* ids, double*
         const double t = std::min(1.0, std::max(0.0, ((p.x() - sp.ax) * sp.dx + (p.y() - sp.ay) * sp.dy) * sp.inv_l2));
         qx = sp.ax + t * sp.dx;
         qy = sp.ay + t * sp.dy;
+      } else if (sp.inv_l2 == -2) {
+        const double vx = p.x() - sp.ax, vy = p.y() - sp.ay, len = std::sqrt(vx * vx + vy * vy);
+        const double k = len > 0 ? sp.dx / len : 0.0;
+        qx = len > 0 ? sp.ax + vx * k : sp.ax + sp.dx;
+        qy = len > 0 ? sp.ay + vy * k : sp.ay;
       } else {
         const ClosestPoint cp = closest_point(plan_.elements[cid[k]], p);
         qx = cp.point.x();

@@ -130,6 +130,11 @@ class Annf {
         const double t = std::min(1.0, std::max(0.0, ((p.x() - s.ax) * s.dx + (p.y() - s.ay) * s.dy) * s.inv_l2));
         qx = s.ax + t * s.dx;
         qy = s.ay + t * s.dy;
+      } else if (s.inv_l2 == -2) {  // circle: centre (ax, ay), radius dx
+        const double vx = p.x() - s.ax, vy = p.y() - s.ay, len = std::sqrt(vx * vx + vy * vy);
+        const double k = len > 0 ? s.dx / len : 0.0;
+        qx = len > 0 ? s.ax + vx * k : s.ax + s.dx;
+        qy = len > 0 ? s.ay + vy * k : s.ay;
       } else {
         const ClosestPoint cp = closest_point(plan_.elements[ids[k]], p);
         qx = cp.point.x();
@@ -180,7 +185,8 @@ class Annf {
 
  private:
   static constexpr uint32_t kLeafBit = 0x80000000u;
-  // Geometry copy in a leaf record (segments: a, b-a, 1/|b-a|^2; inv_l2 < 0: other kinds).
+  // Geometry copy in a leaf record (segments: a, b-a, 1/|b-a|^2; circles: inv_l2 = -2, centre in
+  // ax, ay, radius in dx; arcs: inv_l2 = -1, evaluated from the plan).
   struct FastPrim {
     double ax, ay, dx, dy, inv_l2;
   };
