@@ -203,6 +203,7 @@ bool validate_graph(const LoadedGraph& g, const ValidateHooks& hooks, std::vecto
   producers[kTelemetryChannel].push_back({"(every node)", "telemetry", "fploc.node_status_t", 0});
   const std::string control = g.graph.control_channel().empty() ? kControlChannel : g.graph.control_channel();
   producers[control].push_back({"(fploc node)", "control", "fploc.node_command_t", 0});
+  producers[kInitialPoseChannel].push_back({"(fploc node initial-pose)", "initial_pose", "fploc.pose_t", 0});
 
   bool unknown_ports = false;  // an enabled fploc node could not be described: it may be a missing producer
   for (int i = 0; i < g.graph.node_size(); ++i) {

@@ -1,12 +1,16 @@
 // fploc node restart NAME [--exe EXE] [--set field=value ...] [--graph G | --lcm-url URL] [--token T]
 //                                                             [--timeout S] [--no-wait]
 // fploc node stop NAME / fploc node start NAME
+// fploc node initial-pose X Y YAW_DEG [--graph G | --lcm-url URL] [--channel C]
+//   (re-)initialises the matcher: a pose_t on FPLOC_INITIAL_POSE (an operator's "2D pose estimate").
 // Publishes a node_command_t on the launcher's control channel and waits until the node reports back
 // from its new process (or the launcher rejects the request, naming why).
 #include <fploc/node_command_t.hpp>
 #include <fploc/node_status_t.hpp>
+#include <fploc/pose_t.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <iostream>
 #include <string>
@@ -23,7 +27,70 @@ double now_s() {
 }
 void usage() {
   std::cerr << "usage: fploc node restart|stop|start NAME [--exe EXECUTABLE] [--set field=value ...]\n"
-               "                  [--graph GRAPH | --lcm-url URL] [--token T] [--timeout S] [--no-wait]\n";
+               "                  [--graph GRAPH | --lcm-url URL] [--token T] [--timeout S] [--no-wait]\n"
+               "       fploc node initial-pose X Y YAW_DEG [--graph GRAPH | --lcm-url URL] [--channel C]\n";
+}
+
+LoadedGraph load_or_exit(const std::string& path) {
+  LoadedGraph g;
+  std::vector<GraphError> errors;
+  if (!load_graph(path, g, errors)) {
+    for (const auto& e : errors) std::cerr << e.str() << "\n";
+    std::exit(2);
+  }
+  return g;
+}
+
+// fploc node initial-pose X Y YAW_DEG: one pose_t (z, roll, pitch 0; the segmenter supplies them).
+int initial_pose(int argc, char** argv) {
+  if (argc < 5) {
+    usage();
+    return 2;
+  }
+  double v[3];
+  for (int k = 0; k < 3; ++k) {
+    char* end = nullptr;
+    v[k] = std::strtod(argv[2 + k], &end);
+    if (end == argv[2 + k] || *end != '\0' || !std::isfinite(v[k])) {
+      std::cerr << "fploc node initial-pose: '" << argv[2 + k] << "' is not a number (X Y YAW_DEG)\n";
+      return 2;
+    }
+  }
+  std::string url = getenv("FPLOC_LCM_URL") ? getenv("FPLOC_LCM_URL") : "";
+  std::string channel = kInitialPoseChannel;
+  for (int i = 5; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (i + 1 >= argc) {
+      std::cerr << "fploc node initial-pose: " << a << " needs a value\n";
+      return 2;
+    }
+    if (a == "--lcm-url") url = argv[++i];
+    else if (a == "--graph") url = load_or_exit(argv[++i]).graph.lcm_url();
+    else if (a == "--channel") channel = argv[++i];
+    else {
+      std::cerr << "fploc node initial-pose: unexpected argument '" << a << "'\n";
+      return 2;
+    }
+  }
+  fploc::pose_t p{};
+  p.utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                std::chrono::system_clock::now().time_since_epoch()).count();
+  p.final_estimate = true;
+  p.position[0] = v[0];
+  p.position[1] = v[1];
+  const double half = 0.5 * v[2] * M_PI / 180.0;
+  p.orientation[2] = std::sin(half);
+  p.orientation[3] = std::cos(half);
+  try {
+    Bus bus(url);
+    bus.lcm().publish(channel, &p);
+    std::cerr << "fploc node: initial pose x " << v[0] << " y " << v[1] << " yaw " << v[2] << " deg sent on "
+              << channel << " (" << bus.url() << ")\n";
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "fploc node: " << e.what() << "\n";
+    return 1;
+  }
 }
 struct Watch {
   std::string node;
@@ -49,6 +116,7 @@ struct Watch {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "initial-pose") return initial_pose(argc, argv);
   if (argc < 3) {
     usage();
     return 2;
@@ -76,13 +144,7 @@ int main(int argc, char** argv) {
     else if (a == "--timeout") timeout = std::atof(next().c_str());
     else if (a == "--no-wait") wait = false;
     else if (a == "--graph") {
-      LoadedGraph g;
-      std::vector<GraphError> errors;
-      const std::string path = next();
-      if (!load_graph(path, g, errors)) {
-        for (const auto& e : errors) std::cerr << e.str() << "\n";
-        return 2;
-      }
+      const LoadedGraph g = load_or_exit(next());
       if (url.empty()) url = g.graph.lcm_url();
       if (!g.graph.control_channel().empty()) channel = g.graph.control_channel();
       if (cmd.token.empty()) cmd.token = g.graph.control_token();

@@ -12,6 +12,9 @@ namespace fploc::rt {
 inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304";
 inline constexpr const char* kTelemetryChannel = "FPLOC_TELEMETRY";
 inline constexpr const char* kControlChannel = "FPLOC_CONTROL";
+// Initial / re-initialisation poses (pose_t), published by `fploc node initial-pose` (an operator, like
+// RViz's "2D Pose Estimate"); the matcher subscribes to it.
+inline constexpr const char* kInitialPoseChannel = "FPLOC_INITIAL_POSE";
 
 class Bus {
  public:

@@ -46,7 +46,8 @@ struct ResolvedNode {
 // --describe), the options field against what the executable declares, port names, restart policies,
 // inputs with no producer and producer/consumer LCM type mismatches per channel. A disabled node is not
 // started but its outputs still count as producers (it stands for a source outside the launch, e.g.
-// lcm-logplayer). FPLOC_TELEMETRY and FPLOC_CONTROL are produced by the runtime / `fploc node`.
+// lcm-logplayer). FPLOC_TELEMETRY, FPLOC_CONTROL and FPLOC_INITIAL_POSE are produced by the runtime /
+// `fploc node` / `fploc node initial-pose`.
 // "No producer" is not reported while an executable is missing (its outputs are unknown).
 // A port mapped to channel "" (or whose default channel is "") is not connected.
 bool validate_graph(const LoadedGraph& g, const ValidateHooks& hooks, std::vector<GraphError>& errors,
