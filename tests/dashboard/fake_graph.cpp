@@ -174,6 +174,7 @@ int main(int argc, char** argv) {
         f.y.push_back(float(sy));
         f.kind.push_back(corner ? 0 : 1);
         f.group.push_back(-1);
+        f.t_offset_s.push_back(0.f);
       }
       f.num_points = int32_t(f.x.size());
       lc.publish("FPLOC_FEATURES", &f);

@@ -176,6 +176,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     out_.y.push_back(q.y());
     out_.kind.push_back(kind_of[i]);
     out_.group.push_back(-1);
+    out_.t.push_back(w.t.size() == w.x.size() ? w.t[src] : 0.f);
     out_.source.push_back(int32_t(src));
     if (kind_of[i] == kCorner) {
       close_run();

@@ -100,6 +100,7 @@ Result run(const FloorPlan& plan_in, const Options& o) {
       p.p = {ft.x[i], ft.y[i]};
       p.kind = ft.kind[i] == 0 ? FeatureKind::kCorner : FeatureKind::kSurface;
       p.group = ft.group[i];
+      p.t = ft.t.size() == ft.size() ? ft.t[i] : 0.f;
       frame.points.push_back(p);
     }
     feat_total += double(frame.points.size());

@@ -406,7 +406,12 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
   const int W = scan.width;
   auto& w = out_.wall;
   const size_t cap = size_t(scan.height) * W;
-  w.x.reserve(cap); w.y.reserve(cap); w.z.reserve(cap); w.range.reserve(cap); w.ring.reserve(cap); w.column.reserve(cap);
+  w.x.reserve(cap); w.y.reserve(cap); w.z.reserve(cap); w.range.reserve(cap); w.t.reserve(cap); w.ring.reserve(cap); w.column.reserve(cap);
+  // Column time offsets (staggered column = measurement order), for motion compensation downstream.
+  col_dt_.assign(W, 0.f);
+  if (scan.column_utime.size() == size_t(W))
+    for (int v = 0; v < W; ++v)
+      if (scan.column_utime[v] != 0) col_dt_[v] = float(double(scan.column_utime[v] - scan.utime) * 1e-6);
   for (int u = 0; u < scan.height; ++u) {
     const int shift = u < int(scan.beams.pixel_shift_by_row.size()) ? scan.beams.pixel_shift_by_row[u] : 0;
     for (int cd = 0; cd < W; ++cd) {
@@ -418,7 +423,7 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
       const Eigen::Vector3f& p = xyz_[i];
       const float sc = nc.dot(p), sf = nf.dot(p);
       if (sc > -dc && sf > -df) {
-        w.push(p, r, u, cd);
+        w.push(p, r, u, cd, col_dt_[v]);
         if (keep_labels_) out_.label[i] = 3;
       } else if (keep_labels_) {
         if (sc <= -cin) out_.label[i] = 1;

@@ -96,6 +96,7 @@ TEST(DashboardModel, FeaturesJsonIsValidAndDecimated) {
     f.y.push_back(i == 3 ? NAN : 1.0f);
     f.kind.push_back(int8_t(i % 2));
     f.group.push_back(-1);
+    f.t_offset_s.push_back(0.f);
   }
   f.num_points = 1000;
   auto j = json::parse(Model::features_json(f, 100, "null"));

@@ -10,8 +10,8 @@ namespace fploc {
 
 FeatureFrame from_msg(const features_t& m, int* dropped) {
   const size_t n = size_t(std::max(0, m.num_points));
-  if (m.x.size() != n || m.y.size() != n || m.kind.size() != n || m.group.size() != n)
-    throw std::runtime_error("features_t seq " + std::to_string(m.seq) + ": arrays x/y/kind/group disagree with num_points " +
+  if (m.x.size() != n || m.y.size() != n || m.kind.size() != n || m.group.size() != n || m.t_offset_s.size() != n)
+    throw std::runtime_error("features_t seq " + std::to_string(m.seq) + ": arrays x/y/kind/group/t_offset_s disagree with num_points " +
                              std::to_string(m.num_points));
   FeatureFrame f;
   f.utime = m.utime;
@@ -32,6 +32,7 @@ FeatureFrame from_msg(const features_t& m, int* dropped) {
     p.p = {double(m.x[i]), double(m.y[i])};
     p.kind = m.kind[i] == 0 ? FeatureKind::kCorner : FeatureKind::kSurface;
     p.group = m.group[i];
+    p.t = std::isfinite(m.t_offset_s[i]) ? m.t_offset_s[i] : 0.f;
     f.points.push_back(p);
   }
   if (!std::isfinite(f.roll)) f.roll = 0;

@@ -16,6 +16,7 @@ TEST(LocalizationConvert, FeaturesRoundTripAndBadArrays) {
   m.y = {4.f, 5.f, 6.f};
   m.kind = {0, 1, 1};
   m.group = {-1, 2, 2};
+  m.t_offset_s = {0.f, 0.05f, 0.09f};
   m.z = 1.5;
   int dropped = 0;
   const FeatureFrame f = from_msg(m, &dropped);
@@ -23,6 +24,7 @@ TEST(LocalizationConvert, FeaturesRoundTripAndBadArrays) {
   ASSERT_EQ(f.points.size(), 2u);
   EXPECT_EQ(f.points[0].kind, FeatureKind::kCorner);
   EXPECT_EQ(f.points[1].group, 2);
+  EXPECT_FLOAT_EQ(f.points[1].t, 0.09f);
   EXPECT_EQ(f.scan_seq, 7);
   EXPECT_DOUBLE_EQ(f.z, 1.5);
   m.num_points = 4;

@@ -38,6 +38,7 @@ void to_msg(const seg::Segmentation& s, int64_t seq, segments_t& m) {
   m.ring = w.ring;
   m.column = w.column;
   m.range_m = w.range;
+  m.t_offset_s = w.t.size() == w.size() ? w.t : std::vector<float>(w.size(), 0.f);
 }
 
 void from_msg(const segments_t& m, seg::Segmentation& s) {
@@ -47,8 +48,8 @@ void from_msg(const segments_t& m, seg::Segmentation& s) {
   };
   if (m.num_points < 0) bad("num_points < 0");
   if (m.x.size() != n || m.y.size() != n || m.z_pts.size() != n || m.ring.size() != n || m.column.size() != n ||
-      m.range_m.size() != n)
-    bad("x/y/z_pts/ring/column/range_m sizes disagree with num_points " + std::to_string(n));
+      m.range_m.size() != n || m.t_offset_s.size() != n)
+    bad("x/y/z_pts/ring/column/range_m/t_offset_s sizes disagree with num_points " + std::to_string(n));
   s.utime = m.utime;
   s.seq = m.scan_seq;
   s.status = seg::SegStatus(m.status);
@@ -78,6 +79,7 @@ void from_msg(const segments_t& m, seg::Segmentation& s) {
   w.ring = m.ring;
   w.column = m.column;
   w.range = m.range_m;
+  w.t = m.t_offset_s;
   // The feature extractor needs ring-major, increasing columns; check instead of trusting.
   for (size_t i = 1; i < n; ++i)
     if (w.ring[i] < w.ring[i - 1] || (w.ring[i] == w.ring[i - 1] && w.column[i] <= w.column[i - 1]))
@@ -99,6 +101,7 @@ void to_msg(const feat::Features2D& f, int64_t seq, int64_t scan_seq, features_t
   m.y = f.y;
   m.kind = f.kind;
   m.group = f.group;
+  m.t_offset_s = f.t.size() == f.size() ? f.t : std::vector<float>(f.size(), 0.f);
   m.num_groups = f.num_groups;
 }
 

@@ -41,6 +41,7 @@ struct Features2D {
   std::vector<float> x, y;          // gravity-aligned, sensor-centred [m]
   std::vector<int8_t> kind;
   std::vector<int32_t> group;       // -1 = unclassified
+  std::vector<float> t;             // measurement time - utime [s] (from the wall points)
   int32_t num_groups = 0;
   // Index of each feature in the input wall points (diagnostics, bench).
   std::vector<int32_t> source;

@@ -16,6 +16,7 @@ struct Feature2 {
   Eigen::Vector2d p = Eigen::Vector2d::Zero();  // sensor-centred horizontal frame [m]
   FeatureKind kind = FeatureKind::kSurface;
   int32_t group = -1;                           // PCA line group, -1 unclassified
+  float t = 0.f;                                // measurement time - frame utime [s] (motion compensation)
 };
 
 // One scan's projected features plus the gravity part of the pose passed through from the segmenter.

@@ -51,13 +51,14 @@ struct Plane {
 // Wall points, ring-major (scan row order), each ring in increasing destaggered column.
 struct WallPoints {
   std::vector<float> x, y, z, range;
+  std::vector<float> t;                 // measurement time - scan utime [s] (the column's time stamp)
   std::vector<int16_t> ring, column;
   size_t size() const { return x.size(); }
   void clear() {
-    x.clear(); y.clear(); z.clear(); range.clear(); ring.clear(); column.clear();
+    x.clear(); y.clear(); z.clear(); range.clear(); t.clear(); ring.clear(); column.clear();
   }
-  void push(const Eigen::Vector3f& p, float r, int u, int c) {
-    x.push_back(p.x()); y.push_back(p.y()); z.push_back(p.z()); range.push_back(r);
+  void push(const Eigen::Vector3f& p, float r, int u, int c, float dt) {
+    x.push_back(p.x()); y.push_back(p.y()); z.push_back(p.z()); range.push_back(r); t.push_back(dt);
     ring.push_back(int16_t(u)); column.push_back(int16_t(c));
   }
 };
@@ -129,6 +130,7 @@ class Segmenter {
   int lut_width_ = 0;
   std::vector<Eigen::Vector3f> xyz_;
   std::vector<float> range_;
+  std::vector<float> col_dt_;  // per staggered column: column time - scan utime [s]
   std::vector<int> ring_order_;      // rings sorted by altitude, top first
   Candidates upper_, lower_;
   bool keep_labels_ = false;
