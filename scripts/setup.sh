@@ -21,3 +21,4 @@ if [ ${#missing[@]} -gt 0 ]; then
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
 fi
+bash "$(dirname "${BASH_SOURCE[0]}")/setup-web.sh"
