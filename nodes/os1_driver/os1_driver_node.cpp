@@ -33,8 +33,9 @@ class Os1DriverNode : public fploc::rt::Node {
     pcap_mode_ = !opt.pcap().empty();
     metadata_path_ = opt.metadata().empty() ? std::string() : ctx.resolve_path(opt.metadata());
     // A missing or broken metadata file is bad input, not a reason to die: it is reported (stderr and
-    // telemetry), packets are dropped and counted, and the file is read again every 5 s until it loads.
-    if (!load()) ctx.every(5.0, [this] { if (!assembler_) load(); });
+    // telemetry, once per distinct error), packets are dropped and counted, and the file is read again
+    // every 0.5 s until it loads (e.g. the simulator writes it a moment after the driver starts).
+    if (!load()) ctx.every(0.5, [this] { if (!assembler_) load(); });
     if (pcap_mode_) {
       std::string err;
       const double rate = opt.pcap_rate() == 0 ? 1.0 : opt.pcap_rate();
@@ -76,9 +77,11 @@ class Os1DriverNode : public fploc::rt::Node {
     try {
       info_ = load_metadata(metadata_path_);
     } catch (const MetadataError& e) {
-      ctx_->error(std::string(e.what()) + " (lidar packets are dropped; retrying every 5 s)");
+      if (e.what() != metadata_error_) ctx_->error(std::string(e.what()) + " (lidar packets are dropped; retrying)");
+      metadata_error_ = e.what();
       return false;
     }
+    if (!metadata_error_.empty()) std::cerr << "[" << ctx_->name() << "] metadata " << metadata_path_ << " loaded\n";
     for (const auto& f : info_.defaulted)
       if (f == "pixel_shift_by_row" || f == "lidar_origin_to_beam_origin_mm")
         std::cerr << "[" << ctx_->name() << "] metadata: '" << f << "' absent, using the Ouster default\n";
@@ -148,6 +151,7 @@ class Os1DriverNode : public fploc::rt::Node {
   bool pcap_mode_ = false;
   int port_ = 7502;
   std::string metadata_path_;
+  std::string metadata_error_;  // last load error (reported once)
   uint64_t dropped_without_metadata_ = 0;
 };
 

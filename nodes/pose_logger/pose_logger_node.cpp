@@ -1,9 +1,11 @@
 // Pose logger: every fploc.pose_t on its `pose` port (or fploc.frame_pose_t on its optional `frame_pose`
-// port: single-frame registration results, 6-DoF from x, y, yaw + roll, pitch, z) becomes one TUM line (core `tum_line`, so the
+// port: single-frame registration results, 6-DoF from x, y, yaw + roll, pitch, z; or fploc.ground_truth_t on
+// its optional `ground_truth` port, to record the simulator's truth of a live run) becomes one TUM line (core `tum_line`, so the
 // formatting is deterministic). Each line is handed to the kernel with a single write(2) as soon as the
 // pose arrives: nothing is buffered in the process, so no processed pose is lost on SIGINT or a crash.
 #include <fcntl.h>
 #include <fploc/frame_pose_t.hpp>
+#include <fploc/ground_truth_t.hpp>
 #include <fploc/pose_t.hpp>
 #include <unistd.h>
 
@@ -24,7 +26,8 @@ class PoseLoggerNode : public fploc::rt::Node {
     return {"pose_logger", "pose_logger", "writes FPLOC_POSE to a TUM trajectory file (one flushed line per pose)",
             {fploc::rt::input<fploc::pose_t>("pose", "FPLOC_POSE"),
              // Not connected unless the graph maps it (e.g. to FPLOC_FRAME_POSE); map `pose` to "" then.
-             fploc::rt::input<fploc::frame_pose_t>("frame_pose", "")}};
+             fploc::rt::input<fploc::frame_pose_t>("frame_pose", ""),
+             fploc::rt::input<fploc::ground_truth_t>("ground_truth", "")}};
   }
 
   void setup(fploc::rt::Context& ctx) override {
@@ -38,6 +41,10 @@ class PoseLoggerNode : public fploc::rt::Node {
       ctx.subscribe<fploc::pose_t>("pose", [this](const fploc::pose_t& m) { on_pose(m); });
     if (!ctx.channel("frame_pose").empty())
       ctx.subscribe<fploc::frame_pose_t>("frame_pose", [this](const fploc::frame_pose_t& m) { on_frame_pose(m); });
+    if (!ctx.channel("ground_truth").empty())
+      ctx.subscribe<fploc::ground_truth_t>("ground_truth", [this](const fploc::ground_truth_t& m) {
+        write_pose(m.utime, m.seq, m.position, m.orientation, "ground_truth");
+      });
   }
 
   void shutdown() override {
@@ -63,16 +70,20 @@ class PoseLoggerNode : public fploc::rt::Node {
 
   void on_pose(const fploc::pose_t& m) {
     if (final_only_ && !m.final_estimate) return;
+    write_pose(m.utime, m.seq, m.position, m.orientation, "pose");
+  }
+
+  // position x y z, orientation quaternion x y z w (pose_t and ground_truth_t share the layout).
+  void write_pose(int64_t utime, int64_t seq, const double* position, const double* q, const char* port) {
     fploc::StampedPose p;
-    p.t = double(m.utime) * 1e-6;
-    p.p = Eigen::Vector3d(m.position[0], m.position[1], m.position[2]);
-    const double n2 = m.orientation[0] * m.orientation[0] + m.orientation[1] * m.orientation[1] +
-                      m.orientation[2] * m.orientation[2] + m.orientation[3] * m.orientation[3];
+    p.t = double(utime) * 1e-6;
+    p.p = Eigen::Vector3d(position[0], position[1], position[2]);
+    const double n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
     if (!p.p.allFinite() || !std::isfinite(n2) || n2 < 1e-12) {
-      ctx_->error("pose seq " + std::to_string(m.seq) + ": non-finite position or zero quaternion (skipped)");
+      ctx_->error(std::string(port) + " seq " + std::to_string(seq) + ": non-finite position or zero quaternion (skipped)");
       return;
     }
-    p.q = Eigen::Quaterniond(m.orientation[3], m.orientation[0], m.orientation[1], m.orientation[2]);
+    p.q = Eigen::Quaterniond(q[3], q[0], q[1], q[2]);
     write_line(fploc::tum_line(p) + "\n");
   }
 

@@ -90,7 +90,8 @@ class SimSensorNode : public fploc::rt::Node {
     };
     lidar_addr_ = make_addr(opt.lidar_port() > 0 ? opt.lidar_port() : 7502);
     imu_addr_ = make_addr(opt.imu_port() > 0 ? opt.imu_port() : 7503);
-    wall0_ = wall_now();
+    if (opt.start_delay_s() < 0) throw std::runtime_error("sim.start_delay_s: must be >= 0");
+    wall0_ = wall_now() + opt.start_delay_s();
     ctx.every(0.002, [this] { tick(); });
   }
 
@@ -126,7 +127,7 @@ class SimSensorNode : public fploc::rt::Node {
   }
 
   void tick() {
-    if (done_) return;
+    if (done_ || wall_now() < wall0_) return;
     const double ts = so_.t0_s + (wall_now() - wall0_) * rate_;  // simulated sensor clock
     const double period = 1.0 / so_.rate_hz;
     const int W = so_.width;

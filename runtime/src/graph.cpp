@@ -179,6 +179,33 @@ nlohmann::json describe(const Descriptor* d, int depth) {
 }
 }  // namespace
 
+bool apply_node_overrides(fploc::Graph& graph, const std::vector<std::string>& sets,
+                          const std::function<std::string(const fploc::Node&)>& default_field, std::string& error) {
+  for (const auto& s : sets) {
+    const auto dot = s.find('.');
+    fploc::Node* target = nullptr;
+    for (int i = 0; dot != std::string::npos && i < graph.node_size(); ++i)
+      if (graph.node(i).name() == s.substr(0, dot)) target = graph.mutable_node(i);
+    if (!target) {
+      error = "--set " + s + ": expected NODE.field=value with a node of the graph";
+      return false;
+    }
+    std::string field = node_options_field(*target);
+    if (field.empty() && default_field) field = default_field(*target);
+    const FieldDescriptor* fd = field.empty() ? nullptr : fploc::Node::descriptor()->FindFieldByName(field);
+    if (!fd || !fd->message_type()) {
+      error = "--set " + s + ": node '" + target->name() + "' takes no options";
+      return false;
+    }
+    Message* opts = target->GetReflection()->MutableMessage(target, fd);
+    if (!apply_overrides(*opts, {s.substr(dot + 1)}, error)) {
+      error = "--set " + s + " (node '" + target->name() + "'): " + error;
+      return false;
+    }
+  }
+  return true;
+}
+
 std::string describe_message_json(const Descriptor* d) { return describe(d, 0).dump(); }
 
 }  // namespace fploc::rt

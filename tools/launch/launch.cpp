@@ -1,5 +1,5 @@
 // fploc launch: validates a graph (every error as file:line), then runs and supervises its nodes.
-//   fploc launch GRAPH [--check] [--duration S] [--lcm-url URL]
+//   fploc launch GRAPH [--check] [--duration S] [--lcm-url URL] [--set NODE.field=value ...]
 // Each node is its own process (own process group, PR_SET_PDEATHSIG=SIGKILL) started as
 //   EXE --graph GRAPH --node NAME [--set k=v ...] [args...]   with FPLOC_RESTARTS=<restarts so far>.
 // Supervision: restart policy (never/on-failure/always, max restarts in a window, exponential backoff),
@@ -80,7 +80,7 @@ struct Child {
   bool fploc_node = false;            // speaks the runtime protocol (--graph/--node, telemetry)
   std::string options_field;          // declared by the executable
   NodeSpec spec;                      // its --describe (fploc nodes)
-  std::vector<std::string> sets;      // overrides from control requests
+  std::vector<std::string> sets;      // overrides (launch --set, then control requests), field=value
   std::vector<std::string> args;
   fploc::RestartPolicy policy;
   double heartbeat_timeout = 3.0;
@@ -96,13 +96,16 @@ struct Child {
   int stop_stage = 0;                 // 0 SIGINT sent, 1 SIGTERM sent, 2 SIGKILL sent
   bool restart_after_stop = false;    // control request: start again once stopped
   bool hung = false;
+  int stop_rank = 0;                  // graph-wide stop order: producers before their consumers
 };
 
 double policy_or(double v, double d) { return v > 0 ? v : d; }
 
 class Launcher {
  public:
-  Launcher(LoadedGraph g, std::vector<ResolvedNode> resolved, std::string url, std::string bin_dir)
+  // `sets`: the command line's NODE.field=value overrides (already checked against the graph).
+  Launcher(LoadedGraph g, std::vector<ResolvedNode> resolved, std::string url, std::string bin_dir,
+           const std::vector<std::string>& sets)
       : g_(std::move(g)), bin_dir_(std::move(bin_dir)), bus_(url) {
     for (const auto& rn : resolved) {
       const auto& n = g_.graph.node(rn.index);
@@ -118,6 +121,8 @@ class Launcher {
       c.policy = n.restart();
       c.heartbeat_timeout = policy_or(n.heartbeat_timeout_s(), 3.0);
       c.tracker = RestartTracker(c.policy);
+      for (const auto& s : sets)
+        if (s.rfind(c.name + ".", 0) == 0) c.sets.push_back(s.substr(c.name.size() + 1));
       children_.push_back(std::move(c));
     }
     shutdown_timeout_ = policy_or(g_.graph.shutdown_timeout_s(), 2.0);
@@ -125,6 +130,7 @@ class Launcher {
     bus_.lcm().subscribe(kTelemetryChannel, &Launcher::on_telemetry, this);
     control_channel_ = g_.graph.control_channel().empty() ? kControlChannel : g_.graph.control_channel();
     bus_.lcm().subscribe(control_channel_, &Launcher::on_control, this);
+    rank_for_shutdown(resolved);
   }
 
   int run(double duration) {
@@ -147,7 +153,7 @@ class Launcher {
           if (!shutting_down) {
             log(std::string("received ") + strsignal(buf[k]) + ": stopping every node");
             shutting_down = true;
-            for (auto& c : children_) begin_stop(c, false);
+            begin_stop_all();
           } else {
             log("second signal: killing every node now");
             for (auto& c : children_)
@@ -158,8 +164,9 @@ class Launcher {
       if (!shutting_down && duration > 0 && now_s() - t_start >= duration) {
         log("duration of " + fmt(duration) + " s reached: stopping every node");
         shutting_down = true;
-        for (auto& c : children_) begin_stop(c, false);
+        begin_stop_all();
       }
+      if (shutting_down) advance_stop_all();
       reap();
       const double t = now_s();
       for (auto& c : children_) {
@@ -245,6 +252,71 @@ class Launcher {
     std::string s;
     for (const auto& x : v) s += (s.empty() ? "" : " ") + x;
     return s;
+  }
+
+  // Stop order for the whole graph: a node's rank is one more than the highest rank of the nodes that
+  // produce its inputs (telemetry and control excluded; cycles are cut after N rounds), so sources stop
+  // first and every node still receives what its producers publish while they shut down (the
+  // optimizer's last window reaches the pose logger).
+  void rank_for_shutdown(const std::vector<ResolvedNode>& resolved) {
+    std::map<std::string, std::vector<size_t>> producers;  // channel -> children
+    std::vector<std::vector<std::string>> inputs(children_.size());
+    auto channel_of = [](const fploc::Node& n, const PortSpec& s) {
+      for (const auto& p : s.output ? n.output() : n.input())
+        if (p.port() == s.name) return p.channel();
+      return s.default_channel;
+    };
+    size_t k = 0;
+    for (const auto& rn : resolved) {
+      const auto& n = g_.graph.node(rn.index);
+      if (n.disabled()) continue;
+      for (const auto& s : rn.desc.spec.ports) {
+        const std::string ch = channel_of(n, s);
+        if (ch.empty() || ch == kTelemetryChannel || ch == control_channel_) continue;
+        if (s.output) producers[ch].push_back(k);
+        else inputs[k].push_back(ch);
+      }
+      ++k;
+    }
+    for (size_t round = 0; round < children_.size(); ++round) {
+      bool changed = false;
+      for (size_t i = 0; i < children_.size(); ++i)
+        for (const auto& ch : inputs[i])
+          for (size_t p : producers[ch])
+            if (p != i && children_[p].stop_rank + 1 > children_[i].stop_rank) {
+              children_[i].stop_rank = children_[p].stop_rank + 1;
+              changed = true;
+            }
+      if (!changed) break;
+    }
+  }
+  // Graph-wide stop: SIGINT rank by rank; the next rank goes when the previous has exited or after
+  // 0.25 s. Escalation (SIGTERM, then SIGKILL) counts from the start of the stop, so a hung node costs
+  // at most shutdown_timeout_s + 1 s in all.
+  void begin_stop_all() {
+    stop_all_started_ = now_s();
+    stop_rank_ = -1;
+    stage_started_ = 0;
+    advance_stop_all();
+  }
+  void advance_stop_all() {
+    int max_rank = 0;
+    for (const auto& c : children_) max_rank = std::max(max_rank, c.stop_rank);
+    const double t = now_s();
+    while (stop_rank_ <= max_rank) {
+      const bool stage_done = std::all_of(children_.begin(), children_.end(), [&](const Child& c) {
+        return c.stop_rank > stop_rank_ || c.pid <= 0;
+      });
+      const bool late = t >= stop_all_started_ + shutdown_timeout_;
+      if (stop_rank_ >= 0 && !stage_done && !late && t - stage_started_ < 0.25) return;
+      ++stop_rank_;
+      stage_started_ = t;
+      for (auto& c : children_)
+        if (c.stop_rank == stop_rank_) {
+          begin_stop(c, false);
+          c.stop_deadline = std::max(stop_all_started_ + shutdown_timeout_, t + 0.1);
+        }
+    }
   }
 
   void begin_stop(Child& c, bool restart_after) {
@@ -499,18 +571,22 @@ class Launcher {
   double shutdown_timeout_ = 2.0;
   bool transport_ok_ = false, transport_warned_ = false;
   std::string graph_abs_, control_channel_;
+  double stop_all_started_ = 0, stage_started_ = 0;
+  int stop_rank_ = -1;
 };
 
 void usage() {
-  std::cerr << "usage: fploc launch GRAPH.pbtxt [--check] [--duration SECONDS] [--lcm-url URL]\n"
+  std::cerr << "usage: fploc launch GRAPH.pbtxt [--check] [--duration SECONDS] [--lcm-url URL] [--set NODE.field=value ...]\n"
                "  --check      validate the graph (fields, executables, ports, channel types) and exit\n"
-               "  --duration   stop every node cleanly after SECONDS\n";
+               "  --duration   stop every node cleanly after SECONDS\n"
+               "  --set        override one option of one node for this run (e.g. --set pose_logger.file=run1.tum)\n";
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string graph_path, url;
+  std::vector<std::string> sets;
   bool check = false;
   double duration = 0;
   for (int i = 1; i < argc; ++i) {
@@ -518,6 +594,7 @@ int main(int argc, char** argv) {
     if (a == "--check") check = true;
     else if (a == "--duration" && i + 1 < argc) duration = std::atof(argv[++i]);
     else if (a == "--lcm-url" && i + 1 < argc) url = argv[++i];
+    else if (a == "--set" && i + 1 < argc) sets.push_back(argv[++i]);
     else if (a == "-h" || a == "--help") { usage(); return 0; }
     else if (!a.empty() && a[0] != '-' && graph_path.empty()) graph_path = a;
     else { std::cerr << "fploc launch: unexpected argument '" << a << "'\n"; usage(); return 2; }
@@ -527,8 +604,15 @@ int main(int argc, char** argv) {
   LoadedGraph g;
   std::vector<GraphError> errors;
   load_graph(graph_path, g, errors);
+  const ValidateHooks hooks = default_hooks(self_bin_dir());
+  std::string set_error;
+  if (g.tree && !apply_node_overrides(g.graph, sets, [&](const fploc::Node& n) {
+        const std::string exe = hooks.resolve(n.executable());
+        return exe.empty() ? std::string() : hooks.describe(exe).spec.options_field;
+      }, set_error))
+    errors.push_back({graph_path, 0, set_error});
   std::vector<ResolvedNode> resolved;
-  if (g.tree) validate_graph(g, default_hooks(self_bin_dir()), errors, &resolved);
+  if (g.tree) validate_graph(g, hooks, errors, &resolved);
   if (url.empty()) url = g.graph.lcm_url();
   if (!check && url.rfind("memq://", 0) == 0)
     errors.push_back({graph_path, 0, "lcm_url memq:// only works inside one process (use fploc replay)"});
@@ -558,7 +642,7 @@ int main(int argc, char** argv) {
   sigaction(SIGCHLD, &sa, nullptr);
   signal(SIGPIPE, SIG_IGN);
   try {
-    Launcher l(std::move(g), std::move(resolved), url, self_bin_dir());
+    Launcher l(std::move(g), std::move(resolved), url, self_bin_dir(), sets);
     return l.run(duration);
   } catch (const std::exception& e) {
     std::cerr << "fploc launch: " << e.what() << "\n";

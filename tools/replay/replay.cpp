@@ -78,29 +78,13 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (!out.empty() && loggers > 1) std::cerr << "fploc replay: warning: " << loggers << " pose loggers all write " << out << "\n";
-  for (const auto& s : sets) {
-    const auto dot = s.find('.');
-    fploc::Node* target = nullptr;
-    for (int i = 0; dot != std::string::npos && i < g.graph.node_size(); ++i)
-      if (g.graph.node(i).name() == s.substr(0, dot)) target = g.graph.mutable_node(i);
-    if (!target) {
-      std::cerr << "fploc replay: --set " << s << ": expected NODE.field=value with a node of the graph\n";
-      return 2;
-    }
-    const auto* reg = find_registration(type_from_executable(target->executable()));
-    const std::string field = node_options_field(*target).empty() && reg ? reg->spec.options_field
-                                                                          : node_options_field(*target);
-    const auto* fd = fploc::Node::descriptor()->FindFieldByName(field);
-    if (!fd) {
-      std::cerr << "fploc replay: --set " << s << ": node '" << target->name() << "' takes no options\n";
-      return 2;
-    }
-    auto* opts = target->GetReflection()->MutableMessage(target, fd);
-    std::string err;
-    if (!apply_overrides(*opts, {s.substr(dot + 1)}, err)) {
-      std::cerr << "fploc replay: " << err << "\n";
-      return 2;
-    }
+  std::string set_error;
+  if (!apply_node_overrides(g.graph, sets, [](const fploc::Node& n) {
+        const auto* reg = find_registration(type_from_executable(n.executable()));
+        return reg ? reg->spec.options_field : std::string();
+      }, set_error)) {
+    std::cerr << "fploc replay: " << set_error << "\n";
+    return 2;
   }
 
   try {

@@ -4,6 +4,7 @@
 #include <google/protobuf/message.h>
 #include <google/protobuf/text_format.h>
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -44,6 +45,12 @@ std::unique_ptr<google::protobuf::Message> default_options(const std::string& fi
 // Applies overrides "path.to.field=value" (text-format values; strings may be unquoted) to `opts`.
 // Returns false and sets `error` naming the field when one does not exist or does not parse.
 bool apply_overrides(google::protobuf::Message& opts, const std::vector<std::string>& overrides, std::string& error);
+
+// Applies "NODE.path.to.field=value" overrides to the options of the graph's nodes (fploc launch/replay
+// --set). `default_field(node)` names the options field of a node whose graph entry has no options block
+// (from its executable's spec; "" = takes none). Returns false and sets `error` naming the override.
+bool apply_node_overrides(fploc::Graph& graph, const std::vector<std::string>& sets,
+                          const std::function<std::string(const fploc::Node&)>& default_field, std::string& error);
 
 // JSON schema-ish description of a message type (fields, types, nested messages), for --describe.
 std::string describe_message_json(const google::protobuf::Descriptor* d);
