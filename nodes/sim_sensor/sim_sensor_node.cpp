@@ -18,6 +18,7 @@
 #include <stdexcept>
 
 #include "fploc/floorplan/io.h"
+#include "fploc/nodes/convert.h"
 #include "fploc/os1/packet.h"
 #include "fploc/runtime/node.h"
 #include "fploc/sim/simulator.h"
@@ -107,23 +108,9 @@ class SimSensorNode : public fploc::rt::Node {
     fploc::os1::encode_frame(cur_.scan, uint16_t(frame_counter_ & 0xFFFF), fmt_, pkts_);
     ++frame_counter_;
     next_pkt_ = 0;
-    fploc::ground_truth_t g;
-    g.utime = cur_.scan.utime;
-    g.seq = gt_seq_++;
-    const double t = g.utime * 1e-6;
-    const fploc::StampedPose p = sim_->ground_truth(t);
-    const Eigen::Vector3d v = sim_->velocity(t), w = sim_->angular_velocity(t);
-    for (int i = 0; i < 3; ++i) {
-      g.position[i] = p.p[i];
-      g.linear_velocity[i] = v[i];
-      g.angular_velocity[i] = w[i];
-    }
-    g.orientation[0] = p.q.x();
-    g.orientation[1] = p.q.y();
-    g.orientation[2] = p.q.z();
-    g.orientation[3] = p.q.w();
-    g.scenario = scenario_;
-    gt_.publish(g);
+    const double t = cur_.scan.utime * 1e-6;
+    gt_.publish(fploc::ground_truth_msg(cur_.scan.utime, gt_seq_++, sim_->ground_truth(t), sim_->velocity(t),
+                                        sim_->angular_velocity(t), scenario_));
   }
 
   void tick() {

@@ -133,21 +133,9 @@ int main(int argc, char** argv) {
       sim.frame(k, f);
       // Ground truth at the scan's first column time (published when the sweep starts).
       flush_imu(ts);
-      fploc::ground_truth_t g;
-      g.utime = f.scan.utime;
-      g.seq = k;
       const fploc::StampedPose p = sim.ground_truth(f.scan.utime * 1e-6);
-      const Eigen::Vector3d v = sim.velocity(p.t), w = sim.angular_velocity(p.t);
-      for (int i = 0; i < 3; ++i) {
-        g.position[i] = p.p[i];
-        g.linear_velocity[i] = v[i];
-        g.angular_velocity[i] = w[i];
-      }
-      g.orientation[0] = p.q.x();
-      g.orientation[1] = p.q.y();
-      g.orientation[2] = p.q.z();
-      g.orientation[3] = p.q.w();
-      g.scenario = scenario;
+      const fploc::ground_truth_t g =
+          fploc::ground_truth_msg(f.scan.utime, k, p, sim.velocity(p.t), sim.angular_velocity(p.t), scenario);
       write_event(log, g.utime, "FPLOC_GROUND_TRUTH", g, buf);
       traj.push_back(p);
       // The scan is complete at the end of its sweep.
