@@ -4,11 +4,15 @@
 // never stops the node. Output times are sensor times from the packets (deterministic for a pcap).
 #include <fploc/scan_t.hpp>
 
+#include <chrono>
+#include <fstream>
+#include <iostream>
 #include <memory>
 #include <stdexcept>
 
 #include "fploc/nodes/convert.h"
 #include "fploc/os1/metadata.h"
+#include "fploc/os1/sensor_http.h"
 #include "fploc/os1/packet.h"
 #include "fploc/os1/source.h"
 #include "fploc/runtime/node.h"
@@ -32,6 +36,7 @@ class Os1DriverNode : public fploc::rt::Node {
     port_ = opt.lidar_port() > 0 ? opt.lidar_port() : 7502;
     pcap_mode_ = !opt.pcap().empty();
     metadata_path_ = opt.metadata().empty() ? std::string() : ctx.resolve_path(opt.metadata());
+    sensor_host_ = opt.sensor_hostname();
     // A missing or broken metadata file is bad input, not a reason to die: it is reported (stderr and
     // telemetry, once per distinct error), packets are dropped and counted, and the file is read again
     // every 0.5 s until it loads (e.g. the simulator writes it a moment after the driver starts).
@@ -69,19 +74,48 @@ class Os1DriverNode : public fploc::rt::Node {
   }
 
  private:
+  // Once: a problem with the metadata (each distinct one is reported once; retried by the caller).
+  void report_metadata(const std::string& what) {
+    if (what != metadata_error_) ctx_->error(what + " (lidar packets are dropped; retrying)");
+    metadata_error_ = what;
+  }
+
   bool load() {
-    if (metadata_path_.empty()) {
-      ctx_->error("option 'metadata' (sensor metadata JSON) is not set: lidar packets are dropped");
+    if (metadata_path_.empty() && sensor_host_.empty()) {
+      ctx_->error("neither 'metadata' (sensor metadata JSON) nor 'sensor_hostname' is set: lidar packets are dropped");
       return false;
     }
+    std::string source = metadata_path_;
     try {
-      info_ = load_metadata(metadata_path_);
+      std::string text, err;
+      // From the sensor (at most every 5 s while it does not answer; the file cache meanwhile).
+      if (!sensor_host_.empty() && std::chrono::steady_clock::now() >= next_http_) {
+        if (fetch_sensor_metadata(sensor_host_, 1.0, &text, &err)) {
+          source = "http://" + sensor_host_ + kMetadataPath;
+        } else {
+          next_http_ = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+          if (metadata_path_.empty()) throw MetadataError(err);
+          std::cerr << "[" << ctx_->name() << "] " << err << ": trying the cached " << metadata_path_ << "\n";
+        }
+      }
+      if (!text.empty()) {
+        info_ = parse_metadata(text, source);
+        if (!metadata_path_.empty()) {
+          std::ofstream cache(metadata_path_, std::ios::trunc);
+          cache << text;
+          if (!cache) ctx_->error("cannot write the metadata cache " + metadata_path_);
+        }
+      } else if (!metadata_path_.empty()) {
+        info_ = load_metadata(metadata_path_);
+      } else {
+        return false;  // waiting for the next HTTP attempt
+      }
     } catch (const MetadataError& e) {
-      if (e.what() != metadata_error_) ctx_->error(std::string(e.what()) + " (lidar packets are dropped; retrying)");
-      metadata_error_ = e.what();
+      report_metadata(e.what());
       return false;
     }
-    if (!metadata_error_.empty()) std::cerr << "[" << ctx_->name() << "] metadata " << metadata_path_ << " loaded\n";
+    if (!metadata_error_.empty() || source != metadata_path_)
+      std::cerr << "[" << ctx_->name() << "] metadata from " << source << " (" << info_.sensor_name() << ")\n";
     for (const auto& f : info_.defaulted)
       if (f == "pixel_shift_by_row" || f == "lidar_origin_to_beam_origin_mm")
         std::cerr << "[" << ctx_->name() << "] metadata: '" << f << "' absent, using the Ouster default\n";
@@ -152,6 +186,8 @@ class Os1DriverNode : public fploc::rt::Node {
   int port_ = 7502;
   std::string metadata_path_;
   std::string metadata_error_;  // last load error (reported once)
+  std::string sensor_host_;
+  std::chrono::steady_clock::time_point next_http_{};
   uint64_t dropped_without_metadata_ = 0;
 };
 

@@ -58,6 +58,9 @@ def sdk_digest_mode(log, digest_path, imu_expected):
 
 
 def main():
+    lidar_only = '--lidar-only' in sys.argv  # no IMU driver ran: check the scans only
+    if lidar_only:
+        sys.argv.remove('--lidar-only')
     if sys.argv[1] == '--sdk-digest':
         sdk_digest_mode(sys.argv[2], sys.argv[3], int(sys.argv[4]))
     log, ref_path = sys.argv[1], sys.argv[2]
@@ -78,7 +81,7 @@ def main():
             errors.append(f"scan {s['frame_id']}: missing {s['missing']} status {s['status']}")
         if s['md5'] != ref['range_md5'][0]:
             errors.append(f"scan {s['frame_id']}: range md5 {s['md5']} != decode {ref['range_md5'][0]}")
-    if len(imus) != 2 * ref['imu_packets']:
+    if not lidar_only and len(imus) != 2 * ref['imu_packets']:
         errors.append(f"OS1_IMU: {len(imus)} messages, expected {2 * ref['imu_packets']} (capture sent twice)")
     for m in imus:
         if not 9.0 < m['acc'][2] < 10.6:

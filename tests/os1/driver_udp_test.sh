@@ -98,4 +98,27 @@ kill -INT "$bad"
 wait "$bad" || { echo "FAIL: driver exit status after bad metadata"; cat "$T/bad.txt"; exit 1; }
 grep -q "beam_azimuth_angles" "$T/bad.txt" || { echo "FAIL: metadata error not reported"; cat "$T/bad.txt"; exit 1; }
 grep -q "dropped: no valid metadata" "$T/bad.txt" || { echo "FAIL: dropped packets not reported"; cat "$T/bad.txt"; exit 1; }
+# Metadata from the sensor's HTTP API (GET /api/v1/sensor/metadata; a local HTTP server stands in for
+# the sensor): the driver fetches it, caches it in `metadata`, and decodes the capture; with the "sensor"
+# gone, a restarted driver says so and falls back to the cached file.
+mkdir -p "$T/www/api/v1/sensor" && cp "$META" "$T/www/api/v1/sensor/metadata"
+python3 -m http.server 18080 --bind 127.0.0.1 --directory "$T/www" > "$T/http.txt" 2>&1 & web=$!
+pids+=($web)
+for _ in $(seq 50); do python3 -c "import urllib.request; urllib.request.urlopen('http://127.0.0.1:18080/api/v1/sensor/metadata')" 2>/dev/null && break; sleep 0.1; done
+for run in http cache; do
+  [ "$run" = cache ] && { kill "$web"; wait "$web" 2>/dev/null || true; }
+  lcm-logger --lcm-url="$URL" "$T/log_$run.lcm" > /dev/null 2>&1 & lg=$!
+  "$B/fploc-os1-driver" --lcm-url "$URL" --set sensor_hostname=127.0.0.1:18080 --set metadata="$T/cached.json" \
+    --set lidar_port=17502 > "$T/os1_$run.txt" 2>&1 & drv=$!
+  sleep 1.5
+  "$B/fploc-os1-send" --pcap "$PCAP" --lidar-port 17502 --imu-port 17503 --rate 1
+  sleep 1
+  kill -INT "$drv"; wait "$drv" || { echo "FAIL: driver ($run) exit status"; cat "$T/os1_$run.txt"; exit 1; }
+  kill -INT "$lg"; wait "$lg" 2>/dev/null || true
+  cat "$T/os1_$run.txt"
+  cmp -s "$META" "$T/cached.json" || { echo "FAIL: the fetched metadata was not cached"; exit 1; }
+  python3 "$(dirname "$0")/check_log.py" --lidar-only "$T/log_$run.lcm" "$T/decode.json"
+done
+grep -q "http://127.0.0.1:18080/api/v1/sensor/metadata" "$T/os1_http.txt" || { echo "FAIL: metadata not from HTTP"; exit 1; }
+grep -q "trying the cached" "$T/os1_cache.txt" || { echo "FAIL: unreachable sensor not reported"; exit 1; }
 echo "os1 driver tests passed"
