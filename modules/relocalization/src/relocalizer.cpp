@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <queue>
 #include <stdexcept>
 
 #include "fploc/annf/annf.h"
@@ -30,7 +29,6 @@ bool same_place(const Pose2& a, const Pose2& b, const RelocalizerConfig& c) {
 struct Scored {
   double score;
   Pose2 pose;
-  bool operator>(const Scored& o) const { return score > o.score; }
 };
 
 }  // namespace
@@ -107,14 +105,31 @@ RelocResult Relocalizer::locate(const FeatureFrame& f, const std::optional<Searc
   } else {
     cells = free_;
   }
-  // Correlative search with pruning: a hypothesis stops as soon as it cannot enter the kept list.
+  // Correlative search with pruning: a hypothesis stops as soon as it cannot enter the kept list. The
+  // list keeps *distinct* places only (a better neighbour replaces a worse one), so one strong peak
+  // cannot crowd out the second place of a symmetric plan.
   const float inv_t2 = float(1.0 / (cfg_.truncate_m * cfg_.truncate_m));
-  std::priority_queue<Scored, std::vector<Scored>, std::greater<Scored>> best;  // min-heap of kept
+  std::vector<Scored> kept;
+  double threshold = -1.0;  // lowest kept score once the list is full
+  auto insert = [&](const Scored& h) {
+    for (auto& k : kept)
+      if (same_place(k.pose, h.pose, cfg_)) {
+        if (h.score > k.score) k = h;
+        return;
+      }
+    if (int(kept.size()) < cfg_.keep) {
+      kept.push_back(h);
+    } else {
+      auto worst = std::min_element(kept.begin(), kept.end(), [](const Scored& a, const Scored& b) { return a.score < b.score; });
+      *worst = h;
+    }
+    if (int(kept.size()) >= cfg_.keep)
+      threshold = std::min_element(kept.begin(), kept.end(), [](const Scored& a, const Scored& b) { return a.score < b.score; })->score;
+  };
   for (const auto& c : cells) {
     const float cx = float(c.x()), cy = float(c.y());
     for (size_t k = 0; k < yaws.size(); ++k) {
       ++out.hypotheses;
-      const double threshold = int(best.size()) < cfg_.keep ? -1.0 : best.top().score;
       const Eigen::Vector2f* r = &rot[k * P];
       float s = 0;
       bool pruned = false;
@@ -127,14 +142,8 @@ RelocResult Relocalizer::locate(const FeatureFrame& f, const std::optional<Searc
         }
       }
       if (pruned || double(s) <= threshold) continue;
-      if (int(best.size()) >= cfg_.keep) best.pop();
-      best.push({double(s), Pose2{c.x(), c.y(), yaws[k]}});
+      insert({double(s), Pose2{c.x(), c.y(), yaws[k]}});
     }
-  }
-  std::vector<Scored> kept;
-  while (!best.empty()) {
-    kept.push_back(best.top());
-    best.pop();
   }
   std::sort(kept.begin(), kept.end(), [](const Scored& a, const Scored& b) { return a.score > b.score; });
   // Distinct hypotheses, refined.
@@ -146,6 +155,34 @@ RelocResult Relocalizer::locate(const FeatureFrame& f, const std::optional<Searc
   }
   std::vector<std::vector<uint8_t>> explained;  // per refined candidate: which test points it explains
   const int tstride = std::max(1, (n_all + 799) / 800);
+  // Coarse to fine: a correlative search at a fifth of the steps (and a tighter kernel) around each
+  // seed, then single-frame registration from there.
+  const double fine_t = std::max(cfg_.truncate_m / 3, 2 * cfg_.distance_cell_m);
+  const float fine_inv_t2 = float(1.0 / (fine_t * fine_t));
+  const double fstep = cfg_.grid_m / 5, fyaw = step / 5;
+  for (auto& s : seeds) {
+    Pose2 best_fine = s.pose;
+    double best_score = -1;
+    for (int a = -5; a <= 5; ++a) {
+      const double yaw = s.pose.yaw + a * fyaw;
+      const float c = float(std::cos(yaw)), sn = float(std::sin(yaw));
+      for (int iy = -3; iy <= 3; ++iy)
+        for (int ix = -3; ix <= 3; ++ix) {
+          const float tx = float(s.pose.x + ix * fstep), ty = float(s.pose.y + iy * fstep);
+          float sc = 0;
+          for (const auto& p : pts) {
+            float d = 0;
+            if (grid_->read(Eigen::Vector2d(c * p.x() - sn * p.y() + tx, sn * p.x() + c * p.y() + ty), &d) >= 0)
+              sc += std::max(0.f, 1.f - d * d * fine_inv_t2);
+          }
+          if (sc > best_score) {
+            best_score = sc;
+            best_fine = Pose2{tx, ty, wrap(yaw)};
+          }
+        }
+    }
+    s.pose = best_fine;
+  }
   for (const auto& s : seeds) {
     const MatchResult m = register_frame(lookup_, f, s.pose, cfg_.registration);
     RelocHypothesis h{m.solved, s.score, m.fit, 0.0};

@@ -35,7 +35,7 @@ struct RelocalizerConfig {
   double truncate_m = 0.5;        // a point farther than this from the plan scores 0
   double clearance_m = 0.3;       // hypotheses are at least this far from every element
   double distance_cell_m = 0.1;   // resolution of the distance grid behind the scores
-  int keep = 64;                  // best raw hypotheses kept during the search
+  int keep = 32;                  // best distinct places kept during the search
   int refine = 8;                 // best distinct hypotheses refined with register_frame
   double distinct_m = 1.0;        // hypotheses closer than this (and distinct_deg) are the same place
   double distinct_deg = 20.0;
