@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <iostream>
 #include <memory>
 #include <optional>
 
@@ -61,7 +62,12 @@ class MatcherNode : public fploc::rt::Node {
                                         o.lookup().empty() ? "annf-exact" : o.lookup());
     matcher_ = std::make_unique<fploc::Matcher>(*map_.lookup, config_of(o));
     use_imu_ = !o.ignore_imu();
-    if (!o.wait_for_initial_pose()) matcher_->set_pose({o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()});
+    // The graph's initial pose is where the run starts; a restarted matcher (crash, module swap) waits for
+    // a pose instead (FPLOC_INITIAL_POSE: the relocalizer searches around the last good pose).
+    if (!o.wait_for_initial_pose() && ctx.restarts() == 0)
+      matcher_->set_pose({o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()});
+    else if (ctx.restarts() > 0)
+      std::cerr << "[" << ctx.name() << "] restart " << ctx.restarts() << ": waiting for a pose on initial_pose\n";
     out_ = ctx.advertise<fploc::frame_pose_t>("frame_pose");
     ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) { on_features(m); });
     ctx.subscribe<fploc::imu_t>("imu", [this](const fploc::imu_t& m) { on_imu(m); });

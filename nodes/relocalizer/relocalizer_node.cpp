@@ -3,7 +3,8 @@
 // the plan — when LOST around the last good pose (or the pose the matcher holds) first, the whole plan
 // once the loss lasts longer than `global_after_s` or when there never was a pose — and publishes an
 // unambiguous answer on
-// FPLOC_INITIAL_POSE, from which the matcher re-initialises. A tracking matcher is never touched.
+// FPLOC_INITIAL_POSE, from which the matcher re-initialises (a restarted matcher waits for exactly that:
+// NOT_INITIALISED right after a good pose means a local search). A tracking matcher is never touched.
 // Time is the sensor's (message utimes), so composed replays stay deterministic.
 #include <fploc/features_t.hpp>
 #include <fploc/frame_pose_t.hpp>
@@ -65,6 +66,7 @@ class RelocalizerNode : public fploc::rt::Node {
     const auto st = FitStatus(m.status);
     if (st == FitStatus::kOk) {
       last_ok_ = fploc::Pose2{m.x, m.y, m.yaw};
+      last_ok_utime_ = m.utime;
       have_ok_ = true;
       lost_since_ = 0;
       return;
@@ -86,8 +88,10 @@ class RelocalizerNode : public fploc::rt::Node {
     }
     // LOST: first around the last good pose (or, if there never was one, around the pose the matcher
     // holds — the given initial pose); the whole plan once the loss lasts longer than global_after_s.
+    // NOT_INITIALISED right after a good pose (the matcher was restarted): around that pose too.
     std::optional<fploc::SearchRegion> region;
-    const bool local = st == FitStatus::kLost && m.utime - lost_since_ < global_after_us_;
+    const bool local = m.utime - lost_since_ < global_after_us_ &&
+                       (st == FitStatus::kLost || (have_ok_ && m.utime - last_ok_utime_ < global_after_us_));
     if (local) region = fploc::SearchRegion{have_ok_ ? last_ok_ : fploc::Pose2{m.x, m.y, m.yaw}, radius_, M_PI};
     const fploc::RelocResult r = reloc_->locate(frame, region);
     const std::string where = local ? "near the last pose" : "over the whole plan";
@@ -112,7 +116,7 @@ class RelocalizerNode : public fploc::rt::Node {
   std::deque<fploc::features_t> features_;
   fploc::Pose2 last_ok_;
   bool have_ok_ = false;
-  int64_t lost_since_ = 0, last_search_ = 0, seq_ = 0;
+  int64_t lost_since_ = 0, last_search_ = 0, last_ok_utime_ = 0, seq_ = 0;
   double radius_ = 3.0;
   int64_t global_after_us_ = 2000000, interval_us_ = 500000;
   std::string last_text_;

@@ -360,6 +360,7 @@ int node_main(int argc, char** argv) {
   try {
     Bus bus(url);
     Context ctx(bus, reg.spec, instance, std::move(options), port_map, base_dir, false);
+    ctx.set_restarts(restarts);
     auto node = reg.make();
     try {
       node->setup(ctx);

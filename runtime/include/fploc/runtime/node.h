@@ -105,6 +105,10 @@ class Context {
   std::string resolve_path(const std::string& p) const;
   // True inside `fploc replay` (one process, lock-step): no wall-clock timers or sockets.
   bool composed() const { return composed_; }
+  // How often the launcher has started this node before (FPLOC_RESTARTS; 0 on the first start and in
+  // composed mode). A restarted node may not want the graph's start-of-run state (e.g. an initial pose).
+  int restarts() const { return restarts_; }
+  void set_restarts(int n) { restarts_ = n; }
   const std::string& channel(const std::string& port) const;
 
   template <class Msg>
@@ -135,6 +139,7 @@ class Context {
   std::vector<std::pair<std::string, std::string>> port_map_;
   std::string base_dir_;
   bool composed_;
+  int restarts_ = 0;
   NodeStats stats_;
 };
 

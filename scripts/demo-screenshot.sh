@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# scripts/demo-screenshot.sh [OUT.png] [SECONDS]: runs the README's demo (graphs/demo.pbtxt) in a private
+# network namespace and saves a screenshot of its dashboard after SECONDS (default 35), e.g. for the
+# README (docs/img/demo.png). Needs the browser-test dependencies (scripts/setup-web.sh).
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+OUT="$(realpath -m "${1:-$ROOT/docs/img/demo.png}")"
+WAIT="${2:-35}"
+if [ "${FPLOC_IN_NETNS:-}" != "1" ]; then exec "$ROOT/scripts/netns-run" "$0" "$OUT" "$WAIT"; fi
+"$ROOT/bin/fploc" launch "$ROOT/graphs/demo.pbtxt" --duration "$((WAIT + 15))" 2> /tmp/fploc-demo-screenshot.log &
+L=$!
+sleep 3
+(cd "$ROOT/tests/dashboard" && node screenshot.mjs http://127.0.0.1:8080/ "$OUT" "$(( (WAIT - 3) * 1000 ))")
+kill -INT "$L" 2>/dev/null || true
+wait "$L" || true
