@@ -38,19 +38,20 @@ if grep -E "restarting|hung|dead" "$T/launch.log"; then echo "FAIL: a node faile
 cat "$T/eval.json"; echo
 # The issue's room target (ATE <= 3 cm after windowed optimisation); with the swaps 5 cm: the RANSAC
 # segmenter is the less accurate comparison baseline and the matcher hand-over costs a scan or two.
-MAX_ATE=0.03; [ "$SWAP" = "--swap" ] && MAX_ATE=0.05
-python3 - "$T/eval.json" "$T/gt.tum" "$DUR" "$MAX_ATE" <<'PY'
+# A swapped matcher misses the scans of its restart (start-up, map load, re-seeding): at most 1 s of them.
+MAX_ATE=0.03 MAX_MISSING=2; [ "$SWAP" = "--swap" ] && MAX_ATE=0.05 MAX_MISSING=10
+python3 - "$T/eval.json" "$T/gt.tum" "$DUR" "$MAX_ATE" "$MAX_MISSING" <<'PY'
 import json, sys
 e = json.load(open(sys.argv[1]))
 gt = sum(1 for l in open(sys.argv[2]) if l.strip() and not l.startswith('#'))
-dur, max_ate = float(sys.argv[3]), float(sys.argv[4])
+dur, max_ate, max_missing = float(sys.argv[3]), float(sys.argv[4]), int(sys.argv[5])
 print(f"ground truth {gt} scans, {e['poses']} estimated poses associated, ATE rmse {e['ate_rmse_m']:.4f} m, RPE mean {e['rpe_mean_m']:.4f} m")
 ok = True
 # Every scan the simulator sent becomes a pose: the launcher stops sources first, so the optimizer's
 # last window still reaches the pose logger (at most the sweep in flight at the stop is lost).
 if gt < 0.8 * 10 * (dur - 3):
     print(f"FAIL: only {gt} ground-truth scans in {dur} s (the simulator should send 10 Hz)"); ok = False
-if e['poses'] < gt - 2:
+if e['poses'] < gt - max_missing:
     print(f"FAIL: {e['poses']} poses for {gt} scans"); ok = False
 if e['ate_rmse_m'] > max_ate:
     print(f"FAIL: ATE above {max_ate} m"); ok = False
