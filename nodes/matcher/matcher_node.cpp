@@ -7,10 +7,10 @@
 
 #include <chrono>
 #include <cmath>
-#include <deque>
 #include <memory>
 #include <optional>
 
+#include "fploc/matcher/imu_yaw.h"
 #include "fploc/matcher/map.h"
 #include "fploc/matcher/matcher.h"
 #include "fploc/nodes/localization_convert.h"
@@ -77,24 +77,7 @@ class MatcherNode : public fploc::rt::Node {
 
  private:
   void on_imu(const fploc::imu_t& m) {
-    if (!use_imu_ || !std::isfinite(m.gyro[2])) return;
-    if (!imu_.empty() && m.utime <= imu_.back().first) return;  // out of order / duplicate
-    imu_.emplace_back(m.utime, m.gyro[2]);
-    while (imu_.size() > 4000) imu_.pop_front();
-  }
-
-  // Integrated gyro z over (t0, t1] (trapezoid over the samples inside, held at the ends); nullopt when
-  // the samples do not cover the interval.
-  std::optional<double> yaw_delta(int64_t t0, int64_t t1) {
-    if (imu_.size() < 2 || t1 <= t0 || imu_.front().first > t0 || imu_.back().first < t1 - 20000) return std::nullopt;
-    double sum = 0;
-    for (size_t i = 1; i < imu_.size(); ++i) {
-      const int64_t a = std::max(imu_[i - 1].first, t0), b = std::min(imu_[i].first, t1);
-      if (b <= a) continue;
-      sum += 0.5 * (imu_[i - 1].second + imu_[i].second) * (b - a) * 1e-6;
-    }
-    while (imu_.size() > 2 && imu_[1].first < t0) imu_.pop_front();
-    return sum;
+    if (use_imu_) imu_.add(m.utime, m.gyro[2]);  // out of order / non-finite samples are ignored
   }
 
   void on_features(const fploc::features_t& m) {
@@ -109,7 +92,15 @@ class MatcherNode : public fploc::rt::Node {
     }
     if (dropped) ctx_->error("features seq " + std::to_string(m.seq) + ": " + std::to_string(dropped) + " non-finite points dropped");
     std::optional<double> dyaw;
-    if (use_imu_ && have_prev_) dyaw = yaw_delta(prev_utime_, f.utime);
+    if (use_imu_) {
+      // Prediction: the yaw change since the previous frame; motion compensation: the mean rate over
+      // this frame's sweep (its samples arrive before the scan is complete).
+      if (have_prev_) dyaw = imu_.integral(prev_utime_, f.utime);
+      const double sweep = fploc::sweep_duration(f);
+      if (sweep > 0)
+        if (auto w = imu_.mean_rate(f.utime, f.utime + std::llround(sweep * 1e6))) f.sweep_yaw_rate = *w;
+      imu_.drop_before(std::min(f.utime, have_prev_ ? prev_utime_ : f.utime));
+    }
     const fploc::MatchResult r = matcher_->process(f, dyaw);
     if (r.status != FitStatus::kNotInitialised) {
       prev_utime_ = f.utime;
@@ -128,6 +119,9 @@ class MatcherNode : public fploc::rt::Node {
     o.roll = f.roll;
     o.pitch = f.pitch;
     o.z = f.z;
+    o.twist[0] = r.twist.vx;
+    o.twist[1] = r.twist.vy;
+    o.twist[2] = r.twist.w;
     o.num_points = r.fit.num_points;
     o.num_inliers = r.fit.num_inliers;
     o.inlier_ratio = r.fit.inlier_ratio;
@@ -145,7 +139,7 @@ class MatcherNode : public fploc::rt::Node {
   fploc::LocalizationMap map_;
   std::unique_ptr<fploc::Matcher> matcher_;
   fploc::rt::Publisher<fploc::frame_pose_t> out_;
-  std::deque<std::pair<int64_t, double>> imu_;
+  fploc::ImuYaw imu_;
   bool use_imu_ = true;
   bool have_prev_ = false;
   int64_t prev_utime_ = 0;

@@ -113,6 +113,8 @@ class OptimizerNode : public fploc::rt::Node {
     fploc::FrameInput in;
     in.features = std::move(f);
     in.sfr = {fp.x, fp.y, fp.yaw};
+    if (std::isfinite(fp.twist[0]) && std::isfinite(fp.twist[1]) && std::isfinite(fp.twist[2]))
+      in.twist = {fp.twist[0], fp.twist[1], fp.twist[2]};
     in.status = fp.status <= 2 ? FitStatus(fp.status) : FitStatus::kLost;
     for (int i = 0; i < 9; ++i) in.covariance(i / 3, i % 3) = fp.covariance[i];
     if (!std::isfinite(fp.x) || !std::isfinite(fp.y) || !std::isfinite(fp.yaw)) {

@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   app.add_option("--matcher-points", o.matcher_points);
   app.add_option("--optimizer-points", o.optimizer_points);
   app.add_option("--drop", o.drop_fraction, "fraction of scans dropped");
+  app.add_option("--noise", o.range_noise_m, "range noise sigma [m] (default: the simulator's)");
   app.add_option("--gt-offset", o.gt_offset_s, "ground truth time = scan start + this [s]");
   app.add_option("--init-error", [&](const std::vector<std::string>& v) {
     o.init_dx = std::stod(v.at(0));

@@ -6,11 +6,14 @@
 
 #include "fploc/eval/eval.h"
 #include "fploc/features/features.h"
+#include "fploc/matcher/imu_yaw.h"
 #include "fploc/matcher/map.h"
 #include "fploc/matcher/matcher.h"
 #include "fploc/odometry/odometry.h"
 #include "fploc/optimizer/window.h"
 #include "fploc/segmentation/segmenter.h"
+#include "fploc/nodes/localization_convert.h"
+#include "fploc/nodes/perception_convert.h"
 #include "fploc/sim/simulator.h"
 
 namespace fploc::e2e {
@@ -45,13 +48,14 @@ Result run(const FloorPlan& plan_in, const Options& o) {
   so.scenario = o.scenario;
   so.seed = o.seed;
   so.clutter = o.clutter;
+  if (o.range_noise_m >= 0) so.range_noise_m = o.range_noise_m;
   so.shared_dir = o.shared_dir;
   sim::Simulator sim(plan_in, so);
   const FloorPlan& plan = sim.world().plan();
   LocalizationMap map = make_localization_map(plan, o.lookup);
-  seg::SegmenterConfig scfg;
-  seg::RingSegmenter segmenter(scfg);
-  feat::FeatureExtractor fx;
+  // The graph's nodes' configurations (their options' defaults).
+  seg::RingSegmenter segmenter(config_of(SegmenterOptions{}));
+  feat::FeatureExtractor fx(config_of(FeatureOptions{}));
   const int n = o.max_frames > 0 ? std::min(o.max_frames, sim.num_frames()) : sim.num_frames();
 
   Result r;
@@ -73,7 +77,8 @@ Result run(const FloorPlan& plan_in, const Options& o) {
   std::vector<PoseOut> finals;
   const auto& imu = sim.imu();
   size_t imu_i = 0;
-  double prev_t = -1;
+  ImuYaw imu_yaw;
+  int64_t prev_utime = -1;
   sim::SimScan f;
   double feat_total = 0;
   uint64_t drop_state = o.seed * 2654435761u + 1;
@@ -89,33 +94,25 @@ Result run(const FloorPlan& plan_in, const Options& o) {
     t0 = clk::now();
     const auto& ft = fx.process(s);
     r.us_features += us_since(t0);
-    FeatureFrame frame;
-    frame.utime = ft.utime != 0 ? ft.utime : f.scan.utime;
-    frame.scan_seq = k;
-    frame.roll = ft.roll;
-    frame.pitch = ft.pitch;
-    frame.z = ft.z;
-    for (size_t i = 0; i < ft.size(); ++i) {
-      Feature2 p;
-      p.p = {ft.x[i], ft.y[i]};
-      p.kind = ft.kind[i] == 0 ? FeatureKind::kCorner : FeatureKind::kSurface;
-      p.group = ft.group[i];
-      p.t = ft.t.size() == ft.size() ? ft.t[i] : 0.f;
-      frame.points.push_back(p);
-    }
+    // The graph's conversion path: what fploc-features publishes, what fploc-matcher reads.
+    features_t msg;
+    to_msg(ft, k, k, msg);
+    FeatureFrame frame = from_msg(msg);
+    if (frame.utime == 0) frame.utime = f.scan.utime;
     feat_total += double(frame.points.size());
-    // IMU yaw change since the previous processed scan (motion time = absolute - t0).
-    const double t_rel = frame.utime * 1e-6 - so.t0_s;
+    // IMU samples up to the end of the sweep (when the scan is published), as in the simulator's log.
+    const double t_pub = frame.utime * 1e-6 + 1.0 / sim.options().rate_hz - so.t0_s;
+    for (; imu_i < imu.size() && imu[imu_i].t <= t_pub; ++imu_i)
+      imu_yaw.add(std::llround((so.t0_s + imu[imu_i].t) * 1e6), imu[imu_i].gyro.z());
     std::optional<double> dyaw;
-    if (o.imu && prev_t >= 0) {
-      double sum = 0;
-      while (imu_i < imu.size() && imu[imu_i].t <= t_rel) {
-        if (imu[imu_i].t > prev_t) sum += imu[imu_i].gyro.z() / sim.options().imu_rate_hz;
-        ++imu_i;
-      }
-      dyaw = sum;
+    if (o.imu) {
+      if (prev_utime >= 0) dyaw = imu_yaw.integral(prev_utime, frame.utime);
+      const double sweep = sweep_duration(frame);
+      if (sweep > 0)
+        if (auto w = imu_yaw.mean_rate(frame.utime, frame.utime + std::llround(sweep * 1e6))) frame.sweep_yaw_rate = *w;
+      imu_yaw.drop_before(frame.utime - 1000000);
     }
-    prev_t = t_rel;
+    prev_utime = frame.utime;
     t0 = clk::now();
     const MatchResult m = matcher.process(frame, dyaw);
     r.us_matcher += us_since(t0);
@@ -125,6 +122,7 @@ Result run(const FloorPlan& plan_in, const Options& o) {
     FrameInput in;
     in.features = frame;
     in.sfr = m.pose;
+    in.twist = m.twist;
     in.status = m.status;
     in.covariance = m.covariance;
     opt.add(std::move(in), &finals);

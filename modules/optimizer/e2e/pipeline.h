@@ -17,10 +17,11 @@ struct Options {
   std::string lookup = "annf-exact";
   bool imu = true;
   std::string shared_dir;        // beams from ../shared when present
-  double gt_offset_s = 0.05;     // ground truth at scan start + this (mid-scan at 10 Hz)
+  double gt_offset_s = 0;        // ground truth at the frame's time stamp (scan start) + this
   int window = 10;
   double alpha = 1.1, beta = 0.9;
   bool clutter = true;
+  double range_noise_m = -1;      // < 0: the simulator's default
   double drop_fraction = 0;      // drop this fraction of scans (deterministic)
   double keyframe_distance_m = 0.1;
   int matcher_points = 800, optimizer_points = 400;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "fploc/matcher/plan_terms.h"
 
@@ -35,64 +36,85 @@ Pose2 plus(const Pose2& a, const Eigen::Vector3d& c) { return {a.x + c[0], a.y +
 
 WindowOptimizer::WindowOptimizer(const NearestLookup& lookup, OptimizerConfig cfg) : lookup_(lookup), cfg_(std::move(cfg)) {
   cfg_.window = std::max(1, cfg_.window);
+  if (cfg_.linear_solver != "sparse" && cfg_.linear_solver != "dense")
+    throw std::invalid_argument("optimizer linear_solver '" + cfg_.linear_solver + "': expected sparse or dense");
+  if (cfg_.linear_solver == "sparse" && !ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) &&
+      !ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE))
+    cfg_.linear_solver = "dense";
 }
 WindowOptimizer::~WindowOptimizer() = default;
 
 Eigen::Vector3d WindowOptimizer::newest_correction() const {
   if (!window_.empty()) {
     const Key& k = window_.back();
-    return diff(Pose2{k.x[0], k.x[1], k.x[2]}, k.in.sfr);
+    return diff(Pose2{k.x[0], k.x[1], k.x[2]}, k.f.sfr_tau);
   }
   if (!finals_.empty()) return finals_.back().correction;
   return Eigen::Vector3d::Zero();
 }
 
-PoseOut WindowOptimizer::make_out(const FrameInput& in, const Pose2& p, bool key) const {
+PoseOut WindowOptimizer::make_out(const Frame& f, const Pose2& pose_tau_in, bool key, Stamped* prev) const {
+  const Pose2 pose_tau{pose_tau_in.x, pose_tau_in.y, wrap_angle(pose_tau_in.yaw)};
   PoseOut o;
-  o.utime = in.features.utime;
-  o.scan_seq = in.features.scan_seq;
-  o.pose = p;
-  o.roll = in.features.roll;
-  o.pitch = in.features.pitch;
-  o.z = in.features.z;
+  o.utime = f.in.features.utime;
+  o.scan_seq = f.in.features.scan_seq;
+  const double span = (f.tau - prev->tau) * 1e-6;
+  if (prev->valid && prev->tau <= o.utime && o.utime <= f.tau && span > 0 && span <= 0.5) {
+    // Geodesic interpolation between the two poses at utime.
+    const Twist2 v = log_twist(prev->pose, pose_tau, span);
+    o.pose = compose(prev->pose, exp_twist(v, (o.utime - prev->tau) * 1e-6));
+  } else {
+    o.pose = compose(pose_tau, exp_twist(f.in.twist, -f.t_ref));
+  }
+  *prev = {true, f.tau, pose_tau};
+  o.roll = f.in.features.roll;
+  o.pitch = f.in.features.pitch;
+  o.z = f.in.features.z;
   o.keyframe = key;
-  o.status = in.status;
-  o.covariance = in.covariance;
+  o.status = f.in.status;
+  o.covariance = f.in.covariance;
   return o;
 }
 
 PoseOut WindowOptimizer::add(FrameInput in, std::vector<PoseOut>* finals) {
-  const int64_t t = in.features.utime;
-  bool key = in.status == FitStatus::kOk;
+  Frame fr;
+  fr.in = std::move(in);
+  const int64_t t = fr.in.features.utime;
+  fr.t_ref = mean_time(fr.in.features);
+  fr.tau = t + std::llround(fr.t_ref * 1e6);
+  fr.sfr_tau = compose(fr.in.sfr, exp_twist(fr.in.twist, fr.t_ref));
+  bool key = fr.in.status == FitStatus::kOk;
   if (key && have_last_key_) {
-    const double d = std::hypot(in.sfr.x - last_key_sfr_.x, in.sfr.y - last_key_sfr_.y);
-    const double a = std::abs(wrap_angle(in.sfr.yaw - last_key_sfr_.yaw));
+    const double d = std::hypot(fr.in.sfr.x - last_key_sfr_.x, fr.in.sfr.y - last_key_sfr_.y);
+    const double a = std::abs(wrap_angle(fr.in.sfr.yaw - last_key_sfr_.yaw));
     key = d >= cfg_.keyframe_distance_m || a >= cfg_.keyframe_angle_rad;
     if (key && (t - last_key_utime_) * 1e-6 > cfg_.max_keyframe_gap_s) {
       flush(finals);  // a long gap: the velocities across it mean nothing
       finals_.clear();
     }
   }
+  PoseOut o;
   if (!key) {
-    PoseOut o = make_out(in, plus(in.sfr, newest_correction()), false);
-    pending_.push_back(std::move(in));
-    return o;
+    o = make_out(fr, plus(fr.sfr_tau, newest_correction()), false, &last_latest_);
+    pending_.push_back(std::move(fr));
+  } else {
+    Key k;
+    k.f = std::move(fr);
+    deskew(k.f.in.features, k.f.in.twist, k.f.t_ref, &k.deskewed);
+    const Pose2 init = plus(k.f.sfr_tau, newest_correction());
+    k.x[0] = init.x;
+    k.x[1] = init.y;
+    k.x[2] = init.yaw;
+    last_key_sfr_ = k.f.in.sfr;
+    last_key_utime_ = t;
+    have_last_key_ = true;
+    window_.push_back(std::move(k));
+    while (int(window_.size()) > cfg_.window) finalize_front(finals);
+    solve();
+    const Key& nk = window_.back();
+    o = make_out(nk.f, Pose2{nk.x[0], nk.x[1], nk.x[2]}, true, &last_latest_);
+    o.optimised = nk.optimised;
   }
-  Key k;
-  k.in = std::move(in);
-  const Pose2 init = plus(k.in.sfr, newest_correction());
-  k.x[0] = init.x;
-  k.x[1] = init.y;
-  k.x[2] = init.yaw;
-  last_key_sfr_ = k.in.sfr;
-  last_key_utime_ = t;
-  have_last_key_ = true;
-  window_.push_back(std::move(k));
-  while (int(window_.size()) > cfg_.window) finalize_front(finals);
-  solve();
-  const Key& nk = window_.back();
-  PoseOut o = make_out(nk.in, Pose2{nk.x[0], nk.x[1], wrap_angle(nk.x[2])}, true);
-  o.optimised = nk.optimised;
   return o;
 }
 
@@ -100,7 +122,10 @@ void WindowOptimizer::solve() {
   ceres::Problem::Options po;
   po.disable_all_safety_checks = true;
   ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  // Each keyframe's floor-plan block touches only its own 3 parameters: the normal equations of the
+  // window are block-sparse (band of 3x3 blocks from the velocity terms). The dense solver forms
+  // J^T J from a dense (2 N W) x 3W Jacobian, W times the work.
+  so.linear_solver_type = cfg_.linear_solver == "dense" ? ceres::DENSE_NORMAL_CHOLESKY : ceres::SPARSE_NORMAL_CHOLESKY;
   so.num_threads = 1;
   so.max_num_iterations = std::max(1, cfg_.max_iterations);
   so.logging_type = ceres::SILENT;
@@ -114,25 +139,25 @@ void WindowOptimizer::solve() {
   std::vector<std::pair<double*, int64_t>> chain;  // pose block, utime
   if (cfg_.anchor_final) {
     for (size_t i = 0; i < finals_.size(); ++i) {
-      anchors[i][0] = finals_[i].pose.x;
-      anchors[i][1] = finals_[i].pose.y;
-      anchors[i][2] = finals_[i].pose.yaw;
-      chain.push_back({anchors[i], finals_[i].utime});
+      anchors[i][0] = finals_[i].pose_tau.x;
+      anchors[i][1] = finals_[i].pose_tau.y;
+      anchors[i][2] = finals_[i].pose_tau.yaw;
+      chain.push_back({anchors[i], finals_[i].tau});
     }
   }
-  for (auto& k : window_) chain.push_back({k.x, k.in.features.utime});
+  for (auto& k : window_) chain.push_back({k.x, k.f.tau});
   for (int outer = 0; outer < std::max(1, cfg_.outer); ++outer) {
     ceres::Problem problem(po);
     for (size_t i = 0; i < window_.size(); ++i) {
       Key& k = window_[i];
       AssignOptions aok = ao;
-      const size_t np = k.in.features.points.size();
+      const size_t np = k.deskewed.points.size();
       aok.stride = std::max(1, cfg_.stride);
       if (cfg_.max_points > 0 && np > size_t(cfg_.max_points) * size_t(aok.stride))
         aok.stride = int((np + size_t(cfg_.max_points) - 1) / size_t(cfg_.max_points));
-      assign(lookup_, k.in.features, Pose2{k.x[0], k.x[1], k.x[2]}, aok, &as[i]);
+      assign(lookup_, k.deskewed, Pose2{k.x[0], k.x[1], k.x[2]}, aok, &as[i]);
       problem.AddParameterBlock(k.x, 3);
-      add_frame_term(&problem, k.x, lookup_, k.in.features, as[i], cfg_.loss, cfg_.loss_scale_m);
+      add_frame_term(&problem, k.x, lookup_, k.deskewed, as[i], cfg_.loss, cfg_.loss_scale_m);
     }
     for (size_t i = 0; i + 2 < chain.size(); ++i) {
       const double dt0 = (chain[i + 1].second - chain[i].second) * 1e-6;
@@ -152,19 +177,19 @@ void WindowOptimizer::solve() {
   ++solves_;
 }
 
-void WindowOptimizer::emit_pending_until(int64_t utime, const Eigen::Vector3d& corr_next, std::vector<PoseOut>* finals) {
-  while (!pending_.empty() && pending_.front().features.utime < utime) {
-    const FrameInput& in = pending_.front();
+void WindowOptimizer::emit_pending_until(int64_t tau, const Eigen::Vector3d& corr_next, std::vector<PoseOut>* finals) {
+  while (!pending_.empty() && pending_.front().tau < tau) {
+    const Frame& f = pending_.front();
     Eigen::Vector3d c = corr_next;
     if (!finals_.empty()) {
       const Final& prev = finals_.back();
-      const double span = double(utime - prev.utime);
-      const double s = span > 0 ? std::clamp(double(in.features.utime - prev.utime) / span, 0.0, 1.0) : 1.0;
+      const double span = double(tau - prev.tau);
+      const double s = span > 0 ? std::clamp(double(f.tau - prev.tau) / span, 0.0, 1.0) : 1.0;
       Eigen::Vector3d d = corr_next - prev.correction;
       d[2] = wrap_angle(d[2]);
       c = prev.correction + s * d;
     }
-    PoseOut o = make_out(in, plus(in.sfr, c), false);
+    PoseOut o = make_out(f, plus(f.sfr_tau, c), false, &last_final_);
     o.final_estimate = true;
     if (finals) finals->push_back(o);
     pending_.pop_front();
@@ -174,14 +199,14 @@ void WindowOptimizer::emit_pending_until(int64_t utime, const Eigen::Vector3d& c
 void WindowOptimizer::finalize_front(std::vector<PoseOut>* finals) {
   Key k = std::move(window_.front());
   window_.pop_front();
-  const Pose2 p{k.x[0], k.x[1], wrap_angle(k.x[2])};
-  const Eigen::Vector3d corr = diff(p, k.in.sfr);
-  emit_pending_until(k.in.features.utime, corr, finals);
-  PoseOut o = make_out(k.in, p, true);
+  const Pose2 p_tau{k.x[0], k.x[1], wrap_angle(k.x[2])};
+  const Eigen::Vector3d corr = diff(p_tau, k.f.sfr_tau);
+  emit_pending_until(k.f.tau, corr, finals);
+  PoseOut o = make_out(k.f, p_tau, true, &last_final_);
   o.final_estimate = true;
   o.optimised = k.optimised;
   if (finals) finals->push_back(o);
-  finals_.push_back({k.in.features.utime, p, corr});
+  finals_.push_back({k.f.tau, p_tau, corr});
   while (finals_.size() > 2) finals_.pop_front();
 }
 

@@ -27,6 +27,7 @@ struct MatcherConfig {
   double max_jump_rad = 0.5;
   bool group_rule = true;
   bool motion_model = true;       // constant velocity (else: previous pose)
+  bool deskew = true;             // motion compensation with the motion model's twist (IMU yaw rate if given)
   int stride = 1;                 // use every stride-th point
   int max_points = 800;           // more features than this: the stride grows to keep about this many (0 = all)
 };
@@ -34,15 +35,19 @@ struct MatcherConfig {
 struct MatchResult {
   FitStatus status = FitStatus::kNotInitialised;
   std::string text;
-  Pose2 pose;                     // accepted pose (the prediction when POOR/LOST)
-  Pose2 solved;                   // what the solver found (equal to pose when OK)
-  Pose2 predicted;
+  Pose2 pose;                     // accepted pose at the frame's utime (the prediction when POOR/LOST)
+  Pose2 solved;                   // what the solver found, at utime (equal to pose when OK)
+  Pose2 predicted;                // at utime
+  Pose2 sweep_pose;               // the accepted pose at utime + t_ref (what the registration estimates)
+  double t_ref = 0;               // reference time of the de-skewed sweep [s after utime]
+  Twist2 twist;                   // body twist of the motion compensation and of utime <-> t_ref
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
   FitQuality fit;
   int iterations = 0;
 };
 
-// Stateless registration from an initial guess (used by the Matcher and by tests).
+// Stateless registration from an initial guess (used by the Matcher and by tests). `f` is registered as
+// given (motion compensation, if any, is the caller's: see deskew()).
 MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& guess,
                            const MatcherConfig& cfg);
 
@@ -52,21 +57,28 @@ class Matcher {
   // (Re)initialises the tracker: the next frame is registered from this pose (no motion model).
   void set_pose(const Pose2& p);
   bool initialised() const { return initialised_; }
-  // Registers the frame. yaw_delta: the IMU's integrated yaw change since the previous frame, if any.
+  // Registers the frame; the result is the pose at f.utime. yaw_delta: the IMU's integrated yaw change
+  // since the previous frame, if any (prediction). Motion compensation (cfg.deskew): the sweep is
+  // de-skewed to its mean point time t_ref with the motion model's body twist (its yaw rate replaced by
+  // f.sweep_yaw_rate when that is known) and registered there; the twist is then updated from the last
+  // two registered sweep poses and carries the pose back from utime + t_ref to utime.
   MatchResult process(const FeatureFrame& f, std::optional<double> yaw_delta = std::nullopt);
+  // The body twist the motion model currently assumes (zero until two frames were registered).
+  Twist2 twist() const { return twist_; }
   const MatcherConfig& config() const { return cfg_; }
 
  private:
-  Pose2 predict(int64_t utime, std::optional<double> yaw_delta) const;
+  Pose2 predict(int64_t tau, std::optional<double> yaw_delta) const;
   const NearestLookup& lookup_;
   MatcherConfig cfg_;
   bool initialised_ = false;
-  bool have_last_ = false;      // a registered frame exists (utime_ valid)
+  bool have_last_ = false;      // a frame was processed since set_pose (tau_ valid)
   bool have_velocity_ = false;
-  Pose2 pose_;
-  int64_t utime_ = 0;
-  Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();  // vx, vy [m/s], yaw rate [rad/s] (plan frame)
+  Pose2 pose_;                  // last accepted pose at tau_ (the sweep's reference time)
+  int64_t tau_ = 0;
+  Twist2 twist_;                // constant body twist between the last two registered sweep poses
   int poor_count_ = 0;
+  FeatureFrame deskewed_;       // scratch
 };
 
 }  // namespace fploc
