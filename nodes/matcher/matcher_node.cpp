@@ -39,6 +39,7 @@ fploc::MatcherConfig config_of(const fploc::MatcherOptions& o) {
   c.motion_model = !o.disable_motion_model();
   if (o.stride() > 0) c.stride = o.stride();
   if (o.max_points() != 0) c.max_points = o.max_points() < 0 ? 0 : o.max_points();
+  c.deskew = !o.disable_deskew();
   return c;
 }
 
@@ -61,7 +62,9 @@ class MatcherNode : public fploc::rt::Node {
                                         o.lookup().empty() ? "annf-exact" : o.lookup());
     matcher_ = std::make_unique<fploc::Matcher>(*map_.lookup, config_of(o));
     use_imu_ = !o.ignore_imu();
-    if (!o.wait_for_initial_pose()) matcher_->set_pose({o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()});
+    if (o.initial_search_m() > 0) initial_search_m_ = o.initial_search_m();
+    if (!o.wait_for_initial_pose())
+      matcher_->set_pose({o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()}, initial_search_m_);
     out_ = ctx.advertise<fploc::frame_pose_t>("frame_pose");
     ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) { on_features(m); });
     ctx.subscribe<fploc::imu_t>("imu", [this](const fploc::imu_t& m) { on_imu(m); });
@@ -71,7 +74,9 @@ class MatcherNode : public fploc::rt::Node {
         ctx_->error("initial_pose seq " + std::to_string(m.seq) + ": non-finite pose (ignored)");
         return;
       }
-      matcher_->set_pose(p);
+      // Search within 3 sigma of the message's position covariance when it has one.
+      const double var = std::max(m.covariance[0], m.covariance[7]);
+      matcher_->set_pose(p, std::isfinite(var) && var > 0 ? std::optional<double>(3 * std::sqrt(var)) : initial_search_m_);
     });
   }
 
@@ -141,6 +146,7 @@ class MatcherNode : public fploc::rt::Node {
   fploc::rt::Publisher<fploc::frame_pose_t> out_;
   fploc::ImuYaw imu_;
   bool use_imu_ = true;
+  std::optional<double> initial_search_m_;
   bool have_prev_ = false;
   int64_t prev_utime_ = 0;
   int64_t seq_ = 0;

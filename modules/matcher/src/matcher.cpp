@@ -84,8 +84,10 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
 
 Matcher::Matcher(const NearestLookup& lookup, MatcherConfig cfg) : lookup_(lookup), cfg_(std::move(cfg)) {}
 
-void Matcher::set_pose(const Pose2& p) {
+void Matcher::set_pose(const Pose2& p, std::optional<double> search_m, std::optional<double> search_yaw) {
   pose_ = p;
+  search_m_ = search_m && *search_m > 0 ? *search_m : cfg_.gate_initial_m;
+  search_yaw_ = search_yaw && *search_yaw > 0 ? *search_yaw : cfg_.initial_search_yaw_rad;
   initialised_ = true;
   have_last_ = false;
   have_velocity_ = false;
@@ -114,12 +116,15 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
   const double t_ref = cfg_.deskew ? mean_time(f) : 0.0;
   const int64_t tau = f.utime + std::llround(t_ref * 1e6);
   const Pose2 pred = predict(tau, yaw_delta);
-  MatcherConfig cfg = cfg_;
   const bool lost = poor_count_ >= cfg_.lost_after;
-  if (lost) cfg.gate_initial_m *= 2;  // search wider while lost
-  // Tracking (the previous frame was registered): the motion model is good to centimetres, so start
-  // with the tracking gate (fewer look-up rounds).
-  else if (have_last_ && poor_count_ == 0) cfg.gate_initial_m = std::min(cfg.gate_initial_m, cfg.gate_tracking_m);
+  // Gates: tracking (the previous frame OK) starts at the tracking gate, the first frame after set_pose
+  // searches within the given pose's uncertainty, after a POOR frame the gate starts wide, and wider
+  // still while LOST; each is halved per look-up round down to gate_final_m.
+  MatcherConfig cfg = cfg_;
+  const bool tracking = have_last_ && poor_count_ == 0;
+  if (lost) cfg.gate_initial_m *= 2;
+  else if (tracking) cfg.gate_initial_m = std::min(cfg.gate_initial_m, cfg.gate_tracking_m);
+  else if (!have_last_) cfg.gate_initial_m = search_m_;
   // Motion compensation: the sweep's points moved to the sensor frame at utime + t_ref with the motion
   // model's body twist (zero linear velocity until two frames were registered), the IMU's yaw rate.
   Twist2 tw;
@@ -127,7 +132,31 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
   if (std::isfinite(f.sweep_yaw_rate)) tw.w = f.sweep_yaw_rate;
   const bool comp = cfg_.deskew && (tw.vx != 0 || tw.vy != 0 || tw.w != 0);
   if (comp) deskew(f, tw, t_ref, &deskewed_);
-  MatchResult r = register_frame(lookup_, comp ? deskewed_ : f, pred, cfg);
+  const FeatureFrame& in = comp ? deskewed_ : f;
+  MatchResult r;
+  if (!have_last_ && search_m_ > 2 * cfg_.gate_tracking_m) {
+    // First frame from a pose known only to within search_m / search_yaw: one registration converges
+    // from about half a metre / a few degrees, so start from a grid over the uncertainty (spacing 2/3 of
+    // it, the given pose first) and keep the fit with the most inliers (then the lower rms).
+    const double s = search_m_ * 2 / 3, a = search_yaw_ * 2 / 3;
+    MatcherConfig c = cfg;
+    c.gate_initial_m = std::max(s, cfg_.gate_final_m);
+    bool have = false;
+    for (double dyaw : {0.0, -a, a})
+      for (double dx : {0.0, -s, s})
+        for (double dy : {0.0, -s, s}) {
+          MatchResult ri = register_frame(lookup_, in, Pose2{pred.x + dx, pred.y + dy, wrap_angle(pred.yaw + dyaw)}, c);
+          const int it = r.iterations + ri.iterations;
+          const bool better = !have || (ri.status == FitStatus::kOk && r.status != FitStatus::kOk) ||
+                              (ri.status == r.status && (ri.fit.num_inliers > r.fit.num_inliers ||
+                                                         (ri.fit.num_inliers == r.fit.num_inliers && ri.fit.rms_m < r.fit.rms_m)));
+          if (better) r = ri;
+          r.iterations = it;
+          have = true;
+        }
+  } else {
+    r = register_frame(lookup_, in, pred, cfg);
+  }
   const Pose2 solved_ref = r.solved;
   const double jump = std::hypot(solved_ref.x - pred.x, solved_ref.y - pred.y);
   const double jump_yaw = std::abs(wrap_angle(solved_ref.yaw - pred.yaw));

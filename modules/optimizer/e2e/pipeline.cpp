@@ -3,6 +3,8 @@
 #include <time.h>
 
 #include <cmath>
+#include <cstdio>
+#include <memory>
 
 #include "fploc/eval/eval.h"
 #include "fploc/features/features.h"
@@ -49,6 +51,7 @@ Result run(const FloorPlan& plan_in, const Options& o) {
   so.seed = o.seed;
   so.clutter = o.clutter;
   if (o.range_noise_m >= 0) so.range_noise_m = o.range_noise_m;
+  so.wall_clutter = o.wall_clutter;
   so.shared_dir = o.shared_dir;
   sim::Simulator sim(plan_in, so);
   const FloorPlan& plan = sim.world().plan();
@@ -64,7 +67,7 @@ Result run(const FloorPlan& plan_in, const Options& o) {
   MatcherConfig mcfg;
   mcfg.max_points = o.matcher_points;
   Matcher matcher(*map.lookup, mcfg);
-  matcher.set_pose(init);
+  matcher.set_pose(init, o.init_search_m > 0 ? std::optional<double>(o.init_search_m) : std::nullopt);
   OptimizerConfig ocfg;
   ocfg.window = o.window;
   ocfg.alpha = o.alpha;
@@ -82,6 +85,9 @@ Result run(const FloorPlan& plan_in, const Options& o) {
   sim::SimScan f;
   double feat_total = 0;
   uint64_t drop_state = o.seed * 2654435761u + 1;
+  std::unique_ptr<FILE, int (*)(FILE*)> csv(o.frames_csv.empty() ? nullptr : std::fopen(o.frames_csv.c_str(), "w"), &std::fclose);
+  if (!o.frames_csv.empty() && !csv) throw std::runtime_error(o.frames_csv + ": cannot write");
+  if (csv) std::fprintf(csv.get(), "k,utime,status,points,inliers,inlier_ratio,rms_m,iterations,err_x_m,err_y_m,err_yaw_deg,vx,vy,w\n");
   for (int k = 0; k < n; ++k) {
     if (o.drop_fraction > 0) {
       drop_state = drop_state * 6364136223846793005ull + 1442695040888963407ull;
@@ -117,6 +123,13 @@ Result run(const FloorPlan& plan_in, const Options& o) {
     const MatchResult m = matcher.process(frame, dyaw);
     r.us_matcher += us_since(t0);
     r.ok_frames += m.status == FitStatus::kOk;
+    if (csv) {
+      const StampedPose g = sim.ground_truth(frame.utime * 1e-6 + o.gt_offset_s);
+      std::fprintf(csv.get(), "%d,%lld,%s,%d,%d,%.4f,%.5f,%d,%.5f,%.5f,%.4f,%.4f,%.4f,%.4f\n", k, (long long)frame.utime,
+                   to_string(m.status), m.fit.num_points, m.fit.num_inliers, m.fit.inlier_ratio, m.fit.rms_m, m.iterations,
+                   m.pose.x - g.p.x(), m.pose.y - g.p.y(), wrap_angle(m.pose.yaw - g.rpy()[2]) * 180 / M_PI, m.twist.vx,
+                   m.twist.vy, m.twist.w);
+    }
     r.lost_frames += m.status == FitStatus::kLost;
     t0 = clk::now();
     FrameInput in;

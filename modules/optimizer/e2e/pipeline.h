@@ -22,10 +22,13 @@ struct Options {
   double alpha = 1.1, beta = 0.9;
   bool clutter = true;
   double range_noise_m = -1;      // < 0: the simulator's default
+  double wall_clutter = 0;        // fraction of the walls behind cabinets (simulator option)
   double drop_fraction = 0;      // drop this fraction of scans (deterministic)
   double keyframe_distance_m = 0.1;
   int matcher_points = 800, optimizer_points = 400;
   double init_dx = 0, init_dy = 0, init_dyaw = 0;  // error of the initial pose
+  double init_search_m = 0;      // matcher's first-frame search radius (0 = its default)
+  std::string frames_csv;        // per-frame diagnostics (status, fit, errors against ground truth) to this file
 };
 
 struct Result {

@@ -14,11 +14,14 @@ namespace fploc {
 struct MatcherConfig {
   double gate_initial_m = 1.5;    // correspondence gate of the first outer iteration
   double gate_final_m = 0.3;      // ... halved each outer iteration down to this
-  double gate_tracking_m = 0.6;   // first gate while tracking (previous frame OK)
+  double gate_tracking_m = 0.3;   // first gate while tracking (previous frame OK): the motion model is good to
+                                  // centimetres, and structures not in the plan running parallel to it a few
+                                  // decimetres away (cabinets along a wall) stay out of the correspondences
   double loss_scale_m = 0.05;     // robust (Huber) loss scale
   std::string loss = "huber";     // "huber", "cauchy", "none"
   int max_iterations = 10;        // Ceres iterations per outer iteration
   int max_outer = 5;              // look-up + solve rounds (x6 for point targets, see matcher.cpp)
+  double initial_search_yaw_rad = 10 * M_PI / 180;  // default yaw uncertainty of a pose given by set_pose
   double inlier_m = 0.1;          // a point within this of the plan is an inlier
   double min_inlier_ratio = 0.3;  // below: POOR (the pose is not accepted)
   int min_inliers = 15;
@@ -54,8 +57,11 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
 class Matcher {
  public:
   Matcher(const NearestLookup& lookup, MatcherConfig cfg);
-  // (Re)initialises the tracker: the next frame is registered from this pose (no motion model).
-  void set_pose(const Pose2& p);
+  // (Re)initialises the tracker: the next frame is registered from this pose (no motion model), searching
+  // within search_m / search_yaw of it (the pose's uncertainty; defaults gate_initial_m and
+  // initial_search_yaw_rad). An uncertainty larger than twice the tracking gate is searched from a grid
+  // of starts.
+  void set_pose(const Pose2& p, std::optional<double> search_m = std::nullopt, std::optional<double> search_yaw = std::nullopt);
   bool initialised() const { return initialised_; }
   // Registers the frame; the result is the pose at f.utime. yaw_delta: the IMU's integrated yaw change
   // since the previous frame, if any (prediction). Motion compensation (cfg.deskew): the sweep is
@@ -78,6 +84,8 @@ class Matcher {
   int64_t tau_ = 0;
   Twist2 twist_;                // constant body twist between the last two registered sweep poses
   int poor_count_ = 0;
+  double search_m_ = 0;         // uncertainty of the pose given by set_pose
+  double search_yaw_ = 0;
   FeatureFrame deskewed_;       // scratch
 };
 
