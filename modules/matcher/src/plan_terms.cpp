@@ -106,14 +106,17 @@ inline void robust_scale(LossKind loss, double a, double s, double* g, double* d
 }
 
 // All points of one frame in one residual block (Ceres' per-block overhead dominates per-point
-// blocks). The robust loss is folded into the residuals exactly: r~ = g(s) r with g = sqrt(rho(s)/s),
-// s = |r|^2, so |r~|^2 = rho(s), and the Jacobian is the exact derivative of r~.
+// blocks), one residual per point: its distance to the closest of its candidates, |p' - q(p')| (the
+// paper's ||ANNF(p'), p'||). Its gradient is n^T dp'/dx with n the unit vector from q to p', so the
+// normal equations equal those of the 2D residual p' - q at half the rows. The robust loss is folded in
+// exactly: r~ = w g(s) d with g = sqrt(rho(s)/s), s = d^2, so r~^2 = w^2 rho(s), and dr~/dx =
+// w (g + 2 s g'(s)) dd/dx.
 class FrameCost : public ceres::CostFunction {
  public:
   FrameCost(const std::vector<TargetGeom>* targets, std::vector<Assignment> as, std::vector<Eigen::Vector2d> pts,
             LossKind loss, double scale, double w)
       : targets_(targets), as_(std::move(as)), pts_(std::move(pts)), loss_(loss), a_(scale), w_(w) {
-    set_num_residuals(int(2 * as_.size()));
+    set_num_residuals(int(as_.size()));
     mutable_parameter_block_sizes()->push_back(3);
   }
   bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
@@ -126,20 +129,26 @@ class FrameCost : public ceres::CostFunction {
       const Eigen::Vector2d& p = pts_[i];
       const double rx = c * p.x() - s * p.y(), ry = s * p.x() + c * p.y();
       const Eigen::Vector2d pw(rx + x[0], ry + x[1]);
-      closest_of2(*targets_, as_[i].cand, as_[i].n, pw, &q, jac ? &J : nullptr);
-      const Eigen::Vector2d r = w_ * (pw - q);
+      const double d2 = closest_of2(*targets_, as_[i].cand, as_[i].n, pw, &q, jac ? &J : nullptr);
+      const double d = std::sqrt(d2);
       double g, dg;
-      robust_scale(loss_, a_, r.squaredNorm(), &g, &dg);
-      residuals[2 * i] = g * r.x();
-      residuals[2 * i + 1] = g * r.y();
+      robust_scale(loss_, a_, d2, &g, &dg);
+      residuals[i] = w_ * g * d;
       if (jac) {
-        // d pw / d(x, y, yaw) = [I | (-ry, rx)].
-        Eigen::Matrix<double, 2, 3> Jr;
-        Jr.leftCols<2>() = w_ * J;
-        Jr.col(2) = w_ * (J * Eigen::Vector2d(-ry, rx));
-        Eigen::Matrix<double, 2, 3> Jt = g * Jr;
-        if (dg != 0) Jt += (2 * dg) * r * (r.transpose() * Jr);
-        Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>>(jac + 6 * i) = Jt;
+        // n: from q to p'; at d = 0 the element's normal (segments/circles: the projection J's range).
+        Eigen::Vector2d n;
+        if (d > 1e-12) {
+          n = (pw - q) / d;
+        } else if (J.trace() < 1.5) {  // J = n n^T (interior of a segment / circle): its larger column
+          n = J.col(0).squaredNorm() >= J.col(1).squaredNorm() ? J.col(0) : J.col(1);
+          n.normalize();
+        } else {  // on an end point: no direction
+          n.setZero();
+        }
+        const double k = w_ * (g + 2 * dg * d2);
+        jac[3 * i] = k * n.x();
+        jac[3 * i + 1] = k * n.y();
+        jac[3 * i + 2] = k * (n.x() * -ry + n.y() * rx);
       }
     }
     return true;

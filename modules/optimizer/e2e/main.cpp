@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   app.add_option("--kf-distance", o.keyframe_distance_m);
   app.add_option("--matcher-points", o.matcher_points);
   app.add_option("--optimizer-points", o.optimizer_points);
+  app.add_option("--relook", o.relook_m, "optimizer re-look-up distance [m] (its angle scales along)");
   app.add_option("--drop", o.drop_fraction, "fraction of scans dropped");
   app.add_option("--noise", o.range_noise_m, "range noise sigma [m] (default: the simulator's)");
   app.add_option("--wall-clutter", o.wall_clutter, "fraction of the walls hidden behind 2 m cabinets");
@@ -46,6 +47,7 @@ int main(int argc, char** argv) {
   app.add_option("--units", units);
   app.add_option("--out", out_prefix, "write PREFIX-{gt,sfr,wo,odo}.tum and PREFIX.svg");
   app.add_flag("--no-imu", no_imu);
+  app.add_flag("--gt-gravity", o.gt_gravity, "diagnostic: project the features with the true roll/pitch");
   app.add_flag("--no-clutter", no_clutter);
   CLI11_PARSE(app, argc, argv);
   o.imu = !no_imu;

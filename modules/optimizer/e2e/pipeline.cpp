@@ -74,6 +74,10 @@ Result run(const FloorPlan& plan_in, const Options& o) {
   ocfg.beta = o.beta;
   ocfg.keyframe_distance_m = o.keyframe_distance_m;
   ocfg.max_points = o.optimizer_points;
+  if (o.relook_m >= 0) {
+    ocfg.relook_m = o.relook_m;
+    ocfg.relook_rad = o.relook_m / 0.01 * ocfg.relook_rad;
+  }
   WindowOptimizer opt(*map.lookup, ocfg);
   Odometry2D odo;
   odo.set_pose(init);
@@ -95,8 +99,16 @@ Result run(const FloorPlan& plan_in, const Options& o) {
     }
     sim.frame(k, f);
     auto t0 = clk::now();
-    const auto& s = segmenter.process(f.scan);
+    const auto& s0 = segmenter.process(f.scan);
     r.us_segment += us_since(t0);
+    seg::Segmentation s_gt;
+    if (o.gt_gravity) {
+      s_gt = s0;
+      const Eigen::Vector3d rpy = sim.ground_truth(f.scan.utime * 1e-6 + 0.05).rpy();
+      s_gt.roll = rpy[0];
+      s_gt.pitch = rpy[1];
+    }
+    const seg::Segmentation& s = o.gt_gravity ? s_gt : s0;
     t0 = clk::now();
     const auto& ft = fx.process(s);
     r.us_features += us_since(t0);

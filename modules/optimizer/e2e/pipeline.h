@@ -25,9 +25,11 @@ struct Options {
   double wall_clutter = 0;        // fraction of the walls behind cabinets (simulator option)
   double drop_fraction = 0;      // drop this fraction of scans (deterministic)
   double keyframe_distance_m = 0.1;
-  int matcher_points = 800, optimizer_points = 400;
+  int matcher_points = 800, optimizer_points = 800;
+  double relook_m = -1;          // optimizer's re-look-up distance (< 0: its default)
   double init_dx = 0, init_dy = 0, init_dyaw = 0;  // error of the initial pose
   double init_search_m = 0;      // matcher's first-frame search radius (0 = its default)
+  bool gt_gravity = false;       // diagnostic: features projected with the true roll/pitch (mid-sweep)
   std::string frames_csv;        // per-frame diagnostics (status, fit, errors against ground truth) to this file
 };
 

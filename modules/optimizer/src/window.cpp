@@ -133,7 +133,6 @@ void WindowOptimizer::solve() {
   ao.gate_m = cfg_.gate_m;
   ao.group_rule = cfg_.group_rule;
   ao.stride = cfg_.stride;
-  std::vector<std::vector<Assignment>> as(window_.size());
   // Anchors: the last final key poses, held fixed (optional).
   double anchors[2][3];
   std::vector<std::pair<double*, int64_t>> chain;  // pose block, utime
@@ -147,17 +146,37 @@ void WindowOptimizer::solve() {
   }
   for (auto& k : window_) chain.push_back({k.x, k.f.tau});
   for (int outer = 0; outer < std::max(1, cfg_.outer); ++outer) {
-    ceres::Problem problem(po);
-    for (size_t i = 0; i < window_.size(); ++i) {
-      Key& k = window_[i];
+    // Look-ups: a key keeps its correspondences while its pose stays within relook_m / relook_rad of
+    // where they were looked up (the residuals re-evaluate the closest point on the candidates at every
+    // evaluation anyway); a round in which no key needed a new look-up would repeat the last solve.
+    bool changed = outer == 0;
+    for (auto& k : window_) {
+      const Pose2 xk{k.x[0], k.x[1], k.x[2]};
+      if (k.as_valid && std::hypot(xk.x - k.as_pose.x, xk.y - k.as_pose.y) <= cfg_.relook_m &&
+          std::abs(wrap_angle(xk.yaw - k.as_pose.yaw)) <= cfg_.relook_rad)
+        continue;
       AssignOptions aok = ao;
       const size_t np = k.deskewed.points.size();
       aok.stride = std::max(1, cfg_.stride);
       if (cfg_.max_points > 0 && np > size_t(cfg_.max_points) * size_t(aok.stride))
         aok.stride = int((np + size_t(cfg_.max_points) - 1) / size_t(cfg_.max_points));
-      assign(lookup_, k.deskewed, Pose2{k.x[0], k.x[1], k.x[2]}, aok, &as[i]);
+      std::vector<Assignment> as;
+      assign(lookup_, k.deskewed, xk, aok, &as);
+      changed |= !k.as_valid || as != k.as;
+      k.as = std::move(as);
+      k.as_pose = xk;
+      k.as_valid = true;
+      k.as_stride = aok.stride;
+    }
+    if (!changed) break;
+    ceres::Problem problem(po);
+    for (auto& k : window_) {
       problem.AddParameterBlock(k.x, 3);
-      add_frame_term(&problem, k.x, lookup_, k.deskewed, as[i], cfg_.loss, cfg_.loss_scale_m);
+      // The paper's sigma_sfr sums over all of the frame's features: a point budget (every stride-th
+      // point) estimates that sum with weight stride, so the balance against the velocity terms does not
+      // depend on the budget.
+      const double w = cfg_.budget_weight ? std::sqrt(double(k.as_stride)) : 1.0;
+      add_frame_term(&problem, k.x, lookup_, k.deskewed, k.as, cfg_.loss, cfg_.loss_scale_m, w);
     }
     for (size_t i = 0; i + 2 < chain.size(); ++i) {
       const double dt0 = (chain[i + 1].second - chain[i].second) * 1e-6;

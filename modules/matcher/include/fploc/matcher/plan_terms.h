@@ -12,31 +12,11 @@
 #include <string>
 #include <vector>
 
+#include "fploc/matcher/assignment.h"
 #include "fploc/matcher/lookup.h"
 #include "fploc/matcher/types.h"
 
 namespace fploc {
-
-constexpr int kMaxCandidates = 8;
-
-struct Assignment {
-  int point = -1;
-  int n = 0;
-  int cand[kMaxCandidates] = {};
-  bool operator==(const Assignment& o) const {
-    if (point != o.point || n != o.n) return false;
-    for (int i = 0; i < n; ++i)
-      if (cand[i] != o.cand[i]) return false;
-    return true;
-  }
-};
-
-struct AssignOptions {
-  double gate_m = 1.0;     // points farther than this from all candidates are left out
-  bool group_rule = true;  // one PCA group <-> one element (element look-ups only)
-  int max_candidates = kMaxCandidates;
-  int stride = 1;          // use every stride-th point (1 = all)
-};
 
 // Correspondences of the frame's points at pose x (in point order).
 void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, const AssignOptions& o,
@@ -50,7 +30,7 @@ double closest_of(const std::vector<TargetGeom>& targets, const int* cand, int n
 
 // The frame's terms as ONE residual block (2 residuals per assignment) with the robust loss ("huber",
 // "cauchy", "none", scale [m]) folded exactly into the residuals: much less Ceres overhead than a block
-// per point. Used by the matcher and the optimizer. The frame must outlive the problem's solve.
+// per point. Used by the matcher and the optimizer. The cost is weight^2 sum rho(|r|^2).
 void add_frame_term(ceres::Problem* problem, double* pose, const NearestLookup& lookup, const FeatureFrame& f,
                     const std::vector<Assignment>& a, const std::string& loss, double scale, double weight = 1.0);
 

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "fploc/matcher/lookup.h"
+#include "fploc/matcher/assignment.h"
 #include "fploc/matcher/types.h"
 
 namespace fploc {
@@ -36,7 +37,10 @@ struct OptimizerConfig {
   int outer = 2;                       // look-up + solve rounds per new keyframe
   bool group_rule = true;
   int stride = 1;                      // use every stride-th feature point of a keyframe
-  int max_points = 400;                // per keyframe: the stride grows to keep about this many (0 = all)
+  int max_points = 800;                // per keyframe: the stride grows to keep about this many (0 = all)
+  bool budget_weight = true;           // weight the sampled points by the stride (estimate of the sum over all)
+  double relook_m = 0.01;              // a key's correspondences are looked up again when it moved this far
+  double relook_rad = 0.2 * M_PI / 180;  // ... or turned this much since the last look-up
   bool anchor_final = false;           // also regularise against the last two final key poses (held fixed)
   double max_keyframe_gap_s = 2.0;     // a longer gap (e.g. lost frames) restarts the window
   std::string linear_solver = "sparse";  // "sparse" (SPARSE_NORMAL_CHOLESKY) or "dense" (DENSE_NORMAL_CHOLESKY)
@@ -88,6 +92,10 @@ class WindowOptimizer {
     FeatureFrame deskewed;             // features de-skewed to t_ref
     double x[3];                       // pose at tau
     int optimised = 0;
+    std::vector<Assignment> as;        // correspondences, looked up at as_pose
+    Pose2 as_pose;
+    bool as_valid = false;
+    int as_stride = 1;
   };
   struct Final {
     int64_t tau;
