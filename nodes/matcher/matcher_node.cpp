@@ -96,6 +96,12 @@ class MatcherNode : public fploc::rt::Node {
       return;
     }
     if (dropped) ctx_->error("features seq " + std::to_string(m.seq) + ": " + std::to_string(dropped) + " non-finite points dropped");
+    // Roll/pitch/z the segmenter could not estimate (its "unknown" sigmas): the last known ones are
+    // passed on (the optimizer interpolates them in its final poses).
+    if (f.z_sigma < 1.0) last_z_ = f.z;
+    else if (last_z_) f.z = *last_z_;
+    if (f.roll_pitch_sigma < 0.5) last_rp_ = {f.roll, f.pitch};
+    else if (last_rp_) f.roll = last_rp_->first, f.pitch = last_rp_->second;
     std::optional<double> dyaw;
     if (use_imu_) {
       // Prediction: the yaw change since the previous frame; motion compensation: the mean rate over
@@ -147,6 +153,8 @@ class MatcherNode : public fploc::rt::Node {
   fploc::ImuYaw imu_;
   bool use_imu_ = true;
   std::optional<double> initial_search_m_;
+  std::optional<double> last_z_;
+  std::optional<std::pair<double, double>> last_rp_;
   bool have_prev_ = false;
   int64_t prev_utime_ = 0;
   int64_t seq_ = 0;

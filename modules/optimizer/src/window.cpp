@@ -67,16 +67,54 @@ PoseOut WindowOptimizer::make_out(const Frame& f, const Pose2& pose_tau_in, bool
     o.pose = compose(pose_tau, exp_twist(f.in.twist, -f.t_ref));
   }
   *prev = {true, f.tau, pose_tau};
-  o.roll = f.in.features.roll;
-  o.pitch = f.in.features.pitch;
-  o.z = f.in.features.z;
+  fill_gravity(&o, f.in.features);
   o.keyframe = key;
   o.status = f.in.status;
   o.covariance = f.in.covariance;
   return o;
 }
 
+void WindowOptimizer::fill_gravity(PoseOut* o, const FeatureFrame& f) const {
+  o->roll = f.roll;
+  o->pitch = f.pitch;
+  o->z = f.z;
+  const bool z_known = std::isfinite(f.z) && f.z_sigma < cfg_.unknown_z_sigma_m;
+  const bool rp_known = std::isfinite(f.roll) && std::isfinite(f.pitch) && f.roll_pitch_sigma < cfg_.unknown_rp_sigma_rad;
+  if (z_known && rp_known) return;
+  auto fill = [&](bool Gravity::*known, auto get, double* out) {
+    const Gravity* before = nullptr;
+    const Gravity* after = nullptr;
+    for (const auto& g : gravity_) {
+      if (!(g.*known)) continue;
+      if (g.utime <= f.utime) before = &g;
+      else if (!after) after = &g;
+    }
+    if (before && after) {
+      const double s = double(f.utime - before->utime) / double(after->utime - before->utime);
+      *out = get(*before) + s * (get(*after) - get(*before));
+    } else if (before || after) {
+      *out = get(before ? *before : *after);
+    }
+  };
+  if (!z_known) fill(&Gravity::z_known, [](const Gravity& g) { return g.z; }, &o->z);
+  if (!rp_known) {
+    fill(&Gravity::rp_known, [](const Gravity& g) { return g.roll; }, &o->roll);
+    fill(&Gravity::rp_known, [](const Gravity& g) { return g.pitch; }, &o->pitch);
+  }
+}
+
 PoseOut WindowOptimizer::add(FrameInput in, std::vector<PoseOut>* finals) {
+  {
+    const FeatureFrame& f = in.features;
+    gravity_.push_back({f.utime, f.roll, f.pitch, f.z,
+                        std::isfinite(f.roll) && std::isfinite(f.pitch) && f.roll_pitch_sigma < cfg_.unknown_rp_sigma_rad,
+                        std::isfinite(f.z) && f.z_sigma < cfg_.unknown_z_sigma_m});
+    // Keep what the frames still to be output may need (and a little before).
+    int64_t oldest = f.utime;
+    if (!pending_.empty()) oldest = std::min(oldest, pending_.front().in.features.utime);
+    if (!window_.empty()) oldest = std::min(oldest, window_.front().f.in.features.utime);
+    while (gravity_.size() > 2 && gravity_[1].utime < oldest - 5'000'000) gravity_.pop_front();
+  }
   Frame fr;
   fr.in = std::move(in);
   const int64_t t = fr.in.features.utime;

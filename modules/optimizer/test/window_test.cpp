@@ -173,3 +173,29 @@ TEST(WindowOptimizer, MotionCompensatedPosesAreAtUtime) {
   EXPECT_LT(e_sfr, 0.008);
   EXPECT_LT(e_wo, 0.008);
 }
+
+TEST(WindowOptimizer, UnknownGravityIsInterpolatedFromNeighbours) {
+  // Frames whose segmenter had no z / roll / pitch (its "unknown" sigmas, z = 0): the final poses take
+  // them from the nearest frames that had them (interpolated in time, held at the start).
+  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  WindowOptimizer opt(*map.lookup, OptimizerConfig{});
+  std::vector<PoseOut> finals;
+  for (int k = 0; k < 30; ++k) {
+    FrameInput in;
+    in.features = synth_frame(*map.plan, {4.0 + 0.05 * k, 3, 0}, SynthOptions{}, k * 100000);
+    in.sfr = {4.0 + 0.05 * k, 3, 0};
+    const bool unknown = k == 0 || k == 10 || k == 11;
+    in.features.z = unknown ? 0.0 : 1.20 + 0.01 * k;
+    in.features.z_sigma = unknown ? 1e3 : 0.01;
+    in.features.roll = unknown ? 0.0 : 0.002 * k;
+    in.features.roll_pitch_sigma = unknown ? M_PI : 0.001;
+    opt.add(in, &finals);
+  }
+  opt.flush(&finals);
+  ASSERT_EQ(finals.size(), 30u);
+  EXPECT_NEAR(finals[0].z, 1.21, 1e-12);          // held from the first known
+  EXPECT_NEAR(finals[10].z, 1.20 + 0.10, 1e-9);   // between frames 9 and 12
+  EXPECT_NEAR(finals[11].z, 1.20 + 0.11, 1e-9);
+  EXPECT_NEAR(finals[10].roll, 0.002 * 10, 1e-9);
+  EXPECT_NEAR(finals[5].z, 1.25, 1e-12);          // known ones pass through
+}

@@ -43,6 +43,8 @@ struct OptimizerConfig {
   double relook_rad = 0.2 * M_PI / 180;  // ... or turned this much since the last look-up
   bool anchor_final = false;           // also regularise against the last two final key poses (held fixed)
   double max_keyframe_gap_s = 2.0;     // a longer gap (e.g. lost frames) restarts the window
+  double unknown_z_sigma_m = 1.0;      // the segmenter's z_sigma at or above this: z unknown (it sends 1e3)
+  double unknown_rp_sigma_rad = 0.5;   // ... roll_pitch_sigma at or above this: roll/pitch unknown (it sends pi)
   std::string linear_solver = "sparse";  // "sparse" (SPARSE_NORMAL_CHOLESKY) or "dense" (DENSE_NORMAL_CHOLESKY)
 };
 
@@ -114,6 +116,9 @@ class WindowOptimizer {
   // updated), which closes the interval [prev.tau, tau] containing utime; without one (start, gap) the
   // matcher's twist carries the pose back.
   PoseOut make_out(const Frame& f, const Pose2& pose_tau, bool key, Stamped* prev) const;
+  // Roll/pitch/z of a frame whose segmenter could not estimate them (sigma of "unknown"): interpolated
+  // between the nearest frames that had them (held at the ends).
+  void fill_gravity(PoseOut* o, const FeatureFrame& f) const;
   Eigen::Vector3d newest_correction() const;
 
   const NearestLookup& lookup_;
@@ -122,6 +127,12 @@ class WindowOptimizer {
   std::deque<Frame> pending_;          // non-keyframes waiting for their surrounding keyframes to be final
   std::deque<Final> finals_;           // last two final key poses
   Stamped last_final_, last_latest_;   // previous pose at tau of the final / latest output streams
+  struct Gravity {
+    int64_t utime;
+    double roll, pitch, z;
+    bool rp_known, z_known;
+  };
+  std::deque<Gravity> gravity_;        // recent frames' roll/pitch/z
   bool have_last_key_ = false;
   Pose2 last_key_sfr_;
   int64_t last_key_utime_ = 0;
