@@ -36,6 +36,13 @@ fploc::OptimizerConfig config_of(const fploc::OptimizerOptions& o) {
   if (o.max_points() != 0) c.max_points = o.max_points() < 0 ? 0 : o.max_points();
   if (o.max_keyframe_gap_s() > 0) c.max_keyframe_gap_s = o.max_keyframe_gap_s();
   c.anchor_final = o.anchor_final();
+  c.body_frame_velocity = o.body_frame_velocity();
+  if (o.relook_m() > 0) {
+    c.relook_rad *= o.relook_m() / c.relook_m;
+    c.relook_m = o.relook_m();
+  }
+  if (!o.linear_solver().empty()) c.linear_solver = o.linear_solver();
+  c.budget_weight = !o.disable_budget_weight();
   c.group_rule = !o.disable_group_rule();
   return c;
 }

@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
   app.add_option("--units", units);
   app.add_option("--out", out_prefix, "write PREFIX-{gt,sfr,wo,odo}.tum and PREFIX.svg");
   app.add_flag("--no-imu", no_imu);
+  app.add_flag("--body-velocity", o.body_frame_velocity, "optimizer: body-frame velocity regularisation");
   app.add_flag("--gt-gravity", o.gt_gravity, "diagnostic: project the features with the true roll/pitch");
   app.add_flag("--no-clutter", no_clutter);
   CLI11_PARSE(app, argc, argv);

@@ -74,6 +74,7 @@ Result run(const FloorPlan& plan_in, const Options& o) {
   ocfg.beta = o.beta;
   ocfg.keyframe_distance_m = o.keyframe_distance_m;
   ocfg.max_points = o.optimizer_points;
+  ocfg.body_frame_velocity = o.body_frame_velocity;
   if (o.relook_m >= 0) {
     ocfg.relook_m = o.relook_m;
     ocfg.relook_rad = o.relook_m / 0.01 * ocfg.relook_rad;
@@ -91,7 +92,7 @@ Result run(const FloorPlan& plan_in, const Options& o) {
   uint64_t drop_state = o.seed * 2654435761u + 1;
   std::unique_ptr<FILE, int (*)(FILE*)> csv(o.frames_csv.empty() ? nullptr : std::fopen(o.frames_csv.c_str(), "w"), &std::fclose);
   if (!o.frames_csv.empty() && !csv) throw std::runtime_error(o.frames_csv + ": cannot write");
-  if (csv) std::fprintf(csv.get(), "k,utime,status,points,inliers,inlier_ratio,rms_m,iterations,err_x_m,err_y_m,err_yaw_deg,vx,vy,w\n");
+  if (csv) std::fprintf(csv.get(), "k,utime,status,points,inliers,inlier_ratio,rms_m,iterations,err_x_m,err_y_m,err_yaw_deg,vx,vy,w,z_sigma_m,err_z_m\n");
   for (int k = 0; k < n; ++k) {
     if (o.drop_fraction > 0) {
       drop_state = drop_state * 6364136223846793005ull + 1442695040888963407ull;
@@ -137,10 +138,10 @@ Result run(const FloorPlan& plan_in, const Options& o) {
     r.ok_frames += m.status == FitStatus::kOk;
     if (csv) {
       const StampedPose g = sim.ground_truth(frame.utime * 1e-6 + o.gt_offset_s);
-      std::fprintf(csv.get(), "%d,%lld,%s,%d,%d,%.4f,%.5f,%d,%.5f,%.5f,%.4f,%.4f,%.4f,%.4f\n", k, (long long)frame.utime,
+      std::fprintf(csv.get(), "%d,%lld,%s,%d,%d,%.4f,%.5f,%d,%.5f,%.5f,%.4f,%.4f,%.4f,%.4f,%.5f,%.5f\n", k, (long long)frame.utime,
                    to_string(m.status), m.fit.num_points, m.fit.num_inliers, m.fit.inlier_ratio, m.fit.rms_m, m.iterations,
                    m.pose.x - g.p.x(), m.pose.y - g.p.y(), wrap_angle(m.pose.yaw - g.rpy()[2]) * 180 / M_PI, m.twist.vx,
-                   m.twist.vy, m.twist.w);
+                   m.twist.vy, m.twist.w, frame.z_sigma, frame.z - g.p.z());
     }
     r.lost_frames += m.status == FitStatus::kLost;
     t0 = clk::now();

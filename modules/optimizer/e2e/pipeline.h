@@ -26,6 +26,7 @@ struct Options {
   double drop_fraction = 0;      // drop this fraction of scans (deterministic)
   double keyframe_distance_m = 0.1;
   int matcher_points = 800, optimizer_points = 800;
+  bool body_frame_velocity = false;
   double relook_m = -1;          // optimizer's re-look-up distance (< 0: its default)
   double init_dx = 0, init_dy = 0, init_dyaw = 0;  // error of the initial pose
   double init_search_m = 0;      // matcher's first-frame search radius (0 = its default)

@@ -29,6 +29,40 @@ struct VelocityReg {
   }
 };
 
+// The same with the velocities in the body frame: the constant body twists of the two segments
+// (SE(2) logarithm / dt, series for the small keyframe turns), so a constant-speed turn - what a pushed
+// platform does in a curve - costs nothing, where world-frame velocities change direction.
+struct BodyVelocityReg {
+  double dt0, dt1, sa, sb;
+  template <typename T>
+  static void twist(const T* p, const T* q, double dt, T* v) {
+    using std::atan2;
+    using std::cos;
+    using std::sin;
+    const T c = cos(p[2]), s = sin(p[2]);
+    const T dx = q[0] - p[0], dy = q[1] - p[1];
+    const T rx = c * dx + s * dy, ry = -s * dx + c * dy;
+    const T d = q[2] - p[2];
+    const T th = atan2(sin(d), cos(d));
+    const T t2 = th * th;
+    const T a = T(1) - t2 / T(6) * (T(1) - t2 / T(20)), b = th / T(2) * (T(1) - t2 / T(12));
+    const T den = a * a + b * b;
+    v[0] = (a * rx + b * ry) / den / T(dt);
+    v[1] = (-b * rx + a * ry) / den / T(dt);
+    v[2] = th / T(dt);
+  }
+  template <typename T>
+  bool operator()(const T* p0, const T* p1, const T* p2, T* r) const {
+    T v0[3], v1[3];
+    twist(p0, p1, dt0, v0);
+    twist(p1, p2, dt1, v1);
+    r[0] = sa * (v1[0] - v0[0]);
+    r[1] = sa * (v1[1] - v0[1]);
+    r[2] = sb * (v1[2] - v0[2]);
+    return true;
+  }
+};
+
 Eigen::Vector3d diff(const Pose2& a, const Pose2& b) { return {a.x - b.x, a.y - b.y, wrap_angle(a.yaw - b.yaw)}; }
 Pose2 plus(const Pose2& a, const Eigen::Vector3d& c) { return {a.x + c[0], a.y + c[1], wrap_angle(a.yaw + c[2])}; }
 
@@ -220,8 +254,12 @@ void WindowOptimizer::solve() {
       const double dt0 = (chain[i + 1].second - chain[i].second) * 1e-6;
       const double dt1 = (chain[i + 2].second - chain[i + 1].second) * 1e-6;
       if (!(dt0 > 1e-4 && dt1 > 1e-4)) continue;
-      auto* cost = new ceres::AutoDiffCostFunction<VelocityReg, 3, 3, 3, 3>(
-          new VelocityReg{dt0, dt1, std::sqrt(std::max(cfg_.alpha, 0.0)), std::sqrt(std::max(cfg_.beta, 0.0))});
+      const double sa = std::sqrt(std::max(cfg_.alpha, 0.0)), sb = std::sqrt(std::max(cfg_.beta, 0.0));
+      ceres::CostFunction* cost =
+          cfg_.body_frame_velocity
+              ? static_cast<ceres::CostFunction*>(new ceres::AutoDiffCostFunction<BodyVelocityReg, 3, 3, 3, 3>(
+                    new BodyVelocityReg{dt0, dt1, sa, sb}))
+              : new ceres::AutoDiffCostFunction<VelocityReg, 3, 3, 3, 3>(new VelocityReg{dt0, dt1, sa, sb});
       problem.AddResidualBlock(cost, nullptr, chain[i].first, chain[i + 1].first, chain[i + 2].first);
     }
     if (cfg_.anchor_final)

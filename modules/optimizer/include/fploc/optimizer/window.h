@@ -28,6 +28,8 @@ struct OptimizerConfig {
   int window = 10;                     // W
   double alpha = 1.1;                  // linear velocity regularisation
   double beta = 0.9;                   // angular velocity regularisation
+  bool body_frame_velocity = false;    // regularise body-frame velocities (constant-speed turns cost nothing)
+                                       // instead of the paper's world-frame ones
   double keyframe_distance_m = 0.1;
   double keyframe_angle_rad = 5.0 * M_PI / 180;
   double gate_m = 0.3;                 // correspondence gate around the current estimate
