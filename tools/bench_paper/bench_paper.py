@@ -136,12 +136,14 @@ class Bench:
         x0, y0, yaw0 = g[0][1], g[0][2], yaw_of(g[0])
         dx, dy, dyaw = init_offset
         plan = self.a.plan or os.path.join(ROOT, "data", "plans", "corridor.json" if "corridor" in name else "room.json")
-        out = {k: os.path.join(d, f"{name}-{k}.tum") for k in ("sfr", "wo", "odom")}
+        out = {k: os.path.join(d, f"{name}-{k}.tum") for k in ("sfr", "wo", "odom", "odom_map")}
         s = [f"matcher.plan.file={plan}", f"optimizer.plan.file={plan}",
              f"matcher.initial_pose.x={x0 + dx!r}", f"matcher.initial_pose.y={y0 + dy!r}",
              f"matcher.initial_pose.yaw={yaw0 + dyaw!r}", f"matcher.initial_search_m={search_m!r}",
              f"odometry.initial_pose.x={x0!r}", f"odometry.initial_pose.y={y0!r}", f"odometry.initial_pose.yaw={yaw0!r}",
-             f"sfr_logger.file={out['sfr']}", f"wo_logger.file={out['wo']}", f"odom_logger.file={out['odom']}"]
+             f"odometry_map.initial_pose.x={x0!r}", f"odometry_map.initial_pose.y={y0!r}",
+             f"odometry_map.initial_pose.yaw={yaw0!r}", f"sfr_logger.file={out['sfr']}", f"wo_logger.file={out['wo']}",
+             f"odom_logger.file={out['odom']}", f"odom_map_logger.file={out['odom_map']}"]
         if self.a.plan:
             for n in ("matcher", "optimizer"):
                 for i, layer in enumerate(self.a.layers or []):
@@ -186,8 +188,11 @@ class Bench:
         if seq in PAPER:
             row["paper"] = PAPER[seq][speed]
         base = {"sequence": seq, "speed": speed, "ate_m": res["odom"]["ate_rmse_m"] if res["odom"] else None,
-                "rpe_m": res["odom"]["rpe_mean_m"] if res["odom"] else None}
-        log(f"[{scenario}] ATE sfr {fmt(row['ate_sfr_m'])} wo {fmt(row['ate_wo_m'])} odometry {fmt(base['ate_m'])}  "
+                "rpe_m": res["odom"]["rpe_mean_m"] if res["odom"] else None, "odometry": "frame-to-frame",
+                "ate_local_map_m": res["odom_map"]["ate_rmse_m"] if res["odom_map"] else None,
+                "rpe_local_map_m": res["odom_map"]["rpe_mean_m"] if res["odom_map"] else None}
+        log(f"[{scenario}] ATE sfr {fmt(row['ate_sfr_m'])} wo {fmt(row['ate_wo_m'])} odometry {fmt(base['ate_m'])} "
+            f"(local map {fmt(base['ate_local_map_m'])})  "
             f"{hz} Hz (ms/scan {ms})")
         return row, base
 
@@ -234,7 +239,8 @@ class Bench:
             row = {"case": name, "sequence": scenario, "scans": self.scans(rep),
                    "ate_sfr_m": res["sfr"]["ate_rmse_m"] if res["sfr"] else None,
                    "ate_wo_m": res["wo"]["ate_rmse_m"] if res["wo"] else None,
-                   "ate_odometry_m": res["odom"]["ate_rmse_m"] if res["odom"] else None, "sim": info}
+                   "ate_odometry_m": res["odom"]["ate_rmse_m"] if res["odom"] else None,
+                   "ate_odometry_local_map_m": res["odom_map"]["ate_rmse_m"] if res["odom_map"] else None, "sim": info}
             if kw.get("init_offset"):
                 # Converged: the error of the last 90 % of the poses (the first ones start 1 m off).
                 row["ate_wo_after_first_s_m"] = tail_ate(gt, os.path.join(d, f"{scenario}-{name.split()[0]}-{len(out)}-wo.tum"), 1.0)
@@ -279,7 +285,7 @@ def markdown(doc):
     """The tables of docs/notes/localization.md."""
     L = []
     L.append("| sequence | speed | max / avg speed m/s | length m | RPE SFR cm | ATE SFR cm | RPE WO cm | ATE WO cm | "
-             "paper ATE SFR / WO cm | odometry ATE cm | Hz (1 core) | ms/scan seg / feat / match / opt |")
+             "paper ATE SFR / WO cm | odometry ATE cm: frame-to-frame / local map | Hz (1 core) | ms/scan seg / feat / match / opt |")
     L.append("|---|---|---|---|---|---|---|---|---|---|---|---|")
     base = {(b["sequence"], b["speed"]): b for b in doc["baseline"]}
     for r in doc["rows"]:
@@ -289,7 +295,7 @@ def markdown(doc):
         b = base.get((r["sequence"], r["speed"]), {})
         L.append(f"| {r['sequence']} | {r['speed']} | {r['max_speed_mps']:.2f} / {r['avg_speed_mps']:.2f} | {r['length_m']:.1f} | "
                  f"{fmt(r['rpe_sfr_m'], unit='')} | {fmt(r['ate_sfr_m'], unit='')} | {fmt(r['rpe_wo_m'], unit='')} | "
-                 f"{fmt(r['ate_wo_m'], unit='')} | {paper} | {fmt(b.get('ate_m'), unit='')} | {r['hz']} | "
+                 f"{fmt(r['ate_wo_m'], unit='')} | {paper} | {fmt(b.get('ate_m'), unit='')} / {fmt(b.get('ate_local_map_m'), unit='')} | {r['hz']} | "
                  f"{ms['segmenter']:.2f} / {ms['features']:.2f} / {ms['matcher']:.2f} / {ms['optimizer']:.2f} |")
     if doc.get("lookups"):
         L.append("")
@@ -300,11 +306,12 @@ def markdown(doc):
                      f"{r['optimizer_ms']:.2f} | {r['hz']} |")
     if doc.get("robustness"):
         L.append("")
-        L.append("| case | scans | ATE SFR cm | ATE WO cm | WO / clean | ATE WO after 1 s cm | odometry ATE cm |")
+        L.append("| case | scans | ATE SFR cm | ATE WO cm | WO / clean | ATE WO after 1 s cm | odometry ATE cm (f2f / map) |")
         L.append("|---|---|---|---|---|---|---|")
         for r in doc["robustness"]:
             L.append(f"| {r['case']} | {r['scans']} | {fmt(r['ate_sfr_m'], unit='')} | {fmt(r['ate_wo_m'], unit='')} | "
-                     f"{r['ratio_wo_to_clean']} | {fmt(r.get('ate_wo_after_first_s_m'), unit='')} | {fmt(r['ate_odometry_m'], unit='')} |")
+                     f"{r['ratio_wo_to_clean']} | {fmt(r.get('ate_wo_after_first_s_m'), unit='')} | "
+                     f"{fmt(r['ate_odometry_m'], unit='')} / {fmt(r['ate_odometry_local_map_m'], unit='')} |")
     return "\n".join(L) + "\n"
 
 

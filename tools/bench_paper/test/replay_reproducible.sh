@@ -19,12 +19,14 @@ for run in a b; do
     --set matcher.plan.file="$PLAN" --set optimizer.plan.file="$PLAN" \
     --set matcher.initial_pose.x="$X" --set matcher.initial_pose.y="$Y" --set matcher.initial_pose.yaw="$YAW" \
     --set odometry.initial_pose.x="$X" --set odometry.initial_pose.y="$Y" --set odometry.initial_pose.yaw="$YAW" \
+    --set odometry_map.initial_pose.x="$X" --set odometry_map.initial_pose.y="$Y" --set odometry_map.initial_pose.yaw="$YAW" \
     --set sfr_logger.file="$W/$run-sfr.tum" --set wo_logger.file="$W/$run-wo.tum" --set odom_logger.file="$W/$run-odom.tum" \
+    --set odom_map_logger.file="$W/$run-odom_map.tum" \
     >"$W/$run.json" 2>"$W/$run.err" || { cat "$W/$run.err" >&2; exit 1; }
 done
 frames=$(grep -c . "$W/gt.tum")
 fail=0
-for k in sfr wo odom; do
+for k in sfr wo odom odom_map; do
   if ! cmp -s "$W/a-$k.tum" "$W/b-$k.tum"; then
     echo "FAIL: $k trajectories of two replays differ" >&2
     diff "$W/a-$k.tum" "$W/b-$k.tum" | head -5 >&2
