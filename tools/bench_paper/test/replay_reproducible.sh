@@ -43,4 +43,21 @@ for k in sfr wo; do
   echo "$k: $frames poses, byte-identical, ATE $ate m"
   python3 -c "import sys; sys.exit(0 if $ate < 0.02 else 1)" || { echo "FAIL: $k ATE $ate m >= 0.02 m" >&2; fail=1; }
 done
+# The wrong floor plan (the corridor's) for the room sequence: the matcher must report POOR, then LOST
+# (in the frame poses and as a node error), and hold its prediction instead of jumping.
+"$BIN/fploc-replay" --graph "$ROOT/graphs/paper.pbtxt" --log "$W/log.lcm" --json \
+  --set matcher.plan.file="$ROOT/data/plans/corridor.json" --set optimizer.plan.file="$ROOT/data/plans/corridor.json" \
+  --set matcher.initial_pose.x="$X" --set matcher.initial_pose.y="$Y" --set matcher.initial_pose.yaw="$YAW" \
+  --set sfr_logger.file="$W/bad-sfr.tum" --set wo_logger.file="$W/bad-wo.tum" --set odom_logger.file="$W/bad-odom.tum" \
+  --set odom_map_logger.file="$W/bad-odom_map.tum" >"$W/bad.json" 2>"$W/bad.err" || { cat "$W/bad.err" >&2; exit 1; }
+python3 - "$W/bad.json" "$W/bad-sfr.tum" <<'PY' || fail=1
+import json, math, sys
+rep = json.loads(open(sys.argv[1]).read().strip().splitlines()[-1])
+m = [n for n in rep["nodes"] if n["name"] == "matcher"][0]
+poses = [list(map(float, l.split())) for l in open(sys.argv[2]) if l.strip()]
+jump = max(math.dist(a[1:3], b[1:3]) for a, b in zip(poses, poses[1:]))
+print(f"wrong plan: matcher errors {m['errors']}, last '{m['last_error']}', largest step {jump:.3f} m over {len(poses)} poses")
+assert m["errors"] >= 1 and "LOST" in m["last_error"], m
+assert jump < 0.2, jump
+PY
 exit $fail
