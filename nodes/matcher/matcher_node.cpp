@@ -40,6 +40,8 @@ fploc::MatcherConfig config_of(const fploc::MatcherOptions& o) {
   if (o.stride() > 0) c.stride = o.stride();
   if (o.max_points() != 0) c.max_points = o.max_points() < 0 ? 0 : o.max_points();
   c.deskew = !o.disable_deskew();
+  if (o.prediction_sigma_m() != 0) c.prediction_sigma_m = std::max(0.0, o.prediction_sigma_m());
+  if (o.prediction_sigma_deg() != 0) c.prediction_sigma_rad = std::max(0.0, o.prediction_sigma_deg()) * M_PI / 180;
   return c;
 }
 

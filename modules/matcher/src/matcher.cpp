@@ -19,10 +19,25 @@ Eigen::Matrix3d covariance_of(const Eigen::Matrix3d& H, double sigma2) {
   return sigma2 * es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
 }
 
+struct PriorCost {
+  PosePrior p;
+  template <typename T>
+  bool operator()(const T* x, T* r) const {
+    using std::atan2;
+    using std::cos;
+    using std::sin;
+    const T d = x[2] - T(p.pose.yaw);
+    r[0] = T(p.sqrt_info[0]) * (x[0] - T(p.pose.x));
+    r[1] = T(p.sqrt_info[1]) * (x[1] - T(p.pose.y));
+    r[2] = T(p.sqrt_info[2]) * atan2(sin(d), cos(d));
+    return true;
+  }
+};
+
 }  // namespace
 
 MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& guess,
-                           const MatcherConfig& cfg) {
+                           const MatcherConfig& cfg, const PosePrior* prior) {
   MatchResult r;
   r.predicted = guess;
   double x[3] = {guess.x, guess.y, guess.yaw};
@@ -55,6 +70,7 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
     if (as.size() < 3) break;
     auto problem = std::make_unique<ceres::Problem>(po);
     add_frame_term(problem.get(), x, lookup, f, as, cfg.loss, cfg.loss_scale_m);
+    if (prior) problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, 3>(new PriorCost{*prior}), nullptr, x);
     const double before[3] = {x[0], x[1], x[2]};
     ceres::Solver::Summary sum;
     ceres::Solve(so, problem.get(), &sum);
@@ -71,7 +87,7 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
   r.pose = r.solved;
   // Fit quality over the points the registration used (every ao.stride-th).
   r.fit = evaluate_fit(lookup, f, r.solved, cfg.inlier_m, ao.stride);
-  if (solved)
+  if (solved)  // of the floor-plan terms alone (what this frame says, without the prediction)
     r.covariance = covariance_of(frame_information(lookup, f, last_as, r.solved, cfg.loss, cfg.loss_scale_m),
                                  std::max(r.fit.rms_m * r.fit.rms_m, 1e-6));
   else r.covariance = Eigen::Matrix3d::Identity() * 1e6;
@@ -155,7 +171,18 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
           have = true;
         }
   } else {
-    r = register_frame(lookup_, in, pred, cfg);
+    PosePrior prior;
+    const double dt = (tau - tau_) * 1e-6;
+    const bool use_prior = tracking && have_velocity_ && cfg_.motion_model && last_rms_ > 0 && dt > 0 && dt < 1.0 &&
+                           cfg_.prediction_sigma_m > 0 && cfg_.prediction_sigma_rad > 0;
+    if (use_prior) {
+      // sigma_r / sigma_pred: the prediction as a measurement among point residuals of rms sigma_r.
+      const double grow = std::max(1.0, dt / 0.1), sr = std::clamp(last_rms_, 0.005, cfg_.loss_scale_m);
+      prior.pose = pred;
+      prior.sqrt_info = Eigen::Vector3d(sr / (cfg_.prediction_sigma_m * grow), sr / (cfg_.prediction_sigma_m * grow),
+                                        sr / (cfg_.prediction_sigma_rad * grow));
+    }
+    r = register_frame(lookup_, in, pred, cfg, use_prior ? &prior : nullptr);
   }
   const Pose2 solved_ref = r.solved;
   const double jump = std::hypot(solved_ref.x - pred.x, solved_ref.y - pred.y);
@@ -172,6 +199,7 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
     }
     pose_ = solved_ref;
     poor_count_ = 0;
+    last_rms_ = r.fit.rms_m;
   } else {
     ++poor_count_;
     pose_ = pred;

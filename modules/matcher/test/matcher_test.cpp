@@ -395,3 +395,34 @@ TEST(Matcher, CabinetsAlongAWallDoNotPullAKnownPose) {
   }
   EXPECT_LT(worst, 0.01);
 }
+
+TEST(PlanTerms, PosePriorHoldsOnlyTheDirectionThePlanLeavesOpen) {
+  // A straight corridor seen without its ends: along it the floor plan says nothing, so the prior (the
+  // motion model's prediction in the matcher) decides; across it and in yaw the walls decide, even
+  // against a prior that is 10 cm / 2 degrees off.
+  FloorPlan plan;
+  plan.elements.push_back(Element::segment({-100, 0}, {100, 0}));
+  plan.elements.push_back(Element::segment({-100, 2}, {100, 2}));
+  auto map = make_localization_map(plan, "brute-force");
+  SynthOptions so;
+  so.max_range = 8;
+  so.noise_sigma = 0.01;
+  const Pose2 truth{0, 1, 0};
+  const FeatureFrame f = synth_frame(plan, truth, so);
+  MatcherConfig cfg;
+  cfg.gate_initial_m = 0.3;
+  const Pose2 guess{0.3, 1.05, 0.02};
+  // Without the prior the along-track position is whatever the solver's steps in the null direction
+  // make of it (Levenberg-Marquardt damps a direction without curvature hardly at all).
+  const MatchResult free = register_frame(*map.lookup, f, guess, cfg);
+  std::printf("along-track without prior: %.3f m (guess %.3f), covariance xx %.3g vs yy %.3g\n", free.pose.x, guess.x,
+              free.covariance(0, 0), free.covariance(1, 1));
+  EXPECT_NEAR(free.pose.y, truth.y, 1e-3);
+  PosePrior prior;
+  prior.pose = {0.0, 1.1, 0.035};
+  prior.sqrt_info = Eigen::Vector3d(1.0, 1.0, 1.0);  // one point's worth of a 1 cm / 0.01 rad prediction
+  const MatchResult r = register_frame(*map.lookup, f, guess, cfg, &prior);
+  EXPECT_NEAR(r.pose.x, 0.0, 1e-3);         // along: the prior
+  EXPECT_NEAR(r.pose.y, truth.y, 1e-3);     // across: the walls
+  EXPECT_NEAR(r.pose.yaw, truth.yaw, 1e-3);
+}

@@ -33,6 +33,20 @@ struct MatcherConfig {
   bool deskew = true;             // motion compensation with the motion model's twist (IMU yaw rate if given)
   int stride = 1;                 // use every stride-th point
   int max_points = 800;           // more features than this: the stride grows to keep about this many (0 = all)
+  // While tracking, the prediction enters the registration as one more measurement: its uncertainty over
+  // one frame (a platform's deviation from constant velocity in 0.1 s plus the velocity estimate's error;
+  // grows with the time since the last frame), weighed against the floor-plan residuals by the last fit's
+  // rms. Negligible where the plan constrains the pose (hundreds of points), it holds the directions the
+  // plan leaves open (along a featureless wall) instead of letting them slide. 0 = no prior.
+  double prediction_sigma_m = 0.01;
+  double prediction_sigma_rad = 0.01;
+};
+
+// A Gaussian prior on the registered pose (the motion model's prediction), as residuals
+// sqrt_info (x - pose) (yaw difference wrapped) beside the floor-plan terms.
+struct PosePrior {
+  Pose2 pose;
+  Eigen::Vector3d sqrt_info = Eigen::Vector3d::Zero();  // per x, y, yaw, in the floor-plan terms' units
 };
 
 struct MatchResult {
@@ -52,7 +66,7 @@ struct MatchResult {
 // Stateless registration from an initial guess (used by the Matcher and by tests). `f` is registered as
 // given (motion compensation, if any, is the caller's: see deskew()).
 MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& guess,
-                           const MatcherConfig& cfg);
+                           const MatcherConfig& cfg, const PosePrior* prior = nullptr);
 
 class Matcher {
  public:
@@ -84,6 +98,7 @@ class Matcher {
   int64_t tau_ = 0;
   Twist2 twist_;                // constant body twist between the last two registered sweep poses
   int poor_count_ = 0;
+  double last_rms_ = 0;         // fit rms of the last OK frame
   double search_m_ = 0;         // uncertainty of the pose given by set_pose
   double search_yaw_ = 0;
   FeatureFrame deskewed_;       // scratch
