@@ -7,11 +7,11 @@
 
 #include <chrono>
 #include <cmath>
-#include <deque>
 #include <iostream>
 #include <memory>
 #include <optional>
 
+#include "fploc/matcher/imu_yaw.h"
 #include "fploc/matcher/map.h"
 #include "fploc/matcher/matcher.h"
 #include "fploc/nodes/localization_convert.h"
@@ -40,6 +40,9 @@ fploc::MatcherConfig config_of(const fploc::MatcherOptions& o) {
   c.motion_model = !o.disable_motion_model();
   if (o.stride() > 0) c.stride = o.stride();
   if (o.max_points() != 0) c.max_points = o.max_points() < 0 ? 0 : o.max_points();
+  c.deskew = !o.disable_deskew();
+  if (o.prediction_sigma_m() != 0) c.prediction_sigma_m = std::max(0.0, o.prediction_sigma_m());
+  if (o.prediction_sigma_deg() != 0) c.prediction_sigma_rad = std::max(0.0, o.prediction_sigma_deg()) * M_PI / 180;
   return c;
 }
 
@@ -62,10 +65,11 @@ class MatcherNode : public fploc::rt::Node {
                                         o.lookup().empty() ? "annf-exact" : o.lookup());
     matcher_ = std::make_unique<fploc::Matcher>(*map_.lookup, config_of(o));
     use_imu_ = !o.ignore_imu();
+    if (o.initial_search_m() > 0) initial_search_m_ = o.initial_search_m();
     // The graph's initial pose is where the run starts; a restarted matcher (crash, module swap) waits for
     // a pose instead (FPLOC_INITIAL_POSE: the relocalizer searches around the last good pose).
     if (!o.wait_for_initial_pose() && ctx.restarts() == 0)
-      matcher_->set_pose({o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()});
+      matcher_->set_pose({o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()}, initial_search_m_);
     else if (ctx.restarts() > 0)
       std::cerr << "[" << ctx.name() << "] restart " << ctx.restarts() << ": waiting for a pose on initial_pose\n";
     out_ = ctx.advertise<fploc::frame_pose_t>("frame_pose");
@@ -77,30 +81,15 @@ class MatcherNode : public fploc::rt::Node {
         ctx_->error("initial_pose seq " + std::to_string(m.seq) + ": non-finite pose (ignored)");
         return;
       }
-      matcher_->set_pose(p);
+      // Search within 3 sigma of the message's position covariance when it has one.
+      const double var = std::max(m.covariance[0], m.covariance[7]);
+      matcher_->set_pose(p, std::isfinite(var) && var > 0 ? std::optional<double>(3 * std::sqrt(var)) : initial_search_m_);
     });
   }
 
  private:
   void on_imu(const fploc::imu_t& m) {
-    if (!use_imu_ || !std::isfinite(m.gyro[2])) return;
-    if (!imu_.empty() && m.utime <= imu_.back().first) return;  // out of order / duplicate
-    imu_.emplace_back(m.utime, m.gyro[2]);
-    while (imu_.size() > 4000) imu_.pop_front();
-  }
-
-  // Integrated gyro z over (t0, t1] (trapezoid over the samples inside, held at the ends); nullopt when
-  // the samples do not cover the interval.
-  std::optional<double> yaw_delta(int64_t t0, int64_t t1) {
-    if (imu_.size() < 2 || t1 <= t0 || imu_.front().first > t0 || imu_.back().first < t1 - 20000) return std::nullopt;
-    double sum = 0;
-    for (size_t i = 1; i < imu_.size(); ++i) {
-      const int64_t a = std::max(imu_[i - 1].first, t0), b = std::min(imu_[i].first, t1);
-      if (b <= a) continue;
-      sum += 0.5 * (imu_[i - 1].second + imu_[i].second) * (b - a) * 1e-6;
-    }
-    while (imu_.size() > 2 && imu_[1].first < t0) imu_.pop_front();
-    return sum;
+    if (use_imu_) imu_.add(m.utime, m.gyro[2]);  // out of order / non-finite samples are ignored
   }
 
   void on_features(const fploc::features_t& m) {
@@ -114,8 +103,22 @@ class MatcherNode : public fploc::rt::Node {
       return;
     }
     if (dropped) ctx_->error("features seq " + std::to_string(m.seq) + ": " + std::to_string(dropped) + " non-finite points dropped");
+    // Roll/pitch/z the segmenter could not estimate (its "unknown" sigmas): the last known ones are
+    // passed on (the optimizer interpolates them in its final poses).
+    if (f.z_sigma < 1.0) last_z_ = f.z;
+    else if (last_z_) f.z = *last_z_;
+    if (f.roll_pitch_sigma < 0.5) last_rp_ = {f.roll, f.pitch};
+    else if (last_rp_) f.roll = last_rp_->first, f.pitch = last_rp_->second;
     std::optional<double> dyaw;
-    if (use_imu_ && have_prev_) dyaw = yaw_delta(prev_utime_, f.utime);
+    if (use_imu_) {
+      // Prediction: the yaw change since the previous frame; motion compensation: the mean rate over
+      // this frame's sweep (its samples arrive before the scan is complete).
+      if (have_prev_) dyaw = imu_.integral(prev_utime_, f.utime);
+      const double sweep = fploc::sweep_duration(f);
+      if (sweep > 0)
+        if (auto w = imu_.mean_rate(f.utime, f.utime + std::llround(sweep * 1e6))) f.sweep_yaw_rate = *w;
+      imu_.drop_before(std::min(f.utime, have_prev_ ? prev_utime_ : f.utime));
+    }
     const fploc::MatchResult r = matcher_->process(f, dyaw);
     if (r.status != FitStatus::kNotInitialised) {
       prev_utime_ = f.utime;
@@ -134,6 +137,9 @@ class MatcherNode : public fploc::rt::Node {
     o.roll = f.roll;
     o.pitch = f.pitch;
     o.z = f.z;
+    o.twist[0] = r.twist.vx;
+    o.twist[1] = r.twist.vy;
+    o.twist[2] = r.twist.w;
     o.num_points = r.fit.num_points;
     o.num_inliers = r.fit.num_inliers;
     o.inlier_ratio = r.fit.inlier_ratio;
@@ -151,8 +157,11 @@ class MatcherNode : public fploc::rt::Node {
   fploc::LocalizationMap map_;
   std::unique_ptr<fploc::Matcher> matcher_;
   fploc::rt::Publisher<fploc::frame_pose_t> out_;
-  std::deque<std::pair<int64_t, double>> imu_;
+  fploc::ImuYaw imu_;
   bool use_imu_ = true;
+  std::optional<double> initial_search_m_;
+  std::optional<double> last_z_;
+  std::optional<std::pair<double, double>> last_rp_;
   bool have_prev_ = false;
   int64_t prev_utime_ = 0;
   int64_t seq_ = 0;

@@ -31,6 +31,11 @@ class OdometryNode : public fploc::rt::Node {
     if (o.keyframe_angle_deg() > 0) c.keyframe_angle_rad = o.keyframe_angle_deg() * M_PI / 180;
     if (o.map_keyframes() > 0) c.map_keyframes = o.map_keyframes();
     if (o.max_iterations() > 0) c.max_iterations = o.max_iterations();
+    if (o.frame_to_frame()) {
+      c.map_keyframes = 1;
+      c.keyframe_distance_m = 0;
+      c.keyframe_angle_rad = 0;
+    }
     odo_ = std::make_unique<fploc::Odometry2D>(c);
     odo_->set_pose({o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()});
     out_ = ctx.advertise<fploc::pose_t>("pose");

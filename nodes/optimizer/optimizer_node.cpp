@@ -36,6 +36,13 @@ fploc::OptimizerConfig config_of(const fploc::OptimizerOptions& o) {
   if (o.max_points() != 0) c.max_points = o.max_points() < 0 ? 0 : o.max_points();
   if (o.max_keyframe_gap_s() > 0) c.max_keyframe_gap_s = o.max_keyframe_gap_s();
   c.anchor_final = o.anchor_final();
+  c.body_frame_velocity = o.body_frame_velocity();
+  if (o.relook_m() > 0) {
+    c.relook_rad *= o.relook_m() / c.relook_m;
+    c.relook_m = o.relook_m();
+  }
+  if (!o.linear_solver().empty()) c.linear_solver = o.linear_solver();
+  c.budget_weight = !o.disable_budget_weight();
   c.group_rule = !o.disable_group_rule();
   return c;
 }
@@ -113,6 +120,8 @@ class OptimizerNode : public fploc::rt::Node {
     fploc::FrameInput in;
     in.features = std::move(f);
     in.sfr = {fp.x, fp.y, fp.yaw};
+    if (std::isfinite(fp.twist[0]) && std::isfinite(fp.twist[1]) && std::isfinite(fp.twist[2]))
+      in.twist = {fp.twist[0], fp.twist[1], fp.twist[2]};
     in.status = fp.status <= 2 ? FitStatus(fp.status) : FitStatus::kLost;
     for (int i = 0; i < 9; ++i) in.covariance(i / 3, i % 3) = fp.covariance[i];
     if (!std::isfinite(fp.x) || !std::isfinite(fp.y) || !std::isfinite(fp.yaw)) {

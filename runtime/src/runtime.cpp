@@ -2,6 +2,7 @@
 #include <fploc/node_status_t.hpp>
 #include <poll.h>
 #include <signal.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -118,8 +119,15 @@ void Context::publish_raw(const std::string& channel, const void* data, int size
   }
 }
 
+static double thread_cpu_s() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
 static void raw_handler(const lcm::ReceiveBuffer* rbuf, const std::string&, HandlerEntry* h) {
   const double t0 = now_s();
+  const double c0 = h->ctx->composed() ? thread_cpu_s() : 0.0;
   bool ok = false;
   try {
     ok = h->fn(rbuf->data, int(rbuf->data_size));
@@ -138,8 +146,12 @@ static void raw_handler(const lcm::ReceiveBuffer* rbuf, const std::string&, Hand
   const double dt = now_s() - t0;
   // Live nodes: per-heartbeat window (reset every second). Composed replay: every call (the breakdown
   // of `fploc replay --json`); keeping both in a live node would grow without bound.
-  if (h->ctx->composed()) h->ctx->stats().latency_total.add(dt * 1e3);
-  else h->ctx->stats().latency.add(dt * 1e3);
+  if (h->ctx->composed()) {
+    h->ctx->stats().latency_total.add(dt * 1e3);
+    h->ctx->stats().cpu_s_total += thread_cpu_s() - c0;
+  } else {
+    h->ctx->stats().latency.add(dt * 1e3);
+  }
   h->ctx->stats().busy_s_period += dt;
 }
 

@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> layers;
   uint64_t seed = 0;
   bool no_clutter = false, no_patches = false, json = false;
-  double noise = 0.02, dropout = 0.01, imu_rate = 100, duration = 0, ceiling = 0;
+  double noise = 0.02, dropout = 0.01, imu_rate = 100, duration = 0, ceiling = 0, wall_clutter = 0, drop_scans = 0;
   app.add_option("--plan", plan_file, "floor plan (.dxf/.csv/.json/.fpmap); default: the scenario's demo plan");
   app.add_option("--layers", layers, "layer globs")->delimiter(',');
   app.add_option("--units", units, "m|cm|mm override");
@@ -64,6 +64,8 @@ int main(int argc, char** argv) {
   app.add_option("--ceiling", ceiling, "ceiling height [m] (0 = scenario default)");
   app.add_option("--duration", duration, "stop after this many seconds (0 = whole scenario)");
   app.add_flag("--no-clutter", no_clutter, "no furniture or people");
+  app.add_option("--wall-clutter", wall_clutter, "fraction of the wall length hidden behind 2 m cabinets (robustness tests)");
+  app.add_option("--drop-scans", drop_scans, "fraction of scans left out of the log (deterministic for a seed; robustness tests)");
   app.add_flag("--no-ceiling-patches", no_patches, "flat ceiling everywhere");
   app.add_flag("--json", json, "print a JSON summary on stdout");
   app.add_option("--write-demo-plans", demo_dir, "write the demo plans (room.json, corridor.json) into DIR and exit");
@@ -87,6 +89,9 @@ int main(int argc, char** argv) {
     o.scenario = scenario;
     o.seed = seed;
     o.clutter = !no_clutter;
+    if (!(wall_clutter >= 0 && wall_clutter <= 1)) throw std::runtime_error("--wall-clutter: expected a fraction 0..1");
+    if (!(drop_scans >= 0 && drop_scans < 1)) throw std::runtime_error("--drop-scans: expected a fraction 0..1 (less than 1)");
+    o.wall_clutter = wall_clutter;
     o.ceiling_patches = !no_patches;
     o.range_noise_m = noise;
     o.dropout = dropout;
@@ -112,7 +117,8 @@ int main(int argc, char** argv) {
     size_t imu_k = 0;
     int64_t imu_seq = 0;
     const auto& imu = sim.imu();
-    int frames = 0;
+    int frames = 0, dropped = 0;
+    uint64_t drop_state = seed * 2654435761u + 1;
     auto flush_imu = [&](double until) {
       for (; imu_k < imu.size() && o.t0_s + imu[imu_k].t <= until; ++imu_k) {
         fploc::imu_t m;
@@ -141,8 +147,13 @@ int main(int argc, char** argv) {
       // The scan is complete at the end of its sweep.
       const double t_pub = ts + period;
       flush_imu(t_pub);
-      fploc::to_msg(f.scan, sm);
-      write_event(log, int64_t(std::llround(t_pub * 1e6)), "OS1_SCAN", sm, buf);
+      drop_state = drop_state * 6364136223846793005ull + 1442695040888963407ull;
+      if (drop_scans > 0 && double(drop_state >> 11) / double(1ull << 53) < drop_scans) {
+        ++dropped;  // lost on the way: ground truth and IMU stay
+      } else {
+        fploc::to_msg(f.scan, sm);
+        write_event(log, int64_t(std::llround(t_pub * 1e6)), "OS1_SCAN", sm, buf);
+      }
       ++frames;
       if (frames % 100 == 0) std::cerr << "\r  frame " << frames << "/" << sim.num_frames() << std::flush;
     }
@@ -151,13 +162,15 @@ int main(int argc, char** argv) {
     fploc::write_tum(gt, traj);
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     const double simulated = frames * period;
-    std::cerr << "fploc sim: wrote " << frames << " scans, " << imu_k << " IMU samples to " << out << " in " << wall
+    if (dropped) std::cerr << "fploc sim: " << dropped << " of " << frames << " scans dropped (--drop-scans)\n";
+    std::cerr << "fploc sim: wrote " << frames - dropped << " scans, " << imu_k << " IMU samples to " << out << " in " << wall
               << " s (" << simulated / std::max(wall, 1e-9) << "x real time)\n";
     if (json) {
       nlohmann::json j;
       j["scenario"] = scenario;
       j["seed"] = seed;
       j["frames"] = frames;
+      j["scans_dropped"] = dropped;
       j["imu_samples"] = imu_k;
       j["length_m"] = sim.motion().length();
       j["avg_speed_mps"] = sim.motion().avg_speed();

@@ -7,6 +7,29 @@
 
 namespace fploc {
 
+const std::vector<TargetGeom>& NearestLookup::geometry() const {
+  std::call_once(geom_once_, [this] {
+    const auto& t = targets();
+    geom_.resize(t.size());
+    for (size_t i = 0; i < t.size(); ++i) {
+      const Element& e = t[i];
+      TargetGeom& g = geom_[i];
+      g.kind = e.kind;
+      g.a = e.a;
+      g.b = e.b;
+      g.c = e.c;
+      g.r = e.r;
+      g.a0 = e.a0;
+      g.a1 = e.a1;
+      if (e.kind == ElementKind::kSegment) {
+        g.len = (e.b - e.a).norm();
+        if (g.len > 0) g.u = (e.b - e.a) / g.len;
+      }
+    }
+  });
+  return geom_;
+}
+
 int BruteForceLookup::candidates(const Eigen::Vector2d& p, int* out, int max) const {
   if (max <= 0) return 0;
   const int i = nearest_element_brute_force(plan_, p);

@@ -8,51 +8,47 @@
 
 namespace fploc {
 
-std::unique_ptr<ceres::LossFunction> make_loss(const std::string& name, double scale) {
-  if (name == "none" || scale <= 0) return nullptr;
-  if (name == "cauchy") return std::make_unique<ceres::CauchyLoss>(scale);
-  return std::make_unique<ceres::HuberLoss>(scale);
-}
-
 namespace {
 
-// (J^T J)^-1 scaled by sigma^2, with a floor on the eigenvalues (degenerate directions, e.g. along a
-// corridor, get a large variance instead of an inverse of zero).
-Eigen::Matrix3d covariance_of(ceres::Problem& problem, double sigma2) {
-  ceres::Problem::EvaluateOptions eo;
-  eo.num_threads = 1;
-  ceres::CRSMatrix jac;
-  double cost = 0;
-  if (!problem.Evaluate(eo, &cost, nullptr, nullptr, &jac) || jac.num_cols != 3) return Eigen::Matrix3d::Identity() * 1e6;
-  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
-  for (int r = 0; r < jac.num_rows; ++r) {
-    Eigen::Vector3d row = Eigen::Vector3d::Zero();
-    for (int k = jac.rows[r]; k < jac.rows[r + 1]; ++k) row[jac.cols[k]] = jac.values[k];
-    H += row * row.transpose();
-  }
+// sigma^2 H^-1 with a floor on H's eigenvalues (degenerate directions, e.g. along a corridor, get a
+// large variance instead of an inverse of zero).
+Eigen::Matrix3d covariance_of(const Eigen::Matrix3d& H, double sigma2) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(H);
   Eigen::Vector3d inv;
   for (int i = 0; i < 3; ++i) inv[i] = 1.0 / std::max(es.eigenvalues()[i], 1e-6);
   return sigma2 * es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
 }
 
+struct PriorCost {
+  PosePrior p;
+  template <typename T>
+  bool operator()(const T* x, T* r) const {
+    using std::atan2;
+    using std::cos;
+    using std::sin;
+    const T d = x[2] - T(p.pose.yaw);
+    r[0] = T(p.sqrt_info[0]) * (x[0] - T(p.pose.x));
+    r[1] = T(p.sqrt_info[1]) * (x[1] - T(p.pose.y));
+    r[2] = T(p.sqrt_info[2]) * atan2(sin(d), cos(d));
+    return true;
+  }
+};
+
 }  // namespace
 
 MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& guess,
-                           const MatcherConfig& cfg) {
+                           const MatcherConfig& cfg, const PosePrior* prior) {
   MatchResult r;
   r.predicted = guess;
   double x[3] = {guess.x, guess.y, guess.yaw};
-  auto loss = make_loss(cfg.loss, cfg.loss_scale_m);
   AssignOptions ao;
   ao.gate_m = std::max(cfg.gate_initial_m, cfg.gate_final_m);
   ao.group_rule = cfg.group_rule;
   ao.stride = std::max(1, cfg.stride);
   if (cfg.max_points > 0 && int(f.points.size()) > cfg.max_points * ao.stride)
     ao.stride = int((f.points.size() + size_t(cfg.max_points) - 1) / size_t(cfg.max_points));
-  std::vector<Assignment> as;
+  std::vector<Assignment> as, last_as;
   ceres::Problem::Options po;
-  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   po.disable_all_safety_checks = true;
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
@@ -62,21 +58,26 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
   so.minimizer_progress_to_stdout = false;
   so.function_tolerance = 1e-8;
   so.parameter_tolerance = 1e-8;
-  std::unique_ptr<ceres::Problem> problem;
   bool solved = false;
+  double last_gate = -1;
   // Point targets (kdtree) fix the correspondence for a whole inner solve, like classic ICP, and need
   // many more look-up rounds to converge: give them 6x, so they are measured converged, not truncated.
   const int max_outer = std::max(1, cfg.max_outer) * (lookup.element_targets() ? 1 : 6);
   for (int outer = 0; outer < max_outer; ++outer) {
     assign(lookup, f, Pose2{x[0], x[1], x[2]}, ao, &as);
+    // The same correspondences under the same gate as the last solve: that solve's result is the answer.
+    if (solved && ao.gate_m == last_gate && as == last_as) break;
     if (as.size() < 3) break;
-    problem = std::make_unique<ceres::Problem>(po);
+    auto problem = std::make_unique<ceres::Problem>(po);
     add_frame_term(problem.get(), x, lookup, f, as, cfg.loss, cfg.loss_scale_m);
+    if (prior) problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, 3>(new PriorCost{*prior}), nullptr, x);
     const double before[3] = {x[0], x[1], x[2]};
     ceres::Solver::Summary sum;
     ceres::Solve(so, problem.get(), &sum);
     r.iterations += int(sum.iterations.size());
     solved = true;
+    last_gate = ao.gate_m;
+    std::swap(last_as, as);
     const double step = std::hypot(x[0] - before[0], x[1] - before[1]) + std::abs(x[2] - before[2]);
     const bool final_gate = ao.gate_m <= cfg.gate_final_m + 1e-12;
     if (final_gate && step < 1e-5) break;
@@ -84,8 +85,11 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
   }
   r.solved = Pose2{x[0], x[1], wrap_angle(x[2])};
   r.pose = r.solved;
-  r.fit = evaluate_fit(lookup, f, r.solved, cfg.inlier_m);
-  if (solved && problem) r.covariance = covariance_of(*problem, std::max(r.fit.rms_m * r.fit.rms_m, 1e-6));
+  // Fit quality over the points the registration used (every ao.stride-th).
+  r.fit = evaluate_fit(lookup, f, r.solved, cfg.inlier_m, ao.stride);
+  if (solved)  // of the floor-plan terms alone (what this frame says, without the prediction)
+    r.covariance = covariance_of(frame_information(lookup, f, last_as, r.solved, cfg.loss, cfg.loss_scale_m),
+                                 std::max(r.fit.rms_m * r.fit.rms_m, 1e-6));
   else r.covariance = Eigen::Matrix3d::Identity() * 1e6;
   const bool ok = solved && r.fit.num_inliers >= cfg.min_inliers && r.fit.inlier_ratio >= cfg.min_inlier_ratio;
   r.status = ok ? FitStatus::kOk : FitStatus::kPoor;
@@ -96,26 +100,24 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
 
 Matcher::Matcher(const NearestLookup& lookup, MatcherConfig cfg) : lookup_(lookup), cfg_(std::move(cfg)) {}
 
-void Matcher::set_pose(const Pose2& p) {
+void Matcher::set_pose(const Pose2& p, std::optional<double> search_m, std::optional<double> search_yaw) {
   pose_ = p;
+  search_m_ = search_m && *search_m > 0 ? *search_m : cfg_.gate_initial_m;
+  search_yaw_ = search_yaw && *search_yaw > 0 ? *search_yaw : cfg_.initial_search_yaw_rad;
   initialised_ = true;
   have_last_ = false;
   have_velocity_ = false;
-  velocity_.setZero();
+  twist_ = {};
   poor_count_ = 0;
 }
 
-Pose2 Matcher::predict(int64_t utime, std::optional<double> yaw_delta) const {
-  Pose2 p = pose_;
-  const double dt = (utime - utime_) * 1e-6;
+Pose2 Matcher::predict(int64_t tau, std::optional<double> yaw_delta) const {
+  const double dt = (tau - tau_) * 1e-6;
   const bool valid_dt = have_last_ && dt > 0 && dt < 1.0;
-  if (cfg_.motion_model && have_velocity_ && valid_dt) {
-    p.x += velocity_[0] * dt;
-    p.y += velocity_[1] * dt;
-    p.yaw += velocity_[2] * dt;
-  }
-  if (yaw_delta && (valid_dt || !have_last_)) p.yaw = pose_.yaw + *yaw_delta;
-  p.yaw = wrap_angle(p.yaw);
+  Twist2 v;
+  if (cfg_.motion_model && have_velocity_ && valid_dt) v = twist_;
+  Pose2 p = valid_dt ? compose(pose_, exp_twist(v, dt)) : pose_;
+  if (yaw_delta && (valid_dt || !have_last_)) p.yaw = wrap_angle(pose_.yaw + *yaw_delta);
   return p;
 }
 
@@ -127,43 +129,99 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
     r.fit.num_points = int(f.points.size());
     return r;
   }
-  const Pose2 pred = predict(f.utime, yaw_delta);
-  MatcherConfig cfg = cfg_;
+  const double t_ref = cfg_.deskew ? mean_time(f) : 0.0;
+  const int64_t tau = f.utime + std::llround(t_ref * 1e6);
+  const Pose2 pred = predict(tau, yaw_delta);
   const bool lost = poor_count_ >= cfg_.lost_after;
-  if (lost) cfg.gate_initial_m *= 2;  // search wider while lost
-  // Tracking (the previous frame was registered): the motion model is good to centimetres, so start
-  // with the tracking gate (fewer look-up rounds).
-  else if (have_last_ && poor_count_ == 0) cfg.gate_initial_m = std::min(cfg.gate_initial_m, cfg.gate_tracking_m);
-  MatchResult r = register_frame(lookup_, f, pred, cfg);
-  r.predicted = pred;
-  const double jump = std::hypot(r.solved.x - pred.x, r.solved.y - pred.y);
-  const double jump_yaw = std::abs(wrap_angle(r.solved.yaw - pred.yaw));
+  // Gates: tracking (the previous frame OK) starts at the tracking gate, the first frame after set_pose
+  // searches within the given pose's uncertainty, after a POOR frame the gate starts wide, and wider
+  // still while LOST; each is halved per look-up round down to gate_final_m.
+  MatcherConfig cfg = cfg_;
+  const bool tracking = have_last_ && poor_count_ == 0;
+  if (lost) cfg.gate_initial_m *= 2;
+  else if (tracking) cfg.gate_initial_m = std::min(cfg.gate_initial_m, cfg.gate_tracking_m);
+  else if (!have_last_) cfg.gate_initial_m = search_m_;
+  // Motion compensation: the sweep's points moved to the sensor frame at utime + t_ref with the motion
+  // model's body twist (zero linear velocity until two frames were registered), the IMU's yaw rate.
+  Twist2 tw;
+  if (cfg_.motion_model && have_velocity_ && !lost) tw = twist_;
+  if (std::isfinite(f.sweep_yaw_rate)) tw.w = f.sweep_yaw_rate;
+  const bool comp = cfg_.deskew && (tw.vx != 0 || tw.vy != 0 || tw.w != 0);
+  if (comp) deskew(f, tw, t_ref, &deskewed_);
+  const FeatureFrame& in = comp ? deskewed_ : f;
+  MatchResult r;
+  if (!have_last_ && search_m_ > 2 * cfg_.gate_tracking_m) {
+    // First frame from a pose known only to within search_m / search_yaw: one registration converges
+    // from about half a metre / a few degrees, so start from a grid over the uncertainty (spacing 2/3 of
+    // it, the given pose first) and keep the fit with the most inliers (then the lower rms).
+    const double s = search_m_ * 2 / 3, a = search_yaw_ * 2 / 3;
+    MatcherConfig c = cfg;
+    c.gate_initial_m = std::max(s, cfg_.gate_final_m);
+    bool have = false;
+    for (double dyaw : {0.0, -a, a})
+      for (double dx : {0.0, -s, s})
+        for (double dy : {0.0, -s, s}) {
+          MatchResult ri = register_frame(lookup_, in, Pose2{pred.x + dx, pred.y + dy, wrap_angle(pred.yaw + dyaw)}, c);
+          const int it = r.iterations + ri.iterations;
+          const bool better = !have || (ri.status == FitStatus::kOk && r.status != FitStatus::kOk) ||
+                              (ri.status == r.status && (ri.fit.num_inliers > r.fit.num_inliers ||
+                                                         (ri.fit.num_inliers == r.fit.num_inliers && ri.fit.rms_m < r.fit.rms_m)));
+          if (better) r = ri;
+          r.iterations = it;
+          have = true;
+        }
+  } else {
+    PosePrior prior;
+    const double dt = (tau - tau_) * 1e-6;
+    const bool use_prior = tracking && have_velocity_ && cfg_.motion_model && last_rms_ > 0 && dt > 0 && dt < 1.0 &&
+                           cfg_.prediction_sigma_m > 0 && cfg_.prediction_sigma_rad > 0;
+    if (use_prior) {
+      // sigma_r / sigma_pred: the prediction as a measurement among point residuals of rms sigma_r.
+      const double grow = std::max(1.0, dt / 0.1), sr = std::clamp(last_rms_, 0.005, cfg_.loss_scale_m);
+      prior.pose = pred;
+      prior.sqrt_info = Eigen::Vector3d(sr / (cfg_.prediction_sigma_m * grow), sr / (cfg_.prediction_sigma_m * grow),
+                                        sr / (cfg_.prediction_sigma_rad * grow));
+    }
+    r = register_frame(lookup_, in, pred, cfg, use_prior ? &prior : nullptr);
+  }
+  const Pose2 solved_ref = r.solved;
+  const double jump = std::hypot(solved_ref.x - pred.x, solved_ref.y - pred.y);
+  const double jump_yaw = std::abs(wrap_angle(solved_ref.yaw - pred.yaw));
   if (r.status == FitStatus::kOk && have_last_ && !lost && (jump > cfg_.max_jump_m || jump_yaw > cfg_.max_jump_rad)) {
     r.status = FitStatus::kPoor;
     r.text = "refused jump of " + std::to_string(jump) + " m";
   }
-  const double dt = (f.utime - utime_) * 1e-6;
+  const double dt = (tau - tau_) * 1e-6;
   if (r.status == FitStatus::kOk) {
     if (have_last_ && dt > 0 && dt < 1.0) {
-      velocity_ = Eigen::Vector3d((r.solved.x - pose_.x) / dt, (r.solved.y - pose_.y) / dt,
-                                  wrap_angle(r.solved.yaw - pose_.yaw) / dt);
+      twist_ = log_twist(pose_, solved_ref, dt);
       have_velocity_ = true;
     }
-    pose_ = r.solved;
+    pose_ = solved_ref;
     poor_count_ = 0;
+    last_rms_ = r.fit.rms_m;
   } else {
     ++poor_count_;
-    r.pose = pred;
     pose_ = pred;
     if (poor_count_ >= cfg_.lost_after) {
       r.status = FitStatus::kLost;
-      velocity_.setZero();
+      twist_ = {};
       have_velocity_ = false;
     }
     if (r.text.empty()) r.text = "poor fit";
   }
-  utime_ = f.utime;
+  tau_ = tau;
   have_last_ = true;
+  // Back from utime + t_ref to utime with the updated twist (centred on this sweep).
+  Twist2 back = have_velocity_ ? twist_ : Twist2{};
+  if (std::isfinite(f.sweep_yaw_rate)) back.w = f.sweep_yaw_rate;
+  const Pose2 to_utime = exp_twist(back, -t_ref);
+  r.t_ref = t_ref;
+  r.twist = back;
+  r.sweep_pose = pose_;
+  r.pose = compose(pose_, to_utime);
+  r.solved = compose(solved_ref, to_utime);
+  r.predicted = compose(pred, to_utime);
   return r;
 }
 

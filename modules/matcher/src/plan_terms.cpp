@@ -3,101 +3,120 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 
 namespace fploc {
 namespace {
 
 enum class LossKind { kNone, kHuber, kCauchy };
 
-// Closest point on one element with d(p - q)/dp.
-double closest_one(const Element& e, const Eigen::Vector2d& p, Eigen::Vector2d* q, Eigen::Matrix2d* J) {
-  switch (e.kind) {
-    case ElementKind::kSegment: {
-      const Eigen::Vector2d ab = e.b - e.a;
-      const double l2 = ab.squaredNorm();
-      const double t = l2 > 0 ? (p - e.a).dot(ab) / l2 : 0.0;
-      if (t <= 0.0 || l2 == 0.0) {
-        *q = e.a;
-        if (J) J->setIdentity();
-      } else if (t >= 1.0) {
-        *q = e.b;
-        if (J) J->setIdentity();
-      } else {
-        *q = e.a + t * ab;
-        if (J) {
-          const Eigen::Vector2d n = Eigen::Vector2d(-ab.y(), ab.x()) / std::sqrt(l2);
-          *J = n * n.transpose();
-        }
-      }
-      break;
-    }
-    case ElementKind::kCircle:
-    case ElementKind::kArc: {
-      const Eigen::Vector2d d = p - e.c;
-      const double nd = d.norm();
-      bool inside = true;
-      if (e.kind == ElementKind::kArc) {
-        double ang = std::atan2(d.y(), d.x());
-        double rel = std::fmod(ang - e.a0, 2 * M_PI);
-        if (rel < 0) rel += 2 * M_PI;
-        inside = e.a0 + rel <= e.a1;
-      }
-      if (inside && nd > 0) {
-        const Eigen::Vector2d u = d / nd;
-        *q = e.c + e.r * u;
-        if (J) *J = u * u.transpose();
-      } else if (inside) {
-        *q = e.c + Eigen::Vector2d(e.r, 0);
-        if (J) J->setIdentity();
-      } else {
-        *q = (p - e.a).squaredNorm() <= (p - e.b).squaredNorm() ? e.a : e.b;
-        if (J) J->setIdentity();
-      }
-      break;
-    }
-  }
-  return (p - *q).norm();
+LossKind loss_kind(const std::string& loss, double scale) {
+  if (loss == "none" || scale <= 0) return LossKind::kNone;
+  return loss == "cauchy" ? LossKind::kCauchy : LossKind::kHuber;
 }
 
-class PointCost : public ceres::SizedCostFunction<2, 3> {
- public:
-  PointCost(const std::vector<Element>* targets, const Assignment& a, const Eigen::Vector2d& p, double w)
-      : targets_(targets), a_(a), p_(p), w_(w) {}
-  bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
-    const double* x = params[0];
-    const double c = std::cos(x[2]), s = std::sin(x[2]);
-    const Eigen::Vector2d pw(c * p_.x() - s * p_.y() + x[0], s * p_.x() + c * p_.y() + x[1]);
-    Eigen::Vector2d q;
-    Eigen::Matrix2d J;
-    closest_of(*targets_, a_.cand, a_.n, pw, &q, &J);
-    residuals[0] = w_ * (pw.x() - q.x());
-    residuals[1] = w_ * (pw.y() - q.y());
-    if (jacobians && jacobians[0]) {
-      Eigen::Matrix<double, 2, 3> dp;
-      dp << 1, 0, -s * p_.x() - c * p_.y(), 0, 1, c * p_.x() - s * p_.y();
-      Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> out(jacobians[0]);
-      out = w_ * J * dp;
+// Closest point on one target with d(p - q)/dp; returns the squared distance.
+inline double closest_one(const TargetGeom& e, const Eigen::Vector2d& p, Eigen::Vector2d* q, Eigen::Matrix2d* J) {
+  if (e.kind == ElementKind::kSegment) {
+    const Eigen::Vector2d d = p - e.a;
+    const double t = d.dot(e.u);
+    if (t <= 0.0 || e.len == 0.0) {
+      *q = e.a;
+      if (J) J->setIdentity();
+      return d.squaredNorm();
     }
-    return true;
+    if (t >= e.len) {
+      *q = e.b;
+      if (J) J->setIdentity();
+      return (p - e.b).squaredNorm();
+    }
+    *q = e.a + t * e.u;
+    if (J) {
+      const Eigen::Vector2d n(-e.u.y(), e.u.x());
+      *J = n * n.transpose();
+    }
+    const double cr = d.x() * e.u.y() - d.y() * e.u.x();
+    return cr * cr;
   }
+  // Circle / arc.
+  const Eigen::Vector2d d = p - e.c;
+  const double nd = d.norm();
+  bool inside = true;
+  if (e.kind == ElementKind::kArc) {
+    const double ang = std::atan2(d.y(), d.x());
+    double rel = std::fmod(ang - e.a0, 2 * M_PI);
+    if (rel < 0) rel += 2 * M_PI;
+    inside = e.a0 + rel <= e.a1;
+  }
+  if (inside && nd > 0) {
+    const Eigen::Vector2d u = d / nd;
+    *q = e.c + e.r * u;
+    if (J) *J = u * u.transpose();
+  } else if (inside) {
+    *q = e.c + Eigen::Vector2d(e.r, 0);
+    if (J) J->setIdentity();
+  } else {
+    *q = (p - e.a).squaredNorm() <= (p - e.b).squaredNorm() ? e.a : e.b;
+    if (J) J->setIdentity();
+  }
+  return (p - *q).squaredNorm();
+}
 
- private:
-  const std::vector<Element>* targets_;
-  Assignment a_;
-  Eigen::Vector2d p_;
-  double w_;
-};
+// Closest of the candidates; returns the squared distance (inf when there are none).
+inline double closest_of2(const std::vector<TargetGeom>& g, const int* cand, int n, const Eigen::Vector2d& p,
+                          Eigen::Vector2d* q, Eigen::Matrix2d* J) {
+  if (n == 1) return closest_one(g[size_t(cand[0])], p, q, J);
+  double best = std::numeric_limits<double>::infinity();
+  int bi = -1;
+  Eigen::Vector2d qi;
+  for (int i = 0; i < n; ++i) {
+    const double d2 = closest_one(g[size_t(cand[i])], p, &qi, nullptr);
+    if (d2 < best) {
+      best = d2;
+      bi = i;
+      *q = qi;
+    }
+  }
+  if (bi < 0) {
+    *q = p;
+    if (J) J->setZero();
+    return best;
+  }
+  if (J) closest_one(g[size_t(cand[bi])], p, q, J);
+  return best;
+}
+
+// g = sqrt(rho(s)/s) and dg/ds for the robust loss (rho(s) = s below the scale: g = 1, dg = 0).
+inline void robust_scale(LossKind loss, double a, double s, double* g, double* dg) {
+  *g = 1;
+  *dg = 0;
+  const double a2 = a * a;
+  if (loss == LossKind::kNone || s < 1e-18) return;
+  double rho, rho1;
+  if (loss == LossKind::kHuber) {
+    if (s <= a2) return;
+    const double r = std::sqrt(s);
+    rho = 2 * a * r - a2;
+    rho1 = a / r;
+  } else {  // Cauchy
+    rho = a2 * std::log1p(s / a2);
+    rho1 = 1.0 / (1.0 + s / a2);
+  }
+  *g = std::sqrt(rho / s);
+  *dg = (rho1 * s - rho) / (2 * (*g) * s * s);
+}
 
 // All points of one frame in one residual block (Ceres' per-block overhead dominates per-point
-// blocks). The robust loss is folded into the residuals exactly: r~ = g(s) r with g = sqrt(rho(s)/s),
-// s = |r|^2, so |r~|^2 = rho(s), and the Jacobian is the exact derivative of r~.
+// blocks), one residual per point: its distance to the closest of its candidates, |p' - q(p')| (the
+// paper's ||ANNF(p'), p'||). Its gradient is n^T dp'/dx with n the unit vector from q to p', so the
+// normal equations equal those of the 2D residual p' - q at half the rows. The robust loss is folded in
+// exactly: r~ = w g(s) d with g = sqrt(rho(s)/s), s = d^2, so r~^2 = w^2 rho(s), and dr~/dx =
+// w (g + 2 s g'(s)) dd/dx.
 class FrameCost : public ceres::CostFunction {
  public:
-  FrameCost(const std::vector<Element>* targets, std::vector<Assignment> as, std::vector<Eigen::Vector2d> pts,
+  FrameCost(const std::vector<TargetGeom>* targets, std::vector<Assignment> as, std::vector<Eigen::Vector2d> pts,
             LossKind loss, double scale, double w)
       : targets_(targets), as_(std::move(as)), pts_(std::move(pts)), loss_(loss), a_(scale), w_(w) {
-    set_num_residuals(int(2 * as_.size()));
+    set_num_residuals(int(as_.size()));
     mutable_parameter_block_sizes()->push_back(3);
   }
   bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
@@ -108,45 +127,35 @@ class FrameCost : public ceres::CostFunction {
     Eigen::Matrix2d J;
     for (size_t i = 0; i < as_.size(); ++i) {
       const Eigen::Vector2d& p = pts_[i];
-      const Eigen::Vector2d pw(c * p.x() - s * p.y() + x[0], s * p.x() + c * p.y() + x[1]);
-      closest_of(*targets_, as_[i].cand, as_[i].n, pw, &q, jac ? &J : nullptr);
-      const Eigen::Vector2d r = w_ * (pw - q);
-      const double sq = r.squaredNorm();
-      double g = 1, dg = 0;
-      robust_scale(sq, &g, &dg);
-      residuals[2 * i] = g * r.x();
-      residuals[2 * i + 1] = g * r.y();
+      const double rx = c * p.x() - s * p.y(), ry = s * p.x() + c * p.y();
+      const Eigen::Vector2d pw(rx + x[0], ry + x[1]);
+      const double d2 = closest_of2(*targets_, as_[i].cand, as_[i].n, pw, &q, jac ? &J : nullptr);
+      const double d = std::sqrt(d2);
+      double g, dg;
+      robust_scale(loss_, a_, d2, &g, &dg);
+      residuals[i] = w_ * g * d;
       if (jac) {
-        Eigen::Matrix<double, 2, 3> dp;
-        dp << 1, 0, -s * p.x() - c * p.y(), 0, 1, c * p.x() - s * p.y();
-        const Eigen::Matrix<double, 2, 3> Jr = w_ * J * dp;
-        Eigen::Matrix<double, 2, 3> Jt = g * Jr;
-        if (dg != 0) Jt += (2 * dg) * r * (r.transpose() * Jr);
-        Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>>(jac + 6 * i) = Jt;
+        // n: from q to p'; at d = 0 the element's normal (segments/circles: the projection J's range).
+        Eigen::Vector2d n;
+        if (d > 1e-12) {
+          n = (pw - q) / d;
+        } else if (J.trace() < 1.5) {  // J = n n^T (interior of a segment / circle): its larger column
+          n = J.col(0).squaredNorm() >= J.col(1).squaredNorm() ? J.col(0) : J.col(1);
+          n.normalize();
+        } else {  // on an end point: no direction
+          n.setZero();
+        }
+        const double k = w_ * (g + 2 * dg * d2);
+        jac[3 * i] = k * n.x();
+        jac[3 * i + 1] = k * n.y();
+        jac[3 * i + 2] = k * (n.x() * -ry + n.y() * rx);
       }
     }
     return true;
   }
 
  private:
-  // g = sqrt(rho(s)/s) and dg/ds.
-  void robust_scale(double s, double* g, double* dg) const {
-    const double a2 = a_ * a_;
-    if (loss_ == LossKind::kNone || s < 1e-18) return;
-    double rho, rho1;
-    if (loss_ == LossKind::kHuber) {
-      if (s <= a2) return;
-      const double r = std::sqrt(s);
-      rho = 2 * a_ * r - a2;
-      rho1 = a_ / r;
-    } else {  // Cauchy
-      rho = a2 * std::log1p(s / a2);
-      rho1 = 1.0 / (1.0 + s / a2);
-    }
-    *g = std::sqrt(rho / s);
-    *dg = (rho1 * s - rho) / (2 * (*g) * s * s);
-  }
-  const std::vector<Element>* targets_;
+  const std::vector<TargetGeom>* targets_;
   std::vector<Assignment> as_;
   std::vector<Eigen::Vector2d> pts_;
   LossKind loss_;
@@ -155,86 +164,78 @@ class FrameCost : public ceres::CostFunction {
 
 }  // namespace
 
-double closest_of(const std::vector<Element>& targets, const int* cand, int n, const Eigen::Vector2d& p,
+double closest_of(const std::vector<TargetGeom>& targets, const int* cand, int n, const Eigen::Vector2d& p,
                   Eigen::Vector2d* q, Eigen::Matrix2d* dr_dp) {
-  double best = std::numeric_limits<double>::infinity();
-  int best_i = -1;
-  Eigen::Vector2d qi;
-  for (int i = 0; i < n; ++i) {
-    const double d = closest_one(targets[size_t(cand[i])], p, &qi, nullptr);
-    if (d < best) {
-      best = d;
-      best_i = i;
-      *q = qi;
-    }
-  }
-  if (best_i >= 0 && dr_dp) closest_one(targets[size_t(cand[best_i])], p, q, dr_dp);
-  if (best_i < 0) {
-    *q = p;
-    if (dr_dp) dr_dp->setZero();
-  }
-  return best;
+  return std::sqrt(closest_of2(targets, cand, n, p, q, dr_dp));
 }
 
 void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, const AssignOptions& o,
             std::vector<Assignment>* out) {
   out->clear();
-  const auto& targets = lookup.targets();
+  const auto& g = lookup.geometry();
   const bool groups = o.group_rule && lookup.element_targets();
   const int maxc = std::clamp(o.max_candidates, 1, kMaxCandidates);
-  const int stride = std::max(1, o.stride);
+  const size_t stride = size_t(std::max(1, o.stride));
+  const double g2 = o.gate_m * o.gate_m;
   struct GroupPoint {
+    int32_t group;
     int point;
     Eigen::Vector2d pw;
+    Assignment a;
   };
-  std::map<int32_t, std::vector<GroupPoint>> group_points;
-  std::map<int32_t, std::vector<int>> group_cands;
+  std::vector<GroupPoint> gps;
   Eigen::Vector2d q;
-  for (size_t i = 0; i < f.points.size(); i += size_t(stride)) {
+  const double c = std::cos(x.yaw), s = std::sin(x.yaw);
+  out->reserve(f.points.size() / stride + 1);
+  for (size_t i = 0; i < f.points.size(); i += stride) {
     const auto& fp = f.points[i];
-    const Eigen::Vector2d pw = transform(x, fp.p);
+    const Eigen::Vector2d pw(c * fp.p.x() - s * fp.p.y() + x.x, s * fp.p.x() + c * fp.p.y() + x.y);
     Assignment a;
     a.point = int(i);
     a.n = lookup.candidates(pw, a.cand, maxc);
     if (a.n <= 0) continue;
     if (groups && fp.group >= 0) {
-      group_points[fp.group].push_back({int(i), pw});
-      auto& gc = group_cands[fp.group];
-      for (int k = 0; k < a.n; ++k)
-        if (std::find(gc.begin(), gc.end(), a.cand[k]) == gc.end()) gc.push_back(a.cand[k]);
+      gps.push_back({fp.group, int(i), pw, a});
       continue;
     }
-    if (closest_of(targets, a.cand, a.n, pw, &q, nullptr) <= o.gate_m) out->push_back(a);
+    if (closest_of2(g, a.cand, a.n, pw, &q, nullptr) <= g2) out->push_back(a);
   }
-  // One element per group: the candidate with the smallest truncated sum of squared distances.
-  const double g2 = o.gate_m * o.gate_m;
-  for (const auto& [g, pts] : group_points) {
-    const auto& gc = group_cands[g];
+  if (gps.empty()) return;
+  // One element per group: the candidate (from the union of its points' candidates) with the smallest
+  // truncated sum of squared distances over the group's points; ties to the first found.
+  std::stable_sort(gps.begin(), gps.end(), [](const GroupPoint& a, const GroupPoint& b) { return a.group < b.group; });
+  std::vector<int> cands;
+  const size_t n_single = out->size();
+  for (size_t b = 0; b < gps.size();) {
+    size_t e = b;
+    cands.clear();
+    for (; e < gps.size() && gps[e].group == gps[b].group; ++e)
+      for (int k = 0; k < gps[e].a.n; ++k)
+        if (std::find(cands.begin(), cands.end(), gps[e].a.cand[k]) == cands.end()) cands.push_back(gps[e].a.cand[k]);
     int best = -1;
     double best_cost = std::numeric_limits<double>::infinity();
-    for (int e : gc) {
+    for (int el : cands) {
       double cost = 0;
-      for (const auto& gp : pts) cost += std::min(std::pow(closest_one(targets[size_t(e)], gp.pw, &q, nullptr), 2), g2);
+      for (size_t i = b; i < e && cost < best_cost; ++i) cost += std::min(closest_one(g[size_t(el)], gps[i].pw, &q, nullptr), g2);
       if (cost < best_cost) {
         best_cost = cost;
-        best = e;
+        best = el;
       }
     }
-    if (best < 0) continue;
-    for (const auto& gp : pts) {
-      if (closest_one(targets[size_t(best)], gp.pw, &q, nullptr) > o.gate_m) continue;
-      Assignment a;
-      a.point = gp.point;
-      a.n = 1;
-      a.cand[0] = best;
-      out->push_back(a);
-    }
+    if (best >= 0)
+      for (size_t i = b; i < e; ++i) {
+        if (closest_one(g[size_t(best)], gps[i].pw, &q, nullptr) > g2) continue;
+        Assignment a;
+        a.point = gps[i].point;
+        a.n = 1;
+        a.cand[0] = best;
+        out->push_back(a);
+      }
+    b = e;
   }
-}
-
-ceres::CostFunction* make_point_cost(const std::vector<Element>* targets, const Assignment& a,
-                                     const Eigen::Vector2d& p_sensor, double weight) {
-  return new PointCost(targets, a, p_sensor, weight);
+  // Point order (deterministic and cache-friendly for the residuals).
+  if (out->size() > n_single)
+    std::sort(out->begin(), out->end(), [](const Assignment& a, const Assignment& b) { return a.point < b.point; });
 }
 
 void add_frame_term(ceres::Problem* problem, double* pose, const NearestLookup& lookup, const FeatureFrame& f,
@@ -243,34 +244,54 @@ void add_frame_term(ceres::Problem* problem, double* pose, const NearestLookup& 
   std::vector<Eigen::Vector2d> pts;
   pts.reserve(as.size());
   for (const auto& a : as) pts.push_back(f.points[size_t(a.point)].p);
-  const LossKind k = (loss == "none" || scale <= 0) ? LossKind::kNone : loss == "cauchy" ? LossKind::kCauchy : LossKind::kHuber;
-  problem->AddResidualBlock(new FrameCost(&lookup.targets(), as, std::move(pts), k, scale, weight), nullptr, pose);
+  problem->AddResidualBlock(new FrameCost(&lookup.geometry(), as, std::move(pts), loss_kind(loss, scale), scale, weight),
+                            nullptr, pose);
 }
 
-void add_plan_terms(ceres::Problem* problem, double* pose, const NearestLookup& lookup, const FeatureFrame& f,
-                    const std::vector<Assignment>& as, ceres::LossFunction* loss, double weight) {
-  for (const auto& a : as)
-    problem->AddResidualBlock(make_point_cost(&lookup.targets(), a, f.points[size_t(a.point)].p, weight), loss, pose);
+Eigen::Matrix3d frame_information(const NearestLookup& lookup, const FeatureFrame& f, const std::vector<Assignment>& as,
+                                  const Pose2& x, const std::string& loss, double scale) {
+  const auto& g = lookup.geometry();
+  const LossKind lk = loss_kind(loss, scale);
+  const double c = std::cos(x.yaw), s = std::sin(x.yaw);
+  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+  Eigen::Vector2d q;
+  Eigen::Matrix2d J;
+  for (const auto& a : as) {
+    const Eigen::Vector2d& p = f.points[size_t(a.point)].p;
+    const double rx = c * p.x() - s * p.y(), ry = s * p.x() + c * p.y();
+    const Eigen::Vector2d pw(rx + x.x, ry + x.y);
+    closest_of2(g, a.cand, a.n, pw, &q, &J);
+    Eigen::Matrix<double, 2, 3> Jr;
+    Jr.leftCols<2>() = J;
+    Jr.col(2) = J * Eigen::Vector2d(-ry, rx);
+    double gs, dg;
+    robust_scale(lk, scale, (pw - q).squaredNorm(), &gs, &dg);
+    H += (gs * gs) * Jr.transpose() * Jr;
+  }
+  return H;
 }
 
-FitQuality evaluate_fit(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, double inlier_m) {
-  FitQuality q;
-  q.num_points = int(f.points.size());
+FitQuality evaluate_fit(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, double inlier_m, int stride) {
+  FitQuality fq;
+  const auto& g = lookup.geometry();
+  const size_t st = size_t(std::max(1, stride));
   double sum2 = 0;
   int cand[kMaxCandidates];
   Eigen::Vector2d cp;
-  for (const auto& fp : f.points) {
-    const Eigen::Vector2d pw = transform(x, fp.p);
+  const double in2 = inlier_m * inlier_m;
+  for (size_t i = 0; i < f.points.size(); i += st) {
+    ++fq.num_points;
+    const Eigen::Vector2d pw = transform(x, f.points[i].p);
     const int n = lookup.candidates(pw, cand, kMaxCandidates);
-    const double d = closest_of(lookup.targets(), cand, n, pw, &cp, nullptr);
-    if (d <= inlier_m) {
-      ++q.num_inliers;
-      sum2 += d * d;
+    const double d2 = n > 0 ? closest_of2(g, cand, n, pw, &cp, nullptr) : std::numeric_limits<double>::infinity();
+    if (d2 <= in2) {
+      ++fq.num_inliers;
+      sum2 += d2;
     }
   }
-  q.inlier_ratio = q.num_points > 0 ? double(q.num_inliers) / q.num_points : 0.0;
-  q.rms_m = q.num_inliers > 0 ? std::sqrt(sum2 / q.num_inliers) : 0.0;
-  return q;
+  fq.inlier_ratio = fq.num_points > 0 ? double(fq.num_inliers) / fq.num_points : 0.0;
+  fq.rms_m = fq.num_inliers > 0 ? std::sqrt(sum2 / fq.num_inliers) : 0.0;
+  return fq;
 }
 
 const char* to_string(FitStatus s) {

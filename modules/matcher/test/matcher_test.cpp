@@ -5,6 +5,7 @@
 #include <random>
 #include <set>
 
+#include "fploc/matcher/imu_yaw.h"
 #include "fploc/matcher/map.h"
 #include "fploc/matcher/matcher.h"
 #include "fploc/matcher/plan_terms.h"
@@ -19,6 +20,11 @@ namespace {
 
 double pos_err(const Pose2& a, const Pose2& b) { return std::hypot(a.x - b.x, a.y - b.y); }
 double yaw_err(const Pose2& a, const Pose2& b) { return std::abs(wrap_angle(a.yaw - b.yaw)); }
+double distance_to_plan(const FloorPlan& plan, const Eigen::Vector2d& p) {
+  double d = 0;
+  nearest_element_brute_force(plan, p, &d);
+  return d;
+}
 
 std::vector<std::string> available_lookups() {
   std::vector<std::string> out;
@@ -105,7 +111,7 @@ TEST(Lookup, CandidatesContainTheNearestElement) {
       const int n = map.lookup->candidates(p, cand, kMaxCandidates);
       ASSERT_GT(n, 0);
       Eigen::Vector2d q;
-      EXPECT_NEAR(closest_of(map.lookup->targets(), cand, n, p, &q, nullptr), d_true, 1e-9) << name;
+      EXPECT_NEAR(closest_of(map.lookup->geometry(), cand, n, p, &q, nullptr), d_true, 1e-9) << name;
     }
   }
 }
@@ -120,7 +126,7 @@ TEST(Matcher, FeaturesThatDoNotMatchArePoorThenLost) {
   cfg.lost_after = 3;
   Matcher m(*map.lookup, cfg);
   const Pose2 start{10, 5, 0.4};
-  m.set_pose(start);
+  m.set_pose(start, 0.3);
   // First a good frame, then garbage: the pose must stay at the prediction (no jump), POOR then LOST.
   SynthOptions so;
   auto good = synth_frame(*map.plan, start, so, 1'000'000);
@@ -226,4 +232,197 @@ TEST(PlanTerms, CovarianceIsLargeAlongACorridor) {
   const MatchResult r = register_frame(*map.lookup, f, {0.0, 1.1, 0.02}, MatcherConfig{});
   EXPECT_NEAR(r.pose.y, 1.0, 1e-4);
   EXPECT_GT(r.covariance(0, 0), 100 * r.covariance(1, 1));
+}
+
+TEST(Motion, TwistExpLogRoundTripAndCompose) {
+  const Twist2 v{0.8, -0.1, 0.6};
+  const Pose2 a{2, 3, 0.4};
+  const Pose2 b = compose(a, exp_twist(v, 0.1));
+  const Twist2 w = log_twist(a, b, 0.1);
+  EXPECT_NEAR(w.vx, v.vx, 1e-9);
+  EXPECT_NEAR(w.vy, v.vy, 1e-9);
+  EXPECT_NEAR(w.w, v.w, 1e-9);
+  // exp(-t) undoes exp(t); a straight motion without rotation is a plain translation.
+  const Pose2 back = compose(b, exp_twist(v, -0.1));
+  EXPECT_LT(pos_err(back, a), 1e-11);
+  EXPECT_LT(yaw_err(back, a), 1e-11);
+  const Pose2 s = exp_twist({1.0, 0.5, 0.0}, 0.2);
+  EXPECT_NEAR(s.x, 0.2, 1e-12);
+  EXPECT_NEAR(s.y, 0.1, 1e-12);
+}
+
+TEST(Motion, DeskewWithTheTrueTwistPutsEveryPointOnThePlan) {
+  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  const Pose2 pose{6, 3, 0.5};
+  SynthOptions so;
+  so.sweep_s = 0.1;
+  so.sweep_twist = {1.0, 0.2, 0.8};  // fast: 10 cm and 4.6 degrees over one sweep
+  const FeatureFrame raw = synth_frame(*map.plan, pose, so);
+  FeatureFrame d;
+  const double t_ref = mean_time(raw);
+  EXPECT_NEAR(t_ref, 0.05, 0.005);
+  EXPECT_NEAR(sweep_duration(raw), 0.1, 0.001);
+  deskew(raw, so.sweep_twist, t_ref, &d);
+  ASSERT_EQ(d.points.size(), raw.points.size());
+  // The de-skewed sweep is the scan from the pose at utime + t_ref; the raw one is not.
+  const Pose2 at_ref = compose(pose, exp_twist(so.sweep_twist, t_ref));
+  double worst_d = 0, worst_raw = 0;
+  for (size_t i = 0; i < d.points.size(); ++i) {
+    worst_d = std::max(worst_d, distance_to_plan(*map.plan, transform(at_ref, d.points[i].p)));
+    worst_raw = std::max(worst_raw, distance_to_plan(*map.plan, transform(at_ref, raw.points[i].p)));
+  }
+  EXPECT_LT(worst_d, 1e-6);
+  EXPECT_GT(worst_raw, 0.05);
+}
+
+// A sweep registered without motion compensation is the pose somewhere inside the sweep, distorted;
+// with it, the matcher's pose is the pose at utime (and its motion model, fed back from registered
+// poses, does not oscillate).
+TEST(Matcher, MotionCompensationGivesThePoseAtUtime) {
+  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  auto truth_at = [](double t) { return Pose2{3.0 + 0.8 * t, 3.0 + 1.5 * std::sin(0.3 * t), 0.3 + 0.4 * std::sin(0.5 * t)}; };
+  auto run = [&](bool comp, bool imu) {
+    MatcherConfig cfg;
+    cfg.deskew = comp;
+    Matcher m(*map.lookup, cfg);
+    m.set_pose(truth_at(0));
+    double s2 = 0;
+    int n = 0;
+    for (int k = 0; k < 80; ++k) {
+      const double t = 0.1 * k;
+      SynthOptions so;
+      so.noise_sigma = 0.01;
+      so.seed = uint32_t(k + 1);
+      so.sweep_s = 0.1;
+      so.sweep_twist = log_twist(truth_at(t), truth_at(t + 0.1), 0.1);
+      FeatureFrame f = synth_frame(*map.plan, truth_at(t), so, std::llround(t * 1e6));
+      if (imu) f.sweep_yaw_rate = so.sweep_twist.w;
+      const MatchResult r = m.process(f);
+      EXPECT_EQ(r.status, FitStatus::kOk) << k << " " << r.text;
+      if (k >= 5) {
+        s2 += std::pow(pos_err(r.pose, truth_at(t)), 2);
+        ++n;
+      }
+    }
+    return std::sqrt(s2 / n);
+  };
+  const double without = run(false, false), with = run(true, false), with_imu = run(true, true);
+  std::printf("rms error at utime: no compensation %.4f m, compensated %.4f m, with the IMU's yaw rate %.4f m\n", without,
+              with, with_imu);
+  EXPECT_GT(without, 0.02);  // ~ v * 50 ms
+  EXPECT_LT(with, 0.004);
+  EXPECT_LT(with_imu, 0.004);
+}
+
+TEST(Matcher, StationarySensorWithSweepTimesStaysPut) {
+  // A velocity estimated from noisy registered poses, fed back into de-skewing referenced to the sweep
+  // start, oscillated with growing amplitude; referenced to the sweep's mean time it does not.
+  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  const Pose2 truth{8, 4, 0.7};
+  Matcher m(*map.lookup, {});
+  m.set_pose(truth);
+  double worst = 0;
+  for (int k = 0; k < 100; ++k) {
+    SynthOptions so;
+    so.noise_sigma = 0.03;
+    so.seed = uint32_t(k + 7);
+    so.sweep_s = 0.1;
+    const MatchResult r = m.process(synth_frame(*map.plan, truth, so, k * 100'000));
+    ASSERT_EQ(r.status, FitStatus::kOk);
+    worst = std::max(worst, pos_err(r.pose, truth));
+  }
+  EXPECT_LT(worst, 0.005);
+  EXPECT_LT(std::hypot(m.twist().vx, m.twist().vy), 0.05);
+}
+
+TEST(ImuYaw, IntegralAndMeanRate) {
+  ImuYaw imu;
+  // 1 rad/s for 0.5 s then 2 rad/s, samples every 10 ms.
+  for (int i = 0; i <= 100; ++i) EXPECT_TRUE(imu.add(int64_t(i) * 10'000, i * 10'000 < 500'000 ? 1.0 : 2.0));
+  EXPECT_FALSE(imu.add(500'000, 5.0));       // out of order
+  EXPECT_FALSE(imu.add(2'000'000, NAN));     // non-finite
+  EXPECT_NEAR(*imu.integral(100'000, 300'000), 0.2, 1e-12);
+  EXPECT_NEAR(*imu.mean_rate(600'000, 700'000), 2.0, 1e-12);
+  // Trapezoid across the step: 0.01 * 1 + 0.01 * 1.5 + 2 * 0.01 * 2.
+  EXPECT_NEAR(*imu.integral(480'000, 520'000), 0.065, 1e-12);
+  EXPECT_FALSE(imu.integral(-10'000, 100'000));       // before the first sample
+  EXPECT_FALSE(imu.integral(900'000, 1'100'000));     // more than the slack after the last
+  EXPECT_TRUE(imu.integral(900'000, 1'010'000));      // within the slack (held)
+  imu.drop_before(800'000);
+  EXPECT_FALSE(imu.integral(100'000, 200'000));
+  EXPECT_TRUE(imu.integral(800'000, 900'000));
+}
+
+TEST(Matcher, FirstFrameSearchesTheInitialPoseUncertainty) {
+  // set_pose 1 m / 10 degrees off in each direction: the first frame is searched from a grid of starts
+  // over the uncertainty and lands on the truth.
+  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  const Pose2 truth{6.0, 4.0, 0.6};
+  SynthOptions so;
+  so.noise_sigma = 0.02;
+  so.clutter_fraction = 0.2;
+  for (const auto& d : std::vector<Pose2>{{1, 0, 0.17}, {-1, 0, 0.17}, {0, 1, -0.17}, {0, -1, -0.17}, {0.7, 0.7, 0.17}}) {
+    Matcher m(*map.lookup, {});
+    m.set_pose({truth.x + d.x, truth.y + d.y, truth.yaw + d.yaw});
+    const MatchResult r = m.process(synth_frame(*map.plan, truth, so, 0));
+    EXPECT_EQ(r.status, FitStatus::kOk) << d.x << "," << d.y;
+    EXPECT_LT(pos_err(r.pose, truth), 0.01) << d.x << "," << d.y;
+    EXPECT_LT(yaw_err(r.pose, truth), 0.005) << d.x << "," << d.y;
+  }
+}
+
+TEST(Matcher, CabinetsAlongAWallDoNotPullAKnownPose) {
+  // Not in the plan: cabinet fronts 0.43 m in front of the south and west walls. From a pose known to
+  // 0.3 m and then while tracking, the registration stays on the walls (the cabinet fronts are outside
+  // the narrow gates) instead of aligning the cabinet fronts with the walls.
+  const FloorPlan plan = room_with_pillars();
+  FloorPlan world = plan;
+  world.elements.push_back(Element::segment({0.5, 0.43}, {3.8, 0.43}));
+  world.elements.push_back(Element::segment({0.43, 0.5}, {0.43, 9.5}));
+  auto map = make_localization_map(plan, "brute-force");
+  Matcher m(*map.lookup, {});
+  const Pose2 start{2.0, 2.0, 0.3};
+  m.set_pose(start, 0.3);
+  double worst = 0;
+  for (int k = 0; k < 30; ++k) {
+    const Pose2 truth{2.0 + 0.05 * k, 2.0 + 0.02 * k, 0.3};
+    SynthOptions so;
+    so.noise_sigma = 0.01;
+    so.seed = uint32_t(k + 3);
+    const MatchResult r = m.process(synth_frame(world, truth, so, k * 100'000));
+    ASSERT_EQ(r.status, FitStatus::kOk) << k;
+    worst = std::max(worst, pos_err(r.pose, truth));
+  }
+  EXPECT_LT(worst, 0.01);
+}
+
+TEST(PlanTerms, PosePriorHoldsOnlyTheDirectionThePlanLeavesOpen) {
+  // A straight corridor seen without its ends: along it the floor plan says nothing, so the prior (the
+  // motion model's prediction in the matcher) decides; across it and in yaw the walls decide, even
+  // against a prior that is 10 cm / 2 degrees off.
+  FloorPlan plan;
+  plan.elements.push_back(Element::segment({-100, 0}, {100, 0}));
+  plan.elements.push_back(Element::segment({-100, 2}, {100, 2}));
+  auto map = make_localization_map(plan, "brute-force");
+  SynthOptions so;
+  so.max_range = 8;
+  so.noise_sigma = 0.01;
+  const Pose2 truth{0, 1, 0};
+  const FeatureFrame f = synth_frame(plan, truth, so);
+  MatcherConfig cfg;
+  cfg.gate_initial_m = 0.3;
+  const Pose2 guess{0.3, 1.05, 0.02};
+  // Without the prior the along-track position is whatever the solver's steps in the null direction
+  // make of it (Levenberg-Marquardt damps a direction without curvature hardly at all).
+  const MatchResult free = register_frame(*map.lookup, f, guess, cfg);
+  std::printf("along-track without prior: %.3f m (guess %.3f), covariance xx %.3g vs yy %.3g\n", free.pose.x, guess.x,
+              free.covariance(0, 0), free.covariance(1, 1));
+  EXPECT_NEAR(free.pose.y, truth.y, 1e-3);
+  PosePrior prior;
+  prior.pose = {0.0, 1.1, 0.035};
+  prior.sqrt_info = Eigen::Vector3d(1.0, 1.0, 1.0);  // one point's worth of a 1 cm / 0.01 rad prediction
+  const MatchResult r = register_frame(*map.lookup, f, guess, cfg, &prior);
+  EXPECT_NEAR(r.pose.x, 0.0, 1e-3);         // along: the prior
+  EXPECT_NEAR(r.pose.y, truth.y, 1e-3);     // across: the walls
+  EXPECT_NEAR(r.pose.yaw, truth.yaw, 1e-3);
 }

@@ -88,11 +88,13 @@ FeatureFrame synth_frame(const FloorPlan& plan, const Pose2& pose, const SynthOp
   FeatureFrame f;
   f.utime = utime;
   f.z = 1.5;
-  const Eigen::Vector2d origin(pose.x, pose.y);
   std::vector<int> hit_element;
   for (int i = 0; i < o.beams; ++i) {
     const double a = 2 * M_PI * i / o.beams;  // sensor-frame bearing
-    const Eigen::Vector2d dir(std::cos(a + pose.yaw), std::sin(a + pose.yaw));
+    const double tb = o.sweep_s * i / o.beams;
+    const Pose2 pb = tb > 0 ? compose(pose, exp_twist(o.sweep_twist, tb)) : pose;
+    const Eigen::Vector2d origin(pb.x, pb.y);
+    const Eigen::Vector2d dir(std::cos(a + pb.yaw), std::sin(a + pb.yaw));
     double best = std::numeric_limits<double>::infinity();
     int be = -1;
     for (size_t k = 0; k < plan.elements.size(); ++k) {
@@ -107,6 +109,7 @@ FeatureFrame synth_frame(const FloorPlan& plan, const Pose2& pose, const SynthOp
     Feature2 fp;
     fp.p = range * Eigen::Vector2d(std::cos(a), std::sin(a));
     fp.kind = FeatureKind::kSurface;
+    fp.t = float(tb);
     f.points.push_back(fp);
     hit_element.push_back(plan.elements[size_t(be)].kind == ElementKind::kSegment ? be : -1);
   }

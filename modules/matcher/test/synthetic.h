@@ -23,9 +23,13 @@ struct SynthOptions {
   double clutter_radius = 4.0; // clutter points lie within this distance of the sensor
   bool groups = true;          // group ids for runs of >= 5 hits on one segment
   uint32_t seed = 1;
+  // Rotating sensor: beam i is measured at t = sweep_s * i / beams after utime, from the pose
+  // pose (+) exp_twist(sweep_twist, t), in the sensor frame of that moment (Feature2::t = t).
+  double sweep_s = 0;
+  Twist2 sweep_twist;
 };
 
-// Features as the sensor at `pose` would see them (sensor frame).
+// Features as the sensor at `pose` (its pose at utime) would see them (sensor frame).
 FeatureFrame synth_frame(const FloorPlan& plan, const Pose2& pose, const SynthOptions& o, int64_t utime = 0);
 
 // Random points unrelated to the plan (a frame that cannot match).

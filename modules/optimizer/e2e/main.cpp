@@ -29,7 +29,11 @@ int main(int argc, char** argv) {
   app.add_option("--kf-distance", o.keyframe_distance_m);
   app.add_option("--matcher-points", o.matcher_points);
   app.add_option("--optimizer-points", o.optimizer_points);
+  app.add_option("--relook", o.relook_m, "optimizer re-look-up distance [m] (its angle scales along)");
   app.add_option("--drop", o.drop_fraction, "fraction of scans dropped");
+  app.add_option("--noise", o.range_noise_m, "range noise sigma [m] (default: the simulator's)");
+  app.add_option("--wall-clutter", o.wall_clutter, "fraction of the walls hidden behind 2 m cabinets");
+  app.add_option("--frames-csv", o.frames_csv, "per-frame matcher diagnostics against the ground truth");
   app.add_option("--gt-offset", o.gt_offset_s, "ground truth time = scan start + this [s]");
   app.add_option("--init-error", [&](const std::vector<std::string>& v) {
     o.init_dx = std::stod(v.at(0));
@@ -37,11 +41,14 @@ int main(int argc, char** argv) {
     o.init_dyaw = std::stod(v.at(2)) * M_PI / 180;
     return true;
   }, "dx dy dyaw_deg")->expected(3);
+  app.add_option("--init-search", o.init_search_m, "matcher's first-frame search radius around the initial pose [m]");
   app.add_option("--plan", plan_file);
   app.add_option("--layers", layers)->delimiter(',');
   app.add_option("--units", units);
   app.add_option("--out", out_prefix, "write PREFIX-{gt,sfr,wo,odo}.tum and PREFIX.svg");
   app.add_flag("--no-imu", no_imu);
+  app.add_flag("--body-velocity", o.body_frame_velocity, "optimizer: body-frame velocity regularisation");
+  app.add_flag("--gt-gravity", o.gt_gravity, "diagnostic: project the features with the true roll/pitch");
   app.add_flag("--no-clutter", no_clutter);
   CLI11_PARSE(app, argc, argv);
   o.imu = !no_imu;

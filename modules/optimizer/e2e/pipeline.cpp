@@ -3,14 +3,19 @@
 #include <time.h>
 
 #include <cmath>
+#include <cstdio>
+#include <memory>
 
 #include "fploc/eval/eval.h"
 #include "fploc/features/features.h"
+#include "fploc/matcher/imu_yaw.h"
 #include "fploc/matcher/map.h"
 #include "fploc/matcher/matcher.h"
 #include "fploc/odometry/odometry.h"
 #include "fploc/optimizer/window.h"
 #include "fploc/segmentation/segmenter.h"
+#include "fploc/nodes/localization_convert.h"
+#include "fploc/nodes/perception_convert.h"
 #include "fploc/sim/simulator.h"
 
 namespace fploc::e2e {
@@ -45,13 +50,15 @@ Result run(const FloorPlan& plan_in, const Options& o) {
   so.scenario = o.scenario;
   so.seed = o.seed;
   so.clutter = o.clutter;
+  if (o.range_noise_m >= 0) so.range_noise_m = o.range_noise_m;
+  so.wall_clutter = o.wall_clutter;
   so.shared_dir = o.shared_dir;
   sim::Simulator sim(plan_in, so);
   const FloorPlan& plan = sim.world().plan();
   LocalizationMap map = make_localization_map(plan, o.lookup);
-  seg::SegmenterConfig scfg;
-  seg::RingSegmenter segmenter(scfg);
-  feat::FeatureExtractor fx;
+  // The graph's nodes' configurations (their options' defaults).
+  seg::RingSegmenter segmenter(config_of(SegmenterOptions{}));
+  feat::FeatureExtractor fx(config_of(FeatureOptions{}));
   const int n = o.max_frames > 0 ? std::min(o.max_frames, sim.num_frames()) : sim.num_frames();
 
   Result r;
@@ -60,23 +67,32 @@ Result run(const FloorPlan& plan_in, const Options& o) {
   MatcherConfig mcfg;
   mcfg.max_points = o.matcher_points;
   Matcher matcher(*map.lookup, mcfg);
-  matcher.set_pose(init);
+  matcher.set_pose(init, o.init_search_m > 0 ? std::optional<double>(o.init_search_m) : std::nullopt);
   OptimizerConfig ocfg;
   ocfg.window = o.window;
   ocfg.alpha = o.alpha;
   ocfg.beta = o.beta;
   ocfg.keyframe_distance_m = o.keyframe_distance_m;
   ocfg.max_points = o.optimizer_points;
+  ocfg.body_frame_velocity = o.body_frame_velocity;
+  if (o.relook_m >= 0) {
+    ocfg.relook_m = o.relook_m;
+    ocfg.relook_rad = o.relook_m / 0.01 * ocfg.relook_rad;
+  }
   WindowOptimizer opt(*map.lookup, ocfg);
   Odometry2D odo;
   odo.set_pose(init);
   std::vector<PoseOut> finals;
   const auto& imu = sim.imu();
   size_t imu_i = 0;
-  double prev_t = -1;
+  ImuYaw imu_yaw;
+  int64_t prev_utime = -1;
   sim::SimScan f;
   double feat_total = 0;
   uint64_t drop_state = o.seed * 2654435761u + 1;
+  std::unique_ptr<FILE, int (*)(FILE*)> csv(o.frames_csv.empty() ? nullptr : std::fopen(o.frames_csv.c_str(), "w"), &std::fclose);
+  if (!o.frames_csv.empty() && !csv) throw std::runtime_error(o.frames_csv + ": cannot write");
+  if (csv) std::fprintf(csv.get(), "k,utime,status,points,inliers,inlier_ratio,rms_m,iterations,err_x_m,err_y_m,err_yaw_deg,vx,vy,w,z_sigma_m,err_z_m\n");
   for (int k = 0; k < n; ++k) {
     if (o.drop_fraction > 0) {
       drop_state = drop_state * 6364136223846793005ull + 1442695040888963407ull;
@@ -84,47 +100,55 @@ Result run(const FloorPlan& plan_in, const Options& o) {
     }
     sim.frame(k, f);
     auto t0 = clk::now();
-    const auto& s = segmenter.process(f.scan);
+    const auto& s0 = segmenter.process(f.scan);
     r.us_segment += us_since(t0);
+    seg::Segmentation s_gt;
+    if (o.gt_gravity) {
+      s_gt = s0;
+      const Eigen::Vector3d rpy = sim.ground_truth(f.scan.utime * 1e-6 + 0.05).rpy();
+      s_gt.roll = rpy[0];
+      s_gt.pitch = rpy[1];
+    }
+    const seg::Segmentation& s = o.gt_gravity ? s_gt : s0;
     t0 = clk::now();
     const auto& ft = fx.process(s);
     r.us_features += us_since(t0);
-    FeatureFrame frame;
-    frame.utime = ft.utime != 0 ? ft.utime : f.scan.utime;
-    frame.scan_seq = k;
-    frame.roll = ft.roll;
-    frame.pitch = ft.pitch;
-    frame.z = ft.z;
-    for (size_t i = 0; i < ft.size(); ++i) {
-      Feature2 p;
-      p.p = {ft.x[i], ft.y[i]};
-      p.kind = ft.kind[i] == 0 ? FeatureKind::kCorner : FeatureKind::kSurface;
-      p.group = ft.group[i];
-      p.t = ft.t.size() == ft.size() ? ft.t[i] : 0.f;
-      frame.points.push_back(p);
-    }
+    // The graph's conversion path: what fploc-features publishes, what fploc-matcher reads.
+    features_t msg;
+    to_msg(ft, k, k, msg);
+    FeatureFrame frame = from_msg(msg);
+    if (frame.utime == 0) frame.utime = f.scan.utime;
     feat_total += double(frame.points.size());
-    // IMU yaw change since the previous processed scan (motion time = absolute - t0).
-    const double t_rel = frame.utime * 1e-6 - so.t0_s;
+    // IMU samples up to the end of the sweep (when the scan is published), as in the simulator's log.
+    const double t_pub = frame.utime * 1e-6 + 1.0 / sim.options().rate_hz - so.t0_s;
+    for (; imu_i < imu.size() && imu[imu_i].t <= t_pub; ++imu_i)
+      imu_yaw.add(std::llround((so.t0_s + imu[imu_i].t) * 1e6), imu[imu_i].gyro.z());
     std::optional<double> dyaw;
-    if (o.imu && prev_t >= 0) {
-      double sum = 0;
-      while (imu_i < imu.size() && imu[imu_i].t <= t_rel) {
-        if (imu[imu_i].t > prev_t) sum += imu[imu_i].gyro.z() / sim.options().imu_rate_hz;
-        ++imu_i;
-      }
-      dyaw = sum;
+    if (o.imu) {
+      if (prev_utime >= 0) dyaw = imu_yaw.integral(prev_utime, frame.utime);
+      const double sweep = sweep_duration(frame);
+      if (sweep > 0)
+        if (auto w = imu_yaw.mean_rate(frame.utime, frame.utime + std::llround(sweep * 1e6))) frame.sweep_yaw_rate = *w;
+      imu_yaw.drop_before(frame.utime - 1000000);
     }
-    prev_t = t_rel;
+    prev_utime = frame.utime;
     t0 = clk::now();
     const MatchResult m = matcher.process(frame, dyaw);
     r.us_matcher += us_since(t0);
     r.ok_frames += m.status == FitStatus::kOk;
+    if (csv) {
+      const StampedPose g = sim.ground_truth(frame.utime * 1e-6 + o.gt_offset_s);
+      std::fprintf(csv.get(), "%d,%lld,%s,%d,%d,%.4f,%.5f,%d,%.5f,%.5f,%.4f,%.4f,%.4f,%.4f,%.5f,%.5f\n", k, (long long)frame.utime,
+                   to_string(m.status), m.fit.num_points, m.fit.num_inliers, m.fit.inlier_ratio, m.fit.rms_m, m.iterations,
+                   m.pose.x - g.p.x(), m.pose.y - g.p.y(), wrap_angle(m.pose.yaw - g.rpy()[2]) * 180 / M_PI, m.twist.vx,
+                   m.twist.vy, m.twist.w, frame.z_sigma, frame.z - g.p.z());
+    }
     r.lost_frames += m.status == FitStatus::kLost;
     t0 = clk::now();
     FrameInput in;
     in.features = frame;
     in.sfr = m.pose;
+    in.twist = m.twist;
     in.status = m.status;
     in.covariance = m.covariance;
     opt.add(std::move(in), &finals);

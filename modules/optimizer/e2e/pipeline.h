@@ -17,14 +17,21 @@ struct Options {
   std::string lookup = "annf-exact";
   bool imu = true;
   std::string shared_dir;        // beams from ../shared when present
-  double gt_offset_s = 0.05;     // ground truth at scan start + this (mid-scan at 10 Hz)
+  double gt_offset_s = 0;        // ground truth at the frame's time stamp (scan start) + this
   int window = 10;
   double alpha = 1.1, beta = 0.9;
   bool clutter = true;
+  double range_noise_m = -1;      // < 0: the simulator's default
+  double wall_clutter = 0;        // fraction of the walls behind cabinets (simulator option)
   double drop_fraction = 0;      // drop this fraction of scans (deterministic)
   double keyframe_distance_m = 0.1;
-  int matcher_points = 800, optimizer_points = 400;
+  int matcher_points = 800, optimizer_points = 800;
+  bool body_frame_velocity = false;
+  double relook_m = -1;          // optimizer's re-look-up distance (< 0: its default)
   double init_dx = 0, init_dy = 0, init_dyaw = 0;  // error of the initial pose
+  double init_search_m = 0;      // matcher's first-frame search radius (0 = its default)
+  bool gt_gravity = false;       // diagnostic: features projected with the true roll/pitch (mid-sweep)
+  std::string frames_csv;        // per-frame diagnostics (status, fit, errors against ground truth) to this file
 };
 
 struct Result {

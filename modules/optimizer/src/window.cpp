@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "fploc/matcher/plan_terms.h"
 
@@ -28,6 +29,40 @@ struct VelocityReg {
   }
 };
 
+// The same with the velocities in the body frame: the constant body twists of the two segments
+// (SE(2) logarithm / dt, series for the small keyframe turns), so a constant-speed turn - what a pushed
+// platform does in a curve - costs nothing, where world-frame velocities change direction.
+struct BodyVelocityReg {
+  double dt0, dt1, sa, sb;
+  template <typename T>
+  static void twist(const T* p, const T* q, double dt, T* v) {
+    using std::atan2;
+    using std::cos;
+    using std::sin;
+    const T c = cos(p[2]), s = sin(p[2]);
+    const T dx = q[0] - p[0], dy = q[1] - p[1];
+    const T rx = c * dx + s * dy, ry = -s * dx + c * dy;
+    const T d = q[2] - p[2];
+    const T th = atan2(sin(d), cos(d));
+    const T t2 = th * th;
+    const T a = T(1) - t2 / T(6) * (T(1) - t2 / T(20)), b = th / T(2) * (T(1) - t2 / T(12));
+    const T den = a * a + b * b;
+    v[0] = (a * rx + b * ry) / den / T(dt);
+    v[1] = (-b * rx + a * ry) / den / T(dt);
+    v[2] = th / T(dt);
+  }
+  template <typename T>
+  bool operator()(const T* p0, const T* p1, const T* p2, T* r) const {
+    T v0[3], v1[3];
+    twist(p0, p1, dt0, v0);
+    twist(p1, p2, dt1, v1);
+    r[0] = sa * (v1[0] - v0[0]);
+    r[1] = sa * (v1[1] - v0[1]);
+    r[2] = sb * (v1[2] - v0[2]);
+    return true;
+  }
+};
+
 Eigen::Vector3d diff(const Pose2& a, const Pose2& b) { return {a.x - b.x, a.y - b.y, wrap_angle(a.yaw - b.yaw)}; }
 Pose2 plus(const Pose2& a, const Eigen::Vector3d& c) { return {a.x + c[0], a.y + c[1], wrap_angle(a.yaw + c[2])}; }
 
@@ -35,64 +70,123 @@ Pose2 plus(const Pose2& a, const Eigen::Vector3d& c) { return {a.x + c[0], a.y +
 
 WindowOptimizer::WindowOptimizer(const NearestLookup& lookup, OptimizerConfig cfg) : lookup_(lookup), cfg_(std::move(cfg)) {
   cfg_.window = std::max(1, cfg_.window);
+  if (cfg_.linear_solver != "sparse" && cfg_.linear_solver != "dense")
+    throw std::invalid_argument("optimizer linear_solver '" + cfg_.linear_solver + "': expected sparse or dense");
+  if (cfg_.linear_solver == "sparse" && !ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) &&
+      !ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE))
+    cfg_.linear_solver = "dense";
 }
 WindowOptimizer::~WindowOptimizer() = default;
 
 Eigen::Vector3d WindowOptimizer::newest_correction() const {
   if (!window_.empty()) {
     const Key& k = window_.back();
-    return diff(Pose2{k.x[0], k.x[1], k.x[2]}, k.in.sfr);
+    return diff(Pose2{k.x[0], k.x[1], k.x[2]}, k.f.sfr_tau);
   }
   if (!finals_.empty()) return finals_.back().correction;
   return Eigen::Vector3d::Zero();
 }
 
-PoseOut WindowOptimizer::make_out(const FrameInput& in, const Pose2& p, bool key) const {
+PoseOut WindowOptimizer::make_out(const Frame& f, const Pose2& pose_tau_in, bool key, Stamped* prev) const {
+  const Pose2 pose_tau{pose_tau_in.x, pose_tau_in.y, wrap_angle(pose_tau_in.yaw)};
   PoseOut o;
-  o.utime = in.features.utime;
-  o.scan_seq = in.features.scan_seq;
-  o.pose = p;
-  o.roll = in.features.roll;
-  o.pitch = in.features.pitch;
-  o.z = in.features.z;
+  o.utime = f.in.features.utime;
+  o.scan_seq = f.in.features.scan_seq;
+  const double span = (f.tau - prev->tau) * 1e-6;
+  if (prev->valid && prev->tau <= o.utime && o.utime <= f.tau && span > 0 && span <= 0.5) {
+    // Geodesic interpolation between the two poses at utime.
+    const Twist2 v = log_twist(prev->pose, pose_tau, span);
+    o.pose = compose(prev->pose, exp_twist(v, (o.utime - prev->tau) * 1e-6));
+  } else {
+    o.pose = compose(pose_tau, exp_twist(f.in.twist, -f.t_ref));
+  }
+  *prev = {true, f.tau, pose_tau};
+  fill_gravity(&o, f.in.features);
   o.keyframe = key;
-  o.status = in.status;
-  o.covariance = in.covariance;
+  o.status = f.in.status;
+  o.covariance = f.in.covariance;
   return o;
 }
 
+void WindowOptimizer::fill_gravity(PoseOut* o, const FeatureFrame& f) const {
+  o->roll = f.roll;
+  o->pitch = f.pitch;
+  o->z = f.z;
+  const bool z_known = std::isfinite(f.z) && f.z_sigma < cfg_.unknown_z_sigma_m;
+  const bool rp_known = std::isfinite(f.roll) && std::isfinite(f.pitch) && f.roll_pitch_sigma < cfg_.unknown_rp_sigma_rad;
+  if (z_known && rp_known) return;
+  auto fill = [&](bool Gravity::*known, auto get, double* out) {
+    const Gravity* before = nullptr;
+    const Gravity* after = nullptr;
+    for (const auto& g : gravity_) {
+      if (!(g.*known)) continue;
+      if (g.utime <= f.utime) before = &g;
+      else if (!after) after = &g;
+    }
+    if (before && after) {
+      const double s = double(f.utime - before->utime) / double(after->utime - before->utime);
+      *out = get(*before) + s * (get(*after) - get(*before));
+    } else if (before || after) {
+      *out = get(before ? *before : *after);
+    }
+  };
+  if (!z_known) fill(&Gravity::z_known, [](const Gravity& g) { return g.z; }, &o->z);
+  if (!rp_known) {
+    fill(&Gravity::rp_known, [](const Gravity& g) { return g.roll; }, &o->roll);
+    fill(&Gravity::rp_known, [](const Gravity& g) { return g.pitch; }, &o->pitch);
+  }
+}
+
 PoseOut WindowOptimizer::add(FrameInput in, std::vector<PoseOut>* finals) {
-  const int64_t t = in.features.utime;
-  bool key = in.status == FitStatus::kOk;
+  {
+    const FeatureFrame& f = in.features;
+    gravity_.push_back({f.utime, f.roll, f.pitch, f.z,
+                        std::isfinite(f.roll) && std::isfinite(f.pitch) && f.roll_pitch_sigma < cfg_.unknown_rp_sigma_rad,
+                        std::isfinite(f.z) && f.z_sigma < cfg_.unknown_z_sigma_m});
+    // Keep what the frames still to be output may need (and a little before).
+    int64_t oldest = f.utime;
+    if (!pending_.empty()) oldest = std::min(oldest, pending_.front().in.features.utime);
+    if (!window_.empty()) oldest = std::min(oldest, window_.front().f.in.features.utime);
+    while (gravity_.size() > 2 && gravity_[1].utime < oldest - 5'000'000) gravity_.pop_front();
+  }
+  Frame fr;
+  fr.in = std::move(in);
+  const int64_t t = fr.in.features.utime;
+  fr.t_ref = mean_time(fr.in.features);
+  fr.tau = t + std::llround(fr.t_ref * 1e6);
+  fr.sfr_tau = compose(fr.in.sfr, exp_twist(fr.in.twist, fr.t_ref));
+  bool key = fr.in.status == FitStatus::kOk;
   if (key && have_last_key_) {
-    const double d = std::hypot(in.sfr.x - last_key_sfr_.x, in.sfr.y - last_key_sfr_.y);
-    const double a = std::abs(wrap_angle(in.sfr.yaw - last_key_sfr_.yaw));
+    const double d = std::hypot(fr.in.sfr.x - last_key_sfr_.x, fr.in.sfr.y - last_key_sfr_.y);
+    const double a = std::abs(wrap_angle(fr.in.sfr.yaw - last_key_sfr_.yaw));
     key = d >= cfg_.keyframe_distance_m || a >= cfg_.keyframe_angle_rad;
     if (key && (t - last_key_utime_) * 1e-6 > cfg_.max_keyframe_gap_s) {
       flush(finals);  // a long gap: the velocities across it mean nothing
       finals_.clear();
     }
   }
+  PoseOut o;
   if (!key) {
-    PoseOut o = make_out(in, plus(in.sfr, newest_correction()), false);
-    pending_.push_back(std::move(in));
-    return o;
+    o = make_out(fr, plus(fr.sfr_tau, newest_correction()), false, &last_latest_);
+    pending_.push_back(std::move(fr));
+  } else {
+    Key k;
+    k.f = std::move(fr);
+    deskew(k.f.in.features, k.f.in.twist, k.f.t_ref, &k.deskewed);
+    const Pose2 init = plus(k.f.sfr_tau, newest_correction());
+    k.x[0] = init.x;
+    k.x[1] = init.y;
+    k.x[2] = init.yaw;
+    last_key_sfr_ = k.f.in.sfr;
+    last_key_utime_ = t;
+    have_last_key_ = true;
+    window_.push_back(std::move(k));
+    while (int(window_.size()) > cfg_.window) finalize_front(finals);
+    solve();
+    const Key& nk = window_.back();
+    o = make_out(nk.f, Pose2{nk.x[0], nk.x[1], nk.x[2]}, true, &last_latest_);
+    o.optimised = nk.optimised;
   }
-  Key k;
-  k.in = std::move(in);
-  const Pose2 init = plus(k.in.sfr, newest_correction());
-  k.x[0] = init.x;
-  k.x[1] = init.y;
-  k.x[2] = init.yaw;
-  last_key_sfr_ = k.in.sfr;
-  last_key_utime_ = t;
-  have_last_key_ = true;
-  window_.push_back(std::move(k));
-  while (int(window_.size()) > cfg_.window) finalize_front(finals);
-  solve();
-  const Key& nk = window_.back();
-  PoseOut o = make_out(nk.in, Pose2{nk.x[0], nk.x[1], wrap_angle(nk.x[2])}, true);
-  o.optimised = nk.optimised;
   return o;
 }
 
@@ -100,7 +194,10 @@ void WindowOptimizer::solve() {
   ceres::Problem::Options po;
   po.disable_all_safety_checks = true;
   ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  // Each keyframe's floor-plan block touches only its own 3 parameters: the normal equations of the
+  // window are block-sparse (band of 3x3 blocks from the velocity terms). The dense solver forms
+  // J^T J from a dense (2 N W) x 3W Jacobian, W times the work.
+  so.linear_solver_type = cfg_.linear_solver == "dense" ? ceres::DENSE_NORMAL_CHOLESKY : ceres::SPARSE_NORMAL_CHOLESKY;
   so.num_threads = 1;
   so.max_num_iterations = std::max(1, cfg_.max_iterations);
   so.logging_type = ceres::SILENT;
@@ -108,38 +205,61 @@ void WindowOptimizer::solve() {
   ao.gate_m = cfg_.gate_m;
   ao.group_rule = cfg_.group_rule;
   ao.stride = cfg_.stride;
-  std::vector<std::vector<Assignment>> as(window_.size());
   // Anchors: the last final key poses, held fixed (optional).
   double anchors[2][3];
   std::vector<std::pair<double*, int64_t>> chain;  // pose block, utime
   if (cfg_.anchor_final) {
     for (size_t i = 0; i < finals_.size(); ++i) {
-      anchors[i][0] = finals_[i].pose.x;
-      anchors[i][1] = finals_[i].pose.y;
-      anchors[i][2] = finals_[i].pose.yaw;
-      chain.push_back({anchors[i], finals_[i].utime});
+      anchors[i][0] = finals_[i].pose_tau.x;
+      anchors[i][1] = finals_[i].pose_tau.y;
+      anchors[i][2] = finals_[i].pose_tau.yaw;
+      chain.push_back({anchors[i], finals_[i].tau});
     }
   }
-  for (auto& k : window_) chain.push_back({k.x, k.in.features.utime});
+  for (auto& k : window_) chain.push_back({k.x, k.f.tau});
   for (int outer = 0; outer < std::max(1, cfg_.outer); ++outer) {
-    ceres::Problem problem(po);
-    for (size_t i = 0; i < window_.size(); ++i) {
-      Key& k = window_[i];
+    // Look-ups: a key keeps its correspondences while its pose stays within relook_m / relook_rad of
+    // where they were looked up (the residuals re-evaluate the closest point on the candidates at every
+    // evaluation anyway); a round in which no key needed a new look-up would repeat the last solve.
+    bool changed = outer == 0;
+    for (auto& k : window_) {
+      const Pose2 xk{k.x[0], k.x[1], k.x[2]};
+      if (k.as_valid && std::hypot(xk.x - k.as_pose.x, xk.y - k.as_pose.y) <= cfg_.relook_m &&
+          std::abs(wrap_angle(xk.yaw - k.as_pose.yaw)) <= cfg_.relook_rad)
+        continue;
       AssignOptions aok = ao;
-      const size_t np = k.in.features.points.size();
+      const size_t np = k.deskewed.points.size();
       aok.stride = std::max(1, cfg_.stride);
       if (cfg_.max_points > 0 && np > size_t(cfg_.max_points) * size_t(aok.stride))
         aok.stride = int((np + size_t(cfg_.max_points) - 1) / size_t(cfg_.max_points));
-      assign(lookup_, k.in.features, Pose2{k.x[0], k.x[1], k.x[2]}, aok, &as[i]);
+      std::vector<Assignment> as;
+      assign(lookup_, k.deskewed, xk, aok, &as);
+      changed |= !k.as_valid || as != k.as;
+      k.as = std::move(as);
+      k.as_pose = xk;
+      k.as_valid = true;
+      k.as_stride = aok.stride;
+    }
+    if (!changed) break;
+    ceres::Problem problem(po);
+    for (auto& k : window_) {
       problem.AddParameterBlock(k.x, 3);
-      add_frame_term(&problem, k.x, lookup_, k.in.features, as[i], cfg_.loss, cfg_.loss_scale_m);
+      // The paper's sigma_sfr sums over all of the frame's features: a point budget (every stride-th
+      // point) estimates that sum with weight stride, so the balance against the velocity terms does not
+      // depend on the budget.
+      const double w = cfg_.budget_weight ? std::sqrt(double(k.as_stride)) : 1.0;
+      add_frame_term(&problem, k.x, lookup_, k.deskewed, k.as, cfg_.loss, cfg_.loss_scale_m, w);
     }
     for (size_t i = 0; i + 2 < chain.size(); ++i) {
       const double dt0 = (chain[i + 1].second - chain[i].second) * 1e-6;
       const double dt1 = (chain[i + 2].second - chain[i + 1].second) * 1e-6;
       if (!(dt0 > 1e-4 && dt1 > 1e-4)) continue;
-      auto* cost = new ceres::AutoDiffCostFunction<VelocityReg, 3, 3, 3, 3>(
-          new VelocityReg{dt0, dt1, std::sqrt(std::max(cfg_.alpha, 0.0)), std::sqrt(std::max(cfg_.beta, 0.0))});
+      const double sa = std::sqrt(std::max(cfg_.alpha, 0.0)), sb = std::sqrt(std::max(cfg_.beta, 0.0));
+      ceres::CostFunction* cost =
+          cfg_.body_frame_velocity
+              ? static_cast<ceres::CostFunction*>(new ceres::AutoDiffCostFunction<BodyVelocityReg, 3, 3, 3, 3>(
+                    new BodyVelocityReg{dt0, dt1, sa, sb}))
+              : new ceres::AutoDiffCostFunction<VelocityReg, 3, 3, 3, 3>(new VelocityReg{dt0, dt1, sa, sb});
       problem.AddResidualBlock(cost, nullptr, chain[i].first, chain[i + 1].first, chain[i + 2].first);
     }
     if (cfg_.anchor_final)
@@ -152,19 +272,19 @@ void WindowOptimizer::solve() {
   ++solves_;
 }
 
-void WindowOptimizer::emit_pending_until(int64_t utime, const Eigen::Vector3d& corr_next, std::vector<PoseOut>* finals) {
-  while (!pending_.empty() && pending_.front().features.utime < utime) {
-    const FrameInput& in = pending_.front();
+void WindowOptimizer::emit_pending_until(int64_t tau, const Eigen::Vector3d& corr_next, std::vector<PoseOut>* finals) {
+  while (!pending_.empty() && pending_.front().tau < tau) {
+    const Frame& f = pending_.front();
     Eigen::Vector3d c = corr_next;
     if (!finals_.empty()) {
       const Final& prev = finals_.back();
-      const double span = double(utime - prev.utime);
-      const double s = span > 0 ? std::clamp(double(in.features.utime - prev.utime) / span, 0.0, 1.0) : 1.0;
+      const double span = double(tau - prev.tau);
+      const double s = span > 0 ? std::clamp(double(f.tau - prev.tau) / span, 0.0, 1.0) : 1.0;
       Eigen::Vector3d d = corr_next - prev.correction;
       d[2] = wrap_angle(d[2]);
       c = prev.correction + s * d;
     }
-    PoseOut o = make_out(in, plus(in.sfr, c), false);
+    PoseOut o = make_out(f, plus(f.sfr_tau, c), false, &last_final_);
     o.final_estimate = true;
     if (finals) finals->push_back(o);
     pending_.pop_front();
@@ -174,14 +294,14 @@ void WindowOptimizer::emit_pending_until(int64_t utime, const Eigen::Vector3d& c
 void WindowOptimizer::finalize_front(std::vector<PoseOut>* finals) {
   Key k = std::move(window_.front());
   window_.pop_front();
-  const Pose2 p{k.x[0], k.x[1], wrap_angle(k.x[2])};
-  const Eigen::Vector3d corr = diff(p, k.in.sfr);
-  emit_pending_until(k.in.features.utime, corr, finals);
-  PoseOut o = make_out(k.in, p, true);
+  const Pose2 p_tau{k.x[0], k.x[1], wrap_angle(k.x[2])};
+  const Eigen::Vector3d corr = diff(p_tau, k.f.sfr_tau);
+  emit_pending_until(k.f.tau, corr, finals);
+  PoseOut o = make_out(k.f, p_tau, true, &last_final_);
   o.final_estimate = true;
   o.optimised = k.optimised;
   if (finals) finals->push_back(o);
-  finals_.push_back({k.in.features.utime, p, corr});
+  finals_.push_back({k.f.tau, p_tau, corr});
   while (finals_.size() > 2) finals_.pop_front();
 }
 

@@ -1,6 +1,7 @@
 #include "fploc/sim/simulator.h"
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 
@@ -64,6 +65,7 @@ Simulator::Simulator(FloorPlan plan, SimulatorOptions opt) : opt_(std::move(opt)
     world_->add_ceiling_patch(open);
   }
   if (opt_.clutter) add_clutter();
+  if (opt_.wall_clutter > 0) add_wall_clutter();
   SensorConfig sc;
   if (!opt_.metadata.empty()) {
     if (!load_beam_intrinsics_json(opt_.metadata, sc.beams, &err)) throw std::runtime_error(err);
@@ -80,6 +82,62 @@ Simulator::Simulator(FloorPlan plan, SimulatorOptions opt) : opt_(std::move(opt)
   ic.rate_hz = opt_.imu_rate_hz;
   imu_ = simulate_imu(*motion_, ic, opt_.seed);
   num_frames_ = int(std::floor(motion_->duration() * opt_.rate_hz));
+}
+
+// Tall cabinets (2 m, 0.4 m deep) against the walls: every wall segment of at least 0.8 m is cut into
+// pieces of about 1 m on the side(s) of the wall inside the building; pieces in random order get a
+// cabinet (unless it would stand on the path or against another cabinet) until wall_clutter of the
+// wall length is covered.
+void Simulator::add_wall_clutter() {
+  Rng rng(mix_seed(opt_.seed, 0xCAB1u));
+  const auto path = motion_->sample_path(0.1);
+  const double depth = 0.4, gap = 0.03;
+  struct Piece {
+    Furniture f;
+    double len;
+  };
+  std::vector<Piece> pieces;
+  double wall_len = 0, covered = 0;
+  const FloorPlan plan = world_->plan();
+  for (const auto& e : plan.elements) {
+    if (e.kind != ElementKind::kSegment) continue;
+    const Eigen::Vector2d d = e.b - e.a;
+    const double len = d.norm();
+    if (len < 0.8) continue;
+    const Eigen::Vector2d u = d / len, n(-u.y(), u.x());
+    const int np = std::max(1, int(std::lround(len)));
+    const double pl = len / np;
+    for (int i = 0; i < np; ++i) {
+      const Eigen::Vector2d mid = e.a + u * (pl * (i + 0.5));
+      for (double side : {1.0, -1.0}) {
+        const Eigen::Vector2d c = mid + side * n * (gap + depth / 2);
+        // Outside the building, or inside a wall's thickness (another element closer than the box's depth).
+        if (std::isnan(world_->ceiling_at(c.x(), c.y())) || world_->static_clearance(c) < depth / 2 + gap - 1e-3) continue;
+        wall_len += pl;
+        Piece p;
+        p.f.center = c;
+        p.f.yaw = std::atan2(u.y(), u.x());
+        p.f.half = Eigen::Vector2d(pl / 2 - 0.01, depth / 2);
+        p.f.z0 = 0;
+        p.f.z1 = 2.0;
+        p.f.reflectivity = 35;
+        p.len = pl;
+        pieces.push_back(p);
+      }
+    }
+  }
+  for (size_t i = pieces.size(); i > 1; --i) std::swap(pieces[i - 1], pieces[size_t(rng.uniform() * double(i)) % i]);
+  for (const auto& p : pieces) {
+    if (covered >= opt_.wall_clutter * wall_len) break;
+    if (dist_to_path(path, p.f.center) < p.f.half.y() + 0.35) continue;  // the dolly's path stays free
+    if (world_->static_clearance(p.f.center) < depth / 2 + gap - 1e-3) continue;  // another cabinet there
+    world_->add_furniture(p.f);
+    covered += p.len;
+  }
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "wall clutter: %.1f m of %.1f m of walls behind 2 m cabinets (%.0f %%)\n", covered,
+                wall_len, wall_len > 0 ? 100 * covered / wall_len : 0.0);
+  info_ += buf;
 }
 
 void Simulator::add_clutter() {

@@ -50,6 +50,7 @@ struct NodeStats {
   std::deque<PortCounters> ports;  // deque: stable addresses for publishers/subscribers
   LatencyWindow latency;           // handler latency this period
   LatencyWindow latency_total;     // every handler call, composed replay only (its --json breakdown)
+  double cpu_s_total = 0;          // thread CPU time in handlers, composed replay only (the machine may be shared)
   int64_t errors = 0;
   std::string last_error;
   double busy_s_period = 0;        // time spent in handlers this period

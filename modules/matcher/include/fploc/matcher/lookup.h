@@ -11,6 +11,7 @@
 #pragma once
 #include <Eigen/Core>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -18,9 +19,22 @@
 
 namespace fploc {
 
+// A target's geometry prepared for the residuals: segments with their unit direction and length (no
+// division per evaluation); circles/arcs as in Element.
+struct TargetGeom {
+  ElementKind kind = ElementKind::kSegment;
+  Eigen::Vector2d a = Eigen::Vector2d::Zero(), b = Eigen::Vector2d::Zero();
+  Eigen::Vector2d u = Eigen::Vector2d::Zero();  // segment: (b - a) / len (zero for a point)
+  double len = 0;
+  Eigen::Vector2d c = Eigen::Vector2d::Zero();
+  double r = 0, a0 = 0, a1 = 0;
+};
+
 class NearestLookup {
  public:
   virtual ~NearestLookup() = default;
+  // targets() prepared for the residuals (built on first use, thread-safe).
+  const std::vector<TargetGeom>& geometry() const;
   // What candidate ids refer to.
   virtual const std::vector<Element>& targets() const = 0;
   // Writes up to `max` candidate target ids for point p (plan frame) to out; returns how many. The
@@ -29,6 +43,10 @@ class NearestLookup {
   virtual std::string name() const = 0;
   // False for point targets: the PCA group rule (one group, one element) does not apply.
   virtual bool element_targets() const { return true; }
+
+ private:
+  mutable std::once_flag geom_once_;
+  mutable std::vector<TargetGeom> geom_;
 };
 
 // Exact nearest element by brute force.

@@ -14,11 +14,14 @@ namespace fploc {
 struct MatcherConfig {
   double gate_initial_m = 1.5;    // correspondence gate of the first outer iteration
   double gate_final_m = 0.3;      // ... halved each outer iteration down to this
-  double gate_tracking_m = 0.6;   // first gate while tracking (previous frame OK)
+  double gate_tracking_m = 0.3;   // first gate while tracking (previous frame OK): the motion model is good to
+                                  // centimetres, and structures not in the plan running parallel to it a few
+                                  // decimetres away (cabinets along a wall) stay out of the correspondences
   double loss_scale_m = 0.05;     // robust (Huber) loss scale
   std::string loss = "huber";     // "huber", "cauchy", "none"
   int max_iterations = 10;        // Ceres iterations per outer iteration
   int max_outer = 5;              // look-up + solve rounds (x6 for point targets, see matcher.cpp)
+  double initial_search_yaw_rad = 10 * M_PI / 180;  // default yaw uncertainty of a pose given by set_pose
   double inlier_m = 0.1;          // a point within this of the plan is an inlier
   double min_inlier_ratio = 0.3;  // below: POOR (the pose is not accepted)
   int min_inliers = 15;
@@ -27,46 +30,78 @@ struct MatcherConfig {
   double max_jump_rad = 0.5;
   bool group_rule = true;
   bool motion_model = true;       // constant velocity (else: previous pose)
+  bool deskew = true;             // motion compensation with the motion model's twist (IMU yaw rate if given)
   int stride = 1;                 // use every stride-th point
   int max_points = 800;           // more features than this: the stride grows to keep about this many (0 = all)
+  // While tracking, the prediction enters the registration as one more measurement: its uncertainty over
+  // one frame (a platform's deviation from constant velocity in 0.1 s plus the velocity estimate's error;
+  // grows with the time since the last frame), weighed against the floor-plan residuals by the last fit's
+  // rms. Negligible where the plan constrains the pose (hundreds of points), it holds the directions the
+  // plan leaves open (along a featureless wall) instead of letting them slide. 0 = no prior.
+  double prediction_sigma_m = 0.01;
+  double prediction_sigma_rad = 0.01;
+};
+
+// A Gaussian prior on the registered pose (the motion model's prediction), as residuals
+// sqrt_info (x - pose) (yaw difference wrapped) beside the floor-plan terms.
+struct PosePrior {
+  Pose2 pose;
+  Eigen::Vector3d sqrt_info = Eigen::Vector3d::Zero();  // per x, y, yaw, in the floor-plan terms' units
 };
 
 struct MatchResult {
   FitStatus status = FitStatus::kNotInitialised;
   std::string text;
-  Pose2 pose;                     // accepted pose (the prediction when POOR/LOST)
-  Pose2 solved;                   // what the solver found (equal to pose when OK)
-  Pose2 predicted;
+  Pose2 pose;                     // accepted pose at the frame's utime (the prediction when POOR/LOST)
+  Pose2 solved;                   // what the solver found, at utime (equal to pose when OK)
+  Pose2 predicted;                // at utime
+  Pose2 sweep_pose;               // the accepted pose at utime + t_ref (what the registration estimates)
+  double t_ref = 0;               // reference time of the de-skewed sweep [s after utime]
+  Twist2 twist;                   // body twist of the motion compensation and of utime <-> t_ref
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
   FitQuality fit;
   int iterations = 0;
 };
 
-// Stateless registration from an initial guess (used by the Matcher and by tests).
+// Stateless registration from an initial guess (used by the Matcher and by tests). `f` is registered as
+// given (motion compensation, if any, is the caller's: see deskew()).
 MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& guess,
-                           const MatcherConfig& cfg);
+                           const MatcherConfig& cfg, const PosePrior* prior = nullptr);
 
 class Matcher {
  public:
   Matcher(const NearestLookup& lookup, MatcherConfig cfg);
-  // (Re)initialises the tracker: the next frame is registered from this pose (no motion model).
-  void set_pose(const Pose2& p);
+  // (Re)initialises the tracker: the next frame is registered from this pose (no motion model), searching
+  // within search_m / search_yaw of it (the pose's uncertainty; defaults gate_initial_m and
+  // initial_search_yaw_rad). An uncertainty larger than twice the tracking gate is searched from a grid
+  // of starts.
+  void set_pose(const Pose2& p, std::optional<double> search_m = std::nullopt, std::optional<double> search_yaw = std::nullopt);
   bool initialised() const { return initialised_; }
-  // Registers the frame. yaw_delta: the IMU's integrated yaw change since the previous frame, if any.
+  // Registers the frame; the result is the pose at f.utime. yaw_delta: the IMU's integrated yaw change
+  // since the previous frame, if any (prediction). Motion compensation (cfg.deskew): the sweep is
+  // de-skewed to its mean point time t_ref with the motion model's body twist (its yaw rate replaced by
+  // f.sweep_yaw_rate when that is known) and registered there; the twist is then updated from the last
+  // two registered sweep poses and carries the pose back from utime + t_ref to utime.
   MatchResult process(const FeatureFrame& f, std::optional<double> yaw_delta = std::nullopt);
+  // The body twist the motion model currently assumes (zero until two frames were registered).
+  Twist2 twist() const { return twist_; }
   const MatcherConfig& config() const { return cfg_; }
 
  private:
-  Pose2 predict(int64_t utime, std::optional<double> yaw_delta) const;
+  Pose2 predict(int64_t tau, std::optional<double> yaw_delta) const;
   const NearestLookup& lookup_;
   MatcherConfig cfg_;
   bool initialised_ = false;
-  bool have_last_ = false;      // a registered frame exists (utime_ valid)
+  bool have_last_ = false;      // a frame was processed since set_pose (tau_ valid)
   bool have_velocity_ = false;
-  Pose2 pose_;
-  int64_t utime_ = 0;
-  Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();  // vx, vy [m/s], yaw rate [rad/s] (plan frame)
+  Pose2 pose_;                  // last accepted pose at tau_ (the sweep's reference time)
+  int64_t tau_ = 0;
+  Twist2 twist_;                // constant body twist between the last two registered sweep poses
   int poor_count_ = 0;
+  double last_rms_ = 0;         // fit rms of the last OK frame
+  double search_m_ = 0;         // uncertainty of the pose given by set_pose
+  double search_yaw_ = 0;
+  FeatureFrame deskewed_;       // scratch
 };
 
 }  // namespace fploc

@@ -9,58 +9,38 @@
 #pragma once
 #include <ceres/ceres.h>
 
-#include <memory>
 #include <string>
 #include <vector>
 
+#include "fploc/matcher/assignment.h"
 #include "fploc/matcher/lookup.h"
 #include "fploc/matcher/types.h"
 
 namespace fploc {
 
-constexpr int kMaxCandidates = 8;
-
-struct Assignment {
-  int point = -1;
-  int n = 0;
-  int cand[kMaxCandidates] = {};
-};
-
-struct AssignOptions {
-  double gate_m = 1.0;     // points farther than this from all candidates are left out
-  bool group_rule = true;  // one PCA group <-> one element (element look-ups only)
-  int max_candidates = kMaxCandidates;
-  int stride = 1;          // use every stride-th point (1 = all)
-};
-
-// Correspondences of the frame's points at pose x.
+// Correspondences of the frame's points at pose x (in point order).
 void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, const AssignOptions& o,
             std::vector<Assignment>* out);
 
-// Closest point on the closest of the candidates, with the Jacobian d(p - q)/dp (normal projection
-// for interior points of segments/circles/arcs, identity at end points and point targets).
-double closest_of(const std::vector<Element>& targets, const int* cand, int n, const Eigen::Vector2d& p,
+// Closest point on the closest of the candidates (lookup.geometry() ids) with the Jacobian d(p - q)/dp
+// (normal projection for interior points of segments/circles/arcs, identity at end points and point
+// targets); returns the distance.
+double closest_of(const std::vector<TargetGeom>& targets, const int* cand, int n, const Eigen::Vector2d& p,
                   Eigen::Vector2d* q, Eigen::Matrix2d* dr_dp);
 
-// One point's residual (2 values) on a pose block {x, y, yaw}.
-ceres::CostFunction* make_point_cost(const std::vector<Element>* targets, const Assignment& a,
-                                     const Eigen::Vector2d& p_sensor, double weight);
-
-// Adds one residual block per assignment to the problem. `loss` is not owned by the problem (create the
-// problem with loss_function_ownership = DO_NOT_TAKE_OWNERSHIP).
-void add_plan_terms(ceres::Problem* problem, double* pose, const NearestLookup& lookup, const FeatureFrame& f,
-                    const std::vector<Assignment>& a, ceres::LossFunction* loss, double weight = 1.0);
-
-// Robust loss by name ("huber", "cauchy", "none" = nullptr) with scale [m].
-std::unique_ptr<ceres::LossFunction> make_loss(const std::string& name, double scale);
-
-// The same terms as ONE residual block for the whole frame (2 residuals per assignment) with the robust
-// loss ("huber", "cauchy", "none", scale [m]) folded exactly into the residuals: much less Ceres
-// overhead than a block per point. Used by the matcher and the optimizer.
+// The frame's terms as ONE residual block (2 residuals per assignment) with the robust loss ("huber",
+// "cauchy", "none", scale [m]) folded exactly into the residuals: much less Ceres overhead than a block
+// per point. Used by the matcher and the optimizer. The cost is weight^2 sum rho(|r|^2).
 void add_frame_term(ceres::Problem* problem, double* pose, const NearestLookup& lookup, const FeatureFrame& f,
                     const std::vector<Assignment>& a, const std::string& loss, double scale, double weight = 1.0);
 
-// Inlier ratio and rms against the nearest candidate at pose x (no gating other than inlier_m).
-FitQuality evaluate_fit(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, double inlier_m);
+// Gauss-Newton information J^T J of the frame term at x (robust weights included), for the covariance.
+Eigen::Matrix3d frame_information(const NearestLookup& lookup, const FeatureFrame& f, const std::vector<Assignment>& a,
+                                  const Pose2& x, const std::string& loss, double scale);
+
+// Inlier ratio and rms against the nearest candidate at pose x (no gating other than inlier_m), over
+// every stride-th point.
+FitQuality evaluate_fit(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, double inlier_m,
+                        int stride = 1);
 
 }  // namespace fploc

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -25,8 +26,35 @@ struct FeatureFrame {
   int64_t scan_seq = 0;
   double roll = 0, pitch = 0, z = 0;
   double roll_pitch_sigma = 0, z_sigma = 0;
+  // The IMU's mean yaw rate [rad/s] over the sweep (utime .. utime + the points' largest t); NaN = unknown.
+  double sweep_yaw_rate = std::numeric_limits<double>::quiet_NaN();
   std::vector<Feature2> points;
 };
+
+// Planar velocity of the sensor, in its own frame: linear [m/s] (x forward, y left) and yaw rate [rad/s].
+// Constant over a sweep it is the motion model of the motion compensation (de-skewing).
+struct Twist2 {
+  double vx = 0, vy = 0, w = 0;
+};
+
+// Relative pose after moving with the constant body twist v for t seconds (SE(2) exponential).
+Pose2 exp_twist(const Twist2& v, double t);
+// The constant body twist that takes pose a to pose b in dt seconds (SE(2) logarithm / dt).
+Twist2 log_twist(const Pose2& a, const Pose2& b, double dt);
+// a (+) b: b expressed in a's frame, composed.
+Pose2 compose(const Pose2& a, const Pose2& b);
+
+// Motion compensation: every point, measured at f.utime + p.t from the moving sensor, expressed in the
+// sensor frame at f.utime + t_ref, assuming the body twist v over the sweep:
+// p' = exp_twist(v, p.t - t_ref) (+) p. A pose registered from the result is the pose at f.utime + t_ref.
+// With t_ref = mean_time(f) an error of v distorts the sweep symmetrically about its middle instead of
+// shifting it, so the registered pose hardly depends on v (a velocity estimated from registered poses
+// and fed back into their de-skewing is a loop that oscillates when t_ref = 0).
+void deskew(const FeatureFrame& raw, const Twist2& v, double t_ref, FeatureFrame* out);
+// Largest |t| of the frame's points [s] (0 when the points carry no times).
+double sweep_duration(const FeatureFrame& f);
+// Mean t of the frame's points [s].
+double mean_time(const FeatureFrame& f);
 
 enum class FitStatus : int8_t { kOk = 0, kPoor = 1, kLost = 2, kNotInitialised = 3 };
 const char* to_string(FitStatus s);

@@ -5,6 +5,12 @@
 // beta ||w^{m+1} - w^m||^2. Each key pose is optimised W times and becomes final when it leaves the
 // window. Non-keyframes are passed on with the correction (final - single-frame) of the surrounding
 // keyframes interpolated in time, so the final trajectory has every frame.
+//
+// Motion compensation, as in the matcher: a key pose is the pose at its sweep's reference time
+// tau = utime + t_ref (t_ref = the mean point time; the sweep is de-skewed there with the matcher's twist),
+// the velocities are taken between those times, and every output pose is carried back from tau to its
+// utime along the output trajectory: interpolated between the previous frame's pose at its tau and this
+// one's (utime lies between them), exactly as the matcher's constant twist does for single-frame poses.
 #pragma once
 #include <Eigen/Core>
 #include <cmath>
@@ -13,6 +19,7 @@
 #include <vector>
 
 #include "fploc/matcher/lookup.h"
+#include "fploc/matcher/assignment.h"
 #include "fploc/matcher/types.h"
 
 namespace fploc {
@@ -21,6 +28,8 @@ struct OptimizerConfig {
   int window = 10;                     // W
   double alpha = 1.1;                  // linear velocity regularisation
   double beta = 0.9;                   // angular velocity regularisation
+  bool body_frame_velocity = false;    // regularise body-frame velocities (constant-speed turns cost nothing)
+                                       // instead of the paper's world-frame ones
   double keyframe_distance_m = 0.1;
   double keyframe_angle_rad = 5.0 * M_PI / 180;
   double gate_m = 0.3;                 // correspondence gate around the current estimate
@@ -30,14 +39,21 @@ struct OptimizerConfig {
   int outer = 2;                       // look-up + solve rounds per new keyframe
   bool group_rule = true;
   int stride = 1;                      // use every stride-th feature point of a keyframe
-  int max_points = 400;                // per keyframe: the stride grows to keep about this many (0 = all)
+  int max_points = 800;                // per keyframe: the stride grows to keep about this many (0 = all)
+  bool budget_weight = true;           // weight the sampled points by the stride (estimate of the sum over all)
+  double relook_m = 0.01;              // a key's correspondences are looked up again when it moved this far
+  double relook_rad = 0.2 * M_PI / 180;  // ... or turned this much since the last look-up
   bool anchor_final = false;           // also regularise against the last two final key poses (held fixed)
   double max_keyframe_gap_s = 2.0;     // a longer gap (e.g. lost frames) restarts the window
+  double unknown_z_sigma_m = 1.0;      // the segmenter's z_sigma at or above this: z unknown (it sends 1e3)
+  double unknown_rp_sigma_rad = 0.5;   // ... roll_pitch_sigma at or above this: roll/pitch unknown (it sends pi)
+  std::string linear_solver = "sparse";  // "sparse" (SPARSE_NORMAL_CHOLESKY) or "dense" (DENSE_NORMAL_CHOLESKY)
 };
 
 struct FrameInput {
-  FeatureFrame features;
-  Pose2 sfr;                           // single-frame registration result
+  FeatureFrame features;               // as measured (not de-skewed)
+  Pose2 sfr;                           // single-frame registration result at features.utime
+  Twist2 twist;                        // the matcher's body twist (its motion compensation)
   FitStatus status = FitStatus::kOk;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
 };
@@ -68,27 +84,57 @@ class WindowOptimizer {
   const OptimizerConfig& config() const { return cfg_; }
 
  private:
-  struct Key {
+  // A frame's single-frame result at its sweep's reference time.
+  struct Frame {
     FrameInput in;
-    double x[3];
+    double t_ref = 0;                  // [s after utime]
+    int64_t tau = 0;                   // utime + t_ref [us]
+    Pose2 sfr_tau;                     // the single-frame pose at tau
+  };
+  struct Key {
+    Frame f;
+    FeatureFrame deskewed;             // features de-skewed to t_ref
+    double x[3];                       // pose at tau
     int optimised = 0;
+    std::vector<Assignment> as;        // correspondences, looked up at as_pose
+    Pose2 as_pose;
+    bool as_valid = false;
+    int as_stride = 1;
   };
   struct Final {
-    int64_t utime;
+    int64_t tau;
+    Pose2 pose_tau;
+    Eigen::Vector3d correction;        // pose_tau - sfr_tau
+  };
+  struct Stamped {
+    bool valid = false;
+    int64_t tau = 0;
     Pose2 pose;
-    Eigen::Vector3d correction;
   };
   void solve();
   void finalize_front(std::vector<PoseOut>* finals);
-  void emit_pending_until(int64_t utime, const Eigen::Vector3d& corr_next, std::vector<PoseOut>* finals);
-  PoseOut make_out(const FrameInput& in, const Pose2& p, bool key) const;
+  void emit_pending_until(int64_t tau, const Eigen::Vector3d& corr_next, std::vector<PoseOut>* finals);
+  // The output pose at utime from the pose at tau and the previous output's pose at its tau (`prev`,
+  // updated), which closes the interval [prev.tau, tau] containing utime; without one (start, gap) the
+  // matcher's twist carries the pose back.
+  PoseOut make_out(const Frame& f, const Pose2& pose_tau, bool key, Stamped* prev) const;
+  // Roll/pitch/z of a frame whose segmenter could not estimate them (sigma of "unknown"): interpolated
+  // between the nearest frames that had them (held at the ends).
+  void fill_gravity(PoseOut* o, const FeatureFrame& f) const;
   Eigen::Vector3d newest_correction() const;
 
   const NearestLookup& lookup_;
   OptimizerConfig cfg_;
   std::deque<Key> window_;
-  std::deque<FrameInput> pending_;     // non-keyframes waiting for their surrounding keyframes to be final
+  std::deque<Frame> pending_;          // non-keyframes waiting for their surrounding keyframes to be final
   std::deque<Final> finals_;           // last two final key poses
+  Stamped last_final_, last_latest_;   // previous pose at tau of the final / latest output streams
+  struct Gravity {
+    int64_t utime;
+    double roll, pitch, z;
+    bool rp_known, z_known;
+  };
+  std::deque<Gravity> gravity_;        // recent frames' roll/pitch/z
   bool have_last_key_ = false;
   Pose2 last_key_sfr_;
   int64_t last_key_utime_ = 0;

@@ -25,6 +25,7 @@ struct SimulatorOptions {
   std::string scenario = "room-small-loop-medium";
   uint64_t seed = 0;
   bool clutter = true;            // furniture boxes and walking people (not in the plan)
+  double wall_clutter = 0;        // fraction of the wall length hidden behind 2 m tall cabinets (robustness)
   bool ceiling_patches = true;    // a sloped and a missing ceiling patch (room scenarios and auto-loop)
   double ceiling_height_m = 0;    // 0 = scenario default
   double range_noise_m = 0.02;
@@ -63,6 +64,7 @@ class Simulator {
 
  private:
   void add_clutter();
+  void add_wall_clutter();
   SimulatorOptions opt_;
   ScenarioSpec spec_;
   std::unique_ptr<World> world_;
