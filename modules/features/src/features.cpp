@@ -111,7 +111,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     int corners = 0;
     for (size_t j = 0; j < order_.size() && corners < cfg_.max_corners_per_sector; ++j) {
       if (j == csorted) {
-        const size_t k = std::min(order_.size(), std::max<size_t>(csorted * 2, size_t(8 * cfg_.max_corners_per_sector)));
+        const size_t k = std::min(order_.size(), std::max<size_t>(csorted * 2, size_t(2 * cfg_.max_corners_per_sector)));
         std::partial_sort(order_.begin() + csorted, order_.begin() + k, order_.end(), more);
         csorted = k;
       }
@@ -131,7 +131,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     int surfaces = 0;
     for (size_t j = 0; j < order_.size() && surfaces < cfg_.max_surfaces_per_sector; ++j) {
       if (j == sorted) {
-        const size_t k = std::min(order_.size(), std::max<size_t>(sorted * 2, size_t(4 * cfg_.max_surfaces_per_sector)));
+        const size_t k = std::min(order_.size(), std::max<size_t>(sorted * 2, size_t(2 * cfg_.max_surfaces_per_sector)));
         std::partial_sort(order_.begin() + sorted, order_.begin() + k, order_.end(), less);
         sorted = k;
       }

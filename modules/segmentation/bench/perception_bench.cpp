@@ -2,6 +2,16 @@
 // room: the paper's segmenter, the feature extractor, both together, and the PCL RANSAC segmenter.
 #include <benchmark/benchmark.h>
 
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#if __has_include(<valgrind/callgrind.h>)
+#include <valgrind/callgrind.h>
+#else
+#define CALLGRIND_START_INSTRUMENTATION
+#define CALLGRIND_STOP_INSTRUMENTATION
+#endif
+
 #include "fploc/features/features.h"
 #include "fploc/segmentation/ransac_segmenter.h"
 #include "fploc/segmentation/segmenter.h"
@@ -50,6 +60,51 @@ void BM_RansacSegmenter(benchmark::State& st) {
 }
 BENCHMARK(BM_RansacSegmenter)->Unit(benchmark::kMicrosecond);
 
+// --profile=N: N scans of segmenter + features after a warm-up, instrumented for callgrind only there:
+//   valgrind --tool=callgrind --instr-atstart=no build/bin/perception_bench --profile=20
+// (instruction counts do not depend on the machine's load; divide by N for a per-scan figure).
+int profile(int n, bool with_features) {
+  seg::RingSegmenter sg(seg::SegmenterConfig{});
+  feat::FeatureExtractor fx;
+  sg.process(scan().scan);
+  size_t sink = 0;
+  CALLGRIND_START_INSTRUMENTATION;
+  for (int i = 0; i < n; ++i) {
+    const auto& s = sg.process(scan().scan);
+    sink += with_features ? fx.process(s).size() : s.wall.size();
+  }
+  CALLGRIND_STOP_INSTRUMENTATION;
+  // FNV-1a over the last outputs (planes, wall points, features): "optimised without changing results".
+  uint64_t h = 1469598103934665603ull;
+  auto mix = [&h](const void* p, size_t bytes) {
+    for (size_t i = 0; i < bytes; ++i) h = (h ^ static_cast<const uint8_t*>(p)[i]) * 1099511628211ull;
+  };
+  const auto& s = sg.last();
+  mix(s.ceiling.coeffs.data(), sizeof(double) * 4);
+  mix(s.ground.coeffs.data(), sizeof(double) * 4);
+  for (const auto* v : {&s.wall.x, &s.wall.y, &s.wall.z, &s.wall.range, &s.wall.t}) mix(v->data(), v->size() * sizeof(float));
+  if (with_features) {
+    const auto& f = fx.process(s);
+    mix(f.x.data(), f.x.size() * sizeof(float));
+    mix(f.y.data(), f.y.size() * sizeof(float));
+    mix(f.kind.data(), f.kind.size());
+    mix(f.group.data(), f.group.size() * sizeof(int32_t));
+  }
+  std::cout << "profiled " << n << " scans (" << (with_features ? "segmenter + features" : "segmenter") << "), "
+            << sink / size_t(std::max(1, n)) << " outputs per scan, result hash " << std::hex << h << std::dec << "\n";
+  return 0;
+}
+
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::strncmp(argv[i], "--profile=", 10) == 0) return profile(std::atoi(argv[i] + 10), true);
+    if (std::strncmp(argv[i], "--profile-segmenter=", 20) == 0) return profile(std::atoi(argv[i] + 20), false);
+  }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -206,56 +206,64 @@ bool Segmenter::prepare(const Scan& scan) {
   const bool deskew = deskew_rotations(scan);
   out_.deskewed = deskew;
   if (deskew) raw_.resize(n);
+  // Range gate in integers: float(r) < rmin || float(r) > rmax for the 20-bit ranges (exact in float).
   const float rmin = float(cfg_.min_range_m * 1000.0), rmax = float(cfg_.max_range_m * 1000.0);
-  const bool mids = int(scan.measurement_id.size()) == scan.width;
-  const bool cvalid = int(scan.column_valid.size()) == scan.width;
+  const uint32_t r_lo = uint32_t(std::clamp(std::ceil(double(rmin)), 1.0, 4294967295.0));
+  const uint32_t r_hi = uint32_t(std::clamp(std::floor(double(rmax)), 0.0, 4294967295.0));
+  // Per column (once, not per pixel): look-up column (measurement id) and validity.
+  const int W = scan.width, H = scan.height;
+  const bool mids = int(scan.measurement_id.size()) == W;
+  const bool cvalid = int(scan.column_valid.size()) == W;
+  col_mid_.resize(W);
+  col_ok_.resize(W);
+  for (int c = 0; c < W; ++c) {
+    int mid = mids ? scan.measurement_id[c] : c;
+    if (mid < 0 || mid >= W) mid = c;
+    col_mid_[c] = mid;
+    col_ok_[c] = !(cvalid && !scan.column_valid[c]);
+  }
+  // XYZ of every valid pixel, and in the same pass the candidate sets: upper half rings (top first) and
+  // lower half rings (bottom first), each ring in column order (an odd middle ring is in neither).
   size_t valid = 0;
-  for (int u = 0; u < scan.height; ++u) {
-    for (int c = 0; c < scan.width; ++c) {
-      const size_t i = size_t(u) * scan.width + c;
+  auto ring_pass = [&](int u, Candidates* cs) {
+    const size_t row = size_t(u) * W;
+    for (int c = 0; c < W; ++c) {
+      const size_t i = row + c;
       const uint32_t r = scan.range_mm[i];
-      int mid = mids ? scan.measurement_id[c] : c;
-      if (mid < 0 || mid >= scan.width) mid = c;
-      if (r == 0 || float(r) < rmin || float(r) > rmax || (cvalid && !scan.column_valid[c])) {
+      if (r < r_lo || r > r_hi || !col_ok_[c]) {
         range_[i] = 0.f;
         continue;
       }
-      const size_t k = size_t(u) * scan.width + mid;
-      const Eigen::Vector3f p = lut_.direction.row(k).transpose() * float(r) + lut_.offset.row(k).transpose();
+      const size_t k = row + col_mid_[c];
+      Eigen::Vector3f p = lut_.direction.row(k).transpose() * float(r) + lut_.offset.row(k).transpose();
       if (deskew) {
         raw_[i] = p;
-        xyz_[i] = col_rot_[c] * p;
-      } else {
-        xyz_[i] = p;
+        p = col_rot_[c] * p;
       }
-      range_[i] = float(r) * 1e-3f;
+      xyz_[i] = p;
+      const float rm = float(r) * 1e-3f;
+      range_[i] = rm;
       ++valid;
-    }
-  }
-  if (valid == 0) return fail(SegStatus::kEmpty, "no valid returns in the scan");
-
-  // Candidate sets: upper half rings (top first) and lower half rings (bottom first).
-  auto fill = [&](Candidates& cs, bool upper) {
-    cs.p.clear();
-    cs.range.clear();
-    cs.pixel.clear();
-    cs.ring_start.assign(1, 0);
-    cs.width = scan.width;
-    const int half = scan.height / 2;
-    for (int k = 0; k < half; ++k) {
-      const int u = upper ? ring_order_[k] : ring_order_[scan.height - 1 - k];
-      for (int c = 0; c < scan.width; ++c) {
-        const size_t i = size_t(u) * scan.width + c;
-        if (range_[i] <= 0.f) continue;
-        cs.p.push_back(xyz_[i]);
-        cs.range.push_back(range_[i]);
-        cs.pixel.push_back(int32_t(i));
+      if (cs) {
+        cs->p.push_back(p);
+        cs->range.push_back(rm);
+        cs->pixel.push_back(int32_t(i));
       }
-      cs.ring_start.push_back(int32_t(cs.p.size()));
     }
+    if (cs) cs->ring_start.push_back(int32_t(cs->p.size()));
   };
-  fill(upper_, true);
-  fill(lower_, false);
+  for (Candidates* cs : {&upper_, &lower_}) {
+    cs->p.clear();
+    cs->range.clear();
+    cs->pixel.clear();
+    cs->ring_start.assign(1, 0);
+    cs->width = W;
+  }
+  const int half = H / 2;
+  for (int k = 0; k < half; ++k) ring_pass(ring_order_[k], &upper_);
+  for (int k = 0; k < half; ++k) ring_pass(ring_order_[H - 1 - k], &lower_);
+  if (H % 2 == 1) ring_pass(ring_order_[half], nullptr);
+  if (valid == 0) return fail(SegStatus::kEmpty, "no valid returns in the scan");
   return true;
 }
 
@@ -505,9 +513,9 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
       if (scan.column_utime[v] != 0) col_dt_[v] = float(double(scan.column_utime[v] - scan.utime) * 1e-6);
   for (int u = 0; u < scan.height; ++u) {
     const int shift = u < int(scan.beams.pixel_shift_by_row.size()) ? scan.beams.pixel_shift_by_row[u] : 0;
-    for (int cd = 0; cd < W; ++cd) {
-      int v = (cd - shift) % W;
-      if (v < 0) v += W;
+    int v = ((-shift) % W + W) % W;  // staggered column of destaggered column cd (cd - shift mod W)
+    for (int cd = 0; cd < W; ++cd, ++v) {
+      if (v == W) v = 0;
       const size_t i = size_t(u) * W + v;
       const float r = range_[i];
       if (r <= 0.f) continue;
@@ -665,12 +673,12 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
   const Eigen::Vector3d ref = -cur[3] * cur.head<3>();  // a point of the plane (numerics)
   const Eigen::Vector3f reff = ref.cast<float>();
   double cut = cfg_.irls_initial_scale_m;
-  band_.clear();
+  band_.clear();  // the band's points, contiguous (streamed by every iteration)
   {
     const Eigen::Vector3f n = cur.head<3>().cast<float>();
     const float d = float(cur[3]), cb = float(cut);
     for (size_t i = 0; i < c.p.size(); ++i)
-      if (std::abs(n.dot(c.p[i]) + d) < cb) band_.push_back(int(i));
+      if (std::abs(n.dot(c.p[i]) + d) < cb) band_.push_back(c.p[i]);
   }
   if (band_.size() < 3) return std::nullopt;
   for (int it = 0; it < std::max(1, cfg_.irls_iterations); ++it) {
@@ -683,7 +691,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
     const float inv_bin = float(kBins / cut);
     int inside = 0;
     for (size_t j = 0; j < band_.size(); ++j) {
-      const float r = n.dot(c.p[band_[j]]) + d;
+      const float r = n.dot(band_[j]) + d;
       res_[j] = r;
       const float a = std::abs(r);
       if (a < cut) {
@@ -711,7 +719,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
       const float t = r * r * inv_c2;
       if (t >= 1.f) continue;
       const double w = (1.f - t) * (1.f - t);
-      const Eigen::Vector3f& pf = c.p[band_[j]];
+      const Eigen::Vector3f& pf = band_[j];
       const double x = pf.x() - reff.x(), y = pf.y() - reff.y(), z = pf.z() - reff.z();
       sw += w;
       sx += w * x; sy += w * y; sz += w * z;

@@ -159,6 +159,8 @@ class Segmenter {
   Eigen::Vector3d imu_up_ = Eigen::Vector3d::UnitZ();
   std::deque<std::pair<int64_t, Eigen::Vector3d>> gyro_;  // last ~1 s of gyro samples, increasing time
   std::vector<int64_t> col_t_;
+  std::vector<int> col_mid_;
+  std::vector<uint8_t> col_ok_;
   bool have_imu_ = false;
   std::deque<double> heights_;
   double room_height_ = 0.0;
@@ -178,7 +180,7 @@ class RingSegmenter : public Segmenter {
   std::vector<int> seeds_, all_seeds_;
   std::vector<float> sector_best_;
   std::vector<int> sector_idx_;
-  std::vector<int> band_;
+  std::vector<Eigen::Vector3f> band_;
   std::vector<float> res_;
 };
 
