@@ -80,7 +80,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   for (int j = 0; j + 1 < n; ++j) {
     if (col(j + 1) - col(j) > cfg_.max_column_gap) continue;
     const float a = r(j), c = r(j + 1);
-    if (std::abs(a - c) > occ * std::min(a, c)) {
+    if (std::abs(a - c) > occ * std::fmin(a, c)) {  // fmin: no branch (ranges are finite)
       if (a > c) {
         for (int k = std::max(0, j - hw + 1); k <= j; ++k) ok_[k] = 0;
       } else {
@@ -103,9 +103,14 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     const int sb = hw + (n - 2 * hw) * s / S, se = hw + (n - 2 * hw) * (s + 1) / S;
     if (se <= sb) continue;
     // Corner candidates (few): sorted by decreasing smoothness.
-    order_.clear();
-    for (int i = sb; i < se; ++i)
-      if (ok_[i] && curv_[i] > cthr) order_.push_back(i);
+    // Candidates collected without a data-dependent branch (it mispredicted on every other point).
+    order_.resize(size_t(se - sb));
+    size_t m = 0;
+    for (int i = sb; i < se; ++i) {
+      order_[m] = i;
+      m += size_t(ok_[i] & uint8_t(curv_[i] > cthr));
+    }
+    order_.resize(m);
     auto more = [&](int a, int b) { return curv_[a] > curv_[b] || (curv_[a] == curv_[b] && a < b); };
     size_t csorted = 0;
     int corners = 0;
@@ -123,9 +128,13 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     }
     // Surface candidates: only the smoothest few need ordering (partial sort, widened if the spacing
     // rule rejects too many).
-    order_.clear();
-    for (int i = sb; i < se; ++i)
-      if (ok_[i] && curv_[i] < sthr && !picked_[i]) order_.push_back(i);
+    order_.resize(size_t(se - sb));
+    m = 0;
+    for (int i = sb; i < se; ++i) {
+      order_[m] = i;
+      m += size_t(ok_[i] & uint8_t(curv_[i] < sthr) & uint8_t(!picked_[i]));
+    }
+    order_.resize(m);
     auto less = [&](int a, int b) { return curv_[a] < curv_[b] || (curv_[a] == curv_[b] && a < b); };
     size_t sorted = 0;
     int surfaces = 0;

@@ -2,6 +2,9 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -51,6 +54,16 @@ struct Moments {
     return true;
   }
 };
+
+// max(0, q) without a branch (std::max compiled to one here and mispredicted at every band edge); same
+// value as std::max(0.f, q) for every q, NaN included (maxss returns its second operand then).
+inline float max0(float q) {
+#if defined(__SSE__)
+  return _mm_cvtss_f32(_mm_max_ss(_mm_set_ss(q), _mm_setzero_ps()));
+#else
+  return std::max(0.f, q);
+#endif
+}
 
 double median_inplace(std::vector<float>& v) {
   if (v.empty()) return 0.0;
@@ -618,7 +631,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
     int beyond = 0;
     for (size_t i = 0; i < c.p.size(); i += stride) {
       const float r = n.dot(c.p[i]) + d;
-      soft += std::max(0.f, 1.f - r * r * inv_b2);
+      soft += max0(1.f - r * r * inv_b2);
       beyond += r < -beyond_thr;
     }
     return double(soft - beyond_weight * float(beyond)) * double(stride);
