@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 namespace fploc::feat {
@@ -102,29 +103,28 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   for (int s = 0; s < S; ++s) {
     const int sb = hw + (n - 2 * hw) * s / S, se = hw + (n - 2 * hw) * (s + 1) / S;
     if (se <= sb) continue;
-    // Corner candidates (few): sorted by decreasing smoothness.
-    // Candidates collected without a data-dependent branch (it mispredicted on every other point).
+    // Corners: the sharpest candidate that no earlier pick suppressed, max_corners_per_sector times (the
+    // same picks as walking the candidates sorted by decreasing c, ties by index; a branch-free scan per
+    // pick instead of a sort, which mispredicted on every comparison). Candidates are collected without
+    // a data-dependent branch too.
     order_.resize(size_t(se - sb));
     size_t m = 0;
     for (int i = sb; i < se; ++i) {
       order_[m] = i;
       m += size_t(ok_[i] & uint8_t(curv_[i] > cthr));
     }
-    order_.resize(m);
-    auto more = [&](int a, int b) { return curv_[a] > curv_[b] || (curv_[a] == curv_[b] && a < b); };
-    size_t csorted = 0;
-    int corners = 0;
-    for (size_t j = 0; j < order_.size() && corners < cfg_.max_corners_per_sector; ++j) {
-      if (j == csorted) {
-        const size_t k = std::min(order_.size(), std::max<size_t>(csorted * 2, size_t(2 * cfg_.max_corners_per_sector)));
-        std::partial_sort(order_.begin() + csorted, order_.begin() + k, order_.end(), more);
-        csorted = k;
+    for (int corners = 0; corners < cfg_.max_corners_per_sector; ++corners) {
+      int best = -1;
+      float bv = -std::numeric_limits<float>::infinity();
+      for (size_t j = 0; j < m; ++j) {
+        const int i = order_[j];
+        const bool take = !picked_[i] & (curv_[i] > bv);
+        bv = take ? curv_[i] : bv;
+        best = take ? i : best;
       }
-      const int i = order_[j];
-      if (picked_[i]) continue;
-      kind_of[i] = kCorner;
-      ++corners;
-      for (int k = std::max(0, i - hw); k <= std::min(n - 1, i + hw); ++k) picked_[k] = 1;
+      if (best < 0) break;
+      kind_of[best] = kCorner;
+      for (int k = std::max(0, best - hw); k <= std::min(n - 1, best + hw); ++k) picked_[k] = 1;
     }
     // Surface candidates: only the smoothest few need ordering (partial sort, widened if the spacing
     // rule rejects too many).
