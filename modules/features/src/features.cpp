@@ -72,21 +72,23 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   pre_.resize(size_t(n) + 1);
   pre_[0].setZero();
   for (int j = 0; j < n; ++j) pre_[j + 1] = pre_[j] + P(j).cast<double>();
+  // Branch-free (the window and range tests mispredicted on irregular rings): c is computed everywhere and
+  // only read where ok_ is set.
   for (int i = hw; i < n - hw; ++i) {
     // All of i-hw .. i+hw connected: no break between i-hw and i+hw-1.
-    if (brk_prefix[i + hw] - brk_prefix[i - hw] != 0) continue;
     const float ri = r(i);
-    if (ri < rmin || ri > rmax) continue;
+    const bool ok = (brk_prefix[i + hw] == brk_prefix[i - hw]) & !(ri < rmin) & !(ri > rmax);
     const Eigen::Vector3d diff = (pre_[i + hw + 1] - pre_[i - hw]) - double(2 * hw + 1) * P(i).cast<double>();
     curv_[i] = float(diff.norm()) / (float(2 * hw) * ri);  // LOAM's c = |sum(X_j - X_i)| / (|S| |X_i|)
-    ok_[i] = 1;
+    ok_[i] = uint8_t(ok);
   }
   // LOAM's unreliable points: the far side of an occlusion boundary, and surfaces parallel to the beam.
   const float occ = float(cfg_.occlusion_ratio), par = float(cfg_.parallel_ratio);
   for (int j = 0; j + 1 < n; ++j) {
-    if (col(j + 1) - col(j) > cfg_.max_column_gap) continue;
     const float a = r(j), c = r(j + 1);
-    if (std::abs(a - c) > occ * std::fmin(a, c)) {  // fmin: no branch (ranges are finite)
+    const float mn = a < c ? a : c;  // minss, no branch (std::min here compiled to one, fmin to a call)
+    // One rarely-true test (neighbours and a range jump) instead of two branches.
+    if ((col(j + 1) - col(j) <= cfg_.max_column_gap) & (std::abs(a - c) > occ * mn)) {
       if (a > c) {
         for (int k = std::max(0, j - hw + 1); k <= j; ++k) ok_[k] = 0;
       } else {
@@ -96,7 +98,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   }
   for (int i = 1; i + 1 < n; ++i) {
     const float ri = r(i);
-    if (std::abs(r(i - 1) - ri) > par * ri && std::abs(r(i + 1) - ri) > par * ri) ok_[i] = 0;
+    ok_[i] &= uint8_t(!((std::abs(r(i - 1) - ri) > par * ri) & (std::abs(r(i + 1) - ri) > par * ri)));
   }
 
   // Per-sector selection (sectors split the ring's points evenly, as LOAM does).
@@ -129,6 +131,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       }
       if (best < 0) break;
       kind_of[best] = kCorner;
+      sel_.push_back(best);
       for (int k = std::max(0, best - hw); k <= std::min(n - 1, best + hw); ++k) picked_[k] = 1;
     }
     // Surface candidates: only the smoothest few need ordering (partial sort, widened if the spacing
@@ -152,6 +155,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       const int i = order_[j];
       if (picked_[i]) continue;
       kind_of[i] = kSurface;
+      sel_.push_back(i);
       ++surfaces;
       for (int k = std::max(0, i - cfg_.surface_spacing); k <= std::min(n - 1, i + cfg_.surface_spacing); ++k)
         picked_[k] = 1;
@@ -181,8 +185,8 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     }
     run.clear();
   };
-  for (int i = 0; i < n; ++i) {
-    if (kind_of[i] < 0) continue;
+  std::sort(sel_.begin(), sel_.end());  // the picks in column order (not a scan of all n points)
+  for (const int i : sel_) {
     const size_t src = begin + i;
     const int o = int(out_.x.size());
     const Eigen::Vector3f q = R_ * Eigen::Vector3f(w.x[src], w.y[src], w.z[src]);
