@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -239,12 +240,22 @@ int main(int argc, char** argv) {
 
     cfg.use_imu_prior = imu_prior;
     fploc::seg::RingSegmenter rings(cfg);
+    // A twin without per-pixel labels (they cost time and exist only for this bench): same inputs, same
+    // results, and its CPU time is what the node spends.
+    fploc::seg::RingSegmenter rings_timed(cfg);
+    fploc::feat::FeatureExtractor fx_timed;
     fploc::seg::RansacSegmenter ransac(cfg);
     rings.set_keep_labels(true);
     ransac.set_keep_labels(true);
     fploc::feat::FeatureExtractor fx;
     Acc acc_rings, acc_ransac;
     double us_features = 0;
+    std::vector<double> cpu_seg, cpu_feat, cpu_ransac;
+    auto cpu_us = [] {
+      timespec ts{};
+      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+      return double(ts.tv_sec) * 1e6 + double(ts.tv_nsec) * 1e-3;
+    };
     size_t n_features = 0, n_groups = 0;
     fploc::sim::SimScan f;
     using clk = std::chrono::steady_clock;
@@ -259,25 +270,42 @@ int main(int argc, char** argv) {
         for (const auto& smp : sim.imu())
           if (smp.t >= ta && smp.t < tb) {
             rings.add_accel(smp.accel);
+            rings_timed.add_accel(smp.accel);
             ransac.add_accel(smp.accel);
             const int64_t ut = int64_t(std::llround((o.t0_s + smp.t) * 1e6));
             rings.add_gyro(smp.gyro, ut);
+            rings_timed.add_gyro(smp.gyro, ut);
             ransac.add_gyro(smp.gyro, ut);
           }
       }
       const fploc::StampedPose gt = sim.ground_truth(sim.frame_time(k) + 0.5 / o.rate_hz);
+      // Timed (wall clock and thread CPU): the label-free twin and the features on its output.
       auto t0 = clk::now();
-      const auto& s = rings.process(f.scan);
+      double c0 = cpu_us();
+      const auto& st = rings_timed.process(f.scan);
       const double us_seg = us_since(t0);
+      cpu_seg.push_back(cpu_us() - c0);
       t0 = clk::now();
-      const auto& ft = fx.process(s);
+      c0 = cpu_us();
+      const size_t n_feat_timed = fx_timed.process(st).size();
       us_features += us_since(t0);
+      cpu_feat.push_back(cpu_us() - c0);
+      // Accuracy: the labelled segmenter (identical planes and wall points).
+      const auto& s = rings.process(f.scan);
+      const auto& ft = fx.process(s);
+      if (ft.size() != n_feat_timed || st.wall.size() != s.wall.size())
+        throw std::runtime_error("segmenter with labels differs from the one without (frame " + std::to_string(k) + ")");
       n_features += ft.size();
       n_groups += ft.num_groups;
       acc_rings.add(s, f, gt, us_seg);
       t0 = clk::now();
+      c0 = cpu_us();
       const auto& r = ransac.process(f.scan);
       acc_ransac.add(r, f, gt, us_since(t0));
+      cpu_ransac.push_back(cpu_us() - c0);
+      if (verbose)
+        std::cerr << "  ransac " << fploc::seg::to_string(r.status) << " d " << r.ceiling.distance() << " inl "
+                  << r.ceiling.inliers << " beyond " << r.ceiling.beyond << " '" << r.status_text << "'\n";
       ++done;
       if (verbose) {
         const Eigen::Vector3d rpy = gt.rpy();
@@ -300,6 +328,17 @@ int main(int argc, char** argv) {
     const int n = std::max(1, acc_rings.frames);
     out["us_per_scan"] = {{"segmenter", acc_rings.us / n}, {"features", us_features / n},
                           {"segmenter_ransac", acc_ransac.us / n}};
+    // Thread CPU time (less sensitive to other processes on a shared machine than the wall clock above).
+    auto cpu_stats = [](const std::vector<double>& v) {
+      double sum = 0;
+      for (double x : v) sum += x;
+      return nlohmann::json{{"mean", v.empty() ? 0.0 : sum / double(v.size())}, {"median", median(v)},
+                            {"p95", quantile(v, 0.95)}, {"max", max_of(v)}};
+    };
+    std::vector<double> both(cpu_seg.size());
+    for (size_t i = 0; i < both.size(); ++i) both[i] = cpu_seg[i] + cpu_feat[i];
+    out["cpu_us_per_scan"] = {{"segmenter", cpu_stats(cpu_seg)}, {"features", cpu_stats(cpu_feat)},
+                              {"segmenter_plus_features", cpu_stats(both)}, {"segmenter_ransac", cpu_stats(cpu_ransac)}};
     out["ransac"] = acc_ransac.json();
     out["features_per_scan"] = double(n_features) / n;
     out["groups_per_scan"] = double(n_groups) / n;
