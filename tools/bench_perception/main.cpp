@@ -251,6 +251,7 @@ int main(int argc, char** argv) {
     Acc acc_rings, acc_ransac;
     double us_features = 0;
     std::vector<double> cpu_seg, cpu_feat, cpu_ransac;
+    double imu_fed_until = -1e300;
     auto cpu_us = [] {
       timespec ts{};
       clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
@@ -265,10 +266,12 @@ int main(int argc, char** argv) {
       if (max_frames > 0 && done >= max_frames) break;
       sim.frame(k, f);
       if (imu || imu_prior) {
-        // The IMU samples measured during this sweep (the node averages what arrived since the last scan).
-        const double ta = sim.frame_time(k) - o.t0_s, tb = ta + 1.0 / o.rate_hz;
+        // The IMU stream up to the end of this sweep, as a node receives it (every sample once, also those
+        // between evaluated frames with --stride).
+        const double tb = sim.frame_time(k) - o.t0_s + 1.0 / o.rate_hz;
         for (const auto& smp : sim.imu())
-          if (smp.t >= ta && smp.t < tb) {
+          if (smp.t > imu_fed_until && smp.t < tb) {
+            imu_fed_until = smp.t;
             rings.add_accel(smp.accel);
             rings_timed.add_accel(smp.accel);
             ransac.add_accel(smp.accel);
@@ -345,6 +348,8 @@ int main(int argc, char** argv) {
     out["scenario"] = scenario;
     out["imu"] = imu || imu_prior;
     out["imu_prior"] = imu_prior;
+    if (imu || imu_prior)
+      out["gyro_bias_estimate_rad_s"] = {rings.gyro_bias().x(), rings.gyro_bias().y(), rings.gyro_bias().z()};
     out["seed"] = seed;
     if (json) {
       std::cout << out.dump(2) << "\n";

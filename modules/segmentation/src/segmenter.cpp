@@ -113,15 +113,61 @@ void Segmenter::add_gyro(const Eigen::Vector3d& w, int64_t utime) {
 }
 
 Eigen::Vector3d Segmenter::gyro_at(int64_t t) const {
-  // Linear interpolation between samples; the nearest sample outside their span.
-  if (t <= gyro_.front().first) return gyro_.front().second;
-  if (t >= gyro_.back().first) return gyro_.back().second;
+  // Linear interpolation between samples; the nearest sample outside their span; minus the estimated bias.
+  if (t <= gyro_.front().first) return gyro_.front().second - gyro_bias_;
+  if (t >= gyro_.back().first) return gyro_.back().second - gyro_bias_;
   auto it = std::lower_bound(gyro_.begin(), gyro_.end(), t,
                              [](const std::pair<int64_t, Eigen::Vector3d>& s, int64_t v) { return s.first < v; });
   const auto& b = *it;
   const auto& a = *(it - 1);
   const double f = double(t - a.first) / double(std::max<int64_t>(1, b.first - a.first));
-  return (1 - f) * a.second + f * b.second;
+  return (1 - f) * a.second + f * b.second - gyro_bias_;
+}
+
+bool Segmenter::gyro_covers(int64_t ta, int64_t tb) const {
+  // Samples from before ta to after tb (within 20 ms) without a gap longer than 50 ms.
+  if (gyro_.size() < 2 || gyro_.front().first > ta + 20000 || gyro_.back().first < tb - 20000) return false;
+  int64_t prev = gyro_.front().first;
+  for (const auto& g : gyro_) {
+    if (g.first > tb + 50000) break;
+    if (g.first >= ta - 50000 && g.first - prev > 50000) return false;
+    prev = g.first;
+  }
+  return true;
+}
+
+Eigen::Matrix3d Segmenter::gyro_rotation(int64_t ta, int64_t tb) const {
+  // Orientation at tb relative to ta (body frame), midpoint rule in steps of at most 5 ms.
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  const int steps = int(std::max<int64_t>(1, (std::abs(tb - ta) + 4999) / 5000));
+  for (int k = 0; k < steps; ++k) {
+    const int64_t a = ta + (tb - ta) * k / steps, b = ta + (tb - ta) * (k + 1) / steps;
+    const Eigen::Vector3d th = gyro_at(a + (b - a) / 2) * (1e-6 * double(b - a));
+    const double ang = th.norm();
+    if (ang > 0) R = R * Eigen::AngleAxisd(ang, th / ang).toRotationMatrix();
+  }
+  return R;
+}
+
+void Segmenter::update_gyro_bias(const Eigen::Vector3d& up) {
+  // Gyro bias (the part perpendicular to gravity, the one that tilts the de-skew) from consecutive
+  // ceilings: the up vector of the previous frame carried to this mid-sweep by the (bias-corrected) gyro
+  // should be this frame's up; a residual rotation rate delta = (u_pred x u) / dt is bias left over.
+  // Low-pass (a few seconds); steps of more than 0.03 rad/s (a wrong plane) are ignored.
+  const int64_t t = sweep_tm_;
+  if (t == 0 || !cfg_.deskew_gyro) {
+    have_bias_ref_ = false;
+    return;
+  }
+  if (have_bias_ref_ && t > bias_ref_t_ && t - bias_ref_t_ <= 600000 && gyro_covers(bias_ref_t_, t)) {
+    const double dt = 1e-6 * double(t - bias_ref_t_);
+    const Eigen::Vector3d u_pred = gyro_rotation(bias_ref_t_, t).transpose() * bias_ref_up_;
+    const Eigen::Vector3d delta = u_pred.cross(up) / dt;
+    if (delta.norm() < 0.03) gyro_bias_ += 0.05 * delta;
+  }
+  have_bias_ref_ = true;
+  bias_ref_t_ = t;
+  bias_ref_up_ = up;
 }
 
 bool Segmenter::deskew_rotations(const Scan& scan) {
@@ -129,6 +175,7 @@ bool Segmenter::deskew_rotations(const Scan& scan) {
   // column by column (midpoint rate, linearly interpolated gyro). Needs gyro samples covering the sweep
   // (within 20 ms of both ends) and increasing column times.
   const int W = scan.width;
+  sweep_tm_ = 0;
   if (!cfg_.deskew_gyro || gyro_.size() < 2 || int(scan.column_utime.size()) != W) return false;
   const bool cvalid = int(scan.column_valid.size()) == W;
   int c0 = -1, c1 = -1;
@@ -150,6 +197,7 @@ bool Segmenter::deskew_rotations(const Scan& scan) {
     col_t_[c] = last;
   }
   const int64_t tm = t0 + (t1 - t0) / 2;
+  sweep_tm_ = tm;  // the gyro covers this sweep (planes refer to mid-sweep)
   // Largest rotation over half a sweep: skip the work when it is below 0.001 deg.
   double peak = 0;
   for (const auto& g : gyro_)
@@ -468,7 +516,9 @@ const Segmentation& Segmenter::process(const Scan& scan) {
     prev_z_sigma_ = out_.z_sigma;
     have_prev_ceiling_ = true;
     prev_ceiling_ = out_.ceiling.coeffs;
+    update_gyro_bias(up);
   } else {
+    have_bias_ref_ = false;
     fallback_attitude();
     if (out_.ground.found) {
       out_.z = out_.ground.distance();

@@ -106,6 +106,7 @@ class Segmenter {
   void set_keep_labels(bool on) { keep_labels_ = on; }
   const SegmenterConfig& config() const { return cfg_; }
   double room_height() const { return room_height_; }  // 0 until known
+  const Eigen::Vector3d& gyro_bias() const { return gyro_bias_; }  // rad/s, perpendicular-to-gravity part
   // Last scan's points per pixel (row-major like the scan, de-skewed when last().deskewed; only pixels with a
   // return inside [min_range_m, max_range_m] are meaningful). Diagnostics.
   const std::vector<Eigen::Vector3f>& points() const { return xyz_; }
@@ -132,6 +133,9 @@ class Segmenter {
   bool prepare(const Scan& scan);
   bool deskew_rotations(const Scan& scan);
   Eigen::Vector3d gyro_at(int64_t utime) const;
+  bool gyro_covers(int64_t ta, int64_t tb) const;
+  Eigen::Matrix3d gyro_rotation(int64_t ta, int64_t tb) const;
+  void update_gyro_bias(const Eigen::Vector3d& up);
   void quality(const Candidates& c, Plane& pl) const;
   void select_walls(const Scan& scan, const Eigen::Vector3d& up);
   void update_room_height(double h);
@@ -158,6 +162,11 @@ class Segmenter {
   int accel_n_ = 0;
   Eigen::Vector3d imu_up_ = Eigen::Vector3d::UnitZ();
   std::deque<std::pair<int64_t, Eigen::Vector3d>> gyro_;  // last ~1 s of gyro samples, increasing time
+  Eigen::Vector3d gyro_bias_ = Eigen::Vector3d::Zero();   // estimated from consecutive ceilings
+  int64_t sweep_tm_ = 0;                                  // this scan's mid-sweep time when the gyro covers it
+  bool have_bias_ref_ = false;
+  int64_t bias_ref_t_ = 0;
+  Eigen::Vector3d bias_ref_up_ = Eigen::Vector3d::UnitZ();
   std::vector<int64_t> col_t_;
   std::vector<int> col_mid_;
   std::vector<uint8_t> col_ok_;
