@@ -314,7 +314,7 @@ int main(int argc, char** argv) {
         const Eigen::Vector3d rpy = gt.rpy();
         std::cerr << "frame " << k << " gt z " << gt.p.z() << " roll " << rpy[0] / kDeg << " pitch " << rpy[1] / kDeg
                   << " | rings " << fploc::seg::to_string(s.status) << " c " << s.ceiling.found << " d "
-                  << s.ceiling.distance() << " inl " << s.ceiling.inliers << " g " << s.ground.found << " d "
+                  << s.ceiling.distance() << " inl " << s.ceiling.inliers << " rms " << s.ceiling.rms_m << " beyond " << s.ceiling.beyond << " g " << s.ground.found << " d "
                   << s.ground.distance() << " inl " << s.ground.inliers << " H " << rings.room_height() << " z " << s.z
                   << " roll " << s.roll / kDeg << " pitch " << s.pitch / kDeg << " | err roll "
                   << std::remainder(s.roll - rpy[0], 2 * M_PI) / kDeg << " pitch "
