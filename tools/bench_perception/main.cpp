@@ -15,6 +15,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <map>
 
 #include "fploc/features/features.h"
 #include "fploc/floorplan/io.h"
@@ -252,6 +253,7 @@ int main(int argc, char** argv) {
     double us_features = 0;
     std::vector<double> cpu_seg, cpu_feat, cpu_ransac;
     double imu_fed_until = -1e300;
+    std::map<std::string, Acc> by_region;  // the paper segmenter's accuracy by sensor position
     auto cpu_us = [] {
       timespec ts{};
       clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
@@ -301,6 +303,16 @@ int main(int argc, char** argv) {
       n_features += ft.size();
       n_groups += ft.num_groups;
       acc_rings.add(s, f, gt, us_seg);
+      {
+        // Where the sensor is: under the missing (open) or the sloped ceiling patch of the simulator, or not.
+        std::string where = "flat_ceiling";
+        for (const auto& pt : sim.world().ceiling_patches()) {
+          const Eigen::Vector2d q = gt.p.head<2>();
+          if ((q.array() >= pt.box.min.array()).all() && (q.array() <= pt.box.max.array()).all())
+            where = pt.open ? "under_open_patch" : "under_sloped_patch";
+        }
+        by_region[where].add(s, f, gt, us_seg);
+      }
       t0 = clk::now();
       c0 = cpu_us();
       const auto& r = ransac.process(f.scan);
@@ -343,6 +355,7 @@ int main(int argc, char** argv) {
     out["cpu_us_per_scan"] = {{"segmenter", cpu_stats(cpu_seg)}, {"features", cpu_stats(cpu_feat)},
                               {"segmenter_plus_features", cpu_stats(both)}, {"segmenter_ransac", cpu_stats(cpu_ransac)}};
     out["ransac"] = acc_ransac.json();
+    for (const auto& [where, acc] : by_region) out["by_sensor_position"][where] = acc.json();
     out["features_per_scan"] = double(n_features) / n;
     out["groups_per_scan"] = double(n_groups) / n;
     out["scenario"] = scenario;
