@@ -447,7 +447,10 @@ const Segmentation& Segmenter::process(const Scan& scan) {
   {
     Eigen::Vector4d pl;
     std::string why;
-    if (!fit_plane(upper_, init_up, have_prev_ceiling_ ? &prev_ceiling_ : nullptr, pl)) {
+    tighten_ = true;
+    const bool fitted = fit_plane(upper_, init_up, have_prev_ceiling_ ? &prev_ceiling_ : nullptr, pl);
+    tighten_ = false;
+    if (!fitted) {
       why = "no plane fit on the upper rings";
     } else {
       out_.ceiling.coeffs = pl;
@@ -732,10 +735,10 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
   //    one (0.5 m) lets the band of wall returns below a corridor ceiling (10x the ceiling returns there)
   //    dominate the first weighted fit, which then converges to a plane through the walls.
   double last_sigma = 0;  // robust residual scale of the last refinement's final iteration
-  auto refine = [&](Eigen::Vector4d cur) -> std::optional<Eigen::Vector4d> {
+  auto refine = [&](Eigen::Vector4d cur, double first_cut, double min_cut, bool fixed) -> std::optional<Eigen::Vector4d> {
   const Eigen::Vector3d ref = -cur[3] * cur.head<3>();  // a point of the plane (numerics)
   const Eigen::Vector3f reff = ref.cast<float>();
-  double cut = cfg_.irls_initial_scale_m;
+  double cut = first_cut;
   band_.clear();  // the band's points, contiguous (streamed by every iteration)
   {
     const Eigen::Vector3f n = cur.head<3>().cast<float>();
@@ -770,7 +773,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
     }
     const double sigma = 1.4826 * (bin + 0.5) / inv_bin;
     last_sigma = sigma;
-    const double next_cut = std::max({cut * 0.5, 4.685 * sigma, 0.02});
+    const double next_cut = fixed ? cut : std::max({cut * 0.5, 4.685 * sigma, min_cut});
     const bool final_scale = next_cut >= cut;
     cut = std::min(cut, next_cut);
     const float inv_c2 = float(1.0 / (cut * cut));
@@ -813,7 +816,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
     double sigma;
   };
   auto refine_guarded = [&](const Eigen::Vector4d& start) -> std::optional<Fit> {
-    const auto r = refine(start);
+    const auto r = refine(start, cfg_.irls_initial_scale_m, 0.02, false);
     if (r && score(*r, kFinalStride) >= score(start, kFinalStride)) return Fit{*r, last_sigma};
     return Fit{start, cfg_.inlier_threshold_m / 3};
   };
@@ -825,6 +828,18 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
       if (score_band(res2->pl, kFinalStride, t_sel) > score_band(res1->pl, kFinalStride, t_sel)) res1 = res2;
     } else if (res2) {
       res1 = res2;
+    }
+  }
+  // Ceiling only: a refit at a fixed cut-off of tight_refit_sigmas robust sigmas (>= 1 cm) of the result.
+  // Where two surfaces meet (a sloped ceiling patch next to the flat ceiling) the Tukey fit at 4.7 sigma
+  // settles on a compromise tilted a few tenths of a degree between them; at ~2.5 sigma only the dominant
+  // surface keeps its support. The tighter of the two wins on the narrow-band support.
+  if (res1 && tighten_ && cfg_.tight_refit_sigmas > 0) {
+    const double ct = std::max(cfg_.tight_refit_sigmas * res1->sigma, 0.01);
+    if (const auto r = refine(res1->pl, ct, ct, true)) {
+      const Fit tight{*r, last_sigma};
+      const float t_sel = float(std::clamp(3.0 * std::min(res1->sigma, tight.sigma), 0.01, cfg_.inlier_threshold_m));
+      if (score_band(tight.pl, kFinalStride, t_sel) > score_band(res1->pl, kFinalStride, t_sel)) res1 = tight;
     }
   }
   if (!res1) return false;

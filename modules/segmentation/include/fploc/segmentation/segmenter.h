@@ -35,6 +35,7 @@ struct SegmenterConfig {
   double irls_initial_scale_m = 0.2;  // first Tukey cut-off (4 x the 5 cm band that chose the start);
                                       // halves every iteration down to ~4.7 sigma
   int room_height_window = 51;     // frames in the running median of the floor-to-ceiling height
+  double tight_refit_sigmas = 2.5; // ceiling refit at this many robust sigmas (0 = off), see fit_plane
 };
 
 enum class SegStatus : int8_t { kOk = 0, kNoCeiling = 1, kBadInput = 2, kEmpty = 3 };
@@ -128,6 +129,7 @@ class Segmenter {
                          Eigen::Vector4d& plane) = 0;
 
   SegmenterConfig cfg_;
+  bool tighten_ = false;  // set while fit_plane() fits the ceiling (the plane that gives the attitude)
 
  private:
   bool prepare(const Scan& scan);
