@@ -39,7 +39,9 @@ class FeaturesNode : public fploc::rt::Node {
       return;
     }
     const auto& f = fx_->process(seg_);
-    if (f.status == fploc::feat::FeatStatus::kBadInput)
+    const bool upstream_bad = seg_.status == fploc::seg::SegStatus::kBadInput || seg_.status == fploc::seg::SegStatus::kEmpty;
+    // A bad scan is the segmenter's error (in its telemetry); here only what is wrong with this message.
+    if (f.status == fploc::feat::FeatStatus::kBadInput && !upstream_bad)
       ctx_->error("segments seq " + std::to_string(m.seq) + ": bad input (non-finite roll/pitch)");
     fploc::to_msg(f, seq_++, m.scan_seq, msg);
     out_.publish(msg);

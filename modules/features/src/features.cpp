@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 namespace fploc::feat {
@@ -19,6 +20,11 @@ const Features2D& FeatureExtractor::process(const seg::Segmentation& seg) {
   out_.z = seg.z;
   out_.roll_pitch_sigma = seg.roll_pitch_sigma;
   out_.z_sigma = seg.z_sigma;
+  // An unusable scan upstream (bad or empty input: no planes, no wall points) is passed on as such.
+  if (seg.status == seg::SegStatus::kBadInput || seg.status == seg::SegStatus::kEmpty) {
+    out_.status = FeatStatus::kBadInput;
+    return out_;
+  }
   const auto& w = seg.wall;
   const size_t n = w.x.size();
   if (w.y.size() != n || w.z.size() != n || w.range.size() != n || w.ring.size() != n || w.column.size() != n ||
@@ -66,21 +72,23 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   pre_.resize(size_t(n) + 1);
   pre_[0].setZero();
   for (int j = 0; j < n; ++j) pre_[j + 1] = pre_[j] + P(j).cast<double>();
+  // Branch-free (the window and range tests mispredicted on irregular rings): c is computed everywhere and
+  // only read where ok_ is set.
   for (int i = hw; i < n - hw; ++i) {
     // All of i-hw .. i+hw connected: no break between i-hw and i+hw-1.
-    if (brk_prefix[i + hw] - brk_prefix[i - hw] != 0) continue;
     const float ri = r(i);
-    if (ri < rmin || ri > rmax) continue;
+    const bool ok = (brk_prefix[i + hw] == brk_prefix[i - hw]) & !(ri < rmin) & !(ri > rmax);
     const Eigen::Vector3d diff = (pre_[i + hw + 1] - pre_[i - hw]) - double(2 * hw + 1) * P(i).cast<double>();
     curv_[i] = float(diff.norm()) / (float(2 * hw) * ri);  // LOAM's c = |sum(X_j - X_i)| / (|S| |X_i|)
-    ok_[i] = 1;
+    ok_[i] = uint8_t(ok);
   }
   // LOAM's unreliable points: the far side of an occlusion boundary, and surfaces parallel to the beam.
   const float occ = float(cfg_.occlusion_ratio), par = float(cfg_.parallel_ratio);
   for (int j = 0; j + 1 < n; ++j) {
-    if (col(j + 1) - col(j) > cfg_.max_column_gap) continue;
     const float a = r(j), c = r(j + 1);
-    if (std::abs(a - c) > occ * std::min(a, c)) {
+    const float mn = a < c ? a : c;  // minss, no branch (std::min here compiled to one, fmin to a call)
+    // One rarely-true test (neighbours and a range jump) instead of two branches.
+    if ((col(j + 1) - col(j) <= cfg_.max_column_gap) & (std::abs(a - c) > occ * mn)) {
       if (a > c) {
         for (int k = std::max(0, j - hw + 1); k <= j; ++k) ok_[k] = 0;
       } else {
@@ -90,7 +98,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   }
   for (int i = 1; i + 1 < n; ++i) {
     const float ri = r(i);
-    if (std::abs(r(i - 1) - ri) > par * ri && std::abs(r(i + 1) - ri) > par * ri) ok_[i] = 0;
+    ok_[i] &= uint8_t(!((std::abs(r(i - 1) - ri) > par * ri) & (std::abs(r(i + 1) - ri) > par * ri)));
   }
 
   // Per-sector selection (sectors split the ring's points evenly, as LOAM does).
@@ -102,42 +110,52 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   for (int s = 0; s < S; ++s) {
     const int sb = hw + (n - 2 * hw) * s / S, se = hw + (n - 2 * hw) * (s + 1) / S;
     if (se <= sb) continue;
-    // Corner candidates (few): sorted by decreasing smoothness.
-    order_.clear();
-    for (int i = sb; i < se; ++i)
-      if (ok_[i] && curv_[i] > cthr) order_.push_back(i);
-    auto more = [&](int a, int b) { return curv_[a] > curv_[b] || (curv_[a] == curv_[b] && a < b); };
-    size_t csorted = 0;
-    int corners = 0;
-    for (size_t j = 0; j < order_.size() && corners < cfg_.max_corners_per_sector; ++j) {
-      if (j == csorted) {
-        const size_t k = std::min(order_.size(), std::max<size_t>(csorted * 2, size_t(8 * cfg_.max_corners_per_sector)));
-        std::partial_sort(order_.begin() + csorted, order_.begin() + k, order_.end(), more);
-        csorted = k;
+    // Corners: the sharpest candidate that no earlier pick suppressed, max_corners_per_sector times (the
+    // same picks as walking the candidates sorted by decreasing c, ties by index; a branch-free scan per
+    // pick instead of a sort, which mispredicted on every comparison). Candidates are collected without
+    // a data-dependent branch too.
+    order_.resize(size_t(se - sb));
+    size_t m = 0;
+    for (int i = sb; i < se; ++i) {
+      order_[m] = i;
+      m += size_t(ok_[i] & uint8_t(curv_[i] > cthr));
+    }
+    for (int corners = 0; corners < cfg_.max_corners_per_sector; ++corners) {
+      int best = -1;
+      float bv = -std::numeric_limits<float>::infinity();
+      for (size_t j = 0; j < m; ++j) {
+        const int i = order_[j];
+        const bool take = !picked_[i] & (curv_[i] > bv);
+        bv = take ? curv_[i] : bv;
+        best = take ? i : best;
       }
-      const int i = order_[j];
-      if (picked_[i]) continue;
-      kind_of[i] = kCorner;
-      ++corners;
-      for (int k = std::max(0, i - hw); k <= std::min(n - 1, i + hw); ++k) picked_[k] = 1;
+      if (best < 0) break;
+      kind_of[best] = kCorner;
+      sel_.push_back(best);
+      for (int k = std::max(0, best - hw); k <= std::min(n - 1, best + hw); ++k) picked_[k] = 1;
     }
     // Surface candidates: only the smoothest few need ordering (partial sort, widened if the spacing
     // rule rejects too many).
-    order_.clear();
-    for (int i = sb; i < se; ++i)
-      if (ok_[i] && curv_[i] < sthr && !picked_[i]) order_.push_back(i);
+    order_.resize(size_t(se - sb));
+    m = 0;
+    for (int i = sb; i < se; ++i) {
+      order_[m] = i;
+      m += size_t(ok_[i] & uint8_t(curv_[i] < sthr) & uint8_t(!picked_[i]));
+    }
+    order_.resize(m);
     auto less = [&](int a, int b) { return curv_[a] < curv_[b] || (curv_[a] == curv_[b] && a < b); };
     size_t sorted = 0;
     int surfaces = 0;
     for (size_t j = 0; j < order_.size() && surfaces < cfg_.max_surfaces_per_sector; ++j) {
       if (j == sorted) {
-        const size_t k = std::min(order_.size(), std::max<size_t>(sorted * 2, size_t(4 * cfg_.max_surfaces_per_sector)));
+        const size_t k = std::min(order_.size(), std::max<size_t>(sorted * 2, size_t(2 * cfg_.max_surfaces_per_sector)));
         std::partial_sort(order_.begin() + sorted, order_.begin() + k, order_.end(), less);
         sorted = k;
       }
       const int i = order_[j];
       if (picked_[i]) continue;
       kind_of[i] = kSurface;
+      sel_.push_back(i);
       ++surfaces;
       for (int k = std::max(0, i - cfg_.surface_spacing); k <= std::min(n - 1, i + cfg_.surface_spacing); ++k)
         picked_[k] = 1;
@@ -167,8 +185,8 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     }
     run.clear();
   };
-  for (int i = 0; i < n; ++i) {
-    if (kind_of[i] < 0) continue;
+  std::sort(sel_.begin(), sel_.end());  // the picks in column order (not a scan of all n points)
+  for (const int i : sel_) {
     const size_t src = begin + i;
     const int o = int(out_.x.size());
     const Eigen::Vector3f q = R_ * Eigen::Vector3f(w.x[src], w.y[src], w.z[src]);

@@ -125,7 +125,16 @@ TEST(Features, CornersAtRoomAndPillarCorners) {
 TEST(Features, BadAndEmptyInput) {
   FeatureExtractor fx;
   seg::Segmentation s;
+  s.status = seg::SegStatus::kOk;  // segmented, but no wall points
   EXPECT_EQ(fx.process(s).status, FeatStatus::kFewFeatures);
+  s.status = seg::SegStatus::kNoCeiling;
+  EXPECT_EQ(fx.process(s).status, FeatStatus::kFewFeatures);
+  // An unusable scan upstream is passed on.
+  s.status = seg::SegStatus::kEmpty;
+  EXPECT_EQ(fx.process(s).status, FeatStatus::kBadInput);
+  s.status = seg::SegStatus::kBadInput;
+  EXPECT_EQ(fx.process(s).status, FeatStatus::kBadInput);
+  s.status = seg::SegStatus::kOk;
   s.wall.x.push_back(1.f);
   EXPECT_EQ(fx.process(s).status, FeatStatus::kBadInput);
   s.wall.clear();

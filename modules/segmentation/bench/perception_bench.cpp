@@ -2,10 +2,21 @@
 // room: the paper's segmenter, the feature extractor, both together, and the PCL RANSAC segmenter.
 #include <benchmark/benchmark.h>
 
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#if __has_include(<valgrind/callgrind.h>)
+#include <valgrind/callgrind.h>
+#else
+#define CALLGRIND_START_INSTRUMENTATION
+#define CALLGRIND_STOP_INSTRUMENTATION
+#endif
+
 #include "fploc/features/features.h"
 #include "fploc/segmentation/ransac_segmenter.h"
 #include "fploc/segmentation/segmenter.h"
 #include "fploc/segmentation/synthetic.h"
+#include "fploc/sim/simulator.h"
 
 namespace {
 using namespace fploc;
@@ -43,6 +54,53 @@ void BM_SegmenterPlusFeatures(benchmark::State& st) {
 }
 BENCHMARK(BM_SegmenterPlusFeatures)->Unit(benchmark::kMicrosecond);
 
+// Simulated OS-1-64 scans of a sequence (room-small-loop-medium, every 5th frame: real beam angles and
+// pixel shifts from ../shared, noise, dropouts, clutter, ceiling patches) with their gyro samples.
+struct SimFrame {
+  Scan scan;
+  std::vector<std::pair<int64_t, Eigen::Vector3d>> gyro;
+};
+const std::vector<SimFrame>& sim_frames() {
+  static const auto frames = [] {
+    sim::SimulatorOptions o;
+    o.scenario = "room-small-loop-medium";
+    o.shared_dir = FPLOC_SHARED_DIR;
+    sim::Simulator sim(FloorPlan{}, o);
+    std::vector<SimFrame> out;
+    sim::SimScan f;
+    for (int k = 0; k < sim.num_frames() && out.size() < 24; k += 5) {
+      sim.frame(k, f);
+      SimFrame fr;
+      fr.scan = f.scan;
+      const double t0 = sim.frame_time(k) - o.t0_s, t1 = t0 + 1.0 / o.rate_hz;
+      for (const auto& smp : sim.imu())
+        if (smp.t >= t0 && smp.t < t1) fr.gyro.emplace_back(int64_t(std::llround((o.t0_s + smp.t) * 1e6)), smp.gyro);
+      out.push_back(std::move(fr));
+    }
+    return out;
+  }();
+  return frames;
+}
+
+// Segmenter + features on the simulated sequence, one scan per iteration (cycling through 24 scans);
+// with_gyro: the IMU gyro samples of each sweep are fed first (rotation de-skew).
+void sim_sequence(benchmark::State& st, bool with_gyro) {
+  const auto& fr = sim_frames();
+  seg::RingSegmenter sg(seg::SegmenterConfig{});
+  feat::FeatureExtractor fx;
+  size_t k = 0;
+  for (auto _ : st) {
+    const auto& f = fr[k++ % fr.size()];
+    if (with_gyro)
+      for (const auto& [t, w] : f.gyro) sg.add_gyro(w, t);
+    benchmark::DoNotOptimize(fx.process(sg.process(f.scan)).size());
+  }
+}
+void BM_SimSegmenterPlusFeatures(benchmark::State& st) { sim_sequence(st, false); }
+BENCHMARK(BM_SimSegmenterPlusFeatures)->Unit(benchmark::kMicrosecond);
+void BM_SimSegmenterPlusFeaturesGyro(benchmark::State& st) { sim_sequence(st, true); }
+BENCHMARK(BM_SimSegmenterPlusFeaturesGyro)->Unit(benchmark::kMicrosecond);
+
 void BM_RansacSegmenter(benchmark::State& st) {
   seg::RansacSegmenter sg(seg::SegmenterConfig{});
   sg.process(scan().scan);
@@ -50,6 +108,55 @@ void BM_RansacSegmenter(benchmark::State& st) {
 }
 BENCHMARK(BM_RansacSegmenter)->Unit(benchmark::kMicrosecond);
 
+// --profile=N: N scans of segmenter + features after a warm-up, instrumented for callgrind only there:
+//   valgrind --tool=callgrind --instr-atstart=no build/bin/perception_bench --profile=20
+// (--profile-sim=N: the simulated sequence instead of the synthetic scan; --profile-segmenter=N: no features)
+// (instruction counts do not depend on the machine's load; divide by N for a per-scan figure).
+int profile(int n, bool with_features, bool sim) {
+  seg::RingSegmenter sg(seg::SegmenterConfig{});
+  feat::FeatureExtractor fx;
+  auto next_scan = [&](int i) -> const Scan& { return sim ? sim_frames()[size_t(i) % sim_frames().size()].scan : scan().scan; };
+  sg.process(next_scan(0));
+  size_t sink = 0;
+  CALLGRIND_START_INSTRUMENTATION;
+  for (int i = 0; i < n; ++i) {
+    const auto& s = sg.process(next_scan(i + 1));
+    sink += with_features ? fx.process(s).size() : s.wall.size();
+  }
+  CALLGRIND_STOP_INSTRUMENTATION;
+  // FNV-1a over the last outputs (planes, wall points, features): "optimised without changing results".
+  uint64_t h = 1469598103934665603ull;
+  auto mix = [&h](const void* p, size_t bytes) {
+    for (size_t i = 0; i < bytes; ++i) h = (h ^ static_cast<const uint8_t*>(p)[i]) * 1099511628211ull;
+  };
+  const auto& s = sg.last();
+  mix(s.ceiling.coeffs.data(), sizeof(double) * 4);
+  mix(s.ground.coeffs.data(), sizeof(double) * 4);
+  for (const auto* v : {&s.wall.x, &s.wall.y, &s.wall.z, &s.wall.range, &s.wall.t}) mix(v->data(), v->size() * sizeof(float));
+  if (with_features) {
+    const auto& f = fx.process(s);
+    mix(f.x.data(), f.x.size() * sizeof(float));
+    mix(f.y.data(), f.y.size() * sizeof(float));
+    mix(f.kind.data(), f.kind.size());
+    mix(f.group.data(), f.group.size() * sizeof(int32_t));
+  }
+  std::cout << "profiled " << n << (sim ? " simulated" : " synthetic") << " scans ("
+            << (with_features ? "segmenter + features" : "segmenter") << "), "
+            << sink / size_t(std::max(1, n)) << " outputs per scan, result hash " << std::hex << h << std::dec << "\n";
+  return 0;
+}
+
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::strncmp(argv[i], "--profile=", 10) == 0) return profile(std::atoi(argv[i] + 10), true, false);
+    if (std::strncmp(argv[i], "--profile-sim=", 14) == 0) return profile(std::atoi(argv[i] + 14), true, true);
+    if (std::strncmp(argv[i], "--profile-segmenter=", 20) == 0) return profile(std::atoi(argv[i] + 20), false, false);
+  }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -8,6 +8,7 @@
 #include <pcl/segmentation/sac_segmentation.h>
 
 #include <cmath>
+#include <vector>
 
 namespace fploc::seg {
 
@@ -34,19 +35,50 @@ bool RansacSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_i
   seg.setEpsAngle(cfg_.max_tilt_deg * M_PI / 180.0);
   seg.setDistanceThreshold(cfg_.inlier_threshold_m);
   seg.setMaxIterations(max_iterations_);
-  seg.setInputCloud(cloud);
-  pcl::PointIndices inliers;
-  pcl::ModelCoefficients coeffs;
-  // SACSegmentation seeds its sampler deterministically (fixed seed), so results are reproducible.
-  seg.segment(inliers, coeffs);
-  if (coeffs.values.size() != 4 || inliers.indices.size() < 3) return false;
-  Eigen::Vector4d pl(coeffs.values[0], coeffs.values[1], coeffs.values[2], coeffs.values[3]);
-  const double nn = pl.head<3>().norm();
-  if (!(nn > 0) || !pl.allFinite()) return false;
-  pl /= nn;
-  if (pl.head<3>().dot(up_in) > 0) pl = -pl;  // normal into the room (against `up`)
-  plane = pl;
-  return true;
+  // Sequential extraction: RANSAC's largest horizontal plane is often a band through the walls at one
+  // height (in a corridor, or just above the sensor); a ceiling is where the rays end, so a plane with more
+  // returns beyond it than max_beyond_ratio x its inliers (the acceptance test of Segmenter) is removed from
+  // the cloud and the next largest is tried, up to max_planes.
+  constexpr int kMaxPlanes = 4;
+  const float thr = float(cfg_.inlier_threshold_m);
+  bool have = false;
+  for (int round = 0; round < kMaxPlanes && cloud->size() >= 10; ++round) {
+    seg.setInputCloud(cloud);
+    pcl::PointIndices inliers;
+    pcl::ModelCoefficients coeffs;
+    // SACSegmentation seeds its sampler deterministically (fixed seed), so results are reproducible.
+    seg.segment(inliers, coeffs);
+    if (coeffs.values.size() != 4 || inliers.indices.size() < 3) break;
+    Eigen::Vector4d pl(coeffs.values[0], coeffs.values[1], coeffs.values[2], coeffs.values[3]);
+    const double nn = pl.head<3>().norm();
+    if (!(nn > 0) || !pl.allFinite()) break;
+    pl /= nn;
+    if (pl.head<3>().dot(up_in) > 0) pl = -pl;  // normal into the room (against `up`)
+    if (!have) plane = pl;  // the largest plane, if none passes
+    have = true;
+    // Where the rays end? (all candidates, as Segmenter::quality counts them)
+    const Eigen::Vector3f n = pl.head<3>().cast<float>();
+    const float d = float(pl[3]);
+    int in = 0, beyond = 0;
+    for (const auto& p : c.p) {
+      const float r = n.dot(p) + d;
+      in += std::abs(r) < thr;
+      beyond += r < -2 * thr;
+    }
+    if (beyond <= cfg_.max_beyond_ratio * in) {
+      plane = pl;
+      return true;
+    }
+    // Remove this plane's inliers and try the next one.
+    pcl::PointCloud<pcl::PointXYZ>::Ptr rest(new pcl::PointCloud<pcl::PointXYZ>);
+    rest->reserve(cloud->size() - inliers.indices.size());
+    std::vector<uint8_t> is_in(cloud->size(), 0);
+    for (int i : inliers.indices) is_in[size_t(i)] = 1;
+    for (size_t i = 0; i < cloud->size(); ++i)
+      if (!is_in[i]) rest->push_back((*cloud)[i]);
+    cloud = rest;
+  }
+  return have;  // the largest plane (the acceptance test rejects it with the reason)
 }
 
 }  // namespace fploc::seg

@@ -1,6 +1,10 @@
 #include "fploc/segmentation/segmenter.h"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -51,6 +55,16 @@ struct Moments {
   }
 };
 
+// max(0, q) without a branch (std::max compiled to one here and mispredicted at every band edge); same
+// value as std::max(0.f, q) for every q, NaN included (maxss returns its second operand then).
+inline float max0(float q) {
+#if defined(__SSE__)
+  return _mm_cvtss_f32(_mm_max_ss(_mm_set_ss(q), _mm_setzero_ps()));
+#else
+  return std::max(0.f, q);
+#endif
+}
+
 double median_inplace(std::vector<float>& v) {
   if (v.empty()) return 0.0;
   auto mid = v.begin() + v.size() / 2;
@@ -88,6 +102,130 @@ void Segmenter::add_accel(const Eigen::Vector3d& a) {
   ++accel_n_;
 }
 
+void Segmenter::add_gyro(const Eigen::Vector3d& w, int64_t utime) {
+  if (!w.allFinite() || w.norm() > 35.0 || utime <= 0) return;  // > 2000 deg/s: not a rate an OS-1 IMU reports
+  if (!gyro_.empty() && utime <= gyro_.back().first) {
+    if (utime < gyro_.back().first - 1000000) gyro_.clear();  // time went back (> 1 s): a new log/sensor
+    else return;                                               // duplicate or out of order: ignore
+  }
+  gyro_.emplace_back(utime, w);
+  while (gyro_.size() > 2 && gyro_.front().first < utime - 1000000) gyro_.pop_front();  // keep ~1 s
+}
+
+Eigen::Vector3d Segmenter::gyro_at(int64_t t) const {
+  // Linear interpolation between samples; the nearest sample outside their span; minus the estimated bias.
+  if (t <= gyro_.front().first) return gyro_.front().second - gyro_bias_;
+  if (t >= gyro_.back().first) return gyro_.back().second - gyro_bias_;
+  auto it = std::lower_bound(gyro_.begin(), gyro_.end(), t,
+                             [](const std::pair<int64_t, Eigen::Vector3d>& s, int64_t v) { return s.first < v; });
+  const auto& b = *it;
+  const auto& a = *(it - 1);
+  const double f = double(t - a.first) / double(std::max<int64_t>(1, b.first - a.first));
+  return (1 - f) * a.second + f * b.second - gyro_bias_;
+}
+
+bool Segmenter::gyro_covers(int64_t ta, int64_t tb) const {
+  // Samples from before ta to after tb (within 20 ms) without a gap longer than 50 ms.
+  if (gyro_.size() < 2 || gyro_.front().first > ta + 20000 || gyro_.back().first < tb - 20000) return false;
+  int64_t prev = gyro_.front().first;
+  for (const auto& g : gyro_) {
+    if (g.first > tb + 50000) break;
+    if (g.first >= ta - 50000 && g.first - prev > 50000) return false;
+    prev = g.first;
+  }
+  return true;
+}
+
+Eigen::Matrix3d Segmenter::gyro_rotation(int64_t ta, int64_t tb) const {
+  // Orientation at tb relative to ta (body frame), midpoint rule in steps of at most 5 ms.
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  const int steps = int(std::max<int64_t>(1, (std::abs(tb - ta) + 4999) / 5000));
+  for (int k = 0; k < steps; ++k) {
+    const int64_t a = ta + (tb - ta) * k / steps, b = ta + (tb - ta) * (k + 1) / steps;
+    const Eigen::Vector3d th = gyro_at(a + (b - a) / 2) * (1e-6 * double(b - a));
+    const double ang = th.norm();
+    if (ang > 0) R = R * Eigen::AngleAxisd(ang, th / ang).toRotationMatrix();
+  }
+  return R;
+}
+
+void Segmenter::update_gyro_bias(const Eigen::Vector3d& up) {
+  // Gyro bias (the part perpendicular to gravity, the one that tilts the de-skew) from consecutive
+  // ceilings: the up vector of the previous frame carried to this mid-sweep by the (bias-corrected) gyro
+  // should be this frame's up; a residual rotation rate delta = (u_pred x u) / dt is bias left over.
+  // Low-pass (a few seconds); steps of more than 0.03 rad/s (a wrong plane) are ignored.
+  const int64_t t = sweep_tm_;
+  if (t == 0 || !cfg_.deskew_gyro) {
+    have_bias_ref_ = false;
+    return;
+  }
+  if (have_bias_ref_ && t > bias_ref_t_ && t - bias_ref_t_ <= 600000 && gyro_covers(bias_ref_t_, t)) {
+    const double dt = 1e-6 * double(t - bias_ref_t_);
+    const Eigen::Vector3d u_pred = gyro_rotation(bias_ref_t_, t).transpose() * bias_ref_up_;
+    const Eigen::Vector3d delta = u_pred.cross(up) / dt;
+    if (delta.norm() < 0.03) gyro_bias_ += 0.05 * delta;
+  }
+  have_bias_ref_ = true;
+  bias_ref_t_ = t;
+  bias_ref_up_ = up;
+}
+
+bool Segmenter::deskew_rotations(const Scan& scan) {
+  // Orientation at each column time relative to mid-sweep, R_mid<-c = prod exp([w dt]x), integrated
+  // column by column (midpoint rate, linearly interpolated gyro). Needs gyro samples covering the sweep
+  // (within 20 ms of both ends) and increasing column times.
+  const int W = scan.width;
+  sweep_tm_ = 0;
+  if (!cfg_.deskew_gyro || gyro_.size() < 2 || int(scan.column_utime.size()) != W) return false;
+  const bool cvalid = int(scan.column_valid.size()) == W;
+  int c0 = -1, c1 = -1;
+  for (int c = 0; c < W; ++c) {
+    if (scan.column_utime[c] == 0 || (cvalid && !scan.column_valid[c])) continue;
+    if (c1 >= 0 && scan.column_utime[c] < scan.column_utime[c1]) return false;  // not in time order
+    if (c0 < 0) c0 = c;
+    c1 = c;
+  }
+  if (c0 < 0 || c1 <= c0) return false;
+  const int64_t t0 = scan.column_utime[c0], t1 = scan.column_utime[c1];
+  if (t1 - t0 > 500000) return false;  // a sweep longer than 0.5 s: times do not make sense
+  if (gyro_.front().first > t0 + 20000 || gyro_.back().first < t1 - 20000) return false;
+  // Column times (invalid columns take the previous column's time: they carry no returns anyway).
+  col_t_.resize(W);
+  int64_t last = t0;
+  for (int c = 0; c < W; ++c) {
+    if (c >= c0 && c <= c1 && scan.column_utime[c] != 0 && !(cvalid && !scan.column_valid[c])) last = scan.column_utime[c];
+    col_t_[c] = last;
+  }
+  const int64_t tm = t0 + (t1 - t0) / 2;
+  sweep_tm_ = tm;  // the gyro covers this sweep (planes refer to mid-sweep)
+  // Largest rotation over half a sweep: skip the work when it is below 0.001 deg.
+  double peak = 0;
+  for (const auto& g : gyro_)
+    if (g.first >= t0 - 20000 && g.first <= t1 + 20000) peak = std::max(peak, g.second.norm());
+  if (peak * 0.5e-6 * double(t1 - t0) < 2e-5) return false;
+  col_rot_.resize(W);
+  int cm = c0;
+  while (cm < c1 && col_t_[cm] < tm) ++cm;
+  auto step = [&](const Eigen::Matrix3d& R, int64_t ta, int64_t tb) {
+    const Eigen::Vector3d th = gyro_at(ta + (tb - ta) / 2) * (1e-6 * double(tb - ta));
+    const double a = th.norm();
+    return a > 0 ? Eigen::Matrix3d(R * Eigen::AngleAxisd(a, th / a).toRotationMatrix()) : R;
+  };
+  const Eigen::Matrix3d Rm = step(Eigen::Matrix3d::Identity(), tm, col_t_[cm]);
+  Eigen::Matrix3d R = Rm;
+  col_rot_[cm] = R.cast<float>();
+  for (int c = cm + 1; c < W; ++c) {
+    R = step(R, col_t_[c - 1], col_t_[c]);
+    col_rot_[c] = R.cast<float>();
+  }
+  R = Rm;
+  for (int c = cm - 1; c >= 0; --c) {
+    R = step(R, col_t_[c + 1], col_t_[c]);  // backwards in time: negative dt
+    col_rot_[c] = R.cast<float>();
+  }
+  return true;
+}
+
 bool Segmenter::prepare(const Scan& scan) {
   out_.height = scan.height;
   out_.width = scan.width;
@@ -121,50 +259,72 @@ bool Segmenter::prepare(const Scan& scan) {
   }
   xyz_.resize(n);
   range_.resize(n);
+  // Rotation de-skew: a return measured at column time t_c is rotated into the sensor frame at mid-sweep,
+  // p_mid = R_mid<-c p, R integrated from the gyro (body frame = sensor frame; see deskew_rotations()).
+  // Only rotation matters for the planes: yaw rate leaves heights unchanged, roll/pitch rates tilt them (a few tenths of a degree per sweep when the platform wobbles, worst in corridors where the
+  // ceiling is seen in two short azimuth windows). Translation during the sweep shifts heights by
+  // v_z * 0.05 s (mm). Wall points are published as measured (with their times): downstream compensates.
+  const bool deskew = deskew_rotations(scan);
+  out_.deskewed = deskew;
+  if (deskew) raw_.resize(n);
+  // Range gate in integers: float(r) < rmin || float(r) > rmax for the 20-bit ranges (exact in float).
   const float rmin = float(cfg_.min_range_m * 1000.0), rmax = float(cfg_.max_range_m * 1000.0);
-  const bool mids = int(scan.measurement_id.size()) == scan.width;
-  const bool cvalid = int(scan.column_valid.size()) == scan.width;
+  const uint32_t r_lo = uint32_t(std::clamp(std::ceil(double(rmin)), 1.0, 4294967295.0));
+  const uint32_t r_hi = uint32_t(std::clamp(std::floor(double(rmax)), 0.0, 4294967295.0));
+  // Per column (once, not per pixel): look-up column (measurement id) and validity.
+  const int W = scan.width, H = scan.height;
+  const bool mids = int(scan.measurement_id.size()) == W;
+  const bool cvalid = int(scan.column_valid.size()) == W;
+  col_mid_.resize(W);
+  col_ok_.resize(W);
+  for (int c = 0; c < W; ++c) {
+    int mid = mids ? scan.measurement_id[c] : c;
+    if (mid < 0 || mid >= W) mid = c;
+    col_mid_[c] = mid;
+    col_ok_[c] = !(cvalid && !scan.column_valid[c]);
+  }
+  // XYZ of every valid pixel, and in the same pass the candidate sets: upper half rings (top first) and
+  // lower half rings (bottom first), each ring in column order (an odd middle ring is in neither).
   size_t valid = 0;
-  for (int u = 0; u < scan.height; ++u) {
-    for (int c = 0; c < scan.width; ++c) {
-      const size_t i = size_t(u) * scan.width + c;
+  auto ring_pass = [&](int u, Candidates* cs) {
+    const size_t row = size_t(u) * W;
+    for (int c = 0; c < W; ++c) {
+      const size_t i = row + c;
       const uint32_t r = scan.range_mm[i];
-      int mid = mids ? scan.measurement_id[c] : c;
-      if (mid < 0 || mid >= scan.width) mid = c;
-      if (r == 0 || float(r) < rmin || float(r) > rmax || (cvalid && !scan.column_valid[c])) {
+      if (r < r_lo || r > r_hi || !col_ok_[c]) {
         range_[i] = 0.f;
         continue;
       }
-      const size_t k = size_t(u) * scan.width + mid;
-      xyz_[i] = lut_.direction.row(k).transpose() * float(r) + lut_.offset.row(k).transpose();
-      range_[i] = float(r) * 1e-3f;
-      ++valid;
-    }
-  }
-  if (valid == 0) return fail(SegStatus::kEmpty, "no valid returns in the scan");
-
-  // Candidate sets: upper half rings (top first) and lower half rings (bottom first).
-  auto fill = [&](Candidates& cs, bool upper) {
-    cs.p.clear();
-    cs.range.clear();
-    cs.pixel.clear();
-    cs.ring_start.assign(1, 0);
-    cs.width = scan.width;
-    const int half = scan.height / 2;
-    for (int k = 0; k < half; ++k) {
-      const int u = upper ? ring_order_[k] : ring_order_[scan.height - 1 - k];
-      for (int c = 0; c < scan.width; ++c) {
-        const size_t i = size_t(u) * scan.width + c;
-        if (range_[i] <= 0.f) continue;
-        cs.p.push_back(xyz_[i]);
-        cs.range.push_back(range_[i]);
-        cs.pixel.push_back(int32_t(i));
+      const size_t k = row + col_mid_[c];
+      Eigen::Vector3f p = lut_.direction.row(k).transpose() * float(r) + lut_.offset.row(k).transpose();
+      if (deskew) {
+        raw_[i] = p;
+        p = col_rot_[c] * p;
       }
-      cs.ring_start.push_back(int32_t(cs.p.size()));
+      xyz_[i] = p;
+      const float rm = float(r) * 1e-3f;
+      range_[i] = rm;
+      ++valid;
+      if (cs) {
+        cs->p.push_back(p);
+        cs->range.push_back(rm);
+        cs->pixel.push_back(int32_t(i));
+      }
     }
+    if (cs) cs->ring_start.push_back(int32_t(cs->p.size()));
   };
-  fill(upper_, true);
-  fill(lower_, false);
+  for (Candidates* cs : {&upper_, &lower_}) {
+    cs->p.clear();
+    cs->range.clear();
+    cs->pixel.clear();
+    cs->ring_start.assign(1, 0);
+    cs->width = W;
+  }
+  const int half = H / 2;
+  for (int k = 0; k < half; ++k) ring_pass(ring_order_[k], &upper_);
+  for (int k = 0; k < half; ++k) ring_pass(ring_order_[H - 1 - k], &lower_);
+  if (H % 2 == 1) ring_pass(ring_order_[half], nullptr);
+  if (valid == 0) return fail(SegStatus::kEmpty, "no valid returns in the scan");
   return true;
 }
 
@@ -287,7 +447,10 @@ const Segmentation& Segmenter::process(const Scan& scan) {
   {
     Eigen::Vector4d pl;
     std::string why;
-    if (!fit_plane(upper_, init_up, have_prev_ceiling_ ? &prev_ceiling_ : nullptr, pl)) {
+    tighten_ = true;
+    const bool fitted = fit_plane(upper_, init_up, have_prev_ceiling_ ? &prev_ceiling_ : nullptr, pl);
+    tighten_ = false;
+    if (!fitted) {
       why = "no plane fit on the upper rings";
     } else {
       out_.ceiling.coeffs = pl;
@@ -356,7 +519,9 @@ const Segmentation& Segmenter::process(const Scan& scan) {
     prev_z_sigma_ = out_.z_sigma;
     have_prev_ceiling_ = true;
     prev_ceiling_ = out_.ceiling.coeffs;
+    update_gyro_bias(up);
   } else {
+    have_bias_ref_ = false;
     fallback_attitude();
     if (out_.ground.found) {
       out_.z = out_.ground.distance();
@@ -414,16 +579,16 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
       if (scan.column_utime[v] != 0) col_dt_[v] = float(double(scan.column_utime[v] - scan.utime) * 1e-6);
   for (int u = 0; u < scan.height; ++u) {
     const int shift = u < int(scan.beams.pixel_shift_by_row.size()) ? scan.beams.pixel_shift_by_row[u] : 0;
-    for (int cd = 0; cd < W; ++cd) {
-      int v = (cd - shift) % W;
-      if (v < 0) v += W;
+    int v = ((-shift) % W + W) % W;  // staggered column of destaggered column cd (cd - shift mod W)
+    for (int cd = 0; cd < W; ++cd, ++v) {
+      if (v == W) v = 0;
       const size_t i = size_t(u) * W + v;
       const float r = range_[i];
       if (r <= 0.f) continue;
       const Eigen::Vector3f& p = xyz_[i];
       const float sc = nc.dot(p), sf = nf.dot(p);
       if (sc > -dc && sf > -df) {
-        w.push(p, r, u, cd, col_dt_[v]);
+        w.push(out_.deskewed ? raw_[i] : p, r, u, cd, col_dt_[v]);  // as measured (see prepare())
         if (keep_labels_) out_.label[i] = 3;
       } else if (keep_labels_) {
         if (sc <= -cin) out_.label[i] = 1;
@@ -500,31 +665,42 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
     seeds_.swap(kept);
   }
 
-  // Choose the start with the most support (inliers on a subsample of all half-ring points): the seed
-  // regression, last frame's plane, or planes through seed triplets (deterministic sampling). The
-  // triplets make the start robust when a tilted sensor's longest rays hit far walls, not the ceiling.
+  // Choose the start with the most support on a subsample of all half-ring points: the seed regression,
+  // last frame's plane, or planes through seed triplets (deterministic sampling). The triplets make the
+  // start robust when a tilted sensor's longest rays hit far walls, not the ceiling.
+  //
+  // Support = soft inlier count (MSAC: 1 - (r/T)^2 for |r| < T, T = inlier_threshold_m) minus
+  // (1 / max_beyond_ratio) per return more than 2T *beyond* the plane: a ceiling is where the rays end, so
+  // a plane cutting through walls (many "inliers" at one height in a corridor) loses, and a plane the
+  // acceptance test would reject (beyond > max_beyond_ratio x inliers) scores below zero. The soft count
+  // prefers the tight fit over a loose plane that merely stays within T of a narrow ceiling strip.
   const double max_tilt = cfg_.max_tilt_deg * M_PI / 180.0;
-  auto score = [&](const Eigen::Vector4d& pl) {
+  const float thr = float(cfg_.inlier_threshold_m), beyond_thr = 2 * thr;
+  const float beyond_weight = float(1.0 / std::max(1e-3, cfg_.max_beyond_ratio));
+  auto score_band = [&](const Eigen::Vector4d& pl, size_t stride, float band) {
     const Eigen::Vector3f n = pl.head<3>().cast<float>();
-    const float d = float(pl[3]);
-    // A ceiling is where the rays end: returns beyond the plane (above a ceiling) count against it, so a
-    // horizontal plane cutting through near walls (many "inliers" at one height) loses.
-    int cnt = 0;
-    for (size_t i = 0; i < c.p.size(); i += 24) {
+    const float d = float(pl[3]), inv_b2 = 1.f / (band * band);
+    float soft = 0.f;
+    int beyond = 0;
+    for (size_t i = 0; i < c.p.size(); i += stride) {
       const float r = n.dot(c.p[i]) + d;
-      cnt += std::abs(r) < 0.05f;
-      cnt -= (r < -0.2f);
+      soft += max0(1.f - r * r * inv_b2);
+      beyond += r < -beyond_thr;
     }
-    return cnt;
+    return double(soft - beyond_weight * float(beyond)) * double(stride);
   };
+  auto score = [&](const Eigen::Vector4d& pl, size_t stride) { return score_band(pl, stride, thr); };
+  constexpr size_t kStartStride = 24;  // start selection: ~1.4k of 32k half-ring returns
   Eigen::Vector4d cur;
-  int best = std::numeric_limits<int>::min();
+  double best = -std::numeric_limits<double>::infinity();
+  bool have_start = false;
   auto consider = [&](const Eigen::Vector4d& pl) {
     if (!pl.allFinite() || -pl.head<3>().dot(up) < std::cos(max_tilt) || pl[3] <= 0) return;
-    const int sc = score(pl);
-    if (sc > best) {
+    const double sc = score(pl, kStartStride);
+    if (!have_start || sc > best) {
       best = sc;
       cur = pl;
+      have_start = true;
     }
   };
   if (have_seed_plane) consider(seed_plane);
@@ -551,20 +727,24 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
       consider(pl);
     }
   }
-  if (best == std::numeric_limits<int>::min()) return false;
+  if (!have_start) return false;
 
   // 3. M-estimator (IRLS, Tukey biweight) over all points of the half rings, cut-off shrinking from
-  //    irls_initial_scale_m to ~4.7 robust sigmas of the inliers.
-  auto refine = [&](Eigen::Vector4d cur) -> std::optional<Eigen::Vector4d> {
+  //    irls_initial_scale_m to ~4.7 robust sigmas of the inliers. The start already has its support within
+  //    T = 5 cm, so the first cut-off only needs to cover its tilt error over the far ceiling (0.2 m); a wide
+  //    one (0.5 m) lets the band of wall returns below a corridor ceiling (10x the ceiling returns there)
+  //    dominate the first weighted fit, which then converges to a plane through the walls.
+  double last_sigma = 0;  // robust residual scale of the last refinement's final iteration
+  auto refine = [&](Eigen::Vector4d cur, double first_cut, double min_cut, bool fixed) -> std::optional<Eigen::Vector4d> {
   const Eigen::Vector3d ref = -cur[3] * cur.head<3>();  // a point of the plane (numerics)
   const Eigen::Vector3f reff = ref.cast<float>();
-  double cut = cfg_.irls_initial_scale_m;
-  band_.clear();
+  double cut = first_cut;
+  band_.clear();  // the band's points, contiguous (streamed by every iteration)
   {
     const Eigen::Vector3f n = cur.head<3>().cast<float>();
     const float d = float(cur[3]), cb = float(cut);
     for (size_t i = 0; i < c.p.size(); ++i)
-      if (std::abs(n.dot(c.p[i]) + d) < cb) band_.push_back(int(i));
+      if (std::abs(n.dot(c.p[i]) + d) < cb) band_.push_back(c.p[i]);
   }
   if (band_.size() < 3) return std::nullopt;
   for (int it = 0; it < std::max(1, cfg_.irls_iterations); ++it) {
@@ -577,7 +757,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
     const float inv_bin = float(kBins / cut);
     int inside = 0;
     for (size_t j = 0; j < band_.size(); ++j) {
-      const float r = n.dot(c.p[band_[j]]) + d;
+      const float r = n.dot(band_[j]) + d;
       res_[j] = r;
       const float a = std::abs(r);
       if (a < cut) {
@@ -592,7 +772,8 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
       if (2 * acc >= inside) break;
     }
     const double sigma = 1.4826 * (bin + 0.5) / inv_bin;
-    const double next_cut = std::max({cut * 0.5, 4.685 * sigma, 0.02});
+    last_sigma = sigma;
+    const double next_cut = fixed ? cut : std::max({cut * 0.5, 4.685 * sigma, min_cut});
     const bool final_scale = next_cut >= cut;
     cut = std::min(cut, next_cut);
     const float inv_c2 = float(1.0 / (cut * cut));
@@ -604,7 +785,7 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
       const float t = r * r * inv_c2;
       if (t >= 1.f) continue;
       const double w = (1.f - t) * (1.f - t);
-      const Eigen::Vector3f& pf = c.p[band_[j]];
+      const Eigen::Vector3f& pf = band_[j];
       const double x = pf.x() - reff.x(), y = pf.y() - reff.y(), z = pf.z() - reff.z();
       sw += w;
       sx += w * x; sy += w * y; sz += w * z;
@@ -623,16 +804,46 @@ bool RingSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in,
   }
   return cur;
   };
-  // Refine the best start; when last frame's plane was not that start, refine it too and keep the result
-  // with more support (a lowered/sloped patch must not capture the fit when the main ceiling is known).
-  auto res1 = refine(cur);
-  if (previous && (cur - *previous).norm() > 1e-9 && (!res1 || score(*res1) < score(*previous))) {
-    auto res2 = refine(*previous);
-    if (res2 && (!res1 || score(*res2) > score(*res1))) res1 = res2;
+  // Refine the best start and, when it was not last frame's plane, last frame's plane too. A refinement
+  // that lowers the support (T band, dense subsample) diverged (walls captured it): its start is kept
+  // instead. Of the two, keep the one with the higher support with the soft band narrowed to 3 robust
+  // sigmas of the tighter fit (>= 1 cm): at T = 5 cm a plane tilted a few tenths of a degree through a
+  // narrow corridor ceiling plus the wall tops below it scores as well as the true one; at 3 sigma it
+  // loses the ceiling returns it leaves behind. (A lowered/sloped patch must not capture it either.)
+  constexpr size_t kFinalStride = 3;
+  struct Fit {
+    Eigen::Vector4d pl;
+    double sigma;
+  };
+  auto refine_guarded = [&](const Eigen::Vector4d& start) -> std::optional<Fit> {
+    const auto r = refine(start, cfg_.irls_initial_scale_m, 0.02, false);
+    if (r && score(*r, kFinalStride) >= score(start, kFinalStride)) return Fit{*r, last_sigma};
+    return Fit{start, cfg_.inlier_threshold_m / 3};
+  };
+  std::optional<Fit> res1 = refine_guarded(cur);
+  if (previous && (cur - *previous).norm() > 1e-9) {
+    const std::optional<Fit> res2 = refine_guarded(*previous);
+    if (res2 && res1) {
+      const float t_sel = float(std::clamp(3.0 * std::min(res1->sigma, res2->sigma), 0.01, cfg_.inlier_threshold_m));
+      if (score_band(res2->pl, kFinalStride, t_sel) > score_band(res1->pl, kFinalStride, t_sel)) res1 = res2;
+    } else if (res2) {
+      res1 = res2;
+    }
+  }
+  // Ceiling only: a refit at a fixed cut-off of tight_refit_sigmas robust sigmas (>= 1 cm) of the result.
+  // Where two surfaces meet (a sloped ceiling patch next to the flat ceiling) the Tukey fit at 4.7 sigma
+  // settles on a compromise tilted a few tenths of a degree between them; at ~2.5 sigma only the dominant
+  // surface keeps its support. The tighter of the two wins on the narrow-band support.
+  if (res1 && tighten_ && cfg_.tight_refit_sigmas > 0) {
+    const double ct = std::max(cfg_.tight_refit_sigmas * res1->sigma, 0.01);
+    if (const auto r = refine(res1->pl, ct, ct, true)) {
+      const Fit tight{*r, last_sigma};
+      const float t_sel = float(std::clamp(3.0 * std::min(res1->sigma, tight.sigma), 0.01, cfg_.inlier_threshold_m));
+      if (score_band(tight.pl, kFinalStride, t_sel) > score_band(res1->pl, kFinalStride, t_sel)) res1 = tight;
+    }
   }
   if (!res1) return false;
-  cur = *res1;
-  plane = cur;
+  plane = res1->pl;
   return true;
 }
 

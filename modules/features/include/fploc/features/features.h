@@ -51,7 +51,9 @@ struct Features2D {
 class FeatureExtractor {
  public:
   explicit FeatureExtractor(FeatureConfig cfg = {});
-  // Uses seg.wall (ring-major, increasing column per ring) and seg.roll/pitch.
+  // Uses seg.wall (ring-major, increasing column per ring) and seg.roll/pitch. Status kBadInput when the
+  // segmentation itself is BAD_INPUT/EMPTY (passed on), or its wall arrays disagree in size, or roll/pitch
+  // are not finite.
   const Features2D& process(const seg::Segmentation& seg);
   const FeatureConfig& config() const { return cfg_; }
 

@@ -1,5 +1,6 @@
 // The swappable baseline: the same Segmenter (outputs, fallbacks, wall selection) with the plane fit done
-// by PCL's RANSAC (pcl::SACSegmentation, SACMODEL_PERPENDICULAR_PLANE around the gravity prior).
+// by PCL's RANSAC (pcl::SACSegmentation, SACMODEL_PERPENDICULAR_PLANE around the gravity prior; planes
+// extracted one after another until one passes the "rays end there" test, up to 4).
 // PCL stays inside ransac_segmenter.cpp.
 #pragma once
 #include "fploc/segmentation/segmenter.h"

@@ -7,6 +7,7 @@
 #include <deque>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fploc/core/scan.h"
@@ -23,6 +24,7 @@ struct SegmenterConfig {
   double wall_margin_m = 0.10;     // points closer than this to ceiling/floor are not wall points
   double ceiling_height_m = 0.0;   // known floor-to-ceiling height; 0 = estimated (ceiling + ground fits)
   bool use_imu_prior = false;      // IMU gravity as initial direction, tilt gate and fallback
+  bool deskew_gyro = true;         // rotate returns to mid-sweep with the gyro rate (when gyro samples arrive)
   double min_range_m = 0.4;        // ignore returns closer than this (platform, tripod)
   double max_range_m = 120.0;
   int min_plane_inliers = 200;     // fewer inliers -> plane not found
@@ -30,8 +32,10 @@ struct SegmenterConfig {
   double max_beyond_ratio = 0.25;     // reject a plane with more returns beyond it than this x inliers
   double inlier_threshold_m = 0.05;// inlier band for counting / rms
   int irls_iterations = 8;
-  double irls_initial_scale_m = 0.5;  // first Tukey cut-off; halves every iteration down to ~4.7 sigma
+  double irls_initial_scale_m = 0.2;  // first Tukey cut-off (4 x the 5 cm band that chose the start);
+                                      // halves every iteration down to ~4.7 sigma
   int room_height_window = 51;     // frames in the running median of the floor-to-ceiling height
+  double tight_refit_sigmas = 2.5; // ceiling refit at this many robust sigmas (0 = off), see fit_plane
 };
 
 enum class SegStatus : int8_t { kOk = 0, kNoCeiling = 1, kBadInput = 2, kEmpty = 3 };
@@ -73,6 +77,7 @@ struct Segmentation {
   double roll_pitch_sigma = M_PI;    // 1-sigma [rad]; pi = unknown
   double z_sigma = 1e3;              // 1-sigma [m]
   AttitudeSource attitude_source = AttitudeSource::kNone;
+  bool deskewed = false;             // planes fitted to gyro-de-skewed returns (roll/pitch/z at mid-sweep)
   int height = 0, width = 0;
   WallPoints wall;
   // Per pixel of the scan (row-major, staggered like the scan): 0 none, 1 ceiling, 2 ground, 3 wall.
@@ -96,9 +101,16 @@ class Segmenter {
 
   // IMU accelerometer sample (specific force, m/s^2) in the sensor frame; averaged until the next scan.
   void add_accel(const Eigen::Vector3d& accel);
+  // IMU gyro sample (rad/s, sensor frame) measured at utime [us, the scan's clock]. Samples covering a
+  // sweep de-skew its rotation (config deskew_gyro); without them the scan is used as measured.
+  void add_gyro(const Eigen::Vector3d& rate, int64_t utime);
   void set_keep_labels(bool on) { keep_labels_ = on; }
   const SegmenterConfig& config() const { return cfg_; }
   double room_height() const { return room_height_; }  // 0 until known
+  const Eigen::Vector3d& gyro_bias() const { return gyro_bias_; }  // rad/s, perpendicular-to-gravity part
+  // Last scan's points per pixel (row-major like the scan, de-skewed when last().deskewed; only pixels with a
+  // return inside [min_range_m, max_range_m] are meaningful). Diagnostics.
+  const std::vector<Eigen::Vector3f>& points() const { return xyz_; }
 
  protected:
   // Points offered to a plane fit: the upper (ceiling) or lower (ground, flipped) half rings.
@@ -117,9 +129,15 @@ class Segmenter {
                          Eigen::Vector4d& plane) = 0;
 
   SegmenterConfig cfg_;
+  bool tighten_ = false;  // set while fit_plane() fits the ceiling (the plane that gives the attitude)
 
  private:
   bool prepare(const Scan& scan);
+  bool deskew_rotations(const Scan& scan);
+  Eigen::Vector3d gyro_at(int64_t utime) const;
+  bool gyro_covers(int64_t ta, int64_t tb) const;
+  Eigen::Matrix3d gyro_rotation(int64_t ta, int64_t tb) const;
+  void update_gyro_bias(const Eigen::Vector3d& up);
   void quality(const Candidates& c, Plane& pl) const;
   void select_walls(const Scan& scan, const Eigen::Vector3d& up);
   void update_room_height(double h);
@@ -128,7 +146,9 @@ class Segmenter {
   XyzLut lut_;
   BeamIntrinsics lut_beams_;
   int lut_width_ = 0;
-  std::vector<Eigen::Vector3f> xyz_;
+  std::vector<Eigen::Vector3f> xyz_;   // sensor frame (de-skewed to mid-sweep when out_.deskewed)
+  std::vector<Eigen::Vector3f> raw_;   // as measured (only filled when de-skewing)
+  std::vector<Eigen::Matrix3f> col_rot_;
   std::vector<float> range_;
   std::vector<float> col_dt_;  // per staggered column: column time - scan utime [s]
   std::vector<int> ring_order_;      // rings sorted by altitude, top first
@@ -143,6 +163,15 @@ class Segmenter {
   Eigen::Vector3d accel_sum_ = Eigen::Vector3d::Zero();
   int accel_n_ = 0;
   Eigen::Vector3d imu_up_ = Eigen::Vector3d::UnitZ();
+  std::deque<std::pair<int64_t, Eigen::Vector3d>> gyro_;  // last ~1 s of gyro samples, increasing time
+  Eigen::Vector3d gyro_bias_ = Eigen::Vector3d::Zero();   // estimated from consecutive ceilings
+  int64_t sweep_tm_ = 0;                                  // this scan's mid-sweep time when the gyro covers it
+  bool have_bias_ref_ = false;
+  int64_t bias_ref_t_ = 0;
+  Eigen::Vector3d bias_ref_up_ = Eigen::Vector3d::UnitZ();
+  std::vector<int64_t> col_t_;
+  std::vector<int> col_mid_;
+  std::vector<uint8_t> col_ok_;
   bool have_imu_ = false;
   std::deque<double> heights_;
   double room_height_ = 0.0;
@@ -162,7 +191,7 @@ class RingSegmenter : public Segmenter {
   std::vector<int> seeds_, all_seeds_;
   std::vector<float> sector_best_;
   std::vector<int> sector_idx_;
-  std::vector<int> band_;
+  std::vector<Eigen::Vector3f> band_;
   std::vector<float> res_;
 };
 

@@ -36,13 +36,19 @@ class SegmenterNodeT : public rt::Node {
     out_ = ctx.advertise<segments_t>("segments");
     ctx.subscribe<scan_t>("scan", [this](const scan_t& m) { on_scan(m); });
     ctx.subscribe<imu_t>("imu", [this](const imu_t& m) {
+      // IMU axes = sensor axes (OS-1: imu_to_sensor is a pure translation).
+      const Eigen::Vector3d w(m.gyro[0], m.gyro[1], m.gyro[2]);
+      if (!w.allFinite())
+        ctx_->error("imu seq " + std::to_string(m.seq) + ": non-finite gyro (ignored)");
+      else
+        seg_->add_gyro(w, m.gyro_utime != 0 ? m.gyro_utime : m.utime);  // de-skew of the sweep's rotation
       if (!use_imu_) return;
       const Eigen::Vector3d a(m.accel[0], m.accel[1], m.accel[2]);
       if (!a.allFinite()) {
         ctx_->error("imu seq " + std::to_string(m.seq) + ": non-finite accel (ignored)");
         return;
       }
-      seg_->add_accel(a);  // IMU axes = sensor axes (OS-1: imu_to_sensor is a pure translation)
+      seg_->add_accel(a);
     });
   }
 
