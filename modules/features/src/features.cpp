@@ -20,6 +20,7 @@ const Features2D& FeatureExtractor::process(const seg::Segmentation& seg) {
   out_.z = seg.z;
   out_.roll_pitch_sigma = seg.roll_pitch_sigma;
   out_.z_sigma = seg.z_sigma;
+  out_.attitude_t = seg.attitude_t;
   // An unusable scan upstream (bad or empty input: no planes, no wall points) is passed on as such.
   if (seg.status == seg::SegStatus::kBadInput || seg.status == seg::SegStatus::kEmpty) {
     out_.status = FeatStatus::kBadInput;

@@ -109,45 +109,46 @@ PoseOut WindowOptimizer::make_out(const Frame& f, const Pose2& pose_tau_in, bool
 }
 
 void WindowOptimizer::fill_gravity(PoseOut* o, const FeatureFrame& f) const {
+  // The segmenter's roll/pitch/z hold at utime + attitude_t (mid-sweep), the pose at utime: interpolate
+  // them to utime between the nearest frames that have them. A frame without them (sigma "unknown") is
+  // filled the same way; with a neighbour on one side only (the newest frame), its own values (or that
+  // neighbour's) are used.
   o->roll = f.roll;
   o->pitch = f.pitch;
   o->z = f.z;
   const bool z_known = std::isfinite(f.z) && f.z_sigma < cfg_.unknown_z_sigma_m;
   const bool rp_known = std::isfinite(f.roll) && std::isfinite(f.pitch) && f.roll_pitch_sigma < cfg_.unknown_rp_sigma_rad;
-  if (z_known && rp_known) return;
-  auto fill = [&](bool Gravity::*known, auto get, double* out) {
+  auto fill = [&](bool Gravity::*known, bool self_known, auto get, double* out) {
     const Gravity* before = nullptr;
     const Gravity* after = nullptr;
     for (const auto& g : gravity_) {
       if (!(g.*known)) continue;
-      if (g.utime <= f.utime) before = &g;
+      if (g.t <= f.utime) before = &g;
       else if (!after) after = &g;
     }
     if (before && after) {
-      const double s = double(f.utime - before->utime) / double(after->utime - before->utime);
+      const double s = double(f.utime - before->t) / double(after->t - before->t);
       *out = get(*before) + s * (get(*after) - get(*before));
-    } else if (before || after) {
+    } else if (!self_known && (before || after)) {
       *out = get(before ? *before : *after);
     }
   };
-  if (!z_known) fill(&Gravity::z_known, [](const Gravity& g) { return g.z; }, &o->z);
-  if (!rp_known) {
-    fill(&Gravity::rp_known, [](const Gravity& g) { return g.roll; }, &o->roll);
-    fill(&Gravity::rp_known, [](const Gravity& g) { return g.pitch; }, &o->pitch);
-  }
+  fill(&Gravity::z_known, z_known, [](const Gravity& g) { return g.z; }, &o->z);
+  fill(&Gravity::rp_known, rp_known, [](const Gravity& g) { return g.roll; }, &o->roll);
+  fill(&Gravity::rp_known, rp_known, [](const Gravity& g) { return g.pitch; }, &o->pitch);
 }
 
 PoseOut WindowOptimizer::add(FrameInput in, std::vector<PoseOut>* finals) {
   {
     const FeatureFrame& f = in.features;
-    gravity_.push_back({f.utime, f.roll, f.pitch, f.z,
+    gravity_.push_back({f.utime + std::llround(f.attitude_t * 1e6), f.roll, f.pitch, f.z,
                         std::isfinite(f.roll) && std::isfinite(f.pitch) && f.roll_pitch_sigma < cfg_.unknown_rp_sigma_rad,
                         std::isfinite(f.z) && f.z_sigma < cfg_.unknown_z_sigma_m});
     // Keep what the frames still to be output may need (and a little before).
     int64_t oldest = f.utime;
     if (!pending_.empty()) oldest = std::min(oldest, pending_.front().in.features.utime);
     if (!window_.empty()) oldest = std::min(oldest, window_.front().f.in.features.utime);
-    while (gravity_.size() > 2 && gravity_[1].utime < oldest - 5'000'000) gravity_.pop_front();
+    while (gravity_.size() > 2 && gravity_[1].t < oldest - 5'000'000) gravity_.pop_front();
   }
   Frame fr;
   fr.in = std::move(in);

@@ -382,8 +382,22 @@ void Segmenter::update_room_height(double h) {
   room_height_ = v[v.size() / 2];
 }
 
+double Segmenter::mid_sweep_offset(const Scan& scan) {
+  // Halfway between the first and the last valid column time (0 without column times).
+  const bool cvalid = scan.column_valid.size() == scan.column_utime.size();
+  int64_t t0 = 0, t1 = 0;
+  for (size_t c = 0; c < scan.column_utime.size(); ++c) {
+    const int64_t t = scan.column_utime[c];
+    if (t == 0 || (cvalid && !scan.column_valid[c])) continue;
+    if (t0 == 0 || t < t0) t0 = t;
+    t1 = std::max(t1, t);
+  }
+  return t0 == 0 ? 0.0 : 1e-6 * double(t0 + (t1 - t0) / 2 - scan.utime);
+}
+
 const Segmentation& Segmenter::process(const Scan& scan) {
   out_.utime = scan.utime;
+  out_.attitude_t = mid_sweep_offset(scan);
   out_.seq = scan.seq;
   out_.status = SegStatus::kOk;
   out_.status_text.clear();

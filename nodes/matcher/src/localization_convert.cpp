@@ -21,6 +21,7 @@ FeatureFrame from_msg(const features_t& m, int* dropped) {
   f.z = m.z;
   f.roll_pitch_sigma = std::isfinite(m.roll_pitch_sigma) ? m.roll_pitch_sigma : 0;
   f.z_sigma = std::isfinite(m.z_sigma) ? m.z_sigma : 0;
+  f.attitude_t = std::isfinite(m.attitude_t_offset_s) ? m.attitude_t_offset_s : 0;
   f.points.reserve(n);
   int bad = 0;
   for (size_t i = 0; i < n; ++i) {

@@ -27,7 +27,8 @@ void to_msg(const seg::Segmentation& s, int64_t seq, segments_t& m) {
   m.z = s.z;
   m.roll_pitch_sigma = s.roll_pitch_sigma;
   m.z_sigma = s.z_sigma;
-  m.attitude_source = int8_t(s.attitude_source);  // 3 = none (no ceiling, no history, no IMU)
+  m.attitude_source = int8_t(s.attitude_source);
+  m.attitude_t_offset_s = s.attitude_t;  // 3 = none (no ceiling, no history, no IMU)
   m.height = int16_t(s.height);
   m.width = int16_t(s.width);
   const auto& w = s.wall;
@@ -70,6 +71,7 @@ void from_msg(const segments_t& m, seg::Segmentation& s) {
   s.roll_pitch_sigma = m.roll_pitch_sigma;
   s.z_sigma = m.z_sigma;
   s.attitude_source = seg::AttitudeSource(m.attitude_source);
+  s.attitude_t = std::isfinite(m.attitude_t_offset_s) ? m.attitude_t_offset_s : 0.0;
   s.height = m.height;
   s.width = m.width;
   auto& w = s.wall;
@@ -96,6 +98,7 @@ void to_msg(const feat::Features2D& f, int64_t seq, int64_t scan_seq, features_t
   m.z = f.z;
   m.roll_pitch_sigma = f.roll_pitch_sigma;
   m.z_sigma = f.z_sigma;
+  m.attitude_t_offset_s = f.attitude_t;
   m.num_points = int32_t(f.size());
   m.x = f.x;
   m.y = f.y;

@@ -38,6 +38,7 @@ struct Features2D {
   int64_t utime = 0, seq = 0;
   FeatStatus status = FeatStatus::kOk;
   double roll = 0, pitch = 0, z = 0, roll_pitch_sigma = 0, z_sigma = 0;
+  double attitude_t = 0;            // roll/pitch/z hold at utime + this [s] (from the segmentation)
   std::vector<float> x, y;          // gravity-aligned, sensor-centred [m]
   std::vector<int8_t> kind;
   std::vector<int32_t> group;       // -1 = unclassified

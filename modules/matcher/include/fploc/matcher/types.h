@@ -26,6 +26,7 @@ struct FeatureFrame {
   int64_t scan_seq = 0;
   double roll = 0, pitch = 0, z = 0;
   double roll_pitch_sigma = 0, z_sigma = 0;
+  double attitude_t = 0;  // roll/pitch/z hold at utime + this [s] (mid-sweep; the optimizer interpolates)
   // The IMU's mean yaw rate [rad/s] over the sweep (utime .. utime + the points' largest t); NaN = unknown.
   double sweep_yaw_rate = std::numeric_limits<double>::quiet_NaN();
   std::vector<Feature2> points;

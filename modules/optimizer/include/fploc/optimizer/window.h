@@ -118,8 +118,8 @@ class WindowOptimizer {
   // updated), which closes the interval [prev.tau, tau] containing utime; without one (start, gap) the
   // matcher's twist carries the pose back.
   PoseOut make_out(const Frame& f, const Pose2& pose_tau, bool key, Stamped* prev) const;
-  // Roll/pitch/z of a frame whose segmenter could not estimate them (sigma of "unknown"): interpolated
-  // between the nearest frames that had them (held at the ends).
+  // Roll/pitch/z at the frame's utime: interpolated between the nearest frames that have them (they
+  // hold at utime + attitude_t, mid-sweep); held at the ends when the frame's own are unknown.
   void fill_gravity(PoseOut* o, const FeatureFrame& f) const;
   Eigen::Vector3d newest_correction() const;
 
@@ -130,7 +130,7 @@ class WindowOptimizer {
   std::deque<Final> finals_;           // last two final key poses
   Stamped last_final_, last_latest_;   // previous pose at tau of the final / latest output streams
   struct Gravity {
-    int64_t utime;
+    int64_t t;                         // when roll/pitch/z hold (utime + attitude_t)
     double roll, pitch, z;
     bool rp_known, z_known;
   };

@@ -78,6 +78,9 @@ struct Segmentation {
   double z_sigma = 1e3;              // 1-sigma [m]
   AttitudeSource attitude_source = AttitudeSource::kNone;
   bool deskewed = false;             // planes fitted to gyro-de-skewed returns (roll/pitch/z at mid-sweep)
+  // roll/pitch/z hold at utime + attitude_t [s]: mid-sweep (the returns are de-skewed to it, or the planes
+  // are fitted over the whole sweep); downstream poses stamped at utime interpolate to their own time.
+  double attitude_t = 0;
   int height = 0, width = 0;
   WallPoints wall;
   // Per pixel of the scan (row-major, staggered like the scan): 0 none, 1 ceiling, 2 ground, 3 wall.
@@ -134,6 +137,7 @@ class Segmenter {
  private:
   bool prepare(const Scan& scan);
   bool deskew_rotations(const Scan& scan);
+  static double mid_sweep_offset(const Scan& scan);
   Eigen::Vector3d gyro_at(int64_t utime) const;
   bool gyro_covers(int64_t ta, int64_t tb) const;
   Eigen::Matrix3d gyro_rotation(int64_t ta, int64_t tb) const;
