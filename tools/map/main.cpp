@@ -47,7 +47,7 @@ struct AnnfArgs {
     if (with_depth) app->add_option("--depth", depth, "maximum depth (1 = root fields only)");
     app->add_option("--root", root, "root field length in metres (default 6)");
     app->add_option("--margin", margin, "metres of field around the plan's bounding box (default 2)");
-    app->add_option("--rule", rule, "paper stopping rule: child-leaf | undo-only | child-leaf-ordered | full");
+    app->add_option("--rule", rule, "paper stopping rule: child-leaf | undo-only | child-leaf-ordered | full | collapse-first | collapse-pair");
     app->add_option("--max-candidates", max_candidates, "exact mode: subdivide while a leaf has more candidates");
   }
   AnnfOptions options() const {
@@ -124,6 +124,14 @@ int main(int argc, char** argv) {
   validate->add_option("--mode", v.mode, "paper | exact | both (default both)")->check(CLI::IsMember({"paper", "exact", "both"}));
   validate->add_option("--rule", v.rule, "paper stopping rule (default child-leaf-ordered)");
   validate->add_flag("--distinct", v.distinct, "paper mode: two nearest at distinct distances (the authors' demo)");
+  validate->add_option("--candidates", v.candidates,
+                       "paper mode: a field's two elements among all | passing (elements passing through it; else all) | "
+                       "passing-inherit (else the parent's two)")
+      ->check(CLI::IsMember({"all", "passing", "passing-inherit"}));
+  validate->add_option("--hit-by", v.hit_by,
+                       "distance (default: a hit is any element at the true nearest distance, so ties and duplicates "
+                       "count) | id (only the brute-force element, the lowest id among ties)")
+      ->check(CLI::IsMember({"distance", "id"}));
   validate->add_option("--sample-area", v.sample_area, "bbox (plan's bounding box, default) | fields (area of the root fields)");
   validate->add_flag("--all-rules", v.all_rules, "measure every reading of the paper's stopping rules");
   validate->add_option("--root", v.root, "root field length in metres (default 6)");

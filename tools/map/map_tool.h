@@ -13,6 +13,8 @@ struct ValidateArgs {
   std::string rule = "child-leaf-ordered";
   bool all_rules = false;
   bool distinct = false;
+  std::string candidates = "all";
+  std::string hit_by = "distance";
   std::string sample_area = "bbox";
   double root = 6.0;
   double margin = 2.0;

@@ -75,8 +75,9 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
   std::cerr << "fploc map validate: " << plan.elements.size() << " elements, " << pts.size()
             << " uniform samples in " << bb.size().x() << " x " << bb.size().y() << " m; brute-force ground truth...\n";
   std::vector<double> truth(pts.size());
+  std::vector<int> truth_id(pts.size());
   const double tb0 = now_ns();
-  for (size_t i = 0; i < pts.size(); ++i) nearest_element_brute_force(plan, pts[i], &truth[i]);
+  for (size_t i = 0; i < pts.size(); ++i) truth_id[i] = nearest_element_brute_force(plan, pts[i], &truth[i]);
   const double brute_ns = (now_ns() - tb0) / double(pts.size());
 
   json rows = json::array();
@@ -89,7 +90,8 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
   if (a.mode != "exact") {
     if (a.all_rules) {
       for (bool distinct : {false, true})
-        for (PaperRule r : {PaperRule::kChildLeaf, PaperRule::kUndoOnly, PaperRule::kChildLeafOrdered, PaperRule::kFull})
+        for (PaperRule r : {PaperRule::kChildLeaf, PaperRule::kUndoOnly, PaperRule::kChildLeafOrdered, PaperRule::kFull,
+                            PaperRule::kCollapseFirst, PaperRule::kCollapsePair})
           configs.push_back({AnnfMode::kPaper, r, distinct});
     } else {
       configs.push_back({AnnfMode::kPaper, parse_paper_rule(a.rule), a.distinct});
@@ -97,6 +99,7 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
   }
   if (a.mode != "paper") configs.push_back({AnnfMode::kExact, PaperRule::kChildLeaf, false});
   const size_t timed = std::min<size_t>(pts.size(), 2000000);
+  const bool by_id = a.hit_by == "id";
 
   std::fprintf(stderr, "%-6s %-28s %5s %9s %8s %8s %8s %8s %10s %9s | paper: %6s %6s\n", "mode", "rule", "depth",
                "leaf[cm]", "hit1", "hit1|2", "exact", "ns/q", "bytes", "build[ms]", "hit1", "hit1|2");
@@ -110,6 +113,9 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
       o.max_depth = depth + (mode == AnnfMode::kExact ? a.exact_depth : 0);
       o.exact_max_candidates = a.max_candidates;
       o.paper_distinct_distances = distinct;
+      o.paper_candidates = a.candidates == "passing"           ? AnnfOptions::Candidates::kPassingElseAll
+                           : a.candidates == "passing-inherit" ? AnnfOptions::Candidates::kPassingInherit
+                                                               : AnnfOptions::Candidates::kAll;
       const double t0 = now_ns();
       const Annf f = Annf::build(plan, o);
       const double build_ms = (now_ns() - t0) / 1e6;
@@ -118,10 +124,13 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
         int n;
         const uint32_t* c = f.lookup(pts[i], &n);
         const double t = truth[i] + kTol;
-        if (c && n >= 1 && distance(plan.elements[c[0]], pts[i]) <= t) {
+        auto hit = [&](uint32_t id) {
+          return by_id ? int(id) == truth_id[i] : distance(plan.elements[id], pts[i]) <= t;
+        };
+        if (c && n >= 1 && hit(c[0])) {
           ++h1;
           ++h12;
-        } else if (c && n >= 2 && distance(plan.elements[c[1]], pts[i]) <= t) {
+        } else if (c && n >= 2 && hit(c[1])) {
           ++h12;
         }
         double d;

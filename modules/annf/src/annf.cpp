@@ -89,6 +89,7 @@ struct Builder {
   std::vector<uint32_t>& pool;
   std::unordered_map<std::string, uint32_t> dedupe;
   std::vector<double> smax, smin;
+  std::vector<uint32_t> passing;
   static constexpr uint32_t kLeafBit = 0x80000000u;
 
   uint32_t leaf(const std::vector<uint32_t>& ids) {
@@ -117,17 +118,39 @@ struct Builder {
     return uint32_t(idx);
   }
 
-  // Paper mode: `pair` is this field's two nearest elements to its centre, K its 2-candidates.
+  // Paper mode: a child's candidate list (its 2-candidates: they contain the two nearest elements of
+  // every point of the field, and every element passing through it) and its two elements.
+  void child_pair(const std::vector<uint32_t>& K, const Box2& cb, const Pair& parent, std::vector<uint32_t>* Kc,
+                  Pair* pc) {
+    filter_candidates(plan, K, cb, 2, Kc, &smax, &smin);
+    using C = AnnfOptions::Candidates;
+    if (o.paper_candidates == C::kAll) {
+      *pc = two_nearest(plan, *Kc, centre(cb), o.paper_distinct_distances);
+      return;
+    }
+    passing.clear();
+    for (uint32_t id : *Kc)
+      if (min_distance(plan.elements[id], cb) <= 0) passing.push_back(id);
+    if (!passing.empty())
+      *pc = two_nearest(plan, passing, centre(cb), o.paper_distinct_distances);
+    else if (o.paper_candidates == C::kPassingInherit)
+      *pc = parent;
+    else
+      *pc = two_nearest(plan, *Kc, centre(cb), o.paper_distinct_distances);
+  }
+
+  // Paper mode: `pair` is this field's two nearest elements to its centre, K its candidates.
   uint32_t paper(const Box2& box, int depth, const std::vector<uint32_t>& K, const Pair& pair) {
     if (depth >= o.max_depth) return leaf(pair);
+    if (o.paper_rule == PaperRule::kCollapseFirst || o.paper_rule == PaperRule::kCollapsePair)
+      return paper_bottom_up(box, depth, K, pair);
     std::vector<uint32_t> Kc[4];
     Pair pc[4];
     bool all_same = true;
     const bool ordered = o.paper_rule == PaperRule::kChildLeafOrdered;
     for (int q = 0; q < 4; ++q) {
       const Box2 cb = child_box(box, q);
-      filter_candidates(plan, K, cb, 2, &Kc[q], &smax, &smin);
-      pc[q] = two_nearest(plan, Kc[q], centre(cb), o.paper_distinct_distances);
+      child_pair(K, cb, pair, &Kc[q], &pc[q]);
       all_same = all_same && same_pair(pc[q], pair, ordered);
     }
     if (o.paper_rule != PaperRule::kFull && all_same) return leaf(pair);  // withdraw the division
@@ -142,6 +165,32 @@ struct Builder {
         w = paper(child_box(box, q), depth + 1, Kc[q], pc[q]);
       nodes[base + q] = w;
     }
+    return base;
+  }
+
+  // Bottom-up: divide to max_depth, then withdraw a division whose four children are leaves sharing
+  // this field's nearest element (or ordered pair). Children are built first; a withdrawn division
+  // gives its node groups back (they are the last ones allocated).
+  uint32_t paper_bottom_up(const Box2& box, int depth, const std::vector<uint32_t>& K, const Pair& pair) {
+    if (depth >= o.max_depth) return leaf(pair);
+    const size_t mark = nodes.size();
+    uint32_t w[4];
+    bool collapse = true;
+    for (int q = 0; q < 4; ++q) {
+      const Box2 cb = child_box(box, q);
+      std::vector<uint32_t> Kc;
+      Pair pc;
+      child_pair(K, cb, pair, &Kc, &pc);
+      w[q] = paper_bottom_up(cb, depth + 1, Kc, pc);
+      const bool same = o.paper_rule == PaperRule::kCollapseFirst ? pc.first == pair.first : same_pair(pc, pair, true);
+      collapse = collapse && (w[q] & kLeafBit) && same;
+    }
+    if (collapse) {
+      nodes.resize(mark);
+      return leaf(pair);
+    }
+    const uint32_t base = alloc4();
+    for (int q = 0; q < 4; ++q) nodes[base + q] = w[q];
     return base;
   }
 
@@ -198,6 +247,8 @@ const char* to_string(PaperRule r) {
     case PaperRule::kUndoOnly: return "undo-only";
     case PaperRule::kChildLeafOrdered: return "child-leaf-ordered";
     case PaperRule::kFull: return "full";
+    case PaperRule::kCollapseFirst: return "collapse-first";
+    case PaperRule::kCollapsePair: return "collapse-pair";
   }
   return "?";
 }
@@ -207,9 +258,11 @@ AnnfMode parse_annf_mode(const std::string& s) {
   fail("unknown ANNF mode '" + s + "' (paper or exact)");
 }
 PaperRule parse_paper_rule(const std::string& s) {
-  for (PaperRule r : {PaperRule::kChildLeaf, PaperRule::kUndoOnly, PaperRule::kChildLeafOrdered, PaperRule::kFull})
+  for (PaperRule r : {PaperRule::kChildLeaf, PaperRule::kUndoOnly, PaperRule::kChildLeafOrdered, PaperRule::kFull,
+                      PaperRule::kCollapseFirst, PaperRule::kCollapsePair})
     if (s == to_string(r)) return r;
-  fail("unknown paper stopping rule '" + s + "' (child-leaf, undo-only, child-leaf-ordered, full)");
+  fail("unknown paper stopping rule '" + s +
+       "' (child-leaf, undo-only, child-leaf-ordered, full, collapse-first, collapse-pair)");
 }
 
 void Annf::prepare() {
@@ -301,7 +354,7 @@ Annf Annf::build(const FloorPlan& plan, const AnnfOptions& options) {
   a.nx_ = uint32_t(nxd);
   a.ny_ = uint32_t(nyd);
   a.roots_.assign(size_t(a.nx_) * a.ny_, 0);
-  Builder b{a.plan_, a.options_, a.nodes_, a.pool_, {}, {}, {}};
+  Builder b{a.plan_, a.options_, a.nodes_, a.pool_, {}, {}, {}, {}};
   std::vector<uint32_t> all(plan.elements.size());
   for (size_t i = 0; i < all.size(); ++i) all[i] = uint32_t(i);
   std::vector<uint32_t> K;
@@ -312,8 +365,10 @@ Annf Annf::build(const FloorPlan& plan, const AnnfOptions& options) {
       box.max = box.min + Eigen::Vector2d(L, L);
       uint32_t w;
       if (options.mode == AnnfMode::kPaper) {
-        filter_candidates(a.plan_, all, box, 2, &K, &b.smax, &b.smin);
-        w = b.paper(box, 1, K, two_nearest(a.plan_, K, centre(box), options.paper_distinct_distances));
+        const Pair global = two_nearest(a.plan_, all, centre(box), options.paper_distinct_distances);
+        Pair pair;
+        b.child_pair(all, box, global, &K, &pair);
+        w = b.paper(box, 1, K, pair);
       } else {
         filter_candidates(a.plan_, all, box, 1, &K, &b.smax, &b.smin);
         w = b.exact(box, 1, K);
@@ -459,7 +514,8 @@ AnnfStats Annf::stats() const {
 
 void Annf::write(std::ostream& out) const {
   put<uint8_t>(out, uint8_t(options_.mode));
-  put<uint8_t>(out, uint8_t(uint8_t(options_.paper_rule) | (options_.paper_distinct_distances ? 0x80 : 0)));
+  put<uint8_t>(out, uint8_t(uint8_t(options_.paper_rule) | (options_.paper_distinct_distances ? 0x80 : 0) |
+                            (uint8_t(options_.paper_candidates) << 5)));
   put<double>(out, options_.root_length);
   put<int32_t>(out, options_.max_depth);
   put<int32_t>(out, options_.exact_max_candidates);
@@ -481,8 +537,10 @@ Annf Annf::read(std::istream& in, FloorPlan plan, const std::string& source) {
   Annf a;
   a.plan_ = std::move(plan);
   const uint8_t mode = get<uint8_t>(in, source), rule_byte = get<uint8_t>(in, source);
-  const uint8_t rule = rule_byte & 0x7f;
-  if (mode > 1 || rule > 3) fail(source + ": corrupt map file (mode/rule)");
+  const uint8_t rule = rule_byte & 0x1f, cand = (rule_byte >> 5) & 3;
+  if (cand > 2) fail(source + ": corrupt map file (candidates)");
+  a.options_.paper_candidates = AnnfOptions::Candidates(cand);
+  if (mode > 1 || rule > 5) fail(source + ": corrupt map file (mode/rule)");
   a.options_.paper_distinct_distances = (rule_byte & 0x80) != 0;
   a.options_.mode = AnnfMode(mode);
   a.options_.paper_rule = PaperRule(rule);

@@ -172,3 +172,46 @@ TEST(Annf, BatchEqualsSingle) {
     }
   }
 }
+
+// The bottom-up rule withdraws a division only where every max-depth field below has the same
+// first element, so a look-up's first element equals the one of the full (never stopped) tree,
+// while the tree is smaller.
+TEST(Annf, CollapseFirstKeepsTheFullTreesFirstElement) {
+  const auto plan = synthetic();
+  AnnfOptions o;
+  o.root_length = 4;
+  o.max_depth = 7;
+  o.paper_rule = PaperRule::kFull;
+  const Annf full = Annf::build(plan, o);
+  o.paper_rule = PaperRule::kCollapseFirst;
+  const Annf collapsed = Annf::build(plan, o);
+  EXPECT_LT(collapsed.stats().leaves, full.stats().leaves / 2);
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> U(-1, 13);
+  for (int i = 0; i < 20000; ++i) {
+    const Eigen::Vector2d p(U(rng), U(rng) * 0.7);
+    ASSERT_EQ(collapsed.first_candidate(p), full.first_candidate(p)) << p.transpose();
+  }
+}
+
+// "Passing through": a leaf stores only elements that pass through one of its ancestors' fields
+// (its own when any passes through it).
+TEST(Annf, PassingCandidatesPassThroughTheField) {
+  const auto plan = synthetic();
+  for (auto cand : {AnnfOptions::Candidates::kPassingElseAll, AnnfOptions::Candidates::kPassingInherit}) {
+    AnnfOptions o;
+    o.root_length = 4;
+    o.max_depth = 6;
+    o.paper_candidates = cand;
+    const Annf a = Annf::build(plan, o);
+    size_t checked = 0;
+    a.for_each_leaf([&](const Box2& box, int, const uint32_t* ids, int n) {
+      bool any = false;
+      for (const auto& e : plan.elements) any = any || min_distance(e, box) <= 0;
+      if (!any) return;
+      ++checked;
+      for (int k = 0; k < n; ++k) EXPECT_LE(min_distance(plan.elements[ids[k]], box), 0.0);
+    });
+    EXPECT_GT(checked, 10u);
+  }
+}

@@ -48,6 +48,12 @@ enum class PaperRule : uint8_t {
   kUndoOnly = 1,       // Only "all four equal -> undo"; children equal to the parent still divide.
   kChildLeafOrdered = 2,  // As kChildLeaf, "same" compares the ordered pair (1st, 2nd).
   kFull = 3,           // No stopping rule: every field divides to max_depth (upper bound on accuracy).
+  // Bottom-up readings: every field is divided to max_depth first; a division is then withdrawn
+  // (recursively, from the deepest level up) when all four children are leaves that share the
+  // parent's nearest element (kCollapseFirst: what the authors' public demo does, reverse-engineered
+  // from its leaf table, docs/notes/annf.md) or its ordered pair (kCollapsePair).
+  kCollapseFirst = 4,
+  kCollapsePair = 5,
 };
 
 struct AnnfOptions {
@@ -63,6 +69,13 @@ struct AnnfOptions {
   // (an element tied with the first, e.g. the other wall at a shared corner, is skipped), as the
   // authors' public ANNF demo does (its leaf table shows this).
   bool paper_distinct_distances = false;
+  // Paper mode, literal reading of "we iterate over every element, check which fields they are
+  // passing through, and note down the distance to the center of each field": a field's two
+  // elements are chosen only among the elements passing through it. A field no element passes
+  // through gets the two nearest of the whole plan (kPassingElseAll) or keeps its parent's two
+  // (kPassingInherit; a root field: the two nearest of the whole plan).
+  enum class Candidates : uint8_t { kAll = 0, kPassingElseAll = 1, kPassingInherit = 2 };
+  Candidates paper_candidates = Candidates::kAll;
   // Speed only (not saved, no effect on results): the top levels of the trees are flattened into a
   // dense index of at most this many cells so a look-up starts near the leaf.
   uint32_t index_cells = 1u << 18;
@@ -71,7 +84,8 @@ struct AnnfOptions {
 const char* to_string(AnnfMode m);
 const char* to_string(PaperRule r);
 AnnfMode parse_annf_mode(const std::string& s);    // "paper" | "exact"; throws otherwise
-PaperRule parse_paper_rule(const std::string& s);  // "child-leaf" | "undo-only" | "child-leaf-ordered" | "full"
+PaperRule parse_paper_rule(const std::string& s);  // "child-leaf" | "undo-only" | "child-leaf-ordered" | "full" |
+                                                   // "collapse-first" | "collapse-pair"
 
 struct AnnfStats {
   size_t nodes = 0, leaves = 0, pool_ids = 0;
