@@ -43,9 +43,11 @@ Fixture& fixture() {
     f.paper = std::make_unique<Annf>(Annf::build(f.plan, po));
     AnnfOptions xo;
     xo.mode = AnnfMode::kExact;
-    // FPLOC_EXACT_DEPTH / FPLOC_EXACT_MC: exact-mode depth and leaf candidate threshold.
+    // FPLOC_EXACT_DEPTH / FPLOC_EXACT_MC / FPLOC_EXACT_REFINE: exact-mode depth, leaf candidate
+    // threshold and candidate refinement levels.
     xo.max_depth = std::getenv("FPLOC_EXACT_DEPTH") ? std::atoi(std::getenv("FPLOC_EXACT_DEPTH")) : 9;
-    xo.exact_max_candidates = std::getenv("FPLOC_EXACT_MC") ? std::atoi(std::getenv("FPLOC_EXACT_MC")) : 4;
+    xo.exact_max_candidates = std::getenv("FPLOC_EXACT_MC") ? std::atoi(std::getenv("FPLOC_EXACT_MC")) : 2;
+    xo.exact_refine_levels = std::getenv("FPLOC_EXACT_REFINE") ? std::atoi(std::getenv("FPLOC_EXACT_REFINE")) : 2;
     xo.index_cells = cells;
     f.exact = std::make_unique<Annf>(Annf::build(f.plan, xo));
     const double res = 6.0 / 64;  // the leaf length at depth 7 (9.375 cm)

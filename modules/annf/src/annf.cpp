@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 #include <stdexcept>
+#include <tuple>
 #include <unordered_map>
 
 #include "fploc/floorplan/io.h"
@@ -90,6 +91,7 @@ struct Builder {
   std::unordered_map<std::string, uint32_t> dedupe;
   std::vector<double> smax, smin;
   std::vector<uint32_t> passing;
+  std::vector<uint8_t> mark;  // exact refinement: element already in the union
   static constexpr uint32_t kLeafBit = 0x80000000u;
 
   uint32_t leaf(const std::vector<uint32_t>& ids) {
@@ -194,8 +196,32 @@ struct Builder {
     return base;
   }
 
-  // Exact mode: K = 1-candidates of box.
-  uint32_t exact(const Box2& box, int depth, const std::vector<uint32_t>& K) {
+  // Exact mode: union of the simple-bound sets of the sub-boxes of `box` down to `levels` below it.
+  void refine(const Box2& box, const std::vector<uint32_t>& K, int levels, std::vector<uint8_t>* mark,
+              std::vector<uint32_t>* out) {
+    std::vector<uint32_t> Kc;
+    filter_candidates(plan, K, box, 1, &Kc, &smax, &smin);
+    if (Kc.size() <= 1 || levels == 0) {
+      for (uint32_t id : Kc)
+        if (!(*mark)[id]) {
+          (*mark)[id] = 1;
+          out->push_back(id);
+        }
+      return;
+    }
+    for (int q = 0; q < 4; ++q) refine(child_box(box, q), Kc, levels - 1, mark, out);
+  }
+
+  // Exact mode: K = a candidate set of box (contains the nearest element of each of its points).
+  uint32_t exact(const Box2& box, int depth, const std::vector<uint32_t>& K_in) {
+    std::vector<uint32_t> K = K_in;
+    if (o.exact_refine_levels > 0 && K.size() > 1) {
+      std::vector<uint32_t> R;
+      for (int q = 0; q < 4; ++q) refine(child_box(box, q), K, o.exact_refine_levels - 1, &mark, &R);
+      for (uint32_t id : R) mark[id] = 0;
+      std::sort(R.begin(), R.end());
+      K.swap(R);
+    }
     if (depth >= o.max_depth || int(K.size()) <= o.exact_max_candidates) {
       // Order by distance to the centre: the first candidate is the likely nearest.
       std::vector<std::pair<double, uint32_t>> order;
@@ -216,6 +242,75 @@ struct Builder {
     return base;
   }
 };
+
+// Elements another element covers: an exact duplicate (the lower id is kept), a segment lying on a
+// longer one, an arc on a circle of the same centre and radius. Every point is at least as far from
+// a covered element as from the element covering it, so exact mode leaves them out of its candidate
+// sets (the distance returned is the same; CAD plans draw many walls twice: SIST-F4 walls +
+// columns has 108 duplicates and 11 contained segments among 1732 elements). Containment is checked
+// against elements whose bounding box contains the element's, for plans of up to 50 000 elements
+// (beyond that, duplicates only).
+std::vector<uint8_t> covered_elements(const FloorPlan& plan) {
+  const size_t n = plan.elements.size();
+  std::vector<uint8_t> covered(n, 0);
+  constexpr double kTol = 1e-12;
+  auto same = [&](const Element& e, const Element& f) {
+    if (e.kind != f.kind) return false;
+    if (e.kind == ElementKind::kSegment)
+      return (e.a == f.a && e.b == f.b) || (e.a == f.b && e.b == f.a);
+    return e.c == f.c && e.r == f.r && e.a0 == f.a0 && e.a1 == f.a1;
+  };
+  auto inside = [&](const Element& e, const Element& f) {  // e lies on f (e != f)
+    if (e.kind == ElementKind::kSegment && f.kind == ElementKind::kSegment)
+      return distance(f, e.a) <= kTol && distance(f, e.b) <= kTol;
+    if (e.kind == ElementKind::kArc && f.kind == ElementKind::kCircle) return e.c == f.c && e.r == f.r;
+    return false;
+  };
+  std::vector<Box2> bb(n);
+  std::vector<uint32_t> order(n);
+  for (size_t i = 0; i < n; ++i) {
+    bb[i] = bounds(plan.elements[i]);
+    order[i] = uint32_t(i);
+  }
+  std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) {
+    return bb[x].min.x() < bb[y].min.x() || (bb[x].min.x() == bb[y].min.x() && x < y);
+  });
+  if (n > 50000) {  // duplicates only: equal elements are adjacent in a sort by geometry
+    auto key = [&](uint32_t i) {
+      const Element& e = plan.elements[i];
+      Eigen::Vector2d a = e.a, b = e.b;
+      if (e.kind == ElementKind::kSegment && (b.x() < a.x() || (b.x() == a.x() && b.y() < a.y()))) std::swap(a, b);
+      return std::make_tuple(int(e.kind), a.x(), a.y(), b.x(), b.y(), e.c.x(), e.c.y(), e.r, e.a0, e.a1, i);
+    };
+    std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) { return key(x) < key(y); });
+    for (size_t k = 1; k < n; ++k)
+      if (same(plan.elements[order[k]], plan.elements[order[k - 1]])) covered[order[k]] = 1;
+    return covered;
+  }
+  for (size_t oi = 0; oi < n; ++oi) {
+    const uint32_t i = order[oi];
+    const Element& e = plan.elements[i];
+    // Covering elements f have bb[f].min.x <= bb[i].min.x: the order's prefix up to i (and ties).
+    for (size_t oj = 0; oj < n; ++oj) {
+      const uint32_t j = order[oj];
+      if (bb[j].min.x() > bb[i].min.x() + kTol) break;
+      if (j == i) continue;
+      const Box2& fb = bb[j];
+      if (fb.max.x() < bb[i].max.x() - kTol || fb.min.y() > bb[i].min.y() + kTol || fb.max.y() < bb[i].max.y() - kTol)
+        continue;
+      const Element& f = plan.elements[j];
+      // Equal (or equal within kTol both ways): the lower id covers the higher one.
+      const bool e_in_f = same(e, f) || inside(e, f);
+      if (!e_in_f) continue;
+      const bool f_in_e = same(e, f) || inside(f, e);
+      if (!f_in_e || j < i) {
+        covered[i] = 1;
+        break;
+      }
+    }
+  }
+  return covered;
+}
 
 uint64_t fnv1a(const void* data, size_t n, uint64_t h = 1469598103934665603ull) {
   const auto* p = static_cast<const unsigned char*>(data);
@@ -265,78 +360,144 @@ PaperRule parse_paper_rule(const std::string& s) {
        "' (child-leaf, undo-only, child-leaf-ordered, full, collapse-first, collapse-pair)");
 }
 
+// Re-groups the subtree under `word` (a node with `levels_left` levels below it down to max depth)
+// into 16-ary blocks; returns the word to store for it (a leaf word pointing into lpool_, or a
+// block offset). remap: pool_ offset -> lpool_ offset (or ~0u when not yet copied).
+uint32_t Annf::flatten(uint32_t word, int levels_left, std::vector<uint32_t>* remap) {
+  if (word & kLeafBit) {
+    const uint32_t off = word & ~kLeafBit;
+    uint32_t& at = (*remap)[off];
+    if (at == ~0u) {
+      const uint32_t n = pool_[off];
+      at = uint32_t(lpool_.size());
+      bool arc = false;
+      for (uint32_t k = 0; k < n; ++k) arc = arc || plan_.elements[pool_[off + 1 + k]].kind == ElementKind::kArc;
+      lpool_.push_back(n | (arc ? kArcFlag : 0));
+      for (uint32_t k = 0; k < n; ++k) lpool_.push_back(pool_[off + 1 + k]);
+      for (uint32_t k = n; k < uint32_t(fast_k_); ++k) lpool_.push_back(pool_[off + 1]);
+      if (lpool_.size() >= kLeafBit) fail("ANNF too large (leaf records)");
+    }
+    return kLeafBit | at;
+  }
+  if (levels_left == 1) {  // 4-entry block: the children (leaves at max depth)
+    uint32_t entry[4];
+    for (int q = 0; q < 4; ++q) entry[q] = flatten(nodes_[word + q], 0, remap);
+    const uint32_t at = uint32_t(blocks_.size());
+    blocks_.insert(blocks_.end(), entry, entry + 4);
+    return at;
+  }
+  uint32_t entry[16];
+  for (uint32_t sy = 0; sy < 4; ++sy)
+    for (uint32_t sx = 0; sx < 4; ++sx) {
+      uint32_t w = nodes_[word + (((sy >> 1) << 1) | (sx >> 1))];
+      if (!(w & kLeafBit)) w = nodes_[w + (((sy & 1u) << 1) | (sx & 1u))];
+      entry[sy * 4 + sx] = w;
+    }
+  // Children first (they append to blocks_), then this block at a 64-byte boundary.
+  for (uint32_t& w : entry) w = flatten(w, levels_left - 2, remap);
+  while (blocks_.size() % 16) blocks_.push_back(0);
+  const uint32_t at = uint32_t(blocks_.size());
+  if (size_t(at) + 16 >= kLeafBit) fail("ANNF too large (look-up blocks)");
+  blocks_.insert(blocks_.end(), entry, entry + 16);
+  return at;
+}
+
 void Annf::prepare() {
   leaf_ = options_.root_length / double(1u << (max_depth_ - 1));
   inv_leaf_ = 1.0 / leaf_;
   extent_x_ = double(nx_) * double(1u << (max_depth_ - 1));
   extent_y_ = double(ny_) * double(1u << (max_depth_ - 1));
-  // Fast leaf records with geometry copies; map pool offsets to fast offsets.
-  fast_.clear();
-  std::unordered_map<uint32_t, uint32_t> remap;
-  auto leaf_word = [&](uint32_t w) -> uint32_t {
-    const uint32_t off = w & ~kLeafBit;
-    auto it = remap.find(off);
-    if (it != remap.end()) return kLeafBit | it->second;
-    const uint32_t n = pool_[off];
-    const uint32_t geom = (n + 2) & ~1u;          // geometry offset inside the record (8-byte aligned)
-    const uint32_t size = geom + 10 * n;
-    const uint32_t align = size <= 16 ? 16 : 32;  // 64 B or 128 B
-    while (fast_.size() % align) fast_.push_back(0);
-    const uint32_t at = uint32_t(fast_.size());
-    fast_.push_back(n);
-    for (uint32_t k = 0; k < n; ++k) fast_.push_back(pool_[off + 1 + k]);
-    while (fast_.size() < size_t(at) + geom) fast_.push_back(0);
-    for (uint32_t k = 0; k < n; ++k) {
-      const Element& e = plan_.elements[pool_[off + 1 + k]];
-      FastPrim f{};
-      if (e.kind == ElementKind::kSegment) {
-        f.ax = e.a.x();
-        f.ay = e.a.y();
-        f.dx = e.b.x() - e.a.x();
-        f.dy = e.b.y() - e.a.y();
-        const double l2 = f.dx * f.dx + f.dy * f.dy;
-        f.inv_l2 = l2 > 0 ? 1.0 / l2 : 0.0;
-      } else if (e.kind == ElementKind::kCircle) {
-        f.ax = e.c.x();
-        f.ay = e.c.y();
-        f.dx = e.r;
-        f.inv_l2 = -2;
-      } else {
-        f.inv_l2 = -1;
-      }
-      uint32_t words[10];
-      std::memcpy(words, &f, sizeof f);
-      fast_.insert(fast_.end(), words, words + 10);
+  geom_.assign(plan_.elements.size(), FastPrim{});
+  for (size_t i = 0; i < plan_.elements.size(); ++i) {
+    const Element& e = plan_.elements[i];
+    FastPrim& f = geom_[i];
+    if (e.kind == ElementKind::kSegment) {
+      f.ax = e.a.x();
+      f.ay = e.a.y();
+      f.dx = e.b.x() - e.a.x();
+      f.dy = e.b.y() - e.a.y();
+      const double l2 = f.dx * f.dx + f.dy * f.dy;
+      f.inv_l2 = l2 > 0 ? 1.0 / l2 : 0.0;
+    } else {  // circle (arcs: the same fields, but their leaves take the general path)
+      f.ax = e.c.x();
+      f.ay = e.c.y();
+      f.r = e.r;
     }
-    if (fast_.size() >= kLeafBit) fail("ANNF too large (fast leaf pool)");
-    remap.emplace(off, at);
-    return kLeafBit | at;
-  };
-  fnodes_ = nodes_;
-  for (auto& w : fnodes_)
-    if (w & kLeafBit) w = leaf_word(w);
+  }
+  // Candidates evaluated by the fast path: 2 if leaves with at most 2 candidates cover 95 % of the
+  // area (paper mode: all of it), else 4. Longer leaves take the general loop.
+  double area_total = 0, area_le2 = 0;
+  for_each_leaf([&](const Box2& b, int, const uint32_t*, int n) {
+    const double a = b.size().x() * b.size().y();
+    area_total += a;
+    if (n <= 2) area_le2 += a;
+  });
+  fast_k_ = area_le2 >= 0.95 * area_total ? 2 : 4;
   // Dense index at the deepest level whose cell count fits the budget.
   int g = 1;
   while (g < max_depth_ && double(nx_) * ny_ * double(1ull << (2 * g)) <= double(options_.index_cells)) ++g;
   index_shift_ = max_depth_ - g;
+  block_steps_ = (index_shift_ + 1) / 2;
   const uint32_t per = 1u << (g - 1);
-  index_nx_ = nx_ * per;
-  index_.assign(size_t(index_nx_) * ny_ * per, 0);
-  for (uint32_t j = 0; j < ny_ * per; ++j)
-    for (uint32_t i = 0; i < index_nx_; ++i) {
+  const uint32_t cx = nx_ * per, cy = ny_ * per;
+  index_tiles_x_ = (cx + 3) / 4;
+  const uint32_t tiles_y = (cy + 3) / 4;
+  index_.assign(size_t(index_tiles_x_) * tiles_y * 16, 0);
+  blocks_.assign(16, 0);  // the dummy block read by leaves reached before the last step
+  lpool_.clear();
+  std::vector<uint32_t> remap(pool_.size(), ~0u);
+  for (uint32_t j = 0; j < cy; ++j)
+    for (uint32_t i = 0; i < cx; ++i) {
       uint32_t node = roots_[size_t(j / per) * nx_ + i / per];
-      for (int level = g - 2; level >= 0 && !(node & kLeafBit); --level)
-        node = nodes_[node + (((j >> level) & 1u) << 1 | ((i >> level) & 1u))];
-      index_[size_t(j) * index_nx_ + i] = (node & kLeafBit) ? leaf_word(node) : node;
+      for (int level = g - 1; level > 0 && !(node & kLeafBit); --level)
+        node = nodes_[node + ((((j >> (level - 1)) & 1u)) << 1 | ((i >> (level - 1)) & 1u))];
+      // A node at the index depth is reached from exactly one index cell.
+      index_[index_slot(i, j)] = flatten(node, max_depth_ - g, &remap);
     }
-  fast_.shrink_to_fit();
+  blocks_.shrink_to_fit();
+  lpool_.shrink_to_fit();
+}
+
+Eigen::Vector2d Annf::closest_on(uint32_t id, const Eigen::Vector2d& p) const {
+  return closest_point(plan_.elements[id], p).point;
+}
+
+int Annf::best_of_leaf_general(const uint32_t* rec, const Eigen::Vector2d& p, double* dist,
+                               Eigen::Vector2d* closest) const {
+  const int n = int(rec[0] & kCountMask);
+  const uint32_t* ids = rec + 1;
+  int best = -1;
+  double bd = 1e300;
+  for (int k = 0; k < n; ++k) {
+    const Element& e = plan_.elements[ids[k]];
+    double d;
+    if (e.kind == ElementKind::kArc) {
+      d = distance(e, p);
+    } else {
+      const FastPrim& s = geom_[ids[k]];
+      const double vx = p.x() - s.ax, vy = p.y() - s.ay;
+      const double t = std::min(1.0, std::max(0.0, (vx * s.dx + vy * s.dy) * s.inv_l2));
+      const double ex = vx - t * s.dx, ey = vy - t * s.dy;
+      d = std::abs(std::sqrt(ex * ex + ey * ey) - s.r);
+    }
+    if (d < bd) {
+      bd = d;
+      best = int(ids[k]);
+    }
+  }
+  if (dist) *dist = bd;
+  if (closest && best >= 0) *closest = closest_on(uint32_t(best), p);
+  return best;
 }
 
 Annf Annf::build(const FloorPlan& plan, const AnnfOptions& options) {
   if (plan.elements.empty()) fail(plan.source + ": cannot build an ANNF over an empty plan");
   if (!(options.root_length > 0) || !std::isfinite(options.root_length)) fail("ANNF root length must be > 0");
   if (options.max_depth < 1 || options.max_depth > 20) fail("ANNF max depth must be in 1..20");
-  if (options.exact_max_candidates < 1) fail("ANNF exact_max_candidates must be >= 1");
+  if (options.exact_max_candidates < 1 || options.exact_max_candidates > 0xffff)
+    fail("ANNF exact_max_candidates must be in 1..65535");
+  if (options.exact_refine_levels < 0 || options.exact_refine_levels > 12)
+    fail("ANNF exact_refine_levels must be in 0..12");
   Annf a;
   a.plan_ = plan;
   a.options_ = options;
@@ -354,9 +515,15 @@ Annf Annf::build(const FloorPlan& plan, const AnnfOptions& options) {
   a.nx_ = uint32_t(nxd);
   a.ny_ = uint32_t(nyd);
   a.roots_.assign(size_t(a.nx_) * a.ny_, 0);
-  Builder b{a.plan_, a.options_, a.nodes_, a.pool_, {}, {}, {}, {}};
+  Builder b{a.plan_, a.options_, a.nodes_, a.pool_, {}, {}, {}, {}, std::vector<uint8_t>(plan.elements.size(), 0)};
   std::vector<uint32_t> all(plan.elements.size());
   for (size_t i = 0; i < all.size(); ++i) all[i] = uint32_t(i);
+  std::vector<uint32_t> exact_all;  // exact mode: elements that are not covered by another one
+  if (options.mode == AnnfMode::kExact) {
+    const std::vector<uint8_t> covered = covered_elements(plan);
+    for (uint32_t id : all)
+      if (!covered[id]) exact_all.push_back(id);
+  }
   std::vector<uint32_t> K;
   for (uint32_t j = 0; j < a.ny_; ++j)
     for (uint32_t i = 0; i < a.nx_; ++i) {
@@ -370,7 +537,7 @@ Annf Annf::build(const FloorPlan& plan, const AnnfOptions& options) {
         b.child_pair(all, box, global, &K, &pair);
         w = b.paper(box, 1, K, pair);
       } else {
-        filter_candidates(a.plan_, all, box, 1, &K, &b.smax, &b.smin);
+        filter_candidates(a.plan_, exact_all, box, 1, &K, &b.smax, &b.smin);
         w = b.exact(box, 1, K);
       }
       a.roots_[size_t(j) * a.nx_ + i] = w;
@@ -391,81 +558,31 @@ int Annf::nearest_outside(const Eigen::Vector2d& p, double* dist, Eigen::Vector2
 
 void Annf::nearest_batch(const Eigen::Vector2d* pts, size_t n, int* ids, double* dists,
                          Eigen::Vector2d* closest) const {
-  // Three-stage software pipeline: prefetch the index cell of point i+2D, resolve the leaf of point
-  // i+D (descending, then prefetching its record), compute point i.
-  constexpr size_t D = 8;
-  uint32_t words[D];
-  auto index_ptr = [&](const Eigen::Vector2d& p) -> const uint32_t* {
-    const double fx = (p.x() - origin_.x()) * inv_leaf_, fy = (p.y() - origin_.y()) * inv_leaf_;
-    if (!(fx >= 0 && fy >= 0 && fx < extent_x_ && fy < extent_y_)) return nullptr;
-    return &index_[size_t(uint32_t(fy) >> index_shift_) * index_nx_ + (uint32_t(fx) >> index_shift_)];
-  };
-  auto resolve = [&](const Eigen::Vector2d& p) -> uint32_t {
-    const double fx = (p.x() - origin_.x()) * inv_leaf_, fy = (p.y() - origin_.y()) * inv_leaf_;
-    if (!(fx >= 0 && fy >= 0 && fx < extent_x_ && fy < extent_y_)) return 0;  // 0: outside
-    const uint32_t ix = uint32_t(fx), iy = uint32_t(fy);
-    int sh = index_shift_;
-    uint32_t node = index_[size_t(iy >> sh) * index_nx_ + (ix >> sh)];
-    while (!(node & kLeafBit)) {
-      --sh;
-      node = fnodes_[node + (((iy >> sh) & 1u) << 1 | ((ix >> sh) & 1u))];
-    }
-    const uint32_t* rec = fast_.data() + (node & ~kLeafBit);
-    __builtin_prefetch(rec);
-    __builtin_prefetch(rec + 16);
-    return node;
-  };
-  for (size_t i = 0; i < std::min(n, 2 * D); ++i)
-    if (const uint32_t* q = index_ptr(pts[i])) __builtin_prefetch(q);
-  for (size_t i = 0; i < std::min(n, D); ++i) words[i % D] = resolve(pts[i]);
-  for (size_t i = 0; i < n; ++i) {
-    if (i + 2 * D < n)
-      if (const uint32_t* q = index_ptr(pts[i + 2 * D])) __builtin_prefetch(q);
-    const uint32_t w = words[i % D];
-    if (i + D < n) words[i % D] = resolve(pts[i + D]);
-    const Eigen::Vector2d& p = pts[i];
-    if (w == 0) {
-      double d;
-      Eigen::Vector2d c;
-      ids[i] = nearest_outside(p, &d, &c);
-      dists[i] = d;
-      if (closest) closest[i] = c;
-      continue;
-    }
-    const uint32_t* rec = fast_.data() + (w & ~kLeafBit);
-    const int cnt = int(rec[0]);
-    const uint32_t* cid = rec + 1;
-    const uint32_t* g = rec + ((cnt + 2) & ~1);
-    int best = -1;
-    double bd2 = 1e300, bx = 0, by = 0;
-    for (int k = 0; k < cnt; ++k, g += 10) {
-      FastPrim sp;
-      std::memcpy(&sp, g, sizeof sp);
-      double qx, qy;
-      if (__builtin_expect(sp.inv_l2 >= 0, 1)) {
-        const double t = std::min(1.0, std::max(0.0, ((p.x() - sp.ax) * sp.dx + (p.y() - sp.ay) * sp.dy) * sp.inv_l2));
-        qx = sp.ax + t * sp.dx;
-        qy = sp.ay + t * sp.dy;
-      } else if (sp.inv_l2 == -2) {
-        const double vx = p.x() - sp.ax, vy = p.y() - sp.ay, len = std::sqrt(vx * vx + vy * vy);
-        const double k = len > 0 ? sp.dx / len : 0.0;
-        qx = len > 0 ? sp.ax + vx * k : sp.ax + sp.dx;
-        qy = len > 0 ? sp.ay + vy * k : sp.ay;
-      } else {
-        const ClosestPoint cp = closest_point(plan_.elements[cid[k]], p);
-        qx = cp.point.x();
-        qy = cp.point.y();
+  // Loop fission in chunks: first the leaf words of a chunk of points (the descent: index and
+  // block reads), then their distances (leaf records and geometry). Each loop body is a short
+  // dependency chain, so the out-of-order core keeps many points in flight (a look-up is
+  // latency-bound, not compute-bound).
+  constexpr size_t C = 256;
+  uint32_t words[C];
+  for (size_t base = 0; base < n; base += C) {
+    const size_t m = std::min(C, n - base);
+    const Eigen::Vector2d* p = pts + base;
+    for (size_t k = 0; k < m; ++k) words[k] = leaf_word(p[k]);
+    if (!closest) {
+      for (size_t k = 0; k < m; ++k) {
+        double d;
+        ids[base + k] = words[k] ? best_of_leaf(words[k], p[k], &d, nullptr) : nearest_outside(p[k], &d, nullptr);
+        dists[base + k] = d;
       }
-      const double d2 = (qx - p.x()) * (qx - p.x()) + (qy - p.y()) * (qy - p.y());
-      const bool better = d2 < bd2;
-      bd2 = better ? d2 : bd2;
-      best = better ? int(cid[k]) : best;
-      bx = better ? qx : bx;
-      by = better ? qy : by;
+    } else {
+      for (size_t k = 0; k < m; ++k) {
+        double d;
+        Eigen::Vector2d c;
+        ids[base + k] = words[k] ? best_of_leaf(words[k], p[k], &d, &c) : nearest_outside(p[k], &d, &c);
+        dists[base + k] = d;
+        closest[base + k] = c;
+      }
     }
-    ids[i] = best;
-    dists[i] = std::sqrt(bd2);
-    if (closest) closest[i] = Eigen::Vector2d(bx, by);
   }
 }
 
@@ -499,7 +616,7 @@ AnnfStats Annf::stats() const {
   AnnfStats s;
   s.nodes = roots_.size() + nodes_.size();
   s.pool_ids = pool_.size();
-  s.bytes = (index_.size() + fnodes_.size() + fast_.size()) * sizeof(uint32_t);
+  s.bytes = (index_.size() + blocks_.size() + lpool_.size()) * sizeof(uint32_t) + geom_.size() * sizeof(FastPrim);
   s.file_bytes = (roots_.size() + nodes_.size() + pool_.size()) * sizeof(uint32_t);
   size_t total = 0;
   for_each_leaf([&](const Box2&, int depth, const uint32_t*, int n) {
@@ -518,7 +635,8 @@ void Annf::write(std::ostream& out) const {
                             (uint8_t(options_.paper_candidates) << 5)));
   put<double>(out, options_.root_length);
   put<int32_t>(out, options_.max_depth);
-  put<int32_t>(out, options_.exact_max_candidates);
+  // Low 16 bits: exact_max_candidates; high 16: exact_refine_levels (0 in maps written before it).
+  put<int32_t>(out, int32_t(uint32_t(options_.exact_max_candidates) | uint32_t(options_.exact_refine_levels) << 16));
   put<double>(out, options_.margin);
   put<double>(out, origin_.x());
   put<double>(out, origin_.y());
@@ -546,7 +664,9 @@ Annf Annf::read(std::istream& in, FloorPlan plan, const std::string& source) {
   a.options_.paper_rule = PaperRule(rule);
   a.options_.root_length = get<double>(in, source);
   a.options_.max_depth = get<int32_t>(in, source);
-  a.options_.exact_max_candidates = get<int32_t>(in, source);
+  const uint32_t mc = uint32_t(get<int32_t>(in, source));
+  a.options_.exact_max_candidates = int(mc & 0xffff);
+  a.options_.exact_refine_levels = int(mc >> 16);
   a.options_.margin = get<double>(in, source);
   a.origin_.x() = get<double>(in, source);
   a.origin_.y() = get<double>(in, source);

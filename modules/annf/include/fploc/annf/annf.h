@@ -28,6 +28,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <emmintrin.h>
 #include <iosfwd>
 #include <new>
 #include <string>
@@ -62,6 +63,12 @@ struct AnnfOptions {
   int max_depth = 7;         // 1 = root fields only
   PaperRule paper_rule = PaperRule::kChildLeafOrdered;  // closest to Table III (docs/notes/annf.md)
   int exact_max_candidates = 4;  // exact mode: subdivide while a leaf holds more candidates
+  // Exact mode: a field's candidate set is the union of the simple bound's sets over its quadrants,
+  // recursively, down to this many levels below the field (stopping early where one element is
+  // left). Still provable (each sub-box's set contains the nearest element of each of its points),
+  // much tighter than the simple bound near walls and corners, so fields stop dividing earlier.
+  // 0 = the simple bound only. Saved with the map (it changes the tree, not the look-up).
+  int exact_refine_levels = 0;
   // Metres added around the plan's bounding box: scan points just outside the outer walls stay
   // inside the field (outside it nearest() falls back to brute force).
   double margin = 2.0;
@@ -107,64 +114,22 @@ class Annf {
   // Candidate ids of the leaf containing p (2 or 1 in paper mode, the provable set in exact mode);
   // nullptr and *count = 0 when p is outside the covered area. Never allocates.
   const uint32_t* lookup(const Eigen::Vector2d& p, int* count) const {
-    const double fx = (p.x() - origin_.x()) * inv_leaf_, fy = (p.y() - origin_.y()) * inv_leaf_;
-    if (!(fx >= 0 && fy >= 0 && fx < extent_x_ && fy < extent_y_)) {
+    const uint32_t w = leaf_word(p);
+    if (!w) {
       *count = 0;
       return nullptr;
     }
-    const uint32_t ix = uint32_t(fx), iy = uint32_t(fy);
-    // Root field by rounding (through a dense index of the tree's top levels), then descend.
-    int s = index_shift_;
-    uint32_t node = index_[size_t(iy >> s) * index_nx_ + (ix >> s)];
-    while (!(node & kLeafBit)) {
-      --s;
-      node = fnodes_[node + (((iy >> s) & 1u) << 1 | ((ix >> s) & 1u))];
-    }
-    const uint32_t* leaf = fast_.data() + (node & ~kLeafBit);
-    *count = int(leaf[0]);
-    return leaf + 1;
+    const uint32_t* rec = lpool_.data() + (w & ~kLeafBit);
+    *count = int(rec[0] & kCountMask);
+    return rec + 1;
   }
 
   // Best element among the leaf's candidates (exact in exact mode; the better of the two in paper
   // mode). Outside the covered area: brute force. Returns -1 only for an empty field.
   int nearest(const Eigen::Vector2d& p, double* dist = nullptr, Eigen::Vector2d* closest = nullptr) const {
-    int n;
-    const uint32_t* ids = lookup(p, &n);
-    if (!ids) return nearest_outside(p, dist, closest);
-    // The leaf record holds a copy of its candidates' geometry right after the ids (one cache
-    // line or two): no further dependent memory access.
-    const uint32_t* g = ids - 1 + ((n + 2) & ~1);
-    int best = -1;
-    double bd2 = 1e300, bx = 0, by = 0;
-    for (int k = 0; k < n; ++k, g += 10) {
-      FastPrim s;
-      std::memcpy(&s, g, sizeof s);
-      double qx, qy;
-      if (__builtin_expect(s.inv_l2 >= 0, 1)) {
-        const double t = std::min(1.0, std::max(0.0, ((p.x() - s.ax) * s.dx + (p.y() - s.ay) * s.dy) * s.inv_l2));
-        qx = s.ax + t * s.dx;
-        qy = s.ay + t * s.dy;
-      } else if (s.inv_l2 == -2) {  // circle: centre (ax, ay), radius dx
-        const double vx = p.x() - s.ax, vy = p.y() - s.ay, len = std::sqrt(vx * vx + vy * vy);
-        const double k = len > 0 ? s.dx / len : 0.0;
-        qx = len > 0 ? s.ax + vx * k : s.ax + s.dx;
-        qy = len > 0 ? s.ay + vy * k : s.ay;
-      } else {
-        const ClosestPoint cp = closest_point(plan_.elements[ids[k]], p);
-        qx = cp.point.x();
-        qy = cp.point.y();
-      }
-      const double d2 = (qx - p.x()) * (qx - p.x()) + (qy - p.y()) * (qy - p.y());
-      // Branch-free selection (mispredictions would flush the next queries' memory loads).
-      const bool better = d2 < bd2;
-      bd2 = better ? d2 : bd2;
-      best = better ? int(ids[k]) : best;
-      bx = better ? qx : bx;
-      by = better ? qy : by;
-    }
-    if (dist) *dist = std::sqrt(bd2);
-    if (closest) *closest = Eigen::Vector2d(bx, by);
-    return best;
+    const uint32_t w = leaf_word(p);
+    if (!w) return nearest_outside(p, dist, closest);
+    return best_of_leaf(w, p, dist, closest);
   }
 
   // Batch form of nearest() for a whole scan: the same results as calling nearest() for each point,
@@ -199,14 +164,93 @@ class Annf {
 
  private:
   static constexpr uint32_t kLeafBit = 0x80000000u;
-  // Geometry copy in a leaf record (segments: a, b-a, 1/|b-a|^2; circles: inv_l2 = -2, centre in
-  // ax, ay, radius in dx; arcs: inv_l2 = -1, evaluated from the plan).
-  struct FastPrim {
-    double ax, ay, dx, dy, inv_l2;
+  static constexpr uint32_t kArcFlag = 0x40000000u, kCountMask = 0x3fffffffu;
+  // Per-element geometry for the distance, one array indexed by element id (48 B per element: 83 kB
+  // for SIST-F4 walls + columns), so it stays in cache while the index is what a look-up fetches
+  // from memory. Segments: a, b - a, 1/|b-a|^2 (0 for a point), r = 0. Circles: a = centre, d = 0,
+  // r = radius. Then for both: t = clamp((p-a).d * inv_l2, 0, 1), distance = | |p - a - t d| - r |.
+  // Arcs are evaluated from the plan (their leaves are flagged, see lpool_).
+  struct alignas(16) FastPrim {
+    double ax, ay, dx, dy, inv_l2, r;
   };
-  static_assert(sizeof(FastPrim) == 40);
+  static_assert(sizeof(FastPrim) == 48);
+
+  // Look-up structure derived from the tree in prepare() (not saved): the tree's top levels as a
+  // dense index at depth g (4 x 4 cells per 64-byte line), and below it the tree re-grouped into
+  // 16-ary blocks (one 64-byte line = the 4 x 4 descendants two levels down; a 4-entry block when
+  // one level is left). Index and block entries are a leaf word (kLeafBit | offset of the leaf's
+  // record in lpool_) or the offset of a block in blocks_. The descent always takes block_steps_
+  // steps, without branches: a leaf reached early reads the dummy block at offset 0 and keeps its
+  // word. Returns 0 outside the covered area.
+  uint32_t leaf_word(const Eigen::Vector2d& p) const {
+    const double fx = (p.x() - origin_.x()) * inv_leaf_, fy = (p.y() - origin_.y()) * inv_leaf_;
+    if (!(fx >= 0 && fy >= 0 && fx < extent_x_ && fy < extent_y_)) return 0;
+    const uint32_t ix = uint32_t(fx), iy = uint32_t(fy);
+    int s = index_shift_;
+    uint32_t w = index_[index_slot(ix >> s, iy >> s)];
+    for (int k = 0; k < block_steps_; ++k) {
+      const uint32_t inner = (w >> 31) - 1u;  // all ones for a block offset, 0 for a leaf
+      uint32_t slot;
+      if (s >= 2) {
+        s -= 2;
+        slot = (((iy >> s) & 3u) << 2) | ((ix >> s) & 3u);
+      } else {
+        s = 0;
+        slot = ((iy & 1u) << 1) | (ix & 1u);
+      }
+      const uint32_t next = blocks_[(w & inner) + slot];
+      w = (next & inner) | (w & ~inner);
+    }
+    return w;
+  }
+  size_t index_slot(uint32_t cx, uint32_t cy) const {
+    return ((size_t(cy >> 2) * index_tiles_x_ + (cx >> 2)) << 4) | ((cy & 3u) << 2) | (cx & 3u);
+  }
+  // Leaf record in lpool_: [count | kArcFlag if a candidate is an arc, ids..., padding], the ids
+  // padded to fast_k_ entries with copies of the first, so the fast path always evaluates fast_k_
+  // candidates (2 in paper mode, up to 4 in exact mode), two at a time in SSE2 lanes, with no
+  // data-dependent branch. Longer records and arcs take the general loop.
+  int best_of_leaf(uint32_t w, const Eigen::Vector2d& p, double* dist, Eigen::Vector2d* closest) const {
+    const uint32_t* rec = lpool_.data() + (w & ~kLeafBit);
+    if (__builtin_expect(rec[0] > uint32_t(fast_k_), 0)) return best_of_leaf_general(rec, p, dist, closest);
+    const __m128d px = _mm_set1_pd(p.x()), py = _mm_set1_pd(p.y());
+    const __m128d zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0), sign = _mm_set1_pd(-0.0);
+    double bd = 1e300;
+    uint32_t best = 0;
+    for (int k = 0; k < fast_k_; k += 2) {
+      const uint32_t i0 = rec[1 + k], i1 = rec[2 + k];
+      const double* g0 = &geom_[i0].ax;
+      const double* g1 = &geom_[i1].ax;
+      const __m128d a0 = _mm_load_pd(g0), a1 = _mm_load_pd(g1);
+      const __m128d d0 = _mm_load_pd(g0 + 2), d1 = _mm_load_pd(g1 + 2);
+      const __m128d r0 = _mm_load_pd(g0 + 4), r1 = _mm_load_pd(g1 + 4);
+      const __m128d ax = _mm_unpacklo_pd(a0, a1), ay = _mm_unpackhi_pd(a0, a1);
+      const __m128d dx = _mm_unpacklo_pd(d0, d1), dy = _mm_unpackhi_pd(d0, d1);
+      const __m128d inv = _mm_unpacklo_pd(r0, r1), rad = _mm_unpackhi_pd(r0, r1);
+      const __m128d vx = _mm_sub_pd(px, ax), vy = _mm_sub_pd(py, ay);
+      __m128d t = _mm_mul_pd(_mm_add_pd(_mm_mul_pd(vx, dx), _mm_mul_pd(vy, dy)), inv);
+      t = _mm_min_pd(_mm_max_pd(t, zero), one);
+      const __m128d ex = _mm_sub_pd(vx, _mm_mul_pd(t, dx)), ey = _mm_sub_pd(vy, _mm_mul_pd(t, dy));
+      const __m128d e = _mm_sqrt_pd(_mm_add_pd(_mm_mul_pd(ex, ex), _mm_mul_pd(ey, ey)));
+      const __m128d d = _mm_andnot_pd(sign, _mm_sub_pd(e, rad));
+      const double dl = _mm_cvtsd_f64(d), dh = _mm_cvtsd_f64(_mm_unpackhi_pd(d, d));
+      // Branch-free selection; the first of equal candidates wins.
+      const bool bl = dl < bd;
+      bd = bl ? dl : bd;
+      best = bl ? i0 : best;
+      const bool bh = dh < bd;
+      bd = bh ? dh : bd;
+      best = bh ? i1 : best;
+    }
+    if (dist) *dist = bd;
+    if (closest) *closest = closest_on(best, p);
+    return int(best);
+  }
+  Eigen::Vector2d closest_on(uint32_t id, const Eigen::Vector2d& p) const;
+  int best_of_leaf_general(const uint32_t* rec, const Eigen::Vector2d& p, double* dist, Eigen::Vector2d* closest) const;
   int nearest_outside(const Eigen::Vector2d& p, double* dist, Eigen::Vector2d* closest) const;
   void prepare();
+  uint32_t flatten(uint32_t word, int levels_left, std::vector<uint32_t>* remap);
 
   FloorPlan plan_;
   AnnfOptions options_;
@@ -218,27 +262,25 @@ class Annf {
   std::vector<uint32_t> roots_;  // nx*ny, node word: leaf bit | pool offset, or index of 4 children
   std::vector<uint32_t> nodes_;  // groups of 4 child words
   std::vector<uint32_t> pool_;   // [count, ids...] per leaf
-  // Derived in prepare() (not saved): dense top-level index, nodes with leaf words pointing into
-  // fast_, and fast_ = per leaf [count, ids..., pad, FastPrim x count], each record aligned to 64 B
-  // (128 B when longer than 64 B) so the whole record arrives with one memory round trip.
   template <typename T>
-  struct Aligned128 {
+  struct Aligned64 {
     using value_type = T;
-    Aligned128() = default;
+    Aligned64() = default;
     template <typename U>
-    Aligned128(const Aligned128<U>&) {}
-    T* allocate(size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(128))); }
-    void deallocate(T* p, size_t) { ::operator delete(p, std::align_val_t(128)); }
+    Aligned64(const Aligned64<U>&) {}
+    T* allocate(size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(64))); }
+    void deallocate(T* p, size_t) { ::operator delete(p, std::align_val_t(64)); }
     template <typename U>
-    bool operator==(const Aligned128<U>&) const { return true; }
+    bool operator==(const Aligned64<U>&) const { return true; }
     template <typename U>
-    bool operator!=(const Aligned128<U>&) const { return false; }
+    bool operator!=(const Aligned64<U>&) const { return false; }
   };
-  std::vector<uint32_t> index_;
-  std::vector<uint32_t> fnodes_;
-  std::vector<uint32_t, Aligned128<uint32_t>> fast_;
-  uint32_t index_nx_ = 0;
-  int index_shift_ = 0;
+  std::vector<uint32_t, Aligned64<uint32_t>> index_, blocks_, lpool_;
+  std::vector<FastPrim, Aligned64<FastPrim>> geom_;
+  uint32_t index_tiles_x_ = 0;
+  int index_shift_ = 0;  // finest-leaf index >> index_shift_ = index cell
+  int block_steps_ = 0;  // block levels below the index (ceil((max_depth - g) / 2))
+  int fast_k_ = 2;       // candidates evaluated by the fast path (even)
 };
 
 template <typename F>
