@@ -412,15 +412,17 @@ void Annf::prepare() {
     const Element& e = plan_.elements[i];
     FastPrim& f = geom_[i];
     if (e.kind == ElementKind::kSegment) {
+      const Eigen::Vector2d d = e.b - e.a;
+      const double len = d.norm();
       f.ax = e.a.x();
       f.ay = e.a.y();
-      f.dx = e.b.x() - e.a.x();
-      f.dy = e.b.y() - e.a.y();
-      const double l2 = f.dx * f.dx + f.dy * f.dy;
-      f.inv_l2 = l2 > 0 ? 1.0 / l2 : 0.0;
+      f.ux = len > 0 ? d.x() / len : 1.0;
+      f.uy = len > 0 ? d.y() / len : 0.0;
+      f.len = len;
     } else {  // circle (arcs: the same fields, but their leaves take the general path)
       f.ax = e.c.x();
       f.ay = e.c.y();
+      f.ux = 1.0;
       f.r = e.r;
     }
   }
@@ -474,11 +476,7 @@ int Annf::best_of_leaf_general(const uint32_t* rec, const Eigen::Vector2d& p, do
     if (e.kind == ElementKind::kArc) {
       d = distance(e, p);
     } else {
-      const FastPrim& s = geom_[ids[k]];
-      const double vx = p.x() - s.ax, vy = p.y() - s.ay;
-      const double t = std::min(1.0, std::max(0.0, (vx * s.dx + vy * s.dy) * s.inv_l2));
-      const double ex = vx - t * s.dx, ey = vy - t * s.dy;
-      d = std::abs(std::sqrt(ex * ex + ey * ey) - s.r);
+      d = geom_[ids[k]].distance(p);
     }
     if (d < bd) {
       bd = d;
@@ -556,18 +554,44 @@ int Annf::nearest_outside(const Eigen::Vector2d& p, double* dist, Eigen::Vector2
   return id;
 }
 
-void Annf::nearest_batch(const Eigen::Vector2d* pts, size_t n, int* ids, double* dists,
-                         Eigen::Vector2d* closest) const {
+// The descent of leaf_word() with the index shift as a compile-time constant (no variable shifts;
+// the block steps unrolled). S0 < 0: the run-time shift.
+template <int S0>
+void Annf::batch_impl(const Eigen::Vector2d* pts, size_t n, int* ids, double* dists, Eigen::Vector2d* closest) const {
   // Loop fission in chunks: first the leaf words of a chunk of points (the descent: index and
   // block reads), then their distances (leaf records and geometry). Each loop body is a short
-  // dependency chain, so the out-of-order core keeps many points in flight (a look-up is
-  // latency-bound, not compute-bound).
+  // dependency chain, so the out-of-order core keeps many points in flight.
   constexpr size_t C = 256;
-  uint32_t words[C];
+  alignas(64) uint32_t words[C], cx[C], cy[C];
+  const double ox = origin_.x(), oy = origin_.y(), inv = inv_leaf_, ex = extent_x_, ey = extent_y_;
+  const uint32_t* index = index_.data();
+  const uint32_t* blocks = blocks_.data();
+  const int s0 = S0 >= 0 ? S0 : index_shift_;
+  const int steps = S0 >= 0 ? (S0 + 1) / 2 : block_steps_;
   for (size_t base = 0; base < n; base += C) {
     const size_t m = std::min(C, n - base);
     const Eigen::Vector2d* p = pts + base;
-    for (size_t k = 0; k < m; ++k) words[k] = leaf_word(p[k]);
+    // Index words (independent loads: many cache misses in flight), then the block steps.
+    for (size_t k = 0; k < m; ++k) {
+      const double fx = (p[k].x() - ox) * inv, fy = (p[k].y() - oy) * inv;
+      const bool in = fx >= 0 && fy >= 0 && fx < ex && fy < ey;
+      const uint32_t ix = in ? uint32_t(fx) : 0u, iy = in ? uint32_t(fy) : 0u;
+      cx[k] = ix;
+      cy[k] = iy;
+      const uint32_t w = index[index_slot(ix >> s0, iy >> s0)];
+      words[k] = in ? w : 0u;  // 0: outside (never a valid word: leaf words have kLeafBit)
+    }
+    int s = s0;
+    for (int st = 0; st < steps; ++st) {
+      const int sn = s >= 2 ? s - 2 : 0;
+      const uint32_t mask = s >= 2 ? 3u : 1u, up = s >= 2 ? 2u : 1u;
+      for (size_t k = 0; k < m; ++k) {
+        const uint32_t w = words[k], inner = ((w >> 31) - 1u) & (0u - uint32_t(w != 0));
+        const uint32_t slot = (((cy[k] >> sn) & mask) << up) | ((cx[k] >> sn) & mask);
+        words[k] = (blocks[(w & inner) + slot] & inner) | (w & ~inner);
+      }
+      s = sn;
+    }
     if (!closest) {
       for (size_t k = 0; k < m; ++k) {
         double d;
@@ -583,6 +607,20 @@ void Annf::nearest_batch(const Eigen::Vector2d* pts, size_t n, int* ids, double*
         closest[base + k] = c;
       }
     }
+  }
+}
+
+void Annf::nearest_batch(const Eigen::Vector2d* pts, size_t n, int* ids, double* dists,
+                         Eigen::Vector2d* closest) const {
+  switch (index_shift_) {
+    case 0: return batch_impl<0>(pts, n, ids, dists, closest);
+    case 1: return batch_impl<1>(pts, n, ids, dists, closest);
+    case 2: return batch_impl<2>(pts, n, ids, dists, closest);
+    case 3: return batch_impl<3>(pts, n, ids, dists, closest);
+    case 4: return batch_impl<4>(pts, n, ids, dists, closest);
+    case 5: return batch_impl<5>(pts, n, ids, dists, closest);
+    case 6: return batch_impl<6>(pts, n, ids, dists, closest);
+    default: return batch_impl<-1>(pts, n, ids, dists, closest);
   }
 }
 

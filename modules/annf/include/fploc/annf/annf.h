@@ -167,11 +167,18 @@ class Annf {
   static constexpr uint32_t kArcFlag = 0x40000000u, kCountMask = 0x3fffffffu;
   // Per-element geometry for the distance, one array indexed by element id (48 B per element: 83 kB
   // for SIST-F4 walls + columns), so it stays in cache while the index is what a look-up fetches
-  // from memory. Segments: a, b - a, 1/|b-a|^2 (0 for a point), r = 0. Circles: a = centre, d = 0,
-  // r = radius. Then for both: t = clamp((p-a).d * inv_l2, 0, 1), distance = | |p - a - t d| - r |.
-  // Arcs are evaluated from the plan (their leaves are flagged, see lpool_).
+  // from memory. Segments: start a, unit direction u, length len, r = 0. Circles: a = centre,
+  // u = (1, 0), len = 0, r = radius. For both, with v = p - a, s = v.u:
+  //   distance = | sqrt((v x u)^2 + (s - clamp(s, 0, len))^2) - r |
+  // (for a circle: | |v| - r |). Arcs are evaluated from the plan (their leaves are flagged).
   struct alignas(16) FastPrim {
-    double ax, ay, dx, dy, inv_l2, r;
+    double ax, ay, ux, uy, len, r;
+    double distance(const Eigen::Vector2d& p) const {
+      const double vx = p.x() - ax, vy = p.y() - ay;
+      const double s = vx * ux + vy * uy, perp = vx * uy - vy * ux;
+      const double over = s - std::min(len, std::max(0.0, s));
+      return std::abs(std::sqrt(perp * perp + over * over) - r);
+    }
   };
   static_assert(sizeof(FastPrim) == 48);
 
@@ -182,7 +189,7 @@ class Annf {
   // record in lpool_) or the offset of a block in blocks_. The descent always takes block_steps_
   // steps, without branches: a leaf reached early reads the dummy block at offset 0 and keeps its
   // word. Returns 0 outside the covered area.
-  uint32_t leaf_word(const Eigen::Vector2d& p) const {
+  [[gnu::always_inline]] uint32_t leaf_word(const Eigen::Vector2d& p) const {
     const double fx = (p.x() - origin_.x()) * inv_leaf_, fy = (p.y() - origin_.y()) * inv_leaf_;
     if (!(fx >= 0 && fy >= 0 && fx < extent_x_ && fy < extent_y_)) return 0;
     const uint32_t ix = uint32_t(fx), iy = uint32_t(fy);
@@ -208,47 +215,65 @@ class Annf {
   }
   // Leaf record in lpool_: [count | kArcFlag if a candidate is an arc, ids..., padding], the ids
   // padded to fast_k_ entries with copies of the first, so the fast path always evaluates fast_k_
-  // candidates (2 in paper mode, up to 4 in exact mode), two at a time in SSE2 lanes, with no
-  // data-dependent branch. Longer records and arcs take the general loop.
-  int best_of_leaf(uint32_t w, const Eigen::Vector2d& p, double* dist, Eigen::Vector2d* closest) const {
+  // candidates (2 in paper mode, 2 or 4 in exact mode), two at a time in SSE2 lanes, with no
+  // data-dependent branch. Longer records and arcs take the general loop. (Copying the geometry
+  // into the records saves a dependent access but makes the records 4x larger: measured slower
+  // near walls, where the look-up is cache-bound, docs/notes/annf.md.)
+  [[gnu::always_inline]] int best_of_leaf(uint32_t w, const Eigen::Vector2d& p, double* dist,
+                                          Eigen::Vector2d* closest) const {
     const uint32_t* rec = lpool_.data() + (w & ~kLeafBit);
     if (__builtin_expect(rec[0] > uint32_t(fast_k_), 0)) return best_of_leaf_general(rec, p, dist, closest);
-    const __m128d px = _mm_set1_pd(p.x()), py = _mm_set1_pd(p.y());
-    const __m128d zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0), sign = _mm_set1_pd(-0.0);
-    double bd = 1e300;
-    uint32_t best = 0;
-    for (int k = 0; k < fast_k_; k += 2) {
-      const uint32_t i0 = rec[1 + k], i1 = rec[2 + k];
+    double bd;
+    const uint32_t best = best_of_record(rec, p, &bd);
+    if (dist) *dist = bd;
+    if (closest) *closest = closest_on(best, p);
+    return int(best);
+  }
+  // The fast path on any record (for a longer record: its first fast_k_ candidates).
+  [[gnu::always_inline]] uint32_t best_of_record(const uint32_t* rec, const Eigen::Vector2d& p, double* dist) const {
+    const __m128d pp = _mm_loadu_pd(p.data());
+    const __m128d px = _mm_unpacklo_pd(pp, pp), py = _mm_unpackhi_pd(pp, pp);
+    const __m128d zero = _mm_setzero_pd(), sign = _mm_set1_pd(-0.0);
+    auto pair = [&](uint32_t i0, uint32_t i1) {  // FastPrim::distance for two candidates
       const double* g0 = &geom_[i0].ax;
       const double* g1 = &geom_[i1].ax;
       const __m128d a0 = _mm_load_pd(g0), a1 = _mm_load_pd(g1);
       const __m128d d0 = _mm_load_pd(g0 + 2), d1 = _mm_load_pd(g1 + 2);
       const __m128d r0 = _mm_load_pd(g0 + 4), r1 = _mm_load_pd(g1 + 4);
       const __m128d ax = _mm_unpacklo_pd(a0, a1), ay = _mm_unpackhi_pd(a0, a1);
-      const __m128d dx = _mm_unpacklo_pd(d0, d1), dy = _mm_unpackhi_pd(d0, d1);
-      const __m128d inv = _mm_unpacklo_pd(r0, r1), rad = _mm_unpackhi_pd(r0, r1);
+      const __m128d ux = _mm_unpacklo_pd(d0, d1), uy = _mm_unpackhi_pd(d0, d1);
+      const __m128d len = _mm_unpacklo_pd(r0, r1), rad = _mm_unpackhi_pd(r0, r1);
       const __m128d vx = _mm_sub_pd(px, ax), vy = _mm_sub_pd(py, ay);
-      __m128d t = _mm_mul_pd(_mm_add_pd(_mm_mul_pd(vx, dx), _mm_mul_pd(vy, dy)), inv);
-      t = _mm_min_pd(_mm_max_pd(t, zero), one);
-      const __m128d ex = _mm_sub_pd(vx, _mm_mul_pd(t, dx)), ey = _mm_sub_pd(vy, _mm_mul_pd(t, dy));
-      const __m128d e = _mm_sqrt_pd(_mm_add_pd(_mm_mul_pd(ex, ex), _mm_mul_pd(ey, ey)));
-      const __m128d d = _mm_andnot_pd(sign, _mm_sub_pd(e, rad));
-      const double dl = _mm_cvtsd_f64(d), dh = _mm_cvtsd_f64(_mm_unpackhi_pd(d, d));
-      // Branch-free selection; the first of equal candidates wins.
-      const bool bl = dl < bd;
-      bd = bl ? dl : bd;
-      best = bl ? i0 : best;
-      const bool bh = dh < bd;
-      bd = bh ? dh : bd;
-      best = bh ? i1 : best;
+      const __m128d along = _mm_add_pd(_mm_mul_pd(vx, ux), _mm_mul_pd(vy, uy));
+      const __m128d perp = _mm_sub_pd(_mm_mul_pd(vx, uy), _mm_mul_pd(vy, ux));
+      const __m128d over = _mm_sub_pd(along, _mm_min_pd(len, _mm_max_pd(along, zero)));
+      const __m128d e = _mm_sqrt_pd(_mm_add_pd(_mm_mul_pd(perp, perp), _mm_mul_pd(over, over)));
+      return _mm_andnot_pd(sign, _mm_sub_pd(e, rad));
+    };
+    // Branch-free selection; the first of equal candidates wins.
+    const uint32_t i0 = rec[1], i1 = rec[2];
+    const __m128d d01 = pair(i0, i1);
+    double bd = _mm_cvtsd_f64(d01);
+    const double d1 = _mm_cvtsd_f64(_mm_unpackhi_pd(d01, d01));
+    uint32_t best = d1 < bd ? i1 : i0;
+    bd = d1 < bd ? d1 : bd;
+    if (fast_k_ == 4) {
+      const uint32_t i2 = rec[3], i3 = rec[4];
+      const __m128d d23 = pair(i2, i3);
+      const double d2 = _mm_cvtsd_f64(d23), d3 = _mm_cvtsd_f64(_mm_unpackhi_pd(d23, d23));
+      best = d2 < bd ? i2 : best;
+      bd = d2 < bd ? d2 : bd;
+      best = d3 < bd ? i3 : best;
+      bd = d3 < bd ? d3 : bd;
     }
-    if (dist) *dist = bd;
-    if (closest) *closest = closest_on(best, p);
-    return int(best);
+    *dist = bd;
+    return best;
   }
   Eigen::Vector2d closest_on(uint32_t id, const Eigen::Vector2d& p) const;
   int best_of_leaf_general(const uint32_t* rec, const Eigen::Vector2d& p, double* dist, Eigen::Vector2d* closest) const;
   int nearest_outside(const Eigen::Vector2d& p, double* dist, Eigen::Vector2d* closest) const;
+  template <int S0>
+  void batch_impl(const Eigen::Vector2d* pts, size_t n, int* ids, double* dists, Eigen::Vector2d* closest) const;
   void prepare();
   uint32_t flatten(uint32_t word, int levels_left, std::vector<uint32_t>* remap);
 
