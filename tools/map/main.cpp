@@ -40,7 +40,7 @@ struct PlanArgs {
 
 struct AnnfArgs {
   std::string mode = "paper", rule = "child-leaf-ordered";
-  int depth = 7, max_candidates = 4;
+  int depth = 7, max_candidates = 2, refine = 2;
   double root = 6.0, margin = 2.0;
   void add(CLI::App* app, bool with_depth = true) {
     app->add_option("--mode", mode, "paper | exact")->check(CLI::IsMember({"paper", "exact"}));
@@ -48,7 +48,8 @@ struct AnnfArgs {
     app->add_option("--root", root, "root field length in metres (default 6)");
     app->add_option("--margin", margin, "metres of field around the plan's bounding box (default 2)");
     app->add_option("--rule", rule, "paper stopping rule: child-leaf | undo-only | child-leaf-ordered | full | collapse-first | collapse-pair");
-    app->add_option("--max-candidates", max_candidates, "exact mode: subdivide while a leaf has more candidates");
+    app->add_option("--max-candidates", max_candidates, "exact mode: subdivide while a leaf has more candidates (default 2)");
+    app->add_option("--refine", refine, "exact mode: candidate refinement levels (default 2, 0 = simple bound)");
   }
   AnnfOptions options() const {
     AnnfOptions o;
@@ -57,6 +58,7 @@ struct AnnfArgs {
     o.max_depth = depth;
     o.root_length = root;
     o.exact_max_candidates = max_candidates;
+    o.exact_refine_levels = refine;
     o.margin = margin;
     return o;
   }
@@ -136,7 +138,8 @@ int main(int argc, char** argv) {
   validate->add_flag("--all-rules", v.all_rules, "measure every reading of the paper's stopping rules");
   validate->add_option("--root", v.root, "root field length in metres (default 6)");
   validate->add_option("--margin", v.margin, "metres of field around the plan's bounding box (default 2)");
-  validate->add_option("--max-candidates", v.max_candidates, "exact mode: subdivide while a leaf has more candidates");
+  validate->add_option("--max-candidates", v.max_candidates, "exact mode: subdivide while a leaf has more candidates (default 2)");
+  validate->add_option("--refine", v.refine, "exact mode: candidate refinement levels (default 2)");
   validate->add_option("--exact-depth", v.exact_depth, "exact mode rows: extra depth added (default 0)");
   validate->add_option("--baseline-depth", v.baseline_depth, "KD-tree spacing / grid resolution = leaf length at this depth (default 7)");
   validate->add_option("--seed", v.seed, "random seed");

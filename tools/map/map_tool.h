@@ -18,7 +18,8 @@ struct ValidateArgs {
   std::string sample_area = "bbox";
   double root = 6.0;
   double margin = 2.0;
-  int max_candidates = 4;
+  int max_candidates = 2;
+  int refine = 2;
   int exact_depth = 0;
   int baseline_depth = 7;
   uint32_t seed = 1;

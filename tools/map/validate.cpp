@@ -112,6 +112,7 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
       o.margin = a.margin;
       o.max_depth = depth + (mode == AnnfMode::kExact ? a.exact_depth : 0);
       o.exact_max_candidates = a.max_candidates;
+      o.exact_refine_levels = a.refine;
       o.paper_distinct_distances = distinct;
       o.paper_candidates = a.candidates == "passing"           ? AnnfOptions::Candidates::kPassingElseAll
                            : a.candidates == "passing-inherit" ? AnnfOptions::Candidates::kPassingInherit
@@ -133,9 +134,11 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
         } else if (c && n >= 2 && hit(c[1])) {
           ++h12;
         }
+        // Exact hit: the returned element is at the true nearest distance and the returned
+        // distance is that distance.
         double d;
-        f.nearest(pts[i], &d);
-        hx += d <= t;
+        const int id = f.nearest(pts[i], &d);
+        hx += id >= 0 && distance(plan.elements[id], pts[i]) <= t && std::abs(d - truth[i]) <= kTol;
       }
       const double ns = time_per_query(pts, timed, [&](const Eigen::Vector2d& p) {
         double d;

@@ -36,7 +36,7 @@ Fixture& fixture() {
     o.quiet = true;
     f.plan = load_floor_plan(path, o);
     // FPLOC_INDEX_CELLS: size of the dense top-level index (speed/memory trade-off).
-    const uint32_t cells = std::getenv("FPLOC_INDEX_CELLS") ? uint32_t(std::atol(std::getenv("FPLOC_INDEX_CELLS"))) : (1u << 18);
+    const uint32_t cells = std::getenv("FPLOC_INDEX_CELLS") ? uint32_t(std::atol(std::getenv("FPLOC_INDEX_CELLS"))) : 0;
     AnnfOptions po;
     po.index_cells = cells;
     po.max_depth = 7;
@@ -45,7 +45,7 @@ Fixture& fixture() {
     xo.mode = AnnfMode::kExact;
     // FPLOC_EXACT_DEPTH / FPLOC_EXACT_MC / FPLOC_EXACT_REFINE: exact-mode depth, leaf candidate
     // threshold and candidate refinement levels.
-    xo.max_depth = std::getenv("FPLOC_EXACT_DEPTH") ? std::atoi(std::getenv("FPLOC_EXACT_DEPTH")) : 9;
+    xo.max_depth = std::getenv("FPLOC_EXACT_DEPTH") ? std::atoi(std::getenv("FPLOC_EXACT_DEPTH")) : 8;
     xo.exact_max_candidates = std::getenv("FPLOC_EXACT_MC") ? std::atoi(std::getenv("FPLOC_EXACT_MC")) : 2;
     xo.exact_refine_levels = std::getenv("FPLOC_EXACT_REFINE") ? std::atoi(std::getenv("FPLOC_EXACT_REFINE")) : 2;
     xo.index_cells = cells;

@@ -23,20 +23,31 @@ void filter_candidates(const FloorPlan& plan, const std::vector<uint32_t>& in, c
   out->clear();
   const size_t n = in.size();
   scratch_max->resize(n);
-  scratch_min->resize(n);
-  for (size_t i = 0; i < n; ++i) (*scratch_max)[i] = max_distance(plan.elements[in[i]], box);
+  double m1 = std::numeric_limits<double>::infinity(), m2 = m1;  // the two smallest maxima
+  for (size_t i = 0; i < n; ++i) {
+    const double m = max_distance(plan.elements[in[i]], box);
+    (*scratch_max)[i] = m;
+    if (m < m1) {
+      m2 = m1;
+      m1 = m;
+    } else if (m < m2) {
+      m2 = m;
+    }
+  }
   double bound;
   if (n <= size_t(k)) {
     bound = std::numeric_limits<double>::infinity();
+  } else if (k <= 2) {
+    bound = k == 1 ? m1 : m2;
   } else {
-    std::vector<double> tmp(scratch_max->begin(), scratch_max->end());
-    std::nth_element(tmp.begin(), tmp.begin() + (k - 1), tmp.end());
-    bound = tmp[k - 1];
+    *scratch_min = *scratch_max;
+    std::nth_element(scratch_min->begin(), scratch_min->begin() + (k - 1), scratch_min->end());
+    bound = (*scratch_min)[size_t(k - 1)];
   }
   const double eps = 1e-9 * (1.0 + box.size().norm()) + 1e-9;
   for (size_t i = 0; i < n; ++i) {
-    const double lo = min_distance(plan.elements[in[i]], box);
-    if (lo <= bound + eps) out->push_back(in[i]);
+    // The element's own maximum bounds its minimum: no need to compute the minimum then.
+    if ((*scratch_max)[i] <= bound + eps || min_distance(plan.elements[in[i]], box) <= bound + eps) out->push_back(in[i]);
   }
 }
 
@@ -92,6 +103,7 @@ struct Builder {
   std::vector<double> smax, smin;
   std::vector<uint32_t> passing;
   std::vector<uint8_t> mark;  // exact refinement: element already in the union
+  std::vector<std::vector<uint32_t>> refine_buf;  // per remaining level
   static constexpr uint32_t kLeafBit = 0x80000000u;
 
   uint32_t leaf(const std::vector<uint32_t>& ids) {
@@ -199,7 +211,8 @@ struct Builder {
   // Exact mode: union of the simple-bound sets of the sub-boxes of `box` down to `levels` below it.
   void refine(const Box2& box, const std::vector<uint32_t>& K, int levels, std::vector<uint8_t>* mark,
               std::vector<uint32_t>* out) {
-    std::vector<uint32_t> Kc;
+    if (refine_buf.size() <= size_t(levels)) refine_buf.resize(size_t(levels) + 1);
+    std::vector<uint32_t>& Kc = refine_buf[size_t(levels)];
     filter_candidates(plan, K, box, 1, &Kc, &smax, &smin);
     if (Kc.size() <= 1 || levels == 0) {
       for (uint32_t id : Kc)
@@ -374,7 +387,8 @@ uint32_t Annf::flatten(uint32_t word, int levels_left, std::vector<uint32_t>* re
       for (uint32_t k = 0; k < n; ++k) arc = arc || plan_.elements[pool_[off + 1 + k]].kind == ElementKind::kArc;
       lpool_.push_back(n | (arc ? kArcFlag : 0));
       for (uint32_t k = 0; k < n; ++k) lpool_.push_back(pool_[off + 1 + k]);
-      for (uint32_t k = n; k < uint32_t(fast_k_); ++k) lpool_.push_back(pool_[off + 1]);
+      const uint32_t padded = n > 4 ? n : std::max(uint32_t(fast_k_), (n + 1) & ~1u);
+      for (uint32_t k = n; k < padded; ++k) lpool_.push_back(pool_[off + 1]);
       if (lpool_.size() >= kLeafBit) fail("ANNF too large (leaf records)");
     }
     return kLeafBit | at;
@@ -437,7 +451,9 @@ void Annf::prepare() {
   fast_k_ = area_le2 >= 0.95 * area_total ? 2 : 4;
   // Dense index at the deepest level whose cell count fits the budget.
   int g = 1;
-  while (g < max_depth_ && double(nx_) * ny_ * double(1ull << (2 * g)) <= double(options_.index_cells)) ++g;
+  const double budget = options_.index_cells ? double(options_.index_cells)
+                                             : double(options_.mode == AnnfMode::kExact ? 1u << 20 : 1u << 18);
+  while (g < max_depth_ && double(nx_) * ny_ * double(1ull << (2 * g)) <= budget) ++g;
   index_shift_ = max_depth_ - g;
   block_steps_ = (index_shift_ + 1) / 2;
   const uint32_t per = 1u << (g - 1);
@@ -513,7 +529,7 @@ Annf Annf::build(const FloorPlan& plan, const AnnfOptions& options) {
   a.nx_ = uint32_t(nxd);
   a.ny_ = uint32_t(nyd);
   a.roots_.assign(size_t(a.nx_) * a.ny_, 0);
-  Builder b{a.plan_, a.options_, a.nodes_, a.pool_, {}, {}, {}, {}, std::vector<uint8_t>(plan.elements.size(), 0)};
+  Builder b{a.plan_, a.options_, a.nodes_, a.pool_, {}, {}, {}, {}, std::vector<uint8_t>(plan.elements.size(), 0), {}};
   std::vector<uint32_t> all(plan.elements.size());
   for (size_t i = 0; i < all.size(); ++i) all[i] = uint32_t(i);
   std::vector<uint32_t> exact_all;  // exact mode: elements that are not covered by another one

@@ -62,13 +62,15 @@ struct AnnfOptions {
   double root_length = 6.0;  // metres
   int max_depth = 7;         // 1 = root fields only
   PaperRule paper_rule = PaperRule::kChildLeafOrdered;  // closest to Table III (docs/notes/annf.md)
-  int exact_max_candidates = 4;  // exact mode: subdivide while a leaf holds more candidates
+  // Exact mode: subdivide while a leaf holds more candidates. 2: most look-ups evaluate one SSE2
+  // pair of candidates (docs/notes/annf.md has the measured trade-off against 4).
+  int exact_max_candidates = 2;
   // Exact mode: a field's candidate set is the union of the simple bound's sets over its quadrants,
   // recursively, down to this many levels below the field (stopping early where one element is
   // left). Still provable (each sub-box's set contains the nearest element of each of its points),
   // much tighter than the simple bound near walls and corners, so fields stop dividing earlier.
   // 0 = the simple bound only. Saved with the map (it changes the tree, not the look-up).
-  int exact_refine_levels = 0;
+  int exact_refine_levels = 2;
   // Metres added around the plan's bounding box: scan points just outside the outer walls stay
   // inside the field (outside it nearest() falls back to brute force).
   double margin = 2.0;
@@ -84,8 +86,9 @@ struct AnnfOptions {
   enum class Candidates : uint8_t { kAll = 0, kPassingElseAll = 1, kPassingInherit = 2 };
   Candidates paper_candidates = Candidates::kAll;
   // Speed only (not saved, no effect on results): the top levels of the trees are flattened into a
-  // dense index of at most this many cells so a look-up starts near the leaf.
-  uint32_t index_cells = 1u << 18;
+  // dense index of at most this many cells so a look-up starts near the leaf. 0 = 2^18 in paper
+  // mode, 2^20 in exact mode (deeper trees; measured fastest on SIST-F4, docs/notes/annf.md).
+  uint32_t index_cells = 0;
 };
 
 const char* to_string(AnnfMode m);
@@ -214,22 +217,23 @@ class Annf {
     return ((size_t(cy >> 2) * index_tiles_x_ + (cx >> 2)) << 4) | ((cy & 3u) << 2) | (cx & 3u);
   }
   // Leaf record in lpool_: [count | kArcFlag if a candidate is an arc, ids..., padding], the ids
-  // padded to fast_k_ entries with copies of the first, so the fast path always evaluates fast_k_
-  // candidates (2 in paper mode, 2 or 4 in exact mode), two at a time in SSE2 lanes, with no
-  // data-dependent branch. Longer records and arcs take the general loop. (Copying the geometry
+  // padded with copies of the first to at least fast_k_ entries and to an even count, so the fast
+  // path evaluates candidates two at a time in SSE2 lanes: the first pair always, the second when
+  // there are 3 or 4 (the only data-dependent branch; never taken in paper mode, always when
+  // fast_k_ = 4). Longer records and arcs take the general loop. (Copying the geometry
   // into the records saves a dependent access but makes the records 4x larger: measured slower
   // near walls, where the look-up is cache-bound, docs/notes/annf.md.)
   [[gnu::always_inline]] int best_of_leaf(uint32_t w, const Eigen::Vector2d& p, double* dist,
                                           Eigen::Vector2d* closest) const {
     const uint32_t* rec = lpool_.data() + (w & ~kLeafBit);
-    if (__builtin_expect(rec[0] > uint32_t(fast_k_), 0)) return best_of_leaf_general(rec, p, dist, closest);
+    if (__builtin_expect(rec[0] > 4u, 0)) return best_of_leaf_general(rec, p, dist, closest);
     double bd;
     const uint32_t best = best_of_record(rec, p, &bd);
     if (dist) *dist = bd;
     if (closest) *closest = closest_on(best, p);
     return int(best);
   }
-  // The fast path on any record (for a longer record: its first fast_k_ candidates).
+  // The fast path on a record of at most 4 candidates.
   [[gnu::always_inline]] uint32_t best_of_record(const uint32_t* rec, const Eigen::Vector2d& p, double* dist) const {
     const __m128d pp = _mm_loadu_pd(p.data());
     const __m128d px = _mm_unpacklo_pd(pp, pp), py = _mm_unpackhi_pd(pp, pp);
@@ -257,7 +261,7 @@ class Annf {
     const double d1 = _mm_cvtsd_f64(_mm_unpackhi_pd(d01, d01));
     uint32_t best = d1 < bd ? i1 : i0;
     bd = d1 < bd ? d1 : bd;
-    if (fast_k_ == 4) {
+    if (rec[0] > 2) {  // 3 or 4 candidates (always in exact mode with fast_k_ = 4)
       const uint32_t i2 = rec[3], i3 = rec[4];
       const __m128d d23 = pair(i2, i3);
       const double d2 = _mm_cvtsd_f64(d23), d3 = _mm_cvtsd_f64(_mm_unpackhi_pd(d23, d23));
@@ -305,7 +309,7 @@ class Annf {
   uint32_t index_tiles_x_ = 0;
   int index_shift_ = 0;  // finest-leaf index >> index_shift_ = index cell
   int block_steps_ = 0;  // block levels below the index (ceil((max_depth - g) / 2))
-  int fast_k_ = 2;       // candidates evaluated by the fast path (even)
+  int fast_k_ = 2;       // candidates the fast path always evaluates (2 or 4)
 };
 
 template <typename F>
