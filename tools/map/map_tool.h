@@ -12,8 +12,8 @@ struct ValidateArgs {
   std::string mode = "both";
   std::string rule = "child-leaf-ordered";
   bool all_rules = false;
-  bool distinct = false;
-  std::string candidates = "all";
+  bool distinct = true;
+  std::string candidates = "passing";
   std::string hit_by = "distance";
   std::string sample_area = "bbox";
   double root = 6.0;

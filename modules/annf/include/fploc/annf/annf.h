@@ -61,7 +61,10 @@ struct AnnfOptions {
   AnnfMode mode = AnnfMode::kPaper;
   double root_length = 6.0;  // metres
   int max_depth = 7;         // 1 = root fields only
-  PaperRule paper_rule = PaperRule::kChildLeafOrdered;  // closest to Table III (docs/notes/annf.md)
+  // The defaults of the three paper-mode readings (rule, distinct distances, candidates) are the
+  // combination closest to Table III on the Corridor plan (docs/notes/annf.md: no reading
+  // reproduces the table; the best few differ by < 3 points summed over its 12 numbers).
+  PaperRule paper_rule = PaperRule::kChildLeafOrdered;
   // Exact mode: subdivide while a leaf holds more candidates. 2: most look-ups evaluate one SSE2
   // pair of candidates (docs/notes/annf.md has the measured trade-off against 4).
   int exact_max_candidates = 2;
@@ -77,14 +80,14 @@ struct AnnfOptions {
   // Paper mode: "two nearest" keeps two elements at *different* distances from the field centre
   // (an element tied with the first, e.g. the other wall at a shared corner, is skipped), as the
   // authors' public ANNF demo does (its leaf table shows this).
-  bool paper_distinct_distances = false;
+  bool paper_distinct_distances = true;
   // Paper mode, literal reading of "we iterate over every element, check which fields they are
   // passing through, and note down the distance to the center of each field": a field's two
   // elements are chosen only among the elements passing through it. A field no element passes
   // through gets the two nearest of the whole plan (kPassingElseAll) or keeps its parent's two
   // (kPassingInherit; a root field: the two nearest of the whole plan).
   enum class Candidates : uint8_t { kAll = 0, kPassingElseAll = 1, kPassingInherit = 2 };
-  Candidates paper_candidates = Candidates::kAll;
+  Candidates paper_candidates = Candidates::kPassingElseAll;
   // Speed only (not saved, no effect on results): the top levels of the trees are flattened into a
   // dense index of at most this many cells so a look-up starts near the leaf. 0 = 2^18 in paper
   // mode, 2^20 in exact mode (deeper trees; measured fastest on SIST-F4, docs/notes/annf.md).
