@@ -115,7 +115,9 @@ void BM_AnnfExact(benchmark::State& st) {
 // Batch look-ups of 1024 points (a scan), with software prefetching; time per point.
 void batch(benchmark::State& st, const Annf& a) {
   Fixture& f = fixture();
-  const auto& pts = points(f, int(st.range(0)));
+  auto pts = points(f, int(st.range(0)));
+  // FPLOC_BENCH_POINTS: use only the first N points (N small: everything cache-resident).
+  if (std::getenv("FPLOC_BENCH_POINTS")) pts.resize(size_t(std::atol(std::getenv("FPLOC_BENCH_POINTS"))));
   const size_t B = 1024;
   std::vector<int> ids(B);
   std::vector<double> d(B);

@@ -609,11 +609,31 @@ void Annf::batch_impl(const Eigen::Vector2d* pts, size_t n, int* ids, double* di
       s = sn;
     }
     if (!closest) {
+      // The fast path in a loop without calls (so pointers stay in registers); points outside the
+      // field and long records afterwards.
+      const uint32_t* lp = lpool_.data();
+      const FastPrim* geom = geom_.data();
+      int* id_out = ids + base;
+      double* d_out = dists + base;
+      bool others = false;
       for (size_t k = 0; k < m; ++k) {
+        const uint32_t* rec = lp + (words[k] & ~kLeafBit);
+        if (__builtin_expect(words[k] == 0 || rec[0] > 4u, 0)) {
+          others = true;
+          continue;
+        }
         double d;
-        ids[base + k] = words[k] ? best_of_leaf(words[k], p[k], &d, nullptr) : nearest_outside(p[k], &d, nullptr);
-        dists[base + k] = d;
+        id_out[k] = int(best_of_record(rec, geom, p[k], &d));
+        d_out[k] = d;
       }
+      if (others)
+        for (size_t k = 0; k < m; ++k) {
+          const uint32_t* rec = lp + (words[k] & ~kLeafBit);
+          if (words[k] != 0 && rec[0] <= 4u) continue;
+          double d;
+          id_out[k] = words[k] ? best_of_leaf_general(rec, p[k], &d, nullptr) : nearest_outside(p[k], &d, nullptr);
+          d_out[k] = d;
+        }
     } else {
       for (size_t k = 0; k < m; ++k) {
         double d;

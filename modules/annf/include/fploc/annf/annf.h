@@ -231,19 +231,21 @@ class Annf {
     const uint32_t* rec = lpool_.data() + (w & ~kLeafBit);
     if (__builtin_expect(rec[0] > 4u, 0)) return best_of_leaf_general(rec, p, dist, closest);
     double bd;
-    const uint32_t best = best_of_record(rec, p, &bd);
+    const uint32_t best = best_of_record(rec, geom_.data(), p, &bd);
     if (dist) *dist = bd;
     if (closest) *closest = closest_on(best, p);
     return int(best);
   }
   // The fast path on a record of at most 4 candidates.
-  [[gnu::always_inline]] uint32_t best_of_record(const uint32_t* rec, const Eigen::Vector2d& p, double* dist) const {
+  // (static, with the geometry pointer passed in, so a caller's loop keeps it in a register)
+  [[gnu::always_inline]] static uint32_t best_of_record(const uint32_t* rec, const FastPrim* geom,
+                                                        const Eigen::Vector2d& p, double* dist) {
     const __m128d pp = _mm_loadu_pd(p.data());
     const __m128d px = _mm_unpacklo_pd(pp, pp), py = _mm_unpackhi_pd(pp, pp);
     const __m128d zero = _mm_setzero_pd(), sign = _mm_set1_pd(-0.0);
     auto pair = [&](uint32_t i0, uint32_t i1) {  // FastPrim::distance for two candidates
-      const double* g0 = &geom_[i0].ax;
-      const double* g1 = &geom_[i1].ax;
+      const double* g0 = &geom[i0].ax;
+      const double* g1 = &geom[i1].ax;
       const __m128d a0 = _mm_load_pd(g0), a1 = _mm_load_pd(g1);
       const __m128d d0 = _mm_load_pd(g0 + 2), d1 = _mm_load_pd(g1 + 2);
       const __m128d r0 = _mm_load_pd(g0 + 4), r1 = _mm_load_pd(g1 + 4);
