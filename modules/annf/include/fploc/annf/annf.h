@@ -28,7 +28,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#if defined(__SSE2__)
 #include <emmintrin.h>
+#endif
 #include <iosfwd>
 #include <new>
 #include <string>
@@ -240,6 +242,19 @@ class Annf {
   // (static, with the geometry pointer passed in, so a caller's loop keeps it in a register)
   [[gnu::always_inline]] static uint32_t best_of_record(const uint32_t* rec, const FastPrim* geom,
                                                         const Eigen::Vector2d& p, double* dist) {
+#if !defined(__SSE2__)
+    // Portable fallback (non-x86 builds): the same candidates, one at a time.
+    const int n = int(rec[0]);
+    uint32_t best = rec[1];
+    double bd = geom[rec[1]].distance(p);
+    for (int k = 1; k < (n > 2 ? 4 : 2); ++k) {
+      const double d = geom[rec[1 + k]].distance(p);
+      best = d < bd ? rec[1 + k] : best;
+      bd = d < bd ? d : bd;
+    }
+    *dist = bd;
+    return best;
+#else
     const __m128d pp = _mm_loadu_pd(p.data());
     const __m128d px = _mm_unpacklo_pd(pp, pp), py = _mm_unpackhi_pd(pp, pp);
     const __m128d zero = _mm_setzero_pd(), sign = _mm_set1_pd(-0.0);
@@ -277,6 +292,7 @@ class Annf {
     }
     *dist = bd;
     return best;
+#endif
   }
   Eigen::Vector2d closest_on(uint32_t id, const Eigen::Vector2d& p) const;
   int best_of_leaf_general(const uint32_t* rec, const Eigen::Vector2d& p, double* dist, Eigen::Vector2d* closest) const;
