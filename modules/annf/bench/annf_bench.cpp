@@ -137,6 +137,30 @@ void BM_AnnfExactBatch(benchmark::State& st) {
   if (!fixture().ok) return st.SkipWithError("no ../shared/data");
   batch(st, *fixture().exact);
 }
+// lookup_batch(): candidate ids of 1024 points at a time, no distance.
+void lookup_batch(benchmark::State& st, const Annf& a) {
+  Fixture& f = fixture();
+  auto pts = points(f, int(st.range(0)));
+  if (std::getenv("FPLOC_BENCH_POINTS")) pts.resize(size_t(std::atol(std::getenv("FPLOC_BENCH_POINTS"))));
+  const size_t B = 1024;
+  std::vector<const uint32_t*> ids(B);
+  std::vector<int> n(B);
+  size_t off = 0;
+  for (auto _ : st) {
+    a.lookup_batch(pts.data() + off, B, ids.data(), n.data());
+    benchmark::DoNotOptimize(ids.data());
+    off = (off + B) & (pts.size() - 1);
+  }
+  st.SetItemsProcessed(int64_t(st.iterations() * B));
+}
+void BM_AnnfPaperLookupBatch(benchmark::State& st) {
+  if (!fixture().ok) return st.SkipWithError("no ../shared/data");
+  lookup_batch(st, *fixture().paper);
+}
+void BM_AnnfExactLookupBatch(benchmark::State& st) {
+  if (!fixture().ok) return st.SkipWithError("no ../shared/data");
+  lookup_batch(st, *fixture().exact);
+}
 void BM_AnnfExactLookupOnly(benchmark::State& st) {
   run(st, [](Fixture& f, const Eigen::Vector2d& p) {
     int n;
@@ -179,6 +203,8 @@ BENCHMARK(BM_AnnfPaper)->Arg(0)->Arg(1);
 BENCHMARK(BM_AnnfExact)->Arg(0)->Arg(1);
 BENCHMARK(BM_AnnfPaperBatch)->Arg(0)->Arg(1);
 BENCHMARK(BM_AnnfExactBatch)->Arg(0)->Arg(1);
+BENCHMARK(BM_AnnfPaperLookupBatch)->Arg(0)->Arg(1);
+BENCHMARK(BM_AnnfExactLookupBatch)->Arg(0)->Arg(1);
 BENCHMARK(BM_AnnfExactLookupOnly)->Arg(0)->Arg(1);
 BENCHMARK(BM_AnnfPaperLookupOnly)->Arg(0)->Arg(1);
 BENCHMARK(BM_DistanceGrid)->Arg(0)->Arg(1);

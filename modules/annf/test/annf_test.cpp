@@ -169,12 +169,24 @@ TEST(Annf, BatchEqualsSingle) {
     std::vector<int> ids(pts.size());
     std::vector<double> d(pts.size());
     a.nearest_batch(pts.data(), pts.size(), ids.data(), d.data(), closest.data());
+    std::vector<const uint32_t*> recs(pts.size());
+    std::vector<int> counts(pts.size());
+    a.lookup_batch(pts.data(), pts.size(), recs.data(), counts.data());
+    std::vector<int> ids_no_closest(pts.size());
+    std::vector<double> d_no_closest(pts.size());
+    a.nearest_batch(pts.data(), pts.size(), ids_no_closest.data(), d_no_closest.data());
     for (size_t i = 0; i < pts.size(); ++i) {
       double d1;
       Eigen::Vector2d c1;
       ASSERT_EQ(a.nearest(pts[i], &d1, &c1), ids[i]) << i;
       EXPECT_EQ(d1, d[i]);
       EXPECT_EQ(c1, closest[i]);
+      EXPECT_EQ(ids_no_closest[i], ids[i]);
+      EXPECT_EQ(d_no_closest[i], d[i]);
+      int n1;
+      const uint32_t* c = a.lookup(pts[i], &n1);
+      ASSERT_EQ(recs[i], c);
+      ASSERT_EQ(counts[i], n1);
     }
   }
 }
