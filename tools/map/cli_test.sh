@@ -11,6 +11,9 @@ grep -q "bad.csv:3:" "$T/err" || fail "error does not name bad.csv:3: $(cat "$T/
 printf '  0\nSECTION\n  2\nENTITIES\n  0\nLINE\n  8\nw\n 10\n0\n' > "$T/trunc.dxf"
 if "$MAP" build --plan "$T/trunc.dxf" --out "$T/x.fpmap" 2> "$T/err"; then fail "truncated DXF accepted"; fi
 grep -q "trunc.dxf:" "$T/err" || fail "error does not name trunc.dxf: $(cat "$T/err")"
+printf '  0\nSECTION\n  2\nENTITIES\n  0\nLINE\n  8\nw\n 10\n0\n 20\nnan\n 11\n1\n 21\n1\n  0\nENDSEC\n  0\nEOF\n' > "$T/nan.dxf"
+if "$MAP" build --plan "$T/nan.dxf" --out "$T/x.fpmap" 2> "$T/err"; then fail "NaN DXF accepted"; fi
+grep -q "nan.dxf:11: LINE" "$T/err" || fail "NaN error does not name nan.dxf:11 (the group code) and the entity: $(cat "$T/err")"
 cat > "$T/p.json" <<'J'
 {"units":"m","elements":[{"type":"segment","a":[0,0],"b":[10,0],"layer":"walls"},{"type":"segment","a":[10,0],"b":[10,8],"layer":"walls"},
  {"type":"circle","c":[4,4],"r":0.3,"layer":"cols"},{"type":"arc","c":[2,6],"r":1,"start_deg":0,"end_deg":180,"layer":"walls"}]}
@@ -23,6 +26,8 @@ grep -q '"leaves"' "$T/build.json" || fail "build JSON"
 for k in elements rows depth leaf_length_m hit_first hit_first_or_second hit_exact ns_per_query bytes baselines brute_force_ns kdtree_ns kdtree_hit; do
   grep -q "\"$k\"" "$T/v.json" || fail "validate JSON lacks $k"
 done
+"$MAP" validate --plan "$T/p.json" --mode exact --samples 20000 --depths 5-7 --no-baselines --json > "$T/x.json" 2>/dev/null || fail "validate exact"
+[ "$(grep -c '"hit_exact": 1.0,' "$T/x.json")" = 3 ] || fail "exact mode not exact: $(grep hit_exact "$T/x.json")"
 "$MAP" render --plan "$T/p.json" --map "$T/p.fpmap" --out "$T/r.svg" 2>/dev/null || fail "render"
 grep -q "<svg" "$T/r.svg" || fail "svg"
 "$MAP" export-pgm --plan "$T/p.json" --resolution 0.1 --out "$T/pgm" 2>/dev/null || fail "export-pgm"

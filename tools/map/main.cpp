@@ -40,15 +40,21 @@ struct PlanArgs {
 
 struct AnnfArgs {
   std::string mode = "paper", rule = "child-leaf-ordered";
-  int depth = 7, max_candidates = 4;
+  int depth = 7, max_candidates = 2, refine = 2;
+  bool distinct = true;
+  std::string candidates = "passing";
   double root = 6.0, margin = 2.0;
   void add(CLI::App* app, bool with_depth = true) {
     app->add_option("--mode", mode, "paper | exact")->check(CLI::IsMember({"paper", "exact"}));
     if (with_depth) app->add_option("--depth", depth, "maximum depth (1 = root fields only)");
     app->add_option("--root", root, "root field length in metres (default 6)");
     app->add_option("--margin", margin, "metres of field around the plan's bounding box (default 2)");
-    app->add_option("--rule", rule, "paper stopping rule: child-leaf | undo-only | child-leaf-ordered | full");
-    app->add_option("--max-candidates", max_candidates, "exact mode: subdivide while a leaf has more candidates");
+    app->add_option("--rule", rule, "paper stopping rule: child-leaf | undo-only | child-leaf-ordered | full | collapse-first | collapse-pair");
+    app->add_option("--max-candidates", max_candidates, "exact mode: subdivide while a leaf has more candidates (default 2)");
+    app->add_option("--refine", refine, "exact mode: candidate refinement levels (default 2, 0 = simple bound)");
+    app->add_flag("--distinct,!--no-distinct", distinct, "paper mode: two nearest at distinct distances (default on)");
+    app->add_option("--candidates", candidates, "paper mode: all | passing (default) | passing-inherit")
+        ->check(CLI::IsMember({"all", "passing", "passing-inherit"}));
   }
   AnnfOptions options() const {
     AnnfOptions o;
@@ -57,6 +63,11 @@ struct AnnfArgs {
     o.max_depth = depth;
     o.root_length = root;
     o.exact_max_candidates = max_candidates;
+    o.exact_refine_levels = refine;
+    o.paper_distinct_distances = distinct;
+    o.paper_candidates = candidates == "passing"           ? AnnfOptions::Candidates::kPassingElseAll
+                         : candidates == "passing-inherit" ? AnnfOptions::Candidates::kPassingInherit
+                                                           : AnnfOptions::Candidates::kAll;
     o.margin = margin;
     return o;
   }
@@ -70,6 +81,13 @@ json stats_json(const Annf& a, double build_ms) {
   const AnnfStats s = a.stats();
   return {{"mode", to_string(a.options().mode)},
           {"rule", to_string(a.options().paper_rule)},
+          {"distinct_distances", a.options().paper_distinct_distances},
+          {"candidates", a.options().paper_candidates == AnnfOptions::Candidates::kAll             ? "all"
+                         : a.options().paper_candidates == AnnfOptions::Candidates::kPassingInherit ? "passing-inherit"
+                                                                                                     : "passing"},
+          {"exact_max_candidates", a.options().exact_max_candidates},
+          {"exact_refine_levels", a.options().exact_refine_levels},
+          {"tree_bytes", a.stats().file_bytes},
           {"depth", a.options().max_depth},
           {"root_length_m", a.options().root_length},
           {"leaf_length_m", a.leaf_length()},
@@ -123,12 +141,22 @@ int main(int argc, char** argv) {
   validate->add_option("--samples", v.samples, "uniform samples in the plan's bounding box (default 1000000)");
   validate->add_option("--mode", v.mode, "paper | exact | both (default both)")->check(CLI::IsMember({"paper", "exact", "both"}));
   validate->add_option("--rule", v.rule, "paper stopping rule (default child-leaf-ordered)");
-  validate->add_flag("--distinct", v.distinct, "paper mode: two nearest at distinct distances (the authors' demo)");
+  validate->add_flag("--distinct,!--no-distinct", v.distinct,
+                     "paper mode: two nearest at distinct distances, as the authors' demo (default on)");
+  validate->add_option("--candidates", v.candidates,
+                       "paper mode: a field's two elements among all | passing (elements passing through it; else all; "
+                       "default) | passing-inherit (else the parent's two)")
+      ->check(CLI::IsMember({"all", "passing", "passing-inherit"}));
+  validate->add_option("--hit-by", v.hit_by,
+                       "distance (default: a hit is any element at the true nearest distance, so ties and duplicates "
+                       "count) | id (only the brute-force element, the lowest id among ties)")
+      ->check(CLI::IsMember({"distance", "id"}));
   validate->add_option("--sample-area", v.sample_area, "bbox (plan's bounding box, default) | fields (area of the root fields)");
   validate->add_flag("--all-rules", v.all_rules, "measure every reading of the paper's stopping rules");
   validate->add_option("--root", v.root, "root field length in metres (default 6)");
   validate->add_option("--margin", v.margin, "metres of field around the plan's bounding box (default 2)");
-  validate->add_option("--max-candidates", v.max_candidates, "exact mode: subdivide while a leaf has more candidates");
+  validate->add_option("--max-candidates", v.max_candidates, "exact mode: subdivide while a leaf has more candidates (default 2)");
+  validate->add_option("--refine", v.refine, "exact mode: candidate refinement levels (default 2)");
   validate->add_option("--exact-depth", v.exact_depth, "exact mode rows: extra depth added (default 0)");
   validate->add_option("--baseline-depth", v.baseline_depth, "KD-tree spacing / grid resolution = leaf length at this depth (default 7)");
   validate->add_option("--seed", v.seed, "random seed");

@@ -12,11 +12,14 @@ struct ValidateArgs {
   std::string mode = "both";
   std::string rule = "child-leaf-ordered";
   bool all_rules = false;
-  bool distinct = false;
+  bool distinct = true;
+  std::string candidates = "passing";
+  std::string hit_by = "distance";
   std::string sample_area = "bbox";
   double root = 6.0;
   double margin = 2.0;
-  int max_candidates = 4;
+  int max_candidates = 2;
+  int refine = 2;
   int exact_depth = 0;
   int baseline_depth = 7;
   uint32_t seed = 1;

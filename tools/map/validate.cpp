@@ -75,8 +75,9 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
   std::cerr << "fploc map validate: " << plan.elements.size() << " elements, " << pts.size()
             << " uniform samples in " << bb.size().x() << " x " << bb.size().y() << " m; brute-force ground truth...\n";
   std::vector<double> truth(pts.size());
+  std::vector<int> truth_id(pts.size());
   const double tb0 = now_ns();
-  for (size_t i = 0; i < pts.size(); ++i) nearest_element_brute_force(plan, pts[i], &truth[i]);
+  for (size_t i = 0; i < pts.size(); ++i) truth_id[i] = nearest_element_brute_force(plan, pts[i], &truth[i]);
   const double brute_ns = (now_ns() - tb0) / double(pts.size());
 
   json rows = json::array();
@@ -89,7 +90,8 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
   if (a.mode != "exact") {
     if (a.all_rules) {
       for (bool distinct : {false, true})
-        for (PaperRule r : {PaperRule::kChildLeaf, PaperRule::kUndoOnly, PaperRule::kChildLeafOrdered, PaperRule::kFull})
+        for (PaperRule r : {PaperRule::kChildLeaf, PaperRule::kUndoOnly, PaperRule::kChildLeafOrdered, PaperRule::kFull,
+                            PaperRule::kCollapseFirst, PaperRule::kCollapsePair})
           configs.push_back({AnnfMode::kPaper, r, distinct});
     } else {
       configs.push_back({AnnfMode::kPaper, parse_paper_rule(a.rule), a.distinct});
@@ -97,9 +99,10 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
   }
   if (a.mode != "paper") configs.push_back({AnnfMode::kExact, PaperRule::kChildLeaf, false});
   const size_t timed = std::min<size_t>(pts.size(), 2000000);
+  const bool by_id = a.hit_by == "id";
 
-  std::fprintf(stderr, "%-6s %-28s %5s %9s %8s %8s %8s %8s %10s %9s | paper: %6s %6s\n", "mode", "rule", "depth",
-               "leaf[cm]", "hit1", "hit1|2", "exact", "ns/q", "bytes", "build[ms]", "hit1", "hit1|2");
+  std::fprintf(stderr, "%-6s %-44s %5s %9s %8s %8s %8s %8s %8s %10s %9s | paper: %6s %6s\n", "mode", "rule", "depth",
+               "leaf[cm]", "hit1", "hit1|2", "exact", "ns/q", "batch", "bytes", "build[ms]", "hit1", "hit1|2");
   for (const auto& [mode, rule, distinct] : configs) {
     for (int depth = d0; depth <= d1; ++depth) {
       AnnfOptions o;
@@ -109,7 +112,11 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
       o.margin = a.margin;
       o.max_depth = depth + (mode == AnnfMode::kExact ? a.exact_depth : 0);
       o.exact_max_candidates = a.max_candidates;
+      o.exact_refine_levels = a.refine;
       o.paper_distinct_distances = distinct;
+      o.paper_candidates = a.candidates == "passing"           ? AnnfOptions::Candidates::kPassingElseAll
+                           : a.candidates == "passing-inherit" ? AnnfOptions::Candidates::kPassingInherit
+                                                               : AnnfOptions::Candidates::kAll;
       const double t0 = now_ns();
       const Annf f = Annf::build(plan, o);
       const double build_ms = (now_ns() - t0) / 1e6;
@@ -118,20 +125,40 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
         int n;
         const uint32_t* c = f.lookup(pts[i], &n);
         const double t = truth[i] + kTol;
-        if (c && n >= 1 && distance(plan.elements[c[0]], pts[i]) <= t) {
+        auto hit = [&](uint32_t id) {
+          return by_id ? int(id) == truth_id[i] : distance(plan.elements[id], pts[i]) <= t;
+        };
+        if (c && n >= 1 && hit(c[0])) {
           ++h1;
           ++h12;
-        } else if (c && n >= 2 && distance(plan.elements[c[1]], pts[i]) <= t) {
+        } else if (c && n >= 2 && hit(c[1])) {
           ++h12;
         }
+        // Exact hit: the returned element is at the true nearest distance and the returned
+        // distance is that distance.
         double d;
-        f.nearest(pts[i], &d);
-        hx += d <= t;
+        const int id = f.nearest(pts[i], &d);
+        hx += id >= 0 && distance(plan.elements[id], pts[i]) <= t && std::abs(d - truth[i]) <= kTol;
       }
       const double ns = time_per_query(pts, timed, [&](const Eigen::Vector2d& p) {
         double d;
         return f.nearest(p, &d) + d;
       });
+      // A scan's worth of points at a time through nearest_batch().
+      double batch_ns = 0;
+      {
+        const size_t B = 1024, nb = std::min(timed, pts.size());
+        std::vector<int> bi(B);
+        std::vector<double> bd(B);
+        volatile double sink = 0;
+        const double t0 = now_ns();
+        for (size_t off = 0; off < nb; off += B) {
+          const size_t m = std::min(B, nb - off);
+          f.nearest_batch(pts.data() + off, m, bi.data(), bd.data());
+          sink = sink + bd[0];
+        }
+        batch_ns = (now_ns() - t0) / double(nb);
+      }
       const double lookup_ns = time_per_query(pts, timed, [&](const Eigen::Vector2d& p) {
         int n;
         const uint32_t* c = f.lookup(p, &n);
@@ -142,6 +169,7 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
       json row = {{"mode", to_string(mode)},
                   {"rule", mode == AnnfMode::kPaper ? to_string(rule) : "-"},
                   {"distinct_distances", distinct},
+                  {"candidates", mode == AnnfMode::kPaper ? a.candidates : "-"},
                   {"depth", o.max_depth},
                   {"leaf_length_m", f.leaf_length()},
                   {"hit_first", h1 / N},
@@ -149,7 +177,9 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
                   {"hit_exact", hx / N},
                   {"exact_misses", pts.size() - hx},
                   {"ns_per_query", ns},
+                  {"batch_ns_per_query", batch_ns},
                   {"lookup_ns", lookup_ns},
+                  {"tree_bytes", s.file_bytes},
                   {"bytes", s.bytes},
                   {"nodes", s.nodes},
                   {"leaves", s.leaves},
@@ -162,10 +192,12 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
         row["paper_hit_first_or_second"] = it->second[1] / 100;
       }
       rows.push_back(row);
-      const std::string rname = mode == AnnfMode::kPaper ? std::string(to_string(rule)) + (distinct ? "+distinct" : "") : "-";
-      std::fprintf(stderr, "%-6s %-28s %5d %9.2f %7.2f%% %7.2f%% %7.3f%% %8.2f %10zu %9.0f", to_string(mode),
+      const std::string rname = mode == AnnfMode::kPaper ? std::string(to_string(rule)) + (distinct ? "+distinct" : "") +
+                                                               (a.candidates != "all" ? "+" + a.candidates : "")
+                                                         : "-";
+      std::fprintf(stderr, "%-6s %-44s %5d %9.2f %7.2f%% %7.2f%% %7.3f%% %8.2f %8.2f %10zu %9.0f", to_string(mode),
                    rname.c_str(), o.max_depth, f.leaf_length() * 100, 100 * h1 / N,
-                   100 * h12 / N, 100 * hx / N, ns, s.bytes, build_ms);
+                   100 * h12 / N, 100 * hx / N, ns, batch_ns, s.bytes, build_ms);
       if (mode == AnnfMode::kPaper && it != kPaper.end())
         std::fprintf(stderr, " | paper: %5.2f%% %5.2f%%\n", it->second[0], it->second[1]);
       else

@@ -36,16 +36,18 @@ Fixture& fixture() {
     o.quiet = true;
     f.plan = load_floor_plan(path, o);
     // FPLOC_INDEX_CELLS: size of the dense top-level index (speed/memory trade-off).
-    const uint32_t cells = std::getenv("FPLOC_INDEX_CELLS") ? uint32_t(std::atol(std::getenv("FPLOC_INDEX_CELLS"))) : (1u << 18);
+    const uint32_t cells = std::getenv("FPLOC_INDEX_CELLS") ? uint32_t(std::atol(std::getenv("FPLOC_INDEX_CELLS"))) : 0;
     AnnfOptions po;
     po.index_cells = cells;
     po.max_depth = 7;
     f.paper = std::make_unique<Annf>(Annf::build(f.plan, po));
     AnnfOptions xo;
     xo.mode = AnnfMode::kExact;
-    // FPLOC_EXACT_DEPTH / FPLOC_EXACT_MC: exact-mode depth and leaf candidate threshold.
-    xo.max_depth = std::getenv("FPLOC_EXACT_DEPTH") ? std::atoi(std::getenv("FPLOC_EXACT_DEPTH")) : 9;
-    xo.exact_max_candidates = std::getenv("FPLOC_EXACT_MC") ? std::atoi(std::getenv("FPLOC_EXACT_MC")) : 4;
+    // FPLOC_EXACT_DEPTH / FPLOC_EXACT_MC / FPLOC_EXACT_REFINE: exact-mode depth, leaf candidate
+    // threshold and candidate refinement levels.
+    xo.max_depth = std::getenv("FPLOC_EXACT_DEPTH") ? std::atoi(std::getenv("FPLOC_EXACT_DEPTH")) : 8;
+    xo.exact_max_candidates = std::getenv("FPLOC_EXACT_MC") ? std::atoi(std::getenv("FPLOC_EXACT_MC")) : 2;
+    xo.exact_refine_levels = std::getenv("FPLOC_EXACT_REFINE") ? std::atoi(std::getenv("FPLOC_EXACT_REFINE")) : 2;
     xo.index_cells = cells;
     f.exact = std::make_unique<Annf>(Annf::build(f.plan, xo));
     const double res = 6.0 / 64;  // the leaf length at depth 7 (9.375 cm)
@@ -113,7 +115,9 @@ void BM_AnnfExact(benchmark::State& st) {
 // Batch look-ups of 1024 points (a scan), with software prefetching; time per point.
 void batch(benchmark::State& st, const Annf& a) {
   Fixture& f = fixture();
-  const auto& pts = points(f, int(st.range(0)));
+  auto pts = points(f, int(st.range(0)));
+  // FPLOC_BENCH_POINTS: use only the first N points (N small: everything cache-resident).
+  if (std::getenv("FPLOC_BENCH_POINTS")) pts.resize(size_t(std::atol(std::getenv("FPLOC_BENCH_POINTS"))));
   const size_t B = 1024;
   std::vector<int> ids(B);
   std::vector<double> d(B);
@@ -132,6 +136,30 @@ void BM_AnnfPaperBatch(benchmark::State& st) {
 void BM_AnnfExactBatch(benchmark::State& st) {
   if (!fixture().ok) return st.SkipWithError("no ../shared/data");
   batch(st, *fixture().exact);
+}
+// lookup_batch(): candidate ids of 1024 points at a time, no distance.
+void lookup_batch(benchmark::State& st, const Annf& a) {
+  Fixture& f = fixture();
+  auto pts = points(f, int(st.range(0)));
+  if (std::getenv("FPLOC_BENCH_POINTS")) pts.resize(size_t(std::atol(std::getenv("FPLOC_BENCH_POINTS"))));
+  const size_t B = 1024;
+  std::vector<const uint32_t*> ids(B);
+  std::vector<int> n(B);
+  size_t off = 0;
+  for (auto _ : st) {
+    a.lookup_batch(pts.data() + off, B, ids.data(), n.data());
+    benchmark::DoNotOptimize(ids.data());
+    off = (off + B) & (pts.size() - 1);
+  }
+  st.SetItemsProcessed(int64_t(st.iterations() * B));
+}
+void BM_AnnfPaperLookupBatch(benchmark::State& st) {
+  if (!fixture().ok) return st.SkipWithError("no ../shared/data");
+  lookup_batch(st, *fixture().paper);
+}
+void BM_AnnfExactLookupBatch(benchmark::State& st) {
+  if (!fixture().ok) return st.SkipWithError("no ../shared/data");
+  lookup_batch(st, *fixture().exact);
 }
 void BM_AnnfExactLookupOnly(benchmark::State& st) {
   run(st, [](Fixture& f, const Eigen::Vector2d& p) {
@@ -175,6 +203,8 @@ BENCHMARK(BM_AnnfPaper)->Arg(0)->Arg(1);
 BENCHMARK(BM_AnnfExact)->Arg(0)->Arg(1);
 BENCHMARK(BM_AnnfPaperBatch)->Arg(0)->Arg(1);
 BENCHMARK(BM_AnnfExactBatch)->Arg(0)->Arg(1);
+BENCHMARK(BM_AnnfPaperLookupBatch)->Arg(0)->Arg(1);
+BENCHMARK(BM_AnnfExactLookupBatch)->Arg(0)->Arg(1);
 BENCHMARK(BM_AnnfExactLookupOnly)->Arg(0)->Arg(1);
 BENCHMARK(BM_AnnfPaperLookupOnly)->Arg(0)->Arg(1);
 BENCHMARK(BM_DistanceGrid)->Arg(0)->Arg(1);

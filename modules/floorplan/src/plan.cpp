@@ -20,14 +20,15 @@ bool arc_contains_angle(const Element& e, double ang) { return angle_from(ang, e
 
 Eigen::Vector2d arc_point(const Element& e, double ang) { return e.c + e.r * Eigen::Vector2d(std::cos(ang), std::sin(ang)); }
 
-// Distance from a point to a segment.
-double point_segment(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+// Squared distance from a point to a segment.
+double point_segment_sq(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   const Eigen::Vector2d ab = b - a;
   const double l2 = ab.squaredNorm();
   double t = l2 > 0 ? (p - a).dot(ab) / l2 : 0.0;
   t = std::clamp(t, 0.0, 1.0);
-  return (a + t * ab - p).norm();
+  return (a + t * ab - p).squaredNorm();
 }
+
 
 bool segments_intersect(const Eigen::Vector2d& p1, const Eigen::Vector2d& p2, const Eigen::Vector2d& q1,
                         const Eigen::Vector2d& q2) {
@@ -50,14 +51,14 @@ bool box_contains(const Box2& b, const Eigen::Vector2d& p) {
 double point_box(const Eigen::Vector2d& p, const Box2& b) {
   const double dx = std::max({b.min.x() - p.x(), 0.0, p.x() - b.max.x()});
   const double dy = std::max({b.min.y() - p.y(), 0.0, p.y() - b.max.y()});
-  return std::hypot(dx, dy);
+  return std::sqrt(dx * dx + dy * dy);  // (hypot is ~5x slower; coordinates are far from overflow)
 }
 
 // Largest distance from the point to the box.
 double point_box_far(const Eigen::Vector2d& p, const Box2& b) {
   const double dx = std::max(std::abs(p.x() - b.min.x()), std::abs(p.x() - b.max.x()));
   const double dy = std::max(std::abs(p.y() - b.min.y()), std::abs(p.y() - b.max.y()));
-  return std::hypot(dx, dy);
+  return std::sqrt(dx * dx + dy * dy);
 }
 
 std::array<Eigen::Vector2d, 4> corners(const Box2& b) {
@@ -184,8 +185,9 @@ double min_distance(const Element& e, const Box2& box) {
       for (int i = 0; i < 4; ++i)
         if (segments_intersect(e.a, e.b, c[i], c[(i + 1) % 4])) return 0.0;
       double d = std::min(point_box(e.a, box), point_box(e.b, box));
-      for (int i = 0; i < 4; ++i) d = std::min(d, point_segment(c[i], e.a, e.b));
-      return d;
+      double d2 = d * d;
+      for (int i = 0; i < 4; ++i) d2 = std::min(d2, point_segment_sq(c[i], e.a, e.b));
+      return std::sqrt(d2);
     }
     case ElementKind::kCircle: {
       const double near = point_box(e.c, box), far = point_box_far(e.c, box);
@@ -217,8 +219,8 @@ double max_distance(const Element& e, const Box2& box) {
   double m = 0.0;
   switch (e.kind) {
     case ElementKind::kSegment:
-      for (const auto& p : c) m = std::max(m, point_segment(p, e.a, e.b));
-      return m;
+      for (const auto& p : c) m = std::max(m, point_segment_sq(p, e.a, e.b));
+      return std::sqrt(m);
     case ElementKind::kCircle:
     case ElementKind::kArc: {
       // dist(p, circle) = |‖p - c‖ - r| <= max(far - r, r - near) ; for arcs, dist(p, arc) <= max over the

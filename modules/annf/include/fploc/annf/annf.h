@@ -28,6 +28,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <iosfwd>
 #include <new>
 #include <string>
@@ -48,30 +51,56 @@ enum class PaperRule : uint8_t {
   kUndoOnly = 1,       // Only "all four equal -> undo"; children equal to the parent still divide.
   kChildLeafOrdered = 2,  // As kChildLeaf, "same" compares the ordered pair (1st, 2nd).
   kFull = 3,           // No stopping rule: every field divides to max_depth (upper bound on accuracy).
+  // Bottom-up readings: every field is divided to max_depth first; a division is then withdrawn
+  // (recursively, from the deepest level up) when all four children are leaves that share the
+  // parent's nearest element (kCollapseFirst: what the authors' public demo does, reverse-engineered
+  // from its leaf table, docs/notes/annf.md) or its ordered pair (kCollapsePair).
+  kCollapseFirst = 4,
+  kCollapsePair = 5,
 };
 
 struct AnnfOptions {
   AnnfMode mode = AnnfMode::kPaper;
   double root_length = 6.0;  // metres
   int max_depth = 7;         // 1 = root fields only
-  PaperRule paper_rule = PaperRule::kChildLeafOrdered;  // closest to Table III (docs/notes/annf.md)
-  int exact_max_candidates = 4;  // exact mode: subdivide while a leaf holds more candidates
+  // The defaults of the three paper-mode readings (rule, distinct distances, candidates) are the
+  // combination closest to Table III on the Corridor plan (docs/notes/annf.md: no reading
+  // reproduces the table; the best few differ by < 3 points summed over its 12 numbers).
+  PaperRule paper_rule = PaperRule::kChildLeafOrdered;
+  // Exact mode: subdivide while a leaf holds more candidates. 2: most look-ups evaluate one SSE2
+  // pair of candidates (docs/notes/annf.md has the measured trade-off against 4).
+  int exact_max_candidates = 2;
+  // Exact mode: a field's candidate set is the union of the simple bound's sets over its quadrants,
+  // recursively, down to this many levels below the field (stopping early where one element is
+  // left). Still provable (each sub-box's set contains the nearest element of each of its points),
+  // much tighter than the simple bound near walls and corners, so fields stop dividing earlier.
+  // 0 = the simple bound only. Saved with the map (it changes the tree, not the look-up).
+  int exact_refine_levels = 2;
   // Metres added around the plan's bounding box: scan points just outside the outer walls stay
   // inside the field (outside it nearest() falls back to brute force).
   double margin = 2.0;
   // Paper mode: "two nearest" keeps two elements at *different* distances from the field centre
   // (an element tied with the first, e.g. the other wall at a shared corner, is skipped), as the
   // authors' public ANNF demo does (its leaf table shows this).
-  bool paper_distinct_distances = false;
+  bool paper_distinct_distances = true;
+  // Paper mode, literal reading of "we iterate over every element, check which fields they are
+  // passing through, and note down the distance to the center of each field": a field's two
+  // elements are chosen only among the elements passing through it. A field no element passes
+  // through gets the two nearest of the whole plan (kPassingElseAll) or keeps its parent's two
+  // (kPassingInherit; a root field: the two nearest of the whole plan).
+  enum class Candidates : uint8_t { kAll = 0, kPassingElseAll = 1, kPassingInherit = 2 };
+  Candidates paper_candidates = Candidates::kPassingElseAll;
   // Speed only (not saved, no effect on results): the top levels of the trees are flattened into a
-  // dense index of at most this many cells so a look-up starts near the leaf.
-  uint32_t index_cells = 1u << 18;
+  // dense index of at most this many cells so a look-up starts near the leaf. 0 = 2^18 in paper
+  // mode, 2^20 in exact mode (deeper trees; measured fastest on SIST-F4, docs/notes/annf.md).
+  uint32_t index_cells = 0;
 };
 
 const char* to_string(AnnfMode m);
 const char* to_string(PaperRule r);
 AnnfMode parse_annf_mode(const std::string& s);    // "paper" | "exact"; throws otherwise
-PaperRule parse_paper_rule(const std::string& s);  // "child-leaf" | "undo-only" | "child-leaf-ordered" | "full"
+PaperRule parse_paper_rule(const std::string& s);  // "child-leaf" | "undo-only" | "child-leaf-ordered" | "full" |
+                                                   // "collapse-first" | "collapse-pair"
 
 struct AnnfStats {
   size_t nodes = 0, leaves = 0, pool_ids = 0;
@@ -93,71 +122,31 @@ class Annf {
   // Candidate ids of the leaf containing p (2 or 1 in paper mode, the provable set in exact mode);
   // nullptr and *count = 0 when p is outside the covered area. Never allocates.
   const uint32_t* lookup(const Eigen::Vector2d& p, int* count) const {
-    const double fx = (p.x() - origin_.x()) * inv_leaf_, fy = (p.y() - origin_.y()) * inv_leaf_;
-    if (!(fx >= 0 && fy >= 0 && fx < extent_x_ && fy < extent_y_)) {
+    const uint32_t w = leaf_word(p);
+    if (!w) {
       *count = 0;
       return nullptr;
     }
-    const uint32_t ix = uint32_t(fx), iy = uint32_t(fy);
-    // Root field by rounding (through a dense index of the tree's top levels), then descend.
-    int s = index_shift_;
-    uint32_t node = index_[size_t(iy >> s) * index_nx_ + (ix >> s)];
-    while (!(node & kLeafBit)) {
-      --s;
-      node = fnodes_[node + (((iy >> s) & 1u) << 1 | ((ix >> s) & 1u))];
-    }
-    const uint32_t* leaf = fast_.data() + (node & ~kLeafBit);
-    *count = int(leaf[0]);
-    return leaf + 1;
+    const uint32_t* rec = lpool_.data() + (w & ~kLeafBit);
+    *count = int(rec[0] & kCountMask);
+    return rec + 1;
   }
 
   // Best element among the leaf's candidates (exact in exact mode; the better of the two in paper
   // mode). Outside the covered area: brute force. Returns -1 only for an empty field.
   int nearest(const Eigen::Vector2d& p, double* dist = nullptr, Eigen::Vector2d* closest = nullptr) const {
-    int n;
-    const uint32_t* ids = lookup(p, &n);
-    if (!ids) return nearest_outside(p, dist, closest);
-    // The leaf record holds a copy of its candidates' geometry right after the ids (one cache
-    // line or two): no further dependent memory access.
-    const uint32_t* g = ids - 1 + ((n + 2) & ~1);
-    int best = -1;
-    double bd2 = 1e300, bx = 0, by = 0;
-    for (int k = 0; k < n; ++k, g += 10) {
-      FastPrim s;
-      std::memcpy(&s, g, sizeof s);
-      double qx, qy;
-      if (__builtin_expect(s.inv_l2 >= 0, 1)) {
-        const double t = std::min(1.0, std::max(0.0, ((p.x() - s.ax) * s.dx + (p.y() - s.ay) * s.dy) * s.inv_l2));
-        qx = s.ax + t * s.dx;
-        qy = s.ay + t * s.dy;
-      } else if (s.inv_l2 == -2) {  // circle: centre (ax, ay), radius dx
-        const double vx = p.x() - s.ax, vy = p.y() - s.ay, len = std::sqrt(vx * vx + vy * vy);
-        const double k = len > 0 ? s.dx / len : 0.0;
-        qx = len > 0 ? s.ax + vx * k : s.ax + s.dx;
-        qy = len > 0 ? s.ay + vy * k : s.ay;
-      } else {
-        const ClosestPoint cp = closest_point(plan_.elements[ids[k]], p);
-        qx = cp.point.x();
-        qy = cp.point.y();
-      }
-      const double d2 = (qx - p.x()) * (qx - p.x()) + (qy - p.y()) * (qy - p.y());
-      // Branch-free selection (mispredictions would flush the next queries' memory loads).
-      const bool better = d2 < bd2;
-      bd2 = better ? d2 : bd2;
-      best = better ? int(ids[k]) : best;
-      bx = better ? qx : bx;
-      by = better ? qy : by;
-    }
-    if (dist) *dist = std::sqrt(bd2);
-    if (closest) *closest = Eigen::Vector2d(bx, by);
-    return best;
+    const uint32_t w = leaf_word(p);
+    if (!w) return nearest_outside(p, dist, closest);
+    return best_of_leaf(w, p, dist, closest);
   }
 
   // Batch form of nearest() for a whole scan: the same results as calling nearest() for each point,
-  // but memory accesses of later points are prefetched while earlier ones are computed (a look-up
-  // is memory-latency bound on large plans). ids/dists may not alias pts. closest may be nullptr.
+  // 1.7-2x faster per point (the look-ups of a chunk of points are done stage by stage, so many
+  // are in flight at once). ids/dists may not alias pts. closest may be nullptr.
   void nearest_batch(const Eigen::Vector2d* pts, size_t n, int* ids, double* dists,
                      Eigen::Vector2d* closest = nullptr) const;
+  // Batch form of lookup(): ids[i] / counts[i] as lookup(pts[i], &counts[i]) returns them.
+  void lookup_batch(const Eigen::Vector2d* pts, size_t n, const uint32_t** ids, int* counts) const;
 
   // Like nearest() but also returns the first candidate (paper mode: the leaf's "1st element").
   int first_candidate(const Eigen::Vector2d& p) const {
@@ -185,14 +174,138 @@ class Annf {
 
  private:
   static constexpr uint32_t kLeafBit = 0x80000000u;
-  // Geometry copy in a leaf record (segments: a, b-a, 1/|b-a|^2; circles: inv_l2 = -2, centre in
-  // ax, ay, radius in dx; arcs: inv_l2 = -1, evaluated from the plan).
-  struct FastPrim {
-    double ax, ay, dx, dy, inv_l2;
+  static constexpr uint32_t kArcFlag = 0x40000000u, kCountMask = 0x3fffffffu;
+  // Per-element geometry for the distance, one array indexed by element id (48 B per element: 83 kB
+  // for SIST-F4 walls + columns), so it stays in cache while the index is what a look-up fetches
+  // from memory. Segments: start a, unit direction u, length len, r = 0. Circles: a = centre,
+  // u = (1, 0), len = 0, r = radius. For both, with v = p - a, s = v.u:
+  //   distance = | sqrt((v x u)^2 + (s - clamp(s, 0, len))^2) - r |
+  // (for a circle: | |v| - r |). Arcs are evaluated from the plan (their leaves are flagged).
+  struct alignas(16) FastPrim {
+    double ax, ay, ux, uy, len, r;
+    double distance(const Eigen::Vector2d& p) const {
+      const double vx = p.x() - ax, vy = p.y() - ay;
+      const double s = vx * ux + vy * uy, perp = vx * uy - vy * ux;
+      const double over = s - std::min(len, std::max(0.0, s));
+      return std::abs(std::sqrt(perp * perp + over * over) - r);
+    }
   };
-  static_assert(sizeof(FastPrim) == 40);
+  static_assert(sizeof(FastPrim) == 48);
+
+  // Look-up structure derived from the tree in prepare() (not saved): the tree's top levels as a
+  // dense index at depth g (4 x 4 cells per 64-byte line), and below it the tree re-grouped into
+  // 16-ary blocks (one 64-byte line = the 4 x 4 descendants two levels down; a 4-entry block when
+  // one level is left). Index and block entries are a leaf word (kLeafBit | offset of the leaf's
+  // record in lpool_) or the offset of a block in blocks_. The descent always takes block_steps_
+  // steps, without branches: a leaf reached early reads the dummy block at offset 0 and keeps its
+  // word. Returns 0 outside the covered area.
+  [[gnu::always_inline]] uint32_t leaf_word(const Eigen::Vector2d& p) const {
+    const double fx = (p.x() - origin_.x()) * inv_leaf_, fy = (p.y() - origin_.y()) * inv_leaf_;
+    if (!(fx >= 0 && fy >= 0 && fx < extent_x_ && fy < extent_y_)) return 0;
+    const uint32_t ix = uint32_t(fx), iy = uint32_t(fy);
+    int s = index_shift_;
+    uint32_t w = index_[index_slot(ix >> s, iy >> s)];
+    for (int k = 0; k < block_steps_; ++k) {
+      const uint32_t inner = (w >> 31) - 1u;  // all ones for a block offset, 0 for a leaf
+      uint32_t slot;
+      if (s >= 2) {
+        s -= 2;
+        slot = (((iy >> s) & 3u) << 2) | ((ix >> s) & 3u);
+      } else {
+        s = 0;
+        slot = ((iy & 1u) << 1) | (ix & 1u);
+      }
+      const uint32_t next = blocks_[(w & inner) + slot];
+      w = (next & inner) | (w & ~inner);
+    }
+    return w;
+  }
+  size_t index_slot(uint32_t cx, uint32_t cy) const {
+    return ((size_t(cy >> 2) * index_tiles_x_ + (cx >> 2)) << 4) | ((cy & 3u) << 2) | (cx & 3u);
+  }
+  // Leaf record in lpool_: [count | kArcFlag if a candidate is an arc, ids..., padding], the ids
+  // padded with copies of the first to at least fast_k_ entries and to an even count, so the fast
+  // path evaluates candidates two at a time in SSE2 lanes: the first pair always, the second when
+  // there are 3 or 4 (the only data-dependent branch; never taken in paper mode, always when
+  // fast_k_ = 4). Longer records and arcs take the general loop. (Copying the geometry
+  // into the records saves a dependent access but makes the records 4x larger: measured slower
+  // near walls, where the look-up is cache-bound, docs/notes/annf.md.)
+  [[gnu::always_inline]] int best_of_leaf(uint32_t w, const Eigen::Vector2d& p, double* dist,
+                                          Eigen::Vector2d* closest) const {
+    const uint32_t* rec = lpool_.data() + (w & ~kLeafBit);
+    if (__builtin_expect(rec[0] > 4u, 0)) return best_of_leaf_general(rec, p, dist, closest);
+    double bd;
+    const uint32_t best = best_of_record(rec, geom_.data(), p, &bd);
+    if (dist) *dist = bd;
+    if (closest) *closest = closest_on(best, p);
+    return int(best);
+  }
+  // The fast path on a record of at most 4 candidates.
+  // (static, with the geometry pointer passed in, so a caller's loop keeps it in a register)
+  [[gnu::always_inline]] static uint32_t best_of_record(const uint32_t* rec, const FastPrim* geom,
+                                                        const Eigen::Vector2d& p, double* dist) {
+#if !defined(__SSE2__)
+    // Portable fallback (non-x86 builds): the same candidates, one at a time.
+    const int n = int(rec[0]);
+    uint32_t best = rec[1];
+    double bd = geom[rec[1]].distance(p);
+    for (int k = 1; k < (n > 2 ? 4 : 2); ++k) {
+      const double d = geom[rec[1 + k]].distance(p);
+      best = d < bd ? rec[1 + k] : best;
+      bd = d < bd ? d : bd;
+    }
+    *dist = bd;
+    return best;
+#else
+    const __m128d pp = _mm_loadu_pd(p.data());
+    const __m128d px = _mm_unpacklo_pd(pp, pp), py = _mm_unpackhi_pd(pp, pp);
+    const __m128d zero = _mm_setzero_pd(), sign = _mm_set1_pd(-0.0);
+    auto pair = [&](uint32_t i0, uint32_t i1) {  // FastPrim::distance for two candidates
+      const double* g0 = &geom[i0].ax;
+      const double* g1 = &geom[i1].ax;
+      const __m128d a0 = _mm_load_pd(g0), a1 = _mm_load_pd(g1);
+      const __m128d d0 = _mm_load_pd(g0 + 2), d1 = _mm_load_pd(g1 + 2);
+      const __m128d r0 = _mm_load_pd(g0 + 4), r1 = _mm_load_pd(g1 + 4);
+      const __m128d ax = _mm_unpacklo_pd(a0, a1), ay = _mm_unpackhi_pd(a0, a1);
+      const __m128d ux = _mm_unpacklo_pd(d0, d1), uy = _mm_unpackhi_pd(d0, d1);
+      const __m128d len = _mm_unpacklo_pd(r0, r1), rad = _mm_unpackhi_pd(r0, r1);
+      const __m128d vx = _mm_sub_pd(px, ax), vy = _mm_sub_pd(py, ay);
+      const __m128d along = _mm_add_pd(_mm_mul_pd(vx, ux), _mm_mul_pd(vy, uy));
+      const __m128d perp = _mm_sub_pd(_mm_mul_pd(vx, uy), _mm_mul_pd(vy, ux));
+      const __m128d over = _mm_sub_pd(along, _mm_min_pd(len, _mm_max_pd(along, zero)));
+      const __m128d e = _mm_sqrt_pd(_mm_add_pd(_mm_mul_pd(perp, perp), _mm_mul_pd(over, over)));
+      return _mm_andnot_pd(sign, _mm_sub_pd(e, rad));
+    };
+    // Branch-free selection; the first of equal candidates wins.
+    const uint32_t i0 = rec[1], i1 = rec[2];
+    const __m128d d01 = pair(i0, i1);
+    double bd = _mm_cvtsd_f64(d01);
+    const double d1 = _mm_cvtsd_f64(_mm_unpackhi_pd(d01, d01));
+    uint32_t best = d1 < bd ? i1 : i0;
+    bd = d1 < bd ? d1 : bd;
+    if (rec[0] > 2) {  // 3 or 4 candidates (always in exact mode with fast_k_ = 4)
+      const uint32_t i2 = rec[3], i3 = rec[4];
+      const __m128d d23 = pair(i2, i3);
+      const double d2 = _mm_cvtsd_f64(d23), d3 = _mm_cvtsd_f64(_mm_unpackhi_pd(d23, d23));
+      best = d2 < bd ? i2 : best;
+      bd = d2 < bd ? d2 : bd;
+      best = d3 < bd ? i3 : best;
+      bd = d3 < bd ? d3 : bd;
+    }
+    *dist = bd;
+    return best;
+#endif
+  }
+  Eigen::Vector2d closest_on(uint32_t id, const Eigen::Vector2d& p) const;
+  int best_of_leaf_general(const uint32_t* rec, const Eigen::Vector2d& p, double* dist, Eigen::Vector2d* closest) const;
   int nearest_outside(const Eigen::Vector2d& p, double* dist, Eigen::Vector2d* closest) const;
+  static constexpr size_t kChunk = 256;  // points per stage in the batch look-ups
+  template <int S0>
+  [[gnu::always_inline]] inline void leaf_words(const Eigen::Vector2d* p, size_t m, uint32_t* words) const;
+  template <int S0>
+  void batch_impl(const Eigen::Vector2d* pts, size_t n, int* ids, double* dists, Eigen::Vector2d* closest) const;
   void prepare();
+  uint32_t flatten(uint32_t word, int levels_left, std::vector<uint32_t>* remap);
 
   FloorPlan plan_;
   AnnfOptions options_;
@@ -204,27 +317,25 @@ class Annf {
   std::vector<uint32_t> roots_;  // nx*ny, node word: leaf bit | pool offset, or index of 4 children
   std::vector<uint32_t> nodes_;  // groups of 4 child words
   std::vector<uint32_t> pool_;   // [count, ids...] per leaf
-  // Derived in prepare() (not saved): dense top-level index, nodes with leaf words pointing into
-  // fast_, and fast_ = per leaf [count, ids..., pad, FastPrim x count], each record aligned to 64 B
-  // (128 B when longer than 64 B) so the whole record arrives with one memory round trip.
   template <typename T>
-  struct Aligned128 {
+  struct Aligned64 {
     using value_type = T;
-    Aligned128() = default;
+    Aligned64() = default;
     template <typename U>
-    Aligned128(const Aligned128<U>&) {}
-    T* allocate(size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(128))); }
-    void deallocate(T* p, size_t) { ::operator delete(p, std::align_val_t(128)); }
+    Aligned64(const Aligned64<U>&) {}
+    T* allocate(size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(64))); }
+    void deallocate(T* p, size_t) { ::operator delete(p, std::align_val_t(64)); }
     template <typename U>
-    bool operator==(const Aligned128<U>&) const { return true; }
+    bool operator==(const Aligned64<U>&) const { return true; }
     template <typename U>
-    bool operator!=(const Aligned128<U>&) const { return false; }
+    bool operator!=(const Aligned64<U>&) const { return false; }
   };
-  std::vector<uint32_t> index_;
-  std::vector<uint32_t> fnodes_;
-  std::vector<uint32_t, Aligned128<uint32_t>> fast_;
-  uint32_t index_nx_ = 0;
-  int index_shift_ = 0;
+  std::vector<uint32_t, Aligned64<uint32_t>> index_, blocks_, lpool_;
+  std::vector<FastPrim, Aligned64<FastPrim>> geom_;
+  uint32_t index_tiles_x_ = 0;
+  int index_shift_ = 0;  // finest-leaf index >> index_shift_ = index cell
+  int block_steps_ = 0;  // block levels below the index (ceil((max_depth - g) / 2))
+  int fast_k_ = 2;       // candidates the fast path always evaluates (2 or 4)
 };
 
 template <typename F>
