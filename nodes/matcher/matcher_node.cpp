@@ -59,10 +59,7 @@ class MatcherNode : public fploc::rt::Node {
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::MatcherOptions>();
-    if (o.plan().file().empty()) throw std::runtime_error("matcher.plan.file: no floor plan given");
-    const std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
-    map_ = fploc::load_localization_map(ctx.resolve_path(o.plan().file()), layers, o.plan().units(),
-                                        o.lookup().empty() ? "annf-exact" : o.lookup());
+    map_ = fploc::load_map(ctx, o.plan(), o.lookup(), "matcher");
     matcher_ = std::make_unique<fploc::Matcher>(*map_.lookup, config_of(o));
     use_imu_ = !o.ignore_imu();
     if (o.initial_search_m() > 0) initial_search_m_ = o.initial_search_m();

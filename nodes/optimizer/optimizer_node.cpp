@@ -60,10 +60,7 @@ class OptimizerNode : public fploc::rt::Node {
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::OptimizerOptions>();
-    if (o.plan().file().empty()) throw std::runtime_error("optimizer.plan.file: no floor plan given");
-    const std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
-    map_ = fploc::load_localization_map(ctx.resolve_path(o.plan().file()), layers, o.plan().units(),
-                                        o.lookup().empty() ? "annf-exact" : o.lookup());
+    map_ = fploc::load_map(ctx, o.plan(), o.lookup(), "optimizer");
     opt_ = std::make_unique<fploc::WindowOptimizer>(*map_.lookup, config_of(o));
     pose_out_ = ctx.advertise<fploc::pose_t>("pose");
     latest_out_ = ctx.advertise<fploc::pose_t>("latest");

@@ -38,10 +38,7 @@ class RelocalizerNode : public fploc::rt::Node {
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::RelocalizerOptions>();
-    if (o.plan().file().empty()) throw std::runtime_error("relocalizer.plan.file: no floor plan given");
-    const std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
-    map_ = fploc::load_localization_map(ctx.resolve_path(o.plan().file()), layers, o.plan().units(),
-                                        o.lookup().empty() ? "annf-exact" : o.lookup());
+    map_ = fploc::load_map(ctx, o.plan(), o.lookup(), "relocalizer");
     fploc::RelocalizerConfig c;
     if (o.grid_m() > 0) c.grid_m = o.grid_m();
     if (o.yaw_step_deg() > 0) c.yaw_step_deg = o.yaw_step_deg();

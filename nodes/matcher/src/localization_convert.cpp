@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "fploc/core/pose.h"
+#include "fploc/runtime/node.h"
 
 namespace fploc {
 
@@ -77,6 +78,13 @@ Pose2 pose2_of(const pose_t& m) {
   if (sp.q.squaredNorm() < 1e-12) sp.q = Eigen::Quaterniond::Identity();
   sp.q.normalize();
   return {m.position[0], m.position[1], sp.rpy()[2]};
+}
+
+LocalizationMap load_map(const rt::Context& ctx, const PlanSource& plan, const std::string& lookup,
+                         const std::string& node_field) {
+  if (plan.file().empty()) throw std::runtime_error(node_field + ".plan.file: no floor plan given");
+  const std::vector<std::string> layers(plan.layers().begin(), plan.layers().end());
+  return load_localization_map(ctx.resolve_path(plan.file()), layers, plan.units(), lookup.empty() ? "annf-exact" : lookup);
 }
 
 }  // namespace fploc

@@ -8,7 +8,13 @@
 #include <Eigen/Core>
 #include <string>
 
+#include "fploc/matcher/map.h"
 #include "fploc/matcher/types.h"
+#include "options/common.pb.h"
+
+namespace fploc::rt {
+class Context;
+}
 
 namespace fploc {
 
@@ -24,5 +30,10 @@ pose_t make_pose_msg(int64_t utime, int64_t seq, const Pose2& p, double roll, do
 
 // Pose2 from a pose_t (yaw of its quaternion).
 Pose2 pose2_of(const pose_t& m);
+
+// The localization map of a node's `plan` option (path relative to the graph, layer globs, units) with
+// the named look-up ("" = annf-exact). Throws naming `node_field`.plan.file when no plan is given.
+LocalizationMap load_map(const rt::Context& ctx, const PlanSource& plan, const std::string& lookup,
+                         const std::string& node_field);
 
 }  // namespace fploc
