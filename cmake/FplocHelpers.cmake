@@ -18,6 +18,9 @@ function(fploc_add_test NAME)
   if(A_LABELS)
     set_tests_properties(${NAME} PROPERTIES LABELS "${A_LABELS}")
   endif()
+  if(A_SERIAL)
+    set_tests_properties(${NAME} PROPERTIES RUN_SERIAL TRUE)
+  endif()
 endfunction()
 
 # fploc_add_benchmark(NAME SOURCES ... DEPS ...) -> Google Benchmark executable (not a test)
@@ -44,10 +47,12 @@ endfunction()
 
 set(FPLOC_SHARED_DIR "${PROJECT_SOURCE_DIR}/../shared" CACHE PATH "Shared data folder (tests skip when absent)")
 
-# fploc_add_netns_test(NAME COMMAND cmd args...) -> a ctest that runs inside its own network namespace
-# (scripts/netns-run: loopback only, multicast routed to lo), so processes talking LCM are isolated.
+# fploc_add_netns_test(NAME [SERIAL] COMMAND cmd args...) -> a ctest that runs inside its own network
+# namespace (scripts/netns-run: loopback only, multicast routed to lo), so processes talking LCM are
+# isolated. SERIAL: a real-time pipeline of many processes — no other test runs at the same time (CPU
+# starvation would make LCM drop whole scan messages, a property of the transport, not of the code).
 function(fploc_add_netns_test NAME)
-  cmake_parse_arguments(A "" "TIMEOUT" "COMMAND;LABELS" ${ARGN})
+  cmake_parse_arguments(A "SERIAL" "TIMEOUT" "COMMAND;LABELS" ${ARGN})
   add_test(NAME ${NAME} COMMAND ${PROJECT_SOURCE_DIR}/scripts/netns-run ${A_COMMAND})
   if(NOT A_TIMEOUT)
     set(A_TIMEOUT 300)
