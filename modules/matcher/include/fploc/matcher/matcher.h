@@ -17,8 +17,8 @@ struct MatcherConfig {
   double gate_tracking_m = 0.3;   // first gate while tracking (previous frame OK): the motion model is good to
                                   // centimetres, and structures not in the plan running parallel to it a few
                                   // decimetres away (cabinets along a wall) stay out of the correspondences
-  double loss_scale_m = 0.05;     // robust (Huber) loss scale
-  std::string loss = "huber";     // "huber", "cauchy", "none"
+  double loss_scale_m = 0.05;     // robust loss scale
+  std::string loss = "cauchy";    // "cauchy" (redescending: clutter in front of walls is rejected), "huber", "none"
   int max_iterations = 10;        // Ceres iterations per outer iteration
   int max_outer = 5;              // look-up + solve rounds (x6 for point targets, see matcher.cpp)
   double initial_search_yaw_rad = 10 * M_PI / 180;  // default yaw uncertainty of a pose given by set_pose

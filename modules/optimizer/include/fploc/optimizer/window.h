@@ -34,7 +34,7 @@ struct OptimizerConfig {
   double keyframe_angle_rad = 5.0 * M_PI / 180;
   double gate_m = 0.3;                 // correspondence gate around the current estimate
   double loss_scale_m = 0.05;
-  std::string loss = "huber";
+  std::string loss = "cauchy";    // as MatcherConfig::loss
   int max_iterations = 10;             // Ceres iterations per outer round
   int outer = 2;                       // look-up + solve rounds per new keyframe
   bool group_rule = true;
