@@ -65,8 +65,9 @@ int main(int argc, char** argv) {
     const auto r = eval::rpe(gt, est, pairs, delta, unit == "f");
     if (!plot.empty()) {
       std::ofstream out(plot);
-      out << eval::plot_svg(gt, est, "ATE RMSE " + std::to_string(a.trans.rmse).substr(0, 6) + " m (" + align_s +
-                                         " alignment), " + std::to_string(pairs.size()) + " poses", a.S);
+      out << eval::plot_svg(gt, est, "ATE RMSE " + std::to_string(a.trans.rmse).substr(0, 6) + " m (" +
+                                         (align_s == "none" ? std::string("no") : align_s) + " alignment), " +
+                                         std::to_string(pairs.size()) + " poses", a.S);
       if (!out) throw std::runtime_error(plot + ": cannot write");
     }
     auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
