@@ -11,17 +11,6 @@
 
 namespace fploc::amcl {
 
-// ---- SE(2) ----------------------------------------------------------------------------------------
-Pose2 compose(const Pose2& a, const Pose2& b) {
-  const double c = std::cos(a.yaw), s = std::sin(a.yaw);
-  return {a.x + c * b.x - s * b.y, a.y + s * b.x + c * b.y, wrap_angle(a.yaw + b.yaw)};
-}
-
-Pose2 inverse(const Pose2& a) {
-  const double c = std::cos(a.yaw), s = std::sin(a.yaw);
-  return {-c * a.x - s * a.y, s * a.x - c * a.y, wrap_angle(-a.yaw)};
-}
-
 namespace {
 // nav2 angleutils::angle_diff(a, b): the smaller signed difference a - b.
 double angle_diff(double a, double b) { return wrap_angle(wrap_angle(a) - wrap_angle(b)); }

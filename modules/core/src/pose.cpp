@@ -14,6 +14,16 @@ double wrap_angle(double a) {
   return a - M_PI;
 }
 
+Pose2 compose(const Pose2& a, const Pose2& b) {
+  const double c = std::cos(a.yaw), s = std::sin(a.yaw);
+  return {a.x + c * b.x - s * b.y, a.y + s * b.x + c * b.y, wrap_angle(a.yaw + b.yaw)};
+}
+
+Pose2 inverse(const Pose2& a) {
+  const double c = std::cos(a.yaw), s = std::sin(a.yaw);
+  return {-c * a.x - s * a.y, s * a.x - c * a.y, wrap_angle(-a.yaw)};
+}
+
 Eigen::Isometry3d StampedPose::iso() const {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = q.normalized().toRotationMatrix();

@@ -42,11 +42,6 @@ Twist2 log_twist(const Pose2& p, const Pose2& q, double dt) {
   return {(a * rx + b * ry) / d / dt, (-b * rx + a * ry) / d / dt, th / dt};
 }
 
-Pose2 compose(const Pose2& a, const Pose2& b) {
-  const double c = std::cos(a.yaw), s = std::sin(a.yaw);
-  return {a.x + c * b.x - s * b.y, a.y + s * b.x + c * b.y, wrap_angle(a.yaw + b.yaw)};
-}
-
 
 void deskew(const FeatureFrame& raw, const Twist2& v, double t_ref, FeatureFrame* out) {
   if (out != &raw) {

@@ -30,10 +30,7 @@
 
 namespace fploc::amcl {
 
-// ---- small SE(2) helpers ----------------------------------------------------------------------
-Pose2 compose(const Pose2& a, const Pose2& b);   // a * b
-Pose2 inverse(const Pose2& a);
-inline Pose2 between(const Pose2& a, const Pose2& b) { return compose(inverse(a), b); }  // a^-1 * b
+// ---- small SE(2) helpers (compose / inverse / between: fploc/core/pose.h) ------------------------
 inline bool finite(const Pose2& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.yaw); }
 
 // ---- configuration (defaults = nav2's parameter defaults) ------------------------------------------

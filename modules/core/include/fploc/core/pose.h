@@ -15,6 +15,11 @@ struct Pose2 {
 // Wraps an angle to (-pi, pi].
 double wrap_angle(double a);
 
+// SE(2): a (+) b (b expressed in a's frame, composed), the inverse, and a^-1 (+) b.
+Pose2 compose(const Pose2& a, const Pose2& b);
+Pose2 inverse(const Pose2& a);
+inline Pose2 between(const Pose2& a, const Pose2& b) { return compose(inverse(a), b); }
+
 struct StampedPose {
   double t = 0;  // seconds
   Eigen::Vector3d p = Eigen::Vector3d::Zero();

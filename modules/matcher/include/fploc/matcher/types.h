@@ -42,8 +42,6 @@ struct Twist2 {
 Pose2 exp_twist(const Twist2& v, double t);
 // The constant body twist that takes pose a to pose b in dt seconds (SE(2) logarithm / dt).
 Twist2 log_twist(const Pose2& a, const Pose2& b, double dt);
-// a (+) b: b expressed in a's frame, composed.
-Pose2 compose(const Pose2& a, const Pose2& b);
 
 // Motion compensation: every point, measured at f.utime + p.t from the moving sensor, expressed in the
 // sensor frame at f.utime + t_ref, assuming the body twist v over the sweep:
