@@ -112,6 +112,14 @@ function schedulePoseBox() {
   setTimeout(() => { poseBoxPending = false; renderPoseBox(); }, 100);
 }
 
+// Every input's latency, for the tooltip of the latency cells.
+function portLatencies(n) {
+  const lines = (n.ports || []).filter((p) => !p.output)
+    .map((p) => `${p.port} (${p.channel}): ${fmt(p.rate_hz, 1)} Hz, p50 ${fmt(p.latency_p50_ms, 2)} ms, p99 ${fmt(p.latency_p99_ms, 2)} ms`);
+  lines.push(`all handlers and timers: p50 ${fmt(n.latency_p50_ms, 2)} ms, p99 ${fmt(n.latency_p99_ms, 2)} ms`);
+  return lines.join('\n');
+}
+
 function renderNodes(msg) {
   S.nodes = msg.nodes;
   const body = $('nodes').tBodies[0];
@@ -122,12 +130,15 @@ function renderNodes(msg) {
     tr.dataset.health = n.health;
     const state = n.health === 'bad' ? (n.reason || n.state) : n.state + (n.reporter === 'launcher' ? ' (launcher)' : '');
     const seen = n.age_s !== null, num = (v, d) => (seen ? fmt(v, d) : '–');
-    const cells = [n.node, state, num(n.rate_hz, 1), num(n.latency_p50_ms, 2), num(n.latency_p99_ms, 2), num(n.cpu_percent, 1),
+    const work = n.work_port !== null && n.work_port !== undefined;
+    const cells = [n.node, state, num(n.rate_hz, 1), work ? n.work_port : '–',
+      num(work ? n.work_p50_ms : n.latency_p50_ms, 2), num(work ? n.work_p99_ms : n.latency_p99_ms, 2), num(n.cpu_percent, 1),
       String(n.dropped), String(n.restarts), n.age_s === null ? 'never' : `${fmt(n.age_s, 1)} s ago`, n.last_error || ''];
     for (const [i, text] of cells.entries()) {
       const td = document.createElement('td');
       td.textContent = text;
       if (i === 0) td.title = `${n.executable} pid ${n.pid}`;
+      if (i >= 3 && i <= 5) td.title = portLatencies(n);
       if (i === cells.length - 1) td.title = text;
       tr.append(td);
     }

@@ -321,6 +321,9 @@ void Model::rebuild_nodes(double now_s, int64_t wall_us) {
     double out_rate = 0, in_rate = 0;
     bool has_out = false;
     json ports = json::array();
+    // The input whose handler takes longest (p50) is where the node does its work: the matcher's
+    // features, not its 100 Hz IMU, whose microseconds would otherwise be the node's median.
+    const fploc::port_stats_t* work = nullptr;
     for (const auto& p : s.ports) {
       (p.output ? out_rate : in_rate) += p.rate_hz;
       has_out = has_out || p.output;
@@ -329,7 +332,10 @@ void Model::rebuild_nodes(double now_s, int64_t wall_us) {
                        {"output", bool(p.output)},
                        {"messages", p.messages},
                        {"rate_hz", num(p.rate_hz)},
-                       {"dropped", p.dropped}});
+                       {"dropped", p.dropped},
+                       {"latency_p50_ms", num(r6(p.latency_p50_ms))},
+                       {"latency_p99_ms", num(r6(p.latency_p99_ms))}});
+      if (!p.output && p.rate_hz > 0 && (!work || p.latency_p50_ms > work->latency_p50_ms)) work = &p;
     }
     arr.push_back({{"node", name},
                    {"executable", s.executable},
@@ -340,6 +346,9 @@ void Model::rebuild_nodes(double now_s, int64_t wall_us) {
                    {"cpu_percent", num(r6(s.cpu_percent))},
                    {"latency_p50_ms", num(r6(s.latency_p50_ms))},
                    {"latency_p99_ms", num(r6(s.latency_p99_ms))},
+                   {"work_port", work ? json(work->port) : json(nullptr)},
+                   {"work_p50_ms", work ? num(r6(work->latency_p50_ms)) : json(nullptr)},
+                   {"work_p99_ms", work ? num(r6(work->latency_p99_ms)) : json(nullptr)},
                    {"messages_in", s.messages_in},
                    {"messages_out", s.messages_out},
                    {"rate_hz", num(r6(has_out ? out_rate : in_rate))},

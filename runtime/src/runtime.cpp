@@ -151,6 +151,7 @@ static void raw_handler(const lcm::ReceiveBuffer* rbuf, const std::string&, Hand
     h->ctx->stats().cpu_s_total += thread_cpu_s() - c0;
   } else {
     h->ctx->stats().latency.add(dt * 1e3);
+    h->counters->latency.add(dt * 1e3);
   }
   h->ctx->stats().busy_s_period += dt;
 }
@@ -276,6 +277,8 @@ static fploc::node_status_t make_status(Context& ctx, const std::string& executa
     ps.rate_hz = double(p.period_messages);  // per 1 s period, corrected by the caller
     ps.dropped = p.dropped;
     ps.undecodable = p.undecodable;
+    ps.latency_p50_ms = p.latency.percentile(0.5);
+    ps.latency_p99_ms = p.latency.percentile(0.99);
     s.ports.push_back(ps);
   }
   s.num_ports = int32_t(s.ports.size());

@@ -66,7 +66,10 @@ int64_t NodeStats::undecodable() const {
   return n;
 }
 void NodeStats::end_period() {
-  for (auto& p : ports) p.period_messages = 0;
+  for (auto& p : ports) {
+    p.period_messages = 0;
+    p.latency.reset();
+  }
   latency.reset();
   busy_s_period = 0;
 }

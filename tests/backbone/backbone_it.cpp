@@ -225,6 +225,13 @@ TEST_F(Backbone, KilledNodeIsBackWithinOneSecondAndSigintStopsAll) {
   for (const auto& s : tel.seen)
     if (s.reporter == "node" && s.pid != old_pid) pids.insert(s.pid);
   ASSERT_GE(pids.size(), 2u);
+  // Per-input latency in the heartbeat: the logger's pose port received messages and timed them.
+  bool port_latency = false;
+  for (const auto& s : tel.seen)
+    for (const auto& p : s.ports)
+      if (s.node == "logger" && p.port == "pose" && !p.output && p.rate_hz > 0)
+        port_latency |= p.latency_p99_ms > 0 && p.latency_p99_ms >= p.latency_p50_ms;
+  EXPECT_TRUE(port_latency) << "no logger heartbeat with the pose port's latency";
   const double t_int = now_s();
   kill(launcher.pid, SIGINT);
   const int st = launcher.wait(10);

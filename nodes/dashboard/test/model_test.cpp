@@ -72,6 +72,44 @@ TEST(DashboardModel, NodeTurnsRedWhenSilentOrRestartingAndGreenAgain) {
   EXPECT_EQ(health(), "bad");
 }
 
+static fploc::port_stats_t input(const std::string& port, double rate_hz, double p50, double p99) {
+  fploc::port_stats_t p{};
+  p.port = port;
+  p.channel = "FPLOC_" + port;
+  p.rate_hz = rate_hz;
+  p.latency_p50_ms = p50;
+  p.latency_p99_ms = p99;
+  return p;
+}
+
+TEST(DashboardModel, LatencyShownIsThatOfTheBusiestInput) {
+  Model m;
+  fploc::node_status_t s{};
+  s.node = "matcher";
+  s.state = "running";
+  s.latency_p50_ms = 0.01;  // node-wide: dominated by the 100 Hz IMU
+  s.latency_p99_ms = 3.9;
+  s.ports = {input("imu", 100, 0.01, 0.02), input("features", 10, 3.5, 3.9), input("initial_pose", 0, 9, 9)};
+  fploc::port_stats_t out{};
+  out.port = "frame_pose";
+  out.output = true;
+  out.rate_hz = 10;
+  s.ports.push_back(out);
+  s.num_ports = int32_t(s.ports.size());
+  m.on_status(s, 1.0);
+  const auto n = json::parse(m.state_json())["nodes"]["nodes"][0];
+  EXPECT_EQ(n["work_port"], "features");  // initial_pose is slower but received nothing this period
+  EXPECT_DOUBLE_EQ(n["work_p50_ms"].get<double>(), 3.5);
+  EXPECT_DOUBLE_EQ(n["work_p99_ms"].get<double>(), 3.9);
+  EXPECT_DOUBLE_EQ(n["latency_p50_ms"].get<double>(), 0.01);
+  EXPECT_DOUBLE_EQ(n["ports"][0]["latency_p99_ms"].get<double>(), 0.02);
+
+  s.ports = {out};  // a source: no input, the page falls back to the node-wide numbers
+  s.num_ports = 1;
+  m.on_status(s, 2.0);
+  EXPECT_TRUE(json::parse(m.state_json())["nodes"]["nodes"][0]["work_port"].is_null());
+}
+
 TEST(DashboardModel, ExpectedNodeIsListedBeforeItsFirstHeartbeat) {
   Model m;  // silent_after_s = 2
   m.expect_node("optimizer", "fploc-optimizer", 0.0);

@@ -7,21 +7,6 @@
 
 namespace fploc::rt {
 
-struct PortCounters {
-  std::string port, channel;
-  bool output = false;
-  int64_t messages = 0;        // since start
-  int64_t period_messages = 0; // since the last heartbeat
-  int64_t dropped = 0;
-  int64_t undecodable = 0;
-  int64_t last_seq = -1;
-  // Sequence gaps on an input are counted as drops; a restart of the publisher (seq going back) is not.
-  void observe_seq(int64_t seq) {
-    if (last_seq >= 0 && seq > last_seq + 1) dropped += seq - last_seq - 1;
-    last_seq = seq;
-  }
-};
-
 // Exact percentiles of the samples since the last reset.
 class LatencyWindow {
  public:
@@ -34,6 +19,22 @@ class LatencyWindow {
 
  private:
   std::vector<double> samples_;
+};
+
+struct PortCounters {
+  std::string port, channel;
+  bool output = false;
+  int64_t messages = 0;        // since start
+  int64_t period_messages = 0; // since the last heartbeat
+  int64_t dropped = 0;
+  int64_t undecodable = 0;
+  int64_t last_seq = -1;
+  LatencyWindow latency;       // inputs: this port's handler latency this period
+  // Sequence gaps on an input are counted as drops; a restart of the publisher (seq going back) is not.
+  void observe_seq(int64_t seq) {
+    if (last_seq >= 0 && seq > last_seq + 1) dropped += seq - last_seq - 1;
+    last_seq = seq;
+  }
 };
 
 // CPU time of this process as a percentage of one core between two calls.
