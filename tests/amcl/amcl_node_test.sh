@@ -5,7 +5,9 @@
 #     pose per scan that had odometry, no jump in the output, still tracking; two replays byte-identical;
 #  2. the real pipeline (graphs/amcl.pbtxt: simulator log -> segmenter -> features -> LiDAR odometry ->
 #     AMCL with LiDAR odometry and with simulated wheel odometry): one pose per scan, tracking, two
-#     replays byte-identical.
+#     replays byte-identical;
+#  3. the comparison driver (modules/amcl/bench/amcl_sequences.py) on a short sequence: every one of the
+#     six trajectories scored, one pose per scan, no node error.
 set -euo pipefail
 BIN="${FPLOC_BUILD_DIR:?}/bin"
 ROOT="${FPLOC_ROOT:?}"
@@ -90,5 +92,17 @@ for n in ("amcl_lidar", "amcl_wheel"):
     if max(err) >= 0.4:
         print(f"FAIL: {n} lost track"); ok = False
 sys.exit(0 if ok else 1)
+PY
+echo "--- 3. modules/amcl/bench/amcl_sequences.py, 6 s"
+python3 "$ROOT/modules/amcl/bench/amcl_sequences.py" --scenario room-small-loop-fast --duration 6 \
+  > "$T/seq.json" 2> "$T/seq.log" || { cat "$T/seq.log"; echo "FAIL: amcl_sequences.py"; exit 1; }
+tail -1 "$T/seq.log"
+python3 - "$T/seq.json" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))["rows"][0]
+bad = [k for k in ("amcl_lidar", "amcl_wheel", "wheel_odom", "sfr", "wo", "odom")
+       if not r.get(k) or r[k]["poses"] != r["frames"]]
+if bad or r["node_errors"]:
+    sys.exit(f"FAIL: trajectories missing or short: {bad}, node errors {r['node_errors']}")
 PY
 echo "amcl node tests passed"

@@ -23,91 +23,20 @@
 #include <thread>
 #include <vector>
 
+#include "../support/process.h"
+
 namespace fs = std::filesystem;
+using namespace fploc::test;
 
 namespace {
 
-std::string env(const char* k, const std::string& d = "") {
-  const char* v = getenv(k);
-  return v ? v : d;
-}
-const std::string kRoot = env("FPLOC_ROOT", FPLOC_SOURCE_DIR);
-std::string bin(const std::string& exe) { return env("FPLOC_BUILD_DIR", kRoot + "/build") + "/bin/" + exe; }
+const std::string kRoot = root();
 std::string graph(const std::string& name) { return kRoot + "/graphs/" + name; }
-double now_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-std::string slurp(const std::string& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 std::string lcm_url_of(const std::string& graph_file) {
   std::smatch m;
   const std::string text = slurp(graph_file);
   if (std::regex_search(text, m, std::regex("lcm_url:\\s*\"([^\"]*)\""))) return m[1];
   return "";
-}
-
-// A child process with stdout/stderr redirected to files in the test folder.
-struct Proc {
-  pid_t pid = -1;
-  std::string err_file;
-  static Proc spawn(const std::vector<std::string>& args, const std::string& dir, const std::string& tag) {
-    Proc p;
-    p.err_file = dir + "/" + tag + ".stderr";
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    p.pid = fork();
-    if (p.pid == 0) {
-      if (chdir(dir.c_str()) != 0) _exit(126);
-      const int e = open(p.err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      const int o = open((dir + "/" + tag + ".stdout").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      dup2(e, 2);
-      dup2(o, 1);
-      execv(argv[0], argv.data());
-      _exit(127);
-    }
-    return p;
-  }
-  // Waits up to timeout_s; returns the wait status or -1 on timeout.
-  int wait(double timeout_s) {
-    const double t0 = now_s();
-    int st = 0;
-    while (now_s() - t0 < timeout_s) {
-      const pid_t r = waitpid(pid, &st, WNOHANG);
-      if (r == pid) {
-        pid = -1;
-        return st;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    return -1;
-  }
-  ~Proc() {
-    if (pid > 0) {
-      kill(pid, SIGKILL);
-      waitpid(pid, nullptr, 0);
-    }
-  }
-};
-
-int run(const std::vector<std::string>& args, const std::string& dir, const std::string& tag, double timeout = 60) {
-  Proc p = Proc::spawn(args, dir, tag);
-  const int st = p.wait(timeout);
-  return st < 0 ? -1 : (WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st));
-}
-
-bool alive(pid_t pid) {
-  if (kill(pid, 0) != 0) return false;
-  // A zombie is gone for our purposes (its parent reaps it).
-  std::ifstream st("/proc/" + std::to_string(pid) + "/stat");
-  std::string s;
-  std::getline(st, s);
-  const auto rp = s.rfind(')');
-  return !(rp != std::string::npos && rp + 2 < s.size() && s[rp + 2] == 'Z');
 }
 
 // Listens to FPLOC_TELEMETRY in the test.
@@ -237,7 +166,7 @@ TEST_F(Backbone, KilledNodeIsBackWithinOneSecondAndSigintStopsAll) {
   const int st = launcher.wait(10);
   ASSERT_GE(st, 0) << "launcher did not exit";
   EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << slurp(launcher.err_file);
-  for (int p : pids) EXPECT_FALSE(alive(p)) << "pid " << p << " outlived the launcher";
+  for (int p : pids) EXPECT_FALSE(pid_alive(p)) << "pid " << p << " outlived the launcher";
   const double ds = now_s() - t_int;
   EXPECT_LT(ds, 5.0);
   std::cerr << "shutdown (SIGINT -> launcher and all nodes gone): " << int(ds * 1000) << " ms\n";
@@ -260,7 +189,7 @@ TEST_F(Backbone, LauncherKilledTakesNodesWithIt) {
   bool any = true;
   while (any && now_s() - t0 < 3) {
     any = false;
-    for (int p : pids) any |= alive(p);
+    for (int p : pids) any |= pid_alive(p);
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   EXPECT_FALSE(any) << "a node outlived a SIGKILLed launcher";

@@ -28,69 +28,18 @@
 #include <thread>
 #include <vector>
 
+#include "../support/process.h"
 #include "fploc/nodes/convert.h"
 #include "fploc/sim/simulator.h"
 
 namespace fs = std::filesystem;
+using namespace fploc::test;
 
 namespace {
 
-std::string env(const char* k, const std::string& d = "") {
-  const char* v = getenv(k);
-  return v ? v : d;
-}
-const std::string kRoot = env("FPLOC_ROOT", FPLOC_SOURCE_DIR);
+const std::string kRoot = root();
 const std::string kGraph = kRoot + "/tests/perception/perception_it.pbtxt";
 const std::string kUrl = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608";  // as in the graph
-std::string bin(const std::string& exe) { return env("FPLOC_BUILD_DIR", kRoot + "/build") + "/bin/" + exe; }
-double now_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-std::string slurp(const std::string& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-// A node process (stderr to a file in the test folder), killed at the end if still running.
-struct Proc {
-  pid_t pid = -1;
-  std::string err_file;
-  static Proc spawn(const std::vector<std::string>& args, const std::string& dir, const std::string& tag) {
-    Proc p;
-    p.err_file = dir + "/" + tag + ".stderr";
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    p.pid = fork();
-    if (p.pid == 0) {
-      if (chdir(dir.c_str()) != 0) _exit(126);
-      const int e = open(p.err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      dup2(e, 2);
-      dup2(e, 1);
-      execv(argv[0], argv.data());
-      _exit(127);
-    }
-    return p;
-  }
-  bool alive() const {
-    if (pid <= 0) return false;
-    int st = 0;
-    return waitpid(pid, &st, WNOHANG) == 0;
-  }
-  Proc() = default;
-  Proc(Proc&& o) noexcept : pid(o.pid), err_file(std::move(o.err_file)) { o.pid = -1; }
-  ~Proc() {
-    if (pid > 0) {
-      kill(pid, SIGINT);
-      for (int i = 0; i < 100 && waitpid(pid, nullptr, WNOHANG) == 0; ++i)
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
-      kill(pid, SIGKILL);
-      waitpid(pid, nullptr, 0);
-    }
-  }
-};
 
 // Everything the test hears on the bus.
 struct Listener {

@@ -26,6 +26,18 @@ import tempfile
 
 ROOT = os.environ.get("FPLOC_ROOT") or os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 BIN = os.environ.get("FPLOC_BIN") or os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(ROOT, "tools", "pylib"))
+import fploc_tools  # noqa: E402
+from fploc_tools import log, read_tum, yaw_of  # noqa: E402
+
+
+def run(cmd):
+    return fploc_tools.run(cmd, "fploc bench paper")
+
+
+def evaluate(gt, est, plot=None):
+    return fploc_tools.fploc_eval(BIN, gt, est, "fploc bench paper", plot)
+
 
 # Paper Table I (room: SFR and WO) and Table II (corridor: FP-Loc and LeGO-LOAM): ATE/RPE [m], speeds.
 PAPER = {
@@ -49,25 +61,7 @@ LOOKUPS = ("annf-exact", "annf-paper", "annf-paper-first", "kdtree", "brute-forc
 SCAN_HZ = 10.0
 
 
-def log(msg):
-    print(msg, file=sys.stderr, flush=True)
 
-
-def run(cmd):
-    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    if r.returncode != 0:
-        log(r.stderr[-4000:])
-        raise SystemExit(f"fploc bench paper: {os.path.basename(cmd[0])} failed (exit {r.returncode}): {' '.join(cmd)}")
-    return r.stdout, r.stderr
-
-
-def read_tum(path):
-    rows = []
-    with open(path) as f:
-        for line in f:
-            if line.strip() and not line.startswith("#"):
-                rows.append([float(v) for v in line.split()])
-    return rows
 
 
 def motion_stats(gt):
@@ -85,18 +79,6 @@ def motion_stats(gt):
     return length, (length / moving if moving > 0 else 0.0), vmax
 
 
-def yaw_of(row):
-    qx, qy, qz, qw = row[4:8]
-    return math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
-
-
-def evaluate(gt, est, plot=None):
-    if not os.path.exists(est) or os.path.getsize(est) == 0:
-        return None
-    cmd = [os.path.join(BIN, "fploc-eval"), "--gt", gt, "--est", est, "--json"]
-    if plot:
-        cmd += ["--plot", plot]
-    return json.loads(run(cmd)[0])
 
 
 class Bench:

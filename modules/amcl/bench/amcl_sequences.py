@@ -31,35 +31,16 @@ import tempfile
 ROOT = os.environ.get("FPLOC_ROOT") or os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 BUILD = os.environ.get("FPLOC_BUILD_DIR") or os.path.join(ROOT, "build")
 BIN = os.path.join(BUILD, "bin")
+sys.path.insert(0, os.path.join(ROOT, "tools", "pylib"))
+import fploc_tools  # noqa: E402
+from fploc_tools import log, read_tum, yaw_of  # noqa: E402
 SEQUENCES = [f"{s}-{v}" for s in ("room-small-loop", "room-large-loop", "room-no-loop", "corridor-loop")
              for v in ("slow", "medium", "fast")]
 TRAJ = ("amcl_lidar", "amcl_wheel", "wheel_odom", "sfr", "wo", "odom")
 
 
-def log(msg):
-    print(msg, file=sys.stderr, flush=True)
 
 
-def run(cmd):
-    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    if r.returncode != 0:
-        log(r.stderr[-4000:])
-        raise SystemExit(f"amcl_sequences: {os.path.basename(cmd[0])} failed (exit {r.returncode})")
-    return r.stdout, r.stderr
-
-
-def read_tum(path):
-    rows = []
-    with open(path) as f:
-        for line in f:
-            if line.strip() and not line.startswith("#"):
-                rows.append([float(v) for v in line.split()])
-    return rows
-
-
-def yaw_of(row):
-    qx, qy, qz, qw = row[4:8]
-    return math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
 
 
 def ate_xy(gt, est, max_dt=0.02):
@@ -117,15 +98,18 @@ def settled(gt, est, bound=0.4, max_dt=0.02):
             "first_below_index": first, "scans": len(err)}
 
 
+def run(cmd):
+    return fploc_tools.run(cmd, "amcl_sequences")
+
+
 def length_m(gt):
     return sum(math.dist(a[1:3], b[1:3]) for a, b in zip(gt, gt[1:]))
 
 
 def evaluate(gt_path, est_path):
-    if not os.path.exists(est_path) or os.path.getsize(est_path) == 0:
+    j = fploc_tools.fploc_eval(BIN, gt_path, est_path, "amcl_sequences")
+    if j is None:
         return None
-    out, _ = run([os.path.join(BIN, "fploc-eval"), "--gt", gt_path, "--est", est_path, "--json"])
-    j = json.loads(out)
     g, e = read_tum(gt_path), read_tum(est_path)
     xy, xy_max = ate_xy(g, e)
     return {"ate_m": j["ate_rmse_m"], "ate_max_m": j.get("ate_max_m"), "rpe_m": j["rpe_mean_m"],

@@ -657,23 +657,7 @@ void Annf::batch_impl(const Eigen::Vector2d* pts, size_t n, int* ids, double* di
 #if defined(__SSE2__)
       // Two points per SSE2 operation (lanes = points k, k + 1; the same arithmetic per lane as
       // best_of_record(), so the results are bit-identical): half the instructions per point.
-      const __m128d zero = _mm_setzero_pd(), sign = _mm_set1_pd(-0.0);
-      auto dist2 = [&](__m128d px, __m128d py, uint32_t e0, uint32_t e1) {
-        const double* g0 = &geom[e0].ax;
-        const double* g1 = &geom[e1].ax;
-        const __m128d a0 = _mm_load_pd(g0), a1 = _mm_load_pd(g1);
-        const __m128d d0 = _mm_load_pd(g0 + 2), d1 = _mm_load_pd(g1 + 2);
-        const __m128d r0 = _mm_load_pd(g0 + 4), r1 = _mm_load_pd(g1 + 4);
-        const __m128d ax = _mm_unpacklo_pd(a0, a1), ay = _mm_unpackhi_pd(a0, a1);
-        const __m128d ux = _mm_unpacklo_pd(d0, d1), uy = _mm_unpackhi_pd(d0, d1);
-        const __m128d len = _mm_unpacklo_pd(r0, r1), rad = _mm_unpackhi_pd(r0, r1);
-        const __m128d vx = _mm_sub_pd(px, ax), vy = _mm_sub_pd(py, ay);
-        const __m128d along = _mm_add_pd(_mm_mul_pd(vx, ux), _mm_mul_pd(vy, uy));
-        const __m128d perp = _mm_sub_pd(_mm_mul_pd(vx, uy), _mm_mul_pd(vy, ux));
-        const __m128d over = _mm_sub_pd(along, _mm_min_pd(len, _mm_max_pd(along, zero)));
-        const __m128d e = _mm_sqrt_pd(_mm_add_pd(_mm_mul_pd(perp, perp), _mm_mul_pd(over, over)));
-        return _mm_andnot_pd(sign, _mm_sub_pd(e, rad));
-      };
+      auto dist2 = [&](__m128d px, __m128d py, uint32_t e0, uint32_t e1) { return distance2(geom, e0, e1, px, py); };
       for (; k + 1 < m; k += 2) {
         const uint32_t* r0 = lp + (words[k] & ~kLeafBit);
         const uint32_t* r1 = lp + (words[k + 1] & ~kLeafBit);

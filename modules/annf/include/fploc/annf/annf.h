@@ -191,6 +191,28 @@ class Annf {
     }
   };
   static_assert(sizeof(FastPrim) == 48);
+#if defined(__SSE2__)
+  // FastPrim::distance of two elements in the two SSE2 lanes (lane k: element ek, point (px[k], py[k]));
+  // the same arithmetic per lane as FastPrim::distance, so the results are bit-identical.
+  [[gnu::always_inline]] static __m128d distance2(const FastPrim* geom, uint32_t e0, uint32_t e1, __m128d px,
+                                                  __m128d py) {
+    const __m128d zero = _mm_setzero_pd(), sign = _mm_set1_pd(-0.0);
+    const double* g0 = &geom[e0].ax;
+    const double* g1 = &geom[e1].ax;
+    const __m128d a0 = _mm_load_pd(g0), a1 = _mm_load_pd(g1);
+    const __m128d d0 = _mm_load_pd(g0 + 2), d1 = _mm_load_pd(g1 + 2);
+    const __m128d r0 = _mm_load_pd(g0 + 4), r1 = _mm_load_pd(g1 + 4);
+    const __m128d ax = _mm_unpacklo_pd(a0, a1), ay = _mm_unpackhi_pd(a0, a1);
+    const __m128d ux = _mm_unpacklo_pd(d0, d1), uy = _mm_unpackhi_pd(d0, d1);
+    const __m128d len = _mm_unpacklo_pd(r0, r1), rad = _mm_unpackhi_pd(r0, r1);
+    const __m128d vx = _mm_sub_pd(px, ax), vy = _mm_sub_pd(py, ay);
+    const __m128d along = _mm_add_pd(_mm_mul_pd(vx, ux), _mm_mul_pd(vy, uy));
+    const __m128d perp = _mm_sub_pd(_mm_mul_pd(vx, uy), _mm_mul_pd(vy, ux));
+    const __m128d over = _mm_sub_pd(along, _mm_min_pd(len, _mm_max_pd(along, zero)));
+    const __m128d e = _mm_sqrt_pd(_mm_add_pd(_mm_mul_pd(perp, perp), _mm_mul_pd(over, over)));
+    return _mm_andnot_pd(sign, _mm_sub_pd(e, rad));
+  }
+#endif
 
   // Look-up structure derived from the tree in prepare() (not saved): the tree's top levels as a
   // dense index at depth g (4 x 4 cells per 64-byte line), and below it the tree re-grouped into
@@ -259,33 +281,16 @@ class Annf {
 #else
     const __m128d pp = _mm_loadu_pd(p.data());
     const __m128d px = _mm_unpacklo_pd(pp, pp), py = _mm_unpackhi_pd(pp, pp);
-    const __m128d zero = _mm_setzero_pd(), sign = _mm_set1_pd(-0.0);
-    auto pair = [&](uint32_t i0, uint32_t i1) {  // FastPrim::distance for two candidates
-      const double* g0 = &geom[i0].ax;
-      const double* g1 = &geom[i1].ax;
-      const __m128d a0 = _mm_load_pd(g0), a1 = _mm_load_pd(g1);
-      const __m128d d0 = _mm_load_pd(g0 + 2), d1 = _mm_load_pd(g1 + 2);
-      const __m128d r0 = _mm_load_pd(g0 + 4), r1 = _mm_load_pd(g1 + 4);
-      const __m128d ax = _mm_unpacklo_pd(a0, a1), ay = _mm_unpackhi_pd(a0, a1);
-      const __m128d ux = _mm_unpacklo_pd(d0, d1), uy = _mm_unpackhi_pd(d0, d1);
-      const __m128d len = _mm_unpacklo_pd(r0, r1), rad = _mm_unpackhi_pd(r0, r1);
-      const __m128d vx = _mm_sub_pd(px, ax), vy = _mm_sub_pd(py, ay);
-      const __m128d along = _mm_add_pd(_mm_mul_pd(vx, ux), _mm_mul_pd(vy, uy));
-      const __m128d perp = _mm_sub_pd(_mm_mul_pd(vx, uy), _mm_mul_pd(vy, ux));
-      const __m128d over = _mm_sub_pd(along, _mm_min_pd(len, _mm_max_pd(along, zero)));
-      const __m128d e = _mm_sqrt_pd(_mm_add_pd(_mm_mul_pd(perp, perp), _mm_mul_pd(over, over)));
-      return _mm_andnot_pd(sign, _mm_sub_pd(e, rad));
-    };
     // Branch-free selection; the first of equal candidates wins.
     const uint32_t i0 = rec[1], i1 = rec[2];
-    const __m128d d01 = pair(i0, i1);
+    const __m128d d01 = distance2(geom, i0, i1, px, py);
     double bd = _mm_cvtsd_f64(d01);
     const double d1 = _mm_cvtsd_f64(_mm_unpackhi_pd(d01, d01));
     uint32_t best = d1 < bd ? i1 : i0;
     bd = d1 < bd ? d1 : bd;
     if (rec[0] > 2) {  // 3 or 4 candidates (always in exact mode with fast_k_ = 4)
       const uint32_t i2 = rec[3], i3 = rec[4];
-      const __m128d d23 = pair(i2, i3);
+      const __m128d d23 = distance2(geom, i2, i3, px, py);
       const double d2 = _mm_cvtsd_f64(d23), d3 = _mm_cvtsd_f64(_mm_unpackhi_pd(d23, d23));
       best = d2 < bd ? i2 : best;
       bd = d2 < bd ? d2 : bd;

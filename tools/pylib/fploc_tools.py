@@ -1,0 +1,45 @@
+"""Helpers shared by fploc's Python benchmark drivers (tools/bench_paper, modules/amcl/bench): running
+the built programs, reading TUM trajectories, scoring with `fploc eval`."""
+import json
+import math
+import os
+import subprocess
+import sys
+
+
+def log(msg):
+    print(msg, file=sys.stderr, flush=True)
+
+
+def run(cmd, who):
+    """Runs cmd; on failure prints the end of its stderr and exits naming `who` and the program."""
+    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if r.returncode != 0:
+        log(r.stderr[-4000:])
+        raise SystemExit(f"{who}: {os.path.basename(cmd[0])} failed (exit {r.returncode}): {' '.join(cmd)}")
+    return r.stdout, r.stderr
+
+
+def read_tum(path):
+    """Rows [t, x, y, z, qx, qy, qz, qw] of a TUM file (comments and blank lines skipped)."""
+    rows = []
+    with open(path) as f:
+        for line in f:
+            if line.strip() and not line.startswith("#"):
+                rows.append([float(v) for v in line.split()])
+    return rows
+
+
+def yaw_of(row):
+    qx, qy, qz, qw = row[4:8]
+    return math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
+
+
+def fploc_eval(bin_dir, gt, est, who, plot=None):
+    """`fploc eval --json` of est against gt (dict), or None when est is missing or empty."""
+    if not os.path.exists(est) or os.path.getsize(est) == 0:
+        return None
+    cmd = [os.path.join(bin_dir, "fploc-eval"), "--gt", gt, "--est", est, "--json"]
+    if plot:
+        cmd += ["--plot", plot]
+    return json.loads(run(cmd, who)[0])
