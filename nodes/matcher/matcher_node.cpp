@@ -53,6 +53,10 @@ class MatcherNode : public fploc::rt::Node {
             {fploc::rt::input<fploc::features_t>("features", "FPLOC_FEATURES"),
              fploc::rt::input<fploc::imu_t>("imu", "OS1_IMU"),
              fploc::rt::input<fploc::pose_t>("initial_pose", "FPLOC_INITIAL_POSE"),
+             // The optimizer's window estimate of each frame (FPLOC_POSE_LATEST in the shipped graphs):
+             // the next frame is predicted from it. Not connected by default: the matcher then predicts
+             // from its own single-frame poses only, as the paper's SFR, and runs without an optimizer.
+             fploc::rt::input<fploc::pose_t>("refined", ""),
              fploc::rt::output<fploc::frame_pose_t>("frame_pose", "FPLOC_FRAME_POSE")}};
   }
 
@@ -82,6 +86,16 @@ class MatcherNode : public fploc::rt::Node {
       const double var = std::max(m.covariance[0], m.covariance[7]);
       matcher_->set_pose(p, std::isfinite(var) && var > 0 ? std::optional<double>(3 * std::sqrt(var)) : initial_search_m_);
     });
+    ctx.subscribe<fploc::pose_t>("refined", [this](const fploc::pose_t& m) {
+      // Stale (a later frame was already registered) or LOST: not used; counted, said at shutdown.
+      if (!matcher_->refine(m.utime, fploc::pose2_of(m))) ++refined_ignored_;
+    });
+  }
+
+  void shutdown() override {
+    if (refined_ignored_ > 0)
+      std::cerr << "[" << ctx_->name() << "] " << refined_ignored_
+                << " refined poses not used (for an older frame, or while LOST)\n";
   }
 
  private:
@@ -162,6 +176,7 @@ class MatcherNode : public fploc::rt::Node {
   bool have_prev_ = false;
   int64_t prev_utime_ = 0;
   int64_t seq_ = 0;
+  int64_t refined_ignored_ = 0;
   FitStatus last_status_ = FitStatus::kOk;
 };
 

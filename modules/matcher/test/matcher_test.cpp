@@ -426,3 +426,51 @@ TEST(PlanTerms, PosePriorHoldsOnlyTheDirectionThePlanLeavesOpen) {
   EXPECT_NEAR(r.pose.y, truth.y, 1e-3);     // across: the walls
   EXPECT_NEAR(r.pose.yaw, truth.yaw, 1e-3);
 }
+
+TEST(Matcher, RefinedPosesHoldWhatTheFloorPlanLeavesOpen) {
+  // A long corridor without visible ends, driven at 0.5 m/s: the matcher starts with no velocity and the
+  // plan cannot tell it that it moves, so on its own it stays behind (the prediction prior holds the
+  // along-track direction at the constant-velocity prediction, which is "standing still"). Fed a better
+  // estimate of each frame (here the truth, standing in for the windowed optimizer's), it predicts from
+  // that pose: it keeps its own (zero) velocity, so it stays within one frame's motion of the truth.
+  FloorPlan plan;
+  plan.elements.push_back(Element::segment({-100, 0}, {100, 0}));
+  plan.elements.push_back(Element::segment({-100, 2}, {100, 2}));
+  auto map = make_localization_map(plan, "brute-force");
+  SynthOptions so;
+  so.max_range = 8;
+  so.noise_sigma = 0.005;
+  auto run = [&](bool refine) {
+    Matcher m(*map.lookup, {});
+    m.set_pose({0, 1, 0}, 0.3);
+    double err = 0;
+    for (int k = 0; k < 40; ++k) {
+      const int64_t utime = k * 100'000;
+      const Pose2 truth{0.05 * k, 1, 0};
+      so.seed = uint32_t(k + 1);
+      const MatchResult r = m.process(synth_frame(plan, truth, so, utime));
+      EXPECT_EQ(r.status, FitStatus::kOk) << k << " " << r.text;
+      EXPECT_NEAR(r.pose.y, 1.0, 0.01) << k;  // across the corridor the walls decide
+      err = std::abs(r.pose.x - truth.x);
+      if (refine) {
+        EXPECT_FALSE(m.refine(utime - 100'000, truth)) << "a stale refined pose is not used";
+        EXPECT_TRUE(m.refine(utime, truth));
+      }
+    }
+    return err;
+  };
+  const double alone = run(false), refined = run(true);
+  std::printf("along-track error after 2 m: alone %.3f m, with refined poses %.4f m\n", alone, refined);
+  EXPECT_GT(alone, 1.0);
+  EXPECT_LT(refined, 0.06);
+  Matcher idle(*map.lookup, {});
+  EXPECT_FALSE(idle.refine(0, {0, 1, 0})) << "not initialised";
+  // Re-initialised elsewhere, the optimizer's window still reports the old track: not used.
+  Matcher m(*map.lookup, {});
+  m.set_pose({0, 1, 0}, 0.3);
+  ASSERT_EQ(m.process(synth_frame(plan, {0, 1, 0}, so, 0)).status, FitStatus::kOk);
+  EXPECT_FALSE(m.refine(0, {2.5, 1, 0}));
+  EXPECT_FALSE(m.refine(0, {0, 1, 0.2}));
+  EXPECT_TRUE(m.refine(0, {0.1, 1, 0.01}));
+  EXPECT_TRUE(m.refine(0, {0.6, 1, 0.01})) << "once one agreed, the optimizer's estimate is taken as it is";
+}

@@ -40,6 +40,9 @@ struct MatcherConfig {
   // plan leaves open (along a featureless wall) instead of letting them slide. 0 = no prior.
   double prediction_sigma_m = 0.01;
   double prediction_sigma_rad = 0.01;
+  // refine(): after set_pose, refined poses are used from the first one this close to the matcher's own.
+  double refine_gate_m = 0.3;
+  double refine_gate_rad = 5 * M_PI / 180;
 };
 
 // A Gaussian prior on the registered pose (the motion model's prediction), as residuals
@@ -83,6 +86,13 @@ class Matcher {
   // f.sweep_yaw_rate when that is known) and registered there; the twist is then updated from the last
   // two registered sweep poses and carries the pose back from utime + t_ref to utime.
   MatchResult process(const FeatureFrame& f, std::optional<double> yaw_delta = std::nullopt);
+  // A better estimate of the last processed frame's pose at its utime (the windowed optimizer's, which
+  // holds directions a single frame leaves open, e.g. along a long wall): the next frame is predicted
+  // from it (with the matcher's own velocity). Ignored (false) unless `utime` is the last processed
+  // frame's, the tracker is initialised and not LOST (then the relocalizer, not the optimizer, re-seeds
+  // it) and the pose is finite; after set_pose also until a refined pose agrees with the matcher's own
+  // within refine_gate_m / refine_gate_rad (before, the optimizer's window may still be on the old track).
+  bool refine(int64_t utime, const Pose2& pose_at_utime);
   // The body twist the motion model currently assumes (zero until two frames were registered).
   Twist2 twist() const { return twist_; }
   const MatcherConfig& config() const { return cfg_; }
@@ -96,6 +106,9 @@ class Matcher {
   bool have_velocity_ = false;
   Pose2 pose_;                  // last accepted pose at tau_ (the sweep's reference time)
   int64_t tau_ = 0;
+  int64_t last_utime_ = 0;      // utime of the last processed frame
+  Pose2 utime_to_tau_;          // that frame's pose at utime -> its pose at tau_
+  bool refine_armed_ = false;   // a refined pose agreed with the matcher's since set_pose
   Twist2 twist_;                // constant body twist between the last two registered sweep poses
   int poor_count_ = 0;
   double last_rms_ = 0;         // fit rms of the last OK frame
