@@ -35,9 +35,13 @@ std::string plot_svg(const Trajectory& gt, const Trajectory& est, const std::str
       y1 = std::max(y1, p.y());
     }
   if (x0 > x1) x0 = y0 = -1, x1 = y1 = 1;
-  const double span = std::max({x1 - x0, y1 - y0, 1e-3});
-  const double W = 800, H = 800, M = 50;
-  const double sc = (W - 2 * M) / span;
+  // Equal scale on both axes, 800 px wide; the height follows the trajectory's aspect (at most 800 px,
+  // at least 200 px), so an elongated building does not leave half the picture empty.
+  const double span_x = std::max(x1 - x0, 1e-3), span_y = std::max(y1 - y0, 1e-3);
+  const double span = std::max(span_x, span_y);
+  const double W = 800, M = 50;
+  const double sc = std::min((W - 2 * M) / span_x, (800 - 2 * M) / span_y);
+  const double H = std::max(200.0, 2 * M + span_y * sc);
   auto X = [&](double x) { return M + (x - x0) * sc; };
   auto Y = [&](double y) { return H - M - (y - y0) * sc; };
   std::ostringstream s;
@@ -48,16 +52,17 @@ std::string plot_svg(const Trajectory& gt, const Trajectory& est, const std::str
   double step = 1;
   while (span / step > 20) step *= 5;
   s << "<g stroke=\"#e4e4e4\" stroke-width=\"1\">\n";
-  for (double gx = std::floor(x0 / step) * step; gx <= x0 + span + 1e-9; gx += step)
+  const double gx1 = x0 + (W - 2 * M) / sc, gy1 = y0 + (H - 2 * M) / sc;  // the drawable area
+  for (double gx = std::floor(x0 / step) * step; gx <= gx1 + 1e-9; gx += step)
     if (X(gx) >= M - 1) {
       std::snprintf(buf, sizeof buf, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", X(gx), Y(y0),
-                    X(gx), Y(y0 + span));
+                    X(gx), Y(gy1));
       s << buf;
     }
-  for (double gy = std::floor(y0 / step) * step; gy <= y0 + span + 1e-9; gy += step)
+  for (double gy = std::floor(y0 / step) * step; gy <= gy1 + 1e-9; gy += step)
     if (Y(gy) <= H - M + 1) {
       std::snprintf(buf, sizeof buf, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", X(x0), Y(gy),
-                    X(x0 + span), Y(gy));
+                    X(gx1), Y(gy));
       s << buf;
     }
   s << "</g>\n";
