@@ -12,6 +12,7 @@
 #include "synthetic.h"
 
 using namespace fploc;
+using fploc::testing::endless_corridor;
 using fploc::testing::room_with_pillars;
 using fploc::testing::synth_frame;
 using fploc::testing::SynthOptions;
@@ -400,9 +401,7 @@ TEST(PlanTerms, PosePriorHoldsOnlyTheDirectionThePlanLeavesOpen) {
   // A straight corridor seen without its ends: along it the floor plan says nothing, so the prior (the
   // motion model's prediction in the matcher) decides; across it and in yaw the walls decide, even
   // against a prior that is 10 cm / 2 degrees off.
-  FloorPlan plan;
-  plan.elements.push_back(Element::segment({-100, 0}, {100, 0}));
-  plan.elements.push_back(Element::segment({-100, 2}, {100, 2}));
+  const FloorPlan plan = endless_corridor();
   auto map = make_localization_map(plan, "brute-force");
   SynthOptions so;
   so.max_range = 8;
@@ -433,9 +432,7 @@ TEST(Matcher, RefinedPosesHoldWhatTheFloorPlanLeavesOpen) {
   // along-track direction at the constant-velocity prediction, which is "standing still"). Fed a better
   // estimate of each frame (here the truth, standing in for the windowed optimizer's), it predicts from
   // that pose: it keeps its own (zero) velocity, so it stays within one frame's motion of the truth.
-  FloorPlan plan;
-  plan.elements.push_back(Element::segment({-100, 0}, {100, 0}));
-  plan.elements.push_back(Element::segment({-100, 2}, {100, 2}));
+  const FloorPlan plan = endless_corridor();
   auto map = make_localization_map(plan, "brute-force");
   SynthOptions so;
   so.max_range = 8;

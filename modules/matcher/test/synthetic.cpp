@@ -32,6 +32,14 @@ FloorPlan room_with_pillars() {
   return p;
 }
 
+FloorPlan endless_corridor() {
+  FloorPlan p;
+  p.elements.push_back(Element::segment({-100, 0}, {100, 0}));
+  p.elements.push_back(Element::segment({-100, 2}, {100, 2}));
+  p.source = "synthetic-endless-corridor";
+  return p;
+}
+
 FloorPlan corridor_loop() {
   FloorPlan p;
   auto seg = [&](double x1, double y1, double x2, double y2) { p.elements.push_back(Element::segment({x1, y1}, {x2, y2})); };

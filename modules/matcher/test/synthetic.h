@@ -14,6 +14,9 @@ namespace fploc::testing {
 FloorPlan room_with_pillars();
 // Four bended, self-similar corridors (~2 m wide) around a block.
 FloorPlan corridor_loop();
+// A straight corridor 2 m wide along x (walls y = 0 and y = 2, 200 m long): with a short max_range its
+// ends are never seen, so nothing in the plan fixes x.
+FloorPlan endless_corridor();
 
 struct SynthOptions {
   int beams = 360;             // rays over 360 degrees
