@@ -23,8 +23,8 @@ const map = new MapView($('map'));
 const plots = {
   ate: new Plot($('plot-ate'), [{ label: 'ATE', color: '#dc2626' }, { label: 'error', color: '#9ca3af' }], { digits: 3, zero: true, minSpan: 0.02 }),
   rp: new Plot($('plot-rp'), [{ label: 'roll', color: COL.est }, { label: 'pitch', color: '#ea580c' },
-    { label: 'gt roll', color: COL.est, dash: [3, 3] }, { label: 'gt pitch', color: '#ea580c', dash: [3, 3] }], { digits: 2, minSpan: 0.5 }),
-  z: new Plot($('plot-z'), [{ label: 'z', color: COL.est }, { label: 'gt z', color: COL.gt, dash: [3, 3] }], { digits: 3, minSpan: 0.05 }),
+    { label: 'gt roll', color: COL.est, dash: [3, 3], at: 0 }, { label: 'gt pitch', color: '#ea580c', dash: [3, 3], at: 1 }], { digits: 2, minSpan: 0.5 }),
+  z: new Plot($('plot-z'), [{ label: 'z', color: COL.est }, { label: 'gt z', color: COL.gt, dash: [3, 3], at: 0 }], { digits: 3, minSpan: 0.05 }),
   rate: new Plot($('plot-rate'), [{ label: 'frames', color: COL.fp }, { label: 'poses', color: COL.est }], { digits: 1, zero: true, minSpan: 1 }),
 };
 

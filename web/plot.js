@@ -61,8 +61,21 @@ export class Plot {
     let x = L + 6;
     this.series.forEach((s, i) => {
       const d = this.data[i];
-      const last = d.length ? d[d.length - 1][1].toFixed(this.digits) : '–';
+      // A series with `at: k` shows its value at the time of series k's latest sample (interpolated), so
+      // the ground truth's number compares with the estimate's, not with a newer instant.
+      const ref = s.at !== undefined ? this.data[s.at] : null;
+      const v = ref ? (ref.length ? valueAt(d, ref[ref.length - 1][0]) : null) : (d.length ? d[d.length - 1][1] : null);
+      const last = v === null ? '–' : v.toFixed(this.digits);
       c.fillStyle = s.color; const txt = `${s.label} ${last}`; c.fillText(txt, x, 10); x += c.measureText(txt).width + 10;
     });
   }
+}
+
+// Linear interpolation of samples [t, v] (sorted by t) at time t; null outside them.
+function valueAt(d, t) {
+  if (!d.length || t < d[0][0] || t > d[d.length - 1][0]) return null;
+  let lo = 0, hi = d.length - 1;
+  while (hi - lo > 1) { const m = (lo + hi) >> 1; if (d[m][0] <= t) lo = m; else hi = m; }
+  const [t0, v0] = d[lo], [t1, v1] = d[hi];
+  return t1 > t0 ? v0 + (v1 - v0) * (t - t0) / (t1 - t0) : v0;
 }
