@@ -357,12 +357,7 @@ void Amcl::init_pose(const Pose2& mean, const Eigen::Matrix3d& cov_in) {
     p.yaw = wrap_angle(mean.yaw + v[2]);
     p.w = 1.0 / cfg_.max_particles;
   }
-  w_slow_ = w_fast_ = 0;
-  compute_stats();
-  initialised_ = true;
-  pf_init_ = false;
-  have_estimate_ = false;
-  estimate_ = select_estimate();
+  start_from_set();
 }
 
 void Amcl::init_global() {
@@ -371,6 +366,12 @@ void Amcl::init_global() {
     p = random_pose();
     p.w = 1.0 / cfg_.max_particles;
   }
+  start_from_set();
+}
+
+// A freshly drawn particle set (pf_init / global localization): averages reset, statistics and the
+// estimate of the new set, and the next scan takes the odometry reference.
+void Amcl::start_from_set() {
   w_slow_ = w_fast_ = 0;
   compute_stats();
   initialised_ = true;

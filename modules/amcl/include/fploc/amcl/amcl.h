@@ -225,6 +225,7 @@ class Amcl {
 
  private:
   Particle random_pose();
+  void start_from_set();
   void compute_stats();
   Pose2 select_estimate() const;
   void publish(const Pose2& odom);
