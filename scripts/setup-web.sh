@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what the dashboard's browser test needs on a fresh Debian 12 machine (idempotent):
 # Debian's chromium (playwright drives it; `npx playwright install` is not used) and Node.js/npm from
-# Debian when missing, then playwright-core from tests/dashboard/package-lock.json (npm ci).
+# Debian when missing, then playwright-core from tests/dashboard/package-lock.json and web-ifc from
+# tools/ifc/package-lock.json (npm ci).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 SUDO=""
@@ -21,4 +22,10 @@ cd "$ROOT/tests/dashboard"
 if [ ! -d node_modules/playwright-core ] || [ package-lock.json -nt node_modules/.package-lock.json ]; then
   echo "fploc setup-web: npm ci in tests/dashboard" >&2
   PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error >&2
+fi
+# web-ifc for reading IFC building models (tools/ifc/ifc2plan.mjs, used by modules/floorplan's .ifc reader).
+cd "$ROOT/tools/ifc"
+if [ ! -d node_modules/web-ifc ] || [ package-lock.json -nt node_modules/.package-lock.json ]; then
+  echo "fploc setup-web: npm ci in tools/ifc" >&2
+  npm ci --no-audit --no-fund --loglevel=error >&2
 fi

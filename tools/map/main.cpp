@@ -21,9 +21,12 @@ using namespace fploc;
 namespace {
 
 struct PlanArgs {
-  std::string plan, layers, units;
+  std::string plan, layers, units, floor;
+  double cut_height = 1.0;
   void add(CLI::App* app) {
-    app->add_option("--plan", plan, "floor plan (.dxf, .csv, .json, .fpmap)")->required();
+    app->add_option("--plan", plan, "floor plan (.dxf, .csv, .json, .fpmap), building (.pbtxt) or IFC (.ifc)")->required();
+    app->add_option("--floor", floor, "building/IFC: the floor (storey) to use (default: the first)");
+    app->add_option("--ifc-cut-height", cut_height, "IFC: cut walls, columns, ... this many metres above each storey's floor (default 1)");
     app->add_option("--layers", layers, "layer globs, comma-separated (e.g. '*WALL*,*COLS*')");
     app->add_option("--units", units, "drawing units override: m, cm, mm, in, ft");
   }
@@ -34,6 +37,8 @@ struct PlanArgs {
     while (std::getline(ss, g, ','))
       if (!g.empty()) o.layer_globs.push_back(g);
     o.units_override = units;
+    o.floor = floor;
+    o.ifc_cut_height = cut_height;
     return load_floor_plan(plan, o);
   }
 };

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "fploc/floorplan/building.h"
 #include "fploc/floorplan/dxf.h"
 
 namespace fploc {
@@ -412,6 +413,15 @@ FloorPlan load_floor_plan(const std::string& path, const std::vector<std::string
 
 FloorPlan load_floor_plan(const std::string& path, const PlanLoadOptions& options) {
   const std::string ext = extension(path);
+  if (is_building_file(path)) {
+    BuildingLoadOptions bo;
+    bo.ifc_cut_height = options.ifc_cut_height;
+    bo.quiet = options.quiet;
+    return load_floor_plan(load_building(path, bo), options.floor, options);
+  }
+  if (!options.floor.empty() && options.floor != "0")
+    fail(path + ": floor '" + options.floor + "' requested, but a single plan has one floor (\"0\"); give a building "
+         "(.pbtxt) or an .ifc file");
   FloorPlan plan;
   if (ext == ".csv") {
     std::ifstream f(path);
@@ -429,7 +439,7 @@ FloorPlan load_floor_plan(const std::string& path, const PlanLoadOptions& option
       fail(path + ": a built map is already in metres; --units does not apply");
     filter_layers(plan, options.layer_globs);
   } else {
-    fail(path + ": unknown floor-plan format '" + ext + "' (use .dxf, .csv, .json or .fpmap)");
+    fail(path + ": unknown floor-plan format '" + ext + "' (use .dxf, .csv, .json, .fpmap, a building .pbtxt or .ifc)");
   }
   if (plan.elements.empty()) fail(path + ": the plan has no elements");
   plan.source = path;

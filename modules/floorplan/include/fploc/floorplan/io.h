@@ -48,9 +48,15 @@ struct PlanLoadOptions {
   double outlier_factor = 8.0;
   // DXF only: chord tolerance (metres) used to approximate ELLIPSE and SPLINE by segments.
   double curve_tolerance = 0.01;
+  // Buildings (.pbtxt) and IFC files (fploc/floorplan/building.h): the floor (IFC: storey) whose plan
+  // is loaded; "" = the first floor listed (IFC: the lowest storey).
+  std::string floor;
+  // IFC only: height above each storey's floor (metres) at which walls, columns, ... are cut.
+  double ifc_cut_height = 1.0;
 };
 
-// Dispatch on the extension (.dxf, .csv, .json, .fpmap; case-insensitive).
+// Dispatch on the extension (.dxf, .csv, .json, .fpmap; .pbtxt building and .ifc: the plan of
+// options.floor, see fploc/floorplan/building.h; case-insensitive).
 FloorPlan load_floor_plan(const std::string& path, const std::vector<std::string>& layer_globs = {},
                           const std::string& units_override = "");
 FloorPlan load_floor_plan(const std::string& path, const PlanLoadOptions& options);

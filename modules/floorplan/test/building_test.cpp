@@ -1,0 +1,205 @@
+// Building descriptions (good and bad) and IFC reading (the real Barcelona pavilion, and broken files).
+#include "fploc/floorplan/building.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+
+#include "fploc/floorplan/ifc.h"
+#include "fploc/floorplan/io.h"
+
+using namespace fploc;
+
+namespace {
+
+const std::string kSource = FPLOC_SOURCE_DIR;
+const std::string kShared = std::string(FPLOC_SHARED_DIR) + "/data/floorplans/";
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+std::string write_temp(const std::string& name, const std::string& text) {
+  const std::string dir = testing::TempDir() + "/building_test";
+  std::filesystem::create_directories(dir);
+  const std::string p = dir + "/" + name;
+  std::ofstream(p, std::ios::binary) << text;
+  return p;
+}
+
+bool have_web_ifc() {
+  return std::filesystem::exists(std::filesystem::path(ifc2plan_script()).parent_path() / "node_modules/web-ifc");
+}
+
+}  // namespace
+
+TEST(Building, ExampleTwoFloors) {
+  const std::string path = kSource + "/data/buildings/two-floors.pbtxt";
+  const Building b = load_building(path);
+  ASSERT_EQ(b.floors.size(), 2u);
+  EXPECT_EQ(b.name, "two-floors");
+  EXPECT_EQ(b.floors[0].name, "ground");
+  EXPECT_EQ(b.floors[1].name, "first");
+  EXPECT_DOUBLE_EQ(b.floors[1].elevation, 3.3);
+  const BuildingFloor& g = b.floor("ground");
+  EXPECT_DOUBLE_EQ(g.ceiling_height_at({6, 6}), 3.0);        // default
+  EXPECT_DOUBLE_EQ(g.ceiling_height_at({15, 6}), 6.5);       // the hall
+  EXPECT_NEAR(g.ceiling_height_at({2, 1}), 2.2 + 0.2 * 2, 1e-12);  // sloped
+  ASSERT_NE(g.area_at({15, 6}), nullptr);
+  EXPECT_EQ(g.area_at({15, 6})->name, "hall");
+  ASSERT_EQ(b.connections.size(), 2u);
+  EXPECT_EQ(b.connections[1].kind, ConnectionKind::kLift);
+  EXPECT_TRUE(b.connections[1].contains({9, 11}));
+  EXPECT_FALSE(b.connections[1].contains({11, 11}));
+  // Floor plans: through the building and through load_floor_plan(path, {floor}).
+  const FloorPlan room = load_floor_plan(kSource + "/data/plans/room.json");
+  const FloorPlan corridor = load_floor_plan(kSource + "/data/plans/corridor.json");
+  EXPECT_EQ(load_floor_plan(b, "").elements.size(), room.elements.size());  // default: the first floor
+  PlanLoadOptions o;
+  o.floor = "first";
+  EXPECT_EQ(load_floor_plan(path, o).elements.size(), corridor.elements.size());
+  o.layer_globs = {"walls"};
+  o.floor = "ground";
+  EXPECT_LT(load_floor_plan(path, o).elements.size(), room.elements.size());
+  o.floor = "roof";
+  EXPECT_NE(error_of([&] { load_floor_plan(path, o); }).find("no floor 'roof' (floors: ground, first)"), std::string::npos);
+}
+
+TEST(Building, SinglePlanIsOneFloor) {
+  const Building b = load_building(kSource + "/data/plans/room.json");
+  ASSERT_EQ(b.floors.size(), 1u);
+  EXPECT_EQ(b.floors[0].name, "0");
+  PlanLoadOptions o;
+  o.floor = "first";
+  EXPECT_NE(error_of([&] { load_floor_plan(kSource + "/data/plans/room.json", o); }).find("a single plan has one floor"),
+            std::string::npos);
+}
+
+TEST(Building, BadFilesNameFileLineAndField) {
+  const std::string plan = kSource + "/data/plans/room.json";
+  const std::string floor_ok = "floor { name: \"a\" plan { file: \"" + plan + "\" } ceiling_height_m: 3 }\n";
+  struct Case {
+    std::string text, expect;
+  };
+  const std::vector<Case> cases = {
+      {"floor { name: \"a\" \n plan { file: \"x.json\" } ceiling_height_m: 3 \n", "bad.pbtxt:3:"},  // unterminated
+      {floor_ok + "floor { name: \"b\" plan { file: \"" + plan + "\" } ceilng_height_m: 3 }\n", "bad.pbtxt:2:"},
+      {"", "at least one floor"},
+      {floor_ok + "floor {\n name: \"a\"\n plan { file: \"" + plan + "\" } ceiling_height_m: 3 }\n",
+       "bad.pbtxt:3: floor[1] (a): name 'a' used by another floor"},
+      {"floor { name: \"a\" ceiling_height_m: 3 }\n", "floor[0] (a).plan.file: no plan file"},
+      {"floor { name: \"a\" plan { file: \"" + plan + "\" }\n ceiling_height_m: -1 }\n",
+       "bad.pbtxt:2: floor[0] (a).ceiling_height_m: must be > 0"},
+      {"floor { name: \"a\" plan { file: \"" + plan + "\" units: \"furlong\" } ceiling_height_m: 3 }\n", "unknown units"},
+      {"floor { name: \"a\" plan { file: \"" + plan + "\" } ceiling_height_m: 3\n area { name: \"x\" ceiling_height_m: 4 "
+       "polygon { x: 0 y: 0 } polygon { x: 1 y: 0 } } }\n",
+       "bad.pbtxt:2: floor[0] (a).area[0] (x): polygon needs at least 3 vertices, got 2"},
+      {"floor { name: \"a\" plan { file: \"" + plan + "\" } ceiling_height_m: 3\n area { name: \"x\" "
+       "polygon { x: 0 y: 0 } polygon { x: 1 y: 0 } polygon { x: 1 y: 1 } } }\n",
+       "needs ceiling_height_m or sloped_ceiling"},
+      {"floor { name: \"a\" plan { file: \"" + plan + "\" } ceiling_height_m: 3\n area { sloped_ceiling { height_m: 1 "
+       "slope_x: -1 } polygon { x: 0 y: 0 } polygon { x: 5 y: 0 } polygon { x: 5 y: 1 } } }\n",
+       "the ceiling reaches the floor inside the area"},
+      {floor_ok + "connection { name: \"s\" kind: STAIRS from_floor: \"a\" to_floor: \"z\" polygon { x: 0 y: 0 } "
+       "polygon { x: 1 y: 0 } polygon { x: 1 y: 1 } }\n",
+       "bad.pbtxt:2: connection[0] (s): unknown floor 'z'"},
+      {floor_ok + "connection { name: \"s\" from_floor: \"a\" to_floor: \"a\" }\n", "connection[0] (s).kind: missing"},
+      {floor_ok + "connection { kind: LIFT from_floor: \"a\" to_floor: \"a\" }\n", "from_floor and to_floor are the same"},
+  };
+  for (const auto& c : cases) {
+    const std::string p = write_temp("bad.pbtxt", c.text);
+    const std::string e = error_of([&] { load_building(p); });
+    EXPECT_NE(e.find(c.expect), std::string::npos) << "text:\n" << c.text << "\nerror: " << e;
+    EXPECT_NE(e.find("bad.pbtxt"), std::string::npos) << e;
+  }
+  // A floor whose plan is missing: the error names the building, the floor and the plan file.
+  const std::string p = write_temp("missing.pbtxt", "floor { name: \"f1\" plan { file: \"nothere.dxf\" } ceiling_height_m: 3 }");
+  const std::string e = error_of([&] { load_floor_plan(p, PlanLoadOptions{}); });
+  EXPECT_NE(e.find("missing.pbtxt: floor 'f1': "), std::string::npos) << e;
+  EXPECT_NE(e.find("nothere.dxf: cannot open"), std::string::npos) << e;
+}
+
+TEST(Ifc, BarcelonaPavilion) {
+  const std::string path = kShared + "barcelona_pavilion.ifc";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no ../shared/data (" << path << "): IFC test skipped";
+  if (!have_web_ifc()) GTEST_SKIP() << "web-ifc not installed (scripts/setup-web.sh): IFC test skipped";
+  const Building b = load_building(path);
+  ASSERT_EQ(b.floors.size(), 1u);  // the model has no IfcBuildingStorey: one floor from its IfcBuilding
+  EXPECT_EQ(b.floors[0].name, "Pabellon");
+  EXPECT_NEAR(b.floors[0].ceiling_height, 3.0, 0.01);  // the roof slabs' underside
+  PlanLoadOptions o;
+  o.layer_globs = {"IfcWall*"};
+  const FloorPlan walls = load_floor_plan(b, "", o);
+  EXPECT_GT(walls.elements.size(), 20u);
+  double len = 0;
+  for (const auto& e : walls.elements) len += (e.b - e.a).norm();
+  EXPECT_GT(len, 100.0);  // the pavilion's walls at 1 m: well over 100 m of faces
+  o.layer_globs = {"IfcColumn"};
+  EXPECT_EQ(load_floor_plan(b, "Pabellon", o).elements.size(), 8u * 12u);  // 8 cruciform columns, 12 faces each
+  // The cut height matters: at 4 m (above the roof) nothing is left.
+  o.layer_globs = {};
+  o.ifc_cut_height = 4.0;
+  EXPECT_NE(error_of([&] { load_floor_plan(path, o); }).find("no IfcWall"), std::string::npos);
+}
+
+TEST(Ifc, BrokenFilesGiveOneClearError) {
+  if (!have_web_ifc()) GTEST_SKIP() << "web-ifc not installed (scripts/setup-web.sh): IFC test skipped";
+  const std::string head =
+      "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION((''),'2;1');\nFILE_NAME('x','',(''),(''),'','','');\n"
+      "FILE_SCHEMA(('IFC4'));\nENDSEC;\nDATA;\n#1=IFCPERSON($,$,'A',$,$,$,$,$);\n";
+  // Truncated inside an entity.
+  std::string e = error_of([&] { load_building(write_temp("t.ifc", head + "#2=IFCWALL('abc',$,(1.,")); });
+  EXPECT_NE(e.find("t.ifc:9: truncated file: entity #2=IFCWALL (line 9) is not finished"), std::string::npos) << e;
+  // Truncated after a complete entity.
+  e = error_of([&] { load_building(write_temp("t2.ifc", head)); });
+  EXPECT_NE(e.find("truncated file"), std::string::npos) << e;
+  EXPECT_NE(e.find("#1=IFCPERSON"), std::string::npos) << e;
+  // Garbage between entities.
+  e = error_of([&] { load_building(write_temp("g.ifc", head + "hello world;\nENDSEC;\nEND-ISO-10303-21;\n")); });
+  EXPECT_NE(e.find("g.ifc:9: expected an entity"), std::string::npos) << e;
+  // Unbalanced parenthesis.
+  e = error_of([&] { load_building(write_temp("u.ifc", head + "#2=IFCWALL('a'));\nENDSEC;\nEND-ISO-10303-21;\n")); });
+  EXPECT_NE(e.find("u.ifc:9: #2=IFCWALL: unbalanced ')'"), std::string::npos) << e;
+  // Not IFC at all, and an unsupported schema.
+  e = error_of([&] { load_building(write_temp("n.ifc", "0\nSECTION\n")); });
+  EXPECT_NE(e.find("n.ifc:1: not an IFC (STEP) file"), std::string::npos) << e;
+  std::string old = head;
+  old.replace(old.find("IFC4"), 4, "IFC2X2_FINAL");
+  e = error_of([&] { load_building(write_temp("o.ifc", old + "ENDSEC;\nEND-ISO-10303-21;\n")); });
+  EXPECT_NE(e.find("unsupported IFC schema 'IFC2X2_FINAL'"), std::string::npos) << e;
+  // Well-formed but without any element to cut.
+  e = error_of([&] { load_building(write_temp("empty.ifc", head + "ENDSEC;\nEND-ISO-10303-21;\n")); });
+  EXPECT_NE(e.find("empty.ifc: no IfcWall"), std::string::npos) << e;
+  // The real file cut short (when present): the error names the line and the unfinished entity.
+  const std::string real = kShared + "barcelona_pavilion.ifc";
+  if (std::filesystem::exists(real)) {
+    std::ifstream f(real, std::ios::binary);
+    std::string text((std::istreambuf_iterator<char>(f)), {});
+    e = error_of([&] { load_building(write_temp("cut.ifc", text.substr(0, text.size() / 2))); });
+    EXPECT_NE(e.find("cut.ifc:"), std::string::npos) << e;
+    EXPECT_NE(e.find("truncated file: entity #"), std::string::npos) << e;
+  }
+}
+
+TEST(Ifc, JsonToBuilding) {
+  const Building b = building_from_ifc_json(
+      R"({"storeys":[{"name":"L0","elevation":0,"ceiling_height":2.7,"elements":[{"layer":"IfcWall","id":5,"a":[0,0],"b":[4,0]}],
+          "spaces":[{"name":"R1","ceiling_height":2.5,"polygon":[[0,0],[4,0],[4,3],[0,3]]}]},
+         {"name":"L1","elevation":3,"ceiling_height":0,"elements":[{"layer":"IfcColumn","id":6,"a":[1,1],"b":[1,2]}]}]})",
+      "m.ifc");
+  ASSERT_EQ(b.floors.size(), 2u);
+  EXPECT_DOUBLE_EQ(b.floors[0].ceiling_height_at({1, 1}), 2.5);
+  EXPECT_DOUBLE_EQ(b.floors[0].ceiling_height_at({5, 1}), 2.7);
+  EXPECT_EQ(load_floor_plan(b, "L1").layers[0], "IfcColumn");
+  EXPECT_NE(error_of([] { building_from_ifc_json(R"({"storeys":[{"name":"x","elements":[{"a":[0],"b":[1,1]}]}]})", "m.ifc"); })
+                .find("m.ifc: storey 'x': element #0: expected [x, y]"),
+            std::string::npos);
+}

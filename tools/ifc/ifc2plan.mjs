@@ -1,0 +1,353 @@
+// IFC (IFC2x3 / IFC4) -> fploc building (JSON on stdout), read by modules/floorplan/src/ifc.cpp.
+//
+//   node tools/ifc/ifc2plan.mjs [--cut-height 1.0] [--classes IfcWall,IfcColumn,...] FILE.ifc
+//
+// web-ifc (npm, MPL-2.0) parses the STEP file and turns every element's representation into a
+// triangle mesh (openings already subtracted) with a placement matrix. This script only cuts those
+// meshes with a horizontal plane at `cut height` above each storey's floor: each triangle crossing
+// the plane gives one segment; segments of one element that continue each other on a line are
+// merged. Layers are the IFC class names (IfcWall, IfcCurtainWall, IfcColumn, ...), so layer globs
+// such as 'IfcWall*' select them.
+//
+// Storeys: IfcBuildingStorey with its Elevation (model length unit -> metres). A model without
+// storeys is one floor named after its IfcBuilding (elevation 0). Ceiling heights: per storey, the
+// lowest underside of an IfcSlab / IfcCovering / IfcRoof above the cut plane and below the next
+// storey's cut plane (relative to the storey's floor); per IfcSpace that crosses the cut plane, its
+// footprint (the cut outline) and its top as the area's ceiling height.
+//
+// Output: {"schema", "source", "storeys":[{"name","id","elevation","ceiling_height",
+//          "elements":[{"layer","id","a":[x,y],"b":[x,y]}],"spaces":[{"name","id","ceiling_height","polygon":[[x,y],..]}]}]}
+// Errors: one line on stderr "FILE:LINE: ..." or "FILE: #ID=IFCTYPE: ..." and exit status 2.
+import fs from 'node:fs';
+
+const DEFAULT_CLASSES = ['IfcWall', 'IfcWallStandardCase', 'IfcWallElementedCase', 'IfcCurtainWall', 'IfcPlate',
+  'IfcMember', 'IfcColumn', 'IfcWindow', 'IfcDoor'];
+const CEILING_CLASSES = ['IfcSlab', 'IfcCovering', 'IfcRoof'];
+
+function die(msg) {
+  process.stderr.write(msg + '\n');
+  process.exit(2);
+}
+
+// ---- arguments
+let cut = 1.0, classes = DEFAULT_CLASSES, file = null;
+const argv = process.argv.slice(2);
+for (let i = 0; i < argv.length; ++i) {
+  if (argv[i] === '--cut-height') cut = Number(argv[++i]);
+  else if (argv[i] === '--classes') classes = argv[++i].split(',').filter((s) => s);
+  else if (argv[i].startsWith('--')) die(`ifc2plan: unknown option ${argv[i]}`);
+  else file = argv[i];
+}
+if (!file) die('usage: ifc2plan.mjs [--cut-height M] [--classes A,B] FILE.ifc');
+if (!(cut > 0) || !Number.isFinite(cut)) die(`ifc2plan: --cut-height must be > 0 (got ${cut})`);
+
+let bytes;
+try {
+  bytes = fs.readFileSync(file);
+} catch (e) {
+  die(`${file}: cannot open (${e.message})`);
+}
+
+// ---- STEP syntax check (web-ifc skips what it cannot parse silently; a truncated or garbled file
+// must be one clear error naming the line). Checks the header, that every DATA record is
+// "#id=TYPE(...);" with balanced parentheses outside strings, and the trailer.
+function checkStep(text) {
+  if (!text.startsWith('ISO-10303-21;')) die(`${file}:1: not an IFC (STEP) file: it does not start with ISO-10303-21;`);
+  const schema = /FILE_SCHEMA\s*\(\s*\(\s*'([^']*)'/i.exec(text);
+  if (!schema) die(`${file}: no FILE_SCHEMA in the header`);
+  const s = schema[1].toUpperCase();
+  if (!/^IFC(2X3|4|4X1|4X2|4X3)/.test(s)) die(`${file}: unsupported IFC schema '${schema[1]}' (IFC2X3 and IFC4 are read)`);
+  const dataAt = text.search(/^DATA;/m);
+  if (dataAt < 0) die(`${file}: no DATA section`);
+  let line = text.slice(0, dataAt).split('\n').length;
+  let depth = 0, inStr = false, recStart = -1, recLine = line, recText = '', lastId = '';
+  let ended = false;
+  for (let i = dataAt + 5; i < text.length; ++i) {
+    const c = text[i];
+    if (c === '\n') ++line;
+    if (recStart < 0) {
+      if (/\s/.test(c)) continue;
+      if (text.startsWith('ENDSEC;', i)) {
+        ended = true;
+        break;
+      }
+      if (c !== '#') die(`${file}:${line}: expected an entity '#id=...' or ENDSEC;, got '${text.slice(i, i + 20).split('\n')[0]}'`);
+      recStart = i;
+      recLine = line;
+      continue;
+    }
+    if (inStr) {
+      if (c === "'") {
+        if (text[i + 1] === "'") ++i;
+        else inStr = false;
+      }
+      continue;
+    }
+    if (c === "'") inStr = true;
+    else if (c === '(') ++depth;
+    else if (c === ')') {
+      if (--depth < 0) die(`${file}:${line}: ${head(text, recStart)}: unbalanced ')'`);
+    } else if (c === ';' && depth === 0) {
+      recText = text.slice(recStart, i);
+      if (!/^#\d+\s*=\s*[A-Za-z0-9_]+\s*\(/.test(recText)) die(`${file}:${recLine}: malformed entity '${recText.slice(0, 60)}'`);
+      lastId = head(text, recStart);
+      recStart = -1;
+    }
+  }
+  if (recStart >= 0 || !ended)
+    die(`${file}:${line}: truncated file: ${recStart >= 0 ? `entity ${head(text, recStart)} (line ${recLine}) is not finished` : 'no ENDSEC; after the DATA section'}` +
+        (lastId ? ` (last complete entity ${lastId})` : ''));
+  if (!/END-ISO-10303-21;\s*$/.test(text)) die(`${file}:${line}: truncated file: no END-ISO-10303-21; at the end`);
+  return s;
+}
+function head(text, at) {
+  const m = /^#(\d+)\s*=\s*([A-Za-z0-9_]+)/.exec(text.slice(at, at + 80));
+  return m ? `#${m[1]}=${m[2].toUpperCase()}` : text.slice(at, at + 20);
+}
+const schemaName = checkStep(bytes.toString('latin1'));
+
+// ---- open with web-ifc (imported only now: loading it takes most of a second)
+const WebIFC = await import('web-ifc');
+const api = new WebIFC.IfcAPI();
+await api.Init();
+api.SetLogLevel(WebIFC.LogLevel.LOG_LEVEL_OFF);
+const model = api.OpenModel(new Uint8Array(bytes), { COORDINATE_TO_ORIGIN: false });
+if (model < 0) die(`${file}: web-ifc cannot open the model`);
+const type = (name) => api.GetTypeCodeFromName(name.toUpperCase());
+const typeName = (code) => api.GetNameFromTypeCode(code);
+const value = (x) => (x && typeof x === 'object' && 'value' in x ? x.value : x);
+const label = (id) => {
+  try {
+    return `#${id}=${typeName(api.GetLineType(model, id)).toUpperCase()}`;
+  } catch {
+    return `#${id}`;
+  }
+};
+
+// Length unit of the model (Elevation attributes are in it; web-ifc's meshes are in metres).
+function lengthScale() {
+  const prefix = { EXA: 1e18, PETA: 1e15, TERA: 1e12, GIGA: 1e9, MEGA: 1e6, KILO: 1e3, HECTO: 1e2, DECA: 1e1,
+    DECI: 1e-1, CENTI: 1e-2, MILLI: 1e-3, MICRO: 1e-6, NANO: 1e-9 };
+  for (const id of api.GetLineIDsWithType(model, type('IFCUNITASSIGNMENT'))) {
+    const ua = api.GetLine(model, id, true);
+    for (const u of ua.Units || []) {
+      if (!u || value(u.UnitType) !== 'LENGTHUNIT') continue;
+      if (u.Prefix !== undefined && value(u.Name) === 'METRE') return u.Prefix ? prefix[value(u.Prefix)] ?? 1 : 1;
+      if (u.ConversionFactor) {
+        const f = value(u.ConversionFactor.ValueComponent);
+        const base = u.ConversionFactor.UnitComponent;
+        const bs = base && base.Prefix ? prefix[value(base.Prefix)] ?? 1 : 1;
+        if (Number.isFinite(f)) return f * bs;
+      }
+    }
+  }
+  return 1;
+}
+const unit = lengthScale();
+
+// ---- storeys
+const storeys = [];
+for (const id of api.GetLineIDsWithType(model, type('IFCBUILDINGSTOREY'))) {
+  const s = api.GetLine(model, id);
+  const el = Number(value(s.Elevation));
+  storeys.push({ name: String(value(s.Name) ?? value(s.LongName) ?? `#${id}`), id, elevation: Number.isFinite(el) ? el * unit : 0 });
+}
+if (storeys.length === 0) {
+  const b = [...api.GetLineIDsWithType(model, type('IFCBUILDING'))];
+  const name = b.length ? String(value(api.GetLine(model, b[0]).Name) ?? 'building') : 'building';
+  storeys.push({ name, id: b[0] ?? 0, elevation: 0 });
+}
+storeys.sort((a, b) => a.elevation - b.elevation);
+{
+  const seen = new Map();
+  for (const s of storeys) {  // unique names (storeys may share one)
+    const n = seen.get(s.name) ?? 0;
+    seen.set(s.name, n + 1);
+    if (n) s.name = `${s.name} (#${s.id})`;
+  }
+}
+
+// ---- meshes: world triangles in plan coordinates. web-ifc's frame is y-up: (x, y, z) -> plan
+// (x, -z), height y.
+function worldTriangles(mesh) {
+  const tris = [];
+  const geoms = mesh.geometries;
+  for (let g = 0; g < geoms.size(); ++g) {
+    const pg = geoms.get(g);
+    const geo = api.GetGeometry(model, pg.geometryExpressID);
+    const v = api.GetVertexArray(geo.GetVertexData(), geo.GetVertexDataSize());
+    const ix = api.GetIndexArray(geo.GetIndexData(), geo.GetIndexDataSize());
+    const T = pg.flatTransformation;
+    const P = new Float64Array((v.length / 6) * 3);
+    for (let i = 0, k = 0; i < v.length; i += 6, k += 3) {
+      const x = v[i], y = v[i + 1], z = v[i + 2];
+      const X = T[0] * x + T[4] * y + T[8] * z + T[12];
+      const Y = T[1] * x + T[5] * y + T[9] * z + T[13];
+      const Z = T[2] * x + T[6] * y + T[10] * z + T[14];
+      P[k] = X;
+      P[k + 1] = -Z;
+      P[k + 2] = Y;
+    }
+    geo.delete();
+    for (let t = 0; t + 2 < ix.length; t += 3) tris.push([ix[t] * 3, ix[t + 1] * 3, ix[t + 2] * 3, P]);
+  }
+  return tris;
+}
+
+// Segments where the plane z = h cuts the triangles.
+function cutAt(tris, h) {
+  const segs = [];
+  for (const [i0, i1, i2, P] of tris) {
+    const pts = [];
+    const vs = [i0, i1, i2];
+    for (let e = 0; e < 3; ++e) {
+      const a = vs[e], b = vs[(e + 1) % 3];
+      const za = P[a + 2] - h, zb = P[b + 2] - h;
+      if ((za < 0) === (zb < 0)) continue;
+      const t = za / (za - zb);
+      pts.push([P[a] + t * (P[b] - P[a]), P[a + 1] + t * (P[b + 1] - P[a + 1])]);
+    }
+    if (pts.length === 2 && Math.hypot(pts[1][0] - pts[0][0], pts[1][1] - pts[0][1]) > 1e-6) segs.push(pts);
+  }
+  return segs;
+}
+
+// Merge segments that share an end point and continue on the same line (the two triangles of a
+// face, a face split by the tessellation); drop exact duplicates.
+function mergeCollinear(segs) {
+  const key = (p) => `${Math.round(p[0] * 1e5)},${Math.round(p[1] * 1e5)}`;
+  let changed = true;
+  let list = segs.map((s) => [s[0], s[1]]);
+  while (changed) {
+    changed = false;
+    const ends = new Map();
+    list.forEach((s, i) => {
+      for (const e of [0, 1]) {
+        const k = key(s[e]);
+        if (!ends.has(k)) ends.set(k, []);
+        ends.get(k).push([i, e]);
+      }
+    });
+    const dead = new Uint8Array(list.length);
+    for (const [, at] of ends) {
+      if (at.length !== 2) continue;
+      const [[i, ei], [j, ej]] = at;
+      if (i === j || dead[i] || dead[j]) continue;
+      const s = list[i], t = list[j];
+      const p = s[1 - ei], q = s[ei], r = t[1 - ej];
+      const ux = q[0] - p[0], uy = q[1] - p[1], vx = r[0] - q[0], vy = r[1] - q[1];
+      const lu = Math.hypot(ux, uy), lv = Math.hypot(vx, vy);
+      if (Math.abs(ux * vy - uy * vx) > 1e-6 * lu * lv + 1e-12 || ux * vx + uy * vy <= 0) continue;
+      list[i] = [p, r];
+      dead[j] = 1;
+      changed = true;
+    }
+    list = list.filter((_, i) => !dead[i]);
+  }
+  const seen = new Set();
+  return list.filter((s) => {
+    const a = key(s[0]), b = key(s[1]);
+    const k = a < b ? a + '|' + b : b + '|' + a;
+    if (seen.has(k) || a === b) return false;
+    seen.add(k);
+    return true;
+  });
+}
+
+// Longest closed loop of a set of segments (a space's outline at the cut plane).
+function outline(segs) {
+  const key = (p) => `${Math.round(p[0] * 1e4)},${Math.round(p[1] * 1e4)}`;
+  const adj = new Map();
+  for (const s of segs) {
+    for (const [a, b] of [[s[0], s[1]], [s[1], s[0]]]) {
+      const k = key(a);
+      if (!adj.has(k)) adj.set(k, { p: a, n: [] });
+      adj.get(k).n.push(key(b));
+    }
+  }
+  const used = new Set();
+  let best = [];
+  for (const [start] of adj) {
+    if (used.has(start)) continue;
+    const loop = [];
+    let prev = null, cur = start;
+    while (cur && !used.has(cur)) {
+      used.add(cur);
+      loop.push(adj.get(cur).p);
+      const next = adj.get(cur).n.find((k) => k !== prev && !used.has(k));
+      prev = cur;
+      cur = next;
+    }
+    if (loop.length > best.length) best = loop;
+  }
+  return best;
+}
+
+function streamClass(cls, fn) {
+  const code = type(cls);
+  if (!code) return;
+  const ids = [...api.GetLineIDsWithType(model, code)];
+  for (const id of ids) {
+    let mesh;
+    try {
+      mesh = api.GetFlatMesh(model, id);
+    } catch (e) {
+      die(`${file}: ${label(id)}: web-ifc cannot build its geometry (${e.message ?? e})`);
+    }
+    if (!mesh || mesh.geometries.size() === 0) continue;  // no body (e.g. a container)
+    let tris;
+    try {
+      tris = worldTriangles(mesh);
+    } catch (e) {
+      die(`${file}: ${label(id)}: bad geometry (${e.message ?? e})`);
+    }
+    for (const t of tris)
+      for (const k of [t[0], t[1], t[2]])
+        if (!Number.isFinite(t[3][k]) || !Number.isFinite(t[3][k + 1]) || !Number.isFinite(t[3][k + 2]))
+          die(`${file}: ${label(id)}: geometry has non-finite coordinates`);
+    fn(id, tris);
+  }
+}
+
+// Cut elements.
+const out = storeys.map((s) => ({ ...s, ceiling_height: 0, elements: [], spaces: [] }));
+for (const cls of classes) {
+  const layer = typeName(type(cls)) || cls;
+  streamClass(cls, (id, tris) => {
+    for (const s of out) {
+      for (const [a, b] of mergeCollinear(cutAt(tris, s.elevation + cut))) s.elements.push({ layer, id, a, b });
+    }
+  });
+}
+
+// Ceilings: slab undersides above the cut plane of each storey, below the next storey's cut plane.
+const undersides = [];  // [zmin, xmin, ymin, xmax, ymax]
+for (const cls of CEILING_CLASSES) {
+  streamClass(cls, (id, tris) => {
+    let z = Infinity;
+    for (const t of tris) for (const k of [t[0], t[1], t[2]]) z = Math.min(z, t[3][k + 2]);
+    undersides.push(z);
+  });
+}
+out.forEach((s, i) => {
+  const lo = s.elevation + cut, hi = i + 1 < out.length ? out[i + 1].elevation + cut : Infinity;
+  const zs = undersides.filter((z) => z > lo && z < hi);
+  if (zs.length) s.ceiling_height = Math.min(...zs) - s.elevation;
+});
+
+// Spaces: footprint at the cut plane, top = the space's ceiling.
+streamClass('IfcSpace', (id, tris) => {
+  let top = -Infinity;
+  for (const t of tris) for (const k of [t[0], t[1], t[2]]) top = Math.max(top, t[3][k + 2]);
+  for (const s of out) {
+    const poly = outline(cutAt(tris, s.elevation + cut));
+    if (poly.length < 3) continue;
+    const sp = api.GetLine(model, id);
+    s.spaces.push({ name: String(value(sp.LongName) ?? value(sp.Name) ?? `#${id}`), id, ceiling_height: top - s.elevation, polygon: poly });
+  }
+});
+api.CloseModel(model);
+
+const total = out.reduce((n, s) => n + s.elements.length, 0);
+if (total === 0) die(`${file}: no ${classes.join('/')} element crosses the cut plane ${cut} m above any storey's floor`);
+process.stdout.write(JSON.stringify({ schema: schemaName, source: file, cut_height: cut, storeys: out }));
