@@ -100,7 +100,7 @@ class AmclNode : public fploc::rt::Node {
     const auto& o = ctx.options<fploc::AmclOptions>();
     if (o.plan().file().empty()) throw std::runtime_error("amcl.plan.file: no floor plan given");
     const std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
-    const fploc::FloorPlan plan = fploc::load_floor_plan(ctx.resolve_path(o.plan().file()), layers, o.plan().units());
+    const fploc::FloorPlan plan = fploc::load_floor_plan(ctx.resolve_path(o.plan().file()), layers, o.plan().units(), o.plan().floor());
     cfg_ = config_of(o);
     amcl_ = std::make_unique<am::Amcl>(plan, cfg_);
     sxy_ = o.has_initial_std_xy_m() ? o.initial_std_xy_m() : 0.5;

@@ -145,7 +145,7 @@ class DashboardNode : public fploc::rt::Node {
     const std::string path = ctx_->resolve_path(o.plan().file());
     try {
       std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
-      FloorPlan plan = load_plan_file(path, layers, o.plan().units());
+      FloorPlan plan = load_plan_file(path, layers, o.plan().units(), o.plan().floor());
       model_->set_plan_json(plan_to_json(plan));
       std::cerr << "[" << ctx_->name() << "] plan " << path << ": " << plan.elements.size() << " elements\n";
     } catch (const std::exception& e) {

@@ -12,10 +12,12 @@
 namespace fploc::dashboard {
 using nlohmann::json;
 
-FloorPlan load_plan_file(const std::string& path, const std::vector<std::string>& layers, const std::string& units) {
+FloorPlan load_plan_file(const std::string& path, const std::vector<std::string>& layers, const std::string& units,
+                         const std::string& floor) {
 #ifdef FPLOC_HAVE_PLAN_IO
-  return load_floor_plan(path, layers, units);
+  return load_floor_plan(path, layers, units, floor);
 #else
+  (void)floor;
   // Fallback until the floorplan module's reader is there: the JSON format only, no layer filter.
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open");

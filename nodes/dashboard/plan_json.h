@@ -11,7 +11,9 @@ namespace fploc::dashboard {
 
 // Uses fploc/floorplan/io.h (every plan format) when the floorplan module has it, else reads the
 // JSON plan format only. Throws std::runtime_error naming the file.
-FloorPlan load_plan_file(const std::string& path, const std::vector<std::string>& layers, const std::string& units);
+// `floor`: a building (.pbtxt) or IFC file's floor ("" = the first).
+FloorPlan load_plan_file(const std::string& path, const std::vector<std::string>& layers, const std::string& units,
+                         const std::string& floor = "");
 std::string plan_to_json(const FloorPlan& plan);
 
 }  // namespace fploc::dashboard

@@ -48,7 +48,7 @@ class SimSensorNode : public fploc::rt::Node {
     const auto& opt = ctx.options<fploc::SimOptions>();
     if (!opt.plan().file().empty()) {
       const std::vector<std::string> layers(opt.plan().layers().begin(), opt.plan().layers().end());
-      plan_ = fploc::load_floor_plan(ctx.resolve_path(opt.plan().file()), layers, opt.plan().units());
+      plan_ = fploc::load_floor_plan(ctx.resolve_path(opt.plan().file()), layers, opt.plan().units(), opt.plan().floor());
     }
     so_.scenario = opt.scenario().empty() ? "room-small-loop-medium" : opt.scenario();
     so_.seed = opt.seed();

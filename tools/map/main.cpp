@@ -10,6 +10,7 @@
 #include <random>
 #include <sstream>
 
+#include "fploc/annf/ablation.h"
 #include "fploc/annf/annf.h"
 #include "fploc/annf/baselines.h"
 #include "fploc/floorplan/io.h"
@@ -23,12 +24,13 @@ namespace {
 struct PlanArgs {
   std::string plan, layers, units, floor;
   double cut_height = 1.0;
-  void add(CLI::App* app) {
-    app->add_option("--plan", plan, "floor plan (.dxf, .csv, .json, .fpmap), building (.pbtxt) or IFC (.ifc)")->required();
-    app->add_option("--floor", floor, "building/IFC: the floor (storey) to use (default: the first)");
-    app->add_option("--ifc-cut-height", cut_height, "IFC: cut walls, columns, ... this many metres above each storey's floor (default 1)");
-    app->add_option("--layers", layers, "layer globs, comma-separated (e.g. '*WALL*,*COLS*')");
-    app->add_option("--units", units, "drawing units override: m, cm, mm, in, ft");
+  void add(CLI::App* app, const std::string& prefix = "") {
+    const std::string p = "--" + prefix;
+    app->add_option(p + "plan", plan, "floor plan (.dxf, .csv, .json, .fpmap), building (.pbtxt) or IFC (.ifc)")->required();
+    app->add_option(p + "floor", floor, "building/IFC: the floor (storey) to use (default: the first)");
+    app->add_option(p + "ifc-cut-height", cut_height, "IFC: cut walls, columns, ... this many metres above each storey's floor (default 1)");
+    app->add_option(p + "layers", layers, "layer globs, comma-separated (e.g. '*WALL*,*COLS*')");
+    app->add_option(p + "units", units, "drawing units override: m, cm, mm, in, ft");
   }
   FloorPlan load() const {
     PlanLoadOptions o;
@@ -188,12 +190,26 @@ int main(int argc, char** argv) {
   pgm->add_option("--thickness", p.thickness, "wall thickness drawn in metres (default: one pixel)");
   pgm->add_flag("--json", as_json, "JSON summary on stdout");
 
+  PlanArgs c_plan, c_ref;
+  CompareArgs c;
+  auto* compare = app.add_subcommand("compare", "share of one plan's length within a tolerance of another (e.g. IFC vs DXF)");
+  c_plan.add(compare);
+  c_ref.add(compare, "ref-");
+  compare->add_option("--tolerance", c.tolerance, "metres (default 0.05)");
+  compare->add_option("--step", c.step, "sampling step along the plan's elements in metres (default 0.02)");
+  compare->add_option("--align", c.align, "none | auto (rigid 2D: ICP from the identity and from the box centres, default)")
+      ->check(CLI::IsMember({"none", "auto"}));
+  compare->add_option("--out", c.out, "overlay (.png or .svg): reference grey, plan green within tolerance, red beyond");
+  compare->add_option("--transform", c.transform, "x,y,yaw_deg applied to the plan first (e.g. an alignment found before)");
+  compare->add_flag("--json", as_json, "JSON on stdout");
+
   CLI11_PARSE(app, argc, argv);
   try {
     if (*build) return cmd_build(b_plan, b_annf, b_out, as_json);
     if (*validate) return cmd_validate(v_plan.load(), v, as_json);
     if (*render) return cmd_render(r_plan.load(), r);
     if (*pgm) return cmd_export_pgm(p_plan.load(), p, as_json);
+    if (*compare) return cmd_compare(c_plan.load(), c_ref.load(), c, as_json);
   } catch (const std::exception& e) {
     std::cerr << "fploc map: error: " << e.what() << "\n";
     return 1;

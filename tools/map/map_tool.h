@@ -1,6 +1,7 @@
 #pragma once
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "fploc/floorplan/plan.h"
 
@@ -41,5 +42,18 @@ struct PgmArgs {
   double thickness = 0;
 };
 int cmd_export_pgm(const FloorPlan& plan, const PgmArgs& a, bool as_json);
+
+// RGB image (row-major, 3 bytes per pixel) as PNG; throws when built without libpng.
+void write_rgb_png(const std::string& out, int w, int h, const std::vector<uint8_t>& img);
+
+struct CompareArgs {
+  double tolerance = 0.05;  // metres
+  double step = 0.02;       // sampling step along A's elements
+  std::string align = "auto";
+  std::string out;          // overlay image (.png or .svg)
+  std::string transform;    // "x,y,yaw_deg": applied to the plan before the alignment
+};
+// Share of plan A's length within `tolerance` of plan B (after an optional rigid alignment).
+int cmd_compare(const FloorPlan& a, const FloorPlan& b, const CompareArgs& args, bool as_json);
 
 }  // namespace fploc

@@ -118,6 +118,18 @@ void write_png(const Annf& f, const std::string& out, int width) {
       if (leaf_key[k] != leaf_key[k - 1] || leaf_key[k] != leaf_key[k - w])
         for (int q = 0; q < 3; ++q) img[k * 3 + q] = uint8_t(img[k * 3 + q] * 0.8);
     }
+  write_rgb_png(out, w, h, img);
+#else
+  (void)f;
+  (void)width;
+  throw std::runtime_error(out + ": PNG support not built (libpng-dev missing); use .svg");
+#endif
+}
+
+}  // namespace
+
+void write_rgb_png(const std::string& out, int w, int h, const std::vector<uint8_t>& img) {
+#ifdef FPLOC_HAVE_PNG
   FILE* fp = std::fopen(out.c_str(), "wb");
   if (!fp) throw std::runtime_error(out + ": cannot write");
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
@@ -136,13 +148,12 @@ void write_png(const Annf& f, const std::string& out, int width) {
   png_destroy_write_struct(&png, &info);
   std::fclose(fp);
 #else
-  (void)f;
-  (void)width;
+  (void)w;
+  (void)h;
+  (void)img;
   throw std::runtime_error(out + ": PNG support not built (libpng-dev missing); use .svg");
 #endif
 }
-
-}  // namespace
 
 int cmd_render(const FloorPlan& plan, const RenderArgs& a) {
   Annf f;

@@ -11,6 +11,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "fploc/annf/ablation.h"
 #include "fploc/annf/annf.h"
 #include "fploc/annf/baselines.h"
 #include "map_tool.h"

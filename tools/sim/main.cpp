@@ -45,7 +45,7 @@ void write_event(lcm::LogFile& log, int64_t utime, const std::string& channel, c
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc sim: simulate an OS-1-64 + IMU sequence into an LCM log and a TUM ground truth"};
-  std::string plan_file, scenario, out, gt, units, metadata, demo_dir;
+  std::string plan_file, scenario, out, gt, units, metadata, demo_dir, floor;
   std::vector<std::string> layers;
   uint64_t seed = 0;
   bool no_clutter = false, no_patches = false, json = false;
@@ -53,6 +53,7 @@ int main(int argc, char** argv) {
   app.add_option("--plan", plan_file, "floor plan (.dxf/.csv/.json/.fpmap); default: the scenario's demo plan");
   app.add_option("--layers", layers, "layer globs")->delimiter(',');
   app.add_option("--units", units, "m|cm|mm override");
+  app.add_option("--floor", floor, "building (.pbtxt) or IFC plan: the floor (default: the first)");
   app.add_option("--scenario", scenario, "room-small-loop|room-large-loop|room-no-loop|corridor-loop|auto-loop + -slow|-medium|-fast");
   app.add_option("--seed", seed, "random seed (noise, wobble, clutter)");
   app.add_option("--out", out, "LCM log to write");
@@ -84,7 +85,7 @@ int main(int argc, char** argv) {
       return 2;
     }
     fploc::FloorPlan plan;
-    if (!plan_file.empty()) plan = fploc::load_floor_plan(plan_file, layers, units);
+    if (!plan_file.empty()) plan = fploc::load_floor_plan(plan_file, layers, units, floor);
     fploc::sim::SimulatorOptions o;
     o.scenario = scenario;
     o.seed = seed;

@@ -8,6 +8,7 @@
 
 #include "fploc/annf/annf.h"
 #include "fploc/annf/baselines.h"
+#include "fploc/annf/cache.h"
 
 namespace fploc::amcl {
 
@@ -246,8 +247,8 @@ LikelihoodField::LikelihoodField(const FloorPlan& plan, double resolution, doubl
   AnnfOptions ao;
   ao.mode = AnnfMode::kExact;
   ao.max_depth = 6;  // only cell centres are read; the exact field is exact everywhere
-  const Annf exact = Annf::build(plan, ao);
-  const DistanceGrid grid(exact, resolution);
+  const std::shared_ptr<const Annf> exact = cached_annf(plan, ao);  // shared on disk (fploc/annf/cache.h)
+  const DistanceGrid grid(*exact, resolution);
   ox_ = grid.origin().x();
   oy_ = grid.origin().y();
   nx_ = grid.nx();

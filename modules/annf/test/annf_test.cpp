@@ -6,6 +6,7 @@
 #include <fstream>
 #include <random>
 
+#include "fploc/annf/ablation.h"
 #include "fploc/annf/annf.h"
 #include "fploc/floorplan/io.h"
 

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "fploc/floorplan/binary_io.h"
 #include "fploc/floorplan/building.h"
 #include "fploc/floorplan/dxf.h"
 
@@ -64,29 +65,10 @@ std::vector<std::string> split(const std::string& s, char sep) {
 
 [[noreturn]] void fail(const std::string& msg) { throw std::runtime_error(msg); }
 
-template <typename T>
-void put(std::ostream& out, const T& v) {
-  out.write(reinterpret_cast<const char*>(&v), sizeof(T));
-}
-template <typename T>
-T get(std::istream& in, const std::string& source) {
-  T v{};
-  in.read(reinterpret_cast<char*>(&v), sizeof(T));
-  if (!in) fail(source + ": truncated map file");
-  return v;
-}
-void put_string(std::ostream& out, const std::string& s) {
-  put<uint32_t>(out, uint32_t(s.size()));
-  out.write(s.data(), std::streamsize(s.size()));
-}
-std::string get_string(std::istream& in, const std::string& source) {
-  const uint32_t n = get<uint32_t>(in, source);
-  if (n > (1u << 24)) fail(source + ": corrupt map file (string length " + std::to_string(n) + ")");
-  std::string s(n, '\0');
-  in.read(s.data(), n);
-  if (!in) fail(source + ": truncated map file");
-  return s;
-}
+using binary::get;
+using binary::get_string;
+using binary::put;
+using binary::put_string;
 
 bool finite_element(const Element& e) {
   return std::isfinite(e.a.x()) && std::isfinite(e.a.y()) && std::isfinite(e.b.x()) && std::isfinite(e.b.y()) &&
@@ -404,10 +386,11 @@ FloorPlan read_plan_from_fpmap(const std::string& path) {
 }
 
 FloorPlan load_floor_plan(const std::string& path, const std::vector<std::string>& layer_globs,
-                          const std::string& units_override) {
+                          const std::string& units_override, const std::string& floor) {
   PlanLoadOptions o;
   o.layer_globs = layer_globs;
   o.units_override = units_override;
+  o.floor = floor;
   return load_floor_plan(path, o);
 }
 

@@ -6,6 +6,7 @@
 #include "fploc/floorplan/io.h"
 #ifdef FPLOC_HAVE_ANNF
 #include "fploc/annf/annf.h"
+#include "fploc/annf/cache.h"
 #endif
 
 namespace fploc {
@@ -78,9 +79,9 @@ LocalizationMap finish(LocalizationMap m, const std::string& lookup, std::shared
   if (!annf || annf->options().mode != mode) {
     AnnfOptions o;
     o.mode = mode;
-    annf = std::make_shared<const Annf>(Annf::build(*m.plan, o));
-    m.note += std::string(m.note.empty() ? "" : "; ") + "built ANNF (" + to_string(mode) + ", depth " +
-              std::to_string(o.max_depth) + ")";
+    std::string how;
+    annf = cached_annf(*m.plan, o, &how);  // built once per plan and options, shared (fploc/annf/cache.h)
+    m.note += std::string(m.note.empty() ? "" : "; ") + how;
   }
   m.annf = annf;
   m.lookup = std::make_unique<AnnfLookup>(annf, lookup == "annf-paper-first", lookup);

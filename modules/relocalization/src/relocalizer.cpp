@@ -6,6 +6,7 @@
 
 #include "fploc/annf/annf.h"
 #include "fploc/annf/baselines.h"
+#include "fploc/annf/cache.h"
 
 namespace fploc {
 
@@ -43,8 +44,8 @@ Relocalizer::Relocalizer(const FloorPlan& plan, const NearestLookup& lookup, Rel
   AnnfOptions ao;
   ao.mode = AnnfMode::kExact;
   ao.max_depth = 6;  // the grid reads cell centres; the exact field only needs to be exact there
-  const Annf exact = Annf::build(plan, ao);
-  grid_ = std::make_unique<DistanceGrid>(exact, cfg_.distance_cell_m);
+  const std::shared_ptr<const Annf> exact = cached_annf(plan, ao);  // shared on disk (fploc/annf/cache.h)
+  grid_ = std::make_unique<DistanceGrid>(*exact, cfg_.distance_cell_m);
   const Box2 b = plan.bounds();
   for (double y = b.min.y() + 0.5 * cfg_.grid_m; y < b.max.y(); y += cfg_.grid_m)
     for (double x = b.min.x() + 0.5 * cfg_.grid_m; x < b.max.x(); x += cfg_.grid_m) {

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "fploc/core/pose.h"
+#include "fploc/floorplan/building.h"
 #include "fploc/runtime/node.h"
 
 namespace fploc {
@@ -84,7 +85,14 @@ LocalizationMap load_map(const rt::Context& ctx, const PlanSource& plan, const s
                          const std::string& node_field) {
   if (plan.file().empty()) throw std::runtime_error(node_field + ".plan.file: no floor plan given");
   const std::vector<std::string> layers(plan.layers().begin(), plan.layers().end());
-  return load_localization_map(ctx.resolve_path(plan.file()), layers, plan.units(), lookup.empty() ? "annf-exact" : lookup);
+  const std::string path = ctx.resolve_path(plan.file());
+  if (is_building_file(path) || !plan.floor().empty()) {  // a building (.pbtxt) or IFC: the plan of one floor
+    LocalizationMap m = make_localization_map(load_floor_plan(path, layers, plan.units(), plan.floor()),
+                                              lookup.empty() ? "annf-exact" : lookup);
+    m.note = "loaded " + path + " floor '" + plan.floor() + "'" + (m.note.empty() ? "" : "; " + m.note);
+    return m;
+  }
+  return load_localization_map(path, layers, plan.units(), lookup.empty() ? "annf-exact" : lookup);
 }
 
 }  // namespace fploc

@@ -42,22 +42,10 @@ namespace fploc {
 
 enum class AnnfMode : uint8_t { kPaper = 0, kExact = 1 };
 
-// Readings of the paper's stopping rules ("If a child subfield shares the same two nearest elements
-// with its parent field, it will not be further divided and set as a leaf field. If all four
-// subfields ... have the same two nearest neighbours as their parent's, the division operation will
-// be withdrawn").
-enum class PaperRule : uint8_t {
-  kChildLeaf = 0,      // A child equal to its parent becomes a leaf; all four equal -> undo split.
-  kUndoOnly = 1,       // Only "all four equal -> undo"; children equal to the parent still divide.
-  kChildLeafOrdered = 2,  // As kChildLeaf, "same" compares the ordered pair (1st, 2nd).
-  kFull = 3,           // No stopping rule: every field divides to max_depth (upper bound on accuracy).
-  // Bottom-up readings: every field is divided to max_depth first; a division is then withdrawn
-  // (recursively, from the deepest level up) when all four children are leaves that share the
-  // parent's nearest element (kCollapseFirst: what the authors' public demo does, reverse-engineered
-  // from its leaf table, docs/notes/annf.md) or its ordered pair (kCollapsePair).
-  kCollapseFirst = 4,
-  kCollapsePair = 5,
-};
+// Readings of the paper's stopping rules and candidate choice: the enumerators (and their names for
+// the command line) are in the bench-only header fploc/annf/ablation.h; the localizer uses the
+// defaults below. The value 2 is kChildLeafOrdered.
+enum class PaperRule : uint8_t;
 
 struct AnnfOptions {
   AnnfMode mode = AnnfMode::kPaper;
@@ -66,7 +54,7 @@ struct AnnfOptions {
   // The defaults of the three paper-mode readings (rule, distinct distances, candidates) are the
   // combination closest to Table III on the Corridor plan (docs/notes/annf.md: no reading
   // reproduces the table; the best few differ by < 3 points summed over its 12 numbers).
-  PaperRule paper_rule = PaperRule::kChildLeafOrdered;
+  PaperRule paper_rule = PaperRule{2};  // kChildLeafOrdered (fploc/annf/ablation.h)
   // Exact mode: subdivide while a leaf holds more candidates. 2: most look-ups evaluate one SSE2
   // pair of candidates (docs/notes/annf.md has the measured trade-off against 4).
   int exact_max_candidates = 2;
@@ -88,8 +76,8 @@ struct AnnfOptions {
   // elements are chosen only among the elements passing through it. A field no element passes
   // through gets the two nearest of the whole plan (kPassingElseAll) or keeps its parent's two
   // (kPassingInherit; a root field: the two nearest of the whole plan).
-  enum class Candidates : uint8_t { kAll = 0, kPassingElseAll = 1, kPassingInherit = 2 };
-  Candidates paper_candidates = Candidates::kPassingElseAll;
+  enum class Candidates : uint8_t;  // kAll, kPassingElseAll, kPassingInherit: fploc/annf/ablation.h
+  Candidates paper_candidates = Candidates{1};  // kPassingElseAll
   // Speed only (not saved, no effect on results): the top levels of the trees are flattened into a
   // dense index of at most this many cells so a look-up starts near the leaf. 0 = 2^18 in paper
   // mode, 2^20 in exact mode (deeper trees; measured fastest on SIST-F4, docs/notes/annf.md).
@@ -97,10 +85,7 @@ struct AnnfOptions {
 };
 
 const char* to_string(AnnfMode m);
-const char* to_string(PaperRule r);
 AnnfMode parse_annf_mode(const std::string& s);    // "paper" | "exact"; throws otherwise
-PaperRule parse_paper_rule(const std::string& s);  // "child-leaf" | "undo-only" | "child-leaf-ordered" | "full" |
-                                                   // "collapse-first" | "collapse-pair"
 
 struct AnnfStats {
   size_t nodes = 0, leaves = 0, pool_ids = 0;

@@ -57,8 +57,9 @@ struct PlanLoadOptions {
 
 // Dispatch on the extension (.dxf, .csv, .json, .fpmap; .pbtxt building and .ifc: the plan of
 // options.floor, see fploc/floorplan/building.h; case-insensitive).
+// `floor`: buildings and IFC only (PlanLoadOptions::floor).
 FloorPlan load_floor_plan(const std::string& path, const std::vector<std::string>& layer_globs = {},
-                          const std::string& units_override = "");
+                          const std::string& units_override = "", const std::string& floor = "");
 FloorPlan load_floor_plan(const std::string& path, const PlanLoadOptions& options);
 
 // Individual readers (the `source` name is used in error messages).

@@ -1,0 +1,13 @@
+#!/bin/sh
+# The Barcelona pavilion's IFC walls against its DXF drawing (issue 11 target: >= 90 % of the IFC wall
+# length within 5 cm of a DXF wall after a rigid alignment). Skips without ../shared/data or web-ifc.
+MAP="$1"
+SRC="$(cd "$(dirname "$0")/../.." && pwd)"
+F="$SRC/../shared/data/floorplans"
+if [ ! -f "$F/barcelona_pavilion.ifc" ]; then echo "SKIP: no ../shared/data ($F)"; exit 0; fi
+if [ ! -d "$SRC/tools/ifc/node_modules/web-ifc" ]; then echo "SKIP: web-ifc not installed (scripts/setup-web.sh)"; exit 0; fi
+J=$("$MAP" compare --plan "$F/barcelona_pavilion.ifc" --layers 'IfcWall*' --ref-plan "$F/barcelona_pavilion_plan.dxf" \
+      --ref-layers Walls --json 2>/dev/null) || { echo "FAIL: compare failed"; exit 1; }
+echo "$J"
+share=$(echo "$J" | sed -n 's/.*"share": *\([0-9.]*\).*/\1/p')
+awk -v s="$share" 'BEGIN { if (s + 0 >= 0.90) { print "OK: share " s; exit 0 } print "FAIL: share " s " < 0.90"; exit 1 }'
