@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <iostream>
 #include <stdexcept>
+#include <thread>
 
 #include "fploc/runtime/bus.h"
 #include "fploc/runtime/compose.h"
@@ -377,7 +378,32 @@ int node_main(int argc, char** argv) {
     Context ctx(bus, reg.spec, instance, std::move(options), port_map, base_dir, false);
     ctx.set_restarts(restarts);
     auto node = reg.make();
+    // setup() may take long (a large plan's ANNF on a cold cache, fploc/annf/cache.h): after 2 s a
+    // thread sends a "loading" heartbeat every second, so the launcher does not take a slow start for
+    // a hang (killing it would also throw the half-built field away, every restart again). A quick
+    // setup sends none: its first status is "running", as before.
+    std::atomic<bool> setup_done{false};
+    const fploc::node_status_t loading = make_status(ctx, executable, "loading", 0, 0, restarts);
+    std::thread loading_beats([&] {
+      for (int tick = 0; !setup_done; ++tick) {
+        if (tick >= 20 && tick % 10 == 0) {
+          fploc::node_status_t s = loading;
+          s.utime = wall_utime();
+          bus.lcm().publish(kTelemetryChannel, &s);
+        }
+        usleep(100000);
+      }
+    });
+    struct JoinBeats {
+      std::atomic<bool>& done;
+      std::thread& t;
+      ~JoinBeats() {
+        done = true;
+        t.join();
+      }
+    };
     try {
+      JoinBeats join{setup_done, loading_beats};
       node->setup(ctx);
     } catch (const std::exception& e) {
       std::cerr << "[" << instance << "] setup failed: " << e.what() << std::endl;
