@@ -33,4 +33,14 @@ grep -q "<svg" "$T/r.svg" || fail "svg"
 "$MAP" export-pgm --plan "$T/p.json" --resolution 0.1 --out "$T/pgm" 2>/dev/null || fail "export-pgm"
 head -c 2 "$T/pgm/map.pgm" | grep -q P5 || fail "pgm header"
 grep -q "resolution: 0.1" "$T/pgm/map.yaml" || fail "yaml"
+# Buildings: --floor picks the floor; an unknown floor names the known ones; a single plan has one floor.
+B="$(cd "$(dirname "$0")/../.." && pwd)/data/buildings/two-floors.pbtxt"
+"$MAP" render --plan "$B" --floor first --out "$T/first.svg" 2>/dev/null || fail "render a building floor"
+grep -q "<svg" "$T/first.svg" || fail "building floor svg"
+"$MAP" build --plan "$B" --mode exact --out "$T/ground.fpmap" --json > "$T/b.json" 2>/dev/null || fail "build the first floor"
+grep -q '"elements": 44' "$T/b.json" || fail "the default floor is the first (the room, 44 elements)"
+if "$MAP" validate --plan "$B" --floor roof --no-baselines 2> "$T/err"; then fail "unknown floor accepted"; fi
+grep -q "no floor 'roof' (floors: ground, first)" "$T/err" || fail "unknown floor message: $(cat "$T/err")"
+if "$MAP" render --plan "$T/p.json" --floor first --out "$T/x.svg" 2> "$T/err"; then fail "floor of a single plan accepted"; fi
+grep -q "a single plan has one floor" "$T/err" || fail "single plan floor message: $(cat "$T/err")"
 echo "fploc-map CLI checks passed"

@@ -9,5 +9,9 @@ if [ ! -d "$SRC/tools/ifc/node_modules/web-ifc" ]; then echo "SKIP: web-ifc not 
 J=$("$MAP" compare --plan "$F/barcelona_pavilion.ifc" --layers 'IfcWall*' --ref-plan "$F/barcelona_pavilion_plan.dxf" \
       --ref-layers Walls --json 2>/dev/null) || { echo "FAIL: compare failed"; exit 1; }
 echo "$J"
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+"$MAP" render --plan "$F/barcelona_pavilion.ifc" --out "$T/ifc.png" 2>/dev/null || { echo "FAIL: render of the IFC"; exit 1; }
+[ -s "$T/ifc.png" ] || { echo "FAIL: no PNG"; exit 1; }
 share=$(echo "$J" | sed -n 's/.*"share": *\([0-9.]*\).*/\1/p')
 awk -v s="$share" 'BEGIN { if (s + 0 >= 0.90) { print "OK: share " s; exit 0 } print "FAIL: share " s " < 0.90"; exit 1 }'
