@@ -150,6 +150,31 @@ TEST(Ifc, BarcelonaPavilion) {
   EXPECT_NE(error_of([&] { load_floor_plan(path, o); }).find("no IfcWall"), std::string::npos);
 }
 
+TEST(Ifc, StoreysWithElevations) {
+  // The pavilion with two storeys added (IFC4 IfcBuildingStorey: ..., CompositionType, Elevation):
+  // one floor each, lowest first, cut 1 m above each; the roof slab's underside (3.0 m) is the upper
+  // storey's ceiling (above its cut plane at 2.5 m), the ground's is unknown (above the next cut plane).
+  const std::string path = kShared + "barcelona_pavilion.ifc";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no ../shared/data (" << path << "): IFC test skipped";
+  if (!have_web_ifc()) GTEST_SKIP() << "web-ifc not installed (scripts/setup-web.sh): IFC test skipped";
+  std::ifstream f(path, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(f)), {});
+  text.insert(text.rfind("ENDSEC;"),
+              "#900002=IFCBUILDINGSTOREY('0StoreyUpper0000000001',#5,'Upper',$,$,$,$,$,.ELEMENT.,1.5);\n"
+              "#900001=IFCBUILDINGSTOREY('0StoreyGround000000001',#5,'Ground',$,$,$,$,$,.ELEMENT.,0.);\n");
+  const Building b = load_building(write_temp("storeys.ifc", text));
+  ASSERT_EQ(b.floors.size(), 2u);
+  EXPECT_EQ(b.floors[0].name, "Ground");
+  EXPECT_EQ(b.floors[1].name, "Upper");
+  EXPECT_DOUBLE_EQ(b.floors[1].elevation, 1.5);
+  EXPECT_NEAR(b.floors[1].ceiling_height, 1.5, 0.01);
+  EXPECT_EQ(b.floors[0].ceiling_height, 0.0);
+  PlanLoadOptions o;
+  o.layer_globs = {"IfcDoor"};
+  EXPECT_GT(load_floor_plan(b, "Ground", o).elements.size(), 0u);  // doors are cut at 1 m, not at 2.5 m
+  EXPECT_NE(error_of([&] { load_floor_plan(b, "Upper", o); }).find("no elements on layers matching"), std::string::npos);
+}
+
 TEST(Ifc, BrokenFilesGiveOneClearError) {
   if (!have_web_ifc()) GTEST_SKIP() << "web-ifc not installed (scripts/setup-web.sh): IFC test skipped";
   const std::string head =
