@@ -16,6 +16,7 @@
 //          {"type":"arc","c":[x,y],"r":1,"start_deg":0,"end_deg":90}]}   (arcs counter-clockwise)
 //  - .dxf  ASCII DXF (see dxf.h for what is read). Binary DXF is a clear error.
 //  - .fpmap the plan stored inside a map built by `fploc map build` (fploc/annf/annf.h).
+//  - .yaml/.yml a ROS map_server occupancy map (YAML + PGM/PNG), vectorised (fploc/floorplan/occupancy.h).
 //
 // Layer globs (fnmatch-style `*`, `?`, `[..]`, case-insensitive) select elements by layer name; an
 // empty list keeps everything. A selection that leaves no element is an error that lists the layers.
@@ -50,7 +51,7 @@ struct PlanLoadOptions {
   double curve_tolerance = 0.01;
 };
 
-// Dispatch on the extension (.dxf, .csv, .json, .fpmap; case-insensitive).
+// Dispatch on the extension (.dxf, .csv, .json, .fpmap, .yaml/.yml; case-insensitive).
 FloorPlan load_floor_plan(const std::string& path, const std::vector<std::string>& layer_globs = {},
                           const std::string& units_override = "");
 FloorPlan load_floor_plan(const std::string& path, const PlanLoadOptions& options);
