@@ -1,5 +1,6 @@
 #include "fploc/laser2d/laser2d.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
 
 namespace fploc::laser2d {
@@ -44,7 +45,8 @@ const feat::Features2D& Laser2dFeatures::process(const PlanarScan& s, double rol
                            std::isfinite(s.time_increment) && !s.ranges.empty() && s.ranges.size() < 32768;
   if (!geometry_ok) {
     seg_.status = seg::SegStatus::kBadInput;
-    return fx_.process(seg_);
+    out_ = fx_.process(seg_);
+    return out_;
   }
   const double lo = std::max<double>(cfg_.min_range_m, std::isfinite(s.range_min) ? s.range_min : 0.0);
   const double hi = std::min<double>(cfg_.max_range_m, std::isfinite(s.range_max) && s.range_max > 0 ? s.range_max : cfg_.max_range_m);
@@ -68,7 +70,26 @@ const feat::Features2D& Laser2dFeatures::process(const PlanarScan& s, double rol
     ++stats_.returns;
   }
   seg_.status = seg_.wall.size() ? seg::SegStatus::kOk : seg::SegStatus::kEmpty;
-  return fx_.process(seg_);
+  out_ = fx_.process(seg_);
+  if (!cfg_.all_returns || out_.status == feat::FeatStatus::kBadInput) return out_;
+  used_.assign(seg_.wall.size(), 0);
+  for (int32_t k : out_.source)
+    if (k >= 0 && size_t(k) < used_.size()) used_[size_t(k)] = 1;
+  const Eigen::Matrix3f R = (Eigen::AngleAxisf(float(pitch), Eigen::Vector3f::UnitY()) *
+                             Eigen::AngleAxisf(float(roll), Eigen::Vector3f::UnitX())).toRotationMatrix();
+  const auto& w = seg_.wall;
+  for (size_t k = 0; k < w.size(); ++k) {
+    if (used_[k]) continue;
+    const Eigen::Vector3f p = R * Eigen::Vector3f(w.x[k], w.y[k], w.z[k]);
+    out_.x.push_back(p.x());
+    out_.y.push_back(p.y());
+    out_.kind.push_back(feat::kSurface);
+    out_.group.push_back(-1);
+    out_.t.push_back(w.t[k]);
+    out_.source.push_back(int32_t(k));
+  }
+  if (out_.x.size() >= 30 && out_.status == feat::FeatStatus::kFewFeatures) out_.status = feat::FeatStatus::kOk;
+  return out_;
 }
 
 }  // namespace fploc::laser2d

@@ -35,7 +35,9 @@ double wall_distance(double x, double y) { return std::min({std::abs(x), std::ab
 TEST(Laser2d, FeaturesLieOnTheWalls) {
   const double x0 = 3, y0 = 2, yaw0 = 0.4;
   PlanarScan s = box_scan(x0, y0, yaw0);
-  Laser2dFeatures l2;
+  Laser2dConfig loam_only;
+  loam_only.all_returns = false;
+  Laser2dFeatures l2(loam_only);
   const auto& f = l2.process(s);
   EXPECT_EQ(f.status, feat::FeatStatus::kOk);
   EXPECT_EQ(l2.stats().returns, 360);
@@ -57,6 +59,21 @@ TEST(Laser2d, FeaturesLieOnTheWalls) {
   EXPECT_GE(corners, 3);
   EXPECT_GT(grouped, int(f.size()) / 2);
   EXPECT_GE(f.num_groups, 4);
+}
+
+TEST(Laser2d, AllReturnsAfterTheLoamPicks) {
+  PlanarScan s = box_scan(3, 2, 0.4);
+  Laser2dConfig loam_only;
+  loam_only.all_returns = false;
+  Laser2dFeatures a(loam_only), b;
+  const size_t picks = a.process(s).size();
+  const auto& f = b.process(s);
+  EXPECT_EQ(f.size(), 360u);
+  for (size_t k = 0; k < picks; ++k) EXPECT_EQ(f.source[k], a.process(s).source[k]);
+  for (size_t k = picks; k < f.size(); ++k) {
+    EXPECT_EQ(f.group[k], -1);
+    EXPECT_EQ(f.kind[k], feat::kSurface);
+  }
 }
 
 TEST(Laser2d, DropsNonFiniteAndOutOfRange) {

@@ -33,6 +33,10 @@ struct Laser2dConfig {
   bool upside_down = false;      // mounted upside down: angles mirror
   double z_m = 0;                // the laser's (fixed) height, passed on as z
   feat::FeatureConfig features = default_features();
+  // A planar scan has a few hundred beams, LOAM keeps a few dozen of them (measured on the Radish logs:
+  // 30-60), too few to tell apart the parallel walls of an office: every other return is passed on too, as
+  // an unclassified surface point (group -1), after LOAM's picks. The matcher's point budget (800) holds them.
+  bool all_returns = true;
   // LOAM limits for one ring of a few hundred beams: more surface points per sector than for a 64-ring scan.
   static feat::FeatureConfig default_features();
 };
@@ -56,6 +60,8 @@ class Laser2dFeatures {
  private:
   Laser2dConfig cfg_;
   feat::FeatureExtractor fx_;
+  feat::Features2D out_;
+  std::vector<uint8_t> used_;
   seg::Segmentation seg_;
   Laser2dStats stats_;
 };
