@@ -50,6 +50,7 @@ int main(int argc, char** argv) {
   std::string in, out, tum, map_dir;
   double begin = 0, end = 1, map_begin = 0, map_end = 0.5, resolution = 0.05;
   bool json = false;
+  std::string odom_from = "odom";
   app.add_option("log", in, "CARMEN log (.log or .log.gz)")->required();
   app.add_option("--out", out, "LCM log to write");
   app.add_option("--tum", tum, "reference (FLASER poses) as TUM");
@@ -60,6 +61,10 @@ int main(int argc, char** argv) {
   app.add_option("--map-end", map_end, "(0.5)")->check(CLI::Range(0.0, 1.0));
   app.add_option("--resolution", resolution, "map cell size [m] (0.05)")->check(CLI::PositiveNumber);
   app.add_flag("--json", json, "summary as JSON on stdout");
+  app.add_option("--odom-from", odom_from,
+                 "odom: the ODOM records (wheel odometry, default); flaser: the FLASER odom_* columns (in the corrected "
+                 "Radish logs a copy of the reference: a diagnostic, circular)")
+      ->check(CLI::IsMember({"odom", "flaser"}));
   CLI11_PARSE(app, argc, argv);
   namespace cm = fploc::carmen;
   try {
@@ -86,14 +91,16 @@ int main(int argc, char** argv) {
       for (size_t k = b; k < e; ++k) {
         const auto& s = log.scans[k];
         const int64_t ut = utime_of(k);
-        if (s.have_wheel_odom) {
+        const bool flaser = odom_from == "flaser";
+        const auto& op = flaser ? s.odom : s.wheel_odom;
+        if (flaser || s.have_wheel_odom) {
           fploc::pose_t p{};
           p.utime = ut;
           p.seq = int64_t(k);
           p.status = 0;
-          p.position[0] = s.wheel_odom.x;
-          p.position[1] = s.wheel_odom.y;
-          quat_of_yaw(s.wheel_odom.theta, p.orientation);
+          p.position[0] = op.x;
+          p.position[1] = op.y;
+          quat_of_yaw(op.theta, p.orientation);
           write_event(lf, ut, "WHEEL_ODOM", p, buf);
           ++odom;
         }

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <random>
 
 #include "fploc/floorplan/io.h"
 #include "fploc/floorplan/occupancy.h"
@@ -171,4 +172,36 @@ TEST(Occupancy, ShipInteriorMap) {
   EXPECT_GT(st.occupied_cells, 100u);
   EXPECT_GT(v.elements.size(), 2u);
   EXPECT_LE(st.max_error_m, 0.5 * g.resolution + 1e-9);
+}
+
+// Random edits of a valid YAML and PGM: a value or one clear error naming the source, never a crash
+// (a short in-test fuzz; libyaml does the YAML syntax).
+TEST(Occupancy, MutatedInputsNeverCrash) {
+  std::mt19937 rng(11);
+  const std::string yaml = "image: m.pgm\nresolution: 0.05\norigin: [-1.5, 2.0, 0.3]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.2\nmode: trinary\n";
+  std::string pgm = "P5\n# c\n4 3\n255\n";
+  for (int k = 0; k < 12; ++k) pgm += char(k * 20);
+  const std::string alphabet = "0123456789 .-+:[],#\n\tPabc\xff";
+  int ok = 0, err = 0;
+  for (int it = 0; it < 20000; ++it) {
+    std::string s = it % 2 ? yaml : pgm;
+    for (int e = 1 + int(rng() % 4); e > 0; --e) {
+      const size_t p = rng() % (s.size() + 1);
+      switch (rng() % 3) {
+        case 0: s.insert(p, 1, alphabet[rng() % alphabet.size()]); break;
+        case 1: if (p < s.size()) s.erase(p, 1); break;
+        default: if (p < s.size()) s[p] = alphabet[rng() % alphabet.size()]; break;
+      }
+    }
+    try {
+      if (it % 2) parse_map_yaml(s, "f.yaml");
+      else read_pgm(s, "f.pgm");
+      ++ok;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(it % 2 ? "f.yaml" : "f.pgm"), std::string::npos) << e.what();
+      ++err;
+    }
+  }
+  EXPECT_GT(ok, 0);
+  EXPECT_GT(err, 0);
 }
