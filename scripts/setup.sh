@@ -7,7 +7,7 @@ PKGS=(
   liblcm-dev liblcm-bin liblcm-java default-jre-headless default-jdk-headless libjchart2d-java libglib2.0-dev
   libprotobuf-dev protobuf-compiler
   libgtest-dev libgmock-dev libbenchmark-dev
-  nlohmann-json3-dev libcli11-dev libcpp-httplib-dev libssl-dev libpcap-dev libnanoflann-dev
+  nlohmann-json3-dev libyaml-dev libpng-dev libcli11-dev libcpp-httplib-dev libssl-dev libpcap-dev libnanoflann-dev
   python3
 )
 missing=()

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <optional>
 
@@ -57,6 +58,9 @@ class MatcherNode : public fploc::rt::Node {
              // the next frame is predicted from it. Not connected by default: the matcher then predicts
              // from its own single-frame poses only, as the paper's SFR, and runs without an optimizer.
              fploc::rt::input<fploc::pose_t>("refined", ""),
+             // Optional wheel odometry (pose_t in its own odometry frame, stamped with the scan times, e.g.
+             // `fploc import-carmen`'s WHEEL_ODOM): the increment between two frames predicts the next one.
+             fploc::rt::input<fploc::pose_t>("odom", ""),
              fploc::rt::output<fploc::frame_pose_t>("frame_pose", "FPLOC_FRAME_POSE")}};
   }
 
@@ -85,6 +89,15 @@ class MatcherNode : public fploc::rt::Node {
       // Search within 3 sigma of the message's position covariance when it has one.
       const double var = std::max(m.covariance[0], m.covariance[7]);
       matcher_->set_pose(p, std::isfinite(var) && var > 0 ? std::optional<double>(3 * std::sqrt(var)) : initial_search_m_);
+    });
+    ctx.subscribe<fploc::pose_t>("odom", [this](const fploc::pose_t& m) {
+      const fploc::Pose2 p = fploc::pose2_of(m);
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.yaw)) {
+        ctx_->error("odom seq " + std::to_string(m.seq) + ": non-finite pose (ignored)");
+        return;
+      }
+      odom_[m.utime] = p;
+      while (odom_.size() > 256) odom_.erase(odom_.begin());
     });
     ctx.subscribe<fploc::pose_t>("refined", [this](const fploc::pose_t& m) {
       // Stale (a later frame was already registered) or LOST: not used; counted, said at shutdown.
@@ -130,7 +143,12 @@ class MatcherNode : public fploc::rt::Node {
         if (auto w = imu_.mean_rate(f.utime, f.utime + std::llround(sweep * 1e6))) f.sweep_yaw_rate = *w;
       imu_.drop_before(std::min(f.utime, have_prev_ ? prev_utime_ : f.utime));
     }
-    const fploc::MatchResult r = matcher_->process(f, dyaw);
+    std::optional<fploc::Pose2> motion;
+    if (have_prev_) {
+      auto a = odom_.find(prev_utime_), b = odom_.find(f.utime);
+      if (a != odom_.end() && b != odom_.end()) motion = fploc::compose(fploc::inverse(a->second), b->second);
+    }
+    const fploc::MatchResult r = matcher_->process(f, dyaw, motion);
     if (r.status != FitStatus::kNotInitialised) {
       prev_utime_ = f.utime;
       have_prev_ = true;
@@ -173,6 +191,7 @@ class MatcherNode : public fploc::rt::Node {
   std::optional<double> initial_search_m_;
   std::optional<double> last_z_;
   std::optional<std::pair<double, double>> last_rp_;
+  std::map<int64_t, fploc::Pose2> odom_;  // odometry by utime (the last 256)
   bool have_prev_ = false;
   int64_t prev_utime_ = 0;
   int64_t seq_ = 0;

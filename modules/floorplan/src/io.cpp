@@ -15,6 +15,7 @@
 #include "fploc/floorplan/binary_io.h"
 #include "fploc/floorplan/building.h"
 #include "fploc/floorplan/dxf.h"
+#include "fploc/floorplan/occupancy.h"
 
 namespace fploc {
 namespace {
@@ -421,8 +422,12 @@ FloorPlan load_floor_plan(const std::string& path, const PlanLoadOptions& option
     if (!options.units_override.empty() && metres_per_unit(options.units_override) != 1.0)
       fail(path + ": a built map is already in metres; --units does not apply");
     filter_layers(plan, options.layer_globs);
+  } else if (ext == ".yaml" || ext == ".yml") {  // ROS map_server occupancy map (fploc/floorplan/occupancy.h)
+    plan = load_occupancy_plan(path);
+    if (!options.units_override.empty() && metres_per_unit(options.units_override) != 1.0)
+      fail(path + ": an occupancy map is in metres (its resolution); --units does not apply");
   } else {
-    fail(path + ": unknown floor-plan format '" + ext + "' (use .dxf, .csv, .json, .fpmap, a building .pbtxt or .ifc)");
+    fail(path + ": unknown floor-plan format '" + ext + "' (use .dxf, .csv, .json, .fpmap, a map_server .yaml, a building .pbtxt or .ifc)");
   }
   if (plan.elements.empty()) fail(path + ": the plan has no elements");
   plan.source = path;

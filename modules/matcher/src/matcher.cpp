@@ -131,7 +131,12 @@ bool Matcher::refine(int64_t utime, const Pose2& p) {
   return true;
 }
 
-Pose2 Matcher::predict(int64_t tau, std::optional<double> yaw_delta) const {
+Pose2 Matcher::predict(int64_t tau, std::optional<double> yaw_delta, const std::optional<Pose2>& motion) const {
+  if (motion && have_last_) {
+    Pose2 p = compose(pose_, *motion);
+    p.yaw = wrap_angle(p.yaw);
+    return p;
+  }
   const double dt = (tau - tau_) * 1e-6;
   const bool valid_dt = have_last_ && dt > 0 && dt < 1.0;
   Twist2 v;
@@ -141,7 +146,7 @@ Pose2 Matcher::predict(int64_t tau, std::optional<double> yaw_delta) const {
   return p;
 }
 
-MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_delta) {
+MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_delta, const std::optional<Pose2>& motion) {
   if (!initialised_) {
     MatchResult r;
     r.status = FitStatus::kNotInitialised;
@@ -151,7 +156,7 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
   }
   const double t_ref = cfg_.deskew ? mean_time(f) : 0.0;
   const int64_t tau = f.utime + std::llround(t_ref * 1e6);
-  const Pose2 pred = predict(tau, yaw_delta);
+  const Pose2 pred = predict(tau, yaw_delta, motion);
   const bool lost = poor_count_ >= cfg_.lost_after;
   // Gates: tracking (the previous frame OK) starts at the tracking gate, the first frame after set_pose
   // searches within the given pose's uncertainty, after a POOR frame the gate starts wide, and wider
@@ -159,7 +164,7 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
   MatcherConfig cfg = cfg_;
   const bool tracking = have_last_ && poor_count_ == 0;
   if (lost) cfg.gate_initial_m *= 2;
-  else if (tracking) cfg.gate_initial_m = std::min(cfg.gate_initial_m, cfg.gate_tracking_m);
+  else if (tracking && !motion) cfg.gate_initial_m = std::min(cfg.gate_initial_m, cfg.gate_tracking_m);
   else if (!have_last_) cfg.gate_initial_m = search_m_;
   // Motion compensation: the sweep's points moved to the sensor frame at utime + t_ref with the motion
   // model's body twist (zero linear velocity until two frames were registered), the IMU's yaw rate.
@@ -195,14 +200,22 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
     const double dt = (tau - tau_) * 1e-6;
     const bool use_prior = tracking && have_velocity_ && cfg_.motion_model && last_rms_ > 0 && dt > 0 && dt < 1.0 &&
                            cfg_.prediction_sigma_m > 0 && cfg_.prediction_sigma_rad > 0;
-    if (use_prior) {
+    if (motion && tracking && last_rms_ > 0 && cfg_.prediction_sigma_m > 0) {
+      // Odometry prediction as the prior: wheel odometry is good to about 10 % of the step (plus 5 cm, 1 deg),
+      // which is what holds a frame along a featureless corridor.
+      const double step = std::hypot(motion->x, motion->y), sr = std::clamp(last_rms_, 0.005, cfg_.loss_scale_m);
+      prior.pose = pred;
+      const double sm = 0.05 + 0.1 * step, sa = 0.0175 + 0.1 * std::abs(motion->yaw);
+      prior.sqrt_info = Eigen::Vector3d(sr / sm, sr / sm, sr / sa);
+    } else if (use_prior) {
       // sigma_r / sigma_pred: the prediction as a measurement among point residuals of rms sigma_r.
       const double grow = std::max(1.0, dt / 0.1), sr = std::clamp(last_rms_, 0.005, cfg_.loss_scale_m);
       prior.pose = pred;
       prior.sqrt_info = Eigen::Vector3d(sr / (cfg_.prediction_sigma_m * grow), sr / (cfg_.prediction_sigma_m * grow),
                                         sr / (cfg_.prediction_sigma_rad * grow));
     }
-    r = register_frame(lookup_, in, pred, cfg, use_prior ? &prior : nullptr);
+    const bool odom_prior = motion && tracking && last_rms_ > 0 && cfg_.prediction_sigma_m > 0;
+    r = register_frame(lookup_, in, pred, cfg, use_prior || odom_prior ? &prior : nullptr);
   }
   const Pose2 solved_ref = r.solved;
   const double jump = std::hypot(solved_ref.x - pred.x, solved_ref.y - pred.y);

@@ -16,6 +16,7 @@
 //          {"type":"arc","c":[x,y],"r":1,"start_deg":0,"end_deg":90}]}   (arcs counter-clockwise)
 //  - .dxf  ASCII DXF (see dxf.h for what is read). Binary DXF is a clear error.
 //  - .fpmap the plan stored inside a map built by `fploc map build` (fploc/annf/annf.h).
+//  - .yaml/.yml a ROS map_server occupancy map (YAML + PGM/PNG), vectorised (fploc/floorplan/occupancy.h).
 //
 // Layer globs (fnmatch-style `*`, `?`, `[..]`, case-insensitive) select elements by layer name; an
 // empty list keeps everything. A selection that leaves no element is an error that lists the layers.
@@ -55,8 +56,8 @@ struct PlanLoadOptions {
   double ifc_cut_height = 1.0;
 };
 
-// Dispatch on the extension (.dxf, .csv, .json, .fpmap; .pbtxt building and .ifc: the plan of
-// options.floor, see fploc/floorplan/building.h; case-insensitive).
+// Dispatch on the extension (.dxf, .csv, .json, .fpmap, .yaml/.yml map_server occupancy map; .pbtxt
+// building and .ifc: the plan of options.floor, see fploc/floorplan/building.h; case-insensitive).
 // `floor`: buildings and IFC only (PlanLoadOptions::floor).
 FloorPlan load_floor_plan(const std::string& path, const std::vector<std::string>& layer_globs = {},
                           const std::string& units_override = "", const std::string& floor = "");

@@ -85,7 +85,12 @@ class Matcher {
   // de-skewed to its mean point time t_ref with the motion model's body twist (its yaw rate replaced by
   // f.sweep_yaw_rate when that is known) and registered there; the twist is then updated from the last
   // two registered sweep poses and carries the pose back from utime + t_ref to utime.
-  MatchResult process(const FeatureFrame& f, std::optional<double> yaw_delta = std::nullopt);
+  // motion: the robot's own odometry increment since the previous frame (wheel odometry, in the previous
+  // frame's body frame), if any: the prediction is the previous pose composed with it, whatever the time
+  // between frames (2D laser logs have frames seconds and a metre apart), and the first gate is the wide
+  // one (gate_initial_m), as odometry over such a step is good to decimetres, not to the tracking gate.
+  MatchResult process(const FeatureFrame& f, std::optional<double> yaw_delta = std::nullopt,
+                      const std::optional<Pose2>& motion = std::nullopt);
   // A better estimate of the last processed frame's pose at its utime (the windowed optimizer's, which
   // holds directions a single frame leaves open, e.g. along a long wall): the next frame is predicted
   // from it (with the matcher's own velocity). Ignored (false) unless `utime` is the last processed
@@ -98,7 +103,7 @@ class Matcher {
   const MatcherConfig& config() const { return cfg_; }
 
  private:
-  Pose2 predict(int64_t tau, std::optional<double> yaw_delta) const;
+  Pose2 predict(int64_t tau, std::optional<double> yaw_delta, const std::optional<Pose2>& motion = std::nullopt) const;
   const NearestLookup& lookup_;
   MatcherConfig cfg_;
   bool initialised_ = false;

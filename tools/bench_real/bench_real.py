@@ -1,0 +1,116 @@
+#!/usr/bin/env python3
+"""fploc bench real: fploc (2D LiDAR mode) and AMCL on the real Radish CARMEN logs, non-circular protocol.
+
+Per log: the map is built from the scans and reference (corrected FLASER) poses of the first part of the log
+(--split, by scan count; `fploc import-carmen --map`, a map_server occupancy grid that both localizers load
+as a plan: vectorised on load); the rest is imported as an LCM log (laser_scan_t + wheel odometry) and run
+through graphs/lidar2d.pbtxt with `fploc replay` (fploc matcher + optimizer and AMCL in the same run, on the
+same features and odometry), started from the reference pose (row "ref") and from a pose 1 m / 10 deg off
+(row "off"), and scored against the reference poses with `fploc eval`. LOST %: share of scans whose position
+error exceeds --lost-m (0.5 m). ms per scan: the nodes' thread CPU time (laser2d + matcher + optimizer for
+fploc, AMCL's own) over the scans, from replay's --json.
+
+  fploc bench real [--json] [--logs intel,aces] [--end 0.6] [--out DIR] [--rows ref,off]
+"""
+import argparse, json, math, os, subprocess, sys
+
+ROOT = os.environ.get("FPLOC_ROOT", os.path.abspath(os.path.join(os.path.dirname(os.path.realpath(__file__)), "..", "..")))
+BUILD = os.environ.get("FPLOC_BUILD_DIR", os.path.join(ROOT, "build"))
+SHARED = os.environ.get("FPLOC_SHARED_DIR", os.path.join(ROOT, "..", "shared"))
+BIN = os.path.join(BUILD, "bin")
+LOGS = ["intel", "aces", "fhw", "csail", "freiburg-079"]
+
+
+def run(cmd, **kw):
+    p = subprocess.run(cmd, capture_output=True, text=True, **kw)
+    if p.returncode != 0:
+        sys.stderr.write(p.stderr)
+        raise SystemExit(f"fploc bench real: {os.path.basename(cmd[0])} failed ({p.returncode})")
+    return p
+
+
+def read_tum(path):
+    out = {}
+    with open(path) as f:
+        for line in f:
+            if line.startswith("#") or not line.strip():
+                continue
+            t = line.split()
+            out[round(float(t[0]), 4)] = (float(t[1]), float(t[2]), 2 * math.atan2(float(t[6]), float(t[7])))
+    return out
+
+
+def score(gt_path, est_path, lost_m):
+    j = json.loads(run([os.path.join(BIN, "fploc-eval"), "--gt", gt_path, "--est", est_path, "--json"]).stdout)
+    gt, est = read_tum(gt_path), read_tum(est_path)
+    errs = [math.hypot(est[k][0] - g[0], est[k][1] - g[1]) if k in est else float("inf") for k, g in gt.items()]
+    lost = sum(e > lost_m for e in errs)
+    return {"ate_m": j["ate_rmse_m"], "max_m": j["ate_max_m"], "lost_pct": 100.0 * lost / max(1, len(errs)),
+            "poses": j["poses"]}
+
+
+def main():
+    ap = argparse.ArgumentParser(description="fploc vs AMCL on the Radish logs (non-circular: map from the first part)")
+    ap.add_argument("--json", action="store_true")
+    ap.add_argument("--logs", default=",".join(LOGS))
+    ap.add_argument("--split", type=float, default=0.5, help="map from scans [0, split), localize [split, end)")
+    ap.add_argument("--end", type=float, default=1.0, help="localize up to this fraction (a short test run)")
+    ap.add_argument("--resolution", type=float, default=0.05)
+    ap.add_argument("--rows", default="ref,off")
+    ap.add_argument("--lost-m", type=float, default=0.5)
+    ap.add_argument("--out", default="bench-real")
+    ap.add_argument("--graph", default=os.path.join(ROOT, "graphs", "lidar2d.pbtxt"))
+    a = ap.parse_args()
+    radish = os.path.join(SHARED, "data", "recordings", "radish")
+    if not os.path.isdir(radish):
+        print(f"fploc bench real: {radish} absent (shared data); nothing to do", file=sys.stderr)
+        return 0
+    os.makedirs(a.out, exist_ok=True)
+    rows = []
+    for name in a.logs.split(","):
+        src = os.path.join(radish, f"{name}-corrected.log.gz")
+        d = os.path.join(a.out, name)
+        os.makedirs(d, exist_ok=True)
+        lcm, ref, mapdir = os.path.join(d, "rest.lcm"), os.path.join(d, "ref.tum"), os.path.join(d, "map")
+        imp = json.loads(run([os.path.join(BIN, "fploc-import-carmen"), src, "--out", lcm, "--tum", ref, "--begin", str(a.split),
+                              "--end", str(a.end), "--map", mapdir, "--map-begin", "0", "--map-end", str(a.split),
+                              "--resolution", str(a.resolution), "--json"]).stdout)
+        plan = os.path.join(mapdir, "map.yaml")
+        t0 = min(read_tum(ref).items())[1]
+        for row in a.rows.split(","):
+            x, y, yaw = t0
+            if row == "off":  # 1 m off (along the heading's left diagonal) and 10 degrees
+                x += math.cos(yaw + math.pi / 4)
+                y += math.sin(yaw + math.pi / 4)
+                yaw += math.radians(10)
+            sets = []
+            for n in ("matcher", "optimizer", "amcl"):
+                sets += ["--set", f"{n}.plan.file={os.path.abspath(plan)}"]
+            for n in ("matcher", "amcl"):
+                sets += ["--set", f"{n}.initial_pose.x={x}", "--set", f"{n}.initial_pose.y={y}", "--set", f"{n}.initial_pose.yaw={yaw}"]
+            est = {k: os.path.abspath(os.path.join(d, f"{row}-{k}.tum")) for k in ("wo", "sfr", "amcl")}
+            sets += ["--set", f"wo_logger.file={est['wo']}", "--set", f"sfr_logger.file={est['sfr']}",
+                     "--set", f"amcl_logger.file={est['amcl']}"]
+            rep = json.loads(run([os.path.join(BIN, "fploc-replay"), "--graph", a.graph, "--log", lcm, "--json"] + sets).stdout)
+            cpu = {n["name"]: n.get("cpu_ms", 0.0) for n in rep["nodes"]}
+            scans = imp["end_scan"] - imp["first_scan"]
+            fploc_ms = (cpu.get("laser2d", 0) + cpu.get("matcher", 0) + cpu.get("optimizer", 0)) / max(1, scans)
+            amcl_ms = cpu.get("amcl", 0) / max(1, scans)
+            f, am = score(ref, est["wo"], a.lost_m), score(ref, est["amcl"], a.lost_m)
+            png = os.path.join(d, f"{row}.png")
+            run([os.path.join(BIN, "fploc-occupancy"), plan, "--png", png, "--tum", ref, "--tum", est["wo"], "--tum", est["amcl"]])
+            r = {"log": name, "start": row, "scans": scans, "map_scans": imp["map"]["end_scan"],
+                 "fploc": {**f, "ms_per_scan": fploc_ms}, "amcl": {**am, "ms_per_scan": amcl_ms},
+                 "fploc_half_of_amcl": f["ate_m"] <= 0.5 * am["ate_m"], "plot": png}
+            rows.append(r)
+            print(f"{name:13s} {row:3s} scans {scans:5d}  fploc ATE {f['ate_m']*100:8.1f} cm max {f['max_m']*100:8.1f} cm "
+                  f"LOST {f['lost_pct']:5.1f} % {fploc_ms:6.2f} ms | AMCL ATE {am['ate_m']*100:8.1f} cm max {am['max_m']*100:8.1f} cm "
+                  f"LOST {am['lost_pct']:5.1f} % {amcl_ms:6.2f} ms", file=sys.stderr)
+    if a.json:
+        print(json.dumps({"bench": "real", "protocol": {"split": a.split, "end": a.end, "resolution_m": a.resolution,
+                                                        "lost_m": a.lost_m, "graph": a.graph}, "rows": rows}, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,159 @@
+// fploc import-carmen LOG[.gz] --out LOG.lcm [--tum REF.tum] [--begin F] [--end F]
+//                    [--map DIR --map-begin F --map-end F --resolution M] [--json]
+// A CARMEN log (the Radish 2D laser logs, modules/carmen) -> an LCM log that `fploc replay` and
+// lcm-logplayer accept: LASER_SCAN (laser_scan_t, one per FLASER: 180 degrees from -90, ranges at the
+// scanner's maximum are no return) and WHEEL_ODOM (pose_t: the last wheel-odometry ODOM record before the
+// scan, stamped with the scan's time, as fploc-amcl's "pose" odometry pairs them), and the FLASER poses (the
+// corrected laser poses: the reference) as TUM. --begin/--end select scans by index fraction (e.g. the second
+// half); --map writes a map_server occupancy map (DIR/map.{pgm,yaml}) built from the scans and reference poses
+// of --map-begin..--map-end (e.g. the first half): the non-circular protocol of `fploc bench real`.
+#include <fploc/laser_scan_t.hpp>
+#include <fploc/pose_t.hpp>
+#include <lcm/lcm-cpp.hpp>
+
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "fploc/carmen/carmen.h"
+
+namespace {
+
+template <class Msg>
+void write_event(lcm::LogFile& log, int64_t utime, const std::string& channel, const Msg& m, std::vector<uint8_t>& buf) {
+  const int n = m.getEncodedSize();
+  buf.resize(size_t(n));
+  m.encode(buf.data(), 0, n);
+  lcm::LogEvent ev;
+  ev.eventnum = 0;
+  ev.timestamp = utime;
+  ev.channel = channel;
+  ev.datalen = n;
+  ev.data = buf.data();
+  if (log.writeEvent(&ev) != 0) throw std::runtime_error("cannot write LCM log event on " + channel);
+}
+
+void quat_of_yaw(double yaw, double q[4]) {
+  q[0] = 0;
+  q[1] = 0;
+  q[2] = std::sin(yaw / 2);
+  q[3] = std::cos(yaw / 2);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"fploc import-carmen: CARMEN log (Radish) -> LCM log (laser_scan_t + odometry) + reference TUM"};
+  std::string in, out, tum, map_dir;
+  double begin = 0, end = 1, map_begin = 0, map_end = 0.5, resolution = 0.05;
+  bool json = false;
+  std::string odom_from = "odom";
+  app.add_option("log", in, "CARMEN log (.log or .log.gz)")->required();
+  app.add_option("--out", out, "LCM log to write");
+  app.add_option("--tum", tum, "reference (FLASER poses) as TUM");
+  app.add_option("--begin", begin, "first scan, as a fraction of the log's scans (0)")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--end", end, "end (exclusive), fraction (1)")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--map", map_dir, "write DIR/map.pgm + DIR/map.yaml from --map-begin..--map-end");
+  app.add_option("--map-begin", map_begin, "(0)")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--map-end", map_end, "(0.5)")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--resolution", resolution, "map cell size [m] (0.05)")->check(CLI::PositiveNumber);
+  app.add_flag("--json", json, "summary as JSON on stdout");
+  app.add_option("--odom-from", odom_from,
+                 "odom: the ODOM records (wheel odometry, default); flaser: the FLASER odom_* columns (in the corrected "
+                 "Radish logs a copy of the reference: a diagnostic, circular)")
+      ->check(CLI::IsMember({"odom", "flaser"}));
+  CLI11_PARSE(app, argc, argv);
+  namespace cm = fploc::carmen;
+  try {
+    const cm::Log log = cm::parse_log(cm::read_maybe_gz(in), in);
+    std::string note;
+    const std::vector<double> t = cm::scan_times(log, &note);
+    const float no_return = cm::no_return_range(log);
+    const size_t n = log.scans.size();
+    auto idx = [&](double f) { return std::min(n, size_t(std::llround(f * double(n)))); };
+    const size_t b = idx(begin), e = idx(end);
+    if (e <= b) throw std::runtime_error("--begin/--end select no scans");
+    nlohmann::json j = {{"log", in}, {"scans_total", n}, {"odom_records", log.odom.size()}, {"first_scan", b},
+                        {"end_scan", e}, {"no_return_m", std::isfinite(no_return) ? double(no_return) : -1.0},
+                        {"time_note", note}, {"beams", log.scans[0].ranges.size()}};
+    for (const auto& [k, v] : log.skipped) j["skipped"][k] = v;
+    // Times: microseconds, starting at the log's first scan (whatever the log's epoch).
+    const double t0 = t.front();
+    auto utime_of = [&](size_t k) { return int64_t(std::llround((t[k] - t0) * 1e6)) + 1000000; };
+    if (!out.empty()) {
+      lcm::LogFile lf(out, "w");
+      if (!lf.good()) throw std::runtime_error(out + ": cannot write");
+      std::vector<uint8_t> buf;
+      size_t odom = 0;
+      for (size_t k = b; k < e; ++k) {
+        const auto& s = log.scans[k];
+        const int64_t ut = utime_of(k);
+        const bool flaser = odom_from == "flaser";
+        const auto& op = flaser ? s.odom : s.wheel_odom;
+        if (flaser || s.have_wheel_odom) {
+          fploc::pose_t p{};
+          p.utime = ut;
+          p.seq = int64_t(k);
+          p.status = 0;
+          p.position[0] = op.x;
+          p.position[1] = op.y;
+          quat_of_yaw(op.theta, p.orientation);
+          write_event(lf, ut, "WHEEL_ODOM", p, buf);
+          ++odom;
+        }
+        fploc::laser_scan_t m;
+        m.utime = ut;
+        m.frame = "flaser";
+        m.angle_min = float(-M_PI / 2);
+        m.angle_increment = float(cm::beam_increment(s.ranges.size()));
+        m.time_increment = 0;  // not in the log
+        m.range_min = 0.0f;
+        m.range_max = std::isfinite(no_return) ? no_return : 1000.f;
+        m.num_ranges = int32_t(s.ranges.size());
+        m.ranges = s.ranges;
+        m.num_intensities = 0;
+        write_event(lf, ut, "LASER_SCAN", m, buf);
+      }
+      j["out"] = out;
+      j["odom_events"] = odom;
+    }
+    if (!tum.empty()) {
+      std::ofstream f(tum);
+      if (!f) throw std::runtime_error(tum + ": cannot write");
+      f << "# fploc import-carmen " << in << ": FLASER (corrected) laser poses, scans " << b << ".." << e << "\n";
+      f << std::fixed << std::setprecision(6);
+      for (size_t k = b; k < e; ++k) {
+        const auto& p = log.scans[k].pose;
+        f << double(utime_of(k)) * 1e-6 << " " << p.x << " " << p.y << " 0 0 0 " << std::sin(p.theta / 2) << " "
+          << std::cos(p.theta / 2) << "\n";
+      }
+      j["tum"] = tum;
+    }
+    if (!map_dir.empty()) {
+      const size_t mb = idx(map_begin), me = idx(map_end);
+      if (me <= mb) throw std::runtime_error("--map-begin/--map-end select no scans");
+      std::vector<const cm::LaserRecord*> sel;
+      for (size_t k = mb; k < me; ++k) sel.push_back(&log.scans[k]);
+      cm::GridConfig gc;
+      gc.resolution = resolution;
+      gc.no_return = no_return;
+      const cm::Grid g = cm::build_grid(sel, gc);
+      cm::write_map_server(g, map_dir, "map");
+      size_t occ = 0;
+      for (auto c : g.cells) occ += c == 100;
+      j["map"] = {{"dir", map_dir}, {"first_scan", mb}, {"end_scan", me}, {"width", g.width}, {"height", g.height},
+                  {"resolution_m", resolution}, {"occupied_cells", occ}};
+    }
+    std::cerr << "fploc import-carmen: " << in << ": " << n << " scans (" << log.scans[0].ranges.size() << " beams), "
+              << log.odom.size() << " odometry records; wrote scans " << b << ".." << e
+              << (note.empty() ? "" : "; " + note) << "\n";
+    if (json) std::cout << j.dump(1) << "\n";
+  } catch (const std::exception& ex) {
+    std::cerr << "fploc import-carmen: " << ex.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

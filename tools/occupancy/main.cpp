@@ -1,0 +1,163 @@
+// fploc occupancy MAP.yaml [--tolerance CELLS] [--out PLAN.json|.csv] [--compare PLAN] [--json]
+//                 [--png OUT.png [--scale N] [--tum T.tum ...]]
+// A ROS map_server occupancy map (YAML + PGM/PNG) vectorised into a plan (fploc/floorplan/occupancy.h):
+// prints the grid, the vectorisation's error (boundary cell centres to their segments) and, with --compare,
+// the two-way distance between the vectorised plan and another plan (e.g. the one `fploc map export-pgm` was
+// run on: the round trip).
+#include <CLI/CLI.hpp>
+
+#include <png.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "fploc/floorplan/io.h"
+#include "fploc/floorplan/occupancy.h"
+
+namespace {
+// Largest distance from points sampled every `step` along a's elements to plan b (brute force).
+double max_distance(const fploc::FloorPlan& a, const fploc::FloorPlan& b, double step, double* mean) {
+  double m = 0, s = 0;
+  size_t n = 0;
+  for (const auto& e : a.elements) {
+    if (e.kind != fploc::ElementKind::kSegment) continue;
+    const int k = std::max(1, int(std::ceil((e.b - e.a).norm() / step)));
+    for (int q = 0; q <= k; ++q) {
+      double d = 0;
+      fploc::nearest_element_brute_force(b, e.a + (e.b - e.a) * (double(q) / k), &d);
+      m = std::max(m, d);
+      s += d;
+      ++n;
+    }
+  }
+  if (mean) *mean = n ? s / double(n) : 0.0;
+  return m;
+}
+// TUM file -> (x, y) list (lines "t x y z qx qy qz qw", '#' comments).
+std::vector<Eigen::Vector2d> read_tum_xy(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw std::runtime_error(path + ": cannot open");
+  std::vector<Eigen::Vector2d> out;
+  std::string line;
+  while (std::getline(f, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream s(line);
+    double t, x, y;
+    if (s >> t >> x >> y) out.emplace_back(x, y);
+  }
+  return out;
+}
+
+// PNG: the grid (occupied black, free white, unknown grey), the vectorised segments in red and any TUM
+// trajectories on top (colours in order: green, blue, orange, magenta), `scale` pixels per cell.
+void write_png(const std::string& out, const fploc::OccupancyGrid& g, const fploc::FloorPlan& plan,
+               const std::vector<std::vector<Eigen::Vector2d>>& tracks, int scale) {
+  const int W = g.width * scale, H = g.height * scale;
+  std::vector<uint8_t> img(size_t(W) * H * 3);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const int v = g.at(x / scale, g.height - 1 - y / scale);
+      const uint8_t c = v < 0 ? 200 : v > 100 * g.occupied_thresh ? 90 : uint8_t(255 - 2 * v);
+      for (int k = 0; k < 3; ++k) img[(size_t(y) * W + x) * 3 + k] = c;
+    }
+  const double c = std::cos(g.origin_yaw), s = std::sin(g.origin_yaw);
+  auto px = [&](const Eigen::Vector2d& p) {  // world -> pixel (float)
+    const Eigen::Vector2d d = p - Eigen::Vector2d(g.origin_x, g.origin_y);
+    const double lx = c * d.x() + s * d.y(), ly = -s * d.x() + c * d.y();
+    return Eigen::Vector2d(lx / g.resolution * scale, H - ly / g.resolution * scale);
+  };
+  auto line = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const uint8_t* col, int thick) {
+    const Eigen::Vector2d pa = px(a), pb = px(b);
+    const int n = std::max(1, int(std::ceil((pb - pa).norm())));
+    for (int k = 0; k <= n; ++k) {
+      const Eigen::Vector2d q = pa + (pb - pa) * (double(k) / n);
+      for (int dy = -thick; dy <= thick; ++dy)
+        for (int dx = -thick; dx <= thick; ++dx) {
+          const int x = int(q.x()) + dx, y = int(q.y()) + dy;
+          if (x < 0 || y < 0 || x >= W || y >= H) continue;
+          for (int m = 0; m < 3; ++m) img[(size_t(y) * W + x) * 3 + m] = col[m];
+        }
+    }
+  };
+  static const uint8_t red[3] = {220, 0, 0};
+  static const uint8_t cols[4][3] = {{0, 170, 0}, {0, 60, 255}, {255, 140, 0}, {200, 0, 200}};
+  for (const auto& e : plan.elements) line(e.a, e.b, red, 0);
+  for (size_t t = 0; t < tracks.size(); ++t)
+    for (size_t k = 1; k < tracks[t].size(); ++k) line(tracks[t][k - 1], tracks[t][k], cols[t % 4], 1);
+  FILE* fp = std::fopen(out.c_str(), "wb");
+  if (!fp) throw std::runtime_error(out + ": cannot write");
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png_create_info_struct(png);
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    std::fclose(fp);
+    throw std::runtime_error(out + ": PNG write error");
+  }
+  png_init_io(png, fp);
+  png_set_IHDR(png, info, W, H, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  for (int y = 0; y < H; ++y) png_write_row(png, &img[size_t(y) * W * 3]);
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  std::fclose(fp);
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"occupancy map (map_server YAML + PGM/PNG) -> vectorised plan"};
+  std::string map, out, compare;
+  double tol = 0.5;
+  bool json = false;
+  std::string png_out;
+  int scale = 1;
+  std::vector<std::string> tums;
+  app.add_option("map", map, "map_server YAML")->required();
+  app.add_option("--tolerance", tol, "Douglas-Peucker tolerance [cells] (0.5)");
+  app.add_option("--out", out, "write the plan (.json or .csv)");
+  app.add_option("--compare", compare, "another plan: two-way distances to the vectorised plan");
+  app.add_flag("--json", json, "JSON on stdout");
+  app.add_option("--png", png_out, "picture: grid, segments (red), --tum trajectories (green, blue, orange, magenta)");
+  app.add_option("--scale", scale, "PNG pixels per cell (1)")->check(CLI::Range(1, 16));
+  app.add_option("--tum", tums, "trajectory (TUM) to draw on the PNG; repeatable");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    const fploc::OccupancyGrid g = fploc::read_occupancy_map(map);
+    fploc::VectoriseOptions o;
+    o.tolerance_cells = tol;
+    fploc::VectoriseStats st;
+    fploc::FloorPlan plan = fploc::vectorise_occupancy(g, o, &st);
+    plan.source = map;
+    nlohmann::json j = {{"map", map}, {"width", g.width}, {"height", g.height}, {"resolution_m", g.resolution},
+                        {"origin", {g.origin_x, g.origin_y, g.origin_yaw}}, {"occupied_cells", st.occupied_cells},
+                        {"boundary_cells", st.boundary_cells}, {"chains", st.chains}, {"segments", st.segments},
+                        {"tolerance_cells", tol}, {"max_error_m", st.max_error_m}, {"mean_error_m", st.mean_error_m}};
+    if (!compare.empty()) {
+      const fploc::FloorPlan ref = fploc::load_floor_plan(compare);
+      double m1 = 0, m2 = 0;
+      j["compare"] = compare;
+      j["plan_to_map_max_m"] = max_distance(ref, plan, g.resolution / 2, &m1);
+      j["plan_to_map_mean_m"] = m1;
+      j["map_to_plan_max_m"] = max_distance(plan, ref, g.resolution / 2, &m2);
+      j["map_to_plan_mean_m"] = m2;
+    }
+    if (!out.empty()) fploc::save_floor_plan(plan, out);
+    if (!png_out.empty()) {
+      std::vector<std::vector<Eigen::Vector2d>> tracks;
+      for (const auto& t : tums) tracks.push_back(read_tum_xy(t));
+      write_png(png_out, g, plan, tracks, scale);
+    }
+    std::cerr << "fploc occupancy: " << g.width << " x " << g.height << " cells at " << g.resolution << " m, "
+              << st.boundary_cells << " boundary cells -> " << st.segments << " segments (max error "
+              << st.max_error_m * 1000 << " mm, mean " << st.mean_error_m * 1000 << " mm)" << (out.empty() ? "" : " -> " + out)
+              << "\n";
+    if (json) std::cout << j.dump(1) << "\n";
+  } catch (const std::exception& e) {
+    std::cerr << "fploc occupancy: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

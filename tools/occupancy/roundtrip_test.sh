@@ -1,0 +1,23 @@
+#!/bin/sh
+# fploc map export-pgm PLAN -> fploc occupancy (vectorise) --compare PLAN: both directions within one cell.
+set -e
+MAP="$1"; OCC="$2"; PLAN="$3"
+T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+for RES in 0.05 0.02; do
+  "$MAP" export-pgm --plan "$PLAN" --resolution $RES --out "$T/m$RES" 2>/dev/null || fail "export-pgm $RES"
+  "$OCC" "$T/m$RES/map.yaml" --compare "$PLAN" --json > "$T/r.json" 2>/dev/null || fail "occupancy $RES"
+  python3 - "$T/r.json" "$RES" <<'PY' || fail "round trip at $RES m"
+import json, sys
+j = json.load(open(sys.argv[1])); r = float(sys.argv[2])
+print(f"res {r}: segments {j['segments']} plan->map max {j['plan_to_map_max_m']:.4f} map->plan max {j['map_to_plan_max_m']:.4f} chain max {j['max_error_m']:.4f}")
+assert j['plan_to_map_max_m'] <= r, j
+assert j['map_to_plan_max_m'] <= r, j
+assert j['max_error_m'] <= 0.5 * r + 1e-9, j
+PY
+done
+# A corrupt YAML: one clear error naming file and field, exit 1.
+printf 'image: map.pgm\nresolution: -1\norigin: [0, 0, 0]\n' > "$T/bad.yaml"
+if "$OCC" "$T/bad.yaml" 2> "$T/err"; then fail "bad yaml accepted"; fi
+grep -q "bad.yaml: resolution: must be > 0" "$T/err" || { cat "$T/err"; fail "error text"; }
+echo OK
