@@ -1,6 +1,6 @@
 // Writes an MCAP file with the MCAP project's own writer (@mcap/core) and CDR from @foxglove/cdr: an
 // independent producer for fploc import's tests.
-//   node write_mcap.js OUT.mcap none|zstd|lz4 chunked|unchunked
+//   node write_mcap.js OUT.mcap none|zstd|lz4 chunked|unchunked [small]
 // Content (ROS 2 types, CDR): /velodyne_points  sensor_msgs/msg/PointCloud2, 3 VLP-16-like clouds of a
 // box room (x -4..6, y -2.5..3.5, z -1.5..2 m; fields x y z intensity ring time, Velodyne layout),
 // /hesai_points  the same clouds without a ring field and absolute float64 "timestamp" (Hesai layout),
@@ -13,7 +13,8 @@ const { CdrWriter } = require("@foxglove/cdr");
 const zstd = require("@foxglove/wasm-zstd");
 const lz4js = require("lz4js");
 
-const [out, compression, chunking] = process.argv.slice(2);
+const [out, compression, chunking, size] = process.argv.slice(2);
+const COLS = size === "small" ? 24 : 1800;  // "small": fuzzing seeds
 const T0 = 1700000000n * 1000000000n;
 
 class FileWritable {
@@ -40,7 +41,7 @@ function rayBox(d) {
 }
 
 function cloud(tNs, rev, withRing) {
-  const rings = 16, cols = 1800;
+  const rings = 16, cols = COLS;
   const step = withRing ? 22 : 24;  // x y z intensity (f32) ring (u16) time (f32) | x y z intensity timestamp (f64)
   const data = new Uint8Array(rings * cols * step);
   const view = new DataView(data.buffer);

@@ -115,7 +115,7 @@ int main(int argc, char** argv) {
         last = std::max(last, s.last_ns);
         total += s.count;
       }
-    const double dur = total ? seconds(last - first) : 0.0;
+    const double dur = total ? seconds(last) - seconds(first) : 0.0;
     if (json) {
       nlohmann::json j;
       j["file"] = path;
@@ -239,7 +239,7 @@ int main(int argc, char** argv) {
   while (rec->next(m)) {
     ++read_msgs;
     if (first_ns == INT64_MIN) first_ns = m.time_ns;
-    const double rel = seconds(m.time_ns - first_ns);
+    const double rel = seconds(m.time_ns) - seconds(first_ns);
     if (start >= 0 && rel < start) continue;
     if (end >= 0 && rel > end) break;
     const Connection& c = rec->connections().at(m.conn);

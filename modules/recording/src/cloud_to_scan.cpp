@@ -60,7 +60,7 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
   if (c.point_step == 0 || npts == 0) return *err = "PointCloud2 is empty", false;
   if (c.height > 1 && uint64_t(c.row_step) < uint64_t(c.width) * c.point_step) return *err = "PointCloud2 row_step < width * point_step", false;
   const uint64_t row_step = c.height > 1 ? c.row_step : uint64_t(c.width) * c.point_step;
-  if (row_step * (c.height - 1) + uint64_t(c.width) * c.point_step > c.data_size)
+  if ((unsigned __int128)row_step * (c.height - 1) + (unsigned __int128)c.width * c.point_step > c.data_size)
     return *err = "PointCloud2 data (" + std::to_string(c.data_size) + " B) shorter than height/width/point_step say", false;
   s.points = npts;
 
@@ -88,8 +88,11 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
       q.az = float(std::atan2(y, x));
       q.el = float(std::asin(z / r));
       q.r_mm = uint32_t(std::lround(r * 1000.0));
-      q.ring = gr.ok() ? int(gr(p)) : 0;
-      q.inten = gi.ok() ? float(gi(p)) : 0.f;
+      const double ring = gr.ok() ? gr(p) : 0.0;
+      if (!(ring >= 0.0 && ring <= 1023.0)) return *err = "ring value " + std::to_string(ring) + " out of range", false;
+      q.ring = int(ring);
+      const double inten = gi.ok() ? gi(p) : 0.0;
+      q.inten = std::isfinite(inten) ? float(std::clamp(inten, 0.0, 65535.0)) : 0.f;
       double t = stamp_s;
       if (gt.ok()) {
         const double v = gt(p);
@@ -98,8 +101,7 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
         else if (v > 1e8) t = v;          // absolute s (Hesai, Robosense)
         else t = stamp_s + v;             // relative s (Velodyne)
       }
-      q.t = t;
-      if (gr.ok() && (q.ring < 0 || q.ring > 1023)) return *err = "ring value " + std::to_string(q.ring) + " out of range", false;
+      q.t = std::isfinite(t) && std::abs(t) < 1e11 ? t : stamp_s;  // garbage times: the header stamp
       pts.push_back(q);
     }
   }
