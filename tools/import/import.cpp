@@ -210,7 +210,9 @@ int main(int argc, char** argv) {
   std::map<std::string, uint64_t> written, skipped_types, decode_errors;
   std::map<std::string, std::string> first_decode_error;
   std::vector<Scan> frames;
-  size_t frames_done = 0;
+  size_t frames_total = 0;
+  struct FrameInfo { int32_t frame_id, height, width, missing; };
+  std::vector<FrameInfo> frame_list;  // for the summary (the first 1000)
   scan_t scan_msg;
   std::map<std::string, int64_t> seq;
   CloudStats cstats;
@@ -221,14 +223,19 @@ int main(int argc, char** argv) {
   uint64_t read_msgs = 0;
 
   auto emit_frames = [&](int64_t fallback_ns) {
-    for (; frames_done < frames.size(); ++frames_done) {
-      Scan& s = frames[frames_done];
+    for (size_t i = 0; i < frames.size(); ++i) {
+      Scan& s = frames[i];
       s.seq = seq[ouster_scan_channel]++;
       to_msg(s, scan_msg);
-      const int64_t t = frames_done < ouster.frame_times_ns.size() ? ouster.frame_times_ns[frames_done] : fallback_ns;
+      const int64_t t = i < ouster.frame_times_ns.size() ? ouster.frame_times_ns[i] : fallback_ns;
+      if (frame_list.size() < 1000) frame_list.push_back({s.frame_id, s.height, s.width, s.missing_columns});
       if (!out.empty()) lcm_log.write(ouster_scan_channel, t / 1000, scan_msg);
       ++written[ouster_scan_channel];
     }
+    frames_total += frames.size();
+    for (auto& s : frames) ouster.recycle(std::move(s));  // the next frame reuses the buffers
+    frames.clear();
+    ouster.frame_times_ns.clear();
   };
   auto bad = [&](const Connection& c, const std::string& e) {
     if (!decode_errors[c.topic]++) first_decode_error[c.topic] = e;
@@ -376,9 +383,9 @@ int main(int argc, char** argv) {
     if (ouster.info()) {
       j["ouster"] = {{"sensor", ouster.info()->sensor_name()}, {"pixels_per_column", ouster.info()->pixels_per_column},
                      {"columns_per_frame", ouster.info()->columns_per_frame}, {"udp_profile", os1::to_string(ouster.info()->profile)},
-                     {"lidar_packets", ouster.lidar_packets}, {"imu_packets", ouster.imu_packets}, {"frames", frames.size()}};
+                     {"lidar_packets", ouster.lidar_packets}, {"imu_packets", ouster.imu_packets}, {"frames", frames_total}};
       nlohmann::json fr = nlohmann::json::array();
-      for (const auto& s : frames) fr.push_back({{"frame_id", s.frame_id}, {"height", s.height}, {"width", s.width}, {"missing_columns", s.missing_columns}});
+      for (const auto& s : frame_list) fr.push_back({{"frame_id", s.frame_id}, {"height", s.height}, {"width", s.width}, {"missing_columns", s.missing}});
       j["ouster"]["frame_list"] = fr;
     }
     for (const auto& [t, s] : cloud_info)
@@ -393,7 +400,7 @@ int main(int argc, char** argv) {
     if (ouster.info())
       std::printf("  ouster: %s, %dx%d (%s), %llu lidar + %llu imu packets -> %zu frames\n", ouster.info()->sensor_name().c_str(),
                   ouster.info()->pixels_per_column, ouster.info()->columns_per_frame, os1::to_string(ouster.info()->profile),
-                  (unsigned long long)ouster.lidar_packets, (unsigned long long)ouster.imu_packets, frames.size());
+                  (unsigned long long)ouster.lidar_packets, (unsigned long long)ouster.imu_packets, frames_total);
     for (const auto& [t, s] : cloud_info)
       std::printf("  cloud %s: rings from %s, times from %s, %llu/%llu points kept, %llu collisions\n", t.c_str(), s.ring_source.c_str(),
                   s.time_source.c_str(), (unsigned long long)s.kept, (unsigned long long)s.points, (unsigned long long)s.collisions);

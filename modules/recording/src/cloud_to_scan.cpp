@@ -33,6 +33,25 @@ struct Getter {
   }
 };
 
+// atan2 to ~1e-5 rad (a minimax polynomial for atan on [0, 1]): column binning needs ~1e-4.
+inline float fast_atan2(float y, float x) {
+  const float ax = std::abs(x), ay = std::abs(y);
+  const float mx = std::max(ax, ay), mn = std::min(ax, ay);
+  if (mx == 0.f) return 0.f;
+  const float a = mn / mx, q = a * a;
+  float r = ((-0.0464964749f * q + 0.15931422f) * q - 0.327622764f) * q * a + a;
+  if (ay > ax) r = 1.57079637f - r;
+  if (x < 0.f) r = 3.14159274f - r;
+  return y < 0.f ? -r : r;
+}
+
+inline bool is_f32le(const Getter& g) { return g.type == 7 && !g.swap; }
+inline float f32(const uint8_t* p, int off) {
+  float v;
+  std::memcpy(&v, p + off, 4);
+  return v;
+}
+
 int type_size(uint8_t t) { return t == 0 || t > 8 ? 0 : t <= 2 ? 1 : t <= 4 ? 2 : t <= 7 ? 4 : 8; }
 
 }  // namespace
@@ -74,20 +93,23 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
   std::vector<P> pts;
   pts.reserve(npts);
   const double stamp_s = c.header.stamp_ns * 1e-9;
+  const bool xyz_f32 = is_f32le(gx) && is_f32le(gy) && is_f32le(gz);
   for (uint32_t row = 0; row < c.height; ++row) {
     const uint8_t* base = c.data + row * row_step;
     for (uint32_t k = 0; k < c.width; ++k) {
       const uint8_t* p = base + uint64_t(k) * c.point_step;
-      const double x = gx(p), y = gy(p), z = gz(p);
+      double x, y, z;
+      if (xyz_f32) x = f32(p, gx.off), y = f32(p, gy.off), z = f32(p, gz.off);
+      else x = gx(p), y = gy(p), z = gz(p);
       const double r = std::sqrt(x * x + y * y + z * z);
       if (!std::isfinite(r) || r < 1e-3 || r > 2000.0) {
         ++s.no_return;
         continue;
       }
       P q;
-      q.az = float(std::atan2(y, x));
-      q.el = float(std::asin(z / r));
-      q.r_mm = uint32_t(std::lround(r * 1000.0));
+      q.az = fast_atan2(float(y), float(x));
+      q.el = fast_atan2(float(z), float(std::sqrt(x * x + y * y)));
+      q.r_mm = uint32_t(r * 1000.0 + 0.5);
       const double ring = gr.ok() ? gr(p) : 0.0;
       if (!(ring >= 0.0 && ring <= 1023.0)) return *err = "ring value " + std::to_string(ring) + " out of range", false;
       q.ring = int(ring);
@@ -114,21 +136,22 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
   std::vector<double> alt;
   if (gr.ok() && opt.rings == 0) {
     s.ring_source = "field '" + ring_name + "'";
-    std::map<int, std::pair<double, int>> acc;
+    std::vector<std::pair<double, int>> acc(1024, {0.0, 0});
     for (const auto& q : pts) {
-      auto& a = acc[q.ring];
+      auto& a = acc[size_t(q.ring)];
       a.first += q.el;
       ++a.second;
     }
     std::vector<std::pair<double, int>> order;  // (mean elevation, ring value)
-    for (const auto& [ring, a] : acc) order.push_back({a.first / a.second, ring});
+    for (int ring = 0; ring < 1024; ++ring)
+      if (acc[size_t(ring)].second) order.push_back({acc[size_t(ring)].first / acc[size_t(ring)].second, ring});
     std::sort(order.begin(), order.end(), [](auto& a, auto& b) { return a.first > b.first; });
-    std::map<int, int> row;
+    std::vector<int> row(1024, 0);
     for (size_t i = 0; i < order.size(); ++i) {
-      row[order[i].second] = int(i);
+      row[size_t(order[i].second)] = int(i);
       alt.push_back(order[i].first * 180.0 / M_PI);
     }
-    for (size_t i = 0; i < pts.size(); ++i) ring_of[i] = row[pts[i].ring];
+    for (size_t i = 0; i < pts.size(); ++i) ring_of[i] = row[size_t(pts[i].ring)];
     nrings = int(order.size());
   } else {
     s.ring_source = "elevation";
@@ -205,7 +228,7 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
     out.range_mm[k] = q.r_mm;
     out.signal[k] = uint16_t(std::clamp(q.inten, 0.f, 65535.f));
     out.reflectivity[k] = uint8_t(std::clamp(q.inten, 0.f, 255.f));
-    const int64_t tu = int64_t(std::llround(q.t * 1e6));
+    const int64_t tu = int64_t(std::floor(q.t * 1e6 + 0.5));
     out.column_utime[size_t(v)] = std::min(out.column_utime[size_t(v)], tu);
     t0 = std::min(t0, q.t);
   }

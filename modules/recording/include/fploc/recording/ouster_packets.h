@@ -24,6 +24,10 @@ class OusterPackets {
   // a lidar packet; it is ignored.
   bool add(const uint8_t* buf, size_t n, int64_t time_ns, std::vector<Scan>& frames, os1::ImuSample* imu);
   void flush(std::vector<Scan>& frames);
+  // Hands a consumed frame's buffers back (avoids allocating at the frame rate).
+  void recycle(Scan&& s) {
+    if (assembler_) assembler_->recycle(std::move(s));
+  }
 
   uint64_t lidar_packets = 0, imu_packets = 0, bad_packets = 0, waiting_dropped = 0;
   std::string last_error;  // the latest packet problem (counted in bad_packets)
