@@ -84,7 +84,7 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
   s.points = npts;
 
   struct P {
-    float az, el;
+    float az, el, sn;  // azimuth, elevation (approximate: for clustering), sin(elevation) (exact)
     uint32_t r_mm;
     int ring;
     float inten;
@@ -109,6 +109,7 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
       P q;
       q.az = fast_atan2(float(y), float(x));
       q.el = fast_atan2(float(z), float(std::sqrt(x * x + y * y)));
+      q.sn = float(z / r);
       q.r_mm = uint32_t(r * 1000.0 + 0.5);
       const double ring = gr.ok() ? gr(p) : 0.0;
       if (!(ring >= 0.0 && ring <= 1023.0)) return *err = "ring value " + std::to_string(ring) + " out of range", false;
@@ -139,12 +140,13 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
     std::vector<std::pair<double, int>> acc(1024, {0.0, 0});
     for (const auto& q : pts) {
       auto& a = acc[size_t(q.ring)];
-      a.first += q.el;
+      a.first += q.sn;
       ++a.second;
     }
     std::vector<std::pair<double, int>> order;  // (mean elevation, ring value)
     for (int ring = 0; ring < 1024; ++ring)
-      if (acc[size_t(ring)].second) order.push_back({acc[size_t(ring)].first / acc[size_t(ring)].second, ring});
+      if (acc[size_t(ring)].second)
+        order.push_back({std::asin(std::clamp(acc[size_t(ring)].first / acc[size_t(ring)].second, -1.0, 1.0)), ring});
     std::sort(order.begin(), order.end(), [](auto& a, auto& b) { return a.first > b.first; });
     std::vector<int> row(1024, 0);
     for (size_t i = 0; i < order.size(); ++i) {
@@ -181,10 +183,11 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
     for (size_t i = 0; i < pts.size(); ++i) {
       const int from_bottom = int(std::upper_bound(bounds.begin(), bounds.end(), pts[i].el) - bounds.begin());
       ring_of[i] = nrings - 1 - from_bottom;
-      sum[size_t(ring_of[i])] += pts[i].el;
+      sum[size_t(ring_of[i])] += pts[i].sn;
       ++cnt[size_t(ring_of[i])];
     }
-    for (int r = 0; r < nrings; ++r) alt.push_back(cnt[size_t(r)] ? sum[size_t(r)] / cnt[size_t(r)] * 180.0 / M_PI : 0.0);
+    for (int r = 0; r < nrings; ++r)
+      alt.push_back(cnt[size_t(r)] ? std::asin(std::clamp(sum[size_t(r)] / cnt[size_t(r)], -1.0, 1.0)) * 180.0 / M_PI : 0.0);
   }
 
   int W = opt.columns;
