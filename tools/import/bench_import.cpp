@@ -7,6 +7,7 @@
 // then times `cat BAG > /dev/null` (after one warm-up read, so both run from the page cache),
 // `cat BAG > COPY` (read + write the same volume) and `fploc-import BAG --out LOG.lcm`.
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -26,9 +27,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
+double children_cpu() {
+  rusage u{};
+  getrusage(RUSAGE_CHILDREN, &u);
+  return u.ru_utime.tv_sec + u.ru_stime.tv_sec + 1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+double last_cpu = 0;  // CPU seconds (user + sys) of the last run(): what a busy shared machine does not inflate
+
 double run(const std::string& cmd) {
   const auto t0 = std::chrono::steady_clock::now();
+  const double c0 = children_cpu();
   const int rc = std::system(cmd.c_str());
+  last_cpu = children_cpu() - c0;
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (rc != 0) {
     std::cerr << "fploc bench import: '" << cmd << "' failed (" << rc << ")\n";
@@ -192,9 +202,11 @@ int main(int argc, char** argv) {
     const std::string lcm = (dir / (k + ".lcm")).string(), copy = (dir / (k + ".copy")).string();
     run("cat '" + bag + "' > /dev/null");  // warm-up: both timings below read from the page cache
     const double t_cat = run("cat '" + bag + "' > /dev/null");
+    const double cpu_cat = last_cpu;
     const double t_copy = run("cat '" + bag + "' > '" + copy + "'");
     fs::remove(copy);
     const double t_import = run("'" + importer + "' '" + bag + "' --out '" + lcm + "' --quiet > /dev/null");
+    const double cpu_import = last_cpu;
     const uint64_t lcm_bytes = fs::file_size(lcm);
     // Cold: the bag read from the disk (its pages evicted before each run).
     fs::remove(lcm);
@@ -206,13 +218,13 @@ int main(int argc, char** argv) {
                         {"lcm_bytes", lcm_bytes}, {"cat_s", t_cat}, {"cat_copy_s", t_copy}, {"import_s", t_import},
                         {"ratio_vs_cat", t_import / t_cat}, {"ratio_vs_cat_copy", t_import / t_copy},
                         {"import_MBps", bytes / 1e6 / t_import}, {"cold_cat_s", t_cat_cold}, {"cold_import_s", t_import_cold},
-                        {"cold_ratio_vs_cat", t_import_cold / t_cat_cold}};
+                        {"cold_ratio_vs_cat", t_import_cold / t_cat_cold}, {"cat_cpu_s", cpu_cat}, {"import_cpu_s", cpu_import}};
     out.push_back(j);
     if (!json)
       std::printf("%-6s %s: %.0f MB bag (%llu msgs) -> %.0f MB LCM log\n  page cache: import %.2f s, cat %.2f s (ratio %.2f), cat > copy %.2f s (ratio %.2f)\n"
-                  "  cold file:  import %.2f s, cat %.2f s (ratio %.2f)\n",
+                  "  cold file:  import %.2f s, cat %.2f s (ratio %.2f)\n  CPU (user+sys): import %.2f s, cat %.2f s\n",
                   k.c_str(), compression.c_str(), bytes / 1e6, (unsigned long long)messages, lcm_bytes / 1e6, t_import, t_cat,
-                  t_import / t_cat, t_copy, t_import / t_copy, t_import_cold, t_cat_cold, t_import_cold / t_cat_cold);
+                  t_import / t_cat, t_copy, t_import / t_copy, t_import_cold, t_cat_cold, t_import_cold / t_cat_cold, cpu_import, cpu_cat);
     if (keep.empty()) {
       fs::remove(bag);
       fs::remove(lcm);

@@ -242,6 +242,7 @@ int main(int argc, char** argv) {
   };
 
   bool odom_chosen = !odom_topic.empty();
+  Scan cloud_scan;
   RawMessage m;
   while (rec->next(m)) {
     ++read_msgs;
@@ -291,7 +292,7 @@ int main(int argc, char** argv) {
       case Kind::kCloud: {
         PointCloud2 pc;
         if (!decode(m.data, m.size, c.encoding, pc, &err)) { bad(c, err); break; }
-        Scan s;
+        Scan& s = cloud_scan;  // buffers reused from cloud to cloud
         if (!cloud_to_scan(pc, cloud_opt, s, &cstats, &err)) { bad(c, err); break; }
         const std::string& ch = channel_for(c, k);
         s.seq = seq[ch]++;

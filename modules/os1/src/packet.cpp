@@ -91,7 +91,8 @@ uint16_t LidarPacketView::signal(int c, int b) const {
   return f_.profile == UdpProfile::kRng15Rfl8Nir8 ? 0 : rd<uint16_t>(pixel(c, b) + 6);  // LB: no signal field
 }
 uint16_t LidarPacketView::near_ir(int c, int b) const {
-  return f_.profile == UdpProfile::kRng15Rfl8Nir8 ? pixel(c, b)[3] : rd<uint16_t>(pixel(c, b) + 8);
+  // LB: 8-bit NIR scaled by 16, as the Ouster SDK reads it
+  return f_.profile == UdpProfile::kRng15Rfl8Nir8 ? uint16_t(pixel(c, b)[3] << 4) : rd<uint16_t>(pixel(c, b) + 8);
 }
 
 // ---- encode -----------------------------------------------------------------------------------

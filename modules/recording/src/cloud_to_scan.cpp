@@ -90,7 +90,8 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
     float inten;
     double t;
   };
-  std::vector<P> pts;
+  static thread_local std::vector<P> pts;  // reused: a cloud at 10-20 Hz should not cost page faults
+  pts.clear();
   pts.reserve(npts);
   const double stamp_s = c.header.stamp_ns * 1e-9;
   const bool xyz_f32 = is_f32le(gx) && is_f32le(gy) && is_f32le(gz);
@@ -132,7 +133,8 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
   s.time_source = gt.ok() ? "field '" + time_name + "'" : "header stamp";
 
   // Rings -> rows (top beam first).
-  std::vector<int> ring_of(pts.size());
+  static thread_local std::vector<int> ring_of;
+  ring_of.assign(pts.size(), 0);
   int nrings = 0;
   std::vector<double> alt;
   if (gr.ok() && opt.rings == 0) {
