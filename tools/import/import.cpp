@@ -253,7 +253,7 @@ int main(int argc, char** argv) {
     const Connection& c = rec->connections().at(m.conn);
     if (!wanted.empty() && !wanted.count(c.topic)) continue;
     const Kind k = kind_of(c);
-    if (!quiet && (read_msgs & 255) == 0) {
+    if (!quiet && (read_msgs & 15) == 0) {
       const auto now = std::chrono::steady_clock::now();
       if (now - last_progress > std::chrono::seconds(1)) {
         last_progress = now;
