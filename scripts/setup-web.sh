@@ -29,3 +29,9 @@ if [ ! -d node_modules/web-ifc ] || [ package-lock.json -nt node_modules/.packag
   echo "fploc setup-web: npm ci in tools/ifc" >&2
   npm ci --no-audit --no-fund --loglevel=error >&2
 fi
+# fploc import's MCAP tests: an independent MCAP writer (@mcap/core, @foxglove/cdr, zstd/lz4 codecs).
+cd "$ROOT/tests/import"
+if [ ! -d node_modules/@mcap/core ] || [ package-lock.json -nt node_modules/.package-lock.json ]; then
+  echo "fploc setup-web: npm ci in tests/import" >&2
+  npm ci --no-audit --no-fund --loglevel=error >&2
+fi

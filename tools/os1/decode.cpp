@@ -162,7 +162,7 @@ json compare_digest(const json& ours, const json& ref) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"fploc os1 decode: decode an Ouster pcap (legacy / RNG19 profiles) with its metadata JSON"};
+  CLI::App app{"fploc os1 decode: decode an Ouster pcap (legacy / RNG19 / RNG15 low-data-rate profiles) with its metadata JSON"};
   std::string pcap_path, meta_path, pcd_dir, digest_path;
   bool as_json = false;
   int lidar_port = 0, imu_port = 0;

@@ -112,6 +112,7 @@ const char* to_string(UdpProfile p) {
   switch (p) {
     case UdpProfile::kLegacy: return "LEGACY";
     case UdpProfile::kRng19Rfl8Sig16Nir16: return "RNG19_RFL8_SIG16_NIR16";
+    case UdpProfile::kRng15Rfl8Nir8: return "RNG15_RFL8_NIR8";
   }
   return "?";
 }
@@ -237,7 +238,8 @@ SensorInfo parse_metadata(const std::string& text, const std::string& source) {
   if (r.string("udp_profile_lidar", profile)) {
     if (profile == "LEGACY") info.profile = UdpProfile::kLegacy;
     else if (profile == "RNG19_RFL8_SIG16_NIR16") info.profile = UdpProfile::kRng19Rfl8Sig16Nir16;
-    else r.fail("udp_profile_lidar", "unsupported profile '" + profile + "' (LEGACY, RNG19_RFL8_SIG16_NIR16)");
+    else if (profile == "RNG15_RFL8_NIR8") info.profile = UdpProfile::kRng15Rfl8Nir8;
+    else r.fail("udp_profile_lidar", "unsupported profile '" + profile + "' (LEGACY, RNG19_RFL8_SIG16_NIR16, RNG15_RFL8_NIR8)");
   } else {
     d.push_back("udp_profile_lidar");
   }

@@ -79,14 +79,21 @@ uint16_t LidarPacketView::packet_frame_id() const {
 }
 
 uint32_t LidarPacketView::range_mm(int c, int b) const {
+  if (f_.profile == UdpProfile::kRng15Rfl8Nir8) return uint32_t(rd<uint16_t>(pixel(c, b)) & 0x7FFFu) << 3;
   const uint32_t w = rd<uint32_t>(pixel(c, b));
   return f_.profile == UdpProfile::kLegacy ? (w & 0x000FFFFFu) : (w & 0x0007FFFFu);
 }
 uint16_t LidarPacketView::reflectivity(int c, int b) const {
+  if (f_.profile == UdpProfile::kRng15Rfl8Nir8) return pixel(c, b)[2];
   return f_.profile == UdpProfile::kLegacy ? rd<uint16_t>(pixel(c, b) + 4) : uint16_t(pixel(c, b)[4]);
 }
-uint16_t LidarPacketView::signal(int c, int b) const { return rd<uint16_t>(pixel(c, b) + 6); }
-uint16_t LidarPacketView::near_ir(int c, int b) const { return rd<uint16_t>(pixel(c, b) + 8); }
+uint16_t LidarPacketView::signal(int c, int b) const {
+  return f_.profile == UdpProfile::kRng15Rfl8Nir8 ? 0 : rd<uint16_t>(pixel(c, b) + 6);  // LB: no signal field
+}
+uint16_t LidarPacketView::near_ir(int c, int b) const {
+  // LB: 8-bit NIR scaled by 16, as the Ouster SDK reads it
+  return f_.profile == UdpProfile::kRng15Rfl8Nir8 ? uint16_t(pixel(c, b)[3] << 4) : rd<uint16_t>(pixel(c, b) + 8);
+}
 
 // ---- encode -----------------------------------------------------------------------------------
 void encode_lidar_packet(const Scan& scan, int first_column, uint16_t frame_id, const PacketFormat& f,
@@ -124,6 +131,14 @@ void encode_lidar_packet(const Scan& scan, int first_column, uint16_t frame_id, 
     }
     if (!valid) continue;
     uint8_t* px = p + f.column_header_size();
+    if (f.profile == UdpProfile::kRng15Rfl8Nir8) {
+      for (int b = 0; b < scan.height; ++b, px += 4) {
+        const size_t i = size_t(b) * W + m;
+        wr<uint16_t>(px, uint16_t(std::min<uint32_t>((scan.range_mm[i] + 4) >> 3, 0x7FFFu)));
+        if (has_refl) px[2] = scan.reflectivity[i];
+      }
+      continue;
+    }
     for (int b = 0; b < scan.height; ++b, px += 12) {
       const size_t i = size_t(b) * W + m;
       wr<uint32_t>(px, std::min(scan.range_mm[i], range_mask));
@@ -272,6 +287,15 @@ PacketError FrameAssembler::add_packet(const uint8_t* data, size_t size, std::ve
     uint32_t* rng = cur_.range_mm.data() + m;
     uint16_t* sig = cur_.signal.data() + m;
     uint8_t* refl = cur_.reflectivity.data() + m;
+    if (fmt_.profile == UdpProfile::kRng15Rfl8Nir8) {
+      for (int b = 0; b < fmt_.pixels_per_column; ++b, px += 4) {
+        const size_t o = size_t(b) * W;
+        rng[o] = uint32_t(rd<uint16_t>(px) & 0x7FFFu) << 3;  // 8 mm units
+        sig[o] = 0;                                           // the profile carries no signal
+        refl[o] = px[2];
+      }
+      continue;
+    }
     const uint32_t mask = legacy ? 0x000FFFFFu : 0x0007FFFFu;
     for (int b = 0; b < fmt_.pixels_per_column; ++b, px += 12) {
       const size_t o = size_t(b) * W;

@@ -13,7 +13,8 @@
 
 namespace fploc::os1 {
 
-enum class UdpProfile { kLegacy = 0, kRng19Rfl8Sig16Nir16 = 1 };
+// kRng15Rfl8Nir8: the low-data-rate profile (4-byte pixels: range in 8 mm units, 15 bits; reflectivity; NIR).
+enum class UdpProfile { kLegacy = 0, kRng19Rfl8Sig16Nir16 = 1, kRng15Rfl8Nir8 = 2 };
 const char* to_string(UdpProfile p);
 
 struct SensorInfo {

@@ -1,4 +1,5 @@
-// Ouster UDP packets: lidar (LEGACY and RNG19_RFL8_SIG16_NIR16 profiles) and IMU (48 B), parse and encode,
+// Ouster UDP packets: lidar (LEGACY, RNG19_RFL8_SIG16_NIR16 and the
+// low-data-rate RNG15_RFL8_NIR8 profiles) and IMU (48 B), parse and encode,
 // plus FrameAssembler which turns a stream of lidar packets into Scans (one per frame_id).
 // All multi-byte fields are little-endian on the wire. Nothing here throws or crashes on garbage: bad
 // packets are rejected with a reason and counted.
@@ -29,7 +30,7 @@ struct PacketFormat {
   size_t packet_footer_size() const { return profile == UdpProfile::kLegacy ? 0 : 32; }
   size_t column_header_size() const { return profile == UdpProfile::kLegacy ? 16 : 12; }
   size_t column_footer_size() const { return profile == UdpProfile::kLegacy ? 4 : 0; }
-  size_t pixel_size() const { return 12; }
+  size_t pixel_size() const { return profile == UdpProfile::kRng15Rfl8Nir8 ? 4 : 12; }
   size_t column_size() const { return column_header_size() + size_t(pixels_per_column) * pixel_size() + column_footer_size(); }
   size_t lidar_packet_size() const {
     return packet_header_size() + size_t(columns_per_packet) * column_size() + packet_footer_size();
@@ -80,7 +81,7 @@ class LidarPacketView {
 // Encodes columns [first_column, first_column + columns_per_packet) of `scan` (staggered; column index =
 // measurement id) into one packet of `f`. Column timestamps are scan.column_utime * 1000 ns, encoder
 // counts measurement_id * 90112 / W, status valid (0xFFFFFFFF legacy, 0x1 otherwise) when column_valid.
-// Ranges are clipped to the profile's bits (20 legacy, 19 RNG19). `out` is resized to the packet size.
+// Ranges are clipped to the profile's bits (20 legacy, 19 RNG19; RNG15 stores range/8 in 15 bits). `out` is resized to the packet size.
 void encode_lidar_packet(const Scan& scan, int first_column, uint16_t frame_id, const PacketFormat& f,
                          std::vector<uint8_t>& out);
 // All packets of one frame (W / columns_per_packet of them), in measurement-id order.

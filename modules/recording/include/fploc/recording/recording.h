@@ -1,0 +1,88 @@
+// ROS recordings (ROS 1 bag format 2.0, ROS 2 MCAP) read as one stream of raw messages in file order.
+// No transport, no ROS: a Connection says what a topic carries (type, encoding), a RawMessage points at
+// its serialized bytes. Readers never throw on bad input: the first problem stops the stream with ONE
+// error naming the file, the byte offset and the record; everything delivered before it stays valid.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+
+namespace fploc::rec {
+
+enum class Encoding { kRos1, kCdr, kOther };  // ROS 1 serialization, ROS 2 CDR (XCDR1), anything else (not decoded)
+
+struct Connection {
+  uint32_t id = 0;
+  std::string topic;
+  std::string type;        // normalised "pkg/Name" (MCAP's "pkg/msg/Name" loses its "/msg")
+  std::string definition;  // message definition text when the file has it
+  Encoding encoding = Encoding::kRos1;
+};
+
+struct RawMessage {
+  uint32_t conn = 0;
+  int64_t time_ns = 0;            // record time (bag: receipt time; MCAP: log_time)
+  const uint8_t* data = nullptr;  // valid until the next call to next()
+  size_t size = 0;
+};
+
+struct TopicSummary {
+  std::string type;
+  uint64_t count = 0;
+  int64_t first_ns = 0, last_ns = 0;
+};
+
+class Recording {
+ public:
+  virtual ~Recording() = default;
+  // Next message in file order; false at the end or on the first error (see error()).
+  virtual bool next(RawMessage& m) = 0;
+  const std::map<uint32_t, Connection>& connections() const { return conns_; }
+  const std::string& error() const { return error_; }
+  // Bytes of the file consumed so far (progress), and its size.
+  virtual uint64_t position() const = 0;
+  uint64_t size() const { return size_; }
+  const std::string& format() const { return format_; }  // "bag 2.0" or "mcap"
+
+ protected:
+  bool fail(const std::string& what) {
+    if (error_.empty()) error_ = what;
+    return false;
+  }
+  std::map<uint32_t, Connection> conns_;
+  std::string error_;
+  uint64_t size_ = 0;
+  std::string format_;
+};
+
+// A read-only view of the whole file (mmap), or of memory the caller owns (fuzzing, tests).
+class FileBytes {
+ public:
+  FileBytes() = default;
+  FileBytes(const FileBytes&) = delete;
+  FileBytes& operator=(const FileBytes&) = delete;
+  ~FileBytes();
+  bool map(const std::string& path, std::string* err);
+  void borrow(const uint8_t* data, size_t size) { data_ = data, size_ = size; }
+  const uint8_t* data() const { return data_; }
+  size_t size() const { return size_; }
+
+ private:
+  const uint8_t* data_ = nullptr;
+  size_t size_ = 0;
+  void* mapped_ = nullptr;
+};
+
+// Opens a bag or an MCAP file by its magic bytes. Returns nullptr with *err set when the file cannot be
+// read or is neither; a reader is returned even when its stream ends early (its error() says why).
+std::unique_ptr<Recording> open_recording(const std::string& path, std::string* err);
+// Same over memory (the name is used in messages).
+std::unique_ptr<Recording> open_recording_memory(const uint8_t* data, size_t size, const std::string& name,
+                                                 std::string* err);
+
+// Topics, types, counts and times: a full pass over the stream (errors as for next()).
+std::map<std::string, TopicSummary> summarize(Recording& r);
+
+}  // namespace fploc::rec

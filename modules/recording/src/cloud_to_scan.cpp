@@ -1,0 +1,247 @@
+#include "fploc/recording/cloud_to_scan.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+
+namespace fploc::rec {
+namespace {
+
+struct Getter {
+  int off = -1;
+  uint8_t type = 0;
+  bool swap = false;
+  bool ok() const { return off >= 0; }
+  double operator()(const uint8_t* p) const {
+    p += off;
+    uint8_t b[8];
+    const int n = type <= 2 ? 1 : type <= 4 ? 2 : type <= 7 ? 4 : 8;
+    if (swap) for (int k = 0; k < n; ++k) b[k] = p[n - 1 - k];
+    else std::memcpy(b, p, size_t(n));
+    switch (type) {
+      case 1: return double(int8_t(b[0]));
+      case 2: return double(b[0]);
+      case 3: { int16_t v; std::memcpy(&v, b, 2); return v; }
+      case 4: { uint16_t v; std::memcpy(&v, b, 2); return v; }
+      case 5: { int32_t v; std::memcpy(&v, b, 4); return v; }
+      case 6: { uint32_t v; std::memcpy(&v, b, 4); return v; }
+      case 7: { float v; std::memcpy(&v, b, 4); return v; }
+      case 8: { double v; std::memcpy(&v, b, 8); return v; }
+    }
+    return 0;
+  }
+};
+
+// atan2 to ~1e-5 rad (a minimax polynomial for atan on [0, 1]): column binning needs ~1e-4.
+inline float fast_atan2(float y, float x) {
+  const float ax = std::abs(x), ay = std::abs(y);
+  const float mx = std::max(ax, ay), mn = std::min(ax, ay);
+  if (mx == 0.f) return 0.f;
+  const float a = mn / mx, q = a * a;
+  float r = ((-0.0464964749f * q + 0.15931422f) * q - 0.327622764f) * q * a + a;
+  if (ay > ax) r = 1.57079637f - r;
+  if (x < 0.f) r = 3.14159274f - r;
+  return y < 0.f ? -r : r;
+}
+
+inline bool is_f32le(const Getter& g) { return g.type == 7 && !g.swap; }
+inline float f32(const uint8_t* p, int off) {
+  float v;
+  std::memcpy(&v, p + off, 4);
+  return v;
+}
+
+int type_size(uint8_t t) { return t == 0 || t > 8 ? 0 : t <= 2 ? 1 : t <= 4 ? 2 : t <= 7 ? 4 : 8; }
+
+}  // namespace
+
+bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, CloudStats* st, std::string* err) {
+  CloudStats local;
+  CloudStats& s = st ? *st : local;
+  s = CloudStats{};
+  auto field = [&](std::initializer_list<const char*> names, std::string* which = nullptr) {
+    for (const char* n : names)
+      for (const auto& f : c.fields)
+        if (f.name == n && type_size(f.datatype) > 0 && f.offset + type_size(f.datatype) <= c.point_step) {
+          if (which) *which = n;
+          return Getter{int(f.offset), f.datatype, c.is_bigendian};
+        }
+    return Getter{};
+  };
+  const Getter gx = field({"x"}), gy = field({"y"}), gz = field({"z"});
+  if (!gx.ok() || !gy.ok() || !gz.ok()) return *err = "PointCloud2 without x/y/z fields inside point_step", false;
+  std::string ring_name, time_name;
+  const Getter gi = field({"intensity", "reflectivity", "signal"});
+  const Getter gr = field({"ring", "channel", "line"}, &ring_name);
+  const Getter gt = field({"t", "time", "timestamp", "offset_time", "time_offset"}, &time_name);
+  const uint64_t npts = uint64_t(c.width) * c.height;
+  if (c.point_step == 0 || npts == 0) return *err = "PointCloud2 is empty", false;
+  if (c.height > 1 && uint64_t(c.row_step) < uint64_t(c.width) * c.point_step) return *err = "PointCloud2 row_step < width * point_step", false;
+  const uint64_t row_step = c.height > 1 ? c.row_step : uint64_t(c.width) * c.point_step;
+  if ((unsigned __int128)row_step * (c.height - 1) + (unsigned __int128)c.width * c.point_step > c.data_size)
+    return *err = "PointCloud2 data (" + std::to_string(c.data_size) + " B) shorter than height/width/point_step say", false;
+  s.points = npts;
+
+  struct P {
+    float az, el, sn;  // azimuth, elevation (approximate: for clustering), sin(elevation) (exact)
+    uint32_t r_mm;
+    int ring;
+    float inten;
+    double t;
+  };
+  static thread_local std::vector<P> pts;  // reused: a cloud at 10-20 Hz should not cost page faults
+  pts.clear();
+  pts.reserve(npts);
+  const double stamp_s = c.header.stamp_ns * 1e-9;
+  const bool xyz_f32 = is_f32le(gx) && is_f32le(gy) && is_f32le(gz);
+  for (uint32_t row = 0; row < c.height; ++row) {
+    const uint8_t* base = c.data + row * row_step;
+    for (uint32_t k = 0; k < c.width; ++k) {
+      const uint8_t* p = base + uint64_t(k) * c.point_step;
+      double x, y, z;
+      if (xyz_f32) x = f32(p, gx.off), y = f32(p, gy.off), z = f32(p, gz.off);
+      else x = gx(p), y = gy(p), z = gz(p);
+      const double r = std::sqrt(x * x + y * y + z * z);
+      if (!std::isfinite(r) || r < 1e-3 || r > 2000.0) {
+        ++s.no_return;
+        continue;
+      }
+      P q;
+      q.az = fast_atan2(float(y), float(x));
+      q.el = fast_atan2(float(z), float(std::sqrt(x * x + y * y)));
+      q.sn = float(z / r);
+      q.r_mm = uint32_t(r * 1000.0 + 0.5);
+      const double ring = gr.ok() ? gr(p) : 0.0;
+      if (!(ring >= 0.0 && ring <= 1023.0)) return *err = "ring value " + std::to_string(ring) + " out of range", false;
+      q.ring = int(ring);
+      const double inten = gi.ok() ? gi(p) : 0.0;
+      q.inten = std::isfinite(inten) ? float(std::clamp(inten, 0.0, 65535.0)) : 0.f;
+      double t = stamp_s;
+      if (gt.ok()) {
+        const double v = gt(p);
+        if (time_name == "t" || time_name == "offset_time") t = stamp_s + v * 1e-9;
+        else if (v > 1e15) t = v * 1e-9;  // absolute ns (Livox)
+        else if (v > 1e8) t = v;          // absolute s (Hesai, Robosense)
+        else t = stamp_s + v;             // relative s (Velodyne)
+      }
+      q.t = std::isfinite(t) && std::abs(t) < 1e11 ? t : stamp_s;  // garbage times: the header stamp
+      pts.push_back(q);
+    }
+  }
+  if (pts.empty()) return *err = "PointCloud2 has no finite point", false;
+  s.time_source = gt.ok() ? "field '" + time_name + "'" : "header stamp";
+
+  // Rings -> rows (top beam first).
+  static thread_local std::vector<int> ring_of;
+  ring_of.assign(pts.size(), 0);
+  int nrings = 0;
+  std::vector<double> alt;
+  if (gr.ok() && opt.rings == 0) {
+    s.ring_source = "field '" + ring_name + "'";
+    std::vector<std::pair<double, int>> acc(1024, {0.0, 0});
+    for (const auto& q : pts) {
+      auto& a = acc[size_t(q.ring)];
+      a.first += q.sn;
+      ++a.second;
+    }
+    std::vector<std::pair<double, int>> order;  // (mean elevation, ring value)
+    for (int ring = 0; ring < 1024; ++ring)
+      if (acc[size_t(ring)].second)
+        order.push_back({std::asin(std::clamp(acc[size_t(ring)].first / acc[size_t(ring)].second, -1.0, 1.0)), ring});
+    std::sort(order.begin(), order.end(), [](auto& a, auto& b) { return a.first > b.first; });
+    std::vector<int> row(1024, 0);
+    for (size_t i = 0; i < order.size(); ++i) {
+      row[size_t(order[i].second)] = int(i);
+      alt.push_back(order[i].first * 180.0 / M_PI);
+    }
+    for (size_t i = 0; i < pts.size(); ++i) ring_of[i] = row[size_t(pts[i].ring)];
+    nrings = int(order.size());
+  } else {
+    s.ring_source = "elevation";
+    std::vector<float> el(pts.size());
+    for (size_t i = 0; i < pts.size(); ++i) el[i] = pts[i].el;
+    std::sort(el.begin(), el.end());
+    std::vector<std::pair<float, size_t>> gaps;  // (gap, index after it)
+    for (size_t i = 1; i < el.size(); ++i) gaps.push_back({el[i] - el[i - 1], i});
+    std::vector<size_t> cuts;
+    if (opt.rings > 0) {
+      const size_t k = std::min(gaps.size(), size_t(opt.rings - 1));
+      std::partial_sort(gaps.begin(), gaps.begin() + k, gaps.end(), [](auto& a, auto& b) { return a.first > b.first; });
+      for (size_t i = 0; i < k; ++i) cuts.push_back(gaps[i].second);
+    } else {
+      const float g = float(opt.gap_deg * M_PI / 180.0);
+      for (const auto& [gap, i] : gaps)
+        if (gap > g) cuts.push_back(i);
+    }
+    std::sort(cuts.begin(), cuts.end());
+    if (cuts.size() + 1 > 512) return *err = "no ring structure in the point elevations (give the ring count)", false;
+    // Boundaries (elevations) between rings, ascending; ring from the bottom.
+    std::vector<float> bounds;
+    for (size_t i : cuts) bounds.push_back(0.5f * (el[i - 1] + el[i]));
+    nrings = int(bounds.size()) + 1;
+    std::vector<double> sum(size_t(nrings), 0.0);
+    std::vector<int> cnt(size_t(nrings), 0);
+    for (size_t i = 0; i < pts.size(); ++i) {
+      const int from_bottom = int(std::upper_bound(bounds.begin(), bounds.end(), pts[i].el) - bounds.begin());
+      ring_of[i] = nrings - 1 - from_bottom;
+      sum[size_t(ring_of[i])] += pts[i].sn;
+      ++cnt[size_t(ring_of[i])];
+    }
+    for (int r = 0; r < nrings; ++r)
+      alt.push_back(cnt[size_t(r)] ? std::asin(std::clamp(sum[size_t(r)] / cnt[size_t(r)], -1.0, 1.0)) * 180.0 / M_PI : 0.0);
+  }
+
+  int W = opt.columns;
+  if (W <= 0) {
+    if (c.height > 1 && int(c.height) == nrings) {
+      W = int(c.width);
+    } else {
+      std::vector<int> per(size_t(nrings), 0);
+      for (int r : ring_of) ++per[size_t(r)];
+      W = *std::max_element(per.begin(), per.end());
+    }
+  }
+  W = std::clamp(W, 8, 16384);
+
+  out.resize(nrings, W);
+  out.column_utime.assign(size_t(W), INT64_MAX);
+  out.beams = BeamIntrinsics{};
+  out.beams.altitude_deg = alt;
+  out.beams.azimuth_deg.assign(size_t(nrings), 0.0);
+  out.beams.pixel_shift_by_row.assign(size_t(nrings), 0);
+  out.beams.beam_offset_mm = 0.0;
+  out.beams.lidar_to_sensor = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  out.missing_columns = 0;
+  out.status = ScanStatus::kOk;
+  double t0 = 1e300;
+  const double col = 2.0 * M_PI / W;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const P& q = pts[i];
+    double a = q.az < 0 ? q.az + 2.0 * M_PI : q.az;
+    const double fv = (2.0 * M_PI - a) / col;
+    int v = int(std::lround(fv)) % W;
+    if (v < 0) v += W;
+    s.max_azimuth_error_deg = std::max(s.max_azimuth_error_deg, std::abs(fv - std::round(fv)) * col * 180.0 / M_PI);
+    const size_t k = size_t(ring_of[i]) * W + v;
+    if (out.range_mm[k] != 0) {
+      ++s.collisions;
+      if (out.range_mm[k] <= q.r_mm) continue;  // keep the nearer return
+    } else {
+      ++s.kept;
+    }
+    out.range_mm[k] = q.r_mm;
+    out.signal[k] = uint16_t(std::clamp(q.inten, 0.f, 65535.f));
+    out.reflectivity[k] = uint8_t(std::clamp(q.inten, 0.f, 255.f));
+    const int64_t tu = int64_t(std::floor(q.t * 1e6 + 0.5));
+    out.column_utime[size_t(v)] = std::min(out.column_utime[size_t(v)], tu);
+    t0 = std::min(t0, q.t);
+  }
+  const int64_t stamp_us = c.header.stamp_ns / 1000;
+  for (auto& t : out.column_utime)
+    if (t == INT64_MAX) t = stamp_us;
+  out.utime = gt.ok() ? int64_t(std::llround(t0 * 1e6)) : stamp_us;
+  return true;
+}
+
+}  // namespace fploc::rec

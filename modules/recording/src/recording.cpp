@@ -1,0 +1,96 @@
+#include "fploc/recording/recording.h"
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include "readers.h"
+
+namespace fploc::rec {
+
+FileBytes::~FileBytes() {
+  if (mapped_) munmap(mapped_, size_);
+}
+
+bool FileBytes::map(const std::string& path, std::string* err) {
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0) return *err = path + ": " + std::strerror(errno), false;
+  struct stat st {};
+  if (fstat(fd, &st) != 0) {
+    *err = path + ": " + std::strerror(errno);
+    ::close(fd);
+    return false;
+  }
+  size_ = size_t(st.st_size);
+  if (size_ > 0) {
+    void* p = mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd, 0);
+    if (p == MAP_FAILED) {
+      *err = path + ": mmap: " + std::strerror(errno);
+      ::close(fd);
+      return false;
+    }
+    madvise(p, size_, MADV_SEQUENTIAL);
+    mapped_ = p;
+    data_ = static_cast<const uint8_t*>(p);
+  }
+  ::close(fd);
+  return true;
+}
+
+namespace {
+std::unique_ptr<Recording> by_magic(std::unique_ptr<FileBytes> f, const std::string& name, std::string* err) {
+  const uint8_t* d = f->data();
+  const size_t n = f->size();
+  if (n >= 8 && d[0] == 0x89 && std::memcmp(d + 1, "MCAP", 4) == 0) return std::make_unique<McapReader>(std::move(f), name);
+  if (n >= 9 && std::memcmp(d, "#ROSBAG V", 9) == 0) {
+    if (n < 13 || std::memcmp(d, "#ROSBAG V2.0\n", 13) != 0) {
+      *err = name + ": ROS bag version " + std::string(reinterpret_cast<const char*>(d) + 9, std::min<size_t>(n - 9, 3)) +
+             " is not supported (only 2.0; `rosbag fix` converts 1.2)";
+      return nullptr;
+    }
+    return std::make_unique<BagReader>(std::move(f), name);
+  }
+  *err = name + ": neither a ROS 1 bag (#ROSBAG V2.0) nor an MCAP file";
+  return nullptr;
+}
+}  // namespace
+
+std::unique_ptr<Recording> open_recording(const std::string& path, std::string* err) {
+  auto f = std::make_unique<FileBytes>();
+  if (!f->map(path, err)) return nullptr;
+  return by_magic(std::move(f), path, err);
+}
+
+std::unique_ptr<Recording> open_recording_memory(const uint8_t* data, size_t size, const std::string& name,
+                                                 std::string* err) {
+  auto f = std::make_unique<FileBytes>();
+  f->borrow(data, size);
+  return by_magic(std::move(f), name, err);
+}
+
+std::map<std::string, TopicSummary> summarize(Recording& r) {
+  std::map<std::string, TopicSummary> out;
+  std::map<uint32_t, TopicSummary*> by_conn;
+  RawMessage m;
+  while (r.next(m)) {
+    auto& p = by_conn[m.conn];
+    if (!p) {
+      const auto& c = r.connections().at(m.conn);
+      p = &out[c.topic];
+      p->type = c.type;
+    }
+    if (p->count == 0 || m.time_ns < p->first_ns) p->first_ns = m.time_ns;
+    if (p->count == 0 || m.time_ns > p->last_ns) p->last_ns = m.time_ns;
+    ++p->count;
+  }
+  // Topics whose connection was seen but that carry no message.
+  for (const auto& [id, c] : r.connections())
+    if (!out.count(c.topic)) out[c.topic].type = c.type;
+  return out;
+}
+
+}  // namespace fploc::rec

@@ -1,0 +1,236 @@
+// ROS 1 bags: the official ouster_ros driver's bag (-> one complete frame, equal to the pcap path),
+// the ship-interior bag (bz2 chunks, LaserScan, tf, odometry), written bags (none/bz2/lz4), and
+// truncated / corrupt / unindexed files.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <map>
+
+#include "fploc/os1/packet.h"
+#include "fploc/os1/pcap.h"
+#include "fploc/recording/bag_writer.h"
+#include "fploc/recording/ouster_packets.h"
+#include "fploc/recording/recording.h"
+#include "fploc/recording/ros_msgs.h"
+#include "test_util.h"
+
+using namespace fploc;
+using namespace fploc::rec;
+using namespace fploc::rec::test;
+
+namespace {
+
+const std::string kOusterBag = data_dir() + "/ouster/512x10_raw.bag";
+std::string ship_bag() {
+  const std::string dir = data_dir() + "/recordings/ship-interior";
+  if (!std::filesystem::exists(dir)) return dir + "/missing.bag";
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().extension() == ".bag") return e.path().string();
+  return dir + "/missing.bag";
+}
+
+// A classic pcap (Ethernet/IPv4/UDP) of the given datagrams, all to `port`.
+std::vector<uint8_t> make_pcap(const std::vector<std::vector<uint8_t>>& payloads, uint16_t port) {
+  std::vector<uint8_t> out;
+  auto put = [&](const void* p, size_t n) { out.insert(out.end(), (const uint8_t*)p, (const uint8_t*)p + n); };
+  const uint32_t gh[6] = {0xa1b2c3d4, 0x00040002, 0, 0, 65535, 1};
+  put(gh, 24);
+  uint32_t ts = 0;
+  for (const auto& p : payloads) {
+    const uint32_t len = uint32_t(14 + 20 + 8 + p.size());
+    const uint32_t rh[4] = {++ts, 0, len, len};
+    put(rh, 16);
+    uint8_t eth[14] = {0};
+    eth[12] = 0x08;
+    put(eth, 14);
+    uint8_t ip[20] = {0x45, 0};
+    const uint16_t tot = uint16_t(20 + 8 + p.size());
+    ip[2] = uint8_t(tot >> 8), ip[3] = uint8_t(tot);
+    ip[8] = 64, ip[9] = 17;
+    ip[12] = 10, ip[15] = 1, ip[16] = 10, ip[19] = 2;
+    put(ip, 20);
+    uint8_t udp[8] = {0x1d, 0x4e, uint8_t(port >> 8), uint8_t(port), uint8_t((8 + p.size()) >> 8), uint8_t(8 + p.size()), 0, 0};
+    put(udp, 8);
+    put(p.data(), p.size());
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(Bag, OusterDriverBagGivesOneCompleteFrameEqualToPcapPath) {
+  FPLOC_REQUIRE_FILE(kOusterBag);
+  std::string err;
+  auto r = open_recording(kOusterBag, &err);
+  ASSERT_TRUE(r) << err;
+  OusterPackets op;
+  std::vector<Scan> frames;
+  std::vector<std::vector<uint8_t>> lidar;
+  std::string meta;
+  int imu = 0;
+  RawMessage m;
+  while (r->next(m)) {
+    const Connection& c = r->connections().at(m.conn);
+    if (c.type == "std_msgs/String") {
+      ASSERT_TRUE(decode_string(m.data, m.size, c.encoding, meta, &err)) << err;
+      ASSERT_TRUE(op.set_metadata(meta, c.topic, &err)) << err;
+      continue;
+    }
+    ASSERT_EQ(c.type, "ouster_ros/PacketMsg");
+    const uint8_t* buf;
+    size_t n;
+    ASSERT_TRUE(decode_bytes(m.data, m.size, c.encoding, &buf, &n, &err)) << err;
+    os1::ImuSample s;
+    if (op.add(buf, n, m.time_ns, frames, &s)) {
+      ++imu;
+      EXPECT_NEAR(std::abs(s.accel_mps2[0]) + std::abs(s.accel_mps2[1]) + std::abs(s.accel_mps2[2]), 9.8, 3.0);
+    } else if (n != os1::kImuPacketSize) {
+      lidar.emplace_back(buf, buf + n);
+    }
+  }
+  op.flush(frames);
+  EXPECT_EQ(r->error(), "");
+  EXPECT_EQ(imu, 10);
+  EXPECT_EQ(lidar.size(), 32u);
+  EXPECT_EQ(op.bad_packets, 0u);
+  ASSERT_TRUE(op.info());
+  ASSERT_EQ(frames.size(), 1u);
+  const Scan& s = frames[0];
+  EXPECT_EQ(s.height, op.info()->pixels_per_column);  // pixels per column from the bag's metadata
+  EXPECT_EQ(s.height, 128);
+  EXPECT_EQ(s.width, 512);
+  EXPECT_EQ(s.missing_columns, 0);
+  size_t valid = 0;
+  for (uint32_t v : s.range_mm) valid += v != 0;
+  EXPECT_GT(valid, s.range_mm.size() / 3);
+
+  // The same packets through the pcap path (PcapReader -> FrameAssembler) give the same frame.
+  const auto pcap = make_pcap(lidar, 7502);
+  os1::PcapReader pr;
+  ASSERT_TRUE(pr.open_memory(pcap.data(), pcap.size())) << pr.error();
+  os1::FrameAssembler fa(os1::parse_metadata(meta));
+  std::vector<Scan> pf;
+  os1::UdpDatagram d;
+  while (pr.next(d)) fa.add_packet(d.data, d.size, pf);
+  fa.flush(pf);
+  ASSERT_EQ(pf.size(), 1u);
+  EXPECT_EQ(pf[0].frame_id, s.frame_id);
+  EXPECT_EQ(pf[0].range_mm, s.range_mm);
+  EXPECT_EQ(pf[0].reflectivity, s.reflectivity);
+  EXPECT_EQ(pf[0].column_utime, s.column_utime);
+}
+
+TEST(Bag, ShipInteriorBz2LaserScanTfOdometry) {
+  const std::string path = ship_bag();
+  FPLOC_REQUIRE_FILE(path);
+  std::string err;
+  auto r = open_recording(path, &err);
+  ASSERT_TRUE(r) << err;
+  std::map<std::string, int> count;
+  int tf_transforms = 0, odom = 0;
+  RawMessage m;
+  size_t beams_front = 0;
+  while (r->next(m)) {
+    const Connection& c = r->connections().at(m.conn);
+    ++count[c.topic];
+    if (c.type == "sensor_msgs/LaserScan") {
+      LaserScan l;
+      ASSERT_TRUE(decode(m.data, m.size, c.encoding, l, &err)) << err;
+      EXPECT_GT(l.ranges.size(), 100u);
+      EXPECT_NEAR(l.angle_min + l.angle_increment * (l.ranges.size() - 1), l.angle_max, std::abs(l.angle_increment) * 1.01);
+      if (c.topic == "/guardian/laser_tilt_front") beams_front = l.ranges.size();
+    } else if (c.type == "tf2_msgs/TFMessage") {
+      std::vector<Transform> ts;
+      ASSERT_TRUE(decode_tf(m.data, m.size, c.encoding, ts, &err)) << err;
+      for (const auto& t : ts) EXPECT_NEAR(t.q[0] * t.q[0] + t.q[1] * t.q[1] + t.q[2] * t.q[2] + t.q[3] * t.q[3], 1.0, 1e-3);
+      tf_transforms += int(ts.size());
+    } else if (c.type == "nav_msgs/Odometry") {
+      Odometry o;
+      ASSERT_TRUE(decode(m.data, m.size, c.encoding, o, &err)) << err;
+      ++odom;
+    }
+  }
+  EXPECT_EQ(r->error(), "");
+  EXPECT_EQ(count["/guardian/laser_tilt_front"], 421);
+  EXPECT_EQ(count["/guardian/laser_horizontal_back"], 418);
+  EXPECT_EQ(count["/tf"], 9358);
+  EXPECT_EQ(odom, 839);
+  EXPECT_GT(tf_transforms, 9358);
+  EXPECT_GT(beams_front, 0u);
+}
+
+TEST(Bag, TruncatedFileKeepsWhatCameBefore) {
+  const std::string path = ship_bag();
+  FPLOC_REQUIRE_FILE(path);
+  const auto bytes = slurp(path);
+  std::string err;
+  const auto all = read_all(bytes.data(), bytes.size(), &err);
+  ASSERT_EQ(err, "");
+  const size_t cut = bytes.size() * 6 / 10;
+  const auto part = read_all(bytes.data(), cut, &err, "cut.bag");
+  EXPECT_NE(err.find("cut.bag: record at byte "), std::string::npos) << err;
+  EXPECT_NE(err.find("truncated"), std::string::npos) << err;
+  ASSERT_GT(part.size(), 1000u);
+  ASSERT_LT(part.size(), all.size());
+  for (size_t i = 0; i < part.size(); ++i) {
+    ASSERT_EQ(part[i].topic, all[i].topic);
+    ASSERT_EQ(part[i].data, all[i].data);
+  }
+}
+
+TEST(Bag, WrittenBagsAllCompressionsAndDamage) {
+  const std::string dir = ::testing::TempDir();
+  for (const std::string comp : {"none", "bz2", "lz4"}) {
+    const std::string p = dir + "/w_" + comp + ".bag";
+    {
+      BagWriter w;
+      ASSERT_TRUE(w.open(p, comp, 4000));
+      const uint32_t a = w.add_connection("/a", "std_msgs/String"), b = w.add_connection("/b", "ouster_ros/PacketMsg");
+      for (int i = 0; i < 300; ++i) {
+        std::vector<uint8_t> d(4 + size_t(i % 50));
+        const uint32_t len = uint32_t(d.size() - 4);
+        std::memcpy(d.data(), &len, 4);
+        for (size_t k = 4; k < d.size(); ++k) d[k] = uint8_t('a' + (i + k) % 26);
+        w.write(i % 3 ? a : b, 1000000000LL * 100 + i * 1000000LL, d.data(), d.size());
+      }
+      ASSERT_TRUE(w.close());
+    }
+    const auto bytes = slurp(p);
+    std::string err;
+    const auto msgs = read_all(bytes.data(), bytes.size(), &err, p);
+    EXPECT_EQ(err, "") << comp;
+    ASSERT_EQ(msgs.size(), 300u) << comp;
+    for (int i = 0; i < 300; ++i) {
+      EXPECT_EQ(msgs[i].topic, i % 3 ? "/a" : "/b");
+      EXPECT_EQ(msgs[i].t, 1000000000LL * 100 + i * 1000000LL);
+      EXPECT_EQ(msgs[i].data.size(), 4u + size_t(i % 50));
+    }
+    // Unindexed (a recorder killed before writing the index): everything reads.
+    uint64_t index_pos;
+    const auto* h = bytes.data() + 13 + 4;
+    const void* f = memmem(h, 200, "index_pos=", 10);
+    ASSERT_TRUE(f);
+    std::memcpy(&index_pos, static_cast<const uint8_t*>(f) + 10, 8);
+    const auto unindexed = read_all(bytes.data(), size_t(index_pos), &err);
+    EXPECT_EQ(err, "");
+    EXPECT_EQ(unindexed.size(), 300u);
+    if (comp != "none") {
+      // A damaged compressed chunk: one error naming the chunk and its byte offset.
+      auto bad = bytes;
+      bad[4096 + 200] ^= 0x5A;
+      bad[4096 + 201] ^= 0xA5;
+      const auto some = read_all(bad.data(), bad.size(), &err, "bad.bag");
+      EXPECT_NE(err.find("bad.bag: chunk at byte 4096 (" + comp + ")"), std::string::npos) << err;
+      EXPECT_LT(some.size(), 300u);
+    }
+  }
+}
+
+TEST(Bag, NotABag) {
+  const std::string s = "#ROSBAG V1.2\nxxxxxxxx";
+  std::string err;
+  EXPECT_FALSE(open_recording_memory(reinterpret_cast<const uint8_t*>(s.data()), s.size(), "old.bag", &err));
+  EXPECT_NE(err.find("old.bag: ROS bag version 1.2 is not supported"), std::string::npos) << err;
+  EXPECT_FALSE(open_recording_memory(reinterpret_cast<const uint8_t*>("hello"), 5, "x", &err));
+  EXPECT_NE(err.find("neither"), std::string::npos);
+}

@@ -1,0 +1,90 @@
+#!/usr/bin/env bash
+# fploc import end to end (inside scripts/netns-run; FPLOC_BUILD_DIR, FPLOC_SHARED_DIR, FPLOC_ROOT set):
+# the ouster_ros bag -> LCM log -> fploc replay (segmenter + features) and lcm-logplayer -> lcm-logger
+# (the log is a valid LCM event log); the ship-interior bag -> LaserScan channels and TUM from
+# odometry and tf; a truncated bag -> one error, exit 1, and a log of what came before.
+set -euo pipefail
+B="${FPLOC_BUILD_DIR:?}/bin"
+D="${FPLOC_SHARED_DIR:?}/data"
+BAG="$D/ouster/512x10_raw.bag"
+[ -f "$BAG" ] || { echo "no ../shared/data: skipped"; exit 77; }
+T="$(mktemp -d)"
+pids=()
+cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; rm -rf "$T"; }
+trap cleanup EXIT
+check() {
+  python3 - "$1" "$2" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+ok = eval(sys.argv[2])
+print(sys.argv[1].split("/")[-1] + ":", "ok" if ok else "FAILED: " + sys.argv[2])
+sys.exit(0 if ok else 1)
+PY
+}
+
+"$B/fploc-import" --list --json "$BAG" > "$T/list.json"
+check "$T/list.json" "j['topics']['/os_node0/lidar_packets']['count']==32 and j['topics']['/os_node0/imu_packets']['count']==10 and j['topics']['/os_node0/metadata']['type']=='std_msgs/String' and 0.05<j['duration_s']<0.2"
+
+"$B/fploc-import" "$BAG" --out "$T/x.lcm" --json > "$T/import.json"
+check "$T/import.json" "j['written']['OS1_SCAN']==1 and j['written']['OS1_IMU']==10 and j['ouster']['frame_list'][0]['width']==512 and j['ouster']['frame_list'][0]['height']==j['ouster']['pixels_per_column']==128 and j['ouster']['frame_list'][0]['missing_columns']==0 and j['errors']==[]"
+
+"$B/fploc-replay" --graph "$FPLOC_ROOT/graphs/import.pbtxt" --log "$T/x.lcm" --json > "$T/replay.json" 2> "$T/replay.err"
+check "$T/replay.json" "j['channels_fed']=={'OS1_SCAN':1,'OS1_IMU':10} and [n['messages_out'] for n in j['nodes'] if n['name']=='segmenter']==[1] and [n['messages_out'] for n in j['nodes'] if n['name']=='features']==[1]"
+
+# lcm-logplayer plays it; lcm-logger records the same events.
+URL="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608"
+lcm-logger --lcm-url="$URL" "$T/played.lcm" > "$T/logger.txt" 2>&1 & pids+=($!)
+sleep 0.5
+lcm-logplayer --lcm-url="$URL" --speed=1 "$T/x.lcm"
+sleep 1
+kill "${pids[0]}"; wait "${pids[0]}" 2>/dev/null || true; pids=()
+"$B/fploc-replay" --graph "$FPLOC_ROOT/graphs/import.pbtxt" --log "$T/played.lcm" --json > "$T/replay2.json" 2>/dev/null
+check "$T/replay2.json" "j['channels_fed']=={'OS1_SCAN':1,'OS1_IMU':10}"
+
+SHIP="$(ls "$D"/recordings/ship-interior/*.bag 2>/dev/null | head -1 || true)"
+if [ -n "$SHIP" ]; then
+  "$B/fploc-import" "$SHIP" --out "$T/ship.lcm" --tum-out "$T/odom.tum" --json > "$T/ship.json"
+  check "$T/ship.json" "j['written']['LASER_SCAN']==421 and j['written']['LASER_SCAN_GUARDIAN_LASER_HORIZONTAL_BACK']==418 and j['written']['(tum /guardian/odom)']==839"
+  [ "$(wc -l < "$T/odom.tum")" -ge 800 ] || { echo "odom.tum too short"; exit 1; }
+  "$B/fploc-import" "$SHIP" --tum-out "$T/tf.tum" --tf-parent odom --tf-child base_footprint --start 10 --end 20 --quiet > /dev/null
+  python3 - "$T/tf.tum" <<'PY'
+import sys
+rows = [list(map(float, l.split())) for l in open(sys.argv[1])]
+assert len(rows) > 50, len(rows)
+t = [r[0] for r in rows]
+assert t == sorted(t) and t[-1] - t[0] < 10.5, (t[0], t[-1])
+assert all(abs(sum(q * q for q in r[4:8]) - 1) < 1e-6 for r in rows)
+print("tf.tum: ok", len(rows), "poses")
+PY
+  # Truncated: exit 1, one error with the byte offset, and a valid log of what came before.
+  head -c 700000 "$SHIP" > "$T/cut.bag"
+  set +e
+  "$B/fploc-import" "$T/cut.bag" --out "$T/cut.lcm" --quiet > "$T/cut.txt" 2> "$T/cut.err"
+  rc=$?
+  set -e
+  [ "$rc" = 1 ] || { echo "truncated bag: exit $rc, expected 1"; exit 1; }
+  grep -q "cut.bag: record at byte [0-9]*: .*truncated" "$T/cut.err" || { echo "no byte offset in: $(cat "$T/cut.err")"; exit 1; }
+  [ "$(grep -c . "$T/cut.err")" = 1 ] || { echo "more than one error line"; cat "$T/cut.err"; exit 1; }
+  "$B/fploc-import" "$T/cut.bag" --list --json > "$T/cutlist.json" 2>/dev/null || true
+  check "$T/cutlist.json" "j['topics']['/guardian/laser_tilt_front']['count']>100 and 'record at byte' in j['error']"
+fi
+# Bags written by an independent writer (Python; lz4 chunks from the lz4 tool).
+for c in none bz2 lz4; do
+  [ "$c" = lz4 ] && ! command -v lz4 > /dev/null && { echo "no lz4 tool: lz4 bag skipped"; continue; }
+  python3 "$FPLOC_ROOT/tests/import/make_bag.py" "$T/py_$c.bag" "$c"
+  "$B/fploc-import" "$T/py_$c.bag" --out "$T/py_$c.lcm" --tum-out "$T/py.tum" --json > "$T/py_$c.json" 2>/dev/null
+  check "$T/py_$c.json" "j['written']['OS1_SCAN']==3 and j['written']['LASER_SCAN']==3 and j['written']['OS1_IMU']==6 and j['written']['(tum /odom)']==3 and j['clouds']['/points']['kept']==24"
+done
+# MCAP from the MCAP project's writer (zstd chunks): PointCloud2 (Velodyne + Hesai layouts), Imu,
+# LaserScan -> LCM; tf -> TUM.
+if [ -d "$FPLOC_ROOT/tests/import/node_modules/@mcap/core" ] && command -v node > /dev/null; then
+  (cd "$FPLOC_ROOT/tests/import" && node write_mcap.js "$T/w.mcap" zstd chunked)
+  "$B/fploc-import" "$T/w.mcap" --out "$T/w.lcm" --tum-out "$T/w.tum" --tf-parent odom --tf-child base_link --json > "$T/w.json"
+  check "$T/w.json" "j['format']=='mcap' and j['written']['OS1_SCAN']==3 and j['written']['OS1_SCAN_HESAI_POINTS']==3 and j['written']['OS1_IMU']==20 and j['written']['LASER_SCAN']==3 and j['clouds']['/hesai_points']['ring_source']=='elevation' and j['errors']==[]"
+  [ "$(wc -l < "$T/w.tum")" = 10 ] || { echo "w.tum: expected 10 poses"; exit 1; }
+  "$B/fploc-replay" --graph "$FPLOC_ROOT/graphs/import.pbtxt" --log "$T/w.lcm" --json > "$T/wr.json" 2>/dev/null
+  check "$T/wr.json" "j['channels_fed']['OS1_SCAN']==3 and [n['messages_out'] for n in j['nodes'] if n['name']=='segmenter']==[3]"
+else
+  echo "tests/import/node_modules absent: MCAP part skipped (scripts/setup-web.sh installs it)"
+fi
+echo "import e2e: ok"

@@ -1,0 +1,236 @@
+// fploc bench import [--size-mb 1024] [--kind ouster|cloud|all] [--compression none|lz4|bz2] [--json] [--keep DIR]
+// Import speed as a ratio against `cat` of the same file, timed in the same run (target: <= 2x).
+// Writes a large bag into a temp dir (deleted afterwards), by content:
+//   ouster: the ouster_ros bag's packets (../shared/data/ouster/512x10_raw.bag; OS-0-128, 512x10,
+//           RNG15_RFL8_NIR8) repeated with advancing frame ids and times -> scan_t frames
+//   cloud:  VLP-16-like sensor_msgs/PointCloud2 (16 x 1800 points, Velodyne field layout) -> scan_t
+// then times `cat BAG > /dev/null` (after one warm-up read, so both run from the page cache),
+// `cat BAG > COPY` (read + write the same volume) and `fploc-import BAG --out LOG.lcm`.
+#include <fcntl.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "fploc/recording/bag_writer.h"
+#include "fploc/recording/recording.h"
+
+using namespace fploc::rec;
+namespace fs = std::filesystem;
+
+namespace {
+
+double children_cpu() {
+  rusage u{};
+  getrusage(RUSAGE_CHILDREN, &u);
+  return u.ru_utime.tv_sec + u.ru_stime.tv_sec + 1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+double last_cpu = 0;  // CPU seconds (user + sys) of the last run(): what a busy shared machine does not inflate
+
+double run(const std::string& cmd) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const double c0 = children_cpu();
+  const int rc = std::system(cmd.c_str());
+  last_cpu = children_cpu() - c0;
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (rc != 0) {
+    std::cerr << "fploc bench import: '" << cmd << "' failed (" << rc << ")\n";
+    std::exit(1);
+  }
+  return s;
+}
+
+// Drops one file's pages from the page cache (after writing them back): the next read is a cold read
+// from the disk. Only this file is affected.
+void evict(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0) return;
+  fdatasync(fd);
+  posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED);
+  ::close(fd);
+}
+
+void put32(std::vector<uint8_t>& b, uint32_t v) { b.insert(b.end(), (uint8_t*)&v, (uint8_t*)&v + 4); }
+void put_str(std::vector<uint8_t>& b, const std::string& s) {
+  put32(b, uint32_t(s.size()));
+  b.insert(b.end(), s.begin(), s.end());
+}
+
+// ROS 1 PointCloud2 of a VLP-16 in a 10 x 6 m room (header stamp patched per copy at bytes 4..11).
+std::vector<uint8_t> vlp16_cloud() {
+  std::vector<uint8_t> b;
+  put32(b, 0);
+  put32(b, 0);
+  put32(b, 0);
+  put_str(b, "velodyne");
+  const int rings = 16, cols = 1800, step = 22;
+  put32(b, 1);
+  put32(b, uint32_t(rings * cols));
+  const std::pair<const char*, std::pair<uint32_t, uint8_t>> f[] = {{"x", {0, 7}}, {"y", {4, 7}}, {"z", {8, 7}}, {"intensity", {12, 7}}, {"ring", {16, 4}}, {"time", {18, 7}}};
+  put32(b, 6);
+  for (const auto& [n, ot] : f) {
+    put_str(b, n);
+    put32(b, ot.first);
+    b.push_back(ot.second);
+    put32(b, 1);
+  }
+  b.push_back(0);
+  put32(b, step);
+  put32(b, step * rings * cols);
+  put32(b, step * rings * cols);
+  for (int c = 0; c < cols; ++c)
+    for (int r = 0; r < rings; ++r) {
+      const double az = c * 0.2 * M_PI / 180, el = (-15 + 2 * r) * M_PI / 180;
+      const double d[3] = {std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)};
+      double t = 1e9;
+      const double lo[3] = {-4, -2.5, -1.5}, hi[3] = {6, 3.5, 2};
+      for (int i = 0; i < 3; ++i) {
+        if (d[i] > 1e-9) t = std::min(t, hi[i] / d[i]);
+        if (d[i] < -1e-9) t = std::min(t, lo[i] / d[i]);
+      }
+      float v[4] = {float(t * d[0]), float(t * d[1]), float(t * d[2]), float(r * 10)};
+      const uint16_t ring = uint16_t(r);
+      const float tt = float(c) / cols * 0.1f;
+      const size_t o = b.size();
+      b.resize(o + step);
+      std::memcpy(&b[o], v, 16);
+      std::memcpy(&b[o + 16], &ring, 2);
+      std::memcpy(&b[o + 18], &tt, 4);
+    }
+  b.push_back(1);
+  return b;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"fploc bench import: import speed against cat of the same file (ratio)"};
+  int size_mb = 1024;
+  std::string kind = "all", compression = "none", keep;
+  bool json = false;
+  app.add_option("--size-mb", size_mb, "size of each generated bag");
+  app.add_option("--kind", kind, "ouster, cloud or all");
+  app.add_option("--compression", compression, "chunk compression of the generated bag: none, lz4, bz2");
+  app.add_option("--keep", keep, "write the bags here and keep them");
+  app.add_flag("--json", json, "JSON on stdout");
+  CLI11_PARSE(app, argc, argv);
+  const std::string root = std::getenv("FPLOC_ROOT") ? std::getenv("FPLOC_ROOT") : ".";
+  const std::string shared = std::getenv("FPLOC_SHARED_DIR") ? std::string(std::getenv("FPLOC_SHARED_DIR")) : root + "/../shared";
+  const fs::path self = fs::canonical("/proc/self/exe").parent_path();
+  const std::string importer = (self / "fploc-import").string();
+  const fs::path dir = keep.empty() ? fs::temp_directory_path() / ("fploc-bench-import-" + std::to_string(getpid())) : fs::path(keep);
+  fs::create_directories(dir);
+  const uint64_t target = uint64_t(size_mb) << 20;
+  nlohmann::json out = nlohmann::json::array();
+
+  for (const std::string k : {"ouster", "cloud"}) {
+    if (kind != "all" && kind != k) continue;
+    const std::string bag = (dir / (k + ".bag")).string();
+    BagWriter w;
+    if (!w.open(bag, compression)) {
+      std::cerr << "cannot write " << bag << "\n";
+      return 1;
+    }
+    uint64_t written = 0, messages = 0;
+    if (k == "ouster") {
+      const std::string src = shared + "/data/ouster/512x10_raw.bag";
+      std::string err;
+      auto r = open_recording(src, &err);
+      if (!r) {
+        std::cerr << err << " (needs ../shared/data)\n";
+        return 1;
+      }
+      struct M { uint32_t conn; int64_t t; std::vector<uint8_t> d; std::string type; };
+      std::vector<M> ms;
+      std::map<uint32_t, uint32_t> conn;
+      RawMessage m;
+      while (r->next(m)) {
+        const auto& c = r->connections().at(m.conn);
+        if (!conn.count(m.conn)) conn[m.conn] = w.add_connection(c.topic, c.type);
+        ms.push_back({conn[m.conn], m.time_ns, std::vector<uint8_t>(m.data, m.data + m.size), c.type});
+      }
+      for (int64_t copy = 0; written < target; ++copy) {
+        for (auto& x : ms) {
+          if (x.type == "std_msgs/String") {
+            if (copy == 0) w.write(x.conn, x.t, x.d.data(), x.d.size());
+            continue;
+          }
+          std::vector<uint8_t> d = x.d;
+          const size_t n = d.size() - 4;
+          if (n > 48) {  // lidar packet (RNG15: frame id at packet byte 2, column headers every 12 + 128 * 4 B after 32)
+            uint16_t fid;
+            std::memcpy(&fid, &d[4 + 2], 2);
+            fid = uint16_t(fid + copy);
+            std::memcpy(&d[4 + 2], &fid, 2);
+            for (size_t o = 4 + 32; o + 8 <= d.size() - 32; o += 12 + 128 * 4) {
+              uint64_t ts;
+              std::memcpy(&ts, &d[o], 8);
+              ts += uint64_t(copy) * 100000000ull;
+              std::memcpy(&d[o], &ts, 8);
+            }
+          }
+          w.write(x.conn, x.t + copy * 100000000LL, d.data(), d.size());
+          written += d.size();
+          ++messages;
+        }
+      }
+    } else {
+      const uint32_t c = w.add_connection("/velodyne_points", "sensor_msgs/PointCloud2");
+      std::vector<uint8_t> cloud = vlp16_cloud();
+      for (int64_t i = 0; written < target; ++i) {
+        const int64_t t = 1700000000LL * 1000000000LL + i * 100000000LL;
+        const uint32_t sec = uint32_t(t / 1000000000), nsec = uint32_t(t % 1000000000);
+        std::memcpy(&cloud[4], &sec, 4);
+        std::memcpy(&cloud[8], &nsec, 4);
+        w.write(c, t, cloud.data(), cloud.size());
+        written += cloud.size();
+        ++messages;
+      }
+    }
+    if (!w.close()) {
+      std::cerr << "writing " << bag << " failed\n";
+      return 1;
+    }
+    const uint64_t bytes = fs::file_size(bag);
+    const std::string lcm = (dir / (k + ".lcm")).string(), copy = (dir / (k + ".copy")).string();
+    run("cat '" + bag + "' > /dev/null");  // warm-up: both timings below read from the page cache
+    const double t_cat = run("cat '" + bag + "' > /dev/null");
+    const double cpu_cat = last_cpu;
+    const double t_copy = run("cat '" + bag + "' > '" + copy + "'");
+    fs::remove(copy);
+    const double t_import = run("'" + importer + "' '" + bag + "' --out '" + lcm + "' --quiet > /dev/null");
+    const double cpu_import = last_cpu;
+    const uint64_t lcm_bytes = fs::file_size(lcm);
+    // Cold: the bag read from the disk (its pages evicted before each run).
+    fs::remove(lcm);
+    evict(bag);
+    const double t_cat_cold = run("cat '" + bag + "' > /dev/null");
+    evict(bag);
+    const double t_import_cold = run("'" + importer + "' '" + bag + "' --out '" + lcm + "' --quiet > /dev/null");
+    nlohmann::json j = {{"kind", k}, {"compression", compression}, {"bag_bytes", bytes}, {"messages", messages},
+                        {"lcm_bytes", lcm_bytes}, {"cat_s", t_cat}, {"cat_copy_s", t_copy}, {"import_s", t_import},
+                        {"ratio_vs_cat", t_import / t_cat}, {"ratio_vs_cat_copy", t_import / t_copy},
+                        {"import_MBps", bytes / 1e6 / t_import}, {"cold_cat_s", t_cat_cold}, {"cold_import_s", t_import_cold},
+                        {"cold_ratio_vs_cat", t_import_cold / t_cat_cold}, {"cat_cpu_s", cpu_cat}, {"import_cpu_s", cpu_import}};
+    out.push_back(j);
+    if (!json)
+      std::printf("%-6s %s: %.0f MB bag (%llu msgs) -> %.0f MB LCM log\n  page cache: import %.2f s, cat %.2f s (ratio %.2f), cat > copy %.2f s (ratio %.2f)\n"
+                  "  cold file:  import %.2f s, cat %.2f s (ratio %.2f)\n  CPU (user+sys): import %.2f s, cat %.2f s\n",
+                  k.c_str(), compression.c_str(), bytes / 1e6, (unsigned long long)messages, lcm_bytes / 1e6, t_import, t_cat,
+                  t_import / t_cat, t_copy, t_import / t_copy, t_import_cold, t_cat_cold, t_import_cold / t_cat_cold, cpu_import, cpu_cat);
+    if (keep.empty()) {
+      fs::remove(bag);
+      fs::remove(lcm);
+    }
+  }
+  if (keep.empty()) fs::remove_all(dir);
+  if (json) std::cout << out.dump(2) << "\n";
+  return 0;
+}

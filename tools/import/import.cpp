@@ -1,0 +1,417 @@
+// fploc import RECORDING [--list] [--json] [--out LOG.lcm] [--topics T,...] [--start S] [--end S] ...
+// ROS 1 bags (2.0; none/bz2/lz4 chunks) and ROS 2 MCAP (none/zstd/lz4 chunks, CDR) -> an LCM log that
+// fploc replay and lcm-logplayer play:
+//   ouster_ros/PacketMsg (+ the std_msgs/String metadata topic) -> scan_t on OS1_SCAN, imu_t on OS1_IMU
+//       (decoded by fploc's OS-1 driver code: the same scans as from the live sensor or a pcap)
+//   sensor_msgs/PointCloud2 -> scan_t on OS1_SCAN (rings from the ring field or the elevations)
+//   sensor_msgs/Imu -> imu_t on OS1_IMU;  sensor_msgs/LaserScan -> laser_scan_t on LASER_SCAN
+//   nav_msgs/Odometry, tf2_msgs/TFMessage -> a TUM file (--tum-out, --tf-parent/--tf-child or --odom-topic)
+// A second topic that would go to the same channel gets CHANNEL_<topic>; --channel TOPIC=CH overrides.
+// Bad input: one error with the byte offset and record; the log holds everything read before it.
+#include <fploc/imu_t.hpp>
+#include <fploc/laser_scan_t.hpp>
+#include <fploc/scan_t.hpp>
+
+#include <CLI/CLI.hpp>
+#include <fstream>
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "fploc/nodes/convert.h"
+#include "fploc/recording/cloud_to_scan.h"
+#include "fploc/recording/ouster_packets.h"
+#include "fploc/recording/recording.h"
+#include "fploc/recording/ros_msgs.h"
+#include "lcm_log.h"
+#include "tum_track.h"
+
+using namespace fploc;
+using namespace fploc::rec;
+using fploc::import::LcmLog;
+using fploc::import::TumTrack;
+
+namespace {
+
+enum class Kind { kNone, kOusterPackets, kOusterMetadata, kCloud, kImu, kLaser, kOdom, kTf };
+
+Kind kind_of(const Connection& c) {
+  if (c.encoding == Encoding::kOther) return Kind::kNone;
+  const std::string& t = c.type;
+  if (t == "ouster_ros/PacketMsg" || t == "ouster_sensor_msgs/PacketMsg") return Kind::kOusterPackets;
+  if (t == "std_msgs/String" && c.topic.size() >= 8 && c.topic.compare(c.topic.size() - 8, 8, "metadata") == 0)
+    return Kind::kOusterMetadata;
+  if (t == "sensor_msgs/PointCloud2") return Kind::kCloud;
+  if (t == "sensor_msgs/Imu") return Kind::kImu;
+  if (t == "sensor_msgs/LaserScan") return Kind::kLaser;
+  if (t == "nav_msgs/Odometry") return Kind::kOdom;
+  if (t == "tf2_msgs/TFMessage" || t == "tf/tfMessage") return Kind::kTf;
+  return Kind::kNone;
+}
+
+std::string sanitize(const std::string& topic) {
+  std::string s;
+  for (char ch : topic) s += std::isalnum(uint8_t(ch)) ? char(std::toupper(uint8_t(ch))) : '_';
+  while (!s.empty() && s[0] == '_') s.erase(0, 1);
+  return s;
+}
+
+double seconds(int64_t ns) { return double(ns) * 1e-9; }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"fploc import: ROS 1 bags and ROS 2 MCAP recordings -> LCM log (and a TUM trajectory)"};
+  std::string path, out, tum_out, tf_parent, tf_child, odom_topic, metadata_file;
+  std::vector<std::string> topics, channels;
+  bool list = false, json = false, quiet = false;
+  double start = -1, end = -1;
+  CloudOptions cloud_opt;
+  app.add_option("recording", path, "ROS 1 bag (.bag) or MCAP (.mcap) file")->required();
+  app.add_flag("--list", list, "print topics, types, message counts and the duration; write nothing");
+  app.add_flag("--json", json, "machine-readable summary on stdout");
+  app.add_option("--out", out, "LCM log to write");
+  app.add_option("--topics", topics, "import only these topics (comma separated or repeated)")->delimiter(',');
+  app.add_option("--start", start, "skip messages before START seconds after the first message");
+  app.add_option("--end", end, "stop at END seconds after the first message");
+  app.add_option("--metadata", metadata_file, "Ouster sensor metadata JSON (when the recording has no metadata topic)");
+  app.add_option("--channel", channels, "TOPIC=CHANNEL: the LCM channel of a topic")->delimiter(',');
+  app.add_option("--rings", cloud_opt.rings, "PointCloud2 without ring field: the number of rings (default: elevation gaps)");
+  app.add_option("--columns", cloud_opt.columns, "PointCloud2: columns of the range image (default: organised width or most points per ring)");
+  app.add_option("--tum-out", tum_out, "write a trajectory (TUM) from tf or an Odometry topic");
+  app.add_option("--tf-parent", tf_parent, "with --tum-out: the tf parent frame (e.g. map, odom)");
+  app.add_option("--tf-child", tf_child, "with --tum-out: the tf child frame (e.g. base_link)");
+  app.add_option("--odom-topic", odom_topic, "with --tum-out: the nav_msgs/Odometry topic (default: the first one)");
+  app.add_flag("--quiet", quiet, "no progress on stderr");
+  CLI11_PARSE(app, argc, argv);
+  if (!list && out.empty() && tum_out.empty()) {
+    std::cerr << "fploc import: give --list, --out LOG.lcm or --tum-out FILE\n";
+    return 2;
+  }
+  if (!tum_out.empty() && (tf_parent.empty() != tf_child.empty())) {
+    std::cerr << "fploc import: --tf-parent and --tf-child go together\n";
+    return 2;
+  }
+
+  std::string err;
+  auto rec = open_recording(path, &err);
+  if (!rec) {
+    std::cerr << "fploc import: " << err << "\n";
+    return 1;
+  }
+
+  if (list) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto topics_seen = summarize(*rec);
+    int64_t first = INT64_MAX, last = INT64_MIN;
+    uint64_t total = 0;
+    for (const auto& [t, s] : topics_seen)
+      if (s.count) {
+        first = std::min(first, s.first_ns);
+        last = std::max(last, s.last_ns);
+        total += s.count;
+      }
+    const double dur = total ? seconds(last) - seconds(first) : 0.0;
+    if (json) {
+      nlohmann::json j;
+      j["file"] = path;
+      j["format"] = rec->format();
+      j["messages"] = total;
+      j["duration_s"] = dur;
+      j["start_s"] = total ? seconds(first) : 0.0;
+      j["error"] = rec->error();
+      for (const auto& [t, s] : topics_seen)
+        j["topics"][t] = {{"type", s.type}, {"count", s.count}, {"imported_as", [&] {
+                            for (const auto& [id, c] : rec->connections())
+                              if (c.topic == t) return std::string(kind_of(c) == Kind::kNone ? "" : "yes");
+                            return std::string();
+                          }()}};
+      std::cout << j.dump(2) << "\n";
+    } else {
+      std::printf("%s: %s, %llu messages, %.3f s", path.c_str(), rec->format().c_str(), (unsigned long long)total, dur);
+      if (total) std::printf(" (from %.3f)", seconds(first));
+      std::printf("\n");
+      size_t w = 5;
+      for (const auto& [t, s] : topics_seen) w = std::max(w, t.size());
+      for (const auto& [t, s] : topics_seen) {
+        Connection c;
+        for (const auto& [id, cc] : rec->connections())
+          if (cc.topic == t) c = cc;
+        std::printf("  %-*s %8llu  %s%s\n", int(w), t.c_str(), (unsigned long long)s.count, s.type.c_str(),
+                    kind_of(c) == Kind::kNone ? "" : "  (imported)");
+      }
+    }
+    (void)t0;
+    if (!rec->error().empty()) {
+      std::cerr << "fploc import: " << rec->error() << "\n";
+      return 1;
+    }
+    return 0;
+  }
+
+  // Channels: defaults by kind, unique per topic.
+  std::map<std::string, std::string> channel_override;
+  for (const auto& c : channels) {
+    const auto k = c.find('=');
+    if (k == std::string::npos) {
+      std::cerr << "fploc import: --channel wants TOPIC=CHANNEL, got '" << c << "'\n";
+      return 2;
+    }
+    channel_override[c.substr(0, k)] = c.substr(k + 1);
+  }
+  const std::set<std::string> wanted(topics.begin(), topics.end());
+  std::map<uint32_t, std::string> channel_of;  // connection -> LCM channel
+  std::map<std::string, std::string> topic_channel;
+  std::set<std::string> used_channels;
+  auto channel_for = [&](const Connection& c, Kind k) -> const std::string& {
+    auto it = channel_of.find(c.id);
+    if (it != channel_of.end()) return it->second;
+    std::string ch;
+    auto ov = channel_override.find(c.topic);
+    if (ov != channel_override.end()) {
+      ch = ov->second;
+    } else if (topic_channel.count(c.topic)) {
+      ch = topic_channel[c.topic];
+    } else {
+      const std::string base = k == Kind::kLaser ? "LASER_SCAN" : (k == Kind::kImu ? "OS1_IMU" : "OS1_SCAN");
+      ch = used_channels.count(base) ? base + "_" + sanitize(c.topic) : base;
+    }
+    used_channels.insert(ch);
+    topic_channel[c.topic] = ch;
+    return channel_of[c.id] = ch;
+  };
+
+  LcmLog lcm_log;
+  if (!out.empty() && !lcm_log.open(out)) {
+    std::cerr << "fploc import: cannot write " << out << "\n";
+    return 1;
+  }
+  TumTrack tum;
+  if (!tum_out.empty() && !tum.open(tum_out, tf_parent, tf_child)) {
+    std::cerr << "fploc import: cannot write " << tum_out << "\n";
+    return 1;
+  }
+
+  OusterPackets ouster;
+  if (!metadata_file.empty()) {
+    std::ifstream in(metadata_file);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    if (!in || !ouster.set_metadata(ss.str(), metadata_file, &err)) {
+      std::cerr << "fploc import: " << (in ? err : metadata_file + ": cannot read") << "\n";
+      return 1;
+    }
+  }
+  std::string ouster_scan_channel = "OS1_SCAN", ouster_imu_channel = "OS1_IMU";
+  std::map<std::string, uint64_t> written, skipped_types, decode_errors;
+  std::map<std::string, std::string> first_decode_error;
+  std::vector<Scan> frames;
+  size_t frames_total = 0;
+  struct FrameInfo { int32_t frame_id, height, width, missing; };
+  std::vector<FrameInfo> frame_list;  // for the summary (the first 1000)
+  scan_t scan_msg;
+  std::map<std::string, int64_t> seq;
+  CloudStats cstats;
+  std::map<std::string, CloudStats> cloud_info;
+  int64_t first_ns = INT64_MIN;
+  const auto t_start = std::chrono::steady_clock::now();
+  auto last_progress = t_start;
+  uint64_t read_msgs = 0;
+
+  auto emit_frames = [&](int64_t fallback_ns) {
+    for (size_t i = 0; i < frames.size(); ++i) {
+      Scan& s = frames[i];
+      s.seq = seq[ouster_scan_channel]++;
+      to_msg(s, scan_msg);
+      const int64_t t = i < ouster.frame_times_ns.size() ? ouster.frame_times_ns[i] : fallback_ns;
+      if (frame_list.size() < 1000) frame_list.push_back({s.frame_id, s.height, s.width, s.missing_columns});
+      if (!out.empty()) lcm_log.write(ouster_scan_channel, t / 1000, scan_msg);
+      ++written[ouster_scan_channel];
+    }
+    frames_total += frames.size();
+    for (auto& s : frames) ouster.recycle(std::move(s));  // the next frame reuses the buffers
+    frames.clear();
+    ouster.frame_times_ns.clear();
+  };
+  auto bad = [&](const Connection& c, const std::string& e) {
+    if (!decode_errors[c.topic]++) first_decode_error[c.topic] = e;
+  };
+
+  bool odom_chosen = !odom_topic.empty();
+  Scan cloud_scan;
+  RawMessage m;
+  while (rec->next(m)) {
+    ++read_msgs;
+    if (first_ns == INT64_MIN) first_ns = m.time_ns;
+    const double rel = seconds(m.time_ns) - seconds(first_ns);
+    if (start >= 0 && rel < start) continue;
+    if (end >= 0 && rel > end) break;
+    const Connection& c = rec->connections().at(m.conn);
+    if (!wanted.empty() && !wanted.count(c.topic)) continue;
+    const Kind k = kind_of(c);
+    if (!quiet && (read_msgs & 15) == 0) {
+      const auto now = std::chrono::steady_clock::now();
+      if (now - last_progress > std::chrono::seconds(1)) {
+        last_progress = now;
+        std::fprintf(stderr, "\rfploc import: %5.1f%% (%.0f MB, %.1f s of recording)", 100.0 * rec->position() / std::max<uint64_t>(1, rec->size()),
+                     rec->position() / 1e6, rel);
+      }
+    }
+    switch (k) {
+      case Kind::kNone: ++skipped_types[c.type]; break;
+      case Kind::kOusterMetadata: {
+        std::string text;
+        if (!decode_string(m.data, m.size, c.encoding, text, &err)) { bad(c, err); break; }
+        if (!ouster.set_metadata(text, c.topic, &err)) bad(c, err);
+        ++written["(metadata " + c.topic + ")"];
+        break;
+      }
+      case Kind::kOusterPackets: {
+        const uint8_t* buf = nullptr;
+        size_t n = 0;
+        if (!decode_bytes(m.data, m.size, c.encoding, &buf, &n, &err)) { bad(c, err); break; }
+        os1::ImuSample s;
+        if (ouster.add(buf, n, m.time_ns, frames, &s)) {
+          imu_t im{};
+          im.utime = int64_t(s.accel_ts_ns / 1000);
+          im.seq = seq[ouster_imu_channel]++;
+          im.accel_utime = int64_t(s.accel_ts_ns / 1000);
+          im.gyro_utime = int64_t(s.gyro_ts_ns / 1000);
+          for (int i = 0; i < 3; ++i) im.accel[i] = s.accel_mps2[i], im.gyro[i] = s.gyro_radps[i];
+          im.source = "os1";
+          if (!out.empty()) lcm_log.write(ouster_imu_channel, m.time_ns / 1000, im);
+          ++written[ouster_imu_channel];
+        }
+        emit_frames(m.time_ns);
+        break;
+      }
+      case Kind::kCloud: {
+        PointCloud2 pc;
+        if (!decode(m.data, m.size, c.encoding, pc, &err)) { bad(c, err); break; }
+        Scan& s = cloud_scan;  // buffers reused from cloud to cloud
+        if (!cloud_to_scan(pc, cloud_opt, s, &cstats, &err)) { bad(c, err); break; }
+        const std::string& ch = channel_for(c, k);
+        s.seq = seq[ch]++;
+        s.frame_id = int32_t(s.seq & 0xFFFF);
+        s.sensor = "PointCloud2 " + c.topic + " (" + std::to_string(s.height) + " rings)";
+        cloud_info[c.topic] = cstats;
+        to_msg(s, scan_msg);
+        if (!out.empty()) lcm_log.write(ch, m.time_ns / 1000, scan_msg);
+        ++written[ch];
+        break;
+      }
+      case Kind::kImu: {
+        Imu u;
+        if (!decode(m.data, m.size, c.encoding, u, &err)) { bad(c, err); break; }
+        const std::string& ch = channel_for(c, k);
+        imu_t im{};
+        im.utime = im.accel_utime = im.gyro_utime = u.header.stamp_ns / 1000;
+        im.seq = seq[ch]++;
+        for (int i = 0; i < 3; ++i) im.accel[i] = u.linear_acceleration[i], im.gyro[i] = u.angular_velocity[i];
+        im.source = "ros " + c.topic;
+        if (!out.empty()) lcm_log.write(ch, m.time_ns / 1000, im);
+        ++written[ch];
+        break;
+      }
+      case Kind::kLaser: {
+        LaserScan l;
+        if (!decode(m.data, m.size, c.encoding, l, &err)) { bad(c, err); break; }
+        const std::string& ch = channel_for(c, k);
+        laser_scan_t ls;
+        ls.utime = l.header.stamp_ns / 1000;
+        ls.frame = l.header.frame_id;
+        ls.angle_min = l.angle_min;
+        ls.angle_increment = l.angle_increment;
+        ls.time_increment = l.time_increment;
+        ls.range_min = l.range_min;
+        ls.range_max = l.range_max;
+        ls.num_ranges = int32_t(l.ranges.size());
+        ls.ranges = std::move(l.ranges);
+        ls.num_intensities = int32_t(l.intensities.size());
+        ls.intensities = std::move(l.intensities);
+        if (!out.empty()) lcm_log.write(ch, m.time_ns / 1000, ls);
+        ++written[ch];
+        break;
+      }
+      case Kind::kOdom: {
+        if (tum_out.empty() || !tf_parent.empty()) { ++skipped_types[c.type]; break; }
+        if (!odom_chosen) odom_topic = c.topic, odom_chosen = true;
+        if (c.topic != odom_topic) break;
+        Odometry o;
+        if (!decode(m.data, m.size, c.encoding, o, &err)) { bad(c, err); break; }
+        tum.odometry(o);
+        ++written["(tum " + c.topic + ")"];
+        break;
+      }
+      case Kind::kTf: {
+        if (tum_out.empty() || tf_parent.empty()) { ++skipped_types[c.type]; break; }
+        std::vector<Transform> ts;
+        if (!decode_tf(m.data, m.size, c.encoding, ts, &err)) { bad(c, err); break; }
+        for (const auto& t : ts) tum.tf(t);
+        ++written["(tf " + c.topic + ")"];
+        break;
+      }
+    }
+  }
+  ouster.flush(frames);
+  emit_frames(m.time_ns);
+  if (!quiet && std::chrono::steady_clock::now() - t_start > std::chrono::seconds(1)) std::fprintf(stderr, "\n");
+  lcm_log.close();
+  tum.close();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+
+  std::vector<std::string> problems;
+  if (!rec->error().empty()) problems.push_back(rec->error() + " (the output holds everything before it)");
+  for (const auto& [t, n] : decode_errors) problems.push_back(t + ": " + std::to_string(n) + " messages not decoded; first: " + first_decode_error[t]);
+  if (ouster.lidar_packets > 0 && !ouster.has_metadata())
+    problems.push_back(std::to_string(ouster.lidar_packets) + " Ouster lidar packets without metadata (no metadata topic; give --metadata FILE)");
+  if (ouster.bad_packets) problems.push_back(std::to_string(ouster.bad_packets) + " bad Ouster packets; last: " + ouster.last_error);
+
+  if (json) {
+    nlohmann::json j;
+    j["file"] = path;
+    j["format"] = rec->format();
+    j["messages_read"] = read_msgs;
+    j["written"] = written;
+    j["skipped_types"] = skipped_types;
+    j["channels"] = topic_channel;
+    j["seconds"] = wall;
+    j["events"] = lcm_log.events();
+    if (ouster.info()) {
+      j["ouster"] = {{"sensor", ouster.info()->sensor_name()}, {"pixels_per_column", ouster.info()->pixels_per_column},
+                     {"columns_per_frame", ouster.info()->columns_per_frame}, {"udp_profile", os1::to_string(ouster.info()->profile)},
+                     {"lidar_packets", ouster.lidar_packets}, {"imu_packets", ouster.imu_packets}, {"frames", frames_total}};
+      nlohmann::json fr = nlohmann::json::array();
+      for (const auto& s : frame_list) fr.push_back({{"frame_id", s.frame_id}, {"height", s.height}, {"width", s.width}, {"missing_columns", s.missing}});
+      j["ouster"]["frame_list"] = fr;
+    }
+    for (const auto& [t, s] : cloud_info)
+      j["clouds"][t] = {{"ring_source", s.ring_source}, {"time_source", s.time_source}, {"points", s.points}, {"kept", s.kept},
+                        {"collisions", s.collisions}, {"max_azimuth_error_deg", s.max_azimuth_error_deg}};
+    j["errors"] = problems;
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::printf("%s (%s): %llu messages read in %.2f s\n", path.c_str(), rec->format().c_str(), (unsigned long long)read_msgs, wall);
+    for (const auto& [ch, n] : written) std::printf("  %-28s %8llu\n", ch.c_str(), (unsigned long long)n);
+    for (const auto& [t, ch] : topic_channel) std::printf("  topic %s -> %s\n", t.c_str(), ch.c_str());
+    if (ouster.info())
+      std::printf("  ouster: %s, %dx%d (%s), %llu lidar + %llu imu packets -> %zu frames\n", ouster.info()->sensor_name().c_str(),
+                  ouster.info()->pixels_per_column, ouster.info()->columns_per_frame, os1::to_string(ouster.info()->profile),
+                  (unsigned long long)ouster.lidar_packets, (unsigned long long)ouster.imu_packets, frames_total);
+    for (const auto& [t, s] : cloud_info)
+      std::printf("  cloud %s: rings from %s, times from %s, %llu/%llu points kept, %llu collisions\n", t.c_str(), s.ring_source.c_str(),
+                  s.time_source.c_str(), (unsigned long long)s.kept, (unsigned long long)s.points, (unsigned long long)s.collisions);
+    if (!skipped_types.empty()) {
+      std::printf("  not imported:");
+      for (const auto& [t, n] : skipped_types) std::printf(" %s (%llu)", t.c_str(), (unsigned long long)n);
+      std::printf("\n");
+    }
+    if (!tum_out.empty()) std::printf("  %s: %llu poses\n", tum_out.c_str(), (unsigned long long)tum.poses());
+  }
+  for (const auto& p : problems) std::cerr << "fploc import: " << p << "\n";
+  return rec->error().empty() ? 0 : 1;
+}
