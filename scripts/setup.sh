@@ -9,6 +9,7 @@ PKGS=(
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev libcpp-httplib-dev libssl-dev libpcap-dev libnanoflann-dev
   python3
+  libboost-dev openssh-client openssh-server
 )
 missing=()
 for p in "${PKGS[@]}"; do

@@ -231,7 +231,7 @@ class DashboardNode : public fploc::rt::Node {
       std::lock_guard<std::mutex> lk(cmd_mu_);
       cmds.swap(commands_);
     }
-    for (const auto& c : cmds) ctx_->bus().lcm().publish(fploc::rt::kControlChannel, &c);
+    for (const auto& c : cmds) ctx_->bus().lcm().publish(ctx_->ns(fploc::rt::kControlChannel), &c);
   }
 
   void try_listen() {

@@ -33,9 +33,11 @@
 #include "fploc/runtime/bus.h"
 #include "fploc/runtime/graph.h"
 #include "fploc/runtime/restart.h"
+#include "fploc/runtime/robot.h"
 #include "fploc/runtime/validate.h"
 #include "check_files.h"
 #include "control.h"
+#include "hosts.h"
 #include "process_table.h"
 #include "supervisor.h"
 
@@ -67,29 +69,59 @@ void on_signal(int sig) {
 
 double policy_or(double v, double d) { return v > 0 ? v : d; }
 
+// The graph's hosts as seen from this checkout (build/bin -> the fploc root two levels up).
+std::map<std::string, std::shared_ptr<const HostPlan>> host_plans(const fploc::Graph& g, const std::string& bin_dir) {
+  std::map<std::string, std::shared_ptr<const HostPlan>> out;
+  const auto root = std::filesystem::path(bin_dir).parent_path().parent_path().string();
+  for (const auto& h : g.host()) {
+    auto p = std::make_shared<HostPlan>();
+    p->spec = h;
+    p->local_root = root;
+    p->local_bin = bin_dir;
+    out[h.name()] = p;
+  }
+  return out;
+}
+
 // The event loop: LCM (telemetry, control), signals, the process table and the supervisor.
 class Launcher : public Effects {
  public:
   // `sets`: the command line's NODE.field=value overrides (already checked against the graph).
   Launcher(LoadedGraph g, const std::vector<ResolvedNode>& resolved, std::string url, std::string bin_dir,
            const std::vector<std::string>& sets)
-      : g_(std::move(g)), hooks_(default_hooks(bin_dir)), bus_(url),
-        table_(entries(g_, resolved, sets), std::filesystem::absolute(g_.path).string()),
+      : g_(std::move(g)), robot_(robot_of(&g_.graph)), telemetry_(robot_channel(robot_, kTelemetryChannel)),
+        hooks_(default_hooks(bin_dir)), bus_(url),
+        table_(entries(g_, resolved, sets, host_plans(g_.graph, bin_dir)), std::filesystem::absolute(g_.path).string()),
         sup_(policies(g_, resolved), config(g_), *this) {
-    bus_.lcm().subscribe(kTelemetryChannel, &Launcher::on_telemetry, this);
-    bus_.lcm().subscribe(control_channel(g_.graph), &Launcher::on_control, this);
+    bus_.lcm().subscribe(telemetry_, &Launcher::on_telemetry, this);
+    bus_.lcm().subscribe(robot_channel(robot_, control_channel(g_.graph)), &Launcher::on_control, this);
   }
 
   int run(double duration) {
     const double t_start = now_s();
     sup_.start_all(now_s());
     log("graph '" + g_.graph.name() + "' running: " + std::to_string(table_.size()) + " nodes on " + bus_.url() +
-        (duration > 0 ? ", for " + fmt2(duration) + " s" : "") + "; control on " + control_channel(g_.graph));
+        (robot_.empty() ? "" : " for robot '" + robot_ + "'") + (duration > 0 ? ", for " + fmt2(duration) + " s" : "") +
+        "; control on " + robot_channel(robot_, control_channel(g_.graph)));
     const int lcm_fd = bus_.lcm().getFileno();
+    double next_alive = 0;
     for (;;) {
-      pollfd p[2] = {{lcm_fd, POLLIN, 0}, {g_sig_pipe[0], POLLIN, 0}};
-      ::poll(p, 2, 20);
+      std::vector<pollfd> p{{lcm_fd, POLLIN, 0}, {g_sig_pipe[0], POLLIN, 0}};
+      std::vector<size_t> remote_of;
+      for (size_t i = 0; i < table_.size(); ++i)
+        if (table_.remote(i) && table_.io(i).out >= 0) {
+          p.push_back({table_.io(i).out, POLLIN, 0});
+          remote_of.push_back(i);
+        }
+      ::poll(p.data(), nfds_t(p.size()), 20);
       if (p[0].revents & POLLIN) bus_.lcm().handleTimeout(0);
+      for (size_t k = 2; k < p.size(); ++k)
+        if (p[k].revents & (POLLIN | POLLHUP | POLLERR)) drain_output(remote_of[k - 2]);
+      if (now_s() >= next_alive) {  // the remote watchdogs' keep-alive
+        next_alive = now_s() + 0.5;
+        for (size_t i = 0; i < table_.size(); ++i)
+          if (table_.remote(i)) table_.send(i, '.');
+      }
       if (p[1].revents & POLLIN) {
         char buf[16];
         const ssize_t n = ::read(g_sig_pipe[0], buf, sizeof buf);
@@ -109,7 +141,17 @@ class Launcher : public Effects {
         sup_.begin_shutdown(now_s());
       }
       ExitStatus st;
-      while (const pid_t pid = ProcessTable::reap_one(st)) sup_.on_exit(pid, st, now_s());
+      while (const pid_t pid = ProcessTable::reap_one(st)) {
+        for (size_t i = 0; i < table_.size(); ++i)
+          if (sup_.pid(i) == pid && table_.remote(i)) {
+            drain_output(i);
+            table_.close_io(i);
+            if (st.exited && st.code == 255)
+              log("node '" + table_[i].name + "' on host '" + table_[i].host->spec.name() + "' (" +
+                  table_[i].host->spec.address() + "): ssh connection lost or refused (ssh exit 255)");
+          }
+        sup_.on_exit(pid, st, now_s());
+      }
       sup_.tick(now_s());
       if (auto rc = sup_.finished()) return *rc;
     }
@@ -124,12 +166,19 @@ class Launcher : public Effects {
       log("node '" + e.name + "': " + err);
       return -1;
     }
-    log("node '" + e.name + "' started: pid " + std::to_string(pid) + ", " + e.exe_name +
+    log("node '" + e.name + "' started: " + (e.host ? "on host '" + e.host->spec.name() + "' (" + e.host->spec.address() + ") through ssh, local " : "") +
+        "pid " + std::to_string(pid) + ", " + e.exe_name +
         (e.sets.empty() ? "" : " (overrides: " + join(e.sets) + ")") +
         (restarts ? ", restart " + std::to_string(restarts) : ""));
     return pid;
   }
-  void signal(size_t, pid_t pid, int sig) override { ProcessTable::signal_group(pid, sig); }
+  void signal(size_t i, pid_t pid, int sig) override {
+    if (!table_.remote(i)) return ProcessTable::signal_group(pid, sig);
+    // A remote node: its fploc-remote relays the signal; SIGKILL also ends the ssh session (whose end
+    // makes fploc-remote kill the node, should the 'K' not arrive).
+    table_.send(i, sig == SIGINT ? 'I' : sig == SIGTERM ? 'T' : 'K');
+    if (sig == SIGKILL) ProcessTable::signal_group(pid, SIGKILL);
+  }
   void publish(size_t i, pid_t pid, int restarts, const std::string& state, const std::string& error) override {
     fploc::node_status_t s{};
     s.utime = wall_utime();
@@ -141,16 +190,31 @@ class Launcher : public Effects {
     s.restarts = restarts;
     s.last_error = error;
     s.num_ports = 0;
-    bus_.lcm().publish(kTelemetryChannel, &s);
+    s.robot = robot_;
+    s.host = host_;
+    bus_.lcm().publish(telemetry_, &s);
   }
   void log(const std::string& line) override { log_line(line); }
 
  private:
+  // A remote node's output, line by line, prefixed with its name and host.
+  void drain_output(size_t i) {
+    bool eof = false;
+    for (const auto& l : table_.read_lines(i, eof))
+      std::cerr << "[" << table_[i].name << "@" << table_[i].host->spec.name() << "] " << l << "\n";
+    std::cerr.flush();
+    if (eof && table_.io(i).out >= 0) {
+      ::close(table_.io(i).out);
+      table_.io(i).out = -1;
+    }
+  }
+
   static std::string control_channel(const fploc::Graph& g) {
     return g.control_channel().empty() ? kControlChannel : g.control_channel();
   }
   static std::vector<ProcessEntry> entries(const LoadedGraph& g, const std::vector<ResolvedNode>& resolved,
-                                           const std::vector<std::string>& sets) {
+                                           const std::vector<std::string>& sets,
+                                           const std::map<std::string, std::shared_ptr<const HostPlan>>& hosts) {
     std::vector<ProcessEntry> out;
     for (const auto& rn : resolved) {
       const auto& n = g.graph.node(rn.index);
@@ -163,6 +227,7 @@ class Launcher : public Effects {
       e.options_field = rn.desc.spec.options_field;
       e.spec = rn.desc.spec;
       e.args.assign(n.args().begin(), n.args().end());
+      if (!n.host().empty()) e.host = hosts.at(n.host());
       for (const auto& s : sets)
         if (s.rfind(e.name + ".", 0) == 0) e.sets.push_back(s.substr(e.name.size() + 1));
       out.push_back(std::move(e));
@@ -204,6 +269,12 @@ class Launcher : public Effects {
   void on_telemetry(const lcm::ReceiveBuffer*, const std::string&, const fploc::node_status_t* m) {
     sup_.on_transport_ok();  // our own "starting" reports come back too when the LCM URL works here
     if (m->reporter == "launcher") return;
+    // A remote node reports its pid on its host; the supervisor knows the local ssh process.
+    if (auto i = sup_.find(m->node); i && table_.remote(*i)) {
+      const pid_t rp = table_.io(*i).remote_pid;
+      if (rp > 0 && rp == m->pid) sup_.on_heartbeat(m->node, sup_.pid(*i), now_s());
+      return;
+    }
     sup_.on_heartbeat(m->node, m->pid, now_s());
   }
 
@@ -215,7 +286,9 @@ class Launcher : public Effects {
     s.state = "rejected";
     s.reporter = "launcher";
     s.last_error = "control: " + why;
-    bus_.lcm().publish(kTelemetryChannel, &s);
+    s.robot = robot_;
+    s.host = host_;
+    bus_.lcm().publish(telemetry_, &s);
   }
 
   void on_control(const lcm::ReceiveBuffer*, const std::string&, const fploc::node_command_t* m) {
@@ -236,6 +309,7 @@ class Launcher : public Effects {
   }
 
   LoadedGraph g_;
+  std::string robot_, telemetry_, host_ = host_name();
   ValidateHooks hooks_;
   Bus bus_;
   ProcessTable table_;
@@ -280,8 +354,20 @@ int main(int argc, char** argv) {
     errors.push_back({graph_path, 0, set_error});
   std::vector<ResolvedNode> resolved;
   if (g.tree) validate_graph(g, hooks, errors, &resolved);
+  url = graph_lcm_url(g.graph, url);
   if (check && g.tree) check_option_files(g, errors);
-  if (url.empty()) url = g.graph.lcm_url();
+  if (check && g.tree && errors.empty() && g.graph.host_size() > 0) {
+    std::vector<HostPlan> plans;
+    for (const auto& [name, p] : host_plans(g.graph, self_bin_dir())) plans.push_back(*p);
+    std::vector<std::pair<std::string, std::string>> host_exe;
+    for (const auto& rn : resolved) {
+      const auto& n = g.graph.node(rn.index);
+      if (!n.disabled() && !n.host().empty())
+        host_exe.push_back({n.host(), rn.executable.empty() ? n.executable() : rn.executable});
+    }
+    for (const auto& p : check_hosts(g.graph, plans, host_exe, url))
+      errors.push_back({graph_path, 0, "host '" + p.host + "': " + p.message});
+  }
   if (!check && url.rfind("memq://", 0) == 0)
     errors.push_back({graph_path, 0, "lcm_url memq:// only works inside one process (use fploc replay)"});
   std::stable_sort(errors.begin(), errors.end(), [](const GraphError& a, const GraphError& b) {
