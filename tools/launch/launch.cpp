@@ -70,7 +70,8 @@ void on_signal(int sig) {
 double policy_or(double v, double d) { return v > 0 ? v : d; }
 
 // The graph's hosts as seen from this checkout (build/bin -> the fploc root two levels up).
-std::map<std::string, std::shared_ptr<const HostPlan>> host_plans(const fploc::Graph& g, const std::string& bin_dir) {
+std::map<std::string, std::shared_ptr<const HostPlan>> host_plans(const fploc::Graph& g, const std::string& bin_dir,
+                                                                   bool multiplex = false) {
   std::map<std::string, std::shared_ptr<const HostPlan>> out;
   const auto root = std::filesystem::path(bin_dir).parent_path().parent_path().string();
   for (const auto& h : g.host()) {
@@ -78,6 +79,7 @@ std::map<std::string, std::shared_ptr<const HostPlan>> host_plans(const fploc::G
     p->spec = h;
     p->local_root = root;
     p->local_bin = bin_dir;
+    if (multiplex) p->control_path = "/tmp/fploc-ssh-" + std::to_string(::getpid()) + "-" + h.name();
     out[h.name()] = p;
   }
   return out;
@@ -90,8 +92,8 @@ class Launcher : public Effects {
   Launcher(LoadedGraph g, const std::vector<ResolvedNode>& resolved, std::string url, std::string bin_dir,
            const std::vector<std::string>& sets)
       : g_(std::move(g)), robot_(robot_of(&g_.graph)), telemetry_(robot_channel(robot_, kTelemetryChannel)),
-        hooks_(default_hooks(bin_dir)), bus_(url),
-        table_(entries(g_, resolved, sets, host_plans(g_.graph, bin_dir)), std::filesystem::absolute(g_.path).string()),
+        hooks_(default_hooks(bin_dir)), bus_(url), hosts_(host_plans(g_.graph, bin_dir, true)),
+        table_(entries(g_, resolved, sets, hosts_), std::filesystem::absolute(g_.path).string()),
         sup_(policies(g_, resolved), config(g_), *this) {
     bus_.lcm().subscribe(telemetry_, &Launcher::on_telemetry, this);
     bus_.lcm().subscribe(robot_channel(robot_, control_channel(g_.graph)), &Launcher::on_control, this);
@@ -99,6 +101,16 @@ class Launcher : public Effects {
 
   int run(double duration) {
     const double t_start = now_s();
+    for (size_t i = 0; i < table_.size(); ++i)
+      if (table_.remote(i)) masters_[table_[i].host->spec.name()];
+    tend_masters(false);
+    // Give the master connections a moment, so that the nodes' sessions share them from the start.
+    for (double t0 = now_s(); now_s() - t0 < 3.0;) {
+      bool all = true;
+      for (const auto& [h, m] : masters_) all = all && std::filesystem::exists(hosts_.at(h)->control_path);
+      if (all) break;
+      ::usleep(20000);
+    }
     sup_.start_all(now_s());
     log("graph '" + g_.graph.name() + "' running: " + std::to_string(table_.size()) + " nodes on " + bus_.url() +
         (robot_.empty() ? "" : " for robot '" + robot_ + "'") + (duration > 0 ? ", for " + fmt2(duration) + " s" : "") +
@@ -142,6 +154,14 @@ class Launcher : public Effects {
       }
       ExitStatus st;
       while (const pid_t pid = ProcessTable::reap_one(st)) {
+        for (auto& [h, m] : masters_)
+          if (m.pid == pid) {
+            m.pid = -1;
+            m.next_try = now_s() + 1.0;
+            if (!sup_.shutting_down())
+              log("ssh master connection to host '" + h + "' (" + hosts_.at(h)->spec.address() + ") ended (" + st.str() +
+                  "); reconnecting every second");
+          }
         for (size_t i = 0; i < table_.size(); ++i)
           if (sup_.pid(i) == pid && table_.remote(i)) {
             drain_output(i);
@@ -153,7 +173,13 @@ class Launcher : public Effects {
         sup_.on_exit(pid, st, now_s());
       }
       sup_.tick(now_s());
-      if (auto rc = sup_.finished()) return *rc;
+      tend_masters(sup_.shutting_down());
+      if (auto rc = sup_.finished()) {
+        for (auto& [h, m] : masters_)
+          if (m.pid > 0) ProcessTable::signal_group(m.pid, SIGTERM);
+        for (auto& [h, m] : masters_) std::filesystem::remove(hosts_.at(h)->control_path);
+        return *rc;
+      }
     }
   }
 
@@ -197,6 +223,36 @@ class Launcher : public Effects {
   void log(const std::string& line) override { log_line(line); }
 
  private:
+  // One `ssh -M -N` per host in use, restarted a second after it ends (link cut, host reboot).
+  void tend_masters(bool stopping) {
+    if (stopping) return;
+    for (auto& [h, m] : masters_) {
+      if (m.pid > 0 || now_s() < m.next_try) continue;
+      const auto argv = hosts_.at(h)->master_argv();
+      const pid_t parent = ::getpid();
+      const pid_t pid = ::fork();
+      if (pid == 0) {
+        ::setpgid(0, 0);
+        ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+        if (::getppid() != parent) ::_exit(127);
+        sigset_t none;
+        sigemptyset(&none);
+        ::sigprocmask(SIG_SETMASK, &none, nullptr);
+        for (int sg : {SIGINT, SIGTERM, SIGCHLD, SIGPIPE, SIGHUP}) ::signal(sg, SIG_DFL);
+        const int devnull = ::open("/dev/null", O_RDWR);
+        ::dup2(devnull, 0);
+        std::vector<char*> a;
+        for (const auto& x : argv) a.push_back(const_cast<char*>(x.c_str()));
+        a.push_back(nullptr);
+        ::execvp("ssh", a.data());
+        ::_exit(127);
+      }
+      if (pid > 0) ::setpgid(pid, pid);
+      m.pid = pid;
+      m.next_try = now_s() + 1.0;
+    }
+  }
+
   // A remote node's output, line by line, prefixed with its name and host.
   void drain_output(size_t i) {
     bool eof = false;
@@ -312,13 +368,21 @@ class Launcher : public Effects {
   std::string robot_, telemetry_, host_ = host_name();
   ValidateHooks hooks_;
   Bus bus_;
+  std::map<std::string, std::shared_ptr<const HostPlan>> hosts_;
+  struct Master {
+    pid_t pid = -1;
+    double next_try = 0;
+  };
+  std::map<std::string, Master> masters_;  // hosts with at least one node
   ProcessTable table_;
   Supervisor sup_;
 };
 
 void usage() {
-  std::cerr << "usage: fploc launch GRAPH.pbtxt [--check] [--duration SECONDS] [--lcm-url URL] [--set NODE.field=value ...]\n"
-               "  --check      validate the graph (fields, executables, ports, channel types, the files options name) and exit\n"
+  std::cerr << "usage: fploc launch GRAPH.pbtxt [--check [--skip-hosts]] [--duration SECONDS] [--lcm-url URL] [--set NODE.field=value ...]\n"
+               "  --check      validate the graph (fields, executables, ports, channel types, the files options name) and its\n"
+               "               hosts (reachable with ssh, fploc there at this commit, multicast route), then exit\n"
+               "  --skip-hosts with --check: do not contact the graph's hosts\n"
                "  --duration   stop every node cleanly after SECONDS\n"
                "  --set        override one option of one node for this run (e.g. --set pose_logger.file=run1.tum)\n";
 }
@@ -328,11 +392,12 @@ void usage() {
 int main(int argc, char** argv) {
   std::string graph_path, url;
   std::vector<std::string> sets;
-  bool check = false;
+  bool check = false, skip_hosts = false;
   double duration = 0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--check") check = true;
+    else if (a == "--skip-hosts") skip_hosts = true;
     else if (a == "--duration" && i + 1 < argc) duration = std::atof(argv[++i]);
     else if (a == "--lcm-url" && i + 1 < argc) url = argv[++i];
     else if (a == "--set" && i + 1 < argc) sets.push_back(argv[++i]);
@@ -356,7 +421,7 @@ int main(int argc, char** argv) {
   if (g.tree) validate_graph(g, hooks, errors, &resolved);
   url = graph_lcm_url(g.graph, url);
   if (check && g.tree) check_option_files(g, errors);
-  if (check && g.tree && errors.empty() && g.graph.host_size() > 0) {
+  if (check && !skip_hosts && g.tree && errors.empty() && g.graph.host_size() > 0) {
     std::vector<HostPlan> plans;
     for (const auto& [name, p] : host_plans(g.graph, self_bin_dir())) plans.push_back(*p);
     std::vector<std::pair<std::string, std::string>> host_exe;
