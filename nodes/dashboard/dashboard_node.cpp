@@ -22,6 +22,7 @@
 #include "fploc/runtime/bus.h"
 #include "fploc/runtime/graph.h"
 #include "fploc/runtime/node.h"
+#include "fploc/runtime/robot.h"
 #include "model.h"
 #include "options/tools.pb.h"
 #include "plan_json.h"
@@ -126,6 +127,20 @@ class DashboardNode : public fploc::rt::Node {
         "ground_truth", [this](const fploc::ground_truth_t& m) { model_->on_ground_truth(m, steady_s(), wall_us()); });
     ctx.subscribe<fploc::node_status_t>("telemetry",
                                         [this](const fploc::node_status_t& m) { model_->on_status(m, steady_s()); });
+    // Other robots on the same plan: their poses and telemetry on "R/<the same channel>".
+    std::vector<std::string> others(o.robots().begin(), o.robots().end());
+    model_->set_robots(ctx.robot(), others);
+    auto base = [&](const std::string& port) {
+      const std::string& ch = ctx.channel(port);
+      return ctx.robot().empty() ? ch : ch.substr(ctx.robot().size() + 1);
+    };
+    for (const auto& r : others) {
+      if (r == ctx.robot() || !fploc::rt::valid_robot_name(r) || r.empty()) continue;
+      auto h = std::make_unique<FleetHandler>(FleetHandler{this, r});
+      ctx.bus().lcm().subscribe(fploc::rt::robot_channel(r, base("pose")), &FleetHandler::pose, h.get());
+      ctx.bus().lcm().subscribe(fploc::rt::robot_channel(r, base("telemetry")), &FleetHandler::status, h.get());
+      fleet_.push_back(std::move(h));
+    }
     ctx.every(0.5, [this] {
       model_->tick(steady_s(), wall_us());
       if (!listening_) try_listen();
@@ -187,6 +202,10 @@ class DashboardNode : public fploc::rt::Node {
         } catch (const std::exception&) {
           return text(400, "since: expected an integer utime\n");
         }
+      }
+      if (auto r = req.query.find("robot"); r != req.query.end() && !r->second.empty()) {
+        if (!model_->has_robot(r->second)) return text(404, "no robot '" + r->second + "' on this dashboard\n");
+        return json_reply(model_->fleet_history_json(r->second, since));
       }
       return json_reply(model_->history_json(since));
     }
@@ -268,6 +287,17 @@ class DashboardNode : public fploc::rt::Node {
     if (server_) server_->stop();
   }
 
+  struct FleetHandler {
+    DashboardNode* self;
+    std::string robot;
+    void pose(const lcm::ReceiveBuffer*, const std::string&, const fploc::pose_t* m) {
+      self->model_->on_fleet_pose(robot, *m, steady_s(), wall_us());
+    }
+    void status(const lcm::ReceiveBuffer*, const std::string&, const fploc::node_status_t* m) {
+      self->model_->on_fleet_status(robot, *m, steady_s());
+    }
+  };
+  std::vector<std::unique_ptr<FleetHandler>> fleet_;
   fploc::rt::Context* ctx_ = nullptr;
   std::unique_ptr<Model> model_;
   std::unique_ptr<HttpServer> server_;

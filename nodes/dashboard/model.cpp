@@ -146,6 +146,7 @@ void Model::expect_node(const std::string& name, const std::string& executable, 
 void Model::tick(double now_s, int64_t wall_us) {
   std::lock_guard<std::mutex> lk(mu_);
   rebuild_nodes(now_s, wall_us);
+  for (auto& [r, f] : fleet_) rebuild_fleet_nodes(r, now_s, wall_us);
   json s = {{"frame_rate_hz", num(r6(rate_over(frame_times_, now_s, 2.0)))},
             {"pose_rate_hz", num(r6(rate_over(pose_times_, now_s, 2.0)))},
             {"features_rate_hz", num(r6(rate_over(feature_times_, now_s, 2.0)))},
@@ -155,6 +156,72 @@ void Model::tick(double now_s, int64_t wall_us) {
             {"ate_n", ate_.count()},
             {"wall_us", wall_us}};
   hub_.set("stats", s.dump());
+}
+
+// ---- fleet -----------------------------------------------------------------------------------------
+void Model::set_robots(const std::string& own, const std::vector<std::string>& others) {
+  static const char* kColours[] = {"#1f6feb", "#d97706", "#7c3aed", "#059669", "#db2777", "#0891b2", "#65a30d"};
+  std::lock_guard<std::mutex> lk(mu_);
+  json list = json::array();
+  list.push_back({{"name", own}, {"color", kColours[0]}, {"own", true}});
+  size_t k = 1;
+  for (const auto& r : others) {
+    if (r == own || fleet_.count(r)) continue;
+    fleet_[r];
+    list.push_back({{"name", r}, {"color", kColours[k++ % 7]}, {"own", false}});
+  }
+  hub_.set("robots", list.dump());
+}
+
+bool Model::has_robot(const std::string& robot) const {
+  std::lock_guard<std::mutex> lk(mu_);
+  return fleet_.count(robot) > 0;
+}
+
+void Model::on_fleet_pose(const std::string& robot, const fploc::pose_t& m, double, int64_t wall_us) {
+  const Rpy r = rpy_of(m.orientation);
+  std::lock_guard<std::mutex> lk(mu_);
+  auto it = fleet_.find(robot);
+  if (it == fleet_.end()) return;
+  auto& est = it->second.est;
+  TrailPoint p{m.utime, m.position[0], m.position[1], m.position[2], r.roll, r.pitch, r.yaw, false, 0};
+  if (!est.empty() && est.back().utime == m.utime) est.back() = p;
+  else if (est.empty() || est.back().utime < m.utime) est.push_back(p);
+  while (est.size() > cfg_.max_trail) est.pop_front();
+  hub_.set("pose@" + robot, pose_view(m, r, {std::nullopt, NAN, 0}, wall_us));
+}
+
+void Model::on_fleet_status(const std::string& robot, const fploc::node_status_t& m, double now_s) {
+  std::lock_guard<std::mutex> lk(mu_);
+  auto it = fleet_.find(robot);
+  if (it == fleet_.end()) return;
+  auto& e = it->second.nodes[m.node];
+  e.status = std::make_shared<fploc::node_status_t>(m);
+  e.received_s = now_s;
+  e.seen = true;
+  rebuild_fleet_nodes(robot, now_s, std::chrono::duration_cast<std::chrono::microseconds>(
+                                        std::chrono::system_clock::now().time_since_epoch()).count());
+}
+
+void Model::rebuild_fleet_nodes(const std::string& robot, double now_s, int64_t wall_us) {
+  std::map<std::string, NodeRow> rows;
+  for (const auto& [name, e] : fleet_[robot].nodes) rows[name] = {e.status.get(), now_s - e.received_s, e.seen};
+  std::string text = nodes_view(rows, cfg_.silent_after_s, wall_us);
+  if (hub_.get("nodes@" + robot) != text) hub_.set("nodes@" + robot, std::move(text));
+}
+
+std::string Model::fleet_history_json(const std::string& robot, int64_t since) const {
+  std::lock_guard<std::mutex> lk(mu_);
+  json est = json::array();
+  auto it = fleet_.find(robot);
+  if (it != fleet_.end())
+    for (const auto& p : it->second.est)
+      if (p.utime > since)
+        est.push_back({p.utime, num(r6(p.x)), num(r6(p.y)), num(r6(p.z)), num(r6(p.roll)), num(r6(p.pitch)),
+                       num(r6(p.yaw)), nullptr});
+  json j = {{"robot", robot}, {"fields_est", {"utime", "x", "y", "z", "roll", "pitch", "yaw", "err"}},
+            {"est", est}, {"gt", json::array()}};
+  return j.dump();
 }
 
 void Model::rebuild_nodes(double now_s, int64_t wall_us) {

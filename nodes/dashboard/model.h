@@ -10,6 +10,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "fploc/eval/online_ate.h"
 #include "push_hub.h"
@@ -43,6 +44,15 @@ class Model {
   void set_plan_json(std::string json);
   void set_info(const std::string& key, const std::string& json);  // extra constant info for /api/info
   void set_clients(size_t n);  // open event streams (shown in "stats")
+
+  // ---- a fleet on the same plan: other robots' poses and node tables (their channels "R/...").
+  // Streams "pose@R" and "nodes@R"; "robots" lists every robot with its colour (the own one first,
+  // name "" when the graph has no robot). /api/history?robot=R gives that robot's trail.
+  void set_robots(const std::string& own, const std::vector<std::string>& others);
+  void on_fleet_pose(const std::string& robot, const fploc::pose_t& m, double now_s, int64_t wall_us);
+  void on_fleet_status(const std::string& robot, const fploc::node_status_t& m, double now_s);
+  std::string fleet_history_json(const std::string& robot, int64_t since_utime = INT64_MIN) const;
+  bool has_robot(const std::string& robot) const;
 
   // ---- outputs (HTTP side)
   PushHub& hub() { return hub_; }
@@ -92,6 +102,13 @@ class Model {
   std::unique_ptr<fploc::features_t> features_;
   std::unique_ptr<fploc::frame_pose_t> frame_pose_;
   size_t clients_ = 0;
+
+  struct FleetRobot {
+    std::deque<TrailPoint> est;
+    std::map<std::string, NodeEntry> nodes;
+  };
+  std::map<std::string, FleetRobot> fleet_;
+  void rebuild_fleet_nodes(const std::string& robot, double now_s, int64_t wall_us);  // lock held
 };
 
 }  // namespace fploc::dashboard
