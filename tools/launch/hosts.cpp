@@ -47,9 +47,19 @@ std::vector<std::string> HostPlan::ssh_argv(const std::string& command, double c
   if (spec.port() > 0) a.insert(a.end(), {"-p", std::to_string(spec.port())});
   if (!spec.user().empty()) a.insert(a.end(), {"-l", spec.user()});
   for (const auto& o : spec.ssh_option()) a.insert(a.end(), {"-o", o});
+  if (!control_path.empty()) a.insert(a.end(), {"-o", "ControlMaster=no", "-o", "ControlPath=" + control_path});
   a.push_back(spec.address());
   a.push_back("--");
   a.push_back(command);
+  return a;
+}
+
+std::vector<std::string> HostPlan::master_argv() const {
+  auto a = ssh_argv("true");
+  a.resize(a.size() - 3);  // no address / "--" / command yet
+  for (size_t k = 0; k + 1 < a.size(); ++k)
+    if (a[k] == "-o" && a[k + 1] == "ControlMaster=no") a[k + 1] = "ControlMaster=yes";
+  a.insert(a.end(), {"-o", "ControlPersist=no", "-N", spec.address()});
   return a;
 }
 

@@ -20,6 +20,11 @@ struct HostPlan {
   // ssh argv that runs `command` (a shell command line) on the host: no tty, no password prompts,
   // keep-alives so a cut link is noticed within ~3 s.
   std::vector<std::string> ssh_argv(const std::string& command, double connect_timeout_s = 3) const;
+  // The launcher keeps one master connection per host (`ssh -M -N`) so that a node's (re)start is a new
+  // session on it (milliseconds) instead of a new ssh handshake; sessions fall back to their own
+  // connection while the master is down. "" = no multiplexing.
+  std::string control_path;
+  std::vector<std::string> master_argv() const;
 };
 
 std::string shell_quote(const std::string& s);
