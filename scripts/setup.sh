@@ -10,6 +10,7 @@ PKGS=(
   nlohmann-json3-dev libyaml-dev libpng-dev libcli11-dev libcpp-httplib-dev libssl-dev libpcap-dev libnanoflann-dev
   libbz2-dev liblz4-dev libzstd-dev lz4
   python3
+  libboost-dev openssh-client openssh-server
 )
 missing=()
 for p in "${PKGS[@]}"; do

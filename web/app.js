@@ -14,6 +14,7 @@ const COL = { est: color('--est'), gt: color('--gt'), fp: color('--fp'), corner:
 const S = window.__fploc = {
   connected: false, reconnects: 0, events: {}, latencies: [], rxLatencies: [], trail: [], gtTrail: [],
   pose: null, gt: null, frame: null, features: null, nodes: [], stats: null,
+  robots: [], fleet: {}, selected: null, ownNodes: null,
 };
 const MAX_TRAIL = 50000;
 const MATCH_M = 0.15;  // a projected feature this close to a plan element counts as matched
@@ -29,6 +30,22 @@ const plots = {
 };
 
 // ---- map layers ------------------------------------------------------------------------------
+// Other robots on the same plan (fleet): trail and pose in their colour, named.
+map.layers.push((c, v) => {
+  for (const [name, r] of Object.entries(S.fleet)) {
+    v.polyline(c, r.trail, r.color, 2);
+    if (r.pose && r.pose.x !== null) {
+      v.arrow(c, r.pose.x, r.pose.y, r.pose.yaw, r.color, true);
+      const [sx, sy] = v.toScreen(r.pose.x, r.pose.y);
+      c.fillStyle = r.color; c.font = 'bold 13px sans-serif'; c.fillText(name, sx + 12, sy - 12);
+    }
+  }
+  const own = S.robots.find((r) => r.own);
+  if (own && own.name && S.pose && S.pose.x !== null && S.robots.length > 1) {
+    const [sx, sy] = v.toScreen(S.pose.x, S.pose.y);
+    c.fillStyle = COL.est; c.font = 'bold 13px sans-serif'; c.fillText(own.name, sx + 12, sy - 12);
+  }
+});
 map.layers.push((c, v) => {
   v.polyline(c, S.gtTrail, COL.gt, 2);
   v.polyline(c, S.trail, COL.est, 2);
@@ -88,7 +105,8 @@ function addToTrail(trail, utime, x, y) {
 // ---- readouts ---------------------------------------------------------------------------------
 const fmt = (v, d = 3) => (v === null || v === undefined || !Number.isFinite(v) ? '–' : v.toFixed(d));
 function renderPoseBox() {
-  const p = S.pose, g = S.gt, f = S.frame;
+  const fr = S.selected ? S.fleet[S.selected] : null;
+  const p = fr ? fr.pose : S.pose, g = fr ? null : S.gt, f = fr ? null : S.frame;
   const rows = [
     ['x, y, z [m]', p ? `${fmt(p.x)}, ${fmt(p.y)}, ${fmt(p.z)}` : '–'],
     ['roll, pitch, yaw [°]', p ? `${fmt(p.roll * DEG, 2)}, ${fmt(p.pitch * DEG, 2)}, ${fmt(p.yaw * DEG, 1)}` : '–'],
@@ -122,6 +140,9 @@ function portLatencies(n) {
 
 function renderNodes(msg) {
   S.nodes = msg.nodes;
+  renderNodeTable(msg);
+}
+function renderNodeTable(msg) {
   const body = $('nodes').tBodies[0];
   const rows = msg.nodes.map((n) => {
     const tr = document.createElement('tr');
@@ -272,7 +293,8 @@ function connect() {
   on('gt', onGt);
   on('frame_pose', (f) => { S.frame = f; map.invalidate(); schedulePoseBox(); });
   on('features', (f) => { S.features = f; map.invalidate(); });
-  on('nodes', renderNodes);
+  on('nodes', (m) => { S.ownNodes = m; if (!S.selected) renderNodes(m); });
+  on('robots', (list) => onRobots(list, on));
   on('stats', (s) => {
     S.stats = s;
     const t = S.pose ? tsec(S.pose.utime) : null;
@@ -282,6 +304,38 @@ function connect() {
   });
   on('plan_changed', async () => { try { const plan = await (await fetch('/api/plan')).json(); map.setPlan(plan); planIndex = new PlanIndex(plan); } catch (e) { /* next reconnect */ } });
 }
+
+// ---- fleet: the robots this dashboard shows; a selector picks whose nodes and readouts are listed
+function onRobots(list, on) {
+  S.robots = list;
+  for (const r of list) {
+    if (r.own || S.fleet[r.name]) continue;
+    const f = S.fleet[r.name] = { color: r.color, trail: [], pose: null, nodes: null };
+    on(`pose@${r.name}`, (p) => { f.pose = p; addToTrail(f.trail, p.utime, p.x, p.y); map.invalidate(); if (S.selected === r.name) schedulePoseBox(); });
+    on(`nodes@${r.name}`, (m) => { f.nodes = m; if (S.selected === r.name) renderNodeTable(m); });
+    fetch(`/api/history?robot=${encodeURIComponent(r.name)}`, { cache: 'no-store' }).then((x) => x.json())
+      .then((h) => { f.trail = mergeTrail(f.trail, h.est.map(([u, x, y]) => [x, y, u])); map.invalidate(); })
+      .catch(() => {});
+  }
+  const sel = $('robot');
+  sel.classList.toggle('hidden', list.length < 2);
+  sel.replaceChildren(...list.map((r) => {
+    const o = document.createElement('option');
+    o.value = r.own ? '' : r.name;
+    o.textContent = (r.name || 'this robot') + (r.own ? ' (own graph)' : '');
+    o.style.color = r.color;
+    return o;
+  }));
+  sel.value = S.selected || '';
+}
+$('robot').addEventListener('change', () => {
+  S.selected = $('robot').value || null;
+  const f = S.selected ? S.fleet[S.selected] : null;
+  $('robot').style.color = f ? f.color : '';
+  if (!S.selected) { if (S.ownNodes) renderNodes(S.ownNodes); } else if (f && f.nodes) renderNodeTable(f.nodes);
+  else $('nodes').tBodies[0].replaceChildren();
+  renderPoseBox();
+});
 
 $('fit').addEventListener('click', () => map.fit());
 $('showfeat').addEventListener('change', () => map.invalidate());

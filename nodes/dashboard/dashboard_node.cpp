@@ -1,7 +1,7 @@
 // fploc-dashboard: HTTP + Server-Sent Events view of a running graph (see docs/notes/dashboard.md).
-// LCM handlers run on the node thread and only update latest-value slots in the Model; the HTTP server
-// (cpp-httplib) runs on its own thread pool, one thread per SSE client, each pushing the newest values
-// at most max_push_hz times per second. A slow browser only delays its own thread.
+// LCM handlers run on the node thread and only update latest-value slots in the Model's push hub; the
+// HTTP server (http_server.h: one event-loop thread, Boost.Beast) answers requests and runs ONE broadcaster
+// that sends each due update to every open event stream (capped; beyond the cap: 503).
 #include <fploc/features_t.hpp>
 #include <fploc/frame_pose_t.hpp>
 #include <fploc/ground_truth_t.hpp>
@@ -17,16 +17,17 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
+#include <mutex>
 
 #include "fploc/runtime/bus.h"
 #include "fploc/runtime/graph.h"
 #include "fploc/runtime/node.h"
+#include "fploc/runtime/robot.h"
 #include "model.h"
 #include "options/tools.pb.h"
 #include "plan_json.h"
 #include "web_path.h"
-// Last: httplib pulls in <resolv.h>, whose `_res` macro breaks Eigen headers included after it.
-#include <httplib.h>
+#include "http_server.h"
 
 #ifndef FPLOC_WEB_ROOT
 #define FPLOC_WEB_ROOT ""
@@ -87,6 +88,7 @@ class DashboardNode : public fploc::rt::Node {
     port_ = o.port() > 0 ? o.port() : 8080;
     max_hz_ = o.max_push_hz() > 0 ? std::min(o.max_push_hz(), 20.0) : 20.0;
     token_ = o.control_token();
+    if (o.max_streams() > 0) max_streams_ = size_t(o.max_streams());
     ModelConfig mc;
     if (o.silent_after_s() > 0) mc.silent_after_s = o.silent_after_s();
     model_ = std::make_unique<Model>(mc);
@@ -125,12 +127,25 @@ class DashboardNode : public fploc::rt::Node {
         "ground_truth", [this](const fploc::ground_truth_t& m) { model_->on_ground_truth(m, steady_s(), wall_us()); });
     ctx.subscribe<fploc::node_status_t>("telemetry",
                                         [this](const fploc::node_status_t& m) { model_->on_status(m, steady_s()); });
+    // Other robots on the same plan: their poses and telemetry on "R/<the same channel>".
+    std::vector<std::string> others(o.robots().begin(), o.robots().end());
+    model_->set_robots(ctx.robot(), others);
+    auto base = [&](const std::string& port) {
+      const std::string& ch = ctx.channel(port);
+      return ctx.robot().empty() ? ch : ch.substr(ctx.robot().size() + 1);
+    };
+    for (const auto& r : others) {
+      if (r == ctx.robot() || !fploc::rt::valid_robot_name(r) || r.empty()) continue;
+      auto h = std::make_unique<FleetHandler>(FleetHandler{this, r});
+      ctx.bus().lcm().subscribe(fploc::rt::robot_channel(r, base("pose")), &FleetHandler::pose, h.get());
+      ctx.bus().lcm().subscribe(fploc::rt::robot_channel(r, base("telemetry")), &FleetHandler::status, h.get());
+      fleet_.push_back(std::move(h));
+    }
     ctx.every(0.5, [this] {
       model_->tick(steady_s(), wall_us());
       if (!listening_) try_listen();
       forward_commands();
     });
-    setup_routes();
     try_listen();
   }
 
@@ -154,91 +169,62 @@ class DashboardNode : public fploc::rt::Node {
     }
   }
 
-  void setup_routes() {
-    auto& s = server_;
-    s.new_task_queue = [] { return new httplib::ThreadPool(16); };
-    s.set_tcp_nodelay(true);  // small SSE events must not wait for delayed ACKs (Nagle)
-    s.set_keep_alive_max_count(100);
-    s.set_read_timeout(5, 0);
-    s.set_write_timeout(5, 0);
-    s.set_payload_max_length(64 * 1024);
-    s.set_post_routing_handler([](const httplib::Request&, httplib::Response& res) {
-      res.set_header("X-Content-Type-Options", "nosniff");
-      res.set_header("Referrer-Policy", "no-referrer");
-      res.set_header("Content-Security-Policy",
-                     "default-src 'self'; img-src 'self' data:; style-src 'self'; connect-src 'self'");
-    });
-    auto json_reply = [](httplib::Response& res, const std::string& body) {
-      res.set_header("Cache-Control", "no-store");
-      res.set_content(body, "application/json");
-    };
-    s.Get("/api/plan", [this, json_reply](const httplib::Request&, httplib::Response& res) { json_reply(res, model_->plan_json()); });
-    s.Get("/api/state", [this, json_reply](const httplib::Request&, httplib::Response& res) { json_reply(res, model_->state_json()); });
-    s.Get("/api/history", [this, json_reply](const httplib::Request& req, httplib::Response& res) {
+  HttpReply json_reply(std::string body) {
+    HttpReply r;
+    r.content_type = "application/json";
+    r.body = std::move(body);
+    r.headers.push_back({"Cache-Control", "no-store"});
+    return r;
+  }
+  static HttpReply text(int status, std::string body) {
+    HttpReply r;
+    r.status = status;
+    r.body = std::move(body);
+    return r;
+  }
+
+  HttpReply handle(const HttpRequest& req) {
+    if (req.method == "POST") {
+      if (req.path == "/api/command") return on_command(req);
+      return text(405, "read-only dashboard\n");
+    }
+    if (req.method != "GET" && req.method != "HEAD") return text(405, "read-only dashboard\n");
+    if (req.path == "/api/plan") return json_reply(model_->plan_json());
+    if (req.path == "/api/state") return json_reply(model_->state_json());
+    if (req.path == "/api/info") return json_reply(model_->info_json());
+    if (req.path == "/api/history") {
       int64_t since = INT64_MIN;
-      if (req.has_param("since")) {
+      if (auto it = req.query.find("since"); it != req.query.end()) {
         try {
-          since = std::stoll(req.get_param_value("since"));
+          size_t used = 0;
+          since = std::stoll(it->second, &used);
+          if (used != it->second.size()) throw std::invalid_argument("trailing");
         } catch (const std::exception&) {
-          res.status = 400;
-          res.set_content("since: expected an integer utime\n", "text/plain");
-          return;
+          return text(400, "since: expected an integer utime\n");
         }
       }
-      json_reply(res, model_->history_json(since));
-    });
-    s.Get("/api/info", [this, json_reply](const httplib::Request&, httplib::Response& res) { json_reply(res, model_->info_json()); });
-    s.Get("/api/events", [this](const httplib::Request&, httplib::Response& res) {
-      res.set_header("Cache-Control", "no-store");
-      res.set_header("X-Accel-Buffering", "no");
-      auto cursor = std::make_shared<ClientCursor>();
-      model_->client_count(+1);
-      res.set_chunked_content_provider(
-          "text/event-stream",
-          [this, cursor](size_t, httplib::DataSink& sink) {
-            std::string out;
-            if (!model_->next_push(*cursor, max_hz_, 10.0, out)) {
-              sink.done();
-              return false;
-            }
-            if (out.empty()) out = ": keep-alive\n\n";
-            return sink.write(out.data(), out.size());
-          },
-          [this](bool) { model_->client_count(-1); });
-    });
-    s.Post("/api/command", [this](const httplib::Request& req, httplib::Response& res) { on_command(req, res); });
-    s.Post(R"(/.*)", [](const httplib::Request&, httplib::Response& res) {
-      res.status = 405;
-      res.set_content("read-only dashboard\n", "text/plain");
-    });
-    s.Get(R"(/.*)", [this](const httplib::Request& req, httplib::Response& res) {
-      const std::string file = web_root_.empty() ? std::string() : resolve_web_path(web_root_, req.path);
-      if (file.empty()) {
-        res.status = 404;
-        res.set_content("not found\n", "text/plain");
-        return;
+      if (auto r = req.query.find("robot"); r != req.query.end() && !r->second.empty()) {
+        if (!model_->has_robot(r->second)) return text(404, "no robot '" + r->second + "' on this dashboard\n");
+        return json_reply(model_->fleet_history_json(r->second, since));
       }
-      std::ifstream in(file, std::ios::binary);
-      std::string body((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-      res.set_header("Cache-Control", "no-cache");
-      res.set_content(std::move(body), mime_type(fs::path(file).extension().string()));
-    });
+      return json_reply(model_->history_json(since));
+    }
+    const std::string file = web_root_.empty() ? std::string() : resolve_web_path(web_root_, req.path);
+    if (file.empty()) return text(404, "not found\n");
+    std::ifstream in(file, std::ios::binary);
+    HttpReply r;
+    r.body.assign((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    r.content_type = mime_type(fs::path(file).extension().string());
+    r.headers.push_back({"Cache-Control", "no-cache"});
+    return r;
   }
 
   // Control is off unless the options give a token; then POST /api/command with header
   // X-Fploc-Token and body {"node": ..., "action": "restart"|"stop"|"start"} is forwarded to the
   // launcher on FPLOC_CONTROL (which checks the token again).
-  void on_command(const httplib::Request& req, httplib::Response& res) {
-    if (token_.empty()) {
-      res.status = 403;
-      res.set_content("control is disabled (dashboard.control_token is empty)\n", "text/plain");
-      return;
-    }
-    if (!constant_time_equal(req.get_header_value("X-Fploc-Token"), token_)) {
-      res.status = 403;
-      res.set_content("bad token\n", "text/plain");
-      return;
-    }
+  HttpReply on_command(const HttpRequest& req) {
+    if (token_.empty()) return text(403, "control is disabled (dashboard.control_token is empty)\n");
+    if (!constant_time_equal(req.header("x-fploc-token"), token_)) return text(403, "bad token\n");
     fploc::node_command_t c;
     try {
       auto j = json::parse(req.body);
@@ -246,22 +232,16 @@ class DashboardNode : public fploc::rt::Node {
       c.action = j.at("action").get<std::string>();
       if (c.action != "restart" && c.action != "stop" && c.action != "start") throw std::runtime_error("bad action");
     } catch (const std::exception& e) {
-      res.status = 400;
-      res.set_content(std::string("expected {\"node\":..., \"action\":\"restart|stop|start\"}: ") + e.what() + "\n",
-                      "text/plain");
-      return;
+      return text(400, std::string("expected {\"node\":..., \"action\":\"restart|stop|start\"}: ") + e.what() + "\n");
     }
     c.utime = wall_us();
     c.executable = "";
     c.num_set = 0;
     c.token = token_;
     std::lock_guard<std::mutex> lk(cmd_mu_);
-    if (commands_.size() >= 16) {
-      res.status = 429;
-      return;
-    }
+    if (commands_.size() >= 16) return text(429, "too many commands queued\n");
     commands_.push_back(c);
-    res.set_content("{\"queued\":true}", "application/json");
+    return json_reply("{\"queued\":true}");
   }
 
   void forward_commands() {
@@ -270,39 +250,58 @@ class DashboardNode : public fploc::rt::Node {
       std::lock_guard<std::mutex> lk(cmd_mu_);
       cmds.swap(commands_);
     }
-    for (const auto& c : cmds) ctx_->bus().lcm().publish(fploc::rt::kControlChannel, &c);
+    for (const auto& c : cmds) ctx_->bus().lcm().publish(ctx_->ns(fploc::rt::kControlChannel), &c);
   }
 
   void try_listen() {
     if (listening_ || stopping_) return;
-    if (!server_.bind_to_port(bind_.c_str(), port_)) {
-      if (!bind_error_reported_) ctx_->error("dashboard: cannot listen on " + bind_ + ":" + std::to_string(port_) +
-                                             " (address in use or not local); retrying every 0.5 s");
+    if (!server_) {
+      HttpServerConfig hc;
+      hc.bind = bind_;
+      hc.port = port_;
+      hc.max_push_hz = max_hz_;
+      hc.max_streams = max_streams_;
+      hc.common_headers = {{"X-Content-Type-Options", "nosniff"},
+                           {"Referrer-Policy", "no-referrer"},
+                           {"Content-Security-Policy",
+                            "default-src 'self'; img-src 'self' data:; style-src 'self'; connect-src 'self'"}};
+      server_ = std::make_unique<HttpServer>(hc, model_->hub(), [this](const HttpRequest& r) { return handle(r); });
+      server_->on_streams_changed([this](size_t n) { model_->set_clients(n); });
+    }
+    std::string err;
+    if (!server_->listen(err)) {
+      if (!bind_error_reported_) ctx_->error("dashboard: cannot listen on " + bind_ + ":" + std::to_string(port_) + " (" +
+                                             err + "); retrying every 0.5 s");
       bind_error_reported_ = true;
       return;
     }
     listening_ = true;
+    server_->start();
     std::cerr << "[" << ctx_->name() << "] dashboard on http://" << bind_ << ":" << port_ << "/ (web root "
-              << web_root_.string() << ")" << std::endl;
-    thread_ = std::thread([this] { server_.listen_after_bind(); });
+              << web_root_.string() << "; at most " << max_streams_ << " event streams)" << std::endl;
   }
 
   void stop_server() {
     if (stopping_) return;
     stopping_ = true;
-    if (model_) model_->stop();
-    if (listening_) {
-      // stop() is a no-op before listen_after_bind() has started: wait for it (at most 1 s).
-      for (int i = 0; i < 100 && !server_.is_running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-      server_.stop();
-    }
-    if (thread_.joinable()) thread_.join();
+    if (server_) server_->stop();
   }
 
+  struct FleetHandler {
+    DashboardNode* self;
+    std::string robot;
+    void pose(const lcm::ReceiveBuffer*, const std::string&, const fploc::pose_t* m) {
+      self->model_->on_fleet_pose(robot, *m, steady_s(), wall_us());
+    }
+    void status(const lcm::ReceiveBuffer*, const std::string&, const fploc::node_status_t* m) {
+      self->model_->on_fleet_status(robot, *m, steady_s());
+    }
+  };
+  std::vector<std::unique_ptr<FleetHandler>> fleet_;
   fploc::rt::Context* ctx_ = nullptr;
   std::unique_ptr<Model> model_;
-  httplib::Server server_;
-  std::thread thread_;
+  std::unique_ptr<HttpServer> server_;
+  size_t max_streams_ = 256;
   std::string bind_, token_;
   int port_ = 8080;
   double max_hz_ = 20;

@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "fploc/runtime/bus.h"
+#include "fploc/runtime/robot.h"
 #include "fploc/runtime/compose.h"
 #include "fploc/runtime/graph.h"
 #include "fploc/runtime/node.h"
@@ -99,6 +100,21 @@ std::string Context::resolve_path(const std::string& p) const {
   if (path.is_absolute() || base_dir_.empty()) return p;
   return (std::filesystem::path(base_dir_) / path).lexically_normal().string();
 }
+
+void Context::set_robot(const std::string& r) {
+  // Ports mapped by the graph and ports on their default channel alike move into the robot's namespace.
+  std::vector<std::pair<std::string, std::string>> m;
+  for (const auto& ps : spec_.ports) {
+    std::string ch = ps.default_channel;
+    for (const auto& [p, c] : port_map_)
+      if (p == ps.name) ch = c;
+    m.emplace_back(ps.name, robot_channel(r, ch));
+  }
+  port_map_ = std::move(m);
+  robot_ = r;
+}
+
+std::string Context::ns(const std::string& channel) const { return robot_channel(robot_, channel); }
 
 const std::string& Context::channel(const std::string& port) const {
   for (const auto& [p, c] : port_map_)
@@ -209,6 +225,7 @@ Composition::Composition(const LoadedGraph& graph, Bus& bus, const std::vector<s
     ComposedNode cn;
     cn.name = n.name();
     cn.ctx = std::make_unique<Context>(bus, reg->spec, n.name(), std::move(opts), port_map_of(n), graph.dir, true);
+    cn.ctx->set_robot(robot_of(&graph.graph));
     cn.node = reg->make();
     try {
       cn.node->setup(*cn.ctx);
@@ -283,6 +300,9 @@ static fploc::node_status_t make_status(Context& ctx, const std::string& executa
     s.ports.push_back(ps);
   }
   s.num_ports = int32_t(s.ports.size());
+  s.robot = ctx.robot();
+  static const std::string host = host_name();
+  s.host = host;
   return s;
 }
 
@@ -331,6 +351,7 @@ int node_main(int argc, char** argv) {
   std::vector<std::pair<std::string, std::string>> port_map;
   std::string base_dir = std::filesystem::current_path().string();
   std::string instance = reg.spec.type;
+  std::string robot = robot_of(nullptr);
   if (!graph_path.empty()) {
     LoadedGraph g;
     std::vector<GraphError> errors;
@@ -349,7 +370,8 @@ int node_main(int argc, char** argv) {
     port_map = port_map_of(*found);
     base_dir = g.dir;
     instance = node_name;
-    if (url.empty()) url = g.graph.lcm_url();
+    url = graph_lcm_url(g.graph, url);
+    robot = robot_of(&g.graph);
   }
   if (!sets.empty()) {
     std::string err;
@@ -377,6 +399,8 @@ int node_main(int argc, char** argv) {
     Bus bus(url);
     Context ctx(bus, reg.spec, instance, std::move(options), port_map, base_dir, false);
     ctx.set_restarts(restarts);
+    ctx.set_robot(robot);
+    const std::string telemetry = ctx.ns(kTelemetryChannel);
     auto node = reg.make();
     // setup() may take long (a large plan's ANNF on a cold cache, fploc/annf/cache.h): after 2 s a
     // thread sends a "loading" heartbeat every second, so the launcher does not take a slow start for
@@ -409,7 +433,7 @@ int node_main(int argc, char** argv) {
       std::cerr << "[" << instance << "] setup failed: " << e.what() << std::endl;
       auto s = make_status(ctx, executable, "dead", 0, 0, restarts);
       s.last_error = std::string("setup failed: ") + e.what();
-      bus.lcm().publish(kTelemetryChannel, &s);
+      bus.lcm().publish(telemetry, &s);
       return 1;
     }
     CpuMeter cpu;
@@ -418,7 +442,7 @@ int node_main(int argc, char** argv) {
     const int lcm_fd = bus.lcm().getFileno();
     auto beat = [&](const std::string& state) {
       auto s = make_status(ctx, executable, state, cpu.sample_percent(), now_s() - t_start, restarts);
-      bus.lcm().publish(kTelemetryChannel, &s);
+      bus.lcm().publish(telemetry, &s);
       ctx.stats().end_period();
     };
     auto& L = loop();

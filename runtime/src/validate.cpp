@@ -1,4 +1,5 @@
 #include "fploc/runtime/validate.h"
+#include "fploc/runtime/robot.h"
 
 #include <fcntl.h>
 #include <poll.h>
@@ -204,6 +205,24 @@ bool validate_graph(const LoadedGraph& g, const ValidateHooks& hooks, std::vecto
   const std::string control = g.graph.control_channel().empty() ? kControlChannel : g.graph.control_channel();
   producers[control].push_back({"(fploc node)", "control", "fploc.node_command_t", 0});
   producers[kInitialPoseChannel].push_back({"(fploc node initial-pose)", "initial_pose", "fploc.pose_t", 0});
+
+  if (!valid_robot_name(g.graph.robot()))
+    err(0, "robot '" + g.graph.robot() + "': letters, digits, '_' and '-' only (at most 32), it prefixes every channel");
+  std::map<std::string, int> hosts;
+  for (int h = 0; h < g.graph.host_size(); ++h) {
+    const auto& host = g.graph.host(h);
+    if (!valid_name(host.name())) err(0, "host " + std::to_string(h + 1) + ": name '" + host.name() + "' is not a valid name");
+    else if (hosts.count(host.name())) err(0, "host '" + host.name() + "' is listed twice");
+    hosts[host.name()] = h;
+    if (host.address().empty()) err(0, "host '" + host.name() + "': address is empty");
+  }
+  for (int i = 0; i < g.graph.node_size(); ++i) {
+    const auto& n = g.graph.node(i);
+    if (!n.host().empty() && !hosts.count(n.host()))
+      err(g.node_line(i, "host"), "node '" + n.name() + "': host '" + n.host() + "' is not one of the graph's hosts" +
+                                      (hosts.empty() ? " (the graph lists none)" : ""));
+  }
+  if (g.graph.lcm_ttl() < 0 || g.graph.lcm_ttl() > 255) err(0, "lcm_ttl must be 0..255");
 
   bool unknown_ports = false;  // an enabled fploc node could not be described: it may be a missing producer
   for (int i = 0; i < g.graph.node_size(); ++i) {

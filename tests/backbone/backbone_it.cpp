@@ -88,7 +88,8 @@ TEST_F(Backbone, ShippedGraphsPassCheck) {
   int checked = 0;
   for (const auto& e : fs::directory_iterator(kRoot + "/graphs")) {
     if (e.path().extension() != ".pbtxt" || e.path().filename() == "test-bad.pbtxt") continue;
-    const int rc = run({bin("fploc-launch"), "--check", e.path().string()}, dir_, "check");
+    // --skip-hosts: graphs/multihost.pbtxt names hosts that do not exist here (tests/multihost reaches real ones).
+    const int rc = run({bin("fploc-launch"), "--check", "--skip-hosts", e.path().string()}, dir_, "check");
     EXPECT_EQ(rc, 0) << e.path() << ":\n" << slurp(dir_ + "/check.stderr");
     ++checked;
   }

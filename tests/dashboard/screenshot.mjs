@@ -16,6 +16,11 @@ const page = await browser.newPage({ viewport: { width: 1600, height: 1000 } });
 page.on('pageerror', (e) => console.error('page error:', e.message));
 await page.goto(url);
 await page.waitForTimeout(Number(waitMs));
+// FPLOC_SELECT_ROBOT=r2: pick that robot in the fleet selector first (its nodes and readouts).
+if (process.env.FPLOC_SELECT_ROBOT) {
+  await page.selectOption('#robot', process.env.FPLOC_SELECT_ROBOT);
+  await page.waitForTimeout(1500);
+}
 await page.screenshot({ path: out });
 const state = await page.evaluate(() => ({ connected: window.__fploc?.connected, trail: window.__fploc?.trail?.length }));
 console.error(`screenshot ${out}: ${JSON.stringify(state)}`);

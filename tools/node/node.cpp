@@ -18,6 +18,7 @@
 
 #include "fploc/runtime/bus.h"
 #include "fploc/runtime/graph.h"
+#include "fploc/runtime/robot.h"
 
 using namespace fploc::rt;
 
@@ -27,8 +28,9 @@ double now_s() {
 }
 void usage() {
   std::cerr << "usage: fploc node restart|stop|start NAME [--exe EXECUTABLE] [--set field=value ...]\n"
-               "                  [--graph GRAPH | --lcm-url URL] [--token T] [--timeout S] [--no-wait]\n"
-               "       fploc node initial-pose X Y YAW_DEG [--graph GRAPH | --lcm-url URL] [--channel C]\n";
+               "                  [--graph GRAPH | --lcm-url URL] [--robot R] [--token T] [--timeout S] [--no-wait]\n"
+               "       fploc node initial-pose X Y YAW_DEG [--graph GRAPH | --lcm-url URL] [--robot R] [--channel C]\n"
+               "  --robot R: the robot's channels (R/FPLOC_CONTROL, ...); default: the graph's robot, else $FPLOC_ROBOT\n";
 }
 
 LoadedGraph load_or_exit(const std::string& path) {
@@ -58,6 +60,7 @@ int initial_pose(int argc, char** argv) {
   }
   std::string url = getenv("FPLOC_LCM_URL") ? getenv("FPLOC_LCM_URL") : "";
   std::string channel = kInitialPoseChannel;
+  std::string robot = robot_of(nullptr);
   for (int i = 5; i < argc; ++i) {
     const std::string a = argv[i];
     if (i + 1 >= argc) {
@@ -65,7 +68,11 @@ int initial_pose(int argc, char** argv) {
       return 2;
     }
     if (a == "--lcm-url") url = argv[++i];
-    else if (a == "--graph") url = load_or_exit(argv[++i]).graph.lcm_url();
+    else if (a == "--graph") {
+      const LoadedGraph g = load_or_exit(argv[++i]);
+      url = graph_lcm_url(g.graph, url);
+      robot = robot_of(&g.graph);
+    } else if (a == "--robot") robot = argv[++i];
     else if (a == "--channel") channel = argv[++i];
     else {
       std::cerr << "fploc node initial-pose: unexpected argument '" << a << "'\n";
@@ -82,6 +89,7 @@ int initial_pose(int argc, char** argv) {
   p.orientation[2] = std::sin(half);
   p.orientation[3] = std::cos(half);
   try {
+    channel = robot_channel(robot, channel);
     Bus bus(url);
     bus.lcm().publish(channel, &p);
     std::cerr << "fploc node: initial pose x " << v[0] << " y " << v[1] << " yaw " << v[2] << " deg sent on "
@@ -126,6 +134,7 @@ int main(int argc, char** argv) {
   cmd.node = argv[2];
   std::string url = getenv("FPLOC_LCM_URL") ? getenv("FPLOC_LCM_URL") : "";
   std::string channel = kControlChannel;
+  std::string robot = robot_of(nullptr);
   double timeout = 10;
   bool wait = true;
   for (int i = 3; i < argc; ++i) {
@@ -143,9 +152,11 @@ int main(int argc, char** argv) {
     else if (a == "--token") cmd.token = next();
     else if (a == "--timeout") timeout = std::atof(next().c_str());
     else if (a == "--no-wait") wait = false;
+    else if (a == "--robot") robot = next();
     else if (a == "--graph") {
       const LoadedGraph g = load_or_exit(next());
-      if (url.empty()) url = g.graph.lcm_url();
+      url = graph_lcm_url(g.graph, url);
+      robot = robot_of(&g.graph);
       if (!g.graph.control_channel().empty()) channel = g.graph.control_channel();
       if (cmd.token.empty()) cmd.token = g.graph.control_token();
     } else {
@@ -159,11 +170,12 @@ int main(int argc, char** argv) {
     return 2;
   }
   cmd.num_set = int32_t(cmd.set.size());
+  channel = robot_channel(robot, channel);
   try {
     Bus bus(url);
     Watch w;
     w.node = cmd.node;
-    bus.lcm().subscribe(kTelemetryChannel, &Watch::on, &w);
+    bus.lcm().subscribe(robot_channel(robot, kTelemetryChannel), &Watch::on, &w);
     // Learn the current process from its heartbeat (1 Hz) so that its successor can be recognised.
     const double t_learn = now_s();
     while (wait && w.old_pid < 0 && now_s() - t_learn < 1.5) bus.lcm().handleTimeout(100);

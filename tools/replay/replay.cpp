@@ -31,13 +31,14 @@ double now_s() {
 }
 void usage() {
   std::cerr << "usage: fploc replay --graph GRAPH --log LOG.lcm [--out EST.tum] [--json] [--set NODE.field=value ...]\n"
+               "                    [--robot R]   (the log's channels are R/...; default: the graph's robot, else $FPLOC_ROBOT)\n"
                "  runs the graph's nodes in one process over memq://, lock-step on the log's events\n";
 }
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string graph_path, log_path, out;
-  bool json = false;
+  std::string graph_path, log_path, out, robot;
+  bool json = false, robot_given = false;
   std::vector<std::string> sets;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -53,6 +54,7 @@ int main(int argc, char** argv) {
     else if (a == "--out") out = next();
     else if (a == "--json") json = true;
     else if (a == "--set") sets.push_back(next());
+    else if (a == "--robot") robot = next(), robot_given = true;
     else if (a == "-h" || a == "--help") { usage(); return 0; }
     else { std::cerr << "fploc replay: unexpected argument '" << a << "'\n"; usage(); return 2; }
   }
@@ -66,6 +68,8 @@ int main(int argc, char** argv) {
     for (const auto& e : errors) std::cerr << e.str() << "\n";
     return 1;
   }
+  // --robot: the log's channels are that robot's ("R/FPLOC_SCAN", ...), whatever the graph says.
+  if (robot_given) g.graph.set_robot(robot);
   // Overrides: --out for every pose logger, --set NODE.field=value for one node.
   int loggers = 0;
   for (int i = 0; i < g.graph.node_size(); ++i) {

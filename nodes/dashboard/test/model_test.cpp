@@ -7,7 +7,14 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include <fploc/features_t.hpp>
+#include <fploc/frame_pose_t.hpp>
+#include <fploc/ground_truth_t.hpp>
+#include <fploc/node_status_t.hpp>
+#include <fploc/pose_t.hpp>
+
 #include "model.h"
+#include "push_hub.h"
 #include "web_path.h"
 
 using namespace fploc::dashboard;
@@ -146,33 +153,39 @@ TEST(DashboardModel, FeaturesJsonIsValidAndDecimated) {
   EXPECT_NO_THROW(json::parse(Model::features_json(f, 0, "null")));
 }
 
-TEST(DashboardModel, PushesAreRateCappedAndCarryOnlyTheLatestValue) {
-  Model m;
-  ClientCursor c;
-  std::string out;
-  ASSERT_TRUE(m.next_push(c, 20, 1.0, out));  // greeting
-  std::atomic<bool> done{false};
-  std::thread producer([&] {
-    for (int i = 0; i < 300 && !done; ++i) {
-      m.on_pose(pose(i, i, 0), 0, 0);
-      std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    }
-  });
-  int pushes = 0;
-  const auto t0 = std::chrono::steady_clock::now();
-  while (std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(500)) {
-    ASSERT_TRUE(m.next_push(c, 20, 0.2, out));
-    if (!out.empty()) {
-      ++pushes;
+TEST(DashboardPushHub, RateCappedPerStreamLatestValueOnly) {
+  // Fake clock: poses every 2 ms for 0.5 s, the broadcaster asks whenever it is woken.
+  PushHub hub;
+  int wakeups = 0;
+  hub.set_notify([&] { ++wakeups; });
+  int pose_pushes = 0;
+  std::string last;
+  double next_due = 0;
+  for (int i = 0; i < 250; ++i) {
+    const double t = 0.002 * i;
+    hub.set("pose", "{\"seq\":" + std::to_string(i) + "}");
+    if (i % 50 == 0) hub.set("nodes", "[" + std::to_string(i) + "]");
+    const std::string out = hub.take_due(t, 20, next_due);
+    if (out.find("event: pose") != std::string::npos) {
+      ++pose_pushes;
       EXPECT_EQ(out.find("event: pose"), out.rfind("event: pose"));  // one pose per push, never a queue
+      last = out;
     }
+    if (!out.empty()) continue;
+    EXPECT_GT(next_due, t);  // held back: the broadcaster knows when to come back
+    EXPECT_LE(next_due, t + 0.05 + 1e-9);
   }
-  done = true;
-  producer.join();
-  EXPECT_LE(pushes, 11);  // 20 Hz for 0.5 s (+1 at the start)
-  EXPECT_GE(pushes, 5);
-  m.stop();
-  EXPECT_FALSE(m.next_push(c, 20, 0.2, out));
+  EXPECT_EQ(wakeups, 255);
+  EXPECT_EQ(pose_pushes, 10);  // 20 Hz for 0.5 s
+  // The newest pose (held back at the end) goes out once it is due; then nothing is due, nothing waits.
+  EXPECT_NE(hub.take_due(1.0, 20, next_due).find("event: pose\ndata: {\"seq\":249}"), std::string::npos);
+  EXPECT_EQ(hub.take_due(2.0, 20, next_due), "");
+  EXPECT_TRUE(std::isinf(next_due));
+  // A new client starts from the latest value of every stream.
+  const std::string snap = hub.snapshot();
+  EXPECT_NE(snap.find("event: pose\ndata: {\"seq\":249}\n\n"), std::string::npos) << snap;
+  EXPECT_NE(snap.find("event: nodes\ndata: [200]"), std::string::npos) << snap;
+  EXPECT_EQ(json::parse(hub.state_json())["pose"]["seq"], 249);
 }
 
 TEST(DashboardWebPath, RejectsTraversal) {

@@ -109,6 +109,11 @@ class Context {
   // composed mode). A restarted node may not want the graph's start-of-run state (e.g. an initial pose).
   int restarts() const { return restarts_; }
   void set_restarts(int n) { restarts_ = n; }
+  // The graph's robot (Graph.robot, "" = none). Every port channel already carries it; `ns` applies it
+  // to channels a node uses directly (FPLOC_CONTROL, ...).
+  const std::string& robot() const { return robot_; }
+  void set_robot(const std::string& r);
+  std::string ns(const std::string& channel) const;
   const std::string& channel(const std::string& port) const;
 
   template <class Msg>
@@ -140,6 +145,7 @@ class Context {
   std::string base_dir_;
   bool composed_;
   int restarts_ = 0;
+  std::string robot_;
   NodeStats stats_;
 };
 

@@ -1,0 +1,16 @@
+// `fploc launch --check`: the files a graph's options name must exist and parse before anything starts —
+// floor plans and maps (every PlanSource.file: .dxf/.csv/.json/.fpmap through the floorplan reader), OS-1
+// metadata (`metadata` fields, unless another node of the graph writes that file at run time via
+// `metadata_out`, or the driver fetches it from `sensor_hostname`), pcap captures (`pcap`: the magic
+// number) and the dashboard's `graph`. Output paths (TUM files, stats) are not checked.
+#pragma once
+#include <vector>
+
+#include "fploc/runtime/graph.h"
+
+namespace fploc::launch {
+
+// Appends one error per bad file (file:line of the option, the resolved path and the reader's message).
+void check_option_files(const fploc::rt::LoadedGraph& g, std::vector<fploc::rt::GraphError>& errors);
+
+}  // namespace fploc::launch

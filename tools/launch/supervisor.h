@@ -1,0 +1,130 @@
+// The launcher's supervision policy, as pure logic: which node to start, signal, restart or declare
+// hung/dead, and in which order the graph stops. No process calls and no clock here: times come in as
+// arguments and every effect goes out through `Effects`, so the policy is unit-tested with a fake clock
+// (tools/launch/test/supervisor_test.cpp). The process table (process_table.h) and the control channel
+// (control.h) are the launcher's other two parts.
+#pragma once
+#include <sys/types.h>
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fploc/runtime/restart.h"
+#include "graph.pb.h"
+
+namespace fploc::launch {
+
+enum class State { Starting, Running, Backoff, Stopping, Stopped, Dead };
+const char* state_name(State s);
+
+// What the supervisor needs to know of one node of the graph.
+struct NodePolicy {
+  std::string name;
+  fploc::RestartPolicy restart;
+  double heartbeat_timeout_s = 3.0;  // a running node silent for longer is killed and restarted
+  bool supervised = false;           // sends heartbeats (an fploc node); foreign programs are not watched
+  std::vector<std::string> inputs;   // channels it consumes (for the stop order)
+  std::vector<std::string> outputs;  // channels it produces
+};
+
+// How a process ended (from waitpid).
+struct ExitStatus {
+  bool exited = true;  // false: killed by `signal`
+  int code = 0;
+  int signal = 0;
+  std::string str() const;  // "exited with code 3" / "killed by signal 9 (Killed)"
+  bool failed() const { return !exited || code != 0; }
+};
+
+// The outside world as the supervisor sees it.
+class Effects {
+ public:
+  virtual ~Effects() = default;
+  // Starts node i (FPLOC_RESTARTS=restarts); returns its process (group) id, or -1 when it could not start.
+  virtual pid_t start(size_t i, int restarts) = 0;
+  // Sends `sig` to node i's process group.
+  virtual void signal(size_t i, pid_t pid, int sig) = 0;
+  // node_status_t with reporter "launcher".
+  virtual void publish(size_t i, pid_t pid, int restarts, const std::string& state, const std::string& error) = 0;
+  virtual void log(const std::string& line) = 0;
+};
+
+struct SupervisorConfig {
+  double shutdown_timeout_s = 2.0;  // SIGINT ... SIGTERM after this, SIGKILL 1 s later
+  double stage_gap_s = 0.25;        // graph-wide stop: next rank after this even if the previous still runs
+  double first_beat_grace_s = 10.0; // until its first heartbeat a node may be loading (maps)
+  double report_period_s = 1.0;     // dead/restarting nodes are re-published this often
+  std::vector<std::string> ignored_channels;  // telemetry/control: not part of the stop order
+};
+
+class Supervisor {
+ public:
+  Supervisor(std::vector<NodePolicy> nodes, SupervisorConfig cfg, Effects& fx);
+
+  // ---- inputs
+  void start_all(double t);
+  // A process ended (reaped). Returns false when the pid is not one of ours.
+  bool on_exit(pid_t pid, const ExitStatus& st, double t);
+  // A heartbeat (node_status_t with reporter "node") arrived from `pid` of node `name`.
+  void on_heartbeat(const std::string& name, pid_t pid, double t);
+  // Any telemetry arrived (the launcher's own too): the transport works here.
+  void on_transport_ok() { transport_ok_ = true; }
+  // Control requests: stop node i; stop it (if running) and start it again (fresh restart window).
+  void request_stop(size_t i, double t);
+  void request_restart(size_t i, double t);
+  // Graph-wide ordered stop (SIGINT rank by rank, then SIGTERM, SIGKILL).
+  void begin_shutdown(double t);
+  // Second Ctrl-C: SIGKILL to everything now.
+  void kill_all();
+  // Escalation, backoff restarts, heartbeat checks, shutdown stages, periodic reports.
+  void tick(double t);
+
+  // ---- outputs
+  // The launcher's exit code once it should exit (all finished, or shutdown complete), else nothing.
+  std::optional<int> finished();
+  bool shutting_down() const { return shutting_down_; }
+  size_t size() const { return nodes_.size(); }
+  const std::string& name(size_t i) const { return nodes_[i].policy.name; }
+  State state(size_t i) const { return nodes_[i].state; }
+  pid_t pid(size_t i) const { return nodes_[i].pid; }
+  int restarts(size_t i) const { return nodes_[i].restarts; }
+  int stop_rank(size_t i) const { return nodes_[i].stop_rank; }
+  std::optional<size_t> find(const std::string& name) const;
+  // The node now runs another executable (control request): is it heartbeat-supervised?
+  void set_supervised(size_t i, bool s) { nodes_[i].policy.supervised = s; }
+
+ private:
+  struct Run {
+    NodePolicy policy;
+    pid_t pid = -1;
+    State state = State::Stopped;
+    int restarts = 0;
+    fploc::rt::RestartTracker tracker;
+    double next_start = 0, started_at = 0, last_beat = 0, stop_deadline = 0;
+    int stop_stage = 0;  // 0 SIGINT sent, 1 SIGTERM sent, 2 SIGKILL sent
+    bool restart_after_stop = false, hung = false;
+    int stop_rank = 0;
+  };
+  void start(size_t i, double t);
+  void begin_stop(size_t i, bool restart_after, double t);
+  void escalate(size_t i, double t);
+  void check_heartbeat(size_t i, double t);
+  void apply_restart(size_t i, const fploc::rt::RestartDecision& d, const std::string& why, double t);
+  void advance_shutdown(double t);
+  void rank_for_shutdown();
+  void publish(size_t i, const std::string& state, const std::string& error);
+
+  std::vector<Run> nodes_;
+  SupervisorConfig cfg_;
+  Effects& fx_;
+  bool transport_ok_ = false, transport_warned_ = false;
+  bool shutting_down_ = false;
+  double shutdown_started_ = 0, stage_started_ = 0, last_report_ = 0;
+  int stop_rank_ = -1;
+};
+
+std::string fmt2(double v);  // "%.2f"
+
+}  // namespace fploc::launch

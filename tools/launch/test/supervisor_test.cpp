@@ -1,0 +1,290 @@
+// The launcher's supervision policy with a fake clock and fake processes: restart policy and backoff,
+// giving up, heartbeat timeout, ordered shutdown with escalation, control requests.
+#include "supervisor.h"
+
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <map>
+
+using namespace fploc::launch;
+
+namespace {
+
+struct FakeWorld : Effects {
+  pid_t next_pid = 100;
+  bool fail_start = false;
+  std::vector<std::pair<size_t, pid_t>> starts;           // node, pid
+  std::vector<std::tuple<size_t, pid_t, int>> signals;    // node, pid, signal
+  std::vector<std::pair<size_t, std::string>> published;  // node, state
+  std::vector<std::string> logs;
+  std::map<size_t, int> start_restarts;
+  double now = 0;
+  std::vector<double> start_times;
+
+  pid_t start(size_t i, int restarts) override {
+    if (fail_start) return -1;
+    starts.push_back({i, next_pid});
+    start_restarts[i] = restarts;
+    start_times.push_back(now);
+    return next_pid++;
+  }
+  void signal(size_t i, pid_t pid, int sig) override { signals.push_back({i, pid, sig}); }
+  void publish(size_t i, pid_t, int, const std::string& state, const std::string&) override {
+    published.push_back({i, state});
+  }
+  void log(const std::string& l) override { logs.push_back(l); }
+  // The signals (other than the SIGKILL to the group after an exit) sent to node i, in order.
+  std::vector<int> signals_to(size_t i) const {
+    std::vector<int> out;
+    for (auto& [n, p, s] : signals)
+      if (n == i) out.push_back(s);
+    return out;
+  }
+};
+
+NodePolicy node(const std::string& name, fploc::RestartPolicy::Mode mode = fploc::RestartPolicy::ON_FAILURE) {
+  NodePolicy p;
+  p.name = name;
+  p.restart.set_mode(mode);
+  p.supervised = true;
+  return p;
+}
+
+ExitStatus killed(int sig) { return {false, 0, sig}; }
+ExitStatus code(int c) { return {true, c, 0}; }
+
+}  // namespace
+
+TEST(Supervisor, CrashRestartsWithExponentialBackoff) {
+  FakeWorld w;
+  auto p = node("a");
+  p.restart.set_backoff_initial_s(0.1);
+  p.restart.set_backoff_factor(2);
+  p.restart.set_backoff_max_s(0.5);
+  p.restart.set_max_restarts(10);
+  Supervisor s({p}, {}, w);
+  s.start_all(0);
+  ASSERT_EQ(w.starts.size(), 1u);
+  // Each crash: restart after 0.1, 0.2, 0.4, 0.5 (capped), 0.5 s.
+  const double expected[] = {0.1, 0.2, 0.4, 0.5, 0.5};
+  double t = 1.0;
+  for (int k = 0; k < 5; ++k) {
+    const pid_t pid = s.pid(0);
+    ASSERT_TRUE(s.on_exit(pid, killed(SIGKILL), t));
+    EXPECT_EQ(s.state(0), State::Backoff);
+    s.tick(t + expected[k] - 0.01);
+    EXPECT_EQ(w.starts.size(), size_t(k + 1)) << "started before its backoff";
+    s.tick(t + expected[k] + 1e-9);
+    ASSERT_EQ(w.starts.size(), size_t(k + 2)) << "not restarted after " << expected[k] << " s";
+    EXPECT_EQ(w.start_restarts[0], k + 1);  // FPLOC_RESTARTS of the new process
+    EXPECT_EQ(s.state(0), State::Running);
+    t += expected[k] + 0.05;
+  }
+}
+
+TEST(Supervisor, GivesUpAfterMaxRestartsInWindow) {
+  FakeWorld w;
+  auto p = node("a");
+  p.restart.set_max_restarts(2);
+  p.restart.set_window_s(10);
+  p.restart.set_backoff_initial_s(0.1);
+  p.restart.set_backoff_factor(1);
+  Supervisor s({p}, {}, w);
+  s.start_all(0);
+  double t = 0.5;
+  for (int k = 0; k < 2; ++k) {
+    s.on_exit(s.pid(0), code(3), t);
+    s.tick(t + 0.2);
+    ASSERT_EQ(s.state(0), State::Running);
+    t += 0.5;
+  }
+  s.on_exit(s.pid(0), code(3), t);
+  EXPECT_EQ(s.state(0), State::Dead);
+  EXPECT_EQ(w.published.back().second, "dead");
+  EXPECT_EQ(s.finished(), std::optional<int>(1));
+}
+
+TEST(Supervisor, RestartWindowSlides) {
+  FakeWorld w;
+  auto p = node("a");
+  p.restart.set_max_restarts(1);
+  p.restart.set_window_s(5);
+  Supervisor s({p}, {}, w);
+  s.start_all(0);
+  s.on_exit(s.pid(0), code(1), 1);
+  s.tick(2);
+  ASSERT_EQ(s.state(0), State::Running);
+  // Outside the 5 s window of the first restart: allowed again.
+  s.on_exit(s.pid(0), code(1), 7);
+  EXPECT_EQ(s.state(0), State::Backoff);
+}
+
+TEST(Supervisor, PoliciesNeverAndAlways) {
+  FakeWorld w;
+  Supervisor s({node("never", fploc::RestartPolicy::NEVER), node("always", fploc::RestartPolicy::ALWAYS),
+                node("onfail")},
+               {}, w);
+  s.start_all(0);
+  s.on_exit(s.pid(0), killed(SIGSEGV), 1);
+  s.on_exit(s.pid(1), code(0), 1);
+  s.on_exit(s.pid(2), code(0), 1);
+  EXPECT_EQ(s.state(0), State::Dead);     // failed, never restarted
+  EXPECT_EQ(s.state(1), State::Backoff);  // clean exit, restarted anyway
+  EXPECT_EQ(s.state(2), State::Stopped);  // clean exit, on-failure: done
+  EXPECT_FALSE(s.on_exit(9999, code(0), 1)) << "not our process";
+}
+
+TEST(Supervisor, SilentNodeIsKilledAndRestarted) {
+  FakeWorld w;
+  auto p = node("a");
+  p.heartbeat_timeout_s = 3;
+  SupervisorConfig cfg;
+  cfg.first_beat_grace_s = 10;
+  Supervisor s({p}, cfg, w);
+  s.start_all(0);
+  const pid_t pid = s.pid(0);
+  s.on_transport_ok();
+  // Loading: no heartbeat yet, the grace period applies (10 s, not 3).
+  s.tick(9.9);
+  EXPECT_EQ(s.state(0), State::Running);
+  for (double t = 9.95; t < 20; t += 1.0) {
+    s.on_heartbeat("a", pid, t);
+    s.tick(t + 0.5);
+  }
+  EXPECT_EQ(s.state(0), State::Running);
+  // A heartbeat from another pid (an old process) does not count.
+  s.on_heartbeat("a", pid + 1000, 21);
+  s.tick(22.9);
+  EXPECT_EQ(s.state(0), State::Running);
+  s.tick(23.0);  // 3.05 s after the last heartbeat of this pid
+  EXPECT_EQ(s.state(0), State::Stopping);
+  ASSERT_FALSE(w.signals.empty());
+  EXPECT_EQ(std::get<2>(w.signals.back()), SIGKILL);
+  EXPECT_EQ(w.published.back().second, "hung");
+  s.on_exit(pid, killed(SIGKILL), 23.01);
+  EXPECT_EQ(s.state(0), State::Backoff);
+  s.tick(23.2);
+  EXPECT_EQ(s.state(0), State::Running);
+  EXPECT_NE(s.pid(0), pid);
+  EXPECT_EQ(s.restarts(0), 1);
+}
+
+TEST(Supervisor, NoTransportNoHeartbeatKill) {
+  FakeWorld w;
+  Supervisor s({node("a")}, {}, w);
+  s.start_all(0);
+  s.tick(100);
+  EXPECT_EQ(s.state(0), State::Running) << "killed although no telemetry can arrive at all";
+  EXPECT_NE(w.logs.back().find("heartbeat supervision is off"), std::string::npos);
+}
+
+TEST(Supervisor, UnsupervisedProgramIsNotWatched) {
+  FakeWorld w;
+  auto p = node("tcpdump");
+  p.supervised = false;
+  Supervisor s({p}, {}, w);
+  s.start_all(0);
+  s.on_transport_ok();
+  s.tick(1000);
+  EXPECT_EQ(s.state(0), State::Running);
+}
+
+TEST(Supervisor, ShutdownStopsProducersBeforeConsumers) {
+  FakeWorld w;
+  auto src = node("source"), mid = node("matcher"), sink = node("logger");
+  src.outputs = {"SCAN", "FPLOC_TELEMETRY"};
+  mid.inputs = {"SCAN", "FPLOC_CONTROL"};
+  mid.outputs = {"POSE", "FPLOC_TELEMETRY"};
+  sink.inputs = {"POSE", "FPLOC_TELEMETRY"};
+  SupervisorConfig cfg;
+  cfg.ignored_channels = {"FPLOC_TELEMETRY", "FPLOC_CONTROL"};
+  cfg.shutdown_timeout_s = 2;
+  // Listed consumer first: the order comes from the channels, not the file.
+  Supervisor s({sink, mid, src}, cfg, w);
+  EXPECT_EQ(s.stop_rank(2), 0);
+  EXPECT_EQ(s.stop_rank(1), 1);
+  EXPECT_EQ(s.stop_rank(0), 2);
+  s.start_all(0);
+  const pid_t p_sink = s.pid(0), p_mid = s.pid(1), p_src = s.pid(2);
+  w.signals.clear();
+  s.begin_shutdown(10);
+  ASSERT_EQ(w.signals.size(), 1u);
+  EXPECT_EQ(w.signals[0], std::make_tuple(size_t(2), p_src, SIGINT));
+  // The source exits at once: the matcher is asked next, without waiting for the stage gap.
+  s.on_exit(p_src, code(0), 10.05);
+  s.tick(10.05);
+  ASSERT_EQ(w.signals_to(1), std::vector<int>{SIGINT});
+  EXPECT_TRUE(w.signals_to(0).empty());
+  // The matcher takes its time: the logger is asked after the stage gap (0.25 s) anyway.
+  s.tick(10.2);
+  EXPECT_TRUE(w.signals_to(0).empty());
+  s.tick(10.31);
+  EXPECT_EQ(w.signals_to(0), std::vector<int>{SIGINT});
+  s.on_exit(p_sink, code(0), 10.4);
+  EXPECT_FALSE(s.finished());
+  // The matcher ignores SIGINT: SIGTERM at shutdown_timeout_s, SIGKILL one second later.
+  s.tick(11.99);
+  EXPECT_EQ(w.signals_to(1), std::vector<int>{SIGINT});
+  s.tick(12.0);
+  EXPECT_EQ(w.signals_to(1), (std::vector<int>{SIGINT, SIGTERM}));
+  s.tick(12.99);
+  EXPECT_EQ(w.signals_to(1).size(), 2u);
+  s.tick(13.0);
+  EXPECT_EQ(w.signals_to(1), (std::vector<int>{SIGINT, SIGTERM, SIGKILL}));
+  s.on_exit(p_mid, killed(SIGKILL), 13.01);
+  EXPECT_EQ(s.finished(), std::optional<int>(0));
+  // Nothing restarts during a shutdown.
+  s.tick(20);
+  EXPECT_EQ(w.starts.size(), 3u);
+}
+
+TEST(Supervisor, CrashDuringShutdownIsNotRestarted) {
+  FakeWorld w;
+  auto a = node("a", fploc::RestartPolicy::ALWAYS), b = node("b", fploc::RestartPolicy::ALWAYS);
+  a.outputs = {"X"};
+  b.inputs = {"X"};
+  Supervisor s({a, b}, {}, w);
+  s.start_all(0);
+  s.begin_shutdown(1);
+  s.on_exit(s.pid(1), killed(SIGSEGV), 1.01);  // not asked yet, crashes on its own
+  s.on_exit(s.pid(0), code(0), 1.02);
+  s.tick(5);
+  EXPECT_EQ(w.starts.size(), 2u);
+  EXPECT_EQ(s.finished(), std::optional<int>(0));
+}
+
+TEST(Supervisor, ControlRestartAndStop) {
+  FakeWorld w;
+  auto p = node("a");
+  p.restart.set_max_restarts(1);
+  Supervisor s({p}, {}, w);
+  s.start_all(0);
+  const pid_t pid = s.pid(0);
+  s.request_restart(0, 1);
+  EXPECT_EQ(w.signals_to(0), std::vector<int>{SIGINT});
+  EXPECT_EQ(s.state(0), State::Stopping);
+  s.on_exit(pid, code(0), 1.1);  // stopped on request: started again at once, no backoff
+  EXPECT_EQ(s.state(0), State::Running);
+  EXPECT_EQ(s.restarts(0), 1);
+  EXPECT_EQ(w.start_restarts[0], 1);
+  // The window was reset by the request: a crash now is still restarted.
+  s.on_exit(s.pid(0), code(1), 2);
+  EXPECT_EQ(s.state(0), State::Backoff);
+  s.tick(3);
+  s.request_stop(0, 4);
+  s.on_exit(s.pid(0), code(0), 4.1);
+  EXPECT_EQ(s.state(0), State::Stopped);
+  EXPECT_EQ(s.finished(), std::optional<int>(0));
+}
+
+TEST(Supervisor, FailedStartIsRetriedWithBackoff) {
+  FakeWorld w;
+  w.fail_start = true;
+  Supervisor s({node("a")}, {}, w);
+  s.start_all(0);
+  EXPECT_EQ(s.state(0), State::Backoff);
+  w.fail_start = false;
+  s.tick(0.2);
+  EXPECT_EQ(s.state(0), State::Running);
+}
