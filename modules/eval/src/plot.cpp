@@ -76,7 +76,7 @@ std::string plot_svg(const Trajectory& gt, const Trajectory& est, const std::str
   const double span_x = std::max(x1 - x0, 1e-3), span_y = std::max(y1 - y0, 1e-3);
   const double ML = 70, MR = 30, MT = 50, MB = 60;  // margins: axis labels left and below
   const bool colour = !o.est_error.empty();
-  const double LW = colour ? 110 : 0;             // colour bar on the right
+  const double LW = colour ? 150 : 0;             // colour bar on the right
   const double sc = std::min(820 / span_x, 760 / span_y);
   const double PW = span_x * sc, PH = span_y * sc;
   const double W = ML + PW + MR + LW, H = MT + PH + MB + 30;
