@@ -95,7 +95,6 @@ void Localizer::set_pose(double x, double y, double yaw) {
   y_ = y;
   yaw_ = wrap(yaw);
   have_pose_ = true;
-  have_motion_ = false;
   vx_ = vy_ = w_ = 0;
   t_ = 0;
   bad_ = 0;
@@ -200,7 +199,6 @@ Result Localizer::process(const Scan& s, std::optional<double> dyaw) {
     vx_ = (c * dx + sn * dy) / dt;
     vy_ = (-sn * dx + c * dy) / dt;
     w_ = wrap(r.yaw - yaw_) / dt;
-    have_motion_ = true;
   }
   x_ = r.x, y_ = r.y, yaw_ = r.yaw, t_ = s.t;
   return r;

@@ -85,7 +85,7 @@ class Localizer {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   Config cfg_;
-  bool have_pose_ = false, have_motion_ = false;
+  bool have_pose_ = false;
   double x_ = 0, y_ = 0, yaw_ = 0, t_ = 0;
   double vx_ = 0, vy_ = 0, w_ = 0;       // body velocity [m/s] and yaw rate [rad/s]
   int bad_ = 0;
