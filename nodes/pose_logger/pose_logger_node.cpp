@@ -3,6 +3,8 @@
 // its optional `ground_truth` port, to record the simulator's truth of a live run) becomes one TUM line (core `tum_line`, so the
 // formatting is deterministic). Each line is handed to the kernel with a single write(2) as soon as the
 // pose arrives: nothing is buffered in the process, so no processed pose is lost on SIGINT or a crash.
+// With `uncertainty_file`, each pose_t / frame_pose_t also gives one line "t status xx xy xyaw yy yyaw yawyaw"
+// (its status and x/y/yaw covariance, modules/eval/uncertainty.h) for `fploc eval --uncertainty`.
 #include <fcntl.h>
 #include <fploc/frame_pose_t.hpp>
 #include <fploc/ground_truth_t.hpp>
@@ -15,6 +17,7 @@
 #include <stdexcept>
 
 #include "fploc/core/pose.h"
+#include "fploc/eval/uncertainty.h"
 #include "fploc/runtime/node.h"
 #include "options/tools.pb.h"
 
@@ -37,6 +40,12 @@ class PoseLoggerNode : public fploc::rt::Node {
     fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd_ < 0) throw std::runtime_error("cannot write '" + path_ + "': " + std::strerror(errno));
     ctx_ = &ctx;
+    if (!opt.uncertainty_file().empty()) {
+      unc_path_ = opt.uncertainty_file();
+      unc_fd_ = ::open(unc_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+      if (unc_fd_ < 0) throw std::runtime_error("cannot write '" + unc_path_ + "': " + std::strerror(errno));
+      write_line(unc_fd_, unc_path_, "# t status xx xy xyaw yy yyaw yawyaw (x, y, yaw covariance; status 0 OK 1 POOR 2 LOST)\n");
+    }
     if (!ctx.channel("pose").empty())
       ctx.subscribe<fploc::pose_t>("pose", [this](const fploc::pose_t& m) { on_pose(m); });
     if (!ctx.channel("frame_pose").empty())
@@ -48,6 +57,11 @@ class PoseLoggerNode : public fploc::rt::Node {
   }
 
   void shutdown() override {
+    if (unc_fd_ >= 0) {
+      ::fsync(unc_fd_);
+      ::close(unc_fd_);
+      unc_fd_ = -1;
+    }
     if (fd_ >= 0) {
       ::fsync(fd_);
       ::close(fd_);
@@ -66,34 +80,50 @@ class PoseLoggerNode : public fploc::rt::Node {
       return;
     }
     write_line(fploc::tum_line(p) + "\n");
+    if (unc_fd_ >= 0) {
+      fploc::eval::PoseUncertainty u;
+      u.t = p.t;
+      u.status = m.status;
+      for (int i = 0; i < 9; ++i) u.cov(i / 3, i % 3) = m.covariance[i];
+      write_line(unc_fd_, unc_path_, fploc::eval::uncertainty_line(u) + "\n");
+    }
   }
 
   void on_pose(const fploc::pose_t& m) {
     if (final_only_ && !m.final_estimate) return;
-    write_pose(m.utime, m.seq, m.position, m.orientation, "pose");
+    if (!write_pose(m.utime, m.seq, m.position, m.orientation, "pose") || unc_fd_ < 0) return;
+    fploc::eval::PoseUncertainty u;
+    u.t = double(m.utime) * 1e-6;
+    u.status = m.status;
+    const int ix[3] = {0, 1, 5};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) u.cov(i, j) = m.covariance[ix[i] * 6 + ix[j]];
+    write_line(unc_fd_, unc_path_, fploc::eval::uncertainty_line(u) + "\n");
   }
 
   // position x y z, orientation quaternion x y z w (pose_t and ground_truth_t share the layout).
-  void write_pose(int64_t utime, int64_t seq, const double* position, const double* q, const char* port) {
+  bool write_pose(int64_t utime, int64_t seq, const double* position, const double* q, const char* port) {
     fploc::StampedPose p;
     p.t = double(utime) * 1e-6;
     p.p = Eigen::Vector3d(position[0], position[1], position[2]);
     const double n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
     if (!p.p.allFinite() || !std::isfinite(n2) || n2 < 1e-12) {
       ctx_->error(std::string(port) + " seq " + std::to_string(seq) + ": non-finite position or zero quaternion (skipped)");
-      return;
+      return false;
     }
     p.q = Eigen::Quaterniond(q[3], q[0], q[1], q[2]);
     write_line(fploc::tum_line(p) + "\n");
+    return true;
   }
 
-  void write_line(const std::string& line) {
+  void write_line(const std::string& line) { write_line(fd_, path_, line); }
+  void write_line(int fd, const std::string& path, const std::string& line) {
     size_t off = 0;
     while (off < line.size()) {
-      const ssize_t w = ::write(fd_, line.data() + off, line.size() - off);
+      const ssize_t w = ::write(fd, line.data() + off, line.size() - off);
       if (w < 0) {
         if (errno == EINTR) continue;
-        ctx_->error("write '" + path_ + "': " + std::strerror(errno));
+        ctx_->error("write '" + path + "': " + std::strerror(errno));
         return;
       }
       off += size_t(w);
@@ -101,9 +131,9 @@ class PoseLoggerNode : public fploc::rt::Node {
   }
 
   fploc::rt::Context* ctx_ = nullptr;
-  std::string path_;
+  std::string path_, unc_path_;
   bool final_only_ = false;
-  int fd_ = -1;
+  int fd_ = -1, unc_fd_ = -1;
 };
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -62,6 +63,9 @@ class SimSensorNode : public fploc::rt::Node {
     so_.shared_dir = sd && *sd ? sd : FPLOC_SHARED_DIR;
     loop_ = opt.loop();
     rate_ = opt.rate() > 0 ? opt.rate() : 1.0;
+    if (opt.duration_s() < 0) throw std::runtime_error("sim.duration_s: must be >= 0");
+    duration_s_ = opt.duration_s();
+    clock0_s_ = so_.t0_s;
     scenario_ = so_.scenario;
     sim_ = std::make_unique<fploc::sim::Simulator>(plan_, so_);
     std::cerr << "[" << ctx.name() << "] " << so_.scenario << ": " << sim_->num_frames() << " frames, "
@@ -115,18 +119,19 @@ class SimSensorNode : public fploc::rt::Node {
 
   void tick() {
     if (done_ || wall_now() < wall0_) return;
-    const double ts = so_.t0_s + (wall_now() - wall0_) * rate_;  // simulated sensor clock
+    // The simulated sensor clock runs from clock0_s_ (fixed); each loop's scenario starts at so_.t0_s.
+    const double ts = clock0_s_ + (wall_now() - wall0_) * rate_;
     const double period = 1.0 / so_.rate_hz;
     const int W = so_.width;
     for (int guard = 0; guard < 1000; ++guard) {
-      if (k_ >= sim_->num_frames()) {
+      if (k_ >= frames_per_loop()) {
         if (!loop_) {
           std::cerr << "[" << ctx_->name() << "] scenario finished (" << frame_counter_ << " frames sent)\n";
           done_ = true;
           return;
         }
-        // Start over, continuing the clock.
-        so_.t0_s = sim_->frame_time(sim_->num_frames());
+        // Start over: the next loop's scenario begins where this one ended on the same clock.
+        so_.t0_s = sim_->frame_time(frames_per_loop());
         sim_ = std::make_unique<fploc::sim::Simulator>(plan_, so_);
         k_ = 0;
         imu_k_ = 0;
@@ -147,7 +152,8 @@ class SimSensorNode : public fploc::rt::Node {
       }
     }
     const auto& imu = sim_->imu();
-    for (; imu_k_ < imu.size() && so_.t0_s + imu[imu_k_].t <= ts; ++imu_k_) {
+    const double imu_end = sim_->frame_time(frames_per_loop());
+    for (; imu_k_ < imu.size() && so_.t0_s + imu[imu_k_].t <= ts && so_.t0_s + imu[imu_k_].t < imu_end; ++imu_k_) {
       fploc::os1::ImuSample s;
       s.sys_ts_ns = s.accel_ts_ns = s.gyro_ts_ns = uint64_t(std::llround((so_.t0_s + imu[imu_k_].t) * 1e9));
       for (int i = 0; i < 3; ++i) {
@@ -159,6 +165,12 @@ class SimSensorNode : public fploc::rt::Node {
     }
   }
 
+  // Frames of one pass of the scenario (all of it, or the first duration_s seconds).
+  int frames_per_loop() const {
+    const int n = sim_->num_frames();
+    return duration_s_ > 0 ? std::min(n, int(std::floor(duration_s_ * so_.rate_hz))) : n;
+  }
+
   fploc::rt::Context* ctx_ = nullptr;
   fploc::FloorPlan plan_;
   fploc::sim::SimulatorOptions so_;
@@ -168,7 +180,7 @@ class SimSensorNode : public fploc::rt::Node {
   fploc::rt::Publisher<fploc::ground_truth_t> gt_;
   int fd_ = -1;
   sockaddr_in lidar_addr_{}, imu_addr_{};
-  double wall0_ = 0, rate_ = 1;
+  double wall0_ = 0, rate_ = 1, clock0_s_ = 0, duration_s_ = 0;
   bool loop_ = false, done_ = false;
   std::string scenario_;
   int k_ = 0;

@@ -128,7 +128,7 @@ class Bench:
              f"odom_logger.file={out['odom']}", f"odom_map_logger.file={out['odom_map']}"]
         if self.a.plan:
             for n in ("matcher", "optimizer"):
-                for i, layer in enumerate(self.a.layers or []):
+                for layer in self.a.layers:
                     s.append(f"{n}.plan.layers={layer}")
                 if self.a.units:
                     s.append(f"{n}.plan.units={self.a.units}")
@@ -310,7 +310,8 @@ def main():
     ap = argparse.ArgumentParser(prog="fploc bench paper", description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help=f"only {', '.join(QUICK)}")
     ap.add_argument("--plan", help="any floor plan (.dxf/.csv/.json); with --scenario (e.g. auto-loop-medium)")
-    ap.add_argument("--layers", action="append", help="plan layer globs (with --plan)")
+    ap.add_argument("--layers", action="append",
+                    help="plan layer globs, comma-separated (repeatable; with --plan), e.g. 'Walls,Columns'")
     ap.add_argument("--units", help="m|cm|mm (with --plan)")
     ap.add_argument("--scenario", action="append", help="scenario name (repeatable); default: all of the paper's")
     ap.add_argument("--seed", type=int, default=1)
@@ -332,8 +333,10 @@ def main():
             ap.error(f"--plan {a.plan}: no such file")
         a.plan = os.path.abspath(a.plan)
     a.plan_args = []
-    for layer in a.layers or []:
-        a.plan_args += ["--layers", layer]
+    # One comma-separated list, as in every other command (fploc sim, fploc map) and in plan.layers.
+    a.layers = [g for arg in (a.layers or []) for g in arg.split(",") if g]
+    if a.layers:
+        a.plan_args += ["--layers", ",".join(a.layers)]
     if a.units:
         a.plan_args += ["--units", a.units]
     a.graph = os.path.abspath(a.graph)

@@ -1,13 +1,18 @@
-// fploc eval --gt GT.tum --est EST.tum [--plot FILE.svg] [--json] [--align none|se2|se3]
-//            [--max-dt S] [--offset S] [--delta D] [--delta-unit s|f]
+// fploc eval --gt GT.tum --est EST.tum [--plot FILE.svg [--plan P [--layers A,B] [--units U]]] [--json]
+//            [--align none|se2|se3] [--max-dt S] [--offset S] [--delta D] [--delta-unit s|f]
+//            [--uncertainty EST.unc [--false-ok-m M]]
 // ATE and RPE as in Sturm et al. 2012 (see modules/eval). No alignment by default: fploc poses are in
-// the floor-plan frame, like the ground truth. JSON on stdout with --json, a summary on stderr.
+// the floor-plan frame, like the ground truth. With --uncertainty (fploc-pose-logger's uncertainty_file):
+// NEES of x, y, yaw and the false-OK count (modules/eval/uncertainty.h). JSON on stdout with --json, a
+// summary on stderr.
 #include <cmath>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "fploc/eval/eval.h"
+#include "fploc/eval/uncertainty.h"
+#include "fploc/floorplan/io.h"
 
 using namespace fploc;
 
@@ -15,13 +20,16 @@ static void usage() {
   std::cerr << "usage: fploc eval --gt GT.tum --est EST.tum [--plot FILE.svg] [--json]\n"
                "       [--align none|se2|se3] (default none: both in the floor-plan frame)\n"
                "       [--max-dt S] (association, default 0.02) [--offset S] (added to est times)\n"
-               "       [--delta D] [--delta-unit s|f] (RPE delta, default 1 s; f = frames)\n";
+               "       [--delta D] [--delta-unit s|f] (RPE delta, default 1 s; f = frames)\n"
+               "       [--plan FILE [--layers A,B] [--units U]] (drawn under the trajectories of --plot)\n"
+               "       [--uncertainty FILE] (status + x/y/yaw covariance per pose: NEES and false OK)\n"
+               "       [--false-ok-m M] (horizontal error of a false OK, default 0.3)\n";
 }
 
 int main(int argc, char** argv) {
-  std::string gt_path, est_path, plot, align_s = "none", unit = "s";
+  std::string gt_path, est_path, plot, align_s = "none", unit = "s", plan_path, layers, units, unc_path;
   bool json = false;
-  double max_dt = 0.02, offset = 0, delta = 1.0;
+  double max_dt = 0.02, offset = 0, delta = 1.0, false_ok_m = 0.3;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -41,6 +49,11 @@ int main(int argc, char** argv) {
       else if (a == "--offset") offset = std::stod(next());
       else if (a == "--delta") delta = std::stod(next());
       else if (a == "--delta-unit") unit = next();
+      else if (a == "--plan") plan_path = next();
+      else if (a == "--layers") layers = next();
+      else if (a == "--units") units = next();
+      else if (a == "--uncertainty") unc_path = next();
+      else if (a == "--false-ok-m") false_ok_m = std::stod(next());
       else if (a == "-h" || a == "--help") { usage(); return 0; }
       else { std::cerr << "fploc eval: unexpected argument '" << a << "'\n"; usage(); return 2; }
     } catch (const std::exception&) {
@@ -48,7 +61,8 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (gt_path.empty() || est_path.empty() || (unit != "s" && unit != "f") || !(delta > 0) || !(max_dt >= 0)) {
+  if (gt_path.empty() || est_path.empty() || (unit != "s" && unit != "f") || !(delta > 0) || !(max_dt >= 0) ||
+      !(false_ok_m > 0)) {
     usage();
     return 2;
   }
@@ -64,10 +78,29 @@ int main(int argc, char** argv) {
     const auto a = eval::ate(gt, est, pairs, align);
     const auto r = eval::rpe(gt, est, pairs, delta, unit == "f");
     if (!plot.empty()) {
+      eval::PlotOptions po;
+      if (!plan_path.empty()) {
+        const FloorPlan plan = load_floor_plan(plan_path, {layers}, units);
+        for (const auto& e : plan.elements) {
+          std::vector<Eigen::Vector2d> l;
+          if (e.kind == ElementKind::kSegment) {
+            l = {e.a, e.b};
+          } else {
+            const double a0 = e.kind == ElementKind::kCircle ? 0.0 : e.a0, a1 = e.kind == ElementKind::kCircle ? 2 * M_PI : e.a1;
+            const int n = std::max(8, int(std::ceil((a1 - a0) * 16 / M_PI)));
+            for (int k = 0; k <= n; ++k) {
+              const double t = a0 + (a1 - a0) * k / n;
+              l.push_back(e.c + e.r * Eigen::Vector2d(std::cos(t), std::sin(t)));
+            }
+          }
+          po.plan.push_back(std::move(l));
+        }
+      }
+      po.est_error = eval::pose_errors(gt, est, pairs, a.S);
       std::ofstream out(plot);
       out << eval::plot_svg(gt, est, "ATE RMSE " + std::to_string(a.trans.rmse).substr(0, 6) + " m (" +
                                          (align_s == "none" ? std::string("no") : align_s) + " alignment), " +
-                                         std::to_string(pairs.size()) + " poses", a.S);
+                                         std::to_string(pairs.size()) + " poses", a.S, po);
       if (!out) throw std::runtime_error(plot + ": cannot write");
     }
     auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
@@ -85,6 +118,27 @@ int main(int argc, char** argv) {
                      {"gt_poses", gt.size()},
                      {"est_poses", est.size()},
                      {"align", align_s}};
+    if (!unc_path.empty()) {
+      const auto u = eval::read_uncertainty(unc_path);
+      const auto c = eval::consistency(gt, est, pairs, u, false_ok_m, a.S);
+      if (c.poses == 0)
+        throw std::runtime_error(unc_path + ": no record at the time of an associated pose of " + est_path);
+      j["uncertainty_poses"] = c.poses;
+      j["nees_poses"] = c.nees_poses;
+      j["nees_mean"] = num(c.nees.mean);
+      j["nees_median"] = num(c.nees.median);
+      j["nees_x_median"] = num(c.nees_x.median);
+      j["nees_y_median"] = num(c.nees_y.median);
+      j["nees_yaw_median"] = num(c.nees_yaw.median);
+      j["ok_poses"] = c.ok;
+      j["false_ok_poses"] = c.false_ok;
+      j["false_ok_share"] = c.false_ok_share;
+      j["false_ok_m"] = c.false_ok_m;
+      std::cerr << "fploc eval: uncertainty of " << c.poses << " poses: NEES (x, y, yaw; 3 if consistent) median "
+                << c.nees.median << ", mean " << c.nees.mean << " over " << c.nees_poses << "; 1-DoF medians x "
+                << c.nees_x.median << ", y " << c.nees_y.median << ", yaw " << c.nees_yaw.median << "; " << c.ok
+                << " OK, " << c.false_ok << " false OK (horizontal error > " << c.false_ok_m << " m)\n";
+    }
     std::cerr << "fploc eval: " << pairs.size() << " associated poses (gt " << gt.size() << ", est " << est.size()
               << "); ATE rmse " << a.trans.rmse << " m, mean " << a.trans.mean << " m, max " << a.trans.max
               << " m; RPE/" << delta << unit << " mean " << r.trans.mean << " m, " << r.rot_deg.mean << " deg ("

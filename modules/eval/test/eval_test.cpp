@@ -159,3 +159,37 @@ TEST(Plot, SvgHasBothPaths) {
   EXPECT_EQ(n, 2u);
   EXPECT_NE(svg.find("a &lt; b"), std::string::npos);
 }
+
+// The plot a reader wants (issue 14): the plan under the trajectories, axes in metres, a legend and the
+// estimate coloured by its error with a colour bar.
+TEST(Plot, PlanAxesLegendAndErrorColours) {
+  const auto gt = loop(30);
+  auto est = gt;
+  for (size_t i = 0; i < est.size(); ++i) est[i].p.x() += 0.01 * double(i);
+  PlotOptions o;
+  o.plan = {{Eigen::Vector2d(-20, -20), Eigen::Vector2d(20, -20), Eigen::Vector2d(20, 20)}};
+  const auto pairs = associate(gt, est);
+  o.est_error = pose_errors(gt, est, pairs);
+  ASSERT_EQ(o.est_error.size(), est.size());
+  EXPECT_NEAR(o.est_error.back(), 0.01 * double(est.size() - 1), 1e-9);
+  const auto svg = plot_svg(gt, est, "t", Eigen::Isometry3d::Identity(), o);
+  EXPECT_NE(svg.find("x [m]"), std::string::npos);
+  EXPECT_NE(svg.find("y [m]"), std::string::npos);
+  EXPECT_NE(svg.find("floor plan"), std::string::npos);
+  EXPECT_NE(svg.find("estimate (colour: error)"), std::string::npos);
+  EXPECT_NE(svg.find("ground truth"), std::string::npos);
+  // Tick labels: the plan's corner at -20 / 20 m is inside the axes.
+  EXPECT_NE(svg.find(">-20</text>"), std::string::npos);
+  EXPECT_NE(svg.find(">20</text>"), std::string::npos);
+  // One coloured segment per consecutive estimate pair: the first (lowest error) blue, the last red (jet).
+  const size_t g0 = svg.find("<title>estimate (colour: error)</title>");
+  ASSERT_NE(g0, std::string::npos);
+  const size_t g1 = svg.find("</g>", g0);
+  size_t n = 0;
+  for (size_t p = svg.find("<line x1", g0); p < g1; p = svg.find("<line x1", p + 1)) ++n;
+  EXPECT_EQ(n, est.size() - 1);
+  const std::string first = svg.substr(svg.find("stroke=\"#", g0) + 8, 7), last = svg.substr(svg.rfind("stroke=\"#", g1) + 8, 7);
+  EXPECT_EQ(first, "#000080");  // jet(0)
+  EXPECT_EQ(last.substr(3), "0000") << last;  // jet(~1): red only
+  EXPECT_GT(std::stoi(last.substr(1, 2), nullptr, 16), 0x80) << last;
+}

@@ -108,6 +108,16 @@ bool layer_selected(const std::vector<std::string>& globs, const std::string& la
   return false;
 }
 
+std::vector<std::string> split_layer_globs(const std::vector<std::string>& lists) {
+  std::vector<std::string> out;
+  for (const auto& l : lists) {
+    std::stringstream ss(l);
+    for (std::string g; std::getline(ss, g, ',');)
+      if (!g.empty()) out.push_back(g);
+  }
+  return out;
+}
+
 void filter_layers(FloorPlan& plan, const std::vector<std::string>& globs) {
   if (globs.empty()) return;
   const size_t before = plan.elements.size();
@@ -395,7 +405,10 @@ FloorPlan load_floor_plan(const std::string& path, const std::vector<std::string
   return load_floor_plan(path, o);
 }
 
-FloorPlan load_floor_plan(const std::string& path, const PlanLoadOptions& options) {
+FloorPlan load_floor_plan(const std::string& path, const PlanLoadOptions& options_in) {
+  // Layer globs are comma-separated lists wherever they come from (--layers 'A,B', plan.layers: "A,B").
+  PlanLoadOptions options = options_in;
+  options.layer_globs = split_layer_globs(options_in.layer_globs);
   const std::string ext = extension(path);
   if (is_building_file(path)) {
     BuildingLoadOptions bo;

@@ -73,6 +73,21 @@ TEST(PlanIo, JsonUnitsAndLayerGlobs) {
   EXPECT_NEAR(plan.elements[0].b.x(), 1.0, 1e-12);
 }
 
+// One meaning of a layer list everywhere: "A,B" as one entry (--layers 'A,B', plan.layers: "A,B") selects
+// the same elements as the two entries "A" and "B" (the bench used to pass "A,B" as one glob).
+TEST(PlanIo, CommaSeparatedLayerListIsSplit) {
+  EXPECT_EQ(split_layer_globs({"*wall*,S-COLS", "", "x,,y"}),
+            (std::vector<std::string>{"*wall*", "S-COLS", "x", "y"}));
+  const auto p = std::filesystem::temp_directory_path() / "fploc-layers-test.json";
+  std::ofstream(p) << R"({"elements":[{"type":"segment","a":[0,0],"b":[1,0],"layer":"A-WALL"},
+    {"type":"circle","c":[0,0],"r":0.3,"layer":"S-COLS"},{"type":"segment","a":[0,1],"b":[1,1],"layer":"F"}]})";
+  const auto one = load_floor_plan(p.string(), {"*wall*,S-COLS"});
+  const auto two = load_floor_plan(p.string(), {"*wall*", "S-COLS"});
+  std::filesystem::remove(p);
+  EXPECT_EQ(one.elements.size(), 2u);
+  EXPECT_EQ(two.elements.size(), 2u);
+}
+
 TEST(PlanIo, EmptyLayerSelectionIsAnError) {
   std::istringstream in(R"({"elements":[{"type":"segment","a":[0,0],"b":[1,0],"layer":"walls"}]})");
   PlanLoadOptions o;

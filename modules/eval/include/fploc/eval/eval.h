@@ -51,8 +51,21 @@ struct Rpe {
 Rpe rpe(const Trajectory& gt, const Trajectory& est, const Pairs& pairs, double delta = 1.0, bool frames = false,
         double max_gap_s = 0.05);
 
-// SVG (x-y plane, metres, equal axes) of the ground truth and the (aligned) estimate.
+// What a trajectory plot shows besides the two trajectories.
+struct PlotOptions {
+  // The floor plan as polylines (plan frame, metres), drawn under the trajectories.
+  std::vector<std::vector<Eigen::Vector2d>> plan;
+  // Per estimate pose (same order as `est`), its error [m]; NaN = not associated. Non-empty: the
+  // estimate is coloured by error (as evo's --plot_mode xy with colour mapping) with a colour bar.
+  std::vector<double> est_error;
+};
+
+// SVG (x-y plane, metres, equal axes, ticks and axis labels in metres, legend) of the ground truth and
+// the (aligned) estimate, with the plan and the error colouring of `o`.
 std::string plot_svg(const Trajectory& gt, const Trajectory& est, const std::string& title,
-                     const Eigen::Isometry3d& S = Eigen::Isometry3d::Identity());
+                     const Eigen::Isometry3d& S = Eigen::Isometry3d::Identity(), const PlotOptions& o = {});
+// Per estimate pose, the translational error after S (|gt - S est| of its pair), NaN without a pair.
+std::vector<double> pose_errors(const Trajectory& gt, const Trajectory& est, const Pairs& pairs,
+                                const Eigen::Isometry3d& S = Eigen::Isometry3d::Identity());
 
 }  // namespace fploc::eval

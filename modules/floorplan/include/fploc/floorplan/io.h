@@ -39,8 +39,12 @@ bool glob_match(const std::string& pattern, const std::string& text);
 // True when `layer` matches any glob (or the list is empty).
 bool layer_selected(const std::vector<std::string>& globs, const std::string& layer);
 
+// Splits every entry on commas ("A,B" -> "A", "B"; empty parts dropped): one meaning of a layer list in
+// every command (--layers) and option (plan.layers), applied by load_floor_plan.
+std::vector<std::string> split_layer_globs(const std::vector<std::string>& lists);
+
 struct PlanLoadOptions {
-  std::vector<std::string> layer_globs;  // empty = all layers
+  std::vector<std::string> layer_globs;  // empty = all layers; entries may be comma-separated lists
   std::string units_override;            // "" = the file's own units (CSV: metres)
   bool quiet = false;                    // no notes on stderr (dropped entities etc.)
   // DXF only: robust extents. Entities farther than `outlier_factor` times the robust spread
