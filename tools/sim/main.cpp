@@ -180,7 +180,13 @@ int main(int argc, char** argv) {
                                                                                                : fploc::sim::demo_room_plan())
                                                                 : plan;
       std::ofstream tf(truth_path);
-      tf << edit->truth_json(plan_used) << "\n";
+      // Plus the static clutter the simulator put in (furniture, cabinets): unmapped, but not the building.
+      nlohmann::json tj = nlohmann::json::parse(edit->truth_json(plan_used));
+      auto& fj = tj["furniture"] = nlohmann::json::array();
+      for (const auto& f : sim.world().furniture())
+        fj.push_back({{"c", {f.center.x(), f.center.y()}}, {"yaw", f.yaw}, {"half", {f.half.x(), f.half.y()}}, {"height", f.z1}});
+      tj["people"] = sim.world().people().size();
+      tf << tj.dump(1) << "\n";
       if (!tf) throw std::runtime_error(truth_path + ": cannot write the world truth");
       std::cerr << "fploc sim: world-vs-plan truth written to " << truth_path << "\n";
     }

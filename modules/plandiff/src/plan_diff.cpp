@@ -216,6 +216,20 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
   }
   for (size_t e = 0; e < offs.size(); ++e)
     if (offs[e].size() >= 5) acc_[e].frame_offsets.push_back(float(median_of(offs[e])));
+  // Every unexplained cell seen so far: was it in view in this scan (in range, nothing measured in front)?
+  // Static structure is hit in a good share of the scans that see its place; a person's track is not.
+  for (auto& [k, cell] : cells_) {
+    const int ix = int(k >> 32), iy = int(int32_t(uint32_t(k & 0xffffffff)));
+    const V2 d = V2((ix + 0.5) * o_.new_cell_m, (iy + 0.5) * o_.new_cell_m) - s;
+    const double r = d.norm();
+    if (cell.last_frame == frame) {
+      ++cell.in_view;
+      continue;
+    }
+    if (r < o_.min_range_m || r > o_.max_range_m) continue;
+    if (min_range[size_t(bin_of(d))] < r - 0.2) continue;
+    ++cell.in_view;
+  }
 
   // Visibility probes: expected (in range, not grazing, not behind another plan element, nothing measured
   // well in front of it) and seen (a point of this element in the probe's bearing).
@@ -284,7 +298,7 @@ Diff PlanDiff::result() const {
   std::vector<V2> pts;
   std::vector<int> pf;
   for (const auto& [k, c] : cells_) {
-    if (c.frames < o_.new_min_frames) continue;
+    if (c.frames < o_.new_min_frames || c.frames < o_.new_min_hit_ratio * c.in_view) continue;
     const int ix = int(k >> 32), iy = int(int32_t(uint32_t(k & 0xffffffff)));
     pts.emplace_back((ix + 0.5) * o_.new_cell_m, (iy + 0.5) * o_.new_cell_m);
     pf.push_back(c.frames);

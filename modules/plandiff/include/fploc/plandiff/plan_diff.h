@@ -37,7 +37,8 @@ struct Options {
   double moved_min_m = 0.07;        // |median offset| at least this: moved
   double moved_max_spread_m = 0.05; // ... and the per-frame offsets agree (MAD) within this
   double new_cell_m = 0.05;         // grid of unexplained points
-  int new_min_frames = 5;           // a cell hit in at least this many frames is static structure
+  int new_min_frames = 5;           // a cell hit in at least this many frames ...
+  double new_min_hit_ratio = 0.3;   // ... and in this share of the scans that had it in view is static structure
   double new_min_length_m = 0.8;    // shortest new wall reported
   double new_line_tol_m = 0.05;
   double new_max_gap_m = 0.3;
@@ -94,7 +95,7 @@ class PlanDiff {
     int64_t expected = 0, seen = 0;
   };
   struct Cell {
-    int frames = 0, last_frame = -1, points = 0;
+    int frames = 0, last_frame = -1, points = 0, in_view = 0;
   };
   int nearest(const Eigen::Vector2d& p, double* signed_offset, bool* inside, const Eigen::Vector2d* sensor) const;
   bool plan_blocks(const Eigen::Vector2d& o, const Eigen::Vector2d& q, int skip) const;
