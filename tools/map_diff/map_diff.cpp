@@ -4,7 +4,8 @@
 // reads (default FPLOC_FEATURES and FPLOC_POSE_LATEST) — a live run recorded with lcm-logger, or
 // `fploc replay --graph G --log SIM.lcm --record LOG.lcm`. The plan and the detector's options come from
 // the graph's plan_diff node (or, without one, the plan of its matcher). Writes JSON and/or DXF (layers
-// FPLOC-MISSING, FPLOC-MOVED, FPLOC-NEW, FPLOC-PLAN) by the --out extension; --json prints the summary.
+// FPLOC-MISSING, FPLOC-MOVED, FPLOC-NEW, FPLOC-PLAN) by the --out extension; --json prints the JSON diff on stdout; --all lists
+// every element (also those seen where expected).
 #include <fploc/features_t.hpp>
 #include <fploc/pose_t.hpp>
 #include <lcm/lcm-cpp.hpp>
@@ -25,7 +26,7 @@ namespace {
 
 void usage() {
   std::cerr << "usage: fploc map diff --graph GRAPH --log LOG.lcm --out DIFF.json|DIFF.dxf [--out ...] [--json]\n"
-               "       [--features-channel C] [--pose-channel C]\n";
+               "       [--features-channel C] [--pose-channel C] [--all (every element in the JSON, also those seen)]\n";
 }
 
 std::string lower_ext(const std::string& p) {
@@ -39,7 +40,7 @@ std::string lower_ext(const std::string& p) {
 int main(int argc, char** argv) {
   std::string graph_path, log_path, feat_ch, pose_ch;
   std::vector<std::string> outs;
-  bool json = false;
+  bool json = false, all = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -55,6 +56,7 @@ int main(int argc, char** argv) {
     else if (a == "--features-channel") feat_ch = next();
     else if (a == "--pose-channel") pose_ch = next();
     else if (a == "--json") json = true;
+    else if (a == "--all") all = true;
     else if (a == "-h" || a == "--help") { usage(); return 0; }
     else { std::cerr << "fploc map diff: unexpected argument '" << a << "'\n"; usage(); return 2; }
   }
@@ -150,7 +152,7 @@ int main(int argc, char** argv) {
     for (const auto& o : outs) {
       std::ofstream f(o);
       if (!f) throw std::runtime_error(o + ": cannot write");
-      if (lower_ext(o) == ".json") fploc::plandiff::write_json(r, plan, f);
+      if (lower_ext(o) == ".json") fploc::plandiff::write_json(r, plan, f, all);
       else fploc::plandiff::write_dxf(r, plan, f);
       if (!f) throw std::runtime_error(o + ": write failed");
     }
@@ -158,7 +160,7 @@ int main(int argc, char** argv) {
               << r.count(fploc::plandiff::Status::kSeen) << " seen, " << r.count(fploc::plandiff::Status::kMissing)
               << " missing, " << r.count(fploc::plandiff::Status::kMoved) << " moved, "
               << r.count(fploc::plandiff::Status::kUnobserved) << " unobserved, " << r.added.size() << " new\n";
-    if (json) fploc::plandiff::write_json(r, plan, std::cout);
+    if (json) fploc::plandiff::write_json(r, plan, std::cout, all);
   } catch (const std::exception& e) {
     std::cerr << "fploc map diff: " << e.what() << "\n";
     return 1;
