@@ -3,6 +3,7 @@
 // (cpp-httplib) runs on its own thread pool, one thread per SSE client, each pushing the newest values
 // at most max_push_hz times per second. A slow browser only delays its own thread.
 #include <fploc/features_t.hpp>
+#include <fploc/plan_diff_t.hpp>
 #include <fploc/frame_pose_t.hpp>
 #include <fploc/ground_truth_t.hpp>
 #include <fploc/node_command_t.hpp>
@@ -22,6 +23,7 @@
 #include "fploc/runtime/graph.h"
 #include "fploc/runtime/node.h"
 #include "model.h"
+#include "plan_diff_json.h"
 #include "options/tools.pb.h"
 #include "plan_json.h"
 #include "web_path.h"
@@ -73,7 +75,9 @@ class DashboardNode : public fploc::rt::Node {
              fploc::rt::input<fploc::frame_pose_t>("frame_pose", "FPLOC_FRAME_POSE"),
              fploc::rt::input<fploc::features_t>("features", "FPLOC_FEATURES"),
              fploc::rt::input<fploc::ground_truth_t>("ground_truth", "FPLOC_GROUND_TRUTH"),
-             fploc::rt::input<fploc::node_status_t>("telemetry", fploc::rt::kTelemetryChannel)}};
+             fploc::rt::input<fploc::node_status_t>("telemetry", fploc::rt::kTelemetryChannel),
+             // Not connected unless the graph maps it (to FPLOC_PLAN_DIFF, where fploc-plan-diff publishes).
+             fploc::rt::input<fploc::plan_diff_t>("plan_diff", "")}};
   }
 
   ~DashboardNode() override { stop_server(); }
@@ -125,6 +129,8 @@ class DashboardNode : public fploc::rt::Node {
         "ground_truth", [this](const fploc::ground_truth_t& m) { model_->on_ground_truth(m, steady_s(), wall_us()); });
     ctx.subscribe<fploc::node_status_t>("telemetry",
                                         [this](const fploc::node_status_t& m) { model_->on_status(m, steady_s()); });
+    if (!ctx.channel("plan_diff").empty())
+      ctx.subscribe<fploc::plan_diff_t>("plan_diff", [this](const fploc::plan_diff_t& m) { model_->on_plan_diff(plan_diff_json(m)); });
     ctx.every(0.5, [this] {
       model_->tick(steady_s(), wall_us());
       if (!listening_) try_listen();

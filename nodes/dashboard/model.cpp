@@ -54,6 +54,11 @@ void Model::set_slot(const std::string& name, std::string j) {
   cv_.notify_all();
 }
 
+void Model::on_plan_diff(std::string j) {
+  std::lock_guard<std::mutex> lk(mu_);
+  set_slot("plan_diff", std::move(j));
+}
+
 void Model::set_plan_json(std::string j) {
   std::lock_guard<std::mutex> lk(mu_);
   plan_json_ = std::move(j);

@@ -104,8 +104,11 @@ class PlanDiffNode : public fploc::rt::Node {
     msg.elements_missing = r.count(Status::kMissing);
     msg.elements_moved = r.count(Status::kMoved);
     msg.elements_unobserved = r.count(Status::kUnobserved);
-    auto item = [&](int8_t kind, int32_t el, double x0, double y0, double x1, double y1, double off, double ratio) {
+    msg.scale_error = r.scale_error;
+    msg.scale_sigma = r.scale_sigma;
+    auto item = [&](int8_t kind, int32_t el, bool circle, double x0, double y0, double x1, double y1, double off, double ratio) {
       msg.kind.push_back(kind);
+      msg.circle.push_back(circle);
       msg.element.push_back(el);
       msg.x0.push_back(float(x0));
       msg.y0.push_back(float(y0));
@@ -121,12 +124,12 @@ class PlanDiffNode : public fploc::rt::Node {
       const int8_t kind = e.status == Status::kMissing ? 1 : 2;
       if (p.kind == fploc::ElementKind::kSegment) {
         const Eigen::Vector2d u = (p.b - p.a).normalized(), s = off * Eigen::Vector2d(-u.y(), u.x());
-        item(kind, e.id, p.a.x() + s.x(), p.a.y() + s.y(), p.b.x() + s.x(), p.b.y() + s.y(), off, e.seen_ratio());
+        item(kind, e.id, false, p.a.x() + s.x(), p.a.y() + s.y(), p.b.x() + s.x(), p.b.y() + s.y(), off, e.seen_ratio());
       } else {
-        item(kind, e.id, p.c.x(), p.c.y(), p.r + off, 0, off, e.seen_ratio());
+        item(kind, e.id, true, p.c.x(), p.c.y(), p.r + off, 0, off, e.seen_ratio());
       }
     }
-    for (const auto& n : r.added) item(3, -1, n.a.x(), n.a.y(), n.b.x(), n.b.y(), n.rms_m, 0);
+    for (const auto& n : r.added) item(3, -1, false, n.a.x(), n.a.y(), n.b.x(), n.b.y(), n.rms_m, 0);
     msg.num_items = int32_t(msg.kind.size());
     out_.publish(msg);
   }

@@ -17,6 +17,7 @@ void write_json(const Diff& d, const FloorPlan& plan, std::ostream& out, bool al
                   {"moved", d.count(Status::kMoved)},
                   {"unobserved", d.count(Status::kUnobserved)},
                   {"new", d.added.size()}};
+  j["scale"] = {{"error", d.scale_error}, {"sigma", d.scale_sigma}, {"points", d.scale_points}};
   auto& el = j["elements"] = nlohmann::json::array();
   for (const auto& e : d.elements) {
     if (!all_elements && e.status == Status::kSeen) continue;

@@ -191,6 +191,10 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
   std::vector<std::vector<Obs>> bins(static_cast<size_t>(nb));
   std::vector<float> min_range(size_t(nb), std::numeric_limits<float>::infinity());
   std::vector<std::vector<float>> offs(plan_.elements.size());
+  Eigen::Matrix3d sA = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d sg = Eigen::Vector3d::Zero();
+  double so2 = 0;
+  int scount = 0;
   for (const auto& pf : points) {
     const V2 ps(pf.x(), pf.y());
     const double r = ps.norm();
@@ -204,6 +208,17 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
     min_range[size_t(b)] = std::min(min_range[size_t(b)], float(r));
     if (e >= 0) {
       if (inside) offs[size_t(e)].push_back(float(off));
+      const Element& el = plan_.elements[size_t(e)];
+      if (inside && el.kind == ElementKind::kSegment && std::abs(off) < o_.scale_max_offset_m) {
+        // Scale model: off = scale * n.(q - sensor) + n.b (b: this scan's registration bias).
+        const V2 n = left_normal(el);
+        const double dd = n.dot(p - s) - off;
+        const Eigen::Vector3d row(dd, n.x(), n.y());
+        sA += row * row.transpose();
+        sg += row * off;
+        so2 += off * off;
+        ++scount;
+      }
     } else {
       const int ix = int(std::floor(p.x() / o_.new_cell_m)), iy = int(std::floor(p.y() / o_.new_cell_m));
       Cell& cell = cells_[cell_key(ix, iy)];
@@ -212,15 +227,35 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
         ++cell.frames;
       }
       ++cell.points;
+      Cell& vc = view_[cell_key(int(std::floor(p.x() / o_.new_view_cell_m)), int(std::floor(p.y() / o_.new_view_cell_m)))];
+      if (vc.last_frame != frame) {
+        vc.last_frame = frame;
+        ++vc.frames;
+      }
     }
   }
   for (size_t e = 0; e < offs.size(); ++e)
     if (offs[e].size() >= 5) acc_[e].frame_offsets.push_back(float(median_of(offs[e])));
+  // The scan's bias (b) eliminated (Schur complement): what this scan tells about the scale.
+  if (scount >= 20) {
+    const Eigen::Matrix2d Abb = sA.bottomRightCorner<2, 2>();
+    const double det = Abb(0, 0) * Abb(1, 1) - Abb(0, 1) * Abb(1, 0);
+    if (det > 1e-9 * std::max(1.0, Abb.trace() * Abb.trace())) {
+      Eigen::Matrix2d inv;
+      inv << Abb(1, 1), -Abb(0, 1), -Abb(1, 0), Abb(0, 0);
+      inv /= det;
+      const Eigen::Vector2d Asb = sA.block<2, 1>(1, 0);
+      scale_h_ += sA(0, 0) - Asb.dot(inv * Asb);
+      scale_g_ += sg(0) - Asb.dot(inv * sg.tail<2>());
+      scale_o2_ += so2 - sg.tail<2>().dot(inv * sg.tail<2>());
+      scale_n_ += scount - 2;
+    }
+  }
   // Every unexplained cell seen so far: was it in view in this scan (in range, nothing measured in front)?
   // Static structure is hit in a good share of the scans that see its place; a person's track is not.
-  for (auto& [k, cell] : cells_) {
+  for (auto& [k, cell] : view_) {
     const int ix = int(k >> 32), iy = int(int32_t(uint32_t(k & 0xffffffff)));
-    const V2 d = V2((ix + 0.5) * o_.new_cell_m, (iy + 0.5) * o_.new_cell_m) - s;
+    const V2 d = V2((ix + 0.5) * o_.new_view_cell_m, (iy + 0.5) * o_.new_view_cell_m) - s;
     const double r = d.norm();
     if (cell.last_frame == frame) {
       ++cell.in_view;
@@ -269,6 +304,15 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
 Diff PlanDiff::result() const {
   Diff d;
   d.frames = frames_;
+  if (scale_h_ > 0 && scale_n_ > 10) {
+    d.scale_error = scale_g_ / scale_h_;
+    const double var = std::max(0.0, (scale_o2_ - d.scale_error * scale_g_) / (scale_n_ - 1));
+    // Points of one scan are not independent (the same walls, frame after frame): the sigma counts every
+    // scan as one observation of its walls, i.e. it is inflated by sqrt(points per scan).
+    const double per_scan = double(scale_n_) / std::max(1, frames_);
+    d.scale_sigma = std::sqrt(var / scale_h_ * std::max(1.0, per_scan));
+    d.scale_points = scale_n_;
+  }
   d.elements.resize(plan_.elements.size());
   for (size_t i = 0; i < plan_.elements.size(); ++i) {
     const Acc& a = acc_[i];
@@ -298,8 +342,13 @@ Diff PlanDiff::result() const {
   std::vector<V2> pts;
   std::vector<int> pf;
   for (const auto& [k, c] : cells_) {
-    if (c.frames < o_.new_min_frames || c.frames < o_.new_min_hit_ratio * c.in_view) continue;
+    if (c.frames < o_.new_min_frames) continue;
     const int ix = int(k >> 32), iy = int(int32_t(uint32_t(k & 0xffffffff)));
+    {
+      const V2 q((ix + 0.5) * o_.new_cell_m, (iy + 0.5) * o_.new_cell_m);
+      const auto it = view_.find(cell_key(int(std::floor(q.x() / o_.new_view_cell_m)), int(std::floor(q.y() / o_.new_view_cell_m))));
+      if (it == view_.end() || it->second.frames < o_.new_min_hit_ratio * it->second.in_view) continue;
+    }
     pts.emplace_back((ix + 0.5) * o_.new_cell_m, (iy + 0.5) * o_.new_cell_m);
     pf.push_back(c.frames);
   }

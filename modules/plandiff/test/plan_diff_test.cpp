@@ -124,3 +124,13 @@ TEST(PlanDiff, DxfHasTheLayersAndLoadsBack) {
   plandiff::write_json(r.diff, r.plan, js);
   EXPECT_NE(js.str().find("\"missing\""), std::string::npos);
 }
+
+TEST(PlanDiff, EstimatesTheDrawingScale) {
+  const DiffRun s = simulate_and_diff("scale-0.5pct", 4);  // the building 0.5 % larger than its drawing
+  ASSERT_GT(s.diff.scale_points, 1000);
+  EXPECT_NEAR(s.diff.scale_error, 0.005, 0.001);
+  EXPECT_GT(s.diff.scale_sigma, 0.0);
+  EXPECT_LT(s.diff.scale_sigma, 0.002);
+  const DiffRun c = simulate_and_diff("crowd-15", 4);  // to scale
+  EXPECT_NEAR(c.diff.scale_error, 0.0, 0.001);
+}

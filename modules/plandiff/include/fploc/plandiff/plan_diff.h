@@ -5,6 +5,7 @@
 //   missing   in view (range, incidence), not hidden by another plan element nor by anything nearer that
 //             was measured (ray cast from the pose), and yet no point on it, frame after frame;
 //   moved     its points sit consistently at an offset along its normal (how far: the median offset);
+// a global drawing-scale error (the plan drawn or scanned at a slightly wrong scale);
 // and, for points near no plan element, a grid of cells hit in several frames from which straight runs
 // (RANSAC lines split at gaps) are reported as new structure.
 // No transport: the node (nodes/plan_diff) and `fploc map diff` feed it.
@@ -38,10 +39,12 @@ struct Options {
   double moved_max_spread_m = 0.05; // ... and the per-frame offsets agree (MAD) within this
   double new_cell_m = 0.05;         // grid of unexplained points
   int new_min_frames = 5;           // a cell hit in at least this many frames ...
-  double new_min_hit_ratio = 0.3;   // ... and in this share of the scans that had it in view is static structure
+  double new_min_hit_ratio = 0.3;   // ... and whose view cell was hit in this share of the scans that had it
+  double new_view_cell_m = 0.25;    // in view (nothing measured in front) is static structure
   double new_min_length_m = 0.8;    // shortest new wall reported
   double new_line_tol_m = 0.05;
   double new_max_gap_m = 0.3;
+  double scale_max_offset_m = 0.1;  // points this close to their wall enter the drawing-scale estimate
 };
 
 enum class Status : uint8_t { kUnobserved = 0, kSeen = 1, kMissing = 2, kMoved = 3 };
@@ -70,6 +73,11 @@ struct Diff {
   std::vector<ElementDiff> elements;  // one per plan element
   std::vector<NewStructure> added;
   int frames = 0;
+  // Drawing scale: the building is (1 + scale_error) times the plan (0.005: the drawing is 0.5 % too small),
+  // from every point's offset against its distance to the sensor along the wall's normal, each scan's
+  // registration bias eliminated. 0 with scale_points 0 when there was too little to tell.
+  double scale_error = 0, scale_sigma = 0;
+  int64_t scale_points = 0;
   int count(Status s) const;
 };
 
@@ -105,8 +113,11 @@ class PlanDiff {
   Options o_;
   std::vector<Probe> probes_;
   std::vector<Acc> acc_;
-  std::unordered_map<int64_t, Cell> cells_;
+  std::unordered_map<int64_t, Cell> cells_;  // new_cell_m: where
+  std::unordered_map<int64_t, Cell> view_;   // new_view_cell_m: hit in how many of the scans that saw it
   int frames_ = 0;
+  double scale_h_ = 0, scale_g_ = 0, scale_o2_ = 0;
+  int64_t scale_n_ = 0;
   // Uniform grid of elements (1 m cells, bounding boxes grown by assoc_m) for the point association.
   Eigen::Vector2d gmin_;
   int gx_ = 0, gy_ = 0;
@@ -114,7 +125,8 @@ class PlanDiff {
   std::vector<std::vector<int>> grid_;
 };
 
-// {"frames", "summary": {"seen", "missing", "moved", "unobserved", "new"}, "elements": [{"id", "status",
+// {"frames", "summary": {"seen", "missing", "moved", "unobserved", "new"}, "scale": {"error", "sigma", "points"},
+//  "elements": [{"id", "status",
 //  "offset_m", "offset_spread_m", "seen_ratio", "frames_expected", "frames_with_points", "a", "b" | "c", "r"}],
 //  "new": [{"a", "b", "length_m", "cells", "min_frames", "rms_m"}]}   (elements: only those not "seen"
 //  unless all_elements)
