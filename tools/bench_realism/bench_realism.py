@@ -17,7 +17,8 @@ Prints one JSON document on stdout (progress on stderr):
   {"rows": [{"family", "method", "ate_m", "max_m", "lost", "false_ok", "nees_median", "nees_poses",
              "ms_per_scan", "poses"}],
    "detection": [{"family", "removed", "removed_found", "moved", "moved_found", "added", "added_found",
-                  "flags", "false_flags", "false_flags_per_100m", "new_on_clutter", "precision", "recall"}],
+                  "flags", "false_flags", "false_flags_per_100m", "new_on_clutter", "precision", "recall",
+                  "scale_true", "scale_estimate", "scale_sigma"}],
    "config": {...}}
 Rates (lost, false_ok, precision, recall) are fractions 0..1.
 """
@@ -40,6 +41,8 @@ from fploc_tools import log, read_tum, yaw_of  # noqa: E402
 FAMILIES = ["clean", "asbuilt-2cm", "asbuilt-5cm", "scale-0.5pct", "renovated", "glass", "shelves", "doors",
             "crowd-15", "mixed"]
 # method -> (pose channel in the recorded log, nodes whose CPU time is the method's)
+# fploc+scale: fploc against the plan rescaled by the change detector's drawing-scale estimate (second pass,
+# only where the estimate is significant).
 METHODS = {"fploc": ("FPLOC_POSE", ("segmenter", "features", "matcher", "optimizer")),
            "amcl": ("FPLOC_AMCL_POSE", ("segmenter", "features", "odometry", "amcl_lidar")),
            "ndt": ("FPLOC_POSE", ("segmenter", "ndt"))}
@@ -241,6 +244,26 @@ def score_detection(diff, truth, moved_min=0.10, added_min=1.0):
             "recall": (found_r + found_m + found_a) / truth_n if truth_n else None}
 
 
+def scale_plan_json(src, dst, s):
+    """A JSON plan scaled by s about its bounding-box centre (segments, circles and arcs)."""
+    with open(src) as f:
+        j = json.load(f)
+    xs, ys = [], []
+    for e in j["elements"]:
+        for k in ("a", "b", "c"):
+            if k in e:
+                xs.append(e[k][0]); ys.append(e[k][1])
+    cx, cy = (min(xs) + max(xs)) / 2, (min(ys) + max(ys)) / 2
+    for e in j["elements"]:
+        for k in ("a", "b", "c"):
+            if k in e:
+                e[k] = [cx + s * (e[k][0] - cx), cy + s * (e[k][1] - cy)]
+        if "r" in e:
+            e["r"] = e["r"] * s
+    with open(dst, "w") as f:
+        json.dump(j, f)
+
+
 class Bench:
     def __init__(self, a, work):
         self.a = a
@@ -303,7 +326,24 @@ class Bench:
                  "--out", dj, "--out", os.path.join(d, "diff.dxf"), "--all"])
             with open(dj) as f:
                 diff = json.load(f)
-            det = {"family": fam, **score_detection(diff, truth)}
+            det = {"family": fam, **score_detection(diff, truth),
+                   "scale_true": truth.get("scale", 0.0), "scale_estimate": diff.get("scale", {}).get("error"),
+                   "scale_sigma": diff.get("scale", {}).get("sigma")}
+            est, sig = det["scale_estimate"], det["scale_sigma"] or 0.0
+            if est is not None and abs(est) > max(0.001, 3 * sig):
+                # The scale estimate on: a second pass of fploc against the plan scaled by (1 + estimate)
+                # about its bounding-box centre.
+                sp = os.path.join(d, "plan-scaled.json")
+                scale_plan_json(plan, sp, 1.0 + est)
+                rec2 = os.path.join(d, "run-scaled.lcm")
+                cmd2 = [os.path.join(BIN, "fploc-replay"), "--graph", os.path.join(ROOT, "graphs", "realism.pbtxt"), "--log", logf,
+                        "--record", rec2, "--record-channels", "FPLOC_POSE", "--json"]
+                for x in sets + [f"matcher.plan.file={sp}", f"optimizer.plan.file={sp}"]:
+                    cmd2 += ["--set", x]
+                log(f"[{fam}] scale estimate {100 * est:.3f} %: replaying fploc against the rescaled plan ...")
+                rep2 = json.loads(run(cmd2)[0].strip().splitlines()[-1])
+                rows.append(self.row(fam, "fploc+scale", poses_of(rec2, "FPLOC_POSE"), g, rep2, METHODS["fploc"][1], scans))
+                os.remove(rec2)
             log(f"[{fam}] detection: removed {det['removed_found']}/{det['removed']}, moved {det['moved_found']}/{det['moved']}, "
                 f"added {det['added_found']}/{det['added']}, false flags {det['false_flags']} "
                 f"({det['false_flags_per_100m']:.2f} per 100 m), new on clutter {det['new_on_clutter']}")
@@ -339,7 +379,7 @@ def svg_bars(rows, path, key="ate_m", title="horizontal ATE [cm]", scale=100.0):
     for r in rows:
         if r["method"] not in methods:
             methods.append(r["method"])
-    colors = {"fploc": "#1f77b4", "amcl": "#d62728", "ndt": "#2ca02c", "fploc-dw": "#9467bd"}
+    colors = {"fploc": "#1f77b4", "amcl": "#d62728", "ndt": "#2ca02c", "fploc+scale": "#9467bd"}
     vals = {(r["family"], r["method"]): (r.get(key) or 0) * scale for r in rows}
     vmax = max(list(vals.values()) + [1e-9])
     # Log-free linear scale, capped so small values stay visible: bars above the cap are clipped and labelled.
@@ -390,12 +430,14 @@ def markdown(res, cmdline):
           "Removed = removed walls/pillars and glass in view of the path; moved = walls moved >= 10 cm in view; "
           "added = partitions >= 1 m (found when >= half their length is reported within 15 cm); new structure on the "
           "simulator's furniture is counted apart (unmapped and real, but not the building):", "",
-          "| world | removed found | moved found | added found | flags | false flags | per 100 m of walls | new on furniture | precision | recall |",
-          "|---|---|---|---|---|---|---|---|---|---|"]
+          "| world | removed found | moved found | added found | flags | false flags | per 100 m of walls | new on furniture | precision | recall | scale true / estimated [%] |",
+          "|---|---|---|---|---|---|---|---|---|---|---|"]
     for d in res["detection"]:
         L.append(f"| {d['family']} | {d['removed_found']}/{d['removed']} | {d['moved_found']}/{d['moved']} | "
                  f"{d['added_found']}/{d['added']} | {d['flags']} | {d['false_flags']} | {d['false_flags_per_100m']:.2f} | "
-                 f"{d['new_on_clutter']} | {fmt(d['precision'], 2)} | {fmt(d['recall'], 2)} |")
+                 f"{d['new_on_clutter']} | {fmt(d['precision'], 2)} | {fmt(d['recall'], 2)} | "
+                 f"{100 * d['scale_true']:.2f} / {fmt(100 * d['scale_estimate'] if d['scale_estimate'] is not None else None, 3)} "
+                 f"± {fmt(100 * d['scale_sigma'] if d['scale_sigma'] is not None else None, 3)} |")
     L += ["", "![ATE](realism-ate.svg)", ""]
     return "\n".join(L) + "\n"
 
