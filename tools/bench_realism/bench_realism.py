@@ -6,6 +6,9 @@ glass, shelves, doors, crowd-15, mixed): `fploc sim --perturb FAMILY` writes an 
 truth of the difference (LOG.world.json); `fploc replay` runs graphs/realism.pbtxt (fploc = matcher +
 optimizer, AMCL + LiDAR odometry, plan_diff) on it with --record, keeping every pose_t with its status and
 covariance; if a `fploc-ndt` binary and graphs/ndt.pbtxt exist, the NDT peer runs on the same log too.
+Second passes of fploc: "fploc+diff" against the plan without the elements the detector marked missing or
+moved (where it marked any), "fploc+scale" against the plan rescaled by its drawing-scale estimate (where
+that is significant).
 `fploc map diff` on the recorded run gives the change detector's verdicts, scored against the truth.
 
 Per family x method: horizontal ATE (rmse, no alignment, pose at its own time stamp against the ground
@@ -42,7 +45,8 @@ FAMILIES = ["clean", "asbuilt-2cm", "asbuilt-5cm", "scale-0.5pct", "renovated", 
             "crowd-15", "mixed"]
 # method -> (pose channel in the recorded log, nodes whose CPU time is the method's)
 # fploc+scale: fploc against the plan rescaled by the change detector's drawing-scale estimate (second pass,
-# only where the estimate is significant).
+# only where the estimate is significant). fploc+diff: fploc against the plan without the elements the
+# detector marked missing or moved (second pass, where it marked any): the down-weighting, offline.
 METHODS = {"fploc": ("FPLOC_POSE", ("segmenter", "features", "matcher", "optimizer")),
            "amcl": ("FPLOC_AMCL_POSE", ("segmenter", "features", "odometry", "amcl_lidar")),
            "ndt": ("FPLOC_POSE", ("segmenter", "ndt"))}
@@ -264,6 +268,15 @@ def scale_plan_json(src, dst, s):
         json.dump(j, f)
 
 
+def drop_elements_json(src, dst, ids):
+    """A JSON plan without the elements `ids` (the diff's missing and moved ones)."""
+    with open(src) as f:
+        j = json.load(f)
+    j["elements"] = [e for i, e in enumerate(j["elements"]) if i not in ids]
+    with open(dst, "w") as f:
+        json.dump(j, f)
+
+
 class Bench:
     def __init__(self, a, work):
         self.a = a
@@ -344,6 +357,21 @@ class Bench:
                 rep2 = json.loads(run(cmd2)[0].strip().splitlines()[-1])
                 rows.append(self.row(fam, "fploc+scale", poses_of(rec2, "FPLOC_POSE"), g, rep2, METHODS["fploc"][1], scans))
                 os.remove(rec2)
+            flagged = [e["id"] for e in diff["elements"] if e["status"] in ("missing", "moved")]
+            if flagged:
+                # The diff's verdicts used: a second pass of fploc against the plan without the elements it
+                # marked missing or moved (weight 0), as a later run would use the diff of a survey run.
+                dp = os.path.join(d, "plan-diffed.json")
+                drop_elements_json(plan, dp, set(flagged))
+                rec3 = os.path.join(d, "run-diffed.lcm")
+                cmd3 = [os.path.join(BIN, "fploc-replay"), "--graph", os.path.join(ROOT, "graphs", "realism.pbtxt"), "--log", logf,
+                        "--record", rec3, "--record-channels", "FPLOC_POSE", "--json"]
+                for x in sets + [f"matcher.plan.file={dp}", f"optimizer.plan.file={dp}"]:
+                    cmd3 += ["--set", x]
+                log(f"[{fam}] {len(flagged)} elements missing/moved: replaying fploc against the plan without them ...")
+                rep3 = json.loads(run(cmd3)[0].strip().splitlines()[-1])
+                rows.append(self.row(fam, "fploc+diff", poses_of(rec3, "FPLOC_POSE"), g, rep3, METHODS["fploc"][1], scans))
+                os.remove(rec3)
             log(f"[{fam}] detection: removed {det['removed_found']}/{det['removed']}, moved {det['moved_found']}/{det['moved']}, "
                 f"added {det['added_found']}/{det['added']}, false flags {det['false_flags']} "
                 f"({det['false_flags_per_100m']:.2f} per 100 m), new on clutter {det['new_on_clutter']}")
@@ -379,7 +407,7 @@ def svg_bars(rows, path, key="ate_m", title="horizontal ATE [cm]", scale=100.0):
     for r in rows:
         if r["method"] not in methods:
             methods.append(r["method"])
-    colors = {"fploc": "#1f77b4", "amcl": "#d62728", "ndt": "#2ca02c", "fploc+scale": "#9467bd"}
+    colors = {"fploc": "#1f77b4", "amcl": "#d62728", "ndt": "#2ca02c", "fploc+scale": "#9467bd", "fploc+diff": "#17becf"}
     vals = {(r["family"], r["method"]): (r.get(key) or 0) * scale for r in rows}
     vmax = max(list(vals.values()) + [1e-9])
     # Log-free linear scale, capped so small values stay visible: bars above the cap are clipped and labelled.
