@@ -9,6 +9,7 @@ PKGS=(
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev libcpp-httplib-dev libssl-dev libpcap-dev libnanoflann-dev
   python3
+  python3-ezdxf   # tests: `fploc map diff` DXF read back by a CAD library (ezdxf, strict read + audit)
 )
 missing=()
 for p in "${PKGS[@]}"; do
