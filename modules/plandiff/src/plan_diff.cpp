@@ -332,7 +332,9 @@ Diff PlanDiff::result() const {
         e.seen_ratio() < o_.missing_seen_ratio)
       e.status = Status::kMissing;
     else if (e.frames_with_points >= o_.min_frames && std::abs(e.offset_m) >= o_.moved_min_m &&
-             e.offset_spread_m <= o_.moved_max_spread_m)
+             e.offset_spread_m <= o_.moved_max_spread_m &&
+             (plan_.elements[i].kind != ElementKind::kSegment ||
+              (plan_.elements[i].b - plan_.elements[i].a).norm() >= o_.moved_min_length_m))
       e.status = Status::kMoved;
     else if (e.frames_with_points > 0 || a.seen > 0)
       e.status = Status::kSeen;

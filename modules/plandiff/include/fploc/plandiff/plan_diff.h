@@ -37,6 +37,7 @@ struct Options {
   int missing_min_expected = 30;    // ... over at least this many expected probe observations
   double moved_min_m = 0.07;        // |median offset| at least this: moved
   double moved_max_spread_m = 0.05; // ... and the per-frame offsets agree (MAD) within this
+  double moved_min_length_m = 0.5;  // ... for segments at least this long (a door jamb's end is not a wall)
   double new_cell_m = 0.05;         // grid of unexplained points
   int new_min_frames = 5;           // a cell hit in at least this many frames ...
   double new_min_hit_ratio = 0.3;   // ... and whose view cell was hit in this share of the scans that had it
