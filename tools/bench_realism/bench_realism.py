@@ -6,8 +6,8 @@ glass, shelves, doors, crowd-15, mixed): `fploc sim --perturb FAMILY` writes an 
 truth of the difference (LOG.world.json); `fploc replay` runs graphs/realism.pbtxt (fploc = matcher +
 optimizer, AMCL + LiDAR odometry, plan_diff) on it with --record, keeping every pose_t with its status and
 covariance; if a `fploc-ndt` binary and graphs/ndt.pbtxt exist, the NDT peer runs on the same log too.
-Second passes of fploc: "fploc+diff" against the plan without the elements the detector marked missing or
-moved (where it marked any), "fploc+scale" against the plan rescaled by its drawing-scale estimate (where
+Second passes of fploc: "fploc+diff" against the plan the detector corrected (missing elements dropped, moved
+ones shifted by the offset it measured; where it marked any), "fploc+scale" against the plan rescaled by its drawing-scale estimate (where
 that is significant).
 `fploc map diff` on the recorded run gives the change detector's verdicts, scored against the truth.
 
@@ -45,8 +45,8 @@ FAMILIES = ["clean", "asbuilt-2cm", "asbuilt-5cm", "scale-0.5pct", "renovated", 
             "crowd-15", "mixed"]
 # method -> (pose channel in the recorded log, nodes whose CPU time is the method's)
 # fploc+scale: fploc against the plan rescaled by the change detector's drawing-scale estimate (second pass,
-# only where the estimate is significant). fploc+diff: fploc against the plan without the elements the
-# detector marked missing or moved (second pass, where it marked any): the down-weighting, offline.
+# only where the estimate is significant). fploc+diff: fploc against the plan the detector corrected (missing
+# elements dropped, moved ones shifted by their offset; second pass, where it marked any).
 METHODS = {"fploc": ("FPLOC_POSE", ("segmenter", "features", "matcher", "optimizer")),
            "amcl": ("FPLOC_AMCL_POSE", ("segmenter", "features", "odometry", "amcl_lidar")),
            "ndt": ("FPLOC_POSE", ("segmenter", "ndt"))}
@@ -268,11 +268,66 @@ def scale_plan_json(src, dst, s):
         json.dump(j, f)
 
 
-def drop_elements_json(src, dst, ids):
-    """A JSON plan without the elements `ids` (the diff's missing and moved ones)."""
+def twin_of(els, i):
+    """The other face of a wall drawn with two lines: a parallel segment within 0.4 m overlapping it."""
+    e = els[i]
+    if e.get("type") != "segment":
+        return None
+    ax, ay = e["a"]; bx, by = e["b"]
+    L = math.hypot(bx - ax, by - ay)
+    if L < 1e-9:
+        return None
+    ux, uy = (bx - ax) / L, (by - ay) / L
+    best, best_d = None, 0.4
+    for j, f in enumerate(els):
+        if j == i or f.get("type") != "segment":
+            continue
+        fx0, fy0 = f["a"]; fx1, fy1 = f["b"]
+        fl = math.hypot(fx1 - fx0, fy1 - fy0)
+        if fl < 1e-9 or abs(ux * (fy1 - fy0) / fl - uy * (fx1 - fx0) / fl) > 0.05:
+            continue
+        mx, my = (fx0 + fx1) / 2 - ax, (fy0 + fy1) / 2 - ay
+        d = abs(ux * my - uy * mx)
+        if d < 0.02 or d >= best_d:
+            continue
+        s0, s1 = sorted((ux * (fx0 - ax) + uy * (fy0 - ay), ux * (fx1 - ax) + uy * (fy1 - ay)))
+        if min(s1, L) - max(s0, 0.0) < 0.5 * min(L, s1 - s0):
+            continue
+        best, best_d = j, d
+    return best
+
+
+def corrected_plan_json(src, dst, diff):
+    """The plan as the diff saw the building: elements marked missing dropped, moved ones shifted by their
+    offset along the normal (a wall drawn with two lines loses / moves its other face with it)."""
     with open(src) as f:
         j = json.load(f)
-    j["elements"] = [e for i, e in enumerate(j["elements"]) if i not in ids]
+    els = j["elements"]
+    drop, shift = set(), {}
+    for e in diff["elements"]:
+        i = e["id"]
+        if e["status"] not in ("missing", "moved"):
+            continue
+        group = [i]
+        t = twin_of(els, i)
+        if t is not None:
+            group.append(t)
+        for k in group:
+            if e["status"] == "missing":
+                drop.add(k)
+            elif els[i].get("type") == "segment":
+                (ax, ay), (bx, by) = els[i]["a"], els[i]["b"]
+                L = math.hypot(bx - ax, by - ay)
+                shift[k] = (-(by - ay) / L * e["offset_m"], (bx - ax) / L * e["offset_m"])
+            elif "r" in els[k]:
+                els[k]["r"] = max(0.01, els[k]["r"] + e["offset_m"])
+    for k, (dx, dy) in shift.items():
+        if k in drop:
+            continue
+        for key in ("a", "b", "c"):
+            if key in els[k]:
+                els[k][key] = [els[k][key][0] + dx, els[k][key][1] + dy]
+    j["elements"] = [e for i, e in enumerate(els) if i not in drop]
     with open(dst, "w") as f:
         json.dump(j, f)
 
@@ -359,16 +414,16 @@ class Bench:
                 os.remove(rec2)
             flagged = [e["id"] for e in diff["elements"] if e["status"] in ("missing", "moved")]
             if flagged:
-                # The diff's verdicts used: a second pass of fploc against the plan without the elements it
-                # marked missing or moved (weight 0), as a later run would use the diff of a survey run.
+                # The diff's verdicts used: a second pass of fploc against the plan the diff corrected
+                # (missing elements dropped, moved ones shifted), as a later run would use a survey run's diff.
                 dp = os.path.join(d, "plan-diffed.json")
-                drop_elements_json(plan, dp, set(flagged))
+                corrected_plan_json(plan, dp, diff)
                 rec3 = os.path.join(d, "run-diffed.lcm")
                 cmd3 = [os.path.join(BIN, "fploc-replay"), "--graph", os.path.join(ROOT, "graphs", "realism.pbtxt"), "--log", logf,
                         "--record", rec3, "--record-channels", "FPLOC_POSE", "--json"]
                 for x in sets + [f"matcher.plan.file={dp}", f"optimizer.plan.file={dp}"]:
                     cmd3 += ["--set", x]
-                log(f"[{fam}] {len(flagged)} elements missing/moved: replaying fploc against the plan without them ...")
+                log(f"[{fam}] {len(flagged)} elements missing/moved: replaying fploc against the plan the diff corrected ...")
                 rep3 = json.loads(run(cmd3)[0].strip().splitlines()[-1])
                 rows.append(self.row(fam, "fploc+diff", poses_of(rec3, "FPLOC_POSE"), g, rep3, METHODS["fploc"][1], scans))
                 os.remove(rec3)
