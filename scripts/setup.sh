@@ -11,6 +11,7 @@ PKGS=(
   libbz2-dev liblz4-dev libzstd-dev lz4
   python3
   libboost-dev openssh-client openssh-server
+  python3-ezdxf   # tests: `fploc map diff` DXF read back by a CAD library (ezdxf, strict read + audit)
 )
 missing=()
 for p in "${PKGS[@]}"; do

@@ -3,6 +3,7 @@
 import { MapView } from './map.js';
 import { Plot } from './plot.js';
 import { PlanIndex } from './nearest.js';
+import { planDiffLayer } from './plandiff.js';
 
 const $ = (id) => document.getElementById(id);
 const DEG = 180 / Math.PI;
@@ -89,6 +90,8 @@ map.layers.push((c, v) => {
     v.arrow(c, p.x, p.y, p.yaw, p.status === 0 ? COL.est : '#dc2626', true);
   }
 });
+
+map.layers.push(planDiffLayer(S));  // where the building no longer matches the plan (fploc-plan-diff)
 
 // ---- trail handling (the optimiser re-publishes poses of its window: replace by utime) --------
 function addToTrail(trail, utime, x, y) {
@@ -293,6 +296,7 @@ function connect() {
   on('gt', onGt);
   on('frame_pose', (f) => { S.frame = f; map.invalidate(); schedulePoseBox(); });
   on('features', (f) => { S.features = f; map.invalidate(); });
+  on('plan_diff', (d) => { S.planDiff = d; map.invalidate(); });
   on('nodes', (m) => { S.ownNodes = m; if (!S.selected) renderNodes(m); });
   on('robots', (list) => onRobots(list, on));
   on('stats', (s) => {

@@ -3,6 +3,7 @@
 // HTTP server (http_server.h: one event-loop thread, Boost.Beast) answers requests and runs ONE broadcaster
 // that sends each due update to every open event stream (capped; beyond the cap: 503).
 #include <fploc/features_t.hpp>
+#include <fploc/plan_diff_t.hpp>
 #include <fploc/frame_pose_t.hpp>
 #include <fploc/ground_truth_t.hpp>
 #include <fploc/node_command_t.hpp>
@@ -24,6 +25,7 @@
 #include "fploc/runtime/node.h"
 #include "fploc/runtime/robot.h"
 #include "model.h"
+#include "plan_diff_json.h"
 #include "options/tools.pb.h"
 #include "plan_json.h"
 #include "web_path.h"
@@ -74,7 +76,9 @@ class DashboardNode : public fploc::rt::Node {
              fploc::rt::input<fploc::frame_pose_t>("frame_pose", "FPLOC_FRAME_POSE"),
              fploc::rt::input<fploc::features_t>("features", "FPLOC_FEATURES"),
              fploc::rt::input<fploc::ground_truth_t>("ground_truth", "FPLOC_GROUND_TRUTH"),
-             fploc::rt::input<fploc::node_status_t>("telemetry", fploc::rt::kTelemetryChannel)}};
+             fploc::rt::input<fploc::node_status_t>("telemetry", fploc::rt::kTelemetryChannel),
+             // Not connected unless the graph maps it (to FPLOC_PLAN_DIFF, where fploc-plan-diff publishes).
+             fploc::rt::input<fploc::plan_diff_t>("plan_diff", "")}};
   }
 
   ~DashboardNode() override { stop_server(); }
@@ -141,6 +145,8 @@ class DashboardNode : public fploc::rt::Node {
       ctx.bus().lcm().subscribe(fploc::rt::robot_channel(r, base("telemetry")), &FleetHandler::status, h.get());
       fleet_.push_back(std::move(h));
     }
+    if (!ctx.channel("plan_diff").empty())
+      ctx.subscribe<fploc::plan_diff_t>("plan_diff", [this](const fploc::plan_diff_t& m) { model_->on_plan_diff(plan_diff_json(m)); });
     ctx.every(0.5, [this] {
       model_->tick(steady_s(), wall_us());
       if (!listening_) try_listen();

@@ -32,6 +32,11 @@ void add_time(std::deque<double>& times, double now_s) {
 Model::Model(ModelConfig cfg) : cfg_(cfg), ate_(cfg.ate_match_tolerance_s, cfg.max_trail * 2) {}
 Model::~Model() = default;
 
+void Model::on_plan_diff(std::string j) {
+  std::lock_guard<std::mutex> lk(mu_);
+  set_slot("plan_diff", std::move(j));
+}
+
 void Model::set_plan_json(std::string j) {
   std::lock_guard<std::mutex> lk(mu_);
   plan_json_ = std::move(j);

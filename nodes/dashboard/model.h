@@ -36,6 +36,8 @@ class Model {
   void on_features(const fploc::features_t& m, double now_s, int64_t wall_us);
   void on_ground_truth(const fploc::ground_truth_t& m, double now_s, int64_t wall_us);
   void on_status(const fploc::node_status_t& m, double now_s);
+  // The latest plan diff (FPLOC_PLAN_DIFF, as JSON: plan_diff_json.h), pushed as stream "plan_diff".
+  void on_plan_diff(std::string json);
   // A node of the graph that must be listed even before its first heartbeat (red after silent_after_s).
   void expect_node(const std::string& name, const std::string& executable, double now_s);
   // Re-evaluates node health (silence) and stream rates; call at a few Hz.

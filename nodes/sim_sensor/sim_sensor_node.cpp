@@ -58,6 +58,8 @@ class SimSensorNode : public fploc::rt::Node {
     if (opt.range_noise_m() > 0) so_.range_noise_m = opt.range_noise_m();
     if (opt.dropout() > 0) so_.dropout = opt.dropout();
     so_.ceiling_height_m = opt.ceiling_height_m();
+    if (!opt.perturb().empty()) so_.perturb = fploc::sim::parse_perturb(opt.perturb());
+    if (!opt.world().empty()) so_.world_file = ctx.resolve_path(opt.world());
     if (!opt.metadata().empty()) so_.metadata = ctx.resolve_path(opt.metadata());
     const char* sd = std::getenv("FPLOC_SHARED_DIR");
     so_.shared_dir = sd && *sd ? sd : FPLOC_SHARED_DIR;

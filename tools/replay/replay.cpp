@@ -5,6 +5,9 @@
 // queue is drained completely (lock-step), so the run is deterministic and as fast as the CPU allows.
 // --out sets the file of the graph's pose logger. --json prints per-node timing (wall clock and the
 // handlers' thread CPU time, which is what a shared machine does not distort) and the real-time factor.
+// --record FILE writes what the composed nodes publish on channels matching --record-channels (an LCM
+// regex; default every FPLOC_ channel but FPLOC_SEGMENTS) into an LCM log, stamped with the log time of
+// the event that caused it (for `fploc map diff`, metrics on pose_t status and covariance, lcm-logplayer).
 #include <lcm/lcm-cpp.hpp>
 
 #include <algorithm>
@@ -32,12 +35,13 @@ double now_s() {
 void usage() {
   std::cerr << "usage: fploc replay --graph GRAPH --log LOG.lcm [--out EST.tum] [--json] [--set NODE.field=value ...]\n"
                "                    [--robot R]   (the log's channels are R/...; default: the graph's robot, else $FPLOC_ROBOT)\n"
+               "                    [--record OUT.lcm [--record-channels REGEX]]\n"
                "  runs the graph's nodes in one process over memq://, lock-step on the log's events\n";
 }
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string graph_path, log_path, out, robot;
+  std::string graph_path, log_path, out, robot, record, record_channels = "FPLOC_(?!SEGMENTS$).*";
   bool json = false, robot_given = false;
   std::vector<std::string> sets;
   for (int i = 1; i < argc; ++i) {
@@ -55,6 +59,8 @@ int main(int argc, char** argv) {
     else if (a == "--json") json = true;
     else if (a == "--set") sets.push_back(next());
     else if (a == "--robot") robot = next(), robot_given = true;
+    else if (a == "--record") record = next();
+    else if (a == "--record-channels") record_channels = next();
     else if (a == "-h" || a == "--help") { usage(); return 0; }
     else { std::cerr << "fploc replay: unexpected argument '" << a << "'\n"; usage(); return 2; }
   }
@@ -122,6 +128,24 @@ int main(int argc, char** argv) {
       return 1;
     }
     int64_t events = 0, published = 0, t_first = -1, t_last = -1;
+    std::unique_ptr<lcm::LogFile> rec;
+    if (!record.empty()) {
+      rec = std::make_unique<lcm::LogFile>(record, "w");
+      if (!rec->good()) {
+        std::cerr << "fploc replay: cannot write the record log '" << record << "'\n";
+        return 1;
+      }
+      bus.lcm().subscribeFunction(record_channels, +[](const lcm::ReceiveBuffer* rb, const std::string& channel,
+                                                       std::pair<lcm::LogFile*, int64_t*>* ctx) {
+        lcm::LogEvent ev;
+        ev.eventnum = 0;
+        ev.timestamp = *ctx->second;
+        ev.channel = channel;
+        ev.datalen = int32_t(rb->data_size);
+        ev.data = rb->data;
+        ctx->first->writeEvent(&ev);
+      }, new std::pair<lcm::LogFile*, int64_t*>(rec.get(), &t_last));
+    }
     std::map<std::string, int64_t> per_channel;
     const double w0 = now_s();
     while (const lcm::LogEvent* ev = log.readNextEvent()) {

@@ -45,7 +45,7 @@ void write_event(lcm::LogFile& log, int64_t utime, const std::string& channel, c
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc sim: simulate an OS-1-64 + IMU sequence into an LCM log and a TUM ground truth"};
-  std::string plan_file, scenario, out, gt, units, metadata, demo_dir, floor;
+  std::string plan_file, scenario, out, gt, units, metadata, demo_dir, floor, world_file, perturb, truth;
   std::vector<std::string> layers;
   uint64_t seed = 0;
   bool no_clutter = false, no_patches = false, json = false;
@@ -69,6 +69,11 @@ int main(int argc, char** argv) {
   app.add_option("--drop-scans", drop_scans, "fraction of scans left out of the log (deterministic for a seed; robustness tests)");
   app.add_flag("--no-ceiling-patches", no_patches, "flat ceiling everywhere");
   app.add_flag("--json", json, "print a JSON summary on stdout");
+  app.add_option("--world", world_file, "the world the sensor sees, when it differs from the plan: a plan file or a world JSON (see modules/sim perturb.h)");
+  app.add_option("--perturb", perturb, "seeded world perturbation of the plan: a family (" +
+                 [] { std::string s; for (auto& n : fploc::sim::perturb_family_names()) s += (s.empty() ? "" : ", ") + n; return s; }() +
+                 ") or key=value,... (asbuilt, scale, remove, add, move, glass, doors, shelves, crowd)");
+  app.add_option("--truth", truth, "where to write the world-vs-plan truth JSON (default: LOG without .lcm + .world.json)");
   app.add_option("--write-demo-plans", demo_dir, "write the demo plans (room.json, corridor.json) into DIR and exit");
   CLI11_PARSE(app, argc, argv);
 
@@ -100,8 +105,15 @@ int main(int argc, char** argv) {
     o.shared_dir = shared_dir();
     o.imu_rate_hz = imu_rate;
     o.ceiling_height_m = ceiling;
+    if (!world_file.empty() && !perturb.empty()) throw std::runtime_error("--world and --perturb exclude each other");
+    if (!perturb.empty()) o.perturb = fploc::sim::parse_perturb(perturb);
+    o.world_file = world_file;
+    o.world_layers = layers;
+    o.world_units = units;
+    if (!world_file.empty() && plan_file.empty() && scenario.rfind("auto-loop", 0) == 0)
+      throw std::runtime_error("--world needs --plan for auto-loop scenarios (the path is planned on the plan)");
     const auto t_start = std::chrono::steady_clock::now();
-    fploc::sim::Simulator sim(std::move(plan), o);
+    fploc::sim::Simulator sim(plan, o);
     std::cerr << "fploc sim: " << scenario << " seed " << seed << ", beams: " << sim.beam_source() << "\n" << sim.info();
     std::cerr << "fploc sim: path " << sim.motion().length() << " m, " << sim.motion().moving_time() << " s moving, avg "
               << sim.motion().avg_speed() << " m/s, max " << sim.motion().max_speed() << " m/s, " << sim.num_frames()
@@ -161,6 +173,24 @@ int main(int argc, char** argv) {
     flush_imu(t_end);
     std::cerr << "\n";
     fploc::write_tum(gt, traj);
+    std::string truth_path;
+    if (const auto* edit = sim.world_edit()) {
+      truth_path = !truth.empty() ? truth
+                   : (out.size() > 4 && out.substr(out.size() - 4) == ".lcm" ? out.substr(0, out.size() - 4) : out) + ".world.json";
+      const fploc::FloorPlan& plan_used = plan.elements.empty() ? (scenario.rfind("corridor", 0) == 0 ? fploc::sim::demo_corridor_plan()
+                                                                                               : fploc::sim::demo_room_plan())
+                                                                : plan;
+      std::ofstream tf(truth_path);
+      // Plus the static clutter the simulator put in (furniture, cabinets): unmapped, but not the building.
+      nlohmann::json tj = nlohmann::json::parse(edit->truth_json(plan_used));
+      auto& fj = tj["furniture"] = nlohmann::json::array();
+      for (const auto& f : sim.world().furniture())
+        fj.push_back({{"c", {f.center.x(), f.center.y()}}, {"yaw", f.yaw}, {"half", {f.half.x(), f.half.y()}}, {"height", f.z1}});
+      tj["people"] = sim.world().people().size();
+      tf << tj.dump(1) << "\n";
+      if (!tf) throw std::runtime_error(truth_path + ": cannot write the world truth");
+      std::cerr << "fploc sim: world-vs-plan truth written to " << truth_path << "\n";
+    }
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     const double simulated = frames * period;
     if (dropped) std::cerr << "fploc sim: " << dropped << " of " << frames << " scans dropped (--drop-scans)\n";
@@ -180,6 +210,7 @@ int main(int argc, char** argv) {
       j["beams"] = sim.beam_source();
       j["wall_s"] = wall;
       j["realtime_factor"] = simulated / std::max(wall, 1e-9);
+      if (!truth_path.empty()) j["world_truth"] = truth_path;
       std::cout << j.dump() << std::endl;
     }
   } catch (const std::exception& e) {

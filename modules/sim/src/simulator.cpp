@@ -45,8 +45,20 @@ Simulator::Simulator(FloorPlan plan, SimulatorOptions opt) : opt_(std::move(opt)
   }
   WorldConfig wc;
   wc.ceiling_height_m = opt_.ceiling_height_m > 0 ? opt_.ceiling_height_m : spec_.ceiling_m;
-  world_ = std::make_unique<World>(plan, wc);
   motion_ = std::make_unique<Motion>(spec_.control, spec_.closed, spec_.speed, spec_.length, opt_.seed);
+  if (!opt_.world_file.empty() || opt_.perturb.any()) {
+    edit_ = std::make_unique<WorldEdit>(
+        !opt_.world_file.empty() ? load_world_file(opt_.world_file, plan, opt_.world_layers, opt_.world_units)
+                                 : perturb_world(plan, motion_->sample_path(0.1), opt_.perturb, opt_.seed));
+    world_ = std::make_unique<World>(edit_->world, wc);
+    for (const auto& f : edit_->furniture) world_->add_furniture(f);
+    for (const auto& p : edit_->people) world_->add_person(p);
+    opt_.wall_clutter = std::max(opt_.wall_clutter, edit_->wall_clutter);
+    info_ += "world: " + edit_->source + " (" + std::to_string(edit_->world.elements.size()) + " walls/pillars, " +
+             std::to_string(edit_->added.size()) + " added, " + std::to_string(edit_->people.size()) + " extra people)\n";
+  } else {
+    world_ = std::make_unique<World>(plan, wc);
+  }
   if (opt_.ceiling_patches && spec_.plan_kind != "corridor") {
     // A sloped patch in one corner of the building (rising 0.15 m per metre) and a missing patch (an
     // opening, 2.0 x 1.5 m) at the centre of the plan.

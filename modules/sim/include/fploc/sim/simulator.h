@@ -14,6 +14,7 @@
 #include "fploc/core/pose.h"
 #include "fploc/floorplan/plan.h"
 #include "fploc/sim/motion.h"
+#include "fploc/sim/perturb.h"
 #include "fploc/sim/planner.h"
 #include "fploc/sim/scenarios.h"
 #include "fploc/sim/sensor.h"
@@ -36,6 +37,12 @@ struct SimulatorOptions {
   double t0_s = 1700000000.0;     // time of the first sample [s] (absolute, written into messages)
   int width = 1024;
   double rate_hz = 10;
+  // World != plan (perturb.h): seeded perturbations of the plan, or a world file; the plan still gives
+  // the scenario's path. Empty = the world is the plan.
+  PerturbOptions perturb;
+  std::string world_file;
+  std::vector<std::string> world_layers;
+  std::string world_units;
 };
 
 class Simulator {
@@ -61,12 +68,15 @@ class Simulator {
   const SimulatorOptions& options() const { return opt_; }
   const std::string& beam_source() const { return beam_source_; }
   const std::string& info() const { return info_; }  // planner / clutter notes
+  // The difference between world and plan (nullptr when the world is the plan).
+  const WorldEdit* world_edit() const { return edit_.get(); }
 
  private:
   void add_clutter();
   void add_wall_clutter();
   SimulatorOptions opt_;
   ScenarioSpec spec_;
+  std::unique_ptr<WorldEdit> edit_;
   std::unique_ptr<World> world_;
   std::unique_ptr<Motion> motion_;
   std::unique_ptr<LidarSim> lidar_;

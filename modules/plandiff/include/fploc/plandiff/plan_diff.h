@@ -1,0 +1,140 @@
+// Plan-change detection: where does the building no longer match its floor plan? Fed with registered
+// scans (2D wall features in the sensor frame + the pose that places them on the plan), it keeps, per
+// plan element, evidence over the whole run:
+//   seen      points on the element where the plan puts it;
+//   missing   in view (range, incidence), not hidden by another plan element nor by anything nearer that
+//             was measured (ray cast from the pose), and yet no point on it, frame after frame;
+//   moved     its points sit consistently at an offset along its normal (how far: the median offset);
+// a global drawing-scale error (the plan drawn or scanned at a slightly wrong scale);
+// and, for points near no plan element, a grid of cells hit in several frames from which straight runs
+// (RANSAC lines split at gaps) are reported as new structure.
+// No transport: the node (nodes/plan_diff) and `fploc map diff` feed it.
+//
+//   fploc::plandiff::PlanDiff d(plan);
+//   for each scan: d.add_frame(x, y, yaw, points_in_sensor_frame);
+//   fploc::plandiff::Diff r = d.result();  write_json(r, plan, out); write_dxf(r, plan, out);
+#pragma once
+#include <Eigen/Core>
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "fploc/floorplan/plan.h"
+
+namespace fploc::plandiff {
+
+struct Options {
+  double min_range_m = 0.5, max_range_m = 12.0;
+  double assoc_m = 0.35;            // a point within this of an element observes it
+  double probe_step_m = 0.25;       // visibility probes along each element
+  double bin_deg = 0.75;            // bearing bins of a scan (visibility / occlusion test)
+  double min_incidence_deg = 25;    // probes seen at a more grazing angle are not expected
+  double occlusion_margin_m = 0.4;  // a measured point this much nearer than a probe hides it
+  int min_frames = 5;               // evidence over at least this many frames before a verdict
+  double missing_seen_ratio = 0.08; // seen / expected probe observations below this: missing
+  int missing_min_expected = 30;    // ... over at least this many expected probe observations
+  double moved_min_m = 0.07;        // |median offset| at least this: moved
+  double moved_max_spread_m = 0.05; // ... and the per-frame offsets agree (MAD) within this
+  double moved_min_length_m = 0.5;  // ... for segments at least this long (a door jamb's end is not a wall)
+  double new_cell_m = 0.05;         // grid of unexplained points
+  int new_min_frames = 5;           // a cell hit in at least this many frames ...
+  double new_min_hit_ratio = 0.3;   // ... and whose view cell was hit in this share of the scans that had it
+  double new_view_cell_m = 0.25;    // in view (nothing measured in front) is static structure
+  double new_min_length_m = 0.8;    // shortest new wall reported
+  double new_line_tol_m = 0.05;
+  double new_max_gap_m = 0.3;
+  double scale_max_offset_m = 0.1;  // points this close to their wall enter the drawing-scale estimate
+};
+
+enum class Status : uint8_t { kUnobserved = 0, kSeen = 1, kMissing = 2, kMoved = 3 };
+const char* status_name(Status s);
+
+struct ElementDiff {
+  int id = -1;
+  Status status = Status::kUnobserved;
+  double offset_m = 0;        // median signed offset along the left normal (segments) / radially (circles)
+  double offset_spread_m = 0; // MAD of the per-frame offsets
+  int frames_with_points = 0;
+  int frames_expected = 0;    // frames in which at least one probe was expected visible
+  int64_t probes_expected = 0, probes_seen = 0;
+  double seen_ratio() const { return probes_expected ? double(probes_seen) / double(probes_expected) : 0.0; }
+};
+
+struct NewStructure {
+  Eigen::Vector2d a, b;
+  int cells = 0;
+  int min_frames = 0;         // frames that hit its least-seen cell
+  double rms_m = 0;           // of the cells about the line
+  double length() const { return (b - a).norm(); }
+};
+
+struct Diff {
+  std::vector<ElementDiff> elements;  // one per plan element
+  std::vector<NewStructure> added;
+  int frames = 0;
+  // Drawing scale: the building is (1 + scale_error) times the plan (0.005: the drawing is 0.5 % too small),
+  // from every point's offset against its distance to the sensor along the wall's normal, each scan's
+  // registration bias eliminated. 0 with scale_points 0 when there was too little to tell.
+  double scale_error = 0, scale_sigma = 0;
+  int64_t scale_points = 0;
+  int count(Status s) const;
+};
+
+class PlanDiff {
+ public:
+  explicit PlanDiff(FloorPlan plan, Options o = {});
+  // One registered scan: pose of the sensor on the plan, wall points in the sensor frame (metres).
+  void add_frame(double x, double y, double yaw, const std::vector<Eigen::Vector2f>& points);
+  Diff result() const;
+  int frames() const { return frames_; }
+  const FloorPlan& plan() const { return plan_; }
+  const Options& options() const { return o_; }
+
+ private:
+  struct Probe {
+    Eigen::Vector2d p;
+    Eigen::Vector2d n;  // outward normal at the probe (circles) / the wall normal (segments)
+    int element;
+  };
+  struct Acc {
+    std::vector<float> frame_offsets;  // per-frame median offset
+    int frames_expected = 0;
+    int64_t expected = 0, seen = 0;
+  };
+  struct Cell {
+    int frames = 0, last_frame = -1, points = 0, in_view = 0;
+  };
+  int nearest(const Eigen::Vector2d& p, double* signed_offset, bool* inside, const Eigen::Vector2d* sensor) const;
+  bool plan_blocks(const Eigen::Vector2d& o, const Eigen::Vector2d& q, int skip) const;
+  void cells_of(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, std::vector<int>& out) const;
+
+  FloorPlan plan_;
+  Options o_;
+  std::vector<Probe> probes_;
+  std::vector<Acc> acc_;
+  std::unordered_map<int64_t, Cell> cells_;  // new_cell_m: where
+  std::unordered_map<int64_t, Cell> view_;   // new_view_cell_m: hit in how many of the scans that saw it
+  int frames_ = 0;
+  double scale_h_ = 0, scale_g_ = 0, scale_o2_ = 0;
+  int64_t scale_n_ = 0;
+  // Uniform grid of elements (1 m cells, bounding boxes grown by assoc_m) for the point association.
+  Eigen::Vector2d gmin_;
+  int gx_ = 0, gy_ = 0;
+  double gcell_ = 1.0;
+  std::vector<std::vector<int>> grid_;
+};
+
+// {"frames", "summary": {"seen", "missing", "moved", "unobserved", "new"}, "scale": {"error", "sigma", "points"},
+//  "elements": [{"id", "status",
+//  "offset_m", "offset_spread_m", "seen_ratio", "frames_expected", "frames_with_points", "a", "b" | "c", "r"}],
+//  "new": [{"a", "b", "length_m", "cells", "min_frames", "rms_m"}]}   (elements: only those not "seen"
+//  unless all_elements)
+void write_json(const Diff& d, const FloorPlan& plan, std::ostream& out, bool all_elements = false);
+// ASCII DXF (AC1009, $INSUNITS 6 = metres) with a LAYER table: FPLOC-PLAN (the plan, grey),
+// FPLOC-MISSING (red: missing elements where the plan has them), FPLOC-MOVED (yellow: moved elements
+// where they were seen), FPLOC-NEW (green: new structure). LINE and CIRCLE entities only.
+void write_dxf(const Diff& d, const FloorPlan& plan, std::ostream& out);
+
+}  // namespace fploc::plandiff

@@ -1,0 +1,142 @@
+// JSON and DXF output of a plan diff.
+#include <iomanip>
+#include <nlohmann/json.hpp>
+#include <ostream>
+#include <sstream>
+
+#include "fploc/plandiff/plan_diff.h"
+
+namespace fploc::plandiff {
+
+void write_json(const Diff& d, const FloorPlan& plan, std::ostream& out, bool all_elements) {
+  nlohmann::json j;
+  j["frames"] = d.frames;
+  j["plan"] = plan.source;
+  j["summary"] = {{"seen", d.count(Status::kSeen)},
+                  {"missing", d.count(Status::kMissing)},
+                  {"moved", d.count(Status::kMoved)},
+                  {"unobserved", d.count(Status::kUnobserved)},
+                  {"new", d.added.size()}};
+  j["scale"] = {{"error", d.scale_error}, {"sigma", d.scale_sigma}, {"points", d.scale_points}};
+  auto& el = j["elements"] = nlohmann::json::array();
+  for (const auto& e : d.elements) {
+    if (!all_elements && e.status == Status::kSeen) continue;
+    const Element& p = plan.elements[size_t(e.id)];
+    nlohmann::json o{{"id", e.id},
+                     {"status", status_name(e.status)},
+                     {"offset_m", e.offset_m},
+                     {"offset_spread_m", e.offset_spread_m},
+                     {"seen_ratio", e.seen_ratio()},
+                     {"frames_expected", e.frames_expected},
+                     {"frames_with_points", e.frames_with_points}};
+    if (p.kind == ElementKind::kSegment) {
+      o["a"] = {p.a.x(), p.a.y()};
+      o["b"] = {p.b.x(), p.b.y()};
+    } else {
+      o["c"] = {p.c.x(), p.c.y()};
+      o["r"] = p.r;
+    }
+    el.push_back(o);
+  }
+  auto& nw = j["new"] = nlohmann::json::array();
+  for (const auto& n : d.added)
+    nw.push_back({{"a", {n.a.x(), n.a.y()}}, {"b", {n.b.x(), n.b.y()}}, {"length_m", n.length()}, {"cells", n.cells},
+                  {"min_frames", n.min_frames}, {"rms_m", n.rms_m}});
+  out << j.dump(1) << "\n";
+}
+
+namespace {
+
+void pair(std::ostream& o, int code, const std::string& v) { o << code << "\n" << v << "\n"; }
+void num(std::ostream& o, int code, double v) {
+  std::ostringstream s;
+  s << std::setprecision(10) << v;
+  pair(o, code, s.str());
+}
+
+void entity(std::ostream& o, const Element& e, const char* layer, const Eigen::Vector2d& shift = Eigen::Vector2d::Zero(),
+            double dr = 0) {
+  if (e.kind == ElementKind::kSegment) {
+    pair(o, 0, "LINE");
+    pair(o, 8, layer);
+    num(o, 10, e.a.x() + shift.x());
+    num(o, 20, e.a.y() + shift.y());
+    num(o, 30, 0);
+    num(o, 11, e.b.x() + shift.x());
+    num(o, 21, e.b.y() + shift.y());
+    num(o, 31, 0);
+  } else {
+    pair(o, 0, e.kind == ElementKind::kCircle ? "CIRCLE" : "ARC");
+    pair(o, 8, layer);
+    num(o, 10, e.c.x());
+    num(o, 20, e.c.y());
+    num(o, 30, 0);
+    num(o, 40, std::max(1e-3, e.r + dr));
+    if (e.kind == ElementKind::kArc) {
+      num(o, 50, e.a0 * 180 / M_PI);
+      num(o, 51, e.a1 * 180 / M_PI);
+    }
+  }
+}
+
+}  // namespace
+
+void write_dxf(const Diff& d, const FloorPlan& plan, std::ostream& o) {
+  struct L {
+    const char* name;
+    int color;
+  };
+  const L layers[] = {{"0", 7}, {"FPLOC-PLAN", 8}, {"FPLOC-MISSING", 1}, {"FPLOC-MOVED", 2}, {"FPLOC-NEW", 3}};
+  pair(o, 0, "SECTION");
+  pair(o, 2, "HEADER");
+  pair(o, 9, "$ACADVER");
+  pair(o, 1, "AC1009");
+  pair(o, 9, "$INSUNITS");
+  pair(o, 70, "6");
+  pair(o, 0, "ENDSEC");
+  pair(o, 0, "SECTION");
+  pair(o, 2, "TABLES");
+  pair(o, 0, "TABLE");
+  pair(o, 2, "LTYPE");
+  pair(o, 70, "1");
+  pair(o, 0, "LTYPE");
+  pair(o, 2, "CONTINUOUS");
+  pair(o, 70, "0");
+  pair(o, 3, "Solid line");
+  pair(o, 72, "65");
+  pair(o, 73, "0");
+  num(o, 40, 0);
+  pair(o, 0, "ENDTAB");
+  pair(o, 0, "TABLE");
+  pair(o, 2, "LAYER");
+  pair(o, 70, std::to_string(std::size(layers)));
+  for (const auto& l : layers) {
+    pair(o, 0, "LAYER");
+    pair(o, 2, l.name);
+    pair(o, 70, "0");
+    pair(o, 62, std::to_string(l.color));
+    pair(o, 6, "CONTINUOUS");
+  }
+  pair(o, 0, "ENDTAB");
+  pair(o, 0, "ENDSEC");
+  pair(o, 0, "SECTION");
+  pair(o, 2, "ENTITIES");
+  for (const auto& e : plan.elements) entity(o, e, "FPLOC-PLAN");
+  for (const auto& e : d.elements) {
+    const Element& p = plan.elements[size_t(e.id)];
+    if (e.status == Status::kMissing) entity(o, p, "FPLOC-MISSING");
+    if (e.status == Status::kMoved) {
+      if (p.kind == ElementKind::kSegment) {
+        const Eigen::Vector2d u = (p.b - p.a).normalized();
+        entity(o, p, "FPLOC-MOVED", e.offset_m * Eigen::Vector2d(-u.y(), u.x()));
+      } else {
+        entity(o, p, "FPLOC-MOVED", Eigen::Vector2d::Zero(), e.offset_m);
+      }
+    }
+  }
+  for (const auto& n : d.added) entity(o, Element::segment(n.a, n.b), "FPLOC-NEW");
+  pair(o, 0, "ENDSEC");
+  pair(o, 0, "EOF");
+}
+
+}  // namespace fploc::plandiff

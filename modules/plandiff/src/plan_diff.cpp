@@ -1,0 +1,437 @@
+#include "fploc/plandiff/plan_diff.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace fploc::plandiff {
+namespace {
+
+using V2 = Eigen::Vector2d;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double cross2(const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+bool segments_cross(const V2& p, const V2& q, const V2& a, const V2& b) {
+  const V2 r = q - p, s = b - a;
+  const double den = cross2(r, s);
+  if (std::abs(den) < 1e-12) return false;
+  const double t = cross2(a - p, s) / den, u = cross2(a - p, r) / den;
+  return t > 0 && t < 1 && u >= 0 && u <= 1;
+}
+
+bool blocks(const Element& e, const V2& p, const V2& q) {
+  if (e.kind == ElementKind::kSegment) return segments_cross(p, q, e.a, e.b);
+  const V2 d = q - p;
+  const double t = std::clamp((e.c - p).dot(d) / std::max(d.squaredNorm(), 1e-12), 0.0, 1.0);
+  if ((p + t * d - e.c).norm() >= e.r) return false;
+  if (e.kind == ElementKind::kCircle) return true;
+  // Arc: the first crossing of the full circle must lie on the arc.
+  const double b = d.dot(p - e.c), c = (p - e.c).squaredNorm() - e.r * e.r, a = d.squaredNorm();
+  const double disc = b * b - a * c;
+  if (disc < 0) return false;
+  for (double s : {(-b - std::sqrt(disc)) / a, (-b + std::sqrt(disc)) / a}) {
+    if (s <= 0 || s >= 1) continue;
+    const V2 h = p + s * d - e.c;
+    double ang = std::atan2(h.y(), h.x());
+    while (ang < e.a0) ang += 2 * M_PI;
+    if (ang <= e.a1) return true;
+  }
+  return false;
+}
+
+template <class T>
+double median_of(std::vector<T> v) {
+  if (v.empty()) return 0;
+  const size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + long(m), v.end());
+  return double(v[m]);
+}
+
+V2 left_normal(const Element& e) {
+  const V2 d = (e.b - e.a).normalized();
+  return V2(-d.y(), d.x());
+}
+
+int64_t cell_key(int ix, int iy) { return (int64_t(ix) << 32) ^ int64_t(uint32_t(iy)); }
+
+}  // namespace
+
+const char* status_name(Status s) {
+  switch (s) {
+    case Status::kUnobserved: return "unobserved";
+    case Status::kSeen: return "seen";
+    case Status::kMissing: return "missing";
+    case Status::kMoved: return "moved";
+  }
+  return "?";
+}
+
+int Diff::count(Status s) const {
+  return int(std::count_if(elements.begin(), elements.end(), [s](const ElementDiff& e) { return e.status == s; }));
+}
+
+PlanDiff::PlanDiff(FloorPlan plan, Options o) : plan_(std::move(plan)), o_(o) {
+  if (plan_.elements.empty()) throw std::runtime_error("plan diff: the plan has no elements");
+  acc_.resize(plan_.elements.size());
+  for (size_t i = 0; i < plan_.elements.size(); ++i) {
+    const Element& e = plan_.elements[i];
+    if (e.kind == ElementKind::kSegment) {
+      const double len = (e.b - e.a).norm();
+      if (len < 1e-6) continue;
+      const int n = std::max(1, int(std::floor(len / o_.probe_step_m)));
+      for (int k = 0; k < n; ++k) {
+        const double t = (k + 0.5) / n;
+        probes_.push_back({e.a + t * (e.b - e.a), left_normal(e), int(i)});
+      }
+    } else {
+      const double a0 = e.kind == ElementKind::kArc ? e.a0 : 0.0, a1 = e.kind == ElementKind::kArc ? e.a1 : 2 * M_PI;
+      const int n = std::max(4, int(std::ceil(e.r * (a1 - a0) / o_.probe_step_m)));
+      for (int k = 0; k < n; ++k) {
+        const double a = a0 + (k + 0.5) * (a1 - a0) / n;
+        const V2 u(std::cos(a), std::sin(a));
+        probes_.push_back({e.c + e.r * u, u, int(i)});
+      }
+    }
+  }
+  const Box2 bb = plan_.bounds();
+  gmin_ = bb.min - V2(1, 1);
+  gx_ = int(std::ceil((bb.max.x() - gmin_.x() + 1) / gcell_)) + 1;
+  gy_ = int(std::ceil((bb.max.y() - gmin_.y() + 1) / gcell_)) + 1;
+  grid_.assign(size_t(gx_) * size_t(gy_), {});
+  std::vector<int> cs;
+  for (size_t i = 0; i < plan_.elements.size(); ++i) {
+    const Box2 b = bounds(plan_.elements[i]);
+    cells_of(b.min - V2(o_.assoc_m, o_.assoc_m), b.max + V2(o_.assoc_m, o_.assoc_m), cs);
+    for (int c : cs) grid_[size_t(c)].push_back(int(i));
+  }
+}
+
+void PlanDiff::cells_of(const V2& lo, const V2& hi, std::vector<int>& out) const {
+  out.clear();
+  const int x0 = std::clamp(int(std::floor((lo.x() - gmin_.x()) / gcell_)), 0, gx_ - 1);
+  const int x1 = std::clamp(int(std::floor((hi.x() - gmin_.x()) / gcell_)), 0, gx_ - 1);
+  const int y0 = std::clamp(int(std::floor((lo.y() - gmin_.y()) / gcell_)), 0, gy_ - 1);
+  const int y1 = std::clamp(int(std::floor((hi.y() - gmin_.y()) / gcell_)), 0, gy_ - 1);
+  for (int x = x0; x <= x1; ++x)
+    for (int y = y0; y <= y1; ++y) out.push_back(x * gy_ + y);
+}
+
+int PlanDiff::nearest(const V2& p, double* signed_offset, bool* inside, const V2* sensor) const {
+  const int cx = int(std::floor((p.x() - gmin_.x()) / gcell_)), cy = int(std::floor((p.y() - gmin_.y()) / gcell_));
+  if (cx < 0 || cy < 0 || cx >= gx_ || cy >= gy_) return -1;
+  // Candidates within assoc_m, nearest first; the first whose nearest point the sensor can see (a wall
+  // drawn with two lines: the far face is hidden by the near one) wins.
+  static thread_local std::vector<std::pair<double, int>> cand;
+  cand.clear();
+  for (int i : grid_[size_t(cx * gy_ + cy)]) {
+    const double d = distance(plan_.elements[size_t(i)], p);
+    if (d < o_.assoc_m) cand.push_back({d, i});
+  }
+  if (cand.empty()) return -1;
+  std::sort(cand.begin(), cand.end());
+  int best = cand[0].second;
+  if (cand.size() > 1 && sensor) {
+    for (const auto& [d, i] : cand) {
+      const V2 q = closest_point(plan_.elements[size_t(i)], p).point;
+      const V2 v = *sensor - q;
+      if (v.norm() < 1e-6 || !plan_blocks(*sensor, q + 0.02 * v.normalized(), i)) {
+        best = i;
+        break;
+      }
+    }
+  }
+  const Element& e = plan_.elements[size_t(best)];
+  if (e.kind == ElementKind::kSegment) {
+    const V2 d = e.b - e.a;
+    const double t = (p - e.a).dot(d) / d.squaredNorm();
+    *inside = t > 0.02 && t < 0.98;
+    *signed_offset = left_normal(e).dot(p - e.a);
+  } else {
+    *inside = true;
+    *signed_offset = (p - e.c).norm() - e.r;
+  }
+  return best;
+}
+
+bool PlanDiff::plan_blocks(const V2& o, const V2& q, int skip) const {
+  // Elements in the grid cells the ray passes (sampled at half a cell, with the neighbours).
+  const double len = (q - o).norm();
+  const int n = std::max(1, int(std::ceil(len / (0.5 * gcell_))));
+  static thread_local std::vector<int> seen;
+  seen.clear();
+  for (int k = 0; k <= n; ++k) {
+    const V2 p = o + (q - o) * (double(k) / n);
+    const int cx = int(std::floor((p.x() - gmin_.x()) / gcell_)), cy = int(std::floor((p.y() - gmin_.y()) / gcell_));
+    if (cx < 0 || cy < 0 || cx >= gx_ || cy >= gy_) continue;
+    for (int i : grid_[size_t(cx * gy_ + cy)]) {
+      if (i == skip || std::find(seen.begin(), seen.end(), i) != seen.end()) continue;
+      seen.push_back(i);
+      if (blocks(plan_.elements[size_t(i)], o, q)) return true;
+    }
+  }
+  return false;
+}
+
+void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen::Vector2f>& points) {
+  const int frame = frames_++;
+  const V2 s(x, y);
+  const double c = std::cos(yaw), sn = std::sin(yaw);
+  const int nb = int(std::lround(360.0 / o_.bin_deg));
+  const double bin_w = 2 * M_PI / nb;
+  auto bin_of = [&](const V2& d) {
+    int b = int(std::floor((std::atan2(d.y(), d.x()) + M_PI) / bin_w));
+    return ((b % nb) + nb) % nb;
+  };
+  struct Obs {
+    float range;
+    int element;
+  };
+  std::vector<std::vector<Obs>> bins(static_cast<size_t>(nb));
+  std::vector<float> min_range(size_t(nb), std::numeric_limits<float>::infinity());
+  std::vector<std::vector<float>> offs(plan_.elements.size());
+  Eigen::Matrix3d sA = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d sg = Eigen::Vector3d::Zero();
+  double so2 = 0;
+  int scount = 0;
+  for (const auto& pf : points) {
+    const V2 ps(pf.x(), pf.y());
+    const double r = ps.norm();
+    if (!(r >= o_.min_range_m && r <= o_.max_range_m)) continue;
+    const V2 p = s + V2(c * ps.x() - sn * ps.y(), sn * ps.x() + c * ps.y());
+    double off = 0;
+    bool inside = false;
+    const int e = nearest(p, &off, &inside, &s);
+    const int b = bin_of(p - s);
+    bins[size_t(b)].push_back({float(r), e});
+    min_range[size_t(b)] = std::min(min_range[size_t(b)], float(r));
+    if (e >= 0) {
+      if (inside) offs[size_t(e)].push_back(float(off));
+      const Element& el = plan_.elements[size_t(e)];
+      if (inside && el.kind == ElementKind::kSegment && std::abs(off) < o_.scale_max_offset_m) {
+        // Scale model: off = scale * n.(q - sensor) + n.b (b: this scan's registration bias).
+        const V2 n = left_normal(el);
+        const double dd = n.dot(p - s) - off;
+        const Eigen::Vector3d row(dd, n.x(), n.y());
+        sA += row * row.transpose();
+        sg += row * off;
+        so2 += off * off;
+        ++scount;
+      }
+    } else {
+      const int ix = int(std::floor(p.x() / o_.new_cell_m)), iy = int(std::floor(p.y() / o_.new_cell_m));
+      Cell& cell = cells_[cell_key(ix, iy)];
+      if (cell.last_frame != frame) {
+        cell.last_frame = frame;
+        ++cell.frames;
+      }
+      ++cell.points;
+      Cell& vc = view_[cell_key(int(std::floor(p.x() / o_.new_view_cell_m)), int(std::floor(p.y() / o_.new_view_cell_m)))];
+      if (vc.last_frame != frame) {
+        vc.last_frame = frame;
+        ++vc.frames;
+      }
+    }
+  }
+  for (size_t e = 0; e < offs.size(); ++e)
+    if (offs[e].size() >= 5) acc_[e].frame_offsets.push_back(float(median_of(offs[e])));
+  // The scan's bias (b) eliminated (Schur complement): what this scan tells about the scale.
+  if (scount >= 20) {
+    const Eigen::Matrix2d Abb = sA.bottomRightCorner<2, 2>();
+    const double det = Abb(0, 0) * Abb(1, 1) - Abb(0, 1) * Abb(1, 0);
+    if (det > 1e-9 * std::max(1.0, Abb.trace() * Abb.trace())) {
+      Eigen::Matrix2d inv;
+      inv << Abb(1, 1), -Abb(0, 1), -Abb(1, 0), Abb(0, 0);
+      inv /= det;
+      const Eigen::Vector2d Asb = sA.block<2, 1>(1, 0);
+      scale_h_ += sA(0, 0) - Asb.dot(inv * Asb);
+      scale_g_ += sg(0) - Asb.dot(inv * sg.tail<2>());
+      scale_o2_ += so2 - sg.tail<2>().dot(inv * sg.tail<2>());
+      scale_n_ += scount - 2;
+    }
+  }
+  // Every unexplained cell seen so far: was it in view in this scan (in range, nothing measured in front)?
+  // Static structure is hit in a good share of the scans that see its place; a person's track is not.
+  for (auto& [k, cell] : view_) {
+    const int ix = int(k >> 32), iy = int(int32_t(uint32_t(k & 0xffffffff)));
+    const V2 d = V2((ix + 0.5) * o_.new_view_cell_m, (iy + 0.5) * o_.new_view_cell_m) - s;
+    const double r = d.norm();
+    if (cell.last_frame == frame) {
+      ++cell.in_view;
+      continue;
+    }
+    if (r < o_.min_range_m || r > o_.max_range_m) continue;
+    if (min_range[size_t(bin_of(d))] < r - 0.2) continue;
+    ++cell.in_view;
+  }
+
+  // Visibility probes: expected (in range, not grazing, not behind another plan element, nothing measured
+  // well in front of it) and seen (a point of this element in the probe's bearing).
+  const double sin_inc = std::sin(o_.min_incidence_deg * M_PI / 180);
+  std::vector<int> expected(plan_.elements.size(), 0);
+  for (const Probe& pr : probes_) {
+    const V2 d = pr.p - s;
+    const double r = d.norm();
+    if (r < o_.min_range_m + 0.2 || r > o_.max_range_m - 0.5) continue;
+    const double inc = std::abs(pr.n.dot(d)) / r;
+    if (inc < sin_inc) continue;
+    const Element& el = plan_.elements[size_t(pr.element)];
+    if (el.kind != ElementKind::kSegment && pr.n.dot(d) > 0) continue;  // far side of a pillar
+    const int b = bin_of(d);
+    bool seen = false;
+    for (int db = -1; db <= 1 && !seen; ++db)
+      for (const Obs& ob : bins[size_t(((b + db) % nb + nb) % nb)])
+        if (ob.element == pr.element && std::abs(ob.range - r) < o_.assoc_m + 0.1) {
+          seen = true;
+          break;
+        }
+    if (!seen) {
+      if (min_range[size_t(b)] < r - o_.occlusion_margin_m) continue;  // something unmapped in front
+      if (plan_blocks(s, pr.p - 0.03 * d / r, pr.element)) continue;  // another plan element in front
+    } else if (plan_blocks(s, pr.p - 0.03 * d / r, pr.element)) {
+      continue;
+    }
+    Acc& a = acc_[size_t(pr.element)];
+    ++a.expected;
+    ++expected[size_t(pr.element)];
+    if (seen) ++a.seen;
+  }
+  for (size_t e = 0; e < expected.size(); ++e)
+    if (expected[e] > 0) ++acc_[e].frames_expected;
+}
+
+Diff PlanDiff::result() const {
+  Diff d;
+  d.frames = frames_;
+  if (scale_h_ > 0 && scale_n_ > 10) {
+    d.scale_error = scale_g_ / scale_h_;
+    const double var = std::max(0.0, (scale_o2_ - d.scale_error * scale_g_) / (scale_n_ - 1));
+    // Points of one scan are not independent (the same walls, frame after frame): the sigma counts every
+    // scan as one observation of its walls, i.e. it is inflated by sqrt(points per scan).
+    const double per_scan = double(scale_n_) / std::max(1, frames_);
+    d.scale_sigma = std::sqrt(var / scale_h_ * std::max(1.0, per_scan));
+    d.scale_points = scale_n_;
+  }
+  d.elements.resize(plan_.elements.size());
+  for (size_t i = 0; i < plan_.elements.size(); ++i) {
+    const Acc& a = acc_[i];
+    ElementDiff& e = d.elements[i];
+    e.id = int(i);
+    e.frames_with_points = int(a.frame_offsets.size());
+    e.frames_expected = a.frames_expected;
+    e.probes_expected = a.expected;
+    e.probes_seen = a.seen;
+    if (!a.frame_offsets.empty()) {
+      e.offset_m = median_of(a.frame_offsets);
+      std::vector<float> dev;
+      for (float v : a.frame_offsets) dev.push_back(std::abs(v - float(e.offset_m)));
+      e.offset_spread_m = median_of(dev);
+    }
+    if (a.frames_expected >= o_.min_frames && a.expected >= o_.missing_min_expected &&
+        e.seen_ratio() < o_.missing_seen_ratio)
+      e.status = Status::kMissing;
+    else if (e.frames_with_points >= o_.min_frames && std::abs(e.offset_m) >= o_.moved_min_m &&
+             e.offset_spread_m <= o_.moved_max_spread_m &&
+             (plan_.elements[i].kind != ElementKind::kSegment ||
+              (plan_.elements[i].b - plan_.elements[i].a).norm() >= o_.moved_min_length_m))
+      e.status = Status::kMoved;
+    else if (e.frames_with_points > 0 || a.seen > 0)
+      e.status = Status::kSeen;
+  }
+
+  // New structure: cells hit in enough frames, then straight runs by greedy RANSAC.
+  std::vector<V2> pts;
+  std::vector<int> pf;
+  for (const auto& [k, c] : cells_) {
+    if (c.frames < o_.new_min_frames) continue;
+    const int ix = int(k >> 32), iy = int(int32_t(uint32_t(k & 0xffffffff)));
+    {
+      const V2 q((ix + 0.5) * o_.new_cell_m, (iy + 0.5) * o_.new_cell_m);
+      const auto it = view_.find(cell_key(int(std::floor(q.x() / o_.new_view_cell_m)), int(std::floor(q.y() / o_.new_view_cell_m))));
+      if (it == view_.end() || it->second.frames < o_.new_min_hit_ratio * it->second.in_view) continue;
+    }
+    pts.emplace_back((ix + 0.5) * o_.new_cell_m, (iy + 0.5) * o_.new_cell_m);
+    pf.push_back(c.frames);
+  }
+  // Deterministic order (the hash map's is not).
+  std::vector<size_t> order(pts.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return pts[a].x() != pts[b].x() ? pts[a].x() < pts[b].x() : pts[a].y() < pts[b].y();
+  });
+  std::vector<V2> P;
+  std::vector<int> F;
+  for (size_t i : order) P.push_back(pts[i]), F.push_back(pf[i]);
+  std::vector<char> used(P.size(), 0);
+  uint64_t rs = 0x9E3779B97F4A7C15ull;
+  auto rnd = [&](size_t n) {
+    rs = rs * 6364136223846793005ull + 1442695040888963407ull;
+    return size_t(rs >> 33) % n;
+  };
+  const int min_cells = std::max(6, int(0.4 * o_.new_min_length_m / o_.new_cell_m));
+  for (int round = 0; round < 40; ++round) {
+    std::vector<size_t> free;
+    for (size_t i = 0; i < P.size(); ++i)
+      if (!used[i]) free.push_back(i);
+    if (int(free.size()) < min_cells) break;
+    size_t best_a = 0, best_b = 0;
+    int best_n = 0;
+    for (int it = 0; it < 400; ++it) {
+      const size_t a = free[rnd(free.size())], b = free[rnd(free.size())];
+      if ((P[a] - P[b]).norm() < 0.3) continue;
+      const V2 u = (P[b] - P[a]).normalized();
+      int n = 0;
+      for (size_t i : free)
+        if (std::abs(cross2(u, P[i] - P[a])) < o_.new_line_tol_m) ++n;
+      if (n > best_n) best_n = n, best_a = a, best_b = b;
+    }
+    if (best_n < min_cells) break;
+    const V2 u = (P[best_b] - P[best_a]).normalized();
+    std::vector<std::pair<double, size_t>> on;
+    for (size_t i : free)
+      if (std::abs(cross2(u, P[i] - P[best_a])) < o_.new_line_tol_m) on.push_back({u.dot(P[i] - P[best_a]), i});
+    std::sort(on.begin(), on.end());
+    size_t s0 = 0;
+    for (size_t k = 1; k <= on.size(); ++k) {
+      if (k < on.size() && on[k].first - on[k - 1].first <= o_.new_max_gap_m) continue;
+      // Run on[s0 .. k-1].
+      const double len = on[k - 1].first - on[s0].first + o_.new_cell_m;
+      const int n = int(k - s0);
+      if (len >= o_.new_min_length_m && n >= min_cells) {
+        V2 m = V2::Zero();
+        for (size_t j = s0; j < k; ++j) m += P[on[j].second];
+        m /= n;
+        Eigen::Matrix2d C = Eigen::Matrix2d::Zero();
+        for (size_t j = s0; j < k; ++j) {
+          const V2 q = P[on[j].second] - m;
+          C += q * q.transpose();
+        }
+        const double tr = C.trace(), det = C(0, 0) * C(1, 1) - C(0, 1) * C(1, 0);
+        const double l1 = 0.5 * tr + std::sqrt(std::max(0.0, 0.25 * tr * tr - det));
+        V2 v = std::abs(C(0, 1)) > 1e-12 ? V2(l1 - C(1, 1), C(0, 1)).normalized() : (C(0, 0) >= C(1, 1) ? V2(1, 0) : V2(0, 1));
+        double lo = kInf, hi = -kInf, ss = 0;
+        int fmin = std::numeric_limits<int>::max();
+        for (size_t j = s0; j < k; ++j) {
+          const V2 q = P[on[j].second] - m;
+          lo = std::min(lo, v.dot(q));
+          hi = std::max(hi, v.dot(q));
+          ss += std::pow(cross2(v, q), 2);
+          fmin = std::min(fmin, F[on[j].second]);
+        }
+        NewStructure ns;
+        ns.a = m + lo * v;
+        ns.b = m + hi * v;
+        ns.cells = n;
+        ns.min_frames = fmin;
+        ns.rms_m = std::sqrt(ss / n);
+        d.added.push_back(ns);
+      }
+      s0 = k;
+    }
+    for (auto& [t, i] : on) used[i] = 1;  // inliers of this line are done, reported or not
+  }
+  return d;
+}
+
+}  // namespace fploc::plandiff

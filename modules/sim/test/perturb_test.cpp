@@ -1,0 +1,161 @@
+// World != plan: perturbations are deterministic per seed, their truth matches the world they build,
+// and world files that do not parse give one clear error.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include "fploc/sim/perturb.h"
+#include "fploc/sim/scenarios.h"
+#include "fploc/sim/simulator.h"
+
+using namespace fploc;
+using namespace fploc::sim;
+using V2 = Eigen::Vector2d;
+
+namespace {
+
+std::vector<V2> room_path() {
+  SimulatorOptions o;
+  o.scenario = "room-small-loop-medium";
+  o.clutter = false;
+  o.shared_dir = "";
+  Simulator sim(FloorPlan{}, o);
+  return sim.motion().sample_path(0.1);
+}
+
+std::string tmp_file(const std::string& name, const std::string& text) {
+  const std::string p = ::testing::TempDir() + name;
+  std::ofstream(p) << text;
+  return p;
+}
+
+}  // namespace
+
+TEST(Perturb, DeterministicBySeed) {
+  const FloorPlan plan = demo_room_plan();
+  const auto path = room_path();
+  const PerturbOptions o = perturb_family("mixed");
+  const WorldEdit a = perturb_world(plan, path, o, 7), b = perturb_world(plan, path, o, 7), c = perturb_world(plan, path, o, 8);
+  EXPECT_EQ(a.truth_json(plan), b.truth_json(plan));
+  ASSERT_EQ(a.world.elements.size(), b.world.elements.size());
+  for (size_t i = 0; i < a.world.elements.size(); ++i) {
+    EXPECT_EQ(a.world.elements[i].a, b.world.elements[i].a);
+    EXPECT_EQ(a.world.elements[i].b, b.world.elements[i].b);
+  }
+  ASSERT_EQ(a.people.size(), b.people.size());
+  for (size_t i = 0; i < a.people.size(); ++i) EXPECT_EQ(a.people[i].path[0], b.people[i].path[0]);
+  EXPECT_NE(a.truth_json(plan), c.truth_json(plan));
+}
+
+TEST(Perturb, AsBuiltSigmaAndScale) {
+  const FloorPlan plan = demo_room_plan();
+  const auto path = room_path();
+  const WorldEdit w = perturb_world(plan, path, parse_perturb("asbuilt=0.05"), 3);
+  ASSERT_EQ(w.world.elements.size(), plan.elements.size());
+  double s2 = 0;
+  int n = 0;
+  for (const auto& t : w.elements) {
+    EXPECT_EQ(t.change, ElementChange::kUnchanged);
+    s2 += t.offset_m * t.offset_m;
+    ++n;
+  }
+  const double rms = std::sqrt(s2 / n);
+  EXPECT_GT(rms, 0.02);  // the mean of two N(0, 0.05) ends along the normal: sigma 0.035
+  EXPECT_LT(rms, 0.07);
+  // Walls stay joined: a shared end moves the same way in both walls.
+  EXPECT_EQ(w.world.elements[0].b, w.world.elements[1].a);
+
+  const WorldEdit s = perturb_world(plan, path, parse_perturb("scale=0.01"), 3);
+  const Box2 pb = plan.bounds(), wb = s.world.bounds();
+  EXPECT_NEAR(wb.size().x() / pb.size().x(), 1.01, 1e-9);
+  EXPECT_NEAR(wb.size().y() / pb.size().y(), 1.01, 1e-9);
+}
+
+TEST(Perturb, RenovationTruthMatchesTheWorld) {
+  const FloorPlan plan = demo_room_plan();
+  const auto path = room_path();
+  const WorldEdit w = perturb_world(plan, path, perturb_family("renovated"), 1);
+  int removed = 0, moved = 0, kept = 0;
+  for (size_t i = 0; i < plan.elements.size(); ++i) {
+    const auto& t = w.elements[i];
+    if (t.change == ElementChange::kRemoved) ++removed;
+    if (t.change == ElementChange::kMoved) {
+      ++moved;
+      EXPECT_GE(std::abs(t.offset_m), 0.1 - 1e-9);
+      EXPECT_LE(std::abs(t.offset_m), 0.25 + 1e-9);
+    }
+    if (t.change == ElementChange::kUnchanged) {
+      ++kept;
+      EXPECT_EQ(t.max_shift_m, 0.0);
+    }
+  }
+  EXPECT_GE(removed, 2);  // two removals (a wall takes its other face along)
+  EXPECT_GE(moved, 2);
+  ASSERT_EQ(w.added.size(), 2u);
+  for (const auto& a : w.added) {
+    EXPECT_EQ(a.kind, "partition");
+    EXPECT_GE((a.b - a.a).norm(), 1.2);
+    for (const auto& p : path) EXPECT_GT((p - 0.5 * (a.a + a.b)).norm(), 0.79);
+  }
+  EXPECT_EQ(w.world.elements.size(), size_t(plan.elements.size() - removed + 2));
+}
+
+TEST(Perturb, DoorwaysOfTheDemoRoom) {
+  const auto d = find_doorways(demo_room_plan());
+  ASSERT_EQ(d.size(), 2u);  // the two doors of the room (inner faces; the outer faces are duplicates)
+  for (const auto& [a, b] : d) EXPECT_NEAR((b - a).norm(), 1.0, 1e-9);
+}
+
+TEST(Perturb, ParseErrors) {
+  EXPECT_THROW(parse_perturb("nonsense-family"), std::runtime_error);
+  try {
+    parse_perturb("asbuilt=0.02,wobble=3");
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown key 'wobble'"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(parse_perturb("glass=2"), std::runtime_error);
+  EXPECT_THROW(parse_perturb("remove=1.5"), std::runtime_error);
+}
+
+TEST(WorldFile, ReadsEveryKind) {
+  const FloorPlan plan = demo_room_plan();
+  const std::string f = tmp_file("world_ok.json", R"({"world": {
+    "remove": [2], "glass": [7], "move": [{"id": 9, "offset_m": 0.15}],
+    "add": [{"a": [5, 6], "b": [7, 6]}],
+    "doors": [{"a": [0, 5.75], "b": [0, 6.75], "open": true}],
+    "shelves": [{"a": [13, 0], "b": [16, 0]}],
+    "people": [{"path": [[8, 8], [9, 9]], "speed": 0.8}]}})");
+  const WorldEdit w = load_world_file(f, plan);
+  EXPECT_EQ(w.elements[2].change, ElementChange::kRemoved);
+  EXPECT_EQ(w.elements[7].change, ElementChange::kGlass);
+  EXPECT_EQ(w.elements[9].change, ElementChange::kMoved);
+  EXPECT_NEAR(w.elements[9].offset_m, 0.15, 1e-12);
+  EXPECT_EQ(w.world.elements.size(), plan.elements.size() - 2 + 2);
+  ASSERT_EQ(w.added.size(), 2u);
+  EXPECT_EQ(w.added[1].kind, "door-open");
+  EXPECT_EQ(w.furniture.size(), 1u);
+  EXPECT_EQ(w.people.size(), 1u);
+}
+
+TEST(WorldFile, BadInputIsOneClearError) {
+  const FloorPlan plan = demo_room_plan();
+  auto error_of = [&](const std::string& name, const std::string& text) {
+    try {
+      load_world_file(tmp_file(name, text), plan);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string syntax = error_of("world_syntax.json", "{\"world\": {\"remove\": [2,, 3]}}");
+  EXPECT_NE(syntax.find("world_syntax.json: byte 25: JSON syntax error"), std::string::npos) << syntax;
+  const std::string field = error_of("world_field.json", R"({"world": {"doors": [{"a": [0, 1], "b": [0, "x"]}]}})");
+  EXPECT_NE(field.find("world_field.json: world.doors[0].b: expected [x, y]"), std::string::npos) << field;
+  const std::string id = error_of("world_id.json", R"({"world": {"remove": [999]}})");
+  EXPECT_NE(id.find("world.remove[0]: expected an element id 0..43"), std::string::npos) << id;
+  const std::string key = error_of("world_key.json", R"({"world": {"windows": []}})");
+  EXPECT_NE(key.find("world.windows: unknown key"), std::string::npos) << key;
+}

@@ -1,0 +1,149 @@
+// fploc-plan-diff: plan-change detection as its own process. Each scan's wall features are placed on the
+// plan with the localizer's estimate of that scan (pose_t with the same utime, FPLOC_POSE_LATEST in the
+// shipped graphs) and fed to modules/plandiff; the flagged elements and the new structure found so far are
+// published on FPLOC_PLAN_DIFF (plan_diff_t) at publish_hz of sensor time, so a composed replay is
+// deterministic. With out_json / out_dxf set, the final diff is written at shutdown.
+#include <fploc/features_t.hpp>
+#include <fploc/plan_diff_t.hpp>
+#include <fploc/pose_t.hpp>
+
+#include <cmath>
+#include <deque>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <stdexcept>
+
+#include "fploc/floorplan/io.h"
+#include "fploc/plandiff/plan_diff.h"
+#include "fploc/runtime/node.h"
+#include "options/plandiff.pb.h"
+
+namespace {
+
+using fploc::plandiff::Status;
+
+class PlanDiffNode : public fploc::rt::Node {
+ public:
+  static fploc::rt::NodeSpec spec() {
+    return {"plan_diff", "plan_diff",
+            "plan-change detection: missing / moved plan elements and new structure -> FPLOC_PLAN_DIFF",
+            {fploc::rt::input<fploc::features_t>("features", "FPLOC_FEATURES"),
+             fploc::rt::input<fploc::pose_t>("pose", "FPLOC_POSE_LATEST"),
+             fploc::rt::output<fploc::plan_diff_t>("diff", "FPLOC_PLAN_DIFF")}};
+  }
+
+  void setup(fploc::rt::Context& ctx) override {
+    ctx_ = &ctx;
+    const auto& o = ctx.options<fploc::PlanDiffOptions>();
+    if (o.plan().file().empty()) throw std::runtime_error("plan_diff: plan.file is required");
+    std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
+    plan_ = fploc::load_floor_plan(ctx.resolve_path(o.plan().file()), layers, o.plan().units());
+    fploc::plandiff::Options po;
+    if (o.min_frames() > 0) po.min_frames = o.min_frames();
+    if (o.moved_min_m() > 0) po.moved_min_m = o.moved_min_m();
+    if (o.max_range_m() > 0) po.max_range_m = o.max_range_m();
+    diff_ = std::make_unique<fploc::plandiff::PlanDiff>(plan_, po);
+    publish_us_ = int64_t(1e6 / (o.publish_hz() > 0 ? o.publish_hz() : 1.0));
+    frame_us_ = o.frame_hz() > 0 ? int64_t(1e6 / o.frame_hz()) : 0;
+    out_json_ = o.out_json();
+    out_dxf_ = o.out_dxf();
+    std::cerr << "[" << ctx.name() << "] " << plan_.elements.size() << " plan elements from " << plan_.source << "\n";
+    out_ = ctx.advertise<fploc::plan_diff_t>("diff");
+    ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) {
+      features_.push_back(m);
+      while (features_.size() > 30) features_.pop_front();
+    });
+    ctx.subscribe<fploc::pose_t>("pose", [this](const fploc::pose_t& m) { on_pose(m); });
+  }
+
+  void shutdown() override {
+    if (!diff_ || done_) return;
+    done_ = true;
+    const auto r = diff_->result();
+    if (!out_json_.empty()) {
+      std::ofstream f(out_json_);
+      fploc::plandiff::write_json(r, plan_, f);
+      if (!f) ctx_->error("cannot write " + out_json_);
+    }
+    if (!out_dxf_.empty()) {
+      std::ofstream f(out_dxf_);
+      fploc::plandiff::write_dxf(r, plan_, f);
+      if (!f) ctx_->error("cannot write " + out_dxf_);
+    }
+  }
+
+ private:
+  void on_pose(const fploc::pose_t& m) {
+    if (m.status == 2) return;  // LOST: its features would draw a wrong diff
+    const fploc::features_t* f = nullptr;
+    for (const auto& x : features_)
+      if (x.utime == m.utime) f = &x;
+    if (!f || f->status != 0) return;
+    if (frame_us_ > 0 && last_frame_ != 0 && m.utime - last_frame_ < frame_us_) return;
+    last_frame_ = m.utime;
+    const double* q = m.orientation;  // x y z w
+    const double yaw = std::atan2(2 * (q[3] * q[2] + q[0] * q[1]), 1 - 2 * (q[1] * q[1] + q[2] * q[2]));
+    std::vector<Eigen::Vector2f> pts;
+    pts.reserve(size_t(f->num_points));
+    for (int i = 0; i < f->num_points; ++i) pts.emplace_back(f->x[size_t(i)], f->y[size_t(i)]);
+    diff_->add_frame(m.position[0], m.position[1], yaw, pts);
+    if (last_publish_ == 0 || m.utime - last_publish_ >= publish_us_) {
+      last_publish_ = m.utime;
+      publish(m.utime);
+    }
+  }
+
+  void publish(int64_t utime) {
+    const auto r = diff_->result();
+    fploc::plan_diff_t msg;
+    msg.utime = utime;
+    msg.seq = seq_++;
+    msg.frames = r.frames;
+    msg.elements_seen = r.count(Status::kSeen);
+    msg.elements_missing = r.count(Status::kMissing);
+    msg.elements_moved = r.count(Status::kMoved);
+    msg.elements_unobserved = r.count(Status::kUnobserved);
+    msg.scale_error = r.scale_error;
+    msg.scale_sigma = r.scale_sigma;
+    auto item = [&](int8_t kind, int32_t el, bool circle, double x0, double y0, double x1, double y1, double off, double ratio) {
+      msg.kind.push_back(kind);
+      msg.circle.push_back(circle);
+      msg.element.push_back(el);
+      msg.x0.push_back(float(x0));
+      msg.y0.push_back(float(y0));
+      msg.x1.push_back(float(x1));
+      msg.y1.push_back(float(y1));
+      msg.offset_m.push_back(float(off));
+      msg.seen_ratio.push_back(float(ratio));
+    };
+    for (const auto& e : r.elements) {
+      if (e.status != Status::kMissing && e.status != Status::kMoved) continue;
+      const auto& p = plan_.elements[size_t(e.id)];
+      const double off = e.status == Status::kMoved ? e.offset_m : 0.0;
+      const int8_t kind = e.status == Status::kMissing ? 1 : 2;
+      if (p.kind == fploc::ElementKind::kSegment) {
+        const Eigen::Vector2d u = (p.b - p.a).normalized(), s = off * Eigen::Vector2d(-u.y(), u.x());
+        item(kind, e.id, false, p.a.x() + s.x(), p.a.y() + s.y(), p.b.x() + s.x(), p.b.y() + s.y(), off, e.seen_ratio());
+      } else {
+        item(kind, e.id, true, p.c.x(), p.c.y(), p.r + off, 0, off, e.seen_ratio());
+      }
+    }
+    for (const auto& n : r.added) item(3, -1, false, n.a.x(), n.a.y(), n.b.x(), n.b.y(), n.rms_m, 0);
+    msg.num_items = int32_t(msg.kind.size());
+    out_.publish(msg);
+  }
+
+  fploc::rt::Context* ctx_ = nullptr;
+  fploc::FloorPlan plan_;
+  std::unique_ptr<fploc::plandiff::PlanDiff> diff_;
+  std::deque<fploc::features_t> features_;
+  fploc::rt::Publisher<fploc::plan_diff_t> out_;
+  int64_t publish_us_ = 1000000, frame_us_ = 0, last_publish_ = 0, last_frame_ = 0, seq_ = 0;
+  std::string out_json_, out_dxf_;
+  bool done_ = false;
+};
+
+}  // namespace
+
+FPLOC_REGISTER_NODE(PlanDiffNode)

@@ -1,0 +1,566 @@
+#!/usr/bin/env python3
+"""fploc bench realism: localization and plan-change detection on worlds that differ from the plan.
+
+For every world family (modules/sim perturb.h: clean, asbuilt-2cm, asbuilt-5cm, scale-0.5pct, renovated,
+glass, shelves, doors, crowd-15, mixed): `fploc sim --perturb FAMILY` writes an LCM log of the world and the
+truth of the difference (LOG.world.json); `fploc replay` runs graphs/realism.pbtxt (fploc = matcher +
+optimizer, AMCL + LiDAR odometry, plan_diff) on it with --record, keeping every pose_t with its status and
+covariance; if a `fploc-ndt` binary and graphs/ndt.pbtxt exist, the NDT peer runs on the same log too.
+Second passes of fploc: "fploc+diff" against the plan the detector corrected (missing elements dropped, moved
+ones shifted by the offset it measured; where it marked any), "fploc+scale" against the plan rescaled by its drawing-scale estimate (where
+that is significant).
+`fploc map diff` on the recorded run gives the change detector's verdicts, scored against the truth.
+
+Per family x method: horizontal ATE (rmse, no alignment, pose at its own time stamp against the ground
+truth at the same scan), max error, LOST % (status 2), false-OK % (status OK with horizontal error > 0.3 m),
+NEES median of (x, y, yaw) from the pose_t covariance (3 dof: consistent means 3), ms per scan (thread CPU
+of the method's nodes, `fploc replay --json`, one core). Per family: change detection precision / recall.
+
+Prints one JSON document on stdout (progress on stderr):
+  {"rows": [{"family", "method", "ate_m", "max_m", "lost", "false_ok", "nees_median", "nees_poses",
+             "ms_per_scan", "poses"}],
+   "detection": [{"family", "removed", "removed_found", "moved", "moved_found", "added", "added_found",
+                  "flags", "false_flags", "false_flags_per_100m", "new_on_clutter", "precision", "recall",
+                  "scale_true", "scale_estimate", "scale_sigma"}],
+   "config": {...}}
+Rates (lost, false_ok, precision, recall) are fractions 0..1.
+"""
+import argparse
+import json
+import math
+import os
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.environ.get("FPLOC_ROOT") or os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+BIN = os.environ.get("FPLOC_BIN") or os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(ROOT, "tools", "pylib"))
+import fploc_tools  # noqa: E402
+from fploc_tools import log, read_tum, yaw_of  # noqa: E402
+
+FAMILIES = ["clean", "asbuilt-2cm", "asbuilt-5cm", "scale-0.5pct", "renovated", "glass", "shelves", "doors",
+            "crowd-15", "mixed"]
+# method -> (pose channel in the recorded log, nodes whose CPU time is the method's)
+# fploc+scale: fploc against the plan rescaled by the change detector's drawing-scale estimate (second pass,
+# only where the estimate is significant). fploc+diff: fploc against the plan the detector corrected (missing
+# elements dropped, moved ones shifted by their offset; second pass, where it marked any).
+METHODS = {"fploc": ("FPLOC_POSE", ("segmenter", "features", "matcher", "optimizer")),
+           "amcl": ("FPLOC_AMCL_POSE", ("segmenter", "features", "odometry", "amcl_lidar")),
+           "ndt": ("FPLOC_POSE", ("segmenter", "ndt"))}
+FALSE_OK_M = 0.3
+
+
+def run(cmd):
+    return fploc_tools.run(cmd, "fploc bench realism")
+
+
+# ---- LCM log and pose_t decoding (the LCM wire format: big-endian, 8-byte type hash first) ------------------
+def lcm_events(path):
+    with open(path, "rb") as f:
+        data = f.read()
+    i = 0
+    while i + 28 <= len(data):
+        sync, _num, ts, clen, dlen = struct.unpack(">IqqII", data[i:i + 28])
+        if sync != 0xEDA1DA01:
+            raise RuntimeError(f"{path}: byte {i}: not an LCM log event (sync word {sync:#x})")
+        ch = data[i + 28:i + 28 + clen].decode()
+        yield ts, ch, data[i + 28 + clen:i + 28 + clen + dlen]
+        i += 28 + clen + dlen
+
+
+def decode_pose_t(buf):
+    # int64 utime, int64 seq, int8 status, bool keyframe, bool final_estimate, double position[3],
+    # orientation[4], covariance[36]
+    o = 8
+    utime, _seq, status, _kf, final = struct.unpack(">qqbbb", buf[o:o + 19])
+    o += 19
+    v = struct.unpack(">43d", buf[o:o + 43 * 8])
+    return {"utime": utime, "status": status, "final": bool(final), "p": v[0:3], "q": v[3:7], "cov": v[7:43]}
+
+
+def poses_of(log_path, channel):
+    """The method's pose per scan: the final estimate when the method marks one, else its last pose."""
+    by_t, finals = {}, {}
+    for _ts, ch, buf in lcm_events(log_path):
+        if ch != channel:
+            continue
+        p = decode_pose_t(buf)
+        by_t[p["utime"]] = p
+        if p["final"]:
+            finals[p["utime"]] = p
+    use = finals if len(finals) >= 0.5 * max(len(by_t), 1) else by_t
+    return [use[t] for t in sorted(use)]
+
+
+def quat_yaw(q):
+    x, y, z, w = q
+    return math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+
+
+def solve3(a, b):
+    """x with a x = b for a 3x3 (list of rows); None when singular."""
+    m = [row[:] + [bb] for row, bb in zip(a, b)]
+    for c in range(3):
+        piv = max(range(c, 3), key=lambda r: abs(m[r][c]))
+        if abs(m[piv][c]) < 1e-15:
+            return None
+        m[c], m[piv] = m[piv], m[c]
+        for r in range(3):
+            if r != c:
+                f = m[r][c] / m[c][c]
+                for k in range(c, 4):
+                    m[r][k] -= f * m[c][k]
+    return [m[r][3] / m[r][r] for r in range(3)]
+
+
+def score_poses(poses, gt_rows):
+    """Horizontal ATE, max, LOST, false OK, NEES (x, y, yaw) of pose_t records against the TUM truth."""
+    gt = {round(r[0] * 1e6): r for r in gt_rows}
+    gts = sorted(gt)
+    import bisect
+    errs, nees, lost, false_ok, n = [], [], 0, 0, 0
+    for p in poses:
+        t = p["utime"]
+        k = bisect.bisect_left(gts, t)
+        cand = [gts[j] for j in (k - 1, k) if 0 <= j < len(gts)]
+        if not cand:
+            continue
+        tg = min(cand, key=lambda c: abs(c - t))
+        if abs(tg - t) > 5000:
+            continue
+        g = gt[tg]
+        n += 1
+        ex, ey = p["p"][0] - g[1], p["p"][1] - g[2]
+        e = math.hypot(ex, ey)
+        eyaw = (quat_yaw(p["q"]) - yaw_of(g) + math.pi) % (2 * math.pi) - math.pi
+        if p["status"] == 2:
+            lost += 1
+        if p["status"] == 0 and e > FALSE_OK_M:
+            false_ok += 1
+        errs.append(e)
+        c = p["cov"]
+        idx = (0, 1, 5)
+        S = [[c[i * 6 + j] for j in idx] for i in idx]
+        if all(math.isfinite(x) for row in S for x in row):
+            sol = solve3(S, [ex, ey, eyaw])
+            if sol is not None:
+                v = ex * sol[0] + ey * sol[1] + eyaw * sol[2]
+                if v >= 0:
+                    nees.append(v)
+    if not n:
+        return None
+    nees.sort()
+    return {"poses": n, "ate_m": math.sqrt(sum(e * e for e in errs) / n), "max_m": max(errs),
+            "lost": lost / n, "false_ok": false_ok / n,
+            "nees_median": nees[len(nees) // 2] if nees else None, "nees_poses": len(nees)}
+
+
+# ---- change detection against the truth ------------------------------------------------------------------
+def seg_dist(p, a, b):
+    ax, ay = a
+    bx, by = b
+    dx, dy = bx - ax, by - ay
+    L2 = dx * dx + dy * dy
+    t = 0 if L2 == 0 else max(0, min(1, ((p[0] - ax) * dx + (p[1] - ay) * dy) / L2))
+    return math.hypot(p[0] - ax - t * dx, p[1] - ay - t * dy)
+
+
+def on_furniture(p, furn, tol=0.15):
+    for f in furn:
+        c, yaw, (hx, hy) = f["c"], f["yaw"], f["half"]
+        rx, ry = p[0] - c[0], p[1] - c[1]
+        lx = math.cos(yaw) * rx + math.sin(yaw) * ry
+        ly = -math.sin(yaw) * rx + math.cos(yaw) * ry
+        if abs(lx) <= hx + tol and abs(ly) <= hy + tol:
+            return True
+    return False
+
+
+def score_detection(diff, truth, moved_min=0.10, added_min=1.0):
+    el = {e["id"]: e for e in diff["elements"]}
+    removed = moved = found_r = found_m = 0
+    false_flags, flags, tp_flags = 0, 0, 0
+    offset_err = []
+    for t in truth["elements"]:
+        d = el.get(t["id"])
+        status = d["status"] if d else "seen"
+        in_view = d is not None and (d["frames_expected"] > 0 or d["frames_with_points"] > 0)
+        if status in ("missing", "moved"):
+            flags += 1
+        if t["change"] in ("removed", "glass"):
+            if in_view:
+                removed += 1
+                found_r += status == "missing"
+            tp_flags += status in ("missing", "moved")
+        elif t["change"] == "moved" and abs(t["offset_m"]) >= moved_min:
+            if in_view:
+                moved += 1
+                if status == "moved":
+                    found_m += 1
+                    offset_err.append(abs(d["offset_m"] - t["offset_m"]))
+            tp_flags += status in ("missing", "moved")
+        elif status in ("missing", "moved"):
+            # As built, a wall may really stand some cm off: a "moved" verdict within 3 cm of the truth is right.
+            if status == "moved" and abs(d["offset_m"] - t["offset_m"]) <= 0.03 and abs(t["offset_m"]) >= 0.05:
+                tp_flags += 1
+            else:
+                false_flags += 1
+    furn = truth.get("furniture", [])
+    added_truth = [a for a in truth["added"] if a["kind"] == "partition" and a["length_m"] >= added_min]
+    others = [a for a in truth["added"] if a not in added_truth]
+    found_a = 0
+    matched = set()
+    for a in added_truth:
+        for i, n in enumerate(diff["new"]):
+            mid = [(n["a"][0] + n["b"][0]) / 2, (n["a"][1] + n["b"][1]) / 2]
+            if seg_dist(mid, a["a"], a["b"]) < 0.15 and seg_dist(n["a"], a["a"], a["b"]) < 0.15 and seg_dist(n["b"], a["a"], a["b"]) < 0.15:
+                matched.add(i)
+        if any(seg_dist([(diff["new"][i]["a"][0] + diff["new"][i]["b"][0]) / 2, (diff["new"][i]["a"][1] + diff["new"][i]["b"][1]) / 2], a["a"], a["b"]) < 0.15
+               for i in matched):
+            covered = sum(diff["new"][i]["length_m"] for i in matched
+                          if seg_dist(diff["new"][i]["a"], a["a"], a["b"]) < 0.15)
+            if covered >= 0.5 * a["length_m"]:
+                found_a += 1
+    new_on_clutter = 0
+    for i, n in enumerate(diff["new"]):
+        flags += 1
+        if i in matched:
+            tp_flags += 1
+            continue
+        mid = [(n["a"][0] + n["b"][0]) / 2, (n["a"][1] + n["b"][1]) / 2]
+        if any(seg_dist(mid, a["a"], a["b"]) < 0.15 for a in others) or any(seg_dist(mid, a["a"], a["b"]) < 0.15 for a in added_truth):
+            tp_flags += 1  # a door leaf, a short partition, or a second piece of a found one: there is something new
+        elif on_furniture(mid, furn):
+            new_on_clutter += 1
+            flags -= 1  # static clutter: unmapped and real, but not the building; counted apart
+        else:
+            false_flags += 1
+    wall_m = truth.get("plan_wall_length_m") or 1
+    truth_n = removed + moved + len(added_truth)
+    return {"removed": removed, "removed_found": found_r, "moved": moved, "moved_found": found_m,
+            "moved_offset_err_max_m": max(offset_err) if offset_err else None,
+            "added": len(added_truth), "added_found": found_a, "flags": flags, "false_flags": false_flags,
+            "false_flags_per_100m": false_flags / (wall_m / 100.0), "new_on_clutter": new_on_clutter,
+            "precision": tp_flags / flags if flags else None,
+            "recall": (found_r + found_m + found_a) / truth_n if truth_n else None}
+
+
+def scale_plan_json(src, dst, s):
+    """A JSON plan scaled by s about its bounding-box centre (segments, circles and arcs)."""
+    with open(src) as f:
+        j = json.load(f)
+    xs, ys = [], []
+    for e in j["elements"]:
+        for k in ("a", "b", "c"):
+            if k in e:
+                xs.append(e[k][0]); ys.append(e[k][1])
+    cx, cy = (min(xs) + max(xs)) / 2, (min(ys) + max(ys)) / 2
+    for e in j["elements"]:
+        for k in ("a", "b", "c"):
+            if k in e:
+                e[k] = [cx + s * (e[k][0] - cx), cy + s * (e[k][1] - cy)]
+        if "r" in e:
+            e["r"] = e["r"] * s
+    with open(dst, "w") as f:
+        json.dump(j, f)
+
+
+def twin_of(els, i):
+    """The other face of a wall drawn with two lines: a parallel segment within 0.4 m overlapping it."""
+    e = els[i]
+    if e.get("type") != "segment":
+        return None
+    ax, ay = e["a"]; bx, by = e["b"]
+    L = math.hypot(bx - ax, by - ay)
+    if L < 1e-9:
+        return None
+    ux, uy = (bx - ax) / L, (by - ay) / L
+    best, best_d = None, 0.4
+    for j, f in enumerate(els):
+        if j == i or f.get("type") != "segment":
+            continue
+        fx0, fy0 = f["a"]; fx1, fy1 = f["b"]
+        fl = math.hypot(fx1 - fx0, fy1 - fy0)
+        if fl < 1e-9 or abs(ux * (fy1 - fy0) / fl - uy * (fx1 - fx0) / fl) > 0.05:
+            continue
+        mx, my = (fx0 + fx1) / 2 - ax, (fy0 + fy1) / 2 - ay
+        d = abs(ux * my - uy * mx)
+        if d < 0.02 or d >= best_d:
+            continue
+        s0, s1 = sorted((ux * (fx0 - ax) + uy * (fy0 - ay), ux * (fx1 - ax) + uy * (fy1 - ay)))
+        if min(s1, L) - max(s0, 0.0) < 0.5 * min(L, s1 - s0):
+            continue
+        best, best_d = j, d
+    return best
+
+
+def corrected_plan_json(src, dst, diff):
+    """The plan as the diff saw the building: elements marked missing dropped, moved ones shifted by their
+    offset along the normal (a wall drawn with two lines loses / moves its other face with it)."""
+    with open(src) as f:
+        j = json.load(f)
+    els = j["elements"]
+    drop, shift = set(), {}
+    for e in diff["elements"]:
+        i = e["id"]
+        if e["status"] not in ("missing", "moved"):
+            continue
+        group = [i]
+        t = twin_of(els, i)
+        if t is not None:
+            group.append(t)
+        for k in group:
+            if e["status"] == "missing":
+                drop.add(k)
+            elif els[i].get("type") == "segment":
+                (ax, ay), (bx, by) = els[i]["a"], els[i]["b"]
+                L = math.hypot(bx - ax, by - ay)
+                shift[k] = (-(by - ay) / L * e["offset_m"], (bx - ax) / L * e["offset_m"])
+            elif "r" in els[k]:
+                els[k]["r"] = max(0.01, els[k]["r"] + e["offset_m"])
+    for k, (dx, dy) in shift.items():
+        if k in drop:
+            continue
+        for key in ("a", "b", "c"):
+            if key in els[k]:
+                els[k][key] = [els[k][key][0] + dx, els[k][key][1] + dy]
+    j["elements"] = [e for i, e in enumerate(els) if i not in drop]
+    with open(dst, "w") as f:
+        json.dump(j, f)
+
+
+class Bench:
+    def __init__(self, a, work):
+        self.a = a
+        self.work = work
+        self.ndt_graph = os.path.join(ROOT, "graphs", "ndt.pbtxt")
+        self.have_ndt = os.path.exists(os.path.join(BIN, "fploc-ndt")) and os.path.exists(self.ndt_graph)
+
+    def family(self, fam):
+        d = os.path.join(self.work, fam)
+        os.makedirs(d, exist_ok=True)
+        logf, gt = os.path.join(d, "sim.lcm"), os.path.join(d, "gt.tum")
+        cmd = [os.path.join(BIN, "fploc-sim"), "--scenario", self.a.scenario, "--seed", str(self.a.seed),
+               "--out", logf, "--gt", gt]
+        if fam != "clean":
+            cmd += ["--perturb", fam]
+        if self.a.duration:
+            cmd += ["--duration", str(self.a.duration)]
+        log(f"[{fam}] simulating {self.a.scenario} seed {self.a.seed} ...")
+        run(cmd)
+        truth = None
+        tp = os.path.join(d, "sim.world.json")
+        if os.path.exists(tp):
+            with open(tp) as f:
+                truth = json.load(f)
+        g = read_tum(gt)
+        x0, y0, yaw0 = g[0][1], g[0][2], yaw_of(g[0])
+        plan = os.path.join(ROOT, "data", "plans", "corridor.json" if self.a.scenario.startswith("corridor") else "room.json")
+        rec = os.path.join(d, "run.lcm")
+        sets = [f"{n}.plan.file={plan}" for n in ("matcher", "optimizer", "amcl_lidar", "plan_diff")]
+        for n in ("matcher", "odometry", "amcl_lidar"):
+            sets += [f"{n}.initial_pose.x={x0!r}", f"{n}.initial_pose.y={y0!r}", f"{n}.initial_pose.yaw={yaw0!r}"]
+        sets += [f"wo_logger.file={os.path.join(d, 'wo.tum')}", f"amcl_lidar_logger.file={os.path.join(d, 'amcl.tum')}"]
+        cmd = [os.path.join(BIN, "fploc-replay"), "--graph", os.path.join(ROOT, "graphs", "realism.pbtxt"), "--log", logf,
+               "--record", rec, "--json"]
+        for s in sets:
+            cmd += ["--set", s]
+        log(f"[{fam}] replaying fploc + AMCL + plan diff ...")
+        rep = json.loads(run(cmd)[0].strip().splitlines()[-1])
+        rows = []
+        scans = next((n["messages"] for n in rep["nodes"] if n["name"] == "features"), len(g))
+        for m in ("fploc", "amcl"):
+            ch, nodes = METHODS[m]
+            rows.append(self.row(fam, m, poses_of(rec, ch), g, rep, nodes, scans))
+        if self.have_ndt:
+            nrec = os.path.join(d, "ndt.lcm")
+            cmd = [os.path.join(BIN, "fploc-replay"), "--graph", self.ndt_graph, "--log", logf, "--record", nrec, "--json",
+                   "--set", f"ndt.plan.file={plan}", "--set", f"ndt.initial_pose.x={x0!r}", "--set", f"ndt.initial_pose.y={y0!r}",
+                   "--set", f"ndt.initial_pose.yaw={yaw0!r}", "--set", f"pose_logger.file={os.path.join(d, 'ndt.tum')}"]
+            log(f"[{fam}] replaying NDT ...")
+            try:
+                nrep = json.loads(run(cmd)[0].strip().splitlines()[-1])
+                nscans = next((n["messages"] for n in nrep["nodes"] if n["name"] == "segmenter"), len(g))
+                rows.append(self.row(fam, "ndt", poses_of(nrec, METHODS["ndt"][0]), g, nrep, METHODS["ndt"][1], nscans))
+            except SystemExit:
+                log(f"[{fam}] NDT run failed (left out)")
+        det = None
+        if truth is not None:
+            dj = os.path.join(d, "diff.json")
+            run([os.path.join(BIN, "fploc-map-diff"), "--graph", os.path.join(ROOT, "graphs", "realism.pbtxt"), "--log", rec,
+                 "--out", dj, "--out", os.path.join(d, "diff.dxf"), "--all"])
+            with open(dj) as f:
+                diff = json.load(f)
+            det = {"family": fam, **score_detection(diff, truth),
+                   "scale_true": truth.get("scale", 0.0), "scale_estimate": diff.get("scale", {}).get("error"),
+                   "scale_sigma": diff.get("scale", {}).get("sigma")}
+            est, sig = det["scale_estimate"], det["scale_sigma"] or 0.0
+            if est is not None and abs(est) > max(0.001, 3 * sig):
+                # The scale estimate on: a second pass of fploc against the plan scaled by (1 + estimate)
+                # about its bounding-box centre.
+                sp = os.path.join(d, "plan-scaled.json")
+                scale_plan_json(plan, sp, 1.0 + est)
+                rec2 = os.path.join(d, "run-scaled.lcm")
+                cmd2 = [os.path.join(BIN, "fploc-replay"), "--graph", os.path.join(ROOT, "graphs", "realism.pbtxt"), "--log", logf,
+                        "--record", rec2, "--record-channels", "FPLOC_POSE", "--json"]
+                for x in sets + [f"matcher.plan.file={sp}", f"optimizer.plan.file={sp}"]:
+                    cmd2 += ["--set", x]
+                log(f"[{fam}] scale estimate {100 * est:.3f} %: replaying fploc against the rescaled plan ...")
+                rep2 = json.loads(run(cmd2)[0].strip().splitlines()[-1])
+                rows.append(self.row(fam, "fploc+scale", poses_of(rec2, "FPLOC_POSE"), g, rep2, METHODS["fploc"][1], scans))
+                os.remove(rec2)
+            flagged = [e["id"] for e in diff["elements"] if e["status"] in ("missing", "moved")]
+            if flagged:
+                # The diff's verdicts used: a second pass of fploc against the plan the diff corrected
+                # (missing elements dropped, moved ones shifted), as a later run would use a survey run's diff.
+                dp = os.path.join(d, "plan-diffed.json")
+                corrected_plan_json(plan, dp, diff)
+                rec3 = os.path.join(d, "run-diffed.lcm")
+                cmd3 = [os.path.join(BIN, "fploc-replay"), "--graph", os.path.join(ROOT, "graphs", "realism.pbtxt"), "--log", logf,
+                        "--record", rec3, "--record-channels", "FPLOC_POSE", "--json"]
+                for x in sets + [f"matcher.plan.file={dp}", f"optimizer.plan.file={dp}"]:
+                    cmd3 += ["--set", x]
+                log(f"[{fam}] {len(flagged)} elements missing/moved: replaying fploc against the plan the diff corrected ...")
+                rep3 = json.loads(run(cmd3)[0].strip().splitlines()[-1])
+                rows.append(self.row(fam, "fploc+diff", poses_of(rec3, "FPLOC_POSE"), g, rep3, METHODS["fploc"][1], scans))
+                os.remove(rec3)
+            log(f"[{fam}] detection: removed {det['removed_found']}/{det['removed']}, moved {det['moved_found']}/{det['moved']}, "
+                f"added {det['added_found']}/{det['added']}, false flags {det['false_flags']} "
+                f"({det['false_flags_per_100m']:.2f} per 100 m), new on clutter {det['new_on_clutter']}")
+        if not self.a.keep:
+            for f in (logf, rec, os.path.join(d, "ndt.lcm")):
+                if os.path.exists(f) and not (fam == "renovated" and f == rec):
+                    os.remove(f)
+        return rows, det
+
+    def row(self, fam, method, poses, g, rep, nodes, scans):
+        s = score_poses(poses, g) or {"poses": 0}
+        cpu = sum(n.get("cpu_ms", n["total_ms"]) for n in rep["nodes"] if n["name"] in nodes)
+        r = {"family": fam, "method": method, **s, "ms_per_scan": round(cpu / max(scans, 1), 3)}
+        log(f"[{fam}] {method}: ATE {fmt(r.get('ate_m'))} max {fmt(r.get('max_m'))} LOST {pct(r.get('lost'))} "
+            f"false-OK {pct(r.get('false_ok'))} NEES {fmt(r.get('nees_median'), 2)} {r['ms_per_scan']} ms/scan")
+        return r
+
+
+def fmt(v, nd=4):
+    return "-" if v is None else f"{v:.{nd}f}"
+
+
+def pct(v):
+    return "-" if v is None else f"{100 * v:.1f} %"
+
+
+def svg_bars(rows, path, key="ate_m", title="horizontal ATE [cm]", scale=100.0):
+    fams = []
+    for r in rows:
+        if r["family"] not in fams:
+            fams.append(r["family"])
+    methods = []
+    for r in rows:
+        if r["method"] not in methods:
+            methods.append(r["method"])
+    colors = {"fploc": "#1f77b4", "amcl": "#d62728", "ndt": "#2ca02c", "fploc+scale": "#9467bd", "fploc+diff": "#17becf"}
+    vals = {(r["family"], r["method"]): (r.get(key) or 0) * scale for r in rows}
+    vmax = max(list(vals.values()) + [1e-9])
+    # Log-free linear scale, capped so small values stay visible: bars above the cap are clipped and labelled.
+    cap = min(vmax, 20.0) if vmax > 0 else 1.0
+    W, H, left, bottom = 120 + 70 * len(fams) * max(1, len(methods)) // 2, 360, 60, 80
+    bw = 55.0 / max(1, len(methods))
+    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{H}" font-family="sans-serif" font-size="11">',
+           f'<text x="{W / 2}" y="16" text-anchor="middle" font-size="13">{title}</text>']
+    ph = H - bottom - 30
+    for k in range(5):
+        v = cap * k / 4
+        y = H - bottom - ph * k / 4
+        out.append(f'<line x1="{left}" x2="{W - 10}" y1="{y}" y2="{y}" stroke="#ddd"/>'
+                   f'<text x="{left - 5}" y="{y + 4}" text-anchor="end">{v:.1f}</text>')
+    for i, f in enumerate(fams):
+        x0 = left + 10 + i * 70 * max(1, len(methods)) / 2
+        for j, m in enumerate(methods):
+            v = vals.get((f, m))
+            if v is None:
+                continue
+            h = ph * min(v, cap) / cap
+            x = x0 + j * bw
+            out.append(f'<rect x="{x:.1f}" y="{H - bottom - h:.1f}" width="{bw - 2:.1f}" height="{h:.1f}" fill="{colors.get(m, "#777")}"/>')
+            if v > cap:
+                out.append(f'<text x="{x + bw / 2:.1f}" y="{H - bottom - h - 3:.1f}" text-anchor="middle" font-size="9">{v:.0f}</text>')
+        out.append(f'<text x="{x0 + 20}" y="{H - bottom + 14}" transform="rotate(30 {x0 + 20} {H - bottom + 14})">{f}</text>')
+    for j, m in enumerate(methods):
+        out.append(f'<rect x="{left + 10 + 90 * j}" y="26" width="10" height="10" fill="{colors.get(m, "#777")}"/>'
+                   f'<text x="{left + 24 + 90 * j}" y="35">{m}</text>')
+    out.append("</svg>")
+    with open(path, "w") as f:
+        f.write("\n".join(out))
+
+
+def markdown(res, cmdline):
+    L = ["# Realism bench: worlds that differ from the plan", "",
+         f"Generated by `{cmdline}` ({res['config']['scenario']}, seed {res['config']['seed']}"
+         + (f", first {res['config']['duration']} s" if res['config']['duration'] else "") + ").", "",
+         "Localization (horizontal, every pose of the method against the truth of the same scan, no alignment; "
+         "false OK = status OK with error > 0.3 m; NEES = median of (x, y, yaw) NEES from pose_t's covariance, "
+         "3 for a consistent covariance; ms/scan = thread CPU of the method's nodes on one core):", "",
+         "| world | method | ATE [cm] | max [cm] | LOST | false OK | NEES | ms/scan |", "|---|---|---|---|---|---|---|---|"]
+    for r in res["rows"]:
+        L.append(f"| {r['family']} | {r['method']} | {fmt(100 * r['ate_m'] if r.get('ate_m') is not None else None, 2)} | "
+                 f"{fmt(100 * r['max_m'] if r.get('max_m') is not None else None, 1)} | {pct(r.get('lost'))} | "
+                 f"{pct(r.get('false_ok'))} | {fmt(r.get('nees_median'), 1)} | {r['ms_per_scan']} |")
+    L += ["", "Plan-change detection (`fploc map diff` on the fploc run; truth from `fploc sim`'s LOG.world.json). "
+          "Removed = removed walls/pillars and glass in view of the path; moved = walls moved >= 10 cm in view; "
+          "added = partitions >= 1 m (found when >= half their length is reported within 15 cm); new structure on the "
+          "simulator's furniture is counted apart (unmapped and real, but not the building):", "",
+          "| world | removed found | moved found | added found | flags | false flags | per 100 m of walls | new on furniture | precision | recall | scale true / estimated [%] |",
+          "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for d in res["detection"]:
+        L.append(f"| {d['family']} | {d['removed_found']}/{d['removed']} | {d['moved_found']}/{d['moved']} | "
+                 f"{d['added_found']}/{d['added']} | {d['flags']} | {d['false_flags']} | {d['false_flags_per_100m']:.2f} | "
+                 f"{d['new_on_clutter']} | {fmt(d['precision'], 2)} | {fmt(d['recall'], 2)} | "
+                 f"{100 * d['scale_true']:.2f} / {fmt(100 * d['scale_estimate'] if d['scale_estimate'] is not None else None, 3)} "
+                 f"± {fmt(100 * d['scale_sigma'] if d['scale_sigma'] is not None else None, 3)} |")
+    L += ["", "![ATE](realism-ate.svg)", ""]
+    return "\n".join(L) + "\n"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--json", action="store_true", help="print the JSON document on stdout (always printed)")
+    ap.add_argument("--families", default=",".join(FAMILIES), help="comma-separated world families")
+    ap.add_argument("--scenario", default="room-small-loop-medium")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--duration", type=float, default=0, help="simulate only the first S seconds (0 = whole scenario)")
+    ap.add_argument("--markdown", help="write the tables (Markdown) here, the plot beside it")
+    ap.add_argument("--work", help="keep the intermediate files in this folder")
+    ap.add_argument("--keep", action="store_true", help="keep the LCM logs")
+    a = ap.parse_args()
+    fams = [f for f in a.families.split(",") if f]
+    for f in fams:
+        if f not in FAMILIES:
+            sys.exit(f"fploc bench realism: unknown family '{f}' (families: {', '.join(FAMILIES)})")
+    work = a.work or tempfile.mkdtemp(prefix="fploc-realism-")
+    os.makedirs(work, exist_ok=True)
+    b = Bench(a, work)
+    log(f"fploc bench realism: {len(fams)} families, methods fploc, amcl{', ndt' if b.have_ndt else ' (no fploc-ndt: NDT left out)'}; work in {work}")
+    res = {"rows": [], "detection": [], "config": {"scenario": a.scenario, "seed": a.seed, "duration": a.duration,
+                                                   "families": fams, "ndt": b.have_ndt, "false_ok_m": FALSE_OK_M}}
+    try:
+        for f in fams:
+            rows, det = b.family(f)
+            res["rows"] += rows
+            if det:
+                res["detection"].append(det)
+    finally:
+        if not a.work:
+            shutil.rmtree(work, ignore_errors=True)
+    if a.markdown:
+        with open(a.markdown, "w") as f:
+            f.write(markdown(res, "bin/fploc bench realism " + " ".join(sys.argv[1:])))
+        svg_bars(res["rows"], os.path.join(os.path.dirname(os.path.abspath(a.markdown)), "realism-ate.svg"))
+    print(json.dumps(res))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# fploc bench realism on one renovated world, 10 s of sequence: the JSON contract, every pose scored (no LOST,
+# errors of a localizer that is on the plan, not lost), the detector's rates are fractions.
+set -euo pipefail
+B="${FPLOC_BUILD_DIR:?}/bin"
+out="$("$B/fploc-bench-realism" --families renovated --duration 10 --seed 2 --json 2>/dev/null)"
+python3 - "$out" <<'PY'
+import json, sys
+r = json.loads(sys.argv[1])
+rows = {x["method"]: x for x in r["rows"]}
+assert {"fploc", "amcl"} <= set(rows), rows.keys()
+f = rows["fploc"]
+for k in ("ate_m", "max_m", "lost", "false_ok", "nees_median", "ms_per_scan", "poses"):
+    assert k in f, k
+assert f["poses"] >= 90, f
+assert f["lost"] == 0 and f["false_ok"] == 0, f
+assert f["ate_m"] < 0.5 and f["max_m"] < 1.0, f
+d = r["detection"][0]
+for k in ("removed", "removed_found", "moved", "moved_found", "added", "added_found", "false_flags_per_100m", "precision", "recall"):
+    assert k in d, k
+assert d["precision"] is None or 0 <= d["precision"] <= 1
+assert d["recall"] is None or 0 <= d["recall"] <= 1
+print("bench realism smoke: ok", f["ate_m"], d)
+PY

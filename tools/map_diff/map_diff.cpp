@@ -1,0 +1,169 @@
+// fploc map diff --graph G --log LOG.lcm --out diff.json|diff.dxf [--out ...] [--json]
+// Offline plan-change detection over a recorded run: the LOG holds the wall features (features_t) and the
+// localizer's estimate of each scan (pose_t with the same utime) on the channels the graph's plan_diff node
+// reads (default FPLOC_FEATURES and FPLOC_POSE_LATEST) — a live run recorded with lcm-logger, or
+// `fploc replay --graph G --log SIM.lcm --record LOG.lcm`. The plan and the detector's options come from
+// the graph's plan_diff node (or, without one, the plan of its matcher). Writes JSON and/or DXF (layers
+// FPLOC-MISSING, FPLOC-MOVED, FPLOC-NEW, FPLOC-PLAN) by the --out extension; --json prints the JSON diff on stdout; --all lists
+// every element (also those seen where expected).
+#include <fploc/features_t.hpp>
+#include <fploc/pose_t.hpp>
+#include <lcm/lcm-cpp.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "fploc/floorplan/io.h"
+#include "fploc/plandiff/plan_diff.h"
+#include "fploc/runtime/graph.h"
+
+namespace {
+
+void usage() {
+  std::cerr << "usage: fploc map diff --graph GRAPH --log LOG.lcm --out DIFF.json|DIFF.dxf [--out ...] [--json]\n"
+               "       [--features-channel C] [--pose-channel C] [--all (every element in the JSON, also those seen)]\n";
+}
+
+std::string lower_ext(const std::string& p) {
+  std::string e = std::filesystem::path(p).extension().string();
+  for (auto& c : e) c = char(std::tolower((unsigned char)c));
+  return e;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string graph_path, log_path, feat_ch, pose_ch;
+  std::vector<std::string> outs;
+  bool json = false, all = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::cerr << "fploc map diff: " << a << " needs a value\n";
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--graph") graph_path = next();
+    else if (a == "--log") log_path = next();
+    else if (a == "--out") outs.push_back(next());
+    else if (a == "--features-channel") feat_ch = next();
+    else if (a == "--pose-channel") pose_ch = next();
+    else if (a == "--json") json = true;
+    else if (a == "--all") all = true;
+    else if (a == "-h" || a == "--help") { usage(); return 0; }
+    else { std::cerr << "fploc map diff: unexpected argument '" << a << "'\n"; usage(); return 2; }
+  }
+  if (graph_path.empty() || log_path.empty() || (outs.empty() && !json)) {
+    usage();
+    return 2;
+  }
+  for (const auto& o : outs)
+    if (lower_ext(o) != ".json" && lower_ext(o) != ".dxf") {
+      std::cerr << "fploc map diff: --out " << o << ": expected a .json or .dxf file\n";
+      return 2;
+    }
+  try {
+    fploc::rt::LoadedGraph g;
+    std::vector<fploc::rt::GraphError> errors;
+    if (!fploc::rt::load_graph(graph_path, g, errors)) {
+      for (const auto& e : errors) std::cerr << e.str() << "\n";
+      return 1;
+    }
+    const fploc::Node* node = nullptr;
+    const fploc::PlanSource* src = nullptr;
+    fploc::plandiff::Options po;
+    for (const auto& n : g.graph.node()) {
+      if (n.has_plan_diff() && !node) {
+        node = &n;
+        src = &n.plan_diff().plan();
+        const auto& o = n.plan_diff();
+        if (o.min_frames() > 0) po.min_frames = o.min_frames();
+        if (o.moved_min_m() > 0) po.moved_min_m = o.moved_min_m();
+        if (o.max_range_m() > 0) po.max_range_m = o.max_range_m();
+        for (const auto& in : n.input()) {
+          if (in.port() == "features" && feat_ch.empty()) feat_ch = in.channel();
+          if (in.port() == "pose" && pose_ch.empty()) pose_ch = in.channel();
+        }
+      }
+    }
+    if (!src)
+      for (const auto& n : g.graph.node())
+        if (n.has_matcher() && !n.disabled()) src = &n.matcher().plan();
+    if (!src || src->file().empty())
+      throw std::runtime_error(graph_path + ": no plan_diff node (and no matcher) names a plan");
+    if (feat_ch.empty()) feat_ch = "FPLOC_FEATURES";
+    if (pose_ch.empty()) pose_ch = "FPLOC_POSE_LATEST";
+    std::string plan_file = src->file();
+    if (!plan_file.empty() && plan_file[0] != '/')
+      plan_file = (std::filesystem::path(graph_path).parent_path() / plan_file).lexically_normal().string();
+    std::vector<std::string> layers(src->layers().begin(), src->layers().end());
+    const fploc::FloorPlan plan = fploc::load_floor_plan(plan_file, layers, src->units());
+    fploc::plandiff::PlanDiff diff(plan, po);
+
+    lcm::LogFile log(log_path, "r");
+    if (!log.good()) throw std::runtime_error(log_path + ": cannot read the LCM log");
+    std::map<int64_t, fploc::features_t> feats;
+    int64_t events = 0, n_feat = 0, n_pose = 0, used = 0, bad = 0;
+    while (const lcm::LogEvent* ev = log.readNextEvent()) {
+      ++events;
+      if (ev->channel == feat_ch) {
+        fploc::features_t f;
+        if (f.decode(ev->data, 0, ev->datalen) < 0) {
+          if (bad++ == 0) std::cerr << "fploc map diff: " << log_path << ": event " << events << " on " << feat_ch << " does not decode as features_t (skipped)\n";
+          continue;
+        }
+        ++n_feat;
+        feats[f.utime] = std::move(f);
+        while (feats.size() > 50) feats.erase(feats.begin());
+      } else if (ev->channel == pose_ch) {
+        fploc::pose_t p;
+        if (p.decode(ev->data, 0, ev->datalen) < 0) {
+          if (bad++ == 0) std::cerr << "fploc map diff: " << log_path << ": event " << events << " on " << pose_ch << " does not decode as pose_t (skipped)\n";
+          continue;
+        }
+        ++n_pose;
+        const auto it = feats.find(p.utime);
+        if (it == feats.end() || p.status == 2 || it->second.status != 0) continue;
+        const double* q = p.orientation;
+        const double yaw = std::atan2(2 * (q[3] * q[2] + q[0] * q[1]), 1 - 2 * (q[1] * q[1] + q[2] * q[2]));
+        std::vector<Eigen::Vector2f> pts;
+        for (int i = 0; i < it->second.num_points; ++i) pts.emplace_back(it->second.x[size_t(i)], it->second.y[size_t(i)]);
+        diff.add_frame(p.position[0], p.position[1], yaw, pts);
+        ++used;
+      }
+    }
+    if (n_feat == 0)
+      throw std::runtime_error(log_path + ": no " + feat_ch + " (features_t) events in " + std::to_string(events) +
+                               " log events; record a run with them (lcm-logger during `fploc launch`, or `fploc replay --graph " +
+                               graph_path + " --log SIM.lcm --record LOG.lcm`)");
+    if (n_pose == 0)
+      throw std::runtime_error(log_path + ": no " + pose_ch + " (pose_t) events in " + std::to_string(events) + " log events");
+    if (used == 0)
+      throw std::runtime_error(log_path + ": no " + pose_ch + " pose has the utime of a " + feat_ch + " scan (" +
+                               std::to_string(n_feat) + " scans, " + std::to_string(n_pose) + " poses)");
+    const auto r = diff.result();
+    for (const auto& o : outs) {
+      std::ofstream f(o);
+      if (!f) throw std::runtime_error(o + ": cannot write");
+      if (lower_ext(o) == ".json") fploc::plandiff::write_json(r, plan, f, all);
+      else fploc::plandiff::write_dxf(r, plan, f);
+      if (!f) throw std::runtime_error(o + ": write failed");
+    }
+    std::cerr << "fploc map diff: " << used << " scans of " << log_path << " against " << plan_file << ": "
+              << r.count(fploc::plandiff::Status::kSeen) << " seen, " << r.count(fploc::plandiff::Status::kMissing)
+              << " missing, " << r.count(fploc::plandiff::Status::kMoved) << " moved, "
+              << r.count(fploc::plandiff::Status::kUnobserved) << " unobserved, " << r.added.size() << " new\n";
+    if (json) fploc::plandiff::write_json(r, plan, std::cout, all);
+  } catch (const std::exception& e) {
+    std::cerr << "fploc map diff: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
