@@ -65,8 +65,9 @@ void encode_scan(const Scan& s, std::vector<uint8_t>& out) {
     const size_t k = std::min(n, s.range_mm.size());
     uint8_t* p = o.p;
     const uint32_t* r = s.range_mm.data();
-    for (size_t i = 0; i < k; ++i) {
-      const uint32_t v = __builtin_bswap32(r[i]);
+    for (size_t i = 0; i < k; ++i) {  // shifts (not bswap): SSE2 vectorizes them
+      const uint32_t x = r[i];
+      const uint32_t v = (x >> 24) | ((x >> 8) & 0xFF00u) | ((x << 8) & 0xFF0000u) | (x << 24);
       std::memcpy(p + 4 * i, &v, 4);
     }
     std::memset(p + 4 * k, 0, 4 * (n - k));
@@ -77,7 +78,8 @@ void encode_scan(const Scan& s, std::vector<uint8_t>& out) {
     uint8_t* p = o.p;
     const uint16_t* g = s.signal.data();
     for (size_t i = 0; i < k; ++i) {
-      const uint16_t v = __builtin_bswap16(uint16_t(std::min<uint16_t>(g[i], 32767)));
+      const uint16_t x = std::min<uint16_t>(g[i], 32767);
+      const uint16_t v = uint16_t((x >> 8) | (x << 8));
       std::memcpy(p + 2 * i, &v, 2);
     }
     std::memset(p + 2 * k, 0, 2 * (n - k));
