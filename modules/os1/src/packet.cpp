@@ -287,6 +287,9 @@ PacketError FrameAssembler::add_packet(const uint8_t* data, size_t size, std::ve
   // Headers first, then the pixels row by row: the range image is row-major, so writing each row's
   // run of this packet's columns is sequential instead of one cache line per pixel (the scatter down
   // the columns was most of an import's CPU time).
+  // The packet is read once, mostly from memory (a recording's page cache): ask for all of its lines
+  // now so the misses overlap instead of stalling the pixel loops one by one.
+  for (size_t off = 0; off < size; off += 64) __builtin_prefetch(data + off);
   int ms[kMaxColumnsPerPacket];
   const uint8_t* pxs[kMaxColumnsPerPacket];
   int n = 0;
