@@ -28,6 +28,7 @@
 #include "fploc/recording/recording.h"
 #include "fploc/recording/ros_msgs.h"
 #include "lcm_log.h"
+#include "scan_encode.h"
 #include "tum_track.h"
 
 using namespace fploc;
@@ -213,7 +214,7 @@ int main(int argc, char** argv) {
   size_t frames_total = 0;
   struct FrameInfo { int32_t frame_id, height, width, missing; };
   std::vector<FrameInfo> frame_list;  // for the summary (the first 1000)
-  scan_t scan_msg;
+  std::vector<uint8_t> scan_bytes;  // scan_t encoded straight from the Scan (same bytes as to_msg + encode)
   std::map<std::string, int64_t> seq;
   CloudStats cstats;
   std::map<std::string, CloudStats> cloud_info;
@@ -226,10 +227,12 @@ int main(int argc, char** argv) {
     for (size_t i = 0; i < frames.size(); ++i) {
       Scan& s = frames[i];
       s.seq = seq[ouster_scan_channel]++;
-      to_msg(s, scan_msg);
       const int64_t t = i < ouster.frame_times_ns.size() ? ouster.frame_times_ns[i] : fallback_ns;
       if (frame_list.size() < 1000) frame_list.push_back({s.frame_id, s.height, s.width, s.missing_columns});
-      if (!out.empty()) lcm_log.write(ouster_scan_channel, t / 1000, scan_msg);
+      if (!out.empty()) {
+        fploc::import::encode_scan(s, scan_bytes);
+        lcm_log.write_raw(ouster_scan_channel, t / 1000, scan_bytes.data(), scan_bytes.size());
+      }
       ++written[ouster_scan_channel];
     }
     frames_total += frames.size();
@@ -299,8 +302,10 @@ int main(int argc, char** argv) {
         s.frame_id = int32_t(s.seq & 0xFFFF);
         s.sensor = "PointCloud2 " + c.topic + " (" + std::to_string(s.height) + " rings)";
         cloud_info[c.topic] = cstats;
-        to_msg(s, scan_msg);
-        if (!out.empty()) lcm_log.write(ch, m.time_ns / 1000, scan_msg);
+        if (!out.empty()) {
+          fploc::import::encode_scan(s, scan_bytes);
+          lcm_log.write_raw(ch, m.time_ns / 1000, scan_bytes.data(), scan_bytes.size());
+        }
         ++written[ch];
         break;
       }

@@ -13,8 +13,16 @@ struct Getter {
   uint8_t type = 0;
   bool swap = false;
   bool ok() const { return off >= 0; }
-  double operator()(const uint8_t* p) const {
+  [[gnu::always_inline]] inline double operator()(const uint8_t* p) const {
     p += off;
+    if (!swap) switch (type) {  // the usual little-endian case without the byte shuffle
+        case 2: return double(p[0]);
+        case 4: { uint16_t v; std::memcpy(&v, p, 2); return v; }
+        case 6: { uint32_t v; std::memcpy(&v, p, 4); return v; }
+        case 7: { float v; std::memcpy(&v, p, 4); return v; }
+        case 8: { double v; std::memcpy(&v, p, 8); return v; }
+        default: break;
+      }
     uint8_t b[8];
     const int n = type <= 2 ? 1 : type <= 4 ? 2 : type <= 7 ? 4 : 8;
     if (swap) for (int k = 0; k < n; ++k) b[k] = p[n - 1 - k];
@@ -50,6 +58,17 @@ inline float f32(const uint8_t* p, int off) {
   float v;
   std::memcpy(&v, p + off, 4);
   return v;
+}
+
+// std::lround for x >= 0 (half away from zero) without the libm call; exact: x - trunc(x) is exact.
+inline int64_t round_nonneg(double x) {
+  const int64_t i = int64_t(x);
+  return i + (x - double(i) >= 0.5);
+}
+// std::floor for |x| < 2^62 without the libm call (exact).
+inline int64_t floor_i64(double x) {
+  const int64_t i = int64_t(x);
+  return i - (x < double(i));
 }
 
 int type_size(uint8_t t) { return t == 0 || t > 8 ? 0 : t <= 2 ? 1 : t <= 4 ? 2 : t <= 7 ? 4 : 8; }
@@ -95,6 +114,8 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
   pts.reserve(npts);
   const double stamp_s = c.header.stamp_ns * 1e-9;
   const bool xyz_f32 = is_f32le(gx) && is_f32le(gy) && is_f32le(gz);
+  const bool need_el = !(gr.ok() && opt.rings == 0);  // elevation bins rings only without a ring field
+  const bool t_rel_ns = time_name == "t" || time_name == "offset_time";
   for (uint32_t row = 0; row < c.height; ++row) {
     const uint8_t* base = c.data + row * row_step;
     for (uint32_t k = 0; k < c.width; ++k) {
@@ -109,7 +130,7 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
       }
       P q;
       q.az = fast_atan2(float(y), float(x));
-      q.el = fast_atan2(float(z), float(std::sqrt(x * x + y * y)));
+      q.el = need_el ? fast_atan2(float(z), float(std::sqrt(x * x + y * y))) : 0.f;
       q.sn = float(z / r);
       q.r_mm = uint32_t(r * 1000.0 + 0.5);
       const double ring = gr.ok() ? gr(p) : 0.0;
@@ -120,7 +141,7 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
       double t = stamp_s;
       if (gt.ok()) {
         const double v = gt(p);
-        if (time_name == "t" || time_name == "offset_time") t = stamp_s + v * 1e-9;
+        if (t_rel_ns) t = stamp_s + v * 1e-9;
         else if (v > 1e15) t = v * 1e-9;  // absolute ns (Livox)
         else if (v > 1e8) t = v;          // absolute s (Hesai, Robosense)
         else t = stamp_s + v;             // relative s (Velodyne)
@@ -214,15 +235,16 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
   out.beams.lidar_to_sensor = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
   out.missing_columns = 0;
   out.status = ScanStatus::kOk;
-  double t0 = 1e300;
+  double t0 = 1e300, max_err = s.max_azimuth_error_deg;  // (a local: kept in a register)
   const double col = 2.0 * M_PI / W;
   for (size_t i = 0; i < pts.size(); ++i) {
     const P& q = pts[i];
     double a = q.az < 0 ? q.az + 2.0 * M_PI : q.az;
     const double fv = (2.0 * M_PI - a) / col;
-    int v = int(std::lround(fv)) % W;
+    const int64_t fr = fv >= 0.0 && fv < 1e15 ? round_nonneg(fv) : std::llround(fv);
+    int v = int(fr % W);
     if (v < 0) v += W;
-    s.max_azimuth_error_deg = std::max(s.max_azimuth_error_deg, std::abs(fv - std::round(fv)) * col * 180.0 / M_PI);
+    max_err = std::max(max_err, std::abs(fv - double(fr)) * col * 180.0 / M_PI);
     const size_t k = size_t(ring_of[i]) * W + v;
     if (out.range_mm[k] != 0) {
       ++s.collisions;
@@ -233,10 +255,11 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
     out.range_mm[k] = q.r_mm;
     out.signal[k] = uint16_t(std::clamp(q.inten, 0.f, 65535.f));
     out.reflectivity[k] = uint8_t(std::clamp(q.inten, 0.f, 255.f));
-    const int64_t tu = int64_t(std::floor(q.t * 1e6 + 0.5));
+    const int64_t tu = floor_i64(q.t * 1e6 + 0.5);  // |q.t| < 1e11 s
     out.column_utime[size_t(v)] = std::min(out.column_utime[size_t(v)], tu);
     t0 = std::min(t0, q.t);
   }
+  s.max_azimuth_error_deg = max_err;
   const int64_t stamp_us = c.header.stamp_ns / 1000;
   for (auto& t : out.column_utime)
     if (t == INT64_MAX) t = stamp_us;

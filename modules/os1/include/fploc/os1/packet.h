@@ -136,8 +136,10 @@ class FrameAssembler {
   void recycle(Scan&& s) { spare_ = std::move(s); }
 
  private:
+  static constexpr int kMaxColumnsPerPacket = 32;  // Ouster packets carry 16 columns
   void start(uint16_t frame_id);
   void publish(std::vector<Scan>& out);
+  void scatter_column(const uint8_t* px, int m);  // one column down the range image
   SensorInfo info_;
   PacketFormat fmt_;
   LidarPacketView view_;
