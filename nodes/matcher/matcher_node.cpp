@@ -1,5 +1,6 @@
 // fploc-matcher: FPLOC_FEATURES (+ OS1_IMU yaw rate) -> single-frame registration -> FPLOC_FRAME_POSE
-// for every scan. The map (plan or .fpmap) and the look-up come from the `matcher` options.
+// for every scan: the SFR step of fploc::localizer::Localizer. The map (plan or .fpmap) and the look-up
+// come from the `matcher` options.
 #include <fploc/features_t.hpp>
 #include <fploc/frame_pose_t.hpp>
 #include <fploc/imu_t.hpp>
@@ -11,9 +12,8 @@
 #include <memory>
 #include <optional>
 
-#include "fploc/matcher/imu_yaw.h"
+#include "fploc/localizer/localizer.h"
 #include "fploc/matcher/map.h"
-#include "fploc/matcher/matcher.h"
 #include "fploc/nodes/localization_convert.h"
 #include "fploc/runtime/node.h"
 #include "options/localization.pb.h"
@@ -64,13 +64,15 @@ class MatcherNode : public fploc::rt::Node {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::MatcherOptions>();
     map_ = fploc::load_map(ctx, o.plan(), o.lookup(), "matcher");
-    matcher_ = std::make_unique<fploc::Matcher>(*map_.lookup, config_of(o));
-    use_imu_ = !o.ignore_imu();
-    if (o.initial_search_m() > 0) initial_search_m_ = o.initial_search_m();
+    fploc::localizer::Config cfg;
+    cfg.matcher = config_of(o);
+    cfg.use_imu = !o.ignore_imu();
+    if (o.initial_search_m() > 0) cfg.initial_search_m = o.initial_search_m();
+    loc_ = std::make_unique<fploc::localizer::Localizer>(*map_.lookup, cfg);
     // The graph's initial pose is where the run starts; a restarted matcher (crash, module swap) waits for
     // a pose instead (FPLOC_INITIAL_POSE: the relocalizer searches around the last good pose).
     if (!o.wait_for_initial_pose() && ctx.restarts() == 0)
-      matcher_->set_pose({o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()}, initial_search_m_);
+      loc_->set_pose({o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()});
     else if (ctx.restarts() > 0)
       std::cerr << "[" << ctx.name() << "] restart " << ctx.restarts() << ": waiting for a pose on initial_pose\n";
     out_ = ctx.advertise<fploc::frame_pose_t>("frame_pose");
@@ -84,11 +86,11 @@ class MatcherNode : public fploc::rt::Node {
       }
       // Search within 3 sigma of the message's position covariance when it has one.
       const double var = std::max(m.covariance[0], m.covariance[7]);
-      matcher_->set_pose(p, std::isfinite(var) && var > 0 ? std::optional<double>(3 * std::sqrt(var)) : initial_search_m_);
+      loc_->set_pose(p, std::isfinite(var) && var > 0 ? std::optional<double>(3 * std::sqrt(var)) : std::nullopt);
     });
     ctx.subscribe<fploc::pose_t>("refined", [this](const fploc::pose_t& m) {
       // Stale (a later frame was already registered) or LOST: not used; counted, said at shutdown.
-      if (!matcher_->refine(m.utime, fploc::pose2_of(m))) ++refined_ignored_;
+      if (!loc_->refine(m.utime, fploc::pose2_of(m))) ++refined_ignored_;
     });
   }
 
@@ -99,9 +101,7 @@ class MatcherNode : public fploc::rt::Node {
   }
 
  private:
-  void on_imu(const fploc::imu_t& m) {
-    if (use_imu_) imu_.add(m.utime, m.gyro[2]);  // out of order / non-finite samples are ignored
-  }
+  void on_imu(const fploc::imu_t& m) { loc_->add_imu(m.utime, m.gyro[2]); }
 
   void on_features(const fploc::features_t& m) {
     const auto t_start = std::chrono::steady_clock::now();
@@ -114,27 +114,8 @@ class MatcherNode : public fploc::rt::Node {
       return;
     }
     if (dropped) ctx_->error("features seq " + std::to_string(m.seq) + ": " + std::to_string(dropped) + " non-finite points dropped");
-    // Roll/pitch/z the segmenter could not estimate (its "unknown" sigmas): the last known ones are
-    // passed on (the optimizer interpolates them in its final poses).
-    if (f.z_sigma < 1.0) last_z_ = f.z;
-    else if (last_z_) f.z = *last_z_;
-    if (f.roll_pitch_sigma < 0.5) last_rp_ = {f.roll, f.pitch};
-    else if (last_rp_) f.roll = last_rp_->first, f.pitch = last_rp_->second;
-    std::optional<double> dyaw;
-    if (use_imu_) {
-      // Prediction: the yaw change since the previous frame; motion compensation: the mean rate over
-      // this frame's sweep (its samples arrive before the scan is complete).
-      if (have_prev_) dyaw = imu_.integral(prev_utime_, f.utime);
-      const double sweep = fploc::sweep_duration(f);
-      if (sweep > 0)
-        if (auto w = imu_.mean_rate(f.utime, f.utime + std::llround(sweep * 1e6))) f.sweep_yaw_rate = *w;
-      imu_.drop_before(std::min(f.utime, have_prev_ ? prev_utime_ : f.utime));
-    }
-    const fploc::MatchResult r = matcher_->process(f, dyaw);
-    if (r.status != FitStatus::kNotInitialised) {
-      prev_utime_ = f.utime;
-      have_prev_ = true;
-    }
+    const fploc::localizer::FramePose fp = loc_->register_frame(f);
+    const fploc::MatchResult& r = fp.match;
     fploc::frame_pose_t o;
     o.utime = m.utime;
     o.seq = seq_++;
@@ -145,9 +126,9 @@ class MatcherNode : public fploc::rt::Node {
     o.y = r.pose.y;
     o.yaw = r.pose.yaw;
     for (int i = 0; i < 9; ++i) o.covariance[i] = r.covariance(i / 3, i % 3);
-    o.roll = f.roll;
-    o.pitch = f.pitch;
-    o.z = f.z;
+    o.roll = fp.roll;
+    o.pitch = fp.pitch;
+    o.z = fp.z;
     o.twist[0] = r.twist.vx;
     o.twist[1] = r.twist.vy;
     o.twist[2] = r.twist.w;
@@ -166,15 +147,8 @@ class MatcherNode : public fploc::rt::Node {
 
   fploc::rt::Context* ctx_ = nullptr;
   fploc::LocalizationMap map_;
-  std::unique_ptr<fploc::Matcher> matcher_;
+  std::unique_ptr<fploc::localizer::Localizer> loc_;
   fploc::rt::Publisher<fploc::frame_pose_t> out_;
-  fploc::ImuYaw imu_;
-  bool use_imu_ = true;
-  std::optional<double> initial_search_m_;
-  std::optional<double> last_z_;
-  std::optional<std::pair<double, double>> last_rp_;
-  bool have_prev_ = false;
-  int64_t prev_utime_ = 0;
   int64_t seq_ = 0;
   int64_t refined_ignored_ = 0;
   FitStatus last_status_ = FitStatus::kOk;

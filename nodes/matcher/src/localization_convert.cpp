@@ -72,6 +72,26 @@ pose_t make_pose_msg(int64_t utime, int64_t seq, const Pose2& p, double roll, do
   return m;
 }
 
+pose_t to_msg(const localizer::Pose& p, int64_t seq) {
+  return make_pose_msg(p.utime, seq, p.pose, p.roll, p.pitch, p.z, p.covariance, p.z_sigma, p.roll_pitch_sigma,
+                       int8_t(p.status), p.keyframe, p.final_estimate);
+}
+
+localizer::FramePose frame_pose_of(const frame_pose_t& m) {
+  localizer::FramePose f;
+  f.utime = m.utime;
+  f.scan_seq = m.scan_seq;
+  f.match.pose = {m.x, m.y, m.yaw};
+  if (std::isfinite(m.twist[0]) && std::isfinite(m.twist[1]) && std::isfinite(m.twist[2]))
+    f.match.twist = {m.twist[0], m.twist[1], m.twist[2]};
+  f.match.status = m.status >= 0 && m.status <= 3 ? FitStatus(m.status) : FitStatus::kLost;
+  for (int i = 0; i < 9; ++i) f.match.covariance(i / 3, i % 3) = m.covariance[i];
+  f.roll = m.roll;
+  f.pitch = m.pitch;
+  f.z = m.z;
+  return f;
+}
+
 Pose2 pose2_of(const pose_t& m) {
   StampedPose sp;
   sp.q = Eigen::Quaterniond(m.orientation[3], m.orientation[0], m.orientation[1], m.orientation[2]);

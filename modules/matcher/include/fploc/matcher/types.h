@@ -32,6 +32,17 @@ struct FeatureFrame {
   std::vector<Feature2> points;
 };
 
+// "Unknown" roll/pitch or height: the segmenter sends these sigmas for what it could not estimate; any
+// sigma at or above the *_from threshold (or a non-finite value) means unknown.
+inline constexpr double kUnknownZSigmaM = 1e3;
+inline constexpr double kUnknownRollPitchSigmaRad = M_PI;
+inline constexpr double kZUnknownFromSigmaM = 1.0;
+inline constexpr double kRollPitchUnknownFromSigmaRad = 0.5;
+inline bool z_known(const FeatureFrame& f) { return std::isfinite(f.z) && f.z_sigma < kZUnknownFromSigmaM; }
+inline bool roll_pitch_known(const FeatureFrame& f) {
+  return std::isfinite(f.roll) && std::isfinite(f.pitch) && f.roll_pitch_sigma < kRollPitchUnknownFromSigmaRad;
+}
+
 // Planar velocity of the sensor, in its own frame: linear [m/s] (x forward, y left) and yaw rate [rad/s].
 // Constant over a sweep it is the motion model of the motion compensation (de-skewing).
 struct Twist2 {

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <string>
 
+#include "fploc/localizer/localizer.h"
 #include "fploc/matcher/map.h"
 #include "fploc/matcher/types.h"
 #include "options/common.pb.h"
@@ -27,6 +28,13 @@ FeatureFrame from_msg(const features_t& m, int* dropped = nullptr);
 pose_t make_pose_msg(int64_t utime, int64_t seq, const Pose2& p, double roll, double pitch, double z,
                      const Eigen::Matrix3d& cov_xy_yaw, double z_sigma, double rp_sigma, int8_t status,
                      bool keyframe, bool final_estimate);
+
+// A localized pose (with its own z and roll/pitch sigmas) as a pose_t.
+pose_t to_msg(const localizer::Pose& p, int64_t seq);
+
+// The SFR step's result as the optimizer reads it from a frame_pose_t: a non-finite twist is zero, an
+// unknown status LOST.
+localizer::FramePose frame_pose_of(const frame_pose_t& m);
 
 // Pose2 from a pose_t (yaw of its quaternion).
 Pose2 pose2_of(const pose_t& m);

@@ -8,11 +8,9 @@
 
 #include "fploc/eval/eval.h"
 #include "fploc/features/features.h"
-#include "fploc/matcher/imu_yaw.h"
+#include "fploc/localizer/localizer.h"
 #include "fploc/matcher/map.h"
-#include "fploc/matcher/matcher.h"
 #include "fploc/odometry/odometry.h"
-#include "fploc/optimizer/window.h"
 #include "fploc/segmentation/segmenter.h"
 #include "fploc/nodes/localization_convert.h"
 #include "fploc/nodes/perception_convert.h"
@@ -64,29 +62,27 @@ Result run(const FloorPlan& plan_in, const Options& o) {
   Result r;
   const StampedPose g0 = sim.ground_truth(sim.frame_time(0) + o.gt_offset_s);
   const Pose2 init{g0.p.x() + o.init_dx, g0.p.y() + o.init_dy, g0.rpy()[2] + o.init_dyaw};
-  MatcherConfig mcfg;
-  mcfg.max_points = o.matcher_points;
-  Matcher matcher(*map.lookup, mcfg);
-  matcher.set_pose(init, o.init_search_m > 0 ? std::optional<double>(o.init_search_m) : std::nullopt);
-  OptimizerConfig ocfg;
-  ocfg.window = o.window;
-  ocfg.alpha = o.alpha;
-  ocfg.beta = o.beta;
-  ocfg.keyframe_distance_m = o.keyframe_distance_m;
-  ocfg.max_points = o.optimizer_points;
-  ocfg.body_frame_velocity = o.body_frame_velocity;
+  localizer::Config cfg;
+  cfg.matcher.max_points = o.matcher_points;
+  cfg.optimizer.window = o.window;
+  cfg.optimizer.alpha = o.alpha;
+  cfg.optimizer.beta = o.beta;
+  cfg.optimizer.keyframe_distance_m = o.keyframe_distance_m;
+  cfg.optimizer.max_points = o.optimizer_points;
+  cfg.optimizer.body_frame_velocity = o.body_frame_velocity;
   if (o.relook_m >= 0) {
-    ocfg.relook_m = o.relook_m;
-    ocfg.relook_rad = o.relook_m / 0.01 * ocfg.relook_rad;
+    cfg.optimizer.relook_m = o.relook_m;
+    cfg.optimizer.relook_rad = o.relook_m / 0.01 * cfg.optimizer.relook_rad;
   }
-  WindowOptimizer opt(*map.lookup, ocfg);
+  cfg.use_imu = o.imu;
+  cfg.initial_search_m = o.init_search_m;
+  localizer::Localizer loc(*map.lookup, cfg);
+  loc.set_pose(init);
   Odometry2D odo;
   odo.set_pose(init);
-  std::vector<PoseOut> finals;
+  std::vector<localizer::Pose> finals;
   const auto& imu = sim.imu();
   size_t imu_i = 0;
-  ImuYaw imu_yaw;
-  int64_t prev_utime = -1;
   sim::SimScan f;
   double feat_total = 0;
   uint64_t drop_state = o.seed * 2654435761u + 1;
@@ -122,19 +118,11 @@ Result run(const FloorPlan& plan_in, const Options& o) {
     // IMU samples up to the end of the sweep (when the scan is published), as in the simulator's log.
     const double t_pub = frame.utime * 1e-6 + 1.0 / sim.options().rate_hz - so.t0_s;
     for (; imu_i < imu.size() && imu[imu_i].t <= t_pub; ++imu_i)
-      imu_yaw.add(std::llround((so.t0_s + imu[imu_i].t) * 1e6), imu[imu_i].gyro.z());
-    std::optional<double> dyaw;
-    if (o.imu) {
-      if (prev_utime >= 0) dyaw = imu_yaw.integral(prev_utime, frame.utime);
-      const double sweep = sweep_duration(frame);
-      if (sweep > 0)
-        if (auto w = imu_yaw.mean_rate(frame.utime, frame.utime + std::llround(sweep * 1e6))) frame.sweep_yaw_rate = *w;
-      imu_yaw.drop_before(frame.utime - 1000000);
-    }
-    prev_utime = frame.utime;
+      loc.add_imu(std::llround((so.t0_s + imu[imu_i].t) * 1e6), imu[imu_i].gyro.z());
     t0 = clk::now();
-    const MatchResult m = matcher.process(frame, dyaw);
+    const localizer::FramePose sfr = loc.register_frame(frame);
     r.us_matcher += us_since(t0);
+    const MatchResult& m = sfr.match;
     r.ok_frames += m.status == FitStatus::kOk;
     if (csv) {
       const StampedPose g = sim.ground_truth(frame.utime * 1e-6 + o.gt_offset_s);
@@ -145,24 +133,19 @@ Result run(const FloorPlan& plan_in, const Options& o) {
     }
     r.lost_frames += m.status == FitStatus::kLost;
     t0 = clk::now();
-    FrameInput in;
-    in.features = frame;
-    in.sfr = m.pose;
-    in.twist = m.twist;
-    in.status = m.status;
-    in.covariance = m.covariance;
-    opt.add(std::move(in), &finals);
+    // The window step, and its estimate of this frame predicts the next one (the graphs' `refined` input).
+    if (const auto latest = loc.optimize(frame, sfr, &finals)) loc.refine(latest->utime, latest->pose);
     r.us_optimizer += us_since(t0);
     t0 = clk::now();
     const OdometryResult od = odo.process(frame);
     r.us_odometry += us_since(t0);
-    r.sfr.push_back(to_stamped(frame.utime, m.pose, frame.roll, frame.pitch, frame.z));
+    r.sfr.push_back(to_stamped(frame.utime, m.pose, sfr.roll, sfr.pitch, sfr.z));
     r.odo.push_back(to_stamped(frame.utime, od.pose, frame.roll, frame.pitch, frame.z));
     const StampedPose g = sim.ground_truth(frame.utime * 1e-6 + o.gt_offset_s);
     r.gt.push_back(StampedPose::from(frame.utime * 1e-6, g.iso()));
     ++r.frames;
   }
-  opt.flush(&finals);
+  loc.flush(&finals);
   for (const auto& p : finals) r.wo.push_back(to_stamped(p.utime, p.pose, p.roll, p.pitch, p.z));
   const int nf = std::max(1, r.frames);
   r.us_segment /= nf;

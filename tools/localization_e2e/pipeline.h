@@ -1,7 +1,7 @@
-// Library-level end-to-end run (no LCM): simulator -> ring segmenter -> features -> matcher ->
-// windowed optimizer, plus the no-plan odometry baseline on the same features. Used by the e2e test and
-// by the localization_e2e tool (numbers in docs/notes/localization.md). Built only when modules/sim,
-// modules/segmentation and modules/features exist.
+// Library-level end-to-end run (no LCM): simulator -> ring segmenter -> features -> the Localizer
+// (matcher + windowed optimizer, fploc::localizer) in a loop, plus the no-plan odometry baseline on the
+// same features. Used by the e2e test (tests/localizer) and by the localization_e2e tool (numbers in
+// docs/notes/localization.md).
 #pragma once
 #include <string>
 
