@@ -31,19 +31,20 @@ class FeaturesNode : public fploc::rt::Node {
       fploc::from_msg(m, seg_);
     } catch (const std::exception& e) {
       ctx_->error(std::string("segments: ") + e.what());
-      fploc::feat::Features2D bad;
+      fploc::FeatureFrame bad;
       bad.utime = m.utime;
-      bad.status = fploc::feat::FeatStatus::kBadInput;
-      fploc::to_msg(bad, seq_++, m.scan_seq, msg);
+      bad.scan_seq = m.scan_seq;
+      bad.status = fploc::FeatureStatus::kBadInput;
+      fploc::to_msg(bad, seq_++, msg);
       out_.publish(msg);
       return;
     }
     const auto& f = fx_->process(seg_);
     const bool upstream_bad = seg_.status == fploc::seg::SegStatus::kBadInput || seg_.status == fploc::seg::SegStatus::kEmpty;
     // A bad scan is the segmenter's error (in its telemetry); here only what is wrong with this message.
-    if (f.status == fploc::feat::FeatStatus::kBadInput && !upstream_bad)
+    if (f.status == fploc::FeatureStatus::kBadInput && !upstream_bad)
       ctx_->error("segments seq " + std::to_string(m.seq) + ": bad input (non-finite roll/pitch)");
-    fploc::to_msg(f, seq_++, m.scan_seq, msg);
+    fploc::to_msg(f, seq_++, msg);
     out_.publish(msg);
   }
 

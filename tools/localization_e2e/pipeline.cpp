@@ -12,7 +12,6 @@
 #include "fploc/matcher/map.h"
 #include "fploc/odometry/odometry.h"
 #include "fploc/segmentation/segmenter.h"
-#include "fploc/nodes/localization_convert.h"
 #include "fploc/nodes/perception_convert.h"
 #include "fploc/sim/simulator.h"
 
@@ -109,10 +108,8 @@ Result run(const FloorPlan& plan_in, const Options& o) {
     t0 = clk::now();
     const auto& ft = fx.process(s);
     r.us_features += us_since(t0);
-    // The graph's conversion path: what fploc-features publishes, what fploc-matcher reads.
-    features_t msg;
-    to_msg(ft, k, k, msg);
-    FeatureFrame frame = from_msg(msg);
+    FeatureFrame frame = ft;  // the extractor's frame, as every stage consumes it (no wire type in between)
+    frame.scan_seq = k;
     if (frame.utime == 0) frame.utime = f.scan.utime;
     feat_total += double(frame.points.size());
     // IMU samples up to the end of the sweep (when the scan is published), as in the simulator's log.

@@ -88,10 +88,10 @@ void from_msg(const segments_t& m, seg::Segmentation& s) {
       bad("wall points not ring-major with increasing column at index " + std::to_string(i));
 }
 
-void to_msg(const feat::Features2D& f, int64_t seq, int64_t scan_seq, features_t& m) {
+void to_msg(const FeatureFrame& f, int64_t seq, features_t& m) {
   m.utime = f.utime;
   m.seq = seq;
-  m.scan_seq = scan_seq;
+  m.scan_seq = f.scan_seq;
   m.status = int8_t(f.status);
   m.roll = f.roll;
   m.pitch = f.pitch;
@@ -99,12 +99,21 @@ void to_msg(const feat::Features2D& f, int64_t seq, int64_t scan_seq, features_t
   m.roll_pitch_sigma = f.roll_pitch_sigma;
   m.z_sigma = f.z_sigma;
   m.attitude_t_offset_s = f.attitude_t;
-  m.num_points = int32_t(f.size());
-  m.x = f.x;
-  m.y = f.y;
-  m.kind = f.kind;
-  m.group = f.group;
-  m.t_offset_s = f.t.size() == f.size() ? f.t : std::vector<float>(f.size(), 0.f);
+  const size_t n = f.points.size();
+  m.num_points = int32_t(n);
+  m.x.resize(n);
+  m.y.resize(n);
+  m.kind.resize(n);
+  m.group.resize(n);
+  m.t_offset_s.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Feature2& p = f.points[i];
+    m.x[i] = float(p.p.x());
+    m.y[i] = float(p.p.y());
+    m.kind[i] = int8_t(p.kind);
+    m.group[i] = p.group;
+    m.t_offset_s[i] = p.t;
+  }
   m.num_groups = f.num_groups;
 }
 

@@ -13,7 +13,7 @@ namespace fploc {
 void to_msg(const seg::Segmentation& s, int64_t seq, segments_t& m);
 // Throws std::runtime_error naming the field when the message is inconsistent.
 void from_msg(const segments_t& m, seg::Segmentation& s);
-void to_msg(const feat::Features2D& f, int64_t seq, int64_t scan_seq, features_t& m);
+void to_msg(const FeatureFrame& f, int64_t seq, features_t& m);
 
 seg::SegmenterConfig config_of(const SegmenterOptions& o);
 feat::FeatureConfig config_of(const FeatureOptions& o);
