@@ -10,43 +10,17 @@
 #include <map>
 #include <memory>
 
+#include "fploc/adapters/features_t.h"
+#include "fploc/adapters/frame_pose_t.h"
+#include "fploc/adapters/pose_t.h"
+#include "fploc/config/localization.h"
+#include "fploc/config/plan_source.h"
 #include "fploc/localizer/localizer.h"
-#include "fploc/matcher/map.h"
-#include "fploc/nodes/localization_convert.h"
 #include "fploc/runtime/node.h"
-#include "options/localization.pb.h"
 
 namespace {
 
 using fploc::FitStatus;
-
-fploc::OptimizerConfig config_of(const fploc::OptimizerOptions& o) {
-  fploc::OptimizerConfig c;
-  if (o.window() > 0) c.window = o.window();
-  if (o.alpha() > 0) c.alpha = o.alpha();
-  if (o.beta() > 0) c.beta = o.beta();
-  if (o.disable_regularisation()) c.alpha = c.beta = 0;
-  if (o.keyframe_distance_m() > 0) c.keyframe_distance_m = o.keyframe_distance_m();
-  if (o.keyframe_angle_deg() > 0) c.keyframe_angle_rad = o.keyframe_angle_deg() * M_PI / 180;
-  if (o.gate_m() > 0) c.gate_m = o.gate_m();
-  if (o.huber_m() > 0) c.loss_scale_m = o.huber_m();
-  if (!o.loss().empty()) c.loss = o.loss();
-  if (o.max_iterations() > 0) c.max_iterations = o.max_iterations();
-  if (o.rounds() > 0) c.outer = o.rounds();
-  if (o.stride() > 0) c.stride = o.stride();
-  if (o.max_points() != 0) c.max_points = o.max_points() < 0 ? 0 : o.max_points();
-  if (o.max_keyframe_gap_s() > 0) c.max_keyframe_gap_s = o.max_keyframe_gap_s();
-  c.anchor_final = o.anchor_final();
-  c.body_frame_velocity = o.body_frame_velocity();
-  if (o.relook_m() > 0) {
-    c.relook_rad *= o.relook_m() / c.relook_m;
-    c.relook_m = o.relook_m();
-  }
-  if (!o.linear_solver().empty()) c.linear_solver = o.linear_solver();
-  c.budget_weight = !o.disable_budget_weight();
-  c.group_rule = !o.disable_group_rule();
-  return c;
-}
 
 class OptimizerNode : public fploc::rt::Node {
  public:
@@ -61,15 +35,14 @@ class OptimizerNode : public fploc::rt::Node {
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::OptimizerOptions>();
-    map_ = fploc::load_map(ctx, o.plan(), o.lookup(), "optimizer");
-    fploc::localizer::Config cfg;
-    cfg.optimizer = config_of(o);
-    loc_ = std::make_unique<fploc::localizer::Localizer>(*map_.lookup, cfg);
+    map_ = fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); },
+                                   "optimizer.plan");
+    loc_ = std::make_unique<fploc::localizer::Localizer>(*map_.lookup, fploc::config::localizer_config(o));
     pose_out_ = ctx.advertise<fploc::pose_t>("pose");
     latest_out_ = ctx.advertise<fploc::pose_t>("latest");
     ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) {
       try {
-        features_[m.scan_seq] = fploc::from_msg(m);
+        features_[m.scan_seq] = fploc::adapters::from_msg(m);
       } catch (const std::exception& e) {
         ctx_->error(std::string("features: ") + e.what());
         return;
@@ -122,13 +95,13 @@ class OptimizerNode : public fploc::rt::Node {
       return;
     }
     std::vector<fploc::localizer::Pose> finals;
-    const auto latest = loc_->optimize(f, fploc::frame_pose_of(m), &finals);
-    if (latest) latest_out_.publish(fploc::to_msg(*latest, latest_seq_++));
+    const auto latest = loc_->optimize(f, fploc::adapters::from_msg(m), &finals);
+    if (latest) latest_out_.publish(fploc::adapters::to_msg(*latest, latest_seq_++));
     publish_finals(finals);
   }
 
   void publish_finals(const std::vector<fploc::localizer::Pose>& finals) {
-    for (const auto& p : finals) pose_out_.publish(fploc::to_msg(p, pose_seq_++));
+    for (const auto& p : finals) pose_out_.publish(fploc::adapters::to_msg(p, pose_seq_++));
   }
 
   fploc::rt::Context* ctx_ = nullptr;

@@ -12,7 +12,7 @@
 #include "fploc/matcher/map.h"
 #include "fploc/odometry/odometry.h"
 #include "fploc/segmentation/segmenter.h"
-#include "fploc/nodes/perception_convert.h"
+#include "fploc/config/perception.h"
 #include "fploc/sim/simulator.h"
 
 namespace fploc::e2e {
@@ -54,8 +54,8 @@ Result run(const FloorPlan& plan_in, const Options& o) {
   const FloorPlan& plan = sim.world().plan();
   LocalizationMap map = make_localization_map(plan, o.lookup);
   // The graph's nodes' configurations (their options' defaults).
-  seg::RingSegmenter segmenter(config_of(SegmenterOptions{}));
-  feat::FeatureExtractor fx(config_of(FeatureOptions{}));
+  seg::RingSegmenter segmenter(config::config_of(SegmenterOptions{}));
+  feat::FeatureExtractor fx(config::config_of(FeatureOptions{}));
   const int n = o.max_frames > 0 ? std::min(o.max_frames, sim.num_frames()) : sim.num_frames();
 
   Result r;

@@ -219,7 +219,7 @@ void WindowOptimizer::solve() {
     }
   }
   for (auto& k : window_) chain.push_back({k.x, k.f.tau});
-  for (int outer = 0; outer < std::max(1, cfg_.outer); ++outer) {
+  for (int outer = 0; outer < std::max(1, cfg_.rounds); ++outer) {
     // Look-ups: a key keeps its correspondences while its pose stays within relook_m / relook_rad of
     // where they were looked up (the residuals re-evaluate the closest point on the candidates at every
     // evaluation anyway); a round in which no key needed a new look-up would repeat the last solve.

@@ -20,7 +20,7 @@ struct Config {
   MatcherConfig matcher;             // the SFR step
   OptimizerConfig optimizer;         // the WO step
   bool use_imu = true;               // the IMU's yaw rate: prediction (yaw change) + sweep yaw rate (de-skew)
-  double initial_search_m = 0;       // set_pose without an uncertainty: search this far (0: matcher.gate_initial_m)
+  double initial_search_m = 0;       // set_pose without an uncertainty: search this far (0: matcher.max_correspondence_m)
   bool refine_from_window = true;    // process(): the WO estimate of a frame predicts the next one
 };
 

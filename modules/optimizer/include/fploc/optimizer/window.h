@@ -36,7 +36,7 @@ struct OptimizerConfig {
   double loss_scale_m = 0.05;
   std::string loss = "cauchy";    // as MatcherConfig::loss
   int max_iterations = 10;             // Ceres iterations per outer round
-  int outer = 2;                       // look-up + solve rounds per new keyframe
+  int rounds = 2;                      // look-up + solve rounds per new keyframe
   bool group_rule = true;
   int stride = 1;                      // use every stride-th feature point of a keyframe
   int max_points = 800;                // per keyframe: the stride grows to keep about this many (0 = all)
