@@ -1,10 +1,15 @@
-// Small portable random generator (xoshiro256** seeded by splitmix64) with Box-Muller normals, so a given
-// seed gives the same sequence on every platform and standard library (std::normal_distribution does not).
+// Seeded, portable random numbers: a given seed gives the same sequence on every platform and standard
+// library (std::normal_distribution does not guarantee that). Two generators, each kept bit-exact for the
+// results that depend on it:
+//  - Rng: xoshiro256** seeded by splitmix64, Box-Muller normals (the simulator: scans, motion, worlds);
+//  - PolarRng: std::mt19937_64 with nav2's pf_ran_gaussian (polar Box-Muller, one value used) (AMCL; nav2's
+//    pf uses drand48() seeded from the clock, here the seed is given).
 #pragma once
 #include <cmath>
 #include <cstdint>
+#include <random>
 
-namespace fploc::sim {
+namespace fploc {
 
 inline uint64_t splitmix64(uint64_t& x) {
   uint64_t z = (x += 0x9E3779B97F4A7C15ull);
@@ -68,4 +73,30 @@ class Rng {
   bool has_spare_ = false;
 };
 
-}  // namespace fploc::sim
+class PolarRng {
+ public:
+  explicit PolarRng(uint64_t seed = 1) : g_(seed) {}
+  void seed(uint64_t s) { g_.seed(s); }
+  // Uniform in [0, 1) with 53 random bits.
+  double uniform() { return double(g_() >> 11) * 0x1.0p-53; }
+  // Zero-mean normal with standard deviation sigma (nav2 pf_ran_gaussian: polar Box–Muller, one value used).
+  double gaussian(double sigma) {
+    double x1, x2, w;
+    do {
+      double r;
+      do r = uniform();
+      while (r == 0.0);
+      x1 = 2.0 * r - 1.0;
+      do r = uniform();
+      while (r == 0.0);
+      x2 = 2.0 * r - 1.0;
+      w = x1 * x1 + x2 * x2;
+    } while (w > 1.0 || w == 0.0);
+    return sigma * x2 * std::sqrt(-2.0 * std::log(w) / w);
+  }
+
+ private:
+  std::mt19937_64 g_;
+};
+
+}  // namespace fploc
