@@ -15,6 +15,7 @@
 
 #include "fploc/config/localization.h"
 #include "fploc/config/perception.h"
+#include "fploc/config/relocalization.h"
 
 namespace {
 
@@ -133,6 +134,15 @@ TEST(ConfigDefaults, Perception) {
          {"max_surfaces_per_sector", f.max_surfaces_per_sector}, {"corner_threshold", f.corner_threshold},
          {"surface_threshold", f.surface_threshold}, {"max_range_m", f.max_range_m}, {"min_range_m", f.min_range_m},
          {"half_window", f.half_window}, {"min_group_points", f.min_group_points}, {"line_max_rms_m", f.line_max_rms_m}});
+}
+
+TEST(ConfigDefaults, Relocalizer) {
+  const fploc::RelocalizerConfig c = config_of(fploc::RelocalizerOptions{});
+  // region_radius_m, global_after_s, min_interval_s: fploc-relocalizer's scheduling, not RelocalizerConfig.
+  check("relocalization.proto", "RelocalizerOptions",
+        {{"grid_m", c.grid_m}, {"yaw_step_deg", c.yaw_step_deg}, {"min_inlier_ratio", c.min_inlier_ratio},
+         {"min_evidence", c.min_evidence}},
+        {"region_radius_m", "global_after_s", "min_interval_s"});
 }
 
 }  // namespace

@@ -19,6 +19,7 @@
 #include "fploc/adapters/features_t.h"
 #include "fploc/adapters/pose_t.h"
 #include "fploc/config/plan_source.h"
+#include "fploc/config/relocalization.h"
 #include "fploc/relocalization/relocalizer.h"
 #include "fploc/runtime/node.h"
 #include "options/relocalization.pb.h"
@@ -41,12 +42,7 @@ class RelocalizerNode : public fploc::rt::Node {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::RelocalizerOptions>();
     map_ = fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); }, "relocalizer.plan");
-    fploc::RelocalizerConfig c;
-    if (o.grid_m() > 0) c.grid_m = o.grid_m();
-    if (o.yaw_step_deg() > 0) c.yaw_step_deg = o.yaw_step_deg();
-    if (o.min_inlier_ratio() > 0) c.min_inlier_ratio = o.min_inlier_ratio();
-    if (o.min_evidence() > 0) c.min_evidence = o.min_evidence();
-    reloc_ = std::make_unique<fploc::Relocalizer>(*map_.plan, *map_.lookup, c);
+    reloc_ = std::make_unique<fploc::Relocalizer>(*map_.plan, *map_.lookup, fploc::config::config_of(o));
     radius_ = o.region_radius_m() > 0 ? o.region_radius_m() : 3.0;
     global_after_us_ = int64_t((o.global_after_s() > 0 ? o.global_after_s() : 2.0) * 1e6);
     interval_us_ = int64_t((o.min_interval_s() > 0 ? o.min_interval_s() : 0.5) * 1e6);
