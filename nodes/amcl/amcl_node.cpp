@@ -31,7 +31,8 @@
 #include "fploc/amcl/amcl.h"
 #include "fploc/amcl/odometry.h"
 #include "fploc/floorplan/io.h"
-#include "fploc/nodes/localization_convert.h"
+#include "fploc/adapters/features_t.h"
+#include "fploc/adapters/pose_t.h"
 #include "fploc/runtime/node.h"
 #include "options/amcl.pb.h"
 
@@ -161,7 +162,7 @@ class AmclNode : public fploc::rt::Node {
     odom_out_ = ctx.advertise<fploc::pose_t>("odom_used");
     ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) { on_features(m); });
     if (!wheel_mode_)
-      ctx.subscribe<fploc::pose_t>("odom", [this](const fploc::pose_t& m) { on_odom(m.utime, fploc::pose2_of(m), m.seq); });
+      ctx.subscribe<fploc::pose_t>("odom", [this](const fploc::pose_t& m) { on_odom(m.utime, fploc::adapters::pose2_of(m), m.seq); });
     else
       ctx.subscribe<fploc::ground_truth_t>("ground_truth", [this](const fploc::ground_truth_t& m) { on_truth(m); });
     ctx.subscribe<fploc::pose_t>("initial_pose", [this](const fploc::pose_t& m) { on_initial_pose(m); });
@@ -222,7 +223,7 @@ class AmclNode : public fploc::rt::Node {
     Frame f;
     int dropped = 0;
     try {
-      const fploc::FeatureFrame ff = fploc::from_msg(m, &dropped);
+      const fploc::FeatureFrame ff = fploc::adapters::from_msg(m, &dropped);
       f.utime = ff.utime;
       f.scan_seq = ff.scan_seq;
       f.roll = ff.roll;
@@ -273,7 +274,7 @@ class AmclNode : public fploc::rt::Node {
     last_truth_utime_ = m.utime;
     const Pose2 odo = wheel_->update(truth);
     if (odom_out_.valid() && !odom_out_.channel().empty())
-      odom_out_.publish(fploc::make_pose_msg(m.utime, odom_seq_++, odo, 0, 0, m.position[2], Eigen::Matrix3d::Zero(), 0, 0, 0,
+      odom_out_.publish(fploc::adapters::make_pose_msg(m.utime, odom_seq_++, odo, 0, 0, m.position[2], Eigen::Matrix3d::Zero(), 0, 0, 0,
                                              false, true));
     on_odom(m.utime, odo, m.seq);
   }
@@ -292,7 +293,7 @@ class AmclNode : public fploc::rt::Node {
   }
 
   void on_initial_pose(const fploc::pose_t& m) {
-    const Pose2 p = fploc::pose2_of(m);
+    const Pose2 p = fploc::adapters::pose2_of(m);
     if (!am::finite(p)) {
       ctx_->error("initial_pose seq " + std::to_string(m.seq) + ": non-finite pose (ignored)");
       return;
@@ -360,7 +361,7 @@ class AmclNode : public fploc::rt::Node {
     const double spread = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov.topLeftCorner<2, 2>()).eigenvalues()[1]));
     const bool ok = spread <= cfg_.converged_dist;
     if (ok) ++ok_;
-    out_.publish(fploc::make_pose_msg(f.utime, seq_++, p, f.roll, f.pitch, f.z, cov, f.z_sigma, f.rp_sigma, ok ? 0 : 1,
+    out_.publish(fploc::adapters::make_pose_msg(f.utime, seq_++, p, f.roll, f.pitch, f.z, cov, f.z_sigma, f.rp_sigma, ok ? 0 : 1,
                                       info.updated, true));
     ++scans_;
     if (info.updated) {

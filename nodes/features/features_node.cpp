@@ -4,7 +4,9 @@
 #include <fploc/segments_t.hpp>
 
 #include "fploc/features/features.h"
-#include "fploc/nodes/perception_convert.h"
+#include "fploc/adapters/features_t.h"
+#include "fploc/adapters/segments_t.h"
+#include "fploc/config/perception.h"
 #include "fploc/runtime/node.h"
 
 namespace {
@@ -19,7 +21,7 @@ class FeaturesNode : public fploc::rt::Node {
 
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
-    fx_ = std::make_unique<fploc::feat::FeatureExtractor>(fploc::config_of(ctx.options<fploc::FeatureOptions>()));
+    fx_ = std::make_unique<fploc::feat::FeatureExtractor>(fploc::config::config_of(ctx.options<fploc::FeatureOptions>()));
     out_ = ctx.advertise<fploc::features_t>("features");
     ctx.subscribe<fploc::segments_t>("segments", [this](const fploc::segments_t& m) { on_segments(m); });
   }
@@ -28,22 +30,23 @@ class FeaturesNode : public fploc::rt::Node {
   void on_segments(const fploc::segments_t& m) {
     fploc::features_t msg;
     try {
-      fploc::from_msg(m, seg_);
+      fploc::adapters::from_msg(m, seg_);
     } catch (const std::exception& e) {
       ctx_->error(std::string("segments: ") + e.what());
-      fploc::feat::Features2D bad;
+      fploc::FeatureFrame bad;
       bad.utime = m.utime;
-      bad.status = fploc::feat::FeatStatus::kBadInput;
-      fploc::to_msg(bad, seq_++, m.scan_seq, msg);
+      bad.scan_seq = m.scan_seq;
+      bad.status = fploc::FeatureStatus::kBadInput;
+      fploc::adapters::to_msg(bad, seq_++, msg);
       out_.publish(msg);
       return;
     }
     const auto& f = fx_->process(seg_);
     const bool upstream_bad = seg_.status == fploc::seg::SegStatus::kBadInput || seg_.status == fploc::seg::SegStatus::kEmpty;
     // A bad scan is the segmenter's error (in its telemetry); here only what is wrong with this message.
-    if (f.status == fploc::feat::FeatStatus::kBadInput && !upstream_bad)
+    if (f.status == fploc::FeatureStatus::kBadInput && !upstream_bad)
       ctx_->error("segments seq " + std::to_string(m.seq) + ": bad input (non-finite roll/pitch)");
-    fploc::to_msg(f, seq_++, m.scan_seq, msg);
+    fploc::adapters::to_msg(f, seq_++, msg);
     out_.publish(msg);
   }
 

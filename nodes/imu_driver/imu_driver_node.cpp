@@ -14,6 +14,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "fploc/adapters/imu_t.h"
 #include "fploc/os1/packet.h"
 #include "fploc/os1/source.h"
 #include "fploc/os1/xsens.h"
@@ -176,14 +177,7 @@ class ImuDriverNode : public fploc::rt::Node {
 
  private:
   void publish(const Sample& s) {
-    fploc::imu_t m;
-    m.utime = int64_t(s.s.accel_ts_ns / 1000);
-    m.accel_utime = int64_t(s.s.accel_ts_ns / 1000);
-    m.gyro_utime = int64_t(s.s.gyro_ts_ns / 1000);
-    m.seq = seq_++;
-    for (int i = 0; i < 3; ++i) m.accel[i] = s.s.accel_mps2[i], m.gyro[i] = s.s.gyro_radps[i];
-    m.source = s.source;
-    out_.publish(m);
+    out_.publish(fploc::adapters::to_msg(s.s, seq_++, s.source));
   }
   std::unique_ptr<ImuSource> source_;
   fploc::rt::Publisher<fploc::imu_t> out_;

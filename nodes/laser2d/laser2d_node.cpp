@@ -10,7 +10,7 @@
 #include <cmath>
 
 #include "fploc/laser2d/laser2d.h"
-#include "fploc/nodes/perception_convert.h"
+#include "fploc/adapters/features_t.h"
 #include "fploc/runtime/node.h"
 #include "options/laser2d.pb.h"
 
@@ -81,11 +81,11 @@ class Laser2dNode : public fploc::rt::Node {
       accel_n_ = 0;
     }
     const auto& f = l2_->process(s, roll_, pitch_, rp_sigma_);
-    if (f.status == fploc::feat::FeatStatus::kBadInput && !m.ranges.empty())
+    if (f.status == fploc::FeatureStatus::kBadInput && !m.ranges.empty())
       ctx_->error("scan utime " + std::to_string(m.utime) + ": bad geometry (angle_increment " +
                   std::to_string(m.angle_increment) + ")");
     fploc::features_t msg;
-    fploc::to_msg(f, seq_, seq_, msg);
+    fploc::adapters::to_msg(f, seq_, msg);
     ++seq_;
     out_.publish(msg);
   }

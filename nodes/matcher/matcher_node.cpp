@@ -1,5 +1,6 @@
 // fploc-matcher: FPLOC_FEATURES (+ OS1_IMU yaw rate) -> single-frame registration -> FPLOC_FRAME_POSE
-// for every scan. The map (plan or .fpmap) and the look-up come from the `matcher` options.
+// for every scan: the SFR step of fploc::localizer::Localizer. The map (plan or .fpmap) and the look-up
+// come from the `matcher` options.
 #include <fploc/features_t.hpp>
 #include <fploc/frame_pose_t.hpp>
 #include <fploc/imu_t.hpp>
@@ -12,40 +13,17 @@
 #include <memory>
 #include <optional>
 
-#include "fploc/matcher/imu_yaw.h"
-#include "fploc/matcher/map.h"
-#include "fploc/matcher/matcher.h"
-#include "fploc/nodes/localization_convert.h"
+#include "fploc/adapters/features_t.h"
+#include "fploc/adapters/frame_pose_t.h"
+#include "fploc/adapters/pose_t.h"
+#include "fploc/config/localization.h"
+#include "fploc/config/plan_source.h"
+#include "fploc/localizer/localizer.h"
 #include "fploc/runtime/node.h"
-#include "options/localization.pb.h"
 
 namespace {
 
 using fploc::FitStatus;
-
-fploc::MatcherConfig config_of(const fploc::MatcherOptions& o) {
-  fploc::MatcherConfig c;
-  if (o.max_correspondence_m() > 0) c.gate_initial_m = o.max_correspondence_m();
-  if (o.min_correspondence_m() > 0) c.gate_final_m = o.min_correspondence_m();
-  if (o.huber_m() > 0) c.loss_scale_m = o.huber_m();
-  if (!o.loss().empty()) c.loss = o.loss();
-  if (o.max_iterations() > 0) c.max_iterations = o.max_iterations();
-  if (o.max_rounds() > 0) c.max_outer = o.max_rounds();
-  if (o.inlier_m() > 0) c.inlier_m = o.inlier_m();
-  if (o.min_inlier_ratio() > 0) c.min_inlier_ratio = o.min_inlier_ratio();
-  if (o.min_inliers() > 0) c.min_inliers = o.min_inliers();
-  if (o.lost_after() > 0) c.lost_after = o.lost_after();
-  if (o.max_jump_m() > 0) c.max_jump_m = o.max_jump_m();
-  c.max_jump_rad = (o.max_jump_deg() > 0 ? o.max_jump_deg() : 30.0) * M_PI / 180;
-  c.group_rule = !o.disable_group_rule();
-  c.motion_model = !o.disable_motion_model();
-  if (o.stride() > 0) c.stride = o.stride();
-  if (o.max_points() != 0) c.max_points = o.max_points() < 0 ? 0 : o.max_points();
-  c.deskew = !o.disable_deskew();
-  if (o.prediction_sigma_m() != 0) c.prediction_sigma_m = std::max(0.0, o.prediction_sigma_m());
-  if (o.prediction_sigma_deg() != 0) c.prediction_sigma_rad = std::max(0.0, o.prediction_sigma_deg()) * M_PI / 180;
-  return c;
-}
 
 class MatcherNode : public fploc::rt::Node {
  public:
@@ -67,41 +45,39 @@ class MatcherNode : public fploc::rt::Node {
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::MatcherOptions>();
-    map_ = fploc::load_map(ctx, o.plan(), o.lookup(), "matcher");
-    matcher_ = std::make_unique<fploc::Matcher>(*map_.lookup, config_of(o));
-    use_imu_ = !o.ignore_imu();
-    if (o.initial_search_m() > 0) initial_search_m_ = o.initial_search_m();
+    map_ = fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); },
+                                   "matcher.plan");
+    loc_ = std::make_unique<fploc::localizer::Localizer>(*map_.lookup, fploc::config::localizer_config(o));
     // The graph's initial pose is where the run starts; a restarted matcher (crash, module swap) waits for
     // a pose instead (FPLOC_INITIAL_POSE: the relocalizer searches around the last good pose).
     if (!o.wait_for_initial_pose() && ctx.restarts() == 0)
-      matcher_->set_pose({o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()}, initial_search_m_);
+      loc_->set_pose({o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()});
     else if (ctx.restarts() > 0)
       std::cerr << "[" << ctx.name() << "] restart " << ctx.restarts() << ": waiting for a pose on initial_pose\n";
     out_ = ctx.advertise<fploc::frame_pose_t>("frame_pose");
     ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) { on_features(m); });
     ctx.subscribe<fploc::imu_t>("imu", [this](const fploc::imu_t& m) { on_imu(m); });
     ctx.subscribe<fploc::pose_t>("initial_pose", [this](const fploc::pose_t& m) {
-      const fploc::Pose2 p = fploc::pose2_of(m);
+      const fploc::Pose2 p = fploc::adapters::pose2_of(m);
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.yaw)) {
         ctx_->error("initial_pose seq " + std::to_string(m.seq) + ": non-finite pose (ignored)");
         return;
       }
       // Search within 3 sigma of the message's position covariance when it has one.
       const double var = std::max(m.covariance[0], m.covariance[7]);
-      matcher_->set_pose(p, std::isfinite(var) && var > 0 ? std::optional<double>(3 * std::sqrt(var)) : initial_search_m_);
+      loc_->set_pose(p, std::isfinite(var) && var > 0 ? std::optional<double>(3 * std::sqrt(var)) : std::nullopt);
     });
     ctx.subscribe<fploc::pose_t>("odom", [this](const fploc::pose_t& m) {
-      const fploc::Pose2 p = fploc::pose2_of(m);
+      const fploc::Pose2 p = fploc::adapters::pose2_of(m);
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.yaw)) {
         ctx_->error("odom seq " + std::to_string(m.seq) + ": non-finite pose (ignored)");
         return;
       }
-      odom_[m.utime] = p;
-      while (odom_.size() > 256) odom_.erase(odom_.begin());
+      loc_->add_odometry(m.utime, p);
     });
     ctx.subscribe<fploc::pose_t>("refined", [this](const fploc::pose_t& m) {
       // Stale (a later frame was already registered) or LOST: not used; counted, said at shutdown.
-      if (!matcher_->refine(m.utime, fploc::pose2_of(m))) ++refined_ignored_;
+      if (!loc_->refine(m.utime, fploc::adapters::pose2_of(m))) ++refined_ignored_;
     });
   }
 
@@ -112,88 +88,33 @@ class MatcherNode : public fploc::rt::Node {
   }
 
  private:
-  void on_imu(const fploc::imu_t& m) {
-    if (use_imu_) imu_.add(m.utime, m.gyro[2]);  // out of order / non-finite samples are ignored
-  }
+  void on_imu(const fploc::imu_t& m) { loc_->add_imu(m.utime, m.gyro[2]); }
 
   void on_features(const fploc::features_t& m) {
     const auto t_start = std::chrono::steady_clock::now();
     fploc::FeatureFrame f;
     int dropped = 0;
     try {
-      f = fploc::from_msg(m, &dropped);
+      f = fploc::adapters::from_msg(m, &dropped);
     } catch (const std::exception& e) {
       ctx_->error(std::string("features: ") + e.what());
       return;
     }
     if (dropped) ctx_->error("features seq " + std::to_string(m.seq) + ": " + std::to_string(dropped) + " non-finite points dropped");
-    // Roll/pitch/z the segmenter could not estimate (its "unknown" sigmas): the last known ones are
-    // passed on (the optimizer interpolates them in its final poses).
-    if (f.z_sigma < 1.0) last_z_ = f.z;
-    else if (last_z_) f.z = *last_z_;
-    if (f.roll_pitch_sigma < 0.5) last_rp_ = {f.roll, f.pitch};
-    else if (last_rp_) f.roll = last_rp_->first, f.pitch = last_rp_->second;
-    std::optional<double> dyaw;
-    if (use_imu_) {
-      // Prediction: the yaw change since the previous frame; motion compensation: the mean rate over
-      // this frame's sweep (its samples arrive before the scan is complete).
-      if (have_prev_) dyaw = imu_.integral(prev_utime_, f.utime);
-      const double sweep = fploc::sweep_duration(f);
-      if (sweep > 0)
-        if (auto w = imu_.mean_rate(f.utime, f.utime + std::llround(sweep * 1e6))) f.sweep_yaw_rate = *w;
-      imu_.drop_before(std::min(f.utime, have_prev_ ? prev_utime_ : f.utime));
-    }
-    std::optional<fploc::Pose2> motion;
-    if (have_prev_) {
-      auto a = odom_.find(prev_utime_), b = odom_.find(f.utime);
-      if (a != odom_.end() && b != odom_.end()) motion = fploc::compose(fploc::inverse(a->second), b->second);
-    }
-    const fploc::MatchResult r = matcher_->process(f, dyaw, motion);
-    if (r.status != FitStatus::kNotInitialised) {
-      prev_utime_ = f.utime;
-      have_prev_ = true;
-    }
-    fploc::frame_pose_t o;
-    o.utime = m.utime;
-    o.seq = seq_++;
-    o.scan_seq = m.scan_seq;
-    o.status = int8_t(r.status);
-    o.status_text = r.status == FitStatus::kOk ? "" : std::string(fploc::to_string(r.status)) + ": " + r.text;
-    o.x = r.pose.x;
-    o.y = r.pose.y;
-    o.yaw = r.pose.yaw;
-    for (int i = 0; i < 9; ++i) o.covariance[i] = r.covariance(i / 3, i % 3);
-    o.roll = f.roll;
-    o.pitch = f.pitch;
-    o.z = f.z;
-    o.twist[0] = r.twist.vx;
-    o.twist[1] = r.twist.vy;
-    o.twist[2] = r.twist.w;
-    o.num_points = r.fit.num_points;
-    o.num_inliers = r.fit.num_inliers;
-    o.inlier_ratio = r.fit.inlier_ratio;
-    o.rms_residual_m = r.fit.rms_m;
-    o.iterations = r.iterations;
+    const fploc::localizer::FramePose fp = loc_->register_frame(f);
+    const fploc::MatchResult& r = fp.match;
     // Wall-clock only outside replay (outputs must be reproducible there).
-    o.solve_ms = ctx_->composed() ? 0.0
-                                  : std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
+    const double solve_ms =
+        ctx_->composed() ? 0.0 : std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
     if (r.status == FitStatus::kLost && last_status_ != FitStatus::kLost) ctx_->error("LOST at scan " + std::to_string(m.scan_seq) + ": " + r.text);
     last_status_ = r.status;
-    out_.publish(o);
+    out_.publish(fploc::adapters::to_msg(fp, seq_++, solve_ms));
   }
 
   fploc::rt::Context* ctx_ = nullptr;
   fploc::LocalizationMap map_;
-  std::unique_ptr<fploc::Matcher> matcher_;
+  std::unique_ptr<fploc::localizer::Localizer> loc_;
   fploc::rt::Publisher<fploc::frame_pose_t> out_;
-  fploc::ImuYaw imu_;
-  bool use_imu_ = true;
-  std::optional<double> initial_search_m_;
-  std::optional<double> last_z_;
-  std::optional<std::pair<double, double>> last_rp_;
-  std::map<int64_t, fploc::Pose2> odom_;  // odometry by utime (the last 256)
-  bool have_prev_ = false;
-  int64_t prev_utime_ = 0;
   int64_t seq_ = 0;
   int64_t refined_ignored_ = 0;
   FitStatus last_status_ = FitStatus::kOk;

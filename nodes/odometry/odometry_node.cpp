@@ -7,7 +7,9 @@
 #include <cmath>
 #include <memory>
 
-#include "fploc/nodes/localization_convert.h"
+#include "fploc/adapters/features_t.h"
+#include "fploc/adapters/pose_t.h"
+#include "fploc/config/localization.h"
 #include "fploc/odometry/odometry.h"
 #include "fploc/runtime/node.h"
 #include "options/localization.pb.h"
@@ -25,31 +27,20 @@ class OdometryNode : public fploc::rt::Node {
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::OdometryOptions>();
-    fploc::OdometryConfig c;
-    if (o.max_correspondence_m() > 0) c.max_correspondence_m = o.max_correspondence_m();
-    if (o.keyframe_distance_m() > 0) c.keyframe_distance_m = o.keyframe_distance_m();
-    if (o.keyframe_angle_deg() > 0) c.keyframe_angle_rad = o.keyframe_angle_deg() * M_PI / 180;
-    if (o.map_keyframes() > 0) c.map_keyframes = o.map_keyframes();
-    if (o.max_iterations() > 0) c.max_iterations = o.max_iterations();
-    if (o.frame_to_frame()) {
-      c.map_keyframes = 1;
-      c.keyframe_distance_m = 0;
-      c.keyframe_angle_rad = 0;
-    }
-    odo_ = std::make_unique<fploc::Odometry2D>(c);
+    odo_ = std::make_unique<fploc::Odometry2D>(fploc::config::config_of(o));
     odo_->set_pose({o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()});
     out_ = ctx.advertise<fploc::pose_t>("pose");
     ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) {
       fploc::FeatureFrame f;
       try {
-        f = fploc::from_msg(m);
+        f = fploc::adapters::from_msg(m);
       } catch (const std::exception& e) {
         ctx_->error(std::string("features: ") + e.what());
         return;
       }
       const fploc::OdometryResult r = odo_->process(f);
       Eigen::Matrix3d cov = Eigen::Matrix3d::Identity() * (r.ok ? r.rms_m * r.rms_m : 1e6);
-      out_.publish(fploc::make_pose_msg(f.utime, seq_++, r.pose, f.roll, f.pitch, f.z, cov, f.z_sigma,
+      out_.publish(fploc::adapters::make_pose_msg(f.utime, seq_++, r.pose, f.roll, f.pitch, f.z, cov, f.z_sigma,
                                         f.roll_pitch_sigma, r.ok ? 0 : 1, r.keyframe, true));
     });
   }

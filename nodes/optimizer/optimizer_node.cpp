@@ -1,6 +1,7 @@
 // fploc-optimizer: FPLOC_FEATURES + FPLOC_FRAME_POSE (paired by scan_seq) -> windowed optimisation ->
 // FPLOC_POSE (6-DoF, final estimates: poses that left the window, every frame, in time order) and
-// FPLOC_POSE_LATEST (the current window estimate of each frame, low latency).
+// FPLOC_POSE_LATEST (the current window estimate of each frame, low latency): the WO step of
+// fploc::localizer::Localizer.
 #include <fploc/features_t.hpp>
 #include <fploc/frame_pose_t.hpp>
 #include <fploc/pose_t.hpp>
@@ -9,43 +10,17 @@
 #include <map>
 #include <memory>
 
-#include "fploc/matcher/map.h"
-#include "fploc/nodes/localization_convert.h"
-#include "fploc/optimizer/window.h"
+#include "fploc/adapters/features_t.h"
+#include "fploc/adapters/frame_pose_t.h"
+#include "fploc/adapters/pose_t.h"
+#include "fploc/config/localization.h"
+#include "fploc/config/plan_source.h"
+#include "fploc/localizer/localizer.h"
 #include "fploc/runtime/node.h"
-#include "options/localization.pb.h"
 
 namespace {
 
 using fploc::FitStatus;
-
-fploc::OptimizerConfig config_of(const fploc::OptimizerOptions& o) {
-  fploc::OptimizerConfig c;
-  if (o.window() > 0) c.window = o.window();
-  if (o.alpha() > 0) c.alpha = o.alpha();
-  if (o.beta() > 0) c.beta = o.beta();
-  if (o.disable_regularisation()) c.alpha = c.beta = 0;
-  if (o.keyframe_distance_m() > 0) c.keyframe_distance_m = o.keyframe_distance_m();
-  if (o.keyframe_angle_deg() > 0) c.keyframe_angle_rad = o.keyframe_angle_deg() * M_PI / 180;
-  if (o.gate_m() > 0) c.gate_m = o.gate_m();
-  if (o.huber_m() > 0) c.loss_scale_m = o.huber_m();
-  if (!o.loss().empty()) c.loss = o.loss();
-  if (o.max_iterations() > 0) c.max_iterations = o.max_iterations();
-  if (o.rounds() > 0) c.outer = o.rounds();
-  if (o.stride() > 0) c.stride = o.stride();
-  if (o.max_points() != 0) c.max_points = o.max_points() < 0 ? 0 : o.max_points();
-  if (o.max_keyframe_gap_s() > 0) c.max_keyframe_gap_s = o.max_keyframe_gap_s();
-  c.anchor_final = o.anchor_final();
-  c.body_frame_velocity = o.body_frame_velocity();
-  if (o.relook_m() > 0) {
-    c.relook_rad *= o.relook_m() / c.relook_m;
-    c.relook_m = o.relook_m();
-  }
-  if (!o.linear_solver().empty()) c.linear_solver = o.linear_solver();
-  c.budget_weight = !o.disable_budget_weight();
-  c.group_rule = !o.disable_group_rule();
-  return c;
-}
 
 class OptimizerNode : public fploc::rt::Node {
  public:
@@ -60,13 +35,14 @@ class OptimizerNode : public fploc::rt::Node {
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::OptimizerOptions>();
-    map_ = fploc::load_map(ctx, o.plan(), o.lookup(), "optimizer");
-    opt_ = std::make_unique<fploc::WindowOptimizer>(*map_.lookup, config_of(o));
+    map_ = fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); },
+                                   "optimizer.plan");
+    loc_ = std::make_unique<fploc::localizer::Localizer>(*map_.lookup, fploc::config::localizer_config(o));
     pose_out_ = ctx.advertise<fploc::pose_t>("pose");
     latest_out_ = ctx.advertise<fploc::pose_t>("latest");
     ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) {
       try {
-        features_[m.scan_seq] = fploc::from_msg(m);
+        features_[m.scan_seq] = fploc::adapters::from_msg(m);
       } catch (const std::exception& e) {
         ctx_->error(std::string("features: ") + e.what());
         return;
@@ -82,9 +58,9 @@ class OptimizerNode : public fploc::rt::Node {
   }
 
   void shutdown() override {
-    if (!opt_) return;
-    std::vector<fploc::PoseOut> finals;
-    opt_->flush(&finals);
+    if (!loc_) return;
+    std::vector<fploc::localizer::Pose> finals;
+    loc_->flush(&finals);
     publish_finals(finals);
   }
 
@@ -104,7 +80,7 @@ class OptimizerNode : public fploc::rt::Node {
     } else if (scan_seq <= last_seq_ && have_last_) {
       ctx_->error("scan_seq " + std::to_string(scan_seq) + " arrived after " + std::to_string(last_seq_) + " (dropped)");
     } else if (p->second.status != int8_t(FitStatus::kNotInitialised)) {
-      process(std::move(f->second), p->second);
+      process(f->second, p->second);
       last_seq_ = scan_seq;
       have_last_ = true;
     }
@@ -113,47 +89,27 @@ class OptimizerNode : public fploc::rt::Node {
     frame_poses_.erase(frame_poses_.begin(), std::next(p));
   }
 
-  void process(fploc::FeatureFrame f, const fploc::frame_pose_t& fp) {
-    fploc::FrameInput in;
-    in.features = std::move(f);
-    in.sfr = {fp.x, fp.y, fp.yaw};
-    if (std::isfinite(fp.twist[0]) && std::isfinite(fp.twist[1]) && std::isfinite(fp.twist[2]))
-      in.twist = {fp.twist[0], fp.twist[1], fp.twist[2]};
-    in.status = fp.status <= 2 ? FitStatus(fp.status) : FitStatus::kLost;
-    for (int i = 0; i < 9; ++i) in.covariance(i / 3, i % 3) = fp.covariance[i];
-    if (!std::isfinite(fp.x) || !std::isfinite(fp.y) || !std::isfinite(fp.yaw)) {
-      ctx_->error("frame_pose scan_seq " + std::to_string(fp.scan_seq) + ": non-finite pose (dropped)");
+  void process(const fploc::FeatureFrame& f, const fploc::frame_pose_t& m) {
+    if (!std::isfinite(m.x) || !std::isfinite(m.y) || !std::isfinite(m.yaw)) {
+      ctx_->error("frame_pose scan_seq " + std::to_string(m.scan_seq) + ": non-finite pose (dropped)");
       return;
     }
-    const double z_sigma = in.features.z_sigma, rp_sigma = in.features.roll_pitch_sigma;
-    sigmas_[in.features.utime] = {z_sigma, rp_sigma};
-    std::vector<fploc::PoseOut> finals;
-    const fploc::PoseOut latest = opt_->add(std::move(in), &finals);
-    latest_out_.publish(to_msg(latest, latest_seq_++));
+    std::vector<fploc::localizer::Pose> finals;
+    const auto latest = loc_->optimize(f, fploc::adapters::from_msg(m), &finals);
+    if (latest) latest_out_.publish(fploc::adapters::to_msg(*latest, latest_seq_++));
     publish_finals(finals);
   }
 
-  fploc::pose_t to_msg(const fploc::PoseOut& p, int64_t seq) {
-    const auto s = sigmas_.count(p.utime) ? sigmas_[p.utime] : std::pair<double, double>{0, 0};
-    return fploc::make_pose_msg(p.utime, seq, p.pose, p.roll, p.pitch, p.z, p.covariance, s.first, s.second,
-                                int8_t(p.status), p.keyframe, p.final_estimate);
-  }
-
-  void publish_finals(const std::vector<fploc::PoseOut>& finals) {
-    for (const auto& p : finals) {
-      pose_out_.publish(to_msg(p, pose_seq_++));
-      sigmas_.erase(p.utime);
-    }
-    while (sigmas_.size() > 4096) sigmas_.erase(sigmas_.begin());
+  void publish_finals(const std::vector<fploc::localizer::Pose>& finals) {
+    for (const auto& p : finals) pose_out_.publish(fploc::adapters::to_msg(p, pose_seq_++));
   }
 
   fploc::rt::Context* ctx_ = nullptr;
   fploc::LocalizationMap map_;
-  std::unique_ptr<fploc::WindowOptimizer> opt_;
+  std::unique_ptr<fploc::localizer::Localizer> loc_;
   fploc::rt::Publisher<fploc::pose_t> pose_out_, latest_out_;
   std::map<int64_t, fploc::FeatureFrame> features_;
   std::map<int64_t, fploc::frame_pose_t> frame_poses_;
-  std::map<int64_t, std::pair<double, double>> sigmas_;
   int64_t last_seq_ = 0;
   bool have_last_ = false;
   int64_t pose_seq_ = 0, latest_seq_ = 0;

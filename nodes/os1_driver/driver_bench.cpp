@@ -5,7 +5,7 @@
 
 #include <cstring>
 
-#include "fploc/nodes/convert.h"
+#include "fploc/adapters/scan_t.h"
 #include "fploc/os1/packet.h"
 
 using namespace fploc;
@@ -32,7 +32,7 @@ static void BM_DriverFrame(benchmark::State& st) {
       for (int c = 0; c < 16; ++c) std::memcpy(p.data() + c * 788 + 10, &fid, 2);
       fa.add_packet(p.data(), p.size(), out);
     }
-    to_msg(out.back(), msg);
+    fploc::adapters::to_msg(out.back(), msg);
     buf.resize(size_t(msg.getEncodedSize()));
     msg.encode(buf.data(), 0, int(buf.size()));
     benchmark::DoNotOptimize(buf.data());

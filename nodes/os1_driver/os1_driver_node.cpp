@@ -10,7 +10,7 @@
 #include <memory>
 #include <stdexcept>
 
-#include "fploc/nodes/convert.h"
+#include "fploc/adapters/scan_t.h"
 #include "fploc/os1/metadata.h"
 #include "fploc/os1/sensor_http.h"
 #include "fploc/os1/packet.h"
@@ -164,7 +164,7 @@ class Os1DriverNode : public fploc::rt::Node {
       if (s.missing_columns > 0)
         ctx_->error("frame " + std::to_string(s.frame_id) + ": " + std::to_string(s.missing_columns) +
                     " columns missing (published as invalid)");
-      fploc::to_msg(s, msg_);
+      fploc::adapters::to_msg(s, msg_);
       out_.publish(msg_);
       published_in_poll_ = true;
       assembler_->recycle(std::move(s));

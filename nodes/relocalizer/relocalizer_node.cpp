@@ -16,7 +16,10 @@
 #include <memory>
 
 #include "fploc/matcher/map.h"
-#include "fploc/nodes/localization_convert.h"
+#include "fploc/adapters/features_t.h"
+#include "fploc/adapters/pose_t.h"
+#include "fploc/config/plan_source.h"
+#include "fploc/config/relocalization.h"
 #include "fploc/relocalization/relocalizer.h"
 #include "fploc/runtime/node.h"
 #include "options/relocalization.pb.h"
@@ -38,13 +41,8 @@ class RelocalizerNode : public fploc::rt::Node {
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::RelocalizerOptions>();
-    map_ = fploc::load_map(ctx, o.plan(), o.lookup(), "relocalizer");
-    fploc::RelocalizerConfig c;
-    if (o.grid_m() > 0) c.grid_m = o.grid_m();
-    if (o.yaw_step_deg() > 0) c.yaw_step_deg = o.yaw_step_deg();
-    if (o.min_inlier_ratio() > 0) c.min_inlier_ratio = o.min_inlier_ratio();
-    if (o.min_evidence() > 0) c.min_evidence = o.min_evidence();
-    reloc_ = std::make_unique<fploc::Relocalizer>(*map_.plan, *map_.lookup, c);
+    map_ = fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); }, "relocalizer.plan");
+    reloc_ = std::make_unique<fploc::Relocalizer>(*map_.plan, *map_.lookup, fploc::config::config_of(o));
     radius_ = o.region_radius_m() > 0 ? o.region_radius_m() : 3.0;
     global_after_us_ = int64_t((o.global_after_s() > 0 ? o.global_after_s() : 2.0) * 1e6);
     interval_us_ = int64_t((o.min_interval_s() > 0 ? o.min_interval_s() : 0.5) * 1e6);
@@ -78,7 +76,7 @@ class RelocalizerNode : public fploc::rt::Node {
     last_search_ = m.utime;
     fploc::FeatureFrame frame;
     try {
-      frame = fploc::from_msg(*f);
+      frame = fploc::adapters::from_msg(*f);
     } catch (const std::exception& e) {
       ctx_->error(std::string("features: ") + e.what());
       return;
@@ -101,7 +99,7 @@ class RelocalizerNode : public fploc::rt::Node {
     last_text_.clear();
     std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << " (" << fploc::to_string(st) << "): " << r.text
               << " " << where << "\n";
-    out_.publish(fploc::make_pose_msg(f->utime, seq_++, r.pose, f->roll, f->pitch, f->z,
+    out_.publish(fploc::adapters::make_pose_msg(f->utime, seq_++, r.pose, f->roll, f->pitch, f->z,
                                       Eigen::Matrix3d::Identity() * r.fit.rms_m * r.fit.rms_m, f->z_sigma,
                                       f->roll_pitch_sigma, 0, false, true));
   }

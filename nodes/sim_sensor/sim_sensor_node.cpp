@@ -19,7 +19,7 @@
 #include <stdexcept>
 
 #include "fploc/floorplan/io.h"
-#include "fploc/nodes/convert.h"
+#include "fploc/adapters/ground_truth_t.h"
 #include "fploc/os1/packet.h"
 #include "fploc/runtime/node.h"
 #include "fploc/sim/simulator.h"
@@ -115,7 +115,7 @@ class SimSensorNode : public fploc::rt::Node {
     ++frame_counter_;
     next_pkt_ = 0;
     const double t = cur_.scan.utime * 1e-6;
-    gt_.publish(fploc::ground_truth_msg(cur_.scan.utime, gt_seq_++, sim_->ground_truth(t), sim_->velocity(t),
+    gt_.publish(fploc::adapters::ground_truth_msg(cur_.scan.utime, gt_seq_++, sim_->ground_truth(t), sim_->velocity(t),
                                         sim_->angular_velocity(t), scenario_));
   }
 

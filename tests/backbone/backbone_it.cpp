@@ -31,7 +31,8 @@ using namespace fploc::test;
 namespace {
 
 const std::string kRoot = root();
-std::string graph(const std::string& name) { return kRoot + "/graphs/" + name; }
+// Graph files used only by tests live in tests/graphs (graphs/ holds the shipped ones).
+std::string graph(const std::string& name) { return kRoot + "/tests/graphs/" + name; }
 std::string lcm_url_of(const std::string& graph_file) {
   std::smatch m;
   const std::string text = slurp(graph_file);

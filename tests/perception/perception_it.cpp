@@ -29,7 +29,7 @@
 #include <vector>
 
 #include "../support/process.h"
-#include "fploc/nodes/convert.h"
+#include "fploc/adapters/scan_t.h"
 #include "fploc/sim/simulator.h"
 
 namespace fs = std::filesystem;
@@ -137,7 +137,7 @@ struct SimSource {
     sim.frame(k, f);
     f.scan.seq = seq;
     fploc::scan_t m;
-    fploc::to_msg(f.scan, m);
+    fploc::adapters::to_msg(f.scan, m);
     return m;
   }
   std::vector<fploc::imu_t> imu(int k) const {

@@ -22,7 +22,7 @@
 #include <set>
 #include <sstream>
 
-#include "fploc/nodes/convert.h"
+#include "fploc/adapters/scan_t.h"
 #include "fploc/recording/cloud_to_scan.h"
 #include "fploc/recording/ouster_packets.h"
 #include "fploc/recording/recording.h"

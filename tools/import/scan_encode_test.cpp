@@ -6,7 +6,7 @@
 #include <fploc/scan_t.hpp>
 #include <random>
 
-#include "fploc/nodes/convert.h"
+#include "fploc/adapters/scan_t.h"
 #include "fploc/recording/ouster_packets.h"
 #include "fploc/recording/recording.h"
 #include "fploc/recording/ros_msgs.h"
@@ -17,7 +17,7 @@ namespace {
 
 std::vector<uint8_t> reference(const Scan& s) {
   scan_t m;
-  to_msg(s, m);
+  fploc::adapters::to_msg(s, m);
   std::vector<uint8_t> b(size_t(m.getEncodedSize()));
   EXPECT_EQ(m.encode(b.data(), 0, int(b.size())), int(b.size()));
   return b;

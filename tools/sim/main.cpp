@@ -17,7 +17,8 @@
 #include <iostream>
 
 #include "fploc/floorplan/io.h"
-#include "fploc/nodes/convert.h"
+#include "fploc/adapters/ground_truth_t.h"
+#include "fploc/adapters/scan_t.h"
 #include "fploc/sim/simulator.h"
 
 namespace {
@@ -154,7 +155,7 @@ int main(int argc, char** argv) {
       flush_imu(ts);
       const fploc::StampedPose p = sim.ground_truth(f.scan.utime * 1e-6);
       const fploc::ground_truth_t g =
-          fploc::ground_truth_msg(f.scan.utime, k, p, sim.velocity(p.t), sim.angular_velocity(p.t), scenario);
+          fploc::adapters::ground_truth_msg(f.scan.utime, k, p, sim.velocity(p.t), sim.angular_velocity(p.t), scenario);
       write_event(log, g.utime, "FPLOC_GROUND_TRUTH", g, buf);
       traj.push_back(p);
       // The scan is complete at the end of its sweep.
@@ -164,7 +165,7 @@ int main(int argc, char** argv) {
       if (drop_scans > 0 && double(drop_state >> 11) / double(1ull << 53) < drop_scans) {
         ++dropped;  // lost on the way: ground truth and IMU stay
       } else {
-        fploc::to_msg(f.scan, sm);
+        fploc::adapters::to_msg(f.scan, sm);
         write_event(log, int64_t(std::llround(t_pub * 1e6)), "OS1_SCAN", sm, buf);
       }
       ++frames;

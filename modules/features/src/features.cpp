@@ -11,28 +11,45 @@ namespace fploc::feat {
 
 FeatureExtractor::FeatureExtractor(FeatureConfig cfg) : cfg_(cfg) {}
 
-const Features2D& FeatureExtractor::process(const seg::Segmentation& seg) {
-  out_ = Features2D{};
-  out_.utime = seg.utime;
-  out_.seq = seg.seq;
-  out_.roll = seg.roll;
-  out_.pitch = seg.pitch;
-  out_.z = seg.z;
-  out_.roll_pitch_sigma = seg.roll_pitch_sigma;
-  out_.z_sigma = seg.z_sigma;
-  out_.attitude_t = seg.attitude_t;
-  // An unusable scan upstream (bad or empty input: no planes, no wall points) is passed on as such.
-  if (seg.status == seg::SegStatus::kBadInput || seg.status == seg::SegStatus::kEmpty) {
-    out_.status = FeatStatus::kBadInput;
-    return out_;
+const FeatureFrame& FeatureExtractor::process(const seg::Segmentation& seg) {
+  out_ = Picked{};
+  const FeatureStatus status = extract(seg);
+  frame_ = FeatureFrame{};
+  frame_.utime = seg.utime;
+  frame_.scan_seq = seg.seq;
+  frame_.status = status;
+  frame_.roll = seg.roll;
+  frame_.pitch = seg.pitch;
+  frame_.z = seg.z;
+  frame_.roll_pitch_sigma = seg.roll_pitch_sigma;
+  frame_.z_sigma = seg.z_sigma;
+  frame_.attitude_t = seg.attitude_t;
+  frame_.num_groups = out_.num_groups;
+  const size_t n = out_.x.size();
+  frame_.points.reserve(n);
+  source_.clear();
+  source_.reserve(n);
+  for (size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(out_.x[i]) || !std::isfinite(out_.y[i])) continue;
+    Feature2 p;
+    p.p = {double(out_.x[i]), double(out_.y[i])};
+    p.kind = FeatureKind(out_.kind[i]);
+    p.group = out_.group[i];
+    p.t = out_.t[i];
+    frame_.points.push_back(p);
+    source_.push_back(out_.source[i]);
   }
+  return frame_;
+}
+
+FeatureStatus FeatureExtractor::extract(const seg::Segmentation& seg) {
+  // An unusable scan upstream (bad or empty input: no planes, no wall points) is passed on as such.
+  if (seg.status == seg::SegStatus::kBadInput || seg.status == seg::SegStatus::kEmpty) return FeatureStatus::kBadInput;
   const auto& w = seg.wall;
   const size_t n = w.x.size();
   if (w.y.size() != n || w.z.size() != n || w.range.size() != n || w.ring.size() != n || w.column.size() != n ||
-      !std::isfinite(seg.roll) || !std::isfinite(seg.pitch)) {
-    out_.status = FeatStatus::kBadInput;
-    return out_;
-  }
+      !std::isfinite(seg.roll) || !std::isfinite(seg.pitch))
+    return FeatureStatus::kBadInput;
   // Gravity compensation: p_level = Ry(pitch) Rx(roll) p_sensor (yaw stays in the sensor frame); applied
   // to the selected features only.
   R_ = (Eigen::AngleAxisf(float(seg.pitch), Eigen::Vector3f::UnitY()) *
@@ -45,8 +62,7 @@ const Features2D& FeatureExtractor::process(const seg::Segmentation& seg) {
       b = i;
     }
   }
-  if (out_.x.size() < 30) out_.status = FeatStatus::kFewFeatures;
-  return out_;
+  return out_.x.size() < 30 ? FeatureStatus::kFewFeatures : FeatureStatus::kOk;
 }
 
 void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t end) {

@@ -45,7 +45,7 @@ double plan_distance(const synth::Room& room, double x, double y, int* element =
 
 struct Run {
   seg::Segmentation seg;
-  Features2D f;
+  FeatureFrame f;
 };
 
 Run run(const synth::Room& room, const synth::SensorPose& pose, double noise, uint32_t seed) {
@@ -65,21 +65,21 @@ TEST(Features, EmptyRoomSurfacesOnWallsGroupsOnOneWall) {
   const auto r = run(room, pose, 0.005, 11);
   ASSERT_EQ(r.seg.status, seg::SegStatus::kOk);
   const auto& f = r.f;
-  ASSERT_EQ(f.status, FeatStatus::kOk);
+  ASSERT_EQ(f.status, FeatureStatus::kOk);
   size_t surf = 0, corner = 0, on_plan = 0;
   std::map<int, std::map<int, int>> group_elements;
   const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
   for (size_t i = 0; i < f.size(); ++i) {
-    const double wx = c * f.x[i] - s * f.y[i] + pose.x, wy = s * f.x[i] + c * f.y[i] + pose.y;
+    const double wx = c * f.points[i].p.x() - s * f.points[i].p.y() + pose.x, wy = s * f.points[i].p.x() + c * f.points[i].p.y() + pose.y;
     int el = -1;
     const double d = plan_distance(room, wx, wy, &el);
-    if (f.kind[i] == kSurface) {
+    if (f.points[i].kind == FeatureKind::kSurface) {
       ++surf;
       on_plan += d < 0.03;  // roll/pitch compensated: a tilt error would smear walls by several cm
-      if (f.group[i] >= 0) group_elements[f.group[i]][el]++;
+      if (f.points[i].group >= 0) group_elements[f.points[i].group][el]++;
     } else {
       ++corner;
-      EXPECT_EQ(f.group[i], -1);
+      EXPECT_EQ(f.points[i].group, -1);
     }
   }
   EXPECT_GT(surf, 1000u);
@@ -112,10 +112,10 @@ TEST(Features, CornersAtRoomAndPillarCorners) {
       for (double y : {b.lo.y(), b.hi.y()}) edges.emplace_back(x, y);
   int corners = 0, near_edge = 0;
   for (size_t i = 0; i < r.f.size(); ++i) {
-    if (r.f.kind[i] != kCorner) continue;
+    if (r.f.points[i].kind != FeatureKind::kCorner) continue;
     ++corners;
     double best = 1e9;
-    for (const auto& e : edges) best = std::min(best, std::hypot(r.f.x[i] - e.x(), r.f.y[i] - e.y()));
+    for (const auto& e : edges) best = std::min(best, std::hypot(r.f.points[i].p.x() - e.x(), r.f.points[i].p.y() - e.y()));
     near_edge += best < 0.3;
   }
   ASSERT_GT(corners, 10);
@@ -126,18 +126,18 @@ TEST(Features, BadAndEmptyInput) {
   FeatureExtractor fx;
   seg::Segmentation s;
   s.status = seg::SegStatus::kOk;  // segmented, but no wall points
-  EXPECT_EQ(fx.process(s).status, FeatStatus::kFewFeatures);
+  EXPECT_EQ(fx.process(s).status, FeatureStatus::kFewFeatures);
   s.status = seg::SegStatus::kNoCeiling;
-  EXPECT_EQ(fx.process(s).status, FeatStatus::kFewFeatures);
+  EXPECT_EQ(fx.process(s).status, FeatureStatus::kFewFeatures);
   // An unusable scan upstream is passed on.
   s.status = seg::SegStatus::kEmpty;
-  EXPECT_EQ(fx.process(s).status, FeatStatus::kBadInput);
+  EXPECT_EQ(fx.process(s).status, FeatureStatus::kBadInput);
   s.status = seg::SegStatus::kBadInput;
-  EXPECT_EQ(fx.process(s).status, FeatStatus::kBadInput);
+  EXPECT_EQ(fx.process(s).status, FeatureStatus::kBadInput);
   s.status = seg::SegStatus::kOk;
   s.wall.x.push_back(1.f);
-  EXPECT_EQ(fx.process(s).status, FeatStatus::kBadInput);
+  EXPECT_EQ(fx.process(s).status, FeatureStatus::kBadInput);
   s.wall.clear();
   s.roll = std::nan("");
-  EXPECT_EQ(fx.process(s).status, FeatStatus::kBadInput);
+  EXPECT_EQ(fx.process(s).status, FeatureStatus::kBadInput);
 }

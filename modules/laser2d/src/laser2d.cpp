@@ -27,7 +27,7 @@ feat::FeatureConfig Laser2dConfig::default_features() {
 
 Laser2dFeatures::Laser2dFeatures(Laser2dConfig cfg) : cfg_(cfg), fx_(cfg.features) {}
 
-const feat::Features2D& Laser2dFeatures::process(const PlanarScan& s, double roll, double pitch, double rp_sigma) {
+const FeatureFrame& Laser2dFeatures::process(const PlanarScan& s, double roll, double pitch, double rp_sigma) {
   stats_ = {};
   seg_.wall.clear();
   seg_.utime = s.utime;
@@ -71,9 +71,9 @@ const feat::Features2D& Laser2dFeatures::process(const PlanarScan& s, double rol
   }
   seg_.status = seg_.wall.size() ? seg::SegStatus::kOk : seg::SegStatus::kEmpty;
   out_ = fx_.process(seg_);
-  if (!cfg_.all_returns || out_.status == feat::FeatStatus::kBadInput) return out_;
+  if (!cfg_.all_returns || out_.status == FeatureStatus::kBadInput) return out_;
   used_.assign(seg_.wall.size(), 0);
-  for (int32_t k : out_.source)
+  for (int32_t k : fx_.source())
     if (k >= 0 && size_t(k) < used_.size()) used_[size_t(k)] = 1;
   const Eigen::Matrix3f R = (Eigen::AngleAxisf(float(pitch), Eigen::Vector3f::UnitY()) *
                              Eigen::AngleAxisf(float(roll), Eigen::Vector3f::UnitX())).toRotationMatrix();
@@ -81,14 +81,14 @@ const feat::Features2D& Laser2dFeatures::process(const PlanarScan& s, double rol
   for (size_t k = 0; k < w.size(); ++k) {
     if (used_[k]) continue;
     const Eigen::Vector3f p = R * Eigen::Vector3f(w.x[k], w.y[k], w.z[k]);
-    out_.x.push_back(p.x());
-    out_.y.push_back(p.y());
-    out_.kind.push_back(feat::kSurface);
-    out_.group.push_back(-1);
-    out_.t.push_back(w.t[k]);
-    out_.source.push_back(int32_t(k));
+    Feature2 q;
+    q.p = Eigen::Vector2d(p.x(), p.y());
+    q.kind = FeatureKind::kSurface;
+    q.group = -1;
+    q.t = w.t[k];
+    out_.points.push_back(q);
   }
-  if (out_.x.size() >= 30 && out_.status == feat::FeatStatus::kFewFeatures) out_.status = feat::FeatStatus::kOk;
+  if (out_.size() >= 30 && out_.status == FeatureStatus::kFewFeatures) out_.status = FeatureStatus::kOk;
   return out_;
 }
 

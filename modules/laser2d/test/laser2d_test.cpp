@@ -39,22 +39,22 @@ TEST(Laser2d, FeaturesLieOnTheWalls) {
   loam_only.all_returns = false;
   Laser2dFeatures l2(loam_only);
   const auto& f = l2.process(s);
-  EXPECT_EQ(f.status, feat::FeatStatus::kOk);
+  EXPECT_EQ(f.status, FeatureStatus::kOk);
   EXPECT_EQ(l2.stats().returns, 360);
   ASSERT_GT(f.size(), 60u);
   int corners = 0, grouped = 0;
   for (size_t k = 0; k < f.size(); ++k) {
     // Sensor frame -> world with the scan's pose.
     const double c = std::cos(yaw0), d = std::sin(yaw0);
-    const double wx = x0 + c * f.x[k] - d * f.y[k], wy = y0 + d * f.x[k] + c * f.y[k];
+    const double wx = x0 + c * f.points[k].p.x() - d * f.points[k].p.y(), wy = y0 + d * f.points[k].p.x() + c * f.points[k].p.y();
     EXPECT_LT(wall_distance(wx, wy), 1e-4);
-    if (f.kind[k] == feat::kCorner) {
+    if (f.points[k].kind == FeatureKind::kCorner) {
       ++corners;
       // Corners of a box are only at its four corners.
       const double dc = std::min({std::hypot(wx, wy), std::hypot(wx - 8, wy), std::hypot(wx, wy - 5), std::hypot(wx - 8, wy - 5)});
       EXPECT_LT(dc, 0.6) << wx << " " << wy;
     }
-    grouped += f.group[k] >= 0;
+    grouped += f.points[k].group >= 0;
   }
   EXPECT_GE(corners, 3);
   EXPECT_GT(grouped, int(f.size()) / 2);
@@ -69,10 +69,11 @@ TEST(Laser2d, AllReturnsAfterTheLoamPicks) {
   const size_t picks = a.process(s).size();
   const auto& f = b.process(s);
   EXPECT_EQ(f.size(), 360u);
-  for (size_t k = 0; k < picks; ++k) EXPECT_EQ(f.source[k], a.process(s).source[k]);
+  const FeatureFrame fa = a.process(s);
+  for (size_t k = 0; k < picks; ++k) EXPECT_TRUE(f.points[k].p == fa.points[k].p);
   for (size_t k = picks; k < f.size(); ++k) {
-    EXPECT_EQ(f.group[k], -1);
-    EXPECT_EQ(f.kind[k], feat::kSurface);
+    EXPECT_EQ(f.points[k].group, -1);
+    EXPECT_EQ(f.points[k].kind, FeatureKind::kSurface);
   }
 }
 
@@ -94,9 +95,9 @@ TEST(Laser2d, BadGeometryAndMounting) {
   PlanarScan s = box_scan(3, 2, 0);
   s.angle_increment = std::numeric_limits<float>::quiet_NaN();
   Laser2dFeatures l2;
-  EXPECT_EQ(l2.process(s).status, feat::FeatStatus::kBadInput);
+  EXPECT_EQ(l2.process(s).status, FeatureStatus::kBadInput);
   PlanarScan empty;
-  EXPECT_EQ(l2.process(empty).status, feat::FeatStatus::kBadInput);
+  EXPECT_EQ(l2.process(empty).status, FeatureStatus::kBadInput);
   // A laser mounted 0.2 m ahead, turned 90 degrees: points come out in the robot frame.
   Laser2dConfig c;
   c.mount_x_m = 0.2;

@@ -13,10 +13,6 @@
 using namespace fploc;
 
 static void BM_RegisterFrame(benchmark::State& st, std::string lookup) {
-  if (!have_annf() && lookup.rfind("annf", 0) == 0) {
-    st.SkipWithError("built without modules/annf");
-    return;
-  }
   auto map = make_localization_map(fploc::testing::room_with_pillars(), lookup);
   fploc::testing::SynthOptions so;
   so.noise_sigma = 0.02;
@@ -24,7 +20,7 @@ static void BM_RegisterFrame(benchmark::State& st, std::string lookup) {
   const Pose2 truth{10, 5, 0.7};
   const FeatureFrame f = fploc::testing::synth_frame(*map.plan, truth, so);
   MatcherConfig cfg;
-  cfg.gate_initial_m = cfg.gate_tracking_m;  // as while tracking (Matcher::process)
+  cfg.max_correspondence_m = cfg.gate_tracking_m;  // as while tracking (Matcher::process)
   double err = 0;
   int iters = 0;
   for (auto _ : st) {
@@ -39,10 +35,6 @@ static void BM_RegisterFrame(benchmark::State& st, std::string lookup) {
 }
 
 static void BM_Candidates(benchmark::State& st, std::string lookup) {
-  if (!have_annf() && lookup.rfind("annf", 0) == 0) {
-    st.SkipWithError("built without modules/annf");
-    return;
-  }
   auto map = make_localization_map(fploc::testing::room_with_pillars(), lookup);
   std::mt19937 rng(1);
   std::uniform_real_distribution<double> ux(0, 20), uy(0, 10);

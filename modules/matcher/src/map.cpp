@@ -4,14 +4,11 @@
 #include <stdexcept>
 
 #include "fploc/floorplan/io.h"
-#ifdef FPLOC_HAVE_ANNF
 #include "fploc/annf/annf.h"
 #include "fploc/annf/cache.h"
-#endif
 
 namespace fploc {
 
-#ifdef FPLOC_HAVE_ANNF
 namespace {
 
 // Candidates from the ANNF leaf. Leaves with more candidates than the caller takes (exact mode at
@@ -44,20 +41,12 @@ class AnnfLookup : public NearestLookup {
 };
 
 }  // namespace
-#endif
 
 const std::vector<std::string>& lookup_names() {
   static const std::vector<std::string> n = {"annf-exact", "annf-paper", "annf-paper-first", "kdtree", "brute-force"};
   return n;
 }
 
-bool have_annf() {
-#ifdef FPLOC_HAVE_ANNF
-  return true;
-#else
-  return false;
-#endif
-}
 
 namespace {
 
@@ -73,7 +62,6 @@ LocalizationMap finish(LocalizationMap m, const std::string& lookup, std::shared
     m.lookup = std::make_unique<BruteForceLookup>(*m.plan);
     return m;
   }
-#ifdef FPLOC_HAVE_ANNF
   const AnnfMode mode = lookup == "annf-exact" ? AnnfMode::kExact : AnnfMode::kPaper;
   auto annf = std::static_pointer_cast<const Annf>(annf_in);
   if (!annf || annf->options().mode != mode) {
@@ -86,10 +74,6 @@ LocalizationMap finish(LocalizationMap m, const std::string& lookup, std::shared
   m.annf = annf;
   m.lookup = std::make_unique<AnnfLookup>(annf, lookup == "annf-paper-first", lookup);
   return m;
-#else
-  (void)annf_in;
-  throw std::runtime_error("look-up '" + lookup + "' needs modules/annf, which this build does not have");
-#endif
 }
 
 bool ends_with(std::string s, const std::string& suf) {
@@ -109,7 +93,6 @@ LocalizationMap load_localization_map(const std::string& path, const std::vector
                                       const std::string& units, const std::string& lookup) {
   LocalizationMap m;
   std::shared_ptr<const void> annf;
-#ifdef FPLOC_HAVE_ANNF
   if (ends_with(path, ".fpmap")) {
     auto a = std::make_shared<const Annf>(Annf::load(path));
     m.plan = std::make_shared<const FloorPlan>(a->plan());
@@ -117,7 +100,6 @@ LocalizationMap load_localization_map(const std::string& path, const std::vector
     annf = a;
     return finish(std::move(m), lookup, annf);
   }
-#endif
   m.plan = std::make_shared<const FloorPlan>(load_floor_plan(path, layers, units));
   m.note = "loaded " + path;
   return finish(std::move(m), lookup, annf);

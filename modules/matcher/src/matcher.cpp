@@ -42,7 +42,7 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
   r.predicted = guess;
   double x[3] = {guess.x, guess.y, guess.yaw};
   AssignOptions ao;
-  ao.gate_m = std::max(cfg.gate_initial_m, cfg.gate_final_m);
+  ao.gate_m = std::max(cfg.max_correspondence_m, cfg.min_correspondence_m);
   ao.group_rule = cfg.group_rule;
   ao.stride = std::max(1, cfg.stride);
   if (cfg.max_points > 0 && int(f.points.size()) > cfg.max_points * ao.stride)
@@ -62,7 +62,7 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
   double last_gate = -1;
   // Point targets (kdtree) fix the correspondence for a whole inner solve, like classic ICP, and need
   // many more look-up rounds to converge: give them 6x, so they are measured converged, not truncated.
-  const int max_outer = std::max(1, cfg.max_outer) * (lookup.element_targets() ? 1 : 6);
+  const int max_outer = std::max(1, cfg.max_rounds) * (lookup.element_targets() ? 1 : 6);
   for (int outer = 0; outer < max_outer; ++outer) {
     assign(lookup, f, Pose2{x[0], x[1], x[2]}, ao, &as);
     // The same correspondences under the same gate as the last solve: that solve's result is the answer.
@@ -79,9 +79,9 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
     last_gate = ao.gate_m;
     std::swap(last_as, as);
     const double step = std::hypot(x[0] - before[0], x[1] - before[1]) + std::abs(x[2] - before[2]);
-    const bool final_gate = ao.gate_m <= cfg.gate_final_m + 1e-12;
+    const bool final_gate = ao.gate_m <= cfg.min_correspondence_m + 1e-12;
     if (final_gate && step < 1e-5) break;
-    ao.gate_m = std::max(cfg.gate_final_m, ao.gate_m * 0.5);
+    ao.gate_m = std::max(cfg.min_correspondence_m, ao.gate_m * 0.5);
   }
   r.solved = Pose2{x[0], x[1], wrap_angle(x[2])};
   r.pose = r.solved;
@@ -102,7 +102,7 @@ Matcher::Matcher(const NearestLookup& lookup, MatcherConfig cfg) : lookup_(looku
 
 void Matcher::set_pose(const Pose2& p, std::optional<double> search_m, std::optional<double> search_yaw) {
   pose_ = p;
-  search_m_ = search_m && *search_m > 0 ? *search_m : cfg_.gate_initial_m;
+  search_m_ = search_m && *search_m > 0 ? *search_m : cfg_.max_correspondence_m;
   search_yaw_ = search_yaw && *search_yaw > 0 ? *search_yaw : cfg_.initial_search_yaw_rad;
   initialised_ = true;
   have_last_ = false;
@@ -160,12 +160,12 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
   const bool lost = poor_count_ >= cfg_.lost_after;
   // Gates: tracking (the previous frame OK) starts at the tracking gate, the first frame after set_pose
   // searches within the given pose's uncertainty, after a POOR frame the gate starts wide, and wider
-  // still while LOST; each is halved per look-up round down to gate_final_m.
+  // still while LOST; each is halved per look-up round down to min_correspondence_m.
   MatcherConfig cfg = cfg_;
   const bool tracking = have_last_ && poor_count_ == 0;
-  if (lost) cfg.gate_initial_m *= 2;
-  else if (tracking && !motion) cfg.gate_initial_m = std::min(cfg.gate_initial_m, cfg.gate_tracking_m);
-  else if (!have_last_) cfg.gate_initial_m = search_m_;
+  if (lost) cfg.max_correspondence_m *= 2;
+  else if (tracking && !motion) cfg.max_correspondence_m = std::min(cfg.max_correspondence_m, cfg.gate_tracking_m);
+  else if (!have_last_) cfg.max_correspondence_m = search_m_;
   // Motion compensation: the sweep's points moved to the sensor frame at utime + t_ref with the motion
   // model's body twist (zero linear velocity until two frames were registered), the IMU's yaw rate.
   Twist2 tw;
@@ -181,7 +181,7 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
     // it, the given pose first) and keep the fit with the most inliers (then the lower rms).
     const double s = search_m_ * 2 / 3, a = search_yaw_ * 2 / 3;
     MatcherConfig c = cfg;
-    c.gate_initial_m = std::max(s, cfg_.gate_final_m);
+    c.max_correspondence_m = std::max(s, cfg_.min_correspondence_m);
     bool have = false;
     for (double dyaw : {0.0, -a, a})
       for (double dx : {0.0, -s, s})

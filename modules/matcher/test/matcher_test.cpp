@@ -27,12 +27,7 @@ double distance_to_plan(const FloorPlan& plan, const Eigen::Vector2d& p) {
   return d;
 }
 
-std::vector<std::string> available_lookups() {
-  std::vector<std::string> out;
-  for (const auto& n : lookup_names())
-    if (have_annf() || n.rfind("annf", 0) != 0) out.push_back(n);
-  return out;
-}
+std::vector<std::string> available_lookups() { return lookup_names(); }
 
 const std::vector<Pose2> kPoses = {{3.0, 2.5, 0.3}, {10.0, 5.0, -1.2}, {16.5, 7.5, 2.8}, {5.0, 8.0, 1.6}, {17.0, 2.0, -2.5}};
 
@@ -44,7 +39,7 @@ TEST_P(LookupTest, ExactRecoveryWithoutNoise) {
   auto map = make_localization_map(room_with_pillars(), GetParam());
   MatcherConfig cfg;
   cfg.max_iterations = 30;
-  cfg.max_outer = 8;
+  cfg.max_rounds = 8;
   // Point-to-point against 5 cm samples cannot be exact: its floor is the sampling error. The paper's
   // ANNF (two candidates per leaf, depth 7 = 9.4 cm leaves) gives a wrong element near some element
   // ends, which costs millimetres: measured 0.1-1.8 mm here.
@@ -65,7 +60,7 @@ TEST_P(LookupTest, ExactRecoveryWithoutNoise) {
 TEST_P(LookupTest, ConvergesFromOneMetreTenDegreesWithNoiseAndClutter) {
   auto map = make_localization_map(room_with_pillars(), GetParam());
   MatcherConfig cfg;
-  cfg.max_outer = 8;
+  cfg.max_rounds = 8;
   int converged = 0, total = 0;
   const double offsets[4][3] = {{1.0, 0, 10}, {0, -1.0, -10}, {-0.7, 0.7, 10}, {0.7, 0.7, -10}};
   // Point-to-point registration (kdtree) does not have this basin of convergence (about a third of
@@ -409,7 +404,7 @@ TEST(PlanTerms, PosePriorHoldsOnlyTheDirectionThePlanLeavesOpen) {
   const Pose2 truth{0, 1, 0};
   const FeatureFrame f = synth_frame(plan, truth, so);
   MatcherConfig cfg;
-  cfg.gate_initial_m = 0.3;
+  cfg.max_correspondence_m = 0.3;
   const Pose2 guess{0.3, 1.05, 0.02};
   // Without the prior the along-track position is whatever the solver's steps in the null direction
   // make of it (Levenberg-Marquardt damps a direction without curvature hardly at all).

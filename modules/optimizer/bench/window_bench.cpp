@@ -12,7 +12,7 @@
 using namespace fploc;
 
 static void BM_WindowPerFrame(benchmark::State& st) {
-  auto map = make_localization_map(fploc::testing::room_with_pillars(), have_annf() ? "annf-exact" : "brute-force");
+  auto map = make_localization_map(fploc::testing::room_with_pillars(), "annf-exact");
   std::vector<FrameInput> frames;
   Matcher m(*map.lookup, {});
   auto truth = [](double t) { return Pose2{3.0 + 0.6 * t, 3.0 + 1.5 * std::sin(0.25 * t), 0.1 * t}; };

@@ -105,6 +105,8 @@ PoseOut WindowOptimizer::make_out(const Frame& f, const Pose2& pose_tau_in, bool
   o.keyframe = key;
   o.status = f.in.status;
   o.covariance = f.in.covariance;
+  o.z_sigma = f.in.features.z_sigma;
+  o.roll_pitch_sigma = f.in.features.roll_pitch_sigma;
   return o;
 }
 
@@ -116,8 +118,8 @@ void WindowOptimizer::fill_gravity(PoseOut* o, const FeatureFrame& f) const {
   o->roll = f.roll;
   o->pitch = f.pitch;
   o->z = f.z;
-  const bool z_known = std::isfinite(f.z) && f.z_sigma < cfg_.unknown_z_sigma_m;
-  const bool rp_known = std::isfinite(f.roll) && std::isfinite(f.pitch) && f.roll_pitch_sigma < cfg_.unknown_rp_sigma_rad;
+  const bool z_ok = z_known(f);
+  const bool rp_ok = roll_pitch_known(f);
   auto fill = [&](bool Gravity::*known, bool self_known, auto get, double* out) {
     const Gravity* before = nullptr;
     const Gravity* after = nullptr;
@@ -133,17 +135,16 @@ void WindowOptimizer::fill_gravity(PoseOut* o, const FeatureFrame& f) const {
       *out = get(before ? *before : *after);
     }
   };
-  fill(&Gravity::z_known, z_known, [](const Gravity& g) { return g.z; }, &o->z);
-  fill(&Gravity::rp_known, rp_known, [](const Gravity& g) { return g.roll; }, &o->roll);
-  fill(&Gravity::rp_known, rp_known, [](const Gravity& g) { return g.pitch; }, &o->pitch);
+  fill(&Gravity::z_known, z_ok, [](const Gravity& g) { return g.z; }, &o->z);
+  fill(&Gravity::rp_known, rp_ok, [](const Gravity& g) { return g.roll; }, &o->roll);
+  fill(&Gravity::rp_known, rp_ok, [](const Gravity& g) { return g.pitch; }, &o->pitch);
 }
 
 PoseOut WindowOptimizer::add(FrameInput in, std::vector<PoseOut>* finals) {
   {
     const FeatureFrame& f = in.features;
     gravity_.push_back({f.utime + std::llround(f.attitude_t * 1e6), f.roll, f.pitch, f.z,
-                        std::isfinite(f.roll) && std::isfinite(f.pitch) && f.roll_pitch_sigma < cfg_.unknown_rp_sigma_rad,
-                        std::isfinite(f.z) && f.z_sigma < cfg_.unknown_z_sigma_m});
+                        roll_pitch_known(f), z_known(f)});
     // Keep what the frames still to be output may need (and a little before).
     int64_t oldest = f.utime;
     if (!pending_.empty()) oldest = std::min(oldest, pending_.front().in.features.utime);
@@ -218,7 +219,7 @@ void WindowOptimizer::solve() {
     }
   }
   for (auto& k : window_) chain.push_back({k.x, k.f.tau});
-  for (int outer = 0; outer < std::max(1, cfg_.outer); ++outer) {
+  for (int outer = 0; outer < std::max(1, cfg_.rounds); ++outer) {
     // Look-ups: a key keeps its correspondences while its pose stays within relook_m / relook_rad of
     // where they were looked up (the residuals re-evaluate the closest point on the candidates at every
     // evaluation anyway); a round in which no key needed a new look-up would repeat the last solve.

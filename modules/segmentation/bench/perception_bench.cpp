@@ -135,10 +135,11 @@ int profile(int n, bool with_features, bool sim) {
   for (const auto* v : {&s.wall.x, &s.wall.y, &s.wall.z, &s.wall.range, &s.wall.t}) mix(v->data(), v->size() * sizeof(float));
   if (with_features) {
     const auto& f = fx.process(s);
-    mix(f.x.data(), f.x.size() * sizeof(float));
-    mix(f.y.data(), f.y.size() * sizeof(float));
-    mix(f.kind.data(), f.kind.size());
-    mix(f.group.data(), f.group.size() * sizeof(int32_t));
+    // The same bytes as the extractor's float arrays (the frame's points hold exactly those floats).
+    for (const auto& p : f.points) { const float x = float(p.p.x()); mix(&x, sizeof x); }
+    for (const auto& p : f.points) { const float y = float(p.p.y()); mix(&y, sizeof y); }
+    for (const auto& p : f.points) mix(&p.kind, 1);
+    for (const auto& p : f.points) mix(&p.group, sizeof(int32_t));
   }
   std::cout << "profiled " << n << (sim ? " simulated" : " synthetic") << " scans ("
             << (with_features ? "segmenter + features" : "segmenter") << "), "

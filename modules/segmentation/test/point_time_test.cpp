@@ -1,4 +1,4 @@
-// Per-point measurement time (WallPoints::t, Features2D::t) on simulated OS-1-64 scans, for both
+// Per-point measurement time (WallPoints::t, FeatureFrame points' t) on simulated OS-1-64 scans, for both
 // segmenters. A wall return measured at utime + t by the sensor at its true pose T(utime + t) lies on the
 // plan element it hit, so T(utime + t) * p must be on that element. The scans are noise-free and the
 // platform moves and turns (room-large-loop-fast): with the right t the points sit on their walls to
@@ -112,9 +112,8 @@ void run(seg::Segmenter& sg, bool with_imu) {
 
     // Features carry the time of the wall point they came from.
     const auto& ft = fx.process(s);
-    ASSERT_EQ(ft.t.size(), ft.size());
-    ASSERT_EQ(ft.source.size(), ft.size());
-    for (size_t j = 0; j < ft.size(); ++j) ASSERT_EQ(ft.t[j], s.wall.t[size_t(ft.source[j])]);
+    ASSERT_EQ(fx.source().size(), ft.size());
+    for (size_t j = 0; j < ft.size(); ++j) ASSERT_EQ(ft.points[j].t, s.wall.t[size_t(fx.source()[j])]);
   }
   ASSERT_GE(checked, 6);
   EXPECT_GT(max_t, 0.09);  // times cover the sweep

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "fploc/sim/rng.h"
+#include "fploc/core/rng.h"
 
 namespace fploc::sim {
 namespace {

@@ -11,7 +11,7 @@
 #include <stdexcept>
 
 #include "fploc/floorplan/io.h"
-#include "fploc/sim/rng.h"
+#include "fploc/core/rng.h"
 
 namespace fploc::sim {
 namespace {

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "fploc/sim/rng.h"
+#include "fploc/core/rng.h"
 
 namespace fploc::sim {
 

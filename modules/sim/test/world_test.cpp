@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "fploc/sim/rng.h"
+#include "fploc/core/rng.h"
 #include "fploc/sim/world.h"
 
 using namespace fploc;

@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "fploc/amcl/rng.h"
+#include "fploc/core/rng.h"
 #include "fploc/core/pose.h"
 #include "fploc/floorplan/plan.h"
 
@@ -233,7 +233,7 @@ class Amcl {
   Config cfg_;
   std::unique_ptr<LikelihoodField> field_;
   std::vector<Eigen::Vector2d> free_;
-  Rng rng_;
+  PolarRng rng_;
   std::vector<Particle> set_, next_;
   BinSet bins_;
   SetStats stats_;

@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <string>
 
-#include "fploc/amcl/rng.h"
+#include "fploc/core/rng.h"
 #include "fploc/core/pose.h"
 
 namespace fploc::amcl {
@@ -34,7 +34,7 @@ class WheelOdometrySim {
 
  private:
   WheelOdometryConfig c_;
-  Rng rng_;
+  PolarRng rng_;
   bool have_ = false;
   Pose2 start_, last_truth_, odom_;
   double distance_ = 0;

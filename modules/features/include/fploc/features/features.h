@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "fploc/core/feature_frame.h"
 #include "fploc/segmentation/segmenter.h"
 
 namespace fploc::feat {
@@ -31,37 +32,34 @@ struct FeatureConfig {
   double group_max_gap_m = 1.0;     // consecutive surface points farther apart end a run
 };
 
-enum class FeatStatus : int8_t { kOk = 0, kFewFeatures = 1, kBadInput = 2 };
-enum Kind : int8_t { kCorner = 0, kSurface = 1 };
-
-struct Features2D {
-  int64_t utime = 0, seq = 0;
-  FeatStatus status = FeatStatus::kOk;
-  double roll = 0, pitch = 0, z = 0, roll_pitch_sigma = 0, z_sigma = 0;
-  double attitude_t = 0;            // roll/pitch/z hold at utime + this [s] (from the segmentation)
-  std::vector<float> x, y;          // gravity-aligned, sensor-centred [m]
-  std::vector<int8_t> kind;
-  std::vector<int32_t> group;       // -1 = unclassified
-  std::vector<float> t;             // measurement time - utime [s] (from the wall points)
-  int32_t num_groups = 0;
-  // Index of each feature in the input wall points (diagnostics, bench).
-  std::vector<int32_t> source;
-  size_t size() const { return x.size(); }
-};
-
 class FeatureExtractor {
  public:
   explicit FeatureExtractor(FeatureConfig cfg = {});
   // Uses seg.wall (ring-major, increasing column per ring) and seg.roll/pitch. Status kBadInput when the
   // segmentation itself is BAD_INPUT/EMPTY (passed on), or its wall arrays disagree in size, or roll/pitch
-  // are not finite.
-  const Features2D& process(const seg::Segmentation& seg);
+  // are not finite; kFewFeatures below 30 features. Non-finite points are not in the frame.
+  const FeatureFrame& process(const seg::Segmentation& seg);
+  // Index of each feature of the last frame in the input wall points (diagnostics, bench).
+  const std::vector<int32_t>& source() const { return source_; }
   const FeatureConfig& config() const { return cfg_; }
 
  private:
+  enum Kind : int8_t { kCorner = int8_t(FeatureKind::kCorner), kSurface = int8_t(FeatureKind::kSurface) };
+  // The features as they are picked, ring by ring (structure of arrays).
+  struct Picked {
+    std::vector<float> x, y;          // gravity-aligned, sensor-centred [m]
+    std::vector<int8_t> kind;
+    std::vector<int32_t> group;       // -1 = unclassified
+    std::vector<float> t;             // measurement time - utime [s] (from the wall points)
+    std::vector<int32_t> source;      // index in the wall points
+    int32_t num_groups = 0;
+  };
+  FeatureStatus extract(const seg::Segmentation& seg);
   void ring(const seg::Segmentation& seg, size_t begin, size_t end);
   FeatureConfig cfg_;
-  Features2D out_;
+  Picked out_;
+  FeatureFrame frame_;
+  std::vector<int32_t> source_;
   std::vector<float> curv_;
   std::vector<uint8_t> ok_, picked_;
   std::vector<int> order_;

@@ -1,5 +1,5 @@
 // 2D LiDAR mode: one planar laser scan (sensor_msgs/LaserScan in fploc's terms) -> the 2D wall features the
-// matcher, optimizer, odometry and AMCL consume (fploc::feat::Features2D, the payload of features_t).
+// matcher, optimizer, odometry and AMCL consume (fploc::FeatureFrame, the payload of features_t).
 //
 // Beam i is at angle_min + i * angle_increment [rad] (x forward, counter-clockwise) and was measured
 // i * time_increment [s] after utime. A beam is a return when its range is finite and inside
@@ -51,7 +51,7 @@ class Laser2dFeatures {
   // roll/pitch [rad] (R = Ry(pitch) Rx(roll)); sigma: 1-sigma of roll/pitch [rad]. Status kBadInput when the
   // scan's geometry is not usable (non-finite or zero angle_increment, no beams), kFewFeatures when LOAM
   // selects fewer than 30 points.
-  const feat::Features2D& process(const PlanarScan& s, double roll = 0, double pitch = 0, double roll_pitch_sigma = 0.01);
+  const FeatureFrame& process(const PlanarScan& s, double roll = 0, double pitch = 0, double roll_pitch_sigma = 0.01);
   const Laser2dStats& stats() const { return stats_; }
   const Laser2dConfig& config() const { return cfg_; }
   // The returns of the last scan in the robot frame (diagnostics, tests).
@@ -60,7 +60,7 @@ class Laser2dFeatures {
  private:
   Laser2dConfig cfg_;
   feat::FeatureExtractor fx_;
-  feat::Features2D out_;
+  FeatureFrame out_;
   std::vector<uint8_t> used_;
   seg::Segmentation seg_;
   Laser2dStats stats_;

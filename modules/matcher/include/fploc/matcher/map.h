@@ -23,7 +23,6 @@ struct LocalizationMap {
 
 // Known look-up names.
 const std::vector<std::string>& lookup_names();
-bool have_annf();  // false when built without modules/annf
 
 // From a plan already in memory. The ANNF (if needed) is built with its default options (depth 7,
 // 6 m root fields). Throws std::runtime_error on an unknown name or an empty plan.

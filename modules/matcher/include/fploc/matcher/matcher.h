@@ -12,22 +12,22 @@
 namespace fploc {
 
 struct MatcherConfig {
-  double gate_initial_m = 1.5;    // correspondence gate of the first outer iteration
-  double gate_final_m = 0.3;      // ... halved each outer iteration down to this
+  double max_correspondence_m = 1.5;  // correspondence gate of the first outer iteration
+  double min_correspondence_m = 0.3;  // ... halved each outer iteration down to this
   double gate_tracking_m = 0.3;   // first gate while tracking (previous frame OK): the motion model is good to
                                   // centimetres, and structures not in the plan running parallel to it a few
                                   // decimetres away (cabinets along a wall) stay out of the correspondences
   double loss_scale_m = 0.05;     // robust loss scale
   std::string loss = "cauchy";    // "cauchy" (redescending: clutter in front of walls is rejected), "huber", "none"
   int max_iterations = 10;        // Ceres iterations per outer iteration
-  int max_outer = 5;              // look-up + solve rounds (x6 for point targets, see matcher.cpp)
+  int max_rounds = 5;             // look-up + solve rounds (x6 for point targets, see matcher.cpp)
   double initial_search_yaw_rad = 10 * M_PI / 180;  // default yaw uncertainty of a pose given by set_pose
   double inlier_m = 0.1;          // a point within this of the plan is an inlier
   double min_inlier_ratio = 0.3;  // below: POOR (the pose is not accepted)
   int min_inliers = 15;
   int lost_after = 5;             // consecutive POOR frames -> LOST
   double max_jump_m = 1.5;        // an OK-looking fit this far from the prediction is refused
-  double max_jump_rad = 0.5;
+  double max_jump_rad = 30 * M_PI / 180;
   bool group_rule = true;
   bool motion_model = true;       // constant velocity (else: previous pose)
   bool deskew = true;             // motion compensation with the motion model's twist (IMU yaw rate if given)
@@ -75,7 +75,7 @@ class Matcher {
  public:
   Matcher(const NearestLookup& lookup, MatcherConfig cfg);
   // (Re)initialises the tracker: the next frame is registered from this pose (no motion model), searching
-  // within search_m / search_yaw of it (the pose's uncertainty; defaults gate_initial_m and
+  // within search_m / search_yaw of it (the pose's uncertainty; defaults max_correspondence_m and
   // initial_search_yaw_rad). An uncertainty larger than twice the tracking gate is searched from a grid
   // of starts.
   void set_pose(const Pose2& p, std::optional<double> search_m = std::nullopt, std::optional<double> search_yaw = std::nullopt);
@@ -88,7 +88,7 @@ class Matcher {
   // motion: the robot's own odometry increment since the previous frame (wheel odometry, in the previous
   // frame's body frame), if any: the prediction is the previous pose composed with it, whatever the time
   // between frames (2D laser logs have frames seconds and a metre apart), and the first gate is the wide
-  // one (gate_initial_m), as odometry over such a step is good to decimetres, not to the tracking gate.
+  // one (max_correspondence_m), as odometry over such a step is good to decimetres, not to the tracking gate.
   MatchResult process(const FeatureFrame& f, std::optional<double> yaw_delta = std::nullopt,
                       const std::optional<Pose2>& motion = std::nullopt);
   // A better estimate of the last processed frame's pose at its utime (the windowed optimizer's, which

@@ -1,4 +1,5 @@
-// Transport-free input/output types of the localization libraries (matcher, optimizer, odometry).
+// Transport-free input/output types of the localization libraries (matcher, optimizer, odometry); their
+// input, the FeatureFrame, is core's (fploc/core/feature_frame.h).
 #pragma once
 #include <Eigen/Core>
 #include <cmath>
@@ -7,30 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "fploc/core/feature_frame.h"
 #include "fploc/core/pose.h"
 
 namespace fploc {
-
-enum class FeatureKind : int8_t { kCorner = 0, kSurface = 1 };
-
-struct Feature2 {
-  Eigen::Vector2d p = Eigen::Vector2d::Zero();  // sensor-centred horizontal frame [m]
-  FeatureKind kind = FeatureKind::kSurface;
-  int32_t group = -1;                           // PCA line group, -1 unclassified
-  float t = 0.f;                                // measurement time - frame utime [s] (motion compensation)
-};
-
-// One scan's projected features plus the gravity part of the pose passed through from the segmenter.
-struct FeatureFrame {
-  int64_t utime = 0;
-  int64_t scan_seq = 0;
-  double roll = 0, pitch = 0, z = 0;
-  double roll_pitch_sigma = 0, z_sigma = 0;
-  double attitude_t = 0;  // roll/pitch/z hold at utime + this [s] (mid-sweep; the optimizer interpolates)
-  // The IMU's mean yaw rate [rad/s] over the sweep (utime .. utime + the points' largest t); NaN = unknown.
-  double sweep_yaw_rate = std::numeric_limits<double>::quiet_NaN();
-  std::vector<Feature2> points;
-};
 
 // Planar velocity of the sensor, in its own frame: linear [m/s] (x forward, y left) and yaw rate [rad/s].
 // Constant over a sweep it is the motion model of the motion compensation (de-skewing).

@@ -36,7 +36,7 @@ struct OptimizerConfig {
   double loss_scale_m = 0.05;
   std::string loss = "cauchy";    // as MatcherConfig::loss
   int max_iterations = 10;             // Ceres iterations per outer round
-  int outer = 2;                       // look-up + solve rounds per new keyframe
+  int rounds = 2;                      // look-up + solve rounds per new keyframe
   bool group_rule = true;
   int stride = 1;                      // use every stride-th feature point of a keyframe
   int max_points = 800;                // per keyframe: the stride grows to keep about this many (0 = all)
@@ -45,8 +45,6 @@ struct OptimizerConfig {
   double relook_rad = 0.2 * M_PI / 180;  // ... or turned this much since the last look-up
   bool anchor_final = false;           // also regularise against the last two final key poses (held fixed)
   double max_keyframe_gap_s = 2.0;     // a longer gap (e.g. lost frames) restarts the window
-  double unknown_z_sigma_m = 1.0;      // the segmenter's z_sigma at or above this: z unknown (it sends 1e3)
-  double unknown_rp_sigma_rad = 0.5;   // ... roll_pitch_sigma at or above this: roll/pitch unknown (it sends pi)
   std::string linear_solver = "sparse";  // "sparse" (SPARSE_NORMAL_CHOLESKY) or "dense" (DENSE_NORMAL_CHOLESKY)
 };
 
@@ -66,7 +64,8 @@ struct PoseOut {
   bool keyframe = false;
   bool final_estimate = false;
   FitStatus status = FitStatus::kOk;
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // (x, y, yaw): the frame's single-frame covariance
+  double z_sigma = 0, roll_pitch_sigma = 0;  // the frame's own (as measured; "unknown" sigmas, see types.h)
   int optimised = 0;                   // how many window solves this pose took part in
 };
 

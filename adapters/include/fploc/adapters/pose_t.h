@@ -1,0 +1,22 @@
+// pose_t <-> poses (6-DoF, covariance x y z roll pitch yaw). Pure mappings.
+#pragma once
+#include <fploc/pose_t.hpp>
+
+#include <Eigen/Core>
+
+#include "fploc/core/pose.h"
+#include "fploc/optimizer/window.h"
+
+namespace fploc::adapters {
+
+// From (x, y, yaw) + (roll, pitch, z): the 3x3 (x, y, yaw) covariance is placed in the 6x6, z and
+// roll/pitch get the given sigmas.
+pose_t make_pose_msg(int64_t utime, int64_t seq, const Pose2& p, double roll, double pitch, double z,
+                     const Eigen::Matrix3d& cov_xy_yaw, double z_sigma, double rp_sigma, int8_t status,
+                     bool keyframe, bool final_estimate);
+// A localized pose (it carries its own z and roll/pitch sigmas).
+pose_t to_msg(const PoseOut& p, int64_t seq);
+// Pose2 from a pose_t (yaw of its quaternion; a zero quaternion is the identity).
+Pose2 pose2_of(const pose_t& m);
+
+}  // namespace fploc::adapters

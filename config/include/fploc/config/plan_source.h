@@ -1,0 +1,17 @@
+// Options PlanSource (+ look-up name) -> the localization map a node loads.
+#pragma once
+#include <functional>
+#include <string>
+
+#include "fploc/matcher/map.h"
+#include "options/common.pb.h"
+
+namespace fploc::config {
+
+// The map of a node's `plan` option with the named look-up ("" = annf-exact); `resolve` turns the
+// option's path (relative to the graph file) into a file name. Throws naming `field`.file when no plan
+// is given.
+LocalizationMap load_map(const PlanSource& plan, const std::string& lookup,
+                         const std::function<std::string(const std::string&)>& resolve, const std::string& field);
+
+}  // namespace fploc::config

@@ -1,0 +1,25 @@
+#include "fploc/config/plan_source.h"
+
+#include <stdexcept>
+#include <vector>
+
+#include "fploc/floorplan/building.h"
+#include "fploc/floorplan/io.h"
+
+namespace fploc::config {
+
+LocalizationMap load_map(const PlanSource& plan, const std::string& lookup,
+                         const std::function<std::string(const std::string&)>& resolve, const std::string& field) {
+  if (plan.file().empty()) throw std::runtime_error(field + ".file: no floor plan given");
+  const std::vector<std::string> layers(plan.layers().begin(), plan.layers().end());
+  const std::string path = resolve(plan.file());
+  const std::string how = lookup.empty() ? "annf-exact" : lookup;
+  if (is_building_file(path) || !plan.floor().empty()) {  // a building (.pbtxt) or IFC: the plan of one floor
+    LocalizationMap m = make_localization_map(load_floor_plan(path, layers, plan.units(), plan.floor()), how);
+    m.note = "loaded " + path + " floor '" + plan.floor() + "'" + (m.note.empty() ? "" : "; " + m.note);
+    return m;
+  }
+  return load_localization_map(path, layers, plan.units(), how);
+}
+
+}  // namespace fploc::config

@@ -1,0 +1,148 @@
+// The defaults are written once, in the Config structs; the proto comments state them for the reader of
+// a graph file. This test reads proto/options/*.proto and checks every default a comment states
+// ("(0.3)", "(default 10)", "0 = default 0.4", "(0 = 5)") against config_of(Options{}) of that message,
+// and that no stated default of a covered message is left unchecked.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include "fploc/config/localization.h"
+#include "fploc/config/perception.h"
+#include "fploc/config/relocalization.h"
+
+namespace {
+
+using fploc::config::config_of;
+constexpr double kDeg = 180 / M_PI;
+
+// message -> field -> stated default (text as written), from the proto file.
+std::map<std::string, std::map<std::string, std::string>> stated_defaults(const std::string& file) {
+  std::ifstream in(std::string(FPLOC_SOURCE_DIR) + "/proto/options/" + file);
+  EXPECT_TRUE(in) << file;
+  std::map<std::string, std::map<std::string, std::string>> out;
+  const std::regex msg_re(R"(^message (\w+) \{)");
+  const std::regex field_re(R"(^\s+(?:repeated )?\w+ (\w+) = \d+;\s*(?://(.*))?$)");
+  const std::regex cont_re(R"(^\s+//(.*)$)");
+  const std::regex def_res[] = {std::regex(R"(\(default (-?[0-9.]+)[;), ])"), std::regex(R"(0 = default (-?[0-9.]+))"),
+                                std::regex(R"(\(0 = (-?[0-9.]+)[;), ])"), std::regex(R"(\((-?[0-9.]+)[;),])")};
+  std::string msg, field, comment, line;
+  auto flush = [&] {
+    if (msg.empty() || field.empty()) return;
+    std::smatch m;
+    const std::string c = comment + " ";
+    for (const auto& re : def_res)
+      if (std::regex_search(c, m, re)) {
+        out[msg][field] = m[1];
+        break;
+      }
+    field.clear();
+  };
+  while (std::getline(in, line)) {
+    std::smatch m;
+    if (std::regex_search(line, m, msg_re)) {
+      flush();
+      msg = m[1];
+    } else if (std::regex_match(line, m, field_re)) {
+      flush();
+      field = m[1];
+      comment = m[2];
+    } else if (std::regex_match(line, m, cont_re) && !field.empty()) {
+      comment += " " + std::string(m[1]);
+    } else {
+      flush();
+    }
+  }
+  flush();
+  return out;
+}
+
+// Equal to the precision the comment is written with.
+void expect_stated(const std::string& where, const std::string& text, double value) {
+  const auto dot = text.find('.');
+  const int decimals = dot == std::string::npos ? 0 : int(text.size() - dot - 1);
+  EXPECT_LE(std::abs(std::stod(text) - value), 0.5 * std::pow(10.0, -decimals) + 1e-12)
+      << where << ": the proto comment says " << text << ", the Config default is " << value;
+}
+
+using Table = std::map<std::string, double>;
+
+void check(const std::string& file, const std::string& message, const Table& table,
+           const std::set<std::string>& not_a_config_default = {}) {
+  const auto stated = stated_defaults(file);
+  ASSERT_TRUE(stated.count(message)) << message << " in " << file << " states no default";
+  for (const auto& [field, text] : stated.at(message)) {
+    if (not_a_config_default.count(field)) continue;
+    const auto it = table.find(field);
+    if (it == table.end()) {
+      ADD_FAILURE() << file << " " << message << "." << field << " states a default (" << text
+                    << "): add it to this test's table";
+      continue;
+    }
+    expect_stated(file + " " + message + "." + field, text, it->second);
+  }
+  for (const auto& [field, value] : table)
+    EXPECT_TRUE(stated.at(message).count(field)) << message << "." << field << ": its comment states no default";
+}
+
+TEST(ConfigDefaults, Matcher) {
+  const fploc::MatcherConfig c = config_of(fploc::MatcherOptions{});
+  check("localization.proto", "MatcherOptions",
+        {{"max_correspondence_m", c.max_correspondence_m}, {"loss_scale_m", c.loss_scale_m},
+         {"max_iterations", c.max_iterations}, {"min_inlier_ratio", c.min_inlier_ratio},
+         {"min_correspondence_m", c.min_correspondence_m}, {"max_rounds", c.max_rounds}, {"inlier_m", c.inlier_m},
+         {"min_inliers", c.min_inliers}, {"lost_after", c.lost_after}, {"max_jump_m", c.max_jump_m},
+         {"max_jump_deg", c.max_jump_rad * kDeg}, {"stride", c.stride}, {"max_points", c.max_points},
+         {"prediction_sigma_m", c.prediction_sigma_m}, {"prediction_sigma_deg", c.prediction_sigma_rad * kDeg}});
+}
+
+TEST(ConfigDefaults, Optimizer) {
+  const fploc::OptimizerConfig c = config_of(fploc::OptimizerOptions{});
+  check("localization.proto", "OptimizerOptions",
+        {{"window", c.window}, {"alpha", c.alpha}, {"beta", c.beta}, {"keyframe_distance_m", c.keyframe_distance_m},
+         {"keyframe_angle_deg", c.keyframe_angle_rad * kDeg}, {"gate_m", c.gate_m}, {"loss_scale_m", c.loss_scale_m},
+         {"max_iterations", c.max_iterations}, {"rounds", c.rounds}, {"stride", c.stride},
+         {"max_keyframe_gap_s", c.max_keyframe_gap_s}, {"max_points", c.max_points}, {"relook_m", c.relook_m}});
+}
+
+TEST(ConfigDefaults, Odometry) {
+  const fploc::OdometryConfig c = config_of(fploc::OdometryOptions{});
+  check("localization.proto", "OdometryOptions",
+        {{"max_correspondence_m", c.max_correspondence_m}, {"keyframe_distance_m", c.keyframe_distance_m},
+         {"keyframe_angle_deg", c.keyframe_angle_rad * kDeg}, {"map_keyframes", c.map_keyframes},
+         {"max_iterations", c.max_iterations}});
+}
+
+TEST(ConfigDefaults, Perception) {
+  const fploc::seg::SegmenterConfig s = config_of(fploc::SegmenterOptions{});
+  // ransac_max_iterations: fploc-segmenter-ransac's own argument, not a SegmenterConfig field.
+  check("perception.proto", "SegmenterOptions",
+        {{"seed_rings", s.seed_rings}, {"max_tilt_deg", s.max_tilt_deg}, {"wall_margin_m", s.wall_margin_m},
+         {"min_range_m", s.min_range_m}, {"inlier_threshold_m", s.inlier_threshold_m},
+         {"min_plane_inliers", s.min_plane_inliers}, {"irls_iterations", s.irls_iterations},
+         {"seed_triplets", s.seed_triplets}},
+        {"ransac_max_iterations"});
+  const fploc::feat::FeatureConfig f = config_of(fploc::FeatureOptions{});
+  check("perception.proto", "FeatureOptions",
+        {{"sectors", f.sectors}, {"max_corners_per_sector", f.max_corners_per_sector},
+         {"max_surfaces_per_sector", f.max_surfaces_per_sector}, {"corner_threshold", f.corner_threshold},
+         {"surface_threshold", f.surface_threshold}, {"max_range_m", f.max_range_m}, {"min_range_m", f.min_range_m},
+         {"half_window", f.half_window}, {"min_group_points", f.min_group_points}, {"line_max_rms_m", f.line_max_rms_m}});
+}
+
+TEST(ConfigDefaults, Relocalizer) {
+  const fploc::RelocalizerConfig c = config_of(fploc::RelocalizerOptions{});
+  // region_radius_m, global_after_s, min_interval_s: fploc-relocalizer's scheduling, not RelocalizerConfig.
+  check("relocalization.proto", "RelocalizerOptions",
+        {{"grid_m", c.grid_m}, {"yaw_step_deg", c.yaw_step_deg}, {"min_inlier_ratio", c.min_inlier_ratio},
+         {"min_evidence", c.min_evidence}},
+        {"region_radius_m", "global_after_s", "min_interval_s"});
+}
+
+}  // namespace

@@ -1,0 +1,91 @@
+// The localization pipeline of the paper (Section IV-C) as one object, in the style of KISS-ICP's
+// pipeline class: it owns the IMU yaw (prediction and sweep yaw rate), the attitude hold (roll/pitch/z
+// the segmenter could not estimate are held at their last known values), the single-frame matcher (SFR)
+// and the window optimizer (WO), configured by one Config. No transport: the matcher and optimizer nodes
+// are thin adapters over it, one step each (the paper's SFR / WO split stays two processes in the
+// graphs); in one process, process() runs both steps and feeds the window estimate back to the matcher,
+// as graphs/paper.pbtxt wires FPLOC_POSE_LATEST into the matcher's `refined` input.
+#pragma once
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <vector>
+
+#include "fploc/matcher/imu_yaw.h"
+#include "fploc/matcher/matcher.h"
+#include "fploc/optimizer/window.h"
+
+namespace fploc::localizer {
+
+struct Config {
+  MatcherConfig matcher;             // the SFR step
+  OptimizerConfig optimizer;         // the WO step
+  bool use_imu = true;               // the IMU's yaw rate: prediction (yaw change) + sweep yaw rate (de-skew)
+  double initial_search_m = 0;       // set_pose without an uncertainty: search this far (0: matcher.max_correspondence_m)
+  bool refine_from_window = true;    // process(): the WO estimate of a frame predicts the next one
+};
+
+// The SFR step's result for one frame (what FPLOC_FRAME_POSE carries).
+struct FramePose {
+  int64_t utime = 0;
+  int64_t scan_seq = 0;
+  MatchResult match;
+  // Roll/pitch/z of the frame, the last known ones where the frame's own are unknown (attitude hold),
+  // and the frame's own sigmas (an "unknown" sigma tells the value is held).
+  double roll = 0, pitch = 0, z = 0;
+  double roll_pitch_sigma = kUnknownRollPitchSigmaRad, z_sigma = kUnknownZSigmaM;
+};
+
+// A localized pose (the WO step's output): PoseOut carries its (x, y, yaw) covariance and its own z and
+// roll/pitch sigmas.
+using Pose = PoseOut;
+
+class Localizer {
+ public:
+  Localizer(const NearestLookup& lookup, Config cfg);
+
+  // IMU gyro z sample (out-of-order or non-finite samples are ignored). Ignored unless cfg.use_imu.
+  void add_imu(int64_t utime, double gyro_z);
+  // The robot's own odometry pose at utime (e.g. wheel odometry of a 2D-LiDAR robot); when the poses at
+  // the previous and the current frame's utime are both known, their increment predicts the frame
+  // (Matcher::process's `motion`). The last 256 are kept.
+  void add_odometry(int64_t utime, const Pose2& p);
+  // (Re)initialises the single-frame tracker at p, searching within search_m (default: cfg.initial_search_m).
+  void set_pose(const Pose2& p, std::optional<double> search_m = std::nullopt);
+  // A better estimate of the last registered frame's pose (the window's): see Matcher::refine.
+  bool refine(int64_t utime, const Pose2& pose_at_utime) { return matcher_.refine(utime, pose_at_utime); }
+
+  // SFR step: registers one frame (as measured) against the plan, with the IMU's prediction and the
+  // attitude hold. Status kNotInitialised until set_pose.
+  FramePose register_frame(const FeatureFrame& f);
+  // WO step: the frame as measured and its SFR result (in time order). Frames not registered
+  // (kNotInitialised) are skipped (nullopt). Otherwise appends the poses that became final to `finals`
+  // and returns the current window estimate of this frame.
+  std::optional<Pose> optimize(const FeatureFrame& f, const FramePose& sfr, std::vector<Pose>* finals);
+  // Makes every pose still in the window final (end of a sequence).
+  void flush(std::vector<Pose>* finals) { window_.flush(finals); }
+
+  // Both steps in one process.
+  struct Step {
+    FramePose sfr;
+    std::optional<Pose> latest;
+  };
+  Step process(const FeatureFrame& f, std::vector<Pose>* finals);
+
+  const Config& config() const { return cfg_; }
+  const Matcher& matcher() const { return matcher_; }
+
+ private:
+  Config cfg_;
+  Matcher matcher_;
+  WindowOptimizer window_;
+  ImuYaw imu_;
+  bool have_prev_ = false;           // a frame was registered (prev_utime_ valid)
+  int64_t prev_utime_ = 0;
+  std::optional<double> last_z_;
+  std::optional<std::pair<double, double>> last_rp_;
+  std::map<int64_t, Pose2> odom_;    // odometry poses by utime (add_odometry)
+  FeatureFrame held_;                // scratch: the frame with the IMU's sweep rate and the held attitude
+};
+
+}  // namespace fploc::localizer

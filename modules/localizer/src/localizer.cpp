@@ -1,0 +1,81 @@
+#include "fploc/localizer/localizer.h"
+
+#include <cmath>
+
+namespace fploc::localizer {
+
+Localizer::Localizer(const NearestLookup& lookup, Config cfg)
+    : cfg_(std::move(cfg)), matcher_(lookup, cfg_.matcher), window_(lookup, cfg_.optimizer) {}
+
+void Localizer::add_imu(int64_t utime, double gyro_z) {
+  if (cfg_.use_imu) imu_.add(utime, gyro_z);
+}
+
+void Localizer::add_odometry(int64_t utime, const Pose2& p) {
+  odom_[utime] = p;
+  while (odom_.size() > 256) odom_.erase(odom_.begin());
+}
+
+void Localizer::set_pose(const Pose2& p, std::optional<double> search_m) {
+  if (!search_m && cfg_.initial_search_m > 0) search_m = cfg_.initial_search_m;
+  matcher_.set_pose(p, search_m);
+}
+
+FramePose Localizer::register_frame(const FeatureFrame& f) {
+  held_ = f;
+  // Roll/pitch/z the segmenter could not estimate: the last known ones.
+  if (z_known(f)) last_z_ = f.z;
+  else if (last_z_) held_.z = *last_z_;
+  if (roll_pitch_known(f)) last_rp_ = {f.roll, f.pitch};
+  else if (last_rp_) held_.roll = last_rp_->first, held_.pitch = last_rp_->second;
+  std::optional<double> dyaw;
+  if (cfg_.use_imu) {
+    // Prediction: the yaw change since the previous frame; motion compensation: the mean rate over
+    // this frame's sweep (its samples arrive before the scan is complete).
+    if (have_prev_) dyaw = imu_.integral(prev_utime_, f.utime);
+    const double sweep = sweep_duration(f);
+    if (sweep > 0)
+      if (auto w = imu_.mean_rate(f.utime, f.utime + std::llround(sweep * 1e6))) held_.sweep_yaw_rate = *w;
+    imu_.drop_before(std::min(f.utime, have_prev_ ? prev_utime_ : f.utime));
+  }
+  std::optional<Pose2> motion;
+  if (have_prev_ && !odom_.empty()) {
+    auto a = odom_.find(prev_utime_), b = odom_.find(f.utime);
+    if (a != odom_.end() && b != odom_.end()) motion = between(a->second, b->second);
+  }
+  FramePose out;
+  out.utime = f.utime;
+  out.scan_seq = f.scan_seq;
+  out.match = matcher_.process(held_, dyaw, motion);
+  if (out.match.status != FitStatus::kNotInitialised) {
+    prev_utime_ = f.utime;
+    have_prev_ = true;
+  }
+  out.roll = held_.roll;
+  out.pitch = held_.pitch;
+  out.z = held_.z;
+  out.roll_pitch_sigma = f.roll_pitch_sigma;
+  out.z_sigma = f.z_sigma;
+  return out;
+}
+
+std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& sfr, std::vector<Pose>* finals) {
+  if (sfr.match.status == FitStatus::kNotInitialised) return std::nullopt;
+  FrameInput in;
+  in.features = f;
+  in.sfr = sfr.match.pose;
+  in.twist = sfr.match.twist;
+  in.status = sfr.match.status;
+  in.covariance = sfr.match.covariance;
+  return window_.add(std::move(in), finals);
+}
+
+Localizer::Step Localizer::process(const FeatureFrame& f, std::vector<Pose>* finals) {
+  Step s;
+  s.sfr = register_frame(f);
+  s.latest = optimize(f, s.sfr, finals);
+  if (s.latest && cfg_.refine_from_window) refine(s.latest->utime, s.latest->pose);
+  return s;
+}
+
+}  // namespace fploc::localizer

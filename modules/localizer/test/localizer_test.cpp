@@ -1,0 +1,142 @@
+#include "fploc/localizer/localizer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "fploc/matcher/map.h"
+#include "synthetic.h"
+
+using namespace fploc;
+using fploc::testing::room_with_pillars;
+using fploc::testing::synth_frame;
+using fploc::testing::SynthOptions;
+
+namespace {
+
+// A smooth path through the room at ~0.6 m/s, 10 Hz, turning at up to ~0.16 rad/s.
+Pose2 truth_at(double t) { return {3.0 + 0.6 * t, 3.0 + 1.5 * std::sin(0.25 * t), 0.2 * std::sin(0.3 * t) + 0.1 * t}; }
+double yaw_rate_at(double t) { return 0.06 * std::cos(0.3 * t) + 0.1; }
+
+std::vector<FeatureFrame> make_frames(const FloorPlan& plan, int n) {
+  std::vector<FeatureFrame> frames;
+  for (int k = 0; k < n; ++k) {
+    const double t = 0.1 * k;
+    SynthOptions so;
+    so.seed = uint32_t(k + 1);
+    so.noise_sigma = 0.01;
+    so.sweep_s = 0.1;
+    so.sweep_twist = log_twist(truth_at(t), truth_at(t + so.sweep_s), so.sweep_s);
+    frames.push_back(synth_frame(plan, truth_at(t), so, int64_t(std::llround(t * 1e6))));
+    frames.back().scan_seq = k;
+    frames.back().z = 1.2;
+    frames.back().z_sigma = 0.01;
+    frames.back().roll_pitch_sigma = 0.001;
+  }
+  return frames;
+}
+
+void feed_imu(localizer::Localizer& loc, double t0, double t1) {
+  for (double t = t0; t < t1; t += 0.01) loc.add_imu(int64_t(std::llround(t * 1e6)), yaw_rate_at(t));
+}
+
+class LocalizerTest : public ::testing::Test {
+ protected:
+  LocalizerTest() : map_(make_localization_map(room_with_pillars(), "annf-exact")), frames_(make_frames(*map_.plan, 60)) {}
+  LocalizationMap map_;
+  std::vector<FeatureFrame> frames_;
+};
+
+TEST_F(LocalizerTest, NotInitialisedUntilSetPose) {
+  localizer::Localizer loc(*map_.lookup, {});
+  std::vector<localizer::Pose> finals;
+  const auto s = loc.process(frames_[0], &finals);
+  EXPECT_EQ(s.sfr.match.status, FitStatus::kNotInitialised);
+  EXPECT_FALSE(s.latest);
+  EXPECT_TRUE(finals.empty());
+}
+
+// Both steps in one process: every frame is registered, the window's final poses are every frame's,
+// in time order, on the truth, and carry the frames' own sigmas.
+TEST_F(LocalizerTest, TracksASequenceAndItsPosesCarryTheirSigmas) {
+  localizer::Localizer loc(*map_.lookup, {});
+  loc.set_pose(truth_at(0));
+  std::vector<localizer::Pose> finals;
+  double sfr_err2 = 0;
+  for (size_t k = 0; k < frames_.size(); ++k) {
+    feed_imu(loc, 0.1 * k - 0.1, 0.1 * k + 0.11);
+    const auto s = loc.process(frames_[k], &finals);
+    ASSERT_EQ(s.sfr.match.status, FitStatus::kOk) << "frame " << k;
+    ASSERT_TRUE(s.latest);
+    EXPECT_EQ(s.latest->utime, frames_[k].utime);
+    const Pose2 g = truth_at(0.1 * k);
+    sfr_err2 += std::pow(s.sfr.match.pose.x - g.x, 2) + std::pow(s.sfr.match.pose.y - g.y, 2);
+  }
+  loc.flush(&finals);
+  ASSERT_EQ(finals.size(), frames_.size());
+  double wo_err2 = 0;
+  for (size_t k = 0; k < finals.size(); ++k) {
+    EXPECT_EQ(finals[k].utime, frames_[k].utime);
+    EXPECT_TRUE(finals[k].final_estimate);
+    EXPECT_DOUBLE_EQ(finals[k].z_sigma, 0.01);
+    EXPECT_DOUBLE_EQ(finals[k].roll_pitch_sigma, 0.001);
+    const Pose2 g = truth_at(0.1 * k);
+    wo_err2 += std::pow(finals[k].pose.x - g.x, 2) + std::pow(finals[k].pose.y - g.y, 2);
+  }
+  EXPECT_LT(std::sqrt(sfr_err2 / frames_.size()), 0.03);
+  EXPECT_LT(std::sqrt(wo_err2 / frames_.size()), 0.03);
+}
+
+// The SFR step holds the last known roll/pitch/z when the frame's own are unknown, and says so by the
+// frame's own (unknown) sigmas.
+TEST_F(LocalizerTest, AttitudeHold) {
+  localizer::Localizer loc(*map_.lookup, {});
+  loc.set_pose(truth_at(0));
+  FeatureFrame f0 = frames_[0];
+  f0.roll = 0.01;
+  f0.pitch = -0.02;
+  const auto s0 = loc.register_frame(f0);
+  EXPECT_DOUBLE_EQ(s0.z, 1.2);
+  FeatureFrame f1 = frames_[1];
+  f1.z = 7;
+  f1.z_sigma = kUnknownZSigmaM;
+  f1.roll = f1.pitch = 0.3;
+  f1.roll_pitch_sigma = kUnknownRollPitchSigmaRad;
+  const auto s1 = loc.register_frame(f1);
+  EXPECT_DOUBLE_EQ(s1.z, 1.2);
+  EXPECT_DOUBLE_EQ(s1.roll, 0.01);
+  EXPECT_DOUBLE_EQ(s1.pitch, -0.02);
+  EXPECT_EQ(s1.z_sigma, kUnknownZSigmaM);
+  EXPECT_EQ(s1.roll_pitch_sigma, kUnknownRollPitchSigmaRad);
+  // Known again: used as they come.
+  FeatureFrame f2 = frames_[2];
+  f2.z = 1.3;
+  const auto s2 = loc.register_frame(f2);
+  EXPECT_DOUBLE_EQ(s2.z, 1.3);
+}
+
+// The two steps called separately (as the matcher and optimizer processes do) give what process()
+// gives without the feedback.
+TEST_F(LocalizerTest, TwoStepsEqualOneProcessWithoutFeedback) {
+  localizer::Config cfg;
+  cfg.refine_from_window = false;
+  localizer::Localizer a(*map_.lookup, cfg), sfr(*map_.lookup, cfg), wo(*map_.lookup, cfg);
+  a.set_pose(truth_at(0));
+  sfr.set_pose(truth_at(0));
+  std::vector<localizer::Pose> fa, fb;
+  for (size_t k = 0; k < 30; ++k) {
+    feed_imu(a, 0.1 * k - 0.1, 0.1 * k + 0.11);
+    feed_imu(sfr, 0.1 * k - 0.1, 0.1 * k + 0.11);
+    const auto s = a.process(frames_[k], &fa);
+    const auto r = sfr.register_frame(frames_[k]);
+    const auto latest = wo.optimize(frames_[k], r, &fb);
+    EXPECT_EQ(s.sfr.match.pose.x, r.match.pose.x);
+    EXPECT_EQ(s.sfr.match.pose.yaw, r.match.pose.yaw);
+    ASSERT_TRUE(latest && s.latest);
+    EXPECT_EQ(latest->pose.x, s.latest->pose.x);
+  }
+  ASSERT_EQ(fa.size(), fb.size());
+  for (size_t i = 0; i < fa.size(); ++i) EXPECT_EQ(fa[i].pose.y, fb[i].pose.y);
+}
+
+}  // namespace

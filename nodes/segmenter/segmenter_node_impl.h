@@ -1,0 +1,96 @@
+// The segmenter node body shared by fploc-segmenter (paper) and fploc-segmenter-ransac (PCL): same ports,
+// same message, same options field `segmenter`, so a graph swaps the executable only.
+#pragma once
+#include <fploc/imu_t.hpp>
+#include <fploc/scan_t.hpp>
+#include <fploc/segments_t.hpp>
+
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include "fploc/core/scan.h"
+#include "fploc/adapters/scan_t.h"
+#include "fploc/adapters/segments_t.h"
+#include "fploc/config/perception.h"
+#include "fploc/runtime/node.h"
+
+namespace fploc {
+
+template <class Traits>
+class SegmenterNodeT : public rt::Node {
+ public:
+  static rt::NodeSpec spec() {
+    return {Traits::kType, "segmenter", Traits::kDescription,
+            {rt::input<scan_t>("scan", "OS1_SCAN"), rt::input<imu_t>("imu", "OS1_IMU"),
+             rt::output<segments_t>("segments", "FPLOC_SEGMENTS")}};
+  }
+
+  void setup(rt::Context& ctx) override {
+    ctx_ = &ctx;
+    const auto& o = ctx.options<SegmenterOptions>();
+    if (!o.algorithm().empty() && o.algorithm() != Traits::kAlgorithm)
+      throw std::runtime_error(std::string("segmenter.algorithm: '") + o.algorithm() + "' is not served by fploc-" +
+                               Traits::kExecutable + " (use " + Traits::kOther + ")");
+    seg_ = Traits::make(o);
+    use_imu_ = o.use_imu_prior();
+    out_ = ctx.advertise<segments_t>("segments");
+    ctx.subscribe<scan_t>("scan", [this](const scan_t& m) { on_scan(m); });
+    ctx.subscribe<imu_t>("imu", [this](const imu_t& m) {
+      // IMU axes = sensor axes (OS-1: imu_to_sensor is a pure translation).
+      const Eigen::Vector3d w(m.gyro[0], m.gyro[1], m.gyro[2]);
+      if (!w.allFinite())
+        ctx_->error("imu seq " + std::to_string(m.seq) + ": non-finite gyro (ignored)");
+      else
+        seg_->add_gyro(w, m.gyro_utime != 0 ? m.gyro_utime : m.utime);  // de-skew of the sweep's rotation
+      if (!use_imu_) return;
+      const Eigen::Vector3d a(m.accel[0], m.accel[1], m.accel[2]);
+      if (!a.allFinite()) {
+        ctx_->error("imu seq " + std::to_string(m.seq) + ": non-finite accel (ignored)");
+        return;
+      }
+      seg_->add_accel(a);
+    });
+  }
+
+ private:
+  void on_scan(const scan_t& m) {
+    segments_t msg;
+    try {
+      adapters::from_msg(m, scan_);
+    } catch (const std::exception& e) {
+      // Bad message: say so downstream (status BAD_INPUT) and keep running.
+      seg::Segmentation bad;
+      bad.utime = m.utime;
+      bad.seq = m.seq;
+      bad.status = seg::SegStatus::kBadInput;
+      bad.status_text = e.what();
+      const auto& last = seg_->last();
+      bad.roll = last.roll;
+      bad.pitch = last.pitch;
+      bad.z = last.z;
+      bad.roll_pitch_sigma = last.roll_pitch_sigma;
+      bad.z_sigma = last.z_sigma;
+      bad.attitude_source = seg::AttitudeSource::kPrevious;
+      ctx_->error(std::string("scan: ") + e.what());
+      adapters::to_msg(bad, seq_++, msg);
+      out_.publish(msg);
+      return;
+    }
+    const auto& s = seg_->process(scan_);
+    if (s.status == seg::SegStatus::kBadInput || s.status == seg::SegStatus::kEmpty)
+      ctx_->error("scan seq " + std::to_string(m.seq) + " on " + ctx_->channel("scan") + ": " + seg::to_string(s.status) +
+                  ": " + s.status_text);
+    adapters::to_msg(s, seq_++, msg);
+    out_.publish(msg);
+  }
+
+  rt::Context* ctx_ = nullptr;
+  std::unique_ptr<seg::Segmenter> seg_;
+  rt::Publisher<segments_t> out_;
+  Scan scan_;
+  int64_t seq_ = 0;
+  bool use_imu_ = false;
+};
+
+}  // namespace fploc
