@@ -34,7 +34,7 @@ Model::~Model() = default;
 
 void Model::on_plan_diff(std::string j) {
   std::lock_guard<std::mutex> lk(mu_);
-  set_slot("plan_diff", std::move(j));
+  hub_.set("plan_diff", std::move(j));
 }
 
 void Model::set_plan_json(std::string j) {
