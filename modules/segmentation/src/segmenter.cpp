@@ -138,7 +138,7 @@ const Segmentation& Segmenter::process(const Scan& scan) {
       out_.ceiling.found ? Eigen::Vector3d(-out_.ceiling.coeffs.head<3>()) : init_up.normalized();
   fit_ground(up);
 
-  height_.update(out_, up, imu);
+  height_.update(out_, imu);
   if (out_.ceiling.found) {
     have_prev_ceiling_ = true;
     prev_ceiling_ = out_.ceiling.coeffs;

@@ -10,7 +10,13 @@
 namespace fploc::seg {
 
 enum class SegStatus : int8_t { kOk = 0, kNoCeiling = 1, kBadInput = 2, kEmpty = 3 };
-enum class AttitudeSource : int8_t { kCeiling = 0, kPrevious = 1, kImu = 2, kNone = 3 };
+enum class AttitudeSource : int8_t { kCeiling = 0, kPrevious = 1, kImu = 2, kNone = 3, kGround = 4 };
+// Where z came from: the ceiling with the floor-to-ceiling height of the area (configured, or learned online
+// from ceiling + ground), the floor plane, a prediction (the last estimate, sigma grown; no trustworthy
+// plane or a jump not confirmed by the other plane), or nothing yet.
+enum class HeightSource : int8_t { kCeiling = 0, kGround = 1, kPredicted = 2, kNone = 3 };
+const char* to_string(AttitudeSource s);
+const char* to_string(HeightSource s);
 
 struct Plane {
   Eigen::Vector4d coeffs = Eigen::Vector4d::Zero();  // n.x n.y n.z d, n.p + d = 0, n into the room
@@ -48,6 +54,7 @@ struct Segmentation {
   double roll_pitch_sigma = M_PI;    // 1-sigma [rad]; pi = unknown
   double z_sigma = 1e3;              // 1-sigma [m]
   AttitudeSource attitude_source = AttitudeSource::kNone;
+  HeightSource z_source = HeightSource::kNone;
   bool deskewed = false;             // planes fitted to gyro-de-skewed returns (roll/pitch/z at mid-sweep)
   // roll/pitch/z hold at utime + attitude_t [s]: mid-sweep (the returns are de-skewed to it, or the planes
   // are fitted over the whole sweep); downstream poses stamped at utime interpolate to their own time.

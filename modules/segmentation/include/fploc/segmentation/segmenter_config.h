@@ -23,6 +23,16 @@ struct SegmenterConfig {
   double irls_initial_scale_m = 0.2;  // first Tukey cut-off (4 x the 5 cm band that chose the start);
                                       // halves every iteration down to ~4.7 sigma
   int room_height_window = 51;     // frames in the running median of the floor-to-ceiling height
+  // Height/attitude consistency (attitude_height.cpp): the ceiling's floor-to-ceiling height (ceiling +
+  // ground distance) more than this off the area's height means the ceiling over the sensor is not the
+  // area's (a sloped patch, a lamp, an atrium edge): z from the floor instead.
+  double z_consistency_m = 0.03;
+  // Ceiling and ground normals more than this apart: one of them is not level; the one agreeing with the
+  // IMU (else the better-fitted one) gives roll/pitch.
+  double attitude_consistency_deg = 0.3;
+  // With the ceiling alone: z moving more than this from the last estimate in one scan is a ceiling step
+  // (another area), not motion: z is predicted and the area height re-learned from the new ceiling.
+  double z_jump_m = 0.05;
   double tight_refit_sigmas = 2.5; // ceiling refit at this many robust sigmas (0 = off), see fit_plane
 };
 
