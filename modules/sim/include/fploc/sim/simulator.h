@@ -13,6 +13,7 @@
 
 #include "fploc/core/pose.h"
 #include "fploc/floorplan/plan.h"
+#include "fploc/sim/ceiling_map.h"
 #include "fploc/sim/motion.h"
 #include "fploc/sim/planner.h"
 #include "fploc/sim/scenarios.h"
@@ -61,6 +62,7 @@ class Simulator {
   const SimulatorOptions& options() const { return opt_; }
   const std::string& beam_source() const { return beam_source_; }
   const std::string& info() const { return info_; }  // planner / clutter notes
+  const CeilingMap& ceiling_map() const { return ceiling_map_; }  // building-* scenarios (else empty)
 
  private:
   void add_clutter();
@@ -73,6 +75,7 @@ class Simulator {
   std::vector<ImuSample> imu_;
   int num_frames_ = 0;
   std::string beam_source_, info_;
+  CeilingMap ceiling_map_;
 };
 
 }  // namespace fploc::sim
