@@ -14,7 +14,8 @@ with the simulator's default ceiling patches, on every shipped plan (data/plans)
 Targets (issue 11): z p99 <= 2 cm, roll/pitch p99 <= 0.2 deg, horizontal ATE <= 1 cm, no LOST.
 
 Prints one JSON document on stdout ({"rows": [...], "targets": {...}}); progress on stderr. With --plots DIR
-writes z against ground truth over time (SVG) per row.
+writes z against ground truth over time per row (SVG with axes and legend, and a text-free PNG:
+grid lines every 1 cm and 10 s, truth green, estimate red).
 """
 import argparse
 import bisect
@@ -110,6 +111,46 @@ def plot_z(series, title, path):
         f.write("\n".join(out))
 
 
+def plot_png(series, path, W=900, H=300):
+    """The same plot as a PNG without text (for image viewers): grey grid every 1 cm of z and every 10 s,
+    truth green, estimate red. Written with zlib only."""
+    import struct
+    import zlib
+    t1 = max(s[0] for s in series) or 1.0
+    zs = [s[1] for s in series] + [s[2] for s in series]
+    z0, z1 = min(zs) - 0.005, max(zs) + 0.005
+    img = [bytearray(b"\xff" * (3 * W)) for _ in range(H)]
+
+    def px(x, y, c):
+        if 0 <= x < W and 0 <= y < H:
+            img[y][3 * x:3 * x + 3] = bytes(c)
+    X = lambda t: int((W - 1) * t / t1)  # noqa: E731
+    Y = lambda z: int((H - 1) * (z1 - z) / (z1 - z0))  # noqa: E731
+    z = math.ceil(z0 * 100) / 100
+    while z < z1:
+        for x in range(W):
+            px(x, Y(z), (225, 225, 225))
+        z += 0.01
+    for t in range(0, int(t1) + 1, 10):
+        for y in range(H):
+            px(X(t), y, (225, 225, 225))
+
+    def line(a, b, c):
+        (x0, y0), (x1, y1) = a, b
+        n = max(abs(x1 - x0), abs(y1 - y0), 1)
+        for i in range(n + 1):
+            px(x0 + (x1 - x0) * i // n, y0 + (y1 - y0) * i // n, c)
+    for idx, c in ((2, (30, 160, 80)), (1, (200, 30, 30))):
+        pts = [(X(s[0]), Y(s[idx])) for s in series]
+        for a, b in zip(pts, pts[1:]):
+            line(a, b, c)
+    raw = b"".join(b"\x00" + bytes(r) for r in img)
+    chunk = lambda tag, data: struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data))  # noqa: E731
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", W, H, 8, 2, 0, 0, 0)) +
+                chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
+
+
 def bench(a, work, plan, layers, scenario):
     name = f"{os.path.splitext(os.path.basename(plan))[0]}:{scenario}"
     d = os.path.join(work, name.replace(":", "-"))
@@ -158,6 +199,8 @@ def bench(a, work, plan, layers, scenario):
         path = os.path.join(a.plots, name.replace(":", "-") + "-z.svg")
         plot_z(series, f"{name}: z p99 {100 * m['z_err_p99_m']:.2f} cm, rp p99 {m['rp_err_p99_deg']:.3f} deg", path)
         row["plot"] = path
+        plot_png(series, path[:-4] + ".png")
+        row["plot_png"] = path[:-4] + ".png"
     log(f"[{name}] ATE xy {100 * row.get('ate_xy_m', float('nan')):.2f} cm, z med/p99 "
         f"{100 * row.get('z_err_median_m', float('nan')):.2f}/{100 * row.get('z_err_p99_m', float('nan')):.2f} cm, "
         f"rp p99 {row.get('rp_err_p99_deg', float('nan')):.3f} deg, LOST {row['lost']}, ms/scan {ms}")
