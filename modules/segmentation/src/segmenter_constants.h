@@ -63,5 +63,6 @@ constexpr double kUnknownZSigmaM = 1e3;             // z unknown
 // ---- wall selection (wall_select.cpp) ----
 constexpr double kPlaneMarginRms = 3.0;        // wall margin at least this many plane rms
 constexpr double kHeldPlaneMarginGrowth = 1.5; // margin x this when the plane is last frame's
+constexpr double kNoCeilingWallTopM = 2.0;     // no ceiling known yet: wall points up to this above the floor
 
 }  // namespace fploc::seg::k

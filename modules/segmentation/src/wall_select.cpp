@@ -8,7 +8,9 @@
 namespace fploc::seg {
 
 void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
-  // Upper bound: the ceiling (this frame's or last known); lower bound: the ground plane, else a plane
+  // Upper bound: the ceiling (this frame's or last known), else (no ceiling ever accepted: the start under an
+  // atrium, or next to a higher hall whose returns fail the ceiling's "rays end there" test) a plane
+  // parallel to the ground kNoCeilingWallTopM above the floor; lower bound: the ground plane, else a plane
   // parallel to the ceiling one room height below, else last known ground.
   Eigen::Vector4d ceil, floor;
   double mc = cfg_.wall_margin_m, mf = cfg_.wall_margin_m;
@@ -18,6 +20,10 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
   } else if (have_prev_ceiling_) {
     ceil = prev_ceiling_;
     mc *= k::kHeldPlaneMarginGrowth;
+  } else if (out_.ground.found) {
+    ceil << -out_.ground.coeffs.head<3>(), std::max(k::kNoCeilingWallTopM - out_.ground.distance(), k::kMinCeilingDistM);
+    if (!out_.status_text.empty()) out_.status_text += "; ";
+    out_.status_text += "no ceiling known: wall points up to 2 m above the floor";
   } else {
     if (!out_.status_text.empty()) out_.status_text += "; ";
     out_.status_text += "no ceiling known: no wall points";

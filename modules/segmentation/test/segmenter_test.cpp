@@ -133,7 +133,8 @@ TEST(RingSegmenter, NoCeilingPrefersGroundToImuGravity) {
   EXPECT_NEAR(out.pitch, pose.pitch, 0.05 * kDeg);
 }
 
-TEST(RingSegmenter, NoCeilingNoHistoryHasNoWallsButTheGroundAttitude) {
+// No ceiling and no history: attitude from the floor, wall points up to 2 m above it (all real walls here).
+TEST(RingSegmenter, NoCeilingNoHistoryUsesTheGround) {
   synth::Room room;
   room.ceiling = false;
   RingSegmenter seg(SegmenterConfig{});
@@ -141,7 +142,8 @@ TEST(RingSegmenter, NoCeilingNoHistoryHasNoWallsButTheGroundAttitude) {
   EXPECT_EQ(out.status, SegStatus::kNoCeiling);
   EXPECT_EQ(out.attitude_source, AttitudeSource::kGround);
   EXPECT_NEAR(out.roll, 0.0, 0.05 * kDeg);
-  EXPECT_EQ(out.wall.size(), 0u);
+  EXPECT_GT(out.wall.size(), 1000u);
+  for (size_t i = 0; i < out.wall.size(); ++i) EXPECT_LT(out.wall.z[i], 2.0 - 1.5 + 0.01);  // sensor at 1.5 m
 }
 
 // Neither plane (an empty scan) and no history: unknown, not garbage; then a prediction with a growing sigma.

@@ -122,7 +122,11 @@ CeilingMap make_ceiling_map(const std::string& kind, const Box2& bounds, double 
     add_clutter(m, bounds, rng);
   } else if (kind == "mixed") {
     add_areas(m, bounds, rng);
-    add_atrium(m, bounds);
+    for (auto& a : m.areas)  // the high hall becomes a double-height atrium
+      if (a.name == "high hall") {
+        a.name = "atrium";
+        a.height_m = 2.0 * default_height_m;
+      }
     add_clutter(m, bounds, rng);
   } else {
     std::string valid;

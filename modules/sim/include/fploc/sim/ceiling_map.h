@@ -44,7 +44,7 @@ struct CeilingMap {
 
 // Named kinds for scenarios: "areas" (a low corridor band, a drop ceiling, a high hall, a sloped roof
 // corner), "atrium" (a double-height centre), "clutter" (lamps, beams, ducts, a drop-ceiling grid on the
-// default ceiling), "mixed" (areas + atrium + clutter). Deterministic for (kind, bounds, seed).
+// default ceiling), "mixed" (the areas with the hall at double height, and the clutter). Deterministic for (kind, bounds, seed).
 // Throws std::invalid_argument naming the valid kinds.
 CeilingMap make_ceiling_map(const std::string& kind, const Box2& bounds, double default_height_m, uint64_t seed);
 std::vector<std::string> ceiling_map_kinds();
