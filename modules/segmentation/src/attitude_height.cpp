@@ -93,13 +93,10 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu) {
     const double gate = std::max(cfg_.attitude_consistency_deg * k::kDeg,
                                  3.0 * std::hypot(out.ceiling.tilt_sigma, out.ground.tilt_sigma));
     if (ang > gate) {
-      // One of them is not level (a sloped ceiling patch, a ramp under the sensor): the IMU decides when
-      // given, else the tighter fit (a compromise over two surfaces has the larger residuals).
-      bool ground_better;
-      if (imu.valid)
-        ground_better = up_g.dot(imu.up) > up_c.dot(imu.up);
-      else
-        ground_better = out.ground.tilt_sigma < out.ceiling.tilt_sigma;
+      // One of them is not level (a sloped ceiling under a roof or stairs, a compromise over two ceiling
+      // surfaces, a ramp under the sensor): the IMU decides when given, else the floor (floors are level
+      // far more often than the ceilings above them).
+      const bool ground_better = imu.valid ? up_g.dot(imu.up) > up_c.dot(imu.up) : true;
       if (ground_better) {
         use_ceiling = false;
         use_ground = true;
@@ -118,6 +115,7 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu) {
     out.roll_pitch_sigma = pl.tilt_sigma;
     out.attitude_source = use_ceiling ? AttitudeSource::kCeiling : AttitudeSource::kGround;
     have_prev_ = true;
+    prev_up_ = up;
     prev_roll_ = out.roll;
     prev_pitch_ = out.pitch;
     prev_rp_sigma_ = out.roll_pitch_sigma;

@@ -131,12 +131,16 @@ const Segmentation& Segmenter::process(const Scan& scan) {
   }
   if (keep_labels_) out_.label.assign(size_t(scan.height) * scan.width, 0);
 
-  const Eigen::Vector3d init_up =
-      imu.valid ? imu_up_ : (have_prev_ceiling_ ? Eigen::Vector3d(-prev_ceiling_.head<3>()) : gate_up);
+  // Prior up: the IMU's gravity, else the last measured attitude (the ceiling's up in the paper's case; the
+  // ground's when the ceiling over the sensor was not level), else the sensor's z axis.
+  const Eigen::Vector3d init_up = imu.valid ? imu_up_ : (height_.has_up() ? height_.last_up() : gate_up);
   fit_ceiling(init_up, gate_up);
   const Eigen::Vector3d up =
       out_.ceiling.found ? Eigen::Vector3d(-out_.ceiling.coeffs.head<3>()) : init_up.normalized();
-  fit_ground(up);
+  // The ground is fitted around the ceiling's up when the ceiling agrees with the prior (the paper's case),
+  // else around the prior: a sloped ceiling patch taken as the ceiling must not drag the floor's gate along.
+  const double ceiling_vs_prior = std::acos(std::clamp(up.dot(init_up.normalized()), -1.0, 1.0));
+  fit_ground(ceiling_vs_prior < k::kCeilingPriorAgreeDeg * k::kDeg ? up : init_up.normalized());
 
   height_.update(out_, imu);
   if (out_.ceiling.found) {

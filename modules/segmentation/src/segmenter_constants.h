@@ -40,6 +40,7 @@ constexpr double kMinBeyondRatio = 1e-3;    // guards 1 / max_beyond_ratio
 constexpr double kMinCeilingDistM = 0.2;    // a ceiling closer than this to the sensor is not one
 constexpr double kMinGroundDistM = 0.1;
 constexpr double kMaxGroundTiltDeg = 5.0;   // ground normal vs the ceiling's (or prior) up
+constexpr double kCeilingPriorAgreeDeg = 2.0;  // ceiling this close to the prior: the ground is fitted around it
 
 // ---- gyro de-skew (gyro_deskew.cpp) ----
 constexpr double kMaxGyroRate = 35.0;           // rad/s (> 2000 deg/s: not a rate an OS-1 IMU reports)

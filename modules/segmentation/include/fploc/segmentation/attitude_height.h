@@ -1,7 +1,7 @@
 // The gravity-aligned part of the pose from one scan's planes, robust to ceilings of several heights,
 // sloped or cluttered ceilings and atria:
 //  - roll/pitch from the ceiling's normal; from the ground's when the ceiling is missing, or when the two
-//    disagree and the ground agrees better (with the IMU's gravity when given, else the tighter fit);
+//    disagree (by the IMU's gravity when given, else the floor: floors are level more often than ceilings);
 //  - z from the ceiling with the floor-to-ceiling height of the area the sensor is in (configured, else
 //    learned online from ceiling + ground: a running median that follows the area), checked against the
 //    floor: a ceiling inconsistent with the area's height gives way to the floor plane; with the ceiling
@@ -32,6 +32,9 @@ class AttitudeHeight {
   // A scan whose planes could not be fitted at all (bad or empty input): the predicted estimate.
   void hold(Segmentation& out, const ImuPrior& imu);
   double room_height() const { return room_height_; }  // 0 until known
+  // The last measured up vector (ceiling or ground), the prior of the next scan's fits.
+  bool has_up() const { return have_prev_; }
+  const Eigen::Vector3d& last_up() const { return prev_up_; }
   // Floor-to-ceiling height for wall selection: configured, else learned (0 = unknown).
   double known_room_height() const { return cfg_.ceiling_height_m > 0 ? cfg_.ceiling_height_m : room_height_; }
 
@@ -45,7 +48,8 @@ class AttitudeHeight {
   bool have_prev_ = false;     // an attitude was measured
   bool have_prev_z_ = false;   // a height was measured
   double prev_roll_ = 0, prev_pitch_ = 0, prev_z_ = 0, prev_rp_sigma_ = 0, prev_z_sigma_ = 0;
-  double pred_z_sigma_ = 0;    // sigma of the running prediction (grows per predicted scan)
+  double pred_z_sigma_ = 0;
+  Eigen::Vector3d prev_up_ = Eigen::Vector3d::UnitZ();    // sigma of the running prediction (grows per predicted scan)
   std::deque<double> heights_;
   double room_height_ = 0.0;
 };
