@@ -28,6 +28,7 @@ void to_msg(const seg::Segmentation& s, int64_t seq, segments_t& m) {
   m.roll_pitch_sigma = s.roll_pitch_sigma;
   m.z_sigma = s.z_sigma;
   m.attitude_source = int8_t(s.attitude_source);
+  m.z_source = int8_t(s.z_source);
   m.attitude_t_offset_s = s.attitude_t;  // 3 = none (no ceiling, no history, no IMU)
   m.height = int16_t(s.height);
   m.width = int16_t(s.width);
@@ -71,6 +72,7 @@ void from_msg(const segments_t& m, seg::Segmentation& s) {
   s.roll_pitch_sigma = m.roll_pitch_sigma;
   s.z_sigma = m.z_sigma;
   s.attitude_source = seg::AttitudeSource(m.attitude_source);
+  s.z_source = seg::HeightSource(m.z_source);
   s.attitude_t = std::isfinite(m.attitude_t_offset_s) ? m.attitude_t_offset_s : 0.0;
   s.height = m.height;
   s.width = m.width;

@@ -39,5 +39,6 @@ TEST(RansacSegmenter, BadInputAndNoCeiling) {
   room.wall_top = 40;
   const auto& out = seg.process(synth::render(room, synth::SensorPose{}, synth::os1_like_beams(), 512, 0, 0, 1).scan);
   EXPECT_EQ(out.status, SegStatus::kNoCeiling);
-  EXPECT_EQ(out.attitude_source, AttitudeSource::kNone);
+  EXPECT_EQ(out.attitude_source, AttitudeSource::kGround);  // the floor is seen (no ceiling, no history)
+  EXPECT_NEAR(out.roll, 0.0, 0.1 * M_PI / 180);
 }

@@ -93,7 +93,8 @@ TEST(RingSegmenter, WallPointsAreRingMajorAndDestaggered) {
   for (double o : off) EXPECT_LT(std::abs(std::remainder(o - ref, 2 * M_PI)), 1.5 * 2 * M_PI / 1024.0);
 }
 
-TEST(RingSegmenter, NoCeilingFallsBackToPrevious) {
+// No ceiling (an atrium) but the floor: roll/pitch and z from the ground plane.
+TEST(RingSegmenter, NoCeilingUsesTheGroundPlane) {
   synth::Room room;
   const auto beams = synth::os1_like_beams();
   SegmenterConfig cfg;
@@ -107,14 +108,16 @@ TEST(RingSegmenter, NoCeilingFallsBackToPrevious) {
   EXPECT_EQ(out.status, SegStatus::kNoCeiling);
   EXPECT_FALSE(out.ceiling.found);
   EXPECT_FALSE(out.status_text.empty());
-  EXPECT_EQ(out.attitude_source, AttitudeSource::kPrevious);
-  EXPECT_NEAR(out.roll, 2 * kDeg, 0.1 * kDeg);
-  EXPECT_NEAR(out.pitch, -1 * kDeg, 0.1 * kDeg);
+  EXPECT_EQ(out.attitude_source, AttitudeSource::kGround);
+  EXPECT_NEAR(out.roll, 2 * kDeg, 0.05 * kDeg);
+  EXPECT_NEAR(out.pitch, -1 * kDeg, 0.05 * kDeg);
   EXPECT_TRUE(out.ground.found);
-  EXPECT_NEAR(out.z, 1.5, 0.05);  // from the ground plane
+  EXPECT_EQ(out.z_source, HeightSource::kGround);
+  EXPECT_NEAR(out.z, 1.5, 0.01);
 }
 
-TEST(RingSegmenter, NoCeilingUsesImuGravity) {
+// No ceiling, the IMU prior on: the ground plane (far tighter than the accelerometer's gravity) still wins.
+TEST(RingSegmenter, NoCeilingPrefersGroundToImuGravity) {
   synth::Room room;
   room.ceiling = false;
   SegmenterConfig cfg;
@@ -125,20 +128,45 @@ TEST(RingSegmenter, NoCeilingUsesImuGravity) {
   seg.add_accel(9.81 * up);
   const auto& out = seg.process(synth::render(room, pose, synth::os1_like_beams(), 512, 0.0, 0.0, 5).scan);
   EXPECT_EQ(out.status, SegStatus::kNoCeiling);
-  EXPECT_EQ(out.attitude_source, AttitudeSource::kImu);
-  EXPECT_NEAR(out.roll, pose.roll, 1e-6);
-  EXPECT_NEAR(out.pitch, pose.pitch, 1e-6);
+  EXPECT_EQ(out.attitude_source, AttitudeSource::kGround);
+  EXPECT_NEAR(out.roll, pose.roll, 0.05 * kDeg);
+  EXPECT_NEAR(out.pitch, pose.pitch, 0.05 * kDeg);
 }
 
-TEST(RingSegmenter, NoCeilingNoHistoryIsUnknownNotGarbage) {
+// No ceiling and no history: attitude from the floor, wall points up to 2 m above it (all real walls here).
+TEST(RingSegmenter, NoCeilingNoHistoryUsesTheGround) {
   synth::Room room;
   room.ceiling = false;
   RingSegmenter seg(SegmenterConfig{});
   const auto& out = seg.process(synth::render(room, SensorPose{}, synth::os1_like_beams(), 512, 0.0, 0.0, 5).scan);
   EXPECT_EQ(out.status, SegStatus::kNoCeiling);
+  EXPECT_EQ(out.attitude_source, AttitudeSource::kGround);
+  EXPECT_NEAR(out.roll, 0.0, 0.05 * kDeg);
+  EXPECT_GT(out.wall.size(), 1000u);
+  for (size_t i = 0; i < out.wall.size(); ++i) EXPECT_LT(out.wall.z[i], 2.0 - 1.5 + 0.01);  // sensor at 1.5 m
+}
+
+// Neither plane (an empty scan) and no history: unknown, not garbage; then a prediction with a growing sigma.
+TEST(RingSegmenter, NoPlanesIsUnknownThenPredictedWithGrowingSigma) {
+  RingSegmenter seg(SegmenterConfig{});
+  const auto beams = synth::os1_like_beams();
+  Scan empty = synth::render(synth::Room{}, SensorPose{}, beams, 512, 0.0, 0.0, 5).scan;
+  std::fill(empty.range_mm.begin(), empty.range_mm.end(), 0u);
+  const auto& out = seg.process(empty);
   EXPECT_EQ(out.attitude_source, AttitudeSource::kNone);
   EXPECT_GE(out.roll_pitch_sigma, 1.0);
-  EXPECT_EQ(out.wall.size(), 0u);
+  EXPECT_EQ(out.z_source, HeightSource::kNone);
+  EXPECT_GE(out.z_sigma, 1.0);
+  seg.process(synth::render(synth::Room{}, SensorPose{}, beams, 512, 0.0, 0.0, 6).scan);
+  ASSERT_EQ(seg.last().z_source, HeightSource::kCeiling);
+  double last_sigma = seg.last().z_sigma;
+  for (int k = 0; k < 3; ++k) {
+    const auto& o = seg.process(empty);
+    EXPECT_EQ(o.z_source, HeightSource::kPredicted);
+    EXPECT_NEAR(o.z, 1.5, 0.01);
+    EXPECT_GT(o.z_sigma, last_sigma);
+    last_sigma = o.z_sigma;
+  }
 }
 
 TEST(RingSegmenter, BadInput) {

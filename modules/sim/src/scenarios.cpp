@@ -63,6 +63,13 @@ constexpr PaperRow kPaper[] = {
     // auto-loop: DESIGN.md's room speeds.
     {"auto-loop", "fast", 0.90, 0.65, 0},                  {"auto-loop", "medium", 0.55, 0.40, 0},
     {"auto-loop", "slow", 0.45, 0.30, 0},
+    // building-*: auto-loop with the ceilings of a real building (ceiling_map.h kinds).
+    {"building-areas", "fast", 0.90, 0.65, 0},   {"building-areas", "medium", 0.55, 0.40, 0},
+    {"building-areas", "slow", 0.45, 0.30, 0},   {"building-atrium", "fast", 0.90, 0.65, 0},
+    {"building-atrium", "medium", 0.55, 0.40, 0}, {"building-atrium", "slow", 0.45, 0.30, 0},
+    {"building-clutter", "fast", 0.90, 0.65, 0}, {"building-clutter", "medium", 0.55, 0.40, 0},
+    {"building-clutter", "slow", 0.45, 0.30, 0}, {"building-mixed", "fast", 0.90, 0.65, 0},
+    {"building-mixed", "medium", 0.55, 0.40, 0}, {"building-mixed", "slow", 0.45, 0.30, 0},
 };
 
 }  // namespace
@@ -155,6 +162,7 @@ bool scenario_spec(const std::string& name, ScenarioSpec& out, std::string* erro
       s.control = densify_closed(cl, 1.0);
     } else {
       s.plan_kind = "any";
+      if (s.base.rfind("building-", 0) == 0) s.ceilings = s.base.substr(9);
     }
     s.ceiling_m = s.plan_kind == "corridor" ? kCorridorCeilingM : s.plan_kind == "room" ? kRoomCeilingM : 3.0;
     out = std::move(s);

@@ -59,7 +59,9 @@ Simulator::Simulator(FloorPlan plan, SimulatorOptions opt) : opt_(std::move(opt)
   } else {
     world_ = std::make_unique<World>(plan, wc);
   }
-  if (opt_.ceiling_patches && spec_.plan_kind != "corridor") {
+  if (!spec_.ceilings.empty()) {
+    ceiling_map_ = make_ceiling_map(spec_.ceilings, world_->bounds(), wc.ceiling_height_m, opt_.seed);
+  } else if (opt_.ceiling_patches && spec_.plan_kind != "corridor") {
     // A sloped patch in one corner of the building (rising 0.15 m per metre) and a missing patch (an
     // opening, 2.0 x 1.5 m) at the centre of the plan.
     const Box2 b = world_->bounds();
@@ -78,6 +80,11 @@ Simulator::Simulator(FloorPlan plan, SimulatorOptions opt) : opt_(std::move(opt)
   }
   if (opt_.clutter) add_clutter();
   if (opt_.wall_clutter > 0) add_wall_clutter();
+  if (!spec_.ceilings.empty()) {  // after the clutter: hanging objects do not block furniture placement
+    apply_ceiling_map(ceiling_map_, *world_);
+    info_ += "ceilings: " + spec_.ceilings + ", " + std::to_string(ceiling_map_.areas.size()) + " areas, " +
+             std::to_string(ceiling_map_.objects.size()) + " hanging objects\n";
+  }
   SensorConfig sc;
   if (!opt_.metadata.empty()) {
     if (!load_beam_intrinsics_json(opt_.metadata, sc.beams, &err)) throw std::runtime_error(err);

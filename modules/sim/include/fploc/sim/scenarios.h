@@ -2,6 +2,8 @@
 // data/plans/*.json) and the named scenarios of DESIGN.md:
 //   room-small-loop | room-large-loop | room-no-loop | corridor-loop  + -slow | -medium | -fast
 //   auto-loop-slow | auto-loop-medium | auto-loop-fast   (a loop planned through any plan's free space)
+//   building-areas | building-atrium | building-clutter | building-mixed  + -slow | -medium | -fast
+//     (auto-loop under the ceilings of a real building, ceiling_map.h)
 // Lengths and speeds are the paper's (Tables I and II) per sequence.
 #pragma once
 #include <Eigen/Core>
@@ -33,6 +35,7 @@ struct ScenarioSpec {
   double length = 0;       // target path length [m] (0 = as planned)
   SpeedSpec speed;
   double ceiling_m = 3.0;
+  std::string ceilings;    // building-*: the ceiling_map.h kind ("areas", "atrium", "clutter", "mixed")
 };
 
 // Fills `out` for a scenario name; false with a message listing the valid names.

@@ -13,6 +13,7 @@
 
 #include "fploc/core/pose.h"
 #include "fploc/floorplan/plan.h"
+#include "fploc/sim/ceiling_map.h"
 #include "fploc/sim/motion.h"
 #include "fploc/sim/perturb.h"
 #include "fploc/sim/planner.h"
@@ -70,6 +71,7 @@ class Simulator {
   const std::string& info() const { return info_; }  // planner / clutter notes
   // The difference between world and plan (nullptr when the world is the plan).
   const WorldEdit* world_edit() const { return edit_.get(); }
+  const CeilingMap& ceiling_map() const { return ceiling_map_; }  // building-* scenarios (else empty)
 
  private:
   void add_clutter();
@@ -83,6 +85,7 @@ class Simulator {
   std::vector<ImuSample> imu_;
   int num_frames_ = 0;
   std::string beam_source_, info_;
+  CeilingMap ceiling_map_;
 };
 
 }  // namespace fploc::sim

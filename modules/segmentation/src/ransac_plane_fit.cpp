@@ -1,4 +1,4 @@
-#include "fploc/segmentation/ransac_segmenter.h"
+#include "fploc/segmentation/ransac_plane_fit.h"
 
 #include <pcl/ModelCoefficients.h>
 #include <pcl/point_cloud.h>
@@ -7,23 +7,26 @@
 #include <pcl/sample_consensus/model_types.h>
 #include <pcl/segmentation/sac_segmentation.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
+#include "segmenter_constants.h"
+
 namespace fploc::seg {
 
-RansacSegmenter::RansacSegmenter(SegmenterConfig cfg, int max_iterations, int subsample)
-    : Segmenter(cfg), max_iterations_(max_iterations), subsample_(std::max(1, subsample)) {}
+RansacPlaneFit::RansacPlaneFit(const SegmenterConfig& cfg, int max_iterations, int subsample)
+    : cfg_(cfg), max_iterations_(max_iterations), subsample_(std::max(1, subsample)) {}
 
-bool RansacSegmenter::fit_plane(const Candidates& c, const Eigen::Vector3d& up_in, const Eigen::Vector4d*,
-                                Eigen::Vector4d& plane) {
+bool RansacPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const Eigen::Vector4d*, PlaneRole,
+                         Eigen::Vector4d& plane) {
   const Eigen::Vector3f up = up_in.normalized().cast<float>();
   // Only points above the sensor along the prior can be the ceiling (below, for the flipped ground).
   pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
   cloud->reserve(c.p.size() / subsample_ + 1);
   for (size_t i = 0; i < c.p.size(); i += subsample_) {
     const Eigen::Vector3f& p = c.p[i];
-    if (up.dot(p) < 0.2f) continue;
+    if (up.dot(p) < k::kMinSeedHeightM) continue;
     cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
   }
   if (cloud->size() < 10) return false;

@@ -1,0 +1,110 @@
+// Issue 14 item 7: segmenter + features against the OS-1 decode + XYZ of the SAME frames, in one run.
+// The frames: 24 simulated OS-1-64 scans of room-small-loop-medium (real beam angles from ../shared when
+// present, noise, clutter, ceiling patches), encoded into legacy OS-1 packets once; per iteration one frame
+// is decoded from its packets and turned into XYZ (the driver's work), or segmented and its features
+// extracted (the perception front end's work). Prints both and their ratio (CPU time per frame).
+//   build/bin/perception_ratio_bench [--benchmark_repetitions=N]
+#include <benchmark/benchmark.h>
+
+#include <cstring>
+#include <iostream>
+#include <map>
+
+#include "fploc/core/xyz.h"
+#include "fploc/features/features.h"
+#include "fploc/os1/metadata.h"
+#include "fploc/os1/packet.h"
+#include "fploc/segmentation/segmenter.h"
+#include "fploc/sim/simulator.h"
+
+namespace {
+using namespace fploc;
+
+struct Frames {
+  std::vector<Scan> scans;
+  os1::SensorInfo info;
+  std::vector<std::vector<std::vector<uint8_t>>> packets;  // per frame
+};
+
+const Frames& frames() {
+  static const Frames f = [] {
+    Frames out;
+    sim::SimulatorOptions o;
+    o.scenario = "room-small-loop-medium";
+    o.shared_dir = FPLOC_SHARED_DIR;
+    sim::Simulator sim(FloorPlan{}, o);
+    sim::SimScan s;
+    for (int k = 0; k < sim.num_frames() && out.scans.size() < 24; k += 5) {
+      sim.frame(k, s);
+      out.scans.push_back(s.scan);
+    }
+    const Scan& s0 = out.scans.front();
+    out.info = os1::make_sensor_info(s0.beams.altitude_deg, s0.beams.azimuth_deg);
+    const auto fmt = os1::PacketFormat::from(out.info);
+    for (size_t i = 0; i < out.scans.size(); ++i) {
+      out.packets.emplace_back();
+      os1::encode_frame(out.scans[i], uint16_t(i + 1), fmt, out.packets.back());
+    }
+    return out;
+  }();
+  return f;
+}
+
+void BM_DecodeAndXyz(benchmark::State& st) {
+  const auto& f = frames();
+  os1::FrameAssembler fa(f.info);
+  const XyzLut lut = make_xyz_lut(f.info.beams, f.info.columns_per_frame);
+  auto packets = f.packets;
+  std::vector<Scan> out;
+  std::vector<Eigen::Vector3f> xyz;
+  uint16_t fid = 0;
+  size_t k = 0;
+  for (auto _ : st) {
+    auto& pk = packets[k++ % packets.size()];
+    ++fid;
+    out.clear();
+    for (auto& p : pk) {  // a new frame id every iteration: every iteration assembles a whole frame
+      for (int c = 0; c < 16; ++c) std::memcpy(p.data() + c * 788 + 10, &fid, 2);
+      fa.add_packet(p.data(), p.size(), out);
+    }
+    if (out.empty()) continue;
+    scan_to_xyz(out.back(), lut, xyz);
+    benchmark::DoNotOptimize(xyz.data());
+    fa.recycle(std::move(out.back()));
+  }
+}
+BENCHMARK(BM_DecodeAndXyz)->Unit(benchmark::kMicrosecond);
+
+void BM_SegmenterPlusFeatures(benchmark::State& st) {
+  const auto& f = frames();
+  seg::RingSegmenter sg(seg::SegmenterConfig{});
+  feat::FeatureExtractor fx;
+  size_t k = 0;
+  for (auto _ : st) benchmark::DoNotOptimize(fx.process(sg.process(f.scans[k++ % f.scans.size()])).size());
+}
+BENCHMARK(BM_SegmenterPlusFeatures)->Unit(benchmark::kMicrosecond);
+
+class RatioReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const auto& r : runs)
+      if (r.run_type == Run::RT_Iteration || r.aggregate_name == "median")
+        cpu_[r.run_name.function_name] = r.GetAdjustedCPUTime();
+    ConsoleReporter::ReportRuns(runs);
+  }
+  std::map<std::string, double> cpu_;
+};
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  RatioReporter rep;
+  benchmark::RunSpecifiedBenchmarks(&rep);
+  benchmark::Shutdown();
+  const double d = rep.cpu_["BM_DecodeAndXyz"], s = rep.cpu_["BM_SegmenterPlusFeatures"];
+  if (d > 0 && s > 0)
+    std::cout << "segmenter + features / (decode + XYZ) on the same frames: " << s << " us / " << d
+              << " us = " << s / d << "x (target <= 2x)\n";
+  return 0;
+}

@@ -1,0 +1,57 @@
+// Plane fit strategies of the segmenter: the dominant horizontal plane of a candidate set (the ceiling
+// above the sensor, or the ground with `up` flipped). The paper's ring-seeded robust fit is RingPlaneFit;
+// PCL's RANSAC variant is RansacPlaneFit (ransac_plane_fit.h, PCL stays in its .cpp).
+#pragma once
+#include <Eigen/Core>
+#include <optional>
+#include <vector>
+
+#include "fploc/segmentation/candidates.h"
+#include "fploc/segmentation/segmenter_config.h"
+
+namespace fploc::seg {
+
+// Which plane a fit is for. The ceiling gives the attitude: its fit may spend extra work on accuracy.
+enum class PlaneRole { kCeiling, kGround };
+
+class PlaneFit {
+ public:
+  virtual ~PlaneFit() = default;
+  virtual const char* name() const = 0;
+  // Fits the dominant plane of `c` above the sensor along `up`. `previous` (if non-null) is last frame's
+  // plane in the same convention. Returns the plane with n pointing against `up` (into the room), or false.
+  virtual bool fit(const Candidates& c, const Eigen::Vector3d& up, const Eigen::Vector4d* previous, PlaneRole role,
+                   Eigen::Vector4d& plane) = 0;
+};
+
+// The paper's fit: max-range seeds on the top K_r rings, linear regression, IRLS (Tukey), see
+// ring_plane_fit.cpp.
+class RingPlaneFit : public PlaneFit {
+ public:
+  explicit RingPlaneFit(const SegmenterConfig& cfg) : cfg_(cfg) {}
+  const char* name() const override { return "rings"; }
+  bool fit(const Candidates& c, const Eigen::Vector3d& up, const Eigen::Vector4d* previous, PlaneRole role,
+           Eigen::Vector4d& plane) override;
+
+ private:
+  struct Fit {
+    Eigen::Vector4d pl;
+    double sigma;
+  };
+  void pick_seeds(const Candidates& c, const Eigen::Vector3f& up);
+  bool choose_start(const Candidates& c, const Eigen::Vector3d& up, const Eigen::Vector4d* previous,
+                    Eigen::Vector4d& start);
+  double score_band(const Candidates& c, const Eigen::Vector4d& pl, size_t stride, float band) const;
+  // IRLS from `start`; the cut-off shrinks from first_cut down to min_cut (fixed: stays at first_cut).
+  std::optional<Fit> refine(const Candidates& c, const Eigen::Vector3d& up, Eigen::Vector4d start, double first_cut,
+                            double min_cut, bool fixed);
+
+  SegmenterConfig cfg_;
+  std::vector<int> seeds_, all_seeds_;
+  std::vector<float> sector_best_;
+  std::vector<int> sector_idx_;
+  std::vector<Eigen::Vector3f> band_;
+  std::vector<float> res_;
+};
+
+}  // namespace fploc::seg

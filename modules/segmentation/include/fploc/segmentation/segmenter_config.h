@@ -1,0 +1,39 @@
+// Options of the ceiling/ground segmenter (paper section IV-A); defaults written once, here.
+#pragma once
+
+namespace fploc::seg {
+
+struct SegmenterConfig {
+  int seed_rings = 4;              // K_r: top (bottom) rings giving the seed points
+  int seed_sectors = 64;           // azimuth sectors per seed ring (one max-range candidate each)
+  double seed_fraction = 0.25;     // keep this fraction of the sector maxima (largest ranges) per ring
+  int seed_triplets = 40;          // planes through seed triplets also tried as the IRLS start
+  double max_tilt_deg = 10.0;      // reject planes tilted more than this from the gravity prior
+  double wall_margin_m = 0.10;     // points closer than this to ceiling/floor are not wall points
+  double ceiling_height_m = 0.0;   // known floor-to-ceiling height; 0 = estimated (ceiling + ground fits)
+  bool use_imu_prior = false;      // IMU gravity as initial direction, tilt gate and fallback
+  bool deskew_gyro = true;         // rotate returns to mid-sweep with the gyro rate (when gyro samples arrive)
+  double min_range_m = 0.4;        // ignore returns closer than this (platform, tripod)
+  double max_range_m = 120.0;
+  int min_plane_inliers = 200;     // fewer inliers -> plane not found
+  double min_inlier_fraction = 0.02;  // of the upper (lower) half-ring returns (a corridor ceiling: ~3 %)
+  double max_beyond_ratio = 0.25;     // reject a plane with more returns beyond it than this x inliers
+  double inlier_threshold_m = 0.05;// inlier band for counting / rms
+  int irls_iterations = 8;
+  double irls_initial_scale_m = 0.2;  // first Tukey cut-off (4 x the 5 cm band that chose the start);
+                                      // halves every iteration down to ~4.7 sigma
+  int room_height_window = 51;     // frames in the running median of the floor-to-ceiling height
+  // Height/attitude consistency (attitude_height.cpp): the ceiling's floor-to-ceiling height (ceiling +
+  // ground distance) more than this off the area's height means the ceiling over the sensor is not the
+  // area's (a sloped patch, a lamp, an atrium edge): z from the floor instead.
+  double z_consistency_m = 0.03;
+  // Ceiling and ground normals more than this apart: one of them is not level; the one agreeing with the
+  // IMU (else the better-fitted one) gives roll/pitch.
+  double attitude_consistency_deg = 0.3;
+  // With the ceiling alone: z moving more than this from the last estimate in one scan is a ceiling step
+  // (another area), not motion: z is predicted and the area height re-learned from the new ceiling.
+  double z_jump_m = 0.05;
+  double tight_refit_sigmas = 2.5; // ceiling refit at this many robust sigmas (0 = off), see fit_plane
+};
+
+}  // namespace fploc::seg

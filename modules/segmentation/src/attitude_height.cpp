@@ -1,0 +1,179 @@
+#include "fploc/segmentation/attitude_height.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "segmenter_constants.h"
+
+namespace fploc::seg {
+
+const char* to_string(AttitudeSource s) {
+  switch (s) {
+    case AttitudeSource::kCeiling: return "ceiling";
+    case AttitudeSource::kPrevious: return "previous";
+    case AttitudeSource::kImu: return "imu";
+    case AttitudeSource::kNone: return "none";
+    case AttitudeSource::kGround: return "ground";
+  }
+  return "?";
+}
+
+const char* to_string(HeightSource s) {
+  switch (s) {
+    case HeightSource::kCeiling: return "ceiling";
+    case HeightSource::kGround: return "ground";
+    case HeightSource::kPredicted: return "predicted";
+    case HeightSource::kNone: return "none";
+  }
+  return "?";
+}
+
+void AttitudeHeight::update_room_height(double h) {
+  heights_.push_back(h);
+  while (int(heights_.size()) > std::max(1, cfg_.room_height_window)) heights_.pop_front();
+  std::vector<double> v(heights_.begin(), heights_.end());
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  room_height_ = v[v.size() / 2];
+}
+
+void AttitudeHeight::relearn_room_height(double h) {
+  heights_.clear();
+  update_room_height(h);
+}
+
+void AttitudeHeight::note(Segmentation& out, const std::string& what) const {
+  if (!out.status_text.empty()) out.status_text += "; ";
+  out.status_text += what;
+}
+
+void AttitudeHeight::predict_z(Segmentation& out) {
+  // The last estimate (the platform's height changes slowly), its sigma doubling per predicted scan.
+  if (have_prev_z_) {
+    pred_z_sigma_ = std::max(pred_z_sigma_ * k::kHoldGrowth, std::max(prev_z_sigma_, k::kMinHeldZSigmaM));
+    out.z = prev_z_;
+    out.z_sigma = pred_z_sigma_;
+    out.z_source = HeightSource::kPredicted;
+  } else {
+    out.z = 0;
+    out.z_sigma = k::kUnknownZSigmaM;
+    out.z_source = HeightSource::kNone;
+  }
+}
+
+void AttitudeHeight::hold(Segmentation& out, const ImuPrior& imu) {
+  if (imu.valid) {
+    roll_pitch_from_up(imu.up, out.roll, out.pitch);
+    out.roll_pitch_sigma = k::kImuTiltSigmaRad;
+    out.attitude_source = AttitudeSource::kImu;
+  } else if (have_prev_) {
+    out.roll = prev_roll_;
+    out.pitch = prev_pitch_;
+    out.roll_pitch_sigma = std::max(prev_rp_sigma_ * k::kHoldGrowth, k::kMinHeldTiltSigmaRad);
+    out.attitude_source = AttitudeSource::kPrevious;
+  } else {
+    out.roll = out.pitch = 0;
+    out.roll_pitch_sigma = M_PI;
+    out.attitude_source = AttitudeSource::kNone;
+  }
+  predict_z(out);
+}
+
+Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu) {
+  const bool c = out.ceiling.found, g = out.ground.found;
+  const Eigen::Vector3d up_c = -out.ceiling.coeffs.head<3>();  // normals point into the room
+  const Eigen::Vector3d up_g = out.ground.coeffs.head<3>();
+
+  // ---- roll / pitch ----
+  bool use_ceiling = c, use_ground = !c && g;
+  if (c && g) {
+    const double ang = std::acos(std::clamp(up_c.dot(up_g), -1.0, 1.0));
+    const double gate = std::max(cfg_.attitude_consistency_deg * k::kDeg,
+                                 3.0 * std::hypot(out.ceiling.tilt_sigma, out.ground.tilt_sigma));
+    if (ang > gate) {
+      // One of them is not level (a sloped ceiling under a roof or stairs, a compromise over two ceiling
+      // surfaces, a ramp under the sensor): the IMU decides when given, else the floor (floors are level
+      // far more often than the ceilings above them).
+      const bool ground_better = imu.valid ? up_g.dot(imu.up) > up_c.dot(imu.up) : true;
+      if (ground_better) {
+        use_ceiling = false;
+        use_ground = true;
+      }
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "ceiling and ground normals %.2f deg apart: attitude from the %s", ang / k::kDeg,
+                    ground_better ? "ground" : "ceiling");
+      note(out, buf);
+    }
+  }
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  if (use_ceiling || use_ground) {
+    const Plane& pl = use_ceiling ? out.ceiling : out.ground;
+    up = use_ceiling ? up_c : up_g;
+    roll_pitch_from_up(up, out.roll, out.pitch);
+    out.roll_pitch_sigma = pl.tilt_sigma;
+    out.attitude_source = use_ceiling ? AttitudeSource::kCeiling : AttitudeSource::kGround;
+    have_prev_ = true;
+    prev_up_ = up;
+    prev_roll_ = out.roll;
+    prev_pitch_ = out.pitch;
+    prev_rp_sigma_ = out.roll_pitch_sigma;
+  } else {
+    hold(out, imu);  // sets a predicted z too; overwritten below when a plane gives one
+    up = imu.valid ? imu.up : up_from_roll_pitch(out.roll, out.pitch);
+  }
+
+  // ---- z ----
+  const bool known = cfg_.ceiling_height_m > 0;
+  if (c && g && !known) {
+    const double h = out.ceiling.distance() + out.ground.distance();
+    if (room_height_ > 0 && std::abs(h - room_height_) > std::max(cfg_.z_consistency_m, 3.0 * (out.ceiling.d_sigma + out.ground.d_sigma))) {
+      // The ceiling over the sensor is not the area's (yet): z from the floor; the running median follows
+      // when the new height persists (another area).
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "ceiling %.3f m above the floor vs the area's %.3f m: z from the ground", h,
+                    room_height_);
+      note(out, buf);
+      use_ceiling = false;
+    }
+    update_room_height(h);
+  }
+  const double H = known_room_height();
+  bool measured = false;
+  if (use_ceiling && H > 0) {
+    const double z = H - out.ceiling.distance();
+    const double sig = out.ceiling.d_sigma + (known ? 0.0 : out.ground.d_sigma / std::sqrt(double(std::max<size_t>(1, heights_.size()))));
+    if (!g && have_prev_z_ && std::abs(z - prev_z_) > cfg_.z_jump_m) {
+      // Ceiling alone and a step: another area (or a beam, a lamp). Not a jump of the platform: predict,
+      // and take this ceiling's height as the area's from now on (learned online).
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "ceiling step of %.3f m without a floor to confirm it: z predicted, area height re-learned",
+                    z - prev_z_);
+      note(out, buf);
+      predict_z(out);
+      if (!known) relearn_room_height(prev_z_ + out.ceiling.distance());
+    } else {
+      out.z = z;
+      out.z_sigma = sig;
+      out.z_source = HeightSource::kCeiling;
+      measured = true;
+    }
+  } else if (g) {
+    out.z = out.ground.distance();
+    out.z_sigma = out.ground.d_sigma;
+    out.z_source = HeightSource::kGround;
+    measured = true;
+  } else if (use_ceiling || use_ground) {
+    predict_z(out);
+  }
+  if (measured) {
+    have_prev_z_ = true;
+    prev_z_ = out.z;
+    prev_z_sigma_ = out.z_sigma;
+    pred_z_sigma_ = 0;
+  }
+  return up;
+}
+
+}  // namespace fploc::seg

@@ -1,0 +1,65 @@
+// Small numerical helpers shared by the segmenter's plane fits and plane quality (internal header).
+#pragma once
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace fploc::seg::detail {
+
+// Orthonormal basis (e1, e2) of the plane orthogonal to `u`.
+inline void basis(const Eigen::Vector3d& u, Eigen::Vector3d& e1, Eigen::Vector3d& e2) {
+  const Eigen::Vector3d a = std::abs(u.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  e1 = (a - a.dot(u) * u).normalized();
+  e2 = u.cross(e1);
+}
+
+// Weighted least-squares plane through accumulated moments; normal oriented against `up`.
+struct Moments {
+  double w = 0;
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d ss = Eigen::Matrix3d::Zero();
+  void add(const Eigen::Vector3d& p, double wi) {
+    w += wi;
+    s += wi * p;
+    ss.noalias() += wi * p * p.transpose();
+  }
+  bool plane(const Eigen::Vector3d& ref, const Eigen::Vector3d& up, Eigen::Vector4d& out,
+             Eigen::Vector3d* eigenvalues = nullptr) const {
+    if (w <= 0) return false;
+    const Eigen::Vector3d c = s / w;
+    const Eigen::Matrix3d cov = ss / w - c * c.transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+    es.computeDirect(cov);
+    Eigen::Vector3d n = es.eigenvectors().col(0);
+    if (!n.allFinite()) return false;
+    if (n.dot(up) > 0) n = -n;
+    const Eigen::Vector3d cw = c + ref;
+    out << n, -n.dot(cw);
+    if (eigenvalues) *eigenvalues = es.eigenvalues() * w;
+    return true;
+  }
+};
+
+// max(0, q) without a branch (std::max compiled to one here and mispredicted at every band edge); same
+// value as std::max(0.f, q) for every q, NaN included (maxss returns its second operand then).
+inline float max0(float q) {
+#if defined(__SSE__)
+  return _mm_cvtss_f32(_mm_max_ss(_mm_set_ss(q), _mm_setzero_ps()));
+#else
+  return std::max(0.f, q);
+#endif
+}
+
+inline double median_inplace(std::vector<float>& v) {
+  if (v.empty()) return 0.0;
+  auto mid = v.begin() + v.size() / 2;
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+}  // namespace fploc::seg::detail

@@ -1,0 +1,270 @@
+// The paper's ring-based robust plane fit (section IV-A): max-range seeds on the K_r outermost rings,
+// trimmed linear regression, the best-supported start, IRLS with a Tukey biweight.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "fploc/segmentation/plane_fit.h"
+#include "plane_math.h"
+#include "segmenter_constants.h"
+
+namespace fploc::seg {
+
+using detail::basis;
+using detail::max0;
+using detail::median_inplace;
+using detail::Moments;
+
+void RingPlaneFit::pick_seeds(const Candidates& c, const Eigen::Vector3f& upf) {
+  // On each of the K_r outermost rings, the largest-range point of every azimuth sector, keeping the
+  // largest fraction of those (obstructed rays are shorter), and only points above the sensor.
+  const int S = std::max(k::kMinSectors, cfg_.seed_sectors);
+  seeds_.clear();
+  all_seeds_.clear();
+  const int kr = std::min(std::max(1, cfg_.seed_rings), c.rings());
+  for (int r = 0; r < kr; ++r) {
+    sector_best_.assign(S, -1.f);
+    sector_idx_.assign(S, -1);
+    for (int i = c.ring_start[r]; i < c.ring_start[r + 1]; ++i) {
+      if (upf.dot(c.p[i]) < k::kMinSeedHeightM) continue;
+      const int col = c.pixel[i] % c.width;
+      const int s = col * S / c.width;
+      if (c.range[i] > sector_best_[s]) {
+        sector_best_[s] = c.range[i];
+        sector_idx_[s] = i;
+      }
+    }
+    std::vector<int> cand;
+    for (int s = 0; s < S; ++s)
+      if (sector_idx_[s] >= 0) cand.push_back(sector_idx_[s]);
+    std::sort(cand.begin(), cand.end(), [&](int a, int b) { return c.range[a] > c.range[b]; });
+    const size_t keep = std::min(cand.size(), std::max<size_t>(k::kMinSeedsKept, size_t(std::ceil(cfg_.seed_fraction * S))));
+    seeds_.insert(seeds_.end(), cand.begin(), cand.begin() + keep);
+    all_seeds_.insert(all_seeds_.end(), cand.begin(), cand.end());
+  }
+}
+
+// Support = soft inlier count (MSAC: 1 - (r/T)^2 for |r| < T) minus (1 / max_beyond_ratio) per return more
+// than 2 inlier bands *beyond* the plane: a ceiling is where the rays end, so a plane cutting through
+// walls (many "inliers" at one height in a corridor) loses, and a plane the acceptance test would reject
+// (beyond > max_beyond_ratio x inliers) scores below zero. The soft count prefers the tight fit over a
+// loose plane that merely stays within T of a narrow ceiling strip.
+double RingPlaneFit::score_band(const Candidates& c, const Eigen::Vector4d& pl, size_t stride, float band) const {
+  const float beyond_thr = 2 * float(cfg_.inlier_threshold_m);
+  const float beyond_weight = float(1.0 / std::max(k::kMinBeyondRatio, cfg_.max_beyond_ratio));
+  const Eigen::Vector3f n = pl.head<3>().cast<float>();
+  const float d = float(pl[3]), inv_b2 = 1.f / (band * band);
+  float soft = 0.f;
+  int beyond = 0;
+  for (size_t i = 0; i < c.p.size(); i += stride) {
+    const float r = n.dot(c.p[i]) + d;
+    soft += max0(1.f - r * r * inv_b2);
+    beyond += r < -beyond_thr;
+  }
+  return double(soft - beyond_weight * float(beyond)) * double(stride);
+}
+
+// The start with the most support on a subsample of all half-ring points: the seed regression, last
+// frame's plane, or planes through seed triplets (deterministic sampling). The triplets make the start
+// robust when a tilted sensor's longest rays hit far walls, not the ceiling.
+bool RingPlaneFit::choose_start(const Candidates& c, const Eigen::Vector3d& up, const Eigen::Vector4d* previous,
+                                Eigen::Vector4d& cur) {
+  Eigen::Vector3d e1, e2;
+  basis(up, e1, e2);
+  // Initial plane by linear regression h = a*x1 + b*x2 + g in the prior's frame, trimmed twice.
+  bool have_seed_plane = false;
+  Eigen::Vector4d seed_plane;
+  std::vector<float> res;
+  for (int round = 0; round < k::kSeedTrimRounds && seeds_.size() >= 3; ++round) {
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    for (int i : seeds_) {
+      const Eigen::Vector3d p = c.p[i].cast<double>();
+      const Eigen::Vector3d x(p.dot(e1), p.dot(e2), 1.0);
+      A.noalias() += x * x.transpose();
+      b += x * p.dot(up);
+    }
+    const Eigen::Vector3d sol = A.ldlt().solve(b);
+    if (!sol.allFinite()) break;
+    const Eigen::Vector3d m = up - sol[0] * e1 - sol[1] * e2;
+    const double nm = m.norm();
+    seed_plane << -m / nm, sol[2] / nm;
+    have_seed_plane = true;
+    if (round == k::kSeedTrimRounds - 1) break;
+    res.clear();
+    for (int i : seeds_) res.push_back(std::abs(float(seed_plane.head<3>().dot(c.p[i].cast<double>()) + seed_plane[3])));
+    std::vector<float> tmp = res;
+    const double thr = std::max(k::kSeedTrimMinM, k::kSeedTrimSigmas * k::kMadToSigma * median_inplace(tmp));
+    std::vector<int> kept;
+    for (size_t j = 0; j < seeds_.size(); ++j)
+      if (res[j] <= thr) kept.push_back(seeds_[j]);
+    if (kept.size() < 3 || kept.size() == seeds_.size()) break;
+    seeds_.swap(kept);
+  }
+
+  const double max_tilt = cfg_.max_tilt_deg * k::kDeg;
+  const float thr = float(cfg_.inlier_threshold_m);
+  double best = -std::numeric_limits<double>::infinity();
+  bool have_start = false;
+  auto consider = [&](const Eigen::Vector4d& pl) {
+    if (!pl.allFinite() || -pl.head<3>().dot(up) < std::cos(max_tilt) || pl[3] <= 0) return;
+    const double sc = score_band(c, pl, k::kStartStride, thr);
+    if (!have_start || sc > best) {
+      best = sc;
+      cur = pl;
+      have_start = true;
+    }
+  };
+  if (have_seed_plane) consider(seed_plane);
+  if (previous) consider(*previous);
+  uint32_t state = k::kTripletSeed;
+  auto next = [&]() {
+    state = state * 1664525u + 1013904223u;
+    return state >> 8;
+  };
+  for (int t = 0; t < cfg_.seed_triplets; ++t) {
+    // Alternate between the longest-range seeds (the paper's) and all sector maxima (tilted sensor).
+    const std::vector<int>& pool = (t % 2 == 0) ? seeds_ : all_seeds_;
+    if (pool.size() < 3) continue;
+    const Eigen::Vector3d a = c.p[pool[next() % pool.size()]].cast<double>();
+    const Eigen::Vector3d b = c.p[pool[next() % pool.size()]].cast<double>();
+    const Eigen::Vector3d q = c.p[pool[next() % pool.size()]].cast<double>();
+    Eigen::Vector3d nn = (b - a).cross(q - a);
+    if (nn.norm() < k::kMinTripletNormal) continue;
+    nn.normalize();
+    if (nn.dot(up) > 0) nn = -nn;
+    Eigen::Vector4d pl;
+    pl << nn, -nn.dot(a);
+    consider(pl);
+  }
+  return have_start;
+}
+
+// M-estimator (IRLS, Tukey biweight) over all points of the half rings, cut-off shrinking from first_cut to
+// ~4.7 robust sigmas of the inliers. The start already has its support within T = 5 cm, so the first
+// cut-off only needs to cover its tilt error over the far ceiling (0.2 m); a wide one (0.5 m) lets the band
+// of wall returns below a corridor ceiling (10x the ceiling returns there) dominate the first weighted fit,
+// which then converges to a plane through the walls.
+std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Candidates& c, const Eigen::Vector3d& up,
+                                                      Eigen::Vector4d cur, double first_cut, double min_cut,
+                                                      bool fixed) {
+  double last_sigma = 0;  // robust residual scale of the final iteration
+  const Eigen::Vector3d ref = -cur[3] * cur.head<3>();  // a point of the plane (numerics)
+  const Eigen::Vector3f reff = ref.cast<float>();
+  double cut = first_cut;
+  band_.clear();  // the band's points, contiguous (streamed by every iteration)
+  {
+    const Eigen::Vector3f n = cur.head<3>().cast<float>();
+    const float d = float(cur[3]), cb = float(cut);
+    for (size_t i = 0; i < c.p.size(); ++i)
+      if (std::abs(n.dot(c.p[i]) + d) < cb) band_.push_back(c.p[i]);
+  }
+  if (band_.size() < 3) return std::nullopt;
+  for (int it = 0; it < std::max(1, cfg_.irls_iterations); ++it) {
+    const Eigen::Vector3f n = cur.head<3>().cast<float>();
+    const float d = float(cur[3]);
+    // Residuals once per iteration; robust scale (1.4826 * median |r| inside the cut-off) from a histogram.
+    res_.resize(band_.size());
+    int hist[k::kScaleBins] = {0};
+    const float inv_bin = float(k::kScaleBins / cut);
+    int inside = 0;
+    for (size_t j = 0; j < band_.size(); ++j) {
+      const float r = n.dot(band_[j]) + d;
+      res_[j] = r;
+      const float a = std::abs(r);
+      if (a < cut) {
+        ++hist[std::min(k::kScaleBins - 1, int(a * inv_bin))];
+        ++inside;
+      }
+    }
+    if (inside < 3) return std::nullopt;
+    int acc = 0, bin = 0;
+    for (; bin < k::kScaleBins; ++bin) {
+      acc += hist[bin];
+      if (2 * acc >= inside) break;
+    }
+    const double sigma = k::kMadToSigma * (bin + 0.5) / inv_bin;
+    last_sigma = sigma;
+    const double next_cut = fixed ? cut : std::max({cut * 0.5, k::kTukeyC * sigma, min_cut});
+    const bool final_scale = next_cut >= cut;
+    cut = std::min(cut, next_cut);
+    const float inv_c2 = float(1.0 / (cut * cut));
+    // While the cut-off still shrinks a subsample is enough; at the final scale use every point.
+    const size_t step = final_scale ? 1 : k::kShrinkSubsample;
+    double sw = 0, sx = 0, sy = 0, sz = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
+    for (size_t j = 0; j < band_.size(); j += step) {
+      const float r = res_[j];
+      const float t = r * r * inv_c2;
+      if (t >= 1.f) continue;
+      const double w = (1.f - t) * (1.f - t);
+      const Eigen::Vector3f& pf = band_[j];
+      const double x = pf.x() - reff.x(), y = pf.y() - reff.y(), z = pf.z() - reff.z();
+      sw += w;
+      sx += w * x; sy += w * y; sz += w * z;
+      sxx += w * x * x; sxy += w * x * y; sxz += w * x * z;
+      syy += w * y * y; syz += w * y * z; szz += w * z * z;
+    }
+    Moments m;
+    m.w = sw;
+    m.s << sx, sy, sz;
+    m.ss << sxx, sxy, sxz, sxy, syy, syz, sxz, syz, szz;
+    Eigen::Vector4d next;
+    if (!m.plane(ref, up, next)) return std::nullopt;
+    const double dn = (next.head<3>() - cur.head<3>()).norm(), dd = std::abs(next[3] - cur[3]);
+    cur = next;
+    if (final_scale && dn < k::kConvergedNormal && dd < k::kConvergedDistM) break;
+  }
+  return Fit{cur, last_sigma};
+}
+
+bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const Eigen::Vector4d* previous,
+                       PlaneRole role, Eigen::Vector4d& plane) {
+  if (c.p.size() < size_t(k::kMinCandidatePoints) || c.rings() < 1) return false;
+  const Eigen::Vector3d up = up_in.normalized();
+  pick_seeds(c, up.cast<float>());
+  Eigen::Vector4d cur;
+  if (!choose_start(c, up, previous, cur)) return false;
+
+  // Refine the best start and, when it was not last frame's plane, last frame's plane too. A refinement
+  // that lowers the support (T band, dense subsample) diverged (walls captured it): its start is kept
+  // instead. Of the two, keep the one with the higher support with the soft band narrowed to 3 robust
+  // sigmas of the tighter fit (>= 1 cm): at T = 5 cm a plane tilted a few tenths of a degree through a
+  // narrow corridor ceiling plus the wall tops below it scores as well as the true one; at 3 sigma it
+  // loses the ceiling returns it leaves behind. (A lowered/sloped patch must not capture it either.)
+  const float thr = float(cfg_.inlier_threshold_m);
+  auto score = [&](const Eigen::Vector4d& pl) { return score_band(c, pl, k::kFinalStride, thr); };
+  auto select_band = [&](double s1, double s2) {
+    return float(std::clamp(k::kSelectBandSigmas * std::min(s1, s2), k::kSelectBandMinM, cfg_.inlier_threshold_m));
+  };
+  auto refine_guarded = [&](const Eigen::Vector4d& start) -> std::optional<Fit> {
+    const auto r = refine(c, up, start, cfg_.irls_initial_scale_m, k::kMinCutM, false);
+    if (r && score(r->pl) >= score(start)) return r;
+    return Fit{start, cfg_.inlier_threshold_m / 3};
+  };
+  std::optional<Fit> res1 = refine_guarded(cur);
+  if (previous && (cur - *previous).norm() > 1e-9) {
+    const std::optional<Fit> res2 = refine_guarded(*previous);
+    if (res2 && res1) {
+      const float t_sel = select_band(res1->sigma, res2->sigma);
+      if (score_band(c, res2->pl, k::kFinalStride, t_sel) > score_band(c, res1->pl, k::kFinalStride, t_sel)) res1 = res2;
+    } else if (res2) {
+      res1 = res2;
+    }
+  }
+  // Ceiling only: a refit at a fixed cut-off of tight_refit_sigmas robust sigmas (>= 1 cm) of the result.
+  // Where two surfaces meet (a sloped ceiling patch next to the flat ceiling) the Tukey fit at 4.7 sigma
+  // settles on a compromise tilted a few tenths of a degree between them; at ~2.5 sigma only the dominant
+  // surface keeps its support. The tighter of the two wins on the narrow-band support.
+  if (res1 && role == PlaneRole::kCeiling && cfg_.tight_refit_sigmas > 0) {
+    const double ct = std::max(cfg_.tight_refit_sigmas * res1->sigma, k::kTightMinCutM);
+    if (const auto tight = refine(c, up, res1->pl, ct, ct, true)) {
+      const float t_sel = select_band(res1->sigma, tight->sigma);
+      if (score_band(c, tight->pl, k::kFinalStride, t_sel) > score_band(c, res1->pl, k::kFinalStride, t_sel)) res1 = tight;
+    }
+  }
+  if (!res1) return false;
+  plane = res1->pl;
+  return true;
+}
+
+}  // namespace fploc::seg

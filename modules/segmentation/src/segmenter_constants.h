@@ -1,0 +1,69 @@
+// The segmenter's fixed numbers (not options: they follow from the sensor, the statistics or the numerics),
+// named in one place. Internal header of modules/segmentation.
+#pragma once
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+namespace fploc::seg::k {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// ---- point preparation / candidates ----
+// Seeds and RANSAC points must lie this far above the sensor along the gravity prior [m].
+constexpr float kMinSeedHeightM = 0.2f;
+
+// ---- ring plane fit (ring_plane_fit.cpp) ----
+constexpr int kMinCandidatePoints = 10;     // fewer candidates: no fit
+constexpr int kMinSectors = 4;              // at least this many azimuth sectors per seed ring
+constexpr size_t kMinSeedsKept = 3;         // seeds kept per ring at least
+constexpr int kSeedTrimRounds = 3;          // linear regression rounds (2 trims)
+constexpr double kSeedTrimMinM = 0.05;      // trim cut-off at least this [m]
+constexpr double kSeedTrimSigmas = 3.0;     // trim at this many robust sigmas
+constexpr double kMadToSigma = 1.4826;      // median |r| -> sigma (Gaussian)
+constexpr size_t kStartStride = 24;         // start selection: ~1.4k of 32k half-ring returns
+constexpr size_t kFinalStride = 3;          // support of refined planes: every 3rd return
+constexpr uint32_t kTripletSeed = 12345u;   // deterministic triplet sampling (LCG)
+constexpr double kMinTripletNormal = 1e-3;  // |(b-a) x (q-a)| below this: degenerate triplet
+constexpr int kScaleBins = 256;             // histogram of |r| for the robust scale
+constexpr double kTukeyC = 4.685;           // Tukey biweight cut-off in robust sigmas (95 % efficiency)
+constexpr double kMinCutM = 0.02;           // the shrinking cut-off stops here [m]
+constexpr size_t kShrinkSubsample = 3;      // while the cut-off shrinks, every 3rd band point
+constexpr double kConvergedNormal = 1e-5;   // IRLS converged: normal change (0.0006 deg)
+constexpr double kConvergedDistM = 1e-4;    // and distance change (0.1 mm)
+constexpr double kSelectBandSigmas = 3.0;   // choosing between refinements: soft band at 3 robust sigmas
+constexpr double kSelectBandMinM = 0.01;    // of at least 1 cm
+constexpr double kTightMinCutM = 0.01;      // tight ceiling refit cut-off at least 1 cm
+constexpr double kMinBeyondRatio = 1e-3;    // guards 1 / max_beyond_ratio
+
+// ---- acceptance of planes (segmenter.cpp) ----
+constexpr double kMinCeilingDistM = 0.2;    // a ceiling closer than this to the sensor is not one
+constexpr double kMinGroundDistM = 0.1;
+constexpr double kMaxGroundTiltDeg = 5.0;   // ground normal vs the ceiling's (or prior) up
+constexpr double kCeilingPriorAgreeDeg = 2.0;  // ceiling this close to the prior: the ground is fitted around it
+
+// ---- gyro de-skew (gyro_deskew.cpp) ----
+constexpr double kMaxGyroRate = 35.0;           // rad/s (> 2000 deg/s: not a rate an OS-1 IMU reports)
+constexpr int64_t kGyroKeepUs = 1000000;        // keep ~1 s of samples; time going back > 1 s: new log
+constexpr int64_t kGyroEdgeUs = 20000;          // samples must reach within 20 ms of the sweep's ends
+constexpr int64_t kGyroMaxGapUs = 50000;        // and have no gap longer than 50 ms
+constexpr int64_t kGyroStepUs = 5000;           // integration step (midpoint rule)
+constexpr int64_t kMaxSweepUs = 500000;         // a sweep longer than 0.5 s: column times do not make sense
+constexpr double kMinDeskewRad = 2e-5;          // rotation over half a sweep below this (0.001 deg): skip
+constexpr int64_t kBiasMaxDtUs = 600000;        // consecutive ceilings at most 0.6 s apart for the bias
+constexpr double kBiasMaxStep = 0.03;           // rad/s: larger residual rates are a wrong plane
+constexpr double kBiasGain = 0.05;              // low-pass gain (a few seconds at 10 Hz)
+
+// ---- attitude / height fallbacks (attitude_height.cpp) ----
+constexpr double kImuTiltSigmaRad = 0.5 * kDeg;     // IMU gravity's 1-sigma as attitude source
+constexpr double kMinHeldTiltSigmaRad = 0.2 * kDeg; // a held attitude is at least this uncertain
+constexpr double kMinHeldZSigmaM = 0.05;            // a held height at least this
+constexpr double kHoldGrowth = 2.0;                 // sigma growth per held scan
+constexpr double kUnknownZSigmaM = 1e3;             // z unknown
+
+// ---- wall selection (wall_select.cpp) ----
+constexpr double kPlaneMarginRms = 3.0;        // wall margin at least this many plane rms
+constexpr double kHeldPlaneMarginGrowth = 1.5; // margin x this when the plane is last frame's
+constexpr double kNoCeilingWallTopM = 2.0;     // no ceiling known yet: wall points up to this above the floor
+
+}  // namespace fploc::seg::k
