@@ -5,7 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "fploc/sim/rng.h"
+#include "fploc/core/rng.h"
 #include "fploc/sim/world.h"
 
 namespace fploc::sim {
