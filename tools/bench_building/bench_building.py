@@ -211,7 +211,7 @@ def main():
     ap = argparse.ArgumentParser(prog="fploc bench building", description=__doc__.splitlines()[0])
     ap.add_argument("--plan", action="append", help="floor plan(s) (default: data/plans/room.json and corridor.json)")
     ap.add_argument("--layers", help="comma-separated plan layer globs (with --plan)")
-    ap.add_argument("--scenario", action="append", help=f"scenario(s) (default: {', '.join(SCENARIOS)})")
+    ap.add_argument("--scenario", action="append", help=f"scenario(s), comma-separated or repeated (default: {', '.join(SCENARIOS)})")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--duration", type=float, default=0, help="simulate only this many seconds (tests)")
     ap.add_argument("--graph", default=os.path.join(ROOT, "graphs", "paper.pbtxt"))
@@ -233,7 +233,8 @@ def main():
     rows = []
     try:
         for p in plans:
-            for s in a.scenario or SCENARIOS:
+            # --scenario A,B and --scenario A --scenario B mean the same (as --layers everywhere).
+            for s in [x for arg in (a.scenario or SCENARIOS) for x in arg.split(",") if x]:
                 rows.append(bench(a, work, p, layers, s))
     finally:
         if not a.keep:
