@@ -379,7 +379,8 @@ class Bench:
             nrec = os.path.join(d, "ndt.lcm")
             cmd = [os.path.join(BIN, "fploc-replay"), "--graph", self.ndt_graph, "--log", logf, "--record", nrec, "--json",
                    "--set", f"ndt.plan.file={plan}", "--set", f"ndt.initial_pose.x={x0!r}", "--set", f"ndt.initial_pose.y={y0!r}",
-                   "--set", f"ndt.initial_pose.yaw={yaw0!r}", "--set", f"pose_logger.file={os.path.join(d, 'ndt.tum')}"]
+                   "--set", f"ndt.initial_pose.yaw={yaw0!r}", "--set", f"pose_logger.file={os.path.join(d, 'ndt.tum')}",
+                   "--set", f"pose_logger.uncertainty_file={os.path.join(d, 'ndt.unc')}"]
             log(f"[{fam}] replaying NDT ...")
             try:
                 nrep = json.loads(run(cmd)[0].strip().splitlines()[-1])
