@@ -1,5 +1,7 @@
 #include "fploc/plandiff/plan_diff.h"
 
+#include "fploc/core/segment2d.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,16 +12,6 @@ namespace {
 
 using V2 = Eigen::Vector2d;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-double cross2(const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); }
-
-bool segments_cross(const V2& p, const V2& q, const V2& a, const V2& b) {
-  const V2 r = q - p, s = b - a;
-  const double den = cross2(r, s);
-  if (std::abs(den) < 1e-12) return false;
-  const double t = cross2(a - p, s) / den, u = cross2(a - p, r) / den;
-  return t > 0 && t < 1 && u >= 0 && u <= 1;
-}
 
 bool blocks(const Element& e, const V2& p, const V2& q) {
   if (e.kind == ElementKind::kSegment) return segments_cross(p, q, e.a, e.b);

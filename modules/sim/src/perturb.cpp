@@ -12,6 +12,7 @@
 
 #include "fploc/floorplan/io.h"
 #include "fploc/core/rng.h"
+#include "fploc/core/segment2d.h"
 
 namespace fploc::sim {
 namespace {
@@ -19,19 +20,8 @@ namespace {
 using V2 = Eigen::Vector2d;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-double cross2(const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); }
-
-// Does the open segment p-q cross segment a-b?
-bool segments_cross(const V2& p, const V2& q, const V2& a, const V2& b) {
-  const V2 r = q - p, s = b - a;
-  const double den = cross2(r, s);
-  if (std::abs(den) < 1e-12) return false;
-  const double t = cross2(a - p, s) / den, u = cross2(a - p, r) / den;
-  return t > 1e-6 && t < 1 - 1e-6 && u >= 0 && u <= 1;
-}
-
 bool blocks(const Element& e, const V2& p, const V2& q) {
-  if (e.kind == ElementKind::kSegment) return segments_cross(p, q, e.a, e.b);
+  if (e.kind == ElementKind::kSegment) return segments_cross(p, q, e.a, e.b, 1e-6);
   // Circles and arcs: the closest point of p-q to the centre within the radius (arcs as full circles).
   const V2 d = q - p;
   const double t = std::clamp((e.c - p).dot(d) / std::max(d.squaredNorm(), 1e-12), 0.0, 1.0);
