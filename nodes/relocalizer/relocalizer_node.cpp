@@ -43,9 +43,10 @@ class RelocalizerNode : public fploc::rt::Node {
     const auto& o = ctx.options<fploc::RelocalizerOptions>();
     map_ = fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); }, "relocalizer.plan");
     reloc_ = std::make_unique<fploc::reloc::Relocalizer>(*map_.plan, *map_.lookup, fploc::config::config_of(o));
-    radius_ = o.region_radius_m() > 0 ? o.region_radius_m() : 3.0;
-    global_after_us_ = int64_t((o.global_after_s() > 0 ? o.global_after_s() : 2.0) * 1e6);
-    interval_us_ = int64_t((o.min_interval_s() > 0 ? o.min_interval_s() : 0.5) * 1e6);
+    const fploc::reloc::Schedule when = fploc::config::schedule_of(o);
+    radius_ = when.region_radius_m;
+    global_after_us_ = int64_t(when.global_after_s * 1e6);
+    interval_us_ = int64_t(when.min_interval_s * 1e6);
     std::cerr << "[" << ctx.name() << "] " << map_.plan->elements.size() << " elements, "
               << reloc_->free_cells() << " free search cells\n";
     out_ = ctx.advertise<fploc::pose_t>("initial_pose");
