@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "fploc/annf/annf.h"
+#include "fploc/floorplan/png.h"
 #include "map_tool.h"
 
 namespace fploc {

@@ -8,10 +8,8 @@
 #include <stdexcept>
 
 #include "fploc/annf/annf.h"
+#include "fploc/floorplan/png.h"
 #include "map_tool.h"
-#ifdef FPLOC_HAVE_PNG
-#include <png.h>
-#endif
 
 namespace fploc {
 namespace {
@@ -82,7 +80,6 @@ void write_svg(const annf::Annf& f, const std::string& out, int width) {
 }
 
 void write_png(const annf::Annf& f, const std::string& out, int width) {
-#ifdef FPLOC_HAVE_PNG
   const FloorPlan& plan = f.plan();
   const Box2 b = plan.bounds();
   const double pad = 0.02 * b.size().maxCoeff() + 0.1;
@@ -119,41 +116,10 @@ void write_png(const annf::Annf& f, const std::string& out, int width) {
         for (int q = 0; q < 3; ++q) img[k * 3 + q] = uint8_t(img[k * 3 + q] * 0.8);
     }
   write_rgb_png(out, w, h, img);
-#else
-  (void)f;
-  (void)width;
-  throw std::runtime_error(out + ": PNG support not built (libpng-dev missing); use .svg");
-#endif
 }
 
 }  // namespace
 
-void write_rgb_png(const std::string& out, int w, int h, const std::vector<uint8_t>& img) {
-#ifdef FPLOC_HAVE_PNG
-  FILE* fp = std::fopen(out.c_str(), "wb");
-  if (!fp) throw std::runtime_error(out + ": cannot write");
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  png_infop info = png_create_info_struct(png);
-  if (setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    std::fclose(fp);
-    throw std::runtime_error(out + ": PNG write error");
-  }
-  png_init_io(png, fp);
-  png_set_IHDR(png, info, w, h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
-               PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (int j = 0; j < h; ++j) png_write_row(png, &img[size_t(j) * w * 3]);
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  std::fclose(fp);
-#else
-  (void)w;
-  (void)h;
-  (void)img;
-  throw std::runtime_error(out + ": PNG support not built (libpng-dev missing); use .svg");
-#endif
-}
 
 int cmd_render(const FloorPlan& plan, const RenderArgs& a) {
   annf::Annf f;
