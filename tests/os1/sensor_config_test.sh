@@ -25,7 +25,8 @@ PCAP="$D/OS-1-64_1024x10_fw20.pcap"
 META="$D/OS-1-64_sensor_config_reduced.json"
 T="$(mktemp -d)"
 pids=()
-cleanup() { set +e; for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; wait 2>/dev/null; rm -rf "$T"; }
+FS=""
+cleanup() { set +e; [ -n "$FS" ] && kill "$FS" 2>/dev/null; for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; wait 2>/dev/null; rm -rf "$T"; }
 trap cleanup EXIT
 
 # ---- the network: this host 10.77.0.1 <-veth-> sensor 10.77.0.2 (its own namespace, held by a sleep)
