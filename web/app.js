@@ -151,13 +151,15 @@ function renderNodeTable(msg) {
     const tr = document.createElement('tr');
     tr.className = n.health;
     tr.dataset.node = n.node;
+    if (n.detail) tr.dataset.detail = n.detail;
     tr.dataset.health = n.health;
     const state = n.health === 'bad' ? (n.reason || n.state) : n.state + (n.reporter === 'launcher' ? ' (launcher)' : '');
     const seen = n.age_s !== null, num = (v, d) => (seen ? fmt(v, d) : '–');
     const work = n.work_port !== null && n.work_port !== undefined;
     const cells = [n.node, state, num(n.rate_hz, 1), work ? n.work_port : '–',
       num(work ? n.work_p50_ms : n.latency_p50_ms, 2), num(work ? n.work_p99_ms : n.latency_p99_ms, 2), num(n.cpu_percent, 1),
-      String(n.dropped), String(n.restarts), n.age_s === null ? 'never' : `${fmt(n.age_s, 1)} s ago`, n.last_error || ''];
+      String(n.dropped), String(n.restarts), n.age_s === null ? 'never' : `${fmt(n.age_s, 1)} s ago`,
+      [n.detail, n.last_error].filter(Boolean).join(' | ')];
     for (const [i, text] of cells.entries()) {
       const td = document.createElement('td');
       td.textContent = text;

@@ -188,6 +188,7 @@ std::string nodes_view(const std::map<std::string, NodeRow>& rows, double silent
                    {"dropped", s.dropped},
                    {"undecodable", s.undecodable},
                    {"last_error", s.last_error},
+                   {"detail", s.detail},
                    {"uptime_s", num(r6(s.uptime_s))},
                    {"age_s", e.seen ? num(std::round(age * 10) / 10) : json(nullptr)},
                    {"health", health},

@@ -13,6 +13,7 @@
 #include "fploc/adapters/scan_t.h"
 #include "fploc/os1/metadata.h"
 #include "fploc/os1/sensor_http.h"
+#include "sensor_session.h"
 #include "fploc/os1/packet.h"
 #include "fploc/os1/source.h"
 #include "fploc/runtime/node.h"
@@ -37,6 +38,28 @@ class Os1DriverNode : public fploc::rt::Node {
     pcap_mode_ = !opt.pcap().empty();
     metadata_path_ = opt.metadata().empty() ? std::string() : ctx.resolve_path(opt.metadata());
     sensor_host_ = opt.sensor_hostname();
+    // A live sensor is set up over HTTP on start (unless keep_sensor_config) by a worker thread; its
+    // metadata arrives through drain_session(), its status and alerts go to telemetry.
+    if (!pcap_mode_ && !sensor_host_.empty() && !opt.keep_sensor_config()) {
+      SensorConfigRequest req;
+      req.udp_dest = opt.udp_dest();
+      req.udp_port_lidar = port_;
+      req.udp_port_imu = opt.sensor_imu_port() > 0 ? opt.sensor_imu_port() : 7503;
+      req.lidar_mode = opt.lidar_mode();
+      req.udp_profile_lidar = opt.udp_profile_lidar();
+      req.timestamp_mode = opt.timestamp_mode();
+      req.operating_mode = opt.operating_mode().empty() ? "NORMAL" : opt.operating_mode();
+      req.timeout_s = opt.sensor_timeout_s() > 0 ? opt.sensor_timeout_s() : 60.0;
+      req.persist = opt.persist_sensor_config();
+      try {
+        validate(req);  // a wrong option is a graph error: fail the start with the parameter's name
+      } catch (const SensorConfigError& e) {
+        throw std::runtime_error("os1_driver: sensor " + sensor_host_ + ": " + e.what());
+      }
+      session_ = std::make_unique<SensorSession>(sensor_host_, req, opt.alerts_period_s() > 0 ? opt.alerts_period_s() : 2.0);
+      session_->start();
+      ctx.every(0.2, [this] { drain_session(); });
+    }
     // A missing or broken metadata file is bad input, not a reason to die: it is reported (stderr and
     // telemetry, once per distinct error), packets are dropped and counted, and the file is read again
     // every 0.5 s until it loads (e.g. the simulator writes it a moment after the driver starts).
@@ -67,6 +90,7 @@ class Os1DriverNode : public fploc::rt::Node {
   }
 
   void shutdown() override {
+    session_.reset();  // stops the worker thread
     if (assembler_) {
       assembler_->flush(frames_);
       publish_frames();
@@ -80,7 +104,25 @@ class Os1DriverNode : public fploc::rt::Node {
     metadata_error_ = what;
   }
 
+  // What the sensor set-up worker found: errors to telemetry, the state line, a (new) metadata.
+  void drain_session() {
+    auto u = session_->take();
+    for (const auto& n : u.notes) std::cerr << "[" << ctx_->name() << "] " << n << "\n";
+    for (const auto& e : u.errors) ctx_->error(e);
+    if (u.detail) ctx_->set_detail(*u.detail);
+    session_failed_ = u.setup_failed;
+    if (u.metadata) {
+      session_metadata_ = std::move(*u.metadata);
+      load();  // (re)builds the assembler from the sensor's current metadata
+    } else if (session_failed_ && !assembler_ && !metadata_path_.empty() && !cache_tried_) {
+      cache_tried_ = true;  // the sensor could not be set up: decode with the cached file meanwhile
+      std::cerr << "[" << ctx_->name() << "] sensor set-up failed: trying the cached " << metadata_path_ << "\n";
+      load();
+    }
+  }
+
   bool load() {
+    if (session_) return load_from_session();
     if (metadata_path_.empty() && sensor_host_.empty()) {
       ctx_->error("neither 'metadata' (sensor metadata JSON) nor 'sensor_hostname' is set: lidar packets are dropped");
       return false;
@@ -122,6 +164,37 @@ class Os1DriverNode : public fploc::rt::Node {
     assembler_ = std::make_unique<FrameAssembler>(info_);
     classifier_ = PacketClassifier{pcap_mode_ ? ctx_->options<fploc::Os1DriverOptions>().lidar_port() : port_, -1,
                                    assembler_->format().lidar_packet_size()};
+    return true;
+  }
+
+  // Metadata of a configured sensor (read after its set-up), cached in `metadata`; or the cached file
+  // when the set-up failed.
+  bool load_from_session() {
+    std::string source;
+    try {
+      if (!session_metadata_.empty()) {
+        source = "http://" + sensor_host_ + kMetadataPath + " (after the set-up)";
+        info_ = parse_metadata(session_metadata_, source);
+        if (!metadata_path_.empty()) {
+          std::ofstream cache(metadata_path_, std::ios::trunc);
+          cache << session_metadata_;
+          if (!cache) ctx_->error("cannot write the metadata cache " + metadata_path_);
+        }
+        session_metadata_.clear();
+      } else if (session_failed_ && !metadata_path_.empty()) {
+        source = metadata_path_;
+        info_ = load_metadata(metadata_path_);
+      } else {
+        return false;  // waiting for the sensor
+      }
+    } catch (const MetadataError& e) {
+      report_metadata(e.what());
+      return false;
+    }
+    std::cerr << "[" << ctx_->name() << "] metadata from " << source << " (" << info_.sensor_name() << ", "
+              << info_.lidar_mode << ", " << to_string(info_.profile) << ")\n";
+    assembler_ = std::make_unique<FrameAssembler>(info_);
+    classifier_ = PacketClassifier{port_, -1, assembler_->format().lidar_packet_size()};
     return true;
   }
 
@@ -188,6 +261,9 @@ class Os1DriverNode : public fploc::rt::Node {
   std::string metadata_error_;  // last load error (reported once)
   std::string sensor_host_;
   std::chrono::steady_clock::time_point next_http_{};
+  std::unique_ptr<SensorSession> session_;
+  std::string session_metadata_;
+  bool session_failed_ = false, cache_tried_ = false;
   uint64_t dropped_without_metadata_ = 0;
 };
 

@@ -285,6 +285,7 @@ static fploc::node_status_t make_status(Context& ctx, const std::string& executa
   s.dropped = st.dropped();
   s.undecodable = st.undecodable();
   s.last_error = st.last_error;
+  s.detail = st.detail;
   s.uptime_s = uptime;
   for (const auto& p : st.ports) {
     fploc::port_stats_t ps;

@@ -108,7 +108,7 @@ for _ in $(seq 50); do python3 -c "import urllib.request; urllib.request.urlopen
 for run in http cache; do
   [ "$run" = cache ] && { kill "$web"; wait "$web" 2>/dev/null || true; }
   lcm-logger --lcm-url="$URL" "$T/log_$run.lcm" > /dev/null 2>&1 & lg=$!
-  "$B/fploc-os1-driver" --lcm-url "$URL" --set sensor_hostname=127.0.0.1:18080 --set metadata="$T/cached.json" \
+  "$B/fploc-os1-driver" --lcm-url "$URL" --set sensor_hostname=127.0.0.1:18080 --set keep_sensor_config=true --set metadata="$T/cached.json" \
     --set lidar_port=17502 > "$T/os1_$run.txt" 2>&1 & drv=$!
   sleep 1.5
   "$B/fploc-os1-send" --pcap "$PCAP" --lidar-port 17502 --imu-port 17503 --rate 1

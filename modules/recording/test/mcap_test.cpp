@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <map>
 
 #include "fploc/core/xyz.h"
@@ -131,6 +132,41 @@ TEST_P(Mcap, IndependentWriter) {
   EXPECT_NE(err.find(" at byte "), std::string::npos) << err;
   ASSERT_LT(part.size(), all.size());
   for (size_t i = 0; i < part.size(); ++i) ASSERT_EQ(part[i].data, all[i].data);
+
+  // CRCs: one flipped bit inside the first chunk (chunked files: the chunk's CRC-32, or the decompressor,
+  // names that chunk's byte offset) or inside a message (unchunked: the data section's CRC-32 at the
+  // Data End record). The writer computes both CRCs.
+  size_t at = 8, target = 0, data_end = 0;
+  std::string want;
+  while (at + 9 <= bytes.size()) {
+    const uint8_t op = bytes[at];
+    uint64_t len;
+    std::memcpy(&len, &bytes[at + 1], 8);
+    if (op == 0x06 && !target) {
+      target = at + 9 + len / 2 + 20;
+      want = "chunk at byte " + std::to_string(at) + " (" + (std::string(comp) == "none" ? "none" : comp) + "): ";
+    }
+    if (op == 0x05 && !target) target = at + 9 + len - 3;
+    if (op == 0x0F) data_end = at;
+    if (op == 0x02) break;
+    at += 9 + len;
+  }
+  ASSERT_GT(target, 0u);
+  if (want.empty()) {
+    ASSERT_GT(data_end, 0u);
+    uint32_t crc;
+    std::memcpy(&crc, &bytes[data_end + 9], 4);
+    ASSERT_NE(crc, 0u) << "the writer did not record a data section CRC";
+    want = "data section (bytes 0.." + std::to_string(data_end) + "): CRC-32 ";
+  }
+  auto bad = bytes;
+  bad[target] ^= 0x10;
+  const auto got = read_all(bad.data(), bad.size(), &err, "bad.mcap");
+  EXPECT_EQ(err.rfind("bad.mcap: " + want, 0), 0u) << err;
+  if (std::string(comp) == "none") EXPECT_NE(err.find("CRC-32"), std::string::npos) << err;
+  // A damaged chunk stops before its messages; the data section CRC is only known at its end (the
+  // messages were delivered, the import still ends with the error).
+  if (std::string(chunking) == "chunked") EXPECT_LT(got.size(), all.size());
 }
 
 INSTANTIATE_TEST_SUITE_P(Writers, Mcap,

@@ -127,6 +127,9 @@ class Context {
   void watch_fd(int fd, std::function<void()> fn);
   // Records an error for telemetry (last_error, count) and prints it to stderr the first few times.
   void error(const std::string& msg);
+  // The node's own state line in telemetry (node_status_t.detail, shown on the dashboard), e.g. a
+  // sensor's status and active alerts; unlike last_error it stays until replaced ("" clears it).
+  void set_detail(const std::string& text) { stats_.detail = text; }
   // Asks the process to stop after the current message (e.g. a pcap source reached its end).
   void request_stop();
 

@@ -54,6 +54,7 @@ struct NodeStats {
   double cpu_s_total = 0;          // thread CPU time in handlers, composed replay only (the machine may be shared)
   int64_t errors = 0;
   std::string last_error;
+  std::string detail;              // Context::set_detail (node_status_t.detail)
   double busy_s_period = 0;        // time spent in handlers this period
 
   PortCounters& port(const std::string& name, const std::string& channel, bool output);
