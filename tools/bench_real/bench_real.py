@@ -60,6 +60,9 @@ def main():
     ap.add_argument("--lost-m", type=float, default=0.5)
     ap.add_argument("--out", default="bench-real")
     ap.add_argument("--graph", default=os.path.join(ROOT, "graphs", "lidar2d.pbtxt"))
+    ap.add_argument("--fploc", default="grid", choices=["grid", "wo"],
+                    help="fploc's estimate: grid (fploc-grid2d on the map's raster) or wo (matcher + optimizer on its "
+                         "vectorised plan); the other is reported too (fploc_grid, fploc_plan)")
     a = ap.parse_args()
     radish = os.path.join(SHARED, "data", "recordings", "radish")
     if not os.path.isdir(radish):
@@ -84,28 +87,32 @@ def main():
                 y += math.sin(yaw + math.pi / 4)
                 yaw += math.radians(10)
             sets = []
-            for n in ("matcher", "optimizer", "amcl"):
+            for n in ("matcher", "optimizer", "amcl", "grid2d"):
                 sets += ["--set", f"{n}.plan.file={os.path.abspath(plan)}"]
-            for n in ("matcher", "amcl"):
+            for n in ("matcher", "amcl", "grid2d"):
                 sets += ["--set", f"{n}.initial_pose.x={x}", "--set", f"{n}.initial_pose.y={y}", "--set", f"{n}.initial_pose.yaw={yaw}"]
-            est = {k: os.path.abspath(os.path.join(d, f"{row}-{k}.tum")) for k in ("wo", "sfr", "amcl")}
+            est = {k: os.path.abspath(os.path.join(d, f"{row}-{k}.tum")) for k in ("wo", "sfr", "amcl", "grid")}
             sets += ["--set", f"wo_logger.file={est['wo']}", "--set", f"sfr_logger.file={est['sfr']}",
-                     "--set", f"amcl_logger.file={est['amcl']}"]
+                     "--set", f"amcl_logger.file={est['amcl']}", "--set", f"grid_logger.file={est['grid']}"]
             rep = json.loads(run([os.path.join(BIN, "fploc-replay"), "--graph", a.graph, "--log", lcm, "--json"] + sets).stdout)
             cpu = {n["name"]: n.get("cpu_ms", 0.0) for n in rep["nodes"]}
             scans = imp["end_scan"] - imp["first_scan"]
-            fploc_ms = (cpu.get("laser2d", 0) + cpu.get("matcher", 0) + cpu.get("optimizer", 0)) / max(1, scans)
+            plan_ms = (cpu.get("laser2d", 0) + cpu.get("matcher", 0) + cpu.get("optimizer", 0)) / max(1, scans)
+            grid_ms = cpu.get("grid2d", 0) / max(1, scans)
             amcl_ms = cpu.get("amcl", 0) / max(1, scans)
-            f, am = score(ref, est["wo"], a.lost_m), score(ref, est["amcl"], a.lost_m)
+            g, p, am = score(ref, est["grid"], a.lost_m), score(ref, est["wo"], a.lost_m), score(ref, est["amcl"], a.lost_m)
+            f, fploc_ms = (g, grid_ms) if a.fploc == "grid" else (p, plan_ms)
             png = os.path.join(d, f"{row}.png")
-            run([os.path.join(BIN, "fploc-occupancy"), plan, "--png", png, "--tum", ref, "--tum", est["wo"], "--tum", est["amcl"]])
+            run([os.path.join(BIN, "fploc-occupancy"), plan, "--png", png, "--tum", ref, "--tum", est[a.fploc], "--tum", est["amcl"]])
             r = {"log": name, "start": row, "scans": scans, "map_scans": imp["map"]["end_scan"],
-                 "fploc": {**f, "ms_per_scan": fploc_ms}, "amcl": {**am, "ms_per_scan": amcl_ms},
+                 "fploc": {**f, "ms_per_scan": fploc_ms, "estimator": a.fploc}, "amcl": {**am, "ms_per_scan": amcl_ms},
+                 "fploc_grid": {**g, "ms_per_scan": grid_ms}, "fploc_plan": {**p, "ms_per_scan": plan_ms},
                  "fploc_half_of_amcl": f["ate_m"] <= 0.5 * am["ate_m"], "plot": png}
             rows.append(r)
             print(f"{name:13s} {row:3s} scans {scans:5d}  fploc ATE {f['ate_m']*100:8.1f} cm max {f['max_m']*100:8.1f} cm "
                   f"LOST {f['lost_pct']:5.1f} % {fploc_ms:6.2f} ms | AMCL ATE {am['ate_m']*100:8.1f} cm max {am['max_m']*100:8.1f} cm "
-                  f"LOST {am['lost_pct']:5.1f} % {amcl_ms:6.2f} ms", file=sys.stderr)
+                  f"LOST {am['lost_pct']:5.1f} % {amcl_ms:6.2f} ms | other fploc ({'wo' if a.fploc == 'grid' else 'grid'}) "
+                  f"ATE {(p if a.fploc == 'grid' else g)['ate_m']*100:8.1f} cm", file=sys.stderr)
     if a.json:
         print(json.dumps({"bench": "real", "protocol": {"split": a.split, "end": a.end, "resolution_m": a.resolution,
                                                         "lost_m": a.lost_m, "graph": a.graph}, "rows": rows}, indent=1))
