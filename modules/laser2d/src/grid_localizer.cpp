@@ -241,7 +241,9 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
   const double ex = est.x - pred.x, ey = est.y - pred.y, eyaw = wrap_angle(est.yaw - pred.yaw);
   const double m2 = (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw);
   const bool near = m2 <= cfg_.gate_sigmas * cfg_.gate_sigmas;
-  if (res.inlier_ratio >= cfg_.min_inlier_ratio || (near && res.inlier_ratio >= cfg_.min_inlier_ratio_near)) {
+  // The refinement may not leave the window searched (a scan of one flat wall fits anywhere along it).
+  const bool inside = std::hypot(ex, ey) <= wxy + df.resolution() && std::abs(eyaw) <= wyaw + cfg_.search_yaw_step_rad;
+  if (inside && res.inlier_ratio >= cfg_.min_inlier_ratio || (near && res.inlier_ratio >= cfg_.min_inlier_ratio_near)) {
     // Covariance from the Jacobian at the solution (loss applied).
     ceres::CRSMatrix J;
     problem.Evaluate(ceres::Problem::EvaluateOptions(), nullptr, nullptr, nullptr, &J);
