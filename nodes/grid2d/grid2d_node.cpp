@@ -48,6 +48,11 @@ class Grid2dNode : public fploc::rt::Node {
     if (o.max_range_m() > 0) c.max_range_m = o.max_range_m();
     if (o.min_inlier_ratio() > 0) c.min_inlier_ratio = o.min_inlier_ratio();
     if (o.field_max_m() > 0) c.field_max_m = o.field_max_m();
+    if (o.min_inlier_ratio_near() > 0) c.min_inlier_ratio_near = o.min_inlier_ratio_near();
+    if (o.gate_sigmas() > 0) c.gate_sigmas = o.gate_sigmas();
+    if (o.sigma_xy_per_m() > 0) c.sigma_xy_per_m = o.sigma_xy_per_m();
+    if (o.sigma_yaw_per_rad() > 0) c.sigma_yaw_per_rad = o.sigma_yaw_per_rad();
+    if (o.prior_weight_sigmas() > 0) c.prior_weight_sigmas = o.prior_weight_sigmas();
     const fploc::OccupancyGrid g = fploc::read_occupancy_map(path);
     auto field = std::make_shared<l2::DistanceField>(g, c.field_max_m);
     loc_ = std::make_unique<l2::GridLocalizer>(field, c);

@@ -53,8 +53,8 @@ struct GridLocalizerConfig {
   // when it also lies within gate_sigmas of the prediction (Mahalanobis, x y yaw): a fit that agrees with
   // the odometry needs less support from the map than a jump does (rooms the map saw only through a door).
   double min_inlier_ratio = 0.5;
-  double min_inlier_ratio_near = 0.3;
-  double gate_sigmas = 3.0;
+  double min_inlier_ratio_near = 0.4;
+  double gate_sigmas = 2.0;
   int lost_after = 10;
   double field_max_m = 1.0;  // distance field truncation (the map's DistanceField)
 };
