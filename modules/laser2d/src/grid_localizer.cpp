@@ -115,16 +115,8 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
   // 1. Prediction and its uncertainty.
   Pose2 pred = m.pose;
   double sxy = m.sxy, syaw = m.syaw;
-  std::optional<Pose2> inc_odom;
   if (odom && m.last_odom) {
     const Pose2 inc = between(*m.last_odom, *odom);
-    if (std::hypot(inc.x, inc.y) <= cfg_.max_odom_step_m && std::abs(wrap_angle(inc.yaw)) <= cfg_.max_odom_turn_rad)
-      inc_odom = inc;
-    else
-      ++res.odometry_jumps;
-  }
-  if (inc_odom) {
-    const Pose2 inc = *inc_odom;
     const double step = std::hypot(inc.x, inc.y), turn = std::abs(wrap_angle(inc.yaw));
     pred = compose(m.pose, inc);
     const double qxy = cfg_.sigma_xy_m + cfg_.sigma_xy_per_m * step;

@@ -172,19 +172,6 @@ TEST(GridLocalizer, UnexplainedScanIsPoorAndKeepsTheOdometry) {
   EXPECT_GT(r1.search_xy_m, r0.search_xy_m);  // the uncertainty grew
 }
 
-TEST(GridLocalizer, OdometryJumpIsIgnored) {
-  const OccupancyGrid map = make_room();
-  l2::GridLocalizer loc(std::make_shared<l2::DistanceField>(map, 1.0));
-  loc.set_initial_pose({1, 1, 0});
-  std::mt19937 rng(5);
-  ASSERT_EQ(loc.update(cast(map, {1, 1, 0}, rng), Pose2{0, 0, 0}).status, l2::GridStatus::kOk);
-  // The robot moves 0.3 m; the odometry jumps 7 m (a glitch): the scan is matched around the previous pose.
-  const auto r = loc.update(cast(map, {1.3, 1, 0}, rng), Pose2{7.3, 0, 0});
-  EXPECT_EQ(r.odometry_jumps, 1);
-  EXPECT_EQ(r.status, l2::GridStatus::kOk);
-  EXPECT_LT(std::hypot(r.pose.x - 1.3, r.pose.y - 1), 0.05);
-}
-
 TEST(GridLocalizer, ScanPointsDropInvalidAndApplyMount) {
   const std::vector<float> r{1.f, std::numeric_limits<float>::quiet_NaN(), 0.01f, 50.f, 2.f};
   const auto p = l2::scan_points(r, -M_PI / 2, M_PI / 4, 0.1, 40, {0.5, 0, 0});

@@ -31,9 +31,6 @@ struct GridLocalizerConfig {
   // Odometry (prediction) uncertainty per scan step: sigma = base + k * |increment|.
   double sigma_xy_m = 0.05, sigma_xy_per_m = 0.3;
   double sigma_yaw_rad = 2.0 * M_PI / 180, sigma_yaw_per_rad = 0.3, sigma_yaw_per_m = 3.0 * M_PI / 180;
-  // An odometry increment longer or wider than this between two scans is a glitch of the odometry (csail:
-  // 7 m in one step): the scan is predicted as without odometry (as AMCL's odometry guard does, 3 m / 120 deg).
-  double max_odom_step_m = 3.0, max_odom_turn_rad = 120.0 * M_PI / 180;
   // No odometry: the prediction is the previous pose with this uncertainty per scan.
   double no_odom_sigma_xy_m = 0.3, no_odom_sigma_yaw_rad = 10.0 * M_PI / 180;
   // Initial pose uncertainty (the first search window is +-3 sigma).
@@ -72,7 +69,6 @@ struct GridResult {
   double inlier_ratio = 0, rms_m = 0;
   double search_xy_m = 0, search_yaw_rad = 0;  // the window searched
   int candidates = 0;
-  int odometry_jumps = 0;  // 1: this scan's odometry increment was rejected (max_odom_step_m / turn)
   double score = 0;  // the best candidate's correlative score (0..1, prior-weighted)
   int iterations = 0;
 };
