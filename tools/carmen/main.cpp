@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
   std::string in, out, tum, map_dir;
   double begin = 0, end = 1, map_begin = 0, map_end = 0.5, resolution = 0.05;
   bool json = false;
+  fploc::carmen::GridConfig gcfg;
   std::string odom_from = "odom";
   app.add_option("log", in, "CARMEN log (.log or .log.gz)")->required();
   app.add_option("--out", out, "LCM log to write");
@@ -50,6 +51,11 @@ int main(int argc, char** argv) {
   app.add_option("--map-end", map_end, "(0.5)")->check(CLI::Range(0.0, 1.0));
   app.add_option("--resolution", resolution, "map cell size [m] (0.05)")->check(CLI::PositiveNumber);
   app.add_flag("--json", json, "summary as JSON on stdout");
+  app.add_option("--occupied-ratio", gcfg.occupied_ratio, "map: occupied when hits >= this share of hits + pass-throughs")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--min-hits", gcfg.min_hits, "map: occupied needs at least this many hits")->check(CLI::PositiveNumber);
+  app.add_option("--hit-clearance", gcfg.hit_clearance_m, "map: a beam marks no cell within this [m] of its hit free")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--odom-from", odom_from,
                  "odom: the ODOM records (wheel odometry, default); flaser: the FLASER odom_* columns (in the corrected "
                  "Radish logs a copy of the reference: a diagnostic, circular)")
@@ -126,7 +132,7 @@ int main(int argc, char** argv) {
       if (me <= mb) throw std::runtime_error("--map-begin/--map-end select no scans");
       std::vector<const cm::LaserRecord*> sel;
       for (size_t k = mb; k < me; ++k) sel.push_back(&log.scans[k]);
-      cm::GridConfig gc;
+      cm::GridConfig gc = gcfg;
       gc.resolution = resolution;
       gc.no_return = no_return;
       const cm::Grid g = cm::build_grid(sel, gc);

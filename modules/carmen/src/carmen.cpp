@@ -215,8 +215,11 @@ Grid build_grid(const std::vector<const LaserRecord*>& scans, const GridConfig& 
       // Bresenham from the laser's cell to the end cell (exclusive).
       int di = std::abs(ib - ia), dj = -std::abs(jb - ja), si = ia < ib ? 1 : -1, sj = ja < jb ? 1 : -1, err = di + dj;
       int i = ia, j = ja;
+      // A hit's own surface is not crossed: cells within hit_clearance_m of the end point are not marked free
+      // (beams that graze a wall at a shallow angle would otherwise erase it).
+      const double clear2 = hit ? cfg.hit_clearance_m * cfg.hit_clearance_m / (g.resolution * g.resolution) : -1.0;
       while (i != ib || j != jb) {
-        ++miss[size_t(j) * g.width + i];
+        if (double(i - ib) * (i - ib) + double(j - jb) * (j - jb) > clear2) ++miss[size_t(j) * g.width + i];
         const int e2 = 2 * err;
         if (e2 >= dj) err += dj, i += si;
         if (e2 <= di) err += di, j += sj;

@@ -73,6 +73,7 @@ struct GridConfig {
   double max_free_m = 20.0;
   float no_return = 1e30f;
   double min_range_m = 0.05;
+  double hit_clearance_m = 0.0;  // a beam marks no cell within this of its hit free
 };
 struct Grid {
   int width = 0, height = 0;

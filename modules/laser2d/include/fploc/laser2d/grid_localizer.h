@@ -1,0 +1,100 @@
+// The 2D mode's scan-to-map localizer on a raster map (DistanceField of an occupancy grid), with the wheel
+// odometry as the motion prior. Per scan:
+//  1. prediction: the previous estimate composed with the odometry increment between the two scans (no
+//     odometry: the previous estimate), and its uncertainty: sigma_xy = base + k_xy * step, sigma_yaw =
+//     base + k_yaw * turn (+ k_yaw_per_m * step), added to what is left of the previous one;
+//  2. a correlative search (Olson's correlative scan matching, as Cartographer's real-time matcher does it)
+//     over a window of +-3 sigma around the prediction: every yaw step rotates the points once, every cell
+//     offset sums the points' scores exp(-d^2 / 2 s^2) (d from the distance field); the score is weighted by a
+//     weak Gaussian of the offset (ties along corridors go to the odometry);
+//  3. refinement from the best candidate with Ceres: one residual per point, the distance field at the point
+//     (bicubic interpolation) with a Huber loss, plus the prediction as a prior with the sigmas of step 1;
+//  4. status: OK when the share of points within inlier_m of an occupied cell is at least min_inlier_ratio
+//     (min_inlier_ratio_near when the fit is within gate_sigmas of the prediction);
+//     else POOR and the estimate is the prediction, whose uncertainty keeps growing with the odometry, so the
+//     next search window widens (recovery after a stretch the map does not explain); LOST after lost_after
+//     POOR scans in a row, until a scan matches again.
+// The first scan is searched over the initial pose's uncertainty (initial_sigma_*), e.g. a start 1 m / 10 deg
+// off. Transport-free: nodes/grid2d wraps it.
+#pragma once
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "fploc/core/pose.h"
+#include "fploc/laser2d/distance_field.h"
+
+namespace fploc::laser2d {
+
+struct GridLocalizerConfig {
+  // Odometry (prediction) uncertainty per scan step: sigma = base + k * |increment|.
+  double sigma_xy_m = 0.05, sigma_xy_per_m = 0.3;
+  double sigma_yaw_rad = 2.0 * M_PI / 180, sigma_yaw_per_rad = 0.3, sigma_yaw_per_m = 3.0 * M_PI / 180;
+  // No odometry: the prediction is the previous pose with this uncertainty per scan.
+  double no_odom_sigma_xy_m = 0.3, no_odom_sigma_yaw_rad = 10.0 * M_PI / 180;
+  // Initial pose uncertainty (the first search window is +-3 sigma).
+  double initial_sigma_xy_m = 0.5, initial_sigma_yaw_rad = 5.0 * M_PI / 180;
+  // Search window: +-window_sigmas sigma, capped.
+  double window_sigmas = 3.0, max_window_xy_m = 2.5, max_window_yaw_rad = 45.0 * M_PI / 180;
+  double search_yaw_step_rad = 1.0 * M_PI / 180;
+  double score_sigma_m = 0.1;       // correlative score exp(-d^2 / 2 s^2)
+  double prior_weight_sigmas = 3.0; // the search's weak prior: exp(-m^2 / (2 * this^2)), m = Mahalanobis
+  // Refinement.
+  double huber_m = 0.05;
+  double point_sigma_m = 0.05;
+  int max_iterations = 20;
+  // Points: returns within [min_range_m, max_range_m]; at most max_points (every k-th).
+  double min_range_m = 0.1, max_range_m = 40.0;
+  int max_points = 400;
+  // Status.
+  double inlier_m = 0.1;
+  // A fit is accepted when at least min_inlier_ratio of the points are inliers, or min_inlier_ratio_near
+  // when it also lies within gate_sigmas of the prediction (Mahalanobis, x y yaw): a fit that agrees with
+  // the odometry needs less support from the map than a jump does (rooms the map saw only through a door).
+  double min_inlier_ratio = 0.5;
+  double min_inlier_ratio_near = 0.4;
+  double gate_sigmas = 2.0;
+  int lost_after = 10;
+  double field_max_m = 1.0;  // distance field truncation (the map's DistanceField)
+};
+
+enum class GridStatus { kOk = 0, kPoor = 1, kLost = 2, kNotInitialised = 3 };
+
+struct GridResult {
+  Pose2 pose;
+  GridStatus status = GridStatus::kNotInitialised;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // x, y, yaw
+  int num_points = 0, num_inliers = 0;
+  double inlier_ratio = 0, rms_m = 0;
+  double search_xy_m = 0, search_yaw_rad = 0;  // the window searched
+  int candidates = 0;
+  double score = 0;  // the best candidate's correlative score (0..1, prior-weighted)
+  int iterations = 0;
+};
+
+class GridLocalizer {
+ public:
+  GridLocalizer(std::shared_ptr<const DistanceField> field, GridLocalizerConfig cfg = {});
+  ~GridLocalizer();
+  // (Re)start: the next scan is searched around `pose` with the initial uncertainty.
+  void set_initial_pose(const Pose2& pose);
+  bool initialised() const { return have_pose_; }
+  // points: the scan's returns in the robot frame; odom: the wheel odometry pose at the scan's time (any
+  // frame; only increments are used).
+  GridResult update(const std::vector<Eigen::Vector2d>& points, const std::optional<Pose2>& odom);
+  const GridLocalizerConfig& config() const { return cfg_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  GridLocalizerConfig cfg_;
+  bool have_pose_ = false;
+};
+
+// The returns of a planar scan (beam i at angle_min + i * increment, x forward) in the robot frame, for a
+// laser mounted at (mount_x, mount_y, mount_yaw): ranges outside [min, max] or non-finite are dropped.
+std::vector<Eigen::Vector2d> scan_points(const std::vector<float>& ranges, double angle_min, double increment,
+                                         double min_range, double max_range, const Pose2& mount = {});
+
+}  // namespace fploc::laser2d

@@ -1,0 +1,185 @@
+// The raster-map localizer on a synthetic occupancy grid: an irregular room (walls, an inner wall, pillars),
+// 180-degree scans ray-cast in the grid from a known trajectory, wheel odometry with a scale error and yaw
+// drift. Checks the distance field, tracking from the true start, a start 1 m / 10 deg off, and that a scan
+// the map cannot explain (a different room) is POOR and keeps the odometry prediction.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "fploc/laser2d/distance_field.h"
+#include "fploc/laser2d/grid_localizer.h"
+
+namespace {
+
+using fploc::OccupancyGrid;
+using fploc::Pose2;
+namespace l2 = fploc::laser2d;
+
+OccupancyGrid make_room(bool other_room = false) {
+  OccupancyGrid g;
+  g.width = 300;
+  g.height = 200;
+  g.resolution = 0.05;
+  g.origin_x = -1;
+  g.origin_y = -1;
+  g.data.assign(size_t(g.width) * g.height, 0);
+  auto occ = [&](double x, double y) {
+    const int i = int(std::floor((x - g.origin_x) / g.resolution)), j = int(std::floor((y - g.origin_y) / g.resolution));
+    if (i >= 0 && j >= 0 && i < g.width && j < g.height) g.data[size_t(j) * g.width + i] = 100;
+  };
+  // Outer walls of a 13 x 8 m room.
+  if (!other_room)
+    for (double t = -0.5; t <= 12.5; t += 0.02) occ(t, -0.5), occ(t, 7.5);
+  if (!other_room)
+    for (double t = -0.5; t <= 7.5; t += 0.02) occ(-0.5, t), occ(12.5, t);
+  if (other_room) {
+    for (double t = 2; t <= 6; t += 0.02) occ(t, 3.0);  // one wall elsewhere
+    return g;
+  }
+  // An inner wall with a gap, an alcove, pillars.
+  for (double t = 3.0; t <= 7.5; t += 0.02) occ(4.0, t);
+  for (double t = -0.5; t <= 1.5; t += 0.02) occ(8.0, t);
+  for (double t = 8.0; t <= 10.0; t += 0.02) occ(t, 1.5);
+  for (double a = 0; a < 2 * M_PI; a += 0.05) occ(6.5 + 0.2 * std::cos(a), 4.5 + 0.2 * std::sin(a)), occ(10 + 0.15 * std::cos(a), 5 + 0.15 * std::sin(a));
+  return g;
+}
+
+// 181 beams over 180 degrees, ray-cast to the first occupied cell (max 30 m), noise 1 cm.
+std::vector<Eigen::Vector2d> cast(const OccupancyGrid& g, const Pose2& p, std::mt19937& rng) {
+  std::normal_distribution<double> n(0, 0.01);
+  std::vector<float> r;
+  for (int k = 0; k < 181; ++k) {
+    const double a = p.yaw - M_PI / 2 + k * M_PI / 180;
+    double d = 0.1;
+    for (; d < 30; d += 0.01) {
+      const double x = p.x + d * std::cos(a), y = p.y + d * std::sin(a);
+      const int i = int(std::floor((x - g.origin_x) / g.resolution)), j = int(std::floor((y - g.origin_y) / g.resolution));
+      if (i < 0 || j < 0 || i >= g.width || j >= g.height) { d = 1e9; break; }
+      if (g.occupied(i, j)) break;
+    }
+    r.push_back(d < 30 ? float(d + n(rng)) : std::numeric_limits<float>::infinity());
+  }
+  return l2::scan_points(r, -M_PI / 2, M_PI / 180, 0.1, 30);
+}
+
+// A loop through the room: 1 m steps and turns, as the Radish logs' scan spacing.
+std::vector<Pose2> trajectory() {
+  std::vector<Pose2> t;
+  auto add_line = [&](Pose2 a, Pose2 b, int n) {
+    for (int k = 0; k < n; ++k) {
+      const double s = double(k) / n;
+      t.push_back({a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), a.yaw + s * fploc::wrap_angle(b.yaw - a.yaw)});
+    }
+  };
+  add_line({1, 1, 0}, {7, 1.2, 0}, 8);
+  add_line({7, 1.2, 0}, {7, 2.5, M_PI / 2}, 3);
+  add_line({7, 2.5, M_PI / 2}, {11, 3, 0.2}, 5);
+  add_line({11, 3, 0.2}, {11, 6.5, M_PI / 2}, 5);
+  add_line({11, 6.5, M_PI / 2}, {5, 6.2, M_PI}, 8);
+  add_line({5, 6.2, M_PI}, {2, 2, -M_PI / 2}, 6);
+  return t;
+}
+
+// Wheel odometry: increments with a 3 % scale error and 2 deg/m yaw drift, in a frame of its own.
+std::vector<Pose2> odometry(const std::vector<Pose2>& truth) {
+  std::vector<Pose2> o{{100, -50, 1.0}};
+  for (size_t k = 1; k < truth.size(); ++k) {
+    Pose2 inc = fploc::between(truth[k - 1], truth[k]);
+    const double step = std::hypot(inc.x, inc.y);
+    inc.x *= 1.03;
+    inc.y *= 1.03;
+    inc.yaw += step * 2 * M_PI / 180;
+    o.push_back(fploc::compose(o.back(), inc));
+  }
+  return o;
+}
+
+struct TrackRun {
+  double rms = 0, max = 0;
+  int ok = 0, n = 0;
+};
+
+TrackRun track(const Pose2& start) {
+  const OccupancyGrid g = make_room();
+  auto df = std::make_shared<l2::DistanceField>(g, 1.0);
+  l2::GridLocalizer loc(df);
+  loc.set_initial_pose(start);
+  std::mt19937 rng(7);
+  const auto truth = trajectory();
+  const auto odo = odometry(truth);
+  TrackRun r;
+  double ss = 0;
+  for (size_t k = 0; k < truth.size(); ++k) {
+    const auto res = loc.update(cast(g, truth[k], rng), odo[k]);
+    const double e = std::hypot(res.pose.x - truth[k].x, res.pose.y - truth[k].y);
+    ss += e * e;
+    r.max = std::max(r.max, e);
+    r.ok += res.status == l2::GridStatus::kOk;
+    ++r.n;
+  }
+  r.rms = std::sqrt(ss / r.n);
+  return r;
+}
+
+TEST(DistanceField, ExactWithinTruncation) {
+  OccupancyGrid g;
+  g.width = 40;
+  g.height = 30;
+  g.resolution = 0.1;
+  g.origin_x = 2;
+  g.origin_y = -1;
+  g.data.assign(size_t(g.width) * g.height, 0);
+  g.data[size_t(10) * g.width + 20] = 100;  // cell (20, 10): centre (4.05, 0.05)
+  const l2::DistanceField df(g, 1.0);
+  EXPECT_EQ(df.occupied_cells(), 1u);
+  EXPECT_FLOAT_EQ(df.at(20, 10), 0.f);
+  EXPECT_NEAR(df.at(23, 14), 0.5, 1e-6);                             // 3-4-5 cells
+  EXPECT_FLOAT_EQ(df.at(35, 10), 1.0f);                              // beyond the truncation
+  EXPECT_NEAR(df.nearest({4.05 + 0.3, 0.05}), 0.3, 1e-6);
+  const Eigen::Vector2d c = df.to_cell({4.05, 0.05});
+  EXPECT_NEAR(c.x(), 20, 1e-9);
+  EXPECT_NEAR(c.y(), 10, 1e-9);
+}
+
+TEST(GridLocalizer, TracksWithDriftingOdometry) {
+  const TrackRun r = track({1, 1, 0});
+  EXPECT_LT(r.rms, 0.03) << "max " << r.max;
+  EXPECT_EQ(r.ok, r.n);
+}
+
+TEST(GridLocalizer, StartOneMetreTenDegreesOff) {
+  const TrackRun r = track({1 + std::cos(M_PI / 4), 1 + std::sin(M_PI / 4), 10 * M_PI / 180});
+  EXPECT_LT(r.rms, 0.03) << "max " << r.max;
+  EXPECT_EQ(r.ok, r.n);
+}
+
+TEST(GridLocalizer, UnexplainedScanIsPoorAndKeepsTheOdometry) {
+  const OccupancyGrid map = make_room(), other = make_room(true);
+  l2::GridLocalizer loc(std::make_shared<l2::DistanceField>(map, 1.0));
+  loc.set_initial_pose({1, 1, 0});
+  std::mt19937 rng(3);
+  ASSERT_EQ(loc.update(cast(map, {1, 1, 0}, rng), Pose2{0, 0, 0}).status, l2::GridStatus::kOk);
+  auto r0 = loc.update(cast(map, {1.5, 1, 0}, rng), Pose2{0.5, 0, 0});
+  ASSERT_EQ(r0.status, l2::GridStatus::kOk);
+  // The robot drives 1 m on; the scan comes from a room the map does not contain.
+  auto r1 = loc.update(cast(other, {2.5, 1, 0}, rng), Pose2{1.5, 0, 0});
+  EXPECT_NE(r1.status, l2::GridStatus::kOk);
+  const Pose2 pred = fploc::compose(r0.pose, {1, 0, 0});  // the odometry prediction
+  EXPECT_NEAR(r1.pose.x, pred.x, 1e-9);
+  EXPECT_NEAR(r1.pose.y, pred.y, 1e-9);
+  EXPECT_NEAR(r1.pose.yaw, pred.yaw, 1e-9);
+  EXPECT_GT(r1.search_xy_m, r0.search_xy_m);  // the uncertainty grew
+}
+
+TEST(GridLocalizer, ScanPointsDropInvalidAndApplyMount) {
+  const std::vector<float> r{1.f, std::numeric_limits<float>::quiet_NaN(), 0.01f, 50.f, 2.f};
+  const auto p = l2::scan_points(r, -M_PI / 2, M_PI / 4, 0.1, 40, {0.5, 0, 0});
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_NEAR(p[0].x(), 0.5, 1e-9);
+  EXPECT_NEAR(p[0].y(), -1, 1e-9);
+  EXPECT_NEAR(p[1].x(), 0.5, 1e-9);  // beam 4 at +90 deg, 2 m
+  EXPECT_NEAR(p[1].y(), 2, 1e-9);
+}
+
+}  // namespace

@@ -1,0 +1,116 @@
+// fploc-grid2d: the 2D LiDAR mode's localizer on a raster map. laser_scan_t (LASER_SCAN) + wheel odometry
+// (pose_t on WHEEL_ODOM; optional) -> modules/laser2d GridLocalizer (scans matched directly to the distance
+// field of a map_server occupancy grid: correlative search around the odometry prediction, Ceres refinement)
+// -> pose_t (FPLOC_GRID_POSE) per scan: status OK / POOR (odometry prediction kept) / LOST, covariance
+// (x, y, yaw) from the fit. Odometry pairing: the latest odometry pose whose utime is not after the scan's
+// (`fploc import-carmen` writes it with the scan's own utime, before the scan).
+#include <fploc/laser_scan_t.hpp>
+#include <fploc/pose_t.hpp>
+
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <optional>
+
+#include "fploc/adapters/pose_t.h"
+#include "fploc/floorplan/occupancy.h"
+#include "fploc/laser2d/grid_localizer.h"
+#include "fploc/runtime/node.h"
+#include "options/laser2d.pb.h"
+
+namespace {
+
+namespace l2 = fploc::laser2d;
+using fploc::Pose2;
+
+class Grid2dNode : public fploc::rt::Node {
+ public:
+  static fploc::rt::NodeSpec spec() {
+    return {"grid2d", "grid2d",
+            "2D LiDAR scans + wheel odometry -> localization on an occupancy grid's distance field (pose_t)",
+            {fploc::rt::input<fploc::laser_scan_t>("scan", "LASER_SCAN"),
+             fploc::rt::input<fploc::pose_t>("odom", "WHEEL_ODOM"),  // "" = no odometry (previous pose predicts)
+             fploc::rt::output<fploc::pose_t>("pose", "FPLOC_GRID_POSE")}};
+  }
+
+  void setup(fploc::rt::Context& ctx) override {
+    ctx_ = &ctx;
+    const auto& o = ctx.options<fploc::Grid2dOptions>();
+    if (o.plan().file().empty()) throw std::runtime_error("grid2d.plan.file: no occupancy map (.yaml) given");
+    const std::string path = ctx.resolve_path(o.plan().file());
+    const auto ext = path.size() >= 5 ? path.substr(path.find_last_of('.') + 1) : std::string();
+    if (ext != "yaml" && ext != "yml")
+      throw std::runtime_error("grid2d.plan.file: '" + path + "' is not a map_server occupancy map (.yaml)");
+    l2::GridLocalizerConfig c;
+    if (o.initial_sigma_xy_m() > 0) c.initial_sigma_xy_m = o.initial_sigma_xy_m();
+    if (o.initial_sigma_yaw_deg() > 0) c.initial_sigma_yaw_rad = o.initial_sigma_yaw_deg() * M_PI / 180;
+    if (o.min_range_m() > 0) c.min_range_m = o.min_range_m();
+    if (o.max_range_m() > 0) c.max_range_m = o.max_range_m();
+    if (o.min_inlier_ratio() > 0) c.min_inlier_ratio = o.min_inlier_ratio();
+    if (o.field_max_m() > 0) c.field_max_m = o.field_max_m();
+    if (o.min_inlier_ratio_near() > 0) c.min_inlier_ratio_near = o.min_inlier_ratio_near();
+    if (o.gate_sigmas() > 0) c.gate_sigmas = o.gate_sigmas();
+    if (o.sigma_xy_per_m() > 0) c.sigma_xy_per_m = o.sigma_xy_per_m();
+    if (o.sigma_yaw_per_rad() > 0) c.sigma_yaw_per_rad = o.sigma_yaw_per_rad();
+    if (o.prior_weight_sigmas() > 0) c.prior_weight_sigmas = o.prior_weight_sigmas();
+    const fploc::OccupancyGrid g = fploc::read_occupancy_map(path);
+    auto field = std::make_shared<l2::DistanceField>(g, c.field_max_m);
+    loc_ = std::make_unique<l2::GridLocalizer>(field, c);
+    mount_ = {o.mount_x_m(), o.mount_y_m(), o.mount_yaw_deg() * M_PI / 180};
+    z_ = o.z_m();
+    const Pose2 p0{o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()};
+    loc_->set_initial_pose(p0);
+    std::cerr << "[" << ctx.name() << "] " << path << ": " << g.width << " x " << g.height << " cells at " << g.resolution
+              << " m, " << field->occupied_cells() << " occupied; initial pose " << p0.x << " " << p0.y << " " << p0.yaw
+              << " (+-" << 3 * c.initial_sigma_xy_m << " m, " << 3 * c.initial_sigma_yaw_rad * 180 / M_PI
+              << " deg searched); odometry " << (ctx.channel("odom").empty() ? "none" : ctx.channel("odom")) << "\n";
+    out_ = ctx.advertise<fploc::pose_t>("pose");
+    ctx.subscribe<fploc::laser_scan_t>("scan", [this](const fploc::laser_scan_t& m) { on_scan(m); });
+    ctx.subscribe<fploc::pose_t>("odom", [this](const fploc::pose_t& m) { on_odom(m); });
+  }
+
+ private:
+  void on_odom(const fploc::pose_t& m) {
+    const Pose2 p = fploc::adapters::pose2_of(m);
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.yaw)) {
+      ctx_->error("odometry seq " + std::to_string(m.seq) + ": non-finite pose (ignored)");
+      return;
+    }
+    odom_ = p;
+    odom_utime_ = m.utime;
+  }
+
+  void on_scan(const fploc::laser_scan_t& m) {
+    if (!std::isfinite(m.angle_increment) || m.angle_increment == 0 || m.ranges.empty()) {
+      ctx_->error("scan utime " + std::to_string(m.utime) + ": bad geometry (angle_increment " +
+                  std::to_string(m.angle_increment) + ", " + std::to_string(m.ranges.size()) + " ranges)");
+      return;
+    }
+    const auto& c = loc_->config();
+    const double rmin = std::max<double>(c.min_range_m, m.range_min);
+    const double rmax = m.range_max > 0 ? std::min<double>(c.max_range_m, m.range_max) : c.max_range_m;
+    const auto pts = l2::scan_points(m.ranges, m.angle_min, m.angle_increment, rmin, rmax, mount_);
+    std::optional<Pose2> odom;
+    if (odom_ && odom_utime_ <= m.utime) odom = odom_;
+    const l2::GridResult r = loc_->update(pts, odom);
+    if (debug_)
+      std::cerr << "[grid2d] " << seq_ << " " << r.pose.x << " " << r.pose.y << " " << r.pose.yaw * 180 / M_PI << " status "
+                << int(r.status) << " inl " << r.inlier_ratio << " n " << r.num_points << " win " << r.search_xy_m << " m "
+                << r.search_yaw_rad * 180 / M_PI << " deg score " << r.score << "\n";
+    out_.publish(fploc::adapters::make_pose_msg(m.utime, seq_++, r.pose, 0, 0, z_, r.covariance, 0.01, 0.01,
+                                                int8_t(r.status), true, true));
+  }
+
+  fploc::rt::Context* ctx_ = nullptr;
+  std::unique_ptr<l2::GridLocalizer> loc_;
+  fploc::rt::Publisher<fploc::pose_t> out_;
+  std::optional<Pose2> odom_;
+  int64_t odom_utime_ = 0;
+  Pose2 mount_;
+  double z_ = 0;
+  int64_t seq_ = 0;
+  bool debug_ = std::getenv("FPLOC_GRID2D_DEBUG") != nullptr;
+};
+
+}  // namespace
+FPLOC_REGISTER_NODE(Grid2dNode)
