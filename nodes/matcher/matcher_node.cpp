@@ -16,6 +16,7 @@
 #include "fploc/adapters/features_t.h"
 #include "fploc/adapters/frame_pose_t.h"
 #include "fploc/adapters/pose_t.h"
+#include "fploc/config/floor_ref.h"
 #include "fploc/config/localization.h"
 #include "fploc/config/plan_source.h"
 #include "fploc/localizer/localizer.h"
@@ -47,6 +48,7 @@ class MatcherNode : public fploc::rt::Node {
     const auto& o = ctx.options<fploc::MatcherOptions>();
     map_ = fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); },
                                    "matcher.plan");
+    floor_ = fploc::config::floor_ref(o.plan(), ctx.resolve_path(o.plan().file()));
     loc_ = std::make_unique<fploc::localizer::Localizer>(*map_.lookup, fploc::config::localizer_config(o));
     // The graph's initial pose is where the run starts; a restarted matcher (crash, module swap) waits for
     // a pose instead (FPLOC_INITIAL_POSE: the relocalizer searches around the last good pose).
@@ -101,7 +103,9 @@ class MatcherNode : public fploc::rt::Node {
       return;
     }
     if (dropped) ctx_->error("features seq " + std::to_string(m.seq) + ": " + std::to_string(dropped) + " non-finite points dropped");
-    const fploc::localizer::FramePose fp = loc_->register_frame(f);
+    fploc::localizer::FramePose fp = loc_->register_frame(f);
+    fp.floor_index = floor_.index;
+    fp.floor = floor_.name;
     const fploc::MatchResult& r = fp.match;
     // Wall-clock only outside replay (outputs must be reproducible there).
     const double solve_ms =
@@ -113,6 +117,7 @@ class MatcherNode : public fploc::rt::Node {
 
   fploc::rt::Context* ctx_ = nullptr;
   fploc::LocalizationMap map_;
+  fploc::config::FloorRef floor_;
   std::unique_ptr<fploc::localizer::Localizer> loc_;
   fploc::rt::Publisher<fploc::frame_pose_t> out_;
   int64_t seq_ = 0;

@@ -96,12 +96,19 @@ class OptimizerNode : public fploc::rt::Node {
     }
     std::vector<fploc::localizer::Pose> finals;
     const auto latest = loc_->optimize(f, fploc::adapters::from_msg(m), &finals);
-    if (latest) latest_out_.publish(fploc::adapters::to_msg(*latest, latest_seq_++));
+    // The floor of each frame is the matcher's (frame_pose_t); kept until the frame's pose is final.
+    floor_of_[m.utime] = {m.floor_index, m.floor};
+    if (latest) latest_out_.publish(fploc::adapters::to_msg(*latest, latest_seq_++, m.floor_index, m.floor));
     publish_finals(finals);
   }
 
   void publish_finals(const std::vector<fploc::localizer::Pose>& finals) {
-    for (const auto& p : finals) pose_out_.publish(fploc::adapters::to_msg(p, pose_seq_++));
+    for (const auto& p : finals) {
+      auto it = floor_of_.find(p.utime);
+      const auto fl = it != floor_of_.end() ? it->second : std::pair<int, std::string>{-1, ""};
+      pose_out_.publish(fploc::adapters::to_msg(p, pose_seq_++, fl.first, fl.second));
+      if (it != floor_of_.end()) floor_of_.erase(floor_of_.begin(), std::next(it));
+    }
   }
 
   fploc::rt::Context* ctx_ = nullptr;
@@ -110,6 +117,7 @@ class OptimizerNode : public fploc::rt::Node {
   fploc::rt::Publisher<fploc::pose_t> pose_out_, latest_out_;
   std::map<int64_t, fploc::FeatureFrame> features_;
   std::map<int64_t, fploc::frame_pose_t> frame_poses_;
+  std::map<int64_t, std::pair<int, std::string>> floor_of_;  // utime -> floor (index, name)
   int64_t last_seq_ = 0;
   bool have_last_ = false;
   int64_t pose_seq_ = 0, latest_seq_ = 0;

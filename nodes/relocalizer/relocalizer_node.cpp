@@ -101,7 +101,7 @@ class RelocalizerNode : public fploc::rt::Node {
               << " " << where << "\n";
     out_.publish(fploc::adapters::make_pose_msg(f->utime, seq_++, r.pose, f->roll, f->pitch, f->z,
                                       Eigen::Matrix3d::Identity() * r.fit.rms_m * r.fit.rms_m, f->z_sigma,
-                                      f->roll_pitch_sigma, 0, false, true));
+                                      f->roll_pitch_sigma, 0, false, true, m.floor_index, m.floor));
   }
 
   fploc::rt::Context* ctx_ = nullptr;
