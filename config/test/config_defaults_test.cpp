@@ -92,7 +92,7 @@ void check(const std::string& file, const std::string& message, const Table& tab
 }
 
 TEST(ConfigDefaults, Matcher) {
-  const fploc::MatcherConfig c = config_of(fploc::MatcherOptions{});
+  const fploc::matcher::MatcherConfig c = config_of(fploc::MatcherOptions{});
   check("localization.proto", "MatcherOptions",
         {{"max_correspondence_m", c.max_correspondence_m}, {"loss_scale_m", c.loss_scale_m},
          {"max_iterations", c.max_iterations}, {"min_inlier_ratio", c.min_inlier_ratio},
@@ -103,7 +103,7 @@ TEST(ConfigDefaults, Matcher) {
 }
 
 TEST(ConfigDefaults, Optimizer) {
-  const fploc::OptimizerConfig c = config_of(fploc::OptimizerOptions{});
+  const fploc::optimizer::OptimizerConfig c = config_of(fploc::OptimizerOptions{});
   check("localization.proto", "OptimizerOptions",
         {{"window", c.window}, {"alpha", c.alpha}, {"beta", c.beta}, {"keyframe_distance_m", c.keyframe_distance_m},
          {"keyframe_angle_deg", c.keyframe_angle_rad * kDeg}, {"gate_m", c.gate_m}, {"loss_scale_m", c.loss_scale_m},
@@ -112,7 +112,7 @@ TEST(ConfigDefaults, Optimizer) {
 }
 
 TEST(ConfigDefaults, Odometry) {
-  const fploc::OdometryConfig c = config_of(fploc::OdometryOptions{});
+  const fploc::odometry::OdometryConfig c = config_of(fploc::OdometryOptions{});
   check("localization.proto", "OdometryOptions",
         {{"max_correspondence_m", c.max_correspondence_m}, {"keyframe_distance_m", c.keyframe_distance_m},
          {"keyframe_angle_deg", c.keyframe_angle_rad * kDeg}, {"map_keyframes", c.map_keyframes},
@@ -137,7 +137,7 @@ TEST(ConfigDefaults, Perception) {
 }
 
 TEST(ConfigDefaults, Relocalizer) {
-  const fploc::RelocalizerConfig c = config_of(fploc::RelocalizerOptions{});
+  const fploc::reloc::RelocalizerConfig c = config_of(fploc::RelocalizerOptions{});
   // region_radius_m, global_after_s, min_interval_s: fploc-relocalizer's scheduling, not RelocalizerConfig.
   check("relocalization.proto", "RelocalizerOptions",
         {{"grid_m", c.grid_m}, {"yaw_step_deg", c.yaw_step_deg}, {"min_inlier_ratio", c.min_inlier_ratio},

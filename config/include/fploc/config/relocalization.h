@@ -7,6 +7,6 @@ namespace fploc::config {
 
 // The search's settings; region_radius_m, global_after_s and min_interval_s are fploc-relocalizer's
 // scheduling (when to search), not the search's.
-RelocalizerConfig config_of(const RelocalizerOptions& o);
+reloc::RelocalizerConfig config_of(const RelocalizerOptions& o);
 
 }  // namespace fploc::config
