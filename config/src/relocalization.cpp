@@ -11,4 +11,12 @@ reloc::RelocalizerConfig config_of(const RelocalizerOptions& o) {
   return c;
 }
 
+reloc::Schedule schedule_of(const RelocalizerOptions& o) {
+  reloc::Schedule s;
+  if (o.region_radius_m() > 0) s.region_radius_m = o.region_radius_m();
+  if (o.global_after_s() > 0) s.global_after_s = o.global_after_s();
+  if (o.min_interval_s() > 0) s.min_interval_s = o.min_interval_s();
+  return s;
+}
+
 }  // namespace fploc::config

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "fploc/config/amcl.h"
 #include "fploc/config/localization.h"
 #include "fploc/config/perception.h"
 #include "fploc/config/relocalization.h"
@@ -28,10 +29,10 @@ std::map<std::string, std::map<std::string, std::string>> stated_defaults(const 
   EXPECT_TRUE(in) << file;
   std::map<std::string, std::map<std::string, std::string>> out;
   const std::regex msg_re(R"(^message (\w+) \{)");
-  const std::regex field_re(R"(^\s+(?:repeated )?\w+ (\w+) = \d+;\s*(?://(.*))?$)");
+  const std::regex field_re(R"(^\s+(?:repeated |optional )?\w+ (\w+) = \d+;\s*(?://(.*))?$)");
   const std::regex cont_re(R"(^\s+//(.*)$)");
   const std::regex def_res[] = {std::regex(R"(\(default (-?[0-9.]+)[;), ])"), std::regex(R"(0 = default (-?[0-9.]+))"),
-                                std::regex(R"(\(0 = (-?[0-9.]+)[;), ])"), std::regex(R"(\((-?[0-9.]+)[;),])")};
+                                std::regex(R"(\(0 = (-?[0-9.]+)[;), ])"), std::regex(R"(\((-?[0-9.]+)(?:[;),:]| [a-z=]))")};
   std::string msg, field, comment, line;
   auto flush = [&] {
     if (msg.empty() || field.empty()) return;
@@ -143,6 +144,31 @@ TEST(ConfigDefaults, Relocalizer) {
         {{"grid_m", c.grid_m}, {"yaw_step_deg", c.yaw_step_deg}, {"min_inlier_ratio", c.min_inlier_ratio},
          {"min_evidence", c.min_evidence}},
         {"region_radius_m", "global_after_s", "min_interval_s"});
+  const fploc::reloc::Schedule w = fploc::config::schedule_of(fploc::RelocalizerOptions{});
+  check("relocalization.proto", "RelocalizerOptions",
+        {{"region_radius_m", w.region_radius_m}, {"global_after_s", w.global_after_s}, {"min_interval_s", w.min_interval_s}},
+        {"grid_m", "yaw_step_deg", "min_inlier_ratio", "min_evidence"});
+}
+
+TEST(ConfigDefaults, Amcl) {
+  const fploc::amcl::Settings s = config_of(fploc::AmclOptions{});
+  const fploc::amcl::Config& c = s.filter;
+  check("amcl.proto", "AmclOptions",
+        {{"min_particles", c.min_particles}, {"max_particles", c.max_particles}, {"alpha1", c.alpha1},
+         {"alpha2", c.alpha2}, {"alpha3", c.alpha3}, {"alpha4", c.alpha4}, {"z_hit", c.z_hit}, {"z_rand", c.z_rand},
+         {"sigma_hit", c.sigma_hit}, {"laser_likelihood_max_dist", c.laser_likelihood_max_dist},
+         {"max_beams", c.max_beams}, {"laser_max_range", c.laser_max_range}, {"laser_min_range", c.laser_min_range},
+         {"update_min_d", c.update_min_d}, {"update_min_a", c.update_min_a}, {"resample_interval", c.resample_interval},
+         {"pf_err", c.pf_err}, {"pf_z", c.pf_z}, {"recovery_alpha_slow", c.recovery_alpha_slow},
+         {"recovery_alpha_fast", c.recovery_alpha_fast}, {"map_resolution", c.map_resolution},
+         {"free_clearance_m", c.free_clearance}, {"seed", double(c.seed)},
+         {"scan_bins", s.scan.bins}, {"scan_range_min", s.scan.range_min_m}, {"scan_range_max", s.scan.range_max_m},
+         {"initial_std_xy_m", s.initial.std_xy_m}, {"initial_std_yaw_deg", s.initial.std_yaw_deg},
+         {"max_odom_step_m", s.guard.max_step_m}, {"max_odom_step_deg", s.guard.max_step_rad * kDeg}});
+  check("amcl.proto", "WheelOdometryOptions",
+        {{"scale_error", s.wheel.scale_error}, {"yaw_drift_deg_per_m", s.wheel.yaw_drift_deg_per_m},
+         {"trans_noise_m_per_sqrt_m", s.wheel.trans_noise_m_per_sqrt_m},
+         {"yaw_noise_deg_per_sqrt_m", s.wheel.yaw_noise_deg_per_sqrt_m}, {"seed", double(s.wheel.seed)}});
 }
 
 }  // namespace

@@ -59,9 +59,10 @@ class RelocalizerNode : public fploc::rt::Node {
     floor_ = floors_.initial;
     for (const auto& m : floors_.maps)
       relocs_.push_back(std::make_unique<fploc::reloc::Relocalizer>(*m.plan, *m.lookup, fploc::config::config_of(o)));
-    radius_ = o.region_radius_m() > 0 ? o.region_radius_m() : 3.0;
-    global_after_us_ = int64_t((o.global_after_s() > 0 ? o.global_after_s() : 2.0) * 1e6);
-    interval_us_ = int64_t((o.min_interval_s() > 0 ? o.min_interval_s() : 0.5) * 1e6);
+    const fploc::reloc::Schedule when = fploc::config::schedule_of(o);
+    radius_ = when.region_radius_m;
+    global_after_us_ = int64_t(when.global_after_s * 1e6);
+    interval_us_ = int64_t(when.min_interval_s * 1e6);
     for (size_t i = 0; i < relocs_.size(); ++i)
       std::cerr << "[" << ctx.name() << "] floor '" << floors_.building->floors[i].name << "': "
                 << floors_.maps[i].plan->elements.size() << " elements, " << relocs_[i]->free_cells() << " free search cells\n";
