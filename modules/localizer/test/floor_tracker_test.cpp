@@ -66,6 +66,7 @@ struct LiftRun {
   std::optional<FloorSwitch> sw;
   double switch_t = -1;
   double arrive_t = 0;
+  double z_before_arrival = 0;  // floor_z(1.2) 0.5 s before the arrival (riding)
 };
 
 // Runs a ride of `height` (a = 0.5 m/s^2, 2 s ramps) starting at t = 3 s with the robot standing at p,
@@ -89,6 +90,7 @@ LiftRun run_ride(FloorTracker& tr, const Eigen::Vector2d& p, double height, doub
       o.z = 1.2;
       o.z_known = true;
       if (auto s = tr.update(o); s && !r.sw) r.sw = s, r.switch_t = t;
+      if (std::abs(t - (r.arrive_t - 0.5)) < 0.05) r.z_before_arrival = tr.floor_z(o.z);
     }
   }
   return r;
@@ -129,6 +131,7 @@ TEST(FloorTracker, LiftUpSwitchesAfterArrivalAndSaysWhy) {
   EXPECT_EQ(r.sw->to, 1);
   EXPECT_EQ(r.sw->to_name, "first");
   EXPECT_EQ(r.sw->via.name, "lift");
+  EXPECT_NEAR(r.z_before_arrival, 1.2 + 3.3 - 0.0625, 0.1);  // 0.5 s before the stop: 6.25 cm to go
   EXPECT_GT(r.switch_t, r.arrive_t);
   EXPECT_LT(r.switch_t, r.arrive_t + 2.0);
   EXPECT_NE(r.sw->reason.find("lift 'lift': IMU vertical motion +3.3"), std::string::npos) << r.sw->reason;

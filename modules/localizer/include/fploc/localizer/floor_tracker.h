@@ -93,8 +93,9 @@ class FloorTracker {
   // An operator (or a relocalization) puts the robot on a floor; the reason goes to the status text.
   void set_floor(int floor, const std::string& reason);
 
-  // The segmenter's z as the height above the current floor (see above).
-  double floor_z(double z) const { return z - z_offset_; }
+  // The segmenter's z as the height above the current floor (see above); while riding a lift the cab
+  // moves with the sensor, so the IMU's height since the ride started is added.
+  double floor_z(double z) const { return z - z_offset_ + (in_lift_ && vertical_.riding() ? vertical_.height() : 0.0); }
   double z_offset() const { return z_offset_; }
   std::optional<double> nominal_z() const { return z0_; }
   // What the tracker last decided or noticed ("" while nothing happened).
