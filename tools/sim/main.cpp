@@ -260,6 +260,9 @@ int main(int argc, char** argv) {
       if (sim.building()) {
         j["gt_floors"] = gt_floors;
         j["start_floor"] = sim.floor_name(sim.floor_at(o.t0_s));
+        j["t0"] = o.t0_s;
+        auto& fl = j["floors"] = nlohmann::json::array();
+        for (const auto& f : sim.building()->floors) fl.push_back({{"name", f.name}, {"elevation_m", f.elevation}});
         auto& ch = j["floor_changes"] = nlohmann::json::array();
         for (const auto& c : sim.floor_changes())
           ch.push_back({{"t", o.t0_s + c.t}, {"from", sim.floor_name(c.from)}, {"to", sim.floor_name(c.to)}, {"how", c.how}});
