@@ -314,7 +314,7 @@ def bench(a, work, plan, layers, scenario):
         # floor when the pose says none).
         est = [[e[0], e[1], e[2], e[3] + elev.get(pose_floor.get(round(e[0], 6), -1), elev.get(start, 0.0))] + list(e[4:])
                for e in est]
-        changes = [dict(c, to_index=names.get(c["to"], -1)) for c in simj.get("floor_changes", [])]
+        changes = [dict(c, to_index=names.get(c["to"], -1)) for c in simj.get("floor_changes", []) if c["t"] <= gt[-1][0]]
         floors = score_floors(gt, est, read_gt_floors(gt_path[:-4] + ".floors.csv"), pose_floor, changes, simj.get("t0", gt[0][0]))
         row["building"] = True
     m, series = score(gt, est)
