@@ -139,10 +139,13 @@ class MatcherNode : public fploc::rt::Node {
     const bool registered = fp->match.status != FitStatus::kNotInitialised;
     std::optional<fploc::localizer::FloorSwitch> sw;
     if (registered) sw = tracker_->update(ob);
+    if (!sw && fp->match.status == FitStatus::kOk) last_ok_ = fp->match.pose, have_ok_ = true;
     if (sw) {
       floor_ = sw->to;
       std::cerr << "[" << ctx_->name() << "] scan " << f.scan_seq << ": " << tracker_->status_text() << "\n";
-      const fploc::Pose2 at = fp->match.pose;
+      // Where to start on the new floor: this frame's pose, or the last good one when the old floor's plan
+      // no longer matched (after a lift ride the robot stands where it entered the cab).
+      const fploc::Pose2 at = fp->match.status == FitStatus::kOk || !have_ok_ ? fp->match.pose : last_ok_;
       loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
       for (const auto& s : imu_) loc_->add_imu(s.first, s.second);
       loc_->set_pose(at, sw->search_radius_m);
@@ -189,6 +192,8 @@ class MatcherNode : public fploc::rt::Node {
   std::deque<std::pair<int64_t, double>> imu_;  // recent gyro z (a new floor's Localizer gets them)
   std::string switch_text_;
   int64_t switch_until_ = 0;
+  fploc::Pose2 last_ok_;
+  bool have_ok_ = false;
   std::unique_ptr<fploc::localizer::Localizer> loc_;
   fploc::rt::Publisher<fploc::frame_pose_t> out_;
   int64_t seq_ = 0;

@@ -165,9 +165,17 @@ std::optional<FloorSwitch> FloorTracker::update(const FloorObservation& o) {
     (c.kind == ConnectionKind::kLift ? near_lift : near_climb) = true;
   }
 
-  // ---- lift: the IMU's vertical motion while in (or riding from) a lift area
-  const bool in_lift = near_lift || (in_lift_ && vertical_.riding());
-  if (!in_lift && in_lift_) vertical_.reset();
+  // ---- lift: the IMU's vertical motion while standing in a lift area (driving: no ride; the integration
+  // restarts, so slow drifts of |f| while driving never add up to a "ride")
+  double speed = 0;
+  if (have_lift_prev_ && o.utime > lift_prev_utime_)
+    speed = std::hypot(o.pose.x - lift_prev_.x, o.pose.y - lift_prev_.y) / ((o.utime - lift_prev_utime_) * 1e-6);
+  have_lift_prev_ = true;
+  lift_prev_utime_ = o.utime;
+  lift_prev_ = o.pose;
+  const bool still = speed <= cfg_.lift_max_speed_mps;
+  const bool in_lift = still && (near_lift || (in_lift_ && vertical_.riding()));
+  if (!in_lift) vertical_.reset();
   in_lift_ = in_lift;
   const auto ride = vertical_.take_ride();
   if (vertical_.riding() || ride) {

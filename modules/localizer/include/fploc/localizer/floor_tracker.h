@@ -47,6 +47,7 @@ struct FloorTrackerConfig {
   double z_offset_drop_m = 0.25;       // the segmenter's z within this of z0 on flat floor: offset dropped
   double lift_min_height_m = 0.5;      // a ride below this is no floor change (noise, a lift's levelling)
   double lift_tolerance_fraction = 0.3;  // |ride - elevation difference| <= this * |difference|
+  double lift_max_speed_mps = 0.15;    // the IMU's vertical motion counts only while the robot stands this still
   double tilt_lowpass_s = 0.3;         // IMU tilt: time constant of the specific force's low-pass
   double max_tilt_rad = 0.35;          // a steeper "slope" (e.g. a bump, a jolt) is not integrated
   VerticalImuConfig vertical;
@@ -131,6 +132,9 @@ class FloorTracker {
   int confirm_ = 0, confirm_to_ = -1;
   // Lift: the inlier ratio while riding.
   bool in_lift_ = false;
+  bool have_lift_prev_ = false;
+  int64_t lift_prev_utime_ = 0;
+  Pose2 lift_prev_;
   double ride_inliers_sum_ = 0;
   int ride_frames_ = 0;
   double before_inliers_ = 1;
