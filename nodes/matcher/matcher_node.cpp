@@ -29,7 +29,7 @@
 
 namespace {
 
-using fploc::FitStatus;
+using fploc::matcher::FitStatus;
 
 class MatcherNode : public fploc::rt::Node {
  public:
@@ -171,11 +171,11 @@ class MatcherNode : public fploc::rt::Node {
     if (tracker_) track_floor(f, &fp);
     fp.floor_index = floor_;
     fp.floor = floors_.building->floors[size_t(floor_)].name;
-    const fploc::MatchResult& r = fp.match;
+    const fploc::matcher::MatchResult& r = fp.match;
     // Wall-clock only outside replay (outputs must be reproducible there).
     const double solve_ms =
         ctx_->composed() ? 0.0 : std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
-    if (r.status == FitStatus::kLost && last_status_ != FitStatus::kLost) ctx_->error("LOST at scan " + std::to_string(m.scan_seq) + ": " + r.text);
+    if (r.status == fploc::matcher::FitStatus::kLost && last_status_ != fploc::matcher::FitStatus::kLost) ctx_->error("LOST at scan " + std::to_string(m.scan_seq) + ": " + r.text);
     last_status_ = r.status;
     fploc::frame_pose_t msg = fploc::adapters::to_msg(fp, seq_++, solve_ms);
     // A floor change is said on the frames of the next 3 s (never a silent switch).
@@ -198,7 +198,7 @@ class MatcherNode : public fploc::rt::Node {
   fploc::rt::Publisher<fploc::frame_pose_t> out_;
   int64_t seq_ = 0;
   int64_t refined_ignored_ = 0;
-  FitStatus last_status_ = FitStatus::kOk;
+  fploc::matcher::FitStatus last_status_ = fploc::matcher::FitStatus::kOk;
 };
 
 }  // namespace

@@ -24,7 +24,7 @@
 
 namespace {
 
-using fploc::FitStatus;
+using fploc::matcher::FitStatus;
 
 class OptimizerNode : public fploc::rt::Node {
  public:
@@ -92,7 +92,7 @@ class OptimizerNode : public fploc::rt::Node {
                   " != frame_pose utime " + std::to_string(p->second.utime) + " (dropped)");
     } else if (scan_seq <= last_seq_ && have_last_) {
       ctx_->error("scan_seq " + std::to_string(scan_seq) + " arrived after " + std::to_string(last_seq_) + " (dropped)");
-    } else if (p->second.status != int8_t(FitStatus::kNotInitialised)) {
+    } else if (p->second.status != int8_t(fploc::matcher::FitStatus::kNotInitialised)) {
       process(f->second, p->second);
       last_seq_ = scan_seq;
       have_last_ = true;

@@ -32,7 +32,7 @@
 
 namespace {
 
-using fploc::FitStatus;
+using fploc::matcher::FitStatus;
 
 class RelocalizerNode : public fploc::rt::Node {
  public:
@@ -58,10 +58,11 @@ class RelocalizerNode : public fploc::rt::Node {
     }
     floor_ = floors_.initial;
     for (const auto& m : floors_.maps)
-      relocs_.push_back(std::make_unique<fploc::Relocalizer>(*m.plan, *m.lookup, fploc::config::config_of(o)));
-    radius_ = o.region_radius_m() > 0 ? o.region_radius_m() : 3.0;
-    global_after_us_ = int64_t((o.global_after_s() > 0 ? o.global_after_s() : 2.0) * 1e6);
-    interval_us_ = int64_t((o.min_interval_s() > 0 ? o.min_interval_s() : 0.5) * 1e6);
+      relocs_.push_back(std::make_unique<fploc::reloc::Relocalizer>(*m.plan, *m.lookup, fploc::config::config_of(o)));
+    const fploc::reloc::Schedule when = fploc::config::schedule_of(o);
+    radius_ = when.region_radius_m;
+    global_after_us_ = int64_t(when.global_after_s * 1e6);
+    interval_us_ = int64_t(when.min_interval_s * 1e6);
     for (size_t i = 0; i < relocs_.size(); ++i)
       std::cerr << "[" << ctx.name() << "] floor '" << floors_.building->floors[i].name << "': "
                 << floors_.maps[i].plan->elements.size() << " elements, " << relocs_[i]->free_cells() << " free search cells\n";
@@ -93,20 +94,20 @@ class RelocalizerNode : public fploc::rt::Node {
   }
 
   void on_frame_pose(const fploc::frame_pose_t& m) {
-    const auto st = FitStatus(m.status);
+    const auto st = fploc::matcher::FitStatus(m.status);
     if (m.floor_index >= 0 && size_t(m.floor_index) < relocs_.size() && m.floor_index != floor_) {
       floor_from_ = floor_;
       floor_ = m.floor_index;
       floor_changed_ = m.utime;
     }
-    if (st == FitStatus::kOk) {
+    if (st == fploc::matcher::FitStatus::kOk) {
       last_ok_ = fploc::Pose2{m.x, m.y, m.yaw};
       last_ok_utime_ = m.utime;
       have_ok_ = true;
       lost_since_ = 0;
       return;
     }
-    if (st != FitStatus::kLost && st != FitStatus::kNotInitialised) return;  // POOR: the matcher copes
+    if (st != fploc::matcher::FitStatus::kLost && st != fploc::matcher::FitStatus::kNotInitialised) return;  // POOR: the matcher copes
     if (lost_since_ == 0) lost_since_ = m.utime;
     if (last_search_ != 0 && m.utime - last_search_ < interval_us_) return;
     const fploc::features_t* f = nullptr;
@@ -124,10 +125,10 @@ class RelocalizerNode : public fploc::rt::Node {
     // LOST: first around the last good pose (or, if there never was one, around the pose the matcher
     // holds — the given initial pose); the whole plan once the loss lasts longer than global_after_s.
     // NOT_INITIALISED right after a good pose (the matcher was restarted): around that pose too.
-    std::optional<fploc::SearchRegion> region;
+    std::optional<fploc::reloc::SearchRegion> region;
     const bool local = m.utime - lost_since_ < global_after_us_ &&
-                       (st == FitStatus::kLost || (have_ok_ && m.utime - last_ok_utime_ < global_after_us_));
-    if (local) region = fploc::SearchRegion{have_ok_ ? last_ok_ : fploc::Pose2{m.x, m.y, m.yaw}, radius_, M_PI};
+                       (st == fploc::matcher::FitStatus::kLost || (have_ok_ && m.utime - last_ok_utime_ < global_after_us_));
+    if (local) region = fploc::reloc::SearchRegion{have_ok_ ? last_ok_ : fploc::Pose2{m.x, m.y, m.yaw}, radius_, M_PI};
     std::string where = local ? "near the last pose" : "over the whole plan";
     // Just after a floor change: the connection area between the two floors.
     if (floor_changed_ != 0 && m.utime - floor_changed_ < global_after_us_)
@@ -135,19 +136,19 @@ class RelocalizerNode : public fploc::rt::Node {
         Eigen::Vector2d ctr;
         double rad = 0;
         fploc::localizer::FloorTracker::search_disc(c->polygon, 1.0, &ctr, &rad);
-        region = fploc::SearchRegion{fploc::Pose2{ctr.x(), ctr.y(), 0}, rad, M_PI};
+        region = fploc::reloc::SearchRegion{fploc::Pose2{ctr.x(), ctr.y(), 0}, rad, M_PI};
         where = "in the " + std::string(fploc::to_string(c->kind)) + " area '" + c->name + "' of floor '" + m.floor + "'";
       }
     if (floors_.multi_floor() && where.find("floor '") == std::string::npos) where += " of floor '" + m.floor + "'";
-    const fploc::RelocResult r = relocs_[size_t(floor_)]->locate(frame, region);
-    if (r.status != fploc::RelocStatus::kFound) {
-      const std::string text = std::string(fploc::to_string(r.status)) + " " + where + ": " + r.text;
+    const fploc::reloc::RelocResult r = relocs_[size_t(floor_)]->locate(frame, region);
+    if (r.status != fploc::reloc::RelocStatus::kFound) {
+      const std::string text = std::string(fploc::reloc::to_string(r.status)) + " " + where + ": " + r.text;
       if (text != last_text_) ctx_->error("scan " + std::to_string(m.scan_seq) + ": " + text);
       last_text_ = text;
       return;
     }
     last_text_.clear();
-    std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << " (" << fploc::to_string(st) << "): " << r.text
+    std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << " (" << to_string(st) << "): " << r.text
               << " " << where << "\n";
     out_.publish(fploc::adapters::make_pose_msg(f->utime, seq_++, r.pose, f->roll, f->pitch, f->z,
                                       Eigen::Matrix3d::Identity() * r.fit.rms_m * r.fit.rms_m, f->z_sigma,
@@ -156,7 +157,7 @@ class RelocalizerNode : public fploc::rt::Node {
 
   fploc::rt::Context* ctx_ = nullptr;
   fploc::localizer::FloorMaps floors_;
-  std::vector<std::unique_ptr<fploc::Relocalizer>> relocs_;  // one per floor
+  std::vector<std::unique_ptr<fploc::reloc::Relocalizer>> relocs_;  // one per floor
   int floor_ = 0, floor_from_ = 0;
   int64_t floor_changed_ = 0;
   fploc::rt::Publisher<fploc::pose_t> out_;

@@ -11,7 +11,7 @@ FloorMaps load_floor_maps(const std::string& path, const std::vector<std::string
   o.layer_globs = layers;
   o.units_override = units;
   for (const auto& f : b->floors) {
-    LocalizationMap lm = make_localization_map(load_floor_plan(*b, f.name, o), lookup.empty() ? "annf-exact" : lookup);
+    matcher::LocalizationMap lm = matcher::make_localization_map(load_floor_plan(*b, f.name, o), lookup.empty() ? "annf-exact" : lookup);
     lm.note = "floor '" + f.name + "'" + (lm.note.empty() ? "" : ": " + lm.note);
     m.maps.push_back(std::move(lm));
   }
@@ -19,7 +19,7 @@ FloorMaps load_floor_maps(const std::string& path, const std::vector<std::string
   return m;
 }
 
-FloorMaps one_floor(LocalizationMap map, const std::string& source) {
+FloorMaps one_floor(matcher::LocalizationMap map, const std::string& source) {
   FloorMaps m;
   auto b = std::make_shared<Building>();
   b->source = source;

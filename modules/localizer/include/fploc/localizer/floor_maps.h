@@ -13,7 +13,7 @@ namespace fploc::localizer {
 
 struct FloorMaps {
   std::shared_ptr<const Building> building;
-  std::vector<LocalizationMap> maps;  // one per building floor, same order
+  std::vector<matcher::LocalizationMap> maps;  // one per building floor, same order
   int initial = 0;                    // the floor named by the option ("" = the first)
   bool multi_floor() const { return maps.size() > 1; }
 };
@@ -24,6 +24,6 @@ struct FloorMaps {
 FloorMaps load_floor_maps(const std::string& path, const std::vector<std::string>& layers, const std::string& units,
                           const std::string& floor, const std::string& lookup);
 // A map already loaded (a single plan): a one-floor building named "0".
-FloorMaps one_floor(LocalizationMap map, const std::string& source);
+FloorMaps one_floor(matcher::LocalizationMap map, const std::string& source);
 
 }  // namespace fploc::localizer
