@@ -82,7 +82,7 @@ def floor_at(gtf, t):
 
 
 def score_floors(gt, est, gtf, pose_floor, changes, t0_abs):
-    """Floor rows: poses on the wrong floor (all, and later than 3 s after a floor change), time from each
+    """Floor rows: poses on the wrong floor (all, and those more than 3 s from every floor change), time from each
     floor change to the first pose on the new floor, ATE (horizontal and 3D) over the 10 s after each lift
     ride (from the car's arrival)."""
     ts_f = [g[0] for g in gtf]
@@ -95,8 +95,8 @@ def score_floors(gt, est, gtf, pose_floor, changes, t0_abs):
         i = max(0, bisect.bisect_right(ts_f, e[0]) - 1)
         if f != gtf[i][1]:
             wrong += 1
-            last = max([c["t"] for c in changes if c["t"] <= e[0]], default=-1e18)
-            if e[0] - last > 3.0:
+            # Beyond 3 s of every floor change (the moment of a ramp's change is a convention: its middle).
+            if all(abs(e[0] - c["t"]) > 3.0 for c in changes):
                 wrong_late += 1
     if known == 0:
         return {"floor_scored": False,
