@@ -148,7 +148,10 @@ class MatcherNode : public fploc::rt::Node {
       const fploc::Pose2 at = fp->match.status == FitStatus::kOk || !have_ok_ ? fp->match.pose : last_ok_;
       loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
       for (const auto& s : imu_) loc_->add_imu(s.first, s.second);
-      loc_->set_pose(at, sw->search_radius_m);
+      // A lift: the robot may have turned in the cab and the old plan no longer matched: search the lift's
+      // area. Stairs/ramp: the pose was tracked all the way (one x/y frame), the area can be 25 m long.
+      if (sw->via.kind == fploc::ConnectionKind::kLift) loc_->set_pose(at, sw->search_radius_m);
+      else loc_->set_pose(at);
       *fp = loc_->register_frame(f);
       switch_text_ = tracker_->status_text();
       switch_until_ = f.utime + 3'000'000;

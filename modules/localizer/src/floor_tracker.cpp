@@ -214,6 +214,7 @@ std::optional<FloorSwitch> FloorTracker::update(const FloorObservation& o) {
   }
 
   // ---- stairs / ramp: the climb since entering the area
+  ramp_z_ = 0;
   if (!near_climb) {
     in_climb_area_ = false;
     tilt_climb_ = 0;
@@ -250,6 +251,11 @@ std::optional<FloorSwitch> FloorTracker::update(const FloorObservation& o) {
 
   const std::optional<double> z_climb =
       o.z_known && z0_ ? std::optional<double>(floor_z(o.z) - *z0_) : std::nullopt;
+  {
+    // The segmenter's z did not follow the climb the IMU's tilt measured: floor_z adds it.
+    const double tilt_here = enter_elevation_ + tilt_climb_ - e0;
+    if (tilt_valid_ && z_climb && std::abs(*z_climb) < 0.5 * std::abs(tilt_here)) ramp_z_ = tilt_here;
+  }
   int cand = -1;
   const FloorConnection* cand_via = nullptr;
   std::string cue;
@@ -288,6 +294,7 @@ std::optional<FloorSwitch> FloorTracker::update(const FloorObservation& o) {
   // followed the climb (a ceiling-based z under one ceiling); a z from the ramp's own surface did not move.
   if (z_climb && *z_climb / de > 0.5 * cfg_.switch_fraction) z_offset_ += de;
   switched_in_area_ = true;
+  if (ramp_z_ != 0) ramp_z_ -= de;
   return s;
 }
 

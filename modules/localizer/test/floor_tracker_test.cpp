@@ -202,6 +202,9 @@ double drive_ramp(FloorTracker& tr, bool imu, bool relearn_z) {
       EXPECT_NE(s->reason.find(imu ? "IMU tilt" : "z +1."), std::string::npos) << s->reason;
     }
     if (x > 22) EXPECT_NEAR(tr.floor_z(o.z), 1.2, 0.05) << "x " << x;
+    // On the ramp the height above the current floor follows the climb (IMU tilt or the segmenter's z).
+    if (x > 11 && x < 19 && !(x > 14.5 && x < 17))
+      EXPECT_NEAR(tr.floor_z(o.z) + (tr.floor() == 1 ? 3.3 : 0.0), 1.2 + climb, 0.1) << "x " << x;
   }
   return switch_x;
 }

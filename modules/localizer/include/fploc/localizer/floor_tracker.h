@@ -95,7 +95,11 @@ class FloorTracker {
 
   // The segmenter's z as the height above the current floor (see above); while riding a lift the cab
   // moves with the sensor, so the IMU's height since the ride started is added.
-  double floor_z(double z) const { return z - z_offset_ + (in_lift_ && vertical_.riding() ? vertical_.height() : 0.0); }
+  // On stairs/a ramp whose z the segmenter takes from the sloped floor itself (it does not follow the
+  // climb), the IMU tilt's climb relative to the current floor is added.
+  double floor_z(double z) const {
+    return z - z_offset_ + (in_lift_ && vertical_.riding() ? vertical_.height() : 0.0) + ramp_z_;
+  }
   double z_offset() const { return z_offset_; }
   std::optional<double> nominal_z() const { return z0_; }
   // What the tracker last decided or noticed ("" while nothing happened).
@@ -130,6 +134,7 @@ class FloorTracker {
   double tilt_climb_ = 0;              // since entering (IMU tilt x travel)
   bool tilt_valid_ = false;            // an attitude was known for the integration
   bool switched_in_area_ = false;
+  double ramp_z_ = 0;                  // the climb floor_z adds (see there)
   int confirm_ = 0, confirm_to_ = -1;
   // Lift: the inlier ratio while riding.
   bool in_lift_ = false;
