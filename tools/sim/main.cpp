@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
   app.add_option("--gt-floors", gt_floors, "buildings: the ground-truth floor per scan, CSV t,floor_index,floor,state (default: GT without .tum + .floors.csv)");
   app.add_flag("--no-thresholds", no_thresholds, "buildings: no door thresholds");
   app.add_option("--write-demo-building", demo_building_dir, "write the demo building's plans (ground.json, first.json) into DIR and exit");
-  app.add_option("--scenario", scenario, "room-small-loop|room-large-loop|room-no-loop|corridor-loop|auto-loop + -slow|-medium|-fast");
+  app.add_option("--scenario", scenario, "room-small-loop|room-large-loop|room-no-loop|corridor-loop|auto-loop|building-areas|building-atrium|building-clutter|building-mixed + -slow|-medium|-fast; journeys through the demo building (--plan data/buildings/demo-building.pbtxt): building-twofloor|building-ramp|building-thresholds + -slow|-medium|-fast");
   app.add_option("--seed", seed, "random seed (noise, wobble, clutter)");
   app.add_option("--out", out, "LCM log to write");
   app.add_option("--gt", gt, "ground truth TUM file (one pose per scan, at the scan's first column time)");
