@@ -15,6 +15,7 @@
 #include "fploc/adapters/pose_t.h"
 #include "fploc/floorplan/occupancy.h"
 #include "fploc/laser2d/grid_localizer.h"
+#include "fploc/config/floor_ref.h"
 #include "fploc/runtime/node.h"
 #include "options/laser2d.pb.h"
 
@@ -38,6 +39,7 @@ class Grid2dNode : public fploc::rt::Node {
     const auto& o = ctx.options<fploc::Grid2dOptions>();
     if (o.plan().file().empty()) throw std::runtime_error("grid2d.plan.file: no occupancy map (.yaml) given");
     const std::string path = ctx.resolve_path(o.plan().file());
+    floor_ = fploc::config::floor_ref(o.plan(), path);
     const auto ext = path.size() >= 5 ? path.substr(path.find_last_of('.') + 1) : std::string();
     if (ext != "yaml" && ext != "yml")
       throw std::runtime_error("grid2d.plan.file: '" + path + "' is not a map_server occupancy map (.yaml)");
@@ -98,7 +100,7 @@ class Grid2dNode : public fploc::rt::Node {
                 << int(r.status) << " inl " << r.inlier_ratio << " n " << r.num_points << " win " << r.search_xy_m << " m "
                 << r.search_yaw_rad * 180 / M_PI << " deg score " << r.score << "\n";
     out_.publish(fploc::adapters::make_pose_msg(m.utime, seq_++, r.pose, 0, 0, z_, r.covariance, 0.01, 0.01,
-                                                int8_t(r.status), true, true));
+                                                int8_t(r.status), true, true, floor_.index, floor_.name));
   }
 
   fploc::rt::Context* ctx_ = nullptr;
@@ -109,6 +111,7 @@ class Grid2dNode : public fploc::rt::Node {
   Pose2 mount_;
   double z_ = 0;
   int64_t seq_ = 0;
+  fploc::config::FloorRef floor_;
   bool debug_ = std::getenv("FPLOC_GRID2D_DEBUG") != nullptr;
 };
 
