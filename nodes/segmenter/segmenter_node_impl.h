@@ -2,6 +2,7 @@
 // same message, same options field `segmenter`, so a graph swaps the executable only.
 #pragma once
 #include <fploc/imu_t.hpp>
+#include <fploc/pose_t.hpp>
 #include <fploc/scan_t.hpp>
 #include <fploc/segments_t.hpp>
 
@@ -10,9 +11,11 @@
 #include <string>
 
 #include "fploc/core/scan.h"
+#include "fploc/adapters/pose_t.h"
 #include "fploc/adapters/scan_t.h"
 #include "fploc/adapters/segments_t.h"
 #include "fploc/config/perception.h"
+#include "fploc/floorplan/building.h"
 #include "fploc/runtime/node.h"
 
 namespace fploc {
@@ -23,6 +26,8 @@ class SegmenterNodeT : public rt::Node {
   static rt::NodeSpec spec() {
     return {Traits::kType, "segmenter", Traits::kDescription,
             {rt::input<scan_t>("scan", "OS1_SCAN"), rt::input<imu_t>("imu", "OS1_IMU"),
+             // The localizer's latest pose: places the ceiling points in the building's areas (option building).
+             rt::input<pose_t>("pose", "FPLOC_POSE_LATEST"),
              rt::output<segments_t>("segments", "FPLOC_SEGMENTS")}};
   }
 
@@ -34,6 +39,7 @@ class SegmenterNodeT : public rt::Node {
                                Traits::kExecutable + " (use " + Traits::kOther + ")");
     seg_ = Traits::make(o);
     use_imu_ = o.use_imu_prior();
+    if (o.has_building() && !o.building().file().empty()) use_building(ctx, o.building());
     out_ = ctx.advertise<segments_t>("segments");
     ctx.subscribe<scan_t>("scan", [this](const scan_t& m) { on_scan(m); });
     ctx.subscribe<imu_t>("imu", [this](const imu_t& m) {
@@ -54,6 +60,29 @@ class SegmenterNodeT : public rt::Node {
   }
 
  private:
+  // The floor's area ceilings from the building file, and the pose feedback that places the ceiling points.
+  void use_building(rt::Context& ctx, const PlanSource& src) {
+    const std::string path = ctx.resolve_path(src.file());
+    const Building b = load_building(path);
+    if (b.floor_index(src.floor()) < 0)
+      throw std::runtime_error("segmenter.building.floor: " + path + " has no floor '" + src.floor() + "'");
+    const BuildingFloor& f = b.floor(src.floor());
+    seg::AreaCeilingMap map;
+    map.floor = f.name;
+    map.default_height_m = f.ceiling_height;
+    for (const auto& a : f.areas) map.areas.push_back({a.name, a.polygon, a.height, a.origin, a.slope});
+    seg_->set_areas(map);
+    std::cerr << "[" << ctx.name() << "] " << path << " floor '" << f.name << "': ceiling " << f.ceiling_height
+              << " m (0 = learned), " << f.areas.size() << " areas; plan pose from " << ctx.channel("pose") << "\n";
+    if (ctx.channel("pose").empty())
+      throw std::runtime_error("segmenter.building is set but the pose input is not connected (FPLOC_POSE_LATEST)");
+    ctx.subscribe<pose_t>("pose", [this](const pose_t& m) {
+      const Pose2 p = adapters::pose2_of(m);
+      if (m.status == 2 || !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.yaw)) return;  // LOST
+      seg_->set_plan_pose({m.utime, p.x, p.y, p.yaw, true});
+    });
+  }
+
   void on_scan(const scan_t& m) {
     segments_t msg;
     try {
