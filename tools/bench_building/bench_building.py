@@ -9,7 +9,8 @@ own time (linear interpolation of the truth, no alignment): horizontal ATE (rmse
 LOST transitions, reported as node errors), and ms per scan per node (thread CPU time).
 
 Scenarios: the `building-*` ones (sim/ceiling_map.h: areas with their own ceiling heights and a sloped
-roof, a double-height atrium, lamps/beams/ducts/a drop-ceiling grid, all mixed) and `auto-loop-medium`
+roof, a double-height atrium, lamps/beams/ducts/a drop-ceiling grid, all mixed; the segmenter gets the floor's
+ceilings as a building file, `fploc sim --ceilings-building`, unless --no-building-heights) and `auto-loop-medium`
 with the simulator's default ceiling patches, on every shipped plan (data/plans) unless --plan is given.
 Targets (issue 11): z p99 <= 2 cm, roll/pitch p99 <= 0.2 deg, horizontal ATE <= 1 cm, no LOST.
 
@@ -162,6 +163,11 @@ def bench(a, work, plan, layers, scenario):
         cmd += ["--layers", layer]
     if a.duration:
         cmd += ["--duration", str(a.duration)]
+    building = None
+    if a.building_heights and scenario.startswith("building-"):
+        # The segmenter gets the simulated floor's ceilings as a building file (its areas' heights).
+        building = os.path.join(d, "ceilings.pbtxt")
+        cmd += ["--ceilings-building", building]
     log(f"[{name}] simulating ...")
     _, err = run(cmd)
     info = [l.strip() for l in err.splitlines() if "ceilings" in l or "clutter" in l]
@@ -178,6 +184,8 @@ def bench(a, work, plan, layers, scenario):
     for n in ("matcher", "optimizer"):
         for layer in layers:
             sets.append(f"{n}.plan.layers={layer}")
+    if building:
+        sets.append(f"segmenter.building.file={building}")
     cmd = [os.path.join(BIN, "fploc-replay"), "--graph", a.graph, "--log", logf, "--json"]
     for s in sets:
         cmd += ["--set", s]
@@ -188,6 +196,7 @@ def bench(a, work, plan, layers, scenario):
     scans = nodes.get("features", {}).get("messages", 1) or 1
     ms = {n: round(nodes[n].get("cpu_ms", nodes[n]["total_ms"]) / scans, 3) for n in PIPELINE if n in nodes}
     row = {"plan": os.path.relpath(plan, ROOT), "scenario": scenario, "scans": scans, "sim": info,
+           "segmenter_building": building is not None,
            "lost": nodes.get("matcher", {}).get("errors", 0), "ms_per_scan": ms}
     est = read_tum(wo) if os.path.exists(wo) else []
     m, series = score(gt, est)
@@ -217,6 +226,10 @@ def main():
     ap.add_argument("--graph", default=os.path.join(ROOT, "graphs", "paper.pbtxt"))
     ap.add_argument("--plots", help="write z-against-ground-truth SVGs into this folder")
     ap.add_argument("--keep", help="keep the work folder here")
+    ap.add_argument("--no-building-heights", dest="building_heights", action="store_false",
+                    help="building-* scenarios: do not give the segmenter the simulated floor's ceilings as a building "
+                         "file (segmenter.building: area heights looked up per ceiling point with the pose feedback); "
+                         "it then learns one height online, as on a bare plan")
     ap.add_argument("--json", action="store_true", help="(JSON is always printed on stdout)")
     a = ap.parse_args()
     plans = [os.path.abspath(p) for p in (a.plan or [os.path.join(ROOT, "data", "plans", "room.json"),

@@ -19,5 +19,7 @@ for r in d["rows"]:
     assert set(r["ms_per_scan"]) == {"segmenter", "features", "matcher", "optimizer"}, r
     assert os.path.getsize(r["plot"]) > 1000 and open(r["plot"]).read().startswith("<svg"), r
 assert "ceilings: mixed" in " ".join(d["rows"][0]["sim"]), d["rows"][0]
+# building-*: the segmenter got the simulated ceilings as a building file (segmenter.building + pose feedback).
+assert d["rows"][0]["segmenter_building"] is True and d["rows"][1]["segmenter_building"] is False, d["rows"]
 print("bench building smoke:", [(r["scenario"], r["z_err_p99_m"], r["rp_err_p99_deg"]) for r in d["rows"]])
 PY
