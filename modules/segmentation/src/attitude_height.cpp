@@ -105,14 +105,19 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
       // else the floor.
       bool ground_better = true;
       const char* by = "floors are level more often than ceilings";
+      char by_buf[120];
       if (imu.valid && imu.trusted) {
         ground_better = up_g.dot(imu.up) > up_c.dot(imu.up);
         by = "IMU gravity";
-      } else if (areas_on && census_.sloped_fraction < k::kAreaFlatMaxSloped && census_.known_fraction > k::kAreaKnownMin) {
-        ground_better = false;
-        by = "the building's ceiling is flat there (a ramp or a threshold under the robot)";
-      } else if (areas_on && census_.sloped_fraction > 1.0 - k::kAreaFlatMaxSloped) {
-        by = "the building's ceiling is sloped there";
+      } else if (areas_on && census_.known_fraction > k::kAreaKnownMin) {
+        // The building's ceiling heights: under the right attitude the ceiling points lie at their areas'
+        // heights (one z for all); under the wrong one they trend across the scan (a ramp seen as a
+        // sloped ceiling, or a compromise plane over two ceilings taken as level).
+        const double sc = area_spread(up_c), sg = area_spread(up_g);
+        ground_better = sg <= sc;
+        std::snprintf(by_buf, sizeof by_buf, "the building's ceiling heights fit it better: spread %.1f cm vs %.1f cm",
+                      100 * std::min(sc, sg), 100 * std::max(sc, sg));
+        by = by_buf;
       } else if (imu.valid) {
         ground_better = up_g.dot(imu.up) > up_c.dot(imu.up);
         by = "IMU gravity (shaken)";

@@ -64,7 +64,7 @@ bool AttitudeHeight::census(const Segmentation& out, const Candidates& upper, co
   const size_t stride = std::max<size_t>(1, (size_t(std::max(0, out.ceiling.inliers)) + k::kAreaMaxPoints - 1) / k::kAreaMaxPoints);
   size_t seen = 0;
   std::map<int, int> count;
-  int known = 0, sloped = 0;
+  int known = 0;
   for (const Eigen::Vector3f& pf : upper.p) {
     const Eigen::Vector3d p = pf.cast<double>();
     if (std::abs(n.dot(p) + d) > band) continue;
@@ -77,7 +77,6 @@ bool AttitudeHeight::census(const Segmentation& out, const Candidates& upper, co
     cs.area.push_back(a);
     ++count[a];
     if (area_h_.height_at(a, xy) > 0) ++known;
-    if (a >= 0 && areas_.areas[size_t(a)].slope.squaredNorm() > 0) ++sloped;
   }
   if (cs.p.empty()) return false;
   const double total = double(cs.p.size());
@@ -90,8 +89,22 @@ bool AttitudeHeight::census(const Segmentation& out, const Candidates& upper, co
     }
   cs.dominant_fraction = best / total;
   cs.known_fraction = known / total;
-  cs.sloped_fraction = sloped / total;
   return true;
+}
+
+double AttitudeHeight::area_spread(const Eigen::Vector3d& up) const {
+  std::vector<double> zi;
+  zi.reserve(census_.p.size());
+  for (size_t i = 0; i < census_.p.size(); ++i) {
+    const double H = area_h_.height_at(census_.area[i], census_.xy[i]);
+    if (H > 0) zi.push_back(H - up.dot(census_.p[i].cast<double>()));
+  }
+  if (zi.size() < 3) return 1e9;
+  std::nth_element(zi.begin(), zi.begin() + zi.size() / 2, zi.end());
+  const double m = zi[zi.size() / 2];
+  for (double& v : zi) v = std::abs(v - m);
+  std::nth_element(zi.begin(), zi.begin() + zi.size() / 2, zi.end());
+  return k::kMadToSigma * zi[zi.size() / 2];
 }
 
 void AttitudeHeight::accept_z(Segmentation& out, double z, double sigma, HeightSource src) {

@@ -62,7 +62,6 @@ constexpr double kHoldGrowth = 2.0;                 // sigma growth per held sca
 constexpr double kUnknownZSigmaM = 1e3;             // z unknown
 // With a building's area ceilings (attitude_height_areas.cpp):
 constexpr size_t kAreaMaxPoints = 3000;             // ceiling inliers looked up per scan (subsampled)
-constexpr double kAreaFlatMaxSloped = 0.05;         // <= 5 % of the ceiling points under a sloped area: flat
 constexpr double kAreaKnownMin = 0.5;               // >= half of them with a height (the building's or learned)
 constexpr double kAreaLearnFraction = 0.9;          // learn an area's height from a ceiling >= 90 % in it
 constexpr double kPoseMaxAgeS = 1.0;                // a plan pose older than this is not used

@@ -63,6 +63,8 @@ class AttitudeHeight {
   // The ceiling inliers' areas (under the plan pose at the scan's time); false without a fresh pose.
   bool census(const Segmentation& out, const Candidates& upper, const Eigen::Vector3d& up_c);
   void area_z(Segmentation& out, const Eigen::Vector3d& up, bool ground_level);
+  // Robust spread of the per-point z (area height - height above the sensor along `up`) over the census.
+  double area_spread(const Eigen::Vector3d& up) const;
   bool plan_pose_at(int64_t utime, PlanPose& p) const;
   void accept_z(Segmentation& out, double z, double sigma, HeightSource src);
   struct Census {
@@ -70,7 +72,7 @@ class AttitudeHeight {
     std::vector<Eigen::Vector2d> xy;     // their plan x/y
     std::vector<int> area;               // their area (-1 = the floor's default region)
     int dominant = -1;                   // the area holding most of them
-    double dominant_fraction = 0, known_fraction = 0, sloped_fraction = 0;
+    double dominant_fraction = 0, known_fraction = 0;
   };
   Census census_;
 
