@@ -83,11 +83,23 @@ void AttitudeHeight::hold(Segmentation& out, const ImuPrior& imu) {
 
 Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, const Candidates* upper) {
   const bool c = out.ceiling.found, g = out.ground.found;
-  const Eigen::Vector3d up_c = -out.ceiling.coeffs.head<3>();  // normals point into the room
+  Eigen::Vector3d up_c = -out.ceiling.coeffs.head<3>();  // normals point into the room
   const Eigen::Vector3d up_g = out.ground.coeffs.head<3>();
 
   // The building's view of the ceiling points (their areas), when the floor's areas and a plan pose are known.
   const bool areas_on = have_areas_ && upper != nullptr && c && census(out, *upper, up_c);
+  if (areas_on) {
+    // A ceiling the building says is sloped (over a ramp, under a roof) gives gravity's up once turned by
+    // its slope.
+    double corr = 0;
+    const Eigen::Vector3d level = building_level_up(up_c, &corr);
+    if (corr > 0) {
+      char buf[120];
+      std::snprintf(buf, sizeof buf, "ceiling sloped %.2f deg per the building: its normal turned by that", corr / k::kDeg);
+      note(out, buf);
+      up_c = level;
+    }
+  }
 
   // ---- roll / pitch ----
   bool use_ceiling = c, use_ground = !c && g;

@@ -48,6 +48,7 @@ bool AttitudeHeight::plan_pose_at(int64_t utime, PlanPose& p) const {
 
 bool AttitudeHeight::census(const Segmentation& out, const Candidates& upper, const Eigen::Vector3d& up_c) {
   PlanPose pp;
+  last_utime_ = out.utime;
   if (!plan_pose_at(out.utime, pp)) return false;
   Census& cs = census_;
   cs.p.clear();
@@ -90,6 +91,38 @@ bool AttitudeHeight::census(const Segmentation& out, const Candidates& upper, co
   cs.dominant_fraction = best / total;
   cs.known_fraction = known / total;
   return true;
+}
+
+Eigen::Vector3d AttitudeHeight::building_level_up(const Eigen::Vector3d& up_c, double* correction_rad) const {
+  // The building's ceiling slope of the area holding most of the ceiling points (the plane fitted lies on
+  // one surface); used only when turning the normal by it makes the points fit their heights better.
+  *correction_rad = 0;
+  const int A = census_.dominant;
+  if (A < 0 || !area_h_.known(A) || census_.dominant_fraction < k::kAreaKnownMin) return up_c;
+  const Eigen::Vector2d s = areas_.areas[size_t(A)].slope;
+  if (s.norm() < k::kMinBuildingSlope) return up_c;
+  // The ceiling's upward normal in the plan frame is n_w; the sensor measured it as up_c. Gravity's up in
+  // the sensor frame is up_c turned by the rotation taking n_w to e_z, expressed in the sensor frame (which
+  // needs the attitude itself: a few fixed-point steps, from the ceiling's).
+  const Eigen::Vector3d n_w = Eigen::Vector3d(-s.x(), -s.y(), 1.0).normalized();
+  const Eigen::Vector3d a = n_w.cross(Eigen::Vector3d::UnitZ());
+  const double theta = std::atan2(a.norm(), n_w.z());
+  const Eigen::Vector3d axis_w = a.normalized();
+  PlanPose pp;
+  if (!plan_pose_at(last_utime_, pp)) return up_c;
+  Eigen::Vector3d up = up_c;
+  for (int it = 0; it < 4; ++it) {
+    double roll = 0, pitch = 0;
+    roll_pitch_from_up(up, roll, pitch);
+    const Eigen::Matrix3d R = (Eigen::AngleAxisd(pp.yaw, Eigen::Vector3d::UnitZ()) *
+                               Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                               Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+                                  .toRotationMatrix();
+    up = (Eigen::AngleAxisd(theta, R.transpose() * axis_w) * up_c).normalized();
+  }
+  if (area_spread(up) >= area_spread(up_c)) return up_c;
+  *correction_rad = theta;
+  return up;
 }
 
 double AttitudeHeight::area_spread(const Eigen::Vector3d& up) const {

@@ -69,6 +69,7 @@ constexpr double kPoseMaxExtrapolateS = 0.3;        // extrapolated from the las
 constexpr double kImuTrustNormTolMs2 = 0.4;         // IMU trusted: |mean accel| within this of g
 constexpr double kImuTrustSpreadMs2 = 0.6;          // and the samples' rms spread below this
 constexpr double kGravityMs2 = 9.80665;
+constexpr double kMinBuildingSlope = 1e-3;          // m/m: below this the building's ceiling is flat
 constexpr double kOnSlopeDeg = 1.0;                 // tilted this far from the usual level attitude: on a slope
 constexpr double kLevelUpGain = 0.05;               // running mean of the level attitude (~20 scans)
 

@@ -196,6 +196,28 @@ TEST(AreaHeights, RampWithAFlatBuildingCeiling) {
   EXPECT_TRUE(w.said_building);
 }
 
+// A ramp whose ceiling follows it (3.2 m above its surface, as in a ramp corridor): ceiling and floor
+// agree and both are tilted 2.9 deg with the robot; only the building's sloped ceiling area says so.
+TEST(AreaHeights, RampUnderAParallelCeiling) {
+  synth::Room room;
+  room.half_x = 20;
+  room.height = 3.2;
+  room.wall_top = 3.6;
+  room.ramp = {-2.0, 4.0, 0.3, true};
+  AreaCeilingMap map;
+  map.default_height_m = 3.2;
+  AreaCeiling ramp = rect_area("ramp", -2.0, -6.0, 4.0, 6.0, 3.2);
+  ramp.slope = {0.05, 0.0};
+  map.areas.push_back(ramp);
+  map.areas.push_back(rect_area("landing", 4.0, -6.0, 20.0, 6.0, 3.5));
+  Options o;
+  o.areas = &map;
+  const Walk w = walk(room, line(-12.0, 10.0, 70), 600, o);
+  EXPECT_LT(w.max_rp_err, 0.2 * kDeg);
+  EXPECT_LT(w.max_z_err, 0.02);
+  EXPECT_LT(w.max_step, 0.02);
+}
+
 // A door threshold: one scan jolted (1.5 deg pitch, 0.8 deg roll, 1.2 cm up) with the IMU shaken in it.
 // Both planes move with the robot: roll/pitch and z follow it.
 TEST(AreaHeights, ThresholdJolt) {

@@ -65,6 +65,10 @@ class AttitudeHeight {
   void area_z(Segmentation& out, const Eigen::Vector3d& up, bool ground_level);
   // Robust spread of the per-point z (area height - height above the sensor along `up`) over the census.
   double area_spread(const Eigen::Vector3d& up) const;
+  // Gravity's up from the ceiling's measured up when the building says the ceiling over these points is
+  // sloped (a ceiling following a ramp, a roof): the measured normal turned by the known slope.
+  Eigen::Vector3d building_level_up(const Eigen::Vector3d& up_c, double* correction_rad) const;
+  int64_t last_utime_ = 0;
   bool plan_pose_at(int64_t utime, PlanPose& p) const;
   void accept_z(Segmentation& out, double z, double sigma, HeightSource src);
   struct Census {

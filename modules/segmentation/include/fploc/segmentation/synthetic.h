@@ -27,6 +27,7 @@ struct Room {
   // landing); the ceiling stays at `height` above z = 0. Off when x1 <= x0.
   struct Ramp {
     double x0 = 0, x1 = 0, rise = 0;
+    bool ceiling_follows = false;  // the ceiling `height` above the floor everywhere (rises with the ramp)
   } ramp;
   double floor_at(double x) const;  // floor height under x
 };
