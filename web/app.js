@@ -4,6 +4,7 @@ import { MapView } from './map.js';
 import { Plot } from './plot.js';
 import { PlanIndex } from './nearest.js';
 import { planDiffLayer } from './plandiff.js';
+import { FloorView } from './floors.js';
 
 const $ = (id) => document.getElementById(id);
 const DEG = 180 / Math.PI;
@@ -114,6 +115,7 @@ function renderPoseBox() {
     ['x, y, z [m]', p ? `${fmt(p.x)}, ${fmt(p.y)}, ${fmt(p.z)}` : '–'],
     ['roll, pitch, yaw [°]', p ? `${fmt(p.roll * DEG, 2)}, ${fmt(p.pitch * DEG, 2)}, ${fmt(p.yaw * DEG, 1)}` : '–'],
     ['status', p ? ['OK', 'POOR', 'LOST'][p.status] ?? p.status : '–'],
+    ['floor', p ? floors.describe(p.floor) : '–'],
     ['ATE so far', p && p.ate_n ? `${fmt(p.ate_rmse)} m (${p.ate_n} poses)` : (g ? 'waiting for matches' : 'no ground truth')],
     ['frame pose', f ? `${f.status_text || f.status} · inliers ${fmt(100 * f.inlier_ratio, 0)} % · ${fmt(f.solve_ms, 1)} ms` : '–'],
     ['features', S.features ? `${S.features.n} (shown ${S.features.shown})` +
@@ -214,6 +216,7 @@ function onPose(p) {
   if (S.trail.length && (S.lastPoseSeq === undefined || p.seq > S.lastPoseSeq + 1)) fillGap(S.trail[S.trail.length - 1][2]);
   S.lastPoseSeq = p.seq;
   S.pose = p;
+  floors.setRobotFloor(p.floor);
   addToTrail(S.trail, p.utime, p.x, p.y);
   const lat = Date.now() - p.utime / 1000;
   if (lat > -50 && lat < 10000) {  // only when the stamp is this machine's wall clock (live runs)
@@ -248,6 +251,7 @@ async function loadStatic() {
     fetch('/api/history', { cache: 'no-store' }).then((r) => r.json()),
   ]);
   if (plan) { map.setPlan(plan); planIndex = new PlanIndex(plan); }
+  await floors.load().catch((e) => console.warn('floors', e));
   S.trail = []; S.gtTrail = []; t0 = null; S.lastPoseSeq = undefined; S.lastGtSeq = undefined;
   Object.values(plots).forEach((p) => p.clear());
   let sq = 0, n = 0;
@@ -342,6 +346,8 @@ $('robot').addEventListener('change', () => {
 });
 
 $('fit').addEventListener('click', () => map.fit());
+// The map shows the pose's floor, or the floor picked in the selector (same x/y frame: the view stays).
+const floors = new FloorView($('floor'), (plan) => { map.setPlan(plan, true); planIndex = new PlanIndex(plan); renderPoseBox(); });
 $('showfeat').addEventListener('change', () => map.invalidate());
 $('follow').addEventListener('change', () => map.invalidate());
 setConnected(false);

@@ -50,7 +50,12 @@ export class MapView {
     if (!this.userMoved) this.fit(false);
     this.invalidate();
   }
-  setPlan(plan) { this.plan = plan; this.userMoved = false; this.fit(false); this.invalidate(); }
+  // keepView: another floor of the same building (same x/y frame): the view stays where it is.
+  setPlan(plan, keepView = false) {
+    this.plan = plan;
+    if (!keepView) { this.userMoved = false; this.fit(false); }
+    this.invalidate();
+  }
   fit(user = true) {
     const b = this.plan && this.plan.bounds;
     if (!b) return;

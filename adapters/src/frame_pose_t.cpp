@@ -29,6 +29,8 @@ frame_pose_t to_msg(const localizer::FramePose& f, int64_t seq, double solve_ms)
   o.rms_residual_m = r.fit.rms_m;
   o.iterations = r.iterations;
   o.solve_ms = solve_ms;
+  o.floor_index = int16_t(f.floor_index);
+  o.floor = f.floor;
   return o;
 }
 
@@ -50,6 +52,8 @@ localizer::FramePose from_msg(const frame_pose_t& m) {
   f.roll = m.roll;
   f.pitch = m.pitch;
   f.z = m.z;
+  f.floor_index = m.floor_index;
+  f.floor = m.floor;
   return f;
 }
 

@@ -7,13 +7,15 @@ namespace fploc::adapters {
 
 pose_t make_pose_msg(int64_t utime, int64_t seq, const Pose2& p, double roll, double pitch, double z,
                      const Eigen::Matrix3d& c, double z_sigma, double rp_sigma, int8_t status, bool keyframe,
-                     bool final_estimate) {
+                     bool final_estimate, int floor_index, const std::string& floor) {
   pose_t m;
   m.utime = utime;
   m.seq = seq;
   m.status = status;
   m.keyframe = keyframe;
   m.final_estimate = final_estimate;
+  m.floor_index = int16_t(floor_index);
+  m.floor = floor;
   const StampedPose sp = StampedPose::from_rpy(0, Eigen::Vector3d(p.x, p.y, z), roll, pitch, p.yaw);
   m.position[0] = sp.p.x();
   m.position[1] = sp.p.y();
@@ -33,9 +35,9 @@ pose_t make_pose_msg(int64_t utime, int64_t seq, const Pose2& p, double roll, do
   return m;
 }
 
-pose_t to_msg(const optimizer::PoseOut& p, int64_t seq) {
+pose_t to_msg(const optimizer::PoseOut& p, int64_t seq, int floor_index, const std::string& floor) {
   return make_pose_msg(p.utime, seq, p.pose, p.roll, p.pitch, p.z, p.covariance, p.z_sigma, p.roll_pitch_sigma,
-                       int8_t(p.status), p.keyframe, p.final_estimate);
+                       int8_t(p.status), p.keyframe, p.final_estimate, floor_index, floor);
 }
 
 Pose2 pose2_of(const pose_t& m) {

@@ -17,6 +17,8 @@ TEST(FramePoseAdapter, RoundTripAndSanitising) {
   f.match.covariance = Eigen::Matrix3d::Identity() * 0.01;
   f.roll = 0.01;
   f.z = 1.3;
+  f.floor_index = 1;
+  f.floor = "first";
   const frame_pose_t m = adapters::to_msg(f, 11, 0.0);
   EXPECT_EQ(m.seq, 11);
   EXPECT_EQ(m.status, 1);
@@ -26,6 +28,9 @@ TEST(FramePoseAdapter, RoundTripAndSanitising) {
   EXPECT_EQ(g.match.pose.yaw, 0.3);
   EXPECT_EQ(g.match.twist.vx, 0.5);
   EXPECT_EQ(g.z, 1.3);
+  EXPECT_EQ(m.floor_index, 1);
+  EXPECT_EQ(g.floor_index, 1);
+  EXPECT_EQ(g.floor, "first");
   frame_pose_t bad = m;
   bad.twist[1] = std::numeric_limits<double>::quiet_NaN();
   bad.status = 9;

@@ -34,6 +34,7 @@
 #include "fploc/floorplan/io.h"
 #include "fploc/adapters/features_t.h"
 #include "fploc/adapters/pose_t.h"
+#include "fploc/config/floor_ref.h"
 #include "fploc/runtime/node.h"
 
 namespace {
@@ -68,6 +69,7 @@ class AmclNode : public fploc::rt::Node {
     if (o.plan().file().empty()) throw std::runtime_error("amcl.plan.file: no floor plan given");
     const std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
     const fploc::FloorPlan plan = fploc::load_floor_plan(ctx.resolve_path(o.plan().file()), layers, o.plan().units(), o.plan().floor());
+    floor_ = fploc::config::floor_ref(o.plan(), ctx.resolve_path(o.plan().file()));
     const am::Settings s = fploc::config::config_of(o);
     cfg_ = s.filter;
     amcl_ = std::make_unique<am::Amcl>(plan, cfg_);
@@ -226,7 +228,7 @@ class AmclNode : public fploc::rt::Node {
     const Pose2 odo = wheel_->update(truth);
     if (odom_out_.valid() && !odom_out_.channel().empty())
       odom_out_.publish(fploc::adapters::make_pose_msg(m.utime, odom_seq_++, odo, 0, 0, m.position[2], Eigen::Matrix3d::Zero(), 0, 0, 0,
-                                             false, true));
+                                             false, true, -1, ""));  // the odometry frame: no floor
     on_odom(m.utime, odo, m.seq);
   }
 
@@ -313,7 +315,7 @@ class AmclNode : public fploc::rt::Node {
     const bool ok = spread <= cfg_.converged_dist;
     if (ok) ++ok_;
     out_.publish(fploc::adapters::make_pose_msg(f.utime, seq_++, p, f.roll, f.pitch, f.z, cov, f.z_sigma, f.rp_sigma, ok ? 0 : 1,
-                                      info.updated, true));
+                                      info.updated, true, floor_.index, floor_.name));
     ++scans_;
     if (info.updated) {
       ++updates_;
@@ -329,6 +331,7 @@ class AmclNode : public fploc::rt::Node {
 
   static constexpr size_t kMaxPending = 50;
   fploc::rt::Context* ctx_ = nullptr;
+  fploc::config::FloorRef floor_;
   am::Config cfg_;
   std::unique_ptr<am::Amcl> amcl_;
   std::unique_ptr<am::WheelOdometrySim> wheel_;

@@ -27,6 +27,7 @@
 #include "model.h"
 #include "plan_diff_json.h"
 #include "options/tools.pb.h"
+#include "floors_json.h"
 #include "plan_json.h"
 #include "web_path.h"
 #include "http_server.h"
@@ -166,9 +167,11 @@ class DashboardNode : public fploc::rt::Node {
     const std::string path = ctx_->resolve_path(o.plan().file());
     try {
       std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
-      FloorPlan plan = load_plan_file(path, layers, o.plan().units(), o.plan().floor());
-      model_->set_plan_json(plan_to_json(plan));
-      std::cerr << "[" << ctx_->name() << "] plan " << path << ": " << plan.elements.size() << " elements\n";
+      // Every floor of a building (the page shows the pose's floor or the one the viewer picks).
+      floors_ = load_floor_plans(path, layers, o.plan().units(), o.plan().floor());
+      model_->set_plan_json(floors_.plan_json.at(floors_.initial));
+      std::cerr << "[" << ctx_->name() << "] plan " << path << ": " << floors_.plan_json.size() << " floor(s), showing '"
+                << floors_.initial << "'\n";
     } catch (const std::exception& e) {
       ctx_->error(std::string("dashboard.plan.file: ") + e.what());
       model_->set_plan_json("null");
@@ -195,7 +198,16 @@ class DashboardNode : public fploc::rt::Node {
       return text(405, "read-only dashboard\n");
     }
     if (req.method != "GET" && req.method != "HEAD") return text(405, "read-only dashboard\n");
-    if (req.path == "/api/plan") return json_reply(model_->plan_json());
+    if (req.path == "/api/plan") {
+      if (auto f = req.query.find("floor"); f != req.query.end() && !f->second.empty()) {
+        auto it = floors_.plan_json.find(f->second);
+        if (it == floors_.plan_json.end()) return text(404, "no floor '" + f->second + "' in the plan\n");
+        return json_reply(it->second);
+      }
+      return json_reply(model_->plan_json());
+    }
+    if (req.path == "/api/floors")
+      return json_reply(floors_.floors_json.empty() ? std::string("{\"floors\":[],\"initial\":null}") : floors_.floors_json);
     if (req.path == "/api/state") return json_reply(model_->state_json());
     if (req.path == "/api/info") return json_reply(model_->info_json());
     if (req.path == "/api/history") {
@@ -311,6 +323,7 @@ class DashboardNode : public fploc::rt::Node {
   std::string bind_, token_;
   int port_ = 8080;
   double max_hz_ = 20;
+  FloorPlans floors_;  // set in setup, read by the HTTP thread
   fs::path web_root_;
   bool listening_ = false, stopping_ = false, bind_error_reported_ = false;
   std::mutex cmd_mu_;

@@ -49,6 +49,8 @@ std::string pose_view(const fploc::pose_t& m, const Rpy& r, const AteFigure& ate
             {"err", ate.err ? num(r6(*ate.err)) : json(nullptr)},
             {"ate_rmse", num(r6(ate.rmse))},
             {"ate_n", ate.n},
+            {"floor_index", int(m.floor_index)},
+            {"floor", m.floor},
             {"rx_us", wall_us}};
   return j.dump();
 }
@@ -85,6 +87,8 @@ std::string frame_pose_view(const fploc::frame_pose_t& m, double frame_rate_hz, 
             {"rms_residual_m", num(r6(m.rms_residual_m))},
             {"solve_ms", num(r6(m.solve_ms))},
             {"frame_rate_hz", num(r6(frame_rate_hz))},
+            {"floor_index", int(m.floor_index)},
+            {"floor", m.floor},
             {"rx_us", wall_us}};
   return j.dump();
 }

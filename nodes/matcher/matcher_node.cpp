@@ -1,12 +1,15 @@
 // fploc-matcher: FPLOC_FEATURES (+ OS1_IMU yaw rate) -> single-frame registration -> FPLOC_FRAME_POSE
 // for every scan: the SFR step of fploc::localizer::Localizer. The map (plan or .fpmap) and the look-up
-// come from the `matcher` options.
+// come from the `matcher` options. A building (.pbtxt/.ifc) loads every floor; the FloorTracker (IMU
+// accelerometer + the frames) decides the floor, the matcher switches to that floor's plan, searches the
+// connection area there, and frame_pose_t carries the floor (the optimizer and relocalizer follow it).
 #include <fploc/features_t.hpp>
 #include <fploc/frame_pose_t.hpp>
 #include <fploc/imu_t.hpp>
 #include <fploc/pose_t.hpp>
 
 #include <chrono>
+#include <deque>
 #include <cmath>
 #include <iostream>
 #include <map>
@@ -16,6 +19,9 @@
 #include "fploc/adapters/features_t.h"
 #include "fploc/adapters/frame_pose_t.h"
 #include "fploc/adapters/pose_t.h"
+#include "fploc/floorplan/building.h"
+#include "fploc/localizer/floor_maps.h"
+#include "fploc/localizer/floor_tracker.h"
 #include "fploc/config/localization.h"
 #include "fploc/config/plan_source.h"
 #include "fploc/localizer/localizer.h"
@@ -45,9 +51,20 @@ class MatcherNode : public fploc::rt::Node {
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::MatcherOptions>();
-    map_ = fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); },
-                                   "matcher.plan");
-    loc_ = std::make_unique<fploc::localizer::Localizer>(*map_.lookup, fploc::config::localizer_config(o));
+    const std::string path = o.plan().file().empty() ? "" : ctx.resolve_path(o.plan().file());
+    if (!path.empty() && fploc::is_building_file(path)) {
+      const std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
+      floors_ = fploc::localizer::load_floor_maps(path, layers, o.plan().units(), o.plan().floor(), o.lookup());
+      for (const auto& m : floors_.maps) std::cerr << "[" << ctx.name() << "] " << m.note << "\n";
+    } else {
+      floors_ = fploc::localizer::one_floor(
+          fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); }, "matcher.plan"),
+          path);
+    }
+    floor_ = floors_.initial;
+    if (floors_.multi_floor()) tracker_.emplace(floors_.building, floor_);
+    cfg_ = fploc::config::localizer_config(o);
+    loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
     // The graph's initial pose is where the run starts; a restarted matcher (crash, module swap) waits for
     // a pose instead (FPLOC_INITIAL_POSE: the relocalizer searches around the last good pose).
     if (!o.wait_for_initial_pose() && ctx.restarts() == 0)
@@ -62,6 +79,18 @@ class MatcherNode : public fploc::rt::Node {
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.yaw)) {
         ctx_->error("initial_pose seq " + std::to_string(m.seq) + ": non-finite pose (ignored)");
         return;
+      }
+      // A pose on another floor (an operator's, a relocalization's): that floor's plan from now on.
+      if (m.floor_index >= 0 && size_t(m.floor_index) < floors_.maps.size() && m.floor_index != floor_) {
+        const std::string from = floors_.building->floors[size_t(floor_)].name;
+        floor_ = m.floor_index;
+        loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
+        for (const auto& s : imu_) loc_->add_imu(s.first, s.second);
+        if (tracker_) tracker_->set_floor(floor_, "initial pose on floor '" + m.floor + "' (was '" + from + "')");
+        std::cerr << "[" << ctx_->name() << "] initial pose on floor '" << m.floor << "' (was '" << from << "')\n";
+      } else if (m.floor_index >= int(floors_.maps.size())) {
+        ctx_->error("initial_pose seq " + std::to_string(m.seq) + ": floor_index " + std::to_string(m.floor_index) +
+                    " but the plan has " + std::to_string(floors_.maps.size()) + " floor(s) (floor kept)");
       }
       // Search within 3 sigma of the message's position covariance when it has one.
       const double var = std::max(m.covariance[0], m.covariance[7]);
@@ -88,7 +117,44 @@ class MatcherNode : public fploc::rt::Node {
   }
 
  private:
-  void on_imu(const fploc::imu_t& m) { loc_->add_imu(m.utime, m.gyro[2]); }
+  void on_imu(const fploc::imu_t& m) {
+    loc_->add_imu(m.utime, m.gyro[2]);
+    if (tracker_) tracker_->add_imu(m.utime, {m.accel[0], m.accel[1], m.accel[2]});
+    imu_.push_back({m.utime, m.gyro[2]});
+    while (imu_.size() > 400) imu_.pop_front();
+  }
+
+  // The tracker's view of a registered frame; on a floor change: the new floor's Localizer, started at
+  // the frame's pose with the connection area as its search region, registers the frame again.
+  void track_floor(const fploc::FeatureFrame& f, fploc::localizer::FramePose* fp) {
+    fploc::localizer::FloorObservation ob;
+    ob.utime = f.utime;
+    ob.pose = fp->match.pose;
+    ob.pose_ok = fp->match.status == FitStatus::kOk;
+    ob.inlier_ratio = fp->match.fit.inlier_ratio;
+    ob.z = fp->z;
+    ob.z_known = fploc::z_known(f);
+    ob.roll = f.roll, ob.pitch = f.pitch;
+    ob.roll_pitch_known = fploc::roll_pitch_known(f);
+    const bool registered = fp->match.status != FitStatus::kNotInitialised;
+    std::optional<fploc::localizer::FloorSwitch> sw;
+    if (registered) sw = tracker_->update(ob);
+    if (!sw && fp->match.status == FitStatus::kOk) last_ok_ = fp->match.pose, have_ok_ = true;
+    if (sw) {
+      floor_ = sw->to;
+      std::cerr << "[" << ctx_->name() << "] scan " << f.scan_seq << ": " << tracker_->status_text() << "\n";
+      // Where to start on the new floor: this frame's pose, or the last good one when the old floor's plan
+      // no longer matched (after a lift ride the robot stands where it entered the cab).
+      const fploc::Pose2 at = fp->match.status == FitStatus::kOk || !have_ok_ ? fp->match.pose : last_ok_;
+      loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
+      for (const auto& s : imu_) loc_->add_imu(s.first, s.second);
+      loc_->set_pose(at, sw->search_radius_m);
+      *fp = loc_->register_frame(f);
+      switch_text_ = tracker_->status_text();
+      switch_until_ = f.utime + 3'000'000;
+    }
+    fp->z = tracker_->floor_z(fp->z);
+  }
 
   void on_features(const fploc::features_t& m) {
     const auto t_start = std::chrono::steady_clock::now();
@@ -101,18 +167,33 @@ class MatcherNode : public fploc::rt::Node {
       return;
     }
     if (dropped) ctx_->error("features seq " + std::to_string(m.seq) + ": " + std::to_string(dropped) + " non-finite points dropped");
-    const fploc::localizer::FramePose fp = loc_->register_frame(f);
+    fploc::localizer::FramePose fp = loc_->register_frame(f);
+    if (tracker_) track_floor(f, &fp);
+    fp.floor_index = floor_;
+    fp.floor = floors_.building->floors[size_t(floor_)].name;
     const fploc::matcher::MatchResult& r = fp.match;
     // Wall-clock only outside replay (outputs must be reproducible there).
     const double solve_ms =
         ctx_->composed() ? 0.0 : std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
     if (r.status == fploc::matcher::FitStatus::kLost && last_status_ != fploc::matcher::FitStatus::kLost) ctx_->error("LOST at scan " + std::to_string(m.scan_seq) + ": " + r.text);
     last_status_ = r.status;
-    out_.publish(fploc::adapters::to_msg(fp, seq_++, solve_ms));
+    fploc::frame_pose_t msg = fploc::adapters::to_msg(fp, seq_++, solve_ms);
+    // A floor change is said on the frames of the next 3 s (never a silent switch).
+    if (!switch_text_.empty() && m.utime <= switch_until_)
+      msg.status_text += (msg.status_text.empty() ? "" : "; ") + switch_text_;
+    out_.publish(msg);
   }
 
   fploc::rt::Context* ctx_ = nullptr;
-  fploc::matcher::LocalizationMap map_;
+  fploc::localizer::FloorMaps floors_;
+  int floor_ = 0;
+  std::optional<fploc::localizer::FloorTracker> tracker_;
+  fploc::localizer::Config cfg_;
+  std::deque<std::pair<int64_t, double>> imu_;  // recent gyro z (a new floor's Localizer gets them)
+  std::string switch_text_;
+  int64_t switch_until_ = 0;
+  fploc::Pose2 last_ok_;
+  bool have_ok_ = false;
   std::unique_ptr<fploc::localizer::Localizer> loc_;
   fploc::rt::Publisher<fploc::frame_pose_t> out_;
   int64_t seq_ = 0;

@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "fploc/config/floor_ref.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/matcher/imu_yaw.h"
 #include "fploc/ndt/ndt_localizer.h"
@@ -68,6 +69,7 @@ class NdtNode : public fploc::rt::Node {
     if (!o.has_initial_pose()) throw std::runtime_error("ndt.initial_pose: required (NDT tracks from a known start)");
     const std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
     const fploc::FloorPlan plan = fploc::load_floor_plan(ctx.resolve_path(o.plan().file()), layers, o.plan().units());
+    floor_ = fploc::config::floor_ref(o.plan(), ctx.resolve_path(o.plan().file()));
     try {
       loc_ = std::make_unique<nd::Localizer>(plan, config_of(o));
     } catch (const std::invalid_argument& e) {
@@ -174,6 +176,8 @@ class NdtNode : public fploc::rt::Node {
     o.status = int8_t(std::min(2, int(r.status)));
     o.keyframe = r.matched;
     o.final_estimate = true;
+    o.floor_index = int16_t(floor_.index);
+    o.floor = floor_.name;
     o.position[0] = r.x;
     o.position[1] = r.y;
     o.position[2] = r.z;
@@ -195,6 +199,7 @@ class NdtNode : public fploc::rt::Node {
   }
 
   fploc::rt::Context* ctx_ = nullptr;
+  fploc::config::FloorRef floor_;
   std::unique_ptr<nd::Localizer> loc_;
   fploc::matcher::ImuYaw imu_;
   bool use_imu_ = true, have_prev_ = false, done_ = false;

@@ -41,7 +41,8 @@ class OdometryNode : public fploc::rt::Node {
       const fploc::odometry::OdometryResult r = odo_->process(f);
       Eigen::Matrix3d cov = Eigen::Matrix3d::Identity() * (r.ok ? r.rms_m * r.rms_m : 1e6);
       out_.publish(fploc::adapters::make_pose_msg(f.utime, seq_++, r.pose, f.roll, f.pitch, f.z, cov, f.z_sigma,
-                                        f.roll_pitch_sigma, r.ok ? 0 : 1, r.keyframe, true));
+                                        f.roll_pitch_sigma, r.ok ? 0 : 1, r.keyframe, true,
+                                                  -1, ""));  // the odometry frame: no floor
     });
   }
 

@@ -1,7 +1,9 @@
 // fploc-optimizer: FPLOC_FEATURES + FPLOC_FRAME_POSE (paired by scan_seq) -> windowed optimisation ->
 // FPLOC_POSE (6-DoF, final estimates: poses that left the window, every frame, in time order) and
 // FPLOC_POSE_LATEST (the current window estimate of each frame, low latency): the WO step of
-// fploc::localizer::Localizer.
+// fploc::localizer::Localizer. A building (.pbtxt/.ifc) loads every floor; the window follows the floor
+// of the matcher's frames (frame_pose_t.floor_index): a new floor flushes the window (those poses are
+// final on the old floor) and starts one on the new floor's plan.
 #include <fploc/features_t.hpp>
 #include <fploc/frame_pose_t.hpp>
 #include <fploc/pose_t.hpp>
@@ -15,6 +17,8 @@
 #include "fploc/adapters/pose_t.h"
 #include "fploc/config/localization.h"
 #include "fploc/config/plan_source.h"
+#include "fploc/floorplan/building.h"
+#include "fploc/localizer/floor_maps.h"
 #include "fploc/localizer/localizer.h"
 #include "fploc/runtime/node.h"
 
@@ -35,9 +39,18 @@ class OptimizerNode : public fploc::rt::Node {
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::OptimizerOptions>();
-    map_ = fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); },
-                                   "optimizer.plan");
-    loc_ = std::make_unique<fploc::localizer::Localizer>(*map_.lookup, fploc::config::localizer_config(o));
+    const std::string path = o.plan().file().empty() ? "" : ctx.resolve_path(o.plan().file());
+    if (!path.empty() && fploc::is_building_file(path)) {
+      const std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
+      floors_ = fploc::localizer::load_floor_maps(path, layers, o.plan().units(), o.plan().floor(), o.lookup());
+    } else {
+      floors_ = fploc::localizer::one_floor(
+          fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); }, "optimizer.plan"),
+          path);
+    }
+    floor_ = floors_.initial;
+    cfg_ = fploc::config::localizer_config(o);
+    loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
     pose_out_ = ctx.advertise<fploc::pose_t>("pose");
     latest_out_ = ctx.advertise<fploc::pose_t>("latest");
     ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) {
@@ -95,21 +108,43 @@ class OptimizerNode : public fploc::rt::Node {
       return;
     }
     std::vector<fploc::localizer::Pose> finals;
-    const auto latest = loc_->optimize(f, fploc::adapters::from_msg(m), &finals);
-    if (latest) latest_out_.publish(fploc::adapters::to_msg(*latest, latest_seq_++));
+    if (m.floor_index >= 0 && size_t(m.floor_index) < floors_.maps.size() && m.floor_index != floor_) {
+      // The matcher changed floor: the window's poses are final on the old floor.
+      loc_->flush(&finals);
+      publish_finals(finals);
+      finals.clear();
+      floor_ = m.floor_index;
+      loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
+      std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << ": window on floor '" << m.floor << "'\n";
+    }
+    // The matcher's z is the height above its floor (the segmenter's z carries no floor).
+    fploc::FeatureFrame fz = f;
+    if (fploc::z_known(f)) fz.z = m.z;
+    const auto latest = loc_->optimize(fz, fploc::adapters::from_msg(m), &finals);
+    // The floor of each frame is the matcher's (frame_pose_t); kept until the frame's pose is final.
+    floor_of_[m.utime] = {m.floor_index, m.floor};
+    if (latest) latest_out_.publish(fploc::adapters::to_msg(*latest, latest_seq_++, m.floor_index, m.floor));
     publish_finals(finals);
   }
 
   void publish_finals(const std::vector<fploc::localizer::Pose>& finals) {
-    for (const auto& p : finals) pose_out_.publish(fploc::adapters::to_msg(p, pose_seq_++));
+    for (const auto& p : finals) {
+      auto it = floor_of_.find(p.utime);
+      const auto fl = it != floor_of_.end() ? it->second : std::pair<int, std::string>{-1, ""};
+      pose_out_.publish(fploc::adapters::to_msg(p, pose_seq_++, fl.first, fl.second));
+      if (it != floor_of_.end()) floor_of_.erase(floor_of_.begin(), std::next(it));
+    }
   }
 
   fploc::rt::Context* ctx_ = nullptr;
-  fploc::matcher::LocalizationMap map_;
+  fploc::localizer::FloorMaps floors_;
+  int floor_ = 0;
+  fploc::localizer::Config cfg_;
   std::unique_ptr<fploc::localizer::Localizer> loc_;
   fploc::rt::Publisher<fploc::pose_t> pose_out_, latest_out_;
   std::map<int64_t, fploc::FeatureFrame> features_;
   std::map<int64_t, fploc::frame_pose_t> frame_poses_;
+  std::map<int64_t, std::pair<int, std::string>> floor_of_;  // utime -> floor (index, name)
   int64_t last_seq_ = 0;
   bool have_last_ = false;
   int64_t pose_seq_ = 0, latest_seq_ = 0;

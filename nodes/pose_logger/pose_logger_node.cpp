@@ -5,6 +5,7 @@
 // pose arrives: nothing is buffered in the process, so no processed pose is lost on SIGINT or a crash.
 // With `uncertainty_file`, each pose_t / frame_pose_t also gives one line "t status xx xy xyaw yy yyaw yawyaw"
 // (its status and x/y/yaw covariance, modules/eval/uncertainty.h) for `fploc eval --uncertainty`.
+// With `floor_file`, each pose_t / frame_pose_t also gives one line "t floor_index floor" (the floor it is on).
 #include <fcntl.h>
 #include <fploc/frame_pose_t.hpp>
 #include <fploc/ground_truth_t.hpp>
@@ -13,6 +14,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 
@@ -46,6 +48,12 @@ class PoseLoggerNode : public fploc::rt::Node {
       if (unc_fd_ < 0) throw std::runtime_error("cannot write '" + unc_path_ + "': " + std::strerror(errno));
       write_line(unc_fd_, unc_path_, "# t status xx xy xyaw yy yyaw yawyaw (x, y, yaw covariance; status 0 OK 1 POOR 2 LOST)\n");
     }
+    if (!opt.floor_file().empty()) {
+      floor_path_ = opt.floor_file();
+      floor_fd_ = ::open(floor_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+      if (floor_fd_ < 0) throw std::runtime_error("cannot write '" + floor_path_ + "': " + std::strerror(errno));
+      write_line(floor_fd_, floor_path_, "# t floor_index floor (index in the building's floor list, -1 unknown)\n");
+    }
     if (!ctx.channel("pose").empty())
       ctx.subscribe<fploc::pose_t>("pose", [this](const fploc::pose_t& m) { on_pose(m); });
     if (!ctx.channel("frame_pose").empty())
@@ -57,6 +65,11 @@ class PoseLoggerNode : public fploc::rt::Node {
   }
 
   void shutdown() override {
+    if (floor_fd_ >= 0) {
+      ::fsync(floor_fd_);
+      ::close(floor_fd_);
+      floor_fd_ = -1;
+    }
     if (unc_fd_ >= 0) {
       ::fsync(unc_fd_);
       ::close(unc_fd_);
@@ -80,6 +93,7 @@ class PoseLoggerNode : public fploc::rt::Node {
       return;
     }
     write_line(fploc::tum_line(p) + "\n");
+    write_floor(m.utime, m.floor_index, m.floor);
     if (unc_fd_ >= 0) {
       fploc::eval::PoseUncertainty u;
       u.t = p.t;
@@ -91,7 +105,9 @@ class PoseLoggerNode : public fploc::rt::Node {
 
   void on_pose(const fploc::pose_t& m) {
     if (final_only_ && !m.final_estimate) return;
-    if (!write_pose(m.utime, m.seq, m.position, m.orientation, "pose") || unc_fd_ < 0) return;
+    if (!write_pose(m.utime, m.seq, m.position, m.orientation, "pose")) return;
+    write_floor(m.utime, m.floor_index, m.floor);
+    if (unc_fd_ < 0) return;
     fploc::eval::PoseUncertainty u;
     u.t = double(m.utime) * 1e-6;
     u.status = m.status;
@@ -116,6 +132,13 @@ class PoseLoggerNode : public fploc::rt::Node {
     return true;
   }
 
+  void write_floor(int64_t utime, int floor_index, const std::string& floor) {
+    if (floor_fd_ < 0) return;
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.6f %d ", double(utime) * 1e-6, floor_index);
+    write_line(floor_fd_, floor_path_, buf + (floor.empty() ? std::string("-") : floor) + "\n");
+  }
+
   void write_line(const std::string& line) { write_line(fd_, path_, line); }
   void write_line(int fd, const std::string& path, const std::string& line) {
     size_t off = 0;
@@ -131,9 +154,9 @@ class PoseLoggerNode : public fploc::rt::Node {
   }
 
   fploc::rt::Context* ctx_ = nullptr;
-  std::string path_, unc_path_;
+  std::string path_, unc_path_, floor_path_;
   bool final_only_ = false;
-  int fd_ = -1, unc_fd_ = -1;
+  int fd_ = -1, unc_fd_ = -1, floor_fd_ = -1;
 };
 
 }  // namespace

@@ -6,6 +6,9 @@
 // FPLOC_INITIAL_POSE, from which the matcher re-initialises (a restarted matcher waits for exactly that:
 // NOT_INITIALISED right after a good pose means a local search). A tracking matcher is never touched.
 // Time is the sensor's (message utimes), so composed replays stay deterministic.
+// A building (.pbtxt/.ifc): every floor is loaded; the search runs on the floor of the matcher's frame
+// (frame_pose_t.floor_index), and right after the matcher changed floor (within global_after_s) the
+// local search region is the connection area between the two floors (the disc holding its polygon).
 #include <fploc/features_t.hpp>
 #include <fploc/frame_pose_t.hpp>
 #include <fploc/pose_t.hpp>
@@ -20,6 +23,9 @@
 #include "fploc/adapters/pose_t.h"
 #include "fploc/config/plan_source.h"
 #include "fploc/config/relocalization.h"
+#include "fploc/floorplan/building.h"
+#include "fploc/localizer/floor_maps.h"
+#include "fploc/localizer/floor_tracker.h"
 #include "fploc/relocalization/relocalizer.h"
 #include "fploc/runtime/node.h"
 #include "options/relocalization.pb.h"
@@ -41,14 +47,25 @@ class RelocalizerNode : public fploc::rt::Node {
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::RelocalizerOptions>();
-    map_ = fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); }, "relocalizer.plan");
-    reloc_ = std::make_unique<fploc::reloc::Relocalizer>(*map_.plan, *map_.lookup, fploc::config::config_of(o));
+    const std::string path = o.plan().file().empty() ? "" : ctx.resolve_path(o.plan().file());
+    if (!path.empty() && fploc::is_building_file(path)) {
+      const std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
+      floors_ = fploc::localizer::load_floor_maps(path, layers, o.plan().units(), o.plan().floor(), o.lookup());
+    } else {
+      floors_ = fploc::localizer::one_floor(
+          fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); }, "relocalizer.plan"),
+          path);
+    }
+    floor_ = floors_.initial;
+    for (const auto& m : floors_.maps)
+      relocs_.push_back(std::make_unique<fploc::reloc::Relocalizer>(*m.plan, *m.lookup, fploc::config::config_of(o)));
     const fploc::reloc::Schedule when = fploc::config::schedule_of(o);
     radius_ = when.region_radius_m;
     global_after_us_ = int64_t(when.global_after_s * 1e6);
     interval_us_ = int64_t(when.min_interval_s * 1e6);
-    std::cerr << "[" << ctx.name() << "] " << map_.plan->elements.size() << " elements, "
-              << reloc_->free_cells() << " free search cells\n";
+    for (size_t i = 0; i < relocs_.size(); ++i)
+      std::cerr << "[" << ctx.name() << "] floor '" << floors_.building->floors[i].name << "': "
+                << floors_.maps[i].plan->elements.size() << " elements, " << relocs_[i]->free_cells() << " free search cells\n";
     out_ = ctx.advertise<fploc::pose_t>("initial_pose");
     ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) {
       features_.push_back(m);
@@ -58,8 +75,31 @@ class RelocalizerNode : public fploc::rt::Node {
   }
 
  private:
+  // The connection between the floor left and the current one whose area (with 1 m around it) holds p.
+  const fploc::FloorConnection* connection_near(const fploc::Pose2& p) const {
+    const auto& b = *floors_.building;
+    const std::string& a = b.floors[size_t(floor_from_)].name;
+    const std::string& n = b.floors[size_t(floor_)].name;
+    const fploc::FloorConnection* best = nullptr;
+    double best_d = 1.0;
+    for (const auto& c : b.connections) {
+      if (!((c.from_floor == a && c.to_floor == n) || (c.from_floor == n && c.to_floor == a))) continue;
+      Eigen::Vector2d ctr;
+      double rad = 0;
+      fploc::localizer::FloorTracker::search_disc(c.polygon, 0, &ctr, &rad);
+      const double d = c.contains({p.x, p.y}) ? 0.0 : std::max(0.0, (Eigen::Vector2d(p.x, p.y) - ctr).norm() - rad);
+      if (d <= best_d) best = &c, best_d = d;
+    }
+    return best;
+  }
+
   void on_frame_pose(const fploc::frame_pose_t& m) {
     const auto st = fploc::matcher::FitStatus(m.status);
+    if (m.floor_index >= 0 && size_t(m.floor_index) < relocs_.size() && m.floor_index != floor_) {
+      floor_from_ = floor_;
+      floor_ = m.floor_index;
+      floor_changed_ = m.utime;
+    }
     if (st == fploc::matcher::FitStatus::kOk) {
       last_ok_ = fploc::Pose2{m.x, m.y, m.yaw};
       last_ok_utime_ = m.utime;
@@ -89,8 +129,18 @@ class RelocalizerNode : public fploc::rt::Node {
     const bool local = m.utime - lost_since_ < global_after_us_ &&
                        (st == fploc::matcher::FitStatus::kLost || (have_ok_ && m.utime - last_ok_utime_ < global_after_us_));
     if (local) region = fploc::reloc::SearchRegion{have_ok_ ? last_ok_ : fploc::Pose2{m.x, m.y, m.yaw}, radius_, M_PI};
-    const fploc::reloc::RelocResult r = reloc_->locate(frame, region);
-    const std::string where = local ? "near the last pose" : "over the whole plan";
+    std::string where = local ? "near the last pose" : "over the whole plan";
+    // Just after a floor change: the connection area between the two floors.
+    if (floor_changed_ != 0 && m.utime - floor_changed_ < global_after_us_)
+      if (const fploc::FloorConnection* c = connection_near(have_ok_ ? last_ok_ : fploc::Pose2{m.x, m.y, m.yaw})) {
+        Eigen::Vector2d ctr;
+        double rad = 0;
+        fploc::localizer::FloorTracker::search_disc(c->polygon, 1.0, &ctr, &rad);
+        region = fploc::reloc::SearchRegion{fploc::Pose2{ctr.x(), ctr.y(), 0}, rad, M_PI};
+        where = "in the " + std::string(fploc::to_string(c->kind)) + " area '" + c->name + "' of floor '" + m.floor + "'";
+      }
+    if (floors_.multi_floor() && where.find("floor '") == std::string::npos) where += " of floor '" + m.floor + "'";
+    const fploc::reloc::RelocResult r = relocs_[size_t(floor_)]->locate(frame, region);
     if (r.status != fploc::reloc::RelocStatus::kFound) {
       const std::string text = std::string(fploc::reloc::to_string(r.status)) + " " + where + ": " + r.text;
       if (text != last_text_) ctx_->error("scan " + std::to_string(m.scan_seq) + ": " + text);
@@ -102,12 +152,14 @@ class RelocalizerNode : public fploc::rt::Node {
               << " " << where << "\n";
     out_.publish(fploc::adapters::make_pose_msg(f->utime, seq_++, r.pose, f->roll, f->pitch, f->z,
                                       Eigen::Matrix3d::Identity() * r.fit.rms_m * r.fit.rms_m, f->z_sigma,
-                                      f->roll_pitch_sigma, 0, false, true));
+                                      f->roll_pitch_sigma, 0, false, true, m.floor_index, m.floor));
   }
 
   fploc::rt::Context* ctx_ = nullptr;
-  fploc::matcher::LocalizationMap map_;
-  std::unique_ptr<fploc::reloc::Relocalizer> reloc_;
+  fploc::localizer::FloorMaps floors_;
+  std::vector<std::unique_ptr<fploc::reloc::Relocalizer>> relocs_;  // one per floor
+  int floor_ = 0, floor_from_ = 0;
+  int64_t floor_changed_ = 0;
   fploc::rt::Publisher<fploc::pose_t> out_;
   std::deque<fploc::features_t> features_;
   fploc::Pose2 last_ok_;

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "fploc/core/scan.h"
 #include "fploc/adapters/pose_t.h"
@@ -66,12 +67,17 @@ class SegmenterNodeT : public rt::Node {
     const Building b = load_building(path);
     if (b.floor_index(src.floor()) < 0)
       throw std::runtime_error("segmenter.building.floor: " + path + " has no floor '" + src.floor() + "'");
-    const BuildingFloor& f = b.floor(src.floor());
-    seg::AreaCeilingMap map;
-    map.floor = f.name;
-    map.default_height_m = f.ceiling_height;
-    for (const auto& a : f.areas) map.areas.push_back({a.name, a.polygon, a.height, a.origin, a.slope});
-    seg_->set_areas(map);
+    // Every floor's ceilings; the pose's floor (pose_t.floor_index) picks the one used, from the configured one.
+    for (const BuildingFloor& f : b.floors) {
+      seg::AreaCeilingMap map;
+      map.floor = f.name;
+      map.default_height_m = f.ceiling_height;
+      for (const auto& a : f.areas) map.areas.push_back({a.name, a.polygon, a.height, a.origin, a.slope});
+      floors_.push_back(std::move(map));
+    }
+    floor_ = b.floor_index(src.floor());
+    seg_->set_areas(floors_[size_t(floor_)]);
+    const BuildingFloor& f = b.floors[size_t(floor_)];
     std::cerr << "[" << ctx.name() << "] " << path << " floor '" << f.name << "': ceiling " << f.ceiling_height
               << " m (0 = learned), " << f.areas.size() << " areas; plan pose from " << ctx.channel("pose") << "\n";
     if (ctx.channel("pose").empty())
@@ -79,6 +85,11 @@ class SegmenterNodeT : public rt::Node {
     ctx.subscribe<pose_t>("pose", [this](const pose_t& m) {
       const Pose2 p = adapters::pose2_of(m);
       if (m.status == 2 || !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.yaw)) return;  // LOST
+      if (m.floor_index >= 0 && m.floor_index != floor_ && size_t(m.floor_index) < floors_.size()) {
+        floor_ = m.floor_index;
+        seg_->set_areas(floors_[size_t(floor_)]);  // that floor's ceilings (its learned heights start anew)
+        std::cerr << "[" << ctx_->name() << "] floor '" << floors_[size_t(floor_)].floor << "': its ceiling areas\n";
+      }
       seg_->set_plan_pose({m.utime, p.x, p.y, p.yaw, true});
     });
   }
@@ -120,6 +131,8 @@ class SegmenterNodeT : public rt::Node {
   Scan scan_;
   int64_t seq_ = 0;
   bool use_imu_ = false;
+  std::vector<seg::AreaCeilingMap> floors_;  // option building: every floor's ceilings
+  int floor_ = 0;
 };
 
 }  // namespace fploc

@@ -18,6 +18,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "fploc/floorplan/building.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/adapters/ground_truth_t.h"
 #include "fploc/os1/packet.h"
@@ -39,6 +40,11 @@ class SimSensorNode : public fploc::rt::Node {
             {fploc::rt::output<fploc::ground_truth_t>("ground_truth", "FPLOC_GROUND_TRUTH")}};
   }
 
+  std::unique_ptr<fploc::sim::Simulator> make_sim() const {
+    if (building_) return std::make_unique<fploc::sim::Simulator>(*building_, floor_, so_, plan_options_);
+    return std::make_unique<fploc::sim::Simulator>(plan_, so_);
+  }
+
   ~SimSensorNode() override {
     if (fd_ >= 0) ::close(fd_);
   }
@@ -49,7 +55,16 @@ class SimSensorNode : public fploc::rt::Node {
     const auto& opt = ctx.options<fploc::SimOptions>();
     if (!opt.plan().file().empty()) {
       const std::vector<std::string> layers(opt.plan().layers().begin(), opt.plan().layers().end());
-      plan_ = fploc::load_floor_plan(ctx.resolve_path(opt.plan().file()), layers, opt.plan().units(), opt.plan().floor());
+      const std::string file = ctx.resolve_path(opt.plan().file());
+      if (fploc::is_building_file(file)) {
+        // A building: the floor the sensor is on is simulated; journeys ride ramps and lifts.
+        building_ = std::make_shared<fploc::Building>(fploc::load_building(file));
+        floor_ = opt.plan().floor();
+        plan_options_.layer_globs = layers;
+        plan_options_.units_override = opt.plan().units();
+      } else {
+        plan_ = fploc::load_floor_plan(file, layers, opt.plan().units(), opt.plan().floor());
+      }
     }
     so_.scenario = opt.scenario().empty() ? "room-small-loop-medium" : opt.scenario();
     so_.seed = opt.seed();
@@ -69,7 +84,7 @@ class SimSensorNode : public fploc::rt::Node {
     duration_s_ = opt.duration_s();
     clock0_s_ = so_.t0_s;
     scenario_ = so_.scenario;
-    sim_ = std::make_unique<fploc::sim::Simulator>(plan_, so_);
+    sim_ = make_sim();
     std::cerr << "[" << ctx.name() << "] " << so_.scenario << ": " << sim_->num_frames() << " frames, "
               << sim_->motion().length() << " m; beams: " << sim_->beam_source() << "\n"
               << sim_->info();
@@ -134,7 +149,7 @@ class SimSensorNode : public fploc::rt::Node {
         }
         // Start over: the next loop's scenario begins where this one ended on the same clock.
         so_.t0_s = sim_->frame_time(frames_per_loop());
-        sim_ = std::make_unique<fploc::sim::Simulator>(plan_, so_);
+        sim_ = make_sim();
         k_ = 0;
         imu_k_ = 0;
         continue;
@@ -175,6 +190,9 @@ class SimSensorNode : public fploc::rt::Node {
 
   fploc::rt::Context* ctx_ = nullptr;
   fploc::FloorPlan plan_;
+  std::shared_ptr<fploc::Building> building_;  // when the plan file is a building (.pbtxt/.ifc)
+  std::string floor_;
+  fploc::PlanLoadOptions plan_options_;
   fploc::sim::SimulatorOptions so_;
   std::unique_ptr<fploc::sim::Simulator> sim_;
   fploc::os1::SensorInfo info_;

@@ -41,6 +41,8 @@ pose_t pose_msg(int64_t utime, int64_t seq, const Pose2& p) {
   m.utime = utime;
   m.seq = seq;
   m.final_estimate = true;
+  m.floor_index = 0;
+  m.floor = "0";
   m.position[0] = p.x;
   m.position[1] = p.y;
   m.position[2] = 1.2;

@@ -39,6 +39,8 @@ class TestPoseSource : public fploc::rt::Node {
     m.utime = 1'000'000'000'000 + int64_t(seq_) * 50'000;
     m.seq = seq_++;
     m.final_estimate = true;
+    m.floor_index = 0;
+    m.floor = "0";
     m.position[0] = 2.0 * std::cos(0.2 * t);
     m.position[1] = 2.0 * std::sin(0.2 * t);
     m.position[2] = 0.5;

@@ -194,12 +194,16 @@ int main(int argc, char** argv) {
       fp.rms_residual_m = 0.02;
       fp.iterations = 4;
       fp.solve_ms = 1.5;
+      fp.floor_index = 0;
+      fp.floor = "0";
       lc.publish("FPLOC_FRAME_POSE", &fp);
 
       fploc::pose_t p{};
       p.utime = ut;
       p.seq = seq;
       p.keyframe = (seq % 5) == 0;
+      p.floor_index = 0;
+      p.floor = "0";
       p.position[0] = ex, p.position[1] = ey, p.position[2] = z + 0.01;
       quat_from_rpy(roll, pitch, eyaw, p.orientation);
       p.covariance[0] = p.covariance[7] = 0.0004;

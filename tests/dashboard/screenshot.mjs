@@ -21,7 +21,13 @@ if (process.env.FPLOC_SELECT_ROBOT) {
   await page.selectOption('#robot', process.env.FPLOC_SELECT_ROBOT);
   await page.waitForTimeout(1500);
 }
+// FPLOC_SELECT_FLOOR=first: show that floor's plan (the floor selector; "" = the robot's floor).
+if (process.env.FPLOC_SELECT_FLOOR !== undefined) {
+  await page.selectOption('#floor', process.env.FPLOC_SELECT_FLOOR);
+  await page.waitForTimeout(1500);
+}
 await page.screenshot({ path: out });
-const state = await page.evaluate(() => ({ connected: window.__fploc?.connected, trail: window.__fploc?.trail?.length }));
+const state = await page.evaluate(() => ({ connected: window.__fploc?.connected, trail: window.__fploc?.trail?.length,
+  floor: window.__fploc?.pose?.floor }));
 console.error(`screenshot ${out}: ${JSON.stringify(state)}`);
 await browser.close();

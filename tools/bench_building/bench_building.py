@@ -11,8 +11,17 @@ LOST transitions, reported as node errors), and ms per scan per node (thread CPU
 Scenarios: the `building-*` ones (sim/ceiling_map.h: areas with their own ceiling heights and a sloped
 roof, a double-height atrium, lamps/beams/ducts/a drop-ceiling grid, all mixed; the segmenter gets the floor's
 ceilings as a building file, `fploc sim --ceilings-building`, unless --no-building-heights) and `auto-loop-medium`
-with the simulator's default ceiling patches, on every shipped plan (data/plans) unless --plan is given.
-Targets (issue 11): z p99 <= 2 cm, roll/pitch p99 <= 0.2 deg, horizontal ATE <= 1 cm, no LOST.
+with the simulator's default ceiling patches, on every shipped plan (data/plans) unless --plan is given;
+and the journeys through the demo building (data/buildings/demo-building.pbtxt: building-twofloor, -ramp,
+-thresholds; ramp, lift, door thresholds). A --plan may be a building (.pbtxt): the localizer gets the
+building (every floor), the simulator's ground truth is absolute (z = floor elevation + height above it)
+and its floor per scan (gt.floors.csv) scores the floor rows; the segmenter gets the building too (its floors'
+ceiling areas, the floor from the pose feedback); the pose's floor comes from
+pose_t.floor_index (pose logger `floor_file`), its z (height above that floor) is made absolute with the
+floor's elevation before scoring.
+Targets (issue 11): z p99 <= 2 cm, roll/pitch p99 <= 0.2 deg, horizontal ATE <= 1 cm, no LOST; floor
+changes recognised within 2 s, no pose on the wrong floor 3 s after arriving, ATE over the 10 s after a
+lift ride <= 5 cm.
 
 Prints one JSON document on stdout ({"rows": [...], "targets": {...}}); progress on stderr. With --plots DIR
 writes z against ground truth over time per row (SVG with axes and legend, and a text-free PNG:
@@ -35,8 +44,98 @@ from fploc_tools import log, read_tum, yaw_of  # noqa: E402
 
 SCENARIOS = ["building-areas-medium", "building-atrium-medium", "building-clutter-medium", "building-mixed-medium",
              "auto-loop-medium"]
+DEMO_BUILDING = os.path.join(ROOT, "data", "buildings", "demo-building.pbtxt")
+BUILDING_SCENARIOS = ["building-twofloor-medium", "building-ramp-medium", "building-thresholds-medium"]
 PIPELINE = ("segmenter", "features", "matcher", "optimizer")
-TARGETS = {"z_err_p99_m": 0.02, "rp_err_p99_deg": 0.2, "ate_xy_m": 0.01, "lost": 0}
+TARGETS = {"z_err_p99_m": 0.02, "rp_err_p99_deg": 0.2, "ate_xy_m": 0.01, "lost": 0,
+           "floor_recognised_s": 2.0, "wrong_floor_after_3s": 0, "ate_after_lift_m": 0.05}
+
+
+def is_building(path):
+    return path.endswith(".pbtxt") or path.endswith(".ifc")
+
+
+def read_gt_floors(path):
+    """fploc sim's per-scan ground-truth floor: CSV t,floor_index,floor,state."""
+    out = []
+    with open(path) as f:
+        next(f)
+        for line in f:
+            t, idx, name, state = line.strip().split(",")
+            out.append((float(t), int(idx), name, state))
+    return out
+
+
+def read_pose_floors(path):
+    """The pose logger's floor_file: "t floor_index floor" per pose."""
+    out = {}
+    with open(path) as f:
+        for line in f:
+            if line.startswith("#") or not line.strip():
+                continue
+            t, idx, _ = line.split(None, 2)
+            out[round(float(t), 6)] = int(idx)
+    return out
+
+
+def floor_at(gtf, t):
+    i = bisect.bisect_right([g[0] for g in gtf], t) - 1
+    return gtf[max(0, i)][1]
+
+
+def score_floors(gt, est, gtf, pose_floor, changes, t0_abs):
+    """Floor rows: poses on the wrong floor (all, and those more than 3 s from every floor change), time from each
+    floor change to the first pose on the new floor, ATE (horizontal and 3D) over the 10 s after each lift
+    ride (from the car's arrival)."""
+    ts_f = [g[0] for g in gtf]
+    wrong, wrong_late, known = 0, 0, 0
+    for e in est:
+        f = pose_floor.get(round(e[0], 6), -1)
+        if f < 0:
+            continue
+        known += 1
+        i = max(0, bisect.bisect_right(ts_f, e[0]) - 1)
+        if f != gtf[i][1]:
+            wrong += 1
+            # Beyond 3 s of every floor change (the moment of a ramp's change is a convention: its middle).
+            if all(abs(e[0] - c["t"]) > 3.0 for c in changes):
+                wrong_late += 1
+    if known == 0:
+        return {"floor_scored": False,
+                "floor_note": "the poses carry no floor (pose_t.floor_index -1 or no floor file): floor rows not scored"}
+    rec = []
+    for c in changes:
+        first = next((e[0] for e in est if e[0] >= c["t"] and pose_floor.get(round(e[0], 6), -1) == c["to_index"]), None)
+        rec.append({"t": round(c["t"] - t0_abs, 2), "from": c["from"], "to": c["to"], "how": c["how"],
+                    "recognised_after_s": None if first is None else round(first - c["t"], 2)})
+    ts = [g[0] for g in gt]
+    lifts = []
+    for c in changes:
+        if not c["how"].startswith("lift"):
+            continue
+        exy, e3 = [], []
+        for e in est:
+            if not (c["t"] <= e[0] <= c["t"] + 10.0):
+                continue
+            i = bisect.bisect_left(ts, e[0])
+            if i <= 0 or i >= len(gt):
+                continue
+            a, b = gt[i - 1], gt[i]
+            f = (e[0] - a[0]) / (b[0] - a[0]) if b[0] > a[0] else 0.0
+            p = [a[k] + f * (b[k] - a[k]) for k in (1, 2, 3)]
+            dxy = (e[1] - p[0]) ** 2 + (e[2] - p[1]) ** 2
+            exy.append(dxy)
+            e3.append(dxy + (e[3] - p[2]) ** 2)
+        lifts.append({"t": round(c["t"] - t0_abs, 2), "poses": len(exy),
+                      "ate_xy_m": round(math.sqrt(sum(exy) / len(exy)), 5) if exy else None,
+                      "ate_3d_m": round(math.sqrt(sum(e3) / len(e3)), 5) if e3 else None})
+    recs = [r["recognised_after_s"] for r in rec]
+    return {"floor_scored": True, "poses_with_floor": known, "wrong_floor_poses": wrong,
+            "wrong_floor_after_3s": wrong_late, "floor_changes": rec,
+            "floor_recognised_max_s": (None if not recs or any(r is None for r in recs) else max(recs)),
+            "floor_changes_missed": sum(1 for r in recs if r is None),
+            "lift_rides": lifts,
+            "ate_after_lift_m": max([l["ate_xy_m"] for l in lifts if l["ate_xy_m"] is not None], default=None)}
 
 
 def run(cmd):
@@ -56,7 +155,8 @@ def pct(v, q):
 
 
 def score(gt, est):
-    """Per pose: truth interpolated at the pose's time (roll/pitch from the nearer truth sample)."""
+    """Per pose: truth interpolated at the pose's time (roll/pitch from the nearer truth sample). Buildings:
+    `est` z already made absolute (z + the pose floor's elevation)."""
     ts = [g[0] for g in gt]
     t0 = gt[0][0]
     series, exy, ez, erp = [], [], [], []
@@ -127,11 +227,12 @@ def plot_png(series, path, W=900, H=300):
             img[y][3 * x:3 * x + 3] = bytes(c)
     X = lambda t: int((W - 1) * t / t1)  # noqa: E731
     Y = lambda z: int((H - 1) * (z1 - z) / (z1 - z0))  # noqa: E731
-    z = math.ceil(z0 * 100) / 100
+    step = 0.01 if z1 - z0 < 0.5 else 0.5  # 1 cm grid, or 0.5 m for runs across floors
+    z = math.ceil(z0 / step) * step
     while z < z1:
         for x in range(W):
             px(x, Y(z), (225, 225, 225))
-        z += 0.01
+        z += step
     for t in range(0, int(t1) + 1, 10):
         for y in range(H):
             px(X(t), y, (225, 225, 225))
@@ -157,20 +258,29 @@ def bench(a, work, plan, layers, scenario):
     d = os.path.join(work, name.replace(":", "-"))
     os.makedirs(d, exist_ok=True)
     logf, gt_path = os.path.join(d, "log.lcm"), os.path.join(d, "gt.tum")
+    building = is_building(plan)
     cmd = [os.path.join(BIN, "fploc-sim"), "--scenario", scenario, "--seed", str(a.seed), "--plan", plan,
-           "--out", logf, "--gt", gt_path]
+           "--out", logf, "--gt", gt_path, "--json"]
     for layer in layers:
         cmd += ["--layers", layer]
     if a.duration:
         cmd += ["--duration", str(a.duration)]
-    building = None
-    if a.building_heights and scenario.startswith("building-"):
+    if building and a.floor:
+        cmd += ["--floor", a.floor]
+        name += f"@{a.floor}"
+        d = os.path.join(work, name.replace(":", "-"))
+        os.makedirs(d, exist_ok=True)
+        logf, gt_path = os.path.join(d, "log.lcm"), os.path.join(d, "gt.tum")
+        cmd[cmd.index("--out") + 1], cmd[cmd.index("--gt") + 1] = logf, gt_path
+    seg_building = None
+    if a.building_heights and scenario.startswith("building-") and not building:
         # The segmenter gets the simulated floor's ceilings as a building file (its areas' heights).
-        building = os.path.join(d, "ceilings.pbtxt")
-        cmd += ["--ceilings-building", building]
+        seg_building = os.path.join(d, "ceilings.pbtxt")
+        cmd += ["--ceilings-building", seg_building]
     log(f"[{name}] simulating ...")
-    _, err = run(cmd)
-    info = [l.strip() for l in err.splitlines() if "ceilings" in l or "clutter" in l]
+    out, err = run(cmd)
+    simj = json.loads(out.strip().splitlines()[-1])
+    info = [l.strip() for l in err.splitlines() if "ceilings" in l or "clutter" in l or "floor" in l]
     gt = read_tum(gt_path)
     x0, y0, yaw0 = gt[0][1], gt[0][2], yaw_of(gt[0])
     wo = os.path.join(d, "wo.tum")
@@ -185,7 +295,15 @@ def bench(a, work, plan, layers, scenario):
         for layer in layers:
             sets.append(f"{n}.plan.layers={layer}")
     if building:
-        sets.append(f"segmenter.building.file={building}")
+        start = simj.get("start_floor", "")
+        sets += [f"matcher.plan.floor={start}", f"optimizer.plan.floor={start}",
+                 f"wo_logger.floor_file={os.path.join(d, 'wo.floors')}"]
+        if a.building_heights:
+            seg_building = plan
+    if seg_building:
+        sets.append(f"segmenter.building.file={seg_building}")
+        if building:
+            sets.append(f"segmenter.building.floor={simj.get('start_floor', '')}")
     cmd = [os.path.join(BIN, "fploc-replay"), "--graph", a.graph, "--log", logf, "--json"]
     for s in sets:
         cmd += ["--set", s]
@@ -196,14 +314,36 @@ def bench(a, work, plan, layers, scenario):
     scans = nodes.get("features", {}).get("messages", 1) or 1
     ms = {n: round(nodes[n].get("cpu_ms", nodes[n]["total_ms"]) / scans, 3) for n in PIPELINE if n in nodes}
     row = {"plan": os.path.relpath(plan, ROOT), "scenario": scenario, "scans": scans, "sim": info,
-           "segmenter_building": building is not None,
+           "segmenter_building": seg_building is not None,
            "lost": nodes.get("matcher", {}).get("errors", 0), "ms_per_scan": ms}
     est = read_tum(wo) if os.path.exists(wo) else []
+    floors = None
+    if building:
+        elev = {i: f["elevation_m"] for i, f in enumerate(simj.get("floors", []))}
+        names = {f["name"]: i for i, f in enumerate(simj.get("floors", []))}
+        wf = os.path.join(d, "wo.floors")
+        pose_floor = read_pose_floors(wf) if os.path.exists(wf) else {}
+        start = names.get(simj.get("start_floor", ""), 0)
+        # pose_t z is the height above the pose's floor: absolute with that floor's elevation (the start
+        # floor when the pose says none).
+        est = [[e[0], e[1], e[2], e[3] + elev.get(pose_floor.get(round(e[0], 6), -1), elev.get(start, 0.0))] + list(e[4:])
+               for e in est]
+        changes = [dict(c, to_index=names.get(c["to"], -1)) for c in simj.get("floor_changes", []) if c["t"] <= gt[-1][0]]
+        floors = score_floors(gt, est, read_gt_floors(gt_path[:-4] + ".floors.csv"), pose_floor, changes, simj.get("t0", gt[0][0]))
+        row["building"] = True
     m, series = score(gt, est)
     row.update(m or {"poses": 0})
+    if floors is not None:
+        row.update(floors)
     if m:
         row["meets_targets"] = (m["z_err_p99_m"] <= TARGETS["z_err_p99_m"] and m["rp_err_p99_deg"] <= TARGETS["rp_err_p99_deg"]
                                 and m["ate_xy_m"] <= TARGETS["ate_xy_m"] and row["lost"] == 0)
+        if floors is not None:
+            row["meets_targets"] = row["meets_targets"] and bool(floors.get("floor_scored")) and \
+                floors.get("floor_changes_missed", 1) == 0 and \
+                (floors.get("floor_recognised_max_s") is None or floors["floor_recognised_max_s"] <= TARGETS["floor_recognised_s"]) and \
+                floors.get("wrong_floor_after_3s", 1) == 0 and \
+                (floors.get("ate_after_lift_m") is None or floors["ate_after_lift_m"] <= TARGETS["ate_after_lift_m"])
     if a.plots and series:
         path = os.path.join(a.plots, name.replace(":", "-") + "-z.svg")
         plot_z(series, f"{name}: z p99 {100 * m['z_err_p99_m']:.2f} cm, rp p99 {m['rp_err_p99_deg']:.3f} deg", path)
@@ -213,12 +353,18 @@ def bench(a, work, plan, layers, scenario):
     log(f"[{name}] ATE xy {100 * row.get('ate_xy_m', float('nan')):.2f} cm, z med/p99 "
         f"{100 * row.get('z_err_median_m', float('nan')):.2f}/{100 * row.get('z_err_p99_m', float('nan')):.2f} cm, "
         f"rp p99 {row.get('rp_err_p99_deg', float('nan')):.3f} deg, LOST {row['lost']}, ms/scan {ms}")
+    if floors is not None:
+        log(f"[{name}] floors: " + (f"wrong-floor poses {floors['wrong_floor_poses']} ({floors['wrong_floor_after_3s']} later "
+            f"than 3 s after a change), recognised after {[c['recognised_after_s'] for c in floors['floor_changes']]} s, "
+            f"ATE after lift {floors['ate_after_lift_m']} m" if floors.get("floor_scored") else floors["floor_note"]))
     return row
 
 
 def main():
     ap = argparse.ArgumentParser(prog="fploc bench building", description=__doc__.splitlines()[0])
-    ap.add_argument("--plan", action="append", help="floor plan(s) (default: data/plans/room.json and corridor.json)")
+    ap.add_argument("--plan", action="append", help="floor plan(s) or building(s) (.pbtxt) (default: data/plans/room.json and "
+                    "corridor.json with the ceiling scenarios, and the demo building with its journeys)")
+    ap.add_argument("--floor", help="buildings: the floor for single-floor scenarios (auto-loop-*, building-areas-*, ...)")
     ap.add_argument("--layers", help="comma-separated plan layer globs (with --plan)")
     ap.add_argument("--scenario", action="append", help=f"scenario(s), comma-separated or repeated (default: {', '.join(SCENARIOS)})")
     ap.add_argument("--seed", type=int, default=1)
@@ -233,7 +379,7 @@ def main():
     ap.add_argument("--json", action="store_true", help="(JSON is always printed on stdout)")
     a = ap.parse_args()
     plans = [os.path.abspath(p) for p in (a.plan or [os.path.join(ROOT, "data", "plans", "room.json"),
-                                                     os.path.join(ROOT, "data", "plans", "corridor.json")])]
+                                                     os.path.join(ROOT, "data", "plans", "corridor.json"), DEMO_BUILDING])]
     for p in plans:
         if not os.path.exists(p):
             ap.error(f"--plan {p}: no such file")
@@ -247,7 +393,8 @@ def main():
     try:
         for p in plans:
             # --scenario A,B and --scenario A --scenario B mean the same (as --layers everywhere).
-            for s in [x for arg in (a.scenario or SCENARIOS) for x in arg.split(",") if x]:
+            default = BUILDING_SCENARIOS if is_building(p) and not a.floor else SCENARIOS
+            for s in [x for arg in (a.scenario or default) for x in arg.split(",") if x]:
                 rows.append(bench(a, work, p, layers, s))
     finally:
         if not a.keep:

@@ -98,6 +98,7 @@ int main(int argc, char** argv) {
           p.utime = ut;
           p.seq = int64_t(k);
           p.status = 0;
+          p.floor_index = -1;  // wheel odometry frame: no floor
           p.position[0] = op.x;
           p.position[1] = op.y;
           quat_of_yaw(op.theta, p.orientation);

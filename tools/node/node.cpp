@@ -83,6 +83,7 @@ int initial_pose(int argc, char** argv) {
   p.utime = std::chrono::duration_cast<std::chrono::microseconds>(
                 std::chrono::system_clock::now().time_since_epoch()).count();
   p.final_estimate = true;
+  p.floor_index = -1;  // unknown: the matcher stays on its floor
   p.position[0] = v[0];
   p.position[1] = v[1];
   const double half = 0.5 * v[2] * M_PI / 180.0;

@@ -15,10 +15,14 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
+#include <cstdio>
 
+#include "fploc/floorplan/building.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/adapters/ground_truth_t.h"
 #include "fploc/adapters/scan_t.h"
+#include "fploc/sim/demo_building.h"
 #include "fploc/sim/simulator.h"
 
 namespace {
@@ -46,15 +50,19 @@ void write_event(lcm::LogFile& log, int64_t utime, const std::string& channel, c
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc sim: simulate an OS-1-64 + IMU sequence into an LCM log and a TUM ground truth"};
-  std::string plan_file, scenario, out, gt, units, metadata, demo_dir, floor, world_file, perturb, truth, ceilings_building;
+  std::string plan_file, scenario, out, gt, units, metadata, demo_dir, floor, world_file, perturb, truth, gt_floors,
+      demo_building_dir, ceilings_building;
   std::vector<std::string> layers;
   uint64_t seed = 0;
-  bool no_clutter = false, no_patches = false, json = false;
+  bool no_clutter = false, no_patches = false, json = false, no_thresholds = false;
   double noise = 0.02, dropout = 0.01, imu_rate = 100, duration = 0, ceiling = 0, wall_clutter = 0, drop_scans = 0;
-  app.add_option("--plan", plan_file, "floor plan (.dxf/.csv/.json/.fpmap); default: the scenario's demo plan");
+  app.add_option("--plan", plan_file, "floor plan (.dxf/.csv/.json/.fpmap) or building (.pbtxt/.ifc); default: the scenario's demo plan");
   app.add_option("--layers", layers, "layer globs")->delimiter(',');
   app.add_option("--units", units, "m|cm|mm override");
-  app.add_option("--floor", floor, "building (.pbtxt) or IFC plan: the floor (default: the first)");
+  app.add_option("--floor", floor, "building (.pbtxt) or IFC plan: the floor simulated (default: the first; journeys start where they are drawn)");
+  app.add_option("--gt-floors", gt_floors, "buildings: the ground-truth floor per scan, CSV t,floor_index,floor,state (default: GT without .tum + .floors.csv)");
+  app.add_flag("--no-thresholds", no_thresholds, "buildings: no door thresholds");
+  app.add_option("--write-demo-building", demo_building_dir, "write the demo building's plans (ground.json, first.json) into DIR and exit");
   app.add_option("--scenario", scenario, "room-small-loop|room-large-loop|room-no-loop|corridor-loop|auto-loop + -slow|-medium|-fast");
   app.add_option("--seed", seed, "random seed (noise, wobble, clutter)");
   app.add_option("--out", out, "LCM log to write");
@@ -88,12 +96,20 @@ int main(int argc, char** argv) {
       std::cerr << "wrote " << demo_dir << "/room.json and corridor.json\n";
       return 0;
     }
+    if (!demo_building_dir.empty()) {
+      std::filesystem::create_directories(demo_building_dir);
+      for (const auto& f : fploc::sim::demo_building_floors())
+        fploc::save_floor_plan(fploc::sim::demo_building_plan(f), demo_building_dir + "/" + f + ".json");
+      std::cerr << "wrote " << demo_building_dir << "/ground.json and first.json\n";
+      return 0;
+    }
     if (scenario.empty() || out.empty() || gt.empty()) {
       std::cerr << "fploc sim: --scenario, --out and --gt are required\n" << app.help();
       return 2;
     }
     fploc::FloorPlan plan;
-    if (!plan_file.empty()) plan = fploc::load_floor_plan(plan_file, layers, units, floor);
+    const bool is_building = !plan_file.empty() && fploc::is_building_file(plan_file);
+    if (!plan_file.empty() && !is_building) plan = fploc::load_floor_plan(plan_file, layers, units, floor);
     fploc::sim::SimulatorOptions o;
     o.scenario = scenario;
     o.seed = seed;
@@ -113,10 +129,20 @@ int main(int argc, char** argv) {
     o.world_file = world_file;
     o.world_layers = layers;
     o.world_units = units;
+    o.thresholds = !no_thresholds;
     if (!world_file.empty() && plan_file.empty() && scenario.rfind("auto-loop", 0) == 0)
       throw std::runtime_error("--world needs --plan for auto-loop scenarios (the path is planned on the plan)");
     const auto t_start = std::chrono::steady_clock::now();
-    fploc::sim::Simulator sim(plan, o);
+    std::unique_ptr<fploc::sim::Simulator> simp;
+    if (is_building) {
+      fploc::PlanLoadOptions po;
+      po.layer_globs = layers;
+      po.units_override = units;
+      simp = std::make_unique<fploc::sim::Simulator>(fploc::load_building(plan_file), floor, o, po);
+    } else {
+      simp = std::make_unique<fploc::sim::Simulator>(plan, o);
+    }
+    fploc::sim::Simulator& sim = *simp;
     std::cerr << "fploc sim: " << scenario << " seed " << seed << ", beams: " << sim.beam_source() << "\n" << sim.info();
     if (!ceilings_building.empty()) {
       if (sim.ceiling_map().areas.empty() && sim.ceiling_map().objects.empty())
@@ -136,6 +162,14 @@ int main(int argc, char** argv) {
     const double period = 1.0 / o.rate_hz;
     std::vector<uint8_t> buf;
     fploc::Trajectory traj;
+    std::ofstream floors_csv;
+    if (sim.building()) {
+      if (gt_floors.empty())
+        gt_floors = (gt.size() > 4 && gt.substr(gt.size() - 4) == ".tum" ? gt.substr(0, gt.size() - 4) : gt) + ".floors.csv";
+      floors_csv.open(gt_floors);
+      if (!floors_csv) throw std::runtime_error(gt_floors + ": cannot open for writing");
+      floors_csv << "t,floor_index,floor,state\n";
+    }
     fploc::sim::SimScan f;
     fploc::scan_t sm;
     size_t imu_k = 0;
@@ -168,6 +202,12 @@ int main(int argc, char** argv) {
           fploc::adapters::ground_truth_msg(f.scan.utime, k, p, sim.velocity(p.t), sim.angular_velocity(p.t), scenario);
       write_event(log, g.utime, "FPLOC_GROUND_TRUTH", g, buf);
       traj.push_back(p);
+      if (floors_csv.is_open()) {
+        const int fl = sim.floor_at(p.t);
+        char line[160];
+        std::snprintf(line, sizeof line, "%.6f,%d,%s,%s\n", p.t, fl, sim.floor_name(fl).c_str(), sim.state_at(p.t).c_str());
+        floors_csv << line;
+      }
       // The scan is complete at the end of its sweep.
       const double t_pub = ts + period;
       flush_imu(t_pub);
@@ -184,6 +224,11 @@ int main(int argc, char** argv) {
     flush_imu(t_end);
     std::cerr << "\n";
     fploc::write_tum(gt, traj);
+    if (floors_csv.is_open()) {
+      floors_csv.close();
+      if (!floors_csv) throw std::runtime_error(gt_floors + ": cannot write");
+      std::cerr << "fploc sim: ground-truth floor per scan written to " << gt_floors << "\n";
+    }
     std::string truth_path;
     if (const auto* edit = sim.world_edit()) {
       truth_path = !truth.empty() ? truth
@@ -222,6 +267,16 @@ int main(int argc, char** argv) {
       j["wall_s"] = wall;
       j["realtime_factor"] = simulated / std::max(wall, 1e-9);
       if (!truth_path.empty()) j["world_truth"] = truth_path;
+      if (sim.building()) {
+        j["gt_floors"] = gt_floors;
+        j["start_floor"] = sim.floor_name(sim.floor_at(o.t0_s));
+        j["t0"] = o.t0_s;
+        auto& fl = j["floors"] = nlohmann::json::array();
+        for (const auto& f : sim.building()->floors) fl.push_back({{"name", f.name}, {"elevation_m", f.elevation}});
+        auto& ch = j["floor_changes"] = nlohmann::json::array();
+        for (const auto& c : sim.floor_changes())
+          ch.push_back({{"t", o.t0_s + c.t}, {"from", sim.floor_name(c.from)}, {"to", sim.floor_name(c.to)}, {"how", c.how}});
+      }
       std::cout << j.dump() << std::endl;
     }
   } catch (const std::exception& e) {

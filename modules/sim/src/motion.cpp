@@ -206,38 +206,54 @@ double Motion::s_at_time(double tm, double* v) const {
   return std::clamp(s, 0.0, length_);
 }
 
+double Motion::heading_at(double s) const {
+  const double u = u_at(s);
+  const double us = std::clamp(u, 0.02, nseg_ - 0.02);
+  const Eigen::Vector2d d = closed_ ? spline_d(u) : spline_d(us);
+  return std::atan2(d.y(), d.x());
+}
+
 Eigen::Isometry3d Motion::pose(double t) const {
   t = std::clamp(t, 0.0, duration());
   double v = 0;
   const double s = s_at_time(t - cfg_.preroll_s, &v);
   const double u = u_at(s);
   const Eigen::Vector2d p = spline(u);
-  const double us = std::clamp(u, 0.02, nseg_ - 0.02);
-  const Eigen::Vector2d d = closed_ ? spline_d(u) : spline_d(us);
-  const double heading = std::atan2(d.y(), d.x());
+  const double heading = heading_at(s);
   const double q = std::clamp(v / std::max(speed_.v_max, 1e-6), 0.0, 1.5);
   const double w = cfg_.wobble_deg * kDeg;
   const double two_pi = 2 * M_PI;
-  const double roll = roll0_ * kDeg + w * q * (0.7 * std::sin(two_pi * 0.8 * t + ph_[0]) + 0.3 * std::sin(two_pi * 2.1 * t + ph_[1]));
-  const double pitch = pitch0_ * kDeg + w * q * (0.7 * std::sin(two_pi * 0.6 * t + ph_[2]) + 0.3 * std::sin(two_pi * 1.7 * t + ph_[3]));
-  const double yaw = heading + 0.4 * kDeg * q * std::sin(two_pi * 0.35 * t + ph_[4]);
+  const double tw = t + cfg_.t0;
+  double roll = roll0_ * kDeg + w * q * (0.7 * std::sin(two_pi * 0.8 * tw + ph_[0]) + 0.3 * std::sin(two_pi * 2.1 * tw + ph_[1]));
+  double pitch = pitch0_ * kDeg + w * q * (0.7 * std::sin(two_pi * 0.6 * tw + ph_[2]) + 0.3 * std::sin(two_pi * 1.7 * tw + ph_[3]));
+  const double yaw = heading + 0.4 * kDeg * q * std::sin(two_pi * 0.35 * tw + ph_[4]);
   // Height changes follow the floor (arc length), so standing still is still.
-  const double z = cfg_.sensor_height_m + cfg_.height_change_m * std::sin(two_pi * s / 9.0 + ph_[5]) +
-                   0.002 * q * std::sin(two_pi * 3.1 * t + ph_[6]);
+  double z = cfg_.sensor_height_m + cfg_.height_change_m * std::sin(two_pi * (s + cfg_.s0) / 9.0 + ph_[5]) +
+             0.002 * q * std::sin(two_pi * 3.1 * tw + ph_[6]);
+  if (cfg_.ground) {
+    // Four wheels around the dolly's centre: front/rear along the heading, left/right across it.
+    const Eigen::Vector2d f(std::cos(heading), std::sin(heading)), l(-f.y(), f.x());
+    const double hl = 0.5 * cfg_.wheelbase_m, ht = 0.5 * cfg_.track_m;
+    const double fl = cfg_.ground(s, p + hl * f + ht * l), fr = cfg_.ground(s, p + hl * f - ht * l);
+    const double rl = cfg_.ground(s, p - hl * f + ht * l), rr = cfg_.ground(s, p - hl * f - ht * l);
+    z += 0.25 * (fl + fr + rl + rr);
+    pitch += -std::atan2(0.5 * (fl + fr) - 0.5 * (rl + rr), cfg_.wheelbase_m);  // nose up = negative pitch
+    roll += std::atan2(0.5 * (fl + rl) - 0.5 * (fr + rr), cfg_.track_m);        // left side up = positive roll
+  }
   return StampedPose::from_rpy(t, Eigen::Vector3d(p.x(), p.y(), z), roll, pitch, yaw).iso();
 }
 
-Eigen::Vector3d Motion::velocity(double t) const {
+Eigen::Vector3d SensorTrajectory::velocity(double t) const {
   const double h = 1e-3;
   return (pose(t + h).translation() - pose(t - h).translation()) / (2 * h);
 }
 
-Eigen::Vector3d Motion::acceleration(double t) const {
+Eigen::Vector3d SensorTrajectory::acceleration(double t) const {
   const double h = 1e-2;
   return (pose(t + h).translation() - 2 * pose(t).translation() + pose(t - h).translation()) / (h * h);
 }
 
-Eigen::Vector3d Motion::angular_velocity_body(double t) const {
+Eigen::Vector3d SensorTrajectory::angular_velocity_body(double t) const {
   const double h = 1e-3;
   const Eigen::Matrix3d dR = pose(t - h).linear().transpose() * pose(t + h).linear();
   const Eigen::AngleAxisd aa(dR);
@@ -251,7 +267,7 @@ std::vector<Eigen::Vector2d> Motion::sample_path(double ds) const {
   return out;
 }
 
-std::vector<ImuSample> simulate_imu(const Motion& m, const ImuConfig& cfg, uint64_t seed) {
+std::vector<ImuSample> simulate_imu(const SensorTrajectory& m, const ImuConfig& cfg, uint64_t seed) {
   Rng rng(mix_seed(seed, 0x1A0));
   Eigen::Vector3d ba, bg;
   for (int i = 0; i < 3; ++i) ba[i] = rng.normal(cfg.accel_bias_sigma);

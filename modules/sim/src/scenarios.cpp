@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "fploc/sim/demo_building.h"
+
 namespace fploc::sim {
 namespace {
 
@@ -70,6 +72,12 @@ constexpr PaperRow kPaper[] = {
     {"building-clutter", "fast", 0.90, 0.65, 0}, {"building-clutter", "medium", 0.55, 0.40, 0},
     {"building-clutter", "slow", 0.45, 0.30, 0}, {"building-mixed", "fast", 0.90, 0.65, 0},
     {"building-mixed", "medium", 0.55, 0.40, 0}, {"building-mixed", "slow", 0.45, 0.30, 0},
+    // Journeys through the demo building (ramp, lift, thresholds): demo_building.h.
+    {"building-twofloor", "fast", 0.90, 0.65, 0},   {"building-twofloor", "medium", 0.55, 0.40, 0},
+    {"building-twofloor", "slow", 0.45, 0.30, 0},   {"building-ramp", "fast", 0.90, 0.65, 0},
+    {"building-ramp", "medium", 0.55, 0.40, 0},     {"building-ramp", "slow", 0.45, 0.30, 0},
+    {"building-thresholds", "fast", 0.90, 0.65, 0}, {"building-thresholds", "medium", 0.55, 0.40, 0},
+    {"building-thresholds", "slow", 0.45, 0.30, 0},
 };
 
 }  // namespace
@@ -160,6 +168,10 @@ bool scenario_spec(const std::string& name, ScenarioSpec& out, std::string* erro
       std::vector<double> half;
       corridor_centre(cl, half);
       s.control = densify_closed(cl, 1.0);
+    } else if (!demo_building_journey(s.base).empty()) {
+      s.plan_kind = "building";
+      s.legs = demo_building_journey(s.base);
+      s.closed = false;
     } else {
       s.plan_kind = "any";
       if (s.base.rfind("building-", 0) == 0) s.ceilings = s.base.substr(9);

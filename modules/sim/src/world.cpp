@@ -30,6 +30,33 @@ double angle_in(double ang, double a0) {
 
 }  // namespace
 
+bool polygon_contains(const std::vector<Eigen::Vector2d>& poly, double x, double y) {
+  bool in = false;
+  const size_t n = poly.size();
+  for (size_t i = 0, j = n - 1; i < n; j = i++) {
+    const Eigen::Vector2d& a = poly[i];
+    const Eigen::Vector2d& b = poly[j];
+    if ((a.y() > y) != (b.y() > y) && x < (b.x() - a.x()) * (y - a.y()) / (b.y() - a.y()) + a.x()) in = !in;
+  }
+  return in;
+}
+
+Box2 polygon_bounds(const std::vector<Eigen::Vector2d>& poly) {
+  Box2 b;
+  if (poly.empty()) return b;
+  b.min = b.max = poly[0];
+  for (const auto& p : poly) {
+    b.min = b.min.cwiseMin(p);
+    b.max = b.max.cwiseMax(p);
+  }
+  return b;
+}
+
+bool CeilingPatch::contains(double x, double y) const {
+  if (!inside(box, x, y)) return false;
+  return polygon.empty() || polygon_contains(polygon, x, y);
+}
+
 const char* label_name(Label l) {
   switch (l) {
     case Label::kNone: return "none";
@@ -128,7 +155,32 @@ World::World(const FloorPlan& plan, WorldConfig cfg) : plan_(plan), cfg_(std::mo
   for (const auto& c : cells) cell_walls_.insert(cell_walls_.end(), c.begin(), c.end());
 }
 
-void World::add_ceiling_patch(const CeilingPatch& p) {
+void World::add_ground_patch(GroundPatch p) {
+  p.box = polygon_bounds(p.polygon);
+  for (const auto& v : p.polygon) {
+    const double h = p.height(v.x(), v.y());
+    wall_bottom_ = std::min(wall_bottom_, h - 0.5);
+    wall_top_ = std::max(wall_top_, h + cfg_.ceiling_height_m);
+  }
+  ground_.push_back(std::move(p));
+  for (auto& w : walls_) w.z[0] = float(wall_bottom_);
+}
+
+bool World::in_ground_patch(double x, double y) const {
+  for (const auto& g : ground_)
+    if (inside(g.box, x, y) && polygon_contains(g.polygon, x, y)) return true;
+  return false;
+}
+
+double World::ground_at(double x, double y) const {
+  for (const auto& g : ground_)
+    if (inside(g.box, x, y) && polygon_contains(g.polygon, x, y)) return g.height(x, y);
+  return 0;
+}
+
+void World::add_ceiling_patch(const CeilingPatch& p0) {
+  CeilingPatch p = p0;
+  if (!p.polygon.empty()) p.box = polygon_bounds(p.polygon);
   patches_.push_back(p);
   if (!p.open) {
     for (double x : {p.box.min.x(), p.box.max.x()})
@@ -151,7 +203,7 @@ void World::set_time(double t) {
 double World::ceiling_at(double x, double y) const {
   if (!inside(bounds_, x, y)) return std::numeric_limits<double>::quiet_NaN();
   for (const auto& p : patches_)
-    if (inside(p.box, x, y)) return p.open ? std::numeric_limits<double>::quiet_NaN() : p.height(x, y);
+    if (p.contains(x, y)) return p.open ? std::numeric_limits<double>::quiet_NaN() : p.height(x, y);
   return cfg_.ceiling_height_m;
 }
 
@@ -165,7 +217,7 @@ double World::ceiling_t(const Eigen::Vector3d& o, const Eigen::Vector3d& d, doub
       if (inside(bounds_, x, y)) {
         bool in_patch = false;
         for (const auto& p : patches_)
-          if (inside(p.box, x, y)) {
+          if (p.contains(x, y)) {
             in_patch = true;
             break;
           }
@@ -180,7 +232,7 @@ double World::ceiling_t(const Eigen::Vector3d& o, const Eigen::Vector3d& d, doub
     const double t = (p.h0 + p.slope.x() * (o.x() - p.box.min.x()) + p.slope.y() * (o.y() - p.box.min.y()) - o.z()) / den;
     if (t > kEps && t < std::min(tmax, best)) {
       const double x = o.x() + t * d.x(), y = o.y() + t * d.y();
-      if (inside(p.box, x, y) && inside(bounds_, x, y)) best = t;
+      if (p.contains(x, y) && inside(bounds_, x, y)) best = t;
     }
   }
   return best;
@@ -247,9 +299,10 @@ Hit World::cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_max
   best.t = kInf;
   double tlim = t_max;
   // Floor (everywhere) and ceiling (inside the building).
-  if (d.z() < -1e-12) {
+  // The floor plane z = 0 from above, or from below when the sensor is lower (on a ramp to this floor).
+  if (d.z() < -1e-12 || (d.z() > 1e-12 && o.z() < 0 && !ground_.empty())) {
     const double t = -o.z() / d.z();
-    if (t > kEps && t < tlim) {
+    if (t > kEps && t < tlim && (ground_.empty() || !in_ground_patch(o.x() + t * d.x(), o.y() + t * d.y()))) {
       best.t = t;
       best.label = Label::kFloor;
       best.normal = Eigen::Vector3d::UnitZ();
@@ -257,7 +310,31 @@ Hit World::cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_max
       best.element = -1;
       tlim = t;
     }
-  } else if (d.z() > 1e-12) {
+  }
+  // Ramps, stairs, the storey below: sloped or lower/higher floor planes inside their polygons.
+  for (size_t gi = 0; gi < ground_.size(); ++gi) {
+    const GroundPatch& g = ground_[gi];
+    const double den = d.z() - g.slope.x() * d.x() - g.slope.y() * d.y();
+    if (std::abs(den) < 1e-12) continue;
+    const double t = (g.height(o.x(), o.y()) - o.z()) / den;
+    if (!(t > kEps && t < tlim)) continue;
+    const double x = o.x() + t * d.x(), y = o.y() + t * d.y();
+    if (!inside(g.box, x, y) || !polygon_contains(g.polygon, x, y)) continue;
+    bool first = true;  // the first patch containing the point owns it
+    for (size_t k = 0; k < gi && first; ++k)
+      if (inside(ground_[k].box, x, y) && polygon_contains(ground_[k].polygon, x, y)) first = false;
+    if (!first) continue;
+    Eigen::Vector3d n(-g.slope.x(), -g.slope.y(), 1.0);
+    n.normalize();
+    if (n.dot(d) > 0) n = -n;
+    best.t = t;
+    best.label = Label::kFloor;
+    best.normal = n;
+    best.reflectivity = 18;
+    best.element = -1;
+    tlim = t;
+  }
+  if (d.z() > 1e-12) {
     const double t = ceiling_t(o, d, tlim);
     if (t < tlim) {
       best.t = t;
@@ -311,8 +388,8 @@ Hit World::cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_max
       n.head<2>() = Eigen::Vector2d(c * nl.x() - s * nl.y(), s * nl.x() + c * nl.y());
     }
     best.t = t0;
-    best.label = Label::kClutter;
-    best.element = int32_t(i);
+    best.label = f.ground ? Label::kFloor : Label::kClutter;
+    best.element = f.ground ? -1 : int32_t(i);
     best.normal = n;
     best.reflectivity = f.reflectivity;
     tlim = t0;

@@ -23,3 +23,18 @@ assert "ceilings: mixed" in " ".join(d["rows"][0]["sim"]), d["rows"][0]
 assert d["rows"][0]["segmenter_building"] is True and d["rows"][1]["segmenter_building"] is False, d["rows"]
 print("bench building smoke:", [(r["scenario"], r["z_err_p99_m"], r["rp_err_p99_deg"]) for r in d["rows"]])
 PY
+# A building: the first 4 s of the demo building's ramp journey (ground floor): the floor rows are there.
+"$BIN/fploc-bench-building" --plan "${FPLOC_ROOT:?}/data/buildings/demo-building.pbtxt" --scenario building-ramp-fast \
+  --duration 4 --json >"$W/b.json" 2>"$W/err" || { tail -20 "$W/err" >&2; exit 1; }
+python3 - "$W/b.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+r = d["rows"][0]
+assert r["building"] and r["poses"] >= 30, r
+assert r["z_err_p99_m"] < 0.05 and r["ate_xy_m"] < 0.05 and r["lost"] == 0, r
+if r["floor_scored"]:
+    assert r["wrong_floor_poses"] == 0 and r["floor_changes"] == [] and r["lift_rides"] == [], r
+else:
+    assert "floor" in r["floor_note"], r
+print("bench building smoke (building):", r["scenario"], r["z_err_p99_m"], r.get("wrong_floor_poses"))
+PY

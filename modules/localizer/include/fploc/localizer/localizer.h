@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "fploc/matcher/imu_yaw.h"
@@ -34,6 +35,10 @@ struct FramePose {
   // and the frame's own sigmas (an "unknown" sigma tells the value is held).
   double roll = 0, pitch = 0, z = 0;
   double roll_pitch_sigma = kUnknownRollPitchSigmaRad, z_sigma = kUnknownZSigmaM;
+  // The floor the frame was registered on (index in the building's floor list, its name); z is the
+  // height above that floor's floor. A single plan is floor 0 named "0".
+  int floor_index = 0;
+  std::string floor = "0";
 };
 
 // A localized pose (the WO step's output): PoseOut carries its (x, y, yaw) covariance and its own z and

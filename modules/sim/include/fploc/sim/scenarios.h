@@ -4,6 +4,8 @@
 //   auto-loop-slow | auto-loop-medium | auto-loop-fast   (a loop planned through any plan's free space)
 //   building-areas | building-atrium | building-clutter | building-mixed  + -slow | -medium | -fast
 //     (auto-loop under the ceilings of a real building, ceiling_map.h)
+//   building-twofloor | building-ramp | building-thresholds  + -slow | -medium | -fast
+//     (journeys through the demo building data/buildings/demo-building.pbtxt: demo_building.h)
 // Lengths and speeds are the paper's (Tables I and II) per sequence.
 #pragma once
 #include <Eigen/Core>
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "fploc/floorplan/plan.h"
+#include "fploc/sim/journey.h"
 #include "fploc/sim/motion.h"
 
 namespace fploc::sim {
@@ -29,13 +32,14 @@ struct ScenarioSpec {
   std::string name;        // full name, e.g. "room-small-loop-fast"
   std::string base;        // "room-small-loop", ..., "auto-loop"
   std::string speed_name;  // slow | medium | fast
-  std::string plan_kind;   // "room", "corridor" or "any" (auto-loop)
+  std::string plan_kind;   // "room", "corridor", "any" (auto-loop) or "building" (a journey through the demo building)
   std::vector<Eigen::Vector2d> control;  // B-spline control polygon (empty for auto-loop)
   bool closed = true;
   double length = 0;       // target path length [m] (0 = as planned)
   SpeedSpec speed;
   double ceiling_m = 3.0;
   std::string ceilings;    // building-*: the ceiling_map.h kind ("areas", "atrium", "clutter", "mixed")
+  std::vector<JourneyLeg> legs;  // plan_kind "building": the journey (demo_building.h)
 };
 
 // Fills `out` for a scenario name; false with a message listing the valid names.

@@ -30,14 +30,33 @@ struct WorldConfig {
   double grid_cell_m = 0.5;
 };
 
-// A ceiling region (axis-aligned box in the plan frame) that is either missing (rays pass) or a plane
-// z = h0 + slope.dot(xy - box.min).
+// Point in a simple polygon (even-odd rule; points on an edge may go either way).
+bool polygon_contains(const std::vector<Eigen::Vector2d>& poly, double x, double y);
+Box2 polygon_bounds(const std::vector<Eigen::Vector2d>& poly);
+
+// A ceiling region (axis-aligned box in the plan frame, or a polygon when `polygon` is set: then `box`
+// is its bounding box) that is either missing (rays pass) or a plane z = h0 + slope.dot(xy - box.min).
 struct CeilingPatch {
   Box2 box;
   bool open = false;
   double h0 = 3.0;
   Eigen::Vector2d slope = Eigen::Vector2d::Zero();
+  std::vector<Eigen::Vector2d> polygon;  // empty = the box itself
   double height(double x, double y) const { return h0 + slope.x() * (x - box.min.x()) + slope.y() * (y - box.min.y()); }
+  bool contains(double x, double y) const;
+};
+
+// A region of the floor that is not at z = 0 (a ramp, the flight of a stairs, the floor of the storey
+// below seen from above): a polygon with the plane z = h0 + slope.dot(xy - origin). The first patch
+// containing a point wins; elsewhere the floor is at z = 0.
+struct GroundPatch {
+  std::string name;
+  std::vector<Eigen::Vector2d> polygon;
+  double h0 = 0;
+  Eigen::Vector2d origin = Eigen::Vector2d::Zero();
+  Eigen::Vector2d slope = Eigen::Vector2d::Zero();
+  Box2 box;  // bounding box (set by World::add_ground_patch)
+  double height(double x, double y) const { return h0 + slope.x() * (x - origin.x()) + slope.y() * (y - origin.y()); }
 };
 
 // Furniture: an oriented box standing on z0.
@@ -47,6 +66,7 @@ struct Furniture {
   Eigen::Vector2d half = Eigen::Vector2d(0.5, 0.5);  // half extents in its own frame
   double z0 = 0, z1 = 0.75;
   uint8_t reflectivity = 30;
+  bool ground = false;  // part of the floor (a door threshold): labelled kFloor, not clutter
 };
 
 // A walking person: a vertical cylinder moving back and forth along a polyline at constant speed.
@@ -74,6 +94,10 @@ class World {
   void add_furniture(const Furniture& f);
   void add_person(const Person& p) { people_.push_back(p); }
   void add_ceiling_patch(const CeilingPatch& p);
+  void add_ground_patch(GroundPatch p);
+  const std::vector<GroundPatch>& ground_patches() const { return ground_; }
+  // Floor height at (x, y): the ground patch there, else 0 (thresholds not included).
+  double ground_at(double x, double y) const;
   void clear_clutter() {
     furniture_.clear();
     furn_cs_.clear();
@@ -110,6 +134,7 @@ class World {
   };
   bool hit_wall(const Wall& w, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double tmax, Hit& h) const;
   double ceiling_t(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double tmax) const;
+  bool in_ground_patch(double x, double y) const;
 
   FloorPlan plan_;
   WorldConfig cfg_;
@@ -124,6 +149,8 @@ class World {
   std::vector<uint32_t> cell_walls_;
 
   std::vector<CeilingPatch> patches_;
+  std::vector<GroundPatch> ground_;
+  double wall_bottom_ = 0;  // walls reach down to the lowest ground patch
   std::vector<Furniture> furniture_;
   std::vector<Eigen::Vector3d> furn_cs_;  // cos(yaw), sin(yaw), bounding radius
   std::vector<Person> people_;

@@ -1,0 +1,244 @@
+// FloorTracker and VerticalImu on synthetic inputs: a lift ride (IMU specific force with bias and noise),
+// a ramp (the IMU's tilt, or the segmenter's z), rides that must not switch.
+#include "fploc/localizer/floor_tracker.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+using namespace fploc;
+using namespace fploc::localizer;
+
+namespace {
+
+constexpr double kG = 9.80665;
+
+std::shared_ptr<Building> two_floors() {
+  auto b = std::make_shared<Building>();
+  b->source = "synthetic";
+  BuildingFloor g, f;
+  g.name = "ground";
+  g.elevation = 0;
+  f.name = "first";
+  f.elevation = 3.3;
+  b->floors = {g, f};
+  FloorConnection ramp;
+  ramp.name = "ramp";
+  ramp.kind = ConnectionKind::kRamp;
+  ramp.from_floor = "ground";
+  ramp.to_floor = "first";
+  ramp.polygon = {{10, 0}, {20, 0}, {20, 2}, {10, 2}};
+  FloorConnection lift;
+  lift.name = "lift";
+  lift.kind = ConnectionKind::kLift;
+  lift.from_floor = "ground";
+  lift.to_floor = "first";
+  lift.polygon = {{0, 5}, {2, 5}, {2, 7}, {0, 7}};
+  b->connections = {ramp, lift};
+  return b;
+}
+
+// Specific force of a sensor with roll/pitch (levelled frame: gravity only) plus vertical acceleration a,
+// a constant bias and white noise.
+struct ImuGen {
+  std::mt19937 rng{7};
+  std::normal_distribution<double> n{0, 0.015};
+  Eigen::Vector3d bias{0.04, -0.03, 0.05};
+  Eigen::Vector3d operator()(double roll, double pitch, double a_up) {
+    const double g = kG + a_up;
+    const Eigen::Vector3d f(-std::sin(pitch) * g, std::cos(pitch) * std::sin(roll) * g, std::cos(pitch) * std::cos(roll) * g);
+    return f + bias + Eigen::Vector3d(n(rng), n(rng), n(rng));
+  }
+};
+
+// A lift ride profile: rest, accelerate (a for ta s), cruise (tc s), brake, rest. Returns the height.
+double ride_accel(double t, double a, double ta, double tc, double t0) {
+  const double s = t - t0;
+  if (s < 0) return 0;
+  if (s < ta) return a;
+  if (s < ta + tc) return 0;
+  if (s < 2 * ta + tc) return -a;
+  return 0;
+}
+
+struct LiftRun {
+  std::optional<FloorSwitch> sw;
+  double switch_t = -1;
+  double arrive_t = 0;
+};
+
+// Runs a ride of `height` (a = 0.5 m/s^2, 2 s ramps) starting at t = 3 s with the robot standing at p,
+// frames every 0.1 s, IMU at 200 Hz.
+LiftRun run_ride(FloorTracker& tr, const Eigen::Vector2d& p, double height, double duration = 15) {
+  ImuGen imu;
+  const double a = 0.5 * (height > 0 ? 1 : -1), ta = 2.0;
+  const double tc = std::max(0.0, (std::abs(height) - 0.5 * ta * ta) / (0.5 * ta));  // ramps: 1 m each
+  LiftRun r;
+  r.arrive_t = 3 + 2 * ta + tc;
+  int64_t frame_us = 0;
+  for (int64_t us = 0; us < int64_t(duration * 1e6); us += 5000) {
+    const double t = us * 1e-6;
+    tr.add_imu(us, imu(0.002, -0.003, ride_accel(t, a, ta, tc, 3.0)));
+    if (us >= frame_us) {
+      frame_us += 100000;
+      FloorObservation o;
+      o.utime = us;
+      o.pose = {p.x(), p.y(), 0.3};
+      o.inlier_ratio = t > 3 && t < r.arrive_t ? 0.3 : 0.9;
+      o.z = 1.2;
+      o.z_known = true;
+      if (auto s = tr.update(o); s && !r.sw) r.sw = s, r.switch_t = t;
+    }
+  }
+  return r;
+}
+
+}  // namespace
+
+TEST(VerticalImu, RideHeightWithBiasAndNoise) {
+  VerticalImu v;
+  ImuGen imu;
+  std::optional<VerticalRide> ride;
+  for (int64_t us = 0; us < 15'000'000; us += 5000) {
+    v.add(us, imu(0.01, 0.02, ride_accel(us * 1e-6, 0.5, 2.0, 2.6, 3.0)));
+    if (auto r = v.take_ride()) ride = r;
+  }
+  ASSERT_TRUE(ride);
+  EXPECT_NEAR(ride->height_m, 2.0 + 2.6, 0.05);
+  EXPECT_NEAR(ride->peak_speed_mps, 1.0, 0.05);
+  EXPECT_NEAR(ride->start_utime * 1e-6, 3.45, 0.3);
+  EXPECT_LT(ride->end_utime * 1e-6, 3 + 4 + 2.6 + 1.0);  // at rest within a second of the stop
+}
+
+TEST(VerticalImu, StandingStillIsNoRide) {
+  VerticalImu v;
+  ImuGen imu;
+  for (int64_t us = 0; us < 30'000'000; us += 5000) {
+    v.add(us, imu(0.01, 0.02, 0));
+    EXPECT_FALSE(v.take_ride());
+    EXPECT_FALSE(v.riding());
+  }
+}
+
+TEST(FloorTracker, LiftUpSwitchesAfterArrivalAndSaysWhy) {
+  FloorTracker tr(two_floors(), 0);
+  const LiftRun r = run_ride(tr, {1, 6}, 3.3);
+  ASSERT_TRUE(r.sw);
+  EXPECT_EQ(r.sw->from, 0);
+  EXPECT_EQ(r.sw->to, 1);
+  EXPECT_EQ(r.sw->to_name, "first");
+  EXPECT_EQ(r.sw->via.name, "lift");
+  EXPECT_GT(r.switch_t, r.arrive_t);
+  EXPECT_LT(r.switch_t, r.arrive_t + 2.0);
+  EXPECT_NE(r.sw->reason.find("lift 'lift': IMU vertical motion +3.3"), std::string::npos) << r.sw->reason;
+  EXPECT_NE(r.sw->reason.find("the plan of 'ground' matched"), std::string::npos) << r.sw->reason;
+  EXPECT_EQ(tr.floor(), 1);
+  EXPECT_EQ(tr.floor_name(), "first");
+  EXPECT_NE(tr.status_text().find("'ground' -> 'first'"), std::string::npos);
+  // The search disc holds the lift's polygon.
+  EXPECT_NEAR(r.sw->search_center.x(), 1, 1e-9);
+  EXPECT_NEAR(r.sw->search_center.y(), 6, 1e-9);
+  EXPECT_GE(r.sw->search_radius_m, std::sqrt(2.0));
+}
+
+TEST(FloorTracker, LiftDown) {
+  FloorTracker tr(two_floors(), 1);
+  const LiftRun r = run_ride(tr, {1.5, 5.5}, -3.3);
+  ASSERT_TRUE(r.sw);
+  EXPECT_EQ(r.sw->to, 0);
+  EXPECT_EQ(tr.floor_name(), "ground");
+}
+
+TEST(FloorTracker, RideOutsideALiftOrToNoFloorDoesNotSwitch) {
+  {
+    FloorTracker tr(two_floors(), 0);
+    EXPECT_FALSE(run_ride(tr, {6, 6}, 3.3).sw);  // not in the lift area
+    EXPECT_EQ(tr.floor(), 0);
+  }
+  {
+    FloorTracker tr(two_floors(), 0);
+    EXPECT_FALSE(run_ride(tr, {1, 6}, 1.7).sw);  // half a floor: no floor there
+    EXPECT_EQ(tr.floor(), 0);
+    EXPECT_NE(tr.status_text().find("matches no floor"), std::string::npos) << tr.status_text();
+  }
+  {
+    FloorTracker tr(two_floors(), 0);
+    EXPECT_FALSE(run_ride(tr, {1, 6}, -3.3).sw);  // no floor below the ground floor
+    EXPECT_EQ(tr.floor(), 0);
+  }
+}
+
+namespace {
+
+// Drives along y = 1 from x = 0 to x = 30 at 0.5 m/s; the ramp rises 3.3 m between x = 10 and 20. With
+// `imu` the tilt comes from the IMU (the segmenter's z stays at the ground plane's 1.2 m, as over a
+// ramp), else the segmenter's z follows the climb. Returns the x of the switch (or -1).
+double drive_ramp(FloorTracker& tr, bool imu, bool relearn_z) {
+  ImuGen gen;
+  const double slope = 3.3 / 10, pitch = -std::atan(slope);
+  double switch_x = -1;
+  int64_t frame_us = 0;
+  for (int64_t us = 0; us < 60'000'000; us += 5000) {
+    const double t = us * 1e-6, x = 0.5 * t;
+    const bool on_ramp = x > 10 && x < 20;
+    if (imu) tr.add_imu(us, gen(0.003 * std::sin(t), (on_ramp ? pitch : 0) + 0.005 * std::sin(1.3 * t), 0));
+    if (us < frame_us) continue;
+    frame_us += 100000;
+    const double climb = std::clamp((x - 10) * slope, 0.0, 3.3);
+    FloorObservation o;
+    o.utime = us;
+    o.pose = {x, 1, 0};
+    o.z_known = true;
+    o.z = imu ? 1.2 : 1.2 + climb;
+    if (!imu && relearn_z && x > 24) o.z = 1.2;  // the segmenter re-learned its ceiling on the new floor
+    if (auto s = tr.update(o)) {
+      EXPECT_EQ(switch_x, -1) << "switched twice: " << s->reason;
+      switch_x = x;
+      EXPECT_EQ(s->via.name, "ramp");
+      EXPECT_NE(s->reason.find(imu ? "IMU tilt" : "z +1."), std::string::npos) << s->reason;
+    }
+    if (x > 22) EXPECT_NEAR(tr.floor_z(o.z), 1.2, 0.05) << "x " << x;
+  }
+  return switch_x;
+}
+
+}  // namespace
+
+TEST(FloorTracker, RampUpFromTheImuTilt) {
+  FloorTracker tr(two_floors(), 0);
+  const double x = drive_ramp(tr, true, false);
+  EXPECT_GT(x, 14.5);
+  EXPECT_LT(x, 16.5);
+  EXPECT_EQ(tr.floor(), 1);
+}
+
+TEST(FloorTracker, RampUpFromTheSegmentersZThenItsOffsetIsDropped) {
+  FloorTracker tr(two_floors(), 0);
+  const double x = drive_ramp(tr, false, true);
+  EXPECT_GT(x, 14.5);
+  EXPECT_LT(x, 16.5);
+  EXPECT_EQ(tr.floor(), 1);
+  EXPECT_EQ(tr.z_offset(), 0.0);
+  EXPECT_NE(tr.status_text().find("offset +3.30 m dropped"), std::string::npos) << tr.status_text();
+}
+
+TEST(FloorTracker, FlatDrivingThroughAConnectionAreaStays) {
+  FloorTracker tr(two_floors(), 0);
+  ImuGen gen;
+  int64_t frame_us = 0;
+  for (int64_t us = 0; us < 60'000'000; us += 5000) {
+    const double t = us * 1e-6, x = 0.5 * t;
+    // Wobble, and a forward acceleration at the start (tilts the specific force).
+    tr.add_imu(us, gen(0.01 * std::sin(2 * t), 0.01 * std::sin(1.7 * t) - (t < 1.5 ? 0.035 : 0), 0));
+    if (us < frame_us) continue;
+    frame_us += 100000;
+    FloorObservation o;
+    o.utime = us;
+    o.pose = {x, 1, 0};
+    o.z = 1.2 + 0.04 * std::sin(0.5 * t);
+    o.z_known = true;
+    EXPECT_FALSE(tr.update(o)) << "x " << x << ": " << tr.status_text();
+  }
+  EXPECT_EQ(tr.floor(), 0);
+}

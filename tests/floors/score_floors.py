@@ -1,0 +1,112 @@
+#!/usr/bin/env python3
+"""Scores a floor change: score_floors.py REC.lcm GT.tum FLOORS.txt [LAUNCH.log]
+
+REC.lcm: lcm-logger's recording of FPLOC_POSE (pose_t, with floor_index/floor) and FPLOC_FRAME_POSE;
+GT.tum the ground truth; FLOORS.txt "utime floor" per ground-truth pose plus "# arrival UTIME" and
+"# ride_start UTIME" (tests/floors/make_lift_log). Prints the time from the arrival to the first pose
+on the new floor, the poses on the wrong floor (all, and from 3 s after the arrival), the horizontal
+ATE over the 10 s after the arrival, and fails (exit 1) when a target is missed:
+recognised within 2 s, none wrong 3 s after the arrival, ATE <= 5 cm."""
+import bisect
+import math
+import struct
+import sys
+
+
+def lcm_events(path):
+    data = open(path, "rb").read()
+    i = 0
+    while i + 28 <= len(data):
+        sync, _n, ts, clen, dlen = struct.unpack(">IqqII", data[i:i + 28])
+        if sync != 0xEDA1DA01:
+            raise RuntimeError(f"{path}: byte {i}: not an LCM log event")
+        ch = data[i + 28:i + 28 + clen].decode()
+        yield ts, ch, data[i + 28 + clen:i + 28 + clen + dlen]
+        i += 28 + clen + dlen
+
+
+def decode_pose_t(buf):
+    # hash, int64 utime, int64 seq, int8 status, bool keyframe, bool final, double[3+4+36],
+    # int16 floor_index, string floor
+    o = 8
+    utime, _seq, status, _kf, final = struct.unpack(">qqbbb", buf[o:o + 19])
+    o += 19
+    v = struct.unpack(">43d", buf[o:o + 43 * 8])
+    o += 43 * 8
+    (floor_index,) = struct.unpack(">h", buf[o:o + 2])
+    o += 2
+    (n,) = struct.unpack(">i", buf[o:o + 4])
+    floor = buf[o + 4:o + 4 + n - 1].decode()
+    return {"utime": utime, "status": status, "final": bool(final), "x": v[0], "y": v[1], "z": v[2],
+            "floor_index": floor_index, "floor": floor}
+
+
+def main():
+    rec, gt_path, floors_path = sys.argv[1:4]
+    launch = sys.argv[4] if len(sys.argv) > 4 else None
+    meta, gt_floor = {}, []
+    for line in open(floors_path):
+        p = line.split()
+        if line.startswith("#"):
+            meta[p[1]] = p[2:]
+        elif p:
+            gt_floor.append((int(p[0]), p[1]))
+    arrival = int(meta["arrival"][0])
+    ride_start = int(meta["ride_start"][0])
+    upper = gt_floor[-1][1]
+    lower = gt_floor[0][1]
+    gt = []
+    for line in open(gt_path):
+        if line.strip() and not line.startswith("#"):
+            t, x, y = map(float, line.split()[:3])
+            gt.append((int(round(t * 1e6)), x, y))
+    gt_t = [g[0] for g in gt]
+    poses = {}
+    for _ts, ch, buf in lcm_events(rec):
+        if ch == "FPLOC_POSE":
+            p = decode_pose_t(buf)
+            poses[p["utime"]] = p
+    poses = [poses[t] for t in sorted(poses)]
+    if not poses:
+        print("FAIL: no FPLOC_POSE recorded")
+        return 1
+    ok = True
+    first_upper = next((p for p in poses if p["utime"] >= ride_start and p["floor"] == upper), None)
+    early = [p for p in poses if p["utime"] < ride_start and p["floor"] != lower]
+    wrong_all = [p for p in poses if (p["floor"] != (upper if p["utime"] >= arrival else lower))]
+    wrong_late = [p for p in poses if p["utime"] >= arrival + 3_000_000 and p["floor"] != upper]
+    after = [p for p in poses if arrival <= p["utime"] <= arrival + 10_000_000]
+    errs = []
+    for p in after:
+        k = bisect.bisect_left(gt_t, p["utime"])
+        k = min(max(k, 0), len(gt) - 1)
+        if abs(gt[k][0] - p["utime"]) > 2000:
+            continue
+        errs.append(math.hypot(p["x"] - gt[k][1], p["y"] - gt[k][2]))
+    ate = math.sqrt(sum(e * e for e in errs) / len(errs)) if errs else float("nan")
+    rec_s = (first_upper["utime"] - arrival) * 1e-6 if first_upper else float("inf")
+    print(f"poses: {len(poses)} (final), floors seen: {sorted(set(p['floor'] for p in poses))}")
+    print(f"ride {ride_start} .. arrival {arrival} us; first pose on '{upper}': {rec_s:+.2f} s after the arrival")
+    print(f"poses on the wrong floor: {len(wrong_all)} in all, {len(wrong_late)} from 3 s after the arrival, "
+          f"{len(early)} on '{upper}' before the ride")
+    print(f"horizontal ATE over the 10 s after the arrival: {100 * ate:.2f} cm ({len(errs)} poses, max "
+          f"{100 * max(errs) if errs else float('nan'):.2f} cm)")
+    if not (rec_s <= 2.0):
+        print("FAIL: the new floor was not recognised within 2 s of the arrival"); ok = False
+    if wrong_late:
+        print(f"FAIL: {len(wrong_late)} poses on the wrong floor 3 s after the arrival"); ok = False
+    if early:
+        print(f"FAIL: {len(early)} poses on '{upper}' before the ride"); ok = False
+    if not (ate <= 0.05) or len(errs) < 50:
+        print("FAIL: ATE over the 10 s after the ride above 5 cm (or too few poses)"); ok = False
+    if launch:
+        said = [l.strip() for l in open(launch, errors="replace") if "lift '" in l and "->" in l]
+        if not said:
+            print("FAIL: the matcher did not say why it switched floor"); ok = False
+        else:
+            print("matcher: " + said[0][:300])
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
