@@ -10,12 +10,12 @@ LOST transitions, reported as node errors), and ms per scan per node (thread CPU
 
 Scenarios: the `building-*` ones (sim/ceiling_map.h: areas with their own ceiling heights and a sloped
 roof, a double-height atrium, lamps/beams/ducts/a drop-ceiling grid, all mixed; the segmenter gets the floor's
-ceilings as a building file, `fploc sim --ceilings-building`, unless --no-building-heights) and `auto-loop-medium`
+ceilings as a building file with --building-heights, `fploc sim --ceilings-building`) and `auto-loop-medium`
 with the simulator's default ceiling patches, on every shipped plan (data/plans) unless --plan is given;
 and the journeys through the demo building (data/buildings/demo-building.pbtxt: building-twofloor, -ramp,
 -thresholds; ramp, lift, door thresholds). A --plan may be a building (.pbtxt): the localizer gets the
 building (every floor), the simulator's ground truth is absolute (z = floor elevation + height above it)
-and its floor per scan (gt.floors.csv) scores the floor rows; the segmenter gets the building too (its floors'
+and its floor per scan (gt.floors.csv) scores the floor rows (with --building-heights the segmenter gets the building too: its floors'
 ceiling areas, the floor from the pose feedback); the pose's floor comes from
 pose_t.floor_index (pose logger `floor_file`), its z (height above that floor) is made absolute with the
 floor's elevation before scoring.
@@ -372,10 +372,10 @@ def main():
     ap.add_argument("--graph", default=os.path.join(ROOT, "graphs", "paper.pbtxt"))
     ap.add_argument("--plots", help="write z-against-ground-truth SVGs into this folder")
     ap.add_argument("--keep", help="keep the work folder here")
-    ap.add_argument("--no-building-heights", dest="building_heights", action="store_false",
-                    help="building-* scenarios: do not give the segmenter the simulated floor's ceilings as a building "
-                         "file (segmenter.building: area heights looked up per ceiling point with the pose feedback); "
-                         "it then learns one height online, as on a bare plan")
+    ap.add_argument("--building-heights", action="store_true",
+                    help="give the segmenter the building (segmenter.building: area heights looked up per ceiling point "
+                         "with the pose feedback): the plan when it is a building, else for building-* scenarios the "
+                         "simulated floor's ceilings (fploc sim --ceilings-building)")
     ap.add_argument("--json", action="store_true", help="(JSON is always printed on stdout)")
     a = ap.parse_args()
     plans = [os.path.abspath(p) for p in (a.plan or [os.path.join(ROOT, "data", "plans", "room.json"),

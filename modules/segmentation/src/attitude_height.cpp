@@ -88,7 +88,7 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
 
   // The building's view of the ceiling points (their areas), when the floor's areas and a plan pose are known.
   const bool areas_on = have_areas_ && upper != nullptr && c && census(out, *upper, up_c);
-  if (areas_on) {
+  if (areas_on && cfg_.building_attitude) {
     // A ceiling the building says is sloped (over a ramp, under a roof) gives gravity's up once turned by
     // its slope.
     double corr = 0;
@@ -121,7 +121,7 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
       if (imu.valid && imu.trusted) {
         ground_better = up_g.dot(imu.up) > up_c.dot(imu.up);
         by = "IMU gravity";
-      } else if (areas_on && census_.known_fraction > k::kAreaKnownMin) {
+      } else if (areas_on && cfg_.building_attitude && census_.known_fraction > k::kAreaKnownMin) {
         // The building's ceiling heights: under the right attitude the ceiling points lie at their areas'
         // heights (one z for all); under the wrong one they trend across the scan (a ramp seen as a
         // sloped ceiling, or a compromise plane over two ceilings taken as level).

@@ -56,6 +56,7 @@ struct Options {
   const AreaCeilingMap* areas = nullptr;
   Imu imu = Imu::kNone;
   int jolt_scan = -1;  // this scan's pose is jolted (a threshold under the wheels)
+  bool building_attitude = true;  // SegmenterConfig::building_attitude
 };
 
 // Drives through `room` along `xs` (x per scan), y wiggling; the sensor 1.4 m above the floor under it and
@@ -64,6 +65,7 @@ struct Options {
 Walk walk(const synth::Room& room, const std::vector<double>& xs, uint32_t seed, const Options& opt) {
   SegmenterConfig cfg;
   cfg.use_imu_prior = opt.imu != Imu::kNone;
+  cfg.building_attitude = opt.building_attitude;
   RingSegmenter seg(cfg);
   if (opt.areas) seg.set_areas(*opt.areas);
   const auto beams = synth::os1_like_beams();

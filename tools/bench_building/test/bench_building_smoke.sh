@@ -6,7 +6,7 @@ BIN="${FPLOC_BUILD_DIR:?}/bin"
 W="$(mktemp -d "${TMPDIR:-/tmp}/fploc-bench-building-XXXXXX")"
 trap 'rm -rf "$W"' EXIT
 "$BIN/fploc-bench-building" --plan "${FPLOC_ROOT:?}/data/plans/room.json" --scenario building-mixed-medium \
-  --scenario auto-loop-medium --duration 4 --plots "$W/plots" --json >"$W/out.json" 2>"$W/err" || { tail -20 "$W/err" >&2; exit 1; }
+  --scenario auto-loop-medium --building-heights --duration 4 --plots "$W/plots" --json >"$W/out.json" 2>"$W/err" || { tail -20 "$W/err" >&2; exit 1; }
 python3 - "$W/out.json" <<'PY'
 import json, os, sys
 d = json.load(open(sys.argv[1]))
