@@ -2,17 +2,21 @@
 // same message, same options field `segmenter`, so a graph swaps the executable only.
 #pragma once
 #include <fploc/imu_t.hpp>
+#include <fploc/pose_t.hpp>
 #include <fploc/scan_t.hpp>
 #include <fploc/segments_t.hpp>
 
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "fploc/core/scan.h"
+#include "fploc/adapters/pose_t.h"
 #include "fploc/adapters/scan_t.h"
 #include "fploc/adapters/segments_t.h"
 #include "fploc/config/perception.h"
+#include "fploc/floorplan/building.h"
 #include "fploc/runtime/node.h"
 
 namespace fploc {
@@ -23,6 +27,8 @@ class SegmenterNodeT : public rt::Node {
   static rt::NodeSpec spec() {
     return {Traits::kType, "segmenter", Traits::kDescription,
             {rt::input<scan_t>("scan", "OS1_SCAN"), rt::input<imu_t>("imu", "OS1_IMU"),
+             // The localizer's latest pose: places the ceiling points in the building's areas (option building).
+             rt::input<pose_t>("pose", "FPLOC_POSE_LATEST"),
              rt::output<segments_t>("segments", "FPLOC_SEGMENTS")}};
   }
 
@@ -34,6 +40,7 @@ class SegmenterNodeT : public rt::Node {
                                Traits::kExecutable + " (use " + Traits::kOther + ")");
     seg_ = Traits::make(o);
     use_imu_ = o.use_imu_prior();
+    if (o.has_building() && !o.building().file().empty()) use_building(ctx, o.building());
     out_ = ctx.advertise<segments_t>("segments");
     ctx.subscribe<scan_t>("scan", [this](const scan_t& m) { on_scan(m); });
     ctx.subscribe<imu_t>("imu", [this](const imu_t& m) {
@@ -54,6 +61,39 @@ class SegmenterNodeT : public rt::Node {
   }
 
  private:
+  // The floor's area ceilings from the building file, and the pose feedback that places the ceiling points.
+  void use_building(rt::Context& ctx, const PlanSource& src) {
+    const std::string path = ctx.resolve_path(src.file());
+    const Building b = load_building(path);
+    if (b.floor_index(src.floor()) < 0)
+      throw std::runtime_error("segmenter.building.floor: " + path + " has no floor '" + src.floor() + "'");
+    // Every floor's ceilings; the pose's floor (pose_t.floor_index) picks the one used, from the configured one.
+    for (const BuildingFloor& f : b.floors) {
+      seg::AreaCeilingMap map;
+      map.floor = f.name;
+      map.default_height_m = f.ceiling_height;
+      for (const auto& a : f.areas) map.areas.push_back({a.name, a.polygon, a.height, a.origin, a.slope});
+      floors_.push_back(std::move(map));
+    }
+    floor_ = b.floor_index(src.floor());
+    seg_->set_areas(floors_[size_t(floor_)]);
+    const BuildingFloor& f = b.floors[size_t(floor_)];
+    std::cerr << "[" << ctx.name() << "] " << path << " floor '" << f.name << "': ceiling " << f.ceiling_height
+              << " m (0 = learned), " << f.areas.size() << " areas; plan pose from " << ctx.channel("pose") << "\n";
+    if (ctx.channel("pose").empty())
+      throw std::runtime_error("segmenter.building is set but the pose input is not connected (FPLOC_POSE_LATEST)");
+    ctx.subscribe<pose_t>("pose", [this](const pose_t& m) {
+      const Pose2 p = adapters::pose2_of(m);
+      if (m.status == 2 || !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.yaw)) return;  // LOST
+      if (m.floor_index >= 0 && m.floor_index != floor_ && size_t(m.floor_index) < floors_.size()) {
+        floor_ = m.floor_index;
+        seg_->set_areas(floors_[size_t(floor_)]);  // that floor's ceilings (its learned heights start anew)
+        std::cerr << "[" << ctx_->name() << "] floor '" << floors_[size_t(floor_)].floor << "': its ceiling areas\n";
+      }
+      seg_->set_plan_pose({m.utime, p.x, p.y, p.yaw, true});
+    });
+  }
+
   void on_scan(const scan_t& m) {
     segments_t msg;
     try {
@@ -91,6 +131,8 @@ class SegmenterNodeT : public rt::Node {
   Scan scan_;
   int64_t seq_ = 0;
   bool use_imu_ = false;
+  std::vector<seg::AreaCeilingMap> floors_;  // option building: every floor's ceilings
+  int floor_ = 0;
 };
 
 }  // namespace fploc

@@ -9,12 +9,14 @@ own time (linear interpolation of the truth, no alignment): horizontal ATE (rmse
 LOST transitions, reported as node errors), and ms per scan per node (thread CPU time).
 
 Scenarios: the `building-*` ones (sim/ceiling_map.h: areas with their own ceiling heights and a sloped
-roof, a double-height atrium, lamps/beams/ducts/a drop-ceiling grid, all mixed) and `auto-loop-medium`
+roof, a double-height atrium, lamps/beams/ducts/a drop-ceiling grid, all mixed; the segmenter gets the floor's
+ceilings as a building file with --building-heights, `fploc sim --ceilings-building`) and `auto-loop-medium`
 with the simulator's default ceiling patches, on every shipped plan (data/plans) unless --plan is given;
 and the journeys through the demo building (data/buildings/demo-building.pbtxt: building-twofloor, -ramp,
 -thresholds; ramp, lift, door thresholds). A --plan may be a building (.pbtxt): the localizer gets the
 building (every floor), the simulator's ground truth is absolute (z = floor elevation + height above it)
-and its floor per scan (gt.floors.csv) scores the floor rows; the pose's floor comes from
+and its floor per scan (gt.floors.csv) scores the floor rows (with --building-heights the segmenter gets the building too: its floors'
+ceiling areas, the floor from the pose feedback); the pose's floor comes from
 pose_t.floor_index (pose logger `floor_file`), its z (height above that floor) is made absolute with the
 floor's elevation before scoring.
 Targets (issue 11): z p99 <= 2 cm, roll/pitch p99 <= 0.2 deg, horizontal ATE <= 1 cm, no LOST; floor
@@ -270,6 +272,11 @@ def bench(a, work, plan, layers, scenario):
         os.makedirs(d, exist_ok=True)
         logf, gt_path = os.path.join(d, "log.lcm"), os.path.join(d, "gt.tum")
         cmd[cmd.index("--out") + 1], cmd[cmd.index("--gt") + 1] = logf, gt_path
+    seg_building = None
+    if a.building_heights and scenario.startswith("building-") and not building:
+        # The segmenter gets the simulated floor's ceilings as a building file (its areas' heights).
+        seg_building = os.path.join(d, "ceilings.pbtxt")
+        cmd += ["--ceilings-building", seg_building]
     log(f"[{name}] simulating ...")
     out, err = run(cmd)
     simj = json.loads(out.strip().splitlines()[-1])
@@ -291,6 +298,12 @@ def bench(a, work, plan, layers, scenario):
         start = simj.get("start_floor", "")
         sets += [f"matcher.plan.floor={start}", f"optimizer.plan.floor={start}",
                  f"wo_logger.floor_file={os.path.join(d, 'wo.floors')}"]
+        if a.building_heights:
+            seg_building = plan
+    if seg_building:
+        sets.append(f"segmenter.building.file={seg_building}")
+        if building:
+            sets.append(f"segmenter.building.floor={simj.get('start_floor', '')}")
     cmd = [os.path.join(BIN, "fploc-replay"), "--graph", a.graph, "--log", logf, "--json"]
     for s in sets:
         cmd += ["--set", s]
@@ -301,6 +314,7 @@ def bench(a, work, plan, layers, scenario):
     scans = nodes.get("features", {}).get("messages", 1) or 1
     ms = {n: round(nodes[n].get("cpu_ms", nodes[n]["total_ms"]) / scans, 3) for n in PIPELINE if n in nodes}
     row = {"plan": os.path.relpath(plan, ROOT), "scenario": scenario, "scans": scans, "sim": info,
+           "segmenter_building": seg_building is not None,
            "lost": nodes.get("matcher", {}).get("errors", 0), "ms_per_scan": ms}
     est = read_tum(wo) if os.path.exists(wo) else []
     floors = None
@@ -358,6 +372,10 @@ def main():
     ap.add_argument("--graph", default=os.path.join(ROOT, "graphs", "paper.pbtxt"))
     ap.add_argument("--plots", help="write z-against-ground-truth SVGs into this folder")
     ap.add_argument("--keep", help="keep the work folder here")
+    ap.add_argument("--building-heights", action="store_true",
+                    help="give the segmenter the building (segmenter.building: area heights looked up per ceiling point "
+                         "with the pose feedback): the plan when it is a building, else for building-* scenarios the "
+                         "simulated floor's ceilings (fploc sim --ceilings-building)")
     ap.add_argument("--json", action="store_true", help="(JSON is always printed on stdout)")
     a = ap.parse_args()
     plans = [os.path.abspath(p) for p in (a.plan or [os.path.join(ROOT, "data", "plans", "room.json"),

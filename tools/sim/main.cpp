@@ -40,7 +40,7 @@ using fploc::rt::write_event;
 int main(int argc, char** argv) {
   CLI::App app{"fploc sim: simulate an OS-1-64 + IMU sequence into an LCM log and a TUM ground truth"};
   std::string plan_file, scenario, out, gt, units, metadata, demo_dir, floor, world_file, perturb, truth, gt_floors,
-      demo_building_dir;
+      demo_building_dir, ceilings_building;
   std::vector<std::string> layers;
   uint64_t seed = 0;
   bool no_clutter = false, no_patches = false, json = false, no_thresholds = false;
@@ -72,6 +72,8 @@ int main(int argc, char** argv) {
                  [] { std::string s; for (auto& n : fploc::sim::perturb_family_names()) s += (s.empty() ? "" : ", ") + n; return s; }() +
                  ") or key=value,... (asbuilt, scale, remove, add, move, glass, doors, shelves, crowd)");
   app.add_option("--truth", truth, "where to write the world-vs-plan truth JSON (default: LOG without .lcm + .world.json)");
+  app.add_option("--ceilings-building", ceilings_building,
+                 "building-* scenarios: write the simulated ceilings as a one-floor building file (.pbtxt) for the segmenter");
   app.add_option("--write-demo-plans", demo_dir, "write the demo plans (room.json, corridor.json) into DIR and exit");
   CLI11_PARSE(app, argc, argv);
 
@@ -131,6 +133,14 @@ int main(int argc, char** argv) {
     }
     fploc::sim::Simulator& sim = *simp;
     std::cerr << "fploc sim: " << scenario << " seed " << seed << ", beams: " << sim.beam_source() << "\n" << sim.info();
+    if (!ceilings_building.empty()) {
+      if (sim.ceiling_map().areas.empty() && sim.ceiling_map().objects.empty())
+        throw std::runtime_error("--ceilings-building: scenario " + scenario + " has no ceiling map (building-* scenarios)");
+      std::ofstream cb(ceilings_building);
+      const std::string pf = plan_file.empty() ? "" : std::filesystem::absolute(plan_file).string();
+      cb << fploc::sim::ceiling_map_building_text(sim.ceiling_map(), pf);
+      if (!cb) throw std::runtime_error(ceilings_building + ": cannot write");
+    }
     std::cerr << "fploc sim: path " << sim.motion().length() << " m, " << sim.motion().moving_time() << " s moving, avg "
               << sim.motion().avg_speed() << " m/s, max " << sim.motion().max_speed() << " m/s, " << sim.num_frames()
               << " frames\n";

@@ -81,10 +81,25 @@ void AttitudeHeight::hold(Segmentation& out, const ImuPrior& imu) {
   predict_z(out);
 }
 
-Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu) {
+Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, const Candidates* upper) {
   const bool c = out.ceiling.found, g = out.ground.found;
-  const Eigen::Vector3d up_c = -out.ceiling.coeffs.head<3>();  // normals point into the room
+  Eigen::Vector3d up_c = -out.ceiling.coeffs.head<3>();  // normals point into the room
   const Eigen::Vector3d up_g = out.ground.coeffs.head<3>();
+
+  // The building's view of the ceiling points (their areas), when the floor's areas and a plan pose are known.
+  const bool areas_on = have_areas_ && upper != nullptr && c && census(out, *upper, up_c);
+  if (areas_on && cfg_.building_attitude) {
+    // A ceiling the building says is sloped (over a ramp, under a roof) gives gravity's up once turned by
+    // its slope.
+    double corr = 0;
+    const Eigen::Vector3d level = building_level_up(up_c, &corr);
+    if (corr > 0) {
+      char buf[120];
+      std::snprintf(buf, sizeof buf, "ceiling sloped %.2f deg per the building: its normal turned by that", corr / k::kDeg);
+      note(out, buf);
+      up_c = level;
+    }
+  }
 
   // ---- roll / pitch ----
   bool use_ceiling = c, use_ground = !c && g;
@@ -96,14 +111,36 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu) {
       // One of them is not level (a sloped ceiling under a roof or stairs, a compromise over two ceiling
       // surfaces, a ramp under the sensor): the IMU decides when given, else the floor (floors are level
       // far more often than the ceilings above them).
-      const bool ground_better = imu.valid ? up_g.dot(imu.up) > up_c.dot(imu.up) : true;
+      // A robot on a ramp sees the same pair of planes as a level robot under a sloped ceiling; what tells
+      // them apart: the IMU's gravity when this scan's samples measured gravity alone (no jolt), the
+      // building (the ceiling over these points is flat, or sloped), and otherwise the IMU even when shaken,
+      // else the floor.
+      bool ground_better = true;
+      const char* by = "floors are level more often than ceilings";
+      char by_buf[120];
+      if (imu.valid && imu.trusted) {
+        ground_better = up_g.dot(imu.up) > up_c.dot(imu.up);
+        by = "IMU gravity";
+      } else if (areas_on && cfg_.building_attitude && census_.known_fraction > k::kAreaKnownMin) {
+        // The building's ceiling heights: under the right attitude the ceiling points lie at their areas'
+        // heights (one z for all); under the wrong one they trend across the scan (a ramp seen as a
+        // sloped ceiling, or a compromise plane over two ceilings taken as level).
+        const double sc = area_spread(up_c), sg = area_spread(up_g);
+        ground_better = sg <= sc;
+        std::snprintf(by_buf, sizeof by_buf, "the building's ceiling heights fit it better: spread %.1f cm vs %.1f cm",
+                      100 * std::min(sc, sg), 100 * std::max(sc, sg));
+        by = by_buf;
+      } else if (imu.valid) {
+        ground_better = up_g.dot(imu.up) > up_c.dot(imu.up);
+        by = "IMU gravity (shaken)";
+      }
       if (ground_better) {
         use_ceiling = false;
         use_ground = true;
       }
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "ceiling and ground normals %.2f deg apart: attitude from the %s", ang / k::kDeg,
-                    ground_better ? "ground" : "ceiling");
+      char buf[240];
+      std::snprintf(buf, sizeof buf, "ceiling and ground normals %.2f deg apart: attitude from the %s (%s)", ang / k::kDeg,
+                    ground_better ? "ground" : "ceiling", by);
       note(out, buf);
     }
   }
@@ -126,7 +163,36 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu) {
 
   // ---- z ----
   const bool known = cfg_.ceiling_height_m > 0;
-  if (c && g && !known) {
+  // The floor is level under the attitude taken (not a ramp under the robot): only then is its distance the
+  // height above the area's floor. Without an IMU or a building the attitude is the floor's whenever the two
+  // disagree, so this only differs from "the ground was found" when one of them said "ramp".
+  const double ang_g = g ? std::acos(std::clamp(up_g.dot(up), -1.0, 1.0)) : M_PI;
+  bool ground_level = g && ang_g <= std::max(cfg_.attitude_consistency_deg * k::kDeg,
+                                             3.0 * std::hypot(out.ground.tilt_sigma, out.roll_pitch_sigma));
+  // With a witness of gravity other than the two planes (the IMU, the building): the robot tilted away from
+  // its usual attitude on level floors (the running mean of the up vector there) is on a ramp, at its ends or
+  // on a threshold; the floor it sees is then not the level of the area's floor (a mix of ramp and landing).
+  if (imu.valid || have_areas_) {
+    const double off = std::acos(std::clamp(up.dot(level_up_), -1.0, 1.0));
+    if (have_level_up_ && off > k::kOnSlopeDeg * k::kDeg && (use_ceiling || imu.trusted)) {
+      if (ground_level) note(out, "robot tilted on a ramp or threshold: the floor is not the area's level");
+      ground_level = false;
+    } else if (ground_level && off < k::kOnSlopeDeg * k::kDeg) {
+      level_up_ = have_level_up_ ? (level_up_ + k::kLevelUpGain * (up - level_up_)).normalized() : up;
+      have_level_up_ = true;
+    }
+  }
+  if (areas_on) {
+    if (c && ground_level && !known) update_room_height(out.ceiling.distance() + out.ground.distance());  // wall selection
+    area_z(out, up, ground_level);
+    return up;
+  }
+  if (g && !ground_level && use_ceiling && known_room_height() > 0) {
+    // A ramp (or a tilted floor patch) under the robot, the ceiling level: z from the ceiling, the floor's
+    // distance is not the height above the area's floor.
+    note(out, "floor tilted under the robot (a ramp): z from the ceiling");
+  }
+  if (c && ground_level && !known) {
     const double h = out.ceiling.distance() + out.ground.distance();
     if (room_height_ > 0 && std::abs(h - room_height_) > std::max(cfg_.z_consistency_m, 3.0 * (out.ceiling.d_sigma + out.ground.d_sigma))) {
       // The ceiling over the sensor is not the area's (yet): z from the floor; the running median follows
@@ -159,7 +225,7 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu) {
       out.z_source = HeightSource::kCeiling;
       measured = true;
     }
-  } else if (g) {
+  } else if (g && (ground_level || !have_prev_z_)) {
     out.z = out.ground.distance();
     out.z_sigma = out.ground.d_sigma;
     out.z_source = HeightSource::kGround;

@@ -37,6 +37,7 @@ Segmenter::~Segmenter() = default;
 void Segmenter::add_accel(const Eigen::Vector3d& a) {
   if (!a.allFinite() || a.norm() < 1.0) return;
   accel_sum_ += a;
+  accel_sq_ += a.squaredNorm();
   ++accel_n_;
 }
 
@@ -109,14 +110,20 @@ const Segmentation& Segmenter::process(const Scan& scan) {
 
   // Gravity prior: IMU (when enabled and available), else the sensor's z axis.
   if (accel_n_ > 0) {
-    imu_up_ = (accel_sum_ / accel_n_).normalized();
+    const Eigen::Vector3d mean = accel_sum_ / accel_n_;
+    imu_up_ = mean.normalized();
     have_imu_ = true;
+    // Gravity alone: the mean's magnitude is g and the samples scatter little around it (no jolt).
+    const double spread = std::sqrt(std::max(0.0, accel_sq_ / accel_n_ - mean.squaredNorm()));
+    imu_trusted_ = std::abs(mean.norm() - k::kGravityMs2) < k::kImuTrustNormTolMs2 && spread < k::kImuTrustSpreadMs2;
     accel_sum_.setZero();
+    accel_sq_ = 0;
     accel_n_ = 0;
   }
   ImuPrior imu;
   imu.valid = cfg_.use_imu_prior && have_imu_;
   imu.up = imu_up_;
+  imu.trusted = imu.valid && imu_trusted_;
   const Eigen::Vector3d gate_up = imu.valid ? imu_up_ : Eigen::Vector3d::UnitZ();
 
   if (!prepare(scan)) {
@@ -142,7 +149,7 @@ const Segmentation& Segmenter::process(const Scan& scan) {
   const double ceiling_vs_prior = std::acos(std::clamp(up.dot(init_up.normalized()), -1.0, 1.0));
   fit_ground(ceiling_vs_prior < k::kCeilingPriorAgreeDeg * k::kDeg ? up : init_up.normalized());
 
-  height_.update(out_, imu);
+  height_.update(out_, imu, &upper_);
   if (out_.ceiling.found) {
     have_prev_ceiling_ = true;
     prev_ceiling_ = out_.ceiling.coeffs;

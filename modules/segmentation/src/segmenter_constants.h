@@ -60,6 +60,18 @@ constexpr double kMinHeldTiltSigmaRad = 0.2 * kDeg; // a held attitude is at lea
 constexpr double kMinHeldZSigmaM = 0.05;            // a held height at least this
 constexpr double kHoldGrowth = 2.0;                 // sigma growth per held scan
 constexpr double kUnknownZSigmaM = 1e3;             // z unknown
+// With a building's area ceilings (attitude_height_areas.cpp):
+constexpr size_t kAreaMaxPoints = 3000;             // ceiling inliers looked up per scan (subsampled)
+constexpr double kAreaKnownMin = 0.5;               // >= half of them with a height (the building's or learned)
+constexpr double kAreaLearnFraction = 0.9;          // learn an area's height from a ceiling >= 90 % in it
+constexpr double kPoseMaxAgeS = 1.0;                // a plan pose older than this is not used
+constexpr double kPoseMaxExtrapolateS = 0.3;        // extrapolated from the last two poses at most this far
+constexpr double kImuTrustNormTolMs2 = 0.4;         // IMU trusted: |mean accel| within this of g
+constexpr double kImuTrustSpreadMs2 = 0.6;          // and the samples' rms spread below this
+constexpr double kGravityMs2 = 9.80665;
+constexpr double kMinBuildingSlope = 1e-3;          // m/m: below this the building's ceiling is flat
+constexpr double kOnSlopeDeg = 1.0;                 // tilted this far from the usual level attitude: on a slope
+constexpr double kLevelUpGain = 0.05;               // running mean of the level attitude (~20 scans)
 
 // ---- wall selection (wall_select.cpp) ----
 constexpr double kPlaneMarginRms = 3.0;        // wall margin at least this many plane rms

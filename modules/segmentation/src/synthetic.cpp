@@ -32,7 +32,50 @@ Room furnished_room() {
   return r;
 }
 
+double Room::floor_at(double x) const {
+  if (ramp.x1 <= ramp.x0 || x <= ramp.x0) return 0.0;
+  if (x >= ramp.x1) return ramp.rise;
+  return ramp.rise * (x - ramp.x0) / (ramp.x1 - ramp.x0);
+}
+
 namespace {
+// Distance along a ray to the floor with a ramp (hit from above only): the lower floor before x0, the
+// slope, the landing after x1; +inf if missed.
+double hit_ramp_floor(const Room::Ramp& r, const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
+  double best = std::numeric_limits<double>::infinity();
+  if (d.z() < 0) {
+    const double t0 = -o.z() / d.z();
+    if (t0 > 1e-6 && o.x() + t0 * d.x() <= r.x0) best = std::min(best, t0);
+    const double t2 = (r.rise - o.z()) / d.z();
+    if (t2 > 1e-6 && o.x() + t2 * d.x() >= r.x1) best = std::min(best, t2);
+  }
+  const double s = r.rise / (r.x1 - r.x0), den = d.z() - s * d.x();
+  if (den < 0) {
+    const double t1 = (s * (o.x() - r.x0) - o.z()) / den;
+    const double x = o.x() + t1 * d.x();
+    if (t1 > 1e-6 && x >= r.x0 && x <= r.x1) best = std::min(best, t1);
+  }
+  return best;
+}
+
+// The same for a ceiling `h` above that floor, hit from below.
+double hit_ramp_ceiling(const Room::Ramp& r, double h, const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
+  double best = std::numeric_limits<double>::infinity();
+  if (d.z() > 0) {
+    const double t0 = (h - o.z()) / d.z();
+    if (t0 > 1e-6 && o.x() + t0 * d.x() <= r.x0) best = std::min(best, t0);
+    const double t2 = (h + r.rise - o.z()) / d.z();
+    if (t2 > 1e-6 && o.x() + t2 * d.x() >= r.x1) best = std::min(best, t2);
+  }
+  const double s = r.rise / (r.x1 - r.x0), den = d.z() - s * d.x();
+  if (den > 0) {
+    const double t1 = (h + s * (o.x() - r.x0) - o.z()) / den;
+    const double x = o.x() + t1 * d.x();
+    if (t1 > 1e-6 && x >= r.x0 && x <= r.x1) best = std::min(best, t1);
+  }
+  return best;
+}
+
 // Entry distance of a ray into an axis-aligned box (slab test); +inf if missed.
 double hit_box(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Box& b) {
   double t0 = 0, t1 = std::numeric_limits<double>::infinity();
@@ -82,8 +125,14 @@ SynthScan render(const Room& room, const SensorPose& pose, const BeamIntrinsics&
           lab = l;
         }
       };
-      if (dir.z() > 0 && room.ceiling) consider((room.height - o.z()) / dir.z(), kCeiling);
-      if (dir.z() < 0) consider(-o.z() / dir.z(), kFloor);
+      if (room.ceiling && room.ramp.ceiling_follows && room.ramp.x1 > room.ramp.x0)
+        consider(hit_ramp_ceiling(room.ramp, room.height, o, dir), kCeiling);
+      else if (dir.z() > 0 && room.ceiling)
+        consider((room.height - o.z()) / dir.z(), kCeiling);
+      if (room.ramp.x1 > room.ramp.x0)
+        consider(hit_ramp_floor(room.ramp, o, dir), kFloor);
+      else if (dir.z() < 0)
+        consider(-o.z() / dir.z(), kFloor);
       if (dir.x() > 0) consider((room.half_x - o.x()) / dir.x(), kWall);
       if (dir.x() < 0) consider((-room.half_x - o.x()) / dir.x(), kWall);
       if (dir.y() > 0) consider((room.half_y - o.y()) / dir.y(), kWall);

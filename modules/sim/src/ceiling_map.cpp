@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 #include "fploc/core/rng.h"
@@ -134,6 +135,28 @@ CeilingMap make_ceiling_map(const std::string& kind, const Box2& bounds, double 
     throw std::invalid_argument("unknown ceiling kind '" + kind + "' (valid:" + valid + ")");
   }
   return m;
+}
+
+std::string ceiling_map_building_text(const CeilingMap& m, const std::string& plan_file, const std::string& floor) {
+  std::ostringstream o;
+  o.precision(10);
+  o << "# The simulated floor's ceilings (fploc::sim::ceiling_map_building_text).\n";
+  o << "name: \"simulated\"\nfloor {\n  name: \"" << floor << "\"\n  plan { file: \"" << plan_file << "\" }\n"
+    << "  elevation_m: 0\n  ceiling_height_m: " << m.default_height_m << "\n";
+  for (const auto& a : m.areas) {
+    if (a.open) continue;
+    o << "  area {\n    name: \"" << a.name << "\"\n";
+    if (a.slope.squaredNorm() > 0)
+      o << "    sloped_ceiling { height_m: " << a.height_m << " x: " << a.box.min.x() << " y: " << a.box.min.y()
+        << " slope_x: " << a.slope.x() << " slope_y: " << a.slope.y() << " }\n";
+    else
+      o << "    ceiling_height_m: " << a.height_m << "\n";
+    o << "    polygon { x: " << a.box.min.x() << " y: " << a.box.min.y() << " } polygon { x: " << a.box.max.x()
+      << " y: " << a.box.min.y() << " } polygon { x: " << a.box.max.x() << " y: " << a.box.max.y()
+      << " } polygon { x: " << a.box.min.x() << " y: " << a.box.max.y() << " }\n  }\n";
+  }
+  o << "}\n";
+  return o.str();
 }
 
 void apply_ceiling_map(const CeilingMap& m, World& world) {

@@ -6,7 +6,7 @@ BIN="${FPLOC_BUILD_DIR:?}/bin"
 W="$(mktemp -d "${TMPDIR:-/tmp}/fploc-bench-building-XXXXXX")"
 trap 'rm -rf "$W"' EXIT
 "$BIN/fploc-bench-building" --plan "${FPLOC_ROOT:?}/data/plans/room.json" --scenario building-mixed-medium \
-  --scenario auto-loop-medium --duration 4 --plots "$W/plots" --json >"$W/out.json" 2>"$W/err" || { tail -20 "$W/err" >&2; exit 1; }
+  --scenario auto-loop-medium --building-heights --duration 4 --plots "$W/plots" --json >"$W/out.json" 2>"$W/err" || { tail -20 "$W/err" >&2; exit 1; }
 python3 - "$W/out.json" <<'PY'
 import json, os, sys
 d = json.load(open(sys.argv[1]))
@@ -19,6 +19,8 @@ for r in d["rows"]:
     assert set(r["ms_per_scan"]) == {"segmenter", "features", "matcher", "optimizer"}, r
     assert os.path.getsize(r["plot"]) > 1000 and open(r["plot"]).read().startswith("<svg"), r
 assert "ceilings: mixed" in " ".join(d["rows"][0]["sim"]), d["rows"][0]
+# building-*: the segmenter got the simulated ceilings as a building file (segmenter.building + pose feedback).
+assert d["rows"][0]["segmenter_building"] is True and d["rows"][1]["segmenter_building"] is False, d["rows"]
 print("bench building smoke:", [(r["scenario"], r["z_err_p99_m"], r["rp_err_p99_deg"]) for r in d["rows"]])
 PY
 # A building: the first 4 s of the demo building's ramp journey (ground floor): the floor rows are there.

@@ -40,6 +40,11 @@ class Segmenter {
   // sweep de-skew its rotation (config deskew_gyro); without them the scan is used as measured.
   void add_gyro(const Eigen::Vector3d& rate, int64_t utime) { deskew_.add(rate, utime); }
   void set_keep_labels(bool on) { keep_labels_ = on; }
+  // A building floor's area ceilings and the sensor's plan pose (the localizer's feedback): z from the
+  // height of the area under each ceiling point (AttitudeHeight, attitude_height_areas.cpp).
+  void set_areas(const AreaCeilingMap& map) { height_.set_areas(map); }
+  void set_plan_pose(const PlanPose& pose) { height_.set_plan_pose(pose); }
+  const AttitudeHeight& height_estimator() const { return height_; }
   const SegmenterConfig& config() const { return cfg_; }
   double room_height() const { return height_.room_height(); }  // 0 until known
   const Eigen::Vector3d& gyro_bias() const { return deskew_.bias(); }  // rad/s, perpendicular-to-gravity part
@@ -77,7 +82,9 @@ class Segmenter {
   bool have_prev_ceiling_ = false, have_prev_ground_ = false;
   Eigen::Vector4d prev_ceiling_, prev_ground_;
   Eigen::Vector3d accel_sum_ = Eigen::Vector3d::Zero();
+  double accel_sq_ = 0;  // sum of |a|^2 (the spread: is the IMU measuring gravity alone?)
   int accel_n_ = 0;
+  bool imu_trusted_ = false;
   Eigen::Vector3d imu_up_ = Eigen::Vector3d::UnitZ();
   bool have_imu_ = false;
 };

@@ -33,6 +33,11 @@ struct SegmenterConfig {
   // With the ceiling alone: z moving more than this from the last estimate in one scan is a ceiling step
   // (another area), not motion: z is predicted and the area height re-learned from the new ceiling.
   double z_jump_m = 0.05;
+  // With a building's area ceilings: let the building turn a sloped ceiling's normal by its slope and decide
+  // ceiling-vs-floor disagreements by which attitude fits the areas' heights (attitude_height.cpp). Off by
+  // default: right on synthetic ramps (segmentation_area_height_test) but worse end to end on the simulated
+  // building-areas and demo-building ramp runs (docs/notes/height.md); z from the areas' heights is always on.
+  bool building_attitude = false;
   double tight_refit_sigmas = 2.5; // ceiling refit at this many robust sigmas (0 = off), see fit_plane
 };
 

@@ -23,6 +23,13 @@ struct Room {
   bool ceiling = true;             // false: open sky (no returns upwards)
   double wall_top = 0;             // walls end here (0 = at the ceiling height); an atrium: tall walls
   std::vector<Box> boxes;
+  // A ramp across the room: the floor rises from 0 at x = x0 to `rise` at x = x1 and stays there (a
+  // landing); the ceiling stays at `height` above z = 0. Off when x1 <= x0.
+  struct Ramp {
+    double x0 = 0, x1 = 0, rise = 0;
+    bool ceiling_follows = false;  // the ceiling `height` above the floor everywhere (rises with the ramp)
+  } ramp;
+  double floor_at(double x) const;  // floor height under x
 };
 
 struct SensorPose {

@@ -48,6 +48,10 @@ struct CeilingMap {
 // Throws std::invalid_argument naming the valid kinds.
 CeilingMap make_ceiling_map(const std::string& kind, const Box2& bounds, double default_height_m, uint64_t seed);
 std::vector<std::string> ceiling_map_kinds();
+// The map as one floor of a building description (proto/building.proto text): the default height and the
+// areas (boxes as polygons; sloped ones as sloped_ceiling; openings left out: no ceiling to look up). The
+// hanging objects are not part of a building file. For benches: the segmenter given the building's heights.
+std::string ceiling_map_building_text(const CeilingMap& m, const std::string& plan_file, const std::string& floor = "0");
 // Adds the areas (as ceiling patches) and the objects (as clutter boxes) to the world.
 void apply_ceiling_map(const CeilingMap& m, World& world);
 
