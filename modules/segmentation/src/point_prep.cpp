@@ -46,6 +46,7 @@ bool Segmenter::prepare(const Scan& scan) {
     std::iota(ring_order_.begin(), ring_order_.end(), 0);
     std::stable_sort(ring_order_.begin(), ring_order_.end(),
                      [&](int a, int b) { return scan.beams.altitude_deg[a] > scan.beams.altitude_deg[b]; });
+    scale_ = seg::beam_scaling(scan.beams, scan.width, cfg_);
   }
   xyz_.resize(n);
   range_.resize(n);
@@ -119,6 +120,9 @@ bool Segmenter::prepare(const Scan& scan) {
     // Not cleared first: resize only initialises what the last scan's valid count left short of the full size.
     cs->ring_start.assign(1, 0);
     cs->width = W;
+    cs->seed_rings = scale_.seed_rings;
+    cs->start_stride = scale_.start_stride;
+    cs->final_stride = scale_.final_stride;
     cs->p.resize(size_t(half) * W);
     cs->range.resize(size_t(half) * W);
     cs->pixel.resize(size_t(half) * W);

@@ -21,7 +21,7 @@ void RingPlaneFit::pick_seeds(const Candidates& c, const Eigen::Vector3f& upf) {
   const int S = std::max(k::kMinSectors, cfg_.seed_sectors);
   seeds_.clear();
   all_seeds_.clear();
-  const int kr = std::min(std::max(1, cfg_.seed_rings), c.rings());
+  const int kr = std::min(std::max(1, c.seed_rings > 0 ? c.seed_rings : cfg_.seed_rings), c.rings());
   for (int r = 0; r < kr; ++r) {
     sector_best_.assign(S, -1.f);
     sector_idx_.assign(S, -1);
@@ -123,7 +123,7 @@ bool RingPlaneFit::choose_start(const Candidates& c, const Eigen::Vector3d& up, 
   bool have_start = false;
   auto consider = [&](const Eigen::Vector4d& pl) {
     if (!pl.allFinite() || -pl.head<3>().dot(up) < std::cos(max_tilt) || pl[3] <= 0) return;
-    const double sc = score_band(sub_start_, k::kStartStride, pl, thr);
+    const double sc = score_band(sub_start_, start_stride_, pl, thr);
     if (!have_start || sc > best) {
       best = sc;
       cur = pl;
@@ -254,7 +254,9 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
   const Eigen::Vector3d up = up_in.normalized();
   // The subsamples every score is computed on (every kStartStride-th / kFinalStride-th candidate), copied
   // once: the scores then stream a small contiguous array instead of striding through all candidates.
-  for (auto [sub, stride] : {std::pair{&sub_start_, k::kStartStride}, std::pair{&sub_final_, k::kFinalStride}}) {
+  start_stride_ = c.start_stride > 0 ? c.start_stride : k::kStartStride;
+  final_stride_ = c.final_stride > 0 ? c.final_stride : k::kFinalStride;
+  for (auto [sub, stride] : {std::pair{&sub_start_, start_stride_}, std::pair{&sub_final_, final_stride_}}) {
     sub->resize((c.p.size() + stride - 1) / stride);
     for (size_t i = 0, j = 0; i < c.p.size(); i += stride, ++j) (*sub)[j] = c.p[i];
   }
@@ -269,7 +271,7 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
   // narrow corridor ceiling plus the wall tops below it scores as well as the true one; at 3 sigma it
   // loses the ceiling returns it leaves behind. (A lowered/sloped patch must not capture it either.)
   const float thr = float(cfg_.inlier_threshold_m);
-  auto score = [&](const Eigen::Vector4d& pl) { return score_band(sub_final_, k::kFinalStride, pl, thr); };
+  auto score = [&](const Eigen::Vector4d& pl) { return score_band(sub_final_, final_stride_, pl, thr); };
   auto select_band = [&](double s1, double s2) {
     return float(std::clamp(k::kSelectBandSigmas * std::min(s1, s2), k::kSelectBandMinM, cfg_.inlier_threshold_m));
   };
@@ -283,7 +285,7 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
     const std::optional<Fit> res2 = refine_guarded(*previous);
     if (res2 && res1) {
       const float t_sel = select_band(res1->sigma, res2->sigma);
-      if (score_band(sub_final_, k::kFinalStride, res2->pl, t_sel) > score_band(sub_final_, k::kFinalStride, res1->pl, t_sel)) res1 = res2;
+      if (score_band(sub_final_, final_stride_, res2->pl, t_sel) > score_band(sub_final_, final_stride_, res1->pl, t_sel)) res1 = res2;
     } else if (res2) {
       res1 = res2;
     }
@@ -296,7 +298,7 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
     const double ct = std::max(cfg_.tight_refit_sigmas * res1->sigma, k::kTightMinCutM);
     if (const auto tight = refine(c, up, res1->pl, ct, ct, true)) {
       const float t_sel = select_band(res1->sigma, tight->sigma);
-      if (score_band(sub_final_, k::kFinalStride, tight->pl, t_sel) > score_band(sub_final_, k::kFinalStride, res1->pl, t_sel)) res1 = tight;
+      if (score_band(sub_final_, final_stride_, tight->pl, t_sel) > score_band(sub_final_, final_stride_, res1->pl, t_sel)) res1 = tight;
     }
   }
   if (!res1) return false;

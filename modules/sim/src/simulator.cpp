@@ -1,5 +1,7 @@
 #include "fploc/sim/simulator.h"
 
+#include "fploc/sim/beam_patterns.h"
+
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -90,7 +92,7 @@ Simulator::Simulator(FloorPlan plan, SimulatorOptions opt) : opt_(std::move(opt)
     if (!load_beam_intrinsics_json(opt_.metadata, sc.beams, &err)) throw std::runtime_error(err);
     beam_source_ = opt_.metadata;
   } else {
-    sc.beams = default_beams(opt_.shared_dir, &beam_source_);
+    sc.beams = beam_pattern(opt_.beams, opt_.shared_dir, &beam_source_);
   }
   sc.width = opt_.width;
   sc.rate_hz = opt_.rate_hz;

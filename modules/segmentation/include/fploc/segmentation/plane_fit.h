@@ -52,6 +52,7 @@ class RingPlaneFit : public PlaneFit {
   std::vector<float> sector_best_;
   std::vector<int> sector_idx_;
   std::vector<Eigen::Vector3f> band_, sub_start_, sub_final_;
+  size_t start_stride_ = 1, final_stride_ = 1;  // of the current fit (Candidates, else the reference strides)
   std::vector<float> res_;
 };
 
