@@ -32,6 +32,10 @@ BeamScaling beam_scaling(const BeamIntrinsics& beams, int width, const Segmenter
   s.start_stride = std::max<size_t>(1, size_t(std::lround(double(k::kStartStride) * s.pixel_scale)));
   s.final_stride = std::max<size_t>(1, size_t(std::lround(double(k::kFinalStride) * s.pixel_scale)));
   s.min_plane_inliers = std::max(k::kMinPlaneInliersFloor, int(std::lround(cfg.min_plane_inliers * s.pixel_scale)));
+  const int upper = H / 2;
+  const int steep = int(std::count_if(alt.begin(), alt.begin() + upper, [](double a) { return a >= k::kRefSteepRingDeg; }));
+  const double share = upper > 0 ? double(steep) / upper : 0.0;
+  s.min_inlier_fraction = cfg.min_inlier_fraction * std::min(1.0, share / k::kRefSteepShare);
   return s;
 }
 

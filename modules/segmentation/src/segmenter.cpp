@@ -73,7 +73,7 @@ void Segmenter::fit_ceiling(const Eigen::Vector3d& init_up, const Eigen::Vector3
     else if (out_.ceiling.beyond > cfg_.max_beyond_ratio * out_.ceiling.inliers)
       why = "ceiling not where the rays end: " + std::to_string(out_.ceiling.beyond) + " returns beyond it vs " +
             std::to_string(out_.ceiling.inliers) + " inliers";
-    else if (out_.ceiling.inliers < cfg_.min_inlier_fraction * double(upper_.p.size()))
+    else if (out_.ceiling.inliers < scale_.min_inlier_fraction * double(upper_.p.size()))
       why = "ceiling inliers are only " + std::to_string(100.0 * out_.ceiling.inliers / upper_.p.size()) +
             " % of the upper-ring returns";
   }

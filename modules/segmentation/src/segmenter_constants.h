@@ -17,6 +17,8 @@ constexpr float kMinSeedHeightM = 0.2f;
 constexpr int kRefBeams = 64;               // OS-1-64
 constexpr int kRefWidth = 1024;             // 1024 columns per frame
 constexpr double kRefRingSpacingDeg = 33.2 / 63;  // its rings' altitude spacing
+constexpr double kRefSteepRingDeg = 8.3;    // its median upper ring's altitude (half of +16.6 deg)
+constexpr double kRefSteepShare = 0.5;      // share of its upper rings at or above that
 constexpr int kMinSeedRings = 2;            // a sparse sensor still seeds from two rings
 constexpr int kMinPlaneInliersFloor = 30;   // a plane needs at least this many inliers on any sensor
 

@@ -32,6 +32,7 @@ TEST(BeamScaling, ReferenceSensorKeepsTheOptions) {
   EXPECT_EQ(s.start_stride, 24u);
   EXPECT_EQ(s.final_stride, 3u);
   EXPECT_EQ(s.min_plane_inliers, cfg.min_plane_inliers);
+  EXPECT_EQ(s.min_inlier_fraction, cfg.min_inlier_fraction);
 }
 
 TEST(BeamScaling, SparseAndDenseSensors) {
@@ -49,6 +50,16 @@ TEST(BeamScaling, SparseAndDenseSensors) {
   const BeamScaling half = beam_scaling(synth::os1_like_beams(64), 512, cfg);  // 512 columns
   EXPECT_EQ(half.start_stride, 12u);
   EXPECT_EQ(half.min_plane_inliers, 100);
+  EXPECT_EQ(v16.min_inlier_fraction, cfg.min_inlier_fraction);   // 15, 13, 11, 9 of 8 upper rings >= 8.3 deg
+  EXPECT_EQ(o128.min_inlier_fraction, cfg.min_inlier_fraction);  // never stricter than the option
+  // OS-1-32 "gradient" (a real unit's altitudes): 2 of its 16 upper rings above 8.3 deg.
+  BeamIntrinsics g;
+  g.altitude_deg = {12.75, 10.03, 7.27, 4.47, 3.41, 2.35, 2.02, 1.65, 1.29, 0.93, 0.6, 0.23, -0.13, -0.49, -0.83, -1.17,
+                    -1.54, -1.88, -2.24, -2.6, -2.96, -3.65, -4.36, -5.06, -5.76, -7.17, -8.57, -9.95, -11.31, -12.66, -14.01, -15.32};
+  g.azimuth_deg.assign(32, 0.0);
+  const BeamScaling s32 = beam_scaling(g, 1024, cfg);
+  EXPECT_DOUBLE_EQ(s32.min_inlier_fraction, cfg.min_inlier_fraction * 0.25);
+  EXPECT_EQ(s32.seed_rings, 2);
 }
 
 TEST(BeamScaling, SegmenterFindsTheRoomWithEveryBeamCount) {

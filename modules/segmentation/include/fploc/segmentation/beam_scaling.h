@@ -16,6 +16,10 @@ struct BeamScaling {
   size_t start_stride = 24;   // start scores on every start_stride-th candidate (~1.4k points)
   size_t final_stride = 3;    // refined-plane scores on every final_stride-th candidate (~11k points)
   int min_plane_inliers = 200;// inliers a plane needs (the option counts returns of the reference sensor)
+  // Ceiling inliers needed as a fraction of the upper-ring returns: the option times the share of upper rings
+  // steeper than the reference's median upper ring (8.3 deg) relative to the reference's (one half), at
+  // most 1x. A sensor whose upper rings crowd the horizon (OS-1-32 "gradient") sees the ceiling with few.
+  double min_inlier_fraction = 0.02;
 };
 
 // `beams` and `width` of the scan; cfg.seed_rings and cfg.min_plane_inliers are the reference values.
