@@ -76,6 +76,7 @@ class SimSensorNode : public fploc::rt::Node {
     if (!opt.perturb().empty()) so_.perturb = fploc::sim::parse_perturb(opt.perturb());
     if (!opt.world().empty()) so_.world_file = ctx.resolve_path(opt.world());
     if (!opt.metadata().empty()) so_.metadata = ctx.resolve_path(opt.metadata());
+    so_.beams = opt.beams();
     const char* sd = std::getenv("FPLOC_SHARED_DIR");
     so_.shared_dir = sd && *sd ? sd : FPLOC_SHARED_DIR;
     loop_ = opt.loop();

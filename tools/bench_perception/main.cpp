@@ -1,4 +1,4 @@
-// fploc bench perception [--plan FILE [--layers G,..] [--units U]] --scenario NAME [--seed N] [--imu] [--json]
+// fploc bench perception [--plan FILE [--layers G,..] [--units U]] --scenario NAME [--seed N] [--beams B] [--imu] [--json]
 // Simulates the sequence (modules/sim, no LCM) and runs the paper's segmenter, the PCL RANSAC segmenter
 // and the feature extractor on every scan (every --stride-th). Errors are against the simulator's ground
 // truth at the middle of each sweep (the sensor wobbles during the 0.1 s sweep; without --imu the plane
@@ -198,7 +198,7 @@ std::string shared_dir() {
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc bench perception: segmentation and feature accuracy/speed on a simulated sequence"};
-  std::string plan_file, units, scenario;
+  std::string plan_file, units, scenario, beams;
   std::vector<std::string> layers;
   uint64_t seed = 0;
   int max_frames = 0, stride = 1;
@@ -211,6 +211,7 @@ int main(int argc, char** argv) {
   app.add_option("--units", units, "m|cm|mm override");
   app.add_option("--scenario", scenario, "scenario name (e.g. room-small-loop-medium)")->required();
   app.add_option("--seed", seed, "random seed");
+  app.add_option("--beams", beams, "beam pattern: os1-64 (default), os1-32, os1-128, vlp16 (fploc sim --beams)");
   app.add_option("--max-frames", max_frames, "stop after this many evaluated frames (0 = all)");
   app.add_option("--stride", stride, "evaluate every k-th frame");
   app.add_option("--noise", noise, "range noise sigma [m]");
@@ -235,6 +236,7 @@ int main(int argc, char** argv) {
     o.ceiling_patches = !no_patches;
     o.range_noise_m = noise;
     o.shared_dir = shared_dir();
+    o.beams = beams;
     fploc::sim::Simulator sim(std::move(plan), o);
     std::cerr << "bench perception: " << scenario << " seed " << seed << ", " << sim.num_frames()
               << " frames, beams: " << sim.beam_source() << "\n";
@@ -359,6 +361,8 @@ int main(int argc, char** argv) {
     out["features_per_scan"] = double(n_features) / n;
     out["groups_per_scan"] = double(n_groups) / n;
     out["scenario"] = scenario;
+    out["beams"] = beams.empty() ? "os1-64" : beams;
+    out["beam_source"] = sim.beam_source();
     out["imu"] = imu || imu_prior;
     out["imu_prior"] = imu_prior;
     if (imu || imu_prior)

@@ -39,7 +39,7 @@ using fploc::rt::write_event;
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc sim: simulate an OS-1-64 + IMU sequence into an LCM log and a TUM ground truth"};
-  std::string plan_file, scenario, out, gt, units, metadata, demo_dir, floor, world_file, perturb, truth, gt_floors,
+  std::string plan_file, scenario, out, gt, units, metadata, beams, demo_dir, floor, world_file, perturb, truth, gt_floors,
       demo_building_dir, ceilings_building;
   std::vector<std::string> layers;
   uint64_t seed = 0;
@@ -56,7 +56,9 @@ int main(int argc, char** argv) {
   app.add_option("--seed", seed, "random seed (noise, wobble, clutter)");
   app.add_option("--out", out, "LCM log to write");
   app.add_option("--gt", gt, "ground truth TUM file (one pose per scan, at the scan's first column time)");
-  app.add_option("--metadata", metadata, "Ouster metadata JSON for the beam angles (default: shared OS-1-64, else nominal)");
+  app.add_option("--metadata", metadata, "Ouster metadata JSON for the beam angles (default: --beams)");
+  app.add_option("--beams", beams, "beam pattern: os1-64 (default), os1-32, os1-128 (real metadata from ../shared when "
+                 "present, else nominal), vlp16 (16 beams, +-15 deg)");
   app.add_option("--noise", noise, "range noise sigma [m]");
   app.add_option("--dropout", dropout, "fraction of returns dropped");
   app.add_option("--imu-rate", imu_rate, "IMU rate [Hz]");
@@ -110,6 +112,7 @@ int main(int argc, char** argv) {
     o.range_noise_m = noise;
     o.dropout = dropout;
     o.metadata = metadata;
+    o.beams = beams;
     o.shared_dir = shared_dir();
     o.imu_rate_hz = imu_rate;
     o.ceiling_height_m = ceiling;

@@ -55,10 +55,16 @@ FeatureStatus FeatureExtractor::extract(const seg::Segmentation& seg) {
   R_ = (Eigen::AngleAxisf(float(seg.pitch), Eigen::Vector3f::UnitY()) *
         Eigen::AngleAxisf(float(seg.roll), Eigen::Vector3f::UnitX()))
            .toRotationMatrix();
+  // Beam pattern (issue 13 item 2): the per-ring limits are the paper's for 64 rings. A denser sensor uses
+  // every ring_step-th ring (the same rings' density per degree of elevation, the same work); a sparser one
+  // picks limit_scale times more per ring. Both 1 for 64 rings.
+  const int H = std::max(1, seg.height);
+  ring_step_ = std::max(1, int(std::lround(double(H) / kRefRings)));
+  limit_scale_ = std::max(1.0, double(kRefRings) / H);
   size_t b = 0;
   for (size_t i = 1; i <= n; ++i) {
     if (i == n || w.ring[i] != w.ring[b]) {
-      ring(seg, b, i);
+      if (w.ring[b] % ring_step_ == 0) ring(seg, b, i);
       b = i;
     }
   }
@@ -124,6 +130,8 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   kind_of.assign(n, -1);
   const int S = std::max(1, cfg_.sectors);
   const float cthr = float(cfg_.corner_threshold), sthr = float(cfg_.surface_threshold);
+  const int max_corners = int(std::lround(cfg_.max_corners_per_sector * limit_scale_));
+  const int max_surfaces = int(std::lround(cfg_.max_surfaces_per_sector * limit_scale_));
   for (int s = 0; s < S; ++s) {
     const int sb = hw + (n - 2 * hw) * s / S, se = hw + (n - 2 * hw) * (s + 1) / S;
     if (se <= sb) continue;
@@ -137,7 +145,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       order_[m] = i;
       m += size_t(ok_[i] & uint8_t(curv_[i] > cthr));
     }
-    for (int corners = 0; corners < cfg_.max_corners_per_sector; ++corners) {
+    for (int corners = 0; corners < max_corners; ++corners) {
       int best = -1;
       float bv = -std::numeric_limits<float>::infinity();
       for (size_t j = 0; j < m; ++j) {
@@ -163,9 +171,9 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     auto less = [&](int a, int b) { return curv_[a] < curv_[b] || (curv_[a] == curv_[b] && a < b); };
     size_t sorted = 0;
     int surfaces = 0;
-    for (size_t j = 0; j < order_.size() && surfaces < cfg_.max_surfaces_per_sector; ++j) {
+    for (size_t j = 0; j < order_.size() && surfaces < max_surfaces; ++j) {
       if (j == sorted) {
-        const size_t k = std::min(order_.size(), std::max<size_t>(sorted * 2, size_t(2 * cfg_.max_surfaces_per_sector)));
+        const size_t k = std::min(order_.size(), std::max<size_t>(sorted * 2, size_t(2 * max_surfaces)));
         std::partial_sort(order_.begin() + sorted, order_.begin() + k, order_.end(), less);
         sorted = k;
       }

@@ -46,6 +46,7 @@ bool Segmenter::prepare(const Scan& scan) {
     std::iota(ring_order_.begin(), ring_order_.end(), 0);
     std::stable_sort(ring_order_.begin(), ring_order_.end(),
                      [&](int a, int b) { return scan.beams.altitude_deg[a] > scan.beams.altitude_deg[b]; });
+    scale_ = seg::beam_scaling(scan.beams, scan.width, cfg_);
   }
   xyz_.resize(n);
   range_.resize(n);
@@ -76,40 +77,65 @@ bool Segmenter::prepare(const Scan& scan) {
   }
   // XYZ of every valid pixel, and in the same pass the candidate sets: upper half rings (top first) and
   // lower half rings (bottom first), each ring in column order (an odd middle ring is in neither).
+  // The candidate arrays are sized for every pixel of their rings up front and cut to the valid count after
+  // (no push_back per point); an invalid pixel is written too and overwritten by the next valid one.
   size_t valid = 0;
-  auto ring_pass = [&](int u, Candidates* cs) {
+  const float* dir = lut_.direction.data();
+  const float* off = lut_.offset.data();
+  const uint32_t* rng = scan.range_mm.data();
+  auto ring_pass = [&](int u, Candidates* cs, size_t& m) {
     const size_t row = size_t(u) * W;
+    Eigen::Vector3f* cp = cs ? cs->p.data() : nullptr;
+    float* cr = cs ? cs->range.data() : nullptr;
+    int32_t* cx = cs ? cs->pixel.data() : nullptr;
     for (int c = 0; c < W; ++c) {
       const size_t i = row + c;
-      const uint32_t r = scan.range_mm[i];
+      const uint32_t r = rng[i];
       if (r < r_lo || r > r_hi || !col_ok_[c]) {
         range_[i] = 0.f;
         continue;
       }
-      const size_t k = row + col_mid_[c];
-      Eigen::Vector3f p = lut_.direction.row(k).transpose() * float(r) + lut_.offset.row(k).transpose();
+      const size_t k = 3 * (row + col_mid_[c]);
+      const float fr = float(r);
+      Eigen::Vector3f p(dir[k] * fr + off[k], dir[k + 1] * fr + off[k + 1], dir[k + 2] * fr + off[k + 2]);
       if (deskew) {
         raw_[i] = p;
         p = rots[c] * p;
       }
       xyz_[i] = p;
-      const float rm = float(r) * 1e-3f;
+      const float rm = fr * 1e-3f;
       range_[i] = rm;
       ++valid;
       if (cs) {
-        cs->p.push_back(p);
-        cs->range.push_back(rm);
-        cs->pixel.push_back(int32_t(i));
+        cp[m] = p;
+        cr[m] = rm;
+        cx[m] = int32_t(i);
+        ++m;
       }
     }
-    if (cs) cs->ring_start.push_back(int32_t(cs->p.size()));
+    if (cs) cs->ring_start.push_back(int32_t(m));
   };
-  upper_.clear(W);
-  lower_.clear(W);
   const int half = H / 2;
-  for (int k = 0; k < half; ++k) ring_pass(ring_order_[k], &upper_);
-  for (int k = 0; k < half; ++k) ring_pass(ring_order_[H - 1 - k], &lower_);
-  if (H % 2 == 1) ring_pass(ring_order_[half], nullptr);
+  for (Candidates* cs : {&upper_, &lower_}) {
+    // Not cleared first: resize only initialises what the last scan's valid count left short of the full size.
+    cs->ring_start.assign(1, 0);
+    cs->width = W;
+    cs->seed_rings = scale_.seed_rings;
+    cs->start_stride = scale_.start_stride;
+    cs->final_stride = scale_.final_stride;
+    cs->p.resize(size_t(half) * W);
+    cs->range.resize(size_t(half) * W);
+    cs->pixel.resize(size_t(half) * W);
+  }
+  size_t mu = 0, ml = 0, mm = 0;
+  for (int k = 0; k < half; ++k) ring_pass(ring_order_[k], &upper_, mu);
+  for (int k = 0; k < half; ++k) ring_pass(ring_order_[H - 1 - k], &lower_, ml);
+  if (H % 2 == 1) ring_pass(ring_order_[half], nullptr, mm);
+  for (auto [cs, m] : {std::pair{&upper_, mu}, std::pair{&lower_, ml}}) {
+    cs->p.resize(m);
+    cs->range.resize(m);
+    cs->pixel.resize(m);
+  }
   if (valid == 0) return fail(SegStatus::kEmpty, "no valid returns in the scan");
   return true;
 }

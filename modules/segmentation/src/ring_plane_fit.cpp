@@ -21,7 +21,7 @@ void RingPlaneFit::pick_seeds(const Candidates& c, const Eigen::Vector3f& upf) {
   const int S = std::max(k::kMinSectors, cfg_.seed_sectors);
   seeds_.clear();
   all_seeds_.clear();
-  const int kr = std::min(std::max(1, cfg_.seed_rings), c.rings());
+  const int kr = std::min(std::max(1, c.seed_rings > 0 ? c.seed_rings : cfg_.seed_rings), c.rings());
   for (int r = 0; r < kr; ++r) {
     sector_best_.assign(S, -1.f);
     sector_idx_.assign(S, -1);
@@ -49,19 +49,34 @@ void RingPlaneFit::pick_seeds(const Candidates& c, const Eigen::Vector3f& upf) {
 // walls (many "inliers" at one height in a corridor) loses, and a plane the acceptance test would reject
 // (beyond > max_beyond_ratio x inliers) scores below zero. The soft count prefers the tight fit over a
 // loose plane that merely stays within T of a narrow ceiling strip.
-double RingPlaneFit::score_band(const Candidates& c, const Eigen::Vector4d& pl, size_t stride, float band) const {
+double RingPlaneFit::score_band(const std::vector<Eigen::Vector3f>& sub, size_t stride, const Eigen::Vector4d& pl,
+                                float band) const {
   const float beyond_thr = 2 * float(cfg_.inlier_threshold_m);
   const float beyond_weight = float(1.0 / std::max(k::kMinBeyondRatio, cfg_.max_beyond_ratio));
   const Eigen::Vector3f n = pl.head<3>().cast<float>();
   const float d = float(pl[3]), inv_b2 = 1.f / (band * band);
-  float soft = 0.f;
-  int beyond = 0;
-  for (size_t i = 0; i < c.p.size(); i += stride) {
-    const float r = n.dot(c.p[i]) + d;
-    soft += max0(1.f - r * r * inv_b2);
-    beyond += r < -beyond_thr;
+  // Four independent partial sums (one float sum was a chain of dependent additions, its latency the
+  // loop's cost); the residuals are the same floats as before, the sum's rounding differs in the last bits.
+  float soft[4] = {0.f, 0.f, 0.f, 0.f};
+  int beyond[4] = {0, 0, 0, 0};
+  const Eigen::Vector3f* p = sub.data();
+  const size_t np = sub.size();
+  size_t i = 0;
+  for (; i + 4 <= np; i += 4) {
+    for (int l = 0; l < 4; ++l) {
+      const float r = n.dot(p[i + l]) + d;
+      soft[l] += max0(1.f - r * r * inv_b2);
+      beyond[l] += r < -beyond_thr;
+    }
   }
-  return double(soft - beyond_weight * float(beyond)) * double(stride);
+  for (; i < np; ++i) {
+    const float r = n.dot(p[i]) + d;
+    soft[0] += max0(1.f - r * r * inv_b2);
+    beyond[0] += r < -beyond_thr;
+  }
+  const float s = (soft[0] + soft[1]) + (soft[2] + soft[3]);
+  const int b = (beyond[0] + beyond[1]) + (beyond[2] + beyond[3]);
+  return double(s - beyond_weight * float(b)) * double(stride);
 }
 
 // The start with the most support on a subsample of all half-ring points: the seed regression, last
@@ -108,7 +123,7 @@ bool RingPlaneFit::choose_start(const Candidates& c, const Eigen::Vector3d& up, 
   bool have_start = false;
   auto consider = [&](const Eigen::Vector4d& pl) {
     if (!pl.allFinite() || -pl.head<3>().dot(up) < std::cos(max_tilt) || pl[3] <= 0) return;
-    const double sc = score_band(c, pl, k::kStartStride, thr);
+    const double sc = score_band(sub_start_, start_stride_, pl, thr);
     if (!have_start || sc > best) {
       best = sc;
       cur = pl;
@@ -152,12 +167,19 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Candidates& c, const
   const Eigen::Vector3d ref = -cur[3] * cur.head<3>();  // a point of the plane (numerics)
   const Eigen::Vector3f reff = ref.cast<float>();
   double cut = first_cut;
-  band_.clear();  // the band's points, contiguous (streamed by every iteration)
   {
+    // The band's points, contiguous (streamed by every iteration); compacted without a branch (about one
+    // point in five is in the band, a branch on it mispredicted often).
     const Eigen::Vector3f n = cur.head<3>().cast<float>();
     const float d = float(cur[3]), cb = float(cut);
-    for (size_t i = 0; i < c.p.size(); ++i)
-      if (std::abs(n.dot(c.p[i]) + d) < cb) band_.push_back(c.p[i]);
+    band_.resize(c.p.size() + 1);
+    Eigen::Vector3f* out = band_.data();
+    size_t m = 0;
+    for (const Eigen::Vector3f& q : c.p) {
+      out[m] = q;
+      m += size_t(std::abs(n.dot(q) + d) < cb);
+    }
+    band_.resize(m);
   }
   if (band_.size() < 3) return std::nullopt;
   for (int it = 0; it < std::max(1, cfg_.irls_iterations); ++it) {
@@ -165,22 +187,31 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Candidates& c, const
     const float d = float(cur[3]);
     // Residuals once per iteration; robust scale (1.4826 * median |r| inside the cut-off) from a histogram.
     res_.resize(band_.size());
-    int hist[k::kScaleBins] = {0};
+    // Four interleaved histograms (neighbouring returns fall into the same bin: one histogram made every
+    // increment wait for the previous one's store), summed after; the counts are the same. Residuals
+    // outside the cut-off go to an extra bin instead of a branch. `a < cut` is compared in float against
+    // the smallest float >= cut, which is the same test for every float a.
+    int hist[4][k::kScaleBins + 1] = {};
     const float inv_bin = float(k::kScaleBins / cut);
-    int inside = 0;
-    for (size_t j = 0; j < band_.size(); ++j) {
-      const float r = n.dot(band_[j]) + d;
-      res_[j] = r;
+    float cutf = float(cut);
+    if (double(cutf) < cut) cutf = std::nextafter(cutf, std::numeric_limits<float>::infinity());
+    const size_t nb = band_.size();
+    const Eigen::Vector3f* bp = band_.data();
+    float* rp = res_.data();
+    for (size_t j = 0; j < nb; ++j) {
+      const float r = n.dot(bp[j]) + d;
+      rp[j] = r;
       const float a = std::abs(r);
-      if (a < cut) {
-        ++hist[std::min(k::kScaleBins - 1, int(a * inv_bin))];
-        ++inside;
-      }
+      const int b = a < cutf ? std::min(k::kScaleBins - 1, int(a * inv_bin)) : k::kScaleBins;
+      ++hist[j & 3][b];
     }
+    int inside = 0;
+    for (int h = 0; h < 4; ++h)
+      for (int b = 0; b < k::kScaleBins; ++b) inside += hist[h][b];
     if (inside < 3) return std::nullopt;
     int acc = 0, bin = 0;
     for (; bin < k::kScaleBins; ++bin) {
-      acc += hist[bin];
+      acc += hist[0][bin] + hist[1][bin] + hist[2][bin] + hist[3][bin];
       if (2 * acc >= inside) break;
     }
     const double sigma = k::kMadToSigma * (bin + 0.5) / inv_bin;
@@ -221,6 +252,14 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
                        PlaneRole role, Eigen::Vector4d& plane) {
   if (c.p.size() < size_t(k::kMinCandidatePoints) || c.rings() < 1) return false;
   const Eigen::Vector3d up = up_in.normalized();
+  // The subsamples every score is computed on (every kStartStride-th / kFinalStride-th candidate), copied
+  // once: the scores then stream a small contiguous array instead of striding through all candidates.
+  start_stride_ = c.start_stride > 0 ? c.start_stride : k::kStartStride;
+  final_stride_ = c.final_stride > 0 ? c.final_stride : k::kFinalStride;
+  for (auto [sub, stride] : {std::pair{&sub_start_, start_stride_}, std::pair{&sub_final_, final_stride_}}) {
+    sub->resize((c.p.size() + stride - 1) / stride);
+    for (size_t i = 0, j = 0; i < c.p.size(); i += stride, ++j) (*sub)[j] = c.p[i];
+  }
   pick_seeds(c, up.cast<float>());
   Eigen::Vector4d cur;
   if (!choose_start(c, up, previous, cur)) return false;
@@ -232,7 +271,7 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
   // narrow corridor ceiling plus the wall tops below it scores as well as the true one; at 3 sigma it
   // loses the ceiling returns it leaves behind. (A lowered/sloped patch must not capture it either.)
   const float thr = float(cfg_.inlier_threshold_m);
-  auto score = [&](const Eigen::Vector4d& pl) { return score_band(c, pl, k::kFinalStride, thr); };
+  auto score = [&](const Eigen::Vector4d& pl) { return score_band(sub_final_, final_stride_, pl, thr); };
   auto select_band = [&](double s1, double s2) {
     return float(std::clamp(k::kSelectBandSigmas * std::min(s1, s2), k::kSelectBandMinM, cfg_.inlier_threshold_m));
   };
@@ -246,7 +285,7 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
     const std::optional<Fit> res2 = refine_guarded(*previous);
     if (res2 && res1) {
       const float t_sel = select_band(res1->sigma, res2->sigma);
-      if (score_band(c, res2->pl, k::kFinalStride, t_sel) > score_band(c, res1->pl, k::kFinalStride, t_sel)) res1 = res2;
+      if (score_band(sub_final_, final_stride_, res2->pl, t_sel) > score_band(sub_final_, final_stride_, res1->pl, t_sel)) res1 = res2;
     } else if (res2) {
       res1 = res2;
     }
@@ -259,7 +298,7 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
     const double ct = std::max(cfg_.tight_refit_sigmas * res1->sigma, k::kTightMinCutM);
     if (const auto tight = refine(c, up, res1->pl, ct, ct, true)) {
       const float t_sel = select_band(res1->sigma, tight->sigma);
-      if (score_band(c, tight->pl, k::kFinalStride, t_sel) > score_band(c, res1->pl, k::kFinalStride, t_sel)) res1 = tight;
+      if (score_band(sub_final_, final_stride_, tight->pl, t_sel) > score_band(sub_final_, final_stride_, res1->pl, t_sel)) res1 = tight;
     }
   }
   if (!res1) return false;

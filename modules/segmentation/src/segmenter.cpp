@@ -68,13 +68,13 @@ void Segmenter::fit_ceiling(const Eigen::Vector3d& init_up, const Eigen::Vector3
       why = "ceiling tilted " + std::to_string(tilt / k::kDeg) + " deg > max_tilt_deg";
     else if (pl[3] < k::kMinCeilingDistM)
       why = "ceiling plane not above the sensor";
-    else if (out_.ceiling.inliers < cfg_.min_plane_inliers)
+    else if (out_.ceiling.inliers < scale_.min_plane_inliers)
       why = "ceiling has " + std::to_string(out_.ceiling.inliers) + " inliers < " +
-            std::to_string(cfg_.min_plane_inliers);
+            std::to_string(scale_.min_plane_inliers);
     else if (out_.ceiling.beyond > cfg_.max_beyond_ratio * out_.ceiling.inliers)
       why = "ceiling not where the rays end: " + std::to_string(out_.ceiling.beyond) + " returns beyond it vs " +
             std::to_string(out_.ceiling.inliers) + " inliers";
-    else if (out_.ceiling.inliers < cfg_.min_inlier_fraction * double(upper_.p.size()))
+    else if (out_.ceiling.inliers < scale_.min_inlier_fraction * double(upper_.p.size()))
       why = "ceiling inliers are only " + std::to_string(100.0 * out_.ceiling.inliers / upper_.p.size()) +
             " % of the upper-ring returns";
   }
@@ -93,7 +93,7 @@ void Segmenter::fit_ground(const Eigen::Vector3d& up) {
   quality(lower_, out_.ground);
   const double tilt = std::acos(std::clamp(pl.head<3>().dot(up), -1.0, 1.0));
   out_.ground.found = tilt < std::min(cfg_.max_tilt_deg * k::kDeg, k::kMaxGroundTiltDeg * k::kDeg) &&
-                      pl[3] > k::kMinGroundDistM && out_.ground.inliers >= cfg_.min_plane_inliers &&
+                      pl[3] > k::kMinGroundDistM && out_.ground.inliers >= scale_.min_plane_inliers &&
                       out_.ground.beyond <= cfg_.max_beyond_ratio * out_.ground.inliers;
 }
 

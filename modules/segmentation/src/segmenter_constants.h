@@ -13,6 +13,15 @@ constexpr double kDeg = M_PI / 180.0;
 // Seeds and RANSAC points must lie this far above the sensor along the gravity prior [m].
 constexpr float kMinSeedHeightM = 0.2f;
 
+// ---- the reference sensor the options and strides are stated for (beam_scaling.cpp) ----
+constexpr int kRefBeams = 64;               // OS-1-64
+constexpr int kRefWidth = 1024;             // 1024 columns per frame
+constexpr double kRefRingSpacingDeg = 33.2 / 63;  // its rings' altitude spacing
+constexpr double kRefSteepRingDeg = 8.3;    // its median upper ring's altitude (half of +16.6 deg)
+constexpr double kRefSteepShare = 0.5;      // share of its upper rings at or above that
+constexpr int kMinSeedRings = 2;            // a sparse sensor still seeds from two rings
+constexpr int kMinPlaneInliersFloor = 30;   // a plane needs at least this many inliers on any sensor
+
 // ---- ring plane fit (ring_plane_fit.cpp) ----
 constexpr int kMinCandidatePoints = 10;     // fewer candidates: no fit
 constexpr int kMinSectors = 4;              // at least this many azimuth sectors per seed ring
@@ -21,8 +30,8 @@ constexpr int kSeedTrimRounds = 3;          // linear regression rounds (2 trims
 constexpr double kSeedTrimMinM = 0.05;      // trim cut-off at least this [m]
 constexpr double kSeedTrimSigmas = 3.0;     // trim at this many robust sigmas
 constexpr double kMadToSigma = 1.4826;      // median |r| -> sigma (Gaussian)
-constexpr size_t kStartStride = 24;         // start selection: ~1.4k of 32k half-ring returns
-constexpr size_t kFinalStride = 3;          // support of refined planes: every 3rd return
+constexpr size_t kStartStride = 24;         // start selection: ~1.4k of 32k half-ring returns (reference sensor)
+constexpr size_t kFinalStride = 3;          // support of refined planes: every 3rd return (reference sensor)
 constexpr uint32_t kTripletSeed = 12345u;   // deterministic triplet sampling (LCG)
 constexpr double kMinTripletNormal = 1e-3;  // |(b-a) x (q-a)| below this: degenerate triplet
 constexpr int kScaleBins = 256;             // histogram of |r| for the robust scale

@@ -48,6 +48,9 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
   auto& w = out_.wall;
   const size_t cap = size_t(scan.height) * W;
   w.x.reserve(cap); w.y.reserve(cap); w.z.reserve(cap); w.range.reserve(cap); w.t.reserve(cap); w.ring.reserve(cap); w.column.reserve(cap);
+  const bool labels = keep_labels_, deskewed = out_.deskewed;
+  const float* rng = range_.data();
+  const Eigen::Vector3f* xyz = xyz_.data();
   // Column time offsets (staggered column = measurement order), for motion compensation downstream.
   col_dt_.assign(W, 0.f);
   if (scan.column_utime.size() == size_t(W))
@@ -59,14 +62,14 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
     for (int cd = 0; cd < W; ++cd, ++v) {
       if (v == W) v = 0;
       const size_t i = size_t(u) * W + v;
-      const float r = range_[i];
+      const float r = rng[i];
       if (r <= 0.f) continue;
-      const Eigen::Vector3f& p = xyz_[i];
+      const Eigen::Vector3f& p = xyz[i];
       const float sc = nc.dot(p), sf = nf.dot(p);
       if (sc > -dc && sf > -df) {
-        w.push(out_.deskewed ? raw_[i] : p, r, u, cd, col_dt_[v]);  // as measured (see prepare())
-        if (keep_labels_) out_.label[i] = 3;
-      } else if (keep_labels_) {
+        w.push(deskewed ? raw_[i] : p, r, u, cd, col_dt_[v]);  // as measured (see prepare())
+        if (labels) out_.label[i] = 3;
+      } else if (labels) {
         if (sc <= -cin) out_.label[i] = 1;
         else if (sf <= -fin) out_.label[i] = 2;
       }

@@ -1,5 +1,7 @@
 #include "fploc/sim/simulator.h"
 
+#include "fploc/sim/beam_patterns.h"
+
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -243,7 +245,7 @@ void Simulator::finish() {
     if (!load_beam_intrinsics_json(opt_.metadata, sc.beams, &err)) throw std::runtime_error(err);
     beam_source_ = opt_.metadata;
   } else {
-    sc.beams = default_beams(opt_.shared_dir, &beam_source_);
+    sc.beams = beam_pattern(opt_.beams, opt_.shared_dir, &beam_source_);
   }
   sc.width = opt_.width;
   sc.rate_hz = opt_.rate_hz;

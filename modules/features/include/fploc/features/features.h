@@ -13,6 +13,8 @@
 namespace fploc::feat {
 
 struct FeatureConfig {
+  // Per-ring limits for a 64-ring sensor; with H rings, every round(H/64)-th ring is used (H > 64) or the
+  // limits are multiplied by 64/H (H < 64), so a scan gives about as many features whatever the beam count.
   int sectors = 6;                  // per-ring sectors for the feature limits
   int max_corners_per_sector = 2;
   int max_surfaces_per_sector = 12;
@@ -56,7 +58,10 @@ class FeatureExtractor {
   };
   FeatureStatus extract(const seg::Segmentation& seg);
   void ring(const seg::Segmentation& seg, size_t begin, size_t end);
+  static constexpr int kRefRings = 64;  // the sensor the per-ring limits are stated for (OS-1-64)
   FeatureConfig cfg_;
+  int ring_step_ = 1;        // rings used: every ring_step_-th (from the beam count)
+  double limit_scale_ = 1.0; // per-sector limits times this (from the beam count)
   Picked out_;
   FeatureFrame frame_;
   std::vector<int32_t> source_;

@@ -41,7 +41,8 @@ class RingPlaneFit : public PlaneFit {
   void pick_seeds(const Candidates& c, const Eigen::Vector3f& up);
   bool choose_start(const Candidates& c, const Eigen::Vector3d& up, const Eigen::Vector4d* previous,
                     Eigen::Vector4d& start);
-  double score_band(const Candidates& c, const Eigen::Vector4d& pl, size_t stride, float band) const;
+  // Support of `pl` on `sub`, a subsample of the candidates (every stride-th), scaled by the stride.
+  double score_band(const std::vector<Eigen::Vector3f>& sub, size_t stride, const Eigen::Vector4d& pl, float band) const;
   // IRLS from `start`; the cut-off shrinks from first_cut down to min_cut (fixed: stays at first_cut).
   std::optional<Fit> refine(const Candidates& c, const Eigen::Vector3d& up, Eigen::Vector4d start, double first_cut,
                             double min_cut, bool fixed);
@@ -50,7 +51,8 @@ class RingPlaneFit : public PlaneFit {
   std::vector<int> seeds_, all_seeds_;
   std::vector<float> sector_best_;
   std::vector<int> sector_idx_;
-  std::vector<Eigen::Vector3f> band_;
+  std::vector<Eigen::Vector3f> band_, sub_start_, sub_final_;
+  size_t start_stride_ = 1, final_stride_ = 1;  // of the current fit (Candidates, else the reference strides)
   std::vector<float> res_;
 };
 

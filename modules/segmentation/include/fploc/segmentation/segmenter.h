@@ -16,6 +16,7 @@
 #include "fploc/core/scan.h"
 #include "fploc/core/xyz.h"
 #include "fploc/segmentation/attitude_height.h"
+#include "fploc/segmentation/beam_scaling.h"
 #include "fploc/segmentation/candidates.h"
 #include "fploc/segmentation/gyro_deskew.h"
 #include "fploc/segmentation/plane_fit.h"
@@ -47,6 +48,8 @@ class Segmenter {
   const AttitudeHeight& height_estimator() const { return height_; }
   const SegmenterConfig& config() const { return cfg_; }
   double room_height() const { return height_.room_height(); }  // 0 until known
+  // The sensor-dependent numbers in use (from the last scan's beam pattern, beam_scaling.h).
+  const BeamScaling& beam_scaling() const { return scale_; }
   const Eigen::Vector3d& gyro_bias() const { return deskew_.bias(); }  // rad/s, perpendicular-to-gravity part
   // Last scan's points per pixel (row-major like the scan, de-skewed when last().deskewed; only pixels with a
   // return inside [min_range_m, max_range_m] are meaningful). Diagnostics.
@@ -66,6 +69,7 @@ class Segmenter {
   AttitudeHeight height_;
   Segmentation out_;
   XyzLut lut_;
+  BeamScaling scale_;
   BeamIntrinsics lut_beams_;
   int lut_width_ = 0;
   std::vector<Eigen::Vector3f> xyz_;   // sensor frame (de-skewed to mid-sweep when out_.deskewed)

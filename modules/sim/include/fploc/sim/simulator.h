@@ -35,7 +35,8 @@ struct SimulatorOptions {
   double ceiling_height_m = 0;    // 0 = scenario default
   double range_noise_m = 0.02;
   double dropout = 0.01;
-  std::string metadata;           // Ouster metadata JSON for the beams ("" = default_beams(shared_dir))
+  std::string metadata;           // Ouster metadata JSON for the beams ("" = `beams`)
+  std::string beams;              // beam pattern (beam_patterns.h: os1-64, os1-32, os1-128, vlp16; "" = os1-64)
   std::string shared_dir;         // where ../shared is ("" = no shared data: nominal beams)
   double imu_rate_hz = 100;       // the OS-1's own IMU runs at 100 Hz
   double t0_s = 1700000000.0;     // time of the first sample [s] (absolute, written into messages)
