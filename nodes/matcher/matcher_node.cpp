@@ -4,8 +4,10 @@
 #include <fploc/features_t.hpp>
 #include <fploc/frame_pose_t.hpp>
 #include <fploc/imu_t.hpp>
+#include <fploc/plan_diff_t.hpp>
 #include <fploc/pose_t.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iostream>
@@ -15,6 +17,7 @@
 
 #include "fploc/adapters/features_t.h"
 #include "fploc/adapters/frame_pose_t.h"
+#include "fploc/adapters/plan_diff_t.h"
 #include "fploc/adapters/pose_t.h"
 #include "fploc/config/localization.h"
 #include "fploc/config/plan_source.h"
@@ -39,6 +42,9 @@ class MatcherNode : public fploc::rt::Node {
              // Optional wheel odometry (pose_t in its own odometry frame, stamped with the scan times, e.g.
              // `fploc import-carmen`'s WHEEL_ODOM): the increment between two frames predicts the next one.
              fploc::rt::input<fploc::pose_t>("odom", ""),
+             // Optional: the plan-change detector's verdicts (FPLOC_PLAN_DIFF); elements it marks missing or
+             // moved get weight plan_diff_weight in the registration (default 0: left out).
+             fploc::rt::input<fploc::plan_diff_t>("plan_diff", ""),
              fploc::rt::output<fploc::frame_pose_t>("frame_pose", "FPLOC_FRAME_POSE")}};
   }
 
@@ -47,7 +53,11 @@ class MatcherNode : public fploc::rt::Node {
     const auto& o = ctx.options<fploc::MatcherOptions>();
     map_ = fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); },
                                    "matcher.plan");
-    loc_ = std::make_unique<fploc::localizer::Localizer>(*map_.lookup, fploc::config::localizer_config(o));
+    auto lc = fploc::config::localizer_config(o);
+    const float dw = float(std::max(0.0, o.plan_diff_weight()));
+    weights_ = std::make_unique<fploc::matcher::ElementWeights>(*map_.plan, fploc::matcher::DiffWeightOptions{dw, dw});
+    lc.matcher.element_weight = weights_->weights();
+    loc_ = std::make_unique<fploc::localizer::Localizer>(*map_.lookup, lc);
     // The graph's initial pose is where the run starts; a restarted matcher (crash, module swap) waits for
     // a pose instead (FPLOC_INITIAL_POSE: the relocalizer searches around the last good pose).
     if (!o.wait_for_initial_pose() && ctx.restarts() == 0)
@@ -75,6 +85,7 @@ class MatcherNode : public fploc::rt::Node {
       }
       loc_->add_odometry(m.utime, p);
     });
+    ctx.subscribe<fploc::plan_diff_t>("plan_diff", [this](const fploc::plan_diff_t& m) { on_plan_diff(m); });
     ctx.subscribe<fploc::pose_t>("refined", [this](const fploc::pose_t& m) {
       // Stale (a later frame was already registered) or LOST: not used; counted, said at shutdown.
       if (!loc_->refine(m.utime, fploc::adapters::pose2_of(m))) ++refined_ignored_;
@@ -88,6 +99,17 @@ class MatcherNode : public fploc::rt::Node {
   }
 
  private:
+  void on_plan_diff(const fploc::plan_diff_t& m) {
+    const auto flagged = fploc::adapters::flagged_elements(m);
+    for (const auto& f : flagged)
+      if (size_t(f.id) >= map_.plan->elements.size()) {
+        ctx_->error("plan_diff seq " + std::to_string(m.seq) + ": element " + std::to_string(f.id) + " not in matcher.plan (" +
+                    std::to_string(map_.plan->elements.size()) + " elements): a diff of another plan? (ignored)");
+        return;
+      }
+    weights_->update(flagged);
+  }
+
   void on_imu(const fploc::imu_t& m) { loc_->add_imu(m.utime, m.gyro[2]); }
 
   void on_features(const fploc::features_t& m) {
@@ -113,6 +135,7 @@ class MatcherNode : public fploc::rt::Node {
 
   fploc::rt::Context* ctx_ = nullptr;
   fploc::LocalizationMap map_;
+  std::unique_ptr<fploc::matcher::ElementWeights> weights_;  // before loc_: the matcher reads it
   std::unique_ptr<fploc::localizer::Localizer> loc_;
   fploc::rt::Publisher<fploc::frame_pose_t> out_;
   int64_t seq_ = 0;

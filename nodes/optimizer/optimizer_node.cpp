@@ -4,14 +4,17 @@
 // fploc::localizer::Localizer.
 #include <fploc/features_t.hpp>
 #include <fploc/frame_pose_t.hpp>
+#include <fploc/plan_diff_t.hpp>
 #include <fploc/pose_t.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
 
 #include "fploc/adapters/features_t.h"
 #include "fploc/adapters/frame_pose_t.h"
+#include "fploc/adapters/plan_diff_t.h"
 #include "fploc/adapters/pose_t.h"
 #include "fploc/config/localization.h"
 #include "fploc/config/plan_source.h"
@@ -28,6 +31,8 @@ class OptimizerNode : public fploc::rt::Node {
     return {"optimizer", "optimizer", "windowed keyframe optimisation (floor plan + velocity regularisation) -> 6-DoF pose",
             {fploc::rt::input<fploc::features_t>("features", "FPLOC_FEATURES"),
              fploc::rt::input<fploc::frame_pose_t>("frame_pose", "FPLOC_FRAME_POSE"),
+             // Optional: the plan-change detector's verdicts (FPLOC_PLAN_DIFF), as the matcher's.
+             fploc::rt::input<fploc::plan_diff_t>("plan_diff", ""),
              fploc::rt::output<fploc::pose_t>("pose", "FPLOC_POSE"),
              fploc::rt::output<fploc::pose_t>("latest", "FPLOC_POSE_LATEST")}};
   }
@@ -37,7 +42,11 @@ class OptimizerNode : public fploc::rt::Node {
     const auto& o = ctx.options<fploc::OptimizerOptions>();
     map_ = fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); },
                                    "optimizer.plan");
-    loc_ = std::make_unique<fploc::localizer::Localizer>(*map_.lookup, fploc::config::localizer_config(o));
+    auto lc = fploc::config::localizer_config(o);
+    const float dw = float(std::max(0.0, o.plan_diff_weight()));
+    weights_ = std::make_unique<fploc::matcher::ElementWeights>(*map_.plan, fploc::matcher::DiffWeightOptions{dw, dw});
+    lc.optimizer.element_weight = weights_->weights();
+    loc_ = std::make_unique<fploc::localizer::Localizer>(*map_.lookup, lc);
     pose_out_ = ctx.advertise<fploc::pose_t>("pose");
     latest_out_ = ctx.advertise<fploc::pose_t>("latest");
     ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) {
@@ -49,6 +58,17 @@ class OptimizerNode : public fploc::rt::Node {
       }
       trim(features_);
       try_pair(m.scan_seq);
+    });
+    ctx.subscribe<fploc::plan_diff_t>("plan_diff", [this](const fploc::plan_diff_t& m) {
+      const auto flagged = fploc::adapters::flagged_elements(m);
+      for (const auto& f : flagged)
+        if (size_t(f.id) >= map_.plan->elements.size()) {
+          ctx_->error("plan_diff seq " + std::to_string(m.seq) + ": element " + std::to_string(f.id) +
+                      " not in optimizer.plan (" + std::to_string(map_.plan->elements.size()) +
+                      " elements): a diff of another plan? (ignored)");
+          return;
+        }
+      weights_->update(flagged);
     });
     ctx.subscribe<fploc::frame_pose_t>("frame_pose", [this](const fploc::frame_pose_t& m) {
       frame_poses_[m.scan_seq] = m;
@@ -106,6 +126,7 @@ class OptimizerNode : public fploc::rt::Node {
 
   fploc::rt::Context* ctx_ = nullptr;
   fploc::LocalizationMap map_;
+  std::unique_ptr<fploc::matcher::ElementWeights> weights_;  // before loc_: the optimizer reads it
   std::unique_ptr<fploc::localizer::Localizer> loc_;
   fploc::rt::Publisher<fploc::pose_t> pose_out_, latest_out_;
   std::map<int64_t, fploc::FeatureFrame> features_;
