@@ -23,7 +23,7 @@
 
 namespace {
 
-using fploc::FitStatus;
+using fploc::matcher::FitStatus;
 
 class OptimizerNode : public fploc::rt::Node {
  public:
@@ -99,7 +99,7 @@ class OptimizerNode : public fploc::rt::Node {
                   " != frame_pose utime " + std::to_string(p->second.utime) + " (dropped)");
     } else if (scan_seq <= last_seq_ && have_last_) {
       ctx_->error("scan_seq " + std::to_string(scan_seq) + " arrived after " + std::to_string(last_seq_) + " (dropped)");
-    } else if (p->second.status != int8_t(FitStatus::kNotInitialised)) {
+    } else if (p->second.status != int8_t(fploc::matcher::FitStatus::kNotInitialised)) {
       process(f->second, p->second);
       last_seq_ = scan_seq;
       have_last_ = true;
@@ -125,7 +125,7 @@ class OptimizerNode : public fploc::rt::Node {
   }
 
   fploc::rt::Context* ctx_ = nullptr;
-  fploc::LocalizationMap map_;
+  fploc::matcher::LocalizationMap map_;
   std::unique_ptr<fploc::matcher::ElementWeights> weights_;  // before loc_: the optimizer reads it
   std::unique_ptr<fploc::localizer::Localizer> loc_;
   fploc::rt::Publisher<fploc::pose_t> pose_out_, latest_out_;

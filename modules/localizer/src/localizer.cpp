@@ -4,7 +4,7 @@
 
 namespace fploc::localizer {
 
-Localizer::Localizer(const NearestLookup& lookup, Config cfg)
+Localizer::Localizer(const matcher::NearestLookup& lookup, Config cfg)
     : cfg_(std::move(cfg)), matcher_(lookup, cfg_.matcher), window_(lookup, cfg_.optimizer) {}
 
 void Localizer::add_imu(int64_t utime, double gyro_z) {
@@ -33,7 +33,7 @@ FramePose Localizer::register_frame(const FeatureFrame& f) {
     // Prediction: the yaw change since the previous frame; motion compensation: the mean rate over
     // this frame's sweep (its samples arrive before the scan is complete).
     if (have_prev_) dyaw = imu_.integral(prev_utime_, f.utime);
-    const double sweep = sweep_duration(f);
+    const double sweep = matcher::sweep_duration(f);
     if (sweep > 0)
       if (auto w = imu_.mean_rate(f.utime, f.utime + std::llround(sweep * 1e6))) held_.sweep_yaw_rate = *w;
     imu_.drop_before(std::min(f.utime, have_prev_ ? prev_utime_ : f.utime));
@@ -47,7 +47,7 @@ FramePose Localizer::register_frame(const FeatureFrame& f) {
   out.utime = f.utime;
   out.scan_seq = f.scan_seq;
   out.match = matcher_.process(held_, dyaw, motion);
-  if (out.match.status != FitStatus::kNotInitialised) {
+  if (out.match.status != matcher::FitStatus::kNotInitialised) {
     prev_utime_ = f.utime;
     have_prev_ = true;
   }
@@ -60,8 +60,8 @@ FramePose Localizer::register_frame(const FeatureFrame& f) {
 }
 
 std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& sfr, std::vector<Pose>* finals) {
-  if (sfr.match.status == FitStatus::kNotInitialised) return std::nullopt;
-  FrameInput in;
+  if (sfr.match.status == matcher::FitStatus::kNotInitialised) return std::nullopt;
+  optimizer::FrameInput in;
   in.features = f;
   in.sfr = sfr.match.pose;
   in.twist = sfr.match.twist;

@@ -6,7 +6,7 @@
 
 #include "fploc/matcher/plan_terms.h"
 
-namespace fploc {
+namespace fploc::matcher {
 
 namespace {
 
@@ -261,4 +261,4 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
   return r;
 }
 
-}  // namespace fploc
+}  // namespace fploc::matcher

@@ -1,15 +1,25 @@
-// plan_diff_t -> the elements the plan-change detector flagged (for the matcher's and the optimizer's
-// per-element weights, fploc/matcher/element_weights.h). Pure mapping.
+// plandiff::Diff (modules/plandiff) <-> plan_diff_t (FPLOC_PLAN_DIFF): the missing and moved plan
+// elements (moved ones drawn where they were seen) and the new structure, with the run's counts.
 #pragma once
+
 #include <fploc/plan_diff_t.hpp>
 
+#include <cstdint>
 #include <vector>
 
+#include "fploc/floorplan/plan.h"
 #include "fploc/matcher/element_weights.h"
+#include "fploc/plandiff/plan_diff.h"
 
 namespace fploc::adapters {
 
-// MISSING and MOVED items with an element id (NEW items carry -1 and are skipped).
+// Item kinds in plan_diff_t.kind.
+enum class PlanDiffKind : int8_t { kMissing = 1, kMoved = 2, kNew = 3 };
+
+plan_diff_t to_msg(const plandiff::Diff& d, const FloorPlan& plan, int64_t utime, int64_t seq);
+
+// The MISSING and MOVED items with an element id (for the matcher's and the optimizer's per-element
+// weights, fploc/matcher/element_weights.h); NEW items (element -1) are skipped.
 std::vector<matcher::FlaggedElement> flagged_elements(const plan_diff_t& m);
 
 }  // namespace fploc::adapters

@@ -3,7 +3,7 @@
 #pragma once
 #include <vector>
 
-namespace fploc {
+namespace fploc::matcher {
 
 constexpr int kMaxCandidates = 8;
 
@@ -33,4 +33,4 @@ struct AssignOptions {
   const std::vector<float>* element_weight = nullptr;
 };
 
-}  // namespace fploc
+}  // namespace fploc::matcher
