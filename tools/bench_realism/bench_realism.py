@@ -601,7 +601,8 @@ def main():
     work = a.work or tempfile.mkdtemp(prefix="fploc-realism-")
     os.makedirs(work, exist_ok=True)
     b = Bench(a, work)
-    log(f"fploc bench realism: {len(fams)} families, methods fploc, amcl{', ndt' if b.have_ndt else ' (no fploc-ndt: NDT left out)'}; work in {work}")
+    log(f"fploc bench realism: {len(fams)} families, methods {', '.join(m for m in b.methods if m != 'ndt' or b.have_ndt)}"
+        f"{'' if b.have_ndt or 'ndt' not in b.methods else ' (no fploc-ndt: NDT left out)'}; work in {work}")
     res = {"rows": [], "detection": [], "config": {"scenario": a.scenario, "seed": a.seed, "duration": a.duration,
                                                    "families": fams, "ndt": b.have_ndt, "false_ok_m": FALSE_OK_M,
                                                    "methods": b.methods, "downweight": a.downweight}}
