@@ -1,6 +1,7 @@
 #include "fploc/adapters/plan_diff_t.h"
 
 #include <Eigen/Core>
+#include <algorithm>
 
 namespace fploc::adapters {
 
@@ -43,6 +44,17 @@ plan_diff_t to_msg(const plandiff::Diff& r, const FloorPlan& plan, int64_t utime
   for (const auto& n : r.added) item(PlanDiffKind::kNew, -1, false, n.a.x(), n.a.y(), n.b.x(), n.b.y(), n.rms_m, 0);
   msg.num_items = int32_t(msg.kind.size());
   return msg;
+}
+
+std::vector<matcher::FlaggedElement> flagged_elements(const plan_diff_t& m) {
+  std::vector<matcher::FlaggedElement> out;
+  const size_t n = size_t(std::max(0, m.num_items));
+  for (size_t i = 0; i < n && i < m.kind.size() && i < m.element.size(); ++i) {
+    if (m.element[i] < 0) continue;
+    if (m.kind[i] == int8_t(PlanDiffKind::kMissing)) out.push_back({m.element[i], matcher::DiffVerdict::kMissing});
+    else if (m.kind[i] == int8_t(PlanDiffKind::kMoved)) out.push_back({m.element[i], matcher::DiffVerdict::kMoved});
+  }
+  return out;
 }
 
 }  // namespace fploc::adapters

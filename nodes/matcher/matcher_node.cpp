@@ -6,8 +6,10 @@
 #include <fploc/features_t.hpp>
 #include <fploc/frame_pose_t.hpp>
 #include <fploc/imu_t.hpp>
+#include <fploc/plan_diff_t.hpp>
 #include <fploc/pose_t.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <deque>
 #include <cmath>
@@ -18,6 +20,7 @@
 
 #include "fploc/adapters/features_t.h"
 #include "fploc/adapters/frame_pose_t.h"
+#include "fploc/adapters/plan_diff_t.h"
 #include "fploc/adapters/pose_t.h"
 #include "fploc/floorplan/building.h"
 #include "fploc/localizer/floor_maps.h"
@@ -45,6 +48,9 @@ class MatcherNode : public fploc::rt::Node {
              // Optional wheel odometry (pose_t in its own odometry frame, stamped with the scan times, e.g.
              // `fploc import-carmen`'s WHEEL_ODOM): the increment between two frames predicts the next one.
              fploc::rt::input<fploc::pose_t>("odom", ""),
+             // Optional: the plan-change detector's verdicts (FPLOC_PLAN_DIFF); elements it marks missing or
+             // moved get weight plan_diff_weight in the registration (default 0: left out).
+             fploc::rt::input<fploc::plan_diff_t>("plan_diff", ""),
              fploc::rt::output<fploc::frame_pose_t>("frame_pose", "FPLOC_FRAME_POSE")}};
   }
 
@@ -64,6 +70,8 @@ class MatcherNode : public fploc::rt::Node {
     floor_ = floors_.initial;
     if (floors_.multi_floor()) tracker_.emplace(floors_.building, floor_);
     cfg_ = fploc::config::localizer_config(o);
+    diff_weight_ = float(std::max(0.0, o.plan_diff_weight()));
+    weights_ = make_weights();
     loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
     // The graph's initial pose is where the run starts; a restarted matcher (crash, module swap) waits for
     // a pose instead (FPLOC_INITIAL_POSE: the relocalizer searches around the last good pose).
@@ -84,7 +92,9 @@ class MatcherNode : public fploc::rt::Node {
       if (m.floor_index >= 0 && size_t(m.floor_index) < floors_.maps.size() && m.floor_index != floor_) {
         const std::string from = floors_.building->floors[size_t(floor_)].name;
         floor_ = m.floor_index;
+        auto weights = make_weights();
         loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
+        weights_ = std::move(weights);
         for (const auto& s : imu_) loc_->add_imu(s.first, s.second);
         if (tracker_) tracker_->set_floor(floor_, "initial pose on floor '" + m.floor + "' (was '" + from + "')");
         std::cerr << "[" << ctx_->name() << "] initial pose on floor '" << m.floor << "' (was '" << from << "')\n";
@@ -104,6 +114,7 @@ class MatcherNode : public fploc::rt::Node {
       }
       loc_->add_odometry(m.utime, p);
     });
+    ctx.subscribe<fploc::plan_diff_t>("plan_diff", [this](const fploc::plan_diff_t& m) { on_plan_diff(m); });
     ctx.subscribe<fploc::pose_t>("refined", [this](const fploc::pose_t& m) {
       // Stale (a later frame was already registered) or LOST: not used; counted, said at shutdown.
       if (!loc_->refine(m.utime, fploc::adapters::pose2_of(m))) ++refined_ignored_;
@@ -146,7 +157,9 @@ class MatcherNode : public fploc::rt::Node {
       // Where to start on the new floor: this frame's pose, or the last good one when the old floor's plan
       // no longer matched (after a lift ride the robot stands where it entered the cab).
       const fploc::Pose2 at = fp->match.status == FitStatus::kOk || !have_ok_ ? fp->match.pose : last_ok_;
+      auto weights = make_weights();  // the diff's flags were for the old floor's plan
       loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
+      weights_ = std::move(weights);
       for (const auto& s : imu_) loc_->add_imu(s.first, s.second);
       // A lift: the robot may have turned in the cab and the old plan no longer matched: search the lift's
       // area. Stairs/ramp: the pose was tracked all the way (one x/y frame), the area can be 25 m long.
@@ -157,6 +170,27 @@ class MatcherNode : public fploc::rt::Node {
       switch_until_ = f.utime + 3'000'000;
     }
     fp->z = tracker_->floor_z(fp->z);
+  }
+
+  void on_plan_diff(const fploc::plan_diff_t& m) {
+    const auto flagged = fploc::adapters::flagged_elements(m);
+    const size_t n = floors_.maps[size_t(floor_)].plan->elements.size();
+    for (const auto& f : flagged)
+      if (size_t(f.id) >= n) {
+        ctx_->error("plan_diff seq " + std::to_string(m.seq) + ": element " + std::to_string(f.id) + " not in matcher.plan (" +
+                    std::to_string(n) + " elements): a diff of another plan? (ignored)");
+        return;
+      }
+    weights_->update(flagged);
+  }
+
+  // Per-element weights for the current floor's plan (all 1 until a plan diff flags elements); cfg_'s
+  // matcher reads them through the pointer set here.
+  std::unique_ptr<fploc::matcher::ElementWeights> make_weights() {
+    auto w = std::make_unique<fploc::matcher::ElementWeights>(*floors_.maps[size_t(floor_)].plan,
+                                                             fploc::matcher::DiffWeightOptions{diff_weight_, diff_weight_});
+    cfg_.matcher.element_weight = w->weights();
+    return w;
   }
 
   void on_features(const fploc::features_t& m) {
@@ -197,6 +231,8 @@ class MatcherNode : public fploc::rt::Node {
   int64_t switch_until_ = 0;
   fploc::Pose2 last_ok_;
   bool have_ok_ = false;
+  float diff_weight_ = 0;
+  std::unique_ptr<fploc::matcher::ElementWeights> weights_;  // before loc_: the matcher reads it
   std::unique_ptr<fploc::localizer::Localizer> loc_;
   fploc::rt::Publisher<fploc::frame_pose_t> out_;
   int64_t seq_ = 0;

@@ -6,14 +6,17 @@
 // final on the old floor) and starts one on the new floor's plan.
 #include <fploc/features_t.hpp>
 #include <fploc/frame_pose_t.hpp>
+#include <fploc/plan_diff_t.hpp>
 #include <fploc/pose_t.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
 
 #include "fploc/adapters/features_t.h"
 #include "fploc/adapters/frame_pose_t.h"
+#include "fploc/adapters/plan_diff_t.h"
 #include "fploc/adapters/pose_t.h"
 #include "fploc/config/localization.h"
 #include "fploc/config/plan_source.h"
@@ -32,6 +35,8 @@ class OptimizerNode : public fploc::rt::Node {
     return {"optimizer", "optimizer", "windowed keyframe optimisation (floor plan + velocity regularisation) -> 6-DoF pose",
             {fploc::rt::input<fploc::features_t>("features", "FPLOC_FEATURES"),
              fploc::rt::input<fploc::frame_pose_t>("frame_pose", "FPLOC_FRAME_POSE"),
+             // Optional: the plan-change detector's verdicts (FPLOC_PLAN_DIFF), as the matcher's.
+             fploc::rt::input<fploc::plan_diff_t>("plan_diff", ""),
              fploc::rt::output<fploc::pose_t>("pose", "FPLOC_POSE"),
              fploc::rt::output<fploc::pose_t>("latest", "FPLOC_POSE_LATEST")}};
   }
@@ -50,6 +55,8 @@ class OptimizerNode : public fploc::rt::Node {
     }
     floor_ = floors_.initial;
     cfg_ = fploc::config::localizer_config(o);
+    diff_weight_ = float(std::max(0.0, o.plan_diff_weight()));
+    weights_ = make_weights();
     loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
     pose_out_ = ctx.advertise<fploc::pose_t>("pose");
     latest_out_ = ctx.advertise<fploc::pose_t>("latest");
@@ -62,6 +69,17 @@ class OptimizerNode : public fploc::rt::Node {
       }
       trim(features_);
       try_pair(m.scan_seq);
+    });
+    ctx.subscribe<fploc::plan_diff_t>("plan_diff", [this](const fploc::plan_diff_t& m) {
+      const auto flagged = fploc::adapters::flagged_elements(m);
+      for (const auto& f : flagged)
+        if (size_t(f.id) >= floors_.maps[size_t(floor_)].plan->elements.size()) {
+          ctx_->error("plan_diff seq " + std::to_string(m.seq) + ": element " + std::to_string(f.id) +
+                      " not in optimizer.plan (" + std::to_string(floors_.maps[size_t(floor_)].plan->elements.size()) +
+                      " elements): a diff of another plan? (ignored)");
+          return;
+        }
+      weights_->update(flagged);
     });
     ctx.subscribe<fploc::frame_pose_t>("frame_pose", [this](const fploc::frame_pose_t& m) {
       frame_poses_[m.scan_seq] = m;
@@ -114,7 +132,9 @@ class OptimizerNode : public fploc::rt::Node {
       publish_finals(finals);
       finals.clear();
       floor_ = m.floor_index;
+      auto weights = make_weights();  // the diff's flags were for the old floor's plan
       loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
+      weights_ = std::move(weights);
       std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << ": window on floor '" << m.floor << "'\n";
     }
     // The matcher's z is the height above its floor (the segmenter's z carries no floor).
@@ -136,10 +156,21 @@ class OptimizerNode : public fploc::rt::Node {
     }
   }
 
+  // Per-element weights for the current floor's plan (all 1 until a plan diff flags elements); cfg_'s
+  // optimizer reads them through the pointer set here.
+  std::unique_ptr<fploc::matcher::ElementWeights> make_weights() {
+    auto w = std::make_unique<fploc::matcher::ElementWeights>(*floors_.maps[size_t(floor_)].plan,
+                                                             fploc::matcher::DiffWeightOptions{diff_weight_, diff_weight_});
+    cfg_.optimizer.element_weight = w->weights();
+    return w;
+  }
+
   fploc::rt::Context* ctx_ = nullptr;
   fploc::localizer::FloorMaps floors_;
   int floor_ = 0;
   fploc::localizer::Config cfg_;
+  float diff_weight_ = 0;
+  std::unique_ptr<fploc::matcher::ElementWeights> weights_;  // before loc_: the optimizer reads it
   std::unique_ptr<fploc::localizer::Localizer> loc_;
   fploc::rt::Publisher<fploc::pose_t> pose_out_, latest_out_;
   std::map<int64_t, fploc::FeatureFrame> features_;

@@ -6,19 +6,25 @@ glass, shelves, doors, crowd-15, mixed): `fploc sim --perturb FAMILY` writes an 
 truth of the difference (LOG.world.json); `fploc replay` runs graphs/realism.pbtxt (fploc = matcher +
 optimizer, AMCL + LiDAR odometry, plan_diff) on it with --record, keeping every pose_t with its status and
 covariance; if a `fploc-ndt` binary and graphs/ndt.pbtxt exist, the NDT peer runs on the same log too.
-Second passes of fploc: "fploc+diff" against the plan the detector corrected (missing elements dropped, moved
-ones shifted by the offset it measured; where it marked any), "fploc+scale" against the plan rescaled by its drawing-scale estimate (where
-that is significant).
+"fploc+downweight": fploc with the plan diff used live, in the same single pass: the matcher and the optimizer
+subscribe to FPLOC_PLAN_DIFF (their `plan_diff` input) and give the elements it marks missing or moved (and
+the other face of such a wall) weight `plan_diff_weight` (0: left out).
+Second passes of fploc: "fploc+scale" against the plan rescaled by its drawing-scale estimate (where that is
+significant); with --methods ...,fploc+diff also "fploc+diff" against the plan the detector corrected
+(missing elements dropped, moved ones shifted by the offset it measured; where it marked any).
 `fploc map diff` on the recorded run gives the change detector's verdicts, scored against the truth.
 
 Per family x method: horizontal ATE (rmse, no alignment, pose at its own time stamp against the ground
 truth at the same scan), max error, LOST % (status 2), false-OK % (status OK with horizontal error > 0.3 m),
 NEES median of (x, y, yaw) from the pose_t covariance (3 dof: consistent means 3), ms per scan (thread CPU
-of the method's nodes, `fploc replay --json`, one core). Per family: change detection precision / recall.
+of the method's nodes, `fploc replay --json`, one core: `ms_per_scan` with the segmenter every method shares,
+`ms_per_scan_localizer` without it: fploc = features + matcher + optimizer (+ plan_diff for
+fploc+downweight), NDT = ndt, AMCL = features + odometry + amcl). Per family: change detection precision /
+recall. --jobs N simulates and replays N families at once (CPU times are per thread, so unaffected).
 
 Prints one JSON document on stdout (progress on stderr):
   {"rows": [{"family", "method", "ate_m", "max_m", "lost", "false_ok", "nees_median", "nees_poses",
-             "ms_per_scan", "poses"}],
+             "ms_per_scan", "ms_per_scan_localizer", "poses"}],
    "detection": [{"family", "removed", "removed_found", "moved", "moved_found", "added", "added_found",
                   "flags", "false_flags", "false_flags_per_100m", "new_on_clutter", "precision", "recall",
                   "scale_true", "scale_estimate", "scale_sigma"}],
@@ -48,8 +54,27 @@ FAMILIES = ["clean", "asbuilt-2cm", "asbuilt-5cm", "scale-0.5pct", "renovated", 
 # only where the estimate is significant). fploc+diff: fploc against the plan the detector corrected (missing
 # elements dropped, moved ones shifted by their offset; second pass, where it marked any).
 METHODS = {"fploc": ("FPLOC_POSE", ("segmenter", "features", "matcher", "optimizer")),
+           "fploc+downweight": ("FPLOC_POSE", ("segmenter", "features", "matcher", "optimizer", "plan_diff")),
            "amcl": ("FPLOC_AMCL_POSE", ("segmenter", "features", "odometry", "amcl_lidar")),
            "ndt": ("FPLOC_POSE", ("segmenter", "ndt"))}
+SHARED_NODES = ("segmenter",)  # every method's input: left out of ms_per_scan_localizer
+DEFAULT_METHODS = ["fploc", "fploc+downweight", "amcl", "ndt", "fploc+scale"]
+ALL_METHODS = DEFAULT_METHODS + ["fploc+diff"]
+
+
+def downweight_graph(src, dst):
+    """graphs/realism.pbtxt with the matcher's and the optimizer's plan_diff inputs connected to FPLOC_PLAN_DIFF."""
+    with open(src) as f:
+        s = f.read()
+    a = '  input { port: "refined" channel: "FPLOC_POSE_LATEST" }'
+    b = '  input { port: "frame_pose" channel: "FPLOC_FRAME_POSE" }'
+    if s.count(a) != 1 or s.count(b) != 1:
+        raise SystemExit(f"fploc bench realism: {src}: cannot find the matcher's 'refined' and the optimizer's "
+                         "'frame_pose' inputs to connect plan_diff beside")
+    pd = '\n  input { port: "plan_diff" channel: "FPLOC_PLAN_DIFF" }'
+    s = s.replace(a, a + pd).replace(b, b + pd)
+    with open(dst, "w") as f:
+        f.write(s)
 FALSE_OK_M = 0.3
 
 
@@ -338,6 +363,7 @@ class Bench:
         self.work = work
         self.ndt_graph = os.path.join(ROOT, "graphs", "ndt.pbtxt")
         self.have_ndt = os.path.exists(os.path.join(BIN, "fploc-ndt")) and os.path.exists(self.ndt_graph)
+        self.methods = [m for m in a.methods.split(",") if m]
 
     def family(self, fam):
         d = os.path.join(self.work, fam)
@@ -373,9 +399,25 @@ class Bench:
         rows = []
         scans = next((n["messages"] for n in rep["nodes"] if n["name"] == "features"), len(g))
         for m in ("fploc", "amcl"):
+            if m not in self.methods:
+                continue
             ch, nodes = METHODS[m]
             rows.append(self.row(fam, m, poses_of(rec, ch), g, rep, nodes, scans))
-        if self.have_ndt:
+        if "fploc+downweight" in self.methods:
+            gdw = os.path.join(d, "realism-downweight.pbtxt")
+            downweight_graph(os.path.join(ROOT, "graphs", "realism.pbtxt"), gdw)
+            recd = os.path.join(d, "run-downweight.lcm")
+            cmdd = [os.path.join(BIN, "fploc-replay"), "--graph", gdw, "--log", logf, "--record", recd,
+                    "--record-channels", "FPLOC_POSE", "--json"]
+            for x in sets + [f"matcher.plan_diff_weight={self.a.downweight}", f"optimizer.plan_diff_weight={self.a.downweight}",
+                             f"plan_diff.out_json={os.path.join(d, 'diff-downweight.json')}"]:
+                cmdd += ["--set", x]
+            log(f"[{fam}] replaying fploc with the plan diff's down-weighting (weight {self.a.downweight}) ...")
+            repd = json.loads(run(cmdd)[0].strip().splitlines()[-1])
+            rows.append(self.row(fam, "fploc+downweight", poses_of(recd, "FPLOC_POSE"), g, repd,
+                                 METHODS["fploc+downweight"][1], scans))
+            os.remove(recd)
+        if self.have_ndt and "ndt" in self.methods:
             nrec = os.path.join(d, "ndt.lcm")
             cmd = [os.path.join(BIN, "fploc-replay"), "--graph", self.ndt_graph, "--log", logf, "--record", nrec, "--json",
                    "--set", f"ndt.plan.file={plan}", "--set", f"ndt.initial_pose.x={x0!r}", "--set", f"ndt.initial_pose.y={y0!r}",
@@ -399,7 +441,7 @@ class Bench:
                    "scale_true": truth.get("scale", 0.0), "scale_estimate": diff.get("scale", {}).get("error"),
                    "scale_sigma": diff.get("scale", {}).get("sigma")}
             est, sig = det["scale_estimate"], det["scale_sigma"] or 0.0
-            if est is not None and abs(est) > max(0.001, 3 * sig):
+            if "fploc+scale" in self.methods and est is not None and abs(est) > max(0.001, 3 * sig):
                 # The scale estimate on: a second pass of fploc against the plan scaled by (1 + estimate)
                 # about its bounding-box centre.
                 sp = os.path.join(d, "plan-scaled.json")
@@ -414,7 +456,7 @@ class Bench:
                 rows.append(self.row(fam, "fploc+scale", poses_of(rec2, "FPLOC_POSE"), g, rep2, METHODS["fploc"][1], scans))
                 os.remove(rec2)
             flagged = [e["id"] for e in diff["elements"] if e["status"] in ("missing", "moved")]
-            if flagged:
+            if flagged and "fploc+diff" in self.methods:
                 # The diff's verdicts used: a second pass of fploc against the plan the diff corrected
                 # (missing elements dropped, moved ones shifted), as a later run would use a survey run's diff.
                 dp = os.path.join(d, "plan-diffed.json")
@@ -440,9 +482,12 @@ class Bench:
     def row(self, fam, method, poses, g, rep, nodes, scans):
         s = score_poses(poses, g) or {"poses": 0}
         cpu = sum(n.get("cpu_ms", n["total_ms"]) for n in rep["nodes"] if n["name"] in nodes)
-        r = {"family": fam, "method": method, **s, "ms_per_scan": round(cpu / max(scans, 1), 3)}
+        own = sum(n.get("cpu_ms", n["total_ms"]) for n in rep["nodes"] if n["name"] in nodes and n["name"] not in SHARED_NODES)
+        r = {"family": fam, "method": method, **s, "ms_per_scan": round(cpu / max(scans, 1), 3),
+             "ms_per_scan_localizer": round(own / max(scans, 1), 3)}
         log(f"[{fam}] {method}: ATE {fmt(r.get('ate_m'))} max {fmt(r.get('max_m'))} LOST {pct(r.get('lost'))} "
-            f"false-OK {pct(r.get('false_ok'))} NEES {fmt(r.get('nees_median'), 2)} {r['ms_per_scan']} ms/scan")
+            f"false-OK {pct(r.get('false_ok'))} NEES {fmt(r.get('nees_median'), 2)} {r['ms_per_scan']} ms/scan "
+            f"({r['ms_per_scan_localizer']} without the segmenter)")
         return r
 
 
@@ -463,7 +508,8 @@ def svg_bars(rows, path, key="ate_m", title="horizontal ATE [cm]", scale=100.0):
     for r in rows:
         if r["method"] not in methods:
             methods.append(r["method"])
-    colors = {"fploc": "#1f77b4", "amcl": "#d62728", "ndt": "#2ca02c", "fploc+scale": "#9467bd", "fploc+diff": "#17becf"}
+    colors = {"fploc": "#1f77b4", "amcl": "#d62728", "ndt": "#2ca02c", "fploc+scale": "#9467bd", "fploc+diff": "#17becf",
+              "fploc+downweight": "#ff7f0e"}
     vals = {(r["family"], r["method"]): (r.get(key) or 0) * scale for r in rows}
     vmax = max(list(vals.values()) + [1e-9])
     # Log-free linear scale, capped so small values stay visible: bars above the cap are clipped and labelled.
@@ -504,12 +550,15 @@ def markdown(res, cmdline):
          + (f", first {res['config']['duration']} s" if res['config']['duration'] else "") + ").", "",
          "Localization (horizontal, every pose of the method against the truth of the same scan, no alignment; "
          "false OK = status OK with error > 0.3 m; NEES = median of (x, y, yaw) NEES from pose_t's covariance, "
-         "3 for a consistent covariance; ms/scan = thread CPU of the method's nodes on one core):", "",
-         "| world | method | ATE [cm] | max [cm] | LOST | false OK | NEES | ms/scan |", "|---|---|---|---|---|---|---|---|"]
+         "3 for a consistent covariance; ms/scan = thread CPU of the method's nodes on one core, with and without the "
+         "segmenter every method shares):", "",
+         "| world | method | ATE [cm] | max [cm] | LOST | false OK | NEES | ms/scan | ms/scan w/o segmenter |",
+         "|---|---|---|---|---|---|---|---|---|"]
     for r in res["rows"]:
         L.append(f"| {r['family']} | {r['method']} | {fmt(100 * r['ate_m'] if r.get('ate_m') is not None else None, 2)} | "
                  f"{fmt(100 * r['max_m'] if r.get('max_m') is not None else None, 1)} | {pct(r.get('lost'))} | "
-                 f"{pct(r.get('false_ok'))} | {fmt(r.get('nees_median'), 1)} | {r['ms_per_scan']} |")
+                 f"{pct(r.get('false_ok'))} | {fmt(r.get('nees_median'), 1)} | {r['ms_per_scan']} | "
+                 f"{r.get('ms_per_scan_localizer', '-')} |")
     L += ["", "Plan-change detection (`fploc map diff` on the fploc run; truth from `fploc sim`'s LOG.world.json). "
           "Removed = removed walls/pillars and glass in view of the path; moved = walls moved >= 10 cm in view; "
           "added = partitions >= 1 m (found when >= half their length is reported within 15 cm); new structure on the "
@@ -536,23 +585,34 @@ def main():
     ap.add_argument("--markdown", help="write the tables (Markdown) here, the plot beside it")
     ap.add_argument("--work", help="keep the intermediate files in this folder")
     ap.add_argument("--keep", action="store_true", help="keep the LCM logs")
+    ap.add_argument("--methods", default=",".join(DEFAULT_METHODS),
+                    help=f"comma-separated, of {', '.join(ALL_METHODS)} (ndt only where fploc-ndt is built)")
+    ap.add_argument("--downweight", type=float, default=0.0,
+                    help="plan_diff_weight of fploc+downweight: weight of elements the diff flags (0 = left out)")
+    ap.add_argument("--jobs", type=int, default=1, help="families simulated and replayed at once")
     a = ap.parse_args()
     fams = [f for f in a.families.split(",") if f]
     for f in fams:
         if f not in FAMILIES:
             sys.exit(f"fploc bench realism: unknown family '{f}' (families: {', '.join(FAMILIES)})")
+    for m in a.methods.split(","):
+        if m and m not in ALL_METHODS:
+            sys.exit(f"fploc bench realism: unknown method '{m}' (methods: {', '.join(ALL_METHODS)})")
     work = a.work or tempfile.mkdtemp(prefix="fploc-realism-")
     os.makedirs(work, exist_ok=True)
     b = Bench(a, work)
-    log(f"fploc bench realism: {len(fams)} families, methods fploc, amcl{', ndt' if b.have_ndt else ' (no fploc-ndt: NDT left out)'}; work in {work}")
+    log(f"fploc bench realism: {len(fams)} families, methods {', '.join(m for m in b.methods if m != 'ndt' or b.have_ndt)}"
+        f"{'' if b.have_ndt or 'ndt' not in b.methods else ' (no fploc-ndt: NDT left out)'}; work in {work}")
     res = {"rows": [], "detection": [], "config": {"scenario": a.scenario, "seed": a.seed, "duration": a.duration,
-                                                   "families": fams, "ndt": b.have_ndt, "false_ok_m": FALSE_OK_M}}
+                                                   "families": fams, "ndt": b.have_ndt, "false_ok_m": FALSE_OK_M,
+                                                   "methods": b.methods, "downweight": a.downweight}}
     try:
-        for f in fams:
-            rows, det = b.family(f)
-            res["rows"] += rows
-            if det:
-                res["detection"].append(det)
+        from concurrent.futures import ThreadPoolExecutor
+        with ThreadPoolExecutor(max_workers=max(1, a.jobs)) as ex:
+            for rows, det in ex.map(b.family, fams):  # results in family order
+                res["rows"] += rows
+                if det:
+                    res["detection"].append(det)
     finally:
         if not a.work:
             shutil.rmtree(work, ignore_errors=True)

@@ -7,10 +7,11 @@
 namespace fploc::matcher {
 namespace {
 
-enum class LossKind { kNone, kHuber, kCauchy };
+enum class LossKind { kNone, kHuber, kCauchy, kGemanMcClure };
 
 LossKind loss_kind(const std::string& loss, double scale) {
   if (loss == "none" || scale <= 0) return LossKind::kNone;
+  if (loss == "geman-mcclure") return LossKind::kGemanMcClure;
   return loss == "cauchy" ? LossKind::kCauchy : LossKind::kHuber;
 }
 
@@ -61,9 +62,11 @@ inline double closest_one(const TargetGeom& e, const Eigen::Vector2d& p, Eigen::
   return (p - *q).squaredNorm();
 }
 
-// Closest of the candidates; returns the squared distance (inf when there are none).
+// Closest of the candidates; returns the squared distance (inf when there are none); *which: its index
+// in cand (-1 when none).
 inline double closest_of2(const std::vector<TargetGeom>& g, const int* cand, int n, const Eigen::Vector2d& p,
-                          Eigen::Vector2d* q, Eigen::Matrix2d* J) {
+                          Eigen::Vector2d* q, Eigen::Matrix2d* J, int* which = nullptr) {
+  if (which) *which = n > 0 ? 0 : -1;
   if (n == 1) return closest_one(g[size_t(cand[0])], p, q, J);
   double best = std::numeric_limits<double>::infinity();
   int bi = -1;
@@ -76,6 +79,7 @@ inline double closest_of2(const std::vector<TargetGeom>& g, const int* cand, int
       *q = qi;
     }
   }
+  if (which) *which = bi;
   if (bi < 0) {
     *q = p;
     if (J) J->setZero();
@@ -97,9 +101,14 @@ inline void robust_scale(LossKind loss, double a, double s, double* g, double* d
     const double r = std::sqrt(s);
     rho = 2 * a * r - a2;
     rho1 = a / r;
-  } else {  // Cauchy
+  } else if (loss == LossKind::kCauchy) {
     rho = a2 * std::log1p(s / a2);
     rho1 = 1.0 / (1.0 + s / a2);
+  } else {  // Geman-McClure: rho bounded by a^2, influence falling as 1/r^3 (a wall moved 3a away pulls
+            // ~1/10 of what it pulls under Cauchy, whose influence falls only as 1/r)
+    const double d = a2 + s;
+    rho = a2 * s / d;
+    rho1 = a2 * a2 / (d * d);
   }
   *g = std::sqrt(rho / s);
   *dg = (rho1 * s - rho) / (2 * (*g) * s * s);
@@ -129,11 +138,13 @@ class FrameCost : public ceres::CostFunction {
       const Eigen::Vector2d& p = pts_[i];
       const double rx = c * p.x() - s * p.y(), ry = s * p.x() + c * p.y();
       const Eigen::Vector2d pw(rx + x[0], ry + x[1]);
-      const double d2 = closest_of2(*targets_, as_[i].cand, as_[i].n, pw, &q, jac ? &J : nullptr);
+      int which = -1;
+      const double d2 = closest_of2(*targets_, as_[i].cand, as_[i].n, pw, &q, jac ? &J : nullptr, &which);
       const double d = std::sqrt(d2);
       double g, dg;
       robust_scale(loss_, a_, d2, &g, &dg);
-      residuals[i] = w_ * g * d;
+      const double we = w_ * (which >= 0 ? double(as_[i].w[which]) : 1.0);
+      residuals[i] = we * g * d;
       if (jac) {
         // n: from q to p'; at d = 0 the element's normal (segments/circles: the projection J's range).
         Eigen::Vector2d n;
@@ -145,7 +156,7 @@ class FrameCost : public ceres::CostFunction {
         } else {  // on an end point: no direction
           n.setZero();
         }
-        const double k = w_ * (g + 2 * dg * d2);
+        const double k = we * (g + 2 * dg * d2);
         jac[3 * i] = k * n.x();
         jac[3 * i + 1] = k * n.y();
         jac[3 * i + 2] = k * (n.x() * -ry + n.y() * rx);
@@ -185,6 +196,21 @@ void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, 
   };
   std::vector<GroupPoint> gps;
   Eigen::Vector2d q;
+  const std::vector<float>* ew = lookup.element_targets() ? o.element_weight : nullptr;
+  // Weights of the candidates; those of weight <= 0 are taken out.
+  auto weigh = [ew](Assignment* a) {
+    if (!ew) return;
+    int k = 0;
+    for (int i = 0; i < a->n; ++i) {
+      const size_t id = size_t(a->cand[i]);
+      const float w = id < ew->size() ? (*ew)[id] : 1.0f;
+      if (!(w > 0)) continue;
+      a->cand[k] = a->cand[i];
+      a->w[k] = w;
+      ++k;
+    }
+    a->n = k;
+  };
   const double c = std::cos(x.yaw), s = std::sin(x.yaw);
   out->reserve(f.points.size() / stride + 1);
   for (size_t i = 0; i < f.points.size(); i += stride) {
@@ -193,6 +219,7 @@ void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, 
     Assignment a;
     a.point = int(i);
     a.n = lookup.candidates(pw, a.cand, maxc);
+    weigh(&a);
     if (a.n <= 0) continue;
     if (groups && fp.group >= 0) {
       gps.push_back({fp.group, int(i), pw, a});
@@ -229,6 +256,7 @@ void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, 
         a.point = gps[i].point;
         a.n = 1;
         a.cand[0] = best;
+        if (ew && size_t(best) < ew->size()) a.w[0] = (*ew)[size_t(best)];
         out->push_back(a);
       }
     b = e;
@@ -260,13 +288,15 @@ Eigen::Matrix3d frame_information(const NearestLookup& lookup, const FeatureFram
     const Eigen::Vector2d& p = f.points[size_t(a.point)].p;
     const double rx = c * p.x() - s * p.y(), ry = s * p.x() + c * p.y();
     const Eigen::Vector2d pw(rx + x.x, ry + x.y);
-    closest_of2(g, a.cand, a.n, pw, &q, &J);
+    int which = -1;
+    closest_of2(g, a.cand, a.n, pw, &q, &J, &which);
+    const double we = which >= 0 ? double(a.w[which]) : 1.0;
     Eigen::Matrix<double, 2, 3> Jr;
     Jr.leftCols<2>() = J;
     Jr.col(2) = J * Eigen::Vector2d(-ry, rx);
     double gs, dg;
     robust_scale(lk, scale, (pw - q).squaredNorm(), &gs, &dg);
-    H += (gs * gs) * Jr.transpose() * Jr;
+    H += (we * we * gs * gs) * Jr.transpose() * Jr;
   }
   return H;
 }

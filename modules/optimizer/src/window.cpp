@@ -206,6 +206,7 @@ void WindowOptimizer::solve() {
   matcher::AssignOptions ao;
   ao.gate_m = cfg_.gate_m;
   ao.group_rule = cfg_.group_rule;
+  ao.element_weight = cfg_.element_weight;
   ao.stride = cfg_.stride;
   // Anchors: the last final key poses, held fixed (optional).
   double anchors[2][3];

@@ -3,15 +3,18 @@
 # errors of a localizer that is on the plan, not lost), the detector's rates are fractions.
 set -euo pipefail
 B="${FPLOC_BUILD_DIR:?}/bin"
-out="$("$B/fploc-bench-realism" --families renovated --duration 10 --seed 2 --json 2>/dev/null)"
+out="$("$B/fploc-bench-realism" --families renovated --duration 10 --seed 2 --methods fploc,fploc+downweight,amcl --json 2>/dev/null)"
 python3 - "$out" <<'PY'
 import json, sys
 r = json.loads(sys.argv[1])
 rows = {x["method"]: x for x in r["rows"]}
-assert {"fploc", "amcl"} <= set(rows), rows.keys()
+assert {"fploc", "fploc+downweight", "amcl"} <= set(rows), rows.keys()
 f = rows["fploc"]
-for k in ("ate_m", "max_m", "lost", "false_ok", "nees_median", "ms_per_scan", "poses"):
+for k in ("ate_m", "max_m", "lost", "false_ok", "nees_median", "ms_per_scan", "ms_per_scan_localizer", "poses"):
     assert k in f, k
+assert 0 < f["ms_per_scan_localizer"] < f["ms_per_scan"], f
+dw = rows["fploc+downweight"]
+assert dw["poses"] == f["poses"] and dw["lost"] == 0 and dw["ate_m"] < 0.5, dw
 assert f["poses"] >= 90, f
 assert f["lost"] == 0 and f["false_ok"] == 0, f
 assert f["ate_m"] < 0.5 and f["max_m"] < 1.0, f

@@ -5,8 +5,10 @@
 #include <fploc/plan_diff_t.hpp>
 
 #include <cstdint>
+#include <vector>
 
 #include "fploc/floorplan/plan.h"
+#include "fploc/matcher/element_weights.h"
 #include "fploc/plandiff/plan_diff.h"
 
 namespace fploc::adapters {
@@ -15,5 +17,9 @@ namespace fploc::adapters {
 enum class PlanDiffKind : int8_t { kMissing = 1, kMoved = 2, kNew = 3 };
 
 plan_diff_t to_msg(const plandiff::Diff& d, const FloorPlan& plan, int64_t utime, int64_t seq);
+
+// The MISSING and MOVED items with an element id (for the matcher's and the optimizer's per-element
+// weights, fploc/matcher/element_weights.h); NEW items (element -1) are skipped.
+std::vector<matcher::FlaggedElement> flagged_elements(const plan_diff_t& m);
 
 }  // namespace fploc::adapters

@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "fploc/matcher/lookup.h"
 #include "fploc/matcher/types.h"
@@ -43,6 +44,9 @@ struct MatcherConfig {
   // refine(): after set_pose, refined poses are used from the first one this close to the matcher's own.
   double refine_gate_m = 0.3;
   double refine_gate_rad = 5 * M_PI / 180;
+  // Per plan element weight of its floor-plan terms (matcher/element_weights.h: from the plan-change
+  // detector); null = all 1. Not owned: the caller keeps it alive and may change it between frames.
+  const std::vector<float>* element_weight = nullptr;
 };
 
 // A Gaussian prior on the registered pose (the motion model's prediction), as residuals

@@ -46,6 +46,7 @@ struct OptimizerConfig {
   bool anchor_final = false;           // also regularise against the last two final key poses (held fixed)
   double max_keyframe_gap_s = 2.0;     // a longer gap (e.g. lost frames) restarts the window
   std::string linear_solver = "sparse";  // "sparse" (SPARSE_NORMAL_CHOLESKY) or "dense" (DENSE_NORMAL_CHOLESKY)
+  const std::vector<float>* element_weight = nullptr;  // as MatcherConfig::element_weight
 };
 
 struct FrameInput {
