@@ -7,6 +7,7 @@
 #include <fploc/pose_t.hpp>
 
 #include <cmath>
+#include <iostream>
 #include <map>
 #include <memory>
 
@@ -96,7 +97,14 @@ class OptimizerNode : public fploc::rt::Node {
     }
     std::vector<fploc::localizer::Pose> finals;
     const auto latest = loc_->optimize(f, fploc::adapters::from_msg(m), &finals);
-    if (latest) latest_out_.publish(fploc::adapters::to_msg(*latest, latest_seq_++));
+    if (latest) {
+      latest_out_.publish(fploc::adapters::to_msg(*latest, latest_seq_++));
+      // Status changes with their reason (pose_t has no text): e.g. POOR where the plan leaves a direction open.
+      if (latest->status != last_status_ && ++status_changes_ <= 200)
+        std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << ": " << fploc::to_string(latest->status)
+                  << (latest->status_text.empty() ? "" : ": " + latest->status_text) << "\n";
+      last_status_ = latest->status;
+    }
     publish_finals(finals);
   }
 
@@ -113,6 +121,8 @@ class OptimizerNode : public fploc::rt::Node {
   int64_t last_seq_ = 0;
   bool have_last_ = false;
   int64_t pose_seq_ = 0, latest_seq_ = 0;
+  FitStatus last_status_ = FitStatus::kOk;
+  int status_changes_ = 0;
 };
 
 }  // namespace

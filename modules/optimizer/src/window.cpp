@@ -104,6 +104,9 @@ PoseOut WindowOptimizer::make_out(const Frame& f, const Pose2& pose_tau_in, bool
   fill_gravity(&o, f.in.features);
   o.keyframe = key;
   o.status = f.in.status;
+  if (f.in.status == FitStatus::kOk || f.in.status == FitStatus::kPoor)
+    o.status = std::max(f.in.status, f.in.published_status);  // the worse of the two (OK < POOR < LOST)
+  o.status_text = f.in.status_text;
   o.covariance = f.in.covariance;
   o.z_sigma = f.in.features.z_sigma;
   o.roll_pitch_sigma = f.in.features.roll_pitch_sigma;

@@ -11,6 +11,7 @@
 #include <optional>
 #include <vector>
 
+#include "fploc/localizer/degeneracy.h"
 #include "fploc/matcher/imu_yaw.h"
 #include "fploc/matcher/matcher.h"
 #include "fploc/optimizer/window.h"
@@ -23,6 +24,9 @@ struct Config {
   bool use_imu = true;               // the IMU's yaw rate: prediction (yaw change) + sweep yaw rate (de-skew)
   double initial_search_m = 0;       // set_pose without an uncertainty: search this far (0: matcher.max_correspondence_m)
   bool refine_from_window = true;    // process(): the WO estimate of a frame predicts the next one
+  // The published covariance and status (degeneracy.h); its frame loss/gate follow `matcher` unless
+  // set apart (Localizer's constructor copies them).
+  UncertaintyConfig uncertainty;
 };
 
 // The SFR step's result for one frame (what FPLOC_FRAME_POSE carries).
@@ -74,9 +78,12 @@ class Localizer {
 
   const Config& config() const { return cfg_; }
   const Matcher& matcher() const { return matcher_; }
+  // The uncertainty published with the last optimize()d frame.
+  const UncertaintyState& uncertainty() const { return uncertainty_; }
 
  private:
   Config cfg_;
+  const NearestLookup& lookup_;
   Matcher matcher_;
   WindowOptimizer window_;
   ImuYaw imu_;
@@ -86,6 +93,9 @@ class Localizer {
   std::optional<std::pair<double, double>> last_rp_;
   std::map<int64_t, Pose2> odom_;    // odometry poses by utime (add_odometry)
   FeatureFrame held_;                // scratch: the frame with the IMU's sweep rate and the held attitude
+  FeatureFrame deskewed_;            // scratch: the frame de-skewed as the matcher registered it
+  UncertaintyTracker tracker_;
+  UncertaintyState uncertainty_;
 };
 
 }  // namespace fploc::localizer

@@ -53,7 +53,11 @@ struct FrameInput {
   Pose2 sfr;                           // single-frame registration result at features.utime
   Twist2 twist;                        // the matcher's body twist (its motion compensation)
   FitStatus status = FitStatus::kOk;
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // published with the frame's pose
+  // What to publish besides (localizer/degeneracy.h): a status that only downgrades `status` (POOR where
+  // the plan leaves a direction open) and why. Keyframes are still chosen by `status` alone.
+  FitStatus published_status = FitStatus::kOk;
+  std::string status_text;
 };
 
 struct PoseOut {
@@ -64,7 +68,8 @@ struct PoseOut {
   bool keyframe = false;
   bool final_estimate = false;
   FitStatus status = FitStatus::kOk;
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // (x, y, yaw): the frame's single-frame covariance
+  std::string status_text;             // why not OK
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // (x, y, yaw): FrameInput::covariance of the frame
   double z_sigma = 0, roll_pitch_sigma = 0;  // the frame's own (as measured; "unknown" sigmas, see types.h)
   int optimised = 0;                   // how many window solves this pose took part in
 };
