@@ -22,6 +22,7 @@ namespace {
 struct Obs {
   Eigen::Vector3d j;   // d residual / d (x, y, yaw)
   double w;            // robust weight
+  double d;            // residual (distance to the element)
   double r;            // signed offset along the element's normal (segments) / radial (circles)
   Eigen::Vector2d c;   // sensitivity of the residual to the element's two error parameters
 };
@@ -69,6 +70,7 @@ FrameUncertainty frame_uncertainty(const NearestLookup& lookup, const FeatureFra
     Obs o;
     o.j = Eigen::Vector3d(n.x(), n.y(), n.x() * -ry + n.y() * rx);
     o.w = robust_weight(cfg.loss, cfg.loss_scale_m, d);
+    o.d = d;
     const TargetGeom& e = g[size_t(be)];
     if (e.kind == ElementKind::kSegment && e.len > 0) {
       const Eigen::Vector2d ne(-e.u.y(), e.u.x());
@@ -134,7 +136,9 @@ FrameUncertainty frame_uncertainty(const NearestLookup& lookup, const FeatureFra
     }
     if (cfg.element_correlation) {
       auto it = own.find(id);
-      const double se2 = std::max(floor2, it == own.end() ? 0.0 : it->second);
+      const double o2 = it == own.end() ? 0.0 : it->second;
+      // An element far off the others (a moved wall) keeps its own offset; the rest share the pooled one.
+      const double se2 = cfg.estimator == "model-max" ? std::max(floor2, o2) : (o2 > 4 * floor2 ? o2 : floor2);
       M += se2 * G * G.transpose();
     }
   }

@@ -41,10 +41,9 @@ struct Nees {
 };
 
 // Registers frames of `world` against `plan` from the truth and scores both covariances.
-Nees monte_carlo(const FloorPlan& plan, double world_sigma, double noise, int trials) {
+Nees monte_carlo(const FloorPlan& plan, double world_sigma, double noise, int trials, CovarianceConfig cc = {}) {
   BruteForceLookup lookup(plan);
   MatcherConfig mc;
-  CovarianceConfig cc;
   Nees out;
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> ux(2.0, 18.0), uy(2.0, 8.0), uyaw(-M_PI, M_PI);

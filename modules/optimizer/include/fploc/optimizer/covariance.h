@@ -14,8 +14,9 @@
 // along the wall: an offset plus a rotation), for a circle/arc/point target a translation in x and y.
 // Both sigmas come from the frame's own residuals at the estimate (no constant tuned to one world):
 //   sigma_s^2: the weighted spread of the residuals about their element's mean offset;
-//   sigma_e^2: max(plan_sigma^2, the frame's pooled element-offset variance, this element's own offset^2),
-//              each offset^2 corrected for the noise of its mean and for what the pose absorbed (G/(G-3)).
+//   sigma_e^2: max(plan_sigma^2, the frame's pooled element-offset variance), or the element's own offset^2
+//              where that is > 4x the pooled one (a moved wall), each offset^2 corrected for the noise of
+//              its mean and for what the pose absorbed (G/(G-3)).
 // Rotation-translation coupling is in j_i (the yaw column is the lever arm). Directions that no point
 // constrains (a corridor's axis) get `max_variance` instead of an inverse of zero.
 #pragma once
@@ -31,6 +32,11 @@ struct CovarianceConfig {
   double plan_sigma_m = 0.0;          // floor on each element end's offset sigma (the drawing's own accuracy)
   double min_noise_sigma_m = 0.002;   // floor on the point noise sigma
   bool element_correlation = true;    // false: points independent (sigma_s^2 H^-1 with the observed sigma_s)
+  // Each element's sigma_e^2: "model" = the pooled one, except an element whose own offset^2 is > 4x the
+  // pooled (a moved wall) keeps its own; "model-max" = max(pooled, own) per element (more conservative).
+  // (The cluster-robust meat, sum_e u_e u_e^T of the observed scores, was measured overconfident: mean
+  // NEES 9-59 in covariance_test's Monte Carlo, too few elements per direction.)
+  std::string estimator = "model";
   double gate_m = 0.3;                // correspondence gate around the pose
   bool group_rule = true;
   int max_points = 800;               // every k-th point to keep about this many (0: all)
