@@ -79,7 +79,7 @@ FrameUncertainty frame_uncertainty(const NearestLookup& lookup, const FeatureFra
       o.r = (pw - q).dot(ne);
       // The element's ends displaced by da, db along ne move its line by (1-t) da + t db at q: the
       // residual d changes by -sgn * that.
-      o.c = Eigen::Vector2d(-(1 - t) * sgn, -t * sgn);
+      o.c = cfg.two_ends ? Eigen::Vector2d(-(1 - t) * sgn, -t * sgn) : Eigen::Vector2d(-sgn, 0.0);
     } else {
       // Circle / arc / point target: a translation (dx, dy) of the element changes d by -n . (dx, dy).
       const Eigen::Vector2d radial = e.kind == ElementKind::kSegment ? n : Eigen::Vector2d((q - e.c).normalized());
@@ -116,22 +116,41 @@ FrameUncertainty frame_uncertainty(const NearestLookup& lookup, const FeatureFra
   // offsets' degrees of freedom); a mean offset m of the two-end model has variance sigma_e^2 / 2.
   const double absorb = nel > 4 ? double(nel) / double(nel - 3) : 4.0;
   std::unordered_map<int, double> own;
-  double pooled = 0;
+  std::vector<double> b2s;
   for (const auto& [id, st] : stats) {
-    const double b2 = std::max(0.0, st.mean * st.mean - s2 / st.n_eff) * absorb * 2.0;
+    const double b2 = std::max(0.0, st.mean * st.mean - s2 / st.n_eff) * absorb * (cfg.two_ends ? 2.0 : 1.0);
     own[id] = b2;
-    pooled += b2;
+    b2s.push_back(b2);
   }
-  pooled /= double(std::max(1, nel));
+  // Pooled over the elements: the mean, or robustly the median / 0.455 (a chi-square of one degree of
+  // freedom's median / mean), so that a few elements with clutter or a moved wall do not set everyone's.
+  double pooled = 0;
+  if (!b2s.empty()) {
+    if (cfg.median_pooling) {
+      std::nth_element(b2s.begin(), b2s.begin() + b2s.size() / 2, b2s.end());
+      pooled = b2s[b2s.size() / 2] / 0.455;
+    } else {
+      for (double v : b2s) pooled += v;
+      pooled /= double(b2s.size());
+    }
+  }
   out.element_sigma_m = std::sqrt(pooled);
   const double floor2 = std::max(cfg.plan_sigma_m * cfg.plan_sigma_m, pooled);
+  const double noise_k = double(npts) / dof;
   // Bread and meat.
   Eigen::Matrix3d H = Eigen::Matrix3d::Zero(), M = Eigen::Matrix3d::Zero();
   for (const auto& [id, acc] : elems) {
     Eigen::Matrix<double, 3, 2> G = Eigen::Matrix<double, 3, 2>::Zero();
+    double mean = 0;
+    for (const auto& st : stats)
+      if (st.first == id) mean = st.second.mean;
     for (const auto& o : acc.obs) {
       H += o.w * o.j * o.j.transpose();
-      M += s2 * o.w * o.w * o.j * o.j.transpose();
+      // Noise: the point's own score about its element's offset (heteroscedasticity-consistent: clutter
+      // the loss down-weights counts as little as it pulls), at least the noise floor.
+      const double sc = cfg.robust_noise ? std::max(std::pow(o.w * (o.r - mean), 2) * noise_k, std::pow(o.w * cfg.min_noise_sigma_m, 2))
+                                         : s2 * o.w * o.w;
+      M += sc * o.j * o.j.transpose();
       G += o.w * o.j * o.c.transpose();
     }
     if (cfg.element_correlation) {

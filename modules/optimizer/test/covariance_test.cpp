@@ -4,6 +4,7 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <cstdlib>
 #include <random>
 
 #include "fploc/matcher/lookup.h"
@@ -69,6 +70,20 @@ Nees monte_carlo(const FloorPlan& plan, double world_sigma, double noise, int tr
 }
 
 }  // namespace
+
+TEST(FrameCovariance, VariantsCompared) {
+  if (!std::getenv("FPLOC_COVARIANCE_VARIANTS")) GTEST_SKIP() << "set FPLOC_COVARIANCE_VARIANTS=1 to compare";
+  for (int v = 0; v < 8; ++v)
+    for (double ws : {0.0, 0.01, 0.03}) {
+      CovarianceConfig cc;
+      cc.two_ends = v & 1;
+      cc.robust_noise = v & 2;
+      cc.median_pooling = v & 4;
+      const Nees r = monte_carlo(fploc::testing::room_with_pillars(), ws, 0.01, 60, cc);
+      std::printf("two_ends %d robust_noise %d median %d walls %.0f cm: mean NEES %.2f\n", cc.two_ends, cc.robust_noise,
+                  cc.median_pooling, ws * 100, r.mean_new);
+    }
+}
 
 TEST(FrameCovariance, ConsistentOnAPlanThatMatches) {
   const Nees r = monte_carlo(fploc::testing::room_with_pillars(), 0.0, 0.01, 60);

@@ -37,6 +37,9 @@ struct CovarianceConfig {
   // (The cluster-robust meat, sum_e u_e u_e^T of the observed scores, was measured overconfident: mean
   // NEES 9-59 in covariance_test's Monte Carlo, too few elements per direction.)
   std::string estimator = "model";
+  bool two_ends = true;               // segment error = its two ends' normal offsets (else one offset)
+  bool robust_noise = true;           // noise meat from each point's own score (else sigma_s^2 w^2)
+  bool median_pooling = true;         // pooled element variance = median / 0.455 (else the mean)
   double gate_m = 0.3;                // correspondence gate around the pose
   bool group_rule = true;
   int max_points = 800;               // every k-th point to keep about this many (0: all)

@@ -46,6 +46,9 @@ struct OptimizerConfig {
   bool anchor_final = false;           // also regularise against the last two final key poses (held fixed)
   double max_keyframe_gap_s = 2.0;     // a longer gap (e.g. lost frames) restarts the window
   std::string linear_solver = "sparse";  // "sparse" (SPARSE_NORMAL_CHOLESKY) or "dense" (DENSE_NORMAL_CHOLESKY)
+  // Published covariance: FrameInput::covariance (of the frame's single-frame fix) plus d d^T, d the output
+  // pose minus that fix (the window's pose is not the fix the covariance is about).
+  bool covariance_offset = true;
 };
 
 struct FrameInput {
