@@ -6,13 +6,13 @@
 namespace fploc::adapters {
 
 frame_pose_t to_msg(const localizer::FramePose& f, int64_t seq, double solve_ms) {
-  const MatchResult& r = f.match;
+  const matcher::MatchResult& r = f.match;
   frame_pose_t o;
   o.utime = f.utime;
   o.seq = seq;
   o.scan_seq = f.scan_seq;
   o.status = int8_t(r.status);
-  o.status_text = r.status == FitStatus::kOk ? "" : std::string(to_string(r.status)) + ": " + r.text;
+  o.status_text = r.status == matcher::FitStatus::kOk ? "" : std::string(to_string(r.status)) + ": " + r.text;
   o.x = r.pose.x;
   o.y = r.pose.y;
   o.yaw = r.pose.yaw;
@@ -39,7 +39,7 @@ localizer::FramePose from_msg(const frame_pose_t& m) {
   f.match.pose = {m.x, m.y, m.yaw};
   if (std::isfinite(m.twist[0]) && std::isfinite(m.twist[1]) && std::isfinite(m.twist[2]))
     f.match.twist = {m.twist[0], m.twist[1], m.twist[2]};
-  f.match.status = m.status >= 0 && m.status <= 3 ? FitStatus(m.status) : FitStatus::kLost;
+  f.match.status = m.status >= 0 && m.status <= 3 ? matcher::FitStatus(m.status) : matcher::FitStatus::kLost;
   f.match.text = m.status_text;
   for (int i = 0; i < 9; ++i) f.match.covariance(i / 3, i % 3) = m.covariance[i];
   f.match.fit.num_points = m.num_points;

@@ -33,7 +33,7 @@ pose_t make_pose_msg(int64_t utime, int64_t seq, const Pose2& p, double roll, do
   return m;
 }
 
-pose_t to_msg(const PoseOut& p, int64_t seq) {
+pose_t to_msg(const optimizer::PoseOut& p, int64_t seq) {
   return make_pose_msg(p.utime, seq, p.pose, p.roll, p.pitch, p.z, p.covariance, p.z_sigma, p.roll_pitch_sigma,
                        int8_t(p.status), p.keyframe, p.final_estimate);
 }

@@ -10,7 +10,7 @@ TEST(FramePoseAdapter, RoundTripAndSanitising) {
   localizer::FramePose f;
   f.utime = 100;
   f.scan_seq = 4;
-  f.match.status = FitStatus::kPoor;
+  f.match.status = matcher::FitStatus::kPoor;
   f.match.text = "few inliers";
   f.match.pose = {1, 2, 0.3};
   f.match.twist = {0.5, 0, 0.1};
@@ -22,7 +22,7 @@ TEST(FramePoseAdapter, RoundTripAndSanitising) {
   EXPECT_EQ(m.status, 1);
   EXPECT_EQ(m.status_text, "POOR: few inliers");
   localizer::FramePose g = adapters::from_msg(m);
-  EXPECT_EQ(g.match.status, FitStatus::kPoor);
+  EXPECT_EQ(g.match.status, matcher::FitStatus::kPoor);
   EXPECT_EQ(g.match.pose.yaw, 0.3);
   EXPECT_EQ(g.match.twist.vx, 0.5);
   EXPECT_EQ(g.z, 1.3);
@@ -31,5 +31,5 @@ TEST(FramePoseAdapter, RoundTripAndSanitising) {
   bad.status = 9;
   g = adapters::from_msg(bad);
   EXPECT_EQ(g.match.twist.vx, 0.0);
-  EXPECT_EQ(g.match.status, FitStatus::kLost);
+  EXPECT_EQ(g.match.status, matcher::FitStatus::kLost);
 }

@@ -20,7 +20,7 @@ TEST(PoseAdapter, CarriesYawCovarianceAndSigmas) {
 }
 
 TEST(PoseAdapter, LocalizedPoseCarriesItsOwnSigmas) {
-  PoseOut p;
+  optimizer::PoseOut p;
   p.utime = 7;
   p.pose = {3, 4, -1};
   p.z = 1.1;

@@ -8,8 +8,8 @@ namespace {
 constexpr double kRadPerDeg = M_PI / 180;
 }  // namespace
 
-MatcherConfig config_of(const MatcherOptions& o) {
-  MatcherConfig c;
+matcher::MatcherConfig config_of(const MatcherOptions& o) {
+  matcher::MatcherConfig c;
   if (o.max_correspondence_m() > 0) c.max_correspondence_m = o.max_correspondence_m();
   if (o.min_correspondence_m() > 0) c.min_correspondence_m = o.min_correspondence_m();
   if (o.loss_scale_m() > 0) c.loss_scale_m = o.loss_scale_m();
@@ -32,8 +32,8 @@ MatcherConfig config_of(const MatcherOptions& o) {
   return c;
 }
 
-OptimizerConfig config_of(const OptimizerOptions& o) {
-  OptimizerConfig c;
+optimizer::OptimizerConfig config_of(const OptimizerOptions& o) {
+  optimizer::OptimizerConfig c;
   if (o.window() > 0) c.window = o.window();
   if (o.alpha() > 0) c.alpha = o.alpha();
   if (o.beta() > 0) c.beta = o.beta();
@@ -60,8 +60,8 @@ OptimizerConfig config_of(const OptimizerOptions& o) {
   return c;
 }
 
-OdometryConfig config_of(const OdometryOptions& o) {
-  OdometryConfig c;
+odometry::OdometryConfig config_of(const OdometryOptions& o) {
+  odometry::OdometryConfig c;
   if (o.max_correspondence_m() > 0) c.max_correspondence_m = o.max_correspondence_m();
   if (o.keyframe_distance_m() > 0) c.keyframe_distance_m = o.keyframe_distance_m();
   if (o.keyframe_angle_deg() > 0) c.keyframe_angle_rad = o.keyframe_angle_deg() * kRadPerDeg;

@@ -8,18 +8,18 @@
 
 namespace fploc::config {
 
-LocalizationMap load_map(const PlanSource& plan, const std::string& lookup,
+matcher::LocalizationMap load_map(const PlanSource& plan, const std::string& lookup,
                          const std::function<std::string(const std::string&)>& resolve, const std::string& field) {
   if (plan.file().empty()) throw std::runtime_error(field + ".file: no floor plan given");
   const std::vector<std::string> layers(plan.layers().begin(), plan.layers().end());
   const std::string path = resolve(plan.file());
   const std::string how = lookup.empty() ? "annf-exact" : lookup;
   if (is_building_file(path) || !plan.floor().empty()) {  // a building (.pbtxt) or IFC: the plan of one floor
-    LocalizationMap m = make_localization_map(load_floor_plan(path, layers, plan.units(), plan.floor()), how);
+    matcher::LocalizationMap m = matcher::make_localization_map(load_floor_plan(path, layers, plan.units(), plan.floor()), how);
     m.note = "loaded " + path + " floor '" + plan.floor() + "'" + (m.note.empty() ? "" : "; " + m.note);
     return m;
   }
-  return load_localization_map(path, layers, plan.units(), how);
+  return matcher::load_localization_map(path, layers, plan.units(), how);
 }
 
 }  // namespace fploc::config

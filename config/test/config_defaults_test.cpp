@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "fploc/config/amcl.h"
 #include "fploc/config/localization.h"
 #include "fploc/config/perception.h"
 #include "fploc/config/relocalization.h"
@@ -28,10 +29,10 @@ std::map<std::string, std::map<std::string, std::string>> stated_defaults(const 
   EXPECT_TRUE(in) << file;
   std::map<std::string, std::map<std::string, std::string>> out;
   const std::regex msg_re(R"(^message (\w+) \{)");
-  const std::regex field_re(R"(^\s+(?:repeated )?\w+ (\w+) = \d+;\s*(?://(.*))?$)");
+  const std::regex field_re(R"(^\s+(?:repeated |optional )?\w+ (\w+) = \d+;\s*(?://(.*))?$)");
   const std::regex cont_re(R"(^\s+//(.*)$)");
   const std::regex def_res[] = {std::regex(R"(\(default (-?[0-9.]+)[;), ])"), std::regex(R"(0 = default (-?[0-9.]+))"),
-                                std::regex(R"(\(0 = (-?[0-9.]+)[;), ])"), std::regex(R"(\((-?[0-9.]+)[;),])")};
+                                std::regex(R"(\(0 = (-?[0-9.]+)[;), ])"), std::regex(R"(\((-?[0-9.]+)(?:[;),:]| [a-z=]))")};
   std::string msg, field, comment, line;
   auto flush = [&] {
     if (msg.empty() || field.empty()) return;
@@ -92,7 +93,7 @@ void check(const std::string& file, const std::string& message, const Table& tab
 }
 
 TEST(ConfigDefaults, Matcher) {
-  const fploc::MatcherConfig c = config_of(fploc::MatcherOptions{});
+  const fploc::matcher::MatcherConfig c = config_of(fploc::MatcherOptions{});
   check("localization.proto", "MatcherOptions",
         {{"max_correspondence_m", c.max_correspondence_m}, {"loss_scale_m", c.loss_scale_m},
          {"max_iterations", c.max_iterations}, {"min_inlier_ratio", c.min_inlier_ratio},
@@ -103,7 +104,7 @@ TEST(ConfigDefaults, Matcher) {
 }
 
 TEST(ConfigDefaults, Optimizer) {
-  const fploc::OptimizerConfig c = config_of(fploc::OptimizerOptions{});
+  const fploc::optimizer::OptimizerConfig c = config_of(fploc::OptimizerOptions{});
   check("localization.proto", "OptimizerOptions",
         {{"window", c.window}, {"alpha", c.alpha}, {"beta", c.beta}, {"keyframe_distance_m", c.keyframe_distance_m},
          {"keyframe_angle_deg", c.keyframe_angle_rad * kDeg}, {"gate_m", c.gate_m}, {"loss_scale_m", c.loss_scale_m},
@@ -112,7 +113,7 @@ TEST(ConfigDefaults, Optimizer) {
 }
 
 TEST(ConfigDefaults, Odometry) {
-  const fploc::OdometryConfig c = config_of(fploc::OdometryOptions{});
+  const fploc::odometry::OdometryConfig c = config_of(fploc::OdometryOptions{});
   check("localization.proto", "OdometryOptions",
         {{"max_correspondence_m", c.max_correspondence_m}, {"keyframe_distance_m", c.keyframe_distance_m},
          {"keyframe_angle_deg", c.keyframe_angle_rad * kDeg}, {"map_keyframes", c.map_keyframes},
@@ -137,12 +138,37 @@ TEST(ConfigDefaults, Perception) {
 }
 
 TEST(ConfigDefaults, Relocalizer) {
-  const fploc::RelocalizerConfig c = config_of(fploc::RelocalizerOptions{});
+  const fploc::reloc::RelocalizerConfig c = config_of(fploc::RelocalizerOptions{});
   // region_radius_m, global_after_s, min_interval_s: fploc-relocalizer's scheduling, not RelocalizerConfig.
   check("relocalization.proto", "RelocalizerOptions",
         {{"grid_m", c.grid_m}, {"yaw_step_deg", c.yaw_step_deg}, {"min_inlier_ratio", c.min_inlier_ratio},
          {"min_evidence", c.min_evidence}},
         {"region_radius_m", "global_after_s", "min_interval_s"});
+  const fploc::reloc::Schedule w = fploc::config::schedule_of(fploc::RelocalizerOptions{});
+  check("relocalization.proto", "RelocalizerOptions",
+        {{"region_radius_m", w.region_radius_m}, {"global_after_s", w.global_after_s}, {"min_interval_s", w.min_interval_s}},
+        {"grid_m", "yaw_step_deg", "min_inlier_ratio", "min_evidence"});
+}
+
+TEST(ConfigDefaults, Amcl) {
+  const fploc::amcl::Settings s = config_of(fploc::AmclOptions{});
+  const fploc::amcl::Config& c = s.filter;
+  check("amcl.proto", "AmclOptions",
+        {{"min_particles", c.min_particles}, {"max_particles", c.max_particles}, {"alpha1", c.alpha1},
+         {"alpha2", c.alpha2}, {"alpha3", c.alpha3}, {"alpha4", c.alpha4}, {"z_hit", c.z_hit}, {"z_rand", c.z_rand},
+         {"sigma_hit", c.sigma_hit}, {"laser_likelihood_max_dist", c.laser_likelihood_max_dist},
+         {"max_beams", c.max_beams}, {"laser_max_range", c.laser_max_range}, {"laser_min_range", c.laser_min_range},
+         {"update_min_d", c.update_min_d}, {"update_min_a", c.update_min_a}, {"resample_interval", c.resample_interval},
+         {"pf_err", c.pf_err}, {"pf_z", c.pf_z}, {"recovery_alpha_slow", c.recovery_alpha_slow},
+         {"recovery_alpha_fast", c.recovery_alpha_fast}, {"map_resolution", c.map_resolution},
+         {"free_clearance_m", c.free_clearance}, {"seed", double(c.seed)},
+         {"scan_bins", s.scan.bins}, {"scan_range_min", s.scan.range_min_m}, {"scan_range_max", s.scan.range_max_m},
+         {"initial_std_xy_m", s.initial.std_xy_m}, {"initial_std_yaw_deg", s.initial.std_yaw_deg},
+         {"max_odom_step_m", s.guard.max_step_m}, {"max_odom_step_deg", s.guard.max_step_rad * kDeg}});
+  check("amcl.proto", "WheelOdometryOptions",
+        {{"scale_error", s.wheel.scale_error}, {"yaw_drift_deg_per_m", s.wheel.yaw_drift_deg_per_m},
+         {"trans_noise_m_per_sqrt_m", s.wheel.trans_noise_m_per_sqrt_m},
+         {"yaw_noise_deg_per_sqrt_m", s.wheel.yaw_noise_deg_per_sqrt_m}, {"seed", double(s.wheel.seed)}});
 }
 
 }  // namespace

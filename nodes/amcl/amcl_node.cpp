@@ -30,11 +30,11 @@
 
 #include "fploc/amcl/amcl.h"
 #include "fploc/amcl/odometry.h"
+#include "fploc/config/amcl.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/adapters/features_t.h"
 #include "fploc/adapters/pose_t.h"
 #include "fploc/runtime/node.h"
-#include "options/amcl.pb.h"
 
 namespace {
 
@@ -45,40 +45,6 @@ double thread_cpu_us() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return double(ts.tv_sec) * 1e6 + double(ts.tv_nsec) * 1e-3;
-}
-
-am::Config config_of(const fploc::AmclOptions& o) {
-  am::Config c;
-  if (o.has_min_particles()) c.min_particles = o.min_particles();
-  if (o.has_max_particles()) c.max_particles = o.max_particles();
-  if (o.has_alpha1()) c.alpha1 = o.alpha1();
-  if (o.has_alpha2()) c.alpha2 = o.alpha2();
-  if (o.has_alpha3()) c.alpha3 = o.alpha3();
-  if (o.has_alpha4()) c.alpha4 = o.alpha4();
-  if (o.has_z_hit()) c.z_hit = o.z_hit();
-  if (o.has_z_rand()) c.z_rand = o.z_rand();
-  if (o.has_sigma_hit()) c.sigma_hit = o.sigma_hit();
-  if (o.has_laser_likelihood_max_dist()) c.laser_likelihood_max_dist = o.laser_likelihood_max_dist();
-  if (o.has_max_beams()) c.max_beams = o.max_beams();
-  if (o.has_laser_max_range()) c.laser_max_range = o.laser_max_range();
-  if (o.has_laser_min_range()) c.laser_min_range = o.laser_min_range();
-  if (o.has_update_min_d()) c.update_min_d = o.update_min_d();
-  if (o.has_update_min_a()) c.update_min_a = o.update_min_a();
-  if (o.has_resample_interval()) c.resample_interval = o.resample_interval();
-  if (o.has_pf_err()) c.pf_err = o.pf_err();
-  if (o.has_pf_z()) c.pf_z = o.pf_z();
-  if (o.has_recovery_alpha_slow()) c.recovery_alpha_slow = o.recovery_alpha_slow();
-  if (o.has_recovery_alpha_fast()) c.recovery_alpha_fast = o.recovery_alpha_fast();
-  if (o.resampler() == "low-variance") c.resampler = am::Resampler::kLowVariance;
-  else if (!o.resampler().empty() && o.resampler() != "multinomial")
-    throw std::runtime_error("amcl.resampler: '" + o.resampler() + "' (use \"multinomial\" or \"low-variance\")");
-  if (o.estimate() == "weighted-mean") c.estimate = am::EstimateMode::kWeightedMean;
-  else if (!o.estimate().empty() && o.estimate() != "best-cluster")
-    throw std::runtime_error("amcl.estimate: '" + o.estimate() + "' (use \"best-cluster\" or \"weighted-mean\")");
-  if (o.has_map_resolution()) c.map_resolution = o.map_resolution();
-  if (o.has_free_clearance_m()) c.free_clearance = o.free_clearance_m();
-  if (o.has_seed()) c.seed = o.seed();
-  return c;
 }
 
 class AmclNode : public fploc::rt::Node {
@@ -102,39 +68,24 @@ class AmclNode : public fploc::rt::Node {
     if (o.plan().file().empty()) throw std::runtime_error("amcl.plan.file: no floor plan given");
     const std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
     const fploc::FloorPlan plan = fploc::load_floor_plan(ctx.resolve_path(o.plan().file()), layers, o.plan().units(), o.plan().floor());
-    cfg_ = config_of(o);
+    const am::Settings s = fploc::config::config_of(o);
+    cfg_ = s.filter;
     amcl_ = std::make_unique<am::Amcl>(plan, cfg_);
-    sxy_ = o.has_initial_std_xy_m() ? o.initial_std_xy_m() : 0.5;
-    syaw_ = (o.has_initial_std_yaw_deg() ? o.initial_std_yaw_deg() : 15.0) * M_PI / 180.0;
-    bins_ = o.has_scan_bins() ? o.scan_bins() : 360;
-    if (bins_ < 2) throw std::runtime_error("amcl.scan_bins must be >= 2");
-    range_min_ = o.has_scan_range_min() ? o.scan_range_min() : 0.0;
-    range_max_ = o.has_scan_range_max() ? o.scan_range_max() : 100.0;
-    am::OdometryGuardConfig gc;
-    if (o.has_max_odom_step_m()) gc.max_step_m = o.max_odom_step_m();
-    if (o.has_max_odom_step_deg()) gc.max_step_rad = o.max_odom_step_deg() * M_PI / 180.0;
-    guard_ = am::OdometryGuard(gc);
+    sxy_ = s.initial.std_xy_m;
+    syaw_ = s.initial.std_yaw_deg * M_PI / 180.0;
+    bins_ = s.scan.bins;
+    range_min_ = s.scan.range_min_m;
+    range_max_ = s.scan.range_max_m;
+    guard_ = am::OdometryGuard(s.guard);
     stats_file_ = o.stats_file();
-
-    if (o.odometry().empty() || o.odometry() == "pose") {
-      wheel_mode_ = false;
-    } else if (o.odometry() == "simulated-wheel") {
-      wheel_mode_ = true;
-      am::WheelOdometryConfig wc;
-      const auto& w = o.wheel();
-      if (w.has_scale_error()) wc.scale_error = w.scale_error();
-      if (w.has_yaw_drift_deg_per_m()) wc.yaw_drift_deg_per_m = w.yaw_drift_deg_per_m();
-      if (w.has_trans_noise_m_per_sqrt_m()) wc.trans_noise_m_per_sqrt_m = w.trans_noise_m_per_sqrt_m();
-      if (w.has_yaw_noise_deg_per_sqrt_m()) wc.yaw_noise_deg_per_sqrt_m = w.yaw_noise_deg_per_sqrt_m();
-      if (w.has_seed()) wc.seed = w.seed();
-      wheel_ = std::make_unique<am::WheelOdometrySim>(wc);
+    wheel_mode_ = s.odometry == am::OdometrySource::kSimulatedWheel;
+    if (wheel_mode_) {
+      wheel_ = std::make_unique<am::WheelOdometrySim>(s.wheel);
       // The odometry frame starts at the initial pose when one is given (as fploc-odometry does), so its
       // trajectory can be scored against the ground truth; AMCL itself only uses increments.
       if (o.has_initial_pose() && !o.global_localization()) wheel_->set_start({o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()});
       if (ctx.channel("ground_truth").empty())
         throw std::runtime_error("amcl.odometry = \"simulated-wheel\" needs the ground_truth port mapped (FPLOC_GROUND_TRUTH)");
-    } else {
-      throw std::runtime_error("amcl.odometry: '" + o.odometry() + "' (use \"pose\" or \"simulated-wheel\")");
     }
     if (!wheel_mode_ && ctx.channel("odom").empty())
       throw std::runtime_error("amcl.odometry = \"pose\" needs the odom port mapped");

@@ -23,7 +23,7 @@
 
 namespace {
 
-using fploc::FitStatus;
+using fploc::matcher::FitStatus;
 
 class MatcherNode : public fploc::rt::Node {
  public:
@@ -102,22 +102,22 @@ class MatcherNode : public fploc::rt::Node {
     }
     if (dropped) ctx_->error("features seq " + std::to_string(m.seq) + ": " + std::to_string(dropped) + " non-finite points dropped");
     const fploc::localizer::FramePose fp = loc_->register_frame(f);
-    const fploc::MatchResult& r = fp.match;
+    const fploc::matcher::MatchResult& r = fp.match;
     // Wall-clock only outside replay (outputs must be reproducible there).
     const double solve_ms =
         ctx_->composed() ? 0.0 : std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
-    if (r.status == FitStatus::kLost && last_status_ != FitStatus::kLost) ctx_->error("LOST at scan " + std::to_string(m.scan_seq) + ": " + r.text);
+    if (r.status == fploc::matcher::FitStatus::kLost && last_status_ != fploc::matcher::FitStatus::kLost) ctx_->error("LOST at scan " + std::to_string(m.scan_seq) + ": " + r.text);
     last_status_ = r.status;
     out_.publish(fploc::adapters::to_msg(fp, seq_++, solve_ms));
   }
 
   fploc::rt::Context* ctx_ = nullptr;
-  fploc::LocalizationMap map_;
+  fploc::matcher::LocalizationMap map_;
   std::unique_ptr<fploc::localizer::Localizer> loc_;
   fploc::rt::Publisher<fploc::frame_pose_t> out_;
   int64_t seq_ = 0;
   int64_t refined_ignored_ = 0;
-  FitStatus last_status_ = FitStatus::kOk;
+  fploc::matcher::FitStatus last_status_ = fploc::matcher::FitStatus::kOk;
 };
 
 }  // namespace

@@ -196,7 +196,7 @@ class NdtNode : public fploc::rt::Node {
 
   fploc::rt::Context* ctx_ = nullptr;
   std::unique_ptr<nd::Localizer> loc_;
-  fploc::ImuYaw imu_;
+  fploc::matcher::ImuYaw imu_;
   bool use_imu_ = true, have_prev_ = false, done_ = false;
   int64_t prev_utime_ = 0, seq_ = 0, scans_ = 0, iterations_ = 0, points_ = 0;
   int64_t counts_[3] = {0, 0, 0};

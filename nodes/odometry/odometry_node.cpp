@@ -27,7 +27,7 @@ class OdometryNode : public fploc::rt::Node {
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::OdometryOptions>();
-    odo_ = std::make_unique<fploc::Odometry2D>(fploc::config::config_of(o));
+    odo_ = std::make_unique<fploc::odometry::Odometry2D>(fploc::config::config_of(o));
     odo_->set_pose({o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()});
     out_ = ctx.advertise<fploc::pose_t>("pose");
     ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) {
@@ -38,7 +38,7 @@ class OdometryNode : public fploc::rt::Node {
         ctx_->error(std::string("features: ") + e.what());
         return;
       }
-      const fploc::OdometryResult r = odo_->process(f);
+      const fploc::odometry::OdometryResult r = odo_->process(f);
       Eigen::Matrix3d cov = Eigen::Matrix3d::Identity() * (r.ok ? r.rms_m * r.rms_m : 1e6);
       out_.publish(fploc::adapters::make_pose_msg(f.utime, seq_++, r.pose, f.roll, f.pitch, f.z, cov, f.z_sigma,
                                         f.roll_pitch_sigma, r.ok ? 0 : 1, r.keyframe, true));
@@ -47,7 +47,7 @@ class OdometryNode : public fploc::rt::Node {
 
  private:
   fploc::rt::Context* ctx_ = nullptr;
-  std::unique_ptr<fploc::Odometry2D> odo_;
+  std::unique_ptr<fploc::odometry::Odometry2D> odo_;
   fploc::rt::Publisher<fploc::pose_t> out_;
   int64_t seq_ = 0;
 };

@@ -21,7 +21,7 @@
 
 namespace {
 
-using fploc::FitStatus;
+using fploc::matcher::FitStatus;
 
 class OptimizerNode : public fploc::rt::Node {
  public:
@@ -80,7 +80,7 @@ class OptimizerNode : public fploc::rt::Node {
                   " != frame_pose utime " + std::to_string(p->second.utime) + " (dropped)");
     } else if (scan_seq <= last_seq_ && have_last_) {
       ctx_->error("scan_seq " + std::to_string(scan_seq) + " arrived after " + std::to_string(last_seq_) + " (dropped)");
-    } else if (p->second.status != int8_t(FitStatus::kNotInitialised)) {
+    } else if (p->second.status != int8_t(fploc::matcher::FitStatus::kNotInitialised)) {
       process(f->second, p->second);
       last_seq_ = scan_seq;
       have_last_ = true;
@@ -101,7 +101,7 @@ class OptimizerNode : public fploc::rt::Node {
       latest_out_.publish(fploc::adapters::to_msg(*latest, latest_seq_++));
       // Status changes with their reason (pose_t has no text): e.g. POOR where the plan leaves a direction open.
       if (latest->status != last_status_ && ++status_changes_ <= 200)
-        std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << ": " << fploc::to_string(latest->status)
+        std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << ": " << fploc::matcher::to_string(latest->status)
                   << (latest->status_text.empty() ? "" : ": " + latest->status_text) << "\n";
       last_status_ = latest->status;
     }
@@ -113,7 +113,7 @@ class OptimizerNode : public fploc::rt::Node {
   }
 
   fploc::rt::Context* ctx_ = nullptr;
-  fploc::LocalizationMap map_;
+  fploc::matcher::LocalizationMap map_;
   std::unique_ptr<fploc::localizer::Localizer> loc_;
   fploc::rt::Publisher<fploc::pose_t> pose_out_, latest_out_;
   std::map<int64_t, fploc::FeatureFrame> features_;

@@ -14,6 +14,9 @@
 #include <memory>
 #include <stdexcept>
 
+#include "fploc/adapters/features_t.h"
+#include "fploc/adapters/plan_diff_t.h"
+#include "fploc/adapters/pose_t.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/plandiff/plan_diff.h"
 #include "fploc/runtime/node.h"
@@ -21,7 +24,6 @@
 
 namespace {
 
-using fploc::plandiff::Status;
 
 class PlanDiffNode : public fploc::rt::Node {
  public:
@@ -38,7 +40,7 @@ class PlanDiffNode : public fploc::rt::Node {
     const auto& o = ctx.options<fploc::PlanDiffOptions>();
     if (o.plan().file().empty()) throw std::runtime_error("plan_diff: plan.file is required");
     std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
-    plan_ = fploc::load_floor_plan(ctx.resolve_path(o.plan().file()), layers, o.plan().units());
+    plan_ = fploc::load_floor_plan(ctx.resolve_path(o.plan().file()), layers, o.plan().units(), o.plan().floor());
     fploc::plandiff::Options po;
     if (o.min_frames() > 0) po.min_frames = o.min_frames();
     if (o.moved_min_m() > 0) po.moved_min_m = o.moved_min_m();
@@ -51,7 +53,7 @@ class PlanDiffNode : public fploc::rt::Node {
     std::cerr << "[" << ctx.name() << "] " << plan_.elements.size() << " plan elements from " << plan_.source << "\n";
     out_ = ctx.advertise<fploc::plan_diff_t>("diff");
     ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) {
-      features_.push_back(m);
+      features_.push_back(fploc::adapters::from_msg(m));
       while (features_.size() > 30) features_.pop_front();
     });
     ctx.subscribe<fploc::pose_t>("pose", [this](const fploc::pose_t& m) { on_pose(m); });
@@ -76,68 +78,29 @@ class PlanDiffNode : public fploc::rt::Node {
  private:
   void on_pose(const fploc::pose_t& m) {
     if (m.status == 2) return;  // LOST: its features would draw a wrong diff
-    const fploc::features_t* f = nullptr;
+    const fploc::FeatureFrame* f = nullptr;
     for (const auto& x : features_)
       if (x.utime == m.utime) f = &x;
-    if (!f || f->status != 0) return;
+    if (!f || f->status != fploc::FeatureStatus::kOk) return;
     if (frame_us_ > 0 && last_frame_ != 0 && m.utime - last_frame_ < frame_us_) return;
     last_frame_ = m.utime;
-    const double* q = m.orientation;  // x y z w
-    const double yaw = std::atan2(2 * (q[3] * q[2] + q[0] * q[1]), 1 - 2 * (q[1] * q[1] + q[2] * q[2]));
+    const fploc::Pose2 x = fploc::adapters::pose2_of(m);
     std::vector<Eigen::Vector2f> pts;
-    pts.reserve(size_t(f->num_points));
-    for (int i = 0; i < f->num_points; ++i) pts.emplace_back(f->x[size_t(i)], f->y[size_t(i)]);
-    diff_->add_frame(m.position[0], m.position[1], yaw, pts);
+    pts.reserve(f->points.size());
+    for (const auto& p : f->points) pts.emplace_back(float(p.p.x()), float(p.p.y()));
+    diff_->add_frame(x.x, x.y, x.yaw, pts);
     if (last_publish_ == 0 || m.utime - last_publish_ >= publish_us_) {
       last_publish_ = m.utime;
       publish(m.utime);
     }
   }
 
-  void publish(int64_t utime) {
-    const auto r = diff_->result();
-    fploc::plan_diff_t msg;
-    msg.utime = utime;
-    msg.seq = seq_++;
-    msg.frames = r.frames;
-    msg.elements_seen = r.count(Status::kSeen);
-    msg.elements_missing = r.count(Status::kMissing);
-    msg.elements_moved = r.count(Status::kMoved);
-    msg.elements_unobserved = r.count(Status::kUnobserved);
-    msg.scale_error = r.scale_error;
-    msg.scale_sigma = r.scale_sigma;
-    auto item = [&](int8_t kind, int32_t el, bool circle, double x0, double y0, double x1, double y1, double off, double ratio) {
-      msg.kind.push_back(kind);
-      msg.circle.push_back(circle);
-      msg.element.push_back(el);
-      msg.x0.push_back(float(x0));
-      msg.y0.push_back(float(y0));
-      msg.x1.push_back(float(x1));
-      msg.y1.push_back(float(y1));
-      msg.offset_m.push_back(float(off));
-      msg.seen_ratio.push_back(float(ratio));
-    };
-    for (const auto& e : r.elements) {
-      if (e.status != Status::kMissing && e.status != Status::kMoved) continue;
-      const auto& p = plan_.elements[size_t(e.id)];
-      const double off = e.status == Status::kMoved ? e.offset_m : 0.0;
-      const int8_t kind = e.status == Status::kMissing ? 1 : 2;
-      if (p.kind == fploc::ElementKind::kSegment) {
-        const Eigen::Vector2d u = (p.b - p.a).normalized(), s = off * Eigen::Vector2d(-u.y(), u.x());
-        item(kind, e.id, false, p.a.x() + s.x(), p.a.y() + s.y(), p.b.x() + s.x(), p.b.y() + s.y(), off, e.seen_ratio());
-      } else {
-        item(kind, e.id, true, p.c.x(), p.c.y(), p.r + off, 0, off, e.seen_ratio());
-      }
-    }
-    for (const auto& n : r.added) item(3, -1, false, n.a.x(), n.a.y(), n.b.x(), n.b.y(), n.rms_m, 0);
-    msg.num_items = int32_t(msg.kind.size());
-    out_.publish(msg);
-  }
+  void publish(int64_t utime) { out_.publish(fploc::adapters::to_msg(diff_->result(), plan_, utime, seq_++)); }
 
   fploc::rt::Context* ctx_ = nullptr;
   fploc::FloorPlan plan_;
   std::unique_ptr<fploc::plandiff::PlanDiff> diff_;
-  std::deque<fploc::features_t> features_;
+  std::deque<fploc::FeatureFrame> features_;
   fploc::rt::Publisher<fploc::plan_diff_t> out_;
   int64_t publish_us_ = 1000000, frame_us_ = 0, last_publish_ = 0, last_frame_ = 0, seq_ = 0;
   std::string out_json_, out_dxf_;

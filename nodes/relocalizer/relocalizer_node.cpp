@@ -26,7 +26,7 @@
 
 namespace {
 
-using fploc::FitStatus;
+using fploc::matcher::FitStatus;
 
 class RelocalizerNode : public fploc::rt::Node {
  public:
@@ -42,10 +42,11 @@ class RelocalizerNode : public fploc::rt::Node {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::RelocalizerOptions>();
     map_ = fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); }, "relocalizer.plan");
-    reloc_ = std::make_unique<fploc::Relocalizer>(*map_.plan, *map_.lookup, fploc::config::config_of(o));
-    radius_ = o.region_radius_m() > 0 ? o.region_radius_m() : 3.0;
-    global_after_us_ = int64_t((o.global_after_s() > 0 ? o.global_after_s() : 2.0) * 1e6);
-    interval_us_ = int64_t((o.min_interval_s() > 0 ? o.min_interval_s() : 0.5) * 1e6);
+    reloc_ = std::make_unique<fploc::reloc::Relocalizer>(*map_.plan, *map_.lookup, fploc::config::config_of(o));
+    const fploc::reloc::Schedule when = fploc::config::schedule_of(o);
+    radius_ = when.region_radius_m;
+    global_after_us_ = int64_t(when.global_after_s * 1e6);
+    interval_us_ = int64_t(when.min_interval_s * 1e6);
     std::cerr << "[" << ctx.name() << "] " << map_.plan->elements.size() << " elements, "
               << reloc_->free_cells() << " free search cells\n";
     out_ = ctx.advertise<fploc::pose_t>("initial_pose");
@@ -58,15 +59,15 @@ class RelocalizerNode : public fploc::rt::Node {
 
  private:
   void on_frame_pose(const fploc::frame_pose_t& m) {
-    const auto st = FitStatus(m.status);
-    if (st == FitStatus::kOk) {
+    const auto st = fploc::matcher::FitStatus(m.status);
+    if (st == fploc::matcher::FitStatus::kOk) {
       last_ok_ = fploc::Pose2{m.x, m.y, m.yaw};
       last_ok_utime_ = m.utime;
       have_ok_ = true;
       lost_since_ = 0;
       return;
     }
-    if (st != FitStatus::kLost && st != FitStatus::kNotInitialised) return;  // POOR: the matcher copes
+    if (st != fploc::matcher::FitStatus::kLost && st != fploc::matcher::FitStatus::kNotInitialised) return;  // POOR: the matcher copes
     if (lost_since_ == 0) lost_since_ = m.utime;
     if (last_search_ != 0 && m.utime - last_search_ < interval_us_) return;
     const fploc::features_t* f = nullptr;
@@ -84,20 +85,20 @@ class RelocalizerNode : public fploc::rt::Node {
     // LOST: first around the last good pose (or, if there never was one, around the pose the matcher
     // holds — the given initial pose); the whole plan once the loss lasts longer than global_after_s.
     // NOT_INITIALISED right after a good pose (the matcher was restarted): around that pose too.
-    std::optional<fploc::SearchRegion> region;
+    std::optional<fploc::reloc::SearchRegion> region;
     const bool local = m.utime - lost_since_ < global_after_us_ &&
-                       (st == FitStatus::kLost || (have_ok_ && m.utime - last_ok_utime_ < global_after_us_));
-    if (local) region = fploc::SearchRegion{have_ok_ ? last_ok_ : fploc::Pose2{m.x, m.y, m.yaw}, radius_, M_PI};
-    const fploc::RelocResult r = reloc_->locate(frame, region);
+                       (st == fploc::matcher::FitStatus::kLost || (have_ok_ && m.utime - last_ok_utime_ < global_after_us_));
+    if (local) region = fploc::reloc::SearchRegion{have_ok_ ? last_ok_ : fploc::Pose2{m.x, m.y, m.yaw}, radius_, M_PI};
+    const fploc::reloc::RelocResult r = reloc_->locate(frame, region);
     const std::string where = local ? "near the last pose" : "over the whole plan";
-    if (r.status != fploc::RelocStatus::kFound) {
-      const std::string text = std::string(fploc::to_string(r.status)) + " " + where + ": " + r.text;
+    if (r.status != fploc::reloc::RelocStatus::kFound) {
+      const std::string text = std::string(fploc::reloc::to_string(r.status)) + " " + where + ": " + r.text;
       if (text != last_text_) ctx_->error("scan " + std::to_string(m.scan_seq) + ": " + text);
       last_text_ = text;
       return;
     }
     last_text_.clear();
-    std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << " (" << fploc::to_string(st) << "): " << r.text
+    std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << " (" << to_string(st) << "): " << r.text
               << " " << where << "\n";
     out_.publish(fploc::adapters::make_pose_msg(f->utime, seq_++, r.pose, f->roll, f->pitch, f->z,
                                       Eigen::Matrix3d::Identity() * r.fit.rms_m * r.fit.rms_m, f->z_sigma,
@@ -105,8 +106,8 @@ class RelocalizerNode : public fploc::rt::Node {
   }
 
   fploc::rt::Context* ctx_ = nullptr;
-  fploc::LocalizationMap map_;
-  std::unique_ptr<fploc::Relocalizer> reloc_;
+  fploc::matcher::LocalizationMap map_;
+  std::unique_ptr<fploc::reloc::Relocalizer> reloc_;
   fploc::rt::Publisher<fploc::pose_t> out_;
   std::deque<fploc::features_t> features_;
   fploc::Pose2 last_ok_;

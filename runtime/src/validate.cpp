@@ -1,4 +1,6 @@
 #include "fploc/runtime/validate.h"
+
+#include "fploc/runtime/subprocess.h"
 #include "fploc/runtime/robot.h"
 
 #include <fcntl.h>
@@ -94,62 +96,12 @@ std::string self_bin_dir() {
 
 // Runs argv, returns its stdout; false on failure, timeout or non-zero exit.
 static bool run_capture(const std::vector<std::string>& args, double timeout_s, std::string& out, std::string& err) {
-  int pipefd[2];
-  if (::pipe2(pipefd, O_CLOEXEC) != 0) {
-    err = "pipe failed";
-    return false;
-  }
-  std::vector<char*> argv;
-  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  const pid_t pid = ::fork();
-  if (pid < 0) {
-    err = "fork failed";
-    return false;
-  }
-  if (pid == 0) {
-    ::dup2(pipefd[1], 1);
-    const int devnull = ::open("/dev/null", O_RDWR);
-    if (devnull >= 0) {
-      ::dup2(devnull, 0);
-      ::dup2(devnull, 2);
-    }
-    ::execv(argv[0], argv.data());
-    ::_exit(127);
-  }
-  ::close(pipefd[1]);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  char buf[4096];
-  bool timed_out = false;
-  for (;;) {
-    const auto left = std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
-    if (left <= 0) {
-      timed_out = true;
-      break;
-    }
-    pollfd p{pipefd[0], POLLIN, 0};
-    const int r = ::poll(&p, 1, int(left * 1000) + 1);
-    if (r < 0 && errno == EINTR) continue;
-    if (r <= 0) continue;
-    const ssize_t n = ::read(pipefd[0], buf, sizeof buf);
-    if (n <= 0) break;
-    out.append(buf, size_t(n));
-  }
-  ::close(pipefd[0]);
-  if (timed_out) ::kill(pid, SIGKILL);
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  if (timed_out) {
-    err = "timed out";
-    return false;
-  }
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    err = WIFEXITED(status) ? "exit code " + std::to_string(WEXITSTATUS(status))
-                            : "killed by signal " + std::to_string(WTERMSIG(status));
-    return false;
-  }
-  return true;
+  RunOptions o;
+  o.timeout_s = timeout_s;
+  RunResult r = run_program(args, o);
+  out = std::move(r.output);
+  err = r.problem;
+  return r.exit_code == 0;
 }
 
 DescribeResult describe_executable(const std::string& resolved_path) {

@@ -18,6 +18,7 @@
 #include "fploc/core/pose.h"
 #include "fploc/floorplan/io.h"
 #include "synthetic.h"
+#include "fploc/runtime/log_writer.h"
 
 using namespace fploc;
 
@@ -25,15 +26,8 @@ namespace {
 
 template <class Msg>
 void write(lcm::LogFile& log, const std::string& channel, int64_t utime, const Msg& m) {
-  std::vector<uint8_t> buf(size_t(m.getEncodedSize()));
-  m.encode(buf.data(), 0, int(buf.size()));
-  lcm::LogEvent ev;
-  ev.eventnum = 0;
-  ev.timestamp = utime;
-  ev.channel = channel;
-  ev.datalen = int32_t(buf.size());
-  ev.data = buf.data();
-  log.writeEvent(&ev);
+  std::vector<uint8_t> buf;
+  rt::write_event(log, utime, channel, m, buf);
 }
 
 pose_t pose_msg(int64_t utime, int64_t seq, const Pose2& p) {

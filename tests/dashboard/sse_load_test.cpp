@@ -24,6 +24,8 @@
 #include <thread>
 #include <vector>
 
+#include "../support/process.h"
+
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
@@ -31,30 +33,9 @@ namespace {
 constexpr int kPort = 8091;
 constexpr int kStreams = 200;
 
-std::string build_dir() { return getenv("FPLOC_BUILD_DIR") ? getenv("FPLOC_BUILD_DIR") : FPLOC_BUILD_DIR_DEFAULT; }
-
-pid_t spawn(std::vector<std::string> args) {
-  pid_t pid = fork();
-  if (pid == 0) {
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execv(argv[0], argv.data());
-    _exit(127);
-  }
-  return pid;
-}
-void stop(pid_t pid) {
-  if (pid <= 0) return;
-  kill(pid, SIGTERM);
-  int st = 0;
-  for (int i = 0; i < 50; ++i) {
-    if (waitpid(pid, &st, WNOHANG) == pid) return;
-    std::this_thread::sleep_for(50ms);
-  }
-  kill(pid, SIGKILL);
-  waitpid(pid, &st, 0);
-}
+using fploc::test::build_dir;
+using fploc::test::spawn;
+using fploc::test::stop;
 
 int connect_local() {
   int fd = socket(AF_INET, SOCK_STREAM, 0);

@@ -3,25 +3,16 @@
 (recorded by lcm-logger) arrive at 10 Hz of wall time, over more than two passes of PASS_S seconds, and
 their sensor times advance by 0.1 s per frame (no jump at the restarts)."""
 import struct
+import os
 import sys
 
-
-def events(path):
-    d = open(path, 'rb').read()
-    o = 0
-    while o + 28 <= len(d):
-        sync, _, wall_us, cl, dl = struct.unpack('>IQQII', d[o:o + 28])
-        assert sync == 0xEDA1DA01, f"{path}: bad sync at byte {o}"
-        o += 28
-        ch = d[o:o + cl].decode()
-        o += cl
-        yield ch, wall_us, d[o:o + dl]
-        o += dl
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools", "pylib"))
+from lcm_log import events  # noqa: E402
 
 
 log, pass_s = sys.argv[1], float(sys.argv[2])
 msgs = {'FPLOC_GROUND_TRUTH': [], 'OS1_SCAN': []}
-for ch, wall_us, b in events(log):
+for wall_us, ch, b in events(log, with_time=True):
     if ch in msgs:
         msgs[ch].append((wall_us * 1e-6, struct.unpack('>q', b[8:16])[0] * 1e-6))  # (wall, sensor utime)
 # The driver's first scan is the frame that was in flight when it started (partial, a later utime).

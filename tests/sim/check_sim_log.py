@@ -3,20 +3,11 @@
 wrote directly (same scenario and seed): every complete decoded frame must have the same range image
 (integer millimetres, so the XYZ points are identical) and column times; IMU and ground truth must flow."""
 import struct
+import os
 import sys
 
-
-def events(path):
-    d = open(path, 'rb').read()
-    o = 0
-    while o + 28 <= len(d):
-        sync, _, _, cl, dl = struct.unpack('>IQQII', d[o:o + 28])
-        assert sync == 0xEDA1DA01, f"{path}: bad sync at {o}"
-        o += 28
-        ch = d[o:o + cl].decode()
-        o += cl
-        yield ch, d[o:o + dl]
-        o += dl
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools", "pylib"))
+from lcm_log import events  # noqa: E402
 
 
 def scan(b):

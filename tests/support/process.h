@@ -25,9 +25,15 @@ inline std::string env(const char* k, const std::string& d = "") {
   const char* v = getenv(k);
   return v ? v : d;
 }
-// The source tree and the built programs (FPLOC_ROOT / FPLOC_BUILD_DIR override them).
+// The source tree and the built programs (FPLOC_ROOT / FPLOC_BUILD_DIR override them; a test's CMakeLists
+// may define FPLOC_BUILD_DIR_DEFAULT, its own build folder).
 inline std::string root() { return env("FPLOC_ROOT", FPLOC_SOURCE_DIR); }
-inline std::string bin(const std::string& exe) { return env("FPLOC_BUILD_DIR", root() + "/build") + "/bin/" + exe; }
+#ifdef FPLOC_BUILD_DIR_DEFAULT
+inline std::string build_dir() { return env("FPLOC_BUILD_DIR", FPLOC_BUILD_DIR_DEFAULT); }
+#else
+inline std::string build_dir() { return env("FPLOC_BUILD_DIR", root() + "/build"); }
+#endif
+inline std::string bin(const std::string& exe) { return build_dir() + "/bin/" + exe; }
 
 inline double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -92,6 +98,31 @@ struct Proc {
     waitpid(pid, nullptr, 0);
   }
 };
+
+// A child that shares the test's stdout/stderr (its messages show in the ctest log); stop() ends it.
+inline pid_t spawn(std::vector<std::string> args) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+// SIGTERM, 2.5 s to exit, then SIGKILL.
+inline void stop(pid_t pid) {
+  if (pid <= 0) return;
+  kill(pid, SIGTERM);
+  int st = 0;
+  for (int i = 0; i < 50; ++i) {
+    if (waitpid(pid, &st, WNOHANG) == pid) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  kill(pid, SIGKILL);
+  waitpid(pid, &st, 0);
+}
 
 // Runs a program to its end (or timeout_s); its exit code, 128 + signal, or -1 on timeout.
 inline int run(const std::vector<std::string>& args, const std::string& dir, const std::string& tag,

@@ -19,22 +19,11 @@
 #include <nlohmann/json.hpp>
 
 #include "fploc/carmen/carmen.h"
+#include "fploc/runtime/log_writer.h"
 
 namespace {
 
-template <class Msg>
-void write_event(lcm::LogFile& log, int64_t utime, const std::string& channel, const Msg& m, std::vector<uint8_t>& buf) {
-  const int n = m.getEncodedSize();
-  buf.resize(size_t(n));
-  m.encode(buf.data(), 0, n);
-  lcm::LogEvent ev;
-  ev.eventnum = 0;
-  ev.timestamp = utime;
-  ev.channel = channel;
-  ev.datalen = n;
-  ev.data = buf.data();
-  if (log.writeEvent(&ev) != 0) throw std::runtime_error("cannot write LCM log event on " + channel);
-}
+using fploc::rt::write_event;
 
 void quat_of_yaw(double yaw, double q[4]) {
   q[0] = 0;

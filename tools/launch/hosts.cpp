@@ -1,5 +1,7 @@
 #include "hosts.h"
 
+#include "fploc/runtime/subprocess.h"
+
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
@@ -78,45 +80,13 @@ std::string remote_node_command(const HostPlan& h, const std::vector<std::string
 }
 
 int run_merged(const std::vector<std::string>& args, double timeout_s, std::string& out) {
-  int pipefd[2];
-  if (::pipe2(pipefd, O_CLOEXEC) != 0) return -1;
-  std::vector<char*> argv;
-  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  const pid_t pid = ::fork();
-  if (pid < 0) return -1;
-  if (pid == 0) {
-    ::dup2(pipefd[1], 1);
-    ::dup2(pipefd[1], 2);
-    const int devnull = ::open("/dev/null", O_RDONLY);
-    if (devnull >= 0) ::dup2(devnull, 0);
-    ::setpgid(0, 0);
-    ::execvp(argv[0], argv.data());
-    ::_exit(127);
-  }
-  ::close(pipefd[1]);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  char buf[4096];
-  bool timed_out = false;
-  for (;;) {
-    const double left = std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
-    if (left <= 0) {
-      timed_out = true;
-      break;
-    }
-    pollfd p{pipefd[0], POLLIN, 0};
-    if (::poll(&p, 1, int(left * 1000) + 1) <= 0) continue;
-    const ssize_t n = ::read(pipefd[0], buf, sizeof buf);
-    if (n <= 0) break;
-    out.append(buf, size_t(n));
-  }
-  ::close(pipefd[0]);
-  if (timed_out) ::kill(-pid, SIGKILL);
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  if (timed_out) return -1;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  fploc::rt::RunOptions o;
+  o.timeout_s = timeout_s;
+  o.merge_stderr = true;
+  o.search_path = true;
+  fploc::rt::RunResult r = fploc::rt::run_program(args, o);
+  out += r.output;
+  return r.exit_code;
 }
 
 std::string local_commit(const std::string& root) {

@@ -52,7 +52,7 @@ Result run(const FloorPlan& plan_in, const Options& o) {
   so.shared_dir = o.shared_dir;
   sim::Simulator sim(plan_in, so);
   const FloorPlan& plan = sim.world().plan();
-  LocalizationMap map = make_localization_map(plan, o.lookup);
+  matcher::LocalizationMap map = matcher::make_localization_map(plan, o.lookup);
   // The graph's nodes' configurations (their options' defaults).
   seg::RingSegmenter segmenter(config::config_of(SegmenterOptions{}));
   feat::FeatureExtractor fx(config::config_of(FeatureOptions{}));
@@ -77,7 +77,7 @@ Result run(const FloorPlan& plan_in, const Options& o) {
   cfg.initial_search_m = o.init_search_m;
   localizer::Localizer loc(*map.lookup, cfg);
   loc.set_pose(init);
-  Odometry2D odo;
+  odometry::Odometry2D odo;
   odo.set_pose(init);
   std::vector<localizer::Pose> finals;
   const auto& imu = sim.imu();
@@ -119,8 +119,8 @@ Result run(const FloorPlan& plan_in, const Options& o) {
     t0 = clk::now();
     const localizer::FramePose sfr = loc.register_frame(frame);
     r.us_matcher += us_since(t0);
-    const MatchResult& m = sfr.match;
-    r.ok_frames += m.status == FitStatus::kOk;
+    const matcher::MatchResult& m = sfr.match;
+    r.ok_frames += m.status == matcher::FitStatus::kOk;
     if (csv) {
       const StampedPose g = sim.ground_truth(frame.utime * 1e-6 + o.gt_offset_s);
       std::fprintf(csv.get(), "%d,%lld,%s,%d,%d,%.4f,%.5f,%d,%.5f,%.5f,%.4f,%.4f,%.4f,%.4f,%.5f,%.5f\n", k, (long long)frame.utime,
@@ -128,13 +128,13 @@ Result run(const FloorPlan& plan_in, const Options& o) {
                    m.pose.x - g.p.x(), m.pose.y - g.p.y(), wrap_angle(m.pose.yaw - g.rpy()[2]) * 180 / M_PI, m.twist.vx,
                    m.twist.vy, m.twist.w, frame.z_sigma, frame.z - g.p.z());
     }
-    r.lost_frames += m.status == FitStatus::kLost;
+    r.lost_frames += m.status == matcher::FitStatus::kLost;
     t0 = clk::now();
     // The window step, and its estimate of this frame predicts the next one (the graphs' `refined` input).
     if (const auto latest = loc.optimize(frame, sfr, &finals)) loc.refine(latest->utime, latest->pose);
     r.us_optimizer += us_since(t0);
     t0 = clk::now();
-    const OdometryResult od = odo.process(frame);
+    const odometry::OdometryResult od = odo.process(frame);
     r.us_odometry += us_since(t0);
     r.sfr.push_back(to_stamped(frame.utime, m.pose, sfr.roll, sfr.pitch, sfr.z));
     r.odo.push_back(to_stamped(frame.utime, od.pose, frame.roll, frame.pitch, frame.z));

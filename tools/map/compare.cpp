@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "fploc/annf/annf.h"
+#include "fploc/floorplan/png.h"
 #include "map_tool.h"
 
 namespace fploc {
@@ -48,7 +49,7 @@ std::vector<Sample> sample(const FloorPlan& plan, double step) {
 
 using Rigid = Eigen::Isometry2d;
 
-double share_within(const std::vector<Sample>& s, const Annf& b, const Rigid& T, double tol) {
+double share_within(const std::vector<Sample>& s, const annf::Annf& b, const Rigid& T, double tol) {
   double in = 0, all = 0;
   for (const auto& x : s) {
     double d;
@@ -59,7 +60,7 @@ double share_within(const std::vector<Sample>& s, const Annf& b, const Rigid& T,
   return all > 0 ? in / all : 0;
 }
 
-Rigid icp(const std::vector<Sample>& s, const Annf& b, Rigid T) {
+Rigid icp(const std::vector<Sample>& s, const annf::Annf& b, Rigid T) {
   for (double gate : {0.5, 0.1}) {
     for (int it = 0; it < 30; ++it) {
       Eigen::Vector2d ma(0, 0), mb(0, 0);
@@ -100,11 +101,11 @@ Rigid icp(const std::vector<Sample>& s, const Annf& b, Rigid T) {
 
 int cmd_compare(const FloorPlan& a, const FloorPlan& b, const CompareArgs& args, bool as_json) {
   if (!(args.tolerance > 0) || !(args.step > 0)) throw std::runtime_error("--tolerance and --step must be > 0");
-  AnnfOptions o;
-  o.mode = AnnfMode::kExact;
+  annf::AnnfOptions o;
+  o.mode = annf::AnnfMode::kExact;
   o.max_depth = 9;
   o.margin = 5.0;
-  const Annf fb = Annf::build(b, o);
+  const annf::Annf fb = annf::Annf::build(b, o);
   const std::vector<Sample> s = sample(a, args.step);
   double total = 0;
   for (const auto& x : s) total += x.w;

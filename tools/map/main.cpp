@@ -63,18 +63,18 @@ struct AnnfArgs {
     app->add_option("--candidates", candidates, "paper mode: all | passing (default) | passing-inherit")
         ->check(CLI::IsMember({"all", "passing", "passing-inherit"}));
   }
-  AnnfOptions options() const {
-    AnnfOptions o;
-    o.mode = parse_annf_mode(mode);
-    o.paper_rule = parse_paper_rule(rule);
+  annf::AnnfOptions options() const {
+    annf::AnnfOptions o;
+    o.mode = annf::parse_annf_mode(mode);
+    o.paper_rule = annf::parse_paper_rule(rule);
     o.max_depth = depth;
     o.root_length = root;
     o.exact_max_candidates = max_candidates;
     o.exact_refine_levels = refine;
     o.paper_distinct_distances = distinct;
-    o.paper_candidates = candidates == "passing"           ? AnnfOptions::Candidates::kPassingElseAll
-                         : candidates == "passing-inherit" ? AnnfOptions::Candidates::kPassingInherit
-                                                           : AnnfOptions::Candidates::kAll;
+    o.paper_candidates = candidates == "passing"           ? annf::AnnfOptions::Candidates::kPassingElseAll
+                         : candidates == "passing-inherit" ? annf::AnnfOptions::Candidates::kPassingInherit
+                                                           : annf::AnnfOptions::Candidates::kAll;
     o.margin = margin;
     return o;
   }
@@ -84,13 +84,13 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-json stats_json(const Annf& a, double build_ms) {
-  const AnnfStats s = a.stats();
+json stats_json(const annf::Annf& a, double build_ms) {
+  const annf::AnnfStats s = a.stats();
   return {{"mode", to_string(a.options().mode)},
           {"rule", to_string(a.options().paper_rule)},
           {"distinct_distances", a.options().paper_distinct_distances},
-          {"candidates", a.options().paper_candidates == AnnfOptions::Candidates::kAll             ? "all"
-                         : a.options().paper_candidates == AnnfOptions::Candidates::kPassingInherit ? "passing-inherit"
+          {"candidates", a.options().paper_candidates == annf::AnnfOptions::Candidates::kAll             ? "all"
+                         : a.options().paper_candidates == annf::AnnfOptions::Candidates::kPassingInherit ? "passing-inherit"
                                                                                                      : "passing"},
           {"exact_max_candidates", a.options().exact_max_candidates},
           {"exact_refine_levels", a.options().exact_refine_levels},
@@ -111,7 +111,7 @@ json stats_json(const Annf& a, double build_ms) {
 int cmd_build(const PlanArgs& pa, const AnnfArgs& aa, const std::string& out, bool as_json) {
   const FloorPlan plan = pa.load();
   const auto t0 = std::chrono::steady_clock::now();
-  const Annf a = Annf::build(plan, aa.options());
+  const annf::Annf a = annf::Annf::build(plan, aa.options());
   const double ms = ms_since(t0);
   a.save(out);
   json j = stats_json(a, ms);

@@ -43,8 +43,6 @@ struct PgmArgs {
 };
 int cmd_export_pgm(const FloorPlan& plan, const PgmArgs& a, bool as_json);
 
-// RGB image (row-major, 3 bytes per pixel) as PNG; throws when built without libpng.
-void write_rgb_png(const std::string& out, int w, int h, const std::vector<uint8_t>& img);
 
 struct CompareArgs {
   double tolerance = 0.05;  // metres

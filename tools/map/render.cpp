@@ -8,10 +8,8 @@
 #include <stdexcept>
 
 #include "fploc/annf/annf.h"
+#include "fploc/floorplan/png.h"
 #include "map_tool.h"
-#ifdef FPLOC_HAVE_PNG
-#include <png.h>
-#endif
 
 namespace fploc {
 namespace {
@@ -41,7 +39,7 @@ void colour(uint32_t id, uint8_t rgb[3]) {
   rgb[2] = uint8_t((b + m) * 255);
 }
 
-void write_svg(const Annf& f, const std::string& out, int width) {
+void write_svg(const annf::Annf& f, const std::string& out, int width) {
   const FloorPlan& plan = f.plan();
   const Box2 b = plan.bounds();
   const double pad = 0.02 * b.size().maxCoeff() + 0.1;
@@ -81,18 +79,17 @@ void write_svg(const Annf& f, const std::string& out, int width) {
   if (!s) throw std::runtime_error(out + ": write error");
 }
 
-void write_png(const Annf& f, const std::string& out, int width) {
-#ifdef FPLOC_HAVE_PNG
+void write_png(const annf::Annf& f, const std::string& out, int width) {
   const FloorPlan& plan = f.plan();
   const Box2 b = plan.bounds();
   const double pad = 0.02 * b.size().maxCoeff() + 0.1;
   const double W = b.size().x() + 2 * pad, H = b.size().y() + 2 * pad;
   const int w = std::max(16, width), h = std::max(16, int(std::ceil(w * H / W)));
   const double px = W / w;
-  AnnfOptions xo;
-  xo.mode = AnnfMode::kExact;
+  annf::AnnfOptions xo;
+  xo.mode = annf::AnnfMode::kExact;
   xo.max_depth = 9;
-  const Annf exact = Annf::build(plan, xo);
+  const annf::Annf exact = annf::Annf::build(plan, xo);
   std::vector<uint8_t> img(size_t(w) * h * 3);
   std::vector<int64_t> leaf_key(size_t(w) * h, -1);
   for (int j = 0; j < h; ++j)
@@ -119,50 +116,19 @@ void write_png(const Annf& f, const std::string& out, int width) {
         for (int q = 0; q < 3; ++q) img[k * 3 + q] = uint8_t(img[k * 3 + q] * 0.8);
     }
   write_rgb_png(out, w, h, img);
-#else
-  (void)f;
-  (void)width;
-  throw std::runtime_error(out + ": PNG support not built (libpng-dev missing); use .svg");
-#endif
 }
 
 }  // namespace
 
-void write_rgb_png(const std::string& out, int w, int h, const std::vector<uint8_t>& img) {
-#ifdef FPLOC_HAVE_PNG
-  FILE* fp = std::fopen(out.c_str(), "wb");
-  if (!fp) throw std::runtime_error(out + ": cannot write");
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  png_infop info = png_create_info_struct(png);
-  if (setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    std::fclose(fp);
-    throw std::runtime_error(out + ": PNG write error");
-  }
-  png_init_io(png, fp);
-  png_set_IHDR(png, info, w, h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
-               PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (int j = 0; j < h; ++j) png_write_row(png, &img[size_t(j) * w * 3]);
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  std::fclose(fp);
-#else
-  (void)w;
-  (void)h;
-  (void)img;
-  throw std::runtime_error(out + ": PNG support not built (libpng-dev missing); use .svg");
-#endif
-}
 
 int cmd_render(const FloorPlan& plan, const RenderArgs& a) {
-  Annf f;
+  annf::Annf f;
   if (!a.map.empty()) {
-    f = Annf::load(a.map);
+    f = annf::Annf::load(a.map);
   } else {
-    AnnfOptions o;
+    annf::AnnfOptions o;
     o.max_depth = a.depth;
-    f = Annf::build(plan, o);
+    f = annf::Annf::build(plan, o);
   }
   const std::string ext = lower_ext(a.out);
   if (ext == ".svg")
@@ -184,10 +150,10 @@ int cmd_export_pgm(const FloorPlan& plan, const PgmArgs& a, bool as_json) {
   const double wd = std::ceil(w_m / a.resolution), hd = std::ceil(h_m / a.resolution);
   if (wd * hd > 4e8) throw std::runtime_error("map too large at this resolution");
   const int w = int(wd), h = int(hd);
-  AnnfOptions xo;
-  xo.mode = AnnfMode::kExact;
+  annf::AnnfOptions xo;
+  xo.mode = annf::AnnfMode::kExact;
   xo.max_depth = 9;
-  const Annf exact = Annf::build(plan, xo);
+  const annf::Annf exact = annf::Annf::build(plan, xo);
   // A pixel is occupied when an element passes through it (centre distance <= half diagonal) or is
   // within half the requested wall thickness.
   const double occ = std::max(a.resolution * std::sqrt(0.5), a.thickness / 2);

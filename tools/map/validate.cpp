@@ -60,11 +60,11 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
   if (a.samples < 1) throw std::runtime_error("--samples must be >= 1");
   Box2 bb = plan.bounds();
   if (a.sample_area == "fields") {  // the area covered by the root fields (extends past the plan)
-    AnnfOptions ro;
+    annf::AnnfOptions ro;
     ro.root_length = a.root;
     ro.margin = a.margin;
     ro.max_depth = 1;
-    bb = Annf::build(plan, ro).covered();
+    bb = annf::Annf::build(plan, ro).covered();
   } else if (a.sample_area != "bbox") {
     throw std::runtime_error("--sample-area: bbox or fields");
   }
@@ -83,22 +83,22 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
 
   json rows = json::array();
   struct Config {
-    AnnfMode mode;
-    PaperRule rule;
+    annf::AnnfMode mode;
+    annf::PaperRule rule;
     bool distinct;
   };
   std::vector<Config> configs;
   if (a.mode != "exact") {
     if (a.all_rules) {
       for (bool distinct : {false, true})
-        for (PaperRule r : {PaperRule::kChildLeaf, PaperRule::kUndoOnly, PaperRule::kChildLeafOrdered, PaperRule::kFull,
-                            PaperRule::kCollapseFirst, PaperRule::kCollapsePair})
-          configs.push_back({AnnfMode::kPaper, r, distinct});
+        for (annf::PaperRule r : {annf::PaperRule::kChildLeaf, annf::PaperRule::kUndoOnly, annf::PaperRule::kChildLeafOrdered, annf::PaperRule::kFull,
+                            annf::PaperRule::kCollapseFirst, annf::PaperRule::kCollapsePair})
+          configs.push_back({annf::AnnfMode::kPaper, r, distinct});
     } else {
-      configs.push_back({AnnfMode::kPaper, parse_paper_rule(a.rule), a.distinct});
+      configs.push_back({annf::AnnfMode::kPaper, annf::parse_paper_rule(a.rule), a.distinct});
     }
   }
-  if (a.mode != "paper") configs.push_back({AnnfMode::kExact, PaperRule::kChildLeaf, false});
+  if (a.mode != "paper") configs.push_back({annf::AnnfMode::kExact, annf::PaperRule::kChildLeaf, false});
   const size_t timed = std::min<size_t>(pts.size(), 2000000);
   const bool by_id = a.hit_by == "id";
 
@@ -106,20 +106,20 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
                "leaf[cm]", "hit1", "hit1|2", "exact", "ns/q", "batch", "bytes", "build[ms]", "hit1", "hit1|2");
   for (const auto& [mode, rule, distinct] : configs) {
     for (int depth = d0; depth <= d1; ++depth) {
-      AnnfOptions o;
+      annf::AnnfOptions o;
       o.mode = mode;
       o.paper_rule = rule;
       o.root_length = a.root;
       o.margin = a.margin;
-      o.max_depth = depth + (mode == AnnfMode::kExact ? a.exact_depth : 0);
+      o.max_depth = depth + (mode == annf::AnnfMode::kExact ? a.exact_depth : 0);
       o.exact_max_candidates = a.max_candidates;
       o.exact_refine_levels = a.refine;
       o.paper_distinct_distances = distinct;
-      o.paper_candidates = a.candidates == "passing"           ? AnnfOptions::Candidates::kPassingElseAll
-                           : a.candidates == "passing-inherit" ? AnnfOptions::Candidates::kPassingInherit
-                                                               : AnnfOptions::Candidates::kAll;
+      o.paper_candidates = a.candidates == "passing"           ? annf::AnnfOptions::Candidates::kPassingElseAll
+                           : a.candidates == "passing-inherit" ? annf::AnnfOptions::Candidates::kPassingInherit
+                                                               : annf::AnnfOptions::Candidates::kAll;
       const double t0 = now_ns();
-      const Annf f = Annf::build(plan, o);
+      const annf::Annf f = annf::Annf::build(plan, o);
       const double build_ms = (now_ns() - t0) / 1e6;
       size_t h1 = 0, h12 = 0, hx = 0;
       for (size_t i = 0; i < pts.size(); ++i) {
@@ -165,12 +165,12 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
         const uint32_t* c = f.lookup(p, &n);
         return c ? double(c[0] + n) : 0.0;
       });
-      const AnnfStats s = f.stats();
+      const annf::AnnfStats s = f.stats();
       const double N = double(pts.size());
       json row = {{"mode", to_string(mode)},
-                  {"rule", mode == AnnfMode::kPaper ? to_string(rule) : "-"},
+                  {"rule", mode == annf::AnnfMode::kPaper ? to_string(rule) : "-"},
                   {"distinct_distances", distinct},
-                  {"candidates", mode == AnnfMode::kPaper ? a.candidates : "-"},
+                  {"candidates", mode == annf::AnnfMode::kPaper ? a.candidates : "-"},
                   {"depth", o.max_depth},
                   {"leaf_length_m", f.leaf_length()},
                   {"hit_first", h1 / N},
@@ -188,18 +188,18 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
                   {"max_candidates", s.max_leaf_candidates},
                   {"build_ms", build_ms}};
       auto it = kPaper.find(o.max_depth);
-      if (mode == AnnfMode::kPaper && it != kPaper.end()) {
+      if (mode == annf::AnnfMode::kPaper && it != kPaper.end()) {
         row["paper_hit_first"] = it->second[0] / 100;
         row["paper_hit_first_or_second"] = it->second[1] / 100;
       }
       rows.push_back(row);
-      const std::string rname = mode == AnnfMode::kPaper ? std::string(to_string(rule)) + (distinct ? "+distinct" : "") +
+      const std::string rname = mode == annf::AnnfMode::kPaper ? std::string(to_string(rule)) + (distinct ? "+distinct" : "") +
                                                                (a.candidates != "all" ? "+" + a.candidates : "")
                                                          : "-";
       std::fprintf(stderr, "%-6s %-44s %5d %9.2f %7.2f%% %7.2f%% %7.3f%% %8.2f %8.2f %10zu %9.0f", to_string(mode),
                    rname.c_str(), o.max_depth, f.leaf_length() * 100, 100 * h1 / N,
                    100 * h12 / N, 100 * hx / N, ns, batch_ns, s.bytes, build_ms);
-      if (mode == AnnfMode::kPaper && it != kPaper.end())
+      if (mode == annf::AnnfMode::kPaper && it != kPaper.end())
         std::fprintf(stderr, " | paper: %5.2f%% %5.2f%%\n", it->second[0], it->second[1]);
       else
         std::fprintf(stderr, "\n");
@@ -212,7 +212,7 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
   json base = {{"brute_force_ns", brute_ns}};
   if (!a.no_baselines) {
     const double spacing = a.root / double(1u << (a.baseline_depth - 1));
-    const SampledKdTree kd(plan, spacing);
+    const annf::SampledKdTree kd(plan, spacing);
     size_t kh = 0;
     for (size_t i = 0; i < pts.size(); ++i) {
       const int id = kd.nearest(pts[i]);
@@ -222,13 +222,13 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
       double d;
       return kd.nearest(p, &d) + d;
     });
-    AnnfOptions xo;
-    xo.mode = AnnfMode::kExact;
+    annf::AnnfOptions xo;
+    xo.mode = annf::AnnfMode::kExact;
     xo.root_length = a.root;
     xo.margin = a.margin;
     xo.max_depth = a.baseline_depth + 2;
-    const Annf ex = Annf::build(plan, xo);
-    const DistanceGrid grid(ex, spacing);
+    const annf::Annf ex = annf::Annf::build(plan, xo);
+    const annf::DistanceGrid grid(ex, spacing);
     size_t gh = 0;
     for (size_t i = 0; i < pts.size(); ++i) {
       const int id = grid.read(pts[i]);

@@ -6,7 +6,6 @@
 // run on: the round trip).
 #include <CLI/CLI.hpp>
 
-#include <png.h>
 
 #include <cmath>
 #include <fstream>
@@ -16,6 +15,7 @@
 
 #include "fploc/floorplan/io.h"
 #include "fploc/floorplan/occupancy.h"
+#include "fploc/floorplan/png.h"
 
 namespace {
 // Largest distance from points sampled every `step` along a's elements to plan b (brute force).
@@ -87,23 +87,7 @@ void write_png(const std::string& out, const fploc::OccupancyGrid& g, const fplo
   for (const auto& e : plan.elements) line(e.a, e.b, red, 0);
   for (size_t t = 0; t < tracks.size(); ++t)
     for (size_t k = 1; k < tracks[t].size(); ++k) line(tracks[t][k - 1], tracks[t][k], cols[t % 4], 1);
-  FILE* fp = std::fopen(out.c_str(), "wb");
-  if (!fp) throw std::runtime_error(out + ": cannot write");
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  png_infop info = png_create_info_struct(png);
-  if (setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    std::fclose(fp);
-    throw std::runtime_error(out + ": PNG write error");
-  }
-  png_init_io(png, fp);
-  png_set_IHDR(png, info, W, H, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
-               PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (int y = 0; y < H; ++y) png_write_row(png, &img[size_t(y) * W * 3]);
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  std::fclose(fp);
+  fploc::write_rgb_png(out, W, H, img);
 }
 }  // namespace
 

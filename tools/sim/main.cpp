@@ -20,6 +20,7 @@
 #include "fploc/adapters/ground_truth_t.h"
 #include "fploc/adapters/scan_t.h"
 #include "fploc/sim/simulator.h"
+#include "fploc/runtime/log_writer.h"
 
 namespace {
 
@@ -28,19 +29,7 @@ std::string shared_dir() {
   return FPLOC_SHARED_DIR;
 }
 
-template <class Msg>
-void write_event(lcm::LogFile& log, int64_t utime, const std::string& channel, const Msg& m, std::vector<uint8_t>& buf) {
-  const int n = m.getEncodedSize();
-  buf.resize(size_t(n));
-  m.encode(buf.data(), 0, n);
-  lcm::LogEvent ev;
-  ev.eventnum = 0;
-  ev.timestamp = utime;
-  ev.channel = channel;
-  ev.datalen = n;
-  ev.data = buf.data();
-  if (log.writeEvent(&ev) != 0) throw std::runtime_error("cannot write LCM log event on " + channel);
-}
+using fploc::rt::write_event;
 
 }  // namespace
 

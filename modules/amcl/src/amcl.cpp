@@ -244,11 +244,11 @@ std::vector<int> low_variance_indices(const std::vector<double>& w, int M, doubl
 LikelihoodField::LikelihoodField(const FloorPlan& plan, double resolution, double max_dist)
     : res_(resolution), inv_(1.0 / resolution), max_dist_(max_dist) {
   if (plan.elements.empty()) throw std::runtime_error("amcl: empty floor plan");
-  AnnfOptions ao;
-  ao.mode = AnnfMode::kExact;
+  annf::AnnfOptions ao;
+  ao.mode = annf::AnnfMode::kExact;
   ao.max_depth = 6;  // only cell centres are read; the exact field is exact everywhere
-  const std::shared_ptr<const Annf> exact = cached_annf(plan, ao);  // shared on disk (fploc/annf/cache.h)
-  const DistanceGrid grid(*exact, resolution);
+  const std::shared_ptr<const annf::Annf> exact = annf::cached_annf(plan, ao);  // shared on disk (fploc/annf/cache.h)
+  const annf::DistanceGrid grid(*exact, resolution);
   ox_ = grid.origin().x();
   oy_ = grid.origin().y();
   nx_ = grid.nx();

@@ -4,7 +4,7 @@
 #include <nanoflann.hpp>
 #include <stdexcept>
 
-namespace fploc {
+namespace fploc::annf {
 
 struct SampledKdTree::Impl {
   struct Cloud {
@@ -88,4 +88,4 @@ DistanceGrid::DistanceGrid(const Annf& exact, double resolution) {
     }
 }
 
-}  // namespace fploc
+}  // namespace fploc::annf

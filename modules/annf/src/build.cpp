@@ -10,7 +10,7 @@
 #include "fploc/annf/ablation.h"
 #include "fploc/annf/annf.h"
 
-namespace fploc {
+namespace fploc::annf {
 namespace {
 
 [[noreturn]] void fail(const std::string& m) { throw std::runtime_error(m); }
@@ -409,4 +409,4 @@ Annf Annf::build(const FloorPlan& plan, const AnnfOptions& options) {
   return a;
 }
 
-}  // namespace fploc
+}  // namespace fploc::annf

@@ -16,7 +16,7 @@
 
 #include "fploc/floorplan/io.h"
 
-namespace fploc {
+namespace fploc::annf {
 namespace {
 
 namespace fs = std::filesystem;
@@ -192,4 +192,4 @@ std::shared_ptr<const Annf> cached_annf(const FloorPlan& plan, const AnnfOptions
   }
 }
 
-}  // namespace fploc
+}  // namespace fploc::annf

@@ -9,7 +9,7 @@
 #include "fploc/floorplan/binary_io.h"
 #include "fploc/floorplan/io.h"
 
-namespace fploc {
+namespace fploc::annf {
 namespace {
 
 [[noreturn]] void fail(const std::string& m) { throw std::runtime_error(m); }
@@ -131,4 +131,4 @@ Annf Annf::load(const std::string& path) {
   return a;
 }
 
-}  // namespace fploc
+}  // namespace fploc::annf

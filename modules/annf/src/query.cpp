@@ -8,7 +8,7 @@
 
 #include "fploc/annf/annf.h"
 
-namespace fploc {
+namespace fploc::annf {
 namespace {
 
 [[noreturn]] void fail(const std::string& m) { throw std::runtime_error(m); }
@@ -393,4 +393,4 @@ AnnfStats Annf::stats() const {
   return s;
 }
 
-}  // namespace fploc
+}  // namespace fploc::annf

@@ -11,6 +11,7 @@
 #include "fploc/floorplan/io.h"
 
 using namespace fploc;
+using namespace fploc::annf;
 
 namespace {
 bool have_shared() { return std::filesystem::exists(std::string(FPLOC_SHARED_DIR) + "/data/floorplans"); }

@@ -14,6 +14,7 @@
 #include "fploc/floorplan/io.h"
 
 using namespace fploc;
+using namespace fploc::annf;
 namespace fs = std::filesystem;
 
 namespace {

@@ -65,16 +65,16 @@ void UncertaintyTracker::reset(double sigma_m, double sigma_rad) {
 }
 
 UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d& frame_cov_in, bool frame_valid,
-                                            FitStatus matcher_status, const std::string& matcher_text) {
+                                            matcher::FitStatus matcher_status, const std::string& matcher_text) {
   const double vmax = cfg_.frame.max_variance;
   const double v2 = cfg_.max_velocity_error_mps * cfg_.max_velocity_error_mps;
   const double w2 = cfg_.yaw_rate_sigma_rps * cfg_.yaw_rate_sigma_rps;
   const Eigen::Matrix3d frame_cov = frame_valid ? clamp_spd(frame_cov_in, 1e-14, vmax) : Eigen::Matrix3d::Identity() * vmax;
-  const bool frame_ok = frame_valid && matcher_status == FitStatus::kOk;
+  const bool frame_ok = frame_valid && matcher_status == matcher::FitStatus::kOk;
   const double dt = (utime - last_utime_) * 1e-6;
   const Eigen::Matrix3d unknown_velocity = Eigen::Vector3d(v2, v2, w2).asDiagonal();
   Eigen::Matrix3d P_pred, W_pred;
-  if (matcher_status == FitStatus::kLost) {
+  if (matcher_status == matcher::FitStatus::kLost) {
     P_pred = Eigen::Matrix3d::Identity() * vmax;
     W_pred = unknown_velocity;
   } else if (!have_ || !(dt >= 0) || dt > cfg_.max_gap_s) {
@@ -108,7 +108,7 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
     P_ = P_pred;
     W_ = W_pred;
   }
-  have_ = matcher_status != FitStatus::kLost;
+  have_ = matcher_status != matcher::FitStatus::kLost;
   have_initial_ = false;
   last_utime_ = utime;
   UncertaintyState s;
@@ -119,16 +119,16 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
   s.frame_degenerate = s.frame_sigma_max_m > cfg_.poor_sigma_m;
   s.status = matcher_status;
   s.text = matcher_text;
-  if (matcher_status == FitStatus::kOk) {
+  if (matcher_status == matcher::FitStatus::kOk) {
     char b[200];
     if (s.sigma_max_m > cfg_.poor_sigma_m) {
       std::snprintf(b, sizeof b, "position open along %ld deg (1 sigma %.2f m%s)", std::lround(s.weak_direction_rad * 180 / M_PI),
                     s.sigma_max_m, s.frame_degenerate ? ": the plan does not constrain it here" : "");
-      s.status = FitStatus::kPoor;
+      s.status = matcher::FitStatus::kPoor;
       s.text = b;
     } else if (s.sigma_yaw_rad > cfg_.poor_sigma_rad) {
       std::snprintf(b, sizeof b, "heading weakly constrained (1 sigma %.1f deg)", s.sigma_yaw_rad * 180 / M_PI);
-      s.status = FitStatus::kPoor;
+      s.status = matcher::FitStatus::kPoor;
       s.text = b;
     }
   }

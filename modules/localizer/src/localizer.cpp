@@ -15,7 +15,7 @@ Config with_uncertainty_defaults(Config c) {
 }
 }  // namespace
 
-Localizer::Localizer(const NearestLookup& lookup, Config cfg)
+Localizer::Localizer(const matcher::NearestLookup& lookup, Config cfg)
     : cfg_(with_uncertainty_defaults(std::move(cfg))),
       lookup_(lookup),
       matcher_(lookup, cfg_.matcher),
@@ -51,7 +51,7 @@ FramePose Localizer::register_frame(const FeatureFrame& f) {
     // Prediction: the yaw change since the previous frame; motion compensation: the mean rate over
     // this frame's sweep (its samples arrive before the scan is complete).
     if (have_prev_) dyaw = imu_.integral(prev_utime_, f.utime);
-    const double sweep = sweep_duration(f);
+    const double sweep = matcher::sweep_duration(f);
     if (sweep > 0)
       if (auto w = imu_.mean_rate(f.utime, f.utime + std::llround(sweep * 1e6))) held_.sweep_yaw_rate = *w;
     imu_.drop_before(std::min(f.utime, have_prev_ ? prev_utime_ : f.utime));
@@ -65,7 +65,7 @@ FramePose Localizer::register_frame(const FeatureFrame& f) {
   out.utime = f.utime;
   out.scan_seq = f.scan_seq;
   out.match = matcher_.process(held_, dyaw, motion);
-  if (out.match.status != FitStatus::kNotInitialised) {
+  if (out.match.status != matcher::FitStatus::kNotInitialised) {
     prev_utime_ = f.utime;
     have_prev_ = true;
   }
@@ -78,8 +78,8 @@ FramePose Localizer::register_frame(const FeatureFrame& f) {
 }
 
 std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& sfr, std::vector<Pose>* finals) {
-  if (sfr.match.status == FitStatus::kNotInitialised) return std::nullopt;
-  FrameInput in;
+  if (sfr.match.status == matcher::FitStatus::kNotInitialised) return std::nullopt;
+  optimizer::FrameInput in;
   in.features = f;
   in.sfr = sfr.match.pose;
   in.twist = sfr.match.twist;
@@ -90,9 +90,9 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
   if (cfg_.uncertainty.enabled) {
     // The frame de-skewed to its mean point time with the matcher's twist, at the pose of that time (as
     // the window's keyframes; FramePose from a message carries only the pose at utime and the twist).
-    const double t_ref = mean_time(f);
-    deskew(f, sfr.match.twist, t_ref, &deskewed_);
-    const Pose2 at_ref = compose(sfr.match.pose, exp_twist(sfr.match.twist, t_ref));
+    const double t_ref = matcher::mean_time(f);
+    matcher::deskew(f, sfr.match.twist, t_ref, &deskewed_);
+    const Pose2 at_ref = compose(sfr.match.pose, matcher::exp_twist(sfr.match.twist, t_ref));
     const auto fu = optimizer::frame_uncertainty(lookup_, deskewed_, at_ref, cfg_.uncertainty.frame);
     uncertainty_ = tracker_.update(f.utime, fu.covariance, fu.valid, sfr.match.status, sfr.match.text);
     in.covariance = uncertainty_.covariance;

@@ -10,6 +10,7 @@
 #include "synthetic.h"
 
 using namespace fploc;
+using namespace fploc::matcher;
 using namespace fploc::localizer;
 
 namespace {

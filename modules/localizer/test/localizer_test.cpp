@@ -26,7 +26,7 @@ std::vector<FeatureFrame> make_frames(const FloorPlan& plan, int n) {
     so.seed = uint32_t(k + 1);
     so.noise_sigma = 0.01;
     so.sweep_s = 0.1;
-    so.sweep_twist = log_twist(truth_at(t), truth_at(t + so.sweep_s), so.sweep_s);
+    so.sweep_twist = matcher::log_twist(truth_at(t), truth_at(t + so.sweep_s), so.sweep_s);
     frames.push_back(synth_frame(plan, truth_at(t), so, int64_t(std::llround(t * 1e6))));
     frames.back().scan_seq = k;
     frames.back().z = 1.2;
@@ -42,8 +42,8 @@ void feed_imu(localizer::Localizer& loc, double t0, double t1) {
 
 class LocalizerTest : public ::testing::Test {
  protected:
-  LocalizerTest() : map_(make_localization_map(room_with_pillars(), "annf-exact")), frames_(make_frames(*map_.plan, 60)) {}
-  LocalizationMap map_;
+  LocalizerTest() : map_(matcher::make_localization_map(room_with_pillars(), "annf-exact")), frames_(make_frames(*map_.plan, 60)) {}
+  matcher::LocalizationMap map_;
   std::vector<FeatureFrame> frames_;
 };
 
@@ -51,7 +51,7 @@ TEST_F(LocalizerTest, NotInitialisedUntilSetPose) {
   localizer::Localizer loc(*map_.lookup, {});
   std::vector<localizer::Pose> finals;
   const auto s = loc.process(frames_[0], &finals);
-  EXPECT_EQ(s.sfr.match.status, FitStatus::kNotInitialised);
+  EXPECT_EQ(s.sfr.match.status, matcher::FitStatus::kNotInitialised);
   EXPECT_FALSE(s.latest);
   EXPECT_TRUE(finals.empty());
 }
@@ -66,7 +66,7 @@ TEST_F(LocalizerTest, TracksASequenceAndItsPosesCarryTheirSigmas) {
   for (size_t k = 0; k < frames_.size(); ++k) {
     feed_imu(loc, 0.1 * k - 0.1, 0.1 * k + 0.11);
     const auto s = loc.process(frames_[k], &finals);
-    ASSERT_EQ(s.sfr.match.status, FitStatus::kOk) << "frame " << k;
+    ASSERT_EQ(s.sfr.match.status, matcher::FitStatus::kOk) << "frame " << k;
     ASSERT_TRUE(s.latest);
     EXPECT_EQ(s.latest->utime, frames_[k].utime);
     const Pose2 g = truth_at(0.1 * k);

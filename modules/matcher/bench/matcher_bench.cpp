@@ -11,6 +11,7 @@
 #include "synthetic.h"
 
 using namespace fploc;
+using namespace fploc::matcher;
 
 static void BM_RegisterFrame(benchmark::State& st, std::string lookup) {
   auto map = make_localization_map(fploc::testing::room_with_pillars(), lookup);

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace fploc {
+namespace fploc::matcher {
 
 bool ImuYaw::add(int64_t utime, double gyro_z) {
   if (!std::isfinite(gyro_z)) return false;
@@ -38,4 +38,4 @@ void ImuYaw::drop_before(int64_t utime) {
   while (s_.size() > 2 && s_[1].first < utime) s_.pop_front();
 }
 
-}  // namespace fploc
+}  // namespace fploc::matcher

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace fploc {
+namespace fploc::matcher {
 
 const std::vector<TargetGeom>& NearestLookup::geometry() const {
   std::call_once(geom_once_, [this] {
@@ -101,4 +101,4 @@ int KdTreeLookup::candidates(const Eigen::Vector2d& p, int* out, int max) const 
   return 1;
 }
 
-}  // namespace fploc
+}  // namespace fploc::matcher

@@ -7,7 +7,7 @@
 #include "fploc/annf/annf.h"
 #include "fploc/annf/cache.h"
 
-namespace fploc {
+namespace fploc::matcher {
 
 namespace {
 
@@ -15,7 +15,7 @@ namespace {
 // max depth) and points outside the covered area use Annf::nearest (exact).
 class AnnfLookup : public NearestLookup {
  public:
-  AnnfLookup(std::shared_ptr<const Annf> annf, bool first_only, std::string name)
+  AnnfLookup(std::shared_ptr<const annf::Annf> annf, bool first_only, std::string name)
       : annf_(std::move(annf)), first_only_(first_only), name_(std::move(name)) {}
   const std::vector<Element>& targets() const override { return annf_->plan().elements; }
   int candidates(const Eigen::Vector2d& p, int* out, int max) const override {
@@ -35,7 +35,7 @@ class AnnfLookup : public NearestLookup {
   std::string name() const override { return name_; }
 
  private:
-  std::shared_ptr<const Annf> annf_;
+  std::shared_ptr<const annf::Annf> annf_;
   bool first_only_;
   std::string name_;
 };
@@ -62,13 +62,13 @@ LocalizationMap finish(LocalizationMap m, const std::string& lookup, std::shared
     m.lookup = std::make_unique<BruteForceLookup>(*m.plan);
     return m;
   }
-  const AnnfMode mode = lookup == "annf-exact" ? AnnfMode::kExact : AnnfMode::kPaper;
-  auto annf = std::static_pointer_cast<const Annf>(annf_in);
+  const annf::AnnfMode mode = lookup == "annf-exact" ? annf::AnnfMode::kExact : annf::AnnfMode::kPaper;
+  auto annf = std::static_pointer_cast<const annf::Annf>(annf_in);
   if (!annf || annf->options().mode != mode) {
-    AnnfOptions o;
+    annf::AnnfOptions o;
     o.mode = mode;
     std::string how;
-    annf = cached_annf(*m.plan, o, &how);  // built once per plan and options, shared (fploc/annf/cache.h)
+    annf = annf::cached_annf(*m.plan, o, &how);  // built once per plan and options, shared (fploc/annf/cache.h)
     m.note += std::string(m.note.empty() ? "" : "; ") + how;
   }
   m.annf = annf;
@@ -94,7 +94,7 @@ LocalizationMap load_localization_map(const std::string& path, const std::vector
   LocalizationMap m;
   std::shared_ptr<const void> annf;
   if (ends_with(path, ".fpmap")) {
-    auto a = std::make_shared<const Annf>(Annf::load(path));
+    auto a = std::make_shared<const annf::Annf>(annf::Annf::load(path));
     m.plan = std::make_shared<const FloorPlan>(a->plan());
     m.note = "loaded " + path;
     annf = a;
@@ -105,4 +105,4 @@ LocalizationMap load_localization_map(const std::string& path, const std::vector
   return finish(std::move(m), lookup, annf);
 }
 
-}  // namespace fploc
+}  // namespace fploc::matcher

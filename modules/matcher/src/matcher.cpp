@@ -6,7 +6,7 @@
 
 #include "fploc/matcher/plan_terms.h"
 
-namespace fploc {
+namespace fploc::matcher {
 
 namespace {
 
@@ -260,4 +260,4 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
   return r;
 }
 
-}  // namespace fploc
+}  // namespace fploc::matcher

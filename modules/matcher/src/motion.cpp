@@ -2,7 +2,7 @@
 
 #include "fploc/matcher/types.h"
 
-namespace fploc {
+namespace fploc::matcher {
 namespace {
 // cos, sin, sin(th)/th, (1 - cos(th))/th for the small angles of one sweep: series to 7th order for
 // |th| < 0.2 (error < 1e-11), std:: else.
@@ -79,4 +79,4 @@ double sweep_duration(const FeatureFrame& f) {
   return m;
 }
 
-}  // namespace fploc
+}  // namespace fploc::matcher

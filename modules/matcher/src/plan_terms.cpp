@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-namespace fploc {
+namespace fploc::matcher {
 namespace {
 
 enum class LossKind { kNone, kHuber, kCauchy };
@@ -304,4 +304,4 @@ const char* to_string(FitStatus s) {
   return "?";
 }
 
-}  // namespace fploc
+}  // namespace fploc::matcher

@@ -12,6 +12,7 @@
 #include "synthetic.h"
 
 using namespace fploc;
+using namespace fploc::matcher;
 using fploc::testing::endless_corridor;
 using fploc::testing::room_with_pillars;
 using fploc::testing::synth_frame;

@@ -100,7 +100,7 @@ FeatureFrame synth_frame(const FloorPlan& plan, const Pose2& pose, const SynthOp
   for (int i = 0; i < o.beams; ++i) {
     const double a = 2 * M_PI * i / o.beams;  // sensor-frame bearing
     const double tb = o.sweep_s * i / o.beams;
-    const Pose2 pb = tb > 0 ? compose(pose, exp_twist(o.sweep_twist, tb)) : pose;
+    const Pose2 pb = tb > 0 ? compose(pose, matcher::exp_twist(o.sweep_twist, tb)) : pose;
     const Eigen::Vector2d origin(pb.x, pb.y);
     const Eigen::Vector2d dir(std::cos(a + pb.yaw), std::sin(a + pb.yaw));
     double best = std::numeric_limits<double>::infinity();

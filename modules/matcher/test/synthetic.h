@@ -27,9 +27,9 @@ struct SynthOptions {
   bool groups = true;          // group ids for runs of >= 5 hits on one segment
   uint32_t seed = 1;
   // Rotating sensor: beam i is measured at t = sweep_s * i / beams after utime, from the pose
-  // pose (+) exp_twist(sweep_twist, t), in the sensor frame of that moment (Feature2::t = t).
+  // pose (+) matcher::exp_twist(sweep_twist, t), in the sensor frame of that moment (Feature2::t = t).
   double sweep_s = 0;
-  Twist2 sweep_twist;
+  matcher::Twist2 sweep_twist;
 };
 
 // Features as the sensor at `pose` (its pose at utime) would see them (sensor frame).

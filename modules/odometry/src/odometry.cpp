@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace fploc {
+namespace fploc::odometry {
 
 struct Odometry2D::Map {
   std::vector<Eigen::Vector2d> pts;
@@ -70,7 +70,7 @@ void Odometry2D::set_pose(const Pose2& p) {
 void Odometry2D::add_keyframe(const FeatureFrame& f, const Pose2& p) {
   std::vector<Eigen::Vector2d> w;
   w.reserve(f.points.size());
-  for (const auto& fp : f.points) w.push_back(transform(p, fp.p));
+  for (const auto& fp : f.points) w.push_back(matcher::transform(p, fp.p));
   keyframes_.push_back(std::move(w));
   while (int(keyframes_.size()) > std::max(1, cfg_.map_keyframes)) keyframes_.pop_front();
   map_->rebuild(keyframes_, cfg_.normal_neighbours);
@@ -118,7 +118,7 @@ OdometryResult Odometry2D::process(const FeatureFrame& f_in) {
     inliers = 0;
     sum2 = 0;
     for (const auto& fp : f.points) {
-      const Eigen::Vector2d pw = transform(x, fp.p);
+      const Eigen::Vector2d pw = matcher::transform(x, fp.p);
       uint32_t idx;
       double d2;
       if (map_->tree->knnSearch(pw.data(), 1, &idx, &d2) < 1 || d2 > gate2 || !map_->valid[idx]) continue;
@@ -164,4 +164,4 @@ OdometryResult Odometry2D::process(const FeatureFrame& f_in) {
   return r;
 }
 
-}  // namespace fploc
+}  // namespace fploc::odometry

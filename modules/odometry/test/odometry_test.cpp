@@ -6,6 +6,7 @@
 #include "synthetic.h"
 
 using namespace fploc;
+using namespace fploc::odometry;
 using fploc::testing::synth_frame;
 using fploc::testing::SynthOptions;
 

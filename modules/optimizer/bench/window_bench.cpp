@@ -10,11 +10,12 @@
 #include "synthetic.h"
 
 using namespace fploc;
+using namespace fploc::optimizer;
 
 static void BM_WindowPerFrame(benchmark::State& st) {
-  auto map = make_localization_map(fploc::testing::room_with_pillars(), "annf-exact");
+  auto map = matcher::make_localization_map(fploc::testing::room_with_pillars(), "annf-exact");
   std::vector<FrameInput> frames;
-  Matcher m(*map.lookup, {});
+  matcher::Matcher m(*map.lookup, {});
   auto truth = [](double t) { return Pose2{3.0 + 0.6 * t, 3.0 + 1.5 * std::sin(0.25 * t), 0.1 * t}; };
   m.set_pose(truth(0));
   for (int k = 0; k < 100; ++k) {
@@ -23,7 +24,7 @@ static void BM_WindowPerFrame(benchmark::State& st) {
     so.seed = uint32_t(k + 1);
     FrameInput in;
     in.features = fploc::testing::synth_frame(*map.plan, truth(0.1 * k), so, int64_t(k) * 100000);
-    const MatchResult r = m.process(in.features);
+    const matcher::MatchResult r = m.process(in.features);
     in.sfr = r.pose;
     in.status = r.status;
     frames.push_back(in);

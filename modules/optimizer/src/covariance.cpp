@@ -33,18 +33,18 @@ struct ElementAcc {
 
 }  // namespace
 
-FrameUncertainty frame_uncertainty(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x,
+FrameUncertainty frame_uncertainty(const matcher::NearestLookup& lookup, const FeatureFrame& f, const Pose2& x,
                                    const CovarianceConfig& cfg) {
   FrameUncertainty out;
   out.covariance = Eigen::Matrix3d::Identity() * cfg.max_variance;
-  AssignOptions ao;
+  matcher::AssignOptions ao;
   ao.gate_m = cfg.gate_m;
   ao.group_rule = cfg.group_rule;
   ao.stride = 1;
   if (cfg.max_points > 0 && f.points.size() > size_t(cfg.max_points))
     ao.stride = int((f.points.size() + size_t(cfg.max_points) - 1) / size_t(cfg.max_points));
-  std::vector<Assignment> as;
-  assign(lookup, f, x, ao, &as);
+  std::vector<matcher::Assignment> as;
+  matcher::assign(lookup, f, x, ao, &as);
   const auto& g = lookup.geometry();
   const double c = std::cos(x.yaw), s = std::sin(x.yaw);
   std::unordered_map<int, ElementAcc> elems;
@@ -58,7 +58,7 @@ FrameUncertainty frame_uncertainty(const NearestLookup& lookup, const FeatureFra
     double best = std::numeric_limits<double>::infinity();
     int be = -1;
     for (int k = 0; k < a.n; ++k) {
-      const double d = closest_of(g, &a.cand[k], 1, pw, &qb, &Jb);
+      const double d = matcher::closest_of(g, &a.cand[k], 1, pw, &qb, &Jb);
       if (d < best) best = d, be = a.cand[k], q = qb, J = Jb;
     }
     if (be < 0 || !(best <= cfg.gate_m)) continue;
@@ -71,7 +71,7 @@ FrameUncertainty frame_uncertainty(const NearestLookup& lookup, const FeatureFra
     o.j = Eigen::Vector3d(n.x(), n.y(), n.x() * -ry + n.y() * rx);
     o.w = robust_weight(cfg.loss, cfg.loss_scale_m, d);
     o.d = d;
-    const TargetGeom& e = g[size_t(be)];
+    const matcher::TargetGeom& e = g[size_t(be)];
     if (e.kind == ElementKind::kSegment && e.len > 0) {
       const Eigen::Vector2d ne(-e.u.y(), e.u.x());
       const double sgn = n.dot(ne);                 // +-1 in the interior

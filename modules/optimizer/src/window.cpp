@@ -9,7 +9,7 @@
 
 #include "fploc/matcher/plan_terms.h"
 
-namespace fploc {
+namespace fploc::optimizer {
 namespace {
 
 // sqrt(alpha) (v^{m+1} - v^m), sqrt(beta) (w^{m+1} - w^m) for three consecutive key poses.
@@ -68,7 +68,7 @@ Pose2 plus(const Pose2& a, const Eigen::Vector3d& c) { return {a.x + c[0], a.y +
 
 }  // namespace
 
-WindowOptimizer::WindowOptimizer(const NearestLookup& lookup, OptimizerConfig cfg) : lookup_(lookup), cfg_(std::move(cfg)) {
+WindowOptimizer::WindowOptimizer(const matcher::NearestLookup& lookup, OptimizerConfig cfg) : lookup_(lookup), cfg_(std::move(cfg)) {
   cfg_.window = std::max(1, cfg_.window);
   if (cfg_.linear_solver != "sparse" && cfg_.linear_solver != "dense")
     throw std::invalid_argument("optimizer linear_solver '" + cfg_.linear_solver + "': expected sparse or dense");
@@ -95,16 +95,16 @@ PoseOut WindowOptimizer::make_out(const Frame& f, const Pose2& pose_tau_in, bool
   const double span = (f.tau - prev->tau) * 1e-6;
   if (prev->valid && prev->tau <= o.utime && o.utime <= f.tau && span > 0 && span <= 0.5) {
     // Geodesic interpolation between the two poses at utime.
-    const Twist2 v = log_twist(prev->pose, pose_tau, span);
-    o.pose = compose(prev->pose, exp_twist(v, (o.utime - prev->tau) * 1e-6));
+    const matcher::Twist2 v = matcher::log_twist(prev->pose, pose_tau, span);
+    o.pose = compose(prev->pose, matcher::exp_twist(v, (o.utime - prev->tau) * 1e-6));
   } else {
-    o.pose = compose(pose_tau, exp_twist(f.in.twist, -f.t_ref));
+    o.pose = compose(pose_tau, matcher::exp_twist(f.in.twist, -f.t_ref));
   }
   *prev = {true, f.tau, pose_tau};
   fill_gravity(&o, f.in.features);
   o.keyframe = key;
   o.status = f.in.status;
-  if (f.in.status == FitStatus::kOk || f.in.status == FitStatus::kPoor)
+  if (f.in.status == matcher::FitStatus::kOk || f.in.status == matcher::FitStatus::kPoor)
     o.status = std::max(f.in.status, f.in.published_status);  // the worse of the two (OK < POOR < LOST)
   o.status_text = f.in.status_text;
   o.covariance = f.in.covariance;
@@ -163,10 +163,10 @@ PoseOut WindowOptimizer::add(FrameInput in, std::vector<PoseOut>* finals) {
   Frame fr;
   fr.in = std::move(in);
   const int64_t t = fr.in.features.utime;
-  fr.t_ref = mean_time(fr.in.features);
+  fr.t_ref = matcher::mean_time(fr.in.features);
   fr.tau = t + std::llround(fr.t_ref * 1e6);
-  fr.sfr_tau = compose(fr.in.sfr, exp_twist(fr.in.twist, fr.t_ref));
-  bool key = fr.in.status == FitStatus::kOk;
+  fr.sfr_tau = compose(fr.in.sfr, matcher::exp_twist(fr.in.twist, fr.t_ref));
+  bool key = fr.in.status == matcher::FitStatus::kOk;
   if (key && have_last_key_) {
     const double d = std::hypot(fr.in.sfr.x - last_key_sfr_.x, fr.in.sfr.y - last_key_sfr_.y);
     const double a = std::abs(wrap_angle(fr.in.sfr.yaw - last_key_sfr_.yaw));
@@ -212,7 +212,7 @@ void WindowOptimizer::solve() {
   so.num_threads = 1;
   so.max_num_iterations = std::max(1, cfg_.max_iterations);
   so.logging_type = ceres::SILENT;
-  AssignOptions ao;
+  matcher::AssignOptions ao;
   ao.gate_m = cfg_.gate_m;
   ao.group_rule = cfg_.group_rule;
   ao.stride = cfg_.stride;
@@ -238,12 +238,12 @@ void WindowOptimizer::solve() {
       if (k.as_valid && std::hypot(xk.x - k.as_pose.x, xk.y - k.as_pose.y) <= cfg_.relook_m &&
           std::abs(wrap_angle(xk.yaw - k.as_pose.yaw)) <= cfg_.relook_rad)
         continue;
-      AssignOptions aok = ao;
+      matcher::AssignOptions aok = ao;
       const size_t np = k.deskewed.points.size();
       aok.stride = std::max(1, cfg_.stride);
       if (cfg_.max_points > 0 && np > size_t(cfg_.max_points) * size_t(aok.stride))
         aok.stride = int((np + size_t(cfg_.max_points) - 1) / size_t(cfg_.max_points));
-      std::vector<Assignment> as;
+      std::vector<matcher::Assignment> as;
       assign(lookup_, k.deskewed, xk, aok, &as);
       changed |= !k.as_valid || as != k.as;
       k.as = std::move(as);
@@ -259,7 +259,7 @@ void WindowOptimizer::solve() {
       // point) estimates that sum with weight stride, so the balance against the velocity terms does not
       // depend on the budget.
       const double w = cfg_.budget_weight ? std::sqrt(double(k.as_stride)) : 1.0;
-      add_frame_term(&problem, k.x, lookup_, k.deskewed, k.as, cfg_.loss, cfg_.loss_scale_m, w);
+      matcher::add_frame_term(&problem, k.x, lookup_, k.deskewed, k.as, cfg_.loss, cfg_.loss_scale_m, w);
     }
     for (size_t i = 0; i + 2 < chain.size(); ++i) {
       const double dt0 = (chain[i + 1].second - chain[i].second) * 1e-6;
@@ -322,4 +322,4 @@ void WindowOptimizer::flush(std::vector<PoseOut>* finals) {
   emit_pending_until(std::numeric_limits<int64_t>::max(), c, finals);
 }
 
-}  // namespace fploc
+}  // namespace fploc::optimizer

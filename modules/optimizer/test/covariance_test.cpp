@@ -13,6 +13,7 @@
 #include "synthetic.h"
 
 using namespace fploc;
+using namespace fploc::matcher;
 using fploc::optimizer::CovarianceConfig;
 using fploc::optimizer::frame_uncertainty;
 using fploc::testing::SynthOptions;

@@ -8,6 +8,7 @@
 #include "synthetic.h"
 
 using namespace fploc;
+using namespace fploc::optimizer;
 using fploc::testing::room_with_pillars;
 using fploc::testing::synth_frame;
 using fploc::testing::SynthOptions;
@@ -19,20 +20,20 @@ Pose2 truth_at(double t) { return {3.0 + 0.6 * t, 3.0 + 1.5 * std::sin(0.25 * t)
 
 struct SeqRun {
   std::vector<Pose2> truth;
-  std::vector<MatchResult> sfr;
+  std::vector<matcher::MatchResult> sfr;
   std::vector<FeatureFrame> frames;
 };
 
-SeqRun make_run(const NearestLookup& lookup, const FloorPlan& plan, int n, const SynthOptions& base) {
+SeqRun make_run(const matcher::NearestLookup& lookup, const FloorPlan& plan, int n, const SynthOptions& base) {
   SeqRun run;
-  Matcher m(lookup, MatcherConfig{});
+  matcher::Matcher m(lookup, matcher::MatcherConfig{});
   m.set_pose(truth_at(0));
   for (int k = 0; k < n; ++k) {
     const double t = 0.1 * k;
     SynthOptions so = base;
     so.seed = base.seed + uint32_t(k);
     run.truth.push_back(truth_at(t));
-    if (so.sweep_s > 0) so.sweep_twist = log_twist(truth_at(t), truth_at(t + so.sweep_s), so.sweep_s);
+    if (so.sweep_s > 0) so.sweep_twist = matcher::log_twist(truth_at(t), truth_at(t + so.sweep_s), so.sweep_s);
     run.frames.push_back(synth_frame(plan, run.truth.back(), so, int64_t(std::llround(t * 1e6))));
     run.frames.back().scan_seq = k;
     run.sfr.push_back(m.process(run.frames.back()));
@@ -46,7 +47,7 @@ double rms_err(const std::vector<Pose2>& est, const std::vector<Pose2>& truth) {
   return std::sqrt(s / double(est.size()));
 }
 
-std::vector<PoseOut> optimise(const NearestLookup& lookup, const SeqRun& run, OptimizerConfig cfg) {
+std::vector<PoseOut> optimise(const matcher::NearestLookup& lookup, const SeqRun& run, OptimizerConfig cfg) {
   WindowOptimizer opt(lookup, cfg);
   std::vector<PoseOut> finals;
   for (size_t k = 0; k < run.frames.size(); ++k) {
@@ -66,7 +67,7 @@ std::vector<PoseOut> optimise(const NearestLookup& lookup, const SeqRun& run, Op
 }  // namespace
 
 TEST(WindowOptimizer, EveryFrameBecomesFinalOnceInOrderAndKeysAreOptimisedWTimes) {
-  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  auto map = matcher::make_localization_map(room_with_pillars(), "brute-force");
   SynthOptions so;
   so.noise_sigma = 0.02;
   const SeqRun run = make_run(*map.lookup, *map.plan, 60, so);
@@ -88,7 +89,7 @@ TEST(WindowOptimizer, EveryFrameBecomesFinalOnceInOrderAndKeysAreOptimisedWTimes
 }
 
 TEST(WindowOptimizer, ExactWithoutNoise) {
-  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  auto map = matcher::make_localization_map(room_with_pillars(), "brute-force");
   const SeqRun run = make_run(*map.lookup, *map.plan, 40, SynthOptions{});
   const auto finals = optimise(*map.lookup, run, OptimizerConfig{});
   std::vector<Pose2> est;
@@ -97,7 +98,7 @@ TEST(WindowOptimizer, ExactWithoutNoise) {
 }
 
 TEST(WindowOptimizer, RegularisationSmoothsANoisySequence) {
-  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  auto map = matcher::make_localization_map(room_with_pillars(), "brute-force");
   SynthOptions so;
   so.beams = 60;            // few, noisy features: single-frame poses scatter by centimetres
   so.noise_sigma = 0.08;
@@ -123,7 +124,7 @@ TEST(WindowOptimizer, RegularisationSmoothsANoisySequence) {
 }
 
 TEST(WindowOptimizer, StationarySensorMakesOneKeyframe) {
-  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  auto map = matcher::make_localization_map(room_with_pillars(), "brute-force");
   WindowOptimizer opt(*map.lookup, OptimizerConfig{});
   std::vector<PoseOut> finals;
   int keys = 0;
@@ -139,14 +140,14 @@ TEST(WindowOptimizer, StationarySensorMakesOneKeyframe) {
 }
 
 TEST(WindowOptimizer, PoorFramesAreNeverKeyframes) {
-  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  auto map = matcher::make_localization_map(room_with_pillars(), "brute-force");
   WindowOptimizer opt(*map.lookup, OptimizerConfig{});
   std::vector<PoseOut> finals;
   for (int k = 0; k < 10; ++k) {
     FrameInput in;
     in.features = synth_frame(*map.plan, {4.0 + 0.2 * k, 3, 0}, SynthOptions{}, k * 100000);
     in.sfr = {4.0 + 0.2 * k, 3, 0};
-    in.status = k % 2 ? FitStatus::kPoor : FitStatus::kOk;
+    in.status = k % 2 ? matcher::FitStatus::kPoor : matcher::FitStatus::kOk;
     const PoseOut o = opt.add(in, &finals);
     EXPECT_EQ(o.keyframe, k % 2 == 0);
     EXPECT_EQ(o.status, in.status);
@@ -156,7 +157,7 @@ TEST(WindowOptimizer, PoorFramesAreNeverKeyframes) {
 TEST(WindowOptimizer, MotionCompensatedPosesAreAtUtime) {
   // A rotating sensor (each beam measured 0..0.1 s after utime from the moving pose): the single-frame
   // and the windowed poses are both the poses at utime, not the mid-sweep pose v * 50 ms away.
-  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  auto map = matcher::make_localization_map(room_with_pillars(), "brute-force");
   SynthOptions so;
   so.noise_sigma = 0.01;
   so.sweep_s = 0.1;
@@ -177,7 +178,7 @@ TEST(WindowOptimizer, MotionCompensatedPosesAreAtUtime) {
 TEST(WindowOptimizer, UnknownGravityIsInterpolatedFromNeighbours) {
   // Frames whose segmenter had no z / roll / pitch (its "unknown" sigmas, z = 0): the final poses take
   // them from the nearest frames that had them (interpolated in time, held at the start).
-  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  auto map = matcher::make_localization_map(room_with_pillars(), "brute-force");
   WindowOptimizer opt(*map.lookup, OptimizerConfig{});
   std::vector<PoseOut> finals;
   for (int k = 0; k < 30; ++k) {

@@ -7,10 +7,11 @@
 #include "synthetic.h"
 
 using namespace fploc;
+using namespace fploc::reloc;
 namespace synth = fploc::testing;
 
 static void run(benchmark::State& state, FloorPlan plan, Pose2 truth, bool region) {
-  auto map = make_localization_map(std::move(plan), "annf-exact");
+  auto map = matcher::make_localization_map(std::move(plan), "annf-exact");
   Relocalizer reloc(*map.plan, *map.lookup);
   synth::SynthOptions o;
   o.noise_sigma = 0.02;

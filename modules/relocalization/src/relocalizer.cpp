@@ -8,7 +8,7 @@
 #include "fploc/annf/baselines.h"
 #include "fploc/annf/cache.h"
 
-namespace fploc {
+namespace fploc::reloc {
 
 const char* to_string(RelocStatus s) {
   switch (s) {
@@ -34,18 +34,18 @@ struct Scored {
 
 }  // namespace
 
-Relocalizer::Relocalizer(const FloorPlan& plan, const NearestLookup& lookup, RelocalizerConfig cfg)
+Relocalizer::Relocalizer(const FloorPlan& plan, const matcher::NearestLookup& lookup, RelocalizerConfig cfg)
     : lookup_(lookup), cfg_(cfg) {
   if (plan.elements.empty()) throw std::runtime_error("relocalizer: empty floor plan");
   if (!(cfg_.grid_m > 0) || !(cfg_.yaw_step_deg > 0) || !(cfg_.truncate_m > 0) || !(cfg_.distance_cell_m > 0) ||
       cfg_.max_points < 3 || cfg_.keep < 1 || cfg_.refine < 1)
     throw std::runtime_error("relocalizer: grid_m, yaw_step_deg, truncate_m, distance_cell_m must be > 0, "
                              "max_points >= 3, keep and refine >= 1");
-  AnnfOptions ao;
-  ao.mode = AnnfMode::kExact;
+  annf::AnnfOptions ao;
+  ao.mode = annf::AnnfMode::kExact;
   ao.max_depth = 6;  // the grid reads cell centres; the exact field only needs to be exact there
-  const std::shared_ptr<const Annf> exact = cached_annf(plan, ao);  // shared on disk (fploc/annf/cache.h)
-  grid_ = std::make_unique<DistanceGrid>(*exact, cfg_.distance_cell_m);
+  const std::shared_ptr<const annf::Annf> exact = annf::cached_annf(plan, ao);  // shared on disk (fploc/annf/cache.h)
+  grid_ = std::make_unique<annf::DistanceGrid>(*exact, cfg_.distance_cell_m);
   const Box2 b = plan.bounds();
   for (double y = b.min.y() + 0.5 * cfg_.grid_m; y < b.max.y(); y += cfg_.grid_m)
     for (double x = b.min.x() + 0.5 * cfg_.grid_m; x < b.max.x(); x += cfg_.grid_m) {
@@ -61,7 +61,7 @@ std::vector<uint8_t> Relocalizer::explained_points(const FeatureFrame& f, const 
   int ids[16];
   const auto& targets = lookup_.targets();
   for (size_t i = 0; i < f.points.size(); i += size_t(stride)) {
-    const Eigen::Vector2d q = transform(pose, f.points[i].p);
+    const Eigen::Vector2d q = matcher::transform(pose, f.points[i].p);
     const int n = lookup_.candidates(q, ids, 16);
     double d = 1e9;
     for (int k = 0; k < n; ++k) d = std::min(d, distance(targets[size_t(ids[k])], q));
@@ -185,7 +185,7 @@ RelocResult Relocalizer::locate(const FeatureFrame& f, const std::optional<Searc
     s.pose = best_fine;
   }
   for (const auto& s : seeds) {
-    const MatchResult m = register_frame(lookup_, f, s.pose, cfg_.registration);
+    const matcher::MatchResult m = register_frame(lookup_, f, s.pose, cfg_.registration);
     RelocHypothesis h{m.solved, s.score, m.fit, 0.0};
     std::vector<uint8_t> e = explained_points(f, h.pose, tstride);
     auto same = std::find_if(out.candidates.begin(), out.candidates.end(),
@@ -253,4 +253,4 @@ RelocResult Relocalizer::locate(const FeatureFrame& f, const std::optional<Searc
   return out;
 }
 
-}  // namespace fploc
+}  // namespace fploc::reloc

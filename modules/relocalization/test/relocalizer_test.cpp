@@ -10,6 +10,7 @@
 #include "synthetic.h"
 
 using namespace fploc;
+using namespace fploc::reloc;
 namespace synth = fploc::testing;
 
 namespace {
@@ -31,7 +32,7 @@ synth::SynthOptions noisy(uint32_t seed) {
 // so near the walls a single scan may be reported ambiguous — then with the truth as the best
 // candidate. It must never be confidently wrong, and most poses are found outright.
 TEST(Relocalizer, FindsThePoseInTheRoomWithoutAGuess) {
-  auto map = make_localization_map(synth::room_with_pillars(), "annf-exact");
+  auto map = matcher::make_localization_map(synth::room_with_pillars(), "annf-exact");
   Relocalizer reloc(*map.plan, *map.lookup);
   EXPECT_GT(reloc.free_cells(), 300u);
   const Pose2 poses[] = {{3, 3, 0.3}, {10, 7, 2.0}, {16, 2, -1.2}, {18, 8, 3.0}, {5, 8, -2.5}, {10, 2.5, 1.0}};
@@ -55,7 +56,7 @@ TEST(Relocalizer, FindsThePoseInTheRoomWithoutAGuess) {
 // A 4-fold symmetric corridor ring: one scan cannot tell the four places apart. The answer must be
 // "ambiguous" (with the truth among the candidates), never a confident wrong pose.
 TEST(Relocalizer, SymmetricCorridorIsAmbiguousNotWrong) {
-  auto map = make_localization_map(synth::corridor_loop(), "annf-exact");
+  auto map = matcher::make_localization_map(synth::corridor_loop(), "annf-exact");
   Relocalizer reloc(*map.plan, *map.lookup);
   const Pose2 poses[] = {{1, 12, 1.5}, {12, 1, 0.1}, {23, 18, -1.6}};
   uint32_t seed = 7;
@@ -77,7 +78,7 @@ TEST(Relocalizer, SymmetricCorridorIsAmbiguousNotWrong) {
 
 // Features that belong to no place on the plan: no pose is accepted.
 TEST(Relocalizer, RandomFeaturesFitNowhere) {
-  auto map = make_localization_map(synth::room_with_pillars(), "annf-exact");
+  auto map = matcher::make_localization_map(synth::room_with_pillars(), "annf-exact");
   Relocalizer reloc(*map.plan, *map.lookup);
   const RelocResult r = reloc.locate(synth::random_frame(400, 8.0, 3));
   EXPECT_NE(r.status, RelocStatus::kFound) << r.text;
@@ -87,7 +88,7 @@ TEST(Relocalizer, RandomFeaturesFitNowhere) {
 
 // Recovery after a loss: a search in a disc around the last pose, 2.5 m / 60 deg off the truth.
 TEST(Relocalizer, RegionSearchAroundALostPose) {
-  auto map = make_localization_map(synth::room_with_pillars(), "annf-exact");
+  auto map = matcher::make_localization_map(synth::room_with_pillars(), "annf-exact");
   Relocalizer reloc(*map.plan, *map.lookup);
   const Pose2 truth{12, 8, -0.7};
   SearchRegion region{{10.5, 6.0, truth.yaw + 1.0}, 3.0, M_PI};
@@ -100,7 +101,7 @@ TEST(Relocalizer, RegionSearchAroundALostPose) {
 }
 
 TEST(Relocalizer, RejectsBadConfiguration) {
-  auto map = make_localization_map(synth::room_with_pillars(), "annf-exact");
+  auto map = matcher::make_localization_map(synth::room_with_pillars(), "annf-exact");
   RelocalizerConfig c;
   c.grid_m = 0;
   EXPECT_THROW(Relocalizer(*map.plan, *map.lookup, c), std::runtime_error);

@@ -15,7 +15,7 @@ pose_t make_pose_msg(int64_t utime, int64_t seq, const Pose2& p, double roll, do
                      const Eigen::Matrix3d& cov_xy_yaw, double z_sigma, double rp_sigma, int8_t status,
                      bool keyframe, bool final_estimate);
 // A localized pose (it carries its own z and roll/pitch sigmas).
-pose_t to_msg(const PoseOut& p, int64_t seq);
+pose_t to_msg(const optimizer::PoseOut& p, int64_t seq);
 // Pose2 from a pose_t (yaw of its quaternion; a zero quaternion is the identity).
 Pose2 pose2_of(const pose_t& m);
 

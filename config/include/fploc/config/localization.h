@@ -8,9 +8,9 @@
 
 namespace fploc::config {
 
-MatcherConfig config_of(const MatcherOptions& o);
-OptimizerConfig config_of(const OptimizerOptions& o);
-OdometryConfig config_of(const OdometryOptions& o);
+matcher::MatcherConfig config_of(const MatcherOptions& o);
+optimizer::OptimizerConfig config_of(const OptimizerOptions& o);
+odometry::OdometryConfig config_of(const OdometryOptions& o);
 // The Localizer of a matcher node (SFR step: matcher, IMU, initial search) and of an optimizer node (WO step).
 localizer::Config localizer_config(const MatcherOptions& o);
 localizer::Config localizer_config(const OptimizerOptions& o);

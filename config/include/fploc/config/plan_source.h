@@ -11,7 +11,7 @@ namespace fploc::config {
 // The map of a node's `plan` option with the named look-up ("" = annf-exact); `resolve` turns the
 // option's path (relative to the graph file) into a file name. Throws naming `field`.file when no plan
 // is given.
-LocalizationMap load_map(const PlanSource& plan, const std::string& lookup,
+matcher::LocalizationMap load_map(const PlanSource& plan, const std::string& lookup,
                          const std::function<std::string(const std::string&)>& resolve, const std::string& field);
 
 }  // namespace fploc::config

@@ -8,7 +8,7 @@
 
 #include "fploc/annf/annf.h"
 
-namespace fploc {
+namespace fploc::annf {
 
 // Readings of the paper's stopping rules ("If a child subfield shares the same two nearest elements
 // with its parent field, it will not be further divided and set as a leaf field. If all four
@@ -38,4 +38,4 @@ const char* to_string(PaperRule r);
 PaperRule parse_paper_rule(const std::string& s);  // "child-leaf" | "undo-only" | "child-leaf-ordered" | "full" |
                                                    // "collapse-first" | "collapse-pair"
 
-}  // namespace fploc
+}  // namespace fploc::annf

@@ -38,7 +38,7 @@
 
 #include "fploc/floorplan/plan.h"
 
-namespace fploc {
+namespace fploc::annf {
 
 enum class AnnfMode : uint8_t { kPaper = 0, kExact = 1 };
 
@@ -362,4 +362,4 @@ void Annf::for_each_leaf(F&& fn) const {
     }
 }
 
-}  // namespace fploc
+}  // namespace fploc::annf

@@ -13,7 +13,7 @@
 #include "fploc/annf/annf.h"
 #include "fploc/floorplan/plan.h"
 
-namespace fploc {
+namespace fploc::annf {
 
 class SampledKdTree {
  public:
@@ -61,4 +61,4 @@ class DistanceGrid {
   std::vector<Cell> cells_;
 };
 
-}  // namespace fploc
+}  // namespace fploc::annf

@@ -2,7 +2,7 @@
 // and later runs build each floor's field once.
 //
 //   std::string note;
-//   std::shared_ptr<const Annf> a = fploc::cached_annf(plan, options, &note);
+//   std::shared_ptr<const Annf> a = fploc::annf::cached_annf(plan, options, &note);
 //
 // Key: a hash of the plan's content as loaded (every element's kind, coordinates and layer name,
 // i.e. what the file says after units and layer selection) and of the options saved with the field
@@ -25,7 +25,7 @@
 
 #include "fploc/annf/annf.h"
 
-namespace fploc {
+namespace fploc::annf {
 
 std::string default_annf_cache_dir();  // "" when the cache is off
 std::string annf_cache_key(const FloorPlan& plan, const AnnfOptions& options);  // 16 hex digits
@@ -35,4 +35,4 @@ std::string annf_cache_key(const FloorPlan& plan, const AnnfOptions& options);  
 std::shared_ptr<const Annf> cached_annf(const FloorPlan& plan, const AnnfOptions& options, std::string* note = nullptr,
                                         const std::string& dir = "");
 
-}  // namespace fploc
+}  // namespace fploc::annf

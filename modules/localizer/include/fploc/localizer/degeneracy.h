@@ -48,7 +48,7 @@ struct UncertaintyConfig {
 
 struct UncertaintyState {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // published (x, y, yaw)
-  FitStatus status = FitStatus::kOk;
+  matcher::FitStatus status = matcher::FitStatus::kOk;
   std::string text;                    // why POOR (empty when OK)
   double sigma_max_m = 0;              // 1-sigma along the weakest horizontal direction
   double weak_direction_rad = 0;       // that direction (plan frame, -pi/2 .. pi/2]
@@ -62,7 +62,7 @@ class UncertaintyTracker {
   explicit UncertaintyTracker(UncertaintyConfig cfg = {}) : cfg_(std::move(cfg)) {}
   // One frame, in time order: its own covariance (frame_valid false: the frame fixes nothing) and the
   // matcher's status/text. Returns what to publish with the frame's pose.
-  UncertaintyState update(int64_t utime, const Eigen::Matrix3d& frame_cov, bool frame_valid, FitStatus matcher_status,
+  UncertaintyState update(int64_t utime, const Eigen::Matrix3d& frame_cov, bool frame_valid, matcher::FitStatus matcher_status,
                           const std::string& matcher_text = {});
   // A new initial pose with its uncertainty (1-sigma x/y and yaw); the velocity is unknown.
   void reset(double sigma_m, double sigma_rad);

@@ -19,8 +19,8 @@
 namespace fploc::localizer {
 
 struct Config {
-  MatcherConfig matcher;             // the SFR step
-  OptimizerConfig optimizer;         // the WO step
+  matcher::MatcherConfig matcher;             // the SFR step
+  optimizer::OptimizerConfig optimizer;         // the WO step
   bool use_imu = true;               // the IMU's yaw rate: prediction (yaw change) + sweep yaw rate (de-skew)
   double initial_search_m = 0;       // set_pose without an uncertainty: search this far (0: matcher.max_correspondence_m)
   bool refine_from_window = true;    // process(): the WO estimate of a frame predicts the next one
@@ -33,7 +33,7 @@ struct Config {
 struct FramePose {
   int64_t utime = 0;
   int64_t scan_seq = 0;
-  MatchResult match;
+  matcher::MatchResult match;
   // Roll/pitch/z of the frame, the last known ones where the frame's own are unknown (attitude hold),
   // and the frame's own sigmas (an "unknown" sigma tells the value is held).
   double roll = 0, pitch = 0, z = 0;
@@ -42,11 +42,11 @@ struct FramePose {
 
 // A localized pose (the WO step's output): PoseOut carries its (x, y, yaw) covariance and its own z and
 // roll/pitch sigmas.
-using Pose = PoseOut;
+using Pose = optimizer::PoseOut;
 
 class Localizer {
  public:
-  Localizer(const NearestLookup& lookup, Config cfg);
+  Localizer(const matcher::NearestLookup& lookup, Config cfg);
 
   // IMU gyro z sample (out-of-order or non-finite samples are ignored). Ignored unless cfg.use_imu.
   void add_imu(int64_t utime, double gyro_z);
@@ -77,16 +77,16 @@ class Localizer {
   Step process(const FeatureFrame& f, std::vector<Pose>* finals);
 
   const Config& config() const { return cfg_; }
-  const Matcher& matcher() const { return matcher_; }
+  const matcher::Matcher& matcher() const { return matcher_; }
   // The uncertainty published with the last optimize()d frame.
   const UncertaintyState& uncertainty() const { return uncertainty_; }
 
  private:
   Config cfg_;
-  const NearestLookup& lookup_;
-  Matcher matcher_;
-  WindowOptimizer window_;
-  ImuYaw imu_;
+  const matcher::NearestLookup& lookup_;
+  matcher::Matcher matcher_;
+  optimizer::WindowOptimizer window_;
+  matcher::ImuYaw imu_;
   bool have_prev_ = false;           // a frame was registered (prev_utime_ valid)
   int64_t prev_utime_ = 0;
   std::optional<double> last_z_;

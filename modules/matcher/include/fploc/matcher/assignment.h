@@ -2,7 +2,7 @@
 // optimizer keeps these in its header.
 #pragma once
 
-namespace fploc {
+namespace fploc::matcher {
 
 constexpr int kMaxCandidates = 8;
 
@@ -25,4 +25,4 @@ struct AssignOptions {
   int stride = 1;          // use every stride-th point (1 = all)
 };
 
-}  // namespace fploc
+}  // namespace fploc::matcher

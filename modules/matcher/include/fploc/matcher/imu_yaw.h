@@ -7,7 +7,7 @@
 #include <optional>
 #include <utility>
 
-namespace fploc {
+namespace fploc::matcher {
 
 class ImuYaw {
  public:
@@ -27,4 +27,4 @@ class ImuYaw {
   size_t max_ = 4000;
 };
 
-}  // namespace fploc
+}  // namespace fploc::matcher

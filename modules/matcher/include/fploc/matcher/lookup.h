@@ -17,7 +17,7 @@
 
 #include "fploc/floorplan/plan.h"
 
-namespace fploc {
+namespace fploc::matcher {
 
 // A target's geometry prepared for the residuals: segments with their unit direction and length (no
 // division per evaluation); circles/arcs as in Element.
@@ -81,4 +81,4 @@ class KdTreeLookup : public NearestLookup {
 // Samples points along an element every spacing_m (both ends included).
 std::vector<Eigen::Vector2d> sample_element(const Element& e, double spacing_m);
 
-}  // namespace fploc
+}  // namespace fploc::matcher

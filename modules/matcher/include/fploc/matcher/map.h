@@ -10,13 +10,15 @@
 #include "fploc/floorplan/plan.h"
 #include "fploc/matcher/lookup.h"
 
-namespace fploc {
-
+namespace fploc::annf {
 class Annf;
+}  // namespace fploc::annf
+
+namespace fploc::matcher {
 
 struct LocalizationMap {
   std::shared_ptr<const FloorPlan> plan;
-  std::shared_ptr<const Annf> annf;  // null unless an ANNF look-up is used
+  std::shared_ptr<const annf::Annf> annf;  // null unless an ANNF look-up is used
   std::unique_ptr<NearestLookup> lookup;
   std::string note;                  // what was loaded/built (for logs)
 };
@@ -32,4 +34,4 @@ LocalizationMap make_localization_map(FloorPlan plan, const std::string& lookup 
 LocalizationMap load_localization_map(const std::string& path, const std::vector<std::string>& layers,
                                       const std::string& units, const std::string& lookup = "annf-exact");
 
-}  // namespace fploc
+}  // namespace fploc::matcher

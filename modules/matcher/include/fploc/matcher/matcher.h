@@ -9,7 +9,7 @@
 #include "fploc/matcher/lookup.h"
 #include "fploc/matcher/types.h"
 
-namespace fploc {
+namespace fploc::matcher {
 
 struct MatcherConfig {
   double max_correspondence_m = 1.5;  // correspondence gate of the first outer iteration
@@ -122,4 +122,4 @@ class Matcher {
   FeatureFrame deskewed_;       // scratch
 };
 
-}  // namespace fploc
+}  // namespace fploc::matcher

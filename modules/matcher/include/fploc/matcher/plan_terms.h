@@ -16,7 +16,7 @@
 #include "fploc/matcher/lookup.h"
 #include "fploc/matcher/types.h"
 
-namespace fploc {
+namespace fploc::matcher {
 
 // Correspondences of the frame's points at pose x (in point order).
 void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, const AssignOptions& o,
@@ -43,4 +43,4 @@ Eigen::Matrix3d frame_information(const NearestLookup& lookup, const FeatureFram
 FitQuality evaluate_fit(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, double inlier_m,
                         int stride = 1);
 
-}  // namespace fploc
+}  // namespace fploc::matcher

@@ -11,7 +11,7 @@
 #include "fploc/core/feature_frame.h"
 #include "fploc/core/pose.h"
 
-namespace fploc {
+namespace fploc::matcher {
 
 // Planar velocity of the sensor, in its own frame: linear [m/s] (x forward, y left) and yaw rate [rad/s].
 // Constant over a sweep it is the motion model of the motion compensation (de-skewing).
@@ -52,4 +52,4 @@ inline Eigen::Vector2d transform(const Pose2& x, const Eigen::Vector2d& p) {
   return {c * p.x() - s * p.y() + x.x, s * p.x() + c * p.y() + x.y};
 }
 
-}  // namespace fploc
+}  // namespace fploc::matcher

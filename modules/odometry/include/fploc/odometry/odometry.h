@@ -11,7 +11,7 @@
 
 #include "fploc/matcher/types.h"
 
-namespace fploc {
+namespace fploc::odometry {
 
 struct OdometryConfig {
   double max_correspondence_m = 0.5;
@@ -54,4 +54,4 @@ class Odometry2D {
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();
 };
 
-}  // namespace fploc
+}  // namespace fploc::odometry

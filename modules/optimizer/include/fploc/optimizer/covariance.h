@@ -59,7 +59,7 @@ struct FrameUncertainty {
 };
 
 // The covariance of the pose x of frame f (de-skewed to the pose's time) registered against the plan.
-FrameUncertainty frame_uncertainty(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x,
+FrameUncertainty frame_uncertainty(const matcher::NearestLookup& lookup, const FeatureFrame& f, const Pose2& x,
                                    const CovarianceConfig& cfg);
 
 // IRLS weight rho'(r^2) of the loss ("cauchy", "huber", "none"; other names: cauchy) at residual r.

@@ -22,7 +22,7 @@
 #include "fploc/matcher/assignment.h"
 #include "fploc/matcher/types.h"
 
-namespace fploc {
+namespace fploc::optimizer {
 
 struct OptimizerConfig {
   int window = 10;                     // W
@@ -54,12 +54,12 @@ struct OptimizerConfig {
 struct FrameInput {
   FeatureFrame features;               // as measured (not de-skewed)
   Pose2 sfr;                           // single-frame registration result at features.utime
-  Twist2 twist;                        // the matcher's body twist (its motion compensation)
-  FitStatus status = FitStatus::kOk;
+  matcher::Twist2 twist;                        // the matcher's body twist (its motion compensation)
+  matcher::FitStatus status = matcher::FitStatus::kOk;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // published with the frame's pose
   // What to publish besides (localizer/degeneracy.h): a status that only downgrades `status` (POOR where
   // the plan leaves a direction open) and why. Keyframes are still chosen by `status` alone.
-  FitStatus published_status = FitStatus::kOk;
+  matcher::FitStatus published_status = matcher::FitStatus::kOk;
   std::string status_text;
 };
 
@@ -70,16 +70,16 @@ struct PoseOut {
   double roll = 0, pitch = 0, z = 0;
   bool keyframe = false;
   bool final_estimate = false;
-  FitStatus status = FitStatus::kOk;
+  matcher::FitStatus status = matcher::FitStatus::kOk;
   std::string status_text;             // why not OK
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // (x, y, yaw): FrameInput::covariance of the frame
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // (x, y, yaw): FrameInput::covariance (+ d d^T, see config)
   double z_sigma = 0, roll_pitch_sigma = 0;  // the frame's own (as measured; "unknown" sigmas, see types.h)
   int optimised = 0;                   // how many window solves this pose took part in
 };
 
 class WindowOptimizer {
  public:
-  WindowOptimizer(const NearestLookup& lookup, OptimizerConfig cfg);
+  WindowOptimizer(const matcher::NearestLookup& lookup, OptimizerConfig cfg);
   ~WindowOptimizer();
   // Feeds one frame (in time order). Appends the poses that became final (time order) to `finals` and
   // returns the current estimate of this frame (final_estimate = false).
@@ -103,7 +103,7 @@ class WindowOptimizer {
     FeatureFrame deskewed;             // features de-skewed to t_ref
     double x[3];                       // pose at tau
     int optimised = 0;
-    std::vector<Assignment> as;        // correspondences, looked up at as_pose
+    std::vector<matcher::Assignment> as;        // correspondences, looked up at as_pose
     Pose2 as_pose;
     bool as_valid = false;
     int as_stride = 1;
@@ -130,7 +130,7 @@ class WindowOptimizer {
   void fill_gravity(PoseOut* o, const FeatureFrame& f) const;
   Eigen::Vector3d newest_correction() const;
 
-  const NearestLookup& lookup_;
+  const matcher::NearestLookup& lookup_;
   OptimizerConfig cfg_;
   std::deque<Key> window_;
   std::deque<Frame> pending_;          // non-keyframes waiting for their surrounding keyframes to be final
@@ -148,4 +148,4 @@ class WindowOptimizer {
   int solves_ = 0;
 };
 
-}  // namespace fploc
+}  // namespace fploc::optimizer

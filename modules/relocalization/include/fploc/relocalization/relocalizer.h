@@ -24,9 +24,11 @@
 #include "fploc/matcher/matcher.h"
 #include "fploc/matcher/types.h"
 
-namespace fploc {
-
+namespace fploc::annf {
 class DistanceGrid;
+}  // namespace fploc::annf
+
+namespace fploc::reloc {
 
 struct RelocalizerConfig {
   double grid_m = 0.5;            // translation step of the search
@@ -44,7 +46,7 @@ struct RelocalizerConfig {
   // explains and the other does not, (b - c)^2 / (b + c) >= this (chi-square, 1 dof; 10.83 = p 0.001).
   double min_evidence = 10.83;
   double inlier_m = 0.1;          // a point within this of the plan is explained (for the test above)
-  MatcherConfig registration;     // for the refinement
+  matcher::MatcherConfig registration;     // for the refinement
 };
 
 // Where to search: a disc around `center` (all yaws, or yaw within ± yaw_window of center.yaw).
@@ -57,7 +59,7 @@ struct SearchRegion {
 struct RelocHypothesis {
   Pose2 pose;
   double score = 0;               // correlative score (0..points)
-  FitQuality fit;                 // after refinement (num_points 0 when not refined)
+  matcher::FitQuality fit;                 // after refinement (num_points 0 when not refined)
   double evidence = 0;            // McNemar statistic against the best (0 for the best itself)
 };
 
@@ -67,7 +69,7 @@ const char* to_string(RelocStatus s);
 struct RelocResult {
   RelocStatus status = RelocStatus::kNoFit;
   Pose2 pose;                     // the accepted pose (kFound), else the best refined hypothesis
-  FitQuality fit;
+  matcher::FitQuality fit;
   std::vector<RelocHypothesis> candidates;  // refined, best first
   int64_t hypotheses = 0;         // (x, y, yaw) triples scored (fully or until pruned)
   int points = 0;                 // features used in the scores
@@ -77,7 +79,7 @@ struct RelocResult {
 class Relocalizer {
  public:
   // `lookup` is the one the refinement registers with (the matcher's); the plan gives the distance grid.
-  Relocalizer(const FloorPlan& plan, const NearestLookup& lookup, RelocalizerConfig cfg = {});
+  Relocalizer(const FloorPlan& plan, const matcher::NearestLookup& lookup, RelocalizerConfig cfg = {});
   ~Relocalizer();
   Relocalizer(const Relocalizer&) = delete;
   Relocalizer& operator=(const Relocalizer&) = delete;
@@ -90,10 +92,10 @@ class Relocalizer {
  private:
   // 1 for each test point (every stride-th feature) within inlier_m of the plan at `pose`.
   std::vector<uint8_t> explained_points(const FeatureFrame& f, const Pose2& pose, int stride) const;
-  const NearestLookup& lookup_;
+  const matcher::NearestLookup& lookup_;
   RelocalizerConfig cfg_;
-  std::unique_ptr<DistanceGrid> grid_;
+  std::unique_ptr<annf::DistanceGrid> grid_;
   std::vector<Eigen::Vector2d> free_;  // search cell centres with clearance
 };
 
-}  // namespace fploc
+}  // namespace fploc::reloc

@@ -1,0 +1,48 @@
+#include "fploc/adapters/plan_diff_t.h"
+
+#include <Eigen/Core>
+
+namespace fploc::adapters {
+
+plan_diff_t to_msg(const plandiff::Diff& r, const FloorPlan& plan, int64_t utime, int64_t seq) {
+  using plandiff::Status;
+  plan_diff_t msg;
+  msg.utime = utime;
+  msg.seq = seq;
+  msg.frames = r.frames;
+  msg.elements_seen = r.count(Status::kSeen);
+  msg.elements_missing = r.count(Status::kMissing);
+  msg.elements_moved = r.count(Status::kMoved);
+  msg.elements_unobserved = r.count(Status::kUnobserved);
+  msg.scale_error = r.scale_error;
+  msg.scale_sigma = r.scale_sigma;
+  auto item = [&](PlanDiffKind kind, int32_t el, bool circle, double x0, double y0, double x1, double y1, double off,
+                  double ratio) {
+    msg.kind.push_back(int8_t(kind));
+    msg.circle.push_back(circle);
+    msg.element.push_back(el);
+    msg.x0.push_back(float(x0));
+    msg.y0.push_back(float(y0));
+    msg.x1.push_back(float(x1));
+    msg.y1.push_back(float(y1));
+    msg.offset_m.push_back(float(off));
+    msg.seen_ratio.push_back(float(ratio));
+  };
+  for (const auto& e : r.elements) {
+    if (e.status != Status::kMissing && e.status != Status::kMoved) continue;
+    const auto& p = plan.elements[size_t(e.id)];
+    const double off = e.status == Status::kMoved ? e.offset_m : 0.0;
+    const PlanDiffKind kind = e.status == Status::kMissing ? PlanDiffKind::kMissing : PlanDiffKind::kMoved;
+    if (p.kind == ElementKind::kSegment) {
+      const Eigen::Vector2d u = (p.b - p.a).normalized(), s = off * Eigen::Vector2d(-u.y(), u.x());
+      item(kind, e.id, false, p.a.x() + s.x(), p.a.y() + s.y(), p.b.x() + s.x(), p.b.y() + s.y(), off, e.seen_ratio());
+    } else {
+      item(kind, e.id, true, p.c.x(), p.c.y(), p.r + off, 0, off, e.seen_ratio());
+    }
+  }
+  for (const auto& n : r.added) item(PlanDiffKind::kNew, -1, false, n.a.x(), n.a.y(), n.b.x(), n.b.y(), n.rms_m, 0);
+  msg.num_items = int32_t(msg.kind.size());
+  return msg;
+}
+
+}  // namespace fploc::adapters
