@@ -10,10 +10,12 @@ r = json.loads(sys.argv[1])
 rows = {x["method"]: x for x in r["rows"]}
 assert {"fploc", "amcl"} <= set(rows), rows.keys()
 f = rows["fploc"]
-for k in ("ate_m", "max_m", "lost", "false_ok", "nees_median", "ms_per_scan", "poses"):
+for k in ("ate_m", "max_m", "lost", "false_ok", "false_ok_poses", "poor", "nees_median", "ms_per_scan", "poses"):
     assert k in f, k
 assert f["poses"] >= 90, f
 assert f["lost"] == 0 and f["false_ok"] == 0, f
+# Honest covariance: the median NEES (3 if consistent) was 300 here when points were taken as independent.
+assert f["nees_median"] is not None and 0.3 < f["nees_median"] < 20, f
 assert f["ate_m"] < 0.5 and f["max_m"] < 1.0, f
 d = r["detection"][0]
 for k in ("removed", "removed_found", "moved", "moved_found", "added", "added_found", "false_flags_per_100m", "precision", "recall"):
