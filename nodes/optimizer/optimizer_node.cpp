@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <map>
 #include <memory>
 
@@ -143,7 +144,14 @@ class OptimizerNode : public fploc::rt::Node {
     const auto latest = loc_->optimize(fz, fploc::adapters::from_msg(m), &finals);
     // The floor of each frame is the matcher's (frame_pose_t); kept until the frame's pose is final.
     floor_of_[m.utime] = {m.floor_index, m.floor};
-    if (latest) latest_out_.publish(fploc::adapters::to_msg(*latest, latest_seq_++, m.floor_index, m.floor));
+    if (latest) {
+      latest_out_.publish(fploc::adapters::to_msg(*latest, latest_seq_++, m.floor_index, m.floor));
+      // Status changes with their reason (pose_t has no text): e.g. POOR where the plan leaves a direction open.
+      if (latest->status != last_status_ && ++status_changes_ <= 200)
+        std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << ": " << fploc::matcher::to_string(latest->status)
+                  << (latest->status_text.empty() ? "" : ": " + latest->status_text) << "\n";
+      last_status_ = latest->status;
+    }
     publish_finals(finals);
   }
 
@@ -179,6 +187,8 @@ class OptimizerNode : public fploc::rt::Node {
   int64_t last_seq_ = 0;
   bool have_last_ = false;
   int64_t pose_seq_ = 0, latest_seq_ = 0;
+  FitStatus last_status_ = FitStatus::kOk;
+  int status_changes_ = 0;
 };
 
 }  // namespace

@@ -6,7 +6,9 @@ For every (plan, scenario): `fploc sim` writes an LCM log (OS-1 scans + IMU) and
 lock-step); the windowed optimizer's final poses (WO) are scored against the ground truth at each pose's
 own time (linear interpolation of the truth, no alignment): horizontal ATE (rmse of the x/y error),
 |z error| median and p99, roll/pitch error p99 (the larger of the two per pose), LOST count (the matcher's
-LOST transitions, reported as node errors), and ms per scan per node (thread CPU time).
+LOST transitions, reported as node errors), NEES median of the published (x, y, yaw) covariance
+(`nees_median`, 3 if consistent), false OK (`false_ok`: poses with status OK more than 0.3 m off
+horizontally), POOR poses (`poor_poses`), and ms per scan per node (thread CPU time).
 
 Scenarios: the `building-*` ones (sim/ceiling_map.h: areas with their own ceiling heights and a sloped
 roof, a double-height atrium, lamps/beams/ducts/a drop-ceiling grid, all mixed; the segmenter gets the floor's
@@ -284,7 +286,8 @@ def bench(a, work, plan, layers, scenario):
     gt = read_tum(gt_path)
     x0, y0, yaw0 = gt[0][1], gt[0][2], yaw_of(gt[0])
     wo = os.path.join(d, "wo.tum")
-    sets = [f"matcher.plan.file={plan}", f"optimizer.plan.file={plan}", f"matcher.initial_pose.x={x0!r}",
+    unc = os.path.join(d, "wo.unc")
+    sets = [f"wo_logger.uncertainty_file={unc}", f"matcher.plan.file={plan}", f"optimizer.plan.file={plan}", f"matcher.initial_pose.x={x0!r}",
             f"matcher.initial_pose.y={y0!r}", f"matcher.initial_pose.yaw={yaw0!r}", "matcher.initial_search_m=0.3",
             f"wo_logger.file={wo}", f"sfr_logger.file={os.path.join(d, 'sfr.tum')}",
             f"odom_logger.file={os.path.join(d, 'odom.tum')}", f"odom_map_logger.file={os.path.join(d, 'odom_map.tum')}",
@@ -335,6 +338,12 @@ def bench(a, work, plan, layers, scenario):
     row.update(m or {"poses": 0})
     if floors is not None:
         row.update(floors)
+    # Honest uncertainty (issue 12): NEES of the published covariance and false OK (status OK, > 0.3 m off).
+    ev = fploc_tools.fploc_eval(BIN, gt_path, wo, "fploc bench building", uncertainty=unc) if est else None
+    if ev and "nees_median" in ev:
+        row["nees_median"] = ev["nees_median"]
+        row["false_ok"] = ev["false_ok_poses"]
+        row["poor_poses"] = (fploc_tools.status_counts(unc) or [0, 0, 0])[1]
     if m:
         row["meets_targets"] = (m["z_err_p99_m"] <= TARGETS["z_err_p99_m"] and m["rp_err_p99_deg"] <= TARGETS["rp_err_p99_deg"]
                                 and m["ate_xy_m"] <= TARGETS["ate_xy_m"] and row["lost"] == 0)
@@ -352,7 +361,8 @@ def bench(a, work, plan, layers, scenario):
         row["plot_png"] = path[:-4] + ".png"
     log(f"[{name}] ATE xy {100 * row.get('ate_xy_m', float('nan')):.2f} cm, z med/p99 "
         f"{100 * row.get('z_err_median_m', float('nan')):.2f}/{100 * row.get('z_err_p99_m', float('nan')):.2f} cm, "
-        f"rp p99 {row.get('rp_err_p99_deg', float('nan')):.3f} deg, LOST {row['lost']}, ms/scan {ms}")
+        f"rp p99 {row.get('rp_err_p99_deg', float('nan')):.3f} deg, LOST {row['lost']}, "
+        f"NEES {row.get('nees_median')}, false OK {row.get('false_ok')}, ms/scan {ms}")
     if floors is not None:
         log(f"[{name}] floors: " + (f"wrong-floor poses {floors['wrong_floor_poses']} ({floors['wrong_floor_after_3s']} later "
             f"than 3 s after a change), recognised after {[c['recognised_after_s'] for c in floors['floor_changes']]} s, "

@@ -11,7 +11,8 @@ number of scans over the pipeline nodes' thread CPU time (segmenter + features +
 
 Prints one JSON document on stdout (progress on stderr):
   {"rows": [{"sequence", "speed", "length_m", "avg_speed_mps", "max_speed_mps", "frames", "ate_sfr_m",
-             "rpe_sfr_m", "ate_wo_m", "rpe_wo_m", "hz", "real_time_factor", "ms_per_scan", ...}],
+             "rpe_sfr_m", "ate_wo_m", "rpe_wo_m", "hz", "real_time_factor", "ms_per_scan",
+             "nees_sfr_median", "nees_wo_median", "false_ok_sfr", "false_ok_wo", "poor_sfr", "poor_wo", ...}],
    "baseline": [{"sequence", "speed", "ate_m", "rpe_m"}],
    "lookups": [...] (--lookups), "robustness": [...] (--robustness), "paper": {...}}
 """
@@ -35,8 +36,15 @@ def run(cmd):
     return fploc_tools.run(cmd, "fploc bench paper")
 
 
-def evaluate(gt, est, plot=None):
-    return fploc_tools.fploc_eval(BIN, gt, est, "fploc bench paper", plot)
+def evaluate(gt, est, plot=None, uncertainty=None):
+    return fploc_tools.fploc_eval(BIN, gt, est, "fploc bench paper", plot, uncertainty)
+
+
+def uncertainty_keys(res, k):
+    """NEES median, false-OK and POOR counts of trajectory k (sfr / wo) for a row (None where not measured)."""
+    r = res.get(k) or {}
+    sc = r.get("status_counts") or [None, None, None]
+    return {f"nees_{k}_median": r.get("nees_median"), f"false_ok_{k}": r.get("false_ok_poses"), f"poor_{k}": sc[1]}
 
 
 # Paper Table I (room: SFR and WO) and Table II (corridor: FP-Loc and LeGO-LOAM): ATE/RPE [m], speeds.
@@ -119,7 +127,8 @@ class Bench:
         dx, dy, dyaw = init_offset
         plan = self.a.plan or os.path.join(ROOT, "data", "plans", "corridor.json" if "corridor" in name else "room.json")
         out = {k: os.path.join(d, f"{name}-{k}.tum") for k in ("sfr", "wo", "odom", "odom_map")}
-        s = [f"matcher.plan.file={plan}", f"optimizer.plan.file={plan}",
+        unc = {k: os.path.join(d, f"{name}-{k}.unc") for k in ("sfr", "wo")}
+        s = [f"sfr_logger.uncertainty_file={unc['sfr']}", f"wo_logger.uncertainty_file={unc['wo']}",f"matcher.plan.file={plan}", f"optimizer.plan.file={plan}",
              f"matcher.initial_pose.x={x0 + dx!r}", f"matcher.initial_pose.y={y0 + dy!r}",
              f"matcher.initial_pose.yaw={yaw0 + dyaw!r}", f"matcher.initial_search_m={search_m!r}",
              f"odometry.initial_pose.x={x0!r}", f"odometry.initial_pose.y={y0!r}", f"odometry.initial_pose.yaw={yaw0!r}",
@@ -136,7 +145,10 @@ class Bench:
         for x in s + list(sets):
             cmd += ["--set", x]
         rep = json.loads(run(cmd)[0].strip().splitlines()[-1])
-        res = {k: evaluate(gt, out[k], f"{plots_prefix}-{k}.svg" if plots_prefix else None) for k in out}
+        res = {k: evaluate(gt, out[k], f"{plots_prefix}-{k}.svg" if plots_prefix else None, unc.get(k)) for k in out}
+        for k in unc:
+            if res.get(k) is not None:
+                res[k]["status_counts"] = fploc_tools.status_counts(unc[k])
         return res, rep
 
     @staticmethod
@@ -167,6 +179,8 @@ class Bench:
                "poses_sfr": res["sfr"]["poses"] if res["sfr"] else 0, "poses_wo": res["wo"]["poses"] if res["wo"] else 0,
                "hz": hz, "real_time_factor": round(hz / SCAN_HZ, 2) if hz else None, "ms_per_scan": ms,
                "node_errors": sum(n["errors"] for n in rep["nodes"])}
+        row.update(uncertainty_keys(res, "sfr"))
+        row.update(uncertainty_keys(res, "wo"))
         if seq in PAPER:
             row["paper"] = PAPER[seq][speed]
         base = {"sequence": seq, "speed": speed, "ate_m": res["odom"]["ate_rmse_m"] if res["odom"] else None,
@@ -174,7 +188,8 @@ class Bench:
                 "ate_local_map_m": res["odom_map"]["ate_rmse_m"] if res["odom_map"] else None,
                 "rpe_local_map_m": res["odom_map"]["rpe_mean_m"] if res["odom_map"] else None}
         log(f"[{scenario}] ATE sfr {fmt(row['ate_sfr_m'])} wo {fmt(row['ate_wo_m'])} odometry {fmt(base['ate_m'])} "
-            f"(local map {fmt(base['ate_local_map_m'])})  "
+            f"(local map {fmt(base['ate_local_map_m'])})  NEES wo {row['nees_wo_median']} false OK {row['false_ok_wo']} "
+            f"POOR {row['poor_wo']}  "
             f"{hz} Hz (ms/scan {ms})")
         return row, base
 
@@ -288,6 +303,18 @@ def markdown(doc, argv=None):
                  f"{fmt(r['rpe_sfr_m'], unit='')} | {fmt(r['ate_sfr_m'], unit='')} | {fmt(r['rpe_wo_m'], unit='')} | "
                  f"{fmt(r['ate_wo_m'], unit='')} | {paper} | {fmt(b.get('ate_m'), unit='')} / {fmt(b.get('ate_local_map_m'), unit='')} | {r['hz']} | "
                  f"{ms['segmenter']:.2f} / {ms['features']:.2f} / {ms['matcher']:.2f} / {ms['optimizer']:.2f} |")
+    if any(r.get("nees_wo_median") is not None for r in doc["rows"]):
+        L.append("")
+        L.append("Honest uncertainty (issue 12): NEES median of the published (x, y, yaw) covariance against the truth "
+                 "(3 if consistent; target 1.5-6), false OK = poses with status OK more than 0.3 m off horizontally "
+                 "(target 0), POOR = poses published POOR.")
+        L.append("")
+        L.append("| sequence | speed | NEES SFR | NEES WO | false OK SFR / WO | POOR SFR / WO |")
+        L.append("|---|---|---|---|---|---|")
+        for r in doc["rows"]:
+            n = lambda v: "-" if v is None else f"{v:.2f}"
+            L.append(f"| {r['sequence']} | {r['speed']} | {n(r.get('nees_sfr_median'))} | {n(r.get('nees_wo_median'))} | "
+                     f"{r.get('false_ok_sfr')} / {r.get('false_ok_wo')} | {r.get('poor_sfr')} / {r.get('poor_wo')} |")
     if doc.get("lookups"):
         L.append("")
         L.append("| look-up | ATE SFR cm | ATE WO cm | matcher ms/scan | optimizer ms/scan | pipeline Hz |")

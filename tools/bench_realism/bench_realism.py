@@ -23,7 +23,7 @@ fploc+downweight), NDT = ndt, AMCL = features + odometry + amcl). Per family: ch
 recall. --jobs N simulates and replays N families at once (CPU times are per thread, so unaffected).
 
 Prints one JSON document on stdout (progress on stderr):
-  {"rows": [{"family", "method", "ate_m", "max_m", "lost", "false_ok", "nees_median", "nees_poses",
+  {"rows": [{"family", "method", "ate_m", "max_m", "lost", "false_ok", "false_ok_poses", "poor", "nees_median", "nees_poses",
              "ms_per_scan", "ms_per_scan_localizer", "poses"}],
    "detection": [{"family", "removed", "removed_found", "moved", "moved_found", "added", "added_found",
                   "flags", "false_flags", "false_flags_per_100m", "new_on_clutter", "precision", "recall",
@@ -146,7 +146,7 @@ def score_poses(poses, gt_rows):
     gt = {round(r[0] * 1e6): r for r in gt_rows}
     gts = sorted(gt)
     import bisect
-    errs, nees, lost, false_ok, n = [], [], 0, 0, 0
+    errs, nees, lost, false_ok, poor, n = [], [], 0, 0, 0, 0
     for p in poses:
         t = p["utime"]
         k = bisect.bisect_left(gts, t)
@@ -163,6 +163,8 @@ def score_poses(poses, gt_rows):
         eyaw = (quat_yaw(p["q"]) - yaw_of(g) + math.pi) % (2 * math.pi) - math.pi
         if p["status"] == 2:
             lost += 1
+        if p["status"] == 1:
+            poor += 1
         if p["status"] == 0 and e > FALSE_OK_M:
             false_ok += 1
         errs.append(e)
@@ -179,7 +181,7 @@ def score_poses(poses, gt_rows):
         return None
     nees.sort()
     return {"poses": n, "ate_m": math.sqrt(sum(e * e for e in errs) / n), "max_m": max(errs),
-            "lost": lost / n, "false_ok": false_ok / n,
+            "lost": lost / n, "false_ok": false_ok / n, "false_ok_poses": false_ok, "poor": poor / n,
             "nees_median": nees[len(nees) // 2] if nees else None, "nees_poses": len(nees)}
 
 
@@ -486,7 +488,7 @@ class Bench:
         r = {"family": fam, "method": method, **s, "ms_per_scan": round(cpu / max(scans, 1), 3),
              "ms_per_scan_localizer": round(own / max(scans, 1), 3)}
         log(f"[{fam}] {method}: ATE {fmt(r.get('ate_m'))} max {fmt(r.get('max_m'))} LOST {pct(r.get('lost'))} "
-            f"false-OK {pct(r.get('false_ok'))} NEES {fmt(r.get('nees_median'), 2)} {r['ms_per_scan']} ms/scan "
+            f"false-OK {pct(r.get('false_ok'))} POOR {pct(r.get('poor'))} NEES {fmt(r.get('nees_median'), 2)} {r['ms_per_scan']} ms/scan "
             f"({r['ms_per_scan_localizer']} without the segmenter)")
         return r
 
@@ -550,14 +552,14 @@ def markdown(res, cmdline):
          + (f", first {res['config']['duration']} s" if res['config']['duration'] else "") + ").", "",
          "Localization (horizontal, every pose of the method against the truth of the same scan, no alignment; "
          "false OK = status OK with error > 0.3 m; NEES = median of (x, y, yaw) NEES from pose_t's covariance, "
-         "3 for a consistent covariance; ms/scan = thread CPU of the method's nodes on one core, with and without the "
-         "segmenter every method shares):", "",
-         "| world | method | ATE [cm] | max [cm] | LOST | false OK | NEES | ms/scan | ms/scan w/o segmenter |",
-         "|---|---|---|---|---|---|---|---|---|"]
+         "3 for a consistent covariance; POOR = share of poses published POOR; ms/scan = thread CPU of the method's "
+         "nodes on one core, with and without the segmenter every method shares):", "",
+         "| world | method | ATE [cm] | max [cm] | LOST | POOR | false OK | NEES | ms/scan | ms/scan w/o segmenter |",
+         "|---|---|---|---|---|---|---|---|---|---|"]
     for r in res["rows"]:
         L.append(f"| {r['family']} | {r['method']} | {fmt(100 * r['ate_m'] if r.get('ate_m') is not None else None, 2)} | "
                  f"{fmt(100 * r['max_m'] if r.get('max_m') is not None else None, 1)} | {pct(r.get('lost'))} | "
-                 f"{pct(r.get('false_ok'))} | {fmt(r.get('nees_median'), 1)} | {r['ms_per_scan']} | "
+                 f"{pct(r.get('poor'))} | {pct(r.get('false_ok'))} | {fmt(r.get('nees_median'), 1)} | {r['ms_per_scan']} | "
                  f"{r.get('ms_per_scan_localizer', '-')} |")
     L += ["", "Plan-change detection (`fploc map diff` on the fploc run; truth from `fploc sim`'s LOG.world.json). "
           "Removed = removed walls/pillars and glass in view of the path; moved = walls moved >= 10 cm in view; "

@@ -35,11 +35,28 @@ def yaw_of(row):
     return math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
 
 
-def fploc_eval(bin_dir, gt, est, who, plot=None):
-    """`fploc eval --json` of est against gt (dict), or None when est is missing or empty."""
+def fploc_eval(bin_dir, gt, est, who, plot=None, uncertainty=None):
+    """`fploc eval --json` of est against gt (dict), or None when est is missing or empty. With uncertainty
+    (a fploc-pose-logger uncertainty_file of est, when it exists): also NEES and false OK (nees_median,
+    false_ok_poses, ... see modules/eval/uncertainty.h)."""
     if not os.path.exists(est) or os.path.getsize(est) == 0:
         return None
     cmd = [os.path.join(bin_dir, "fploc-eval"), "--gt", gt, "--est", est, "--json"]
     if plot:
         cmd += ["--plot", plot]
+    if uncertainty and os.path.exists(uncertainty) and os.path.getsize(uncertainty) > 0:
+        cmd += ["--uncertainty", uncertainty]
     return json.loads(run(cmd, who)[0])
+
+
+def status_counts(uncertainty):
+    """Poses per status (OK, POOR, LOST) in a fploc-pose-logger uncertainty_file (None when missing)."""
+    if not uncertainty or not os.path.exists(uncertainty):
+        return None
+    n = [0, 0, 0]
+    with open(uncertainty) as f:
+        for line in f:
+            v = line.split()
+            if v and not v[0].startswith("#") and len(v) >= 2 and v[1] in ("0", "1", "2"):
+                n[int(v[1])] += 1
+    return n

@@ -4,8 +4,23 @@
 
 namespace fploc::localizer {
 
+namespace {
+Config with_uncertainty_defaults(Config c) {
+  // The frame covariance is of the matcher's estimate: its loss and final gate.
+  c.uncertainty.frame.loss = c.matcher.loss;
+  c.uncertainty.frame.loss_scale_m = c.matcher.loss_scale_m;
+  c.uncertainty.frame.gate_m = c.matcher.min_correspondence_m;
+  c.uncertainty.frame.group_rule = c.matcher.group_rule;
+  return c;
+}
+}  // namespace
+
 Localizer::Localizer(const matcher::NearestLookup& lookup, Config cfg)
-    : cfg_(std::move(cfg)), matcher_(lookup, cfg_.matcher), window_(lookup, cfg_.optimizer) {}
+    : cfg_(with_uncertainty_defaults(std::move(cfg))),
+      lookup_(lookup),
+      matcher_(lookup, cfg_.matcher),
+      window_(lookup, cfg_.optimizer),
+      tracker_(cfg_.uncertainty) {}
 
 void Localizer::add_imu(int64_t utime, double gyro_z) {
   if (cfg_.use_imu) imu_.add(utime, gyro_z);
@@ -19,6 +34,9 @@ void Localizer::add_odometry(int64_t utime, const Pose2& p) {
 void Localizer::set_pose(const Pose2& p, std::optional<double> search_m) {
   if (!search_m && cfg_.initial_search_m > 0) search_m = cfg_.initial_search_m;
   matcher_.set_pose(p, search_m);
+  // The search region as a 3-sigma bound of the initial pose.
+  const double sm = search_m && *search_m > 0 ? *search_m : cfg_.matcher.max_correspondence_m;
+  tracker_.reset(sm / 3, cfg_.matcher.initial_search_yaw_rad / 3);
 }
 
 FramePose Localizer::register_frame(const FeatureFrame& f) {
@@ -67,6 +85,20 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
   in.twist = sfr.match.twist;
   in.status = sfr.match.status;
   in.covariance = sfr.match.covariance;
+  in.published_status = sfr.match.status;
+  in.status_text = sfr.match.text;
+  if (cfg_.uncertainty.enabled) {
+    // The frame de-skewed to its mean point time with the matcher's twist, at the pose of that time (as
+    // the window's keyframes; FramePose from a message carries only the pose at utime and the twist).
+    const double t_ref = matcher::mean_time(f);
+    matcher::deskew(f, sfr.match.twist, t_ref, &deskewed_);
+    const Pose2 at_ref = compose(sfr.match.pose, matcher::exp_twist(sfr.match.twist, t_ref));
+    const auto fu = optimizer::frame_uncertainty(lookup_, deskewed_, at_ref, cfg_.uncertainty.frame);
+    uncertainty_ = tracker_.update(f.utime, fu.covariance, fu.valid, sfr.match.status, sfr.match.text);
+    in.covariance = uncertainty_.covariance;
+    in.published_status = uncertainty_.status;
+    in.status_text = uncertainty_.text;
+  }
   return window_.add(std::move(in), finals);
 }
 

@@ -104,7 +104,16 @@ PoseOut WindowOptimizer::make_out(const Frame& f, const Pose2& pose_tau_in, bool
   fill_gravity(&o, f.in.features);
   o.keyframe = key;
   o.status = f.in.status;
+  if (f.in.status == matcher::FitStatus::kOk || f.in.status == matcher::FitStatus::kPoor)
+    o.status = std::max(f.in.status, f.in.published_status);  // the worse of the two (OK < POOR < LOST)
+  o.status_text = f.in.status_text;
   o.covariance = f.in.covariance;
+  if (cfg_.covariance_offset) {
+    // The covariance is of the frame's own fix (its single-frame pose); the published pose lies d from it
+    // (the window smooths, or holds what the fix does not see): the error's second moment is P + d d^T.
+    const Eigen::Vector3d d = diff(o.pose, f.in.sfr);
+    o.covariance += d * d.transpose();
+  }
   o.z_sigma = f.in.features.z_sigma;
   o.roll_pitch_sigma = f.in.features.roll_pitch_sigma;
   return o;

@@ -16,6 +16,8 @@ for r in d["rows"]:
         assert k in r and r[k] is not None, (k, r)
     assert r["poses"] >= 35, r
     assert r["z_err_p99_m"] < 0.05 and r["ate_xy_m"] < 0.05 and r["lost"] == 0, r
+    # Honest uncertainty (issue 12): the published covariance is scored, no pose is OK while > 0.3 m off.
+    assert r["nees_median"] is not None and r["nees_median"] > 0 and r["false_ok"] == 0, r
     assert set(r["ms_per_scan"]) == {"segmenter", "features", "matcher", "optimizer"}, r
     assert os.path.getsize(r["plot"]) > 1000 and open(r["plot"]).read().startswith("<svg"), r
 assert "ceilings: mixed" in " ".join(d["rows"][0]["sim"]), d["rows"][0]

@@ -10,13 +10,15 @@ r = json.loads(sys.argv[1])
 rows = {x["method"]: x for x in r["rows"]}
 assert {"fploc", "fploc+downweight", "amcl"} <= set(rows), rows.keys()
 f = rows["fploc"]
-for k in ("ate_m", "max_m", "lost", "false_ok", "nees_median", "ms_per_scan", "ms_per_scan_localizer", "poses"):
+for k in ("ate_m", "max_m", "lost", "false_ok", "false_ok_poses", "poor", "nees_median", "ms_per_scan", "ms_per_scan_localizer", "poses"):
     assert k in f, k
 assert 0 < f["ms_per_scan_localizer"] < f["ms_per_scan"], f
 dw = rows["fploc+downweight"]
 assert dw["poses"] == f["poses"] and dw["lost"] == 0 and dw["ate_m"] < 0.5, dw
 assert f["poses"] >= 90, f
 assert f["lost"] == 0 and f["false_ok"] == 0, f
+# Honest covariance: the median NEES (3 if consistent) was 300 here when points were taken as independent.
+assert f["nees_median"] is not None and 0.3 < f["nees_median"] < 20, f
 assert f["ate_m"] < 0.5 and f["max_m"] < 1.0, f
 d = r["detection"][0]
 for k in ("removed", "removed_found", "moved", "moved_found", "added", "added_found", "false_flags_per_100m", "precision", "recall"):

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "fploc/localizer/degeneracy.h"
 #include "fploc/matcher/imu_yaw.h"
 #include "fploc/matcher/matcher.h"
 #include "fploc/optimizer/window.h"
@@ -24,6 +25,9 @@ struct Config {
   bool use_imu = true;               // the IMU's yaw rate: prediction (yaw change) + sweep yaw rate (de-skew)
   double initial_search_m = 0;       // set_pose without an uncertainty: search this far (0: matcher.max_correspondence_m)
   bool refine_from_window = true;    // process(): the WO estimate of a frame predicts the next one
+  // The published covariance and status (degeneracy.h); its frame loss/gate follow `matcher` unless
+  // set apart (Localizer's constructor copies them).
+  UncertaintyConfig uncertainty;
 };
 
 // The SFR step's result for one frame (what FPLOC_FRAME_POSE carries).
@@ -79,9 +83,12 @@ class Localizer {
 
   const Config& config() const { return cfg_; }
   const matcher::Matcher& matcher() const { return matcher_; }
+  // The uncertainty published with the last optimize()d frame.
+  const UncertaintyState& uncertainty() const { return uncertainty_; }
 
  private:
   Config cfg_;
+  const matcher::NearestLookup& lookup_;
   matcher::Matcher matcher_;
   optimizer::WindowOptimizer window_;
   matcher::ImuYaw imu_;
@@ -91,6 +98,9 @@ class Localizer {
   std::optional<std::pair<double, double>> last_rp_;
   std::map<int64_t, Pose2> odom_;    // odometry poses by utime (add_odometry)
   FeatureFrame held_;                // scratch: the frame with the IMU's sweep rate and the held attitude
+  FeatureFrame deskewed_;            // scratch: the frame de-skewed as the matcher registered it
+  UncertaintyTracker tracker_;
+  UncertaintyState uncertainty_;
 };
 
 }  // namespace fploc::localizer

@@ -47,6 +47,9 @@ struct OptimizerConfig {
   double max_keyframe_gap_s = 2.0;     // a longer gap (e.g. lost frames) restarts the window
   std::string linear_solver = "sparse";  // "sparse" (SPARSE_NORMAL_CHOLESKY) or "dense" (DENSE_NORMAL_CHOLESKY)
   const std::vector<float>* element_weight = nullptr;  // as MatcherConfig::element_weight
+  // Published covariance: FrameInput::covariance (of the frame's single-frame fix) plus d d^T, d the output
+  // pose minus that fix (the window's pose is not the fix the covariance is about).
+  bool covariance_offset = true;
 };
 
 struct FrameInput {
@@ -54,7 +57,11 @@ struct FrameInput {
   Pose2 sfr;                           // single-frame registration result at features.utime
   matcher::Twist2 twist;                        // the matcher's body twist (its motion compensation)
   matcher::FitStatus status = matcher::FitStatus::kOk;
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // published with the frame's pose
+  // What to publish besides (localizer/degeneracy.h): a status that only downgrades `status` (POOR where
+  // the plan leaves a direction open) and why. Keyframes are still chosen by `status` alone.
+  matcher::FitStatus published_status = matcher::FitStatus::kOk;
+  std::string status_text;
 };
 
 struct PoseOut {
@@ -65,7 +72,8 @@ struct PoseOut {
   bool keyframe = false;
   bool final_estimate = false;
   matcher::FitStatus status = matcher::FitStatus::kOk;
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // (x, y, yaw): the frame's single-frame covariance
+  std::string status_text;             // why not OK
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // (x, y, yaw): FrameInput::covariance (+ d d^T, see config)
   double z_sigma = 0, roll_pitch_sigma = 0;  // the frame's own (as measured; "unknown" sigmas, see types.h)
   int optimised = 0;                   // how many window solves this pose took part in
 };

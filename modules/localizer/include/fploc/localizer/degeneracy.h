@@ -1,0 +1,90 @@
+// Degeneracy and the published pose status (issue 12, "honest uncertainty").
+//
+// Each frame's honest covariance (optimizer/covariance.h) says what that frame alone fixes. Where the plan
+// leaves a direction open (a long featureless wall or corridor) the frame fixes nothing along it, and what
+// the localizer publishes there is dead reckoning: the constant-velocity prediction (matcher) and the
+// window's velocity regularisation carry the pose, whose error grows with the time since the direction
+// was last fixed, and faster the longer the velocity along it has not been seen. The window's own marginal
+// covariance would hide that (its velocity terms "constrain" the open direction), so the published
+// covariance is tracked here instead, with the velocity error as a second covariance W (vx, vy, yaw rate):
+//
+//   predicted  W- = (sqrt(W) + accel dt)^2, capped at max_velocity_error (the platform's speed)
+//              P- = (sqrt(P) + sqrt(W-) dt)^2   standard deviations add (a held velocity error is not
+//                                               averaged away); per direction of the basis that
+//                                               diagonalises both
+//   published  P  = per direction the tighter of P- and the frame's P_f (same basis trick): where the frame
+//                   fixes the pose P = P_f (frames are NOT fused with each other: their plan errors are the
+//                   same walls' errors, so fusing them would be overconfident), where it does not P = P-.
+//              W  = the tighter of W- and what the frame observes: velocity_sigma_mps along the
+//                   directions it fixes (consecutive fixes give the velocity), nothing along the others.
+//
+// Status: OK while the published 1-sigma along the weakest horizontal direction (the largest eigenvalue
+// of the x/y block) stays below poor_sigma_m and the heading's below poor_sigma_rad; otherwise POOR, with
+// a text naming the direction ("position open along 87 deg (1 sigma 0.31 m): the plan does not constrain
+// it here"). The matcher's POOR/LOST stay as they are (LOST means lost, not merely uncertain).
+#pragma once
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+
+#include "fploc/matcher/types.h"
+#include "fploc/optimizer/covariance.h"
+
+namespace fploc::localizer {
+
+struct UncertaintyConfig {
+  bool enabled = true;                 // false: the matcher's covariance and status as they were
+  optimizer::CovarianceConfig frame;   // the per-frame covariance
+  // The platform (not the world): how well consecutive fixes give the velocity, how fast the velocity may
+  // change where it is not seen, and the largest velocity error (its top speed).
+  double velocity_sigma_mps = 0.05;
+  double accel_sigma_mps2 = 0.5;
+  double max_velocity_error_mps = 1.5;
+  double yaw_rate_sigma_rps = 0.005;   // the IMU's yaw rate carries the heading
+  double poor_sigma_m = 0.1;           // POOR beyond this 1-sigma along the weakest horizontal direction
+  double poor_sigma_rad = 0.05;        // ... or in heading
+  double max_gap_s = 2.0;              // a longer gap between frames restarts from the frame alone
+};
+
+struct UncertaintyState {
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // published (x, y, yaw)
+  matcher::FitStatus status = matcher::FitStatus::kOk;
+  std::string text;                    // why POOR (empty when OK)
+  double sigma_max_m = 0;              // 1-sigma along the weakest horizontal direction
+  double weak_direction_rad = 0;       // that direction (plan frame, -pi/2 .. pi/2]
+  double sigma_yaw_rad = 0;
+  double frame_sigma_max_m = 0;        // the frame's own 1-sigma along its weakest horizontal direction
+  bool frame_degenerate = false;       // the frame alone leaves a direction open (frame sigma > poor_sigma_m)
+};
+
+class UncertaintyTracker {
+ public:
+  explicit UncertaintyTracker(UncertaintyConfig cfg = {}) : cfg_(std::move(cfg)) {}
+  // One frame, in time order: its own covariance (frame_valid false: the frame fixes nothing) and the
+  // matcher's status/text. Returns what to publish with the frame's pose.
+  UncertaintyState update(int64_t utime, const Eigen::Matrix3d& frame_cov, bool frame_valid, matcher::FitStatus matcher_status,
+                          const std::string& matcher_text = {});
+  // A new initial pose with its uncertainty (1-sigma x/y and yaw); the velocity is unknown.
+  void reset(double sigma_m, double sigma_rad);
+  void reset() { have_ = false; }
+  const UncertaintyConfig& config() const { return cfg_; }
+
+ private:
+  UncertaintyConfig cfg_;
+  bool have_ = false;
+  int64_t last_utime_ = 0;
+  Eigen::Matrix3d P_ = Eigen::Matrix3d::Identity();   // pose (x, y, yaw)
+  Eigen::Matrix3d W_ = Eigen::Matrix3d::Identity();   // velocity error (vx, vy, yaw rate)
+  bool have_initial_ = false;                          // P_ / W_ hold reset()'s initial uncertainty
+};
+
+// The tighter of two covariances per direction of their common eigenbasis (generalised eigenvectors).
+Eigen::Matrix3d tighter_of(const Eigen::Matrix3d& A, const Eigen::Matrix3d& B);
+// (sqrt(P) + sqrt(Q))^2 per direction of the basis that diagonalises both: standard deviations add.
+Eigen::Matrix3d add_sigmas(const Eigen::Matrix3d& P, const Eigen::Matrix3d& Q);
+// add_sigmas(P, diag(a)^2): every axis' standard deviation grows by its a.
+Eigen::Matrix3d grow_linear(const Eigen::Matrix3d& P, const Eigen::Vector3d& a);
+// Largest 1-sigma of the x/y block and its direction [rad, (-pi/2, pi/2]].
+double weakest_horizontal(const Eigen::Matrix3d& P, double* direction_rad);
+
+}  // namespace fploc::localizer

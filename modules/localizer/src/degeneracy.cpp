@@ -1,0 +1,138 @@
+#include "fploc/localizer/degeneracy.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace fploc::localizer {
+
+namespace {
+Eigen::Matrix3d sym(const Eigen::Matrix3d& P) { return 0.5 * (P + P.transpose()); }
+// Positive definite with eigenvalues in [lo, hi].
+Eigen::Matrix3d clamp_spd(const Eigen::Matrix3d& P, double lo, double hi) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(sym(P));
+  const Eigen::Vector3d ev = es.eigenvalues().cwiseMax(lo).cwiseMin(hi);
+  return es.eigenvectors() * ev.asDiagonal() * es.eigenvectors().transpose();
+}
+}  // namespace
+
+Eigen::Matrix3d tighter_of(const Eigen::Matrix3d& A_in, const Eigen::Matrix3d& B_in) {
+  const Eigen::Matrix3d A = clamp_spd(A_in, 1e-14, 1e12), B = clamp_spd(B_in, 1e-14, 1e12);
+  Eigen::LLT<Eigen::Matrix3d> llt(A);
+  const Eigen::Matrix3d L = llt.matrixL();
+  const Eigen::Matrix3d Li = L.inverse();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(sym(Li * B * Li.transpose()));
+  const Eigen::Vector3d mu = es.eigenvalues().cwiseMin(1.0);
+  const Eigen::Matrix3d T = L * es.eigenvectors();
+  return sym(T * mu.asDiagonal() * T.transpose());
+}
+
+Eigen::Matrix3d add_sigmas(const Eigen::Matrix3d& P_in, const Eigen::Matrix3d& Q_in) {
+  const Eigen::Matrix3d P = clamp_spd(P_in, 1e-14, 1e12), Q = clamp_spd(Q_in, 0.0, 1e12);
+  Eigen::LLT<Eigen::Matrix3d> llt(P);
+  const Eigen::Matrix3d L = llt.matrixL();
+  const Eigen::Matrix3d Li = L.inverse();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(sym(Li * Q * Li.transpose()));
+  const Eigen::Vector3d g = (es.eigenvalues().cwiseMax(0.0).cwiseSqrt().array() + 1.0).square();
+  const Eigen::Matrix3d T = L * es.eigenvectors();
+  return sym(T * g.asDiagonal() * T.transpose());
+}
+
+Eigen::Matrix3d grow_linear(const Eigen::Matrix3d& P, const Eigen::Vector3d& a) {
+  return add_sigmas(P, a.cwiseProduct(a).asDiagonal());
+}
+
+double weakest_horizontal(const Eigen::Matrix3d& P, double* direction_rad) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(0.5 * (P.topLeftCorner<2, 2>() + P.topLeftCorner<2, 2>().transpose()));
+  const Eigen::Vector2d v = es.eigenvectors().col(1);  // largest eigenvalue last
+  if (direction_rad) {
+    double a = std::atan2(v.y(), v.x());
+    if (a > M_PI / 2) a -= M_PI;
+    if (a <= -M_PI / 2) a += M_PI;
+    *direction_rad = a + 0.0;  // no "-0"
+  }
+  return std::sqrt(std::max(0.0, es.eigenvalues()[1]));
+}
+
+void UncertaintyTracker::reset(double sigma_m, double sigma_rad) {
+  const double v2 = cfg_.max_velocity_error_mps * cfg_.max_velocity_error_mps;
+  P_ = Eigen::Vector3d(sigma_m * sigma_m, sigma_m * sigma_m, sigma_rad * sigma_rad).asDiagonal();
+  W_ = Eigen::Vector3d(v2, v2, cfg_.yaw_rate_sigma_rps * cfg_.yaw_rate_sigma_rps).asDiagonal();
+  have_ = false;
+  have_initial_ = true;
+}
+
+UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d& frame_cov_in, bool frame_valid,
+                                            matcher::FitStatus matcher_status, const std::string& matcher_text) {
+  const double vmax = cfg_.frame.max_variance;
+  const double v2 = cfg_.max_velocity_error_mps * cfg_.max_velocity_error_mps;
+  const double w2 = cfg_.yaw_rate_sigma_rps * cfg_.yaw_rate_sigma_rps;
+  const Eigen::Matrix3d frame_cov = frame_valid ? clamp_spd(frame_cov_in, 1e-14, vmax) : Eigen::Matrix3d::Identity() * vmax;
+  const bool frame_ok = frame_valid && matcher_status == matcher::FitStatus::kOk;
+  const double dt = (utime - last_utime_) * 1e-6;
+  const Eigen::Matrix3d unknown_velocity = Eigen::Vector3d(v2, v2, w2).asDiagonal();
+  Eigen::Matrix3d P_pred, W_pred;
+  if (matcher_status == matcher::FitStatus::kLost) {
+    P_pred = Eigen::Matrix3d::Identity() * vmax;
+    W_pred = unknown_velocity;
+  } else if (!have_ || !(dt >= 0) || dt > cfg_.max_gap_s) {
+    // Start (from reset()'s initial uncertainty, if any) or restart after a gap: the frame alone.
+    P_pred = have_initial_ && !have_ ? P_ : Eigen::Matrix3d::Identity() * vmax;
+    W_pred = have_initial_ && !have_ ? W_ : unknown_velocity;
+  } else {
+    // The velocity error grows by accel * dt (capped at the platform's speed), the pose's by it * dt.
+    const double a = cfg_.accel_sigma_mps2 * dt;
+    W_pred = grow_linear(W_, Eigen::Vector3d(a, a, 0.0));
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> ev(0.5 * (W_pred.topLeftCorner<2, 2>() + W_pred.topLeftCorner<2, 2>().transpose()));
+    W_pred.topLeftCorner<2, 2>() =
+        ev.eigenvectors() * ev.eigenvalues().cwiseMin(v2).cwiseMax(0.0).asDiagonal() * ev.eigenvectors().transpose();
+    W_pred.block<2, 1>(0, 2).setZero();
+    W_pred.block<1, 2>(2, 0).setZero();
+    W_pred(2, 2) = std::min(W_pred(2, 2), w2);
+    P_pred = clamp_spd(add_sigmas(P_, W_pred * dt * dt), 1e-14, vmax);
+  }
+  if (frame_ok) {
+    P_ = tighter_of(P_pred, frame_cov);
+    // What the frame observes of the velocity: along the directions it fixes, consecutive fixes give it.
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> ef(0.5 * (frame_cov.topLeftCorner<2, 2>() + frame_cov.topLeftCorner<2, 2>().transpose()));
+    Eigen::Vector2d vo;
+    for (int i = 0; i < 2; ++i)
+      vo[i] = std::sqrt(std::max(0.0, ef.eigenvalues()[i])) < cfg_.poor_sigma_m ? cfg_.velocity_sigma_mps * cfg_.velocity_sigma_mps : v2;
+    Eigen::Matrix3d W_obs = Eigen::Matrix3d::Zero();
+    W_obs.topLeftCorner<2, 2>() = ef.eigenvectors() * vo.asDiagonal() * ef.eigenvectors().transpose();
+    W_obs(2, 2) = w2;
+    W_ = tighter_of(W_pred, W_obs);
+  } else {
+    P_ = P_pred;
+    W_ = W_pred;
+  }
+  have_ = matcher_status != matcher::FitStatus::kLost;
+  have_initial_ = false;
+  last_utime_ = utime;
+  UncertaintyState s;
+  s.covariance = P_;
+  s.sigma_max_m = weakest_horizontal(P_, &s.weak_direction_rad);
+  s.sigma_yaw_rad = std::sqrt(std::max(0.0, P_(2, 2)));
+  s.frame_sigma_max_m = weakest_horizontal(frame_cov, nullptr);
+  s.frame_degenerate = s.frame_sigma_max_m > cfg_.poor_sigma_m;
+  s.status = matcher_status;
+  s.text = matcher_text;
+  if (matcher_status == matcher::FitStatus::kOk) {
+    char b[200];
+    if (s.sigma_max_m > cfg_.poor_sigma_m) {
+      std::snprintf(b, sizeof b, "position open along %ld deg (1 sigma %.2f m%s)", std::lround(s.weak_direction_rad * 180 / M_PI),
+                    s.sigma_max_m, s.frame_degenerate ? ": the plan does not constrain it here" : "");
+      s.status = matcher::FitStatus::kPoor;
+      s.text = b;
+    } else if (s.sigma_yaw_rad > cfg_.poor_sigma_rad) {
+      std::snprintf(b, sizeof b, "heading weakly constrained (1 sigma %.1f deg)", s.sigma_yaw_rad * 180 / M_PI);
+      s.status = matcher::FitStatus::kPoor;
+      s.text = b;
+    }
+  }
+  return s;
+}
+
+}  // namespace fploc::localizer

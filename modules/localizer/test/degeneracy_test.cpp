@@ -1,0 +1,148 @@
+// The published covariance and status (degeneracy.h): growth along an open direction, POOR naming it,
+// back to OK when the plan fixes the pose again; the matrix helpers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "fploc/localizer/degeneracy.h"
+#include "fploc/localizer/localizer.h"
+#include "fploc/matcher/map.h"
+#include "synthetic.h"
+
+using namespace fploc;
+using namespace fploc::matcher;
+using namespace fploc::localizer;
+
+namespace {
+Eigen::Matrix3d diag(double sx, double sy, double syaw) { return Eigen::Vector3d(sx * sx, sy * sy, syaw * syaw).asDiagonal(); }
+}  // namespace
+
+TEST(Degeneracy, TighterOfTakesEachDirectionFromTheBetterSource) {
+  const Eigen::Matrix3d A = diag(0.01, 1.0, 0.01), B = diag(1.0, 0.02, 0.1);
+  const Eigen::Matrix3d T = tighter_of(A, B);
+  EXPECT_NEAR(T(0, 0), 1e-4, 1e-9);
+  EXPECT_NEAR(T(1, 1), 4e-4, 1e-9);
+  EXPECT_NEAR(T(2, 2), 1e-4, 1e-9);
+  // Never tighter than both, never looser than either.
+  const Eigen::Matrix3d S = tighter_of(B, B);
+  EXPECT_TRUE(S.isApprox(B, 1e-9));
+}
+
+TEST(Degeneracy, StartsFromTheInitialPoseUncertaintyWithAnUnknownVelocity) {
+  UncertaintyTracker tr;
+  tr.reset(0.05, 0.02);
+  const Eigen::Matrix3d open = diag(100.0, 0.005, 0.002);
+  auto s = tr.update(0, open, true, FitStatus::kOk);
+  EXPECT_NEAR(std::sqrt(s.covariance(0, 0)), 0.05, 1e-9);  // the initial pose's along the open x
+  EXPECT_EQ(s.status, FitStatus::kOk);
+  // The velocity along x is unknown (the platform's speed): one frame later the pose is too.
+  s = tr.update(100000, open, true, FitStatus::kOk);
+  EXPECT_NEAR(std::sqrt(s.covariance(0, 0)), 0.05 + 1.5 * 0.1, 1e-6);
+  EXPECT_EQ(s.status, FitStatus::kPoor);
+  EXPECT_NE(s.text.find("along 0 deg"), std::string::npos) << s.text;
+}
+
+TEST(Degeneracy, GrowLinearAddsToTheStandardDeviation) {
+  const Eigen::Matrix3d G = grow_linear(diag(0.03, 0.04, 0.01), Eigen::Vector3d(0.01, 0.01, 0.001));
+  EXPECT_NEAR(std::sqrt(G(0, 0)), 0.04, 1e-9);
+  EXPECT_NEAR(std::sqrt(G(1, 1)), 0.05, 1e-9);
+  EXPECT_NEAR(std::sqrt(G(2, 2)), 0.011, 1e-9);
+}
+
+TEST(Degeneracy, CorridorGrowsPoorNamesTheDirectionThenRecovers) {
+  UncertaintyConfig cfg;
+  cfg.velocity_sigma_mps = 0.05;
+  cfg.accel_sigma_mps2 = 0.5;
+  cfg.max_velocity_error_mps = 1.5;
+  cfg.poor_sigma_m = 0.1;
+  UncertaintyTracker tr(cfg);
+  const int64_t dt = 100000;  // 10 Hz
+  int64_t t = 0;
+  const Eigen::Matrix3d fixed = diag(0.005, 0.005, 0.002);
+  // A 30-degree corridor: the frames fix the pose across it only.
+  const double a = 30 * M_PI / 180;
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  R.topLeftCorner<2, 2>() << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+  const Eigen::Matrix3d open = R * diag(100.0, 0.005, 0.002) * R.transpose();
+  for (int k = 0; k < 10; ++k, t += dt) {
+    const auto s = tr.update(t, fixed, true, FitStatus::kOk);
+    EXPECT_EQ(s.status, FitStatus::kOk);
+    EXPECT_NEAR(s.sigma_max_m, 0.005, 1e-6);
+  }
+  double sigma = 0.005, sigma_v = 0.05;
+  int first_poor = -1;
+  for (int k = 0; k < 30; ++k, t += dt) {
+    const auto s = tr.update(t, open, true, FitStatus::kOk);
+    // Along the corridor the velocity error grows by accel * dt per frame (up to the platform's speed)
+    // and the position's standard deviation by that velocity error * dt; across the corridor it stays.
+    sigma_v = std::min(1.5, sigma_v + 0.5 * 0.1);
+    sigma += sigma_v * 0.1;
+    EXPECT_NEAR(s.sigma_max_m, sigma, 1e-6) << k;
+    EXPECT_NEAR(std::abs(s.weak_direction_rad), a, 1e-3);
+    const Eigen::Vector2d across(-std::sin(a), std::cos(a));
+    EXPECT_NEAR(std::sqrt(across.dot(s.covariance.topLeftCorner<2, 2>() * across)), 0.005, 1e-4);
+    EXPECT_TRUE(s.frame_degenerate);
+    if (s.status == FitStatus::kPoor && first_poor < 0) {
+      first_poor = k;
+      EXPECT_NE(s.text.find("along 30 deg"), std::string::npos) << s.text;
+    }
+  }
+  EXPECT_EQ(first_poor, 4);  // 0.005 + 0.01 + 0.015 + 0.02 + 0.025 + 0.03 > 0.1
+  // The plan fixes the pose again: OK with the frame's covariance at once.
+  const auto s = tr.update(t, fixed, true, FitStatus::kOk);
+  EXPECT_EQ(s.status, FitStatus::kOk);
+  EXPECT_TRUE(s.text.empty());
+  EXPECT_NEAR(s.sigma_max_m, 0.005, 1e-6);
+}
+
+TEST(Degeneracy, MatcherStatusIsKept) {
+  UncertaintyTracker tr;
+  const Eigen::Matrix3d fixed = diag(0.005, 0.005, 0.002);
+  tr.update(0, fixed, true, FitStatus::kOk);
+  // A frame the matcher did not accept adds nothing: the prediction grows.
+  const auto p = tr.update(100000, fixed, true, FitStatus::kPoor, "inliers 3/100");
+  EXPECT_EQ(p.status, FitStatus::kPoor);
+  EXPECT_EQ(p.text, "inliers 3/100");
+  EXPECT_NEAR(p.sigma_max_m, 0.005 + (0.05 + 0.5 * 0.1) * 0.1, 1e-6);  // grown by the velocity error over one frame
+  const auto l = tr.update(200000, fixed, true, FitStatus::kLost, "lost");
+  EXPECT_EQ(l.status, FitStatus::kLost);
+  EXPECT_GT(l.sigma_max_m, 10.0);
+}
+
+// The whole localizer along a corridor whose ends are never seen, driven at 0.5 m/s: the plan fixes y and
+// the heading, nothing fixes x. The published status must say POOR before the x error grows, and never OK
+// while the pose is more than 0.3 m off (false OK); across the corridor the covariance stays small.
+TEST(Degeneracy, LocalizerAlongAnEndlessCorridorIsPoorBeforeTheErrorGrows) {
+  const FloorPlan plan = fploc::testing::endless_corridor();
+  auto map = make_localization_map(plan, "brute-force");
+  localizer::Localizer loc(*map.lookup, {});
+  loc.set_pose({50, 1, 0}, 0.15);
+  fploc::testing::SynthOptions so;
+  so.max_range = 8;
+  so.noise_sigma = 0.005;
+  std::vector<localizer::Pose> finals;
+  int first_poor = -1, false_ok = 0;
+  double err_at_first_poor = -1, max_err = 0;
+  for (int k = 0; k < 60; ++k) {
+    const int64_t utime = k * 100'000;
+    const Pose2 truth{50 + 0.05 * k, 1, 0};
+    so.seed = uint32_t(k + 1);
+    const auto s = loc.process(fploc::testing::synth_frame(plan, truth, so, utime), &finals);
+    ASSERT_TRUE(s.latest);
+    const double err = std::hypot(s.latest->pose.x - truth.x, s.latest->pose.y - truth.y);
+    max_err = std::max(max_err, err);
+    if (s.latest->status == FitStatus::kOk && err > 0.3) ++false_ok;
+    if (s.latest->status == FitStatus::kPoor && first_poor < 0) {
+      first_poor = k;
+      err_at_first_poor = err;
+      EXPECT_NE(s.latest->status_text.find("along 0 deg"), std::string::npos) << s.latest->status_text;
+    }
+    EXPECT_NE(s.latest->status, FitStatus::kLost) << k;
+    EXPECT_LT(std::sqrt(s.latest->covariance(1, 1)), 0.02) << k;  // across: the walls
+  }
+  std::printf("endless corridor: first POOR at frame %d (error %.3f m), max error %.2f m\n", first_poor, err_at_first_poor,
+              max_err);
+  ASSERT_GE(first_poor, 0);
+  EXPECT_LT(err_at_first_poor, 0.1);
+  EXPECT_EQ(false_ok, 0);
+}
