@@ -28,7 +28,7 @@ class SegmenterNodeT : public rt::Node {
     return {Traits::kType, "segmenter", Traits::kDescription,
             {rt::input<scan_t>("scan", "OS1_SCAN"), rt::input<imu_t>("imu", "OS1_IMU"),
              // The localizer's latest pose: places the ceiling points in the building's areas (option building).
-             rt::input<pose_t>("pose", "FPLOC_POSE_LATEST"),
+             rt::input<pose_t>("pose", ""),  // only with segmenter.building; map it to FPLOC_POSE_LATEST
              rt::output<segments_t>("segments", "FPLOC_SEGMENTS")}};
   }
 
@@ -81,7 +81,7 @@ class SegmenterNodeT : public rt::Node {
     std::cerr << "[" << ctx.name() << "] " << path << " floor '" << f.name << "': ceiling " << f.ceiling_height
               << " m (0 = learned), " << f.areas.size() << " areas; plan pose from " << ctx.channel("pose") << "\n";
     if (ctx.channel("pose").empty())
-      throw std::runtime_error("segmenter.building is set but the pose input is not connected (FPLOC_POSE_LATEST)");
+      throw std::runtime_error("segmenter.building is set but the pose input is not connected (map it: input { port: \"pose\" channel: \"FPLOC_POSE_LATEST\" })");
     ctx.subscribe<pose_t>("pose", [this](const pose_t& m) {
       const Pose2 p = adapters::pose2_of(m);
       if (m.status == 2 || !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.yaw)) return;  // LOST
