@@ -172,3 +172,20 @@ TEST(ConfigDefaults, Amcl) {
 }
 
 }  // namespace
+
+// Not a default, but the same mapping: an unknown robust loss is one error naming the option.
+TEST(ConfigMapping, UnknownLossNamesTheOption) {
+  fploc::MatcherOptions m;
+  m.set_loss("cauchyy");
+  try {
+    (void)fploc::config::config_of(m);
+    ADD_FAILURE() << "no error for loss 'cauchyy'";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("matcher.loss: unknown loss 'cauchyy'"), std::string::npos) << e.what();
+  }
+  fploc::OptimizerOptions o;
+  o.set_loss("geman-mcclure");
+  EXPECT_EQ(fploc::config::config_of(o).loss, "geman-mcclure");
+  o.set_loss("L2");
+  EXPECT_THROW((void)fploc::config::config_of(o), std::runtime_error);
+}
