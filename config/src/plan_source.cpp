@@ -22,4 +22,15 @@ matcher::LocalizationMap load_map(const PlanSource& plan, const std::string& loo
   return matcher::load_localization_map(path, layers, plan.units(), how);
 }
 
+localizer::FloorMaps load_floor_maps(const PlanSource& plan, const std::string& lookup,
+                                     const std::function<std::string(const std::string&)>& resolve,
+                                     const std::string& field) {
+  const std::string path = plan.file().empty() ? "" : resolve(plan.file());
+  if (!path.empty() && is_building_file(path)) {
+    const std::vector<std::string> layers(plan.layers().begin(), plan.layers().end());
+    return localizer::load_floor_maps(path, layers, plan.units(), plan.floor(), lookup);
+  }
+  return localizer::one_floor(load_map(plan, lookup, resolve, field), path);
+}
+
 }  // namespace fploc::config

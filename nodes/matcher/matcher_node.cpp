@@ -57,16 +57,10 @@ class MatcherNode : public fploc::rt::Node {
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::MatcherOptions>();
-    const std::string path = o.plan().file().empty() ? "" : ctx.resolve_path(o.plan().file());
-    if (!path.empty() && fploc::is_building_file(path)) {
-      const std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
-      floors_ = fploc::localizer::load_floor_maps(path, layers, o.plan().units(), o.plan().floor(), o.lookup());
+    floors_ = fploc::config::load_floor_maps(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); },
+                                             "matcher.plan");
+    if (floors_.multi_floor())
       for (const auto& m : floors_.maps) std::cerr << "[" << ctx.name() << "] " << m.note << "\n";
-    } else {
-      floors_ = fploc::localizer::one_floor(
-          fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); }, "matcher.plan"),
-          path);
-    }
     floor_ = floors_.initial;
     if (floors_.multi_floor()) tracker_.emplace(floors_.building, floor_);
     cfg_ = fploc::config::localizer_config(o);

@@ -45,15 +45,8 @@ class OptimizerNode : public fploc::rt::Node {
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::OptimizerOptions>();
-    const std::string path = o.plan().file().empty() ? "" : ctx.resolve_path(o.plan().file());
-    if (!path.empty() && fploc::is_building_file(path)) {
-      const std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
-      floors_ = fploc::localizer::load_floor_maps(path, layers, o.plan().units(), o.plan().floor(), o.lookup());
-    } else {
-      floors_ = fploc::localizer::one_floor(
-          fploc::config::load_map(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); }, "optimizer.plan"),
-          path);
-    }
+    floors_ = fploc::config::load_floor_maps(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); },
+                                             "optimizer.plan");
     floor_ = floors_.initial;
     cfg_ = fploc::config::localizer_config(o);
     diff_weight_ = float(std::max(0.0, o.plan_diff_weight()));

@@ -3,6 +3,7 @@
 #include <functional>
 #include <string>
 
+#include "fploc/localizer/floor_maps.h"
 #include "fploc/matcher/map.h"
 #include "options/common.pb.h"
 
@@ -13,5 +14,11 @@ namespace fploc::config {
 // is given.
 matcher::LocalizationMap load_map(const PlanSource& plan, const std::string& lookup,
                          const std::function<std::string(const std::string&)>& resolve, const std::string& field);
+
+// Every floor of the option's building (`.pbtxt`/`.ifc`: one map per floor, the option's `floor` first to
+// be used), or the option's single plan as a one-floor building. Throws naming `field`.file.
+localizer::FloorMaps load_floor_maps(const PlanSource& plan, const std::string& lookup,
+                                     const std::function<std::string(const std::string&)>& resolve,
+                                     const std::string& field);
 
 }  // namespace fploc::config
