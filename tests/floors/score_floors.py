@@ -9,36 +9,11 @@ ATE over the 10 s after the arrival, and fails (exit 1) when a target is missed:
 recognised within 2 s, none wrong 3 s after the arrival, ATE <= 5 cm."""
 import bisect
 import math
-import struct
+import os
 import sys
 
-
-def lcm_events(path):
-    data = open(path, "rb").read()
-    i = 0
-    while i + 28 <= len(data):
-        sync, _n, ts, clen, dlen = struct.unpack(">IqqII", data[i:i + 28])
-        if sync != 0xEDA1DA01:
-            raise RuntimeError(f"{path}: byte {i}: not an LCM log event")
-        ch = data[i + 28:i + 28 + clen].decode()
-        yield ts, ch, data[i + 28 + clen:i + 28 + clen + dlen]
-        i += 28 + clen + dlen
-
-
-def decode_pose_t(buf):
-    # hash, int64 utime, int64 seq, int8 status, bool keyframe, bool final, double[3+4+36],
-    # int16 floor_index, string floor
-    o = 8
-    utime, _seq, status, _kf, final = struct.unpack(">qqbbb", buf[o:o + 19])
-    o += 19
-    v = struct.unpack(">43d", buf[o:o + 43 * 8])
-    o += 43 * 8
-    (floor_index,) = struct.unpack(">h", buf[o:o + 2])
-    o += 2
-    (n,) = struct.unpack(">i", buf[o:o + 4])
-    floor = buf[o + 4:o + 4 + n - 1].decode()
-    return {"utime": utime, "status": status, "final": bool(final), "x": v[0], "y": v[1], "z": v[2],
-            "floor_index": floor_index, "floor": floor}
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools", "pylib"))
+from lcm_log import decode_pose_t, events  # noqa: E402
 
 
 def main():
@@ -62,7 +37,7 @@ def main():
             gt.append((int(round(t * 1e6)), x, y))
     gt_t = [g[0] for g in gt]
     poses = {}
-    for _ts, ch, buf in lcm_events(rec):
+    for _ts, ch, buf in events(rec, with_time=True):
         if ch == "FPLOC_POSE":
             p = decode_pose_t(buf)
             poses[p["utime"]] = p

@@ -36,7 +36,6 @@ import json
 import math
 import os
 import shutil
-import struct
 import subprocess
 import sys
 import tempfile
@@ -46,6 +45,7 @@ BIN = os.environ.get("FPLOC_BIN") or os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(ROOT, "tools", "pylib"))
 import fploc_tools  # noqa: E402
 from fploc_tools import log, read_tum, yaw_of  # noqa: E402
+from lcm_log import decode_pose_t, events  # noqa: E402
 
 FAMILIES = ["clean", "asbuilt-2cm", "asbuilt-5cm", "scale-0.5pct", "renovated", "glass", "shelves", "doors",
             "crowd-15", "mixed"]
@@ -83,33 +83,10 @@ def run(cmd):
 
 
 # ---- LCM log and pose_t decoding (the LCM wire format: big-endian, 8-byte type hash first) ------------------
-def lcm_events(path):
-    with open(path, "rb") as f:
-        data = f.read()
-    i = 0
-    while i + 28 <= len(data):
-        sync, _num, ts, clen, dlen = struct.unpack(">IqqII", data[i:i + 28])
-        if sync != 0xEDA1DA01:
-            raise RuntimeError(f"{path}: byte {i}: not an LCM log event (sync word {sync:#x})")
-        ch = data[i + 28:i + 28 + clen].decode()
-        yield ts, ch, data[i + 28 + clen:i + 28 + clen + dlen]
-        i += 28 + clen + dlen
-
-
-def decode_pose_t(buf):
-    # int64 utime, int64 seq, int8 status, bool keyframe, bool final_estimate, double position[3],
-    # orientation[4], covariance[36]
-    o = 8
-    utime, _seq, status, _kf, final = struct.unpack(">qqbbb", buf[o:o + 19])
-    o += 19
-    v = struct.unpack(">43d", buf[o:o + 43 * 8])
-    return {"utime": utime, "status": status, "final": bool(final), "p": v[0:3], "q": v[3:7], "cov": v[7:43]}
-
-
 def poses_of(log_path, channel):
     """The method's pose per scan: the final estimate when the method marks one, else its last pose."""
     by_t, finals = {}, {}
-    for _ts, ch, buf in lcm_events(log_path):
+    for _ts, ch, buf in events(log_path, with_time=True):
         if ch != channel:
             continue
         p = decode_pose_t(buf)
