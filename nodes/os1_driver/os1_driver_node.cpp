@@ -158,6 +158,10 @@ class Os1DriverNode : public fploc::rt::Node {
     }
     if (!metadata_error_.empty() || source != metadata_path_)
       std::cerr << "[" << ctx_->name() << "] metadata from " << source << " (" << info_.sensor_name() << ")\n";
+    if (!metadata_error_.empty()) {  // the start-up wait is over: the dashboard no longer shows it as the last error
+      ctx_->error_resolved();
+      metadata_error_.clear();
+    }
     for (const auto& f : info_.defaulted)
       if (f == "pixel_shift_by_row" || f == "lidar_origin_to_beam_origin_mm")
         std::cerr << "[" << ctx_->name() << "] metadata: '" << f << "' absent, using the Ouster default\n";

@@ -127,6 +127,9 @@ class Context {
   void watch_fd(int fd, std::function<void()> fn);
   // Records an error for telemetry (last_error, count) and prints it to stderr the first few times.
   void error(const std::string& msg);
+  // The condition behind the last error is over (e.g. the metadata file appeared): telemetry's last_error
+  // is cleared, the error count stays.
+  void error_resolved() { stats_.last_error.clear(); }
   // The node's own state line in telemetry (node_status_t.detail, shown on the dashboard), e.g. a
   // sensor's status and active alerts; unlike last_error it stays until replaced ("" clears it).
   void set_detail(const std::string& text) { stats_.detail = text; }
