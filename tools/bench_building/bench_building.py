@@ -307,15 +307,9 @@ def bench(a, work, plan, layers, scenario):
         sets.append(f"segmenter.building.file={seg_building}")
         if building:
             sets.append(f"segmenter.building.floor={simj.get('start_floor', '')}")
-    cmd = [os.path.join(BIN, "fploc-replay"), "--graph", a.graph, "--log", logf, "--json"]
-    for s in sets:
-        cmd += ["--set", s]
     log(f"[{name}] replaying {len(gt)} scans ...")
-    rep = json.loads(run(cmd)[0].strip().splitlines()[-1])
+    nodes, scans, ms = fploc_tools.replay(BIN, a.graph, logf, sets, PIPELINE, "fploc bench building")
     os.remove(logf)
-    nodes = {n["name"]: n for n in rep["nodes"]}
-    scans = nodes.get("features", {}).get("messages", 1) or 1
-    ms = {n: round(nodes[n].get("cpu_ms", nodes[n]["total_ms"]) / scans, 3) for n in PIPELINE if n in nodes}
     row = {"plan": os.path.relpath(plan, ROOT), "scenario": scenario, "scans": scans, "sim": info,
            "segmenter_building": seg_building is not None,
            "lost": nodes.get("matcher", {}).get("errors", 0), "ms_per_scan": ms}

@@ -89,15 +89,9 @@ def bench(a, work, beams, scenario):
             f"odometry.initial_pose.x={x0!r}", f"odometry.initial_pose.y={y0!r}", f"odometry.initial_pose.yaw={yaw0!r}",
             f"odometry_map.initial_pose.x={x0!r}", f"odometry_map.initial_pose.y={y0!r}",
             f"odometry_map.initial_pose.yaw={yaw0!r}"]
-    cmd = [os.path.join(BIN, "fploc-replay"), "--graph", a.graph, "--log", logf, "--json"]
-    for s in sets:
-        cmd += ["--set", s]
     log(f"[{name}] replaying {len(gt)} scans ...")
-    rep = json.loads(run(cmd)[0].strip().splitlines()[-1])
+    nodes, scans, ms = fploc_tools.replay(BIN, a.graph, logf, sets, PIPELINE, "fploc bench sensors")
     os.remove(logf)
-    nodes = {n["name"]: n for n in rep["nodes"]}
-    scans = nodes.get("features", {}).get("messages", 1) or 1
-    ms = {n: round(nodes[n].get("cpu_ms", nodes[n]["total_ms"]) / scans, 3) for n in PIPELINE if n in nodes}
     row = {"beams": beams, "beam_source": source, "scenario": scenario, "scans": scans,
            "lost": nodes.get("matcher", {}).get("errors", 0), "ms_per_scan": ms,
            "ms_per_scan_pipeline": round(sum(ms.values()), 3)}

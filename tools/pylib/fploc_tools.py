@@ -60,3 +60,16 @@ def status_counts(uncertainty):
             if v and not v[0].startswith("#") and len(v) >= 2 and v[1] in ("0", "1", "2"):
                 n[int(v[1])] += 1
     return n
+
+
+def replay(bin_dir, graph, log_path, sets, pipeline, who):
+    """`fploc replay --graph GRAPH --log LOG --json --set ...`: returns (nodes by name, scans, ms per scan of
+    each node named in `pipeline`: its thread CPU time, else its total, over the feature frames)."""
+    cmd = [os.path.join(bin_dir, "fploc-replay"), "--graph", graph, "--log", log_path, "--json"]
+    for s in sets:
+        cmd += ["--set", s]
+    rep = json.loads(run(cmd, who)[0].strip().splitlines()[-1])
+    nodes = {n["name"]: n for n in rep["nodes"]}
+    scans = nodes.get("features", {}).get("messages", 1) or 1
+    ms = {n: round(nodes[n].get("cpu_ms", nodes[n]["total_ms"]) / scans, 3) for n in pipeline if n in nodes}
+    return nodes, scans, ms
