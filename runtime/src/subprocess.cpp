@@ -3,11 +3,14 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/prctl.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <chrono>
+#include <cstring>
 
 namespace fploc::rt {
 
@@ -77,6 +80,57 @@ RunResult run_program(const std::vector<std::string>& args, const RunOptions& o)
     r.problem = "killed by signal " + std::to_string(WTERMSIG(status));
   }
   return r;
+}
+
+pid_t spawn_supervised(const std::vector<std::string>& args, const SpawnOptions& o, std::string& error) {
+  if (args.empty()) {
+    error = "no program";
+    return -1;
+  }
+  // Everything the child needs is built before fork: only async-signal-safe calls after it.
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  std::vector<char*> envp;
+  if (o.env) {
+    for (const auto& e : *o.env) envp.push_back(const_cast<char*>(e.c_str()));
+    envp.push_back(nullptr);
+  }
+  const std::string failed = (o.who.empty() ? std::string() : o.who + ": ") + "cannot run " + args[0] + ": ";
+  const pid_t parent = ::getpid();
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    error = std::string("fork failed: ") + std::strerror(errno);
+    return -1;
+  }
+  if (pid == 0) {
+    ::setpgid(0, 0);
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(127);  // the parent died before prctl
+    sigset_t none;
+    sigemptyset(&none);
+    ::sigprocmask(SIG_SETMASK, &none, nullptr);
+    for (int s : {SIGINT, SIGTERM, SIGCHLD, SIGPIPE, SIGHUP}) ::signal(s, SIG_DFL);
+    if (o.stdin_fd == SpawnOptions::kDevNull) {
+      const int devnull = ::open("/dev/null", O_RDONLY);
+      if (devnull >= 0) ::dup2(devnull, 0);
+    } else if (o.stdin_fd >= 0) {
+      ::dup2(o.stdin_fd, 0);
+    }
+    if (o.stdout_fd >= 0) ::dup2(o.stdout_fd, 1);
+    if (o.stderr_fd >= 0) ::dup2(o.stderr_fd, 2);
+    if (o.close_other_fds) ::syscall(SYS_close_range, 3u, ~0u, 0u);
+    char** env = o.env ? envp.data() : environ;
+    if (o.search_path) ::execvpe(argv[0], argv.data(), env);
+    else ::execve(argv[0], argv.data(), env);
+    const char* why = std::strerror(errno);
+    [[maybe_unused]] auto r1 = ::write(2, failed.data(), failed.size());
+    [[maybe_unused]] auto r2 = ::write(2, why, std::strlen(why));
+    [[maybe_unused]] auto r3 = ::write(2, "\n", 1);
+    ::_exit(127);
+  }
+  ::setpgid(pid, pid);
+  return pid;
 }
 
 }  // namespace fploc::rt

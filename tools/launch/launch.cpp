@@ -12,8 +12,6 @@
 #include <fploc/node_status_t.hpp>
 #include <poll.h>
 #include <signal.h>
-#include <sys/prctl.h>
-#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -34,6 +32,7 @@
 #include "fploc/runtime/graph.h"
 #include "fploc/runtime/restart.h"
 #include "fploc/runtime/robot.h"
+#include "fploc/runtime/subprocess.h"
 #include "fploc/runtime/validate.h"
 #include "check_files.h"
 #include "control.h"
@@ -228,26 +227,13 @@ class Launcher : public Effects {
     if (stopping) return;
     for (auto& [h, m] : masters_) {
       if (m.pid > 0 || now_s() < m.next_try) continue;
-      const auto argv = hosts_.at(h)->master_argv();
-      const pid_t parent = ::getpid();
-      const pid_t pid = ::fork();
-      if (pid == 0) {
-        ::setpgid(0, 0);
-        ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-        if (::getppid() != parent) ::_exit(127);
-        sigset_t none;
-        sigemptyset(&none);
-        ::sigprocmask(SIG_SETMASK, &none, nullptr);
-        for (int sg : {SIGINT, SIGTERM, SIGCHLD, SIGPIPE, SIGHUP}) ::signal(sg, SIG_DFL);
-        const int devnull = ::open("/dev/null", O_RDWR);
-        ::dup2(devnull, 0);
-        std::vector<char*> a;
-        for (const auto& x : argv) a.push_back(const_cast<char*>(x.c_str()));
-        a.push_back(nullptr);
-        ::execvp("ssh", a.data());
-        ::_exit(127);
-      }
-      if (pid > 0) ::setpgid(pid, pid);
+      fploc::rt::SpawnOptions o;
+      o.search_path = true;
+      o.stdin_fd = fploc::rt::SpawnOptions::kDevNull;
+      o.who = "fploc launch";
+      std::string error;
+      const pid_t pid = fploc::rt::spawn_supervised(hosts_.at(h)->master_argv(), o, error);
+      if (pid < 0) log_line("ssh master for host " + h + ": " + error);
       m.pid = pid;
       m.next_try = now_s() + 1.0;
     }

@@ -1,8 +1,8 @@
 #include "process_table.h"
 
+#include "fploc/runtime/subprocess.h"
+
 #include <signal.h>
-#include <sys/prctl.h>
-#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -81,44 +81,26 @@ pid_t ProcessTable::spawn(size_t i, int restarts, std::string& error) {
       return -1;
     }
   }
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  std::vector<std::string> env_s;
+  std::vector<std::string> env;
   for (char** e = environ; *e; ++e)
-    if (std::strncmp(*e, "FPLOC_RESTARTS=", 15) != 0) env_s.push_back(*e);
-  env_s.push_back("FPLOC_RESTARTS=" + std::to_string(restarts));
-  std::vector<char*> envp;
-  for (auto& e : env_s) envp.push_back(e.data());
-  envp.push_back(nullptr);
-  const pid_t parent = ::getpid();
-  const pid_t pid = ::fork();
+    if (std::strncmp(*e, "FPLOC_RESTARTS=", 15) != 0) env.push_back(*e);
+  env.push_back("FPLOC_RESTARTS=" + std::to_string(restarts));
+  rt::SpawnOptions o;
+  o.close_other_fds = true;
+  o.who = "fploc launch";
+  if (in_pipe[0] >= 0) {  // through ssh: its stdin/stdout carry the watchdog protocol and the output
+    o.search_path = true;
+    o.stdin_fd = in_pipe[0];
+    o.stdout_fd = o.stderr_fd = out_pipe[1];
+  } else {
+    o.env = &env;
+  }
+  const pid_t pid = rt::spawn_supervised(args, o, error);
   if (pid < 0) {
-    error = std::string("fork failed: ") + strerror(errno);
+    for (int fd : {in_pipe[0], in_pipe[1], out_pipe[0], out_pipe[1]})
+      if (fd >= 0) ::close(fd);
     return -1;
   }
-  if (pid == 0) {
-    ::setpgid(0, 0);
-    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-    if (::getppid() != parent) ::_exit(127);  // the launcher died before prctl
-    sigset_t none;
-    sigemptyset(&none);
-    ::sigprocmask(SIG_SETMASK, &none, nullptr);
-    for (int s : {SIGINT, SIGTERM, SIGCHLD, SIGPIPE, SIGHUP}) ::signal(s, SIG_DFL);
-    if (in_pipe[0] >= 0) {
-      ::dup2(in_pipe[0], 0);
-      ::dup2(out_pipe[1], 1);
-      ::dup2(out_pipe[1], 2);
-      ::syscall(SYS_close_range, 3u, ~0u, 0u);
-      ::execvp("ssh", argv.data());
-    }
-    ::syscall(SYS_close_range, 3u, ~0u, 0u);
-    ::execve(argv[0], argv.data(), envp.data());
-    const char msg[] = "fploc launch: exec failed\n";
-    [[maybe_unused]] auto r = ::write(2, msg, sizeof msg - 1);
-    ::_exit(127);
-  }
-  ::setpgid(pid, pid);  // also from the parent: no race with kill(-pid)
   if (in_pipe[0] >= 0) {
     ::close(in_pipe[0]);
     ::close(out_pipe[1]);

@@ -6,10 +6,11 @@
 // (the link was cut and ssh has not noticed yet), the node is killed — no orphan survives its launcher.
 // First line on stdout: "FPLOC_REMOTE_PID <pid>" (how the launcher matches the node's heartbeats).
 // Exit status: the node's (128 + signal when killed), so the launcher's restart policy sees it.
+#include "fploc/runtime/subprocess.h"
+
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
-#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -53,24 +54,16 @@ int main(int argc, char** argv) {
   for (int s : {SIGINT, SIGTERM, SIGHUP, SIGCHLD}) sigaction(s, &sa, nullptr);
   signal(SIGPIPE, SIG_IGN);
   ::setenv("FPLOC_RESTARTS", restarts.c_str(), 1);
-  const pid_t parent = ::getpid();
-  const pid_t pid = ::fork();
-  if (pid < 0) return 1;
-  if (pid == 0) {
-    ::setpgid(0, 0);
-    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-    if (::getppid() != parent) ::_exit(127);
-    sigset_t none;
-    sigemptyset(&none);
-    ::sigprocmask(SIG_SETMASK, &none, nullptr);
-    for (int s : {SIGINT, SIGTERM, SIGHUP, SIGCHLD, SIGPIPE}) ::signal(s, SIG_DFL);
-    const int devnull = ::open("/dev/null", O_RDONLY);
-    ::dup2(devnull, 0);
-    ::execvp(argv[i], argv + i);
-    std::fprintf(stderr, "fploc-remote: cannot run %s: %s\n", argv[i], std::strerror(errno));
-    ::_exit(127);
+  fploc::rt::SpawnOptions o;
+  o.search_path = true;
+  o.stdin_fd = fploc::rt::SpawnOptions::kDevNull;
+  o.who = "fploc-remote";
+  std::string error;
+  const pid_t pid = fploc::rt::spawn_supervised(std::vector<std::string>(argv + i, argv + argc), o, error);
+  if (pid < 0) {
+    std::fprintf(stderr, "fploc-remote: %s\n", error.c_str());
+    return 1;
   }
-  ::setpgid(pid, pid);
   std::printf("FPLOC_REMOTE_PID %d\n", int(pid));
   std::fflush(stdout);
   auto kill_node = [&](int sig) { ::kill(-pid, sig); };
