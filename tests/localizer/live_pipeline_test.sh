@@ -3,14 +3,8 @@
 # runs segmenter -> features -> matcher -> optimizer -> pose loggers, the matcher waiting for its initial
 # pose; `fploc node initial-pose` sends it; lcm-logplayer plays a simulated sequence. The live
 # trajectories must cover the sequence and lie on the ground truth.
-set -euo pipefail
-B="${FPLOC_BUILD_DIR:?}/bin"
+source "$(dirname "${BASH_SOURCE[0]}")/../support/netns_test.sh"
 ROOT="${FPLOC_ROOT:?}"
-T="$(mktemp -d)"
-pids=()
-cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; rm -rf "$T"; }
-trap cleanup EXIT
-URL="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608"
 "$B/fploc-sim" --scenario room-small-loop-fast --seed 5 --duration 6 --out "$T/log.lcm" --gt "$T/gt.tum" 2> "$T/sim.txt"
 read -r X Y YAW_DEG < <(python3 -c "
 import math

@@ -1,19 +1,11 @@
 #!/usr/bin/env bash
 # Runs inside scripts/netns-run (FPLOC_BUILD_DIR, FPLOC_SHARED_DIR set by fploc_add_netns_test).
-set -euo pipefail
-B="${FPLOC_BUILD_DIR:?}/bin"
+source "$(dirname "${BASH_SOURCE[0]}")/../support/netns_test.sh"
+require_shared ouster/OS-1-64_1024x10_fw20.pcap
+require_exes fploc-os1-driver fploc-imu-driver fploc-os1-send fploc-os1-decode
 D="${FPLOC_SHARED_DIR:?}/data/ouster"
-[ -f "$D/OS-1-64_1024x10_fw20.pcap" ] || { echo "no ../shared/data: skipped"; exit 77; }
-for exe in fploc-os1-driver fploc-imu-driver fploc-os1-send fploc-os1-decode; do
-  [ -x "$B/$exe" ] || { echo "missing $B/$exe (build it first)"; exit 1; }
-done
-T="$(mktemp -d)"
-pids=()
-cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; rm -rf "$T"; }
-trap cleanup EXIT
 PCAP="$D/OS-1-64_1024x10_fw20.pcap"
 META="$D/OS-1-64_sensor_config_reduced.json"
-URL="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608"
 
 lcm-logger --lcm-url="$URL" "$T/log.lcm" > "$T/logger.txt" 2>&1 & pids+=($!)
 "$B/fploc-os1-driver" --lcm-url "$URL" --set metadata="$META" --set lidar_port=17502 > "$T/os1.txt" 2>&1 & pids+=($!)

@@ -4,16 +4,8 @@
 # 10 Hz of wall time with sensor times advancing 0.1 s per frame across the restarts (the defect was a
 # clock that added the loop's length again at each restart and flooded the pipeline).
 # Runs inside scripts/netns-run (FPLOC_BUILD_DIR set by fploc_add_netns_test).
-set -euo pipefail
-B="${FPLOC_BUILD_DIR:?}/bin"
-for exe in fploc-sim-sensor fploc-os1-driver; do
-  [ -x "$B/$exe" ] || { echo "missing $B/$exe (build it first)"; exit 1; }
-done
-T="$(mktemp -d)"
-pids=()
-cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; rm -rf "$T"; }
-trap cleanup EXIT
-URL="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608"
+source "$(dirname "${BASH_SOURCE[0]}")/../support/netns_test.sh"
+require_exes fploc-sim-sensor fploc-os1-driver
 
 lcm-logger --lcm-url="$URL" "$T/run.lcm" > "$T/logger.txt" 2>&1 & pids+=($!)
 "$B/fploc-sim-sensor" --lcm-url "$URL" --set scenario=room-small-loop-fast --set seed=2 --set loop=true \

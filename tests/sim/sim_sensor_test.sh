@@ -1,16 +1,8 @@
 #!/usr/bin/env bash
 # Runs inside scripts/netns-run (FPLOC_BUILD_DIR set by fploc_add_netns_test). Optional argument: a beam
 # pattern (fploc sim --beams; e.g. vlp16: 16-beam OS-1 packets with a 16-beam metadata).
-set -euo pipefail
-B="${FPLOC_BUILD_DIR:?}/bin"
-for exe in fploc-sim-sensor fploc-os1-driver fploc-imu-driver fploc-sim; do
-  [ -x "$B/$exe" ] || { echo "missing $B/$exe (build it first)"; exit 1; }
-done
-T="$(mktemp -d)"
-pids=()
-cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; rm -rf "$T"; }
-trap cleanup EXIT
-URL="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608"
+source "$(dirname "${BASH_SOURCE[0]}")/../support/netns_test.sh"
+require_exes fploc-sim-sensor fploc-os1-driver fploc-imu-driver fploc-sim
 SCEN=room-small-loop-fast
 SEED=3
 BEAMS="${1:-}"
