@@ -49,36 +49,39 @@ std::vector<V> densify_closed(const std::vector<V>& pts, double step) {
   return out;
 }
 
-struct PaperRow {
+struct SpeedRow {
   const char* base;
   const char* speed;
   double v_max, v_avg, length;
 };
 // The paper's Tables I and II (max speed, average speed, length).
-constexpr PaperRow kPaper[] = {
+constexpr SpeedRow kPaper[] = {
     {"room-small-loop", "fast", 0.8719, 0.6236, 25.797},   {"room-small-loop", "medium", 0.5641, 0.4090, 25.849},
     {"room-small-loop", "slow", 0.4425, 0.3109, 25.714},   {"room-large-loop", "fast", 0.9213, 0.7253, 46.725},
     {"room-large-loop", "medium", 0.6878, 0.5357, 46.773}, {"room-large-loop", "slow", 0.4742, 0.3552, 46.421},
     {"room-no-loop", "fast", 0.8458, 0.6926, 25.287},      {"room-no-loop", "medium", 0.5277, 0.3904, 25.322},
     {"room-no-loop", "slow", 0.4028, 0.2954, 25.208},      {"corridor-loop", "fast", 1.2678, 1.0487, 81.448},
     {"corridor-loop", "medium", 0.9296, 0.7777, 81.789},   {"corridor-loop", "slow", 0.6603, 0.5547, 82.072},
-    // auto-loop: DESIGN.md's room speeds.
-    {"auto-loop", "fast", 0.90, 0.65, 0},                  {"auto-loop", "medium", 0.55, 0.40, 0},
-    {"auto-loop", "slow", 0.45, 0.30, 0},
-    // building-*: auto-loop with the ceilings of a real building (ceiling_map.h kinds).
-    {"building-areas", "fast", 0.90, 0.65, 0},   {"building-areas", "medium", 0.55, 0.40, 0},
-    {"building-areas", "slow", 0.45, 0.30, 0},   {"building-atrium", "fast", 0.90, 0.65, 0},
-    {"building-atrium", "medium", 0.55, 0.40, 0}, {"building-atrium", "slow", 0.45, 0.30, 0},
-    {"building-clutter", "fast", 0.90, 0.65, 0}, {"building-clutter", "medium", 0.55, 0.40, 0},
-    {"building-clutter", "slow", 0.45, 0.30, 0}, {"building-mixed", "fast", 0.90, 0.65, 0},
-    {"building-mixed", "medium", 0.55, 0.40, 0}, {"building-mixed", "slow", 0.45, 0.30, 0},
-    // Journeys through the demo building (ramp, lift, thresholds): demo_building.h.
-    {"building-twofloor", "fast", 0.90, 0.65, 0},   {"building-twofloor", "medium", 0.55, 0.40, 0},
-    {"building-twofloor", "slow", 0.45, 0.30, 0},   {"building-ramp", "fast", 0.90, 0.65, 0},
-    {"building-ramp", "medium", 0.55, 0.40, 0},     {"building-ramp", "slow", 0.45, 0.30, 0},
-    {"building-thresholds", "fast", 0.90, 0.65, 0}, {"building-thresholds", "medium", 0.55, 0.40, 0},
-    {"building-thresholds", "slow", 0.45, 0.30, 0},
 };
+// Every other family runs at DESIGN.md's room speeds; its length follows from the plan or the journey.
+constexpr SpeedRow kRoomSpeeds[] = {
+    {"", "fast", 0.90, 0.65, 0}, {"", "medium", 0.55, 0.40, 0}, {"", "slow", 0.45, 0.30, 0}};
+constexpr const char* kFamilies[] = {
+    "auto-loop",  // any plan: a loop around its free space
+    // auto-loop with the ceilings of a real building (ceiling_map.h kinds).
+    "building-areas", "building-atrium", "building-clutter", "building-mixed",
+    // Journeys through the demo building (ramp, lift, thresholds): demo_building.h.
+    "building-twofloor", "building-ramp", "building-thresholds"};
+
+std::vector<SpeedRow> all_rows() {
+  std::vector<SpeedRow> rows(std::begin(kPaper), std::end(kPaper));
+  for (const char* family : kFamilies)
+    for (SpeedRow r : kRoomSpeeds) {
+      r.base = family;
+      rows.push_back(r);
+    }
+  return rows;
+}
 
 }  // namespace
 
@@ -139,12 +142,12 @@ FloorPlan demo_corridor_plan() {
 
 std::vector<std::string> scenario_names() {
   std::vector<std::string> out;
-  for (const auto& r : kPaper) out.push_back(std::string(r.base) + "-" + r.speed);
+  for (const auto& r : all_rows()) out.push_back(std::string(r.base) + "-" + r.speed);
   return out;
 }
 
 bool scenario_spec(const std::string& name, ScenarioSpec& out, std::string* error) {
-  for (const auto& r : kPaper) {
+  for (const auto& r : all_rows()) {
     if (name != std::string(r.base) + "-" + r.speed) continue;
     ScenarioSpec s;
     s.name = name;
