@@ -380,11 +380,12 @@ int main(int argc, char** argv) {
   ouster.flush(frames);
   emit_frames(m.time_ns);
   if (!quiet && std::chrono::steady_clock::now() - t_start > std::chrono::seconds(1)) std::fprintf(stderr, "\n");
-  lcm_log.close();
+  const bool log_ok = lcm_log.close();
   tum.close();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
 
   std::vector<std::string> problems;
+  if (!log_ok) problems.push_back(out + ": writing failed (disk full?); the log is cut short");
   if (!rec->error().empty()) problems.push_back(rec->error() + " (the output holds everything before it)");
   for (const auto& [t, n] : decode_errors) problems.push_back(t + ": " + std::to_string(n) + " messages not decoded; first: " + first_decode_error[t]);
   if (ouster.lidar_packets > 0 && !ouster.has_metadata())
@@ -455,5 +456,5 @@ int main(int argc, char** argv) {
     if (!tum_out.empty()) std::printf("  %s: %llu poses\n", tum_out.c_str(), (unsigned long long)tum.poses());
   }
   for (const auto& p : problems) std::cerr << "fploc import: " << p << "\n";
-  return rec->error().empty() ? 0 : 1;
+  return rec->error().empty() && log_ok ? 0 : 1;
 }
