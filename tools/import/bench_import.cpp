@@ -69,13 +69,28 @@ void put_str(std::vector<uint8_t>& b, const std::string& s) {
   b.insert(b.end(), s.begin(), s.end());
 }
 
+// std_msgs/Header (ROS 1): seq, stamp (patched per copy), frame_id.
+std::vector<uint8_t> ros1_header(const std::string& frame) {
+  std::vector<uint8_t> b;
+  for (int i = 0; i < 3; ++i) put32(b, 0);
+  put_str(b, frame);
+  return b;
+}
+
+// Range from the origin along the unit direction d (2 or 3 components) to the walls of a 10 x 6 x 3.5 m room.
+double room_range(const double* d, int dims) {
+  double t = 1e9;
+  const double lo[3] = {-4, -2.5, -1.5}, hi[3] = {6, 3.5, 2};
+  for (int i = 0; i < dims; ++i) {
+    if (d[i] > 1e-9) t = std::min(t, hi[i] / d[i]);
+    if (d[i] < -1e-9) t = std::min(t, lo[i] / d[i]);
+  }
+  return t;
+}
+
 // ROS 1 PointCloud2 of a VLP-16 in a 10 x 6 m room (header stamp patched per copy at bytes 4..11).
 std::vector<uint8_t> vlp16_cloud() {
-  std::vector<uint8_t> b;
-  put32(b, 0);
-  put32(b, 0);
-  put32(b, 0);
-  put_str(b, "velodyne");
+  std::vector<uint8_t> b = ros1_header("velodyne");
   const int rings = 16, cols = 1800, step = 22;
   put32(b, 1);
   put32(b, uint32_t(rings * cols));
@@ -95,12 +110,7 @@ std::vector<uint8_t> vlp16_cloud() {
     for (int r = 0; r < rings; ++r) {
       const double az = c * 0.2 * M_PI / 180, el = (-15 + 2 * r) * M_PI / 180;
       const double d[3] = {std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)};
-      double t = 1e9;
-      const double lo[3] = {-4, -2.5, -1.5}, hi[3] = {6, 3.5, 2};
-      for (int i = 0; i < 3; ++i) {
-        if (d[i] > 1e-9) t = std::min(t, hi[i] / d[i]);
-        if (d[i] < -1e-9) t = std::min(t, lo[i] / d[i]);
-      }
+      const double t = room_range(d, 3);
       float v[4] = {float(t * d[0]), float(t * d[1]), float(t * d[2]), float(r * 10)};
       const uint16_t ring = uint16_t(r);
       const float tt = float(c) / cols * 0.1f;
@@ -116,11 +126,7 @@ std::vector<uint8_t> vlp16_cloud() {
 
 // ROS 1 LaserScan: 1081 beams over 270 degrees with intensities, in a 10 x 6 m room (stamp at bytes 4..11).
 std::vector<uint8_t> laser_scan() {
-  std::vector<uint8_t> b;
-  put32(b, 0);
-  put32(b, 0);
-  put32(b, 0);
-  put_str(b, "laser");
+  std::vector<uint8_t> b = ros1_header("laser");
   const int n = 1081;
   const float amin = float(-0.75 * M_PI), inc = float(1.5 * M_PI / (n - 1));
   const float f[7] = {amin, -amin, inc, 0.025f / n, 0.025f, 0.02f, 30.0f};
@@ -128,13 +134,7 @@ std::vector<uint8_t> laser_scan() {
   put32(b, n);
   for (int i = 0; i < n; ++i) {
     const double a = amin + i * inc, d[2] = {std::cos(a), std::sin(a)};
-    double t = 1e9;
-    const double lo[2] = {-4, -2.5}, hi[2] = {6, 3.5};
-    for (int k = 0; k < 2; ++k) {
-      if (d[k] > 1e-9) t = std::min(t, hi[k] / d[k]);
-      if (d[k] < -1e-9) t = std::min(t, lo[k] / d[k]);
-    }
-    const float r = float(t);
+    const float r = float(room_range(d, 2));
     b.insert(b.end(), (const uint8_t*)&r, (const uint8_t*)&r + 4);
   }
   put32(b, n);
@@ -143,6 +143,21 @@ std::vector<uint8_t> laser_scan() {
     b.insert(b.end(), (const uint8_t*)&v, (const uint8_t*)&v + 4);
   }
   return b;
+}
+
+// Copies of one message (a std_msgs/Header first: its stamp at bytes 4..11 set to the record time), one
+// every period_ns, until `target` bytes are written.
+void write_copies(BagWriter& w, uint32_t conn, std::vector<uint8_t> msg, int64_t period_ns, uint64_t target,
+                  uint64_t& written, uint64_t& messages) {
+  for (int64_t i = 0; written < target; ++i) {
+    const int64_t t = 1700000000LL * 1000000000LL + i * period_ns;
+    const uint32_t sec = uint32_t(t / 1000000000), nsec = uint32_t(t % 1000000000);
+    std::memcpy(&msg[4], &sec, 4);
+    std::memcpy(&msg[8], &nsec, 4);
+    w.write(conn, t, msg.data(), msg.size());
+    written += msg.size();
+    ++messages;
+  }
 }
 
 double median(std::vector<double> v) {
@@ -225,29 +240,10 @@ int main(int argc, char** argv) {
         }
       }
     } else if (k == "laser") {
-      const uint32_t c = w.add_connection("/scan", "sensor_msgs/LaserScan");
-      std::vector<uint8_t> scan = laser_scan();
-      for (int64_t i = 0; written < target; ++i) {
-        const int64_t t = 1700000000LL * 1000000000LL + i * 25000000LL;
-        const uint32_t sec = uint32_t(t / 1000000000), nsec = uint32_t(t % 1000000000);
-        std::memcpy(&scan[4], &sec, 4);
-        std::memcpy(&scan[8], &nsec, 4);
-        w.write(c, t, scan.data(), scan.size());
-        written += scan.size();
-        ++messages;
-      }
+      write_copies(w, w.add_connection("/scan", "sensor_msgs/LaserScan"), laser_scan(), 25000000LL, target, written, messages);
     } else {
-      const uint32_t c = w.add_connection("/velodyne_points", "sensor_msgs/PointCloud2");
-      std::vector<uint8_t> cloud = vlp16_cloud();
-      for (int64_t i = 0; written < target; ++i) {
-        const int64_t t = 1700000000LL * 1000000000LL + i * 100000000LL;
-        const uint32_t sec = uint32_t(t / 1000000000), nsec = uint32_t(t % 1000000000);
-        std::memcpy(&cloud[4], &sec, 4);
-        std::memcpy(&cloud[8], &nsec, 4);
-        w.write(c, t, cloud.data(), cloud.size());
-        written += cloud.size();
-        ++messages;
-      }
+      write_copies(w, w.add_connection("/velodyne_points", "sensor_msgs/PointCloud2"), vlp16_cloud(), 100000000LL, target,
+                   written, messages);
     }
     if (!w.close()) {
       std::cerr << "writing " << bag << " failed\n";

@@ -1,8 +1,9 @@
 // An LCM event log (the format lcm-logger writes and lcm-logplayer and fploc replay read), opened and
 // closed with lcm's eventlog API. Events are framed here (sync word 0xEDA1DA01, event number,
-// timestamp, channel length, data length, channel, data; big-endian) into 4 MiB buffers that a writer
-// thread hands to the file while the importer goes on decoding: a 1 GB import makes ~250 large writes
-// and its write() time (the copy into the page cache) overlaps the reading and decoding. A message can
+// timestamp, channel length, data length, channel, data; big-endian) into 256 KiB buffers that a
+// writer thread hands to the file while the importer goes on decoding: its write() time (the copy into
+// the page cache) overlaps the reading and decoding, and a buffer still sits in the cache when it is
+// copied (4 MiB buffers cost more CPU: they are read back from memory). A message can
 // be written from two parts (its header and a payload that stays where it is) without assembling it
 // first. close() (also on a bad input, where the importer stops) writes everything before it.
 #pragma once
@@ -40,7 +41,7 @@ class LcmLog {
   uint64_t bytes() const { return bytes_; }
 
  private:
-  static constexpr size_t kBufBytes = 4 << 20;
+  static constexpr size_t kBufBytes = 256 << 10;
   void hand_over();  // the current buffer to the writer thread; takes a free one
   void writer();
   lcm_eventlog_t* log_ = nullptr;

@@ -99,46 +99,6 @@ BagReader::BagReader(std::unique_ptr<FileBytes> f, std::string name) : f_(std::m
   pos_ = kMagicLen;
 }
 
-BagReader::~BagReader() {
-  for (auto& a : ahead_)
-    if (a.result.valid()) a.result.wait();
-}
-
-namespace {
-constexpr size_t kChunksAhead = 2;
-}
-
-void BagReader::prefetch() {
-  if (scan_pos_ < pos_) scan_pos_ = pos_;
-  Record r;
-  std::string why;
-  while (ahead_.size() < kChunksAhead && scan_pos_ < size_) {
-    const size_t at = scan_pos_;
-    if (!read_record(f_->data(), size_, scan_pos_, r, &why)) {
-      scan_pos_ = size_;  // the reader reports it when it gets there
-      return;
-    }
-    if (r.op != 0x05) continue;
-    const Field* c = find(r.fields, "compression");
-    uint32_t usize = 0;
-    if (!c || !field_u32(r, "size", usize, &why)) return;
-    const std::string method = text(c);
-    if (method == "none") continue;
-    Ahead a;
-    a.at = at;
-    if (!spare_.empty()) {
-      a.buf = std::move(spare_.back());
-      spare_.pop_back();
-    } else {
-      a.buf = std::make_unique<std::vector<uint8_t>>();
-    }
-    a.result = std::async(std::launch::async, [method, d = r.data, n = r.data_len, usize, out = a.buf.get()] {
-      return decompress(method, d, n, usize, *out);
-    });
-    ahead_.push_back(std::move(a));
-  }
-}
-
 bool BagReader::stop(const std::string& what) {
   done_ = true;
   return fail(name_ + ": " + what);
@@ -199,22 +159,10 @@ bool BagReader::next(RawMessage& m) {
         cd_ = r.data;
         cn_ = r.data_len;
       } else {
-        std::string e;
-        if (!ahead_.empty() && ahead_.front().at == at) {
-          Ahead a = std::move(ahead_.front());
-          ahead_.pop_front();
-          e = a.result.get();
-          auto old = std::make_unique<std::vector<uint8_t>>(std::move(buf_));  // the chunk just read: free again
-          buf_ = std::move(*a.buf);
-          *a.buf = std::move(*old);
-          spare_.push_back(std::move(a.buf));
-        } else {
-          e = decompress(method, r.data, r.data_len, usize, buf_);
-        }
+        const std::string e = decompress(method, r.data, r.data_len, usize, buf_);
         if (!e.empty()) return stop(chunk_what_ + ": " + e);
         cd_ = buf_.data();
         cn_ = buf_.size();
-        prefetch();
       }
       cpos_ = 0;
       chunk_at_ = at;

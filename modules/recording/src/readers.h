@@ -1,8 +1,5 @@
 // The two readers behind open_recording() (internal).
 #pragma once
-#include <deque>
-#include <future>
-#include <memory>
 #include <vector>
 
 #include "fploc/recording/recording.h"
@@ -28,19 +25,6 @@ class BagReader : public Recording {
   size_t cn_ = 0, cpos_ = 0, chunk_at_ = 0;
   std::string chunk_what_;
   std::vector<uint8_t> buf_;
-  // Compressed chunks ahead of the one being read, decompressed by worker threads meanwhile (so bz2/lz4
-  // decompression overlaps the importer's work and uses the second core). Errors surface in file order.
-  struct Ahead {
-    size_t at = 0;  // byte offset of the chunk record
-    std::unique_ptr<std::vector<uint8_t>> buf;
-    std::future<std::string> result;
-  };
-  void prefetch();
-  std::deque<Ahead> ahead_;
-  size_t scan_pos_ = 0;  // where prefetch() looks for the next chunk
-  std::vector<std::unique_ptr<std::vector<uint8_t>>> spare_;
- public:
-  ~BagReader() override;
 };
 
 // MCAP (data section in file order: chunks none/zstd/lz4, or messages outside chunks; the summary
