@@ -144,6 +144,7 @@ bool BagReader::next(RawMessage& m) {
       return false;
     }
     const size_t at = pos_;
+    f_->read_ahead(at);
     if (!read_record(f_->data(), size_, pos_, r, &why)) {
       pos_ = at;
       return stop("record at byte " + std::to_string(at) + ": " + why);

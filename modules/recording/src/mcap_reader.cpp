@@ -163,6 +163,7 @@ bool McapReader::next(RawMessage& m) {
       continue;
     }
     const size_t at = pos_;
+    f_->read_ahead(at);
     if (size_ - pos_ < 9) return stop("record at byte " + std::to_string(at) + ": cut off (file truncated? no footer)");
     const uint8_t* d = f_->data();
     const uint8_t op = d[pos_];
