@@ -402,6 +402,16 @@ int main(int argc, char** argv) {
     written[raw.lidar_channel] = raw.lidar_packets - raw.waiting_dropped;
     written[raw.metadata_channel] = 1;
   }
+  // The graph that replays what was written: the drivers' one for packets, the pipeline for scans.
+  std::string replay_graph;
+  for (const auto& [ch, n] : written) {
+    if (!n) continue;
+    if (ch == raw.lidar_channel) replay_graph = "graphs/replay-packets.pbtxt";
+    else if (ch.rfind("OS1_SCAN", 0) == 0 && replay_graph.empty()) replay_graph = "graphs/replay.pbtxt";
+  }
+  if (replay_graph.empty())
+    for (const auto& [ch, n] : written)
+      if (n && ch.rfind("LASER_SCAN", 0) == 0) replay_graph = "graphs/lidar2d.pbtxt";
   if (ouster.bad_packets) problems.push_back(std::to_string(ouster.bad_packets) + " bad Ouster packets; last: " + ouster.last_error);
 
   if (json) {
@@ -414,11 +424,11 @@ int main(int argc, char** argv) {
     j["channels"] = topic_channel;
     j["seconds"] = wall;
     j["events"] = lcm_log.events();
+    j["replay_graph"] = replay_graph;
     if (raw.has_metadata() && raw.lidar_packets + raw.imu_packets > 0)
       j["ouster"] = {{"mode", "packets"}, {"sensor", raw.sensor}, {"pixels_per_column", raw.pixels_per_column},
                      {"columns_per_frame", raw.columns_per_frame}, {"udp_profile", raw.udp_profile},
-                     {"lidar_packets", raw.lidar_packets}, {"imu_packets", raw.imu_packets},
-                     {"replay_graph", "graphs/replay-packets.pbtxt"}};
+                     {"lidar_packets", raw.lidar_packets}, {"imu_packets", raw.imu_packets}};
     if (ouster.info()) {
       j["ouster"] = {{"mode", "scans"}, {"sensor", ouster.info()->sensor_name()}, {"pixels_per_column", ouster.info()->pixels_per_column},
                      {"columns_per_frame", ouster.info()->columns_per_frame}, {"udp_profile", os1::to_string(ouster.info()->profile)},
@@ -437,8 +447,8 @@ int main(int argc, char** argv) {
     for (const auto& [ch, n] : written) std::printf("  %-28s %8llu\n", ch.c_str(), (unsigned long long)n);
     for (const auto& [t, ch] : topic_channel) std::printf("  topic %s -> %s\n", t.c_str(), ch.c_str());
     if (raw.has_metadata() && raw.lidar_packets + raw.imu_packets > 0)
-      std::printf("  ouster: %s, %dx%d (%s), %llu lidar + %llu imu packets written as they are (decoded on replay by the\n"
-                  "          drivers: fploc replay --graph graphs/replay-packets.pbtxt; --decode writes scan_t here)\n",
+      std::printf("  ouster: %s, %dx%d (%s), %llu lidar + %llu imu packets written as they are\n"
+                  "          (the OS-1 and IMU drivers decode them on replay; --decode writes scan_t and imu_t here)\n",
                   raw.sensor.c_str(), raw.pixels_per_column, raw.columns_per_frame, raw.udp_profile.c_str(),
                   (unsigned long long)raw.lidar_packets, (unsigned long long)raw.imu_packets);
     if (ouster.info())
@@ -453,6 +463,8 @@ int main(int argc, char** argv) {
       for (const auto& [t, n] : skipped_types) std::printf(" %s (%llu)", t.c_str(), (unsigned long long)n);
       std::printf("\n");
     }
+    if (!out.empty() && !replay_graph.empty())
+      std::printf("  replay: bin/fploc replay --graph %s --log %s [--set ...]\n", replay_graph.c_str(), out.c_str());
     if (!tum_out.empty()) std::printf("  %s: %llu poses\n", tum_out.c_str(), (unsigned long long)tum.poses());
   }
   for (const auto& p : problems) std::cerr << "fploc import: " << p << "\n";
