@@ -28,7 +28,7 @@ check "$T/list.json" "j['topics']['/os_node0/lidar_packets']['count']==32 and j[
 
 # Default: the packets as they are, decoded on replay by the OS-1 and IMU drivers (graphs/replay-packets.pbtxt).
 "$B/fploc-import" "$BAG" --out "$T/p.lcm" --json > "$T/importp.json"
-check "$T/importp.json" "j['written']['OS1_LIDAR_PACKETS']==32 and j['written']['OS1_IMU_PACKETS']==10 and j['written']['OS1_METADATA']==1 and 'OS1_SCAN' not in j['written'] and j['ouster']['mode']=='packets' and j['ouster']['pixels_per_column']==128 and j['errors']==[]"
+check "$T/importp.json" "j['replay_graph']=='graphs/replay-packets.pbtxt' and j['written']['OS1_LIDAR_PACKETS']==32 and j['written']['OS1_IMU_PACKETS']==10 and j['written']['OS1_METADATA']==1 and 'OS1_SCAN' not in j['written'] and j['ouster']['mode']=='packets' and j['ouster']['pixels_per_column']==128 and j['errors']==[]"
 "$B/fploc-replay" --graph "$FPLOC_ROOT/graphs/replay-packets.pbtxt" --log "$T/p.lcm" --json --out "$T/p.tum" \
   --record "$T/p_rec.lcm" --record-channels 'OS1_SCAN|OS1_IMU' > "$T/replayp.json" 2> "$T/replayp.err"
 check "$T/replayp.json" "j['channels_fed']=={'OS1_LIDAR_PACKETS':32,'OS1_IMU_PACKETS':10,'OS1_METADATA':1} and [n['messages_out'] for n in j['nodes'] if n['name'] in ('os1_driver','imu_driver','segmenter')]==[1,10,1] and all(n['errors']==0 for n in j['nodes'] if n['name'] in ('os1_driver','imu_driver'))"
