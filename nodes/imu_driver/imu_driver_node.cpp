@@ -1,8 +1,11 @@
 // IMU driver: publishes imu_t (SI units) on OS1_IMU. A source turns raw input into ImuSamples; the only
 // one implemented is "os1" (Ouster 48-byte IMU packets over UDP, default port 7503, or from a pcap,
 // including captures where lidar and IMU share a port: IMU packets are told apart by their size).
-// "xsens" is an Xsens MTi (MTData2 over a serial port or from a recorded stream).
+// "xsens" is an Xsens MTi (MTData2 over a serial port or from a recorded stream). With the input port
+// "packets" mapped (os1_packet_t, e.g. an ouster_ros bag imported by `fploc import`), Ouster IMU packets
+// come from there instead of UDP or a pcap.
 #include <fploc/imu_t.hpp>
+#include <fploc/os1_packet_t.hpp>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -162,7 +165,8 @@ class ImuDriverNode : public fploc::rt::Node {
  public:
   static fploc::rt::NodeSpec spec() {
     return {"imu_driver", "imu_driver", "IMU samples (Ouster IMU packets over UDP/pcap, or Xsens MTi MTData2 over serial) in SI units -> OS1_IMU",
-            {fploc::rt::output<fploc::imu_t>("imu", "OS1_IMU")}};
+            {fploc::rt::output<fploc::imu_t>("imu", "OS1_IMU"),
+             fploc::rt::input<fploc::os1_packet_t>("packets", "")}};  // recorded packets (not connected by default)
   }
 
   void setup(fploc::rt::Context& ctx) override {
@@ -172,6 +176,20 @@ class ImuDriverNode : public fploc::rt::Node {
     else if (kind == "xsens") source_ = std::make_unique<XsensSource>();
     else throw std::runtime_error("imu_driver: option 'source': unknown '" + kind + "' (os1, xsens)");
     out_ = ctx.advertise<fploc::imu_t>("imu");
+    if (!ctx.channel("packets").empty()) {
+      if (kind != "os1") throw std::runtime_error("imu_driver: input 'packets' carries Ouster packets: option 'source' must be 'os1'");
+      ctx.subscribe<fploc::os1_packet_t>("packets", [this, &ctx](const fploc::os1_packet_t& m) {
+        Sample s{{}, "os1"};
+        if (m.data.size() != kImuPacketSize) {
+          ctx.error("imu packet: " + std::to_string(m.data.size()) + " B, expected 48");
+        } else if (!parse_imu_packet(m.data.data(), m.data.size(), s.s)) {
+          ctx.error("imu packet: non-finite accel/gyro value");
+        } else {
+          publish(s);
+        }
+      });
+      return;
+    }
     source_->setup(ctx, opt, [this](const Sample& s) { publish(s); });
   }
 

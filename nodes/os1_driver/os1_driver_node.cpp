@@ -1,7 +1,11 @@
-// OS-1 lidar driver: Ouster lidar packets from UDP (default port 7502) or a pcap -> FrameAssembler ->
-// OS1_SCAN (scan_t: staggered range image, signal, reflectivity, column times, beam intrinsics).
+// OS-1 lidar driver: Ouster lidar packets from UDP (default port 7502), a pcap, or os1_packet_t messages
+// (input port "packets", e.g. an ouster_ros bag imported by `fploc import`, with the metadata on the
+// "metadata" port or in the `metadata` option) -> FrameAssembler -> OS1_SCAN (scan_t: staggered range
+// image, signal, reflectivity, column times, beam intrinsics).
 // Bad input (wrong sizes, garbage columns, late packets, missing columns) is counted with ctx.error and
 // never stops the node. Output times are sensor times from the packets (deterministic for a pcap).
+#include <fploc/os1_metadata_t.hpp>
+#include <fploc/os1_packet_t.hpp>
 #include <fploc/scan_t.hpp>
 
 #include <chrono>
@@ -27,7 +31,10 @@ class Os1DriverNode : public fploc::rt::Node {
  public:
   static fploc::rt::NodeSpec spec() {
     return {"os1_driver", "os1_driver", "Ouster OS-1 lidar packets (UDP or pcap) -> full frames on OS1_SCAN",
-            {fploc::rt::output<fploc::scan_t>("scan", "OS1_SCAN")}};
+            {fploc::rt::output<fploc::scan_t>("scan", "OS1_SCAN"),
+             // Recorded packets (not connected unless the graph maps them: then no UDP, no pcap).
+             fploc::rt::input<fploc::os1_packet_t>("packets", ""),
+             fploc::rt::input<fploc::os1_metadata_t>("metadata", "")}};
   }
 
   void setup(fploc::rt::Context& ctx) override {
@@ -38,6 +45,10 @@ class Os1DriverNode : public fploc::rt::Node {
     pcap_mode_ = !opt.pcap().empty();
     metadata_path_ = opt.metadata().empty() ? std::string() : ctx.resolve_path(opt.metadata());
     sensor_host_ = opt.sensor_hostname();
+    if (!ctx.channel("packets").empty()) {
+      setup_packets(ctx);
+      return;
+    }
     // A live sensor is set up over HTTP on start (unless keep_sensor_config) by a worker thread; its
     // metadata arrives through drain_session(), its status and alerts go to telemetry.
     if (!pcap_mode_ && !sensor_host_.empty() && !opt.keep_sensor_config()) {
@@ -98,6 +109,35 @@ class Os1DriverNode : public fploc::rt::Node {
   }
 
  private:
+  // Packets from LCM (a recording): the metadata comes from the `metadata` option's file, else from the
+  // first os1_metadata_t on the "metadata" port; packets before it are dropped and counted, as live.
+  void setup_packets(fploc::rt::Context& ctx) {
+    packets_mode_ = true;
+    if (!metadata_path_.empty()) load();
+    ctx.subscribe<fploc::os1_metadata_t>("metadata", [this](const fploc::os1_metadata_t& m) {
+      if (assembler_) return;  // latched and republished: the first one counts
+      try {
+        info_ = parse_metadata(m.json, m.source.empty() ? std::string("os1_metadata_t") : m.source);
+      } catch (const MetadataError& e) {
+        report_metadata(e.what());
+        return;
+      }
+      assembler_ = std::make_unique<FrameAssembler>(info_);
+      if (!metadata_error_.empty()) ctx_->error_resolved(), metadata_error_.clear();
+    });
+    ctx.subscribe<fploc::os1_packet_t>("packets", [this](const fploc::os1_packet_t& m) {
+      if (!assembler_) {
+        if (++dropped_without_metadata_ % 6400 == 1) ctx_->error("lidar packets dropped: no valid metadata yet");
+        return;
+      }
+      const size_t n = m.data.size();
+      if (n == kImuPacketSize) return;  // IMU packets: the imu driver's job
+      const PacketError e = assembler_->add_packet(m.data.data(), n, frames_);
+      if (e != PacketError::kNone) report(e, n);
+      publish_frames();
+    });
+  }
+
   // Once: a problem with the metadata (each distinct one is reported once; retried by the caller).
   void report_metadata(const std::string& what) {
     if (what != metadata_error_) ctx_->error(what + " (lidar packets are dropped; retrying)");
@@ -260,6 +300,7 @@ class Os1DriverNode : public fploc::rt::Node {
   fploc::rt::Publisher<fploc::scan_t> out_;
   bool published_in_poll_ = false;
   bool pcap_mode_ = false;
+  bool packets_mode_ = false;
   int port_ = 7502;
   std::string metadata_path_;
   std::string metadata_error_;  // last load error (reported once)

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # fploc import end to end (inside scripts/netns-run; FPLOC_BUILD_DIR, FPLOC_SHARED_DIR, FPLOC_ROOT set):
-# the ouster_ros bag -> LCM log -> fploc replay (segmenter + features) and lcm-logplayer -> lcm-logger
-# (the log is a valid LCM event log); the ship-interior bag -> LaserScan channels and TUM from
+# the ouster_ros bag -> LCM log of its packets -> fploc replay through the OS-1 and IMU drivers
+# (graphs/replay-packets.pbtxt) gives byte for byte the scan_t and imu_t of `--decode`; the --decode log
+# -> fploc replay (segmenter + features) and lcm-logplayer -> lcm-logger (a valid LCM event log); the ship-interior bag -> LaserScan channels and TUM from
 # odometry and tf; a truncated bag -> one error, exit 1, and a log of what came before.
 set -euo pipefail
 B="${FPLOC_BUILD_DIR:?}/bin"
@@ -25,8 +26,25 @@ PY
 "$B/fploc-import" --list --json "$BAG" > "$T/list.json"
 check "$T/list.json" "j['topics']['/os_node0/lidar_packets']['count']==32 and j['topics']['/os_node0/imu_packets']['count']==10 and j['topics']['/os_node0/metadata']['type']=='std_msgs/String' and 0.05<j['duration_s']<0.2"
 
-"$B/fploc-import" "$BAG" --out "$T/x.lcm" --json > "$T/import.json"
-check "$T/import.json" "j['written']['OS1_SCAN']==1 and j['written']['OS1_IMU']==10 and j['ouster']['frame_list'][0]['width']==512 and j['ouster']['frame_list'][0]['height']==j['ouster']['pixels_per_column']==128 and j['ouster']['frame_list'][0]['missing_columns']==0 and j['errors']==[]"
+# Default: the packets as they are, decoded on replay by the OS-1 and IMU drivers (graphs/replay-packets.pbtxt).
+"$B/fploc-import" "$BAG" --out "$T/p.lcm" --json > "$T/importp.json"
+check "$T/importp.json" "j['replay_graph']=='graphs/replay-packets.pbtxt' and j['written']['OS1_LIDAR_PACKETS']==32 and j['written']['OS1_IMU_PACKETS']==10 and j['written']['OS1_METADATA']==1 and 'OS1_SCAN' not in j['written'] and j['ouster']['mode']=='packets' and j['ouster']['pixels_per_column']==128 and j['errors']==[]"
+"$B/fploc-replay" --graph "$FPLOC_ROOT/graphs/replay-packets.pbtxt" --log "$T/p.lcm" --json --out "$T/p.tum" \
+  --record "$T/p_rec.lcm" --record-channels 'OS1_SCAN|OS1_IMU' > "$T/replayp.json" 2> "$T/replayp.err"
+check "$T/replayp.json" "j['channels_fed']=={'OS1_LIDAR_PACKETS':32,'OS1_IMU_PACKETS':10,'OS1_METADATA':1} and [n['messages_out'] for n in j['nodes'] if n['name'] in ('os1_driver','imu_driver','segmenter')]==[1,10,1] and all(n['errors']==0 for n in j['nodes'] if n['name'] in ('os1_driver','imu_driver'))"
+
+# --decode: scan_t and imu_t written by the importer, byte for byte what the drivers give on replay.
+"$B/fploc-import" "$BAG" --decode --out "$T/x.lcm" --json > "$T/import.json"
+PYTHONPATH="$FPLOC_ROOT/tools/pylib" python3 - "$T/x.lcm" "$T/p_rec.lcm" <<'PY'
+import sys, lcm_log
+a = [(c, d) for c, d in lcm_log.events(sys.argv[1]) if c in ('OS1_SCAN', 'OS1_IMU')]
+b = list(lcm_log.events(sys.argv[2]))
+for ch in ('OS1_SCAN', 'OS1_IMU'):
+    x, y = [d for c, d in a if c == ch], [d for c, d in b if c == ch]
+    assert x and x == y, f"{ch}: --decode gives {len(x)} messages, the drivers on the packets {len(y)} (or different bytes)"
+print("--decode == drivers on the packets: ok", len(a), "messages")
+PY
+check "$T/import.json" "j['ouster']['mode']=='scans' and j['written']['OS1_SCAN']==1 and j['written']['OS1_IMU']==10 and j['ouster']['frame_list'][0]['width']==512 and j['ouster']['frame_list'][0]['height']==j['ouster']['pixels_per_column']==128 and j['ouster']['frame_list'][0]['missing_columns']==0 and j['errors']==[]"
 
 "$B/fploc-replay" --graph "$FPLOC_ROOT/graphs/import.pbtxt" --log "$T/x.lcm" --json > "$T/replay.json" 2> "$T/replay.err"
 check "$T/replay.json" "j['channels_fed']=={'OS1_SCAN':1,'OS1_IMU':10} and [n['messages_out'] for n in j['nodes'] if n['name']=='segmenter']==[1] and [n['messages_out'] for n in j['nodes'] if n['name']=='features']==[1]"
@@ -73,7 +91,7 @@ for c in none bz2 lz4; do
   [ "$c" = lz4 ] && ! command -v lz4 > /dev/null && { echo "no lz4 tool: lz4 bag skipped"; continue; }
   python3 "$FPLOC_ROOT/tests/import/make_bag.py" "$T/py_$c.bag" "$c"
   "$B/fploc-import" "$T/py_$c.bag" --out "$T/py_$c.lcm" --tum-out "$T/py.tum" --json > "$T/py_$c.json" 2>/dev/null
-  check "$T/py_$c.json" "j['written']['OS1_SCAN']==3 and j['written']['LASER_SCAN']==3 and j['written']['OS1_IMU']==6 and j['written']['(tum /odom)']==3 and j['clouds']['/points']['kept']==24"
+  check "$T/py_$c.json" "j['written']['OS1_SCAN']==3 and j['written']['LASER_SCAN']==3 and j['written']['OS1_IMU']==3 and j['written']['OS1_IMU_PACKETS']==3 and j['written']['(tum /odom)']==3 and j['clouds']['/points']['kept']==24"
 done
 # MCAP from the MCAP project's writer (zstd chunks): PointCloud2 (Velodyne + Hesai layouts), Imu,
 # LaserScan -> LCM; tf -> TUM.

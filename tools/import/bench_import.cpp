@@ -1,17 +1,23 @@
-// fploc bench import [--size-mb 1024] [--kind ouster|cloud|all] [--compression none|lz4|bz2] [--json] [--keep DIR]
+// fploc bench import [--size-mb 1024] [--kind ouster|cloud|laser|all] [--compression none|lz4|bz2] [--runs 3]
+//                    [--json] [--keep DIR]
 // Import speed as a ratio against `cat` of the same file, timed in the same run (target: <= 2x).
 // Writes a large bag into a temp dir (deleted afterwards), by content:
 //   ouster: the ouster_ros bag's packets (../shared/data/ouster/512x10_raw.bag; OS-0-128, 512x10,
-//           RNG15_RFL8_NIR8) repeated with advancing frame ids and times -> scan_t frames
+//           RNG15_RFL8_NIR8) repeated with advancing frame ids and times; imported twice: as packets
+//           (the default, "ouster") and decoded to scan_t frames ("ouster --decode")
 //   cloud:  VLP-16-like sensor_msgs/PointCloud2 (16 x 1800 points, Velodyne field layout) -> scan_t
-// then times `cat BAG > /dev/null` (after one warm-up read, so both run from the page cache),
-// `cat BAG > COPY` (read + write the same volume) and `fploc-import BAG --out LOG.lcm`.
+//   laser:  sensor_msgs/LaserScan (1081 beams with intensities, a Hokuyo UTM-30LX-like scan) -> laser_scan_t
+// then times, --runs times each, interleaved: `cat BAG > /dev/null` (after one warm-up read, so both run
+// from the page cache), `cat BAG > COPY` (read + write the same volume) and `fploc-import BAG --out
+// LOG.lcm`; and again with the bag's pages evicted before each run (cold). Medians are reported.
 #include <fcntl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <map>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -63,13 +69,28 @@ void put_str(std::vector<uint8_t>& b, const std::string& s) {
   b.insert(b.end(), s.begin(), s.end());
 }
 
+// std_msgs/Header (ROS 1): seq, stamp (patched per copy), frame_id.
+std::vector<uint8_t> ros1_header(const std::string& frame) {
+  std::vector<uint8_t> b;
+  for (int i = 0; i < 3; ++i) put32(b, 0);
+  put_str(b, frame);
+  return b;
+}
+
+// Range from the origin along the unit direction d (2 or 3 components) to the walls of a 10 x 6 x 3.5 m room.
+double room_range(const double* d, int dims) {
+  double t = 1e9;
+  const double lo[3] = {-4, -2.5, -1.5}, hi[3] = {6, 3.5, 2};
+  for (int i = 0; i < dims; ++i) {
+    if (d[i] > 1e-9) t = std::min(t, hi[i] / d[i]);
+    if (d[i] < -1e-9) t = std::min(t, lo[i] / d[i]);
+  }
+  return t;
+}
+
 // ROS 1 PointCloud2 of a VLP-16 in a 10 x 6 m room (header stamp patched per copy at bytes 4..11).
 std::vector<uint8_t> vlp16_cloud() {
-  std::vector<uint8_t> b;
-  put32(b, 0);
-  put32(b, 0);
-  put32(b, 0);
-  put_str(b, "velodyne");
+  std::vector<uint8_t> b = ros1_header("velodyne");
   const int rings = 16, cols = 1800, step = 22;
   put32(b, 1);
   put32(b, uint32_t(rings * cols));
@@ -89,12 +110,7 @@ std::vector<uint8_t> vlp16_cloud() {
     for (int r = 0; r < rings; ++r) {
       const double az = c * 0.2 * M_PI / 180, el = (-15 + 2 * r) * M_PI / 180;
       const double d[3] = {std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)};
-      double t = 1e9;
-      const double lo[3] = {-4, -2.5, -1.5}, hi[3] = {6, 3.5, 2};
-      for (int i = 0; i < 3; ++i) {
-        if (d[i] > 1e-9) t = std::min(t, hi[i] / d[i]);
-        if (d[i] < -1e-9) t = std::min(t, lo[i] / d[i]);
-      }
+      const double t = room_range(d, 3);
       float v[4] = {float(t * d[0]), float(t * d[1]), float(t * d[2]), float(r * 10)};
       const uint16_t ring = uint16_t(r);
       const float tt = float(c) / cols * 0.1f;
@@ -108,15 +124,57 @@ std::vector<uint8_t> vlp16_cloud() {
   return b;
 }
 
+// ROS 1 LaserScan: 1081 beams over 270 degrees with intensities, in a 10 x 6 m room (stamp at bytes 4..11).
+std::vector<uint8_t> laser_scan() {
+  std::vector<uint8_t> b = ros1_header("laser");
+  const int n = 1081;
+  const float amin = float(-0.75 * M_PI), inc = float(1.5 * M_PI / (n - 1));
+  const float f[7] = {amin, -amin, inc, 0.025f / n, 0.025f, 0.02f, 30.0f};
+  b.insert(b.end(), (const uint8_t*)f, (const uint8_t*)f + sizeof f);
+  put32(b, n);
+  for (int i = 0; i < n; ++i) {
+    const double a = amin + i * inc, d[2] = {std::cos(a), std::sin(a)};
+    const float r = float(room_range(d, 2));
+    b.insert(b.end(), (const uint8_t*)&r, (const uint8_t*)&r + 4);
+  }
+  put32(b, n);
+  for (int i = 0; i < n; ++i) {
+    const float v = float(1000 + i % 200);
+    b.insert(b.end(), (const uint8_t*)&v, (const uint8_t*)&v + 4);
+  }
+  return b;
+}
+
+// Copies of one message (a std_msgs/Header first: its stamp at bytes 4..11 set to the record time), one
+// every period_ns, until `target` bytes are written.
+void write_copies(BagWriter& w, uint32_t conn, std::vector<uint8_t> msg, int64_t period_ns, uint64_t target,
+                  uint64_t& written, uint64_t& messages) {
+  for (int64_t i = 0; written < target; ++i) {
+    const int64_t t = 1700000000LL * 1000000000LL + i * period_ns;
+    const uint32_t sec = uint32_t(t / 1000000000), nsec = uint32_t(t % 1000000000);
+    std::memcpy(&msg[4], &sec, 4);
+    std::memcpy(&msg[8], &nsec, 4);
+    w.write(conn, t, msg.data(), msg.size());
+    written += msg.size();
+    ++messages;
+  }
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : (v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc bench import: import speed against cat of the same file (ratio)"};
-  int size_mb = 1024;
+  int size_mb = 1024, runs = 3;
   std::string kind = "all", compression = "none", keep;
   bool json = false;
   app.add_option("--size-mb", size_mb, "size of each generated bag");
-  app.add_option("--kind", kind, "ouster, cloud or all");
+  app.add_option("--kind", kind, "ouster, cloud, laser or all");
+  app.add_option("--runs", runs, "timed runs of each command (medians reported)");
   app.add_option("--compression", compression, "chunk compression of the generated bag: none, lz4, bz2");
   app.add_option("--keep", keep, "write the bags here and keep them");
   app.add_flag("--json", json, "JSON on stdout");
@@ -130,7 +188,7 @@ int main(int argc, char** argv) {
   const uint64_t target = uint64_t(size_mb) << 20;
   nlohmann::json out = nlohmann::json::array();
 
-  for (const std::string k : {"ouster", "cloud"}) {
+  for (const std::string k : {"ouster", "cloud", "laser"}) {
     if (kind != "all" && kind != k) continue;
     const std::string bag = (dir / (k + ".bag")).string();
     BagWriter w;
@@ -181,18 +239,11 @@ int main(int argc, char** argv) {
           ++messages;
         }
       }
+    } else if (k == "laser") {
+      write_copies(w, w.add_connection("/scan", "sensor_msgs/LaserScan"), laser_scan(), 25000000LL, target, written, messages);
     } else {
-      const uint32_t c = w.add_connection("/velodyne_points", "sensor_msgs/PointCloud2");
-      std::vector<uint8_t> cloud = vlp16_cloud();
-      for (int64_t i = 0; written < target; ++i) {
-        const int64_t t = 1700000000LL * 1000000000LL + i * 100000000LL;
-        const uint32_t sec = uint32_t(t / 1000000000), nsec = uint32_t(t % 1000000000);
-        std::memcpy(&cloud[4], &sec, 4);
-        std::memcpy(&cloud[8], &nsec, 4);
-        w.write(c, t, cloud.data(), cloud.size());
-        written += cloud.size();
-        ++messages;
-      }
+      write_copies(w, w.add_connection("/velodyne_points", "sensor_msgs/PointCloud2"), vlp16_cloud(), 100000000LL, target,
+                   written, messages);
     }
     if (!w.close()) {
       std::cerr << "writing " << bag << " failed\n";
@@ -200,35 +251,53 @@ int main(int argc, char** argv) {
     }
     const uint64_t bytes = fs::file_size(bag);
     const std::string lcm = (dir / (k + ".lcm")).string(), copy = (dir / (k + ".copy")).string();
-    run("cat '" + bag + "' > /dev/null");  // warm-up: both timings below read from the page cache
-    const double t_cat = run("cat '" + bag + "' > /dev/null");
-    const double cpu_cat = last_cpu;
-    const double t_copy = run("cat '" + bag + "' > '" + copy + "'");
-    fs::remove(copy);
-    const double t_import = run("'" + importer + "' '" + bag + "' --out '" + lcm + "' --quiet > /dev/null");
-    const double cpu_import = last_cpu;
-    const uint64_t lcm_bytes = fs::file_size(lcm);
-    // Cold: the bag read from the disk (its pages evicted before each run).
-    fs::remove(lcm);
-    evict(bag);
-    const double t_cat_cold = run("cat '" + bag + "' > /dev/null");
-    evict(bag);
-    const double t_import_cold = run("'" + importer + "' '" + bag + "' --out '" + lcm + "' --quiet > /dev/null");
-    nlohmann::json j = {{"kind", k}, {"compression", compression}, {"bag_bytes", bytes}, {"messages", messages},
-                        {"lcm_bytes", lcm_bytes}, {"cat_s", t_cat}, {"cat_copy_s", t_copy}, {"import_s", t_import},
-                        {"ratio_vs_cat", t_import / t_cat}, {"ratio_vs_cat_copy", t_import / t_copy},
-                        {"import_MBps", bytes / 1e6 / t_import}, {"cold_cat_s", t_cat_cold}, {"cold_import_s", t_import_cold},
-                        {"cold_ratio_vs_cat", t_import_cold / t_cat_cold}, {"cat_cpu_s", cpu_cat}, {"import_cpu_s", cpu_import}};
-    out.push_back(j);
-    if (!json)
-      std::printf("%-6s %s: %.0f MB bag (%llu msgs) -> %.0f MB LCM log\n  page cache: import %.2f s, cat %.2f s (ratio %.2f), cat > copy %.2f s (ratio %.2f)\n"
-                  "  cold file:  import %.2f s, cat %.2f s (ratio %.2f)\n  CPU (user+sys): import %.2f s, cat %.2f s\n",
-                  k.c_str(), compression.c_str(), bytes / 1e6, (unsigned long long)messages, lcm_bytes / 1e6, t_import, t_cat,
-                  t_import / t_cat, t_copy, t_import / t_copy, t_import_cold, t_cat_cold, t_import_cold / t_cat_cold, cpu_import, cpu_cat);
-    if (keep.empty()) {
-      fs::remove(bag);
-      fs::remove(lcm);
+    run("cat '" + bag + "' > /dev/null");  // warm-up: the page-cache timings below read from memory
+    std::vector<std::pair<std::string, std::string>> variants = {{k, ""}};
+    if (k == "ouster") variants.push_back({"ouster --decode", " --decode"});
+    std::vector<double> cat_s, cat_cpu, copy_s, cat_cold_s;
+    std::map<std::string, std::vector<double>> imp_s, imp_cpu, imp_cold_s;
+    std::map<std::string, uint64_t> lcm_bytes;
+    for (int i = 0; i < runs; ++i) {  // interleaved, so a change in the machine's load hits every command
+      cat_s.push_back(run("cat '" + bag + "' > /dev/null"));
+      cat_cpu.push_back(last_cpu);
+      copy_s.push_back(run("cat '" + bag + "' > '" + copy + "'"));
+      fs::remove(copy);
+      for (const auto& [name, flag] : variants) {
+        imp_s[name].push_back(run("'" + importer + "' '" + bag + "' --out '" + lcm + "' --quiet" + flag + " > /dev/null"));
+        imp_cpu[name].push_back(last_cpu);
+        lcm_bytes[name] = fs::file_size(lcm);
+        fs::remove(lcm);
+      }
     }
+    // Cold: the bag read from the disk (its pages evicted before each run).
+    for (int i = 0; i < runs; ++i) {
+      evict(bag);
+      cat_cold_s.push_back(run("cat '" + bag + "' > /dev/null"));
+      for (const auto& [name, flag] : variants) {
+        evict(bag);
+        imp_cold_s[name].push_back(run("'" + importer + "' '" + bag + "' --out '" + lcm + "' --quiet" + flag + " > /dev/null"));
+        fs::remove(lcm);
+      }
+    }
+    const double t_cat = median(cat_s), t_copy = median(copy_s), t_cat_cold = median(cat_cold_s), cpu_cat = median(cat_cpu);
+    for (const auto& [name, flag] : variants) {
+      const double t_import = median(imp_s[name]), t_import_cold = median(imp_cold_s[name]), cpu_import = median(imp_cpu[name]);
+      nlohmann::json j = {{"kind", name}, {"compression", compression}, {"bag_bytes", bytes}, {"messages", messages},
+                          {"lcm_bytes", lcm_bytes[name]}, {"runs", runs}, {"cat_s", t_cat}, {"cat_copy_s", t_copy},
+                          {"import_s", t_import}, {"ratio_vs_cat", t_import / t_cat}, {"ratio_vs_cat_copy", t_import / t_copy},
+                          {"import_MBps", bytes / 1e6 / t_import}, {"cold_cat_s", t_cat_cold}, {"cold_import_s", t_import_cold},
+                          {"cold_ratio_vs_cat", t_import_cold / t_cat_cold}, {"cat_cpu_s", cpu_cat}, {"import_cpu_s", cpu_import},
+                          {"import_runs_s", imp_s[name]}, {"cat_runs_s", cat_s}};
+      out.push_back(j);
+      if (!json)
+        std::printf("%-15s %s: %.0f MB bag (%llu msgs) -> %.0f MB LCM log; medians of %d runs\n"
+                    "  page cache: import %.2f s, cat %.2f s (ratio %.2f), cat > copy %.2f s (ratio %.2f)\n"
+                    "  cold file:  import %.2f s, cat %.2f s (ratio %.2f)\n  CPU (user+sys): import %.2f s, cat %.2f s\n",
+                    name.c_str(), compression.c_str(), bytes / 1e6, (unsigned long long)messages, lcm_bytes[name] / 1e6, runs,
+                    t_import, t_cat, t_import / t_cat, t_copy, t_import / t_copy, t_import_cold, t_cat_cold,
+                    t_import_cold / t_cat_cold, cpu_import, cpu_cat);
+    }
+    if (keep.empty()) fs::remove(bag);
   }
   if (keep.empty()) fs::remove_all(dir);
   if (json) std::cout << out.dump(2) << "\n";

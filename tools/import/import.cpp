@@ -1,8 +1,10 @@
 // fploc import RECORDING [--list] [--json] [--out LOG.lcm] [--topics T,...] [--start S] [--end S] ...
 // ROS 1 bags (2.0; none/bz2/lz4 chunks) and ROS 2 MCAP (none/zstd/lz4 chunks, CDR) -> an LCM log that
 // fploc replay and lcm-logplayer play:
-//   ouster_ros/PacketMsg (+ the std_msgs/String metadata topic) -> scan_t on OS1_SCAN, imu_t on OS1_IMU
-//       (decoded by fploc's OS-1 driver code: the same scans as from the live sensor or a pcap)
+//   ouster_ros/PacketMsg (+ the std_msgs/String metadata topic) -> the packets as they are: os1_packet_t on
+//       OS1_LIDAR_PACKETS / OS1_IMU_PACKETS, os1_metadata_t on OS1_METADATA, decoded on replay by the OS-1
+//       and IMU drivers (graphs/replay-packets.pbtxt) as the live sensor's packets; with --decode:
+//       scan_t on OS1_SCAN, imu_t on OS1_IMU decoded here by the same OS-1 code (same scans)
 //   sensor_msgs/PointCloud2 -> scan_t on OS1_SCAN (rings from the ring field or the elevations)
 //   sensor_msgs/Imu -> imu_t on OS1_IMU;  sensor_msgs/LaserScan -> laser_scan_t on LASER_SCAN
 //   nav_msgs/Odometry, tf2_msgs/TFMessage -> a TUM file (--tum-out, --tf-parent/--tf-child or --odom-topic)
@@ -28,12 +30,14 @@
 #include "fploc/recording/recording.h"
 #include "fploc/recording/ros_msgs.h"
 #include "lcm_log.h"
+#include "ouster_raw.h"
 #include "scan_encode.h"
 #include "tum_track.h"
 
 using namespace fploc;
 using namespace fploc::rec;
 using fploc::import::LcmLog;
+using fploc::import::OusterRawWriter;
 using fploc::import::TumTrack;
 
 namespace {
@@ -69,7 +73,7 @@ int main(int argc, char** argv) {
   CLI::App app{"fploc import: ROS 1 bags and ROS 2 MCAP recordings -> LCM log (and a TUM trajectory)"};
   std::string path, out, tum_out, tf_parent, tf_child, odom_topic, metadata_file;
   std::vector<std::string> topics, channels;
-  bool list = false, json = false, quiet = false;
+  bool list = false, json = false, quiet = false, decode_ouster = false;
   double start = -1, end = -1;
   CloudOptions cloud_opt;
   app.add_option("recording", path, "ROS 1 bag (.bag) or MCAP (.mcap) file")->required();
@@ -80,6 +84,8 @@ int main(int argc, char** argv) {
   app.add_option("--start", start, "skip messages before START seconds after the first message");
   app.add_option("--end", end, "stop at END seconds after the first message");
   app.add_option("--metadata", metadata_file, "Ouster sensor metadata JSON (when the recording has no metadata topic)");
+  app.add_flag("--decode", decode_ouster,
+               "Ouster packets: write scan_t (OS1_SCAN) and imu_t (OS1_IMU) decoded here, instead of the packets for the drivers");
   app.add_option("--channel", channels, "TOPIC=CHANNEL: the LCM channel of a topic")->delimiter(',');
   app.add_option("--rings", cloud_opt.rings, "PointCloud2 without ring field: the number of rings (default: elevation gaps)");
   app.add_option("--columns", cloud_opt.columns, "PointCloud2: columns of the range image (default: organised width or most points per ring)");
@@ -198,11 +204,15 @@ int main(int argc, char** argv) {
   }
 
   OusterPackets ouster;
+  OusterRawWriter raw(out.empty() ? nullptr : &lcm_log);
+  std::string metadata_text;  // --metadata, written (packets mode) with the first Ouster packet's time
   if (!metadata_file.empty()) {
     std::ifstream in(metadata_file);
     std::stringstream ss;
     ss << in.rdbuf();
-    if (!in || !ouster.set_metadata(ss.str(), metadata_file, &err)) {
+    metadata_text = ss.str();
+    if (!in || !(decode_ouster ? ouster.set_metadata(metadata_text, metadata_file, &err)
+                               : OusterRawWriter(nullptr).metadata(metadata_text, metadata_file, 0, &err))) {
       std::cerr << "fploc import: " << (in ? err : metadata_file + ": cannot read") << "\n";
       return 1;
     }
@@ -269,7 +279,7 @@ int main(int argc, char** argv) {
       case Kind::kOusterMetadata: {
         std::string text;
         if (!decode_string(m.data, m.size, c.encoding, text, &err)) { bad(c, err); break; }
-        if (!ouster.set_metadata(text, c.topic, &err)) bad(c, err);
+        if (!(decode_ouster ? ouster.set_metadata(text, c.topic, &err) : raw.metadata(text, c.topic, m.time_ns, &err))) bad(c, err);
         ++written["(metadata " + c.topic + ")"];
         break;
       }
@@ -277,6 +287,11 @@ int main(int argc, char** argv) {
         const uint8_t* buf = nullptr;
         size_t n = 0;
         if (!decode_bytes(m.data, m.size, c.encoding, &buf, &n, &err)) { bad(c, err); break; }
+        if (!decode_ouster) {
+          if (!raw.has_metadata() && !metadata_text.empty()) raw.metadata(metadata_text, metadata_file, m.time_ns, &err);
+          raw.packet(buf, n, m.time_ns);
+          break;
+        }
         os1::ImuSample s;
         if (ouster.add(buf, n, m.time_ns, frames, &s)) {
           imu_t im{};
@@ -365,15 +380,38 @@ int main(int argc, char** argv) {
   ouster.flush(frames);
   emit_frames(m.time_ns);
   if (!quiet && std::chrono::steady_clock::now() - t_start > std::chrono::seconds(1)) std::fprintf(stderr, "\n");
-  lcm_log.close();
+  const bool log_ok = lcm_log.close();
   tum.close();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
 
   std::vector<std::string> problems;
+  if (!log_ok) problems.push_back(out + ": writing failed (disk full?); the log is cut short");
   if (!rec->error().empty()) problems.push_back(rec->error() + " (the output holds everything before it)");
   for (const auto& [t, n] : decode_errors) problems.push_back(t + ": " + std::to_string(n) + " messages not decoded; first: " + first_decode_error[t]);
   if (ouster.lidar_packets > 0 && !ouster.has_metadata())
     problems.push_back(std::to_string(ouster.lidar_packets) + " Ouster lidar packets without metadata (no metadata topic; give --metadata FILE)");
+  if (raw.lidar_packets > 0 && !raw.has_metadata())
+    problems.push_back(std::to_string(raw.lidar_packets) + " Ouster lidar packets without metadata (no metadata topic; give --metadata FILE)");
+  if (raw.waiting_dropped)
+    problems.push_back(std::to_string(raw.waiting_dropped) + " Ouster lidar packets before the metadata dropped (more than 20000 waited)");
+  if (raw.other_size)
+    problems.push_back(std::to_string(raw.other_size) + " Ouster lidar packets not of the metadata's size " + std::to_string(raw.lidar_size()) +
+                       " B (written as they are; the driver will report them)");
+  if (raw.imu_packets) written[raw.imu_channel] = raw.imu_packets;  // IMU packets need no metadata
+  if (raw.lidar_packets && raw.has_metadata()) {
+    written[raw.lidar_channel] = raw.lidar_packets - raw.waiting_dropped;
+    written[raw.metadata_channel] = 1;
+  }
+  // The graph that replays what was written: the drivers' one for packets, the pipeline for scans.
+  std::string replay_graph;
+  for (const auto& [ch, n] : written) {
+    if (!n) continue;
+    if (ch == raw.lidar_channel) replay_graph = "graphs/replay-packets.pbtxt";
+    else if (ch.rfind("OS1_SCAN", 0) == 0 && replay_graph.empty()) replay_graph = "graphs/replay.pbtxt";
+  }
+  if (replay_graph.empty())
+    for (const auto& [ch, n] : written)
+      if (n && ch.rfind("LASER_SCAN", 0) == 0) replay_graph = "graphs/lidar2d.pbtxt";
   if (ouster.bad_packets) problems.push_back(std::to_string(ouster.bad_packets) + " bad Ouster packets; last: " + ouster.last_error);
 
   if (json) {
@@ -386,8 +424,13 @@ int main(int argc, char** argv) {
     j["channels"] = topic_channel;
     j["seconds"] = wall;
     j["events"] = lcm_log.events();
+    j["replay_graph"] = replay_graph;
+    if (raw.has_metadata() && raw.lidar_packets + raw.imu_packets > 0)
+      j["ouster"] = {{"mode", "packets"}, {"sensor", raw.sensor}, {"pixels_per_column", raw.pixels_per_column},
+                     {"columns_per_frame", raw.columns_per_frame}, {"udp_profile", raw.udp_profile},
+                     {"lidar_packets", raw.lidar_packets}, {"imu_packets", raw.imu_packets}};
     if (ouster.info()) {
-      j["ouster"] = {{"sensor", ouster.info()->sensor_name()}, {"pixels_per_column", ouster.info()->pixels_per_column},
+      j["ouster"] = {{"mode", "scans"}, {"sensor", ouster.info()->sensor_name()}, {"pixels_per_column", ouster.info()->pixels_per_column},
                      {"columns_per_frame", ouster.info()->columns_per_frame}, {"udp_profile", os1::to_string(ouster.info()->profile)},
                      {"lidar_packets", ouster.lidar_packets}, {"imu_packets", ouster.imu_packets}, {"frames", frames_total}};
       nlohmann::json fr = nlohmann::json::array();
@@ -403,6 +446,11 @@ int main(int argc, char** argv) {
     std::printf("%s (%s): %llu messages read in %.2f s\n", path.c_str(), rec->format().c_str(), (unsigned long long)read_msgs, wall);
     for (const auto& [ch, n] : written) std::printf("  %-28s %8llu\n", ch.c_str(), (unsigned long long)n);
     for (const auto& [t, ch] : topic_channel) std::printf("  topic %s -> %s\n", t.c_str(), ch.c_str());
+    if (raw.has_metadata() && raw.lidar_packets + raw.imu_packets > 0)
+      std::printf("  ouster: %s, %dx%d (%s), %llu lidar + %llu imu packets written as they are\n"
+                  "          (the OS-1 and IMU drivers decode them on replay; --decode writes scan_t and imu_t here)\n",
+                  raw.sensor.c_str(), raw.pixels_per_column, raw.columns_per_frame, raw.udp_profile.c_str(),
+                  (unsigned long long)raw.lidar_packets, (unsigned long long)raw.imu_packets);
     if (ouster.info())
       std::printf("  ouster: %s, %dx%d (%s), %llu lidar + %llu imu packets -> %zu frames\n", ouster.info()->sensor_name().c_str(),
                   ouster.info()->pixels_per_column, ouster.info()->columns_per_frame, os1::to_string(ouster.info()->profile),
@@ -415,8 +463,10 @@ int main(int argc, char** argv) {
       for (const auto& [t, n] : skipped_types) std::printf(" %s (%llu)", t.c_str(), (unsigned long long)n);
       std::printf("\n");
     }
+    if (!out.empty() && !replay_graph.empty())
+      std::printf("  replay: bin/fploc replay --graph %s --log %s [--set ...]\n", replay_graph.c_str(), out.c_str());
     if (!tum_out.empty()) std::printf("  %s: %llu poses\n", tum_out.c_str(), (unsigned long long)tum.poses());
   }
   for (const auto& p : problems) std::cerr << "fploc import: " << p << "\n";
-  return rec->error().empty() ? 0 : 1;
+  return rec->error().empty() && log_ok ? 0 : 1;
 }

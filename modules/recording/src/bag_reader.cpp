@@ -14,13 +14,6 @@ namespace {
 constexpr char kMagic[] = "#ROSBAG V2.0\n";
 constexpr size_t kMagicLen = 13;
 
-template <class T>
-T rd(const uint8_t* p) {
-  T v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-
 struct Field {
   std::string_view name;
   const uint8_t* v = nullptr;
@@ -89,9 +82,7 @@ std::string text(const Field* f) { return f ? std::string(reinterpret_cast<const
 
 }  // namespace
 
-BagReader::BagReader(std::unique_ptr<FileBytes> f, std::string name) : f_(std::move(f)), name_(std::move(name)) {
-  format_ = "bag 2.0";
-  size_ = f_->size();
+BagReader::BagReader(std::unique_ptr<FileBytes> f, std::string name) : FileReader(std::move(f), std::move(name), "bag 2.0") {
   if (size_ < kMagicLen || std::memcmp(f_->data(), kMagic, kMagicLen) != 0) {
     stop("not a ROS bag 2.0 (no '#ROSBAG V2.0' magic)");
     return;
@@ -99,20 +90,11 @@ BagReader::BagReader(std::unique_ptr<FileBytes> f, std::string name) : f_(std::m
   pos_ = kMagicLen;
 }
 
-bool BagReader::stop(const std::string& what) {
-  done_ = true;
-  return fail(name_ + ": " + what);
-}
-
 bool BagReader::next(RawMessage& m) {
   Record r;
   std::string why;
   while (!done_) {
-    if (cd_) {
-      if (cpos_ >= cn_) {
-        cd_ = nullptr;
-        continue;
-      }
+    if (in_chunk()) {
       const size_t at = cpos_;
       if (!read_record(cd_, cn_, cpos_, r, &why))
         return stop(chunk_what_ + ": record at chunk offset " + std::to_string(at) + ": " + why);
@@ -144,6 +126,7 @@ bool BagReader::next(RawMessage& m) {
       return false;
     }
     const size_t at = pos_;
+    f_->read_ahead(at);
     if (!read_record(f_->data(), size_, pos_, r, &why)) {
       pos_ = at;
       return stop("record at byte " + std::to_string(at) + ": " + why);

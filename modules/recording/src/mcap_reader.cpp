@@ -19,13 +19,6 @@ namespace {
 
 constexpr uint8_t kMagic[8] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
 
-template <class T>
-T rd(const uint8_t* p) {
-  T v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-
 // Bounded little-endian reads over one record body.
 struct Body {
   const uint8_t* p;
@@ -87,19 +80,12 @@ std::string hex32(uint32_t v) {
 
 }  // namespace
 
-McapReader::McapReader(std::unique_ptr<FileBytes> f, std::string name) : f_(std::move(f)), name_(std::move(name)) {
-  format_ = "mcap";
-  size_ = f_->size();
+McapReader::McapReader(std::unique_ptr<FileBytes> f, std::string name) : FileReader(std::move(f), std::move(name), "mcap") {
   if (size_ < 8 || std::memcmp(f_->data(), kMagic, 8) != 0) {
     stop("not an MCAP file (no magic)");
     return;
   }
   pos_ = 8;
-}
-
-bool McapReader::stop(const std::string& what) {
-  done_ = true;
-  return fail(name_ + ": " + what);
 }
 
 bool McapReader::on_record(uint8_t op, const uint8_t* p, size_t n, RawMessage* m, bool* is_message, std::string* why) {
@@ -147,11 +133,7 @@ bool McapReader::next(RawMessage& m) {
   std::string why;
   bool is_msg = false;
   while (!done_) {
-    if (cd_) {
-      if (cpos_ >= cn_) {
-        cd_ = nullptr;
-        continue;
-      }
+    if (in_chunk()) {
       const size_t at = cpos_;
       if (cn_ - cpos_ < 9) return stop(chunk_what_ + ": record header cut at chunk offset " + std::to_string(at));
       const uint8_t op = cd_[cpos_];
@@ -163,6 +145,7 @@ bool McapReader::next(RawMessage& m) {
       continue;
     }
     const size_t at = pos_;
+    f_->read_ahead(at);
     if (size_ - pos_ < 9) return stop("record at byte " + std::to_string(at) + ": cut off (file truncated? no footer)");
     const uint8_t* d = f_->data();
     const uint8_t op = d[pos_];

@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -39,6 +40,16 @@ bool FileBytes::map(const std::string& path, std::string* err) {
   }
   ::close(fd);
   return true;
+}
+
+void FileBytes::read_ahead(size_t pos) {
+  constexpr size_t kAhead = size_t(64) << 20, kStep = size_t(32) << 20;
+  if (!mapped_ || advised_ >= size_ || pos + (kAhead - kStep) < advised_) return;
+  const size_t page = size_t(sysconf(_SC_PAGESIZE));
+  const size_t from = std::max(advised_, pos) & ~(page - 1);
+  const size_t to = std::min(size_, pos + kAhead);
+  if (to > from) madvise(static_cast<uint8_t*>(mapped_) + from, to - from, MADV_WILLNEED);
+  advised_ = to;
 }
 
 namespace {

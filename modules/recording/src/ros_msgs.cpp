@@ -103,11 +103,9 @@ bool decode(const uint8_t* d, size_t n, Encoding e, LaserScan& m, std::string* e
   m.range_min = w.get<float>();
   m.range_max = w.get<float>();
   w.field("ranges");
-  m.ranges.resize(w.count(4));
-  for (auto& r : m.ranges) r = w.get<float>();
+  w.floats(m.ranges, w.count(4));
   w.field("intensities");
-  m.intensities.resize(w.count(4));
-  for (auto& r : m.intensities) r = w.get<float>();
+  w.floats(m.intensities, w.count(4));
   return done(w, "sensor_msgs/LaserScan", err);
 }
 

@@ -3,6 +3,7 @@
 // header; strings count their NUL). Reading past the end sets ok = false and the name of the field.
 #pragma once
 #include <cstring>
+#include <vector>
 #include <string>
 #include <type_traits>
 
@@ -64,6 +65,21 @@ class Wire {
     const uint32_t c = get<uint32_t>();
     if (ok_ && min_size > 0 && c > (n_ - i_) / min_size) return bad(cur_), 0;
     return c;
+  }
+  // A float32[] of c elements (after its count), in one pass.
+  void floats(std::vector<float>& out, uint32_t c) {
+    align(4);
+    if (!ok_ || c > (n_ - i_) / 4) return bad(cur_), out.clear();
+    out.resize(c);
+    if (c) std::memcpy(out.data(), d_ + i_, size_t(c) * 4);
+    if (swap_)
+      for (auto& f : out) {
+        uint32_t u;
+        std::memcpy(&u, &f, 4);
+        u = __builtin_bswap32(u);
+        std::memcpy(&f, &u, 4);
+      }
+    i_ += size_t(c) * 4;
   }
   // Raw bytes of a uint8[] (after its count).
   const uint8_t* bytes(size_t len) {

@@ -1,0 +1,76 @@
+// LcmLog (own framing, buffers handed to a writer thread) writes byte for byte what lcm's
+// lcm_eventlog_write_event writes, for events smaller and larger than its buffers and split in two parts.
+#include <gtest/gtest.h>
+#include <lcm/eventlog.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <random>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+#include "lcm_log.h"
+
+namespace {
+
+std::vector<char> slurp(const std::string& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(LcmLog, SameBytesAsLcmEventlog) {
+  const auto dir = std::filesystem::temp_directory_path() / ("lcm_log_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string a = (dir / "ours.lcm").string(), b = (dir / "lcm.lcm").string();
+  std::mt19937 rng(7);
+  fploc::import::LcmLog ours;
+  ASSERT_TRUE(ours.open(a));
+  lcm_eventlog_t* ref = lcm_eventlog_create(b.c_str(), "w");
+  ASSERT_NE(ref, nullptr);
+  for (int i = 0; i < 400; ++i) {
+    // Mostly packet-sized events, some larger than a 256 KiB buffer, some empty.
+    const size_t n = i % 97 == 5 ? size_t(1) << 20 : (i % 50 == 3 ? 0 : 1 + rng() % 20000);
+    std::vector<uint8_t> d(n);
+    for (auto& x : d) x = uint8_t(rng());
+    const std::string ch = i % 3 ? "OS1_LIDAR_PACKETS" : "OS1_IMU";
+    const int64_t t = 1700000000000000 + i * 1000;
+    const size_t cut = n / 3;
+    if (i % 2) ASSERT_TRUE(ours.write_parts(ch, t, d.data(), cut, d.data() + cut, n - cut));
+    else ASSERT_TRUE(ours.write_raw(ch, t, d.data(), n));
+    lcm_eventlog_event_t e{};
+    e.timestamp = t;
+    e.channellen = int32_t(ch.size());
+    e.datalen = int32_t(n);
+    e.channel = const_cast<char*>(ch.c_str());
+    e.data = d.data();
+    ASSERT_EQ(lcm_eventlog_write_event(ref, &e), 0);
+  }
+  EXPECT_TRUE(ours.close());
+  lcm_eventlog_destroy(ref);
+  EXPECT_EQ(ours.events(), 400u);
+  const auto x = slurp(a), y = slurp(b);
+  EXPECT_GT(x.size(), size_t(4) << 20);
+  EXPECT_TRUE(x == y) << "sizes " << x.size() << " vs " << y.size();
+  std::filesystem::remove_all(dir);
+}
+
+TEST(LcmLog, WriteToUnwritableFileFails) {
+  fploc::import::LcmLog log;
+  EXPECT_FALSE(log.open("/nonexistent-dir/x.lcm"));
+  EXPECT_FALSE(log.write_raw("C", 0, nullptr, 0));
+}
+
+TEST(LcmLog, FullDiskIsReported) {
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  fploc::import::LcmLog log;
+  ASSERT_TRUE(log.open("/dev/full"));
+  std::vector<uint8_t> d(100000, 1);
+  bool ok = true;
+  for (int i = 0; i < 50 && ok; ++i) ok = log.write_raw("C", i, d.data(), d.size());
+  EXPECT_FALSE(log.close() && ok);
+}
+
+}  // namespace
