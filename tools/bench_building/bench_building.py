@@ -19,8 +19,8 @@ and the journeys through the demo building (data/buildings/demo-building.pbtxt: 
 building (every floor), the simulator's ground truth is absolute (z = floor elevation + height above it)
 and its floor per scan (gt.floors.csv) scores the floor rows (with --building-heights the segmenter gets the building too: its floors'
 ceiling areas, the floor from the pose feedback); the pose's floor comes from
-pose_t.floor_index (pose logger `floor_file`), its z (height above that floor) is made absolute with the
-floor's elevation before scoring.
+pose_t.floor_index (pose logger `floor_file`); its z is absolute too (pose_t convention: the floor's
+elevation + the height above it) and is scored as it is.
 Targets (issue 11): z p99 <= 2 cm, roll/pitch p99 <= 0.2 deg, horizontal ATE <= 1 cm, no LOST; floor
 changes recognised within 2 s, no pose on the wrong floor 3 s after arriving, ATE over the 10 s after a
 lift ride <= 5 cm.
@@ -158,7 +158,7 @@ def pct(v, q):
 
 def score(gt, est):
     """Per pose: truth interpolated at the pose's time (roll/pitch from the nearer truth sample). Buildings:
-    `est` z already made absolute (z + the pose floor's elevation)."""
+    `est` z absolute as the truth (pose_t: the floor's elevation + the height above it)."""
     ts = [g[0] for g in gt]
     t0 = gt[0][0]
     series, exy, ez, erp = [], [], [], []
@@ -316,15 +316,11 @@ def bench(a, work, plan, layers, scenario):
     est = read_tum(wo) if os.path.exists(wo) else []
     floors = None
     if building:
-        elev = {i: f["elevation_m"] for i, f in enumerate(simj.get("floors", []))}
         names = {f["name"]: i for i, f in enumerate(simj.get("floors", []))}
         wf = os.path.join(d, "wo.floors")
         pose_floor = read_pose_floors(wf) if os.path.exists(wf) else {}
-        start = names.get(simj.get("start_floor", ""), 0)
-        # pose_t z is the height above the pose's floor: absolute with that floor's elevation (the start
-        # floor when the pose says none).
-        est = [[e[0], e[1], e[2], e[3] + elev.get(pose_floor.get(round(e[0], 6), -1), elev.get(start, 0.0))] + list(e[4:])
-               for e in est]
+        # pose_t z is absolute (the floor's elevation + the height above it), as the simulator's truth: scored
+        # as it is (docs/notes/floors.md).
         changes = [dict(c, to_index=names.get(c["to"], -1)) for c in simj.get("floor_changes", []) if c["t"] <= gt[-1][0]]
         floors = score_floors(gt, est, read_gt_floors(gt_path[:-4] + ".floors.csv"), pose_floor, changes, simj.get("t0", gt[0][0]))
         row["building"] = True
