@@ -173,8 +173,15 @@ class MatcherNode : public fploc::rt::Node {
       }
       sw = tracker_->probe_result(results);
       if (sw) switch_floor(f, fp, *sw, probe_pose_[sw->to], std::nullopt);
-      else std::cerr << "[" << ctx_->name() << "] scan " << f.scan_seq << ": " << tracker_->status_text() << "\n";
     }
+    // Anything else the tracker noticed (a refused ride or probe, z from the building instead of the
+    // segmenter, ...): printed and said on the frames of the next 3 s as a switch is.
+    if (!sw && tracker_->status_text() != said_) {
+      std::cerr << "[" << ctx_->name() << "] scan " << f.scan_seq << ": " << tracker_->status_text() << "\n";
+      switch_text_ = tracker_->status_text();
+      switch_until_ = f.utime + 3'000'000;
+    }
+    said_ = tracker_->status_text();
     fp->z = tracker_->pose_z();
     fp->z_sigma = tracker_->pose_z_sigma(fp->z_sigma);
   }
@@ -251,6 +258,7 @@ class MatcherNode : public fploc::rt::Node {
   fploc::localizer::Config cfg_;
   std::deque<std::pair<int64_t, double>> imu_;  // recent gyro z (a new floor's Localizer gets them)
   std::string switch_text_;
+  std::string said_;  // the tracker's last status text
   int64_t switch_until_ = 0;
   fploc::Pose2 last_ok_;
   std::map<int, fploc::Pose2> probe_pose_;  // plan mismatch: where each floor's probe put the frame

@@ -183,7 +183,7 @@ def score(gt, est):
             "rp_err_max_deg": round(math.degrees(max(erp)), 4)}, series
 
 
-def plot_z(series, title, path):
+def plot_z(series, title, path, marks=()):
     """z estimate and truth against time, SVG (axes in s and m)."""
     W, H, L, R, T, B = 900, 320, 60, 20, 30, 40
     t1 = max(s[0] for s in series) or 1.0
@@ -207,6 +207,8 @@ def plot_z(series, title, path):
     for idx, colour, name in ((2, "#2a7", "ground truth z [m]"), (1, "#c22", "estimate z [m] (WO)")):
         pts = " ".join(f"{X(s[0]):.1f},{Y(s[idx]):.1f}" for s in series)
         out.append(f'<polyline fill="none" stroke="{colour}" stroke-width="1.2" points="{pts}"/>')
+    for t in marks:
+        out.append(f'<line x1="{X(t):.1f}" y1="{T}" x2="{X(t):.1f}" y2="{H - B}" stroke="#36d" stroke-dasharray="4 3"/>')
     out.append(f'<text x="{W - R - 260}" y="18" fill="#2a7">ground truth z</text>')
     out.append(f'<text x="{W - R - 150}" y="18" fill="#c22">estimate z (WO)</text>')
     out.append("</svg>")
@@ -214,9 +216,10 @@ def plot_z(series, title, path):
         f.write("\n".join(out))
 
 
-def plot_png(series, path, W=900, H=300):
-    """The same plot as a PNG without text (for image viewers): grey grid every 1 cm of z and every 10 s,
-    truth green, estimate red. Written with zlib only."""
+def plot_png(series, path, W=900, H=300, marks=()):
+    """The same plot as a PNG without text (for image viewers): grey grid every 1 cm of z (0.5 m across
+    floors) and every 10 s, truth green, estimate red, floor changes (`marks`, s) blue. Written with zlib
+    only."""
     import struct
     import zlib
     t1 = max(s[0] for s in series) or 1.0
@@ -238,6 +241,9 @@ def plot_png(series, path, W=900, H=300):
     for t in range(0, int(t1) + 1, 10):
         for y in range(H):
             px(X(t), y, (225, 225, 225))
+    for t in marks:
+        for y in range(0, H, 2):
+            px(X(t), y, (60, 90, 220))
 
     def line(a, b, c):
         (x0, y0), (x1, y1) = a, b
@@ -345,9 +351,11 @@ def bench(a, work, plan, layers, scenario):
                 (floors.get("ate_after_lift_m") is None or floors["ate_after_lift_m"] <= TARGETS["ate_after_lift_m"])
     if a.plots and series:
         path = os.path.join(a.plots, name.replace(":", "-") + "-z.svg")
-        plot_z(series, f"{name}: z p99 {100 * m['z_err_p99_m']:.2f} cm, rp p99 {m['rp_err_p99_deg']:.3f} deg", path)
+        marks = [c["t"] - gt[0][0] for c in (changes if building else [])]
+        plot_z(series, f"{name}: z p99 {100 * m['z_err_p99_m']:.2f} cm, rp p99 {m['rp_err_p99_deg']:.3f} deg"
+               + (" (dashed: floor changes)" if marks else ""), path, marks)
         row["plot"] = path
-        plot_png(series, path[:-4] + ".png")
+        plot_png(series, path[:-4] + ".png", marks=marks)
         row["plot_png"] = path[:-4] + ".png"
     log(f"[{name}] ATE xy {100 * row.get('ate_xy_m', float('nan')):.2f} cm, z med/p99 "
         f"{100 * row.get('z_err_median_m', float('nan')):.2f}/{100 * row.get('z_err_p99_m', float('nan')):.2f} cm, "
@@ -399,6 +407,15 @@ def main():
     finally:
         if not a.keep:
             shutil.rmtree(work, ignore_errors=True)
+    # Per scenario, the floor rows beside z (stderr; the JSON has them all).
+    log("scenario | z med/p99 cm | ATE xy cm | floor changes recognised after s | wrong floor (>3 s) | ATE 10 s after lift cm")
+    for r in rows:
+        rec = ", ".join(f"{c['how']} {c['recognised_after_s']}" for c in r.get("floor_changes", [])) or "-"
+        lift = r.get("ate_after_lift_m")
+        log(f"{r['plan']}:{r['scenario']} | {100 * r.get('z_err_median_m', float('nan')):.2f}/"
+            f"{100 * r.get('z_err_p99_m', float('nan')):.2f} | {100 * r.get('ate_xy_m', float('nan')):.2f} | {rec} | "
+            f"{r.get('wrong_floor_poses', '-')} ({r.get('wrong_floor_after_3s', '-')}) | "
+            f"{'-' if lift is None else f'{100 * lift:.2f}'}")
     print(json.dumps({"rows": rows, "targets": TARGETS, "seed": a.seed, "graph": os.path.relpath(a.graph, ROOT),
                       "all_meet_targets": all(r.get("meets_targets") for r in rows)}, indent=1))
 

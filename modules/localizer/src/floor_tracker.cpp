@@ -180,6 +180,7 @@ std::optional<FloorSwitch> FloorTracker::update(const FloorObservation& o) {
 }
 
 double FloorTracker::pose_z_sigma(double segmenter_sigma) const {
+  if (z_gated_) return std::max(segmenter_sigma, cfg_.z_gated_sigma_m);
   if (!(ride_active_ && vertical_.riding())) return segmenter_sigma;
   // The double-integrated accelerometer: a residual acceleration error grows as 0.5 a t^2.
   const double t = std::max<int64_t>(0, vertical_.last_utime() - vertical_.ride_start_utime()) * 1e-6;
@@ -200,6 +201,7 @@ void FloorTracker::resolve_z(const FloorObservation& o, const std::optional<Floo
     }
     h_ = ride_base_ + vertical_.height();
     have_h_ = true;
+    z_gated_ = false;
     pose_z_ = e + h_;
     z_source_ = "lift ride (IMU)";
     return;
@@ -242,8 +244,23 @@ void FloorTracker::resolve_z(const FloorObservation& o, const std::optional<Floo
   z_ref_kind_ = refs[best].kind;
   h_ = o.z + refs[best].r;
   have_h_ = true;
+  z_source_ = "segmenter (above " + refs[best].name + ")";
+  // Consistency with the building: the sensor stands z0 above the surface under it (a floor, an incline,
+  // a lift car at rest). A segmenter's z further off than the gate (a ceiling of another height than it
+  // learned, the car's ceiling, ...) is not used: the prediction, with a grown sigma, and said.
+  const bool was_gated = z_gated_;
+  z_gated_ = false;
+  if (z0_ && std::abs(h_ - (*z0_ + g)) > cfg_.z_gate_m) {
+    const double off = h_ - (*z0_ + g);
+    h_ = *z0_ + g;
+    z_gated_ = true;
+    z_source_ = "building: nominal height " + fmt("%.2f m", *z0_) + " above " + (refs.size() > 1 && g != 0 ? refs[1].name : refs[0].name) +
+                " (the segmenter's z is " + fmt("%+.2f m", off) + " off)";
+    if (!was_gated) text_ = "z: " + z_source_;
+  } else if (was_gated) {
+    text_ = "z: the segmenter's again (" + fmt("%.2f m", h_) + " above " + refs[best].name + ")";
+  }
   pose_z_ = e + h_;
-  z_source_ = refs[best].name;
   if ((s && s->via.kind == ConnectionKind::kLift) || ride_ended)
     text_ += "; z " + fmt("%.2f m", before) + " -> " + fmt("%.2f m", pose_z_) + " (the IMU's ride ended: '" + fl.name +
              "' at " + fmt("%.2f m", e) + " + the segmenter's " + fmt("%.2f m", h_) + ")";
@@ -375,7 +392,9 @@ std::optional<FloorSwitch> FloorTracker::update_floor(const FloorObservation& o)
   if (!vertical_.riding() && !ride) {
     ride_inliers_sum_ = 0;
     ride_frames_ = 0;
-    before_inliers_ += (std::clamp(o.inlier_ratio, 0.0, 1.0) - before_inliers_) * 0.2;
+    // How well the plan matched before (frames that matched: a mismatch does not pull it down).
+    if (o.pose_ok && o.inlier_ratio >= cfg_.mismatch_ratio)
+      before_inliers_ += (std::clamp(o.inlier_ratio, 0.0, 1.0) - before_inliers_) * 0.2;
   }
 
   // ---- flat floor: the nominal sensor height, and the offset carried since a ramp/stairs switch
@@ -386,7 +405,8 @@ std::optional<FloorSwitch> FloorTracker::update_floor(const FloorObservation& o)
       z_offset_ = 0;
     }
     const double zf = floor_z(o.z);
-    if (!z0_ || std::abs(zf - *z0_) < cfg_.z_offset_drop_m) {
+    // (Once known, only z within the gate teaches it: a segmenter off by a wrong ceiling does not.)
+    if (!z0_ || std::abs(zf - *z0_) < std::min(cfg_.z_offset_drop_m, cfg_.z_gate_m)) {
       flat_z_.push_back(zf);
       while (int(flat_z_.size()) > cfg_.nominal_z_frames) flat_z_.pop_front();
       if (flat_z_.size() >= 10) z0_ = median(std::vector<double>(flat_z_.begin(), flat_z_.end()));

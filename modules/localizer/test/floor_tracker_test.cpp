@@ -321,3 +321,24 @@ TEST(FloorTracker, PlanMismatchOutsideALiftAreaProbesNothing) {
   EXPECT_TRUE(stand_until_probe(tr, {6, 6}, 0.1, true, &us).empty());
   EXPECT_EQ(tr.floor(), 0);
 }
+
+TEST(FloorTracker, ASegmenterZOffTheBuildingIsNotUsedAndSaid) {
+  FloorTracker tr(two_floors(), 0);
+  for (int k = 0; k < 200; ++k) {
+    FloorObservation o;
+    o.utime = int64_t(k) * 100000;
+    o.pose = {3 + 0.01 * k, 10, 0};
+    o.z_known = true;
+    // 1.2 m, then 8 s of a segmenter 15 cm too high (a ceiling of another height), then right again.
+    o.z = 1.2 + 0.003 * std::sin(0.3 * k) + (k >= 100 && k < 180 ? 0.15 : 0.0);
+    EXPECT_FALSE(tr.update(o));
+    EXPECT_NEAR(tr.pose_z(), 1.2, 0.01) << k << ": " << tr.z_source();
+    if (k == 120) {
+      EXPECT_NE(tr.z_source().find("building: nominal height 1.20 m"), std::string::npos) << tr.z_source();
+      EXPECT_NE(tr.status_text().find("+0.15 m off"), std::string::npos) << tr.status_text();
+      EXPECT_NEAR(tr.pose_z_sigma(0.005), 0.03, 1e-9);
+    }
+  }
+  EXPECT_NE(tr.status_text().find("the segmenter's again"), std::string::npos) << tr.status_text();
+  EXPECT_NEAR(tr.nominal_z().value_or(0), 1.2, 0.005);  // the wrong z did not teach the nominal height
+}

@@ -26,7 +26,8 @@
 // building, a flat ceiling over a ramp), possibly still the floor just left. pose_z() picks, per frame, the
 // reference that puts the sensor nearest its nominal height z0 above the surface the building's geometry
 // (fploc/floorplan/incline.h) gives under the robot: that floor's level, the incline's surface, or the
-// level of the floor left at the last ramp/stairs switch. While riding a lift the height is z0 + the IMU's
+// level of the floor left at the last ramp/stairs switch. A segmenter's z still further than z_gate_m from
+// z0 above that surface is not used (the prediction instead, grown sigma, said in the status text). While riding a lift the height is z0 + the IMU's
 // vertical motion since the ride started (z sigma grown by the double integration); on arrival it snaps to
 // the new floor's elevation + the segmenter's z, said in status_text().
 //
@@ -66,6 +67,8 @@ struct FloorTrackerConfig {
   double ride_accel_sigma_mps2 = 0.02; // lift: residual vertical acceleration error (z sigma 0.5 a t^2)
   double max_ride_z_sigma_m = 0.5;     // ... at most (z stays "known": below 1 m)
   double z_reference_hysteresis_m = 0.02;  // the segmenter's z reference changes when better by this much
+  double z_gate_m = 0.08;              // the segmenter's z this far from z0 above the surface: not used ...
+  double z_gated_sigma_m = 0.03;       // ... the prediction instead, with this sigma
   // Plan mismatch in a lift area (floor switch without the IMU).
   double mismatch_ratio = 0.6;         // inlier ratio below this (or LOST): the plan does not match
   int mismatch_frames = 3;             // ... for this many frames in a row
@@ -141,7 +144,8 @@ class FloorTracker {
   // The pose's absolute z for the last update()'s frame (see above), and its sigma given the segmenter's.
   double pose_z() const { return pose_z_; }
   double pose_z_sigma(double segmenter_sigma) const;
-  // Which reference the last frame's z used ("floor", "incline 'ramp'", "floor 'ground' (left)", "lift ride").
+  // Where the last frame's z came from ("segmenter (above floor 'first')", "segmenter (above ramp 'ramp'
+  // surface)", "building: nominal height ... (the segmenter's z is +0.15 m off)", "lift ride (IMU)", "held").
   const std::string& z_source() const { return z_source_; }
   double z_offset() const { return z_offset_; }
   // Plan mismatch: the floors to try for the last update()'s frame (empty: nothing to do), and their
@@ -200,7 +204,8 @@ class FloorTracker {
   std::vector<Incline> inclines_;
   double pose_z_ = 0, h_ = 0;
   bool have_h_ = false;
-  int z_ref_kind_ = 0;                 // 0 floor level, 1 incline surface, 2 level of the floor left
+  int z_ref_kind_ = 0;
+  bool z_gated_ = false;                 // 0 floor level, 1 incline surface, 2 level of the floor left
   std::string z_source_ = "floor";
   double ride_base_ = 0;               // lift: the height above the floor when the ride started
   bool ride_active_ = false;
