@@ -219,30 +219,37 @@ void FloorTracker::resolve_z(const FloorObservation& o, const std::optional<Floo
     int kind;
     double r;  // the segmenter's zero above the current floor's level
     std::string name;
+    double scale = 1;  // a height measured across an incline's plane: vertically it is z / cos(slope)
   };
   std::vector<Ref> refs{{0, 0.0, "floor '" + fl.name + "'"}};
   const Eigen::Vector2d p(o.pose.x, o.pose.y);
-  double g = 0;
+  double g = 0, inv_cos = 1;
   for (const auto& in : inclines_) {
     if ((in.from_floor != floor_ && in.to_floor != floor_) || !in.contains(p)) continue;
     g = std::clamp(in.z_at(p), std::min(in.z_foot, in.z_head), std::max(in.z_foot, in.z_head)) - e;
-    refs.push_back({1, g, std::string(to_string(in.kind)) + " '" + in.name + "' surface"});
+    const double run = (in.head - in.foot).norm();
+    inv_cos = std::hypot(run, in.z_head - in.z_foot) / run;
+    refs.push_back({1, g, std::string(to_string(in.kind)) + " '" + in.name + "' surface", inv_cos});
     break;
   }
   if (z_offset_ != 0) refs.push_back({2, -z_offset_, "floor left (" + fmt("%+.2f m", -z_offset_) + ")"});
   size_t best = 0;
+  // The sensor's nominal height above the surface under it, vertically: z0 on flat floor; on an incline
+  // between z0 (a mount that keeps the sensor's height, as the simulator's) and z0 / cos (a rigid mast
+  // across the plane): the middle, with half the difference as extra tolerance below.
+  const double want = z0_ ? *z0_ * 0.5 * (1 + inv_cos) + g : 0.0;
+  const auto height = [&](const Ref& r) { return o.z * r.scale + r.r; };
   if (z0_) {
     // The reference that puts the sensor nearest its nominal height above the surface under it; the one in
     // use is kept unless another is better by the hysteresis.
-    const double want = *z0_ + g;
-    const auto res = [&](const Ref& r) { return std::abs(o.z + r.r - want); };
+    const auto res = [&](const Ref& r) { return std::abs(height(r) - want); };
     for (size_t i = 1; i < refs.size(); ++i)
       if (res(refs[i]) < res(refs[best])) best = i;
     for (size_t i = 0; i < refs.size(); ++i)
       if (refs[i].kind == z_ref_kind_ && res(refs[i]) <= res(refs[best]) + cfg_.z_reference_hysteresis_m) best = i;
   }
   z_ref_kind_ = refs[best].kind;
-  h_ = o.z + refs[best].r;
+  h_ = height(refs[best]);
   have_h_ = true;
   z_source_ = "segmenter (above " + refs[best].name + ")";
   // Consistency with the building: the sensor stands z0 above the surface under it (a floor, an incline,
@@ -250,9 +257,9 @@ void FloorTracker::resolve_z(const FloorObservation& o, const std::optional<Floo
   // learned, the car's ceiling, ...) is not used: the prediction, with a grown sigma, and said.
   const bool was_gated = z_gated_;
   z_gated_ = false;
-  if (z0_ && std::abs(h_ - (*z0_ + g)) > cfg_.z_gate_m) {
-    const double off = h_ - (*z0_ + g);
-    h_ = *z0_ + g;
+  if (z0_ && std::abs(h_ - want) > cfg_.z_gate_m + *z0_ * 0.5 * (inv_cos - 1)) {
+    const double off = h_ - want;
+    h_ = want;
     z_gated_ = true;
     z_source_ = "building: nominal height " + fmt("%.2f m", *z0_) + " above " + (refs.size() > 1 && g != 0 ? refs[1].name : refs[0].name) +
                 " (the segmenter's z is " + fmt("%+.2f m", off) + " off)";
