@@ -141,6 +141,7 @@ class MatcherNode : public fploc::rt::Node {
     ob.z_known = fploc::z_known(f);
     ob.roll = f.roll, ob.pitch = f.pitch;
     ob.roll_pitch_known = fploc::roll_pitch_known(f);
+    ob.attitude_t = std::isfinite(f.attitude_t) ? f.attitude_t : 0.0;
     const bool registered = fp->match.status != FitStatus::kNotInitialised;
     std::optional<fploc::localizer::FloorSwitch> sw;
     if (registered) sw = tracker_->update(ob);

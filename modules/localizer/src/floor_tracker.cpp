@@ -197,9 +197,13 @@ void FloorTracker::resolve_z(const FloorObservation& o, const std::optional<Floo
   if (in_lift_ && vertical_.riding()) {
     if (!ride_active_) {
       ride_active_ = true;
-      ride_base_ = z0_ ? *z0_ : have_h_ ? h_ : o.z_known ? o.z : 0.0;
+      // The height the segmenter measured last while it agreed with the building (in the lift before the
+      // doors closed: the sensor's height varies along a path), else the nominal one.
+      ride_base_ = have_good_h_ && o.utime - good_h_utime_ < 15'000'000 ? good_h_ : z0_ ? *z0_ : have_h_ ? h_ : o.z_known ? o.z : 0.0;
     }
-    h_ = ride_base_ + vertical_.height();
+    // The IMU's height at the frame's attitude time (its samples run ahead of the frame by up to a sweep).
+    const double ahead = std::clamp((vertical_.last_utime() - o.utime) * 1e-6 - o.attitude_t, 0.0, 0.3);
+    h_ = ride_base_ + vertical_.height() - vertical_.velocity() * ahead;
     have_h_ = true;
     z_gated_ = false;
     pose_z_ = e + h_;
@@ -266,6 +270,11 @@ void FloorTracker::resolve_z(const FloorObservation& o, const std::optional<Floo
     if (!was_gated) text_ = "z: " + z_source_;
   } else if (was_gated) {
     text_ = "z: the segmenter's again (" + fmt("%.2f m", h_) + " above " + refs[best].name + ")";
+  }
+  if (!z_gated_ && g == 0) {
+    good_h_ = h_;
+    good_h_utime_ = o.utime;
+    have_good_h_ = true;
   }
   pose_z_ = e + h_;
   if ((s && s->via.kind == ConnectionKind::kLift) || ride_ended)

@@ -88,6 +88,7 @@ struct FloorObservation {
   bool z_known = false;
   double roll = 0, pitch = 0;          // the frame's attitude (used when there is no IMU)
   bool roll_pitch_known = false;
+  double attitude_t = 0;               // z holds at utime + this (mid-sweep; the lift ride's z is given there)
 };
 
 struct FloorSwitch {
@@ -209,6 +210,9 @@ class FloorTracker {
   std::string z_source_ = "floor";
   double ride_base_ = 0;               // lift: the height above the floor when the ride started
   bool ride_active_ = false;
+  double good_h_ = 0;                  // the last height above a flat floor the segmenter measured (not gated)
+  int64_t good_h_utime_ = 0;
+  bool have_good_h_ = false;
   int64_t last_utime_ = 0;
   // Plan mismatch.
   int mismatch_ = 0, since_probe_ = 0;
