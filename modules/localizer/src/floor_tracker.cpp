@@ -269,7 +269,7 @@ void FloorTracker::resolve_z(const FloorObservation& o, const std::optional<Floo
                 " (the segmenter's z is " + fmt("%+.2f m", off) + " off)";
     if (!was_gated) text_ = "z: " + z_source_;
   } else if (was_gated) {
-    text_ = "z: the segmenter's again (" + fmt("%.2f m", h_) + " above " + refs[best].name + ")";
+    text_ = "z: the segmenter's again (" + fmt("%.2f m", h_ - (refs[best].kind == 1 ? g : 0.0)) + " above " + refs[best].name + ")";
   }
   if (!z_gated_ && g == 0) {
     good_h_ = h_;
