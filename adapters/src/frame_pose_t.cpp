@@ -31,6 +31,7 @@ frame_pose_t to_msg(const localizer::FramePose& f, int64_t seq, double solve_ms)
   o.solve_ms = solve_ms;
   o.floor_index = int16_t(f.floor_index);
   o.floor = f.floor;
+  o.z_sigma = f.z_sigma;
   return o;
 }
 
@@ -54,6 +55,7 @@ localizer::FramePose from_msg(const frame_pose_t& m) {
   f.z = m.z;
   f.floor_index = m.floor_index;
   f.floor = m.floor;
+  f.z_sigma = std::isfinite(m.z_sigma) ? m.z_sigma : f.z_sigma;
   return f;
 }
 

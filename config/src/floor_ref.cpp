@@ -20,10 +20,10 @@ FloorRef floor_ref(const PlanSource& plan, const std::string& path) {
   if (ext == ".pbtxt") {
     const Building b = load_building(path);
     const BuildingFloor& f = b.floor(plan.floor());  // throws naming the floors
-    return {b.floor_index(f.name), f.name};
+    return {b.floor_index(f.name), f.name, f.elevation};
   }
-  if (ext == ".ifc") return {plan.floor().empty() ? 0 : -1, plan.floor()};
-  return {0, plan.floor().empty() ? "0" : plan.floor()};
+  if (ext == ".ifc") return {plan.floor().empty() ? 0 : -1, plan.floor(), 0.0};
+  return {0, plan.floor().empty() ? "0" : plan.floor(), 0.0};
 }
 
 }  // namespace fploc::config

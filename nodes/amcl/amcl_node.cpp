@@ -314,7 +314,7 @@ class AmclNode : public fploc::rt::Node {
     const double spread = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov.topLeftCorner<2, 2>()).eigenvalues()[1]));
     const bool ok = spread <= cfg_.converged_dist;
     if (ok) ++ok_;
-    out_.publish(fploc::adapters::make_pose_msg(f.utime, seq_++, p, f.roll, f.pitch, f.z, cov, f.z_sigma, f.rp_sigma, ok ? 0 : 1,
+    out_.publish(fploc::adapters::make_pose_msg(f.utime, seq_++, p, f.roll, f.pitch, f.z + floor_.elevation, cov, f.z_sigma, f.rp_sigma, ok ? 0 : 1,
                                       info.updated, true, floor_.index, floor_.name));
     ++scans_;
     if (info.updated) {

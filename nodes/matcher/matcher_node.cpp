@@ -141,29 +141,66 @@ class MatcherNode : public fploc::rt::Node {
     ob.z_known = fploc::z_known(f);
     ob.roll = f.roll, ob.pitch = f.pitch;
     ob.roll_pitch_known = fploc::roll_pitch_known(f);
+    ob.attitude_t = std::isfinite(f.attitude_t) ? f.attitude_t : 0.0;
     const bool registered = fp->match.status != FitStatus::kNotInitialised;
     std::optional<fploc::localizer::FloorSwitch> sw;
     if (registered) sw = tracker_->update(ob);
     if (!sw && fp->match.status == FitStatus::kOk) last_ok_ = fp->match.pose, have_ok_ = true;
+    // Where to start on the new floor: this frame's pose, or the last good one when the old floor's plan
+    // no longer matched (after a lift ride the robot stands where it entered the cab).
+    const fploc::Pose2 at = fp->match.status == FitStatus::kOk || !have_ok_ ? fp->match.pose : last_ok_;
     if (sw) {
-      floor_ = sw->to;
-      std::cerr << "[" << ctx_->name() << "] scan " << f.scan_seq << ": " << tracker_->status_text() << "\n";
-      // Where to start on the new floor: this frame's pose, or the last good one when the old floor's plan
-      // no longer matched (after a lift ride the robot stands where it entered the cab).
-      const fploc::Pose2 at = fp->match.status == FitStatus::kOk || !have_ok_ ? fp->match.pose : last_ok_;
-      auto weights = make_weights();  // the diff's flags were for the old floor's plan
-      loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
-      weights_ = std::move(weights);
-      for (const auto& s : imu_) loc_->add_imu(s.first, s.second);
       // A lift: the robot may have turned in the cab and the old plan no longer matched: search the lift's
       // area. Stairs/ramp: the pose was tracked all the way (one x/y frame), the area can be 25 m long.
-      if (sw->via.kind == fploc::ConnectionKind::kLift) loc_->set_pose(at, sw->search_radius_m);
-      else loc_->set_pose(at);
-      *fp = loc_->register_frame(f);
+      switch_floor(f, fp, *sw, at, sw->via.kind == fploc::ConnectionKind::kLift ? std::optional<double>(sw->search_radius_m)
+                                                                                 : std::nullopt);
+    } else if (!tracker_->probe_request().empty()) {
+      // The plan no longer matches in a lift area: the same frame on each floor the lift serves (and on this
+      // floor, the same search), from the last good pose within the lift's area.
+      std::vector<fploc::localizer::FloorProbeResult> results;
+      std::optional<fploc::Pose2> found;
+      fploc::localizer::Config probe_cfg = cfg_;
+      probe_cfg.matcher.element_weight = nullptr;
+      for (const auto& q : tracker_->probe_request()) {
+        fploc::localizer::Localizer probe(*floors_.maps[size_t(q.floor)].lookup, probe_cfg);
+        for (const auto& s : imu_) probe.add_imu(s.first, s.second);
+        // From the last good pose, far enough to cover the lift's disc.
+        probe.set_pose(at, q.search_radius_m + std::hypot(at.x - q.search_center.x(), at.y - q.search_center.y()));
+        const auto r = probe.register_frame(f);
+        results.push_back({q.floor, r.match.status == FitStatus::kOk, r.match.fit.inlier_ratio});
+        std::cerr << "[" << ctx_->name() << "] scan " << f.scan_seq << ": plan of '" << q.name << "' in the lift area: "
+                  << fploc::matcher::to_string(r.match.status) << ", " << int(std::lround(100 * r.match.fit.inlier_ratio)) << " %\n";
+        if (q.floor != floor_) probe_pose_[q.floor] = r.match.pose;
+      }
+      sw = tracker_->probe_result(results);
+      if (sw) switch_floor(f, fp, *sw, probe_pose_[sw->to], std::nullopt);
+    }
+    // Anything else the tracker noticed (a refused ride or probe, z from the building instead of the
+    // segmenter, ...): printed and said on the frames of the next 3 s as a switch is.
+    if (!sw && tracker_->status_text() != said_) {
+      std::cerr << "[" << ctx_->name() << "] scan " << f.scan_seq << ": " << tracker_->status_text() << "\n";
       switch_text_ = tracker_->status_text();
       switch_until_ = f.utime + 3'000'000;
     }
-    fp->z = tracker_->floor_z(fp->z);
+    said_ = tracker_->status_text();
+    fp->z = tracker_->pose_z();
+    fp->z_sigma = tracker_->pose_z_sigma(fp->z_sigma);
+  }
+
+  // The new floor's Localizer, started at `at` (within `search_m` when given), registers the frame again.
+  void switch_floor(const fploc::FeatureFrame& f, fploc::localizer::FramePose* fp, const fploc::localizer::FloorSwitch& sw,
+                    const fploc::Pose2& at, std::optional<double> search_m) {
+    floor_ = sw.to;
+    std::cerr << "[" << ctx_->name() << "] scan " << f.scan_seq << ": " << tracker_->status_text() << "\n";
+    auto weights = make_weights();  // the diff's flags were for the old floor's plan
+    loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
+    weights_ = std::move(weights);
+    for (const auto& s : imu_) loc_->add_imu(s.first, s.second);
+    if (search_m) loc_->set_pose(at, *search_m);
+    else loc_->set_pose(at);
+    *fp = loc_->register_frame(f);
+    switch_text_ = tracker_->status_text();
+    switch_until_ = f.utime + 3'000'000;
   }
 
   void on_plan_diff(const fploc::plan_diff_t& m) {
@@ -222,8 +259,10 @@ class MatcherNode : public fploc::rt::Node {
   fploc::localizer::Config cfg_;
   std::deque<std::pair<int64_t, double>> imu_;  // recent gyro z (a new floor's Localizer gets them)
   std::string switch_text_;
+  std::string said_;  // the tracker's last status text
   int64_t switch_until_ = 0;
   fploc::Pose2 last_ok_;
+  std::map<int, fploc::Pose2> probe_pose_;  // plan mismatch: where each floor's probe put the frame
   bool have_ok_ = false;
   float diff_weight_ = 0;
   std::unique_ptr<fploc::matcher::ElementWeights> weights_;  // before loc_: the matcher reads it

@@ -180,7 +180,7 @@ class NdtNode : public fploc::rt::Node {
     o.floor = floor_.name;
     o.position[0] = r.x;
     o.position[1] = r.y;
-    o.position[2] = r.z;
+    o.position[2] = r.z + floor_.elevation;  // absolute (pose_t convention)
     const Eigen::Quaterniond q = Eigen::AngleAxisd(r.yaw, Eigen::Vector3d::UnitZ()) *
                                  Eigen::AngleAxisd(r.pitch, Eigen::Vector3d::UnitY()) *
                                  Eigen::AngleAxisd(r.roll, Eigen::Vector3d::UnitX());

@@ -131,9 +131,13 @@ class OptimizerNode : public fploc::rt::Node {
       weights_ = std::move(weights);
       std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << ": window on floor '" << m.floor << "'\n";
     }
-    // The matcher's z is the height above its floor (the segmenter's z carries no floor).
+    // The matcher's z is absolute (its floor's elevation + the height above it; the segmenter's z carries
+    // no floor), its sigma grown while a lift ride is integrated from the IMU.
     fploc::FeatureFrame fz = f;
-    if (fploc::z_known(f)) fz.z = m.z;
+    if (fploc::z_known(f)) {
+      fz.z = m.z;
+      if (std::isfinite(m.z_sigma) && m.z_sigma > fz.z_sigma && m.z_sigma < fploc::kZUnknownFromSigmaM) fz.z_sigma = m.z_sigma;
+    }
     const auto latest = loc_->optimize(fz, fploc::adapters::from_msg(m), &finals);
     // The floor of each frame is the matcher's (frame_pose_t); kept until the frame's pose is final.
     floor_of_[m.utime] = {m.floor_index, m.floor};

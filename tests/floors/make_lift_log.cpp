@@ -161,7 +161,7 @@ int main(int argc, char** argv) {
       out.push_back(encode(u, "OS1_SCAN", s));
       TumPose p = pa;
       p.t = u * 1e-6;
-      p.z = pa.z + h_at((u - ride_start) * 1e-6);  // height above the lower floor while riding
+      p.z = pa.z + h_at((u - ride_start) * 1e-6);  // absolute (the lower floor is at 0)
       gt.push_back(p);
       fploc::ground_truth_t gm{};
       gm.utime = u;
@@ -200,6 +200,7 @@ int main(int argc, char** argv) {
         m.seq += scan_seq0;
         const Eigen::Vector2d xy = R * Eigen::Vector2d(m.position[0], m.position[1]) + tr;
         m.position[0] = xy.x(), m.position[1] = xy.y();
+        m.position[2] += height;  // absolute z (pose_t convention): the upper floor's elevation + the height above it
         const Eigen::Quaterniond o = Eigen::Quaterniond(Eigen::AngleAxisd(dyaw, Eigen::Vector3d::UnitZ())) *
                                      Eigen::Quaterniond(m.orientation[3], m.orientation[0], m.orientation[1], m.orientation[2]);
         m.orientation[0] = o.x(), m.orientation[1] = o.y(), m.orientation[2] = o.z(), m.orientation[3] = o.w();
@@ -214,6 +215,7 @@ int main(int argc, char** argv) {
       q.t = p.t + shift * 1e-6;
       const Eigen::Vector2d xy = R * Eigen::Vector2d(p.x, p.y) + tr;
       q.x = xy.x(), q.y = xy.y();
+      q.z = p.z + height;  // absolute
       const Eigen::Quaterniond o = qr * Eigen::Quaterniond(p.qw, p.qx, p.qy, p.qz);
       q.qx = o.x(), q.qy = o.y(), q.qz = o.z(), q.qw = o.w();
       gt.push_back(q);

@@ -5,8 +5,11 @@ REC.lcm: lcm-logger's recording of FPLOC_POSE (pose_t, with floor_index/floor) a
 GT.tum the ground truth; FLOORS.txt "utime floor" per ground-truth pose plus "# arrival UTIME" and
 "# ride_start UTIME" (tests/floors/make_lift_log). Prints the time from the arrival to the first pose
 on the new floor, the poses on the wrong floor (all, and from 3 s after the arrival), the horizontal
-ATE over the 10 s after the arrival, and fails (exit 1) when a target is missed:
-recognised within 2 s, none wrong 3 s after the arrival, ATE <= 5 cm."""
+ATE over the 10 s after the arrival, the z error (pose_t z is absolute: the floor's elevation + the
+height above it, as the ground truth) during the ride and from 3 s after the arrival, and fails (exit 1)
+when a target is missed: recognised within 2 s, none wrong 3 s after the arrival, ATE <= 5 cm, z median
+<= 5 cm from 3 s after the arrival, and with the IMU (not FPLOC_FLOOR_NO_IMU=1) z within 30 cm during the
+ride (integrated from the IMU)."""
 import bisect
 import math
 import os
@@ -33,8 +36,8 @@ def main():
     gt = []
     for line in open(gt_path):
         if line.strip() and not line.startswith("#"):
-            t, x, y = map(float, line.split()[:3])
-            gt.append((int(round(t * 1e6)), x, y))
+            t, x, y, z = map(float, line.split()[:4])
+            gt.append((int(round(t * 1e6)), x, y, z))
     gt_t = [g[0] for g in gt]
     poses = {}
     for _ts, ch, buf in events(rec, with_time=True):
@@ -59,6 +62,17 @@ def main():
             continue
         errs.append(math.hypot(p["x"] - gt[k][1], p["y"] - gt[k][2]))
     ate = math.sqrt(sum(e * e for e in errs) / len(errs)) if errs else float("nan")
+
+    def z_errs(sel):
+        out = []
+        for p in sel:
+            k = min(max(bisect.bisect_left(gt_t, p["utime"]), 0), len(gt) - 1)
+            if abs(gt[k][0] - p["utime"]) <= 2000:
+                out.append(abs(p["z"] - gt[k][3]))
+        return sorted(out)
+    z_ride = z_errs([p for p in poses if ride_start <= p["utime"] < arrival])
+    z_after = z_errs([p for p in poses if arrival + 3_000_000 <= p["utime"] <= arrival + 10_000_000])
+    no_imu = os.environ.get("FPLOC_FLOOR_NO_IMU") == "1"
     rec_s = (first_upper["utime"] - arrival) * 1e-6 if first_upper else float("inf")
     print(f"poses: {len(poses)} (final), floors seen: {sorted(set(p['floor'] for p in poses))}")
     print(f"ride {ride_start} .. arrival {arrival} us; first pose on '{upper}': {rec_s:+.2f} s after the arrival")
@@ -66,6 +80,14 @@ def main():
           f"{len(early)} on '{upper}' before the ride")
     print(f"horizontal ATE over the 10 s after the arrival: {100 * ate:.2f} cm ({len(errs)} poses, max "
           f"{100 * max(errs) if errs else float('nan'):.2f} cm)")
+    zmed = z_after[len(z_after) // 2] if z_after else float("nan")
+    zride = z_ride[-1] if z_ride else float("nan")
+    print(f"z error (absolute z): during the ride max {100 * zride:.1f} cm ({len(z_ride)} poses{', no IMU' if no_imu else ''}); "
+          f"3-10 s after the arrival median {100 * zmed:.2f} cm, max {100 * (z_after[-1] if z_after else float('nan')):.2f} cm")
+    if not (zmed <= 0.05):
+        print("FAIL: z median above 5 cm from 3 s after the arrival (absolute z)"); ok = False
+    if not no_imu and not (zride <= 0.3):
+        print("FAIL: z more than 30 cm off during the ride (IMU vertical motion)"); ok = False
     if not (rec_s <= 2.0):
         print("FAIL: the new floor was not recognised within 2 s of the arrival"); ok = False
     if wrong_late:

@@ -19,8 +19,8 @@ and the journeys through the demo building (data/buildings/demo-building.pbtxt: 
 building (every floor), the simulator's ground truth is absolute (z = floor elevation + height above it)
 and its floor per scan (gt.floors.csv) scores the floor rows (with --building-heights the segmenter gets the building too: its floors'
 ceiling areas, the floor from the pose feedback); the pose's floor comes from
-pose_t.floor_index (pose logger `floor_file`), its z (height above that floor) is made absolute with the
-floor's elevation before scoring.
+pose_t.floor_index (pose logger `floor_file`); its z is absolute too (pose_t convention: the floor's
+elevation + the height above it) and is scored as it is.
 Targets (issue 11): z p99 <= 2 cm, roll/pitch p99 <= 0.2 deg, horizontal ATE <= 1 cm, no LOST; floor
 changes recognised within 2 s, no pose on the wrong floor 3 s after arriving, ATE over the 10 s after a
 lift ride <= 5 cm.
@@ -158,7 +158,7 @@ def pct(v, q):
 
 def score(gt, est):
     """Per pose: truth interpolated at the pose's time (roll/pitch from the nearer truth sample). Buildings:
-    `est` z already made absolute (z + the pose floor's elevation)."""
+    `est` z absolute as the truth (pose_t: the floor's elevation + the height above it)."""
     ts = [g[0] for g in gt]
     t0 = gt[0][0]
     series, exy, ez, erp = [], [], [], []
@@ -183,7 +183,7 @@ def score(gt, est):
             "rp_err_max_deg": round(math.degrees(max(erp)), 4)}, series
 
 
-def plot_z(series, title, path):
+def plot_z(series, title, path, marks=()):
     """z estimate and truth against time, SVG (axes in s and m)."""
     W, H, L, R, T, B = 900, 320, 60, 20, 30, 40
     t1 = max(s[0] for s in series) or 1.0
@@ -207,6 +207,8 @@ def plot_z(series, title, path):
     for idx, colour, name in ((2, "#2a7", "ground truth z [m]"), (1, "#c22", "estimate z [m] (WO)")):
         pts = " ".join(f"{X(s[0]):.1f},{Y(s[idx]):.1f}" for s in series)
         out.append(f'<polyline fill="none" stroke="{colour}" stroke-width="1.2" points="{pts}"/>')
+    for t in marks:
+        out.append(f'<line x1="{X(t):.1f}" y1="{T}" x2="{X(t):.1f}" y2="{H - B}" stroke="#36d" stroke-dasharray="4 3"/>')
     out.append(f'<text x="{W - R - 260}" y="18" fill="#2a7">ground truth z</text>')
     out.append(f'<text x="{W - R - 150}" y="18" fill="#c22">estimate z (WO)</text>')
     out.append("</svg>")
@@ -214,9 +216,10 @@ def plot_z(series, title, path):
         f.write("\n".join(out))
 
 
-def plot_png(series, path, W=900, H=300):
-    """The same plot as a PNG without text (for image viewers): grey grid every 1 cm of z and every 10 s,
-    truth green, estimate red. Written with zlib only."""
+def plot_png(series, path, W=900, H=300, marks=()):
+    """The same plot as a PNG without text (for image viewers): grey grid every 1 cm of z (0.5 m across
+    floors) and every 10 s, truth green, estimate red, floor changes (`marks`, s) blue. Written with zlib
+    only."""
     import struct
     import zlib
     t1 = max(s[0] for s in series) or 1.0
@@ -238,6 +241,9 @@ def plot_png(series, path, W=900, H=300):
     for t in range(0, int(t1) + 1, 10):
         for y in range(H):
             px(X(t), y, (225, 225, 225))
+    for t in marks:
+        for y in range(0, H, 2):
+            px(X(t), y, (60, 90, 220))
 
     def line(a, b, c):
         (x0, y0), (x1, y1) = a, b
@@ -316,15 +322,11 @@ def bench(a, work, plan, layers, scenario):
     est = read_tum(wo) if os.path.exists(wo) else []
     floors = None
     if building:
-        elev = {i: f["elevation_m"] for i, f in enumerate(simj.get("floors", []))}
         names = {f["name"]: i for i, f in enumerate(simj.get("floors", []))}
         wf = os.path.join(d, "wo.floors")
         pose_floor = read_pose_floors(wf) if os.path.exists(wf) else {}
-        start = names.get(simj.get("start_floor", ""), 0)
-        # pose_t z is the height above the pose's floor: absolute with that floor's elevation (the start
-        # floor when the pose says none).
-        est = [[e[0], e[1], e[2], e[3] + elev.get(pose_floor.get(round(e[0], 6), -1), elev.get(start, 0.0))] + list(e[4:])
-               for e in est]
+        # pose_t z is absolute (the floor's elevation + the height above it), as the simulator's truth: scored
+        # as it is (docs/notes/floors.md).
         changes = [dict(c, to_index=names.get(c["to"], -1)) for c in simj.get("floor_changes", []) if c["t"] <= gt[-1][0]]
         floors = score_floors(gt, est, read_gt_floors(gt_path[:-4] + ".floors.csv"), pose_floor, changes, simj.get("t0", gt[0][0]))
         row["building"] = True
@@ -349,9 +351,11 @@ def bench(a, work, plan, layers, scenario):
                 (floors.get("ate_after_lift_m") is None or floors["ate_after_lift_m"] <= TARGETS["ate_after_lift_m"])
     if a.plots and series:
         path = os.path.join(a.plots, name.replace(":", "-") + "-z.svg")
-        plot_z(series, f"{name}: z p99 {100 * m['z_err_p99_m']:.2f} cm, rp p99 {m['rp_err_p99_deg']:.3f} deg", path)
+        marks = [c["t"] - gt[0][0] for c in (changes if building else [])]
+        plot_z(series, f"{name}: z p99 {100 * m['z_err_p99_m']:.2f} cm, rp p99 {m['rp_err_p99_deg']:.3f} deg"
+               + (" (dashed: floor changes)" if marks else ""), path, marks)
         row["plot"] = path
-        plot_png(series, path[:-4] + ".png")
+        plot_png(series, path[:-4] + ".png", marks=marks)
         row["plot_png"] = path[:-4] + ".png"
     log(f"[{name}] ATE xy {100 * row.get('ate_xy_m', float('nan')):.2f} cm, z med/p99 "
         f"{100 * row.get('z_err_median_m', float('nan')):.2f}/{100 * row.get('z_err_p99_m', float('nan')):.2f} cm, "
@@ -403,6 +407,15 @@ def main():
     finally:
         if not a.keep:
             shutil.rmtree(work, ignore_errors=True)
+    # Per scenario, the floor rows beside z (stderr; the JSON has them all).
+    log("scenario | z med/p99 cm | ATE xy cm | floor changes recognised after s | wrong floor (>3 s) | ATE 10 s after lift cm")
+    for r in rows:
+        rec = ", ".join(f"{c['how']} {c['recognised_after_s']}" for c in r.get("floor_changes", [])) or "-"
+        lift = r.get("ate_after_lift_m")
+        log(f"{r['plan']}:{r['scenario']} | {100 * r.get('z_err_median_m', float('nan')):.2f}/"
+            f"{100 * r.get('z_err_p99_m', float('nan')):.2f} | {100 * r.get('ate_xy_m', float('nan')):.2f} | {rec} | "
+            f"{r.get('wrong_floor_poses', '-')} ({r.get('wrong_floor_after_3s', '-')}) | "
+            f"{'-' if lift is None else f'{100 * lift:.2f}'}")
     print(json.dumps({"rows": rows, "targets": TARGETS, "seed": a.seed, "graph": os.path.relpath(a.graph, ROOT),
                       "all_meet_targets": all(r.get("meets_targets") for r in rows)}, indent=1))
 

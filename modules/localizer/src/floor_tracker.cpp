@@ -34,6 +34,12 @@ FloorTracker::FloorTracker(std::shared_ptr<const Building> building, int initial
   if (!building_ || building_->floors.empty()) throw std::invalid_argument("FloorTracker: a building with floors is needed");
   if (initial_floor < 0 || size_t(initial_floor) >= building_->floors.size())
     throw std::invalid_argument("FloorTracker: no floor " + std::to_string(initial_floor) + " in " + building_->source);
+  try {
+    inclines_ = building_inclines(*building_);
+  } catch (const std::exception& e) {
+    // Without the incline geometry the pose's z on a ramp is the segmenter's (the climb cues still work).
+    text_ = std::string("ramps/stairs without geometry: ") + e.what();
+  }
 }
 
 const std::string& FloorTracker::floor_name() const { return building_->floors[size_t(floor_)].name; }
@@ -77,6 +83,9 @@ void FloorTracker::set_floor(int floor, const std::string& reason) {
   confirm_ = 0;
   confirm_to_ = -1;
   vertical_.reset();
+  ride_active_ = false;
+  mismatch_ = 0;
+  probe_.clear();
   text_ = "on '" + floor_name() + "': " + reason;
 }
 
@@ -96,20 +105,12 @@ FloorSwitch FloorTracker::make_switch(int to, const FloorConnection& via, const 
   return s;
 }
 
-std::optional<FloorSwitch> FloorTracker::check_lift(const FloorObservation& o, const VerticalRide& ride) {
-  const Eigen::Vector2d p(o.pose.x, o.pose.y);
-  const double e0 = building_->floors[size_t(floor_)].elevation;
-  const std::string h = fmt("%+.2f m", ride.height_m);
-  const std::string dur = fmt("%.1f s", (ride.end_utime - ride.start_utime) * 1e-6);
-  if (std::abs(ride.height_m) < cfg_.lift_min_height_m) {
-    text_ = "lift ride of " + h + " in " + dur + ": no floor change (below " + fmt("%.2f m", cfg_.lift_min_height_m) + ")";
-    return std::nullopt;
-  }
-  // Floors reachable through lift connections near the robot (a lift serving several floors has one
-  // connection per pair), with the connection of the last hop.
+std::vector<int> FloorTracker::lift_reachable(const Eigen::Vector2d& p, std::vector<int>* via_out) const {
+  // Floors reachable through lift connections near p (a lift serving several floors has one connection per
+  // pair), with the connection of the last hop.
   std::vector<int> via(building_->floors.size(), -1);
   std::vector<bool> seen(building_->floors.size(), false);
-  std::vector<int> todo{floor_};
+  std::vector<int> todo{floor_}, out;
   seen[size_t(floor_)] = true;
   while (!todo.empty()) {
     const int f = todo.back();
@@ -124,8 +125,24 @@ std::optional<FloorSwitch> FloorTracker::check_lift(const FloorObservation& o, c
       seen[size_t(oi)] = true;
       via[size_t(oi)] = int(k);
       todo.push_back(oi);
+      out.push_back(oi);
     }
   }
+  *via_out = std::move(via);
+  return out;
+}
+
+std::optional<FloorSwitch> FloorTracker::check_lift(const FloorObservation& o, const VerticalRide& ride) {
+  const Eigen::Vector2d p(o.pose.x, o.pose.y);
+  const double e0 = building_->floors[size_t(floor_)].elevation;
+  const std::string h = fmt("%+.2f m", ride.height_m);
+  const std::string dur = fmt("%.1f s", (ride.end_utime - ride.start_utime) * 1e-6);
+  if (std::abs(ride.height_m) < cfg_.lift_min_height_m) {
+    text_ = "lift ride of " + h + " in " + dur + ": no floor change (below " + fmt("%.2f m", cfg_.lift_min_height_m) + ")";
+    return std::nullopt;
+  }
+  std::vector<int> via;
+  lift_reachable(p, &via);
   int best = -1;
   double best_err = 0;
   for (size_t f = 0; f < via.size(); ++f) {
@@ -155,6 +172,201 @@ std::optional<FloorSwitch> FloorTracker::check_lift(const FloorObservation& o, c
 }
 
 std::optional<FloorSwitch> FloorTracker::update(const FloorObservation& o) {
+  auto s = update_floor(o);
+  resolve_z(o, s);
+  check_mismatch(o, s.has_value());
+  last_utime_ = o.utime;
+  return s;
+}
+
+double FloorTracker::pose_z_sigma(double segmenter_sigma) const {
+  if (z_gated_) return std::max(segmenter_sigma, cfg_.z_gated_sigma_m);
+  if (!(ride_active_ && vertical_.riding())) return segmenter_sigma;
+  // The double-integrated accelerometer: a residual acceleration error grows as 0.5 a t^2.
+  const double t = std::max<int64_t>(0, vertical_.last_utime() - vertical_.ride_start_utime()) * 1e-6;
+  const double r = std::min(cfg_.max_ride_z_sigma_m, 0.5 * cfg_.ride_accel_sigma_mps2 * t * t);
+  return std::sqrt(segmenter_sigma * segmenter_sigma + r * r);
+}
+
+void FloorTracker::resolve_z(const FloorObservation& o, const std::optional<FloorSwitch>& s) {
+  const BuildingFloor& fl = building_->floors[size_t(floor_)];
+  const double e = fl.elevation;
+  const double before = pose_z_;
+  // Lift: the sensor stands on the car's floor; its height is the nominal one plus the IMU's vertical
+  // motion since the ride started (the segmenter sees the car, whatever its ceiling).
+  if (in_lift_ && vertical_.riding()) {
+    if (!ride_active_) {
+      ride_active_ = true;
+      // The height the segmenter measured last while it agreed with the building (in the lift before the
+      // doors closed: the sensor's height varies along a path), else the nominal one.
+      ride_base_ = have_good_h_ && o.utime - good_h_utime_ < 15'000'000 ? good_h_ : z0_ ? *z0_ : have_h_ ? h_ : o.z_known ? o.z : 0.0;
+    }
+    // The IMU's height at the frame's attitude time (its samples run ahead of the frame by up to a sweep).
+    const double ahead = std::clamp((vertical_.last_utime() - o.utime) * 1e-6 - o.attitude_t, 0.0, 0.3);
+    h_ = ride_base_ + vertical_.height() - vertical_.velocity() * ahead;
+    have_h_ = true;
+    z_gated_ = false;
+    pose_z_ = e + h_;
+    z_source_ = "lift ride (IMU)";
+    return;
+  }
+  const bool ride_ended = ride_active_;
+  ride_active_ = false;
+  if (!o.z_known) {
+    // Held: the same absolute z (a switch changes the floor, not where the sensor is).
+    if (have_h_) h_ = pose_z_ - e;
+    else pose_z_ = e + o.z;
+    z_source_ = "held";
+    return;
+  }
+  struct Ref {
+    int kind;
+    double r;  // the segmenter's zero above the current floor's level
+    std::string name;
+    double scale = 1;  // a height measured across an incline's plane: vertically it is z / cos(slope)
+  };
+  std::vector<Ref> refs{{0, 0.0, "floor '" + fl.name + "'"}};
+  const Eigen::Vector2d p(o.pose.x, o.pose.y);
+  double g = 0, inv_cos = 1;
+  for (const auto& in : inclines_) {
+    if ((in.from_floor != floor_ && in.to_floor != floor_) || !in.contains(p)) continue;
+    g = std::clamp(in.z_at(p), std::min(in.z_foot, in.z_head), std::max(in.z_foot, in.z_head)) - e;
+    const double run = (in.head - in.foot).norm();
+    inv_cos = std::hypot(run, in.z_head - in.z_foot) / run;
+    refs.push_back({1, g, std::string(to_string(in.kind)) + " '" + in.name + "' surface", inv_cos});
+    break;
+  }
+  if (z_offset_ != 0) refs.push_back({2, -z_offset_, "floor left (" + fmt("%+.2f m", -z_offset_) + ")"});
+  size_t best = 0;
+  // The sensor's nominal height above the surface under it, vertically: z0 on flat floor; on an incline
+  // between z0 (a mount that keeps the sensor's height, as the simulator's) and z0 / cos (a rigid mast
+  // across the plane): the middle, with half the difference as extra tolerance below.
+  const double want = z0_ ? *z0_ * 0.5 * (1 + inv_cos) + g : 0.0;
+  const auto height = [&](const Ref& r) { return o.z * r.scale + r.r; };
+  if (z0_) {
+    // The reference that puts the sensor nearest its nominal height above the surface under it; the one in
+    // use is kept unless another is better by the hysteresis.
+    const auto res = [&](const Ref& r) { return std::abs(height(r) - want); };
+    for (size_t i = 1; i < refs.size(); ++i)
+      if (res(refs[i]) < res(refs[best])) best = i;
+    for (size_t i = 0; i < refs.size(); ++i)
+      if (refs[i].kind == z_ref_kind_ && res(refs[i]) <= res(refs[best]) + cfg_.z_reference_hysteresis_m) best = i;
+  }
+  z_ref_kind_ = refs[best].kind;
+  h_ = height(refs[best]);
+  have_h_ = true;
+  z_source_ = "segmenter (above " + refs[best].name + ")";
+  // Consistency with the building: the sensor stands z0 above the surface under it (a floor, an incline,
+  // a lift car at rest). A segmenter's z further off than the gate (a ceiling of another height than it
+  // learned, the car's ceiling, ...) is not used: the prediction, with a grown sigma, and said.
+  const bool was_gated = z_gated_;
+  z_gated_ = false;
+  if (z0_ && std::abs(h_ - want) > cfg_.z_gate_m + *z0_ * 0.5 * (inv_cos - 1)) {
+    const double off = h_ - want;
+    h_ = want;
+    z_gated_ = true;
+    z_source_ = "building: nominal height " + fmt("%.2f m", *z0_) + " above " + (refs.size() > 1 && g != 0 ? refs[1].name : refs[0].name) +
+                " (the segmenter's z is " + fmt("%+.2f m", off) + " off)";
+    if (!was_gated) text_ = "z: " + z_source_;
+  } else if (was_gated) {
+    text_ = "z: the segmenter's again (" + fmt("%.2f m", h_ - (refs[best].kind == 1 ? g : 0.0)) + " above " + refs[best].name + ")";
+  }
+  if (!z_gated_ && g == 0) {
+    good_h_ = h_;
+    good_h_utime_ = o.utime;
+    have_good_h_ = true;
+  }
+  pose_z_ = e + h_;
+  if ((s && s->via.kind == ConnectionKind::kLift) || ride_ended)
+    text_ += "; z " + fmt("%.2f m", before) + " -> " + fmt("%.2f m", pose_z_) + " (the IMU's ride ended: '" + fl.name +
+             "' at " + fmt("%.2f m", e) + " + the segmenter's " + fmt("%.2f m", h_) + ")";
+}
+
+void FloorTracker::check_mismatch(const FloorObservation& o, bool switched) {
+  probe_.clear();
+  const Eigen::Vector2d p(o.pose.x, o.pose.y);
+  if (switched || vertical_.riding()) {
+    mismatch_ = 0;
+    return;
+  }
+  const bool bad = !o.pose_ok || o.inlier_ratio < cfg_.mismatch_ratio;
+  if (!bad) {
+    mismatch_ = 0;
+    mismatch_at_ = p;  // where the plan matched last (the pose may drift once it no longer does)
+    return;
+  }
+  ++mismatch_;
+  if (mismatch_ < cfg_.mismatch_frames || (mismatch_ - cfg_.mismatch_frames) % std::max(1, cfg_.probe_every_frames) != 0)
+    return;
+  std::vector<int> via;
+  const std::vector<int> floors = lift_reachable(mismatch_at_, &via);
+  if (floors.empty()) return;
+  FloorProbe cur;
+  cur.floor = floor_;
+  cur.name = floor_name();
+  const FloorConnection& c0 = building_->connections[size_t(via[size_t(floors.front())])];
+  search_disc(c0.polygon, cfg_.connection_margin_m, &cur.search_center, &cur.search_radius_m);
+  probe_.push_back(cur);
+  for (int f : floors) {
+    FloorProbe q;
+    q.floor = f;
+    q.name = building_->floors[size_t(f)].name;
+    q.connection = via[size_t(f)];
+    search_disc(building_->connections[size_t(q.connection)].polygon, cfg_.connection_margin_m, &q.search_center,
+                &q.search_radius_m);
+    probe_.push_back(q);
+  }
+}
+
+std::optional<FloorSwitch> FloorTracker::probe_result(const std::vector<FloorProbeResult>& results) {
+  if (probe_.empty() || results.empty()) return std::nullopt;
+  double cur = 0;
+  int best = -1;
+  double best_ratio = 0;
+  for (const auto& r : results) {
+    const double ratio = r.ok ? std::clamp(r.inlier_ratio, 0.0, 1.0) : 0.0;
+    if (r.floor == floor_) cur = std::max(cur, ratio);
+    else if (ratio > best_ratio) best = r.floor, best_ratio = ratio;
+  }
+  const FloorProbe* q = nullptr;
+  for (const auto& p : probe_)
+    if (p.floor == best) q = &p;
+  std::string others;
+  for (const auto& r : results)
+    if (r.floor != floor_)
+      others += (others.empty() ? "" : ", ") + ("'" + building_->floors[size_t(r.floor)].name + "' ") +
+                (r.ok ? fmt("%.0f %%", 100 * r.inlier_ratio) : std::string("no fit"));
+  const std::string lift = q ? building_->connections[size_t(q->connection)].name : std::string("?");
+  const std::string imu = vertical_.has_gravity() ? "the IMU saw no ride" : "no IMU";
+  const std::string here = "the plan of '" + floor_name() + "' no longer matches in lift '" + lift + "' (" +
+                           std::to_string(mismatch_) + " frames; " + fmt("%.0f %%", 100 * cur) + " in the lift area, before " +
+                           fmt("%.0f %%", 100 * before_inliers_) + "), " + imu;
+  if (!q || best_ratio < cfg_.probe_min_ratio || best_ratio < cur + cfg_.probe_margin) {
+    text_ = here + "; other floors' plans: " + (others.empty() ? "none" : others) + ": staying on '" + floor_name() + "'";
+    probe_.clear();
+    return std::nullopt;
+  }
+  const std::string reason = here + "; the plan of '" + building_->floors[size_t(best)].name + "' matches " +
+                             fmt("%.0f %%", 100 * best_ratio) + " (" + others + ")";
+  const double e_old = building_->floors[size_t(floor_)].elevation;
+  const double before = pose_z_;
+  FloorSwitch s = make_switch(best, building_->connections[size_t(q->connection)], reason);
+  // The sensor stands on the car's floor, now the new floor's level: its height above the floor is kept,
+  // the elevation is the new floor's (no IMU to follow the ride: a jump, said here).
+  const double e = building_->floors[size_t(floor_)].elevation;
+  if (have_h_) pose_z_ = e + h_;
+  text_ += "; z " + fmt("%.2f m", before) + " -> " + fmt("%.2f m", pose_z_) + " ('" + s.to_name + "' at " + fmt("%.2f m", e) +
+           " instead of " + fmt("%.2f m", e_old) + ")";
+  z_offset_ = 0;
+  in_climb_area_ = false;
+  have_prev_ = false;
+  mismatch_ = 0;
+  vertical_.reset();
+  probe_.clear();
+  return s;
+}
+
+std::optional<FloorSwitch> FloorTracker::update_floor(const FloorObservation& o) {
   const Eigen::Vector2d p(o.pose.x, o.pose.y);
   const std::string& name = floor_name();
   const double e0 = building_->floors[size_t(floor_)].elevation;
@@ -174,7 +386,8 @@ std::optional<FloorSwitch> FloorTracker::update(const FloorObservation& o) {
   lift_prev_utime_ = o.utime;
   lift_prev_ = o.pose;
   const bool still = speed <= cfg_.lift_max_speed_mps;
-  const bool in_lift = still && (near_lift || (in_lift_ && vertical_.riding()));
+  // Once a ride started it continues until the IMU is at rest (the matcher's pose may wander in the car).
+  const bool in_lift = (still && near_lift) || (in_lift_ && vertical_.riding());
   if (!in_lift) vertical_.reset();
   in_lift_ = in_lift;
   const auto ride = vertical_.take_ride();
@@ -195,7 +408,9 @@ std::optional<FloorSwitch> FloorTracker::update(const FloorObservation& o) {
   if (!vertical_.riding() && !ride) {
     ride_inliers_sum_ = 0;
     ride_frames_ = 0;
-    before_inliers_ += (std::clamp(o.inlier_ratio, 0.0, 1.0) - before_inliers_) * 0.2;
+    // How well the plan matched before (frames that matched: a mismatch does not pull it down).
+    if (o.pose_ok && o.inlier_ratio >= cfg_.mismatch_ratio)
+      before_inliers_ += (std::clamp(o.inlier_ratio, 0.0, 1.0) - before_inliers_) * 0.2;
   }
 
   // ---- flat floor: the nominal sensor height, and the offset carried since a ramp/stairs switch
@@ -206,7 +421,8 @@ std::optional<FloorSwitch> FloorTracker::update(const FloorObservation& o) {
       z_offset_ = 0;
     }
     const double zf = floor_z(o.z);
-    if (!z0_ || std::abs(zf - *z0_) < cfg_.z_offset_drop_m) {
+    // (Once known, only z within the gate teaches it: a segmenter off by a wrong ceiling does not.)
+    if (!z0_ || std::abs(zf - *z0_) < std::min(cfg_.z_offset_drop_m, cfg_.z_gate_m)) {
       flat_z_.push_back(zf);
       while (int(flat_z_.size()) > cfg_.nominal_z_frames) flat_z_.pop_front();
       if (flat_z_.size() >= 10) z0_ = median(std::vector<double>(flat_z_.begin(), flat_z_.end()));

@@ -10,6 +10,7 @@ namespace fploc::config {
 struct FloorRef {
   int index = 0;          // -1: unknown (an IFC storey other than the lowest: its index needs the model)
   std::string name = "0";
+  double elevation = 0;   // the floor's elevation [m]: pose_t z is absolute (elevation + height above it)
 };
 
 // `path` is the option's file as resolved by the node. A building (.pbtxt) is read (not its plans) to

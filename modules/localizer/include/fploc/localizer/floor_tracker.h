@@ -19,10 +19,23 @@
 //    no longer matching (the current floor's inlier ratio during the ride) is reported beside it.
 // Every switch and every refused candidate has a status text; nothing switches silently.
 //
-// z: the segmenter does not know about floors. floor_z() turns its z into the height above the
-// current floor: after a ramp/stairs switch the segmenter's z is still relative to the old floor until
-// it re-learns its ceiling, so the elevation difference is carried as an offset, dropped once the
-// segmenter's z is back near z0 on flat floor.
+// z (the pose's z is ABSOLUTE: the current floor's elevation + the sensor's height above that floor's
+// level; continuous across ramps, stairs and lifts; elevation 0 for a single plan, so nothing changes
+// there): the segmenter does not know about floors, and its z may be the height above the surface under
+// the robot (floor plane, a ceiling parallel to a ramp) or above a floor's level (a ceiling area of the
+// building, a flat ceiling over a ramp), possibly still the floor just left. pose_z() picks, per frame, the
+// reference that puts the sensor nearest its nominal height z0 above the surface the building's geometry
+// (fploc/floorplan/incline.h) gives under the robot: that floor's level, the incline's surface, or the
+// level of the floor left at the last ramp/stairs switch. A segmenter's z still further than z_gate_m from
+// z0 above that surface is not used (the prediction instead, grown sigma, said in the status text). While riding a lift the height is z0 + the IMU's
+// vertical motion since the ride started (z sigma grown by the double integration); on arrival it snaps to
+// the new floor's elevation + the segmenter's z, said in status_text().
+//
+// Plan mismatch (no IMU, or an IMU that saw no ride): standing in a lift area, the current floor's plan
+// no longer matches for `mismatch_frames` frames -> probe_request() names the floors reachable through the
+// lift; the matcher node registers the frame on each (and on the current floor, the same search disc) and
+// hands the inlier ratios to probe_result(), which switches to the best one when it clearly beats the
+// current floor.
 #pragma once
 #include <Eigen/Core>
 #include <cstdint>
@@ -34,6 +47,7 @@
 
 #include "fploc/core/pose.h"
 #include "fploc/floorplan/building.h"
+#include "fploc/floorplan/incline.h"
 #include "fploc/localizer/vertical_imu.h"
 
 namespace fploc::localizer {
@@ -50,6 +64,17 @@ struct FloorTrackerConfig {
   double lift_max_speed_mps = 0.15;    // the IMU's vertical motion counts only while the robot stands this still
   double tilt_lowpass_s = 0.3;         // IMU tilt: time constant of the specific force's low-pass
   double max_tilt_rad = 0.35;          // a steeper "slope" (e.g. a bump, a jolt) is not integrated
+  double ride_accel_sigma_mps2 = 0.02; // lift: residual vertical acceleration error (z sigma 0.5 a t^2)
+  double max_ride_z_sigma_m = 0.5;     // ... at most (z stays "known": below 1 m)
+  double z_reference_hysteresis_m = 0.02;  // the segmenter's z reference changes when better by this much
+  double z_gate_m = 0.08;              // the segmenter's z this far from z0 above the surface: not used ...
+  double z_gated_sigma_m = 0.03;       // ... the prediction instead, with this sigma
+  // Plan mismatch in a lift area (floor switch without the IMU).
+  double mismatch_ratio = 0.6;         // inlier ratio below this (or LOST): the plan does not match
+  int mismatch_frames = 3;             // ... for this many frames in a row
+  int probe_every_frames = 5;          // probe the other floors at most every this many frames
+  double probe_min_ratio = 0.7;        // a floor's plan matches when its inlier ratio is at least this ...
+  double probe_margin = 0.15;          // ... and beats the current floor's (same search) by this
   VerticalImuConfig vertical;
 };
 
@@ -63,6 +88,7 @@ struct FloorObservation {
   bool z_known = false;
   double roll = 0, pitch = 0;          // the frame's attitude (used when there is no IMU)
   bool roll_pitch_known = false;
+  double attitude_t = 0;               // z holds at utime + this (mid-sweep; the lift ride's z is given there)
 };
 
 struct FloorSwitch {
@@ -74,6 +100,21 @@ struct FloorSwitch {
   // it (plus the margin).
   Eigen::Vector2d search_center = Eigen::Vector2d::Zero();
   double search_radius_m = 0;
+};
+
+// Plan mismatch in a lift area: the floors whose plans to try (the current floor first), each with the
+// search disc of the connection area.
+struct FloorProbe {
+  int floor = 0;
+  std::string name;
+  int connection = -1;                 // index into building.connections (-1: the current floor)
+  Eigen::Vector2d search_center = Eigen::Vector2d::Zero();
+  double search_radius_m = 0;
+};
+struct FloorProbeResult {
+  int floor = 0;
+  bool ok = false;                     // the registration's status was OK
+  double inlier_ratio = 0;
 };
 
 class FloorTracker {
@@ -97,10 +138,21 @@ class FloorTracker {
   // moves with the sensor, so the IMU's height since the ride started is added.
   // On stairs/a ramp whose z the segmenter takes from the sloped floor itself (it does not follow the
   // climb), the IMU tilt's climb relative to the current floor is added.
+  // (Relative to the current floor: the climb cue's view of the segmenter's z.)
   double floor_z(double z) const {
     return z - z_offset_ + (in_lift_ && vertical_.riding() ? vertical_.height() : 0.0) + ramp_z_;
   }
+  // The pose's absolute z for the last update()'s frame (see above), and its sigma given the segmenter's.
+  double pose_z() const { return pose_z_; }
+  double pose_z_sigma(double segmenter_sigma) const;
+  // Where the last frame's z came from ("segmenter (above floor 'first')", "segmenter (above ramp 'ramp'
+  // surface)", "building: nominal height ... (the segmenter's z is +0.15 m off)", "lift ride (IMU)", "held").
+  const std::string& z_source() const { return z_source_; }
   double z_offset() const { return z_offset_; }
+  // Plan mismatch: the floors to try for the last update()'s frame (empty: nothing to do), and their
+  // results (the current floor's first); a switch when one clearly matches better.
+  const std::vector<FloorProbe>& probe_request() const { return probe_; }
+  std::optional<FloorSwitch> probe_result(const std::vector<FloorProbeResult>& results);
   std::optional<double> nominal_z() const { return z0_; }
   // What the tracker last decided or noticed ("" while nothing happened).
   const std::string& status_text() const { return text_; }
@@ -112,6 +164,10 @@ class FloorTracker {
   bool near(const FloorConnection& c, const Eigen::Vector2d& p) const;
   std::optional<FloorSwitch> check_lift(const FloorObservation& o, const VerticalRide& ride);
   std::optional<FloorSwitch> check_climb(const FloorObservation& o);
+  std::optional<FloorSwitch> update_floor(const FloorObservation& o);
+  void resolve_z(const FloorObservation& o, const std::optional<FloorSwitch>& s);
+  void check_mismatch(const FloorObservation& o, bool switched);
+  std::vector<int> lift_reachable(const Eigen::Vector2d& p, std::vector<int>* via) const;
   FloorSwitch make_switch(int to, const FloorConnection& via, const std::string& reason);
 
   std::shared_ptr<const Building> building_;
@@ -145,6 +201,23 @@ class FloorTracker {
   int ride_frames_ = 0;
   double before_inliers_ = 1;
   std::string text_;
+  // Pose z.
+  std::vector<Incline> inclines_;
+  double pose_z_ = 0, h_ = 0;
+  bool have_h_ = false;
+  int z_ref_kind_ = 0;
+  bool z_gated_ = false;                 // 0 floor level, 1 incline surface, 2 level of the floor left
+  std::string z_source_ = "floor";
+  double ride_base_ = 0;               // lift: the height above the floor when the ride started
+  bool ride_active_ = false;
+  double good_h_ = 0;                  // the last height above a flat floor the segmenter measured (not gated)
+  int64_t good_h_utime_ = 0;
+  bool have_good_h_ = false;
+  int64_t last_utime_ = 0;
+  // Plan mismatch.
+  int mismatch_ = 0, since_probe_ = 0;
+  Eigen::Vector2d mismatch_at_ = Eigen::Vector2d::Zero();
+  std::vector<FloorProbe> probe_;
 };
 
 }  // namespace fploc::localizer

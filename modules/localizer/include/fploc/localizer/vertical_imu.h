@@ -46,6 +46,8 @@ class VerticalImu {
   void reset();
 
   bool riding() const { return riding_; }
+  int64_t ride_start_utime() const { return ride_start_; }  // while riding
+  int64_t last_utime() const { return last_utime_; }
   double height() const { return h_; }              // since the last rest [m]
   double velocity() const { return v_; }            // [m/s]
   bool has_gravity() const { return have_g_; }

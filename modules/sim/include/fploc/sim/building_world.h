@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "fploc/floorplan/building.h"
+#include "fploc/floorplan/incline.h"
 #include "fploc/sim/world.h"
 
 namespace fploc::sim {
@@ -28,23 +29,9 @@ struct Threshold {
   double width = 0.06;
 };
 
-// A ramp or stairs between two floors, in the building's x/y frame and absolute heights.
-struct Incline {
-  std::string name;
-  ConnectionKind kind = ConnectionKind::kRamp;
-  int from_floor = -1, to_floor = -1;   // foot and head floors (indices into Building::floors)
-  std::vector<Eigen::Vector2d> polygon;
-  Eigen::Vector2d foot = Eigen::Vector2d::Zero(), head = Eigen::Vector2d::Zero();  // edge midpoints
-  double z_foot = 0, z_head = 0;        // absolute surface heights there
-  // Position along the incline: 0 at the foot, 1 at the head (not clamped).
-  double tau(const Eigen::Vector2d& p) const;
-  double z_at(const Eigen::Vector2d& p) const { return z_foot + tau(p) * (z_head - z_foot); }
-  bool contains(const Eigen::Vector2d& p) const;
-};
-
-// Every RAMP and STAIRS connection of the building as an Incline. Throws naming the connection when its
-// polygon is not a quadrilateral or its floors have the same elevation.
-std::vector<Incline> building_inclines(const Building& b);
+// Ramps and stairs: fploc/floorplan/incline.h (shared with the localizer's pose z across floors).
+using fploc::Incline;
+using fploc::building_inclines;
 
 // The ground of one floor as seen by the wheels: inclines touching the floor, thresholds.
 struct FloorGround {
