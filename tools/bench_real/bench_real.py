@@ -14,7 +14,8 @@ the reference poses (time association, no alignment). Scored: the scans the map 
 within 10 cm of an occupied cell at the reference pose); the others are reported separately ("uncovered", and
 "all"). LOST %: share of scans whose position error exceeds --lost-m (0.5 m). ms per scan: the nodes' thread
 CPU time (grid2d; laser2d + matcher + optimizer for the plan path; AMCL's own) over the scans, from replay's
---json. Plots per row: ROW.png (reference green, fploc blue, AMCL orange) and ROW-fploc.png (without AMCL).
+--json. "floor": the RMSE over the covered scans of the map fit started at each scan's own reference pose
+(fploc-real-floor): how far the map and the reference poses of the rest disagree. Plots per row: ROW.png (reference green, fploc blue, AMCL orange) and ROW-fploc.png (without AMCL).
 
   fploc bench real [--json] [--logs intel,aces] [--split auto|F] [--end 0.6] [--out DIR] [--rows ref,off]
 """
@@ -115,6 +116,14 @@ def main():
         # Scans the map covers (>= coverage_ratio of the returns within 10 cm of an occupied cell at the reference
         # pose) are scored; the others are reported separately ("uncovered").
         keep = {k for k, c in zip(sorted(reft), imp["coverage"]) if c >= imp["coverage_ratio"]}
+        # The floor: every scan's map fit started at its own reference pose (fploc-real-floor); its offset from
+        # the reference is how much the map (first part's scans at their reference poses) and the reference poses
+        # of the rest disagree. RMSE over the covered scans, as fploc's ATE.
+        fl = json.loads(run([os.path.join(BIN, "fploc-real-floor"), src, "--map", plan, "--first-scan", str(imp["first_scan"]),
+                             "--end-scan", str(imp["end_scan"])]).stdout)["scans"]
+        fe = [r["dxy_m"] for k, r in zip(sorted(reft), fl) if k in keep]
+        floor = {"ate_m": math.sqrt(sum(e * e for e in fe) / len(fe)) if fe else float("nan"),
+                 "median_m": sorted(fe)[len(fe) // 2] if fe else float("nan"), "max_m": max(fe) if fe else float("nan")}
         for row in a.rows.split(","):
             x, y, yaw = t0
             if row == "off":  # 1 m off (along the heading's left diagonal) and 10 degrees
@@ -144,6 +153,7 @@ def main():
             run([os.path.join(BIN, "fploc-occupancy"), plan, "--png", png_f, "--tum", ref, "--tum", est[a.fploc]])
             r = {"log": name, "start": row, "scans": scans, "map_scans": imp["map"]["end_scan"],
                  "split": imp["split"] if "split" in imp else {"fraction": float(a.split)}, "covered_scans": len(keep),
+                 "floor": floor,
                  "fploc": {**f, "ms_per_scan": fploc_ms, "estimator": a.fploc}, "amcl": {**am, "ms_per_scan": amcl_ms},
                  "fploc_grid": {**g, "ms_per_scan": grid_ms}, "fploc_plan": {**p, "ms_per_scan": plan_ms},
                  "fploc_half_of_amcl": f["ate_m"] <= 0.5 * am["ate_m"], "plot": png, "plot_fploc": png_f}
@@ -152,7 +162,7 @@ def main():
                   f"LOST {f['lost_pct']:5.1f} % {fploc_ms:6.2f} ms | AMCL ATE {am['ate_m']*100:8.1f} cm max {am['max_m']*100:8.1f} cm "
                   f"LOST {am['lost_pct']:5.1f} % {amcl_ms:6.2f} ms | other fploc ({'wo' if a.fploc == 'grid' else 'grid'}) "
                   f"ATE {(p if a.fploc == 'grid' else g)['ate_m']*100:8.1f} cm | all scans: fploc {f['all']['ate_m']*100:.1f} cm "
-                  f"LOST {f['all']['lost_pct']:.1f} %, AMCL {am['all']['ate_m']*100:.1f} cm", file=sys.stderr)
+                  f"LOST {f['all']['lost_pct']:.1f} %, AMCL {am['all']['ate_m']*100:.1f} cm | floor {floor['ate_m']*100:.1f} cm", file=sys.stderr)
     if a.json:
         print(json.dumps({"bench": "real", "protocol": {"split": a.split, "scored": "scans covered by the map", "end": a.end, "resolution_m": a.resolution,
                                                         "map": {"min_hits": a.min_hits, "occupied_ratio": a.occupied_ratio,

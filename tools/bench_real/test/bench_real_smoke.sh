@@ -16,7 +16,8 @@ for k in ("log", "start", "scans", "fploc", "amcl", "plot"):
 for k in ("ate_m", "max_m", "lost_pct", "ms_per_scan"):
     assert k in r["fploc"] and k in r["amcl"], k
 assert r["scans"] == 91, r["scans"]
-for k in ("covered_scans", "split"):
+assert 0 < r["floor"]["ate_m"] < 0.2, r["floor"]
+for k in ("covered_scans", "split", "floor"):
     assert k in r, k
 for k in ("all", "uncovered", "missing"):
     assert k in r["fploc"] and k in r["amcl"], k
