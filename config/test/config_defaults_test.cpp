@@ -14,6 +14,7 @@
 #include <string>
 
 #include "fploc/config/amcl.h"
+#include "fploc/config/laser2d.h"
 #include "fploc/config/localization.h"
 #include "fploc/config/perception.h"
 #include "fploc/config/relocalization.h"
@@ -169,6 +170,16 @@ TEST(ConfigDefaults, Amcl) {
         {{"scale_error", s.wheel.scale_error}, {"yaw_drift_deg_per_m", s.wheel.yaw_drift_deg_per_m},
          {"trans_noise_m_per_sqrt_m", s.wheel.trans_noise_m_per_sqrt_m},
          {"yaw_noise_deg_per_sqrt_m", s.wheel.yaw_noise_deg_per_sqrt_m}, {"seed", double(s.wheel.seed)}});
+}
+
+TEST(ConfigDefaults, Grid2d) {
+  const fploc::laser2d::GridLocalizerConfig c = config_of(fploc::Grid2dOptions{});
+  check("laser2d.proto", "Grid2dOptions",
+        {{"initial_sigma_xy_m", c.initial_sigma_xy_m}, {"initial_sigma_yaw_deg", c.initial_sigma_yaw_rad * kDeg},
+         {"min_range_m", c.min_range_m}, {"max_range_m", c.max_range_m}, {"min_inlier_ratio", c.min_inlier_ratio},
+         {"field_max_m", c.field_max_m}, {"min_inlier_ratio_near", c.min_inlier_ratio_near},
+         {"gate_sigmas", c.gate_sigmas}, {"sigma_xy_per_m", c.sigma_xy_per_m},
+         {"sigma_yaw_per_rad", c.sigma_yaw_per_rad}, {"prior_weight_sigmas", c.prior_weight_sigmas}});
 }
 
 }  // namespace

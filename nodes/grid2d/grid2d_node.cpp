@@ -16,6 +16,7 @@
 #include "fploc/floorplan/occupancy.h"
 #include "fploc/laser2d/grid_localizer.h"
 #include "fploc/config/floor_ref.h"
+#include "fploc/config/laser2d.h"
 #include "fploc/runtime/node.h"
 #include "options/laser2d.pb.h"
 
@@ -43,18 +44,7 @@ class Grid2dNode : public fploc::rt::Node {
     const auto ext = path.size() >= 5 ? path.substr(path.find_last_of('.') + 1) : std::string();
     if (ext != "yaml" && ext != "yml")
       throw std::runtime_error("grid2d.plan.file: '" + path + "' is not a map_server occupancy map (.yaml)");
-    l2::GridLocalizerConfig c;
-    if (o.initial_sigma_xy_m() > 0) c.initial_sigma_xy_m = o.initial_sigma_xy_m();
-    if (o.initial_sigma_yaw_deg() > 0) c.initial_sigma_yaw_rad = o.initial_sigma_yaw_deg() * M_PI / 180;
-    if (o.min_range_m() > 0) c.min_range_m = o.min_range_m();
-    if (o.max_range_m() > 0) c.max_range_m = o.max_range_m();
-    if (o.min_inlier_ratio() > 0) c.min_inlier_ratio = o.min_inlier_ratio();
-    if (o.field_max_m() > 0) c.field_max_m = o.field_max_m();
-    if (o.min_inlier_ratio_near() > 0) c.min_inlier_ratio_near = o.min_inlier_ratio_near();
-    if (o.gate_sigmas() > 0) c.gate_sigmas = o.gate_sigmas();
-    if (o.sigma_xy_per_m() > 0) c.sigma_xy_per_m = o.sigma_xy_per_m();
-    if (o.sigma_yaw_per_rad() > 0) c.sigma_yaw_per_rad = o.sigma_yaw_per_rad();
-    if (o.prior_weight_sigmas() > 0) c.prior_weight_sigmas = o.prior_weight_sigmas();
+    const l2::GridLocalizerConfig c = fploc::config::config_of(o);
     const fploc::OccupancyGrid g = fploc::read_occupancy_map(path);
     auto field = std::make_shared<l2::DistanceField>(g, c.field_max_m);
     loc_ = std::make_unique<l2::GridLocalizer>(field, c);

@@ -2,15 +2,22 @@
 """fploc bench real: fploc (2D LiDAR mode) and AMCL on the real Radish CARMEN logs, non-circular protocol.
 
 Per log: the map is built from the scans and reference (corrected FLASER) poses of the first part of the log
-(--split, by scan count; `fploc import-carmen --map`, a map_server occupancy grid that both localizers load
-as a plan: vectorised on load); the rest is imported as an LCM log (laser_scan_t + wheel odometry) and run
-through graphs/lidar2d.pbtxt with `fploc replay` (fploc matcher + optimizer and AMCL in the same run, on the
-same features and odometry), started from the reference pose (row "ref") and from a pose 1 m / 10 deg off
-(row "off"), and scored against the reference poses with `fploc eval`. LOST %: share of scans whose position
-error exceeds --lost-m (0.5 m). ms per scan: the nodes' thread CPU time (laser2d + matcher + optimizer for
-fploc, AMCL's own) over the scans, from replay's --json.
+(`fploc import-carmen --map`, a map_server occupancy grid: fploc-grid2d matches scans to its raster, the matcher,
+optimizer and AMCL load it as a plan, vectorised on load). Where the first part ends (--split auto, the default):
+the smallest split S in 0.20, 0.25 .. 0.80 of the scans whose scans cover >= 75 % of the remaining scans (a scan
+is covered when >= 50 % of its returns lie within 10 cm of a return of [0, S) at the reference poses), else
+the candidate with the largest covered share: the same rule and values for every log (modules/carmen/coverage.h).
+The rest is imported as an LCM log (laser_scan_t + wheel odometry) and run through graphs/lidar2d.pbtxt with
+`fploc replay` (grid2d, matcher + optimizer and AMCL in the same run, on the same scans, odometry and map),
+started from the reference pose (row "ref") and from a pose 1 m / 10 deg off (row "off"), and scored against
+the reference poses (time association, no alignment). Scored: the scans the map covers (>= 50 % of the returns
+within 10 cm of an occupied cell at the reference pose); the others are reported separately ("uncovered", and
+"all"). LOST %: share of scans whose position error exceeds --lost-m (0.5 m). ms per scan: the nodes' thread
+CPU time (grid2d; laser2d + matcher + optimizer for the plan path; AMCL's own) over the scans, from replay's
+--json. "floor": the RMSE over the covered scans of the map fit started at each scan's own reference pose
+(fploc-real-floor): how far the map and the reference poses of the rest disagree. Plots per row: ROW.png (reference green, fploc blue, AMCL orange) and ROW-fploc.png (without AMCL).
 
-  fploc bench real [--json] [--logs intel,aces] [--end 0.6] [--out DIR] [--rows ref,off]
+  fploc bench real [--json] [--logs intel,aces] [--split auto|F] [--end 0.6] [--out DIR] [--rows ref,off]
 """
 import argparse, json, math, os, subprocess, sys
 
@@ -40,20 +47,36 @@ def read_tum(path):
     return out
 
 
-def score(gt_path, est_path, lost_m):
-    j = json.loads(run([os.path.join(BIN, "fploc-eval"), "--gt", gt_path, "--est", est_path, "--json"]).stdout)
+def score(gt_path, est_path, lost_m, keep=None):
+    """ATE (RMSE of the position error, no alignment: both in the map frame, the reference pose associated by time
+    with fploc eval's association), max, LOST % (position error > lost_m; a scan without an estimate counts as
+    LOST and as its own entry in "missing"). keep: the reference times to score (None: all); the others are
+    reported as "uncovered" with their own ATE."""
     gt, est = read_tum(gt_path), read_tum(est_path)
-    errs = [math.hypot(est[k][0] - g[0], est[k][1] - g[1]) if k in est else float("inf") for k, g in gt.items()]
-    lost = sum(e > lost_m for e in errs)
-    return {"ate_m": j["ate_rmse_m"], "max_m": j["ate_max_m"], "lost_pct": 100.0 * lost / max(1, len(errs)),
-            "poses": j["poses"]}
+    def part(times):
+        errs = [math.hypot(est[k][0] - gt[k][0], est[k][1] - gt[k][1]) if k in est else float("inf") for k in times]
+        fin = [e for e in errs if math.isfinite(e)]
+        return {"scans": len(times), "ate_m": math.sqrt(sum(e * e for e in fin) / len(fin)) if fin else float("nan"),
+                "max_m": max(fin) if fin else float("nan"), "missing": len(errs) - len(fin),
+                "lost_pct": 100.0 * sum(e > lost_m for e in errs) / max(1, len(errs))}
+    times = sorted(gt)
+    covered = [k for k in times if keep is None or k in keep]
+    out = part(covered)
+    # fploc eval on the same pairs (cross-check of the association and the RMSE).
+    j = json.loads(run([os.path.join(BIN, "fploc-eval"), "--gt", gt_path, "--est", est_path, "--json"]).stdout)
+    out["all"] = {**part(times), "fploc_eval_ate_m": j["ate_rmse_m"], "fploc_eval_poses": j["poses"]}
+    out["uncovered"] = part([k for k in times if keep is not None and k not in keep])
+    return out
 
 
 def main():
     ap = argparse.ArgumentParser(description="fploc vs AMCL on the Radish logs (non-circular: map from the first part)")
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--logs", default=",".join(LOGS))
-    ap.add_argument("--split", type=float, default=0.5, help="map from scans [0, split), localize [split, end)")
+    ap.add_argument("--split", default="auto",
+                    help="auto (default): the coverage rule of modules/carmen/coverage.h (the smallest split in 0.20, "
+                         "0.25 .. 0.80 whose map covers >= 75 %% of the remaining scans, else the best of them), or a fraction: "
+                         "map from scans [0, split), localize [split, end)")
     ap.add_argument("--end", type=float, default=1.0, help="localize up to this fraction (a short test run)")
     ap.add_argument("--resolution", type=float, default=0.05)
     ap.add_argument("--rows", default="ref,off")
@@ -82,12 +105,25 @@ def main():
         d = os.path.join(a.out, name)
         os.makedirs(d, exist_ok=True)
         lcm, ref, mapdir = os.path.join(d, "rest.lcm"), os.path.join(d, "ref.tum"), os.path.join(d, "map")
-        imp = json.loads(run([os.path.join(BIN, "fploc-import-carmen"), src, "--out", lcm, "--tum", ref, "--begin", str(a.split),
-                              "--end", str(a.end), "--map", mapdir, "--map-begin", "0", "--map-end", str(a.split),
+        split = ["--auto-split"] if a.split == "auto" else ["--begin", a.split, "--map-begin", "0", "--map-end", a.split]
+        imp = json.loads(run([os.path.join(BIN, "fploc-import-carmen"), src, "--out", lcm, "--tum", ref, "--end", str(a.end),
+                              "--map", mapdir] + split + [
                               "--resolution", str(a.resolution), "--min-hits", str(a.min_hits), "--occupied-ratio",
                               str(a.occupied_ratio), "--hit-clearance", str(a.hit_clearance), "--json"]).stdout)
         plan = os.path.join(mapdir, "map.yaml")
-        t0 = min(read_tum(ref).items())[1]
+        reft = read_tum(ref)
+        t0 = min(reft.items())[1]
+        # Scans the map covers (>= coverage_ratio of the returns within 10 cm of an occupied cell at the reference
+        # pose) are scored; the others are reported separately ("uncovered").
+        keep = {k for k, c in zip(sorted(reft), imp["coverage"]) if c >= imp["coverage_ratio"]}
+        # The floor: every scan's map fit started at its own reference pose (fploc-real-floor); its offset from
+        # the reference is how much the map (first part's scans at their reference poses) and the reference poses
+        # of the rest disagree. RMSE over the covered scans, as fploc's ATE.
+        fl = json.loads(run([os.path.join(BIN, "fploc-real-floor"), src, "--map", plan, "--first-scan", str(imp["first_scan"]),
+                             "--end-scan", str(imp["end_scan"])]).stdout)["scans"]
+        fe = [r["dxy_m"] for k, r in zip(sorted(reft), fl) if k in keep]
+        floor = {"ate_m": math.sqrt(sum(e * e for e in fe) / len(fe)) if fe else float("nan"),
+                 "median_m": sorted(fe)[len(fe) // 2] if fe else float("nan"), "max_m": max(fe) if fe else float("nan")}
         for row in a.rows.split(","):
             x, y, yaw = t0
             if row == "off":  # 1 m off (along the heading's left diagonal) and 10 degrees
@@ -108,21 +144,27 @@ def main():
             plan_ms = (cpu.get("laser2d", 0) + cpu.get("matcher", 0) + cpu.get("optimizer", 0)) / max(1, scans)
             grid_ms = cpu.get("grid2d", 0) / max(1, scans)
             amcl_ms = cpu.get("amcl", 0) / max(1, scans)
-            g, p, am = score(ref, est["grid"], a.lost_m), score(ref, est["wo"], a.lost_m), score(ref, est["amcl"], a.lost_m)
+            g, p, am = (score(ref, est[k], a.lost_m, keep) for k in ("grid", "wo", "amcl"))
             f, fploc_ms = (g, grid_ms) if a.fploc == "grid" else (p, plan_ms)
             png = os.path.join(d, f"{row}.png")
             run([os.path.join(BIN, "fploc-occupancy"), plan, "--png", png, "--tum", ref, "--tum", est[a.fploc], "--tum", est["amcl"]])
+            # AMCL's jumps hide fploc's track in the picture of all three: fploc alone (blue) on the reference (green).
+            png_f = os.path.join(d, f"{row}-fploc.png")
+            run([os.path.join(BIN, "fploc-occupancy"), plan, "--png", png_f, "--tum", ref, "--tum", est[a.fploc]])
             r = {"log": name, "start": row, "scans": scans, "map_scans": imp["map"]["end_scan"],
+                 "split": imp["split"] if "split" in imp else {"fraction": float(a.split)}, "covered_scans": len(keep),
+                 "floor": floor,
                  "fploc": {**f, "ms_per_scan": fploc_ms, "estimator": a.fploc}, "amcl": {**am, "ms_per_scan": amcl_ms},
                  "fploc_grid": {**g, "ms_per_scan": grid_ms}, "fploc_plan": {**p, "ms_per_scan": plan_ms},
-                 "fploc_half_of_amcl": f["ate_m"] <= 0.5 * am["ate_m"], "plot": png}
+                 "fploc_half_of_amcl": f["ate_m"] <= 0.5 * am["ate_m"], "plot": png, "plot_fploc": png_f}
             rows.append(r)
-            print(f"{name:13s} {row:3s} scans {scans:5d}  fploc ATE {f['ate_m']*100:8.1f} cm max {f['max_m']*100:8.1f} cm "
+            print(f"{name:13s} {row:3s} split {r['split']['fraction']:.2f} scans {scans:5d} covered {len(keep):5d}  fploc ATE {f['ate_m']*100:8.1f} cm max {f['max_m']*100:8.1f} cm "
                   f"LOST {f['lost_pct']:5.1f} % {fploc_ms:6.2f} ms | AMCL ATE {am['ate_m']*100:8.1f} cm max {am['max_m']*100:8.1f} cm "
                   f"LOST {am['lost_pct']:5.1f} % {amcl_ms:6.2f} ms | other fploc ({'wo' if a.fploc == 'grid' else 'grid'}) "
-                  f"ATE {(p if a.fploc == 'grid' else g)['ate_m']*100:8.1f} cm", file=sys.stderr)
+                  f"ATE {(p if a.fploc == 'grid' else g)['ate_m']*100:8.1f} cm | all scans: fploc {f['all']['ate_m']*100:.1f} cm "
+                  f"LOST {f['all']['lost_pct']:.1f} %, AMCL {am['all']['ate_m']*100:.1f} cm | floor {floor['ate_m']*100:.1f} cm", file=sys.stderr)
     if a.json:
-        print(json.dumps({"bench": "real", "protocol": {"split": a.split, "end": a.end, "resolution_m": a.resolution,
+        print(json.dumps({"bench": "real", "protocol": {"split": a.split, "scored": "scans covered by the map", "end": a.end, "resolution_m": a.resolution,
                                                         "map": {"min_hits": a.min_hits, "occupied_ratio": a.occupied_ratio,
                                                                 "hit_clearance_m": a.hit_clearance},
                                                         "lost_m": a.lost_m, "graph": a.graph}, "rows": rows}, indent=1))

@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fploc/carmen/carmen.h"
+#include "fploc/carmen/coverage.h"
 #include "fploc/runtime/log_writer.h"
 
 namespace {
@@ -41,6 +42,9 @@ int main(int argc, char** argv) {
   bool json = false;
   fploc::carmen::GridConfig gcfg;
   std::string odom_from = "odom";
+  bool auto_split = false;
+  fploc::carmen::SplitRule rule;
+  fploc::carmen::CoverageConfig ccfg;
   app.add_option("log", in, "CARMEN log (.log or .log.gz)")->required();
   app.add_option("--out", out, "LCM log to write");
   app.add_option("--tum", tum, "reference (FLASER poses) as TUM");
@@ -60,6 +64,18 @@ int main(int argc, char** argv) {
                  "odom: the ODOM records (wheel odometry, default); flaser: the FLASER odom_* columns (in the corrected "
                  "Radish logs a copy of the reference: a diagnostic, circular)")
       ->check(CLI::IsMember({"odom", "flaser"}));
+  app.add_flag("--auto-split", auto_split,
+               "choose the split by the coverage rule (modules/carmen/coverage.h): map from scans [0, S), the LCM log "
+               "and TUM from [S, --end); overrides --begin, --map-begin, --map-end");
+  app.add_option("--split-min", rule.min_fraction, "auto split: smallest candidate fraction (0.2)")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--split-max", rule.max_fraction, "auto split: largest candidate fraction (0.8)")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--split-step", rule.step, "auto split: candidate step (0.05)")->check(CLI::Range(0.001, 1.0));
+  app.add_option("--split-covered-share", rule.covered_share,
+                 "auto split: share of the remaining scans the prefix must cover (0.75)")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--coverage-radius", ccfg.radius_m, "a return within this [m] of a mapped cell is covered (0.1)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--coverage-ratio", ccfg.covered_ratio, "a scan is covered when this share of its returns is (0.5)")
+      ->check(CLI::Range(0.0, 1.0));
   CLI11_PARSE(app, argc, argv);
   namespace cm = fploc::carmen;
   try {
@@ -69,12 +85,27 @@ int main(int argc, char** argv) {
     const float no_return = cm::no_return_range(log);
     const size_t n = log.scans.size();
     auto idx = [&](double f) { return std::min(n, size_t(std::llround(f * double(n)))); };
-    const size_t b = idx(begin), e = idx(end);
+    size_t b = idx(begin), e = idx(end);
+    ccfg.resolution = resolution;
+    ccfg.no_return = no_return;
+    nlohmann::json split_j;
+    if (auto_split) {
+      const auto first_cover = cm::prefix_coverage(log.scans, ccfg);
+      const cm::Split sp = cm::choose_split(first_cover, rule);
+      b = sp.split;
+      map_begin = 0;
+      map_end = double(sp.split) / double(n);
+      split_j = {{"rule", {{"min_fraction", rule.min_fraction}, {"max_fraction", rule.max_fraction}, {"step", rule.step},
+                           {"covered_share", rule.covered_share}, {"radius_m", ccfg.radius_m},
+                           {"covered_ratio", ccfg.covered_ratio}}},
+                 {"split", sp.split}, {"fraction", sp.fraction}, {"covered_share", sp.covered_share}, {"met", sp.met}};
+    }
     if (e <= b) throw std::runtime_error("--begin/--end select no scans");
     nlohmann::json j = {{"log", in}, {"scans_total", n}, {"odom_records", log.odom.size()}, {"first_scan", b},
                         {"end_scan", e}, {"no_return_m", std::isfinite(no_return) ? double(no_return) : -1.0},
                         {"time_note", note}, {"beams", log.scans[0].ranges.size()}};
     for (const auto& [k, v] : log.skipped) j["skipped"][k] = v;
+    if (auto_split) j["split"] = split_j;
     // Times: microseconds, starting at the log's first scan (whatever the log's epoch).
     const double t0 = t.front();
     auto utime_of = [&](size_t k) { return int64_t(std::llround((t[k] - t0) * 1e6)) + 1000000; };
@@ -129,7 +160,7 @@ int main(int argc, char** argv) {
       j["tum"] = tum;
     }
     if (!map_dir.empty()) {
-      const size_t mb = idx(map_begin), me = idx(map_end);
+      const size_t mb = auto_split ? 0 : idx(map_begin), me = auto_split ? b : idx(map_end);
       if (me <= mb) throw std::runtime_error("--map-begin/--map-end select no scans");
       std::vector<const cm::LaserRecord*> sel;
       for (size_t k = mb; k < me; ++k) sel.push_back(&log.scans[k]);
@@ -142,6 +173,10 @@ int main(int argc, char** argv) {
       for (auto c : g.cells) occ += c == 100;
       j["map"] = {{"dir", map_dir}, {"first_scan", mb}, {"end_scan", me}, {"width", g.width}, {"height", g.height},
                   {"resolution_m", resolution}, {"occupied_cells", occ}};
+      // Per scan of [b, e): the share of its returns within coverage_radius of an occupied cell of this map
+      // at the reference pose (the bench scores the scans with >= coverage_ratio separately).
+      j["coverage"] = cm::grid_coverage(g, log.scans, b, e, ccfg);
+      j["coverage_ratio"] = ccfg.covered_ratio;
     }
     std::cerr << "fploc import-carmen: " << in << ": " << n << " scans (" << log.scans[0].ranges.size() << " beams), "
               << log.odom.size() << " odometry records; wrote scans " << b << ".." << e

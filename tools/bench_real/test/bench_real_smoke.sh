@@ -1,10 +1,11 @@
 #!/bin/sh
 # fploc bench real on a slice of one log (intel: map from the first half, localize scans 50-60 %): the JSON
-# contract, and fploc tracking that slice from the reference start (a real run; seconds).
+# contract, and fploc tracking that slice from the reference start (a real run; seconds); and the split rule's
+# JSON (import-carmen --auto-split on aces).
 set -e
 if [ ! -d "$FPLOC_SHARED_DIR/data/recordings/radish" ]; then echo "SKIP: shared data absent"; exit 0; fi
 T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
-"$FPLOC_BUILD_DIR/bin/fploc-bench-real" --json --logs intel --end 0.6 --rows ref --out "$T" > "$T/r.json"
+"$FPLOC_BUILD_DIR/bin/fploc-bench-real" --json --logs intel --split 0.5 --end 0.6 --rows ref --out "$T" > "$T/r.json"
 python3 - "$T/r.json" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
@@ -15,7 +16,27 @@ for k in ("log", "start", "scans", "fploc", "amcl", "plot"):
 for k in ("ate_m", "max_m", "lost_pct", "ms_per_scan"):
     assert k in r["fploc"] and k in r["amcl"], k
 assert r["scans"] == 91, r["scans"]
+assert 0 < r["floor"]["ate_m"] < 0.2, r["floor"]
+for k in ("covered_scans", "split", "floor"):
+    assert k in r, k
+for k in ("all", "uncovered", "missing"):
+    assert k in r["fploc"] and k in r["amcl"], k
+assert r["fploc"]["all"]["scans"] == 91 and r["fploc"]["missing"] == 0, r["fploc"]
+assert 0 < r["covered_scans"] <= 91 and r["fploc"]["uncovered"]["scans"] == 91 - r["covered_scans"], r
 assert r["fploc"]["ate_m"] < 0.3 and r["fploc"]["lost_pct"] < 10, r["fploc"]
 PY
 test -s "$T/intel/ref.png"
+test -s "$T/intel/ref-fploc.png"
+# The split rule on a whole log: the JSON states the rule, the split and the covered share it reached.
+"$FPLOC_BUILD_DIR/bin/fploc-import-carmen" "$FPLOC_SHARED_DIR/data/recordings/radish/aces-corrected.log.gz" --auto-split \
+  --map "$T/aces-map" --json > "$T/aces.json"
+python3 - "$T/aces.json" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+s = j["split"]
+assert s["met"] == (s["covered_share"] >= s["rule"]["covered_share"]), s
+assert j["first_scan"] == s["split"] == j["map"]["end_scan"], j
+assert len(j["coverage"]) == j["end_scan"] - j["first_scan"], len(j["coverage"])
+print("aces split", s["fraction"], "covered", s["covered_share"])
+PY
 echo OK

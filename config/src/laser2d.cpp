@@ -1,0 +1,24 @@
+#include "fploc/config/laser2d.h"
+
+#include <cmath>
+
+namespace fploc::config {
+
+laser2d::GridLocalizerConfig config_of(const Grid2dOptions& o) {
+  laser2d::GridLocalizerConfig c;
+  constexpr double kRad = M_PI / 180;
+  if (o.initial_sigma_xy_m() > 0) c.initial_sigma_xy_m = o.initial_sigma_xy_m();
+  if (o.initial_sigma_yaw_deg() > 0) c.initial_sigma_yaw_rad = o.initial_sigma_yaw_deg() * kRad;
+  if (o.min_range_m() > 0) c.min_range_m = o.min_range_m();
+  if (o.max_range_m() > 0) c.max_range_m = o.max_range_m();
+  if (o.min_inlier_ratio() > 0) c.min_inlier_ratio = o.min_inlier_ratio();
+  if (o.field_max_m() > 0) c.field_max_m = o.field_max_m();
+  if (o.min_inlier_ratio_near() > 0) c.min_inlier_ratio_near = o.min_inlier_ratio_near();
+  if (o.gate_sigmas() > 0) c.gate_sigmas = o.gate_sigmas();
+  if (o.sigma_xy_per_m() > 0) c.sigma_xy_per_m = o.sigma_xy_per_m();
+  if (o.sigma_yaw_per_rad() > 0) c.sigma_yaw_per_rad = o.sigma_yaw_per_rad();
+  if (o.prior_weight_sigmas() > 0) c.prior_weight_sigmas = o.prior_weight_sigmas();
+  return c;
+}
+
+}  // namespace fploc::config
