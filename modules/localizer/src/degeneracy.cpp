@@ -1,5 +1,6 @@
 #include "fploc/localizer/degeneracy.h"
 
+
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -56,21 +57,35 @@ double weakest_horizontal(const Eigen::Matrix3d& P, double* direction_rad) {
   return std::sqrt(std::max(0.0, es.eigenvalues()[1]));
 }
 
+double chi2_3dof_of_sigmas(double k) {
+  // P(chi2_3 <= x) = erf(sqrt(x/2)) - sqrt(2x/pi) exp(-x/2): bisection for the probability erf(k/sqrt2).
+  const double p = std::erf(k / std::sqrt(2.0));
+  double lo = 0, hi = 200;
+  for (int i = 0; i < 100; ++i) {
+    const double x = 0.5 * (lo + hi);
+    const double c = std::erf(std::sqrt(x / 2)) - std::sqrt(2 * x / M_PI) * std::exp(-x / 2);
+    (c < p ? lo : hi) = x;
+  }
+  return 0.5 * (lo + hi);
+}
+
 void UncertaintyTracker::reset(double sigma_m, double sigma_rad) {
   const double v2 = cfg_.max_velocity_error_mps * cfg_.max_velocity_error_mps;
   P_ = Eigen::Vector3d(sigma_m * sigma_m, sigma_m * sigma_m, sigma_rad * sigma_rad).asDiagonal();
   W_ = Eigen::Vector3d(v2, v2, cfg_.yaw_rate_sigma_rps * cfg_.yaw_rate_sigma_rps).asDiagonal();
   have_ = false;
   have_initial_ = true;
+  have_mean_ = false;
 }
 
 UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d& frame_cov_in, bool frame_valid,
-                                            matcher::FitStatus matcher_status, const std::string& matcher_text) {
+                                            matcher::FitStatus matcher_status, const std::string& matcher_text,
+                                            const Pose2* fix, const matcher::Twist2* twist) {
   const double vmax = cfg_.frame.max_variance;
   const double v2 = cfg_.max_velocity_error_mps * cfg_.max_velocity_error_mps;
   const double w2 = cfg_.yaw_rate_sigma_rps * cfg_.yaw_rate_sigma_rps;
   const Eigen::Matrix3d frame_cov = frame_valid ? clamp_spd(frame_cov_in, 1e-14, vmax) : Eigen::Matrix3d::Identity() * vmax;
-  const bool frame_ok = frame_valid && matcher_status == matcher::FitStatus::kOk;
+  bool frame_ok = frame_valid && matcher_status == matcher::FitStatus::kOk;
   const double dt = (utime - last_utime_) * 1e-6;
   const Eigen::Matrix3d unknown_velocity = Eigen::Vector3d(v2, v2, w2).asDiagonal();
   Eigen::Matrix3d P_pred, W_pred;
@@ -92,6 +107,31 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
     W_pred.block<1, 2>(2, 0).setZero();
     W_pred(2, 2) = std::min(W_pred(2, 2), w2);
     P_pred = clamp_spd(add_sigmas(P_, W_pred * dt * dt), 1e-14, vmax);
+  }
+  // The tracked prediction: the last fix (or, after a refused one, the last prediction) carried on with
+  // the matcher's body twist (its constant velocity and the IMU's yaw rate), as the matcher predicts.
+  const bool continuing = have_ && have_mean_ && dt >= 0 && dt <= cfg_.max_gap_s && matcher_status != matcher::FitStatus::kLost;
+  Pose2 mean_pred = mean_;
+  if (continuing) mean_pred = compose(mean_, matcher::exp_twist(twist_, dt));
+  mean_pred.yaw = wrap_angle(mean_pred.yaw);
+  double innovation_sigma = 0;
+  bool refused = false;
+  Eigen::Vector3d nu = Eigen::Vector3d::Zero();
+  if (fix && continuing && frame_ok && cfg_.gate_sigma > 0) {
+    nu = Eigen::Vector3d(fix->x - mean_pred.x, fix->y - mean_pred.y, wrap_angle(fix->yaw - mean_pred.yaw));
+    Eigen::LDLT<Eigen::Matrix3d> ldlt(sym(P_pred + frame_cov));
+    const double d2 = nu.dot(ldlt.solve(nu));
+    innovation_sigma = std::sqrt(std::max(0.0, d2));
+    if (d2 > chi2_3dof_of_sigmas(cfg_.gate_sigma)) {
+      refused = true;
+      frame_ok = false;  // the prediction goes on; the fix is not taken
+    }
+  }
+  if (fix) {
+    if (frame_ok || !continuing) mean_ = Pose2{fix->x, fix->y, wrap_angle(fix->yaw)};
+    else mean_ = mean_pred;
+    if (twist) twist_ = *twist;
+    have_mean_ = matcher_status != matcher::FitStatus::kLost && (continuing || frame_valid);
   }
   if (frame_ok) {
     P_ = tighter_of(P_pred, frame_cov);
@@ -119,9 +159,16 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
   s.frame_degenerate = s.frame_sigma_max_m > cfg_.poor_sigma_m;
   s.status = matcher_status;
   s.text = matcher_text;
+  s.innovation_sigma = innovation_sigma;
+  s.refused = refused;
   if (matcher_status == matcher::FitStatus::kOk) {
     char b[200];
-    if (s.sigma_max_m > cfg_.poor_sigma_m) {
+    if (refused) {
+      std::snprintf(b, sizeof b, "fix refused: %.2f m / %.1f deg from the prediction (Mahalanobis %.1f > %.1f)",
+                    std::hypot(nu[0], nu[1]), std::abs(nu[2]) * 180 / M_PI, innovation_sigma, std::sqrt(chi2_3dof_of_sigmas(cfg_.gate_sigma)));
+      s.status = matcher::FitStatus::kPoor;
+      s.text = b;
+    } else if (s.sigma_max_m > cfg_.poor_sigma_m) {
       std::snprintf(b, sizeof b, "position open along %ld deg (1 sigma %.2f m%s)", std::lround(s.weak_direction_rad * 180 / M_PI),
                     s.sigma_max_m, s.frame_degenerate ? ": the plan does not constrain it here" : "");
       s.status = matcher::FitStatus::kPoor;

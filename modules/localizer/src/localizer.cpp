@@ -11,6 +11,9 @@ Config with_uncertainty_defaults(Config c) {
   c.uncertainty.frame.loss_scale_m = c.matcher.loss_scale_m;
   c.uncertainty.frame.gate_m = c.matcher.min_correspondence_m;
   c.uncertainty.frame.group_rule = c.matcher.group_rule;
+  // The window publishes POOR where its pose's covariance (the fix's + the offset from it) says what the
+  // tracker's status says for the fix's.
+  if (c.uncertainty.enabled && c.optimizer.poor_sigma_m <= 0) c.optimizer.poor_sigma_m = c.uncertainty.poor_sigma_m;
   return c;
 }
 }  // namespace
@@ -94,7 +97,8 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
     matcher::deskew(f, sfr.match.twist, t_ref, &deskewed_);
     const Pose2 at_ref = compose(sfr.match.pose, matcher::exp_twist(sfr.match.twist, t_ref));
     const auto fu = optimizer::frame_uncertainty(lookup_, deskewed_, at_ref, cfg_.uncertainty.frame);
-    uncertainty_ = tracker_.update(f.utime, fu.covariance, fu.valid, sfr.match.status, sfr.match.text);
+    uncertainty_ = tracker_.update(f.utime, fu.covariance, fu.valid, sfr.match.status, sfr.match.text, &sfr.match.pose,
+                                   &sfr.match.twist);
     in.covariance = uncertainty_.covariance;
     in.published_status = uncertainty_.status;
     in.status_text = uncertainty_.text;

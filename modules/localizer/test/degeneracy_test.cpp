@@ -146,3 +146,53 @@ TEST(Degeneracy, LocalizerAlongAnEndlessCorridorIsPoorBeforeTheErrorGrows) {
   EXPECT_LT(err_at_first_poor, 0.1);
   EXPECT_EQ(false_ok, 0);
 }
+
+TEST(Degeneracy, ChiSquareQuantileOfThreeSigmas) {
+  EXPECT_NEAR(chi2_3dof_of_sigmas(3.0), 14.16, 0.01);
+  EXPECT_NEAR(chi2_3dof_of_sigmas(1.0), 3.53, 0.01);
+}
+
+// The innovation gate: a confident fix far from where the last fix and the matcher's twist say the
+// platform is now is refused (POOR, naming it), the next consistent one is taken again.
+TEST(Degeneracy, RefusesAConfidentFixFarFromThePrediction) {
+  UncertaintyTracker tr;
+  const Eigen::Matrix3d fixed = diag(0.01, 0.01, 0.002);
+  matcher::Twist2 v;
+  v.vx = 0.5;  // body forward; heading 0: +x in the plan
+  int64_t t = 0;
+  Pose2 p{1.0, 2.0, 0.0};
+  for (int k = 0; k < 20; ++k, t += 100000, p.x += 0.05) {
+    const auto s = tr.update(t, fixed, true, FitStatus::kOk, {}, &p, &v);
+    ASSERT_EQ(s.status, FitStatus::kOk) << k << " " << s.text;
+    EXPECT_LT(s.innovation_sigma, 1.0);
+  }
+  // 0.3 m sideways in one frame, with a 1 cm fix.
+  Pose2 jump = p;
+  jump.y += 0.3;
+  auto s = tr.update(t, fixed, true, FitStatus::kOk, {}, &jump, &v);
+  EXPECT_EQ(s.status, FitStatus::kPoor);
+  EXPECT_TRUE(s.refused);
+  EXPECT_NE(s.text.find("fix refused"), std::string::npos) << s.text;
+  EXPECT_GT(s.innovation_sigma, 10.0);
+  // The prediction went on: the next fix where the platform really is passes again.
+  t += 100000;
+  p.x += 0.05;
+  Pose2 next = p;
+  next.x += 0.05;
+  s = tr.update(t, fixed, true, FitStatus::kOk, {}, &next, &v);
+  EXPECT_EQ(s.status, FitStatus::kOk) << s.text;
+  EXPECT_FALSE(s.refused);
+}
+
+TEST(Degeneracy, GateOffOrWithoutAFixChangesNothing) {
+  UncertaintyConfig off;
+  off.gate_sigma = 0;
+  UncertaintyTracker a(off), b;
+  const Eigen::Matrix3d fixed = diag(0.01, 0.01, 0.002);
+  Pose2 p{0, 0, 0};
+  a.update(0, fixed, true, FitStatus::kOk, {}, &p);
+  b.update(0, fixed, true, FitStatus::kOk);
+  Pose2 jump{1.0, 0, 0};
+  EXPECT_EQ(a.update(100000, fixed, true, FitStatus::kOk, {}, &jump).status, FitStatus::kOk);
+  EXPECT_EQ(b.update(100000, fixed, true, FitStatus::kOk).status, FitStatus::kOk);
+}

@@ -1,5 +1,6 @@
 #include "fploc/matcher/plan_terms.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -123,12 +124,19 @@ inline void robust_scale(LossKind loss, double a, double s, double* g, double* d
 class FrameCost : public ceres::CostFunction {
  public:
   FrameCost(const std::vector<TargetGeom>* targets, std::vector<Assignment> as, std::vector<Eigen::Vector2d> pts,
-            LossKind loss, double scale, double w)
-      : targets_(targets), as_(std::move(as)), pts_(std::move(pts)), loss_(loss), a_(scale), w_(w) {
-    set_num_residuals(int(as_.size()));
+            LossKind loss, double scale, double w, bool compact)
+      : targets_(targets), as_(std::move(as)), pts_(std::move(pts)), loss_(loss), a_(scale), w_(w), compact_(compact) {
+    set_num_residuals(compact_ ? 4 : int(as_.size()));
     mutable_parameter_block_sizes()->push_back(3);
   }
   bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
+    if (compact_) return evaluate_compact(params[0], residuals, jacobians ? jacobians[0] : nullptr);
+    return evaluate_points(params, residuals, jacobians);
+  }
+
+ private:
+  // The per-point form: one residual (and Jacobian row) per assignment.
+  bool evaluate_points(double const* const* params, double* residuals, double** jacobians) const {
     const double* x = params[0];
     const double c = std::cos(x[2]), s = std::sin(x[2]);
     double* jac = jacobians ? jacobians[0] : nullptr;
@@ -164,13 +172,56 @@ class FrameCost : public ceres::CostFunction {
     }
     return true;
   }
+  // The compact form (square-root information): the same cost, gradient and Gauss-Newton matrix as the
+  // per-point form in 4 residuals. With J (n x 3) and r (n) of the per-point form, H = J^T J = V L V^T:
+  // J~ = [L^1/2 V^T; 0], r~ = [L^-1/2 V^T J^T r; sqrt(|r|^2 - |L^-1/2 V^T J^T r|^2)] give J~^T J~ = H,
+  // J~^T r~ = J^T r and |r~|^2 = |r|^2 (J^T r lies in H's range), so the trust-region steps and the
+  // costs Ceres sees are those of the per-point form, without its n x 3 Jacobian and per-row work.
+  bool evaluate_compact(const double* x, double* residuals, double* jac) const {
+    thread_local std::vector<double> r, J;  // scratch (Ceres evaluates one block at a time per thread)
+    r.resize(as_.size());
+    J.resize(3 * as_.size());
+    const double* xs[1] = {x};
+    double* js[1] = {J.data()};
+    evaluate_points(xs, r.data(), js);
+    Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d g = Eigen::Vector3d::Zero();
+    double cost2 = 0;
+    for (size_t i = 0; i < as_.size(); ++i) {
+      const Eigen::Vector3d j(J[3 * i], J[3 * i + 1], J[3 * i + 2]);
+      H.noalias() += j * j.transpose();
+      g += r[i] * j;
+      cost2 += r[i] * r[i];
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(H);
+    const double lmax = std::max(es.eigenvalues().maxCoeff(), 0.0);
+    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> Jt = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rt = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      const double l = es.eigenvalues()[k];
+      if (!(l > 1e-14 * lmax) || !(l > 0)) continue;
+      const Eigen::Vector3d v = es.eigenvectors().col(k);
+      const double sl = std::sqrt(l);
+      Jt.row(k) = sl * v.transpose();
+      rt[k] = v.dot(g) / sl;
+    }
+    residuals[0] = rt[0];
+    residuals[1] = rt[1];
+    residuals[2] = rt[2];
+    residuals[3] = std::sqrt(std::max(0.0, cost2 - rt.squaredNorm()));
+    if (jac) {
+      for (int k = 0; k < 9; ++k) jac[k] = Jt.data()[k];
+      jac[9] = jac[10] = jac[11] = 0.0;
+    }
+    return true;
+  }
 
- private:
   const std::vector<TargetGeom>* targets_;
   std::vector<Assignment> as_;
   std::vector<Eigen::Vector2d> pts_;
   LossKind loss_;
   double a_, w_;
+  bool compact_;
 };
 
 }  // namespace
@@ -267,13 +318,13 @@ void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, 
 }
 
 void add_frame_term(ceres::Problem* problem, double* pose, const NearestLookup& lookup, const FeatureFrame& f,
-                    const std::vector<Assignment>& as, const std::string& loss, double scale, double weight) {
+                    const std::vector<Assignment>& as, const std::string& loss, double scale, double weight, bool compact) {
   if (as.empty()) return;
   std::vector<Eigen::Vector2d> pts;
   pts.reserve(as.size());
   for (const auto& a : as) pts.push_back(f.points[size_t(a.point)].p);
-  problem->AddResidualBlock(new FrameCost(&lookup.geometry(), as, std::move(pts), loss_kind(loss, scale), scale, weight),
-                            nullptr, pose);
+  problem->AddResidualBlock(
+      new FrameCost(&lookup.geometry(), as, std::move(pts), loss_kind(loss, scale), scale, weight, compact), nullptr, pose);
 }
 
 Eigen::Matrix3d frame_information(const NearestLookup& lookup, const FeatureFrame& f, const std::vector<Assignment>& as,

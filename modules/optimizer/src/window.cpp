@@ -3,6 +3,7 @@
 #include <ceres/ceres.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -113,6 +114,17 @@ PoseOut WindowOptimizer::make_out(const Frame& f, const Pose2& pose_tau_in, bool
     // (the window smooths, or holds what the fix does not see): the error's second moment is P + d d^T.
     const Eigen::Vector3d d = diff(o.pose, f.in.sfr);
     o.covariance += d * d.transpose();
+    if (cfg_.poor_sigma_m > 0 && o.status == matcher::FitStatus::kOk) {
+      const Eigen::Matrix2d C = 0.5 * (o.covariance.topLeftCorner<2, 2>() + o.covariance.topLeftCorner<2, 2>().transpose());
+      const double tr = C.trace(), det = C.determinant();
+      const double sigma = std::sqrt(std::max(0.0, tr / 2 + std::sqrt(std::max(0.0, tr * tr / 4 - det))));
+      if (sigma > cfg_.poor_sigma_m) {
+        char b[160];
+        std::snprintf(b, sizeof b, "window pose %.2f m from the frame's fix (1 sigma %.2f m)", std::hypot(d[0], d[1]), sigma);
+        o.status = matcher::FitStatus::kPoor;
+        o.status_text = b;
+      }
+    }
   }
   o.z_sigma = f.in.features.z_sigma;
   o.roll_pitch_sigma = f.in.features.roll_pitch_sigma;
@@ -208,7 +220,10 @@ void WindowOptimizer::solve() {
   // Each keyframe's floor-plan block touches only its own 3 parameters: the normal equations of the
   // window are block-sparse (band of 3x3 blocks from the velocity terms). The dense solver forms
   // J^T J from a dense (2 N W) x 3W Jacobian, W times the work.
-  so.linear_solver_type = cfg_.linear_solver == "dense" ? ceres::DENSE_NORMAL_CHOLESKY : ceres::SPARSE_NORMAL_CHOLESKY;
+  // With compact terms the whole Jacobian is (4 W + 3 (W - 2)) x 3 W: dense is cheaper than any sparse
+  // factorisation's set-up.
+  so.linear_solver_type = cfg_.linear_solver == "dense" || cfg_.compact_terms ? ceres::DENSE_NORMAL_CHOLESKY
+                                                                               : ceres::SPARSE_NORMAL_CHOLESKY;
   so.num_threads = 1;
   so.max_num_iterations = std::max(1, cfg_.max_iterations);
   so.logging_type = ceres::SILENT;
@@ -260,7 +275,7 @@ void WindowOptimizer::solve() {
       // point) estimates that sum with weight stride, so the balance against the velocity terms does not
       // depend on the budget.
       const double w = cfg_.budget_weight ? std::sqrt(double(k.as_stride)) : 1.0;
-      matcher::add_frame_term(&problem, k.x, lookup_, k.deskewed, k.as, cfg_.loss, cfg_.loss_scale_m, w);
+      matcher::add_frame_term(&problem, k.x, lookup_, k.deskewed, k.as, cfg_.loss, cfg_.loss_scale_m, w, cfg_.compact_terms);
     }
     for (size_t i = 0; i + 2 < chain.size(); ++i) {
       const double dt0 = (chain[i + 1].second - chain[i].second) * 1e-6;

@@ -200,3 +200,56 @@ TEST(WindowOptimizer, UnknownGravityIsInterpolatedFromNeighbours) {
   EXPECT_NEAR(finals[10].roll, 0.002 * 10, 1e-9);
   EXPECT_NEAR(finals[5].z, 1.25, 1e-12);          // known ones pass through
 }
+
+// The compact (square-root information) frame terms give the solver the same cost, gradient and
+// Gauss-Newton matrix as one residual per point: the same poses, to rounding.
+TEST(WindowOptimizer, CompactTermsGiveThePerPointSolution) {
+  auto map = matcher::make_localization_map(room_with_pillars(), "brute-force");
+  SynthOptions so;
+  so.beams = 90;
+  so.noise_sigma = 0.03;
+  so.clutter_fraction = 0.1;
+  so.seed = 5;
+  const SeqRun run = make_run(*map.lookup, *map.plan, 60, so);
+  OptimizerConfig per_point;
+  per_point.compact_terms = false;
+  OptimizerConfig compact;
+  compact.compact_terms = true;
+  const auto a = optimise(*map.lookup, run, per_point);
+  const auto b = optimise(*map.lookup, run, compact);
+  ASSERT_EQ(a.size(), b.size());
+  double worst = 0;
+  for (size_t i = 0; i < a.size(); ++i)
+    worst = std::max({worst, std::abs(a[i].pose.x - b[i].pose.x), std::abs(a[i].pose.y - b[i].pose.y),
+                      std::abs(a[i].pose.yaw - b[i].pose.yaw)});
+  EXPECT_LT(worst, 1e-6);
+  std::vector<Pose2> est;
+  for (const auto& f : b) est.push_back(f.pose);
+  EXPECT_LT(rms_err(est, run.truth), 0.02);
+}
+
+// A pose whose covariance (the fix's plus its offset from the fix) is wide is not published OK.
+TEST(WindowOptimizer, PoseFarFromItsFixIsPublishedPoor) {
+  auto map = matcher::make_localization_map(room_with_pillars(), "brute-force");
+  const SeqRun run = make_run(*map.lookup, *map.plan, 5, SynthOptions{});
+  OptimizerConfig cfg;
+  cfg.poor_sigma_m = 0.1;
+  WindowOptimizer opt(*map.lookup, cfg);
+  std::vector<PoseOut> finals;
+  for (size_t k = 0; k < run.frames.size(); ++k) {
+    FrameInput in;
+    in.features = run.frames[k];
+    in.sfr = run.sfr[k].pose;
+    in.twist = run.sfr[k].twist;
+    in.status = run.sfr[k].status;
+    in.covariance = Eigen::Matrix3d::Identity() * 1e-6;
+    if (k == 4) in.sfr.x += 0.4;  // a fix 0.4 m off its frame's points: the window stays where they fit
+    const PoseOut o = opt.add(in, &finals);
+    if (k < 4) {
+      EXPECT_EQ(o.status, matcher::FitStatus::kOk) << k;
+    } else {
+      EXPECT_EQ(o.status, matcher::FitStatus::kPoor);
+      EXPECT_NE(o.status_text.find("from the frame's fix"), std::string::npos) << o.status_text;
+    }
+  }
+}

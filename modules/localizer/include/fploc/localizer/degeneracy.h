@@ -44,6 +44,11 @@ struct UncertaintyConfig {
   double poor_sigma_m = 0.1;           // POOR beyond this 1-sigma along the weakest horizontal direction
   double poor_sigma_rad = 0.05;        // ... or in heading
   double max_gap_s = 2.0;              // a longer gap between frames restarts from the frame alone
+  // Innovation gate: a fix (the frame's pose, update() with `fix`) whose Mahalanobis distance from the
+  // tracked prediction (the last fix carried on with the matcher's twist: its velocity and the IMU's yaw
+  // rate; covariance P- + P_f) exceeds gate_sigma (as the 3-DoF chi-square quantile of that many sigmas:
+  // 3 -> 14.2) is refused: status POOR, the prediction and P- go on. 0: off.
+  double gate_sigma = 3.0;
 };
 
 struct UncertaintyState {
@@ -55,6 +60,8 @@ struct UncertaintyState {
   double sigma_yaw_rad = 0;
   double frame_sigma_max_m = 0;        // the frame's own 1-sigma along its weakest horizontal direction
   bool frame_degenerate = false;       // the frame alone leaves a direction open (frame sigma > poor_sigma_m)
+  double innovation_sigma = 0;         // Mahalanobis distance of the fix from the prediction (0: not tested)
+  bool refused = false;                // the fix failed the innovation gate
 };
 
 class UncertaintyTracker {
@@ -62,8 +69,11 @@ class UncertaintyTracker {
   explicit UncertaintyTracker(UncertaintyConfig cfg = {}) : cfg_(std::move(cfg)) {}
   // One frame, in time order: its own covariance (frame_valid false: the frame fixes nothing) and the
   // matcher's status/text. Returns what to publish with the frame's pose.
+  // With `fix` (the frame's own pose, that P_f is about) and the matcher's body twist of the frame (its
+  // motion model, carried to the next frame) the innovation gate applies (see gate_sigma).
   UncertaintyState update(int64_t utime, const Eigen::Matrix3d& frame_cov, bool frame_valid, matcher::FitStatus matcher_status,
-                          const std::string& matcher_text = {});
+                          const std::string& matcher_text = {}, const Pose2* fix = nullptr,
+                          const matcher::Twist2* twist = nullptr);
   // A new initial pose with its uncertainty (1-sigma x/y and yaw); the velocity is unknown.
   void reset(double sigma_m, double sigma_rad);
   void reset() { have_ = false; }
@@ -76,7 +86,13 @@ class UncertaintyTracker {
   Eigen::Matrix3d P_ = Eigen::Matrix3d::Identity();   // pose (x, y, yaw)
   Eigen::Matrix3d W_ = Eigen::Matrix3d::Identity();   // velocity error (vx, vy, yaw rate)
   bool have_initial_ = false;                          // P_ / W_ hold reset()'s initial uncertainty
+  bool have_mean_ = false;                             // the tracked pose and twist (innovation gate)
+  Pose2 mean_;
+  matcher::Twist2 twist_;
 };
+
+// The 3-DoF chi-square quantile with the probability of a 1-D Gaussian within k sigma (k = 3: 14.16).
+double chi2_3dof_of_sigmas(double k);
 
 // The tighter of two covariances per direction of their common eigenbasis (generalised eigenvectors).
 Eigen::Matrix3d tighter_of(const Eigen::Matrix3d& A, const Eigen::Matrix3d& B);

@@ -31,8 +31,11 @@ double closest_of(const std::vector<TargetGeom>& targets, const int* cand, int n
 // The frame's terms as ONE residual block (2 residuals per assignment) with the robust loss ("huber",
 // "cauchy", "none", scale [m]) folded exactly into the residuals: much less Ceres overhead than a block
 // per point. Used by the matcher and the optimizer. The cost is weight^2 sum rho(|r|^2).
+// compact: the same cost, gradient and Gauss-Newton matrix in 4 residuals (square-root information form,
+// see FrameCost::evaluate_compact): the solver's steps are the same, without Ceres' per-row work.
 void add_frame_term(ceres::Problem* problem, double* pose, const NearestLookup& lookup, const FeatureFrame& f,
-                    const std::vector<Assignment>& a, const std::string& loss, double scale, double weight = 1.0);
+                    const std::vector<Assignment>& a, const std::string& loss, double scale, double weight = 1.0,
+                    bool compact = false);
 
 // Gauss-Newton information J^T J of the frame term at x (robust weights included), for the covariance.
 Eigen::Matrix3d frame_information(const NearestLookup& lookup, const FeatureFrame& f, const std::vector<Assignment>& a,

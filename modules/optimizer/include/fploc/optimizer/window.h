@@ -46,10 +46,18 @@ struct OptimizerConfig {
   bool anchor_final = false;           // also regularise against the last two final key poses (held fixed)
   double max_keyframe_gap_s = 2.0;     // a longer gap (e.g. lost frames) restarts the window
   std::string linear_solver = "sparse";  // "sparse" (SPARSE_NORMAL_CHOLESKY) or "dense" (DENSE_NORMAL_CHOLESKY)
+  // Each keyframe's floor-plan term in the compact square-root form (matcher::add_frame_term): the same
+  // steps, 4 residuals per keyframe instead of one per point (then the dense solver is the cheaper one).
+  bool compact_terms = true;
   const std::vector<float>* element_weight = nullptr;  // as MatcherConfig::element_weight
   // Published covariance: FrameInput::covariance (of the frame's single-frame fix) plus d d^T, d the output
   // pose minus that fix (the window's pose is not the fix the covariance is about).
   bool covariance_offset = true;
+  // A pose published OK whose covariance (with the offset above) has a 1-sigma beyond this along its weakest
+  // horizontal direction is published POOR ("window pose d m from the frame's fix"): the window and the
+  // fix disagree by more than the fix's uncertainty allows. 0: off (localizer::Localizer sets it to its
+  // uncertainty.poor_sigma_m).
+  double poor_sigma_m = 0;
 };
 
 struct FrameInput {
