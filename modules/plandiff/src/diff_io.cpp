@@ -43,6 +43,9 @@ void write_json(const Diff& d, const FloorPlan& plan, std::ostream& out, bool al
   for (const auto& n : d.added)
     nw.push_back({{"a", {n.a.x(), n.a.y()}}, {"b", {n.b.x(), n.b.y()}}, {"length_m", n.length()}, {"cells", n.cells},
                   {"min_frames", n.min_frames}, {"rms_m", n.rms_m}, {"extends", n.extends}});
+  auto& rf = j["refined"] = nlohmann::json::array();
+  for (const auto& r : d.refined)
+    rf.push_back({{"id", r.element}, {"offset_a", r.offset_a}, {"offset_b", r.offset_b}, {"frames", r.frames}});
   auto& mp = j["missing_parts"] = nlohmann::json::array();
   for (const auto& m : d.missing_parts)
     mp.push_back({{"id", m.element}, {"a", {m.a.x(), m.a.y()}}, {"b", {m.b.x(), m.b.y()}}, {"length_m", m.length()},

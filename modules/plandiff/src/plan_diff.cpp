@@ -430,9 +430,19 @@ Diff PlanDiff::result() const {
     Eigen::MatrixXd H = ref_H_;
     H.diagonal().array() += lam;
     const Eigen::VectorXd o = H.ldlt().solve(ref_g_);
-    for (size_t i = 0; i < plan_.elements.size(); ++i)
-      if (ref_frames_[i] >= o_.min_frames && std::isfinite(o[2 * long(i)]) && std::isfinite(o[2 * long(i) + 1]))
-        d.refined.push_back({int(i), o[2 * long(i)], o[2 * long(i) + 1], ref_frames_[i]});
+    const double kmin = o_.refine_min_info;
+    for (size_t i = 0; i < plan_.elements.size(); ++i) {
+      const long a = 2 * long(i), b = a + 1;
+      if (ref_frames_[i] < o_.min_frames || !std::isfinite(o[a]) || !std::isfinite(o[b])) continue;
+      // Both ends observed well enough (the data's own information on each, scans' errors eliminated), else
+      // the mean offset (a wall seen near one end only), else nothing.
+      if (o_.refine_ends && ref_H_(a, a) >= kmin && ref_H_(b, b) >= kmin) {
+        d.refined.push_back({int(i), o[a], o[b], ref_frames_[i]});
+      } else if (ref_H_(a, a) + ref_H_(b, b) + 2 * ref_H_(a, b) >= 4 * kmin) {
+        const double m = 0.5 * (o[a] + o[b]);
+        d.refined.push_back({int(i), m, m, ref_frames_[i]});
+      }
+    }
   }
   d.elements.resize(plan_.elements.size());
   for (size_t i = 0; i < plan_.elements.size(); ++i) {

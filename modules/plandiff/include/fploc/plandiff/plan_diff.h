@@ -74,6 +74,11 @@ struct Options {
   double refine_prior_m = 0.05;
   double refine_obs_sigma_m = 0.01;
   int refine_min_points = 5;          // points of the wall in the scan for an observation
+  bool refine_ends = false;           // report each end's offset (else the wall's mean offset at both: the
+                                      // difference, a wall's rotation, is poorly observed and was measured to hurt)
+  double refine_min_info = 3;         // ends with this much information (in observations at that end, after the
+                                      // scans' errors) are reported, else the wall's mean offset if it has as
+                                      // much, else the wall is left as drawn
 };
 
 enum class Status : uint8_t { kUnobserved = 0, kSeen = 1, kMissing = 2, kMoved = 3 };
@@ -184,7 +189,8 @@ class PlanDiff {
 //  "elements": [{"id", "status",
 //  "offset_m", "offset_spread_m", "seen_ratio", "frames_expected", "frames_with_points", "a", "b" | "c", "r"}],
 //  "new": [{"a", "b", "length_m", "cells", "min_frames", "rms_m", "extends"}],
-//  "missing_parts": [{"id", "a", "b", "length_m", "seen_ratio", "through_ratio"}]}   (elements: only those not
+//  "missing_parts": [{"id", "a", "b", "length_m", "seen_ratio", "through_ratio"}],
+//  "refined": [{"id", "offset_a", "offset_b", "frames"}]}   (elements: only those not
 //  "seen" unless all_elements)
 void write_json(const Diff& d, const FloorPlan& plan, std::ostream& out, bool all_elements = false);
 // ASCII DXF (AC1009, $INSUNITS 6 = metres) with a LAYER table: FPLOC-PLAN (the plan, grey),
