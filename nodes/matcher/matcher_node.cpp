@@ -200,21 +200,22 @@ class MatcherNode : public fploc::rt::Node {
     const bool refined = refine_on_ && refine_.update(fploc::adapters::refined_offsets(m), m.utime);
     if (!sc && !refined) return;
     const double s_new = scale_.applied();
-    const double* s = &s_new;
     const fploc::FloorPlan& plan = *floors_.maps[0].plan;
     auto map = std::make_unique<fploc::matcher::LocalizationMap>(
         fploc::matcher::corrected_localization_map(plan, s_new, refine_.applied(), lookup_name_));
     auto loc = std::make_unique<fploc::localizer::Localizer>(*map->lookup, cfg_);
     for (const auto& i : imu_) loc->add_imu(i.first, i.second);
     if (have_pose_)
-      loc->set_pose(fploc::matcher::rescaled_pose(last_pose_, 1 + before, 1 + *s, fploc::matcher::scale_centre(plan)), 0.1);
+      loc->set_pose(fploc::matcher::rescaled_pose(last_pose_, 1 + before, 1 + s_new, fploc::matcher::scale_centre(plan)), 0.1);
     loc_ = std::move(loc);  // the old Localizer (and its look-up's map) go
     scaled_map_ = std::move(map);
     double worst = 0;
     for (const auto& o : refine_.applied()) worst = std::max({worst, std::abs(o.offset_a), std::abs(o.offset_b)});
     char buf[200];
-    std::snprintf(buf, sizeof buf, "plan corrected: scale %+.3f %% (estimate %+.3f +- %.3f %%), %zu walls refined (up to %.1f cm)",
-                  100 * *s, 100 * m.scale_error, 100 * m.scale_sigma, refine_.applied().size(), 100 * worst);
+    int k = std::snprintf(buf, sizeof buf, "plan corrected: scale %+.3f %% (estimate %+.3f +- %.3f %%)", 100 * s_new,
+                          100 * m.scale_error, 100 * m.scale_sigma);
+    if (refine_on_ && k > 0 && size_t(k) < sizeof buf)
+      std::snprintf(buf + k, sizeof buf - size_t(k), ", %zu walls refined (up to %.1f cm)", refine_.applied().size(), 100 * worst);
     std::cerr << "[" << ctx_->name() << "] " << buf << "\n";
     switch_text_ = buf;
     switch_until_ = m.utime + 3'000'000;

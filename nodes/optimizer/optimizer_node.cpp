@@ -165,16 +165,17 @@ class OptimizerNode : public fploc::rt::Node {
     const bool refined = refine_on_ && refine_.update(fploc::adapters::refined_offsets(m), m.utime);
     if (!sc && !refined) return;
     const double s_new = scale_.applied();
-    const double* s = &s_new;
     std::vector<fploc::localizer::Pose> finals;
     loc_->flush(&finals);
     publish_finals(finals);
     auto map = std::make_unique<fploc::matcher::LocalizationMap>(
-        fploc::matcher::corrected_localization_map(*floors_.maps[0].plan, *s, refine_.applied(), lookup_name_));
+        fploc::matcher::corrected_localization_map(*floors_.maps[0].plan, s_new, refine_.applied(), lookup_name_));
     loc_ = std::make_unique<fploc::localizer::Localizer>(*map->lookup, cfg_);
     scaled_map_ = std::move(map);
-    std::cerr << "[" << ctx_->name() << "] plan corrected: scale " << 100 * *s << " % (estimate " << 100 * m.scale_error
-              << " +- " << 100 * m.scale_sigma << " %), " << refine_.applied().size() << " walls refined\n";
+    std::cerr << "[" << ctx_->name() << "] plan corrected: scale " << 100 * s_new << " % (estimate " << 100 * m.scale_error
+              << " +- " << 100 * m.scale_sigma << " %)";
+    if (refine_on_) std::cerr << ", " << refine_.applied().size() << " walls refined";
+    std::cerr << "\n";
   }
 
   void publish_finals(const std::vector<fploc::localizer::Pose>& finals) {
