@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <cmath>
 
 namespace fploc::adapters {
 
@@ -41,8 +42,17 @@ plan_diff_t to_msg(const plandiff::Diff& r, const FloorPlan& plan, int64_t utime
       item(kind, e.id, true, p.c.x(), p.c.y(), p.r + off, 0, off, e.seen_ratio());
     }
   }
-  for (const auto& n : r.added) item(PlanDiffKind::kNew, -1, false, n.a.x(), n.a.y(), n.b.x(), n.b.y(), n.rms_m, 0);
+  for (const auto& n : r.added) item(PlanDiffKind::kNew, n.extends, false, n.a.x(), n.a.y(), n.b.x(), n.b.y(), n.rms_m, 0);
+  for (const auto& m : r.missing_parts)
+    item(PlanDiffKind::kMissingPart, m.element, false, m.a.x(), m.a.y(), m.b.x(), m.b.y(), 0,
+         m.expected ? double(m.seen) / double(m.expected) : 0.0);
   msg.num_items = int32_t(msg.kind.size());
+  for (const auto& rs : r.refined) {
+    msg.refined_element.push_back(rs.element);
+    msg.refined_offset_a.push_back(float(rs.offset_a));
+    msg.refined_offset_b.push_back(float(rs.offset_b));
+  }
+  msg.num_refined = int32_t(msg.refined_element.size());
   return msg;
 }
 
@@ -54,6 +64,15 @@ std::vector<matcher::FlaggedElement> flagged_elements(const plan_diff_t& m) {
     if (m.kind[i] == int8_t(PlanDiffKind::kMissing)) out.push_back({m.element[i], matcher::DiffVerdict::kMissing});
     else if (m.kind[i] == int8_t(PlanDiffKind::kMoved)) out.push_back({m.element[i], matcher::DiffVerdict::kMoved});
   }
+  return out;
+}
+
+std::vector<matcher::SegmentOffset> refined_offsets(const plan_diff_t& m) {
+  std::vector<matcher::SegmentOffset> out;
+  const size_t n = size_t(std::max(0, m.num_refined));
+  for (size_t i = 0; i < n && i < m.refined_element.size() && i < m.refined_offset_a.size() && i < m.refined_offset_b.size(); ++i)
+    if (m.refined_element[i] >= 0 && std::isfinite(m.refined_offset_a[i]) && std::isfinite(m.refined_offset_b[i]))
+      out.push_back({m.refined_element[i], m.refined_offset_a[i], m.refined_offset_b[i]});
   return out;
 }
 

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <deque>
 #include <cmath>
 #include <iostream>
@@ -28,6 +29,7 @@
 #include "fploc/config/localization.h"
 #include "fploc/config/plan_source.h"
 #include "fploc/localizer/localizer.h"
+#include "fploc/matcher/plan_scale.h"
 #include "fploc/runtime/node.h"
 
 namespace {
@@ -49,7 +51,8 @@ class MatcherNode : public fploc::rt::Node {
              // `fploc import-carmen`'s WHEEL_ODOM): the increment between two frames predicts the next one.
              fploc::rt::input<fploc::pose_t>("odom", ""),
              // Optional: the plan-change detector's verdicts (FPLOC_PLAN_DIFF); elements it marks missing or
-             // moved get weight plan_diff_weight in the registration (default 0: left out).
+             // moved get weight plan_diff_weight in the registration (default 0: left out); with plan_diff_scale
+             // the plan is rescaled by its drawing-scale estimate once that is significant.
              fploc::rt::input<fploc::plan_diff_t>("plan_diff", ""),
              fploc::rt::output<fploc::frame_pose_t>("frame_pose", "FPLOC_FRAME_POSE")}};
   }
@@ -65,6 +68,9 @@ class MatcherNode : public fploc::rt::Node {
     if (floors_.multi_floor()) tracker_.emplace(floors_.building, floor_);
     cfg_ = fploc::config::localizer_config(o);
     diff_weight_ = float(std::max(0.0, o.plan_diff_weight()));
+    scale_on_ = o.plan_diff_scale();
+    refine_on_ = o.plan_diff_refine();
+    lookup_name_ = o.lookup();
     weights_ = make_weights();
     loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
     // The graph's initial pose is where the run starts; a restarted matcher (crash, module swap) waits for
@@ -213,6 +219,43 @@ class MatcherNode : public fploc::rt::Node {
         return;
       }
     weights_->update(flagged);
+    if (scale_on_ || refine_on_) correct_plan(m);
+  }
+
+  // plan_diff_scale: the building is (1 + scale_error) times the plan; once the estimate is significant
+  // (matcher/plan_scale.h), register against the plan scaled by it about the plan's centre. The tracker
+  // restarts there from its last pose moved into the new plan's frame (searching 0.1 m around it).
+  // plan_diff_refine: against the plan with each wall where the diff's as-built refinement puts it.
+  void correct_plan(const fploc::plan_diff_t& m) {
+    if (floors_.multi_floor()) {
+      if (!scale_warned_) ctx_->error("plan_diff_scale / plan_diff_refine: not for a building of several floors (ignored)");
+      scale_warned_ = true;
+      return;
+    }
+    const double before = scale_.applied();
+    const auto sc = scale_on_ ? scale_.update(m.scale_error, m.scale_sigma) : std::nullopt;
+    const bool refined = refine_on_ && refine_.update(fploc::adapters::refined_offsets(m), m.utime);
+    if (!sc && !refined) return;
+    const double s_new = scale_.applied();
+    const fploc::FloorPlan& plan = *floors_.maps[0].plan;
+    auto map = std::make_unique<fploc::matcher::LocalizationMap>(
+        fploc::matcher::corrected_localization_map(plan, s_new, refine_.applied(), lookup_name_));
+    auto loc = std::make_unique<fploc::localizer::Localizer>(*map->lookup, cfg_);
+    for (const auto& i : imu_) loc->add_imu(i.first, i.second);
+    if (have_pose_)
+      loc->set_pose(fploc::matcher::rescaled_pose(last_pose_, 1 + before, 1 + s_new, fploc::matcher::scale_centre(plan)), 0.1);
+    loc_ = std::move(loc);  // the old Localizer (and its look-up's map) go
+    scaled_map_ = std::move(map);
+    double worst = 0;
+    for (const auto& o : refine_.applied()) worst = std::max({worst, std::abs(o.offset_a), std::abs(o.offset_b)});
+    char buf[200];
+    int k = std::snprintf(buf, sizeof buf, "plan corrected: scale %+.3f %% (estimate %+.3f +- %.3f %%)", 100 * s_new,
+                          100 * m.scale_error, 100 * m.scale_sigma);
+    if (refine_on_ && k > 0 && size_t(k) < sizeof buf)
+      std::snprintf(buf + k, sizeof buf - size_t(k), ", %zu walls refined (up to %.1f cm)", refine_.applied().size(), 100 * worst);
+    std::cerr << "[" << ctx_->name() << "] " << buf << "\n";
+    switch_text_ = buf;
+    switch_until_ = m.utime + 3'000'000;
   }
 
   // Per-element weights for the current floor's plan (all 1 until a plan diff flags elements); cfg_'s
@@ -237,6 +280,7 @@ class MatcherNode : public fploc::rt::Node {
     if (dropped) ctx_->error("features seq " + std::to_string(m.seq) + ": " + std::to_string(dropped) + " non-finite points dropped");
     fploc::localizer::FramePose fp = loc_->register_frame(f);
     if (tracker_) track_floor(f, &fp);
+    if (fp.match.status != FitStatus::kNotInitialised) last_pose_ = fp.match.pose, have_pose_ = true;
     fp.floor_index = floor_;
     fp.floor = floors_.building->floors[size_t(floor_)].name;
     const fploc::matcher::MatchResult& r = fp.match;
@@ -266,6 +310,13 @@ class MatcherNode : public fploc::rt::Node {
   bool have_ok_ = false;
   float diff_weight_ = 0;
   std::unique_ptr<fploc::matcher::ElementWeights> weights_;  // before loc_: the matcher reads it
+  bool scale_on_ = false, refine_on_ = false, scale_warned_ = false;
+  std::string lookup_name_;
+  fploc::matcher::ScaleCorrection scale_;
+  fploc::matcher::RefineCorrection refine_;
+  std::unique_ptr<fploc::matcher::LocalizationMap> scaled_map_;  // the rescaled plan in use (null: none); before loc_
+  fploc::Pose2 last_pose_;
+  bool have_pose_ = false;
   std::unique_ptr<fploc::localizer::Localizer> loc_;
   fploc::rt::Publisher<fploc::frame_pose_t> out_;
   int64_t seq_ = 0;

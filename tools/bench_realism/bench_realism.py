@@ -6,6 +6,9 @@ glass, shelves, doors, crowd-15, mixed): `fploc sim --perturb FAMILY` writes an 
 truth of the difference (LOG.world.json); `fploc replay` runs graphs/realism.pbtxt (fploc = matcher +
 optimizer, AMCL + LiDAR odometry, plan_diff) on it with --record, keeping every pose_t with its status and
 covariance; if a `fploc-ndt` binary and graphs/ndt.pbtxt exist, the NDT peer runs on the same log too.
+"fploc": matcher + optimizer with the online drawing-scale correction (options plan_diff_scale, their plan_diff
+inputs connected to FPLOC_PLAN_DIFF with plan_diff_weight 1 = no down-weighting; the plan_diff node then counts
+in fploc's CPU, run on --scale-frame-hz scans per second); --no-online-scale: the plain matcher + optimizer.
 "fploc+downweight": fploc with the plan diff used live, in the same single pass: the matcher and the optimizer
 subscribe to FPLOC_PLAN_DIFF (their `plan_diff` input) and give the elements it marks missing or moved (and
 the other face of such a wall) weight `plan_diff_weight` (0: left out).
@@ -26,7 +29,9 @@ Prints one JSON document on stdout (progress on stderr):
   {"rows": [{"family", "method", "ate_m", "max_m", "lost", "false_ok", "false_ok_poses", "poor", "nees_median", "nees_poses",
              "ms_per_scan", "ms_per_scan_localizer", "poses"}],
    "detection": [{"family", "removed", "removed_found", "moved", "moved_found", "added", "added_found",
-                  "flags", "false_flags", "false_flags_per_100m", "new_on_clutter", "precision", "recall",
+                  "doors_moved", "doors_moved_found" (both pieces), "door_opened_found" (the wall piece the new
+                  opening took: a missing part), "door_closed_found" (the old opening's piece that is wall now:
+                  new structure), "missing_parts", "flags", "false_flags", "false_flags_per_100m", "new_on_clutter", "precision", "recall",
                   "scale_true", "scale_estimate", "scale_sigma"}],
    "config": {...}}
 Rates (lost, false_ok, precision, recall) are fractions 0..1.
@@ -48,7 +53,7 @@ from fploc_tools import log, read_tum, yaw_of  # noqa: E402
 from lcm_log import decode_pose_t, events  # noqa: E402
 
 FAMILIES = ["clean", "asbuilt-2cm", "asbuilt-5cm", "scale-0.5pct", "renovated", "glass", "shelves", "doors",
-            "crowd-15", "mixed"]
+            "crowd-15", "mixed", "doors-moved"]
 # method -> (pose channel in the recorded log, nodes whose CPU time is the method's)
 # fploc+scale: fploc against the plan rescaled by the change detector's drawing-scale estimate (second pass,
 # only where the estimate is significant). fploc+diff: fploc against the plan the detector corrected (missing
@@ -206,6 +211,8 @@ def score_detection(diff, truth, moved_min=0.10, added_min=1.0):
                     found_m += 1
                     offset_err.append(abs(d["offset_m"] - t["offset_m"]))
             tp_flags += status in ("missing", "moved")
+        elif t["change"] == "door-moved":
+            tp_flags += status in ("missing", "moved")  # a face or jamb of a moved doorway: it did change
         elif status in ("missing", "moved"):
             # As built, a wall may really stand some cm off: a "moved" verdict within 3 cm of the truth is right.
             if status == "moved" and abs(d["offset_m"] - t["offset_m"]) <= 0.03 and abs(t["offset_m"]) >= 0.05:
@@ -242,14 +249,50 @@ def score_detection(diff, truth, moved_min=0.10, added_min=1.0):
             flags -= 1  # static clutter: unmapped and real, but not the building; counted apart
         else:
             false_flags += 1
+    # Doors moved: the piece of wall the new opening took (a missing part) and the piece of the old opening
+    # that is wall now (new structure continuing a wall), each found when >= half of it is reported within 15 cm.
+    def covered(a, b, segs, tol=0.15):
+        n = 40
+        hit = 0
+        for k in range(n + 1):
+            x = [a[0] + (b[0] - a[0]) * k / n, a[1] + (b[1] - a[1]) * k / n]
+            if any(seg_dist(x, s["a"], s["b"]) < tol for s in segs):
+                hit += 1
+        return math.hypot(b[0] - a[0], b[1] - a[1]) * hit / (n + 1)
+    parts = diff.get("missing_parts", [])
+    dm = truth.get("doors_moved", [])
+    opened_found = closed_found = doors_found = 0
+    for t in dm:
+        L = abs(t["shift_m"])
+        o = covered(t["opened"][0], t["opened"][1], parts) >= 0.5 * L
+        c = covered(t["closed"][0], t["closed"][1], diff["new"]) >= 0.5 * L
+        opened_found += o
+        closed_found += c
+        doors_found += o and c
+    for p in parts:
+        flags += 1
+        mid = [(p["a"][0] + p["b"][0]) / 2, (p["a"][1] + p["b"][1]) / 2]
+        if any(seg_dist(mid, t["opened"][0], t["opened"][1]) < 0.15 for t in dm):
+            tp_flags += 1
+        else:
+            false_flags += 1
+    for i, n in enumerate(diff["new"]):
+        # New structure on a closed piece of an old doorway was counted false above: it is right.
+        mid = [(n["a"][0] + n["b"][0]) / 2, (n["a"][1] + n["b"][1]) / 2]
+        if i not in matched and any(seg_dist(mid, t["closed"][0], t["closed"][1]) < 0.15 for t in dm) and \
+                not any(seg_dist(mid, a["a"], a["b"]) < 0.15 for a in others + added_truth) and not on_furniture(mid, furn):
+            false_flags -= 1
+            tp_flags += 1
     wall_m = truth.get("plan_wall_length_m") or 1
-    truth_n = removed + moved + len(added_truth)
+    truth_n = removed + moved + len(added_truth) + 2 * len(dm)
     return {"removed": removed, "removed_found": found_r, "moved": moved, "moved_found": found_m,
             "moved_offset_err_max_m": max(offset_err) if offset_err else None,
             "added": len(added_truth), "added_found": found_a, "flags": flags, "false_flags": false_flags,
             "false_flags_per_100m": false_flags / (wall_m / 100.0), "new_on_clutter": new_on_clutter,
+            "doors_moved": len(dm), "doors_moved_found": doors_found, "door_opened_found": opened_found,
+            "door_closed_found": closed_found, "missing_parts": len(parts),
             "precision": tp_flags / flags if flags else None,
-            "recall": (found_r + found_m + found_a) / truth_n if truth_n else None}
+            "recall": (found_r + found_m + found_a + opened_found + closed_found) / truth_n if truth_n else None}
 
 
 def scale_plan_json(src, dst, s):
@@ -365,13 +408,20 @@ class Bench:
         x0, y0, yaw0 = g[0][1], g[0][2], yaw_of(g[0])
         plan = os.path.join(ROOT, "data", "plans", "corridor.json" if self.a.scenario.startswith("corridor") else "room.json")
         rec = os.path.join(d, "run.lcm")
+        graph = os.path.join(ROOT, "graphs", "realism.pbtxt")
         sets = [f"{n}.plan.file={plan}" for n in ("matcher", "optimizer", "amcl_lidar", "plan_diff")]
         for n in ("matcher", "odometry", "amcl_lidar"):
             sets += [f"{n}.initial_pose.x={x0!r}", f"{n}.initial_pose.y={y0!r}", f"{n}.initial_pose.yaw={yaw0!r}"]
         sets += [f"wo_logger.file={os.path.join(d, 'wo.tum')}", f"amcl_lidar_logger.file={os.path.join(d, 'amcl.tum')}"]
-        cmd = [os.path.join(BIN, "fploc-replay"), "--graph", os.path.join(ROOT, "graphs", "realism.pbtxt"), "--log", logf,
-               "--record", rec, "--json"]
-        for s in sets:
+        main_sets = list(sets)
+        if self.a.online_scale:
+            # The online scale correction (matcher/plan_scale.h): the plan diff's estimate used live, no down-weighting.
+            graph = os.path.join(d, "realism-scale.pbtxt")
+            downweight_graph(os.path.join(ROOT, "graphs", "realism.pbtxt"), graph)
+            main_sets += [f"{n}.{k}" for n in ("matcher", "optimizer") for k in ("plan_diff_weight=1", "plan_diff_scale=true")]
+            main_sets += [f"plan_diff.frame_hz={self.a.scale_frame_hz}"]
+        cmd = [os.path.join(BIN, "fploc-replay"), "--graph", graph, "--log", logf, "--record", rec, "--json"]
+        for s in main_sets:
             cmd += ["--set", s]
         log(f"[{fam}] replaying fploc + AMCL + plan diff ...")
         rep = json.loads(run(cmd)[0].strip().splitlines()[-1])
@@ -381,6 +431,8 @@ class Bench:
             if m not in self.methods:
                 continue
             ch, nodes = METHODS[m]
+            if m == "fploc" and self.a.online_scale:
+                nodes = nodes + ("plan_diff",)
             rows.append(self.row(fam, m, poses_of(rec, ch), g, rep, nodes, scans))
         if "fploc+downweight" in self.methods:
             gdw = os.path.join(d, "realism-downweight.pbtxt")
@@ -388,7 +440,8 @@ class Bench:
             recd = os.path.join(d, "run-downweight.lcm")
             cmdd = [os.path.join(BIN, "fploc-replay"), "--graph", gdw, "--log", logf, "--record", recd,
                     "--record-channels", "FPLOC_POSE", "--json"]
-            for x in sets + [f"matcher.plan_diff_weight={self.a.downweight}", f"optimizer.plan_diff_weight={self.a.downweight}",
+            scale_sets = [f"{n}.plan_diff_scale=true" for n in ("matcher", "optimizer")] if self.a.online_scale else []
+            for x in sets + scale_sets + [f"matcher.plan_diff_weight={self.a.downweight}", f"optimizer.plan_diff_weight={self.a.downweight}",
                              f"plan_diff.out_json={os.path.join(d, 'diff-downweight.json')}"]:
                 cmdd += ["--set", x]
             log(f"[{fam}] replaying fploc with the plan diff's down-weighting (weight {self.a.downweight}) ...")
@@ -542,11 +595,12 @@ def markdown(res, cmdline):
           "Removed = removed walls/pillars and glass in view of the path; moved = walls moved >= 10 cm in view; "
           "added = partitions >= 1 m (found when >= half their length is reported within 15 cm); new structure on the "
           "simulator's furniture is counted apart (unmapped and real, but not the building):", "",
-          "| world | removed found | moved found | added found | flags | false flags | per 100 m of walls | new on furniture | precision | recall | scale true / estimated [%] |",
-          "|---|---|---|---|---|---|---|---|---|---|---|"]
+          "| world | removed found | moved found | added found | doors moved found (opened / closed piece) | flags | false flags | per 100 m of walls | new on furniture | precision | recall | scale true / estimated [%] |",
+          "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for d in res["detection"]:
         L.append(f"| {d['family']} | {d['removed_found']}/{d['removed']} | {d['moved_found']}/{d['moved']} | "
-                 f"{d['added_found']}/{d['added']} | {d['flags']} | {d['false_flags']} | {d['false_flags_per_100m']:.2f} | "
+                 f"{d['added_found']}/{d['added']} | {d.get('doors_moved_found', 0)}/{d.get('doors_moved', 0)} "
+                 f"({d.get('door_opened_found', 0)} / {d.get('door_closed_found', 0)}) | {d['flags']} | {d['false_flags']} | {d['false_flags_per_100m']:.2f} | "
                  f"{d['new_on_clutter']} | {fmt(d['precision'], 2)} | {fmt(d['recall'], 2)} | "
                  f"{100 * d['scale_true']:.2f} / {fmt(100 * d['scale_estimate'] if d['scale_estimate'] is not None else None, 3)} "
                  f"± {fmt(100 * d['scale_sigma'] if d['scale_sigma'] is not None else None, 3)} |")
@@ -569,6 +623,10 @@ def main():
     ap.add_argument("--downweight", type=float, default=0.0,
                     help="plan_diff_weight of fploc+downweight: weight of elements the diff flags (0 = left out)")
     ap.add_argument("--jobs", type=int, default=1, help="families simulated and replayed at once")
+    ap.add_argument("--no-online-scale", dest="online_scale", action="store_false",
+                    help="fploc and fploc+downweight without the online drawing-scale correction (plan_diff_scale)")
+    ap.add_argument("--scale-frame-hz", type=float, default=2.0,
+                    help="scans per second the live plan diff of the fploc row uses for its scale estimate (2)")
     a = ap.parse_args()
     fams = [f for f in a.families.split(",") if f]
     for f in fams:
@@ -584,7 +642,8 @@ def main():
         f"{'' if b.have_ndt or 'ndt' not in b.methods else ' (no fploc-ndt: NDT left out)'}; work in {work}")
     res = {"rows": [], "detection": [], "config": {"scenario": a.scenario, "seed": a.seed, "duration": a.duration,
                                                    "families": fams, "ndt": b.have_ndt, "false_ok_m": FALSE_OK_M,
-                                                   "methods": b.methods, "downweight": a.downweight}}
+                                                   "methods": b.methods, "downweight": a.downweight,
+                                                   "online_scale": a.online_scale, "scale_frame_hz": a.scale_frame_hz}}
     try:
         from concurrent.futures import ThreadPoolExecutor
         with ThreadPoolExecutor(max_workers=max(1, a.jobs)) as ex:

@@ -16,7 +16,8 @@ void write_json(const Diff& d, const FloorPlan& plan, std::ostream& out, bool al
                   {"missing", d.count(Status::kMissing)},
                   {"moved", d.count(Status::kMoved)},
                   {"unobserved", d.count(Status::kUnobserved)},
-                  {"new", d.added.size()}};
+                  {"new", d.added.size()},
+                  {"missing_parts", d.missing_parts.size()}};
   j["scale"] = {{"error", d.scale_error}, {"sigma", d.scale_sigma}, {"points", d.scale_points}};
   auto& el = j["elements"] = nlohmann::json::array();
   for (const auto& e : d.elements) {
@@ -41,7 +42,15 @@ void write_json(const Diff& d, const FloorPlan& plan, std::ostream& out, bool al
   auto& nw = j["new"] = nlohmann::json::array();
   for (const auto& n : d.added)
     nw.push_back({{"a", {n.a.x(), n.a.y()}}, {"b", {n.b.x(), n.b.y()}}, {"length_m", n.length()}, {"cells", n.cells},
-                  {"min_frames", n.min_frames}, {"rms_m", n.rms_m}});
+                  {"min_frames", n.min_frames}, {"rms_m", n.rms_m}, {"extends", n.extends}});
+  auto& rf = j["refined"] = nlohmann::json::array();
+  for (const auto& r : d.refined)
+    rf.push_back({{"id", r.element}, {"offset_a", r.offset_a}, {"offset_b", r.offset_b}, {"frames", r.frames}});
+  auto& mp = j["missing_parts"] = nlohmann::json::array();
+  for (const auto& m : d.missing_parts)
+    mp.push_back({{"id", m.element}, {"a", {m.a.x(), m.a.y()}}, {"b", {m.b.x(), m.b.y()}}, {"length_m", m.length()},
+                  {"seen_ratio", m.expected ? double(m.seen) / double(m.expected) : 0.0},
+                  {"through_ratio", m.expected ? double(m.through) / double(m.expected) : 0.0}});
   out << j.dump(1) << "\n";
 }
 
@@ -134,6 +143,7 @@ void write_dxf(const Diff& d, const FloorPlan& plan, std::ostream& o) {
       }
     }
   }
+  for (const auto& m : d.missing_parts) entity(o, Element::segment(m.a, m.b), "FPLOC-MISSING");
   for (const auto& n : d.added) entity(o, Element::segment(n.a, n.b), "FPLOC-NEW");
   pair(o, 0, "ENDSEC");
   pair(o, 0, "EOF");

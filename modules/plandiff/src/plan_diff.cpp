@@ -2,6 +2,7 @@
 
 #include "fploc/core/segment2d.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -87,6 +88,12 @@ PlanDiff::PlanDiff(FloorPlan plan, Options o) : plan_(std::move(plan)), o_(o) {
       }
     }
   }
+  ref_H_ = Eigen::MatrixXd::Zero(2 * long(plan_.elements.size()), 2 * long(plan_.elements.size()));
+  ref_g_ = Eigen::VectorXd::Zero(2 * long(plan_.elements.size()));
+  ref_frames_.assign(plan_.elements.size(), 0);
+  probe_expected_.assign(probes_.size(), 0);
+  probe_seen_.assign(probes_.size(), 0);
+  probe_through_.assign(probes_.size(), 0);
   const Box2 bb = plan_.bounds();
   gmin_ = bb.min - V2(1, 1);
   gx_ = int(std::ceil((bb.max.x() - gmin_.x() + 1) / gcell_)) + 1;
@@ -147,6 +154,54 @@ int PlanDiff::nearest(const V2& p, double* signed_offset, bool* inside, const V2
   return best;
 }
 
+bool PlanDiff::extends_beyond_end(const V2& p) const {
+  const int cx = int(std::floor((p.x() - gmin_.x()) / gcell_)), cy = int(std::floor((p.y() - gmin_.y()) / gcell_));
+  if (cx < 0 || cy < 0 || cx >= gx_ || cy >= gy_) return false;
+  const auto& cands = grid_[size_t(cx * gy_ + cy)];
+  for (int e : cands) {
+    const Element& el = plan_.elements[size_t(e)];
+    if (el.kind != ElementKind::kSegment) continue;
+    const V2 d = el.b - el.a;
+    const double len = d.norm();
+    if (len < 1e-6 || std::abs(left_normal(el).dot(p - el.a)) >= o_.ext_lateral_m) continue;
+    const double t = (p - el.a).dot(d) / len;  // along the segment [m]
+    if (t > -o_.ext_min_beyond_m && t < len + o_.ext_min_beyond_m) continue;
+    // On the segment's line past its end, and on no other element (the wall meeting it at a corner, a jamb).
+    bool clear = true;
+    for (int i : cands)
+      if (i != e && distance(plan_.elements[size_t(i)], p) < o_.ext_clear_m) {
+        clear = false;
+        break;
+      }
+    if (clear) return true;
+  }
+  return false;
+}
+
+int PlanDiff::extended_element(const V2& a, const V2& b) const {
+  const V2 u = (b - a).normalized();
+  int best = -1;
+  double best_d = o_.ext_touch_m;
+  for (size_t i = 0; i < plan_.elements.size(); ++i) {
+    const Element& e = plan_.elements[i];
+    if (e.kind != ElementKind::kSegment) continue;
+    const double len = (e.b - e.a).norm();
+    if (len < 0.3) continue;
+    const V2 v = (e.b - e.a) / len;
+    if (std::abs(cross2(u, v)) > 0.09) continue;  // ~5 deg
+    const V2 n(-v.y(), v.x());
+    if (std::abs(n.dot(a - e.a)) > o_.ext_lateral_m || std::abs(n.dot(b - e.a)) > o_.ext_lateral_m) continue;
+    // The run lies past one end (overlapping the segment by at most ext_touch_m) and starts near it.
+    double s0 = v.dot(a - e.a), s1 = v.dot(b - e.a);
+    if (s0 > s1) std::swap(s0, s1);
+    double gap = kInf;
+    if (s0 >= len - o_.ext_touch_m) gap = std::abs(s0 - len);
+    else if (s1 <= o_.ext_touch_m) gap = std::abs(s1);
+    if (gap < best_d) best_d = gap, best = int(i);
+  }
+  return best;
+}
+
 bool PlanDiff::plan_blocks(const V2& o, const V2& q, int skip) const {
   // Elements in the grid cells the ray passes (sampled at half a cell, with the neighbours).
   const double len = (q - o).norm();
@@ -183,6 +238,7 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
   std::vector<std::vector<Obs>> bins(static_cast<size_t>(nb));
   std::vector<float> min_range(size_t(nb), std::numeric_limits<float>::infinity());
   std::vector<std::vector<float>> offs(plan_.elements.size());
+  std::vector<V2> along_sum(plan_.elements.size(), V2::Zero());  // sum of (point - sensor) of the inside points
   Eigen::Matrix3d sA = Eigen::Matrix3d::Zero();
   Eigen::Vector3d sg = Eigen::Vector3d::Zero();
   double so2 = 0;
@@ -195,11 +251,16 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
     double off = 0;
     bool inside = false;
     const int e = nearest(p, &off, &inside, &s);
+    bool e_as_new = false;  // continues a wall beyond its drawn end: unexplained (see extends_beyond_end)
     const int b = bin_of(p - s);
     bins[size_t(b)].push_back({float(r), e});
     min_range[size_t(b)] = std::min(min_range[size_t(b)], float(r));
-    if (e >= 0) {
-      if (inside) offs[size_t(e)].push_back(float(off));
+    if (e >= 0 && !inside && extends_beyond_end(p)) e_as_new = true;
+    if (e >= 0 && !e_as_new) {
+      if (inside) {
+        offs[size_t(e)].push_back(float(off));
+        along_sum[size_t(e)] += p - s;
+      }
       const Element& el = plan_.elements[size_t(e)];
       if (inside && el.kind == ElementKind::kSegment && std::abs(off) < o_.scale_max_offset_m) {
         // Scale model: off = scale * n.(q - sensor) + n.b (b: this scan's registration bias).
@@ -228,6 +289,52 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
   }
   for (size_t e = 0; e < offs.size(); ++e)
     if (offs[e].size() >= 5) acc_[e].frame_offsets.push_back(float(median_of(offs[e])));
+  // As-built refinement: median offset of each wall = (1 - t) o_a + t o_b + c . (bx, by, byaw) (c: how the
+  // scan's registration error moves the wall's points along its normal); the scan's error is eliminated
+  // (Schur complement) and the rest accumulated over the run.
+  {
+    struct RObs {
+      int e;
+      double t, m;
+      Eigen::Vector3d c;
+    };
+    std::vector<RObs> obs;
+    for (size_t e = 0; e < offs.size(); ++e) {
+      const Element& el = plan_.elements[e];
+      if (el.kind != ElementKind::kSegment || int(offs[e].size()) < o_.refine_min_points) continue;
+      const V2 d = el.b - el.a;
+      const V2 rc = along_sum[e] / double(offs[e].size());  // mean point, relative to the sensor
+      const double t = std::clamp((s + rc - el.a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+      const V2 n = left_normal(el);
+      obs.push_back({int(e), t, median_of(offs[e]), Eigen::Vector3d(-n.x(), -n.y(), -(n.y() * rc.x() - n.x() * rc.y()))});
+    }
+    Eigen::Matrix3d Hbb = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d gb = Eigen::Vector3d::Zero();
+    for (const auto& o : obs) Hbb += o.c * o.c.transpose(), gb += o.c * o.m;
+    Eigen::LDLT<Eigen::Matrix3d> ldlt(Hbb);
+    const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Hbb).eigenvalues();
+    if (obs.size() >= 4 && ev.minCoeff() > 1e-6 * std::max(1.0, ev.maxCoeff())) {
+      std::vector<Eigen::Vector3d> Ki(obs.size());  // Hbb^-1 c_k
+      for (size_t k = 0; k < obs.size(); ++k) Ki[k] = ldlt.solve(obs[k].c);
+      const Eigen::Vector3d bg = ldlt.solve(gb);
+      for (size_t k = 0; k < obs.size(); ++k) {
+        const long ia = 2 * obs[k].e, ib = ia + 1;
+        const double wa = 1 - obs[k].t, wb = obs[k].t;
+        ref_g_[ia] += wa * (obs[k].m - obs[k].c.dot(bg));
+        ref_g_[ib] += wb * (obs[k].m - obs[k].c.dot(bg));
+        for (size_t l = 0; l < obs.size(); ++l) {
+          const long ja = 2 * obs[l].e, jb = ja + 1;
+          const double v = (k == l ? 1.0 : 0.0) - obs[k].c.dot(Ki[l]);
+          const double xa = 1 - obs[l].t, xb = obs[l].t;
+          ref_H_(ia, ja) += wa * v * xa;
+          ref_H_(ia, jb) += wa * v * xb;
+          ref_H_(ib, ja) += wb * v * xa;
+          ref_H_(ib, jb) += wb * v * xb;
+        }
+        ++ref_frames_[size_t(obs[k].e)];
+      }
+    }
+  }
   // The scan's bias (b) eliminated (Schur complement): what this scan tells about the scale.
   if (scount >= 20) {
     const Eigen::Matrix2d Abb = sA.bottomRightCorner<2, 2>();
@@ -262,7 +369,8 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
   // well in front of it) and seen (a point of this element in the probe's bearing).
   const double sin_inc = std::sin(o_.min_incidence_deg * M_PI / 180);
   std::vector<int> expected(plan_.elements.size(), 0);
-  for (const Probe& pr : probes_) {
+  for (size_t pi = 0; pi < probes_.size(); ++pi) {
+    const Probe& pr = probes_[pi];
     const V2 d = pr.p - s;
     const double r = d.norm();
     if (r < o_.min_range_m + 0.2 || r > o_.max_range_m - 0.5) continue;
@@ -288,6 +396,17 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
     ++a.expected;
     ++expected[size_t(pr.element)];
     if (seen) ++a.seen;
+    ++probe_expected_[pi];
+    if (seen) {
+      ++probe_seen_[pi];
+    } else {
+      // Seen through: something measured beyond the probe in its bearing (the wall is not there).
+      for (const Obs& ob : bins[size_t(b)])
+        if (ob.range > r + o_.part_through_m) {
+          ++probe_through_[pi];
+          break;
+        }
+    }
   }
   for (size_t e = 0; e < expected.size(); ++e)
     if (expected[e] > 0) ++acc_[e].frames_expected;
@@ -304,6 +423,26 @@ Diff PlanDiff::result() const {
     const double per_scan = double(scale_n_) / std::max(1, frames_);
     d.scale_sigma = std::sqrt(var / scale_h_ * std::max(1.0, per_scan));
     d.scale_points = scale_n_;
+  }
+  // As-built refinement: (H / sigma_obs^2 + I / sigma_prior^2) o = g / sigma_obs^2.
+  {
+    const double lam = std::pow(o_.refine_obs_sigma_m / o_.refine_prior_m, 2);
+    Eigen::MatrixXd H = ref_H_;
+    H.diagonal().array() += lam;
+    const Eigen::VectorXd o = H.ldlt().solve(ref_g_);
+    const double kmin = o_.refine_min_info;
+    for (size_t i = 0; i < plan_.elements.size(); ++i) {
+      const long a = 2 * long(i), b = a + 1;
+      if (ref_frames_[i] < o_.min_frames || !std::isfinite(o[a]) || !std::isfinite(o[b])) continue;
+      // Both ends observed well enough (the data's own information on each, scans' errors eliminated), else
+      // the mean offset (a wall seen near one end only), else nothing.
+      if (o_.refine_ends && ref_H_(a, a) >= kmin && ref_H_(b, b) >= kmin) {
+        d.refined.push_back({int(i), o[a], o[b], ref_frames_[i]});
+      } else if (ref_H_(a, a) + ref_H_(b, b) + 2 * ref_H_(a, b) >= 4 * kmin) {
+        const double m = 0.5 * (o[a] + o[b]);
+        d.refined.push_back({int(i), m, m, ref_frames_[i]});
+      }
+    }
   }
   d.elements.resize(plan_.elements.size());
   for (size_t i = 0; i < plan_.elements.size(); ++i) {
@@ -330,6 +469,50 @@ Diff PlanDiff::result() const {
       e.status = Status::kMoved;
     else if (e.frames_with_points > 0 || a.seen > 0)
       e.status = Status::kSeen;
+  }
+
+  // Missing parts of elements otherwise seen: runs of probes expected, not seen, and seen through.
+  for (size_t k = 0; k < probes_.size();) {
+    const int el = probes_[k].element;
+    size_t end = k;
+    while (end < probes_.size() && probes_[end].element == el) ++end;
+    const Element& pe = plan_.elements[size_t(el)];
+    if (pe.kind == ElementKind::kSegment && d.elements[size_t(el)].status == Status::kSeen) {
+      // Of the expected observations that measured something at or beyond the probe (a sparse scan often
+      // has no point in a probe's bearing at all), most saw through it.
+      auto gone = [&](size_t i) {
+        const int told = probe_seen_[i] + probe_through_[i];
+        return probe_expected_[i] >= o_.part_min_expected && probe_through_[i] >= o_.part_min_through &&
+               probe_seen_[i] < o_.part_seen_ratio * told;
+      };
+      const double n = double(end - k);
+      for (size_t i = k; i < end;) {
+        if (!gone(i)) {
+          ++i;
+          continue;
+        }
+        MissingPart mp;
+        mp.element = el;
+        size_t j = i;
+        for (; j < end && gone(j); ++j) {
+          mp.expected += probe_expected_[j];
+          mp.seen += probe_seen_[j];
+          mp.through += probe_through_[j];
+        }
+        // Probe q sits at (q + 0.5) / n of the segment: the piece spans its probes' cells, and half the cell
+        // of a neighbour that was seen through about as often as seen (the piece's end lies in that cell).
+        auto half = [&](size_t q) {
+          const int told = probe_seen_[q] + probe_through_[q];
+          return probe_through_[q] >= o_.part_min_through && probe_seen_[q] < 2 * o_.part_seen_ratio * told ? 0.5 : 0.0;
+        };
+        const double t0 = double(i - k) - (i > k ? half(i - 1) : 0.0), t1 = double(j - k) + (j < end ? half(j) : 0.0);
+        mp.a = pe.a + (t0 / n) * (pe.b - pe.a);
+        mp.b = pe.a + (t1 / n) * (pe.b - pe.a);
+        d.missing_parts.push_back(mp);
+        i = j;
+      }
+    }
+    k = end;
   }
 
   // New structure: cells hit in enough frames, then straight runs by greedy RANSAC.
@@ -362,11 +545,13 @@ Diff PlanDiff::result() const {
     return size_t(rs >> 33) % n;
   };
   const int min_cells = std::max(6, int(0.4 * o_.new_min_length_m / o_.new_cell_m));
+  const int ext_min_cells = std::max(4, int(0.4 * o_.ext_min_length_m / o_.new_cell_m));
+  const int any_min_cells = std::min(min_cells, ext_min_cells);
   for (int round = 0; round < 40; ++round) {
     std::vector<size_t> free;
     for (size_t i = 0; i < P.size(); ++i)
       if (!used[i]) free.push_back(i);
-    if (int(free.size()) < min_cells) break;
+    if (int(free.size()) < any_min_cells) break;
     size_t best_a = 0, best_b = 0;
     int best_n = 0;
     for (int it = 0; it < 400; ++it) {
@@ -378,7 +563,7 @@ Diff PlanDiff::result() const {
         if (std::abs(cross2(u, P[i] - P[a])) < o_.new_line_tol_m) ++n;
       if (n > best_n) best_n = n, best_a = a, best_b = b;
     }
-    if (best_n < min_cells) break;
+    if (best_n < any_min_cells) break;
     const V2 u = (P[best_b] - P[best_a]).normalized();
     std::vector<std::pair<double, size_t>> on;
     for (size_t i : free)
@@ -390,7 +575,7 @@ Diff PlanDiff::result() const {
       // Run on[s0 .. k-1].
       const double len = on[k - 1].first - on[s0].first + o_.new_cell_m;
       const int n = int(k - s0);
-      if (len >= o_.new_min_length_m && n >= min_cells) {
+      if ((len >= o_.new_min_length_m && n >= min_cells) || (len >= o_.ext_min_length_m && n >= ext_min_cells)) {
         V2 m = V2::Zero();
         for (size_t j = s0; j < k; ++j) m += P[on[j].second];
         m /= n;
@@ -414,6 +599,12 @@ Diff PlanDiff::result() const {
         NewStructure ns;
         ns.a = m + lo * v;
         ns.b = m + hi * v;
+        ns.extends = extended_element(ns.a, ns.b);
+        // Shorter than new_min_length_m: only as a wall's continuation.
+        if (!(len >= o_.new_min_length_m && n >= min_cells) && ns.extends < 0) {
+          s0 = k;
+          continue;
+        }
         ns.cells = n;
         ns.min_frames = fmin;
         ns.rms_m = std::sqrt(ss / n);

@@ -2,6 +2,7 @@
 // from poses along the demo room's loop, diffed against the original plan.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -23,7 +24,9 @@ struct DiffRun {
   plandiff::Diff diff;
 };
 
-DiffRun simulate_and_diff(const std::string& family, uint64_t seed) {
+// pose_error_m > 0: every scan is given to the diff with its pose off by a random (x, y, yaw) error of
+// about that size (a registration error, the same for all its points).
+DiffRun simulate_and_diff(const std::string& family, uint64_t seed, double pose_error_m = 0) {
   DiffRun r;
   r.plan = sim::demo_room_plan();
   sim::SimulatorOptions so;
@@ -51,7 +54,15 @@ DiffRun simulate_and_diff(const std::string& family, uint64_t seed) {
       const double rel = a - yaw;
       pts.emplace_back(float(h.t * std::cos(rel)), float(h.t * std::sin(rel)));
     }
-    d.add_frame(o.x(), o.y(), yaw, pts);
+    double ex = 0, ey = 0, eyaw = 0;
+    if (pose_error_m > 0) {
+      auto u = [&st] {
+        st = st * 6364136223846793005ull + 1442695040888963407ull;
+        return double(st >> 11) * 0x1.0p-53 - 0.5;
+      };
+      ex = 2 * pose_error_m * u(), ey = 2 * pose_error_m * u(), eyaw = 2 * pose_error_m / 10 * u();
+    }
+    d.add_frame(o.x() + ex, o.y() + ey, yaw + eyaw, pts);
   }
   r.diff = d.result();
   return r;
@@ -104,7 +115,55 @@ TEST(PlanDiff, CleanWorldHasNoFlags) {
   EXPECT_EQ(r.diff.count(plandiff::Status::kMissing), 0);
   EXPECT_EQ(r.diff.count(plandiff::Status::kMoved), 0);
   EXPECT_TRUE(r.diff.added.empty()) << r.diff.added.size() << " new, first " << r.diff.added[0].a.transpose();
+  EXPECT_TRUE(r.diff.missing_parts.empty()) << r.diff.missing_parts.size() << " missing parts, first on element "
+                                            << r.diff.missing_parts[0].element;
   EXPECT_GT(r.diff.count(plandiff::Status::kSeen), 20);
+}
+
+namespace {
+// Length of the part of segment a-b within tol of segment p-q (sampled).
+double covered(const V2& a, const V2& b, const V2& p, const V2& q, double tol = 0.1) {
+  int in = 0;
+  const int n = 50;
+  for (int k = 0; k <= n; ++k) {
+    const V2 x = a + (double(k) / n) * (b - a);
+    const V2 d = q - p;
+    const double t = std::clamp((x - p).dot(d) / d.squaredNorm(), 0.0, 1.0);
+    if ((p + t * d - x).norm() < tol) ++in;
+  }
+  return (b - a).norm() * in / (n + 1);
+}
+}  // namespace
+
+TEST(PlanDiff, FindsMovedDoors) {
+  // Doorways shifted along their wall: the piece of wall the new opening took is a missing part of that
+  // wall; the piece of the old opening that is wall now continues the other wall beyond its drawn end.
+  for (uint64_t seed : {1u, 2u}) {
+    const DiffRun r = simulate_and_diff("doors-moved", seed);
+    ASSERT_EQ(r.edit.doors_moved.size(), 2u);
+    for (const auto& dm : r.edit.doors_moved) {
+      double opened = 0, closed = 0;
+      for (const auto& m : r.diff.missing_parts) opened += covered(dm.opened_a, dm.opened_b, m.a, m.b);
+      for (const auto& n : r.diff.added)
+        if (n.extends >= 0) closed += covered(dm.closed_a, dm.closed_b, n.a, n.b);
+      const double len = std::abs(dm.shift_m);
+      EXPECT_GE(opened, 0.5 * len) << "seed " << seed << " door " << dm.from_a.transpose() << ": opened piece";
+      // The closed piece is seen from inside the room only, and shortened by the old jambs' clearance: in
+      // these sparse scans (every 5th pose, a third of the beams) it is found from about 0.6 m.
+      if (len >= 0.6) EXPECT_GE(closed, 0.5 * len) << "seed " << seed << " door " << dm.from_a.transpose() << ": closed piece";
+    }
+    // Nothing else: missing parts only on the doors' walls, no whole wall missing or moved.
+    for (const auto& m : r.diff.missing_parts)
+      EXPECT_EQ(r.edit.elements[size_t(m.element)].change, sim::ElementChange::kDoorMoved) << "element " << m.element;
+    for (size_t i = 0; i < r.plan.elements.size(); ++i)
+      if (r.edit.elements[i].change == sim::ElementChange::kUnchanged)
+        EXPECT_TRUE(r.diff.elements[i].status != plandiff::Status::kMissing && r.diff.elements[i].status != plandiff::Status::kMoved)
+            << "element " << i;
+    std::ostringstream js;
+    plandiff::write_json(r.diff, r.plan, js);
+    EXPECT_NE(js.str().find("\"missing_parts\""), std::string::npos);
+    if (!r.diff.added.empty()) EXPECT_NE(js.str().find("\"extends\""), std::string::npos);
+  }
 }
 
 TEST(PlanDiff, DxfHasTheLayersAndLoadsBack) {
@@ -119,7 +178,7 @@ TEST(PlanDiff, DxfHasTheLayersAndLoadsBack) {
   { std::ofstream(path) << text; }
   const FloorPlan back = load_floor_plan(path, {"FPLOC-MISSING", "FPLOC-MOVED", "FPLOC-NEW"});
   EXPECT_EQ(back.elements.size(), size_t(r.diff.count(plandiff::Status::kMissing) + r.diff.count(plandiff::Status::kMoved)) +
-                                      r.diff.added.size());
+                                      r.diff.added.size() + r.diff.missing_parts.size());
   std::ostringstream js;
   plandiff::write_json(r.diff, r.plan, js);
   EXPECT_NE(js.str().find("\"missing\""), std::string::npos);
@@ -133,4 +192,42 @@ TEST(PlanDiff, EstimatesTheDrawingScale) {
   EXPECT_LT(s.diff.scale_sigma, 0.002);
   const DiffRun c = simulate_and_diff("crowd-15", 4);  // to scale
   EXPECT_NEAR(c.diff.scale_error, 0.0, 0.001);
+}
+
+// As-built refinement: every wall 5 cm-ish off (sigma per end), every scan registered with its own error of
+// up to 3 cm and 0.2 deg: the walls' offsets come back up to a rigid motion of the whole plan (which no
+// scan can tell from its own registration error: the prior keeps the offsets as small as the data allow).
+TEST(PlanDiff, RefinesAsBuiltWalls) {
+  const DiffRun r = simulate_and_diff("asbuilt-5cm", 3, 0.03);
+  ASSERT_GT(r.diff.refined.size(), 15u);
+  // Error of each wall's mid offset; its rigid part (x, y, rotation about the plan's centre) fitted and removed.
+  const V2 c = 0.5 * (r.plan.bounds().min + r.plan.bounds().max);
+  std::vector<double> err;
+  std::vector<Eigen::Vector3d> rows;
+  double tru2 = 0;
+  for (const auto& rs : r.diff.refined) {
+    if (rs.frames < 20) continue;
+    const auto& t = r.edit.elements[size_t(rs.element)];
+    const Element& e = r.plan.elements[size_t(rs.element)];
+    const V2 u = (e.b - e.a).normalized(), n(-u.y(), u.x()), m = 0.5 * (e.a + e.b) - c;
+    err.push_back(0.5 * (rs.offset_a + rs.offset_b) - t.offset_m);
+    rows.emplace_back(n.x(), n.y(), n.y() * m.x() - n.x() * m.y());
+    tru2 += t.offset_m * t.offset_m;
+  }
+  ASSERT_GT(err.size(), 10u);
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d g = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < err.size(); ++i) A += rows[i] * rows[i].transpose(), g += rows[i] * err[i];
+  const Eigen::Vector3d rigid = A.ldlt().solve(g);
+  double res2 = 0;
+  for (size_t i = 0; i < err.size(); ++i) res2 += std::pow(err[i] - rows[i].dot(rigid), 2);
+  const double res = std::sqrt(res2 / double(err.size())), tru = std::sqrt(tru2 / double(err.size()));
+  EXPECT_LT(res, 0.3 * tru) << "refined offsets: rms error " << res << " m after the rigid part, offsets rms " << tru << " m";
+  EXPECT_LT(res, 0.01);
+  // A plan to scale and as drawn: nothing to refine beyond millimetres.
+  const DiffRun cl = simulate_and_diff("crowd-15", 2, 0.03);
+  for (const auto& rs : cl.diff.refined) {
+    EXPECT_LT(std::abs(rs.offset_a), 0.01) << "element " << rs.element;
+    EXPECT_LT(std::abs(rs.offset_b), 0.01) << "element " << rs.element;
+  }
 }

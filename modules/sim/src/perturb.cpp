@@ -13,6 +13,7 @@
 #include "fploc/floorplan/io.h"
 #include "fploc/core/rng.h"
 #include "fploc/core/segment2d.h"
+#include "perturb_doors.h"
 
 namespace fploc::sim {
 namespace {
@@ -134,12 +135,14 @@ const char* change_name(ElementChange c) {
     case ElementChange::kMoved: return "moved";
     case ElementChange::kRemoved: return "removed";
     case ElementChange::kGlass: return "glass";
+    case ElementChange::kDoorMoved: return "door-moved";
   }
   return "?";
 }
 
 std::vector<std::string> perturb_family_names() {
-  return {"clean", "asbuilt-2cm", "asbuilt-5cm", "scale-0.5pct", "renovated", "glass", "shelves", "doors", "crowd-15", "mixed"};
+  return {"clean", "asbuilt-2cm", "asbuilt-5cm", "scale-0.5pct", "renovated", "glass", "shelves", "doors", "crowd-15", "mixed",
+          "doors-moved"};
 }
 
 PerturbOptions perturb_family(const std::string& name) {
@@ -154,6 +157,7 @@ PerturbOptions perturb_family(const std::string& name) {
   else if (name == "shelves") o.shelves = 0.3;
   else if (name == "doors") o.doors = true;
   else if (name == "crowd-15") o.crowd = 15;
+  else if (name == "doors-moved") o.doors_moved = 2;
   else if (name == "mixed") {
     o.asbuilt_sigma_m = 0.02; o.remove = 1; o.add = 1; o.move = 1; o.glass = 0.15; o.doors = true; o.shelves = 0.15; o.crowd = 8;
   } else {
@@ -198,11 +202,16 @@ PerturbOptions parse_perturb(const std::string& spec) {
     else if (k == "doors") need(x == 0 || x == 1, "0 or 1"), o.doors = x == 1;
     else if (k == "shelves") need(x >= 0 && x <= 1, "a fraction 0..1"), o.shelves = x;
     else if (k == "crowd") need(count_ok, "a count"), o.crowd = int(x);
+    else if (k == "doors_moved") need(count_ok, "a count"), o.doors_moved = int(x);
+    else if (k == "door_shift_min") need(x > 0 && x < 5, "metres 0..5"), o.door_shift_min_m = x;
+    else if (k == "door_shift_max") need(x > 0 && x < 5, "metres 0..5"), o.door_shift_max_m = x;
     else
       throw std::runtime_error("--perturb: unknown key '" + k +
-                               "' (keys: asbuilt, scale, remove, add, move, move_min, move_max, glass, doors, shelves, crowd)");
+                               "' (keys: asbuilt, scale, remove, add, move, move_min, move_max, glass, doors, shelves, crowd, "
+                               "doors_moved, door_shift_min, door_shift_max)");
   }
   if (o.move_max_m < o.move_min_m) throw std::runtime_error("--perturb: move_max < move_min");
+  if (o.door_shift_max_m < o.door_shift_min_m) throw std::runtime_error("--perturb: door_shift_max < door_shift_min");
   return o;
 }
 
@@ -337,6 +346,12 @@ WorldEdit perturb_world(const FloorPlan& plan, const std::vector<V2>& path, cons
       take(id, ElementChange::kGlass);
       glass += seg_len(plan.elements[size_t(id)]);
     }
+  }
+
+  // Renovation: doorways moved along their wall (own random stream: the other perturbations stay as they were).
+  if (o.doors_moved > 0) {
+    Rng drng(mix_seed(seed, 0xD00Bu));
+    detail::move_doors(plan, path, o.doors_moved, o.door_shift_min_m, o.door_shift_max_m, drng, cur, w);
   }
 
   // The world: plan elements that are still there (their world geometry), then what was added.
@@ -474,6 +489,11 @@ std::string WorldEdit::truth_json(const FloorPlan& plan) const {
   auto& ad = j["added"] = nlohmann::json::array();
   for (const auto& a : added)
     ad.push_back({{"kind", a.kind}, {"a", {a.a.x(), a.a.y()}}, {"b", {a.b.x(), a.b.y()}}, {"length_m", (a.b - a.a).norm()}});
+  auto& dm = j["doors_moved"] = nlohmann::json::array();
+  auto seg = [](const V2& a, const V2& b) { return nlohmann::json::array({{a.x(), a.y()}, {b.x(), b.y()}}); };
+  for (const auto& d : doors_moved)
+    dm.push_back({{"from", seg(d.from_a, d.from_b)}, {"to", seg(d.to_a, d.to_b)}, {"closed", seg(d.closed_a, d.closed_b)},
+                  {"opened", seg(d.opened_a, d.opened_b)}, {"shift_m", d.shift_m}, {"elements", d.elements}});
   j["shelves_fraction"] = wall_clutter;
   j["shelves"] = furniture.size();
   j["people"] = people.size();

@@ -159,3 +159,62 @@ TEST(WorldFile, BadInputIsOneClearError) {
   const std::string key = error_of("world_key.json", R"({"world": {"windows": []}})");
   EXPECT_NE(key.find("world.windows: unknown key"), std::string::npos) << key;
 }
+
+// "doors moved": a doorway shifted along its wall. Deterministic per seed; the truth says what closed and
+// what opened, and the world's wall ends (both faces, the jambs) are where the truth puts the new opening.
+TEST(Perturb, DoorsMovedDeterministicAndTruthMatchesTheWorld) {
+  const FloorPlan plan = demo_room_plan();
+  const auto path = room_path();
+  const PerturbOptions o = perturb_family("doors-moved");
+  EXPECT_EQ(o.doors_moved, 2);
+  const WorldEdit a = perturb_world(plan, path, o, 1), b = perturb_world(plan, path, o, 1);
+  EXPECT_EQ(a.truth_json(plan), b.truth_json(plan));
+  ASSERT_EQ(a.world.elements.size(), plan.elements.size());  // nothing removed or added: ends moved
+  for (size_t i = 0; i < a.world.elements.size(); ++i) {
+    EXPECT_EQ(a.world.elements[i].a, b.world.elements[i].a);
+    EXPECT_EQ(a.world.elements[i].b, b.world.elements[i].b);
+  }
+  ASSERT_EQ(a.doors_moved.size(), 2u) << a.truth_json(plan);  // the room's two doorways
+  bool differs = false;
+  for (uint64_t seed : {2u, 3u}) {
+    const WorldEdit c = perturb_world(plan, path, o, seed);
+    differs = differs || c.truth_json(plan) != a.truth_json(plan);
+  }
+  EXPECT_TRUE(differs);
+  for (const auto& d : a.doors_moved) {
+    EXPECT_GE(std::abs(d.shift_m), o.door_shift_min_m - 1e-9);
+    EXPECT_LE(std::abs(d.shift_m), o.door_shift_max_m + 1e-9);
+    EXPECT_NEAR((d.to_a - d.from_a).norm(), std::abs(d.shift_m), 1e-9);
+    EXPECT_NEAR((d.to_b - d.to_a).norm(), (d.from_b - d.from_a).norm(), 1e-9);
+    // Closed + opened pieces: each as long as the shift (shift < width here).
+    EXPECT_NEAR((d.closed_b - d.closed_a).norm(), std::abs(d.shift_m), 1e-9);
+    EXPECT_NEAR((d.opened_b - d.opened_a).norm(), std::abs(d.shift_m), 1e-9);
+    // Both faces and both jambs: at least 6 elements (4 faces, 2 jambs in room.json).
+    EXPECT_GE(d.elements.size(), 6u);
+    for (int id : d.elements) {
+      EXPECT_EQ(a.elements[size_t(id)].change, ElementChange::kDoorMoved);
+      EXPECT_EQ(change_name(a.elements[size_t(id)].change), std::string("door-moved"));
+    }
+    // The world has wall ends at the new opening's ends (inner face) and none at the old ones.
+    auto has_end = [&](const V2& x) {
+      for (const auto& e : a.world.elements)
+        if ((e.a - x).norm() < 1e-9 || (e.b - x).norm() < 1e-9) return true;
+      return false;
+    };
+    EXPECT_TRUE(has_end(d.to_a));
+    EXPECT_TRUE(has_end(d.to_b));
+    EXPECT_FALSE(has_end(d.from_a));
+    EXPECT_FALSE(has_end(d.from_b));
+    // The closed piece is wall now: a world segment covers its midpoint.
+    const V2 mid = 0.5 * (d.closed_a + d.closed_b);
+    double dmin = 1e9;
+    nearest_element_brute_force(a.world, mid, &dmin);
+    EXPECT_LT(dmin, 1e-6);
+  }
+  // The truth JSON lists them.
+  EXPECT_NE(a.truth_json(plan).find("\"doors_moved\""), std::string::npos);
+  EXPECT_NE(a.truth_json(plan).find("\"door-moved\""), std::string::npos);
+  // Bad values name the key.
+  EXPECT_THROW(parse_perturb("doors_moved=1.5"), std::runtime_error);
+  EXPECT_THROW(parse_perturb("door_shift_min=0.8,door_shift_max=0.5"), std::runtime_error);
+}

@@ -9,17 +9,21 @@
 
 #include "fploc/floorplan/plan.h"
 #include "fploc/matcher/element_weights.h"
+#include "fploc/matcher/plan_scale.h"
 #include "fploc/plandiff/plan_diff.h"
 
 namespace fploc::adapters {
 
 // Item kinds in plan_diff_t.kind.
-enum class PlanDiffKind : int8_t { kMissing = 1, kMoved = 2, kNew = 3 };
+enum class PlanDiffKind : int8_t { kMissing = 1, kMoved = 2, kNew = 3, kMissingPart = 4 };
 
 plan_diff_t to_msg(const plandiff::Diff& d, const FloorPlan& plan, int64_t utime, int64_t seq);
 
 // The MISSING and MOVED items with an element id (for the matcher's and the optimizer's per-element
 // weights, fploc/matcher/element_weights.h); NEW items (element -1) are skipped.
 std::vector<matcher::FlaggedElement> flagged_elements(const plan_diff_t& m);
+
+// The as-built refinement (refined_* fields): per-segment offsets at both ends (non-finite ones skipped).
+std::vector<matcher::SegmentOffset> refined_offsets(const plan_diff_t& m);
 
 }  // namespace fploc::adapters

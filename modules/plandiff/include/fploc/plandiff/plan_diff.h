@@ -8,6 +8,11 @@
 // a global drawing-scale error (the plan drawn or scanned at a slightly wrong scale);
 // and, for points near no plan element, a grid of cells hit in several frames from which straight runs
 // (RANSAC lines split at gaps) are reported as new structure.
+// Pieces (a doorway moved along its wall: the wall lost a piece to the new opening and grew over the
+// old one): a missing part is a run of an element's probes that were expected, not seen, and seen
+// *through* (something measured beyond them in their bearing, frame after frame); an extension is new
+// straight structure continuing a wall beyond its drawn end (points collinear with the wall past its
+// end go to the new-structure grid; such runs are reported from ext_min_length_m, with `extends`).
 // No transport: the node (nodes/plan_diff) and `fploc map diff` feed it.
 //
 //   fploc::plandiff::PlanDiff d(plan);
@@ -15,6 +20,7 @@
 //   fploc::plandiff::Diff r = d.result();  write_json(r, plan, out); write_dxf(r, plan, out);
 #pragma once
 #include <Eigen/Core>
+#include <Eigen/Dense>
 #include <cstdint>
 #include <iosfwd>
 #include <string>
@@ -46,6 +52,33 @@ struct Options {
   double new_line_tol_m = 0.05;
   double new_max_gap_m = 0.3;
   double scale_max_offset_m = 0.1;  // points this close to their wall enter the drawing-scale estimate
+  // Missing parts of an element otherwise seen: runs of probes each expected in >= part_min_expected frames,
+  // seen through (a point >= part_through_m beyond it in its bearing) in >= part_min_through of them, and
+  // seen in < part_seen_ratio of the frames that measured either.
+  int part_min_expected = 10;
+  int part_min_through = 5;
+  double part_seen_ratio = 0.4;
+  double part_through_m = 0.3;
+  // Extensions: points within ext_lateral_m of a segment's line, >= ext_min_beyond_m past its end and not
+  // within ext_clear_m of another element, are unexplained (new-structure grid); a run collinear with the
+  // segment starting within ext_touch_m of its end is reported from ext_min_length_m (else new_min_length_m).
+  double ext_lateral_m = 0.05;
+  double ext_min_beyond_m = 0.05;
+  double ext_clear_m = 0.08;
+  double ext_touch_m = 0.35;
+  double ext_min_length_m = 0.3;
+  // As-built refinement (Diff::refined): every scan's median offset of each wall it sees, at the mean
+  // position of its points along the wall, is (1 - t) o_a + t o_b minus the scan's registration error
+  // (x, y, yaw, eliminated per scan); o_a, o_b (each segment's offset at its ends) are solved over the run
+  // with a prior N(0, refine_prior_m) per end against refine_obs_sigma_m per observation.
+  double refine_prior_m = 0.05;
+  double refine_obs_sigma_m = 0.01;
+  int refine_min_points = 5;          // points of the wall in the scan for an observation
+  bool refine_ends = false;           // report each end's offset (else the wall's mean offset at both: the
+                                      // difference, a wall's rotation, is poorly observed and was measured to hurt)
+  double refine_min_info = 3;         // ends with this much information (in observations at that end, after the
+                                      // scans' errors) are reported, else the wall's mean offset if it has as
+                                      // much, else the wall is left as drawn
 };
 
 enum class Status : uint8_t { kUnobserved = 0, kSeen = 1, kMissing = 2, kMoved = 3 };
@@ -64,21 +97,41 @@ struct ElementDiff {
 
 struct NewStructure {
   Eigen::Vector2d a, b;
+  int extends = -1;           // the plan segment this run continues beyond its drawn end (-1: none)
   int cells = 0;
   int min_frames = 0;         // frames that hit its least-seen cell
   double rms_m = 0;           // of the cells about the line
   double length() const { return (b - a).norm(); }
 };
 
+// A piece of a plan segment that is gone (where the plan draws it), the rest of the element being there.
+struct MissingPart {
+  int element = -1;
+  Eigen::Vector2d a, b;
+  int64_t expected = 0, seen = 0, through = 0;  // probe observations over the piece
+  double length() const { return (b - a).norm(); }
+};
+
+// The plan refined to the building (as built): segment `element` offset along its left normal by
+// offset_a at its end a and offset_b at b. The frame is that of the whole plan (the per-scan registration
+// error is eliminated, the prior holds the gauge: the offsets are as small as the data allow).
+struct RefinedSegment {
+  int element = -1;
+  double offset_a = 0, offset_b = 0;
+  int frames = 0;  // scans that observed it
+};
+
 struct Diff {
   std::vector<ElementDiff> elements;  // one per plan element
   std::vector<NewStructure> added;
+  std::vector<MissingPart> missing_parts;
   int frames = 0;
   // Drawing scale: the building is (1 + scale_error) times the plan (0.005: the drawing is 0.5 % too small),
   // from every point's offset against its distance to the sensor along the wall's normal, each scan's
   // registration bias eliminated. 0 with scale_points 0 when there was too little to tell.
   double scale_error = 0, scale_sigma = 0;
   int64_t scale_points = 0;
+  std::vector<RefinedSegment> refined;  // segments observed in >= min_frames scans (empty: too little yet)
   int count(Status s) const;
 };
 
@@ -107,18 +160,24 @@ class PlanDiff {
     int frames = 0, last_frame = -1, points = 0, in_view = 0;
   };
   int nearest(const Eigen::Vector2d& p, double* signed_offset, bool* inside, const Eigen::Vector2d* sensor) const;
+  bool extends_beyond_end(const Eigen::Vector2d& p) const;
+  int extended_element(const Eigen::Vector2d& a, const Eigen::Vector2d& b) const;
   bool plan_blocks(const Eigen::Vector2d& o, const Eigen::Vector2d& q, int skip) const;
   void cells_of(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, std::vector<int>& out) const;
 
   FloorPlan plan_;
   Options o_;
   std::vector<Probe> probes_;
+  std::vector<int> probe_expected_, probe_seen_, probe_through_;  // per probe
   std::vector<Acc> acc_;
   std::unordered_map<int64_t, Cell> cells_;  // new_cell_m: where
   std::unordered_map<int64_t, Cell> view_;   // new_view_cell_m: hit in how many of the scans that saw it
   int frames_ = 0;
   double scale_h_ = 0, scale_g_ = 0, scale_o2_ = 0;
   int64_t scale_n_ = 0;
+  Eigen::MatrixXd ref_H_;   // as-built refinement: normal equations in (o_a, o_b) per segment, scans eliminated
+  Eigen::VectorXd ref_g_;
+  std::vector<int> ref_frames_;
   // Uniform grid of elements (1 m cells, bounding boxes grown by assoc_m) for the point association.
   Eigen::Vector2d gmin_;
   int gx_ = 0, gy_ = 0;
@@ -129,11 +188,13 @@ class PlanDiff {
 // {"frames", "summary": {"seen", "missing", "moved", "unobserved", "new"}, "scale": {"error", "sigma", "points"},
 //  "elements": [{"id", "status",
 //  "offset_m", "offset_spread_m", "seen_ratio", "frames_expected", "frames_with_points", "a", "b" | "c", "r"}],
-//  "new": [{"a", "b", "length_m", "cells", "min_frames", "rms_m"}]}   (elements: only those not "seen"
-//  unless all_elements)
+//  "new": [{"a", "b", "length_m", "cells", "min_frames", "rms_m", "extends"}],
+//  "missing_parts": [{"id", "a", "b", "length_m", "seen_ratio", "through_ratio"}],
+//  "refined": [{"id", "offset_a", "offset_b", "frames"}]}   (elements: only those not
+//  "seen" unless all_elements)
 void write_json(const Diff& d, const FloorPlan& plan, std::ostream& out, bool all_elements = false);
 // ASCII DXF (AC1009, $INSUNITS 6 = metres) with a LAYER table: FPLOC-PLAN (the plan, grey),
-// FPLOC-MISSING (red: missing elements where the plan has them), FPLOC-MOVED (yellow: moved elements
+// FPLOC-MISSING (red: missing elements and missing parts where the plan has them), FPLOC-MOVED (yellow: moved elements
 // where they were seen), FPLOC-NEW (green: new structure). LINE and CIRCLE entities only.
 void write_dxf(const Diff& d, const FloorPlan& plan, std::ostream& out);
 

@@ -1,5 +1,6 @@
 // World != plan: the building the simulator scans, built from the plan the localizer gets, either by
-// named, seeded perturbations (as-built wall offsets, a global scale error, renovations, glass, doors,
+// named, seeded perturbations (as-built wall offsets, a global scale error, renovations (walls removed,
+// moved, partitions added, doorways moved along their wall), glass, doors,
 // crowds, shelving) or from a world file. The ground truth of the difference (which plan elements were
 // moved / removed / turned to glass, which structure was added, by how much) is kept as JSON.
 //
@@ -40,21 +41,27 @@ struct PerturbOptions {
   bool doors = false;             // doorways of the plan get a door leaf, open or closed at random
   double shelves = 0;             // fraction of the wall length behind 2 m shelving (SimulatorOptions::wall_clutter)
   int crowd = 0;                  // people walking near the path
+  int doors_moved = 0;            // doorways shifted along their wall by door_shift_min..max (either way)
+  double door_shift_min_m = 0.4, door_shift_max_m = 0.9;
   bool any() const {
-    return asbuilt_sigma_m > 0 || scale != 0 || remove || add || move || glass > 0 || doors || shelves > 0 || crowd;
+    return asbuilt_sigma_m > 0 || scale != 0 || remove || add || move || glass > 0 || doors || shelves > 0 || crowd ||
+           doors_moved;
   }
 };
 
 // "key=value,..." with keys asbuilt (sigma m), scale, remove, add, move, move_min, move_max, glass,
-// doors (0/1), shelves, crowd; or a family name. Throws on an unknown key/family or a bad value.
+// doors (0/1), shelves, crowd, doors_moved (count), door_shift_min, door_shift_max; or a family name.
+// Throws on an unknown key/family or a bad value.
 PerturbOptions parse_perturb(const std::string& spec);
 // The bench families: clean, asbuilt-2cm, asbuilt-5cm, scale-0.5pct, renovated, glass, shelves, doors,
-// crowd-15, mixed. Throws on an unknown name (listing the names).
+// crowd-15, mixed, doors-moved. Throws on an unknown name (listing the names).
 PerturbOptions perturb_family(const std::string& name);
 std::vector<std::string> perturb_family_names();
 
 // Status of one plan element in the world.
-enum class ElementChange : uint8_t { kUnchanged = 0, kMoved = 1, kRemoved = 2, kGlass = 3 };
+// kDoorMoved: a wall face or jamb of a doorway that was shifted along its wall (the face grew or lost a
+// piece at that end, the jamb moved with the opening; see DoorMovedTruth).
+enum class ElementChange : uint8_t { kUnchanged = 0, kMoved = 1, kRemoved = 2, kGlass = 3, kDoorMoved = 4 };
 const char* change_name(ElementChange c);
 
 struct ElementTruth {
@@ -69,6 +76,15 @@ struct AddedTruth {
   Eigen::Vector2d a, b;
 };
 
+// A doorway moved along its wall by shift_m (along from_a -> from_b): the old opening from_a-from_b is now
+// to_a-to_b; closed_a-closed_b (part of the old opening) is wall now, opened_a-opened_b (part of a drawn
+// wall) is open now, both along the face from_a-from_b lies on.
+struct DoorMovedTruth {
+  Eigen::Vector2d from_a, from_b, to_a, to_b, closed_a, closed_b, opened_a, opened_b;
+  double shift_m = 0;
+  std::vector<int> elements;  // plan elements that changed (faces, jambs)
+};
+
 struct WorldEdit {
   FloorPlan world;                       // the walls the sensor sees (world-only structure included)
   std::vector<Furniture> furniture;      // shelves of a world file
@@ -76,12 +92,14 @@ struct WorldEdit {
   double wall_clutter = 0;               // shelving fraction for the simulator's wall clutter
   std::vector<ElementTruth> elements;    // one per plan element
   std::vector<AddedTruth> added;
+  std::vector<DoorMovedTruth> doors_moved;
   double scale = 0;
   std::string source;                    // family / spec / world file
   uint64_t seed = 0;
   // The truth as JSON text: {"source", "seed", "scale", "plan_elements", "elements": [{"id", "change",
   // "offset_m", "max_shift_m", "rotation_deg", "length_m"}], "added": [{"kind", "a", "b", "length_m"}],
-  // "shelves_fraction", "people"}.
+  // "shelves_fraction", "people", "doors_moved": [{"from", "to", "closed", "opened" (each [[x, y], [x, y]]),
+  // "shift_m", "elements"}]}.
   std::string truth_json(const FloorPlan& plan) const;
 };
 
