@@ -2,6 +2,7 @@
 // GyroDeskew can), and in the same pass the candidate sets of the plane fits (upper / lower half rings).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <string>
 
@@ -86,6 +87,9 @@ bool Segmenter::prepare(const Scan& scan) {
   auto ring_pass = [&](int u, Candidates* cs, size_t& m) {
     const size_t row = size_t(u) * W;
     Eigen::Vector3f* cp = cs ? cs->p.data() : nullptr;
+    float* cxs = cs ? cs->x.data() : nullptr;
+    float* cys = cs ? cs->y.data() : nullptr;
+    float* czs = cs ? cs->z.data() : nullptr;
     float* cr = cs ? cs->range.data() : nullptr;
     int32_t* cx = cs ? cs->pixel.data() : nullptr;
     for (int c = 0; c < W; ++c) {
@@ -108,6 +112,9 @@ bool Segmenter::prepare(const Scan& scan) {
       ++valid;
       if (cs) {
         cp[m] = p;
+        cxs[m] = p.x();
+        cys[m] = p.y();
+        czs[m] = p.z();
         cr[m] = rm;
         cx[m] = int32_t(i);
         ++m;
@@ -124,6 +131,9 @@ bool Segmenter::prepare(const Scan& scan) {
     cs->start_stride = scale_.start_stride;
     cs->final_stride = scale_.final_stride;
     cs->p.resize(size_t(half) * W);
+    cs->x.resize(size_t(half) * W + Candidates::kLanes);
+    cs->y.resize(size_t(half) * W + Candidates::kLanes);
+    cs->z.resize(size_t(half) * W + Candidates::kLanes);
     cs->range.resize(size_t(half) * W);
     cs->pixel.resize(size_t(half) * W);
   }
@@ -133,6 +143,11 @@ bool Segmenter::prepare(const Scan& scan) {
   if (H % 2 == 1) ring_pass(ring_order_[half], nullptr, mm);
   for (auto [cs, m] : {std::pair{&upper_, mu}, std::pair{&lower_, ml}}) {
     cs->p.resize(m);
+    const size_t padded = (m + Candidates::kLanes - 1) / Candidates::kLanes * Candidates::kLanes;
+    for (auto* v : {&cs->x, &cs->y, &cs->z}) {
+      v->resize(padded);
+      std::fill(v->begin() + m, v->end(), std::numeric_limits<float>::quiet_NaN());
+    }
     cs->range.resize(m);
     cs->pixel.resize(m);
   }

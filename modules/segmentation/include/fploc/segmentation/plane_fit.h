@@ -42,18 +42,24 @@ class RingPlaneFit : public PlaneFit {
   bool choose_start(const Candidates& c, const Eigen::Vector3d& up, const Eigen::Vector4d* previous,
                     Eigen::Vector4d& start);
   // Support of `pl` on `sub`, a subsample of the candidates (every stride-th), scaled by the stride.
-  double score_band(const std::vector<Eigen::Vector3f>& sub, size_t stride, const Eigen::Vector4d& pl, float band) const;
-  // IRLS from `start`; the cut-off shrinks from first_cut down to min_cut (fixed: stays at first_cut).
-  std::optional<Fit> refine(const Candidates& c, const Eigen::Vector3d& up, Eigen::Vector4d start, double first_cut,
-                            double min_cut, bool fixed);
+  double score_band(const PointsSoa& sub, size_t stride, const Eigen::Vector4d& pl, float band) const;
+  // IRLS from `start` over the candidates (xs_/ys_/zs_); the cut-off shrinks from first_cut down to min_cut
+  // (fixed: stays at first_cut).
+  std::optional<Fit> refine(const Eigen::Vector3d& up, Eigen::Vector4d start, double first_cut, double min_cut,
+                            bool fixed);
 
   SegmenterConfig cfg_;
   std::vector<int> seeds_, all_seeds_;
   std::vector<float> sector_best_;
   std::vector<int> sector_idx_;
-  std::vector<Eigen::Vector3f> band_, sub_start_, sub_final_;
+  // The current fit's candidates as float arrays (Candidates' own, or copied into own_ when it has none),
+  // padded with NaN to a multiple of 4.
+  const float *xs_ = nullptr, *ys_ = nullptr, *zs_ = nullptr;
+  size_t np_ = 0;
+  PointsSoa own_;
+  PointsSoa band_, band_sub_, sub_start_, sub_final_;  // band_: relative to the refinement's reference point
   size_t start_stride_ = 1, final_stride_ = 1;  // of the current fit (Candidates, else the reference strides)
-  std::vector<float> res_;
+  std::vector<int32_t> bins_;
 };
 
 }  // namespace fploc::seg
