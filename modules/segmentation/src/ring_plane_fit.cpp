@@ -27,7 +27,7 @@ void RingPlaneFit::pick_seeds(const Candidates& c, const Eigen::Vector3f& upf) {
     sector_best_.assign(S, -1.f);
     sector_idx_.assign(S, -1);
     for (int i = c.ring_start[r]; i < c.ring_start[r + 1]; ++i) {
-      if (upf.dot(c.p[i]) < k::kMinSeedHeightM) continue;
+      if (upf.dot(c.point(size_t(i))) < k::kMinSeedHeightM) continue;
       const int col = c.pixel[i] % c.width;
       const int s = col * S / c.width;
       if (c.range[i] > sector_best_[s]) {
@@ -84,7 +84,7 @@ bool RingPlaneFit::choose_start(const Candidates& c, const Eigen::Vector3d& up, 
     Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
     Eigen::Vector3d b = Eigen::Vector3d::Zero();
     for (int i : seeds_) {
-      const Eigen::Vector3d p = c.p[i].cast<double>();
+      const Eigen::Vector3d p = c.point(size_t(i)).cast<double>();
       const Eigen::Vector3d x(p.dot(e1), p.dot(e2), 1.0);
       A.noalias() += x * x.transpose();
       b += x * p.dot(up);
@@ -97,7 +97,7 @@ bool RingPlaneFit::choose_start(const Candidates& c, const Eigen::Vector3d& up, 
     have_seed_plane = true;
     if (round == k::kSeedTrimRounds - 1) break;
     res.clear();
-    for (int i : seeds_) res.push_back(std::abs(float(seed_plane.head<3>().dot(c.p[i].cast<double>()) + seed_plane[3])));
+    for (int i : seeds_) res.push_back(std::abs(float(seed_plane.head<3>().dot(c.point(size_t(i)).cast<double>()) + seed_plane[3])));
     std::vector<float> tmp = res;
     const double thr = std::max(k::kSeedTrimMinM, k::kSeedTrimSigmas * k::kMadToSigma * median_inplace(tmp));
     std::vector<int> kept;
@@ -131,9 +131,9 @@ bool RingPlaneFit::choose_start(const Candidates& c, const Eigen::Vector3d& up, 
     // Alternate between the longest-range seeds (the paper's) and all sector maxima (tilted sensor).
     const std::vector<int>& pool = (t % 2 == 0) ? seeds_ : all_seeds_;
     if (pool.size() < 3) continue;
-    const Eigen::Vector3d a = c.p[pool[next() % pool.size()]].cast<double>();
-    const Eigen::Vector3d b = c.p[pool[next() % pool.size()]].cast<double>();
-    const Eigen::Vector3d q = c.p[pool[next() % pool.size()]].cast<double>();
+    const Eigen::Vector3d a = c.point(size_t(pool[next() % pool.size()])).cast<double>();
+    const Eigen::Vector3d b = c.point(size_t(pool[next() % pool.size()])).cast<double>();
+    const Eigen::Vector3d q = c.point(size_t(pool[next() % pool.size()])).cast<double>();
     Eigen::Vector3d nn = (b - a).cross(q - a);
     if (nn.norm() < k::kMinTripletNormal) continue;
     nn.normalize();
@@ -199,9 +199,13 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
   const size_t nb = band_.n;
   if (nb < 3) return std::nullopt;
   bins_.resize(band_.padded());
+  // While the cut-off still shrinks, the scale and the weighted fit use every kShrinkSubsample-th band point
+  // (band_sub_); once it stops shrinking, every point (band_).
+  bool shrinking = !fixed;
   for (int it = 0; it < std::max(1, cfg_.irls_iterations); ++it) {
     const v4f nx = splat(float(cur[0])), ny = splat(float(cur[1])), nz = splat(float(cur[2]));
     const v4f d = splat(float(cur.head<3>().dot(ref) + cur[3]));  // the plane's offset relative to ref
+    const PointsSoa* src = shrinking ? &band_sub_ : &band_;
     // Robust scale (1.4826 * median |r| inside the cut-off) from a histogram of the residuals: bins computed
     // four at a time, residuals outside the cut-off go to an extra bin. `a < cut` is compared in float
     // against the smallest float >= cut, which is the same test for every float a. Four interleaved
@@ -214,15 +218,15 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     {
       const v4f inv_bin = splat(inv_binf), cutv = splat(cutf);
       const v4i last = splati(k::kScaleBins - 1), outside = splati(k::kScaleBins);
-      const float *bx = band_.x.data(), *by = band_.y.data(), *bz = band_.z.data();
+      const float *bx = src->x.data(), *by = src->y.data(), *bz = src->z.data();
       int32_t* bins = bins_.data();
-      for (size_t j = 0, np = band_.padded(); j < np; j += 4) {
+      for (size_t j = 0, np = src->padded(); j < np; j += 4) {
         const v4f a = abs(nx * load(bx + j) + ny * load(by + j) + nz * load(bz + j) + d);
         v4i b = __builtin_convertvector(a * inv_bin, v4i);
         b = b < last ? b : last;
         store(bins + j, a < cutv ? b : outside);
       }
-      for (size_t j = 0; j < nb; ++j) ++hist[j & 3][bins[j]];
+      for (size_t j = 0, nj = src->n; j < nj; ++j) ++hist[j & 3][bins[j]];
     }
     int inside = 0;
     for (int h = 0; h < 4; ++h)
@@ -238,13 +242,18 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     const double next_cut = fixed ? cut : std::max({cut * 0.5, k::kTukeyC * sigma, min_cut});
     const bool final_scale = next_cut >= cut;
     cut = std::min(cut, next_cut);
-    // Tukey-weighted moments. While the cut-off still shrinks a subsample is enough; at the final scale
-    // every point. Sums in float over blocks of 256 points (four lanes), added up in double.
-    const PointsSoa& src = final_scale ? band_ : band_sub_;
+    if (final_scale && shrinking) {
+      // The cut-off stopped shrinking on the subsample's scale: from now on every point (scale re-estimated
+      // on all of them, this iteration's fit on all of them).
+      shrinking = false;
+      --it;
+      continue;
+    }
+    // Tukey-weighted moments, sums in float over blocks of 256 points (four lanes), added up in double.
     const v4f inv_c2 = splat(float(1.0 / (cut * cut))), one = splat(1.f), zero = splat(0.f);
     double S[10] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
-    const float *bx = src.x.data(), *by = src.y.data(), *bz = src.z.data();
-    for (size_t j0 = 0, np = src.padded(); j0 < np; j0 += 256) {
+    const float *bx = src->x.data(), *by = src->y.data(), *bz = src->z.data();
+    for (size_t j0 = 0, np = src->padded(); j0 < np; j0 += 256) {
       v4f sw = zero, sx = zero, sy = zero, sz = zero, sxx = zero, sxy = zero, sxz = zero, syy = zero, syz = zero,
           szz = zero;
       for (size_t j = j0, je = std::min(np, j0 + 256); j < je; j += 4) {
@@ -277,32 +286,17 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
 
 bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const Eigen::Vector4d* previous,
                        PlaneRole role, Eigen::Vector4d& plane) {
-  if (c.p.size() < size_t(k::kMinCandidatePoints) || c.rings() < 1) return false;
+  if (c.size() < size_t(k::kMinCandidatePoints) || c.rings() < 1) return false;
   const Eigen::Vector3d up = up_in.normalized();
   // The subsamples every score is computed on (every kStartStride-th / kFinalStride-th candidate), copied
   // once: the scores then stream a small contiguous array instead of striding through all candidates.
   start_stride_ = c.start_stride > 0 ? c.start_stride : k::kStartStride;
   final_stride_ = c.final_stride > 0 ? c.final_stride : k::kFinalStride;
-  const size_t n = c.p.size();
-  if (c.x.size() >= n && c.y.size() >= n && c.z.size() >= n && c.x.size() % 4 == 0 && c.x.size() == c.y.size() &&
-      c.x.size() == c.z.size()) {
-    xs_ = c.x.data();
-    ys_ = c.y.data();
-    zs_ = c.z.data();
-    np_ = c.x.size();
-  } else {  // candidates without their float arrays (filled by hand): copy
-    own_.resize(n);
-    for (size_t i = 0; i < n; ++i) {
-      own_.x[i] = c.p[i].x();
-      own_.y[i] = c.p[i].y();
-      own_.z[i] = c.p[i].z();
-    }
-    own_.pad();
-    xs_ = own_.x.data();
-    ys_ = own_.y.data();
-    zs_ = own_.z.data();
-    np_ = own_.padded();
-  }
+  const size_t n = c.size();
+  xs_ = c.x.data();
+  ys_ = c.y.data();
+  zs_ = c.z.data();
+  np_ = (n + 3) & ~size_t(3);  // NaN-padded (Candidates)
   for (auto [sub, stride] : {std::pair{&sub_start_, start_stride_}, std::pair{&sub_final_, final_stride_}}) {
     sub->resize((n + stride - 1) / stride);
     for (size_t i = 0, j = 0; i < n; i += stride, ++j) {

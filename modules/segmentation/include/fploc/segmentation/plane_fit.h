@@ -18,6 +18,8 @@ class PlaneFit {
  public:
   virtual ~PlaneFit() = default;
   virtual const char* name() const = 0;
+  // Whether fit() reads Candidates::p (else only the float arrays; p is then not filled).
+  virtual bool reads_points() const { return true; }
   // Fits the dominant plane of `c` above the sensor along `up`. `previous` (if non-null) is last frame's
   // plane in the same convention. Returns the plane with n pointing against `up` (into the room), or false.
   virtual bool fit(const Candidates& c, const Eigen::Vector3d& up, const Eigen::Vector4d* previous, PlaneRole role,
@@ -30,6 +32,7 @@ class RingPlaneFit : public PlaneFit {
  public:
   explicit RingPlaneFit(const SegmenterConfig& cfg) : cfg_(cfg) {}
   const char* name() const override { return "rings"; }
+  bool reads_points() const override { return false; }
   bool fit(const Candidates& c, const Eigen::Vector3d& up, const Eigen::Vector4d* previous, PlaneRole role,
            Eigen::Vector4d& plane) override;
 
@@ -52,11 +55,9 @@ class RingPlaneFit : public PlaneFit {
   std::vector<int> seeds_, all_seeds_;
   std::vector<float> sector_best_;
   std::vector<int> sector_idx_;
-  // The current fit's candidates as float arrays (Candidates' own, or copied into own_ when it has none),
-  // padded with NaN to a multiple of 4.
+  // The current fit's candidates (Candidates' float arrays, NaN-padded to np_, a multiple of 4).
   const float *xs_ = nullptr, *ys_ = nullptr, *zs_ = nullptr;
   size_t np_ = 0;
-  PointsSoa own_;
   PointsSoa band_, band_sub_, sub_start_, sub_final_;  // band_: relative to the refinement's reference point
   size_t start_stride_ = 1, final_stride_ = 1;  // of the current fit (Candidates, else the reference strides)
   std::vector<int32_t> bins_;
