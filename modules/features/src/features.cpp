@@ -6,6 +6,9 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace fploc::feat {
 
@@ -110,7 +113,30 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   const float den = float(2 * hw);
   for (int i = 0; i < hw; ++i) ok_[i] = 0;
   for (int i = std::max(hw, n - hw); i < n; ++i) ok_[i] = 0;
-  for (int i = hw; i < n - hw; ++i) {
+  int i = hw;
+#if defined(__SSE2__)
+  // Two points at a time in double lanes (sqrtpd: the same correctly rounded roots as one at a time).
+  for (; i + 2 <= n - hw; i += 2) {
+    auto ld = [](const double* p) { return _mm_loadu_pd(p); };
+    const __m128d w2 = _mm_set1_pd(win);
+    const __m128d xi = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(X + i))));
+    const __m128d yi = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(Y + i))));
+    const __m128d zi = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(Z + i))));
+    const __m128d dx = _mm_sub_pd(_mm_sub_pd(ld(px + i + hw + 1), ld(px + i - hw)), _mm_mul_pd(w2, xi));
+    const __m128d dy = _mm_sub_pd(_mm_sub_pd(ld(py + i + hw + 1), ld(py + i - hw)), _mm_mul_pd(w2, yi));
+    const __m128d dz = _mm_sub_pd(_mm_sub_pd(ld(pz + i + hw + 1), ld(pz + i - hw)), _mm_mul_pd(w2, zi));
+    const __m128d s2 = _mm_add_pd(_mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)), _mm_mul_pd(dz, dz));
+    double nrm[2];
+    _mm_storeu_pd(nrm, _mm_sqrt_pd(s2));
+    for (int l = 0; l < 2; ++l) {
+      const int q = i + l;
+      const float rq = R[q];
+      curv_[q] = float(nrm[l]) / (den * rq);
+      ok_[q] = uint8_t((brk_prefix[q + hw] == brk_prefix[q - hw]) & !(rq < rmin) & !(rq > rmax));
+    }
+  }
+#endif
+  for (; i < n - hw; ++i) {
     // All of i-hw .. i+hw connected: no break between i-hw and i+hw-1.
     const float ri = R[i];
     const bool ok = (brk_prefix[i + hw] == brk_prefix[i - hw]) & !(ri < rmin) & !(ri > rmax);
