@@ -15,9 +15,17 @@ namespace fploc::feat {
 FeatureExtractor::FeatureExtractor(FeatureConfig cfg) : cfg_(cfg) {}
 
 const FeatureFrame& FeatureExtractor::process(const seg::Segmentation& seg) {
-  out_ = Picked{};
+  // Cleared, not re-created: the arrays keep their capacity from scan to scan.
+  for (auto* v : {&out_.x, &out_.y, &out_.t}) v->clear();
+  out_.kind.clear();
+  out_.group.clear();
+  out_.source.clear();
+  out_.num_groups = 0;
   const FeatureStatus status = extract(seg);
+  std::vector<Feature2> points = std::move(frame_.points);
+  points.clear();
   frame_ = FeatureFrame{};
+  frame_.points = std::move(points);
   frame_.utime = seg.utime;
   frame_.scan_seq = seg.seq;
   frame_.status = status;
@@ -92,8 +100,6 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   brk_prefix.resize(n + 1);
   brk_prefix[0] = 0;
   const int gap = cfg_.max_column_gap;
-  for (int j = 0; j + 1 < n; ++j) brk_prefix[j + 1] = brk_prefix[j] + int(C[j + 1] - C[j] > gap);
-  brk_prefix[n] = brk_prefix[n - 1] + 1;
   const float rmin = float(cfg_.min_range_m), rmax = float(cfg_.max_range_m);
   // Window sums by prefix sums (double: ring coordinates reach ~100 m): sum(X_j - X_i) = S - (2hw+1) X_i,
   // one array per coordinate.
@@ -103,6 +109,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   double *px = prex_.data(), *py = prey_.data(), *pz = prez_.data();
   px[0] = py[0] = pz[0] = 0.0;
   for (int j = 0; j < n; ++j) {
+    brk_prefix[j + 1] = brk_prefix[j] + (j + 1 < n ? int(C[j + 1] - C[j] > gap) : 1);
     px[j + 1] = px[j] + double(X[j]);
     py[j + 1] = py[j] + double(Y[j]);
     pz[j + 1] = pz[j] + double(Z[j]);

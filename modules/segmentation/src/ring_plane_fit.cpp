@@ -23,13 +23,20 @@ void RingPlaneFit::pick_seeds(const Candidates& c, const Eigen::Vector3f& upf) {
   seeds_.clear();
   all_seeds_.clear();
   const int kr = std::min(std::max(1, c.seed_rings > 0 ? c.seed_rings : cfg_.seed_rings), c.rings());
+  if (int(sector_of_col_.size()) != c.width || sector_cols_s_ != S) {  // col * S / width, once per sensor
+    sector_of_col_.resize(size_t(std::max(0, c.width)));
+    for (int col = 0; col < c.width; ++col) sector_of_col_[size_t(col)] = col * S / c.width;
+    sector_cols_s_ = S;
+  }
   for (int r = 0; r < kr; ++r) {
     sector_best_.assign(S, -1.f);
     sector_idx_.assign(S, -1);
+    // A ring is one scan row: its column is the pixel index minus the row's first pixel (no division per point).
+    const int row0 = c.ring_start[r] < c.ring_start[r + 1] ? c.pixel[c.ring_start[r]] / c.width * c.width : 0;
     for (int i = c.ring_start[r]; i < c.ring_start[r + 1]; ++i) {
       if (upf.dot(c.point(size_t(i))) < k::kMinSeedHeightM) continue;
-      const int col = c.pixel[i] % c.width;
-      const int s = col * S / c.width;
+      const int col = c.pixel[i] - row0;
+      const int s = sector_of_col_[size_t(col)];
       if (c.range[i] > sector_best_[s]) {
         sector_best_[s] = c.range[i];
         sector_idx_[s] = i;

@@ -81,9 +81,20 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
     return movemask(in) & ((1 << std::min(4, b - j)) - 1);  // lanes past the piece's end: off
   };
   static constexpr uint8_t kBits[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};  // set bits
-  size_t m = 0;
-  for (const Piece& pc : pieces_)
-    for (int32_t j = pc.a; j < pc.b; j += 4) m += size_t(kBits[mask(*pc.cs, j, pc.b)]);
+  // Count first (the output arrays are sized once, not grown point by point); the masks are kept for the
+  // second pass.
+  size_t m = 0, groups = 0;
+  for (const Piece& pc : pieces_) groups += size_t((pc.b - pc.a + 3) / 4);
+  masks_.resize(groups);
+  {
+    size_t g = 0;
+    for (const Piece& pc : pieces_)
+      for (int32_t j = pc.a; j < pc.b; j += 4) {
+        const int mk = mask(*pc.cs, j, pc.b);
+        masks_[g++] = uint8_t(mk);
+        m += size_t(kBits[mk]);
+      }
+  }
   auto& w = out_.wall;
   for (auto* v : {&w.x, &w.y, &w.z, &w.range, &w.t}) v->resize(m);
   w.ring.resize(m);
@@ -93,12 +104,12 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
   const bool deskewed = out_.deskewed;
   const float* dir = lut_.direction.data();
   const float* lut_off = lut_.offset.data();
-  size_t o = 0;
+  size_t o = 0, g = 0;
   for (const Piece& pc : pieces_) {
     const Candidates& cs = *pc.cs;
     const int32_t row = int32_t(pc.u) * W;
     for (int32_t j = pc.a; j < pc.b; j += 4) {
-      const int mk = mask(cs, j, pc.b);
+      const int mk = masks_[g++];
       if (mk == 0) continue;
       if (mk == 15 && !deskewed) {
         std::memcpy(ox + o, cs.x.data() + j, 4 * sizeof(float));

@@ -55,6 +55,8 @@ class RingPlaneFit : public PlaneFit {
   std::vector<int> seeds_, all_seeds_;
   std::vector<float> sector_best_;
   std::vector<int> sector_idx_;
+  std::vector<int> sector_of_col_;  // azimuth sector of each staggered column (pick_seeds)
+  int sector_cols_s_ = 0;
   // The current fit's candidates (Candidates' float arrays, NaN-padded to np_, a multiple of 4).
   const float *xs_ = nullptr, *ys_ = nullptr, *zs_ = nullptr;
   size_t np_ = 0;

@@ -88,6 +88,7 @@ class Segmenter {
     int16_t u;
   };
   std::vector<WallPiece> pieces_;
+  std::vector<uint8_t> masks_;  // wall selection: lane mask of each group of four candidates
   Candidates upper_, lower_, middle_;  // middle_: an odd beam count's middle ring (wall points only)
   bool keep_labels_ = false;
 
