@@ -205,7 +205,7 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
   }
   const size_t nb = band_.n;
   if (nb < 3) return std::nullopt;
-  bins_.resize(band_.padded());
+  if (bins_.size() < band_.padded()) bins_.resize(band_.padded());
   // While the cut-off still shrinks, the scale and the weighted fit use every kShrinkSubsample-th band point
   // (band_sub_); once it stops shrinking, every point (band_).
   bool shrinking = !fixed;

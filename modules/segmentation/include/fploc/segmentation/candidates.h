@@ -14,17 +14,20 @@ namespace fploc::seg {
 struct PointsSoa {
   std::vector<float> x, y, z;
   size_t n = 0;  // points (without the padding)
-  size_t padded() const { return x.size(); }
+  size_t padded() const { return (n + 3) & ~size_t(3); }
+  // n = m; the arrays only grow (no re-initialisation when a later call asks for fewer points).
   void resize(size_t m) {
     n = m;
-    const size_t p = (m + 3) & ~size_t(3);
-    x.resize(p);
-    y.resize(p);
-    z.resize(p);
+    const size_t p = padded();
+    if (x.size() < p) {
+      x.resize(p);
+      y.resize(p);
+      z.resize(p);
+    }
   }
   void pad(float px = std::numeric_limits<float>::quiet_NaN(), float py = std::numeric_limits<float>::quiet_NaN(),
            float pz = std::numeric_limits<float>::quiet_NaN()) {
-    for (size_t i = n; i < x.size(); ++i) {
+    for (size_t i = n, e = padded(); i < e; ++i) {
       x[i] = px;
       y[i] = py;
       z[i] = pz;
