@@ -6,15 +6,26 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace fploc::feat {
 
 FeatureExtractor::FeatureExtractor(FeatureConfig cfg) : cfg_(cfg) {}
 
 const FeatureFrame& FeatureExtractor::process(const seg::Segmentation& seg) {
-  out_ = Picked{};
+  // Cleared, not re-created: the arrays keep their capacity from scan to scan.
+  for (auto* v : {&out_.x, &out_.y, &out_.t}) v->clear();
+  out_.kind.clear();
+  out_.group.clear();
+  out_.source.clear();
+  out_.num_groups = 0;
   const FeatureStatus status = extract(seg);
+  std::vector<Feature2> points = std::move(frame_.points);
+  points.clear();
   frame_ = FeatureFrame{};
+  frame_.points = std::move(points);
   frame_.utime = seg.utime;
   frame_.scan_seq = seg.seq;
   frame_.status = status;
@@ -76,42 +87,79 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   const int n = int(end - begin);
   const int hw = std::max(1, cfg_.half_window);
   if (n < 2 * hw + 1) return;
-  auto P = [&](int j) { return Eigen::Vector3f(w.x[begin + j], w.y[begin + j], w.z[begin + j]); };
-  auto r = [&](int j) { return w.range[begin + j]; };
-  auto col = [&](int j) { return int(w.column[begin + j]); };
+  const float *X = w.x.data() + begin, *Y = w.y.data() + begin, *Z = w.z.data() + begin;
+  const float* R = w.range.data() + begin;
+  const int16_t* C = w.column.data() + begin;
 
-  curv_.assign(n, 0.f);
-  ok_.assign(n, 0);
+  // Not cleared: curv_ is written wherever it is read ([hw, n-hw)), ok_ is written everywhere below.
+  curv_.resize(n);
+  ok_.resize(n);
   picked_.assign(n, 0);
   // breaks[j] = 1 when points j and j+1 are not neighbours (column gap); prefix sums for window tests.
   auto& brk_prefix = brk_;
-  brk_prefix.assign(n + 1, 0);
-  for (int j = 0; j < n; ++j) {
-    const int br = j + 1 < n ? (col(j + 1) - col(j) > cfg_.max_column_gap) : 1;
-    brk_prefix[j + 1] = brk_prefix[j] + br;
-  }
+  brk_prefix.resize(n + 1);
+  brk_prefix[0] = 0;
+  const int gap = cfg_.max_column_gap;
   const float rmin = float(cfg_.min_range_m), rmax = float(cfg_.max_range_m);
-  // Window sums by prefix sums (double: ring coordinates reach ~100 m): sum(X_j - X_i) = S - (2hw+1) X_i.
-  pre_.resize(size_t(n) + 1);
-  pre_[0].setZero();
-  for (int j = 0; j < n; ++j) pre_[j + 1] = pre_[j] + P(j).cast<double>();
+  // Window sums by prefix sums (double: ring coordinates reach ~100 m): sum(X_j - X_i) = S - (2hw+1) X_i,
+  // one array per coordinate.
+  prex_.resize(size_t(n) + 1);
+  prey_.resize(size_t(n) + 1);
+  prez_.resize(size_t(n) + 1);
+  double *px = prex_.data(), *py = prey_.data(), *pz = prez_.data();
+  px[0] = py[0] = pz[0] = 0.0;
+  for (int j = 0; j < n; ++j) {
+    brk_prefix[j + 1] = brk_prefix[j] + (j + 1 < n ? int(C[j + 1] - C[j] > gap) : 1);
+    px[j + 1] = px[j] + double(X[j]);
+    py[j + 1] = py[j] + double(Y[j]);
+    pz[j + 1] = pz[j] + double(Z[j]);
+  }
   // Branch-free (the window and range tests mispredicted on irregular rings): c is computed everywhere and
   // only read where ok_ is set.
-  for (int i = hw; i < n - hw; ++i) {
+  const double win = double(2 * hw + 1);
+  const float den = float(2 * hw);
+  for (int i = 0; i < hw; ++i) ok_[i] = 0;
+  for (int i = std::max(hw, n - hw); i < n; ++i) ok_[i] = 0;
+  int i = hw;
+#if defined(__SSE2__)
+  // Two points at a time in double lanes (sqrtpd: the same correctly rounded roots as one at a time).
+  for (; i + 2 <= n - hw; i += 2) {
+    auto ld = [](const double* p) { return _mm_loadu_pd(p); };
+    const __m128d w2 = _mm_set1_pd(win);
+    const __m128d xi = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(X + i))));
+    const __m128d yi = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(Y + i))));
+    const __m128d zi = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(Z + i))));
+    const __m128d dx = _mm_sub_pd(_mm_sub_pd(ld(px + i + hw + 1), ld(px + i - hw)), _mm_mul_pd(w2, xi));
+    const __m128d dy = _mm_sub_pd(_mm_sub_pd(ld(py + i + hw + 1), ld(py + i - hw)), _mm_mul_pd(w2, yi));
+    const __m128d dz = _mm_sub_pd(_mm_sub_pd(ld(pz + i + hw + 1), ld(pz + i - hw)), _mm_mul_pd(w2, zi));
+    const __m128d s2 = _mm_add_pd(_mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)), _mm_mul_pd(dz, dz));
+    double nrm[2];
+    _mm_storeu_pd(nrm, _mm_sqrt_pd(s2));
+    for (int l = 0; l < 2; ++l) {
+      const int q = i + l;
+      const float rq = R[q];
+      curv_[q] = float(nrm[l]) / (den * rq);
+      ok_[q] = uint8_t((brk_prefix[q + hw] == brk_prefix[q - hw]) & !(rq < rmin) & !(rq > rmax));
+    }
+  }
+#endif
+  for (; i < n - hw; ++i) {
     // All of i-hw .. i+hw connected: no break between i-hw and i+hw-1.
-    const float ri = r(i);
+    const float ri = R[i];
     const bool ok = (brk_prefix[i + hw] == brk_prefix[i - hw]) & !(ri < rmin) & !(ri > rmax);
-    const Eigen::Vector3d diff = (pre_[i + hw + 1] - pre_[i - hw]) - double(2 * hw + 1) * P(i).cast<double>();
-    curv_[i] = float(diff.norm()) / (float(2 * hw) * ri);  // LOAM's c = |sum(X_j - X_i)| / (|S| |X_i|)
+    const double dx = (px[i + hw + 1] - px[i - hw]) - win * double(X[i]);
+    const double dy = (py[i + hw + 1] - py[i - hw]) - win * double(Y[i]);
+    const double dz = (pz[i + hw + 1] - pz[i - hw]) - win * double(Z[i]);
+    curv_[i] = float(std::sqrt(dx * dx + dy * dy + dz * dz)) / (den * ri);  // LOAM's c = |sum(X_j - X_i)| / (|S| |X_i|)
     ok_[i] = uint8_t(ok);
   }
   // LOAM's unreliable points: the far side of an occlusion boundary, and surfaces parallel to the beam.
   const float occ = float(cfg_.occlusion_ratio), par = float(cfg_.parallel_ratio);
   for (int j = 0; j + 1 < n; ++j) {
-    const float a = r(j), c = r(j + 1);
+    const float a = R[j], c = R[j + 1];
     const float mn = a < c ? a : c;  // minss, no branch (std::min here compiled to one, fmin to a call)
     // One rarely-true test (neighbours and a range jump) instead of two branches.
-    if ((col(j + 1) - col(j) <= cfg_.max_column_gap) & (std::abs(a - c) > occ * mn)) {
+    if ((C[j + 1] - C[j] <= gap) & (std::abs(a - c) > occ * mn)) {
       if (a > c) {
         for (int k = std::max(0, j - hw + 1); k <= j; ++k) ok_[k] = 0;
       } else {
@@ -120,14 +168,14 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     }
   }
   for (int i = 1; i + 1 < n; ++i) {
-    const float ri = r(i);
-    ok_[i] &= uint8_t(!((std::abs(r(i - 1) - ri) > par * ri) & (std::abs(r(i + 1) - ri) > par * ri)));
+    const float ri = R[i];
+    ok_[i] &= uint8_t(!((std::abs(R[i - 1] - ri) > par * ri) & (std::abs(R[i + 1] - ri) > par * ri)));
   }
 
   // Per-sector selection (sectors split the ring's points evenly, as LOAM does).
   sel_.clear();
   auto& kind_of = kind_;
-  kind_of.assign(n, -1);
+  kind_of.resize(n);  // read only at the picks, which set it
   const int S = std::max(1, cfg_.sectors);
   const float cthr = float(cfg_.corner_threshold), sthr = float(cfg_.surface_threshold);
   const int max_corners = int(std::lround(cfg_.max_corners_per_sector * limit_scale_));
@@ -139,11 +187,17 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     // same picks as walking the candidates sorted by decreasing c, ties by index; a branch-free scan per
     // pick instead of a sort, which mispredicted on every comparison). Candidates are collected without
     // a data-dependent branch too.
+    // Corner (c > corner threshold) and surface (c < surface threshold) candidates in one pass. Surface
+    // candidates a corner pick suppresses are skipped when walking them (the same picks as leaving them out).
     order_.resize(size_t(se - sb));
-    size_t m = 0;
+    surf_.resize(size_t(se - sb));
+    size_t m = 0, ms = 0;
     for (int i = sb; i < se; ++i) {
+      const float ci = curv_[i];
       order_[m] = i;
-      m += size_t(ok_[i] & uint8_t(curv_[i] > cthr));
+      surf_[ms] = i;
+      m += size_t(ok_[i] & uint8_t(ci > cthr));
+      ms += size_t(ok_[i] & uint8_t(ci < sthr));
     }
     for (int corners = 0; corners < max_corners; ++corners) {
       int best = -1;
@@ -161,23 +215,17 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     }
     // Surface candidates: only the smoothest few need ordering (partial sort, widened if the spacing
     // rule rejects too many).
-    order_.resize(size_t(se - sb));
-    m = 0;
-    for (int i = sb; i < se; ++i) {
-      order_[m] = i;
-      m += size_t(ok_[i] & uint8_t(curv_[i] < sthr) & uint8_t(!picked_[i]));
-    }
-    order_.resize(m);
+    surf_.resize(ms);
     auto less = [&](int a, int b) { return curv_[a] < curv_[b] || (curv_[a] == curv_[b] && a < b); };
     size_t sorted = 0;
     int surfaces = 0;
-    for (size_t j = 0; j < order_.size() && surfaces < max_surfaces; ++j) {
+    for (size_t j = 0; j < surf_.size() && surfaces < max_surfaces; ++j) {
       if (j == sorted) {
-        const size_t k = std::min(order_.size(), std::max<size_t>(sorted * 2, size_t(2 * max_surfaces)));
-        std::partial_sort(order_.begin() + sorted, order_.begin() + k, order_.end(), less);
+        const size_t k = std::min(surf_.size(), std::max<size_t>(sorted * 2, size_t(2 * max_surfaces)));
+        std::partial_sort(surf_.begin() + sorted, surf_.begin() + k, surf_.end(), less);
         sorted = k;
       }
-      const int i = order_[j];
+      const int i = surf_[j];
       if (picked_[i]) continue;
       kind_of[i] = kSurface;
       sel_.push_back(i);

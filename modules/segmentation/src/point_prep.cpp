@@ -2,10 +2,13 @@
 // GyroDeskew can), and in the same pass the candidate sets of the plane fits (upper / lower half rings).
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <numeric>
 #include <string>
 
 #include "fploc/segmentation/segmenter.h"
+#include "simd4.h"
 
 namespace fploc::seg {
 
@@ -47,9 +50,22 @@ bool Segmenter::prepare(const Scan& scan) {
     std::stable_sort(ring_order_.begin(), ring_order_.end(),
                      [&](int a, int b) { return scan.beams.altitude_deg[a] > scan.beams.altitude_deg[b]; });
     scale_ = seg::beam_scaling(scan.beams, scan.width, cfg_);
+    for (int e = 0; e < 6; ++e) {  // the table as float arrays: direction x/y/z, offset x/y/z per pixel
+      const auto& src = e < 3 ? lut_.direction : lut_.offset;
+      lut_soa_[e].resize(size_t(src.rows()));
+      for (Eigen::Index i = 0; i < src.rows(); ++i) lut_soa_[e][size_t(i)] = src(i, e % 3);
+    }
+    // Where each scan row's returns are among the candidates (see below): its set and ring there.
+    const int Hh = scan.height, hh = Hh / 2;
+    row_set_.assign(Hh, 2);
+    row_ring_.assign(Hh, 0);
+    for (int k = 0; k < hh; ++k) {
+      row_set_[ring_order_[k]] = 0;
+      row_ring_[ring_order_[k]] = k;
+      row_set_[ring_order_[Hh - 1 - k]] = 1;
+      row_ring_[ring_order_[Hh - 1 - k]] = k;
+    }
   }
-  xyz_.resize(n);
-  range_.resize(n);
   // Rotation de-skew: a return measured at column time t_c is rotated into the sensor frame at mid-sweep,
   // p_mid = R_mid<-c p, R integrated from the gyro (body frame = sensor frame; see GyroDeskew).
   // Only rotation matters for the planes: yaw rate leaves heights unchanged, roll/pitch rates tilt them (a few tenths of a degree per sweep when the platform wobbles, worst in corridors where the
@@ -57,7 +73,6 @@ bool Segmenter::prepare(const Scan& scan) {
   // v_z * 0.05 s (mm). Wall points are published as measured (with their times): downstream compensates.
   const bool deskew = deskew_.prepare(scan);
   out_.deskewed = deskew;
-  if (deskew) raw_.resize(n);
   const std::vector<Eigen::Matrix3f>& rots = deskew_.rotations();
   // Range gate in integers: float(r) < rmin || float(r) > rmax for the 20-bit ranges (exact in float).
   const float rmin = float(cfg_.min_range_m * 1000.0), rmax = float(cfg_.max_range_m * 1000.0);
@@ -75,69 +90,132 @@ bool Segmenter::prepare(const Scan& scan) {
     col_mid_[c] = mid;
     col_ok_[c] = !(cvalid && !scan.column_valid[c]);
   }
-  // XYZ of every valid pixel, and in the same pass the candidate sets: upper half rings (top first) and
-  // lower half rings (bottom first), each ring in column order (an odd middle ring is in neither).
-  // The candidate arrays are sized for every pixel of their rings up front and cut to the valid count after
-  // (no push_back per point); an invalid pixel is written too and overwritten by the next valid one.
-  size_t valid = 0;
+  // One pass over the pixels writes only the candidate sets: upper half rings (top first), lower half rings
+  // (bottom first), an odd middle ring on its own (no fit; wall points only); each ring in column order.
+  // No per-pixel image: wall selection reads the candidates. The arrays keep their full size from scan to
+  // scan (nothing re-initialised); every pixel is written at the next free slot and the slot is kept only
+  // for a return in range (no branch on it: dropouts and sky are irregular).
   const float* dir = lut_.direction.data();
   const float* off = lut_.offset.data();
   const uint32_t* rng = scan.range_mm.data();
-  auto ring_pass = [&](int u, Candidates* cs, size_t& m) {
+  // Four columns at a time when the look-up columns are the scan's own (measurement id = column, the usual
+  // case) and the width is a multiple of 4: the table as float arrays (lut_soa_, built with the table), the
+  // range gate and column validity as a lane mask, and four slots written at once when all four are kept
+  // (most of a ring). The arithmetic is the same per point as the scalar pass.
+  bool identity = W % 4 == 0;
+  for (int c = 0; c < W && identity; ++c) identity = col_mid_[c] == c;
+  if (identity) {
+    col_okm_.resize(W);
+    for (int c = 0; c < W; ++c) col_okm_[c] = col_ok_[c] ? -1 : 0;
+    if (deskew) {
+      for (auto& v : rot_soa_) v.resize(W);
+      for (int c = 0; c < W; ++c)
+        for (int e = 0; e < 9; ++e) rot_soa_[e][c] = rots[c](e / 3, e % 3);
+    }
+  }
+  auto ring_pass4 = [&](int u, Candidates& cs) {
+    using namespace simd;
     const size_t row = size_t(u) * W;
-    Eigen::Vector3f* cp = cs ? cs->p.data() : nullptr;
-    float* cr = cs ? cs->range.data() : nullptr;
-    int32_t* cx = cs ? cs->pixel.data() : nullptr;
+    float *cx = cs.x.data(), *cy = cs.y.data(), *cz = cs.z.data(), *cr = cs.range.data();
+    int32_t* cp = cs.pixel.data();
+    const float *dx = lut_soa_[0].data() + row, *dy = lut_soa_[1].data() + row, *dz = lut_soa_[2].data() + row;
+    const float *ox = lut_soa_[3].data() + row, *oy = lut_soa_[4].data() + row, *oz = lut_soa_[5].data() + row;
+    const v4i lo = splati(int32_t(std::min<uint32_t>(r_lo, 0x7fffffffu))), hi = splati(int32_t(std::min<uint32_t>(r_hi, 0x7fffffffu)));
+    const v4f mm = splat(1e-3f);
+    size_t m = cs.n;
+    for (int c = 0; c < W; c += 4) {
+      v4i ri;
+      std::memcpy(&ri, rng + row + c, sizeof ri);
+      v4i okm;
+      std::memcpy(&okm, col_okm_.data() + c, sizeof okm);
+      // Ranges are 20-bit (OS-1), far below 2^31: compared as signed integers; larger values fail the gate
+      // only if r_hi is below them, which the clamp to 2^31-1 keeps (a negative int is < lo).
+      const int in = movemask((ri >= lo) & (ri <= hi) & okm);
+      if (in == 0) continue;
+      const v4f fr = __builtin_convertvector(ri, v4f);
+      v4f x = load(dx + c) * fr + load(ox + c), y = load(dy + c) * fr + load(oy + c), z = load(dz + c) * fr + load(oz + c);
+      if (deskew) {
+        const auto R = [&](int e) { return load(rot_soa_[e].data() + c); };
+        const v4f X = R(0) * x + R(1) * y + R(2) * z, Y = R(3) * x + R(4) * y + R(5) * z, Z = R(6) * x + R(7) * y + R(8) * z;
+        x = X;
+        y = Y;
+        z = Z;
+      }
+      const v4f rm = fr * mm;
+      const int32_t pix0 = int32_t(row + c);
+      if (in == 15) {
+        store(cx + m, x);
+        store(cy + m, y);
+        store(cz + m, z);
+        store(cr + m, rm);
+        store(cp + m, v4i{pix0, pix0 + 1, pix0 + 2, pix0 + 3});
+        m += 4;
+        continue;
+      }
+      for (int l = 0; l < 4; ++l) {
+        cx[m] = x[l];
+        cy[m] = y[l];
+        cz[m] = z[l];
+        cr[m] = rm[l];
+        cp[m] = pix0 + l;
+        m += size_t((in >> l) & 1);
+      }
+    }
+    cs.n = m;
+    cs.ring_start.push_back(int32_t(m));
+  };
+  auto ring_pass1 = [&](int u, Candidates& cs) {
+    const size_t row = size_t(u) * W;
+    float *cx = cs.x.data(), *cy = cs.y.data(), *cz = cs.z.data(), *cr = cs.range.data();
+    int32_t* cp = cs.pixel.data();
+    size_t m = cs.n;
     for (int c = 0; c < W; ++c) {
       const size_t i = row + c;
       const uint32_t r = rng[i];
-      if (r < r_lo || r > r_hi || !col_ok_[c]) {
-        range_[i] = 0.f;
-        continue;
-      }
+      const bool ok = (r >= r_lo) & (r <= r_hi) & (col_ok_[c] != 0);
       const size_t k = 3 * (row + col_mid_[c]);
       const float fr = float(r);
       Eigen::Vector3f p(dir[k] * fr + off[k], dir[k + 1] * fr + off[k + 1], dir[k + 2] * fr + off[k + 2]);
-      if (deskew) {
-        raw_[i] = p;
-        p = rots[c] * p;
-      }
-      xyz_[i] = p;
-      const float rm = fr * 1e-3f;
-      range_[i] = rm;
-      ++valid;
-      if (cs) {
-        cp[m] = p;
-        cr[m] = rm;
-        cx[m] = int32_t(i);
-        ++m;
-      }
+      if (deskew) p = rots[c] * p;
+      cx[m] = p.x();
+      cy[m] = p.y();
+      cz[m] = p.z();
+      cr[m] = fr * 1e-3f;
+      cp[m] = int32_t(i);
+      m += size_t(ok);
     }
-    if (cs) cs->ring_start.push_back(int32_t(m));
+    cs.n = m;
+    cs.ring_start.push_back(int32_t(m));
   };
+  auto ring_pass = [&](int u, Candidates& cs) { identity ? ring_pass4(u, cs) : ring_pass1(u, cs); };
   const int half = H / 2;
-  for (Candidates* cs : {&upper_, &lower_}) {
-    // Not cleared first: resize only initialises what the last scan's valid count left short of the full size.
+  for (auto [cs, rings] : {std::pair{&upper_, half}, std::pair{&lower_, half}, std::pair{&middle_, H % 2}}) {
+    const size_t cap = size_t(rings) * W + Candidates::kLanes;
+    for (auto* v : {&cs->x, &cs->y, &cs->z, &cs->range}) v->resize(cap);
+    cs->pixel.resize(cap);
+    cs->p.clear();
+    cs->n = 0;
     cs->ring_start.assign(1, 0);
     cs->width = W;
     cs->seed_rings = scale_.seed_rings;
     cs->start_stride = scale_.start_stride;
     cs->final_stride = scale_.final_stride;
-    cs->p.resize(size_t(half) * W);
-    cs->range.resize(size_t(half) * W);
-    cs->pixel.resize(size_t(half) * W);
   }
-  size_t mu = 0, ml = 0, mm = 0;
-  for (int k = 0; k < half; ++k) ring_pass(ring_order_[k], &upper_, mu);
-  for (int k = 0; k < half; ++k) ring_pass(ring_order_[H - 1 - k], &lower_, ml);
-  if (H % 2 == 1) ring_pass(ring_order_[half], nullptr, mm);
-  for (auto [cs, m] : {std::pair{&upper_, mu}, std::pair{&lower_, ml}}) {
-    cs->p.resize(m);
-    cs->range.resize(m);
-    cs->pixel.resize(m);
-  }
+  for (int k = 0; k < half; ++k) ring_pass(ring_order_[k], upper_);
+  for (int k = 0; k < half; ++k) ring_pass(ring_order_[H - 1 - k], lower_);
+  if (H % 2 == 1) ring_pass(ring_order_[half], middle_);
+  for (Candidates* cs : {&upper_, &lower_, &middle_})
+    for (auto* v : {&cs->x, &cs->y, &cs->z}) std::fill(v->begin() + cs->n, v->begin() + cs->n + Candidates::kLanes, std::numeric_limits<float>::quiet_NaN());
+  const size_t valid = upper_.n + lower_.n + middle_.n;
   if (valid == 0) return fail(SegStatus::kEmpty, "no valid returns in the scan");
   return true;
+}
+
+const std::vector<Eigen::Vector3f>& Segmenter::points() const {
+  points_.assign(size_t(out_.height) * out_.width, Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()));
+  for (const Candidates* cs : {&upper_, &lower_, &middle_})
+    for (size_t j = 0; j < cs->n; ++j) points_[size_t(cs->pixel[j])] = cs->point(j);
+  return points_;
 }
 
 }  // namespace fploc::seg

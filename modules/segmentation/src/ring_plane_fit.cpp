@@ -7,6 +7,7 @@
 #include "fploc/segmentation/plane_fit.h"
 #include "plane_math.h"
 #include "segmenter_constants.h"
+#include "simd4.h"
 
 namespace fploc::seg {
 
@@ -22,13 +23,20 @@ void RingPlaneFit::pick_seeds(const Candidates& c, const Eigen::Vector3f& upf) {
   seeds_.clear();
   all_seeds_.clear();
   const int kr = std::min(std::max(1, c.seed_rings > 0 ? c.seed_rings : cfg_.seed_rings), c.rings());
+  if (int(sector_of_col_.size()) != c.width || sector_cols_s_ != S) {  // col * S / width, once per sensor
+    sector_of_col_.resize(size_t(std::max(0, c.width)));
+    for (int col = 0; col < c.width; ++col) sector_of_col_[size_t(col)] = col * S / c.width;
+    sector_cols_s_ = S;
+  }
   for (int r = 0; r < kr; ++r) {
     sector_best_.assign(S, -1.f);
     sector_idx_.assign(S, -1);
+    // A ring is one scan row: its column is the pixel index minus the row's first pixel (no division per point).
+    const int row0 = c.ring_start[r] < c.ring_start[r + 1] ? c.pixel[c.ring_start[r]] / c.width * c.width : 0;
     for (int i = c.ring_start[r]; i < c.ring_start[r + 1]; ++i) {
-      if (upf.dot(c.p[i]) < k::kMinSeedHeightM) continue;
-      const int col = c.pixel[i] % c.width;
-      const int s = col * S / c.width;
+      if (upf.dot(c.point(size_t(i))) < k::kMinSeedHeightM) continue;
+      const int col = c.pixel[i] - row0;
+      const int s = sector_of_col_[size_t(col)];
       if (c.range[i] > sector_best_[s]) {
         sector_best_[s] = c.range[i];
         sector_idx_[s] = i;
@@ -49,34 +57,23 @@ void RingPlaneFit::pick_seeds(const Candidates& c, const Eigen::Vector3f& upf) {
 // walls (many "inliers" at one height in a corridor) loses, and a plane the acceptance test would reject
 // (beyond > max_beyond_ratio x inliers) scores below zero. The soft count prefers the tight fit over a
 // loose plane that merely stays within T of a narrow ceiling strip.
-double RingPlaneFit::score_band(const std::vector<Eigen::Vector3f>& sub, size_t stride, const Eigen::Vector4d& pl,
-                                float band) const {
+double RingPlaneFit::score_band(const PointsSoa& sub, size_t stride, const Eigen::Vector4d& pl, float band) const {
+  using namespace simd;
   const float beyond_thr = 2 * float(cfg_.inlier_threshold_m);
   const float beyond_weight = float(1.0 / std::max(k::kMinBeyondRatio, cfg_.max_beyond_ratio));
-  const Eigen::Vector3f n = pl.head<3>().cast<float>();
-  const float d = float(pl[3]), inv_b2 = 1.f / (band * band);
-  // Four independent partial sums (one float sum was a chain of dependent additions, its latency the
-  // loop's cost); the residuals are the same floats as before, the sum's rounding differs in the last bits.
-  float soft[4] = {0.f, 0.f, 0.f, 0.f};
-  int beyond[4] = {0, 0, 0, 0};
-  const Eigen::Vector3f* p = sub.data();
-  const size_t np = sub.size();
-  size_t i = 0;
-  for (; i + 4 <= np; i += 4) {
-    for (int l = 0; l < 4; ++l) {
-      const float r = n.dot(p[i + l]) + d;
-      soft[l] += max0(1.f - r * r * inv_b2);
-      beyond[l] += r < -beyond_thr;
-    }
+  const v4f nx = splat(float(pl[0])), ny = splat(float(pl[1])), nz = splat(float(pl[2])), d = splat(float(pl[3]));
+  const v4f inv_b2 = splat(1.f / (band * band)), one = splat(1.f), bthr = splat(-beyond_thr);
+  // Four lanes (element i in lane i % 4; one float sum was a chain of dependent additions); the NaN
+  // padding adds nothing.
+  v4f soft = splat(0.f);
+  v4i beyond = splati(0);
+  const float *x = sub.x.data(), *y = sub.y.data(), *z = sub.z.data();
+  for (size_t i = 0, np = sub.padded(); i < np; i += 4) {
+    const v4f r = nx * load(x + i) + ny * load(y + i) + nz * load(z + i) + d;
+    soft += max0(one - r * r * inv_b2);
+    beyond -= (r < bthr);  // true = -1
   }
-  for (; i < np; ++i) {
-    const float r = n.dot(p[i]) + d;
-    soft[0] += max0(1.f - r * r * inv_b2);
-    beyond[0] += r < -beyond_thr;
-  }
-  const float s = (soft[0] + soft[1]) + (soft[2] + soft[3]);
-  const int b = (beyond[0] + beyond[1]) + (beyond[2] + beyond[3]);
-  return double(s - beyond_weight * float(b)) * double(stride);
+  return double(hsum(soft) - beyond_weight * float(hsum(beyond))) * double(stride);
 }
 
 // The start with the most support on a subsample of all half-ring points: the seed regression, last
@@ -94,7 +91,7 @@ bool RingPlaneFit::choose_start(const Candidates& c, const Eigen::Vector3d& up, 
     Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
     Eigen::Vector3d b = Eigen::Vector3d::Zero();
     for (int i : seeds_) {
-      const Eigen::Vector3d p = c.p[i].cast<double>();
+      const Eigen::Vector3d p = c.point(size_t(i)).cast<double>();
       const Eigen::Vector3d x(p.dot(e1), p.dot(e2), 1.0);
       A.noalias() += x * x.transpose();
       b += x * p.dot(up);
@@ -107,7 +104,7 @@ bool RingPlaneFit::choose_start(const Candidates& c, const Eigen::Vector3d& up, 
     have_seed_plane = true;
     if (round == k::kSeedTrimRounds - 1) break;
     res.clear();
-    for (int i : seeds_) res.push_back(std::abs(float(seed_plane.head<3>().dot(c.p[i].cast<double>()) + seed_plane[3])));
+    for (int i : seeds_) res.push_back(std::abs(float(seed_plane.head<3>().dot(c.point(size_t(i)).cast<double>()) + seed_plane[3])));
     std::vector<float> tmp = res;
     const double thr = std::max(k::kSeedTrimMinM, k::kSeedTrimSigmas * k::kMadToSigma * median_inplace(tmp));
     std::vector<int> kept;
@@ -141,9 +138,9 @@ bool RingPlaneFit::choose_start(const Candidates& c, const Eigen::Vector3d& up, 
     // Alternate between the longest-range seeds (the paper's) and all sector maxima (tilted sensor).
     const std::vector<int>& pool = (t % 2 == 0) ? seeds_ : all_seeds_;
     if (pool.size() < 3) continue;
-    const Eigen::Vector3d a = c.p[pool[next() % pool.size()]].cast<double>();
-    const Eigen::Vector3d b = c.p[pool[next() % pool.size()]].cast<double>();
-    const Eigen::Vector3d q = c.p[pool[next() % pool.size()]].cast<double>();
+    const Eigen::Vector3d a = c.point(size_t(pool[next() % pool.size()])).cast<double>();
+    const Eigen::Vector3d b = c.point(size_t(pool[next() % pool.size()])).cast<double>();
+    const Eigen::Vector3d q = c.point(size_t(pool[next() % pool.size()])).cast<double>();
     Eigen::Vector3d nn = (b - a).cross(q - a);
     if (nn.norm() < k::kMinTripletNormal) continue;
     nn.normalize();
@@ -160,50 +157,83 @@ bool RingPlaneFit::choose_start(const Candidates& c, const Eigen::Vector3d& up, 
 // cut-off only needs to cover its tilt error over the far ceiling (0.2 m); a wide one (0.5 m) lets the band
 // of wall returns below a corridor ceiling (10x the ceiling returns there) dominate the first weighted fit,
 // which then converges to a plane through the walls.
-std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Candidates& c, const Eigen::Vector3d& up,
-                                                      Eigen::Vector4d cur, double first_cut, double min_cut,
-                                                      bool fixed) {
+std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up, Eigen::Vector4d cur,
+                                                      double first_cut, double min_cut, bool fixed) {
+  using namespace simd;
   double last_sigma = 0;  // robust residual scale of the final iteration
   const Eigen::Vector3d ref = -cur[3] * cur.head<3>();  // a point of the plane (numerics)
   const Eigen::Vector3f reff = ref.cast<float>();
   double cut = first_cut;
   {
-    // The band's points, contiguous (streamed by every iteration); compacted without a branch (about one
-    // point in five is in the band, a branch on it mispredicted often).
-    const Eigen::Vector3f n = cur.head<3>().cast<float>();
-    const float d = float(cur[3]), cb = float(cut);
-    band_.resize(c.p.size() + 1);
-    Eigen::Vector3f* out = band_.data();
+    // The band's points relative to ref, contiguous float arrays (streamed by every iteration); compacted
+    // without a branch (about one point in five is in the band, a branch on it mispredicted often).
+    const v4f nx = splat(float(cur[0])), ny = splat(float(cur[1])), nz = splat(float(cur[2])), d = splat(float(cur[3]));
+    const v4f cb = splat(float(cut));
+    band_.resize(np_);
+    float *bx = band_.x.data(), *by = band_.y.data(), *bz = band_.z.data();
     size_t m = 0;
-    for (const Eigen::Vector3f& q : c.p) {
-      out[m] = q;
-      m += size_t(std::abs(n.dot(q) + d) < cb);
+    for (size_t i = 0; i < np_; i += 4) {
+      const v4f x = load(xs_ + i), y = load(ys_ + i), z = load(zs_ + i);
+      const int in = movemask(abs(nx * x + ny * y + nz * z + d) < cb);  // NaN padding: false
+      if (in == 0) continue;  // the band is a few contiguous runs per ring: mostly all or none of four
+      const v4f qx = x - splat(reff.x()), qy = y - splat(reff.y()), qz = z - splat(reff.z());
+      if (in == 15) {
+        store(bx + m, qx);
+        store(by + m, qy);
+        store(bz + m, qz);
+        m += 4;
+        continue;
+      }
+      for (int l = 0; l < 4; ++l) {
+        bx[m] = qx[l];
+        by[m] = qy[l];
+        bz[m] = qz[l];
+        m += size_t((in >> l) & 1);
+      }
     }
+    // Padding: a point 1 km off the start plane (zero weight, outside every cut-off, finite).
     band_.resize(m);
+    band_.pad(1e3f * float(cur[0]), 1e3f * float(cur[1]), 1e3f * float(cur[2]));
+    // Every kShrinkSubsample-th band point (the subsample of the iterations whose cut-off still shrinks).
+    band_sub_.resize((m + k::kShrinkSubsample - 1) / k::kShrinkSubsample);
+    for (size_t j = 0, o = 0; j < m; j += k::kShrinkSubsample, ++o) {
+      band_sub_.x[o] = bx[j];
+      band_sub_.y[o] = by[j];
+      band_sub_.z[o] = bz[j];
+    }
+    band_sub_.pad(1e3f * float(cur[0]), 1e3f * float(cur[1]), 1e3f * float(cur[2]));
   }
-  if (band_.size() < 3) return std::nullopt;
+  const size_t nb = band_.n;
+  if (nb < 3) return std::nullopt;
+  if (bins_.size() < band_.padded()) bins_.resize(band_.padded());
+  // While the cut-off still shrinks, the scale and the weighted fit use every kShrinkSubsample-th band point
+  // (band_sub_); once it stops shrinking, every point (band_).
+  bool shrinking = !fixed;
   for (int it = 0; it < std::max(1, cfg_.irls_iterations); ++it) {
-    const Eigen::Vector3f n = cur.head<3>().cast<float>();
-    const float d = float(cur[3]);
-    // Residuals once per iteration; robust scale (1.4826 * median |r| inside the cut-off) from a histogram.
-    res_.resize(band_.size());
-    // Four interleaved histograms (neighbouring returns fall into the same bin: one histogram made every
-    // increment wait for the previous one's store), summed after; the counts are the same. Residuals
-    // outside the cut-off go to an extra bin instead of a branch. `a < cut` is compared in float against
-    // the smallest float >= cut, which is the same test for every float a.
+    const v4f nx = splat(float(cur[0])), ny = splat(float(cur[1])), nz = splat(float(cur[2]));
+    const v4f d = splat(float(cur.head<3>().dot(ref) + cur[3]));  // the plane's offset relative to ref
+    const PointsSoa* src = shrinking ? &band_sub_ : &band_;
+    // Robust scale (1.4826 * median |r| inside the cut-off) from a histogram of the residuals: bins computed
+    // four at a time, residuals outside the cut-off go to an extra bin. `a < cut` is compared in float
+    // against the smallest float >= cut, which is the same test for every float a. Four interleaved
+    // histograms (neighbouring returns fall into the same bin: one histogram made every increment wait for
+    // the previous one's store), summed after; the counts are the same.
     int hist[4][k::kScaleBins + 1] = {};
-    const float inv_bin = float(k::kScaleBins / cut);
+    const float inv_binf = float(k::kScaleBins / cut);
     float cutf = float(cut);
     if (double(cutf) < cut) cutf = std::nextafter(cutf, std::numeric_limits<float>::infinity());
-    const size_t nb = band_.size();
-    const Eigen::Vector3f* bp = band_.data();
-    float* rp = res_.data();
-    for (size_t j = 0; j < nb; ++j) {
-      const float r = n.dot(bp[j]) + d;
-      rp[j] = r;
-      const float a = std::abs(r);
-      const int b = a < cutf ? std::min(k::kScaleBins - 1, int(a * inv_bin)) : k::kScaleBins;
-      ++hist[j & 3][b];
+    {
+      const v4f inv_bin = splat(inv_binf), cutv = splat(cutf);
+      const v4i last = splati(k::kScaleBins - 1), outside = splati(k::kScaleBins);
+      const float *bx = src->x.data(), *by = src->y.data(), *bz = src->z.data();
+      int32_t* bins = bins_.data();
+      for (size_t j = 0, np = src->padded(); j < np; j += 4) {
+        const v4f a = abs(nx * load(bx + j) + ny * load(by + j) + nz * load(bz + j) + d);
+        v4i b = __builtin_convertvector(a * inv_bin, v4i);
+        b = b < last ? b : last;
+        store(bins + j, a < cutv ? b : outside);
+      }
+      for (size_t j = 0, nj = src->n; j < nj; ++j) ++hist[j & 3][bins[j]];
     }
     int inside = 0;
     for (int h = 0; h < 4; ++h)
@@ -214,31 +244,44 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Candidates& c, const
       acc += hist[0][bin] + hist[1][bin] + hist[2][bin] + hist[3][bin];
       if (2 * acc >= inside) break;
     }
-    const double sigma = k::kMadToSigma * (bin + 0.5) / inv_bin;
+    const double sigma = k::kMadToSigma * (bin + 0.5) / inv_binf;
     last_sigma = sigma;
     const double next_cut = fixed ? cut : std::max({cut * 0.5, k::kTukeyC * sigma, min_cut});
     const bool final_scale = next_cut >= cut;
     cut = std::min(cut, next_cut);
-    const float inv_c2 = float(1.0 / (cut * cut));
-    // While the cut-off still shrinks a subsample is enough; at the final scale use every point.
-    const size_t step = final_scale ? 1 : k::kShrinkSubsample;
-    double sw = 0, sx = 0, sy = 0, sz = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
-    for (size_t j = 0; j < band_.size(); j += step) {
-      const float r = res_[j];
-      const float t = r * r * inv_c2;
-      if (t >= 1.f) continue;
-      const double w = (1.f - t) * (1.f - t);
-      const Eigen::Vector3f& pf = band_[j];
-      const double x = pf.x() - reff.x(), y = pf.y() - reff.y(), z = pf.z() - reff.z();
-      sw += w;
-      sx += w * x; sy += w * y; sz += w * z;
-      sxx += w * x * x; sxy += w * x * y; sxz += w * x * z;
-      syy += w * y * y; syz += w * y * z; szz += w * z * z;
+    if (final_scale && shrinking) {
+      // The cut-off stopped shrinking on the subsample's scale: from now on every point (scale re-estimated
+      // on all of them, this iteration's fit on all of them).
+      shrinking = false;
+      --it;
+      continue;
+    }
+    // Tukey-weighted moments, sums in float over blocks of 256 points (four lanes), added up in double.
+    const v4f inv_c2 = splat(float(1.0 / (cut * cut))), one = splat(1.f), zero = splat(0.f);
+    double S[10] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    const float *bx = src->x.data(), *by = src->y.data(), *bz = src->z.data();
+    for (size_t j0 = 0, np = src->padded(); j0 < np; j0 += 256) {
+      v4f sw = zero, sx = zero, sy = zero, sz = zero, sxx = zero, sxy = zero, sxz = zero, syy = zero, syz = zero,
+          szz = zero;
+      for (size_t j = j0, je = std::min(np, j0 + 256); j < je; j += 4) {
+        const v4f x = load(bx + j), y = load(by + j), z = load(bz + j);
+        const v4f r = nx * x + ny * y + nz * z + d;
+        const v4f t = r * r * inv_c2;
+        const v4f u = one - t;
+        const v4f w = t < one ? u * u : zero;
+        const v4f wx = w * x, wy = w * y, wz = w * z;
+        sw += w;
+        sx += wx; sy += wy; sz += wz;
+        sxx += wx * x; sxy += wx * y; sxz += wx * z;
+        syy += wy * y; syz += wy * z; szz += wz * z;
+      }
+      const v4f all[10] = {sw, sx, sy, sz, sxx, sxy, sxz, syy, syz, szz};
+      for (int q = 0; q < 10; ++q) S[q] += double(hsum(all[q]));
     }
     Moments m;
-    m.w = sw;
-    m.s << sx, sy, sz;
-    m.ss << sxx, sxy, sxz, sxy, syy, syz, sxz, syz, szz;
+    m.w = S[0];
+    m.s << S[1], S[2], S[3];
+    m.ss << S[4], S[5], S[6], S[5], S[7], S[8], S[6], S[8], S[9];
     Eigen::Vector4d next;
     if (!m.plane(ref, up, next)) return std::nullopt;
     const double dn = (next.head<3>() - cur.head<3>()).norm(), dd = std::abs(next[3] - cur[3]);
@@ -250,15 +293,25 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Candidates& c, const
 
 bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const Eigen::Vector4d* previous,
                        PlaneRole role, Eigen::Vector4d& plane) {
-  if (c.p.size() < size_t(k::kMinCandidatePoints) || c.rings() < 1) return false;
+  if (c.size() < size_t(k::kMinCandidatePoints) || c.rings() < 1) return false;
   const Eigen::Vector3d up = up_in.normalized();
   // The subsamples every score is computed on (every kStartStride-th / kFinalStride-th candidate), copied
   // once: the scores then stream a small contiguous array instead of striding through all candidates.
   start_stride_ = c.start_stride > 0 ? c.start_stride : k::kStartStride;
   final_stride_ = c.final_stride > 0 ? c.final_stride : k::kFinalStride;
+  const size_t n = c.size();
+  xs_ = c.x.data();
+  ys_ = c.y.data();
+  zs_ = c.z.data();
+  np_ = (n + 3) & ~size_t(3);  // NaN-padded (Candidates)
   for (auto [sub, stride] : {std::pair{&sub_start_, start_stride_}, std::pair{&sub_final_, final_stride_}}) {
-    sub->resize((c.p.size() + stride - 1) / stride);
-    for (size_t i = 0, j = 0; i < c.p.size(); i += stride, ++j) (*sub)[j] = c.p[i];
+    sub->resize((n + stride - 1) / stride);
+    for (size_t i = 0, j = 0; i < n; i += stride, ++j) {
+      sub->x[j] = xs_[i];
+      sub->y[j] = ys_[i];
+      sub->z[j] = zs_[i];
+    }
+    sub->pad();
   }
   pick_seeds(c, up.cast<float>());
   Eigen::Vector4d cur;
@@ -276,7 +329,7 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
     return float(std::clamp(k::kSelectBandSigmas * std::min(s1, s2), k::kSelectBandMinM, cfg_.inlier_threshold_m));
   };
   auto refine_guarded = [&](const Eigen::Vector4d& start) -> std::optional<Fit> {
-    const auto r = refine(c, up, start, cfg_.irls_initial_scale_m, k::kMinCutM, false);
+    const auto r = refine(up, start, cfg_.irls_initial_scale_m, k::kMinCutM, false);
     if (r && score(r->pl) >= score(start)) return r;
     return Fit{start, cfg_.inlier_threshold_m / 3};
   };
@@ -296,7 +349,7 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
   // surface keeps its support. The tighter of the two wins on the narrow-band support.
   if (res1 && role == PlaneRole::kCeiling && cfg_.tight_refit_sigmas > 0) {
     const double ct = std::max(cfg_.tight_refit_sigmas * res1->sigma, k::kTightMinCutM);
-    if (const auto tight = refine(c, up, res1->pl, ct, ct, true)) {
+    if (const auto tight = refine(up, res1->pl, ct, ct, true)) {
       const float t_sel = select_band(res1->sigma, tight->sigma);
       if (score_band(sub_final_, final_stride_, tight->pl, t_sel) > score_band(sub_final_, final_stride_, res1->pl, t_sel)) res1 = tight;
     }

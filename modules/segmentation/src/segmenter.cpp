@@ -74,8 +74,8 @@ void Segmenter::fit_ceiling(const Eigen::Vector3d& init_up, const Eigen::Vector3
     else if (out_.ceiling.beyond > cfg_.max_beyond_ratio * out_.ceiling.inliers)
       why = "ceiling not where the rays end: " + std::to_string(out_.ceiling.beyond) + " returns beyond it vs " +
             std::to_string(out_.ceiling.inliers) + " inliers";
-    else if (out_.ceiling.inliers < scale_.min_inlier_fraction * double(upper_.p.size()))
-      why = "ceiling inliers are only " + std::to_string(100.0 * out_.ceiling.inliers / upper_.p.size()) +
+    else if (out_.ceiling.inliers < scale_.min_inlier_fraction * double(upper_.size()))
+      why = "ceiling inliers are only " + std::to_string(100.0 * out_.ceiling.inliers / upper_.size()) +
             " % of the upper-ring returns";
   }
   out_.ceiling.found = why.empty();
@@ -105,8 +105,7 @@ const Segmentation& Segmenter::process(const Scan& scan) {
   out_.status_text.clear();
   out_.ceiling = Plane{};
   out_.ground = Plane{};
-  out_.wall.clear();
-  out_.label.clear();
+  out_.label.clear();  // (the wall points are rewritten by select_walls, cleared on the early returns)
 
   // Gravity prior: IMU (when enabled and available), else the sensor's z axis.
   if (accel_n_ > 0) {
@@ -127,16 +126,22 @@ const Segmentation& Segmenter::process(const Scan& scan) {
   const Eigen::Vector3d gate_up = imu.valid ? imu_up_ : Eigen::Vector3d::UnitZ();
 
   if (!prepare(scan)) {
+    out_.wall.clear();
     height_.hold(out_, imu);
     return out_;
   }
   if (scan.status == ScanStatus::kBadInput) {
     out_.status = SegStatus::kBadInput;
     out_.status_text = "scan marked bad by the driver";
+    out_.wall.clear();
     height_.hold(out_, imu);
     return out_;
   }
   if (keep_labels_) out_.label.assign(size_t(scan.height) * scan.width, 0);
+  if (fit_->reads_points()) {  // Candidates::p for fits that read it (RANSAC)
+    upper_.fill_points();
+    lower_.fill_points();
+  }
 
   // Prior up: the IMU's gravity, else the last measured attitude (the ceiling's up in the paper's case; the
   // ground's when the ceiling over the sensor was not level), else the sensor's z axis.
@@ -149,6 +154,7 @@ const Segmentation& Segmenter::process(const Scan& scan) {
   const double ceiling_vs_prior = std::acos(std::clamp(up.dot(init_up.normalized()), -1.0, 1.0));
   fit_ground(ceiling_vs_prior < k::kCeilingPriorAgreeDeg * k::kDeg ? up : init_up.normalized());
 
+  if (height_.has_areas() && upper_.p.size() != upper_.size()) upper_.fill_points();  // the area census reads p
   height_.update(out_, imu, &upper_);
   if (out_.ceiling.found) {
     have_prev_ceiling_ = true;

@@ -67,11 +67,11 @@ class FeatureExtractor {
   std::vector<int32_t> source_;
   std::vector<float> curv_;
   std::vector<uint8_t> ok_, picked_;
-  std::vector<int> order_;
+  std::vector<int> order_, surf_;
   Eigen::Matrix3f R_ = Eigen::Matrix3f::Identity();
   std::vector<int> sel_, brk_;
   std::vector<int8_t> kind_;
-  std::vector<Eigen::Vector3d> pre_;
+  std::vector<double> prex_, prey_, prez_;
 };
 
 }  // namespace fploc::feat

@@ -18,6 +18,8 @@ class PlaneFit {
  public:
   virtual ~PlaneFit() = default;
   virtual const char* name() const = 0;
+  // Whether fit() reads Candidates::p (else only the float arrays; p is then not filled).
+  virtual bool reads_points() const { return true; }
   // Fits the dominant plane of `c` above the sensor along `up`. `previous` (if non-null) is last frame's
   // plane in the same convention. Returns the plane with n pointing against `up` (into the room), or false.
   virtual bool fit(const Candidates& c, const Eigen::Vector3d& up, const Eigen::Vector4d* previous, PlaneRole role,
@@ -30,6 +32,7 @@ class RingPlaneFit : public PlaneFit {
  public:
   explicit RingPlaneFit(const SegmenterConfig& cfg) : cfg_(cfg) {}
   const char* name() const override { return "rings"; }
+  bool reads_points() const override { return false; }
   bool fit(const Candidates& c, const Eigen::Vector3d& up, const Eigen::Vector4d* previous, PlaneRole role,
            Eigen::Vector4d& plane) override;
 
@@ -42,18 +45,24 @@ class RingPlaneFit : public PlaneFit {
   bool choose_start(const Candidates& c, const Eigen::Vector3d& up, const Eigen::Vector4d* previous,
                     Eigen::Vector4d& start);
   // Support of `pl` on `sub`, a subsample of the candidates (every stride-th), scaled by the stride.
-  double score_band(const std::vector<Eigen::Vector3f>& sub, size_t stride, const Eigen::Vector4d& pl, float band) const;
-  // IRLS from `start`; the cut-off shrinks from first_cut down to min_cut (fixed: stays at first_cut).
-  std::optional<Fit> refine(const Candidates& c, const Eigen::Vector3d& up, Eigen::Vector4d start, double first_cut,
-                            double min_cut, bool fixed);
+  double score_band(const PointsSoa& sub, size_t stride, const Eigen::Vector4d& pl, float band) const;
+  // IRLS from `start` over the candidates (xs_/ys_/zs_); the cut-off shrinks from first_cut down to min_cut
+  // (fixed: stays at first_cut).
+  std::optional<Fit> refine(const Eigen::Vector3d& up, Eigen::Vector4d start, double first_cut, double min_cut,
+                            bool fixed);
 
   SegmenterConfig cfg_;
   std::vector<int> seeds_, all_seeds_;
   std::vector<float> sector_best_;
   std::vector<int> sector_idx_;
-  std::vector<Eigen::Vector3f> band_, sub_start_, sub_final_;
+  std::vector<int> sector_of_col_;  // azimuth sector of each staggered column (pick_seeds)
+  int sector_cols_s_ = 0;
+  // The current fit's candidates (Candidates' float arrays, NaN-padded to np_, a multiple of 4).
+  const float *xs_ = nullptr, *ys_ = nullptr, *zs_ = nullptr;
+  size_t np_ = 0;
+  PointsSoa band_, band_sub_, sub_start_, sub_final_;  // band_: relative to the refinement's reference point
   size_t start_stride_ = 1, final_stride_ = 1;  // of the current fit (Candidates, else the reference strides)
-  std::vector<float> res_;
+  std::vector<int32_t> bins_;
 };
 
 }  // namespace fploc::seg

@@ -51,9 +51,9 @@ class Segmenter {
   // The sensor-dependent numbers in use (from the last scan's beam pattern, beam_scaling.h).
   const BeamScaling& beam_scaling() const { return scale_; }
   const Eigen::Vector3d& gyro_bias() const { return deskew_.bias(); }  // rad/s, perpendicular-to-gravity part
-  // Last scan's points per pixel (row-major like the scan, de-skewed when last().deskewed; only pixels with a
-  // return inside [min_range_m, max_range_m] are meaningful). Diagnostics.
-  const std::vector<Eigen::Vector3f>& points() const { return xyz_; }
+  // Last scan's points per pixel (row-major like the scan, de-skewed when last().deskewed; NaN where there
+  // is no return inside [min_range_m, max_range_m]). Diagnostics: built on each call.
+  const std::vector<Eigen::Vector3f>& points() const;
 
  private:
   bool prepare(const Scan& scan);
@@ -72,14 +72,24 @@ class Segmenter {
   BeamScaling scale_;
   BeamIntrinsics lut_beams_;
   int lut_width_ = 0;
-  std::vector<Eigen::Vector3f> xyz_;   // sensor frame (de-skewed to mid-sweep when out_.deskewed)
-  std::vector<Eigen::Vector3f> raw_;   // as measured (only filled when de-skewing)
-  std::vector<float> range_;
+  mutable std::vector<Eigen::Vector3f> points_;  // points() (diagnostics)
   std::vector<float> col_dt_;  // per staggered column: column time - scan utime [s]
   std::vector<int> ring_order_;      // rings sorted by altitude, top first
   std::vector<int> col_mid_;
   std::vector<uint8_t> col_ok_;
-  Candidates upper_, lower_;
+  std::vector<int32_t> col_okm_;            // col_ok_ as lane masks (-1 / 0)
+  std::vector<float> lut_soa_[6];           // lut_ as float arrays: direction x/y/z, offset x/y/z
+  std::vector<float> rot_soa_[9];           // de-skew rotation per column, entry (e / 3, e % 3)
+  std::vector<int8_t> row_set_;   // per scan row: 0 upper_, 1 lower_, 2 middle_ (with row_ring_: its ring there)
+  std::vector<int> row_ring_;
+  struct WallPiece {  // wall selection: a contiguous run of one row's candidates (wall_select.cpp)
+    const Candidates* cs;
+    int32_t a, b, off;
+    int16_t u;
+  };
+  std::vector<WallPiece> pieces_;
+  std::vector<uint8_t> masks_;  // wall selection: lane mask of each group of four candidates
+  Candidates upper_, lower_, middle_;  // middle_: an odd beam count's middle ring (wall points only)
   bool keep_labels_ = false;
 
   // Plane tracking (priors for the next scan's fits and wall bounds).
