@@ -109,6 +109,7 @@ const Segmentation& Segmenter::process(const Scan& scan) {
   out_.label.clear();
 
   // Gravity prior: IMU (when enabled and available), else the sensor's z axis.
+  accel_this_scan_ = false;
   if (accel_n_ > 0) {
     const Eigen::Vector3d mean = accel_sum_ / accel_n_;
     imu_up_ = mean.normalized();
@@ -116,6 +117,8 @@ const Segmentation& Segmenter::process(const Scan& scan) {
     // Gravity alone: the mean's magnitude is g and the samples scatter little around it (no jolt).
     const double spread = std::sqrt(std::max(0.0, accel_sq_ / accel_n_ - mean.squaredNorm()));
     imu_trusted_ = std::abs(mean.norm() - k::kGravityMs2) < k::kImuTrustNormTolMs2 && spread < k::kImuTrustSpreadMs2;
+    accel_mean_ = mean;
+    accel_this_scan_ = true;
     accel_sum_.setZero();
     accel_sq_ = 0;
     accel_n_ = 0;
@@ -149,7 +152,8 @@ const Segmentation& Segmenter::process(const Scan& scan) {
   const double ceiling_vs_prior = std::acos(std::clamp(up.dot(init_up.normalized()), -1.0, 1.0));
   fit_ground(ceiling_vs_prior < k::kCeilingPriorAgreeDeg * k::kDeg ? up : init_up.normalized());
 
-  height_.update(out_, imu, &upper_);
+  const Eigen::Vector3d plane_up = height_.update(out_, imu, &upper_);
+  fuse_imu(scan, plane_up);
   if (out_.ceiling.found) {
     have_prev_ceiling_ = true;
     prev_ceiling_ = out_.ceiling.coeffs;
@@ -163,6 +167,7 @@ const Segmentation& Segmenter::process(const Scan& scan) {
   }
 
   select_walls(scan, up);
+  attitude_to_scan_time(scan);
   return out_;
 }
 
