@@ -73,7 +73,9 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
                                             const Eigen::Vector3d* accel, const Eigen::Vector3d& bias) {
   Result r;
   const bool acc_ok = accel && accel->allFinite() && std::abs(accel->norm() - k::kGravityMs2) < cfg_.accel_norm_tol;
-  const Eigen::Vector3d ad = acc_ok ? Eigen::Vector3d(accel->normalized()) : Eigen::Vector3d::UnitZ();
+  // The accelerometer's direction, less its tilt bias (learned on level floors; sensor-fixed, like the bias).
+  const Eigen::Vector3d ad_raw = acc_ok ? Eigen::Vector3d(accel->normalized()) : Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d ad = acc_ok ? Eigen::Vector3d((ad_raw - acc_bias_).normalized()) : ad_raw;
   if (!started_) {
     if (!plane_up) return r;  // nothing to carry yet
     started_ = true;
@@ -175,6 +177,13 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
       held_ = 0;
     }
     if (mode_ == Mode::kLevel) {
+      if (acc_ok && held_ == 0) {
+        // Level floor: the planes are gravity; what the accelerometer says beside it is its bias (the
+        // platform's accelerations average out over accel_bias_tau_s).
+        const double kb = 1 - std::exp(-std::max(0.0, dt) / cfg_.accel_bias_tau_s);
+        Eigen::Vector3d d = ad_raw - p;
+        acc_bias_ += kb * (d - acc_bias_);
+      }
       g_ = p;
       sigma_ = plane_sigma;
       r.valid = r.from_planes = true;

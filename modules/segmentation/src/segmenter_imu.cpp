@@ -52,7 +52,20 @@ void Segmenter::attitude_to_scan_time(const Scan& scan) {
   roll_pitch_from_up(up_u, roll_u, pitch_u);
   out_.roll = roll_u;
   out_.pitch = pitch_u;
-  out_.attitude_t = 0;  // roll/pitch now at utime; z stays the planes' (mid-sweep: mm at these speeds)
+  // z: measured at mid-sweep; at utime it is interpolated between the last scan's mid-sweep z and this one
+  // (what downstream did with attitude_t before: the gyro says nothing about height).
+  const bool z_known = out_.z_source == HeightSource::kCeiling || out_.z_source == HeightSource::kGround;
+  const double z_mid = out_.z;
+  if (z_known && have_prev_mid_z_ && tm > prev_mid_t_ && scan.utime >= prev_mid_t_ && tm - prev_mid_t_ < 1000000) {
+    const double s = double(scan.utime - prev_mid_t_) / double(tm - prev_mid_t_);
+    out_.z = prev_mid_z_ + s * (z_mid - prev_mid_z_);
+  }
+  if (z_known) {
+    have_prev_mid_z_ = true;
+    prev_mid_t_ = tm;
+    prev_mid_z_ = z_mid;
+  }
+  out_.attitude_t = 0;  // roll/pitch/z now at utime
 }
 
 }  // namespace fploc::seg

@@ -39,6 +39,7 @@ struct GravityFusionConfig {
   double level_deg = 0.4;        // on a slope: the surface tilt below this is level again
   int max_hold_scans = 3;        // level: planes off the gyro by more than step_deg: gyro-carried for at most this
   double accel_tau_s = 10.0;     // on a slope: the accelerometer's pull on the surface tilt
+  double accel_bias_tau_s = 30.0; // level floors: the accelerometer's tilt bias against the planes, low-passed
   double accel_lp_tau_s = 1.0;   // low-pass of the accelerometer's gravity for the entry check
   double accel_norm_tol = 0.3;   // m/s^2: |mean specific force| this close to g to be used
   double gyro_noise = 0.0015;    // rad/s white noise per sample (sigma growth without planes)
@@ -88,6 +89,7 @@ class GravityFusion {
   Eigen::Vector3d u_ = Eigen::Vector3d::Zero();    // leaky sum of the planes' unexplained change (LEVEL)
   Eigen::Vector3d acc_lp_ = Eigen::Vector3d::UnitZ();  // accelerometer gravity, low-passed (gyro-carried)
   bool have_acc_lp_ = false;
+  Eigen::Vector3d acc_bias_ = Eigen::Vector3d::Zero();  // accelerometer direction minus gravity on level floors
   int held_ = 0;             // scans carried by the gyro since the planes stepped (LEVEL)
   Eigen::Vector3d held_nu_ = Eigen::Vector3d::Zero();  // last scan's disagreement
   bool refused_ = false;     // a change without the accelerometer's agreement was said (once per episode)

@@ -101,6 +101,9 @@ class Segmenter {
   bool imu_trusted_ = false;
   Eigen::Vector3d imu_up_ = Eigen::Vector3d::UnitZ();
   bool have_imu_ = false;
+  bool have_prev_mid_z_ = false;  // the last measured z at its mid-sweep time (z moved to utime)
+  int64_t prev_mid_t_ = 0;
+  double prev_mid_z_ = 0;
   bool accel_this_scan_ = false;  // samples arrived since the last scan (accel_mean_ is theirs)
   Eigen::Vector3d accel_mean_ = Eigen::Vector3d::Zero();
 };
