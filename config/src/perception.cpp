@@ -9,6 +9,7 @@ seg::SegmenterConfig config_of(const SegmenterOptions& o) {
   if (o.wall_margin_m() > 0) c.wall_margin_m = o.wall_margin_m();
   c.use_imu_prior = o.use_imu_prior();
   c.deskew_gyro = !o.no_gyro_deskew();
+  c.imu_attitude = !o.no_imu_attitude();
   if (o.ceiling_height_m() > 0) c.ceiling_height_m = o.ceiling_height_m();
   if (o.min_range_m() > 0) c.min_range_m = o.min_range_m();
   if (o.inlier_threshold_m() > 0) c.inlier_threshold_m = o.inlier_threshold_m();

@@ -39,7 +39,7 @@ class SegmenterNodeT : public rt::Node {
       throw std::runtime_error(std::string("segmenter.algorithm: '") + o.algorithm() + "' is not served by fploc-" +
                                Traits::kExecutable + " (use " + Traits::kOther + ")");
     seg_ = Traits::make(o);
-    use_imu_ = o.use_imu_prior();
+    use_imu_ = o.use_imu_prior() || !o.no_imu_attitude();  // the accelerometer: prior and/or gravity fusion
     if (o.has_building() && !o.building().file().empty()) use_building(ctx, o.building());
     out_ = ctx.advertise<segments_t>("segments");
     ctx.subscribe<scan_t>("scan", [this](const scan_t& m) { on_scan(m); });

@@ -17,6 +17,8 @@ const char* to_string(AttitudeSource s) {
     case AttitudeSource::kImu: return "imu";
     case AttitudeSource::kNone: return "none";
     case AttitudeSource::kGround: return "ground";
+    case AttitudeSource::kSlope: return "planes+slope";
+    case AttitudeSource::kGyro: return "gyro";
   }
   return "?";
 }

@@ -108,6 +108,7 @@ const Segmentation& Segmenter::process(const Scan& scan) {
   out_.label.clear();  // (the wall points are rewritten by select_walls, cleared on the early returns)
 
   // Gravity prior: IMU (when enabled and available), else the sensor's z axis.
+  accel_this_scan_ = false;
   if (accel_n_ > 0) {
     const Eigen::Vector3d mean = accel_sum_ / accel_n_;
     imu_up_ = mean.normalized();
@@ -115,6 +116,8 @@ const Segmentation& Segmenter::process(const Scan& scan) {
     // Gravity alone: the mean's magnitude is g and the samples scatter little around it (no jolt).
     const double spread = std::sqrt(std::max(0.0, accel_sq_ / accel_n_ - mean.squaredNorm()));
     imu_trusted_ = std::abs(mean.norm() - k::kGravityMs2) < k::kImuTrustNormTolMs2 && spread < k::kImuTrustSpreadMs2;
+    accel_mean_ = mean;
+    accel_this_scan_ = true;
     accel_sum_.setZero();
     accel_sq_ = 0;
     accel_n_ = 0;
@@ -155,7 +158,8 @@ const Segmentation& Segmenter::process(const Scan& scan) {
   fit_ground(ceiling_vs_prior < k::kCeilingPriorAgreeDeg * k::kDeg ? up : init_up.normalized());
 
   if (height_.has_areas() && upper_.p.size() != upper_.size()) upper_.fill_points();  // the area census reads p
-  height_.update(out_, imu, &upper_);
+  const Eigen::Vector3d plane_up = height_.update(out_, imu, &upper_);
+  fuse_imu(scan, plane_up);
   if (out_.ceiling.found) {
     have_prev_ceiling_ = true;
     prev_ceiling_ = out_.ceiling.coeffs;
@@ -169,6 +173,7 @@ const Segmentation& Segmenter::process(const Scan& scan) {
   }
 
   select_walls(scan, up);
+  attitude_to_scan_time(scan);
   return out_;
 }
 

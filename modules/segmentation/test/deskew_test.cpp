@@ -51,7 +51,8 @@ SeqResult run(bool with_gyro, const Eigen::Vector3d& added_bias, int first = 150
     ++r.frames;
     r.deskewed += s.deskewed;
     if (!s.ceiling.found) continue;
-    const Eigen::Vector3d rpy = sim.ground_truth(sim.frame_time(k) + 0.5 / o.rate_hz).rpy();
+    // roll/pitch hold at utime + attitude_t (mid-sweep, or the scan's time when the gyro moved them there).
+    const Eigen::Vector3d rpy = sim.ground_truth(sim.frame_time(k) + s.attitude_t).rpy();
     r.tilt_err_deg.push_back(std::abs(std::remainder(s.roll - rpy[0], 2 * M_PI)) / kDeg);
     r.tilt_err_deg.push_back(std::abs(std::remainder(s.pitch - rpy[1], 2 * M_PI)) / kDeg);
   }

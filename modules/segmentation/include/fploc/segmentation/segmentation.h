@@ -10,7 +10,9 @@
 namespace fploc::seg {
 
 enum class SegStatus : int8_t { kOk = 0, kNoCeiling = 1, kBadInput = 2, kEmpty = 3 };
-enum class AttitudeSource : int8_t { kCeiling = 0, kPrevious = 1, kImu = 2, kNone = 3, kGround = 4 };
+// kSlope: the planes' attitude turned by the slope of the surfaces they are on (ramps: the IMU's gravity against
+// the planes, gravity_fusion.h); kGyro: no plane, gravity carried by the gyro from the last scan.
+enum class AttitudeSource : int8_t { kCeiling = 0, kPrevious = 1, kImu = 2, kNone = 3, kGround = 4, kSlope = 5, kGyro = 6 };
 // Where z came from: the ceiling with the floor-to-ceiling height of the area (configured, or learned online
 // from ceiling + ground), the floor plane, a prediction (the last estimate, sigma grown; no trustworthy
 // plane or a jump not confirmed by the other plane), or nothing yet.

@@ -18,6 +18,7 @@
 #include "fploc/segmentation/attitude_height.h"
 #include "fploc/segmentation/beam_scaling.h"
 #include "fploc/segmentation/candidates.h"
+#include "fploc/segmentation/gravity_fusion.h"
 #include "fploc/segmentation/gyro_deskew.h"
 #include "fploc/segmentation/plane_fit.h"
 #include "fploc/segmentation/segmentation.h"
@@ -39,13 +40,17 @@ class Segmenter {
   void add_accel(const Eigen::Vector3d& accel);
   // IMU gyro sample (rad/s, sensor frame) measured at utime [us, the scan's clock]. Samples covering a
   // sweep de-skew its rotation (config deskew_gyro); without them the scan is used as measured.
-  void add_gyro(const Eigen::Vector3d& rate, int64_t utime) { deskew_.add(rate, utime); }
+  void add_gyro(const Eigen::Vector3d& rate, int64_t utime) {
+    deskew_.add(rate, utime);
+    if (cfg_.imu_attitude) fusion_.add_gyro(rate, utime);  // roll/pitch against gravity (segmenter_imu.cpp)
+  }
   void set_keep_labels(bool on) { keep_labels_ = on; }
   // A building floor's area ceilings and the sensor's plan pose (the localizer's feedback): z from the
   // height of the area under each ceiling point (AttitudeHeight, attitude_height_areas.cpp).
   void set_areas(const AreaCeilingMap& map) { height_.set_areas(map); }
   void set_plan_pose(const PlanPose& pose) { height_.set_plan_pose(pose); }
   const AttitudeHeight& height_estimator() const { return height_; }
+  const GravityFusion& gravity_fusion() const { return fusion_; }
   const SegmenterConfig& config() const { return cfg_; }
   double room_height() const { return height_.room_height(); }  // 0 until known
   // The sensor-dependent numbers in use (from the last scan's beam pattern, beam_scaling.h).
@@ -62,10 +67,15 @@ class Segmenter {
   void fit_ceiling(const Eigen::Vector3d& init_up, const Eigen::Vector3d& gate_up);
   void fit_ground(const Eigen::Vector3d& up);
   void select_walls(const Scan& scan, const Eigen::Vector3d& up);
+  // The IMU's part of roll/pitch (segmenter_imu.cpp): gravity vs the planes' up, then the attitude moved from
+  // mid-sweep to the scan's time with the gyro.
+  void fuse_imu(const Scan& scan, const Eigen::Vector3d& plane_up);
+  void attitude_to_scan_time(const Scan& scan);
 
   SegmenterConfig cfg_;
   std::unique_ptr<PlaneFit> fit_;
   GyroDeskew deskew_;
+  GravityFusion fusion_;
   AttitudeHeight height_;
   Segmentation out_;
   XyzLut lut_;
@@ -101,6 +111,11 @@ class Segmenter {
   bool imu_trusted_ = false;
   Eigen::Vector3d imu_up_ = Eigen::Vector3d::UnitZ();
   bool have_imu_ = false;
+  bool have_prev_mid_z_ = false;  // the last measured z at its mid-sweep time (z moved to utime)
+  int64_t prev_mid_t_ = 0;
+  double prev_mid_z_ = 0;
+  bool accel_this_scan_ = false;  // samples arrived since the last scan (accel_mean_ is theirs)
+  Eigen::Vector3d accel_mean_ = Eigen::Vector3d::Zero();
 };
 
 // The paper's segmenter: max-range seeds on the top K_r rings, linear regression, IRLS (Tukey).

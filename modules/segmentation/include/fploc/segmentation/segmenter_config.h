@@ -12,7 +12,11 @@ struct SegmenterConfig {
   double wall_margin_m = 0.10;     // points closer than this to ceiling/floor are not wall points
   double ceiling_height_m = 0.0;   // known floor-to-ceiling height; 0 = estimated (ceiling + ground fits)
   bool use_imu_prior = false;      // IMU gravity as initial direction, tilt gate and fallback
-  bool deskew_gyro = true;         // rotate returns to mid-sweep with the gyro rate (when gyro samples arrive)
+  bool deskew_gyro = true;
+  // Roll/pitch against gravity with the IMU (gravity_fusion.h) when gyro samples arrive: slopes (ramps) from the
+  // planes' disagreement with the gyro/accelerometer, gyro prediction without planes, and roll/pitch moved
+  // from mid-sweep to the scan's time (jolts). Level floors: the planes' attitude unchanged.
+  bool imu_attitude = true;         // rotate returns to mid-sweep with the gyro rate (when gyro samples arrive)
   double min_range_m = 0.4;        // ignore returns closer than this (platform, tripod)
   double max_range_m = 120.0;
   int min_plane_inliers = 200;     // fewer inliers -> plane not found

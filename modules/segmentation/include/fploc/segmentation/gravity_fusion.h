@@ -1,0 +1,102 @@
+// Roll/pitch against gravity from the planes and the IMU (issue 11 item 3: ramps and thresholds).
+//
+// The ceiling and ground planes give the sensor's attitude relative to the surfaces it sees, to a few
+// hundredths of a degree; that is the attitude against gravity only when those surfaces are level. On a
+// ramp under a ceiling parallel to it both planes tilt with the robot, and the planes alone cannot tell a
+// robot on a 7 deg ramp from a level one. The IMU can: the gyro measures every rotation of the sensor, the
+// accelerometer measures gravity (plus the platform's acceleration).
+//
+// The fusion keeps, in the sensor frame, the gravity up vector g and the surface's tilt o = g - p (p: the
+// planes' up; both world-fixed vectors, carried between scans by the gyro rotation):
+//  - LEVEL (o = 0): the output is the planes' attitude itself (bit-identical to the plane-only estimate).
+//    The planes' up changing by more than the gyro says (their unexplained change, summed over the last
+//    seconds) means the surface under/over the sensor changed: when that change is past `change_deg` and
+//    the accelerometer's gravity (low-passed over ~1 s) agrees with it, the robot is on a slope (o = the
+//    change the gyro carried across).
+//  - SLOPE: g = p + o. While the planes move as the gyro says (the same surfaces), the planes carry the
+//    robot's rotation and o stays; a step of the planes the gyro does not see (a fit moving to another
+//    surface: the ramp's foot or head, the ceiling beyond) is carried by the gyro (o absorbs it). The
+//    accelerometer pulls o slowly (`accel_tau_s`) towards its gravity (platform accelerations average out).
+//    o below `level_deg` again: back to LEVEL (said, never a silent jump).
+//  - No plane: g carried by the gyro (sigma grows with the gyro's noise and bias); no gyro: not handled
+//    here (the caller holds the last estimate with a grown sigma).
+// The disagreement between the planes and gravity is the floor's slope: slope_deg() (0 on level floors).
+// Transport-free; Segmenter feeds it (segmenter_imu.cpp).
+#pragma once
+#include <Eigen/Core>
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <utility>
+
+namespace fploc::seg {
+
+struct GravityFusionConfig {
+  double change_deg = 1.5;       // unexplained change of the planes' up (leaky sum) that means another surface
+  double change_leak_s = 3.0;    // time constant of that leaky sum (gyro drift and plane noise forgotten)
+  double accel_agree_deg = 1.5;  // the accelerometer's tilt agrees with the gyro's to this (or half the change)
+  double step_deg = 0.3;         // on a slope: a plane step larger than this (vs the gyro) is a surface change
+  double level_deg = 0.4;        // on a slope: the surface tilt below this is level again
+  int max_hold_scans = 3;        // level: planes off the gyro by more than step_deg: gyro-carried for at most this
+  double accel_tau_s = 10.0;     // on a slope: the accelerometer's pull on the surface tilt
+  double accel_bias_tau_s = 30.0; // level floors: the accelerometer's tilt bias against the planes, low-passed
+  double accel_lp_tau_s = 1.0;   // low-pass of the accelerometer's gravity for the entry check
+  double accel_norm_tol = 0.3;   // m/s^2: |mean specific force| this close to g to be used
+  double gyro_noise = 0.0015;    // rad/s white noise per sample (sigma growth without planes)
+  double gyro_bias_sigma = 0.0005;  // rad/s left after the bias estimate (sigma growth without planes)
+};
+
+class GravityFusion {
+ public:
+  enum class Mode { kLevel, kSlope };
+  struct Result {
+    bool valid = false;       // false: nothing to say (no planes and no gyro, or not started)
+    Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // gravity up in the sensor frame at the given time
+    double sigma = M_PI;      // 1-sigma of the tilt [rad]
+    bool from_planes = false; // the planes' own attitude (level surfaces), bit-identical
+    bool predicted = false;   // no plane: carried by the gyro
+    std::string text;         // what happened (empty: nothing new)
+  };
+
+  explicit GravityFusion(GravityFusionConfig cfg = {}) : cfg_(cfg) {}
+
+  // Gyro sample (rad/s, sensor frame) at utime [us]; out-of-order samples ignored, time going back resets.
+  void add_gyro(const Eigen::Vector3d& rate, int64_t utime);
+  bool has_gyro() const { return gyro_.size() >= 2; }
+  // The sensor's rotation from time ta to tb (orientation at tb relative to ta, body frame; a world-fixed
+  // vector v: v(tb) = R^T v(ta)), bias-corrected; false when the gyro does not cover [ta, tb].
+  bool rotation(int64_t ta, int64_t tb, const Eigen::Vector3d& bias, Eigen::Matrix3d* R) const;
+
+  // One scan at time t (the planes' time, mid-sweep): `plane_up` the planes' up (nullptr: no plane accepted),
+  // its sigma; `accel` the mean specific force since the last scan (nullptr: none); `bias` the gyro bias.
+  Result update(int64_t t, const Eigen::Vector3d* plane_up, double plane_sigma, const Eigen::Vector3d* accel,
+                const Eigen::Vector3d& bias);
+
+  Mode mode() const { return mode_; }
+  // The surface's tilt against gravity [deg] (0 on level floors): the floor's slope when the planes are the floor's.
+  double slope_deg() const;
+
+ private:
+  GravityFusionConfig cfg_;
+  std::deque<std::pair<int64_t, Eigen::Vector3d>> gyro_;
+  Eigen::Vector3d rate_at(int64_t t, const Eigen::Vector3d& bias) const;
+
+  bool started_ = false;
+  int64_t t_ = 0;
+  Mode mode_ = Mode::kLevel;
+  Eigen::Vector3d g_ = Eigen::Vector3d::UnitZ();   // gravity up (sensor frame, at t_)
+  Eigen::Vector3d o_ = Eigen::Vector3d::Zero();    // surface tilt: g - p (world-fixed difference vector)
+  Eigen::Vector3d u_ = Eigen::Vector3d::Zero();    // leaky sum of the planes' unexplained change (LEVEL)
+  Eigen::Vector3d acc_lp_ = Eigen::Vector3d::UnitZ();  // accelerometer gravity, low-passed (gyro-carried)
+  bool have_acc_lp_ = false;
+  Eigen::Vector3d acc_bias_ = Eigen::Vector3d::Zero();  // accelerometer direction minus gravity on level floors
+  int held_ = 0;             // scans carried by the gyro since the planes stepped (LEVEL)
+  Eigen::Vector3d held_nu_ = Eigen::Vector3d::Zero();  // last scan's disagreement
+  bool refused_ = false;     // a change without the accelerometer's agreement was said (once per episode)
+  double sigma_ = M_PI;      // tilt sigma of g
+  double o_sigma_ = 0;       // of the surface tilt
+};
+
+const char* to_string(GravityFusion::Mode m);
+
+}  // namespace fploc::seg

@@ -1,0 +1,235 @@
+#include "fploc/segmentation/gravity_fusion.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "segmenter_constants.h"
+
+namespace fploc::seg {
+
+namespace {
+std::string fmt_deg(const char* f, double a, double b = 0) {
+  char buf[200];
+  std::snprintf(buf, sizeof buf, f, a / k::kDeg, b / k::kDeg);
+  return buf;
+}
+double angle_of(const Eigen::Vector3d& tilt) { return std::asin(std::min(1.0, tilt.norm())); }
+}  // namespace
+
+const char* to_string(GravityFusion::Mode m) { return m == GravityFusion::Mode::kLevel ? "level" : "slope"; }
+
+void GravityFusion::add_gyro(const Eigen::Vector3d& w, int64_t utime) {
+  if (!w.allFinite() || w.norm() > k::kMaxGyroRate || utime <= 0) return;
+  if (!gyro_.empty() && utime <= gyro_.back().first) {
+    if (utime < gyro_.back().first - k::kGyroKeepUs) {  // time went back: a new log/sensor
+      gyro_.clear();
+      started_ = false;
+    } else {
+      return;  // duplicate or out of order
+    }
+  }
+  gyro_.emplace_back(utime, w);
+  while (gyro_.size() > 2 && gyro_.front().first < utime - 2 * k::kGyroKeepUs) gyro_.pop_front();
+}
+
+Eigen::Vector3d GravityFusion::rate_at(int64_t t, const Eigen::Vector3d& bias) const {
+  if (t <= gyro_.front().first) return gyro_.front().second - bias;
+  if (t >= gyro_.back().first) return gyro_.back().second - bias;
+  auto it = std::lower_bound(gyro_.begin(), gyro_.end(), t,
+                             [](const std::pair<int64_t, Eigen::Vector3d>& s, int64_t v) { return s.first < v; });
+  const auto& b = *it;
+  const auto& a = *(it - 1);
+  const double f = double(t - a.first) / double(std::max<int64_t>(1, b.first - a.first));
+  return (1 - f) * a.second + f * b.second - bias;
+}
+
+bool GravityFusion::rotation(int64_t ta, int64_t tb, const Eigen::Vector3d& bias, Eigen::Matrix3d* R) const {
+  *R = Eigen::Matrix3d::Identity();
+  if (gyro_.size() < 2) return false;
+  const int64_t lo = std::min(ta, tb), hi = std::max(ta, tb);
+  if (gyro_.front().first > lo + k::kGyroEdgeUs || gyro_.back().first < hi - k::kGyroEdgeUs) return false;
+  int64_t prev = gyro_.front().first;
+  for (const auto& g : gyro_) {  // no gap longer than kGyroMaxGapUs inside [lo, hi]
+    if (g.first > hi + k::kGyroMaxGapUs) break;
+    if (g.first >= lo - k::kGyroMaxGapUs && g.first - prev > k::kGyroMaxGapUs) return false;
+    prev = g.first;
+  }
+  // Midpoint rule in steps of at most kGyroStepUs (negative dt when tb < ta).
+  const int steps = int(std::max<int64_t>(1, (hi - lo + k::kGyroStepUs - 1) / k::kGyroStepUs));
+  for (int s = 0; s < steps; ++s) {
+    const int64_t a = ta + (tb - ta) * s / steps, b = ta + (tb - ta) * (s + 1) / steps;
+    const Eigen::Vector3d th = rate_at(a + (b - a) / 2, bias) * (1e-6 * double(b - a));
+    const double ang = th.norm();
+    if (ang > 0) *R = *R * Eigen::AngleAxisd(ang, th / ang).toRotationMatrix();
+  }
+  return true;
+}
+
+double GravityFusion::slope_deg() const { return mode_ == Mode::kSlope ? angle_of(o_) / k::kDeg : 0.0; }
+
+GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* plane_up, double plane_sigma,
+                                            const Eigen::Vector3d* accel, const Eigen::Vector3d& bias) {
+  Result r;
+  const bool acc_ok = accel && accel->allFinite() && std::abs(accel->norm() - k::kGravityMs2) < cfg_.accel_norm_tol;
+  // The accelerometer's direction, less its tilt bias (learned on level floors; sensor-fixed, like the bias).
+  const Eigen::Vector3d ad_raw = acc_ok ? Eigen::Vector3d(accel->normalized()) : Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d ad = acc_ok ? Eigen::Vector3d((ad_raw - acc_bias_).normalized()) : ad_raw;
+  if (!started_) {
+    if (!plane_up) return r;  // nothing to carry yet
+    started_ = true;
+    t_ = t;
+    mode_ = Mode::kLevel;
+    g_ = *plane_up;
+    o_.setZero();
+    u_.setZero();
+    sigma_ = plane_sigma;
+    if (acc_ok) acc_lp_ = ad, have_acc_lp_ = true;
+    r.valid = r.from_planes = true;
+    r.up = *plane_up;
+    r.sigma = plane_sigma;
+    return r;
+  }
+  const double dt = 1e-6 * double(t - t_);
+  Eigen::Matrix3d R;
+  const bool gyro_ok = dt >= 0 && dt <= 1.0 && rotation(t_, t, bias, &R);
+  if (!gyro_ok) R.setIdentity();
+  t_ = t;
+  const Eigen::Matrix3d Rt = R.transpose();
+  // Carry the world-fixed vectors into this scan's sensor frame.
+  const Eigen::Vector3d g_pred = (Rt * g_).normalized();
+  const Eigen::Vector3d o_pred = Rt * o_;
+  u_ = std::exp(-std::max(0.0, dt) / cfg_.change_leak_s) * (Rt * u_);
+  if (have_acc_lp_) acc_lp_ = (Rt * acc_lp_).normalized();
+  if (acc_ok) {
+    if (!have_acc_lp_) acc_lp_ = ad, have_acc_lp_ = true;
+    else acc_lp_ = (acc_lp_ + (1 - std::exp(-std::max(0.0, dt) / cfg_.accel_lp_tau_s)) * (ad - acc_lp_)).normalized();
+  }
+
+  if (!plane_up) {
+    if (!gyro_ok) return r;  // no source: the caller holds with a grown sigma
+    g_ = g_pred;
+    const double grow = cfg_.gyro_bias_sigma * dt + cfg_.gyro_noise * std::sqrt(std::max(0.0, dt) * 0.01);
+    sigma_ = std::min(M_PI, sigma_ + grow);
+    r.valid = r.predicted = true;
+    r.up = g_;
+    r.sigma = sigma_;
+    return r;
+  }
+  const Eigen::Vector3d& p = *plane_up;
+
+  if (mode_ == Mode::kLevel) {
+    if (gyro_ok) {
+      // The planes' change the gyro does not explain (g is last scan's gravity carried: the planes' when they
+      // were taken).
+      Eigen::Vector3d nu = p - g_pred;
+      nu -= nu.dot(p) * p;
+      if (nu.norm() < std::sin(15 * k::kDeg)) u_ += held_ > 0 ? Eigen::Vector3d(nu - held_nu_) : nu;
+      held_nu_ = nu;
+      u_ -= u_.dot(p) * p;
+      const double change = std::max(angle_of(u_), angle_of(nu));
+      if (change > cfg_.change_deg * k::kDeg) {
+        const Eigen::Vector3d o_gyro = angle_of(nu) > angle_of(u_) ? Eigen::Vector3d(-nu) : Eigen::Vector3d(-u_);
+        bool agree = false;
+        double acc_off = M_PI;
+        if (have_acc_lp_) {
+          Eigen::Vector3d o_acc = acc_lp_ - p;
+          acc_off = (o_acc - o_gyro).norm();
+          agree = acc_off < std::max(std::sin(cfg_.accel_agree_deg * k::kDeg), 0.5 * o_gyro.norm());
+        }
+        if (agree) {
+          mode_ = Mode::kSlope;
+          o_ = o_gyro;
+          o_sigma_ = std::max(0.05 * k::kDeg, 0.02 * angle_of(o_));
+          u_.setZero();
+          refused_ = false;
+          held_ = 0;
+          r.text = fmt_deg("planes turned %.2f deg more than the gyro (the accelerometer agrees within %.2f deg): on a slope",
+                           change, std::asin(std::min(1.0, acc_off)));
+        } else if (!refused_) {
+          refused_ = true;
+          r.text = fmt_deg("planes turned %.2f deg more than the gyro, the accelerometer disagrees by %.2f deg: taken as level",
+                           change, std::asin(std::min(1.0, acc_off)));
+        }
+      } else if (change < 0.5 * cfg_.change_deg * k::kDeg) {
+        refused_ = false;
+      }
+      if (mode_ == Mode::kLevel && nu.norm() > std::sin(cfg_.step_deg * k::kDeg) && held_ < cfg_.max_hold_scans &&
+          !refused_) {
+        // One scan's planes off what the gyro carried (a compromise plane, another surface seen for a moment):
+        // gravity carried by the gyro for a while; the planes again once they agree (or after max_hold_scans).
+        if (held_ == 0) {
+          r.text = fmt_deg("planes %.2f deg off the gyro's prediction: attitude carried by the gyro", angle_of(nu));
+        }
+        ++held_;
+        g_ = g_pred;
+        const double grow = cfg_.gyro_bias_sigma * dt + cfg_.gyro_noise * std::sqrt(std::max(0.0, dt) * 0.01);
+        sigma_ = std::min(M_PI, sigma_ + grow);
+        r.valid = r.predicted = true;
+        r.up = g_;
+        r.sigma = sigma_;
+        return r;
+      }
+      if (held_ > 0 && mode_ == Mode::kLevel)
+        r.text = fmt_deg(held_ >= cfg_.max_hold_scans ? "planes %.2f deg off the gyro for too long: the planes again"
+                                                      : "planes agree with the gyro again (%.2f deg)", angle_of(nu));
+      held_ = 0;
+    }
+    if (mode_ == Mode::kLevel) {
+      if (acc_ok && held_ == 0) {
+        // Level floor: the planes are gravity; what the accelerometer says beside it is its bias (the
+        // platform's accelerations average out over accel_bias_tau_s).
+        const double kb = 1 - std::exp(-std::max(0.0, dt) / cfg_.accel_bias_tau_s);
+        Eigen::Vector3d d = ad_raw - p;
+        acc_bias_ += kb * (d - acc_bias_);
+      }
+      g_ = p;
+      sigma_ = plane_sigma;
+      r.valid = r.from_planes = true;
+      r.up = p;
+      r.sigma = plane_sigma;
+      return r;
+    }
+  } else if (gyro_ok) {
+    Eigen::Vector3d nu = p - (g_pred - o_pred);
+    nu -= nu.dot(p) * p;
+    if (nu.norm() > std::sin(cfg_.step_deg * k::kDeg)) {
+      // The planes stepped, the sensor did not: the fit is on another surface. Gravity carried by the gyro.
+      o_ = g_pred - p;
+      o_sigma_ += 0.02 * nu.norm();
+      r.text = fmt_deg("plane step of %.2f deg the gyro did not see: another surface, its slope %.2f deg", angle_of(nu),
+                       angle_of(o_));
+    } else {
+      o_ = o_pred;  // the same surfaces: the planes carry the sensor's rotation
+    }
+  }
+  if (acc_ok) {
+    // The accelerometer's gravity, slowly: the platform's accelerations average out.
+    const double kacc = 1 - std::exp(-std::max(0.0, dt) / cfg_.accel_tau_s);
+    o_ += kacc * ((ad - p) - o_);
+    o_sigma_ = std::max(0.05 * k::kDeg, o_sigma_ * (1 - 0.5 * kacc));
+  }
+  o_ -= o_.dot(p) * p;
+  if (angle_of(o_) < cfg_.level_deg * k::kDeg) {
+    r.text += std::string(r.text.empty() ? "" : "; ") +
+              fmt_deg("surface tilt %.2f deg: level again, attitude from the planes", angle_of(o_));
+    mode_ = Mode::kLevel;
+    o_.setZero();
+    u_.setZero();
+    g_ = p;
+    sigma_ = plane_sigma;
+    r.valid = r.from_planes = true;
+    r.up = p;
+    r.sigma = plane_sigma;
+    return r;
+  }
+  g_ = (p + o_).normalized();
+  sigma_ = std::hypot(plane_sigma, o_sigma_);
+  r.valid = true;
+  r.up = g_;
+  r.sigma = sigma_;
+  return r;
+}
+
+}  // namespace fploc::seg
