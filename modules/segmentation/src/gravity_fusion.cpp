@@ -67,6 +67,15 @@ bool GravityFusion::rotation(int64_t ta, int64_t tb, const Eigen::Vector3d& bias
   return true;
 }
 
+void GravityFusion::carry_by_gyro(const Eigen::Vector3d& g_pred, double dt, Result& r) {
+  g_ = g_pred;
+  const double grow = cfg_.gyro_bias_sigma * dt + cfg_.gyro_noise * std::sqrt(std::max(0.0, dt) * 0.01);
+  sigma_ = std::min(M_PI, sigma_ + grow);
+  r.valid = r.predicted = true;
+  r.up = g_;
+  r.sigma = sigma_;
+}
+
 double GravityFusion::slope_deg() const { return mode_ == Mode::kSlope ? angle_of(o_) / k::kDeg : 0.0; }
 
 GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* plane_up, double plane_sigma,
@@ -109,12 +118,7 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
 
   if (!plane_up) {
     if (!gyro_ok) return r;  // no source: the caller holds with a grown sigma
-    g_ = g_pred;
-    const double grow = cfg_.gyro_bias_sigma * dt + cfg_.gyro_noise * std::sqrt(std::max(0.0, dt) * 0.01);
-    sigma_ = std::min(M_PI, sigma_ + grow);
-    r.valid = r.predicted = true;
-    r.up = g_;
-    r.sigma = sigma_;
+    carry_by_gyro(g_pred, dt, r);
     return r;
   }
   const Eigen::Vector3d& p = *plane_up;
@@ -163,12 +167,7 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
           r.text = fmt_deg("planes %.2f deg off the gyro's prediction: attitude carried by the gyro", angle_of(nu));
         }
         ++held_;
-        g_ = g_pred;
-        const double grow = cfg_.gyro_bias_sigma * dt + cfg_.gyro_noise * std::sqrt(std::max(0.0, dt) * 0.01);
-        sigma_ = std::min(M_PI, sigma_ + grow);
-        r.valid = r.predicted = true;
-        r.up = g_;
-        r.sigma = sigma_;
+        carry_by_gyro(g_pred, dt, r);
         return r;
       }
       if (held_ > 0 && mode_ == Mode::kLevel)

@@ -80,6 +80,8 @@ class GravityFusion {
   GravityFusionConfig cfg_;
   std::deque<std::pair<int64_t, Eigen::Vector3d>> gyro_;
   Eigen::Vector3d rate_at(int64_t t, const Eigen::Vector3d& bias) const;
+  // Gravity carried by the gyro alone over dt: its sigma grows with the bias and noise; r gets it.
+  void carry_by_gyro(const Eigen::Vector3d& g_pred, double dt, Result& r);
 
   bool started_ = false;
   int64_t t_ = 0;
