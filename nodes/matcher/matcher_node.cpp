@@ -68,8 +68,7 @@ class MatcherNode : public fploc::rt::Node {
     if (floors_.multi_floor()) tracker_.emplace(floors_.building, floor_);
     cfg_ = fploc::config::localizer_config(o);
     diff_weight_ = float(std::max(0.0, o.plan_diff_weight()));
-    scale_on_ = o.plan_diff_scale();
-    refine_on_ = o.plan_diff_refine();
+    correction_ = fploc::matcher::PlanCorrection(o.plan_diff_scale(), o.plan_diff_refine());
     lookup_name_ = o.lookup();
     weights_ = make_weights();
     loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
@@ -219,7 +218,7 @@ class MatcherNode : public fploc::rt::Node {
         return;
       }
     weights_->update(flagged);
-    if (scale_on_ || refine_on_) correct_plan(m);
+    if (correction_.enabled()) correct_plan(m);
   }
 
   // plan_diff_scale: the building is (1 + scale_error) times the plan; once the estimate is significant
@@ -232,29 +231,21 @@ class MatcherNode : public fploc::rt::Node {
       scale_warned_ = true;
       return;
     }
-    const double before = scale_.applied();
-    const auto sc = scale_on_ ? scale_.update(m.scale_error, m.scale_sigma) : std::nullopt;
-    const bool refined = refine_on_ && refine_.update(fploc::adapters::refined_offsets(m), m.utime);
-    if (!sc && !refined) return;
-    const double s_new = scale_.applied();
+    const double before = correction_.scale();
     const fploc::FloorPlan& plan = *floors_.maps[0].plan;
-    auto map = std::make_unique<fploc::matcher::LocalizationMap>(
-        fploc::matcher::corrected_localization_map(plan, s_new, refine_.applied(), lookup_name_));
+    std::string said;
+    auto map = correction_.update(plan, m.scale_error, m.scale_sigma, fploc::adapters::refined_offsets(m), m.utime,
+                                  lookup_name_, &said);
+    if (!map) return;
     auto loc = std::make_unique<fploc::localizer::Localizer>(*map->lookup, cfg_);
     for (const auto& i : imu_) loc->add_imu(i.first, i.second);
     if (have_pose_)
-      loc->set_pose(fploc::matcher::rescaled_pose(last_pose_, 1 + before, 1 + s_new, fploc::matcher::scale_centre(plan)), 0.1);
+      loc->set_pose(fploc::matcher::rescaled_pose(last_pose_, 1 + before, 1 + correction_.scale(), fploc::matcher::scale_centre(plan)),
+                    0.1);
     loc_ = std::move(loc);  // the old Localizer (and its look-up's map) go
     scaled_map_ = std::move(map);
-    double worst = 0;
-    for (const auto& o : refine_.applied()) worst = std::max({worst, std::abs(o.offset_a), std::abs(o.offset_b)});
-    char buf[200];
-    int k = std::snprintf(buf, sizeof buf, "plan corrected: scale %+.3f %% (estimate %+.3f +- %.3f %%)", 100 * s_new,
-                          100 * m.scale_error, 100 * m.scale_sigma);
-    if (refine_on_ && k > 0 && size_t(k) < sizeof buf)
-      std::snprintf(buf + k, sizeof buf - size_t(k), ", %zu walls refined (up to %.1f cm)", refine_.applied().size(), 100 * worst);
-    std::cerr << "[" << ctx_->name() << "] " << buf << "\n";
-    switch_text_ = buf;
+    std::cerr << "[" << ctx_->name() << "] " << said << "\n";
+    switch_text_ = said;
     switch_until_ = m.utime + 3'000'000;
   }
 
@@ -310,10 +301,9 @@ class MatcherNode : public fploc::rt::Node {
   bool have_ok_ = false;
   float diff_weight_ = 0;
   std::unique_ptr<fploc::matcher::ElementWeights> weights_;  // before loc_: the matcher reads it
-  bool scale_on_ = false, refine_on_ = false, scale_warned_ = false;
+  bool scale_warned_ = false;
   std::string lookup_name_;
-  fploc::matcher::ScaleCorrection scale_;
-  fploc::matcher::RefineCorrection refine_;
+  fploc::matcher::PlanCorrection correction_{false, false};
   std::unique_ptr<fploc::matcher::LocalizationMap> scaled_map_;  // the rescaled plan in use (null: none); before loc_
   fploc::Pose2 last_pose_;
   bool have_pose_ = false;

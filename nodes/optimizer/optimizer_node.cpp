@@ -51,8 +51,7 @@ class OptimizerNode : public fploc::rt::Node {
     floor_ = floors_.initial;
     cfg_ = fploc::config::localizer_config(o);
     diff_weight_ = float(std::max(0.0, o.plan_diff_weight()));
-    scale_on_ = o.plan_diff_scale();
-    refine_on_ = o.plan_diff_refine();
+    correction_ = fploc::matcher::PlanCorrection(o.plan_diff_scale(), o.plan_diff_refine());
     lookup_name_ = o.lookup();
     weights_ = make_weights();
     loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
@@ -78,7 +77,7 @@ class OptimizerNode : public fploc::rt::Node {
           return;
         }
       weights_->update(flagged);
-      if (scale_on_ || refine_on_) correct_plan(m);
+      if (correction_.enabled()) correct_plan(m);
     });
     ctx.subscribe<fploc::frame_pose_t>("frame_pose", [this](const fploc::frame_pose_t& m) {
       frame_poses_[m.scan_seq] = m;
@@ -165,21 +164,16 @@ class OptimizerNode : public fploc::rt::Node {
       scale_warned_ = true;
       return;
     }
-    const auto sc = scale_on_ ? scale_.update(m.scale_error, m.scale_sigma) : std::nullopt;
-    const bool refined = refine_on_ && refine_.update(fploc::adapters::refined_offsets(m), m.utime);
-    if (!sc && !refined) return;
-    const double s_new = scale_.applied();
+    std::string said;
+    auto map = correction_.update(*floors_.maps[0].plan, m.scale_error, m.scale_sigma, fploc::adapters::refined_offsets(m),
+                                  m.utime, lookup_name_, &said);
+    if (!map) return;
     std::vector<fploc::localizer::Pose> finals;
     loc_->flush(&finals);
     publish_finals(finals);
-    auto map = std::make_unique<fploc::matcher::LocalizationMap>(
-        fploc::matcher::corrected_localization_map(*floors_.maps[0].plan, s_new, refine_.applied(), lookup_name_));
     loc_ = std::make_unique<fploc::localizer::Localizer>(*map->lookup, cfg_);
     scaled_map_ = std::move(map);
-    std::cerr << "[" << ctx_->name() << "] plan corrected: scale " << 100 * s_new << " % (estimate " << 100 * m.scale_error
-              << " +- " << 100 * m.scale_sigma << " %)";
-    if (refine_on_) std::cerr << ", " << refine_.applied().size() << " walls refined";
-    std::cerr << "\n";
+    std::cerr << "[" << ctx_->name() << "] " << said << "\n";
   }
 
   void publish_finals(const std::vector<fploc::localizer::Pose>& finals) {
@@ -206,10 +200,9 @@ class OptimizerNode : public fploc::rt::Node {
   fploc::localizer::Config cfg_;
   float diff_weight_ = 0;
   std::unique_ptr<fploc::matcher::ElementWeights> weights_;  // before loc_: the optimizer reads it
-  bool scale_on_ = false, refine_on_ = false, scale_warned_ = false;
+  bool scale_warned_ = false;
   std::string lookup_name_;
-  fploc::matcher::ScaleCorrection scale_;
-  fploc::matcher::RefineCorrection refine_;
+  fploc::matcher::PlanCorrection correction_{false, false};
   std::unique_ptr<fploc::matcher::LocalizationMap> scaled_map_;  // the rescaled plan in use (null: none); before loc_
   std::unique_ptr<fploc::localizer::Localizer> loc_;
   fploc::rt::Publisher<fploc::pose_t> pose_out_, latest_out_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace fploc::matcher {
 
@@ -90,6 +91,26 @@ std::optional<double> ScaleCorrection::update(double error, double sigma) {
     return std::nullopt;
   applied_ = target;
   return applied_;
+}
+
+std::unique_ptr<LocalizationMap> PlanCorrection::update(const FloorPlan& plan, double scale_error, double scale_sigma,
+                                                       const std::vector<SegmentOffset>& offsets, int64_t utime,
+                                                       const std::string& lookup, std::string* said) {
+  const bool scaled = scale_on_ && scale_.update(scale_error, scale_sigma).has_value();
+  const bool refined = refine_on_ && refine_.update(offsets, utime);
+  if (!scaled && !refined) return nullptr;
+  if (said) {
+    double worst = 0;
+    for (const auto& o : refine_.applied()) worst = std::max({worst, std::abs(o.offset_a), std::abs(o.offset_b)});
+    char buf[200];
+    int k = std::snprintf(buf, sizeof buf, "plan corrected: scale %+.3f %% (estimate %+.3f +- %.3f %%)",
+                          100 * scale_.applied(), 100 * scale_error, 100 * scale_sigma);
+    if (refine_on_ && k > 0 && size_t(k) < sizeof buf)
+      std::snprintf(buf + k, sizeof buf - size_t(k), ", %zu walls refined (up to %.1f cm)", refine_.applied().size(),
+                    100 * worst);
+    *said = buf;
+  }
+  return std::make_unique<LocalizationMap>(corrected_localization_map(plan, scale_.applied(), refine_.applied(), lookup));
 }
 
 }  // namespace fploc::matcher

@@ -83,3 +83,21 @@ TEST(PlanScale, CorrectionOnlyWhenSignificant) {
   EXPECT_EQ(*c, 0.0);
   EXPECT_EQ(sc.applied(), 0.0);
 }
+
+TEST(PlanScale, PlanCorrectionGivesAMapOnlyWhenTheCorrectionChanges) {
+  const FloorPlan plan = fploc::testing::room_with_pillars();
+  std::string said;
+  PlanCorrection off(false, false);
+  EXPECT_FALSE(off.enabled());
+  EXPECT_EQ(off.update(plan, 0.0045, 0.0002, {}, 0, "annf-exact", &said), nullptr);  // off: never
+  PlanCorrection pc(true, false);
+  EXPECT_TRUE(pc.enabled());
+  EXPECT_EQ(pc.update(plan, 0.003, 0.001, {}, 0, "annf-exact", &said), nullptr);  // not significant yet
+  auto map = pc.update(plan, 0.0045, 0.0002, {}, 1, "annf-exact", &said);
+  ASSERT_NE(map, nullptr);
+  EXPECT_DOUBLE_EQ(pc.scale(), 0.0045);
+  EXPECT_EQ(said, "plan corrected: scale +0.450 % (estimate +0.450 +- 0.020 %)");
+  EXPECT_NEAR(map->plan->bounds().max.x() - map->plan->bounds().min.x(),
+              1.0045 * (plan.bounds().max.x() - plan.bounds().min.x()), 1e-9);
+  EXPECT_EQ(pc.update(plan, 0.0047, 0.0001, {}, 2, "annf-exact", &said), nullptr);  // kept: no new map
+}

@@ -24,6 +24,7 @@
 #include <vector>
 #include <Eigen/Core>
 #include <cstdint>
+#include <memory>
 #include <optional>
 
 #include <string>
@@ -102,6 +103,25 @@ class ScaleCorrection {
  private:
   ScaleCorrectionOptions o_;
   double applied_ = 0;
+};
+
+// Both live corrections of a one-floor plan from the plan diff, as the matcher and optimizer apply them:
+// the drawing scale (plan_diff_scale) and the as-built wall offsets (plan_diff_refine).
+class PlanCorrection {
+ public:
+  PlanCorrection(bool scale, bool refine) : scale_on_(scale), refine_on_(refine) {}
+  bool enabled() const { return scale_on_ || refine_on_; }
+  // A new diff estimate. Returns the localization map of the corrected plan when the correction changed
+  // (nullptr when it stays); `said` then describes it ("plan corrected: scale ...").
+  std::unique_ptr<LocalizationMap> update(const FloorPlan& plan, double scale_error, double scale_sigma,
+                                          const std::vector<SegmentOffset>& offsets, int64_t utime,
+                                          const std::string& lookup, std::string* said);
+  double scale() const { return scale_.applied(); }  // the scale error corrected for now (0: none)
+
+ private:
+  bool scale_on_, refine_on_;
+  ScaleCorrection scale_;
+  RefineCorrection refine_;
 };
 
 }  // namespace fploc::matcher
