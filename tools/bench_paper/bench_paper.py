@@ -257,19 +257,15 @@ def tail_ate(gt_path, est_path, skip_s):
     if not est:
         return None
     t0 = est[0][0]
-    import bisect
-    gts = [r[0] for r in gt]
+    truth = fploc_tools.Truth(gt)
     s, n = 0.0, 0
     for e in est:
         if e[0] - t0 < skip_s:
             continue
-        i = bisect.bisect_left(gts, e[0])
-        i = min(max(i, 0), len(gt) - 1)
-        if i > 0 and abs(gts[i - 1] - e[0]) < abs(gts[i] - e[0]):
-            i -= 1
-        if abs(gts[i] - e[0]) > 0.02:
+        g = truth.nearest(e[0], 0.02)
+        if g is None:
             continue
-        s += sum((e[k] - gt[i][k]) ** 2 for k in (1, 2, 3))
+        s += sum((e[k] - g[k]) ** 2 for k in (1, 2, 3))
         n += 1
     return math.sqrt(s / n) if n else None
 

@@ -15,7 +15,6 @@ Targets: horizontal ATE <= 1 cm (OS-1-32/64/128) and <= 3 cm (16 beams), no LOST
 Prints one JSON document on stdout ({"rows": [...], "targets": {...}}); progress on stderr.
 """
 import argparse
-import bisect
 import json
 import math
 import os
@@ -27,7 +26,7 @@ ROOT = os.environ.get("FPLOC_ROOT") or os.path.abspath(os.path.join(os.path.dirn
 BIN = os.environ.get("FPLOC_BIN") or os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(ROOT, "tools", "pylib"))
 import fploc_tools  # noqa: E402
-from fploc_tools import log, read_tum, yaw_of  # noqa: E402
+from fploc_tools import log, pct, read_tum, yaw_of  # noqa: E402
 
 BEAMS = ["vlp16", "os1-32", "os1-64", "os1-128"]
 SCENARIOS = ["room-small-loop-medium", "corridor-loop-medium"]
@@ -42,21 +41,14 @@ def run(cmd):
     return fploc_tools.run(cmd, "fploc bench sensors")
 
 
-def pct(v, q):
-    s = sorted(v)
-    return s[min(len(s) - 1, int(q * len(s)))] if s else None
-
-
 def score(gt, est):
-    ts = [g[0] for g in gt]
+    truth = fploc_tools.Truth(gt)
     exy, ez = [], []
     for e in est:
-        i = bisect.bisect_left(ts, e[0])
-        if i <= 0 or i >= len(gt):
+        at = truth.interpolated(e[0])
+        if at is None:
             continue
-        a, b = gt[i - 1], gt[i]
-        f = (e[0] - a[0]) / (b[0] - a[0]) if b[0] > a[0] else 0.0
-        p = [a[k] + f * (b[k] - a[k]) for k in (1, 2, 3)]
+        p = at[0]
         exy.append((e[1] - p[0]) ** 2 + (e[2] - p[1]) ** 2)
         ez.append(abs(e[3] - p[2]))
     if not ez:

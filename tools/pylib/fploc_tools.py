@@ -1,5 +1,6 @@
 """Helpers shared by fploc's Python benchmark drivers (tools/bench_paper, modules/amcl/bench): running
 the built programs, reading TUM trajectories, scoring with `fploc eval`."""
+import bisect
 import json
 import math
 import os
@@ -28,6 +29,39 @@ def read_tum(path):
             if line.strip() and not line.startswith("#"):
                 rows.append([float(v) for v in line.split()])
     return rows
+
+
+class Truth:
+    """A TUM ground truth (rows of read_tum) looked up at a pose's own time stamp."""
+
+    def __init__(self, rows):
+        self.rows = rows
+        self.t = [r[0] for r in rows]
+
+    def interpolated(self, t):
+        """(x, y, z) linearly interpolated at t and the nearer truth row (for the attitude), or None
+        outside the truth's time span."""
+        i = bisect.bisect_left(self.t, t)
+        if i <= 0 or i >= len(self.rows):
+            return None
+        a, b = self.rows[i - 1], self.rows[i]
+        f = (t - a[0]) / (b[0] - a[0]) if b[0] > a[0] else 0.0
+        return [a[k] + f * (b[k] - a[k]) for k in (1, 2, 3)], (a if f < 0.5 else b)
+
+    def nearest(self, t, tolerance_s):
+        """The truth row nearest to t, or None when it is more than tolerance_s away."""
+        if not self.rows:
+            return None
+        i = min(max(bisect.bisect_left(self.t, t), 0), len(self.rows) - 1)
+        if i > 0 and abs(self.t[i - 1] - t) < abs(self.t[i] - t):
+            i -= 1
+        return self.rows[i] if abs(self.t[i] - t) <= tolerance_s else None
+
+
+def pct(values, q):
+    """The q-quantile (0..1) of values by rank, None for none."""
+    s = sorted(values)
+    return s[min(len(s) - 1, int(q * len(s)))] if s else None
 
 
 def yaw_of(row):
