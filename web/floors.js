@@ -50,9 +50,10 @@ export class FloorView {
       this.onPlan(plan, want, byViewer);
     } catch (e) { console.warn('floor plan load failed', e); }
   }
-  // For the readouts: "first" or "ground (map shows first)".
+  // For the readouts: "first" or "ground (map shows first)"; "single floor" for a plain plan.
   describe(poseFloor) {
     if (!poseFloor) return '–';
+    if (this.floors.length < 2) return 'single floor';  // a plain plan (its one floor is named 0)
     return poseFloor + (this.shown && this.floors.length > 1 && this.shown !== poseFloor ? ` (map shows '${this.shown}')` : '');
   }
 }
