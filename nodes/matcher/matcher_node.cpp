@@ -24,7 +24,7 @@
 #include "fploc/adapters/plan_diff_t.h"
 #include "fploc/adapters/pose_t.h"
 #include "fploc/floorplan/building.h"
-#include "fploc/localizer/floor_maps.h"
+#include "fploc/localizer/active_plan.h"
 #include "fploc/localizer/floor_tracker.h"
 #include "fploc/config/localization.h"
 #include "fploc/config/plan_source.h"
@@ -60,18 +60,16 @@ class MatcherNode : public fploc::rt::Node {
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::MatcherOptions>();
-    floors_ = fploc::config::load_floor_maps(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); },
-                                             "matcher.plan");
-    if (floors_.multi_floor())
-      for (const auto& m : floors_.maps) std::cerr << "[" << ctx.name() << "] " << m.note << "\n";
-    floor_ = floors_.initial;
-    if (floors_.multi_floor()) tracker_.emplace(floors_.building, floor_);
+    plan_ = fploc::localizer::ActivePlan(
+        fploc::config::load_floor_maps(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); },
+                                       "matcher.plan"),
+        float(std::max(0.0, o.plan_diff_weight())), fploc::matcher::PlanCorrection(o.plan_diff_scale(), o.plan_diff_refine()),
+        o.lookup());
+    if (plan_.multi_floor())
+      for (const auto& m : plan_.floors().maps) std::cerr << "[" << ctx.name() << "] " << m.note << "\n";
+    if (plan_.multi_floor()) tracker_.emplace(plan_.floors().building, plan_.floor());
     cfg_ = fploc::config::localizer_config(o);
-    diff_weight_ = float(std::max(0.0, o.plan_diff_weight()));
-    correction_ = fploc::matcher::PlanCorrection(o.plan_diff_scale(), o.plan_diff_refine());
-    lookup_name_ = o.lookup();
-    weights_ = make_weights();
-    loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
+    loc_ = plan_.make_localizer(cfg_);
     // The graph's initial pose is where the run starts; a restarted matcher (crash, module swap) waits for
     // a pose instead (FPLOC_INITIAL_POSE: the relocalizer searches around the last good pose).
     if (!o.wait_for_initial_pose() && ctx.restarts() == 0)
@@ -88,18 +86,16 @@ class MatcherNode : public fploc::rt::Node {
         return;
       }
       // A pose on another floor (an operator's, a relocalization's): that floor's plan from now on.
-      if (m.floor_index >= 0 && size_t(m.floor_index) < floors_.maps.size() && m.floor_index != floor_) {
-        const std::string from = floors_.building->floors[size_t(floor_)].name;
-        floor_ = m.floor_index;
-        auto weights = make_weights();
-        loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
-        weights_ = std::move(weights);
-        for (const auto& s : imu_) loc_->add_imu(s.first, s.second);
-        if (tracker_) tracker_->set_floor(floor_, "initial pose on floor '" + m.floor + "' (was '" + from + "')");
+      const int floors = int(plan_.floors().maps.size());
+      if (m.floor_index >= 0 && m.floor_index < floors && m.floor_index != plan_.floor()) {
+        const std::string from = plan_.floor_name();
+        plan_.set_floor(m.floor_index);
+        new_localizer();
+        if (tracker_) tracker_->set_floor(plan_.floor(), "initial pose on floor '" + m.floor + "' (was '" + from + "')");
         std::cerr << "[" << ctx_->name() << "] initial pose on floor '" << m.floor << "' (was '" << from << "')\n";
-      } else if (m.floor_index >= int(floors_.maps.size())) {
+      } else if (m.floor_index >= floors) {
         ctx_->error("initial_pose seq " + std::to_string(m.seq) + ": floor_index " + std::to_string(m.floor_index) +
-                    " but the plan has " + std::to_string(floors_.maps.size()) + " floor(s) (floor kept)");
+                    " but the plan has " + std::to_string(floors) + " floor(s) (floor kept)");
       }
       // Search within 3 sigma of the message's position covariance when it has one.
       const double var = std::max(m.covariance[0], m.covariance[7]);
@@ -167,7 +163,7 @@ class MatcherNode : public fploc::rt::Node {
       fploc::localizer::Config probe_cfg = cfg_;
       probe_cfg.matcher.element_weight = nullptr;
       for (const auto& q : tracker_->probe_request()) {
-        fploc::localizer::Localizer probe(*floors_.maps[size_t(q.floor)].lookup, probe_cfg);
+        fploc::localizer::Localizer probe(*plan_.floors().maps[size_t(q.floor)].lookup, probe_cfg);
         for (const auto& s : imu_) probe.add_imu(s.first, s.second);
         // From the last good pose, far enough to cover the lift's disc.
         probe.set_pose(at, q.search_radius_m + std::hypot(at.x - q.search_center.x(), at.y - q.search_center.y()));
@@ -175,7 +171,7 @@ class MatcherNode : public fploc::rt::Node {
         results.push_back({q.floor, r.match.status == FitStatus::kOk, r.match.fit.inlier_ratio});
         std::cerr << "[" << ctx_->name() << "] scan " << f.scan_seq << ": plan of '" << q.name << "' in the lift area: "
                   << fploc::matcher::to_string(r.match.status) << ", " << int(std::lround(100 * r.match.fit.inlier_ratio)) << " %\n";
-        if (q.floor != floor_) probe_pose_[q.floor] = r.match.pose;
+        if (q.floor != plan_.floor()) probe_pose_[q.floor] = r.match.pose;
       }
       sw = tracker_->probe_result(results);
       if (sw) switch_floor(f, fp, *sw, probe_pose_[sw->to], std::nullopt);
@@ -195,12 +191,9 @@ class MatcherNode : public fploc::rt::Node {
   // The new floor's Localizer, started at `at` (within `search_m` when given), registers the frame again.
   void switch_floor(const fploc::FeatureFrame& f, fploc::localizer::FramePose* fp, const fploc::localizer::FloorSwitch& sw,
                     const fploc::Pose2& at, std::optional<double> search_m) {
-    floor_ = sw.to;
+    plan_.set_floor(sw.to);
     std::cerr << "[" << ctx_->name() << "] scan " << f.scan_seq << ": " << tracker_->status_text() << "\n";
-    auto weights = make_weights();  // the diff's flags were for the old floor's plan
-    loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
-    weights_ = std::move(weights);
-    for (const auto& s : imu_) loc_->add_imu(s.first, s.second);
+    new_localizer();
     if (search_m) loc_->set_pose(at, *search_m);
     else loc_->set_pose(at);
     *fp = loc_->register_frame(f);
@@ -208,54 +201,33 @@ class MatcherNode : public fploc::rt::Node {
     switch_until_ = f.utime + 3'000'000;
   }
 
-  void on_plan_diff(const fploc::plan_diff_t& m) {
-    const auto flagged = fploc::adapters::flagged_elements(m);
-    const size_t n = floors_.maps[size_t(floor_)].plan->elements.size();
-    for (const auto& f : flagged)
-      if (size_t(f.id) >= n) {
-        ctx_->error("plan_diff seq " + std::to_string(m.seq) + ": element " + std::to_string(f.id) + " not in matcher.plan (" +
-                    std::to_string(n) + " elements): a diff of another plan? (ignored)");
-        return;
-      }
-    weights_->update(flagged);
-    if (correction_.enabled()) correct_plan(m);
+  // A new Localizer on the plan in use (after a floor change or a plan correction), with the recent gyro.
+  void new_localizer() {
+    loc_ = plan_.make_localizer(cfg_);
+    for (const auto& s : imu_) loc_->add_imu(s.first, s.second);
   }
 
-  // plan_diff_scale: the building is (1 + scale_error) times the plan; once the estimate is significant
-  // (matcher/plan_scale.h), register against the plan scaled by it about the plan's centre. The tracker
+  // plan_diff_weight: elements the diff flags get that weight. plan_diff_scale / plan_diff_refine: once
+  // the correction changes (matcher/plan_scale.h), register against the corrected plan; the tracker
   // restarts there from its last pose moved into the new plan's frame (searching 0.1 m around it).
-  // plan_diff_refine: against the plan with each wall where the diff's as-built refinement puts it.
-  void correct_plan(const fploc::plan_diff_t& m) {
-    if (floors_.multi_floor()) {
-      if (!scale_warned_) ctx_->error("plan_diff_scale / plan_diff_refine: not for a building of several floors (ignored)");
-      scale_warned_ = true;
+  void on_plan_diff(const fploc::plan_diff_t& m) {
+    std::string error, said;
+    if (!plan_.apply_flags(fploc::adapters::flagged_elements(m), &error)) {
+      ctx_->error("plan_diff seq " + std::to_string(m.seq) + ": matcher.plan: " + error);
       return;
     }
-    const double before = correction_.scale();
-    const fploc::FloorPlan& plan = *floors_.maps[0].plan;
-    std::string said;
-    auto map = correction_.update(plan, m.scale_error, m.scale_sigma, fploc::adapters::refined_offsets(m), m.utime,
-                                  lookup_name_, &said);
-    if (!map) return;
-    auto loc = std::make_unique<fploc::localizer::Localizer>(*map->lookup, cfg_);
-    for (const auto& i : imu_) loc->add_imu(i.first, i.second);
+    const double before = plan_.scale();
+    if (!plan_.correct(m.scale_error, m.scale_sigma, fploc::adapters::refined_offsets(m), m.utime, &said, &error)) {
+      if (!error.empty()) ctx_->error(error);
+      return;
+    }
+    new_localizer();
     if (have_pose_)
-      loc->set_pose(fploc::matcher::rescaled_pose(last_pose_, 1 + before, 1 + correction_.scale(), fploc::matcher::scale_centre(plan)),
-                    0.1);
-    loc_ = std::move(loc);  // the old Localizer (and its look-up's map) go
-    scaled_map_ = std::move(map);
+      loc_->set_pose(fploc::matcher::rescaled_pose(last_pose_, 1 + before, 1 + plan_.scale(), fploc::matcher::scale_centre(plan_.plan())),
+                     0.1);
     std::cerr << "[" << ctx_->name() << "] " << said << "\n";
     switch_text_ = said;
     switch_until_ = m.utime + 3'000'000;
-  }
-
-  // Per-element weights for the current floor's plan (all 1 until a plan diff flags elements); cfg_'s
-  // matcher reads them through the pointer set here.
-  std::unique_ptr<fploc::matcher::ElementWeights> make_weights() {
-    auto w = std::make_unique<fploc::matcher::ElementWeights>(*floors_.maps[size_t(floor_)].plan,
-                                                             fploc::matcher::DiffWeightOptions{diff_weight_, diff_weight_});
-    cfg_.matcher.element_weight = w->weights();
-    return w;
   }
 
   void on_features(const fploc::features_t& m) {
@@ -272,8 +244,8 @@ class MatcherNode : public fploc::rt::Node {
     fploc::localizer::FramePose fp = loc_->register_frame(f);
     if (tracker_) track_floor(f, &fp);
     if (fp.match.status != FitStatus::kNotInitialised) last_pose_ = fp.match.pose, have_pose_ = true;
-    fp.floor_index = floor_;
-    fp.floor = floors_.building->floors[size_t(floor_)].name;
+    fp.floor_index = plan_.floor();
+    fp.floor = plan_.floor_name();
     const fploc::matcher::MatchResult& r = fp.match;
     // Wall-clock only outside replay (outputs must be reproducible there).
     const double solve_ms =
@@ -288,8 +260,7 @@ class MatcherNode : public fploc::rt::Node {
   }
 
   fploc::rt::Context* ctx_ = nullptr;
-  fploc::localizer::FloorMaps floors_;
-  int floor_ = 0;
+  fploc::localizer::ActivePlan plan_;  // before loc_: the Localizer reads its weights and map
   std::optional<fploc::localizer::FloorTracker> tracker_;
   fploc::localizer::Config cfg_;
   std::deque<std::pair<int64_t, double>> imu_;  // recent gyro z (a new floor's Localizer gets them)
@@ -299,12 +270,6 @@ class MatcherNode : public fploc::rt::Node {
   fploc::Pose2 last_ok_;
   std::map<int, fploc::Pose2> probe_pose_;  // plan mismatch: where each floor's probe put the frame
   bool have_ok_ = false;
-  float diff_weight_ = 0;
-  std::unique_ptr<fploc::matcher::ElementWeights> weights_;  // before loc_: the matcher reads it
-  bool scale_warned_ = false;
-  std::string lookup_name_;
-  fploc::matcher::PlanCorrection correction_{false, false};
-  std::unique_ptr<fploc::matcher::LocalizationMap> scaled_map_;  // the rescaled plan in use (null: none); before loc_
   fploc::Pose2 last_pose_;
   bool have_pose_ = false;
   std::unique_ptr<fploc::localizer::Localizer> loc_;

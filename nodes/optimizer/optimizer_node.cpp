@@ -22,7 +22,7 @@
 #include "fploc/config/localization.h"
 #include "fploc/config/plan_source.h"
 #include "fploc/floorplan/building.h"
-#include "fploc/localizer/floor_maps.h"
+#include "fploc/localizer/active_plan.h"
 #include "fploc/localizer/localizer.h"
 #include "fploc/matcher/plan_scale.h"
 #include "fploc/runtime/node.h"
@@ -46,15 +46,13 @@ class OptimizerNode : public fploc::rt::Node {
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
     const auto& o = ctx.options<fploc::OptimizerOptions>();
-    floors_ = fploc::config::load_floor_maps(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); },
-                                             "optimizer.plan");
-    floor_ = floors_.initial;
+    plan_ = fploc::localizer::ActivePlan(
+        fploc::config::load_floor_maps(o.plan(), o.lookup(), [&](const std::string& p) { return ctx.resolve_path(p); },
+                                       "optimizer.plan"),
+        float(std::max(0.0, o.plan_diff_weight())), fploc::matcher::PlanCorrection(o.plan_diff_scale(), o.plan_diff_refine()),
+        o.lookup());
     cfg_ = fploc::config::localizer_config(o);
-    diff_weight_ = float(std::max(0.0, o.plan_diff_weight()));
-    correction_ = fploc::matcher::PlanCorrection(o.plan_diff_scale(), o.plan_diff_refine());
-    lookup_name_ = o.lookup();
-    weights_ = make_weights();
-    loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
+    loc_ = plan_.make_localizer(cfg_);
     pose_out_ = ctx.advertise<fploc::pose_t>("pose");
     latest_out_ = ctx.advertise<fploc::pose_t>("latest");
     ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) {
@@ -67,18 +65,7 @@ class OptimizerNode : public fploc::rt::Node {
       trim(features_);
       try_pair(m.scan_seq);
     });
-    ctx.subscribe<fploc::plan_diff_t>("plan_diff", [this](const fploc::plan_diff_t& m) {
-      const auto flagged = fploc::adapters::flagged_elements(m);
-      for (const auto& f : flagged)
-        if (size_t(f.id) >= floors_.maps[size_t(floor_)].plan->elements.size()) {
-          ctx_->error("plan_diff seq " + std::to_string(m.seq) + ": element " + std::to_string(f.id) +
-                      " not in optimizer.plan (" + std::to_string(floors_.maps[size_t(floor_)].plan->elements.size()) +
-                      " elements): a diff of another plan? (ignored)");
-          return;
-        }
-      weights_->update(flagged);
-      if (correction_.enabled()) correct_plan(m);
-    });
+    ctx.subscribe<fploc::plan_diff_t>("plan_diff", [this](const fploc::plan_diff_t& m) { on_plan_diff(m); });
     ctx.subscribe<fploc::frame_pose_t>("frame_pose", [this](const fploc::frame_pose_t& m) {
       frame_poses_[m.scan_seq] = m;
       trim(frame_poses_);
@@ -124,15 +111,13 @@ class OptimizerNode : public fploc::rt::Node {
       return;
     }
     std::vector<fploc::localizer::Pose> finals;
-    if (m.floor_index >= 0 && size_t(m.floor_index) < floors_.maps.size() && m.floor_index != floor_) {
+    if (m.floor_index >= 0 && size_t(m.floor_index) < plan_.floors().maps.size() && m.floor_index != plan_.floor()) {
       // The matcher changed floor: the window's poses are final on the old floor.
       loc_->flush(&finals);
       publish_finals(finals);
       finals.clear();
-      floor_ = m.floor_index;
-      auto weights = make_weights();  // the diff's flags were for the old floor's plan
-      loc_ = std::make_unique<fploc::localizer::Localizer>(*floors_.maps[size_t(floor_)].lookup, cfg_);
-      weights_ = std::move(weights);
+      plan_.set_floor(m.floor_index);
+      loc_ = plan_.make_localizer(cfg_);
       std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << ": window on floor '" << m.floor << "'\n";
     }
     // The matcher's z is absolute (its floor's elevation + the height above it; the segmenter's z carries
@@ -156,23 +141,22 @@ class OptimizerNode : public fploc::rt::Node {
     publish_finals(finals);
   }
 
-  // plan_diff_scale / plan_diff_refine (as the matcher's): the window's poses become final on the old plan,
-  // a new window starts on the corrected plan.
-  void correct_plan(const fploc::plan_diff_t& m) {
-    if (floors_.multi_floor()) {
-      if (!scale_warned_) ctx_->error("plan_diff_scale / plan_diff_refine: not for a building of several floors (ignored)");
-      scale_warned_ = true;
+  // As the matcher's: flagged elements get plan_diff_weight; when the plan correction changes, the
+  // window's poses become final on the old plan and a new window starts on the corrected plan.
+  void on_plan_diff(const fploc::plan_diff_t& m) {
+    std::string error, said;
+    if (!plan_.apply_flags(fploc::adapters::flagged_elements(m), &error)) {
+      ctx_->error("plan_diff seq " + std::to_string(m.seq) + ": optimizer.plan: " + error);
       return;
     }
-    std::string said;
-    auto map = correction_.update(*floors_.maps[0].plan, m.scale_error, m.scale_sigma, fploc::adapters::refined_offsets(m),
-                                  m.utime, lookup_name_, &said);
-    if (!map) return;
+    if (!plan_.correct(m.scale_error, m.scale_sigma, fploc::adapters::refined_offsets(m), m.utime, &said, &error)) {
+      if (!error.empty()) ctx_->error(error);
+      return;
+    }
     std::vector<fploc::localizer::Pose> finals;
     loc_->flush(&finals);
     publish_finals(finals);
-    loc_ = std::make_unique<fploc::localizer::Localizer>(*map->lookup, cfg_);
-    scaled_map_ = std::move(map);
+    loc_ = plan_.make_localizer(cfg_);
     std::cerr << "[" << ctx_->name() << "] " << said << "\n";
   }
 
@@ -185,25 +169,9 @@ class OptimizerNode : public fploc::rt::Node {
     }
   }
 
-  // Per-element weights for the current floor's plan (all 1 until a plan diff flags elements); cfg_'s
-  // optimizer reads them through the pointer set here.
-  std::unique_ptr<fploc::matcher::ElementWeights> make_weights() {
-    auto w = std::make_unique<fploc::matcher::ElementWeights>(*floors_.maps[size_t(floor_)].plan,
-                                                             fploc::matcher::DiffWeightOptions{diff_weight_, diff_weight_});
-    cfg_.optimizer.element_weight = w->weights();
-    return w;
-  }
-
   fploc::rt::Context* ctx_ = nullptr;
-  fploc::localizer::FloorMaps floors_;
-  int floor_ = 0;
+  fploc::localizer::ActivePlan plan_;  // before loc_: the Localizer reads its weights and map
   fploc::localizer::Config cfg_;
-  float diff_weight_ = 0;
-  std::unique_ptr<fploc::matcher::ElementWeights> weights_;  // before loc_: the optimizer reads it
-  bool scale_warned_ = false;
-  std::string lookup_name_;
-  fploc::matcher::PlanCorrection correction_{false, false};
-  std::unique_ptr<fploc::matcher::LocalizationMap> scaled_map_;  // the rescaled plan in use (null: none); before loc_
   std::unique_ptr<fploc::localizer::Localizer> loc_;
   fploc::rt::Publisher<fploc::pose_t> pose_out_, latest_out_;
   std::map<int64_t, fploc::FeatureFrame> features_;
