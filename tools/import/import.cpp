@@ -299,7 +299,7 @@ int main(int argc, char** argv) {
         if (!decode_bytes(m.data, m.size, c.encoding, &buf, &n, &err)) { bad(c, err); break; }
         if (!decode_ouster) {
           if (!raw.has_metadata() && !metadata_text.empty()) raw.metadata(metadata_text, metadata_file, m.time_ns, &err);
-          raw.packet(buf, n, m.time_ns);
+          raw.packet(buf, n, m.time_ns, rec->stable(buf, n));
           break;
         }
         os1::ImuSample s;
@@ -330,7 +330,8 @@ int main(int argc, char** argv) {
           }
           if (!out.empty()) {
             fploc::adapters::encode_without_data(pc, seq[ch], c.topic, cloud_header);
-            lcm_log.write_parts(ch, m.time_ns / 1000, cloud_header.data(), cloud_header.size(), pc.data, pc.data_size);
+            lcm_log.write_parts(ch, m.time_ns / 1000, cloud_header.data(), cloud_header.size(), pc.data, pc.data_size,
+                                rec->stable(pc.data, pc.data_size));
           }
           ++seq[ch];
           ++written[ch];

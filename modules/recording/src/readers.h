@@ -22,6 +22,10 @@ T rd(const uint8_t* p) {
 class FileReader : public Recording {
  public:
   uint64_t position() const override { return pos_; }
+  bool stable(const uint8_t* p, size_t n) const override {
+    const uint8_t* d = f_->data();
+    return d && p >= d && n <= f_->size() && size_t(p - d) <= f_->size() - n;
+  }
 
  protected:
   FileReader(std::unique_ptr<FileBytes> f, std::string name, std::string format) : f_(std::move(f)), name_(std::move(name)) {
