@@ -3,7 +3,9 @@
 # the ouster_ros bag -> LCM log of its packets -> fploc replay through the OS-1 and IMU drivers
 # (graphs/replay-packets.pbtxt) gives byte for byte the scan_t and imu_t of `--decode`; the --decode log
 # -> fploc replay (segmenter + features) and lcm-logplayer -> lcm-logger (a valid LCM event log); the ship-interior bag -> LaserScan channels and TUM from
-# odometry and tf; a truncated bag -> one error, exit 1, and a log of what came before.
+# odometry and tf; a truncated bag -> one error, exit 1, and a log of what came before; an MCAP from
+# @mcap/core: its PointCloud2 topics as point_cloud2_t, converted on replay by the cloud-to-scan node
+# (graphs/replay-clouds.pbtxt) into the scan_t `--decode` writes, byte for byte.
 set -euo pipefail
 B="${FPLOC_BUILD_DIR:?}/bin"
 D="${FPLOC_SHARED_DIR:?}/data"
@@ -91,16 +93,40 @@ for c in none bz2 lz4; do
   [ "$c" = lz4 ] && ! command -v lz4 > /dev/null && { echo "no lz4 tool: lz4 bag skipped"; continue; }
   python3 "$FPLOC_ROOT/tests/import/make_bag.py" "$T/py_$c.bag" "$c"
   "$B/fploc-import" "$T/py_$c.bag" --out "$T/py_$c.lcm" --tum-out "$T/py.tum" --json > "$T/py_$c.json" 2>/dev/null
-  check "$T/py_$c.json" "j['written']['OS1_SCAN']==3 and j['written']['LASER_SCAN']==3 and j['written']['OS1_IMU']==3 and j['written']['OS1_IMU_PACKETS']==3 and j['written']['(tum /odom)']==3 and j['clouds']['/points']['kept']==24"
+  check "$T/py_$c.json" "j['written']['POINT_CLOUD']==3 and j['replay_graph']=='graphs/replay-clouds.pbtxt' and j['clouds']['/points']['mode']=='clouds' and j['written']['LASER_SCAN']==3 and j['written']['OS1_IMU']==3 and j['written']['OS1_IMU_PACKETS']==3 and j['written']['(tum /odom)']==3 and j['clouds']['/points']['kept']==24"
 done
 # MCAP from the MCAP project's writer (zstd chunks): PointCloud2 (Velodyne + Hesai layouts), Imu,
 # LaserScan -> LCM; tf -> TUM.
 if [ -d "$FPLOC_ROOT/tests/import/node_modules/@mcap/core" ] && command -v node > /dev/null; then
   (cd "$FPLOC_ROOT/tests/import" && node write_mcap.js "$T/w.mcap" zstd chunked)
   "$B/fploc-import" "$T/w.mcap" --out "$T/w.lcm" --tum-out "$T/w.tum" --tf-parent odom --tf-child base_link --json > "$T/w.json"
-  check "$T/w.json" "j['format']=='mcap' and j['written']['OS1_SCAN']==3 and j['written']['OS1_SCAN_HESAI_POINTS']==3 and j['written']['OS1_IMU']==20 and j['written']['LASER_SCAN']==3 and j['clouds']['/hesai_points']['ring_source']=='elevation' and j['errors']==[]"
+  # Default: the clouds as they are (point_cloud2_t), converted on replay by the cloud-to-scan node.
+  check "$T/w.json" "j['format']=='mcap' and j['written']['POINT_CLOUD']==3 and j['written']['POINT_CLOUD_HESAI_POINTS']==3 and j['written']['OS1_IMU']==20 and j['written']['LASER_SCAN']==3 and j['clouds']['/hesai_points']['ring_source']=='elevation' and j['replay_graph']=='graphs/replay-clouds.pbtxt' and j['errors']==[]"
   [ "$(wc -l < "$T/w.tum")" = 10 ] || { echo "w.tum: expected 10 poses"; exit 1; }
-  "$B/fploc-replay" --graph "$FPLOC_ROOT/graphs/import.pbtxt" --log "$T/w.lcm" --json > "$T/wr.json" 2>/dev/null
+  # Each layout (Velodyne: ring field; Hesai: rings from the elevations): the node's scan_t on replay are
+  # byte for byte those `--decode` writes at import time. Velodyne from uncompressed chunks (the points go
+  # from the mapped file to the log in place), Hesai from zstd chunks (copied out of the decompressed chunk).
+  (cd "$FPLOC_ROOT/tests/import" && node write_mcap.js "$T/w0.mcap" none chunked)
+  for topic in /velodyne_points /hesai_points; do
+    n="${topic#/}"
+    src="$T/w.mcap"
+    [ "$topic" = /velodyne_points ] && src="$T/w0.mcap"
+    "$B/fploc-import" "$src" --topics "$topic,/imu" --out "$T/c_$n.lcm" --quiet > /dev/null
+    "$B/fploc-import" "$src" --topics "$topic,/imu" --decode --out "$T/d_$n.lcm" --quiet > /dev/null
+    "$B/fploc-replay" --graph "$FPLOC_ROOT/graphs/replay-clouds.pbtxt" --log "$T/c_$n.lcm" --json --out "$T/c_$n.tum" \
+      --record "$T/c_${n}_rec.lcm" --record-channels 'OS1_SCAN' > "$T/c_$n.json" 2> "$T/c_$n.err"
+    check "$T/c_$n.json" "j['channels_fed']=={'POINT_CLOUD':3,'OS1_IMU':20} and [n['messages_out'] for n in j['nodes'] if n['name'] in ('cloud_to_scan','segmenter')]==[3,3] and all(n['errors']==0 for n in j['nodes'] if n['name']=='cloud_to_scan')"
+    PYTHONPATH="$FPLOC_ROOT/tools/pylib" python3 - "$T/d_$n.lcm" "$T/c_${n}_rec.lcm" "$topic" <<'PY'
+import sys, lcm_log
+x = [d for c, d in lcm_log.events(sys.argv[1]) if c == 'OS1_SCAN']
+y = [d for c, d in lcm_log.events(sys.argv[2]) if c == 'OS1_SCAN']
+assert len(x) == 3 and x == y, f"{sys.argv[3]}: --decode gives {len(x)} scans, the node on the clouds {len(y)} (or different bytes)"
+print(sys.argv[3] + ": --decode == cloud-to-scan node on replay: ok", len(x), "scans")
+PY
+  done
+  "$B/fploc-import" "$T/w.mcap" --decode --out "$T/wd.lcm" --json > "$T/wd.json"
+  check "$T/wd.json" "j['written']['OS1_SCAN']==3 and j['written']['OS1_SCAN_HESAI_POINTS']==3 and j['clouds']['/velodyne_points']['mode']=='scans' and j['replay_graph']=='graphs/replay.pbtxt' and j['errors']==[]"
+  "$B/fploc-replay" --graph "$FPLOC_ROOT/graphs/import.pbtxt" --log "$T/wd.lcm" --json > "$T/wr.json" 2>/dev/null
   check "$T/wr.json" "j['channels_fed']['OS1_SCAN']==3 and [n['messages_out'] for n in j['nodes'] if n['name']=='segmenter']==[3]"
 else
   echo "tests/import/node_modules absent: MCAP part skipped (scripts/setup-web.sh installs it)"

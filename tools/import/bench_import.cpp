@@ -10,6 +10,10 @@
 // then times, --runs times each, interleaved: `cat BAG > /dev/null` (after one warm-up read, so both run
 // from the page cache), `cat BAG > COPY` (read + write the same volume) and `fploc-import BAG --out
 // LOG.lcm`; and again with the bag's pages evicted before each run (cold). Medians are reported.
+// Compressed bags (--compression bz2|lz4): the same compressed chunks, concatenated into one file, are
+// also decompressed by the compression's own tool (`bzip2 -dc`, `lz4 -dc`; libbz2/liblz4 behind both),
+// to /dev/null and into a file, in the same runs: the decompressor's speed on the same data, the bound
+// an importer cannot beat (the `cat` ratio of a compressed bag includes all of the decompression).
 #include <fcntl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -196,6 +200,12 @@ int main(int argc, char** argv) {
       std::cerr << "cannot write " << bag << "\n";
       return 1;
     }
+    const std::string chunks = (dir / (k + ".chunks." + compression)).string();
+    std::FILE* chunk_copy = nullptr;
+    if (compression != "none") {
+      chunk_copy = std::fopen(chunks.c_str(), "wb");
+      w.chunk_copy = chunk_copy;
+    }
     uint64_t written = 0, messages = 0;
     if (k == "ouster") {
       const std::string src = shared + "/data/ouster/512x10_raw.bag";
@@ -245,16 +255,17 @@ int main(int argc, char** argv) {
       write_copies(w, w.add_connection("/velodyne_points", "sensor_msgs/PointCloud2"), vlp16_cloud(), 100000000LL, target,
                    written, messages);
     }
-    if (!w.close()) {
+    if (!w.close() || (chunk_copy && std::fclose(chunk_copy) != 0)) {
       std::cerr << "writing " << bag << " failed\n";
       return 1;
     }
+    const std::string tool = compression == "bz2" ? "bzip2 -dc" : compression == "lz4" ? "lz4 -dc" : "";
     const uint64_t bytes = fs::file_size(bag);
     const std::string lcm = (dir / (k + ".lcm")).string(), copy = (dir / (k + ".copy")).string();
     run("cat '" + bag + "' > /dev/null");  // warm-up: the page-cache timings below read from memory
     std::vector<std::pair<std::string, std::string>> variants = {{k, ""}};
     if (k == "ouster") variants.push_back({"ouster --decode", " --decode"});
-    std::vector<double> cat_s, cat_cpu, copy_s, cat_cold_s;
+    std::vector<double> cat_s, cat_cpu, copy_s, cat_cold_s, tool_s, tool_file_s, tool_cpu;
     std::map<std::string, std::vector<double>> imp_s, imp_cpu, imp_cold_s;
     std::map<std::string, uint64_t> lcm_bytes;
     for (int i = 0; i < runs; ++i) {  // interleaved, so a change in the machine's load hits every command
@@ -262,6 +273,12 @@ int main(int argc, char** argv) {
       cat_cpu.push_back(last_cpu);
       copy_s.push_back(run("cat '" + bag + "' > '" + copy + "'"));
       fs::remove(copy);
+      if (!tool.empty()) {
+        tool_s.push_back(run(tool + " '" + chunks + "' > /dev/null"));
+        tool_cpu.push_back(last_cpu);
+        tool_file_s.push_back(run(tool + " '" + chunks + "' > '" + copy + "'"));
+        fs::remove(copy);
+      }
       for (const auto& [name, flag] : variants) {
         imp_s[name].push_back(run("'" + importer + "' '" + bag + "' --out '" + lcm + "' --quiet" + flag + " > /dev/null"));
         imp_cpu[name].push_back(last_cpu);
@@ -288,6 +305,16 @@ int main(int argc, char** argv) {
                           {"import_MBps", bytes / 1e6 / t_import}, {"cold_cat_s", t_cat_cold}, {"cold_import_s", t_import_cold},
                           {"cold_ratio_vs_cat", t_import_cold / t_cat_cold}, {"cat_cpu_s", cpu_cat}, {"import_cpu_s", cpu_import},
                           {"import_runs_s", imp_s[name]}, {"cat_runs_s", cat_s}};
+      if (!tool.empty()) {
+        const double t_tool = median(tool_s), t_tool_file = median(tool_file_s);
+        j["decompressor"] = tool;
+        j["decompressor_s"] = t_tool;
+        j["decompressor_to_file_s"] = t_tool_file;
+        j["decompressor_cpu_s"] = median(tool_cpu);
+        j["ratio_vs_decompressor"] = t_import / t_tool;
+        j["ratio_vs_decompressor_to_file"] = t_import / t_tool_file;
+        j["decompressor_runs_s"] = tool_s;
+      }
       out.push_back(j);
       if (!json)
         std::printf("%-15s %s: %.0f MB bag (%llu msgs) -> %.0f MB LCM log; medians of %d runs\n"
@@ -296,8 +323,11 @@ int main(int argc, char** argv) {
                     name.c_str(), compression.c_str(), bytes / 1e6, (unsigned long long)messages, lcm_bytes[name] / 1e6, runs,
                     t_import, t_cat, t_import / t_cat, t_copy, t_import / t_copy, t_import_cold, t_cat_cold,
                     t_import_cold / t_cat_cold, cpu_import, cpu_cat);
+      if (!json && !tool.empty())
+        std::printf("  %s of the same chunks: %.2f s to /dev/null (import ratio %.2f), %.2f s to a file (ratio %.2f)\n",
+                    tool.c_str(), median(tool_s), t_import / median(tool_s), median(tool_file_s), t_import / median(tool_file_s));
     }
-    if (keep.empty()) fs::remove(bag);
+    if (keep.empty()) fs::remove(bag), fs::remove(chunks);
   }
   if (keep.empty()) fs::remove_all(dir);
   if (json) std::cout << out.dump(2) << "\n";

@@ -5,13 +5,16 @@
 //       OS1_LIDAR_PACKETS / OS1_IMU_PACKETS, os1_metadata_t on OS1_METADATA, decoded on replay by the OS-1
 //       and IMU drivers (graphs/replay-packets.pbtxt) as the live sensor's packets; with --decode:
 //       scan_t on OS1_SCAN, imu_t on OS1_IMU decoded here by the same OS-1 code (same scans)
-//   sensor_msgs/PointCloud2 -> scan_t on OS1_SCAN (rings from the ring field or the elevations)
+//   sensor_msgs/PointCloud2 -> the clouds as they are: point_cloud2_t on POINT_CLOUD (bytes + field layout),
+//       converted to scan_t on replay by the cloud-to-scan node (graphs/replay-clouds.pbtxt); with --decode:
+//       scan_t on OS1_SCAN converted here by the same code (rings from the ring field or the elevations)
 //   sensor_msgs/Imu -> imu_t on OS1_IMU;  sensor_msgs/LaserScan -> laser_scan_t on LASER_SCAN
 //   nav_msgs/Odometry, tf2_msgs/TFMessage -> a TUM file (--tum-out, --tf-parent/--tf-child or --odom-topic)
 // A second topic that would go to the same channel gets CHANNEL_<topic>; --channel TOPIC=CH overrides.
 // Bad input: one error with the byte offset and record; the log holds everything read before it.
 #include <fploc/imu_t.hpp>
 #include <fploc/laser_scan_t.hpp>
+#include <fploc/point_cloud2_t.hpp>
 #include <fploc/scan_t.hpp>
 
 #include <CLI/CLI.hpp>
@@ -24,6 +27,7 @@
 #include <set>
 #include <sstream>
 
+#include "fploc/adapters/point_cloud2_t.h"
 #include "fploc/adapters/scan_t.h"
 #include "fploc/recording/cloud_to_scan.h"
 #include "fploc/recording/ouster_packets.h"
@@ -85,7 +89,8 @@ int main(int argc, char** argv) {
   app.add_option("--end", end, "stop at END seconds after the first message");
   app.add_option("--metadata", metadata_file, "Ouster sensor metadata JSON (when the recording has no metadata topic)");
   app.add_flag("--decode", decode_ouster,
-               "Ouster packets: write scan_t (OS1_SCAN) and imu_t (OS1_IMU) decoded here, instead of the packets for the drivers");
+               "decode here: Ouster packets -> scan_t (OS1_SCAN) and imu_t (OS1_IMU), PointCloud2 -> scan_t (OS1_SCAN), "
+               "instead of the packets for the drivers and the clouds for the cloud-to-scan node");
   app.add_option("--channel", channels, "TOPIC=CHANNEL: the LCM channel of a topic")->delimiter(',');
   app.add_option("--rings", cloud_opt.rings, "PointCloud2 without ring field: the number of rings (default: elevation gaps)");
   app.add_option("--columns", cloud_opt.columns, "PointCloud2: columns of the range image (default: organised width or most points per ring)");
@@ -184,7 +189,10 @@ int main(int argc, char** argv) {
     } else if (topic_channel.count(c.topic)) {
       ch = topic_channel[c.topic];
     } else {
-      const std::string base = k == Kind::kLaser ? "LASER_SCAN" : (k == Kind::kImu ? "OS1_IMU" : "OS1_SCAN");
+      const std::string base = k == Kind::kLaser ? "LASER_SCAN"
+                               : k == Kind::kImu ? "OS1_IMU"
+                               : (k == Kind::kCloud && !decode_ouster) ? "POINT_CLOUD"
+                                                                       : "OS1_SCAN";
       ch = used_channels.count(base) ? base + "_" + sanitize(c.topic) : base;
     }
     used_channels.insert(ch);
@@ -256,6 +264,8 @@ int main(int argc, char** argv) {
 
   bool odom_chosen = !odom_topic.empty();
   Scan cloud_scan;
+  std::vector<uint8_t> cloud_header;  // point_cloud2_t up to its data; the points follow from the recording
+  std::map<std::string, std::string> cloud_check_error;  // topic -> why its first cloud does not convert
   RawMessage m;
   while (rec->next(m)) {
     ++read_msgs;
@@ -289,7 +299,7 @@ int main(int argc, char** argv) {
         if (!decode_bytes(m.data, m.size, c.encoding, &buf, &n, &err)) { bad(c, err); break; }
         if (!decode_ouster) {
           if (!raw.has_metadata() && !metadata_text.empty()) raw.metadata(metadata_text, metadata_file, m.time_ns, &err);
-          raw.packet(buf, n, m.time_ns);
+          raw.packet(buf, n, m.time_ns, rec->stable(buf, n));
           break;
         }
         os1::ImuSample s;
@@ -310,6 +320,23 @@ int main(int argc, char** argv) {
       case Kind::kCloud: {
         PointCloud2 pc;
         if (!decode(m.data, m.size, c.encoding, pc, &err)) { bad(c, err); break; }
+        if (!decode_ouster) {
+          // Kept as it is (point_cloud2_t); the cloud-to-scan node converts it on replay. The first cloud of
+          // each topic is converted here once, to report its layout and to say now when it cannot be.
+          const std::string& ch = channel_for(c, k);
+          if (!cloud_info.count(c.topic)) {
+            if (!cloud_to_scan(pc, cloud_opt, cloud_scan, &cstats, &err)) cloud_check_error[c.topic] = err;
+            cloud_info[c.topic] = cstats;
+          }
+          if (!out.empty()) {
+            fploc::adapters::encode_without_data(pc, seq[ch], c.topic, cloud_header);
+            lcm_log.write_parts(ch, m.time_ns / 1000, cloud_header.data(), cloud_header.size(), pc.data, pc.data_size,
+                                rec->stable(pc.data, pc.data_size));
+          }
+          ++seq[ch];
+          ++written[ch];
+          break;
+        }
         Scan& s = cloud_scan;  // buffers reused from cloud to cloud
         if (!cloud_to_scan(pc, cloud_opt, s, &cstats, &err)) { bad(c, err); break; }
         const std::string& ch = channel_for(c, k);
@@ -407,11 +434,17 @@ int main(int argc, char** argv) {
   for (const auto& [ch, n] : written) {
     if (!n) continue;
     if (ch == raw.lidar_channel) replay_graph = "graphs/replay-packets.pbtxt";
-    else if (ch.rfind("OS1_SCAN", 0) == 0 && replay_graph.empty()) replay_graph = "graphs/replay.pbtxt";
   }
+  for (const auto& [ch, n] : written)
+    if (n && ch.rfind("POINT_CLOUD", 0) == 0 && replay_graph.empty()) replay_graph = "graphs/replay-clouds.pbtxt";
+  for (const auto& [ch, n] : written)
+    if (n && ch.rfind("OS1_SCAN", 0) == 0 && replay_graph.empty()) replay_graph = "graphs/replay.pbtxt";
   if (replay_graph.empty())
     for (const auto& [ch, n] : written)
       if (n && ch.rfind("LASER_SCAN", 0) == 0) replay_graph = "graphs/lidar2d.pbtxt";
+  for (const auto& [t, e] : cloud_check_error)
+    problems.push_back(t + ": its first cloud does not convert to a range image (" + e +
+                       "); the clouds are written as they are, the cloud-to-scan node will report the same on replay");
   if (ouster.bad_packets) problems.push_back(std::to_string(ouster.bad_packets) + " bad Ouster packets; last: " + ouster.last_error);
 
   if (json) {
@@ -438,7 +471,7 @@ int main(int argc, char** argv) {
       j["ouster"]["frame_list"] = fr;
     }
     for (const auto& [t, s] : cloud_info)
-      j["clouds"][t] = {{"ring_source", s.ring_source}, {"time_source", s.time_source}, {"points", s.points}, {"kept", s.kept},
+      j["clouds"][t] = {{"mode", decode_ouster ? "scans" : "clouds"}, {"ring_source", s.ring_source}, {"time_source", s.time_source}, {"points", s.points}, {"kept", s.kept},
                         {"collisions", s.collisions}, {"max_azimuth_error_deg", s.max_azimuth_error_deg}};
     j["errors"] = problems;
     std::cout << j.dump(2) << "\n";
@@ -456,8 +489,12 @@ int main(int argc, char** argv) {
                   ouster.info()->pixels_per_column, ouster.info()->columns_per_frame, os1::to_string(ouster.info()->profile),
                   (unsigned long long)ouster.lidar_packets, (unsigned long long)ouster.imu_packets, frames_total);
     for (const auto& [t, s] : cloud_info)
-      std::printf("  cloud %s: rings from %s, times from %s, %llu/%llu points kept, %llu collisions\n", t.c_str(), s.ring_source.c_str(),
-                  s.time_source.c_str(), (unsigned long long)s.kept, (unsigned long long)s.points, (unsigned long long)s.collisions);
+      std::printf("  cloud %s: rings from %s, times from %s, %llu/%llu points kept, %llu collisions%s\n", t.c_str(), s.ring_source.c_str(),
+                  s.time_source.c_str(), (unsigned long long)s.kept, (unsigned long long)s.points, (unsigned long long)s.collisions,
+                  decode_ouster ? "" : " (first cloud)");
+    if (!decode_ouster && !cloud_info.empty())
+      std::printf("  clouds written as they are (point_cloud2_t); the cloud-to-scan node converts them on replay\n"
+                  "          (--set cloud_to_scan.rings=N / cloud_to_scan.columns=W there; --decode converts here)\n");
     if (!skipped_types.empty()) {
       std::printf("  not imported:");
       for (const auto& [t, n] : skipped_types) std::printf(" %s (%llu)", t.c_str(), (unsigned long long)n);

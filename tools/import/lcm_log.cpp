@@ -1,5 +1,9 @@
 #include "lcm_log.h"
 
+#include <sys/uio.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstring>
 
 namespace fploc::import {
@@ -11,12 +15,38 @@ constexpr int kBuffers = 3;  // one being filled, up to two queued for (or in) t
 bool LcmLog::open(const std::string& path) {
   log_ = lcm_eventlog_create(path.c_str(), "w");
   if (!log_) return false;
-  setvbuf(log_->f, nullptr, _IONBF, 0);  // the buffers below are the buffering
-  cur_.resize(kBufBytes);
-  fill_ = 0;
-  for (int i = 1; i < kBuffers; ++i) free_.emplace_back(kBufBytes);
+  setvbuf(log_->f, nullptr, _IONBF, 0);  // the batches below are the buffering (written with writev on its fd)
+  cur_ = Batch{};
+  cur_.bytes.resize(kBufBytes);
+  for (int i = 1; i < kBuffers; ++i) {
+    free_.emplace_back();
+    free_.back().bytes.resize(kBufBytes);
+  }
   done_ = failed_ = false;
   thread_ = std::thread([this] { writer(); });
+  return true;
+}
+
+bool LcmLog::write_batch(const Batch& b) {
+  iovec iov[kMaxSegs];
+  size_t n = 0;
+  for (const auto& s : b.segs) iov[n++] = {const_cast<uint8_t*>(s.p ? s.p : b.bytes.data() + s.off), s.len};
+  const int fd = fileno(log_->f);
+  size_t i = 0;
+  while (i < n) {
+    const ssize_t w = ::writev(fd, iov + i, int(n - i));
+    if (w < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    if (w == 0) return false;
+    size_t left = size_t(w);
+    while (i < n && left >= iov[i].iov_len) left -= iov[i++].iov_len;
+    if (i < n) {  // a partial write: the rest of this iovec next
+      iov[i].iov_base = static_cast<uint8_t*>(iov[i].iov_base) + left;
+      iov[i].iov_len -= left;
+    }
+  }
   return true;
 }
 
@@ -25,39 +55,41 @@ void LcmLog::writer() {
   for (;;) {
     cv_.wait(lk, [this] { return done_ || !full_.empty(); });
     if (full_.empty()) return;  // done and drained
-    auto [b, n] = std::move(full_.front());
+    Batch b = std::move(full_.front());
     full_.pop_front();
     lk.unlock();
-    const bool ok = fwrite(b.data(), 1, n, log_->f) == n;
+    const bool ok = failed_ || write_batch(b);
     lk.lock();
     if (!ok) failed_ = true;
+    b.clear();
     free_.push_back(std::move(b));
     cv_.notify_all();
   }
 }
 
 void LcmLog::hand_over() {
-  if (!fill_) return;
+  if (cur_.segs.empty()) return;
   std::unique_lock<std::mutex> lk(mu_);
-  full_.emplace_back(std::move(cur_), fill_);
+  full_.push_back(std::move(cur_));
   cv_.notify_all();
   cv_.wait(lk, [this] { return !free_.empty(); });
   cur_ = std::move(free_.back());
   free_.pop_back();
-  fill_ = 0;
+  cur_.clear();
 }
 
 bool LcmLog::write_parts(const std::string& channel, int64_t utime, const uint8_t* a, size_t na, const uint8_t* b,
-                         size_t nb) {
+                         size_t nb, bool b_stable) {
   if (!log_ || failed_) return false;
   const size_t n = na + nb;
   if (n > size_t(INT32_MAX)) return false;
-  const size_t need = 28 + channel.size() + n;
-  if (fill_ + need > cur_.size()) {
+  const bool by_ref = b_stable && nb > 0;
+  const size_t copy = 28 + channel.size() + na + (by_ref ? 0 : nb);
+  if (cur_.fill + copy > cur_.bytes.size() || cur_.segs.size() + 2 > kMaxSegs || cur_.total >= kBatchBytes) {
     hand_over();
-    if (need > cur_.size()) cur_.resize(need);  // a message larger than a buffer gets a larger buffer
+    if (copy > cur_.bytes.size()) cur_.bytes.resize(copy);  // a message larger than a buffer gets a larger buffer
   }
-  uint8_t* p = cur_.data() + fill_;
+  uint8_t* p = cur_.bytes.data() + cur_.fill;
   const uint32_t sync = __builtin_bswap32(0xEDA1DA01u);
   const uint64_t num = __builtin_bswap64(uint64_t(log_->eventcount)), ts = __builtin_bswap64(uint64_t(utime));
   const uint32_t cl = __builtin_bswap32(uint32_t(channel.size())), dl = __builtin_bswap32(uint32_t(n));
@@ -70,8 +102,14 @@ bool LcmLog::write_parts(const std::string& channel, int64_t utime, const uint8_
   std::memcpy(p, channel.data(), channel.size());
   p += channel.size();
   if (na) std::memcpy(p, a, na);
-  if (nb) std::memcpy(p + na, b, nb);
-  fill_ += need;
+  if (nb && !by_ref) std::memcpy(p + na, b, nb);
+  // The copied bytes extend the last segment when it is the one just before them.
+  auto& segs = cur_.segs;
+  if (!segs.empty() && !segs.back().p && segs.back().off + segs.back().len == cur_.fill) segs.back().len += copy;
+  else segs.push_back({nullptr, cur_.fill, copy});
+  cur_.fill += copy;
+  if (by_ref) segs.push_back({b, 0, nb});
+  cur_.total += 28 + channel.size() + n;
   ++log_->eventcount;
   ++events_;
   bytes_ += n;
@@ -82,8 +120,8 @@ bool LcmLog::close() {
   if (!log_) return !failed_;
   {
     std::unique_lock<std::mutex> lk(mu_);
-    if (fill_) full_.emplace_back(std::move(cur_), fill_);
-    fill_ = 0;
+    if (!cur_.segs.empty()) full_.push_back(std::move(cur_));
+    cur_ = Batch{};
     done_ = true;
     cv_.notify_all();
   }
@@ -92,7 +130,6 @@ bool LcmLog::close() {
   log_ = nullptr;
   full_.clear();
   free_.clear();
-  cur_.clear();
   return !failed_;
 }
 

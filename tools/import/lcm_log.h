@@ -5,7 +5,10 @@
 // the page cache) overlaps the reading and decoding, and a buffer still sits in the cache when it is
 // copied (4 MiB buffers cost more CPU: they are read back from memory). A message can
 // be written from two parts (its header and a payload that stays where it is) without assembling it
-// first. close() (also on a bad input, where the importer stops) writes everything before it.
+// first; a payload that stays valid until close() (`stable`: the recording's mapped bytes) is not
+// copied at all: the writer thread hands it to writev() beside the framing, so the only copy of the
+// recording's bytes is the kernel's into the log's page cache. close() (also on a bad input, where
+// the importer stops) writes everything before it.
 #pragma once
 #include <lcm/eventlog.h>
 
@@ -32,8 +35,10 @@ class LcmLog {
   bool write_raw(const std::string& channel, int64_t utime, const uint8_t* data, size_t n) {
     return write_parts(channel, utime, data, n, nullptr, 0);
   }
-  // One event whose data is a followed by b. False once a write to the file has failed.
-  bool write_parts(const std::string& channel, int64_t utime, const uint8_t* a, size_t na, const uint8_t* b, size_t nb);
+  // One event whose data is a followed by b. b_stable: b stays valid (unchanged) until close(), so it
+  // is written from where it is. False once a write to the file has failed.
+  bool write_parts(const std::string& channel, int64_t utime, const uint8_t* a, size_t na, const uint8_t* b, size_t nb,
+                   bool b_stable = false);
   // Writes what is buffered and closes the file; false when a write failed.
   bool close();
   ~LcmLog() { close(); }
@@ -42,16 +47,29 @@ class LcmLog {
 
  private:
   static constexpr size_t kBufBytes = 256 << 10;
-  void hand_over();  // the current buffer to the writer thread; takes a free one
+  static constexpr size_t kMaxSegs = 512;               // iovecs per writev (IOV_MAX is 1024)
+  static constexpr size_t kBatchBytes = size_t(1) << 20;  // bytes per batch, stable payloads included
+  // What one writev writes: framing and copied data in `bytes`, stable payloads where they are.
+  struct Batch {
+    struct Seg {
+      const uint8_t* p;  // a stable payload, or nullptr: bytes[off, off + len)
+      size_t off, len;
+    };
+    std::vector<uint8_t> bytes;
+    size_t fill = 0, total = 0;
+    std::vector<Seg> segs;
+    void clear() { fill = total = 0, segs.clear(); }
+  };
+  void hand_over();  // the current batch to the writer thread; takes a free one
   void writer();
+  bool write_batch(const Batch& b);
   lcm_eventlog_t* log_ = nullptr;
   std::vector<uint8_t> buf_;  // encoding scratch for write()
-  std::vector<uint8_t> cur_;  // being filled
-  size_t fill_ = 0;
+  Batch cur_;                 // being filled
   std::mutex mu_;
   std::condition_variable cv_;
-  std::deque<std::pair<std::vector<uint8_t>, size_t>> full_;  // (buffer, bytes) for the writer
-  std::vector<std::vector<uint8_t>> free_;
+  std::deque<Batch> full_;  // for the writer
+  std::vector<Batch> free_;
   bool done_ = false;
   std::atomic<bool> failed_{false};
   std::thread thread_;

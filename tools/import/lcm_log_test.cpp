@@ -1,9 +1,11 @@
 // LcmLog (own framing, buffers handed to a writer thread) writes byte for byte what lcm's
-// lcm_eventlog_write_event writes, for events smaller and larger than its buffers and split in two parts.
+// lcm_eventlog_write_event writes, for events smaller and larger than its buffers, split in two parts, and
+// with payloads written from where they are (writev; more than a batch's iovecs in a row).
 #include <gtest/gtest.h>
 #include <lcm/eventlog.h>
 
 #include <cstdio>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -30,15 +32,18 @@ TEST(LcmLog, SameBytesAsLcmEventlog) {
   ASSERT_TRUE(ours.open(a));
   lcm_eventlog_t* ref = lcm_eventlog_create(b.c_str(), "w");
   ASSERT_NE(ref, nullptr);
-  for (int i = 0; i < 400; ++i) {
-    // Mostly packet-sized events, some larger than a 256 KiB buffer, some empty.
-    const size_t n = i % 97 == 5 ? size_t(1) << 20 : (i % 50 == 3 ? 0 : 1 + rng() % 20000);
-    std::vector<uint8_t> d(n);
+  std::deque<std::vector<uint8_t>> kept;  // stable payloads: valid until close()
+  const int kEvents = 2000;
+  for (int i = 0; i < kEvents; ++i) {
+    // Mostly packet-sized events, some larger than a 256 KiB buffer, some empty, a run of 700 tiny ones.
+    const size_t n = i % 97 == 5 ? size_t(1) << 20 : (i % 50 == 3 ? 0 : (i > 1000 && i < 1700 ? 1 + rng() % 16 : 1 + rng() % 20000));
+    std::vector<uint8_t>& d = kept.emplace_back(n);
     for (auto& x : d) x = uint8_t(rng());
     const std::string ch = i % 3 ? "OS1_LIDAR_PACKETS" : "OS1_IMU";
     const int64_t t = 1700000000000000 + i * 1000;
     const size_t cut = n / 3;
-    if (i % 2) ASSERT_TRUE(ours.write_parts(ch, t, d.data(), cut, d.data() + cut, n - cut));
+    if (i % 4 == 1) ASSERT_TRUE(ours.write_parts(ch, t, d.data(), cut, d.data() + cut, n - cut));
+    else if (i % 4 == 3 || (i > 1000 && i < 1700)) ASSERT_TRUE(ours.write_parts(ch, t, d.data(), cut, d.data() + cut, n - cut, true));
     else ASSERT_TRUE(ours.write_raw(ch, t, d.data(), n));
     lcm_eventlog_event_t e{};
     e.timestamp = t;
@@ -50,7 +55,7 @@ TEST(LcmLog, SameBytesAsLcmEventlog) {
   }
   EXPECT_TRUE(ours.close());
   lcm_eventlog_destroy(ref);
-  EXPECT_EQ(ours.events(), 400u);
+  EXPECT_EQ(ours.events(), uint64_t(kEvents));
   const auto x = slurp(a), y = slurp(b);
   EXPECT_GT(x.size(), size_t(4) << 20);
   EXPECT_TRUE(x == y) << "sizes " << x.size() << " vs " << y.size();
@@ -69,7 +74,7 @@ TEST(LcmLog, FullDiskIsReported) {
   ASSERT_TRUE(log.open("/dev/full"));
   std::vector<uint8_t> d(100000, 1);
   bool ok = true;
-  for (int i = 0; i < 50 && ok; ++i) ok = log.write_raw("C", i, d.data(), d.size());
+  for (int i = 0; i < 50 && ok; ++i) ok = log.write_parts("C", i, d.data(), 10, d.data() + 10, d.size() - 10, i % 2);
   EXPECT_FALSE(log.close() && ok);
 }
 

@@ -43,10 +43,10 @@ bool OusterRawWriter::metadata(const std::string& json, const std::string& sourc
   return true;
 }
 
-void OusterRawWriter::packet(const uint8_t* d, size_t n, int64_t time_ns) {
+void OusterRawWriter::packet(const uint8_t* d, size_t n, int64_t time_ns, bool stable) {
   if (n == os1::kImuPacketSize) {
     ++imu_packets;
-    write(imu_channel, time_ns, d, n);
+    write(imu_channel, time_ns, d, n, stable);
     return;
   }
   ++lidar_packets;
@@ -57,10 +57,10 @@ void OusterRawWriter::packet(const uint8_t* d, size_t n, int64_t time_ns) {
   }
   if (n == lidar_size_ + 1) n = lidar_size_;  // ouster_ros 0.x: buf is one byte longer than the packet
   if (n != lidar_size_) ++other_size;         // written as it is: the driver reports it, as it would live
-  write(lidar_channel, time_ns, d, n);
+  write(lidar_channel, time_ns, d, n, stable);
 }
 
-void OusterRawWriter::write(const std::string& ch, int64_t time_ns, const uint8_t* d, size_t n) {
+void OusterRawWriter::write(const std::string& ch, int64_t time_ns, const uint8_t* d, size_t n, bool stable) {
   if (!log_) return;
   // os1_packet_t: fingerprint, utime, size, data (big-endian), the payload straight from the recording.
   const int64_t utime = time_ns / 1000;
@@ -70,7 +70,7 @@ void OusterRawWriter::write(const std::string& ch, int64_t time_ns, const uint8_
   std::memcpy(h, &hash, 8);
   std::memcpy(h + 8, &ut, 8);
   std::memcpy(h + 16, &sz, 4);
-  log_->write_parts(ch, utime, h, sizeof h, d, n);
+  log_->write_parts(ch, utime, h, sizeof h, d, n, stable);
 }
 
 }  // namespace fploc::import

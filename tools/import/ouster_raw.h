@@ -21,8 +21,8 @@ class OusterRawWriter {
   // The metadata JSON (topic or --metadata file): checked with the OS-1 metadata parser; the first good
   // one is written (the driver republishes it latched). False with *err when unusable.
   bool metadata(const std::string& json, const std::string& source, int64_t time_ns, std::string* err);
-  // One PacketMsg buf.
-  void packet(const uint8_t* d, size_t n, int64_t time_ns);
+  // One PacketMsg buf; stable: d stays valid until the log is closed (written from where it is).
+  void packet(const uint8_t* d, size_t n, int64_t time_ns, bool stable = false);
   bool has_metadata() const { return lidar_size_ > 0; }
 
   std::string lidar_channel = "OS1_LIDAR_PACKETS", imu_channel = "OS1_IMU_PACKETS", metadata_channel = "OS1_METADATA";
@@ -32,7 +32,7 @@ class OusterRawWriter {
   size_t lidar_size() const { return lidar_size_; }
 
  private:
-  void write(const std::string& ch, int64_t time_ns, const uint8_t* d, size_t n);
+  void write(const std::string& ch, int64_t time_ns, const uint8_t* d, size_t n, bool stable);
   LcmLog* log_;
   size_t lidar_size_ = 0;
   std::vector<std::pair<int64_t, std::vector<uint8_t>>> waiting_;

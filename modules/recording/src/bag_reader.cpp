@@ -80,7 +80,44 @@ bool field_u32(const Record& r, std::string_view name, uint32_t& v, std::string*
 
 std::string text(const Field* f) { return f ? std::string(reinterpret_cast<const char*>(f->v), f->n) : std::string(); }
 
+// The next compressed chunk record at or after pos (index data and chunk info records skipped; a
+// message or connection record outside chunks, a bad record or the end: none).
+bool next_compressed_chunk(const uint8_t* base, size_t n, size_t pos, size_t& at, Record& r) {
+  std::string why;
+  for (int k = 0; k < 256 && pos < n; ++k) {
+    at = pos;
+    if (!read_record(base, n, pos, r, &why)) return false;
+    if (r.op == 0x05) {
+      const Field* c = find(r.fields, "compression");
+      return c && text(c) != "none";
+    }
+    if (r.op == 0x02 || r.op == 0x07) return false;
+  }
+  return false;
+}
+
 }  // namespace
+
+BagReader::~BagReader() {
+  if (ahead_.valid()) ahead_.wait();
+}
+
+void BagReader::prefetch_after(size_t pos) {
+  if (ahead_.valid()) return;
+  size_t at = 0;
+  Record r;
+  if (!next_compressed_chunk(f_->data(), size_, pos, at, r)) return;
+  uint32_t usize = 0;
+  std::string why;
+  if (!field_u32(r, "size", usize, &why)) return;  // reported when the chunk is reached
+  ahead_at_ = at;
+  ahead_ = std::async(std::launch::async, [method = text(find(r.fields, "compression")), d = r.data, n = r.data_len, usize,
+                                           out = std::move(spare_)]() mutable {
+    std::string e = decompress(method, d, n, usize, out);
+    return std::make_pair(std::move(e), std::move(out));
+  });
+  spare_.clear();
+}
 
 BagReader::BagReader(std::unique_ptr<FileBytes> f, std::string name) : FileReader(std::move(f), std::move(name), "bag 2.0") {
   if (size_ < kMagicLen || std::memcmp(f_->data(), kMagic, kMagicLen) != 0) {
@@ -142,10 +179,24 @@ bool BagReader::next(RawMessage& m) {
         cd_ = r.data;
         cn_ = r.data_len;
       } else {
-        const std::string e = decompress(method, r.data, r.data_len, usize, buf_);
+        std::string e;
+        if (ahead_.valid()) {
+          auto res = ahead_.get();
+          if (ahead_at_ == at) {
+            e = std::move(res.first);
+            spare_ = std::move(buf_);  // the previous chunk's buffer: its messages are consumed
+            buf_ = std::move(res.second);
+          } else {
+            spare_ = std::move(res.second);
+            e = decompress(method, r.data, r.data_len, usize, buf_);
+          }
+        } else {
+          e = decompress(method, r.data, r.data_len, usize, buf_);
+        }
         if (!e.empty()) return stop(chunk_what_ + ": " + e);
         cd_ = buf_.data();
         cn_ = buf_.size();
+        prefetch_after(pos_);
       }
       cpos_ = 0;
       chunk_at_ = at;

@@ -83,6 +83,7 @@ void BagWriter::flush_chunk() {
   ci.start = chunk_start_;
   ci.end = chunk_end_;
   const std::vector<uint8_t> z = compress(compression_, chunk_.data(), chunk_.size());
+  if (chunk_copy && compression_ != "none") ok_ = ok_ && std::fwrite(z.data(), 1, z.size(), chunk_copy) == z.size();
   std::vector<uint8_t> h, out;
   field_op(h, 0x05);
   field(h, "compression", compression_);

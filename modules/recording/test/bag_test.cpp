@@ -222,6 +222,27 @@ TEST(Bag, WrittenBagsAllCompressionsAndDamage) {
       const auto some = read_all(bad.data(), bad.size(), &err, "bad.bag");
       EXPECT_NE(err.find("bad.bag: chunk at byte 4096 (" + comp + ")"), std::string::npos) << err;
       EXPECT_LT(some.size(), 300u);
+
+      // A damaged later chunk (decompressed ahead, on the second thread, while the earlier ones are
+      // read): the same one error naming that chunk, after every message of the chunks before it.
+      std::vector<size_t> chunk_at, chunk_mid;  // chunk records: offset, and the middle of their data
+      for (size_t pos = 13; pos + 8 <= bytes.size();) {
+        uint32_t hl, dl;
+        std::memcpy(&hl, &bytes[pos], 4);
+        std::memcpy(&dl, &bytes[pos + 4 + hl], 4);
+        if (memmem(&bytes[pos + 4], hl, "op=\x05", 4)) chunk_at.push_back(pos), chunk_mid.push_back(pos + 8 + hl + dl / 2);
+        pos += 8 + size_t(hl) + dl;
+      }
+      ASSERT_GE(chunk_at.size(), 4u) << comp;
+      auto bad3 = bytes;
+      for (size_t k = 0; k < 8; ++k) bad3[chunk_mid[2] + k] ^= 0x5A;
+      const auto before = read_all(bad3.data(), bad3.size(), &err, "bad3.bag");
+      EXPECT_NE(err.find("bad3.bag: chunk at byte " + std::to_string(chunk_at[2]) + " (" + comp + ")"), std::string::npos) << err;
+      ASSERT_GT(before.size(), 0u);
+      ASSERT_LT(before.size(), 300u);
+      for (size_t i = 0; i < before.size(); ++i) EXPECT_EQ(before[i].data, msgs[i].data) << i;
+      const auto upto2 = read_all(bytes.data(), chunk_at[2], &err);  // the file cut right before that chunk
+      EXPECT_EQ(before.size(), upto2.size()) << comp;
     }
   }
 }

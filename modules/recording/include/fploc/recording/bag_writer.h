@@ -20,6 +20,10 @@ class BagWriter {
   // Writes the last chunk and the index; false on an I/O error.
   bool close();
   ~BagWriter() { if (f_) close(); }
+  // When set, every compressed chunk's payload is also appended here: a concatenation of bz2 streams or
+  // LZ4 frames that `bzip2 -dc` / `lz4 -dc` decode (the benchmark times the decompressor's own tool on
+  // the same data).
+  std::FILE* chunk_copy = nullptr;
 
  private:
   struct Conn { std::string topic, type, md5, def; };

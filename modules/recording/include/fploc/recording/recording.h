@@ -45,6 +45,12 @@ class Recording {
   virtual uint64_t position() const = 0;
   uint64_t size() const { return size_; }
   const std::string& format() const { return format_; }  // "bag 2.0" or "mcap"
+  // True when [p, p + n) lies in the recording's own bytes (an uncompressed chunk or record: not a
+  // decompressed copy), which stay valid and unchanged until the Recording is destroyed.
+  virtual bool stable(const uint8_t* p, size_t n) const {
+    (void)p, (void)n;
+    return false;
+  }
 
  protected:
   bool fail(const std::string& what) {
