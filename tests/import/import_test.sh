@@ -6,15 +6,10 @@
 # odometry and tf; a truncated bag -> one error, exit 1, and a log of what came before; an MCAP from
 # @mcap/core: its PointCloud2 topics as point_cloud2_t, converted on replay by the cloud-to-scan node
 # (graphs/replay-clouds.pbtxt) into the scan_t `--decode` writes, byte for byte.
-set -euo pipefail
-B="${FPLOC_BUILD_DIR:?}/bin"
-D="${FPLOC_SHARED_DIR:?}/data"
+source "$(dirname "${BASH_SOURCE[0]}")/../support/netns_test.sh"
+require_shared ouster/512x10_raw.bag
+D="$FPLOC_SHARED_DIR/data"
 BAG="$D/ouster/512x10_raw.bag"
-[ -f "$BAG" ] || { echo "no ../shared/data: skipped"; exit 77; }
-T="$(mktemp -d)"
-pids=()
-cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; rm -rf "$T"; }
-trap cleanup EXIT
 check() {
   python3 - "$1" "$2" <<'PY'
 import json, sys
@@ -52,7 +47,6 @@ check "$T/import.json" "j['ouster']['mode']=='scans' and j['written']['OS1_SCAN'
 check "$T/replay.json" "j['channels_fed']=={'OS1_SCAN':1,'OS1_IMU':10} and [n['messages_out'] for n in j['nodes'] if n['name']=='segmenter']==[1] and [n['messages_out'] for n in j['nodes'] if n['name']=='features']==[1]"
 
 # lcm-logplayer plays it; lcm-logger records the same events.
-URL="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608"
 lcm-logger --lcm-url="$URL" "$T/played.lcm" > "$T/logger.txt" 2>&1 & pids+=($!)
 sleep 0.5
 lcm-logplayer --lcm-url="$URL" --speed=1 "$T/x.lcm"
