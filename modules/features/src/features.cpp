@@ -95,81 +95,97 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   curv_.resize(n);
   ok_.resize(n);
   picked_.assign(n, 0);
-  // breaks[j] = 1 when points j and j+1 are not neighbours (column gap); prefix sums for window tests.
-  auto& brk_prefix = brk_;
-  brk_prefix.resize(n + 1);
-  brk_prefix[0] = 0;
+  // One pass (issue 14 item 7; the same values as the earlier separate passes): the break prefix (brk[j] =
+  // number of column gaps among the first j neighbour pairs), the window sums by prefix sums (double: ring
+  // coordinates reach ~100 m; sum(X_j - X_i) = S - (2hw+1) X_i), and, hw points behind the prefix, the
+  // smoothness, the window/range test and the parallel-surface test of point i = j - hw. The prefix sums
+  // are a chain of dependent additions; the smoothness of earlier points fills the cycles between them.
+  // Occlusion boundaries (rare) are only recorded here and applied after the pass (the rules only clear
+  // ok_, so the order does not matter).
+  auto& brk = brk_;
+  brk.resize(n + 1);
+  brk[0] = 0;
   const int gap = cfg_.max_column_gap;
   const float rmin = float(cfg_.min_range_m), rmax = float(cfg_.max_range_m);
-  // Window sums by prefix sums (double: ring coordinates reach ~100 m): sum(X_j - X_i) = S - (2hw+1) X_i,
-  // one array per coordinate.
+  const float occ = float(cfg_.occlusion_ratio), par = float(cfg_.parallel_ratio);
   prex_.resize(size_t(n) + 1);
   prey_.resize(size_t(n) + 1);
   prez_.resize(size_t(n) + 1);
   double *px = prex_.data(), *py = prey_.data(), *pz = prez_.data();
   px[0] = py[0] = pz[0] = 0.0;
-  for (int j = 0; j < n; ++j) {
-    brk_prefix[j + 1] = brk_prefix[j] + (j + 1 < n ? int(C[j + 1] - C[j] > gap) : 1);
+  const double win = double(2 * hw + 1);
+  const float den = float(2 * hw);
+  float* curv = curv_.data();
+  uint8_t* ok = ok_.data();
+  occ_.clear();
+  auto prefix = [&](int j) __attribute__((always_inline)) {
+    const int step = j + 1 < n ? C[j + 1] - C[j] : gap + 1;
+    brk[j + 1] = brk[j] + int(step > gap);
     px[j + 1] = px[j] + double(X[j]);
     py[j + 1] = py[j] + double(Y[j]);
     pz[j + 1] = pz[j] + double(Z[j]);
-  }
-  // Branch-free (the window and range tests mispredicted on irregular rings): c is computed everywhere and
-  // only read where ok_ is set.
-  const double win = double(2 * hw + 1);
-  const float den = float(2 * hw);
-  for (int i = 0; i < hw; ++i) ok_[i] = 0;
-  for (int i = std::max(hw, n - hw); i < n; ++i) ok_[i] = 0;
-  int i = hw;
-#if defined(__SSE2__)
-  // Two points at a time in double lanes (sqrtpd: the same correctly rounded roots as one at a time).
-  for (; i + 2 <= n - hw; i += 2) {
-    auto ld = [](const double* p) { return _mm_loadu_pd(p); };
-    const __m128d w2 = _mm_set1_pd(win);
-    const __m128d xi = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(X + i))));
-    const __m128d yi = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(Y + i))));
-    const __m128d zi = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(Z + i))));
-    const __m128d dx = _mm_sub_pd(_mm_sub_pd(ld(px + i + hw + 1), ld(px + i - hw)), _mm_mul_pd(w2, xi));
-    const __m128d dy = _mm_sub_pd(_mm_sub_pd(ld(py + i + hw + 1), ld(py + i - hw)), _mm_mul_pd(w2, yi));
-    const __m128d dz = _mm_sub_pd(_mm_sub_pd(ld(pz + i + hw + 1), ld(pz + i - hw)), _mm_mul_pd(w2, zi));
-    const __m128d s2 = _mm_add_pd(_mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)), _mm_mul_pd(dz, dz));
-    double nrm[2];
-    _mm_storeu_pd(nrm, _mm_sqrt_pd(s2));
-    for (int l = 0; l < 2; ++l) {
-      const int q = i + l;
-      const float rq = R[q];
-      curv_[q] = float(nrm[l]) / (den * rq);
-      ok_[q] = uint8_t((brk_prefix[q + hw] == brk_prefix[q - hw]) & !(rq < rmin) & !(rq > rmax));
+    // LOAM's unreliable points, part 1: the far side of an occlusion boundary between neighbours j, j+1.
+    if (j + 1 < n) {
+      const float a = R[j], c = R[j + 1];
+      const float mn = a < c ? a : c;  // minss, no branch
+      if ((step <= gap) & (std::abs(a - c) > occ * mn)) occ_.push_back(a > c ? -(j + 1) : j + 1);
     }
-  }
-#endif
-  for (; i < n - hw; ++i) {
-    // All of i-hw .. i+hw connected: no break between i-hw and i+hw-1.
+  };
+  auto point = [&](int i) {
+    // All of i-hw .. i+hw connected: no break between i-hw and i+hw-1. LOAM's unreliable points, part 2:
+    // surfaces parallel to the beam (range jumps to both sides).
     const float ri = R[i];
-    const bool ok = (brk_prefix[i + hw] == brk_prefix[i - hw]) & !(ri < rmin) & !(ri > rmax);
+    const bool okw = (brk[i + hw] == brk[i - hw]) & !(ri < rmin) & !(ri > rmax);
+    const bool parallel = (std::abs(R[i - 1] - ri) > par * ri) & (std::abs(R[i + 1] - ri) > par * ri);
     const double dx = (px[i + hw + 1] - px[i - hw]) - win * double(X[i]);
     const double dy = (py[i + hw + 1] - py[i - hw]) - win * double(Y[i]);
     const double dz = (pz[i + hw + 1] - pz[i - hw]) - win * double(Z[i]);
-    curv_[i] = float(std::sqrt(dx * dx + dy * dy + dz * dz)) / (den * ri);  // LOAM's c = |sum(X_j - X_i)| / (|S| |X_i|)
-    ok_[i] = uint8_t(ok);
-  }
-  // LOAM's unreliable points: the far side of an occlusion boundary, and surfaces parallel to the beam.
-  const float occ = float(cfg_.occlusion_ratio), par = float(cfg_.parallel_ratio);
-  for (int j = 0; j + 1 < n; ++j) {
-    const float a = R[j], c = R[j + 1];
-    const float mn = a < c ? a : c;  // minss, no branch (std::min here compiled to one, fmin to a call)
-    // One rarely-true test (neighbours and a range jump) instead of two branches.
-    if ((C[j + 1] - C[j] <= gap) & (std::abs(a - c) > occ * mn)) {
-      if (a > c) {
-        for (int k = std::max(0, j - hw + 1); k <= j; ++k) ok_[k] = 0;
-      } else {
-        for (int k = j + 1; k <= std::min(n - 1, j + hw); ++k) ok_[k] = 0;
-      }
+    curv[i] = float(std::sqrt(dx * dx + dy * dy + dz * dz)) / (den * ri);  // LOAM's c = |sum(X_j - X_i)| / (|S| |X_i|)
+    ok[i] = uint8_t(okw & !parallel);
+  };
+  for (int i = 0; i < hw; ++i) ok[i] = 0;
+  for (int i = n - hw; i < n; ++i) ok[i] = 0;
+  for (int j = 0; j < 2 * hw; ++j) prefix(j);
+  int j = 2 * hw;
+#if defined(__SSE2__)
+  // Four points at a time: two sqrtpd (the same correctly rounded roots as one at a time) and one divps
+  // (the same quotients): the divider, shared by square roots and divisions, was the bottleneck.
+  const __m128d w2 = _mm_set1_pd(win);
+  const __m128 den4 = _mm_set1_ps(den);
+  auto ld = [](const double* p) { return _mm_loadu_pd(p); };
+  auto cvt2 = [](const float* p) { return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)))); };
+  auto norm2 = [&](int i) {  // |sum(X_j - X_i)| of points i, i+1
+    const __m128d dx = _mm_sub_pd(_mm_sub_pd(ld(px + i + hw + 1), ld(px + i - hw)), _mm_mul_pd(w2, cvt2(X + i)));
+    const __m128d dy = _mm_sub_pd(_mm_sub_pd(ld(py + i + hw + 1), ld(py + i - hw)), _mm_mul_pd(w2, cvt2(Y + i)));
+    const __m128d dz = _mm_sub_pd(_mm_sub_pd(ld(pz + i + hw + 1), ld(pz + i - hw)), _mm_mul_pd(w2, cvt2(Z + i)));
+    return _mm_cvtpd_ps(_mm_sqrt_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)), _mm_mul_pd(dz, dz))));
+  };
+  for (; j + 4 <= n; j += 4) {
+    for (int q = j; q < j + 4; ++q) prefix(q);
+    const int i = j - hw;  // points i .. i+3 need the prefix up to i + 3 + hw + 1 = j + 4
+    const __m128 nrm = _mm_movelh_ps(norm2(i), norm2(i + 2));
+    _mm_storeu_ps(curv + i, _mm_div_ps(nrm, _mm_mul_ps(den4, _mm_loadu_ps(R + i))));
+    for (int l = 0; l < 4; ++l) {
+      const int q = i + l;
+      const float rq = R[q];
+      const bool okw = (brk[q + hw] == brk[q - hw]) & !(rq < rmin) & !(rq > rmax);
+      const bool parallel = (std::abs(R[q - 1] - rq) > par * rq) & (std::abs(R[q + 1] - rq) > par * rq);
+      ok[q] = uint8_t(okw & !parallel);
     }
   }
-  for (int i = 1; i + 1 < n; ++i) {
-    const float ri = R[i];
-    ok_[i] &= uint8_t(!((std::abs(R[i - 1] - ri) > par * ri) & (std::abs(R[i + 1] - ri) > par * ri)));
+#endif
+  for (; j < n; ++j) {
+    prefix(j);
+    point(j - hw);  // needs the prefix up to j + 1 = i + hw + 1
+  }
+  for (const int e : occ_) {  // +(j+1): the near side is j (clear j+1 .. j+hw); -(j+1): clear j-hw+1 .. j
+    if (e < 0) {
+      const int j = -e - 1;
+      for (int k = std::max(0, j - hw + 1); k <= j; ++k) ok[k] = 0;
+    } else {
+      const int j = e - 1;
+      for (int k = j + 1; k <= std::min(n - 1, j + hw); ++k) ok[k] = 0;
+    }
   }
 
   // Per-sector selection (sectors split the ring's points evenly, as LOAM does).
@@ -191,18 +207,25 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     // candidates a corner pick suppresses are skipped when walking them (the same picks as leaving them out).
     order_.resize(size_t(se - sb));
     surf_.resize(size_t(se - sb));
+    // The first corner pick is found in the same pass (picked_ holds only the earlier sectors' picks then).
     size_t m = 0, ms = 0;
+    int best0 = -1;
+    float bv0 = -std::numeric_limits<float>::infinity();
     for (int i = sb; i < se; ++i) {
       const float ci = curv_[i];
       order_[m] = i;
       surf_[ms] = i;
-      m += size_t(ok_[i] & uint8_t(ci > cthr));
+      const bool corner = ok_[i] & uint8_t(ci > cthr);
+      m += size_t(corner);
       ms += size_t(ok_[i] & uint8_t(ci < sthr));
+      const bool take = corner & !picked_[i] & (ci > bv0);
+      bv0 = take ? ci : bv0;
+      best0 = take ? i : best0;
     }
     for (int corners = 0; corners < max_corners; ++corners) {
-      int best = -1;
+      int best = corners == 0 ? best0 : -1;
       float bv = -std::numeric_limits<float>::infinity();
-      for (size_t j = 0; j < m; ++j) {
+      for (size_t j = 0; corners > 0 && j < m; ++j) {
         const int i = order_[j];
         const bool take = !picked_[i] & (curv_[i] > bv);
         bv = take ? curv_[i] : bv;
@@ -221,8 +244,11 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     int surfaces = 0;
     for (size_t j = 0; j < surf_.size() && surfaces < max_surfaces; ++j) {
       if (j == sorted) {
+        // The next k smallest in order: selection then a sort of those k (the order is total, so the same
+        // elements in the same order as a partial sort).
         const size_t k = std::min(surf_.size(), std::max<size_t>(sorted * 2, size_t(2 * max_surfaces)));
-        std::partial_sort(surf_.begin() + sorted, surf_.begin() + k, surf_.end(), less);
+        if (k < surf_.size()) std::nth_element(surf_.begin() + sorted, surf_.begin() + k, surf_.end(), less);
+        std::sort(surf_.begin() + sorted, surf_.begin() + k, less);
         sorted = k;
       }
       const int i = surf_[j];

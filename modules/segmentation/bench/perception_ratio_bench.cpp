@@ -84,6 +84,27 @@ void BM_SegmenterPlusFeatures(benchmark::State& st) {
 }
 BENCHMARK(BM_SegmenterPlusFeatures)->Unit(benchmark::kMicrosecond);
 
+// The two stages alone (breakdown; not part of the ratio): the segmenter, and the features of segmentations
+// computed once before the timing.
+void BM_SegmenterOnly(benchmark::State& st) {
+  const auto& f = frames();
+  seg::RingSegmenter sg(seg::SegmenterConfig{});
+  size_t k = 0;
+  for (auto _ : st) benchmark::DoNotOptimize(sg.process(f.scans[k++ % f.scans.size()]).wall.x.size());
+}
+BENCHMARK(BM_SegmenterOnly)->Unit(benchmark::kMicrosecond);
+
+void BM_FeaturesOnly(benchmark::State& st) {
+  const auto& f = frames();
+  seg::RingSegmenter sg(seg::SegmenterConfig{});
+  std::vector<seg::Segmentation> segs;
+  for (const auto& s : f.scans) segs.push_back(sg.process(s));
+  feat::FeatureExtractor fx;
+  size_t k = 0;
+  for (auto _ : st) benchmark::DoNotOptimize(fx.process(segs[k++ % segs.size()]).size());
+}
+BENCHMARK(BM_FeaturesOnly)->Unit(benchmark::kMicrosecond);
+
 class RatioReporter : public benchmark::ConsoleReporter {
  public:
   void ReportRuns(const std::vector<Run>& runs) override {

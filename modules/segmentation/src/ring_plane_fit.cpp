@@ -205,7 +205,6 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
   }
   const size_t nb = band_.n;
   if (nb < 3) return std::nullopt;
-  if (bins_.size() < band_.padded()) bins_.resize(band_.padded());
   // While the cut-off still shrinks, the scale and the weighted fit use every kShrinkSubsample-th band point
   // (band_sub_); once it stops shrinking, every point (band_).
   bool shrinking = !fixed;
@@ -226,14 +225,20 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
       const v4f inv_bin = splat(inv_binf), cutv = splat(cutf);
       const v4i last = splati(k::kScaleBins - 1), outside = splati(k::kScaleBins);
       const float *bx = src->x.data(), *by = src->y.data(), *bz = src->z.data();
-      int32_t* bins = bins_.data();
+      // Bins and counts in one pass (no bins array written and read back); the padding points (1 km off
+      // the plane) land in the outside bin, which no count below reads.
       for (size_t j = 0, np = src->padded(); j < np; j += 4) {
         const v4f a = abs(nx * load(bx + j) + ny * load(by + j) + nz * load(bz + j) + d);
         v4i b = __builtin_convertvector(a * inv_bin, v4i);
         b = b < last ? b : last;
-        store(bins + j, a < cutv ? b : outside);
+        b = a < cutv ? b : outside;
+        int32_t q[4];
+        store(q, b);
+        ++hist[0][q[0]];
+        ++hist[1][q[1]];
+        ++hist[2][q[2]];
+        ++hist[3][q[3]];
       }
-      for (size_t j = 0, nj = src->n; j < nj; ++j) ++hist[j & 3][bins[j]];
     }
     int inside = 0;
     for (int h = 0; h < 4; ++h)

@@ -69,7 +69,7 @@ class FeatureExtractor {
   std::vector<uint8_t> ok_, picked_;
   std::vector<int> order_, surf_;
   Eigen::Matrix3f R_ = Eigen::Matrix3f::Identity();
-  std::vector<int> sel_, brk_;
+  std::vector<int> sel_, brk_, occ_;
   std::vector<int8_t> kind_;
   std::vector<double> prex_, prey_, prez_;
 };

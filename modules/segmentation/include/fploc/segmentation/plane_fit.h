@@ -62,7 +62,6 @@ class RingPlaneFit : public PlaneFit {
   size_t np_ = 0;
   PointsSoa band_, band_sub_, sub_start_, sub_final_;  // band_: relative to the refinement's reference point
   size_t start_stride_ = 1, final_stride_ = 1;  // of the current fit (Candidates, else the reference strides)
-  std::vector<int32_t> bins_;
 };
 
 }  // namespace fploc::seg
