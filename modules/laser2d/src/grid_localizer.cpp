@@ -4,8 +4,12 @@
 #include <ceres/cubic_interpolation.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
+
+#include "fploc/laser2d/correlative_search.h"
 
 namespace fploc::laser2d {
 
@@ -53,13 +57,45 @@ struct PriorCost {
   double ixy_, iyaw_;
 };
 
+// Ceres refinement of x (in/out) on the distance field, the prediction as a prior; returns the problem (for the
+// covariance) and its final cost.
+std::unique_ptr<ceres::Problem> refine_problem(const FieldInterp& interp, const DistanceField& df,
+                                               const GridLocalizerConfig& cfg, const std::vector<Eigen::Vector2d>& pts,
+                                               const Pose2& pred, double sxy, double syaw, double* x, double* cost,
+                                               int* iterations) {
+  ceres::Problem::Options po;
+  po.loss_function_ownership = ceres::TAKE_OWNERSHIP;
+  po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  auto problem = std::make_unique<ceres::Problem>(po);
+  const double inv_sigma = 1 / cfg.point_sigma_m;
+  for (const auto& p : pts)
+    problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PointCost, 1, 3>(new PointCost(&interp, &df, p, inv_sigma)),
+                              new ceres::HuberLoss(cfg.huber_m * inv_sigma), x);
+  problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, 3>(new PriorCost(pred, sxy, syaw)), nullptr, x);
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = cfg.max_iterations;
+  so.num_threads = 1;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary sum;
+  ceres::Solve(so, problem.get(), &sum);
+  if (iterations) *iterations += int(sum.iterations.size());
+  *cost = sum.final_cost;
+  return problem;
+}
+
 }  // namespace
 
 struct GridLocalizer::Impl {
+  std::unique_ptr<ceres::Problem> refine_at(const std::vector<Eigen::Vector2d>& pts, const Pose2& pred, double sxy,
+                                            double syaw, double* x, double* cost, int* iterations) const {
+    return refine_problem(interp, *df, cfg, pts, pred, sxy, syaw, x, cost, iterations);
+  }
   std::shared_ptr<const DistanceField> df;
   FieldGrid grid;
   FieldInterp interp;
-  std::vector<float> score;  // exp(-d^2 / 2 s^2) per cell
+  std::unique_ptr<ScorePyramid> pyramid;  // exp(-d^2 / 2 s^2) per cell and its max-pooled levels
+  GridLocalizerConfig cfg;
   Pose2 pose;
   double sxy = 0, syaw = 0;  // current uncertainty of `pose`
   std::optional<Pose2> last_odom;
@@ -68,9 +104,8 @@ struct GridLocalizer::Impl {
 
   Impl(std::shared_ptr<const DistanceField> f, const GridLocalizerConfig& c)
       : df(std::move(f)), grid(df->data().data(), 0, df->height(), 0, df->width()), interp(grid) {
-    score.resize(df->data().size());
-    const double k = -0.5 / (c.score_sigma_m * c.score_sigma_m);
-    for (size_t i = 0; i < score.size(); ++i) score[i] = float(std::exp(k * double(df->data()[i]) * df->data()[i]));
+    pyramid = std::make_unique<ScorePyramid>(*df, c.score_sigma_m, c.search_levels);
+    cfg = c;
   }
 };
 
@@ -155,70 +190,48 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
     return res;
   }
 
-  // 2. Correlative search around the prediction (search on at most ~100 points).
+  // 2. Correlative search around the prediction (branch and bound; the best `refine_candidates` distinct
+  // candidates within candidate_ratio of the best are kept).
   const size_t sk = std::max<size_t>(1, pts.size() / 100);
   std::vector<Eigen::Vector2d> sp;
   for (size_t i = 0; i < pts.size(); i += sk) sp.push_back(pts[i]);
-  const int nxy = int(std::ceil(wxy / df.resolution()));
-  const int nyaw = int(std::ceil(wyaw / cfg_.search_yaw_step_rad));
-  const int W = df.width(), H = df.height();
-  double best = -1;
-  int bdi = 0, bdj = 0, bdy = 0;
-  std::vector<int> ci(sp.size()), cj(sp.size());
-  const double kappa2 = cfg_.prior_weight_sigmas * cfg_.prior_weight_sigmas;
-  const double oc = std::cos(df.origin_yaw()), os = std::sin(df.origin_yaw());
-  for (int ky = -nyaw; ky <= nyaw; ++ky) {
-    const double yaw = pred.yaw + ky * cfg_.search_yaw_step_rad;
-    const double c = std::cos(yaw), s = std::sin(yaw);
-    for (size_t k = 0; k < sp.size(); ++k) {
-      const Eigen::Vector2d w(pred.x + c * sp[k].x() - s * sp[k].y(), pred.y + s * sp[k].x() + c * sp[k].y());
-      const Eigen::Vector2d cc = df.to_cell(w);
-      ci[k] = int(std::lround(cc.x()));
-      cj[k] = int(std::lround(cc.y()));
-    }
-    const double dyaw = ky * cfg_.search_yaw_step_rad;
-    for (int dj = -nxy; dj <= nxy; ++dj)
-      for (int di = -nxy; di <= nxy; ++di) {
-        double sum = 0;
-        for (size_t k = 0; k < sp.size(); ++k) {
-          const int a = ci[k] + di, b = cj[k] + dj;
-          if (a >= 0 && b >= 0 && a < W && b < H) sum += m.score[size_t(b) * size_t(W) + size_t(a)];
-        }
-        ++res.candidates;
-        const double dx = di * df.resolution(), dy = dj * df.resolution();
-        const double m2 = (dx * dx + dy * dy) / (sxy * sxy) + dyaw * dyaw / (syaw * syaw);
-        const double sc = sum / double(sp.size()) * std::exp(-0.5 * m2 / kappa2);
-        if (sc > best) {
-          best = sc;
-          bdi = di;
-          bdj = dj;
-          bdy = ky;
-        }
-      }
-  }
-  res.score = best;
-  // Offsets are in map-cell axes: back to world.
-  const double odx = bdi * df.resolution(), ody = bdj * df.resolution();
-  double x[3] = {pred.x + oc * odx - os * ody, pred.y + os * odx + oc * ody, pred.yaw + bdy * cfg_.search_yaw_step_rad};
+  SearchWindow win;
+  win.center = pred;
+  win.xy_m = wxy;
+  win.yaw_rad = wyaw;
+  win.yaw_step_rad = cfg_.search_yaw_step_rad;
+  win.sigma_xy_m = sxy;
+  win.sigma_yaw_rad = syaw;
+  win.prior_kappa = cfg_.prior_weight_sigmas;
+  SearchOptions sopt;
+  sopt.keep = std::max(1, cfg_.refine_candidates);
+  sopt.min_ratio = cfg_.candidate_ratio;
+  SearchStats sst;
+  const std::vector<SearchCandidate> cands = correlative_search(df, *m.pyramid, sp, win, sopt, &sst);
+  res.candidates = int(sst.leaves);
+  res.score = cands.empty() ? 0 : cands.front().score;
 
-  // 3. Refinement on the distance field with the prediction as a prior.
-  ceres::Problem::Options po;
-  po.loss_function_ownership = ceres::TAKE_OWNERSHIP;
-  po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
-  ceres::Problem problem(po);
-  const double inv_sigma = 1 / cfg_.point_sigma_m;
-  for (const auto& p : pts)
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PointCost, 1, 3>(new PointCost(&m.interp, &df, p, inv_sigma)),
-                             new ceres::HuberLoss(cfg_.huber_m * inv_sigma), x);
-  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, 3>(new PriorCost(pred, sxy, syaw)), nullptr, x);
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
-  so.max_num_iterations = cfg_.max_iterations;
-  so.num_threads = 1;
-  so.logging_type = ceres::SILENT;
-  ceres::Solver::Summary sum;
-  ceres::Solve(so, &problem, &sum);
-  res.iterations = int(sum.iterations.size());
+  // 3. Refinement of each candidate on the distance field with the prediction as a prior; the one of least
+  // cost (robust point residuals + prior) is the fit (a corridor's shifted candidate scores almost as well in
+  // the search, but its refined cost is higher).
+  std::unique_ptr<ceres::Problem> problem;
+  std::vector<std::array<double, 3>> xs;  // parameter blocks (alive while their problem is)
+  xs.reserve(cands.size() + 1);
+  for (const auto& c : cands) xs.push_back({c.pose.x, c.pose.y, c.pose.yaw});
+  if (xs.empty()) xs.push_back({pred.x, pred.y, pred.yaw});
+  size_t bi = 0;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < xs.size(); ++i) {
+    double cost = 0;
+    auto pb = m.refine_at(pts, pred, sxy, syaw, xs[i].data(), &cost, &res.iterations);
+    if (cost < best_cost) {
+      best_cost = cost;
+      problem = std::move(pb);
+      bi = i;
+    }
+  }
+  const double* x = xs[bi].data();
+  res.refined = int(xs.size());
 
   // 4. Status from the inliers at the refined pose.
   const Pose2 est{x[0], x[1], wrap_angle(x[2])};
@@ -246,7 +259,7 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
   if (inside && res.inlier_ratio >= cfg_.min_inlier_ratio || (near && res.inlier_ratio >= cfg_.min_inlier_ratio_near)) {
     // Covariance from the Jacobian at the solution (loss applied).
     ceres::CRSMatrix J;
-    problem.Evaluate(ceres::Problem::EvaluateOptions(), nullptr, nullptr, nullptr, &J);
+    problem->Evaluate(ceres::Problem::EvaluateOptions(), nullptr, nullptr, nullptr, &J);
     Eigen::Matrix3d Hm = Eigen::Matrix3d::Zero();
     for (int r = 0; r < J.num_rows; ++r) {
       Eigen::Vector3d row = Eigen::Vector3d::Zero();
