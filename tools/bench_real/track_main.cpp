@@ -37,6 +37,9 @@ int main(int argc, char** argv) {
   fploc::laser2d::GridLocalizerConfig c;
   app.add_option("--refine-candidates", c.refine_candidates, "distinct search candidates refined per scan");
   app.add_option("--candidate-ratio", c.candidate_ratio, "kept when >= this share of the best score");
+  app.add_option("--reacquire-after", c.reacquire_after, "POOR scans after which jumps need confirmation");
+  app.add_option("--follow-weak", c.follow_weak, "follow weak near fits while re-acquiring");
+  app.add_option("--reacquire", c.reacquire, "re-acquisition with hypotheses");
   CLI11_PARSE(app, argc, argv);
   namespace cm = fploc::carmen;
   namespace l2 = fploc::laser2d;

@@ -67,6 +67,18 @@ struct GridLocalizerConfig {
   double min_inlier_ratio_near = 0.4;
   double gate_sigmas = 2.0;
   int lost_after = 10;
+  // Re-acquisition while LOST (multiple hypotheses): a wide search (+-window_sigmas sigma of the dead-reckoned
+  // prediction, capped at reacquire_xy_m / reacquire_yaw_rad) proposes up to reacquire_candidates distinct
+  // poses per scan; each that fits (>= min_inlier_ratio) becomes a hypothesis tracked by the odometry and its own
+  // local fit, dropped at its first failed fit; at most max_hypotheses. One is taken when it has matched
+  // confirm_scans scans in a row and the runner-up has matched fewer than confirm_scans - 1 or has a mean
+  // inlier share lower by confirm_margin. Off: a single accepted fit ends LOST (the earlier behaviour).
+  bool reacquire = true;
+  double reacquire_xy_m = 10.0, reacquire_yaw_rad = M_PI;
+  bool follow_weak = true;   // while re-acquiring, follow a weak fit near the prediction (else dead-reckon)
+  int reacquire_after = 1;  // POOR scans in a row after which a jump needs confirmation
+  int reacquire_candidates = 4, max_hypotheses = 8, confirm_scans = 5;
+  double confirm_margin = 0.1;
   double field_max_m = 1.0;  // distance field truncation (the map's DistanceField)
 };
 
@@ -83,7 +95,8 @@ struct GridResult {
   double score = 0;  // the best candidate's correlative score (0..1, prior-weighted)
   int iterations = 0;
   int refined = 0;  // candidates refined
-  int hypotheses = 1;  // hypotheses tracked after this scan (re-acquisition)
+  int hypotheses = 0;      // re-acquisition hypotheses tracked after this scan (while LOST)
+  bool reacquired = false;  // this scan ended LOST with a confirmed hypothesis
 };
 
 class GridLocalizer {
