@@ -40,6 +40,8 @@ int main(int argc, char** argv) {
   app.add_option("--reacquire-after", c.reacquire_after, "POOR scans after which jumps need confirmation");
   app.add_option("--follow-weak", c.follow_weak, "follow weak near fits while re-acquiring");
   app.add_option("--reacquire", c.reacquire, "re-acquisition with hypotheses");
+  app.add_option("--confirm-inlier-ratio", c.confirm_inlier_ratio, "mean inlier share to take a hypothesis");
+  app.add_option("--reacquire-xy", c.reacquire_xy_m, "re-acquisition window [m]");
   CLI11_PARSE(app, argc, argv);
   namespace cm = fploc::carmen;
   namespace l2 = fploc::laser2d;

@@ -122,7 +122,7 @@ struct Bnb {
   SearchStats st;
 
   double threshold() const {
-    double t = kept.empty() ? -1 : opt.min_ratio * kept.front().score;
+    double t = std::max(opt.min_score, kept.empty() ? -1 : opt.min_ratio * kept.front().score);
     if (int(kept.size()) >= std::max(1, opt.keep)) t = std::max(t, kept.back().score);
     return t;
   }

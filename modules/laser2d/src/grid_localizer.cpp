@@ -319,6 +319,8 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
     {
       const double ex = f.est.x - pred.x, ey = f.est.y - pred.y, eyaw = wrap_angle(f.est.yaw - pred.yaw);
       const bool near = (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw) <= cfg_.gate_sigmas * cfg_.gate_sigmas;
+      // (Tried: leaving LOST only with confirm_inlier_ratio here too: intel 18.1 -> 185 cm, more weak fits
+      // followed; freiburg-079 86 -> 91 cm.)
       if (f.accepted && near && f.inlier_ratio >= cfg_.min_inlier_ratio) {
         m.hyps.clear();
         m.pose = f.est;
@@ -333,11 +335,9 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
         res.search_yaw_rad = f.wyaw;
         return res;
       }
-      if (f.accepted && cfg_.follow_weak) {  // weak, near the prediction: follow it
-        pred = f.est;
-        sxy = std::max(std::sqrt(std::max(f.cov(0, 0), f.cov(1, 1))), qxy);
-        syaw = std::max(std::sqrt(f.cov(2, 2)), qyaw);
-      }
+      // Weak, near the prediction: follow it, but keep the dead-reckoned uncertainty (a weak fit does not
+      // confirm the pose; shrinking it would narrow the re-acquisition search around a wrong place).
+      if (f.accepted && cfg_.follow_weak) pred = f.est;
     }
     std::vector<Impl::Hypothesis> kept;
     for (auto& h : m.hyps) {
@@ -352,8 +352,13 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
       kept.push_back(h);
     }
     m.hyps = std::move(kept);
-    const double wide_xy = std::clamp(cfg_.window_sigmas * sxy, 2 * df.resolution(), cfg_.reacquire_xy_m);
-    const double wide_yaw = std::clamp(cfg_.window_sigmas * syaw, cfg_.search_yaw_step_rad, cfg_.reacquire_yaw_rad);
+    // POOR: +-window_sigmas sigma of the dead-reckoned pose; LOST: the whole re-acquisition window (a LOST
+    // tracker's own uncertainty is no longer to be trusted: it may have been confirmed at a wrong place).
+    const bool lost = m.poor_run >= cfg_.lost_after;
+    const double wide_xy = lost ? cfg_.reacquire_xy_m
+                                : std::clamp(cfg_.window_sigmas * sxy, 2 * df.resolution(), cfg_.reacquire_xy_m);
+    const double wide_yaw = lost ? cfg_.reacquire_yaw_rad
+                                 : std::clamp(cfg_.window_sigmas * syaw, cfg_.search_yaw_step_rad, cfg_.reacquire_yaw_rad);
     res.search_xy_m = wide_xy;
     res.search_yaw_rad = wide_yaw;
     res.inlier_ratio = f.inlier_ratio;
@@ -370,6 +375,10 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
       SearchOptions so;
       so.keep = cfg_.reacquire_candidates;
       so.min_ratio = cfg_.candidate_ratio;
+      // A pose with min_inlier_ratio of the points within inlier_m scores at least this much: nothing below it
+      // can become a hypothesis (prunes most of a wide search where the map does not explain the scan).
+      so.min_score = cfg_.min_inlier_ratio *
+                     std::exp(-0.5 * (cfg_.inlier_m / cfg_.score_sigma_m) * (cfg_.inlier_m / cfg_.score_sigma_m));
       const size_t sk = std::max<size_t>(1, pts.size() / 100);
       std::vector<Eigen::Vector2d> sp;
       for (size_t i = 0; i < pts.size(); i += sk) sp.push_back(pts[i]);
@@ -395,7 +404,7 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
       return a.hits != b.hits ? a.hits > b.hits : a.mean() > b.mean();
     });
     if (int(m.hyps.size()) > cfg_.max_hypotheses) m.hyps.resize(size_t(cfg_.max_hypotheses));
-    if (!m.hyps.empty() && m.hyps[0].hits >= cfg_.confirm_scans &&
+    if (!m.hyps.empty() && m.hyps[0].hits >= cfg_.confirm_scans && m.hyps[0].mean() >= cfg_.confirm_inlier_ratio &&
         (m.hyps.size() == 1 || m.hyps[1].hits < cfg_.confirm_scans - 1 ||
          m.hyps[0].mean() >= m.hyps[1].mean() + cfg_.confirm_margin)) {
       const Impl::Hypothesis h = m.hyps[0];

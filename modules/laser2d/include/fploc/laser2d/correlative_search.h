@@ -60,6 +60,7 @@ struct SearchOptions {
   int keep = 1;                    // distinct candidates returned (best first)
   double sep_xy_m = 0.3, sep_yaw_rad = 10 * M_PI / 180;  // distinct: farther apart than either
   double min_ratio = 0.0;          // prune blocks whose bound < min_ratio * best (0: only the K-th best prunes)
+  double min_score = 0.0;          // prune blocks whose bound < this (candidates below it are of no use)
 };
 
 struct SearchStats {

@@ -79,6 +79,7 @@ struct GridLocalizerConfig {
   int reacquire_after = 1;  // POOR scans in a row after which a jump needs confirmation
   int reacquire_candidates = 4, max_hypotheses = 8, confirm_scans = 5;
   double confirm_margin = 0.1;
+  double confirm_inlier_ratio = 0.7;  // mean inlier share a hypothesis needs to be taken (a jump needs more than tracking)
   double field_max_m = 1.0;  // distance field truncation (the map's DistanceField)
 };
 
