@@ -12,6 +12,7 @@ PKGS=(
   python3
   libboost-dev openssh-client openssh-server
   python3-ezdxf   # tests: `fploc map diff` DXF read back by a CAD library (ezdxf, strict read + audit)
+  python3-matplotlib   # tools/bench_real/plot_errors.py (per-scan error plots of fploc-real-track, diagnostic)
 )
 missing=()
 for p in "${PKGS[@]}"; do

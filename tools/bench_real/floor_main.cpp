@@ -44,7 +44,7 @@ int main(int argc, char** argv) {
       const double rmax = std::isfinite(no_return) ? std::min<double>(c.max_range_m, no_return) : c.max_range_m;
       const auto pts = l2::scan_points(s.ranges, -M_PI / 2, cm::beam_increment(s.ranges.size()), c.min_range_m, rmax);
       const l2::GridResult r = loc.update(pts, std::nullopt);
-      rows.push_back({{"scan", k}, {"dxy_m", std::hypot(r.pose.x - ref.x, r.pose.y - ref.y)},
+      rows.push_back({{"scan", k}, {"x", r.pose.x}, {"y", r.pose.y}, {"yaw", r.pose.yaw}, {"dxy_m", std::hypot(r.pose.x - ref.x, r.pose.y - ref.y)},
                       {"dyaw_deg", fploc::wrap_angle(r.pose.yaw - ref.yaw) * 180 / M_PI},
                       {"inlier_ratio", r.inlier_ratio}, {"ok", r.status == l2::GridStatus::kOk}});
     }

@@ -4,8 +4,12 @@
 #include <ceres/cubic_interpolation.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
+
+#include "fploc/laser2d/correlative_search.h"
 
 namespace fploc::laser2d {
 
@@ -53,24 +57,76 @@ struct PriorCost {
   double ixy_, iyaw_;
 };
 
+// Ceres refinement of x (in/out) on the distance field, the prediction as a prior; returns the problem (for the
+// covariance) and its final cost.
+std::unique_ptr<ceres::Problem> refine_problem(const FieldInterp& interp, const DistanceField& df,
+                                               const GridLocalizerConfig& cfg, const std::vector<Eigen::Vector2d>& pts,
+                                               const Pose2& pred, double sxy, double syaw, double* x, double* cost,
+                                               int* iterations) {
+  ceres::Problem::Options po;
+  po.loss_function_ownership = ceres::TAKE_OWNERSHIP;
+  po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  auto problem = std::make_unique<ceres::Problem>(po);
+  const double inv_sigma = 1 / cfg.point_sigma_m;
+  for (const auto& p : pts)
+    problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PointCost, 1, 3>(new PointCost(&interp, &df, p, inv_sigma)),
+                              new ceres::HuberLoss(cfg.huber_m * inv_sigma), x);
+  problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, 3>(new PriorCost(pred, sxy, syaw)), nullptr, x);
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = cfg.max_iterations;
+  so.num_threads = 1;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary sum;
+  ceres::Solve(so, problem.get(), &sum);
+  if (iterations) *iterations += int(sum.iterations.size());
+  *cost = sum.final_cost;
+  return problem;
+}
+
 }  // namespace
 
 struct GridLocalizer::Impl {
+  std::unique_ptr<ceres::Problem> refine_at(const std::vector<Eigen::Vector2d>& pts, const Pose2& pred, double sxy,
+                                            double syaw, double* x, double* cost, int* iterations) const {
+    return refine_problem(interp, *df, cfg, pts, pred, sxy, syaw, x, cost, iterations);
+  }
   std::shared_ptr<const DistanceField> df;
   FieldGrid grid;
   FieldInterp interp;
-  std::vector<float> score;  // exp(-d^2 / 2 s^2) per cell
+  std::unique_ptr<ScorePyramid> pyramid;  // exp(-d^2 / 2 s^2) per cell and its max-pooled levels
+  GridLocalizerConfig cfg;
   Pose2 pose;
   double sxy = 0, syaw = 0;  // current uncertainty of `pose`
   std::optional<Pose2> last_odom;
   int poor_run = 0;
   bool first = true;
+  // Re-acquisition hypotheses (while LOST): each tracked by odometry and its own local fit.
+  struct Hypothesis {
+    Pose2 pose;
+    double sxy = 0, syaw = 0;
+    int hits = 0;
+    double inlier_sum = 0;
+    double mean() const { return hits > 0 ? inlier_sum / hits : 0; }
+  };
+  std::vector<Hypothesis> hyps;
+
+  // One local fit: the search around pred (+-window_sigmas sigma, capped at max_xy / max_yaw), the refinement,
+  // the inliers, the acceptance test and the covariance.
+  struct Fit {
+    Pose2 est;
+    bool accepted = false;
+    double inlier_ratio = 0, rms = 0, score = 0, wxy = 0, wyaw = 0;
+    int inliers = 0, leaves = 0, iterations = 0, refined = 0;
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();
+  };
+  Fit fit(const std::vector<Eigen::Vector2d>& pts, const Pose2& pred, double sxy, double syaw, double max_xy,
+          double max_yaw, int keep, double min_inlier_ratio) const;
 
   Impl(std::shared_ptr<const DistanceField> f, const GridLocalizerConfig& c)
       : df(std::move(f)), grid(df->data().data(), 0, df->height(), 0, df->width()), interp(grid) {
-    score.resize(df->data().size());
-    const double k = -0.5 / (c.score_sigma_m * c.score_sigma_m);
-    for (size_t i = 0; i < score.size(); ++i) score[i] = float(std::exp(k * double(df->data()[i]) * df->data()[i]));
+    pyramid = std::make_unique<ScorePyramid>(*df, c.score_sigma_m, c.search_levels);
+    cfg = c;
   }
 };
 
@@ -106,26 +162,119 @@ std::vector<Eigen::Vector2d> scan_points(const std::vector<float>& ranges, doubl
   return out;
 }
 
+
+GridLocalizer::Impl::Fit GridLocalizer::Impl::fit(const std::vector<Eigen::Vector2d>& pts, const Pose2& pred, double sxy,
+                                                  double syaw, double max_xy, double max_yaw, int keep,
+                                                  double min_inlier_ratio) const {
+  Fit f;
+  const DistanceField& d = *df;
+  f.wxy = std::clamp(cfg.window_sigmas * sxy, 2 * d.resolution(), max_xy);
+  f.wyaw = std::clamp(cfg.window_sigmas * syaw, cfg.search_yaw_step_rad, max_yaw);
+  // Correlative search (branch and bound, on at most ~100 points).
+  const size_t sk = std::max<size_t>(1, pts.size() / 100);
+  std::vector<Eigen::Vector2d> sp;
+  for (size_t i = 0; i < pts.size(); i += sk) sp.push_back(pts[i]);
+  SearchWindow win;
+  win.center = pred;
+  win.xy_m = f.wxy;
+  win.yaw_rad = f.wyaw;
+  win.yaw_step_rad = cfg.search_yaw_step_rad;
+  win.sigma_xy_m = sxy;
+  win.sigma_yaw_rad = syaw;
+  win.prior_kappa = cfg.prior_weight_sigmas;
+  SearchOptions sopt;
+  sopt.keep = std::max(1, keep);
+  sopt.min_ratio = cfg.candidate_ratio;
+  SearchStats sst;
+  const std::vector<SearchCandidate> cands = correlative_search(d, *pyramid, sp, win, sopt, &sst);
+  f.leaves = int(sst.leaves);
+  f.score = cands.empty() ? 0 : cands.front().score;
+  // Refinement of each candidate with the prediction as a prior; the least cost is the fit.
+  std::unique_ptr<ceres::Problem> problem;
+  std::vector<std::array<double, 3>> xs;  // parameter blocks (alive while their problem is)
+  for (const auto& c : cands) xs.push_back({c.pose.x, c.pose.y, c.pose.yaw});
+  if (xs.empty()) xs.push_back({pred.x, pred.y, pred.yaw});
+  size_t bi = 0;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < xs.size(); ++i) {
+    double cost = 0;
+    auto pb = refine_at(pts, pred, sxy, syaw, xs[i].data(), &cost, &f.iterations);
+    if (cost < best_cost) {
+      best_cost = cost;
+      problem = std::move(pb);
+      bi = i;
+    }
+  }
+  f.refined = int(xs.size());
+  const double* x = xs[bi].data();
+  f.est = {x[0], x[1], wrap_angle(x[2])};
+  // Inliers at the refined pose.
+  double ss = 0;
+  {
+    const double c = std::cos(f.est.yaw), s = std::sin(f.est.yaw);
+    for (const auto& p : pts) {
+      const Eigen::Vector2d w(f.est.x + c * p.x() - s * p.y(), f.est.y + s * p.x() + c * p.y());
+      const double dd = d.nearest(w);
+      if (dd < cfg.inlier_m) {
+        ++f.inliers;
+        ss += dd * dd;
+      }
+    }
+  }
+  f.inlier_ratio = pts.empty() ? 0 : double(f.inliers) / double(pts.size());
+  f.rms = f.inliers > 0 ? std::sqrt(ss / f.inliers) : 0;
+  const double ex = f.est.x - pred.x, ey = f.est.y - pred.y, eyaw = wrap_angle(f.est.yaw - pred.yaw);
+  const double m2 = (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw);
+  const bool near = m2 <= cfg.gate_sigmas * cfg.gate_sigmas;
+  // The refinement may not leave the window searched (a scan of one flat wall fits anywhere along it).
+  const bool inside = std::hypot(ex, ey) <= f.wxy + d.resolution() && std::abs(eyaw) <= f.wyaw + cfg.search_yaw_step_rad;
+  f.accepted = (inside && f.inlier_ratio >= min_inlier_ratio) || (near && f.inlier_ratio >= cfg.min_inlier_ratio_near);
+  if (f.accepted) {
+    // Covariance from the Jacobian at the solution (loss applied).
+    ceres::CRSMatrix J;
+    problem->Evaluate(ceres::Problem::EvaluateOptions(), nullptr, nullptr, nullptr, &J);
+    Eigen::Matrix3d Hm = Eigen::Matrix3d::Zero();
+    for (int r = 0; r < J.num_rows; ++r) {
+      Eigen::Vector3d row = Eigen::Vector3d::Zero();
+      for (int k = J.rows[r]; k < J.rows[r + 1]; ++k) row[J.cols[k]] = J.values[k];
+      Hm += row * row.transpose();
+    }
+    f.cov = Hm.inverse();
+    if (!f.cov.allFinite()) f.cov = Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
+  }
+  return f;
+}
+
 GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, const std::optional<Pose2>& odom) {
   GridResult res;
   if (!have_pose_) return res;
   Impl& m = *impl_;
   const DistanceField& df = *m.df;
 
-  // 1. Prediction and its uncertainty.
+  // 1. Prediction and its uncertainty (also of every re-acquisition hypothesis).
   Pose2 pred = m.pose;
   double sxy = m.sxy, syaw = m.syaw;
+  double qxy = 0, qyaw = 0;
+  std::optional<Pose2> inc;
   if (odom && m.last_odom) {
-    const Pose2 inc = between(*m.last_odom, *odom);
-    const double step = std::hypot(inc.x, inc.y), turn = std::abs(wrap_angle(inc.yaw));
-    pred = compose(m.pose, inc);
-    const double qxy = cfg_.sigma_xy_m + cfg_.sigma_xy_per_m * step;
-    const double qyaw = cfg_.sigma_yaw_rad + cfg_.sigma_yaw_per_rad * turn + cfg_.sigma_yaw_per_m * step;
+    inc = between(*m.last_odom, *odom);
+    const double step = std::hypot(inc->x, inc->y), turn = std::abs(wrap_angle(inc->yaw));
+    pred = compose(m.pose, *inc);
+    qxy = cfg_.sigma_xy_m + cfg_.sigma_xy_per_m * step;
+    qyaw = cfg_.sigma_yaw_rad + cfg_.sigma_yaw_per_rad * turn + cfg_.sigma_yaw_per_m * step;
     sxy = std::sqrt(sxy * sxy + qxy * qxy + step * step * syaw * syaw);
     syaw = std::sqrt(syaw * syaw + qyaw * qyaw);
   } else if (!m.first) {
-    sxy = std::sqrt(sxy * sxy + cfg_.no_odom_sigma_xy_m * cfg_.no_odom_sigma_xy_m);
-    syaw = std::sqrt(syaw * syaw + cfg_.no_odom_sigma_yaw_rad * cfg_.no_odom_sigma_yaw_rad);
+    qxy = cfg_.no_odom_sigma_xy_m;
+    qyaw = cfg_.no_odom_sigma_yaw_rad;
+    sxy = std::sqrt(sxy * sxy + qxy * qxy);
+    syaw = std::sqrt(syaw * syaw + qyaw * qyaw);
+  }
+  for (auto& h : m.hyps) {
+    const double step = inc ? std::hypot(inc->x, inc->y) : 0;
+    if (inc) h.pose = compose(h.pose, *inc);
+    h.sxy = std::sqrt(h.sxy * h.sxy + qxy * qxy + step * step * h.syaw * h.syaw);
+    h.syaw = std::sqrt(h.syaw * h.syaw + qyaw * qyaw);
   }
   m.first = false;
   if (odom) m.last_odom = odom;
@@ -141,134 +290,166 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
     }
   }
   res.num_points = int(pts.size());
-  const double wxy = std::clamp(cfg_.window_sigmas * sxy, 2 * df.resolution(), cfg_.max_window_xy_m);
-  const double wyaw = std::clamp(cfg_.window_sigmas * syaw, cfg_.search_yaw_step_rad, cfg_.max_window_yaw_rad);
-  res.search_xy_m = wxy;
-  res.search_yaw_rad = wyaw;
-  if (pts.size() < 10) {
+  auto keep_prediction = [&]() {
     m.pose = pred;
     m.sxy = sxy;
     m.syaw = syaw;
     ++m.poor_run;
     res.pose = pred;
     res.status = m.poor_run >= cfg_.lost_after ? GridStatus::kLost : GridStatus::kPoor;
+    res.covariance = Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
+    res.hypotheses = int(m.hyps.size());
+  };
+  if (pts.size() < 10) {
+    res.search_xy_m = std::clamp(cfg_.window_sigmas * sxy, 2 * df.resolution(), cfg_.max_window_xy_m);
+    res.search_yaw_rad = std::clamp(cfg_.window_sigmas * syaw, cfg_.search_yaw_step_rad, cfg_.max_window_yaw_rad);
+    keep_prediction();
     return res;
   }
 
-  // 2. Correlative search around the prediction (search on at most ~100 points).
-  const size_t sk = std::max<size_t>(1, pts.size() / 100);
-  std::vector<Eigen::Vector2d> sp;
-  for (size_t i = 0; i < pts.size(); i += sk) sp.push_back(pts[i]);
-  const int nxy = int(std::ceil(wxy / df.resolution()));
-  const int nyaw = int(std::ceil(wyaw / cfg_.search_yaw_step_rad));
-  const int W = df.width(), H = df.height();
-  double best = -1;
-  int bdi = 0, bdj = 0, bdy = 0;
-  std::vector<int> ci(sp.size()), cj(sp.size());
-  const double kappa2 = cfg_.prior_weight_sigmas * cfg_.prior_weight_sigmas;
-  const double oc = std::cos(df.origin_yaw()), os = std::sin(df.origin_yaw());
-  for (int ky = -nyaw; ky <= nyaw; ++ky) {
-    const double yaw = pred.yaw + ky * cfg_.search_yaw_step_rad;
-    const double c = std::cos(yaw), s = std::sin(yaw);
-    for (size_t k = 0; k < sp.size(); ++k) {
-      const Eigen::Vector2d w(pred.x + c * sp[k].x() - s * sp[k].y(), pred.y + s * sp[k].x() + c * sp[k].y());
-      const Eigen::Vector2d cc = df.to_cell(w);
-      ci[k] = int(std::lround(cc.x()));
-      cj[k] = int(std::lround(cc.y()));
-    }
-    const double dyaw = ky * cfg_.search_yaw_step_rad;
-    for (int dj = -nxy; dj <= nxy; ++dj)
-      for (int di = -nxy; di <= nxy; ++di) {
-        double sum = 0;
-        for (size_t k = 0; k < sp.size(); ++k) {
-          const int a = ci[k] + di, b = cj[k] + dj;
-          if (a >= 0 && b >= 0 && a < W && b < H) sum += m.score[size_t(b) * size_t(W) + size_t(a)];
-        }
-        ++res.candidates;
-        const double dx = di * df.resolution(), dy = dj * df.resolution();
-        const double m2 = (dx * dx + dy * dy) / (sxy * sxy) + dyaw * dyaw / (syaw * syaw);
-        const double sc = sum / double(sp.size()) * std::exp(-0.5 * m2 / kappa2);
-        if (sc > best) {
-          best = sc;
-          bdi = di;
-          bdj = dj;
-          bdy = ky;
-        }
+  // 2. LOST: re-acquisition. A single scan's fit no longer decides (after a long stretch the map does not
+  // explain, a wrong place can match one scan well): every hypothesis is tracked by the odometry and its own
+  // local fit and dropped when a fit fails; new ones come from a wide search around the dead-reckoned
+  // prediction (+-window_sigmas sigma, capped at reacquire_xy_m / reacquire_yaw_rad); one is taken when it has
+  // matched confirm_scans scans in a row and no other hypothesis has matched nearly as many.
+  if (cfg_.reacquire && m.poor_run >= cfg_.reacquire_after) {
+    // The fit around the dead-reckoned prediction: a strong fit that agrees with it (within gate_sigmas) ends
+    // LOST at once (the map and the odometry agree; nothing to confirm); a weak one near it is followed (POOR).
+    const Impl::Fit f = m.fit(pts, pred, sxy, syaw, cfg_.max_window_xy_m, cfg_.max_window_yaw_rad, 1, 1.1);
+    {
+      const double ex = f.est.x - pred.x, ey = f.est.y - pred.y, eyaw = wrap_angle(f.est.yaw - pred.yaw);
+      const bool near = (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw) <= cfg_.gate_sigmas * cfg_.gate_sigmas;
+      // (Tried: leaving LOST only with confirm_inlier_ratio here too: intel 18.1 -> 185 cm, more weak fits
+      // followed; freiburg-079 86 -> 91 cm.)
+      if (f.accepted && near && f.inlier_ratio >= cfg_.min_inlier_ratio) {
+        m.hyps.clear();
+        m.pose = f.est;
+        m.sxy = std::sqrt(std::max(f.cov(0, 0), f.cov(1, 1)));
+        m.syaw = std::sqrt(f.cov(2, 2));
+        m.poor_run = 0;
+        res.pose = f.est;
+        res.status = GridStatus::kOk;
+        res.covariance = f.cov;
+        res.inlier_ratio = f.inlier_ratio;
+        res.search_xy_m = f.wxy;
+        res.search_yaw_rad = f.wyaw;
+        return res;
       }
-  }
-  res.score = best;
-  // Offsets are in map-cell axes: back to world.
-  const double odx = bdi * df.resolution(), ody = bdj * df.resolution();
-  double x[3] = {pred.x + oc * odx - os * ody, pred.y + os * odx + oc * ody, pred.yaw + bdy * cfg_.search_yaw_step_rad};
-
-  // 3. Refinement on the distance field with the prediction as a prior.
-  ceres::Problem::Options po;
-  po.loss_function_ownership = ceres::TAKE_OWNERSHIP;
-  po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
-  ceres::Problem problem(po);
-  const double inv_sigma = 1 / cfg_.point_sigma_m;
-  for (const auto& p : pts)
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PointCost, 1, 3>(new PointCost(&m.interp, &df, p, inv_sigma)),
-                             new ceres::HuberLoss(cfg_.huber_m * inv_sigma), x);
-  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, 3>(new PriorCost(pred, sxy, syaw)), nullptr, x);
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
-  so.max_num_iterations = cfg_.max_iterations;
-  so.num_threads = 1;
-  so.logging_type = ceres::SILENT;
-  ceres::Solver::Summary sum;
-  ceres::Solve(so, &problem, &sum);
-  res.iterations = int(sum.iterations.size());
-
-  // 4. Status from the inliers at the refined pose.
-  const Pose2 est{x[0], x[1], wrap_angle(x[2])};
-  double ss = 0;
-  int inl = 0;
-  {
-    const double c = std::cos(est.yaw), s = std::sin(est.yaw);
-    for (const auto& p : pts) {
-      const Eigen::Vector2d w(est.x + c * p.x() - s * p.y(), est.y + s * p.x() + c * p.y());
-      const double d = df.nearest(w);
-      if (d < cfg_.inlier_m) {
-        ++inl;
-        ss += d * d;
+      // Weak, near the prediction: follow it, but keep the dead-reckoned uncertainty (a weak fit does not
+      // confirm the pose; shrinking it would narrow the re-acquisition search around a wrong place).
+      if (f.accepted && cfg_.follow_weak) pred = f.est;
+    }
+    std::vector<Impl::Hypothesis> kept;
+    for (auto& h : m.hyps) {
+      const Impl::Fit f = m.fit(pts, h.pose, h.sxy, h.syaw, cfg_.max_window_xy_m, cfg_.max_window_yaw_rad, 1,
+                                cfg_.min_inlier_ratio);
+      if (!f.accepted || f.inlier_ratio < cfg_.min_inlier_ratio) continue;
+      h.pose = f.est;
+      h.sxy = std::sqrt(std::max(f.cov(0, 0), f.cov(1, 1)));
+      h.syaw = std::sqrt(f.cov(2, 2));
+      ++h.hits;
+      h.inlier_sum += f.inlier_ratio;
+      kept.push_back(h);
+    }
+    m.hyps = std::move(kept);
+    // POOR: +-window_sigmas sigma of the dead-reckoned pose; LOST: the whole re-acquisition window (a LOST
+    // tracker's own uncertainty is no longer to be trusted: it may have been confirmed at a wrong place).
+    const bool lost = m.poor_run >= cfg_.lost_after;
+    const double wide_xy = lost ? cfg_.reacquire_xy_m
+                                : std::clamp(cfg_.window_sigmas * sxy, 2 * df.resolution(), cfg_.reacquire_xy_m);
+    const double wide_yaw = lost ? cfg_.reacquire_yaw_rad
+                                 : std::clamp(cfg_.window_sigmas * syaw, cfg_.search_yaw_step_rad, cfg_.reacquire_yaw_rad);
+    res.search_xy_m = wide_xy;
+    res.search_yaw_rad = wide_yaw;
+    res.inlier_ratio = f.inlier_ratio;
+    // New hypotheses: the wide search's distinct candidates, each refined on its own.
+    {
+      SearchWindow win;
+      win.center = pred;
+      win.xy_m = wide_xy;
+      win.yaw_rad = wide_yaw;
+      win.yaw_step_rad = cfg_.search_yaw_step_rad;
+      win.sigma_xy_m = sxy;
+      win.sigma_yaw_rad = syaw;
+      win.prior_kappa = 0;  // where the robot is after a long dead-reckoning: no preference within the window
+      SearchOptions so;
+      so.keep = cfg_.reacquire_candidates;
+      so.min_ratio = cfg_.candidate_ratio;
+      // A pose with min_inlier_ratio of the points within inlier_m scores at least this much: nothing below it
+      // can become a hypothesis (prunes most of a wide search where the map does not explain the scan).
+      so.min_score = cfg_.min_inlier_ratio *
+                     std::exp(-0.5 * (cfg_.inlier_m / cfg_.score_sigma_m) * (cfg_.inlier_m / cfg_.score_sigma_m));
+      const size_t sk = std::max<size_t>(1, pts.size() / 100);
+      std::vector<Eigen::Vector2d> sp;
+      for (size_t i = 0; i < pts.size(); i += sk) sp.push_back(pts[i]);
+      for (const auto& c : correlative_search(df, *m.pyramid, sp, win, so)) {
+        const double s0 = 2 * df.resolution(), y0 = 2 * cfg_.search_yaw_step_rad;
+        const Impl::Fit f = m.fit(pts, c.pose, s0, y0, s0, y0, 1, cfg_.min_inlier_ratio);
+        if (!f.accepted || f.inlier_ratio < cfg_.min_inlier_ratio) continue;
+        bool dup = false;
+        for (const auto& h : m.hyps)
+          dup = dup || (std::hypot(h.pose.x - f.est.x, h.pose.y - f.est.y) < so.sep_xy_m &&
+                        std::abs(wrap_angle(h.pose.yaw - f.est.yaw)) < so.sep_yaw_rad);
+        if (dup) continue;
+        Impl::Hypothesis h;
+        h.pose = f.est;
+        h.sxy = std::sqrt(std::max(f.cov(0, 0), f.cov(1, 1)));
+        h.syaw = std::sqrt(f.cov(2, 2));
+        h.hits = 1;
+        h.inlier_sum = f.inlier_ratio;
+        m.hyps.push_back(h);
       }
     }
-  }
-  res.num_inliers = inl;
-  res.inlier_ratio = double(inl) / double(pts.size());
-  res.rms_m = inl > 0 ? std::sqrt(ss / inl) : 0;
-  const double ex = est.x - pred.x, ey = est.y - pred.y, eyaw = wrap_angle(est.yaw - pred.yaw);
-  const double m2 = (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw);
-  const bool near = m2 <= cfg_.gate_sigmas * cfg_.gate_sigmas;
-  // The refinement may not leave the window searched (a scan of one flat wall fits anywhere along it).
-  const bool inside = std::hypot(ex, ey) <= wxy + df.resolution() && std::abs(eyaw) <= wyaw + cfg_.search_yaw_step_rad;
-  if (inside && res.inlier_ratio >= cfg_.min_inlier_ratio || (near && res.inlier_ratio >= cfg_.min_inlier_ratio_near)) {
-    // Covariance from the Jacobian at the solution (loss applied).
-    ceres::CRSMatrix J;
-    problem.Evaluate(ceres::Problem::EvaluateOptions(), nullptr, nullptr, nullptr, &J);
-    Eigen::Matrix3d Hm = Eigen::Matrix3d::Zero();
-    for (int r = 0; r < J.num_rows; ++r) {
-      Eigen::Vector3d row = Eigen::Vector3d::Zero();
-      for (int k = J.rows[r]; k < J.rows[r + 1]; ++k) row[J.cols[k]] = J.values[k];
-      Hm += row * row.transpose();
+    std::sort(m.hyps.begin(), m.hyps.end(), [](const auto& a, const auto& b) {
+      return a.hits != b.hits ? a.hits > b.hits : a.mean() > b.mean();
+    });
+    if (int(m.hyps.size()) > cfg_.max_hypotheses) m.hyps.resize(size_t(cfg_.max_hypotheses));
+    if (!m.hyps.empty() && m.hyps[0].hits >= cfg_.confirm_scans && m.hyps[0].mean() >= cfg_.confirm_inlier_ratio &&
+        (m.hyps.size() == 1 || m.hyps[1].hits < cfg_.confirm_scans - 1 ||
+         m.hyps[0].mean() >= m.hyps[1].mean() + cfg_.confirm_margin)) {
+      const Impl::Hypothesis h = m.hyps[0];
+      m.hyps.clear();
+      m.pose = h.pose;
+      m.sxy = h.sxy;
+      m.syaw = h.syaw;
+      m.poor_run = 0;
+      res.pose = h.pose;
+      res.status = GridStatus::kOk;
+      res.covariance = Eigen::Vector3d(h.sxy * h.sxy, h.sxy * h.sxy, h.syaw * h.syaw).asDiagonal();
+      res.hypotheses = 0;
+      res.reacquired = true;
+      return res;
     }
-    res.covariance = Hm.inverse();
-    if (!res.covariance.allFinite()) res.covariance = Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
-    m.pose = est;
-    m.sxy = std::sqrt(std::max(res.covariance(0, 0), res.covariance(1, 1)));
-    m.syaw = std::sqrt(res.covariance(2, 2));
-    m.poor_run = 0;
-    res.status = GridStatus::kOk;
-    res.pose = est;
+    keep_prediction();
+    return res;
+  }
+  m.hyps.clear();
+
+  // 3. Tracking: the local fit around the prediction.
+  const Impl::Fit f = m.fit(pts, pred, sxy, syaw, cfg_.max_window_xy_m, cfg_.max_window_yaw_rad,
+                            cfg_.refine_candidates, cfg_.min_inlier_ratio);
+  res.search_xy_m = f.wxy;
+  res.search_yaw_rad = f.wyaw;
+  res.candidates = f.leaves;
+  res.score = f.score;
+  res.iterations = f.iterations;
+  res.refined = f.refined;
+  res.num_inliers = f.inliers;
+  res.inlier_ratio = f.inlier_ratio;
+  res.rms_m = f.rms;
+  if (f.accepted) {
+    res.covariance = f.cov;
+    m.pose = f.est;
+    m.sxy = std::sqrt(std::max(f.cov(0, 0), f.cov(1, 1)));
+    m.syaw = std::sqrt(f.cov(2, 2));
+    res.pose = f.est;
+    // A weak fit (accepted only because it agrees with the prediction) is followed, but a run of them is a
+    // track the map no longer confirms: they count towards LOST (re-acquisition) like failed fits.
+    const bool weak = cfg_.reacquire && f.inlier_ratio < cfg_.min_inlier_ratio;
+    m.poor_run = weak ? m.poor_run + 1 : 0;
+    res.status = weak && m.poor_run >= cfg_.lost_after ? GridStatus::kLost : GridStatus::kOk;
   } else {
-    m.pose = pred;
-    m.sxy = sxy;
-    m.syaw = syaw;
-    ++m.poor_run;
-    res.status = m.poor_run >= cfg_.lost_after ? GridStatus::kLost : GridStatus::kPoor;
-    res.pose = pred;
-    res.covariance = Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
+    keep_prediction();
   }
   return res;
 }

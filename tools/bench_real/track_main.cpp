@@ -1,0 +1,88 @@
+// fploc-real-track LOG[.gz] --map MAP.yaml --first-scan S [--end-scan E] [--start ref|off] : fploc-grid2d's
+// tracker (modules/laser2d GridLocalizer, the node's own point extraction and odometry pairing) run in-process
+// over scans [S, E) of a CARMEN log, without LCM: per scan the estimate, the reference, the status, the fit's
+// inlier share and the CPU time of the update, as JSON. The bench's numbers come from `fploc replay` of the
+// lidar2d graph (fploc bench real); this is the same computation for looking at one log's errors scan by scan
+// (tools/bench_real/plot_errors.py) and for profiling.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "fploc/carmen/carmen.h"
+#include "fploc/floorplan/occupancy.h"
+#include "fploc/laser2d/grid_localizer.h"
+
+namespace {
+double thread_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"fploc real-track: grid2d's tracker over a CARMEN log's scans, in-process, per-scan JSON"};
+  std::string log_path, map_path, start = "ref";
+  size_t first = 0, end = 0;
+  app.add_option("log", log_path, "CARMEN log (.log or .log.gz)")->required();
+  app.add_option("--map", map_path, "map_server occupancy map (.yaml)")->required();
+  app.add_option("--first-scan", first, "first scan index")->required();
+  app.add_option("--end-scan", end, "end scan index (exclusive; 0 = the log's end)");
+  app.add_option("--start", start, "ref: the reference pose of the first scan; off: 1 m / 10 deg off (as the bench)")
+      ->check(CLI::IsMember({"ref", "off"}));
+  fploc::laser2d::GridLocalizerConfig c;
+  app.add_option("--refine-candidates", c.refine_candidates, "distinct search candidates refined per scan");
+  app.add_option("--candidate-ratio", c.candidate_ratio, "kept when >= this share of the best score");
+  app.add_option("--reacquire-after", c.reacquire_after, "POOR scans after which jumps need confirmation");
+  app.add_option("--follow-weak", c.follow_weak, "follow weak near fits while re-acquiring");
+  app.add_option("--reacquire", c.reacquire, "re-acquisition with hypotheses");
+  app.add_option("--confirm-inlier-ratio", c.confirm_inlier_ratio, "mean inlier share to take a hypothesis");
+  app.add_option("--reacquire-xy", c.reacquire_xy_m, "re-acquisition window [m]");
+  CLI11_PARSE(app, argc, argv);
+  namespace cm = fploc::carmen;
+  namespace l2 = fploc::laser2d;
+  try {
+    const cm::Log log = cm::parse_log(cm::read_maybe_gz(log_path), log_path);
+    const float no_return = cm::no_return_range(log);
+    if (end == 0 || end > log.scans.size()) end = log.scans.size();
+    if (first >= end) throw std::runtime_error("--first-scan/--end-scan select no scans");
+    const auto field = std::make_shared<l2::DistanceField>(fploc::read_occupancy_map(map_path), c.field_max_m);
+    l2::GridLocalizer loc(field, c);
+    const auto& s0 = log.scans[first].pose;
+    fploc::Pose2 p0{s0.x, s0.y, s0.theta};
+    if (start == "off") p0 = {p0.x + std::cos(p0.yaw + M_PI / 4), p0.y + std::sin(p0.yaw + M_PI / 4), p0.yaw + 10 * M_PI / 180};
+    loc.set_initial_pose(p0);
+    const double rmax = std::min<double>(c.max_range_m, std::isfinite(no_return) ? no_return : 1000.f);
+    nlohmann::json rows = nlohmann::json::array();
+    double total_ms = 0;
+    for (size_t k = first; k < end; ++k) {
+      const auto& s = log.scans[k];
+      const double t0 = thread_cpu_ms();
+      const auto pts = l2::scan_points(s.ranges, -M_PI / 2, cm::beam_increment(s.ranges.size()), c.min_range_m, rmax);
+      std::optional<fploc::Pose2> odom;
+      if (s.have_wheel_odom) odom = fploc::Pose2{s.wheel_odom.x, s.wheel_odom.y, s.wheel_odom.theta};
+      const l2::GridResult r = loc.update(pts, odom);
+      const double ms = thread_cpu_ms() - t0;
+      total_ms += ms;
+      rows.push_back({{"scan", k}, {"x", r.pose.x}, {"y", r.pose.y}, {"yaw", r.pose.yaw}, {"ref_x", s.pose.x},
+                      {"ref_y", s.pose.y}, {"ref_yaw", s.pose.theta},
+                      {"err_m", std::hypot(r.pose.x - s.pose.x, r.pose.y - s.pose.y)},
+                      {"err_yaw_deg", fploc::wrap_angle(r.pose.yaw - s.pose.theta) * 180 / M_PI},
+                      {"status", int(r.status)}, {"inlier_ratio", r.inlier_ratio}, {"window_m", r.search_xy_m},
+                      {"window_deg", r.search_yaw_rad * 180 / M_PI}, {"sigma_xy_m", std::sqrt(r.covariance(0, 0))},
+                      {"hypotheses", r.hypotheses}, {"ms", ms}});
+    }
+    std::cout << nlohmann::json{{"log", log_path}, {"map", map_path}, {"start", start},
+                                {"ms_per_scan", total_ms / double(end - first)}, {"scans", rows}}
+                     .dump()
+              << "\n";
+  } catch (const std::exception& ex) {
+    std::cerr << "fploc real-track: " << ex.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
