@@ -16,6 +16,17 @@ const std::string& checked_loss(const std::string& loss, const char* field) {
                            "' (use \"cauchy\", \"geman-mcclure\", \"huber\" or \"none\")");
 }
 
+// The as-built model's options (the same fields in MatcherOptions and OptimizerOptions).
+template <class O>
+matcher::AsBuiltModel as_built_of(const O& o) {
+  matcher::AsBuiltModel m;
+  m.sigma_m = std::max(0.0, o.as_built_sigma_m());
+  if (o.as_built_point_sigma_m() > 0) m.point_sigma_m = o.as_built_point_sigma_m();
+  if (o.as_built_loss_scale_m() != 0) m.loss_scale_m = std::max(0.0, o.as_built_loss_scale_m());
+  m.keep_information = !o.as_built_free_information();
+  return m;
+}
+
 }  // namespace
 namespace {
 constexpr double kRadPerDeg = M_PI / 180;
@@ -42,6 +53,7 @@ matcher::MatcherConfig config_of(const MatcherOptions& o) {
   c.deskew = !o.disable_deskew();
   if (o.prediction_sigma_m() != 0) c.prediction_sigma_m = std::max(0.0, o.prediction_sigma_m());
   if (o.prediction_sigma_deg() != 0) c.prediction_sigma_rad = std::max(0.0, o.prediction_sigma_deg()) * kRadPerDeg;
+  c.as_built = as_built_of(o);
   return c;
 }
 
@@ -70,6 +82,7 @@ optimizer::OptimizerConfig config_of(const OptimizerOptions& o) {
   if (!o.linear_solver().empty()) c.linear_solver = o.linear_solver();
   c.budget_weight = !o.disable_budget_weight();
   c.group_rule = !o.disable_group_rule();
+  c.as_built = as_built_of(o);
   return c;
 }
 

@@ -101,7 +101,9 @@ TEST(ConfigDefaults, Matcher) {
          {"min_correspondence_m", c.min_correspondence_m}, {"max_rounds", c.max_rounds}, {"inlier_m", c.inlier_m},
          {"min_inliers", c.min_inliers}, {"lost_after", c.lost_after}, {"max_jump_m", c.max_jump_m},
          {"max_jump_deg", c.max_jump_rad * kDeg}, {"stride", c.stride}, {"max_points", c.max_points},
-         {"prediction_sigma_m", c.prediction_sigma_m}, {"prediction_sigma_deg", c.prediction_sigma_rad * kDeg}});
+         {"prediction_sigma_m", c.prediction_sigma_m}, {"prediction_sigma_deg", c.prediction_sigma_rad * kDeg},
+         {"as_built_sigma_m", c.as_built.sigma_m}, {"as_built_point_sigma_m", c.as_built.point_sigma_m},
+         {"as_built_loss_scale_m", c.as_built.loss_scale_m}});
 }
 
 TEST(ConfigDefaults, Optimizer) {
@@ -110,7 +112,9 @@ TEST(ConfigDefaults, Optimizer) {
         {{"window", c.window}, {"alpha", c.alpha}, {"beta", c.beta}, {"keyframe_distance_m", c.keyframe_distance_m},
          {"keyframe_angle_deg", c.keyframe_angle_rad * kDeg}, {"gate_m", c.gate_m}, {"loss_scale_m", c.loss_scale_m},
          {"max_iterations", c.max_iterations}, {"rounds", c.rounds}, {"stride", c.stride},
-         {"max_keyframe_gap_s", c.max_keyframe_gap_s}, {"max_points", c.max_points}, {"relook_m", c.relook_m}});
+         {"max_keyframe_gap_s", c.max_keyframe_gap_s}, {"max_points", c.max_points}, {"relook_m", c.relook_m},
+         {"as_built_sigma_m", c.as_built.sigma_m}, {"as_built_point_sigma_m", c.as_built.point_sigma_m},
+         {"as_built_loss_scale_m", c.as_built.loss_scale_m}});
 }
 
 TEST(ConfigDefaults, Odometry) {

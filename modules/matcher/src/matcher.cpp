@@ -70,7 +70,7 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
     if (solved && ao.gate_m == last_gate && as == last_as) break;
     if (as.size() < 3) break;
     auto problem = std::make_unique<ceres::Problem>(po);
-    add_frame_term(problem.get(), x, lookup, f, as, cfg.loss, cfg.loss_scale_m, 1.0, /*compact=*/true);
+    add_frame_term(problem.get(), x, lookup, f, as, cfg.loss, cfg.loss_scale_m, 1.0, /*compact=*/true, &cfg.as_built);
     if (prior) problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, 3>(new PriorCost{*prior}), nullptr, x);
     const double before[3] = {x[0], x[1], x[2]};
     ceres::Solver::Summary sum;

@@ -115,6 +115,41 @@ inline void robust_scale(LossKind loss, double a, double s, double* g, double* d
   *dg = (rho1 * s - rho) / (2 * (*g) * s * s);
 }
 
+// rho(s) and rho'(s) of the robust loss (s = r^2; rho(s) = s for none).
+inline void robust_rho(LossKind loss, double a, double s, double* rho, double* rho1) {
+  const double a2 = a * a;
+  switch (loss) {
+    case LossKind::kNone: *rho = s; *rho1 = 1; return;
+    case LossKind::kHuber:
+      if (s <= a2) { *rho = s; *rho1 = 1; return; }
+      *rho = 2 * a * std::sqrt(s) - a2;
+      *rho1 = a / std::sqrt(s);
+      return;
+    case LossKind::kCauchy: *rho = a2 * std::log1p(s / a2); *rho1 = 1.0 / (1.0 + s / a2); return;
+    case LossKind::kGemanMcClure: {
+      const double d = a2 + s;
+      *rho = a2 * s / d;
+      *rho1 = a2 * a2 / (d * d);
+      return;
+    }
+  }
+}
+
+// rho'(s) alone (IRLS weights).
+inline double robust_weight(LossKind loss, double a, double s) {
+  const double a2 = a * a;
+  switch (loss) {
+    case LossKind::kNone: return 1;
+    case LossKind::kHuber: return s <= a2 ? 1.0 : a / std::sqrt(s);
+    case LossKind::kCauchy: return 1.0 / (1.0 + s / a2);
+    case LossKind::kGemanMcClure: {
+      const double d = a2 + s;
+      return a2 * a2 / (d * d);
+    }
+  }
+  return 1;
+}
+
 // All points of one frame in one residual block (Ceres' per-block overhead dominates per-point
 // blocks), one residual per point: its distance to the closest of its candidates, |p' - q(p')| (the
 // paper's ||ANNF(p'), p'||). Its gradient is n^T dp'/dx with n the unit vector from q to p', so the
@@ -124,10 +159,28 @@ inline void robust_scale(LossKind loss, double a, double s, double* g, double* d
 class FrameCost : public ceres::CostFunction {
  public:
   FrameCost(const std::vector<TargetGeom>* targets, std::vector<Assignment> as, std::vector<Eigen::Vector2d> pts,
-            LossKind loss, double scale, double w, bool compact)
-      : targets_(targets), as_(std::move(as)), pts_(std::move(pts)), loss_(loss), a_(scale), w_(w), compact_(compact) {
+            LossKind loss, double scale, double w, bool compact, const AsBuiltModel* ab = nullptr)
+      : targets_(targets), as_(std::move(as)), pts_(std::move(pts)), loss_(loss), a_(scale), w_(w),
+        compact_(compact || (ab && ab->on())) {
+    if (ab && ab->on()) ab_ = *ab;
     set_num_residuals(compact_ ? 4 : int(as_.size()));
     mutable_parameter_block_sizes()->push_back(3);
+  }
+  // As-built model: the robust weights of the points and of the offsets, from the offsets solved at x (IRLS),
+  // fixed for this term's solve (the look-up rounds refresh them), so the term is a weighted least-squares
+  // cost that the offsets enter linearly and are eliminated from exactly. keep_information: the scale that
+  // gives the term the plain term's translational information at x.
+  void prepare(const double* x) {
+    if (!ab_.on()) return;
+    Eigen::Matrix3d Hp, Ha;
+    Eigen::Vector3d g;
+    double c2;
+    accumulate(x, true, &Ha, &g, &c2);
+    prepared_ = true;
+    if (!ab_.keep_information) return;
+    accumulate(x, false, &Hp, &g, &c2);
+    const double tp = Hp(0, 0) + Hp(1, 1), ta = Ha(0, 0) + Ha(1, 1);
+    if (tp > 0 && ta > 0) kappa_ = tp / ta;
   }
   bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
     if (compact_) return evaluate_compact(params[0], residuals, jacobians ? jacobians[0] : nullptr);
@@ -135,42 +188,242 @@ class FrameCost : public ceres::CostFunction {
   }
 
  private:
+  // A point of the as-built model: on element `el`, signed offset r (along the segment's left normal, or
+  // radially), r = U . (the element's offsets) + noise, d r / d x = j; w2 its squared weight.
+  struct Obs {
+    int el, i;          // element, assignment
+    double r, w2;
+    Eigen::Vector2d U;  // d r / d (o_a, o_b) (segments) or d r / d (centre offset) (circles), up to sign
+    Eigen::Vector3d j;
+  };
+  // Point i at pose x (c, s: cos, sin of the yaw): its folded robust residual and Jacobian row (plain), or,
+  // with ob and the point on a segment's interior, its Obs (returns false: no plain row).
+  bool row(size_t i, const double* x, double c, double s, double* res, double* jrow, Obs* ob) const {
+    const Eigen::Vector2d& p = pts_[i];
+    const double rx = c * p.x() - s * p.y(), ry = s * p.x() + c * p.y();
+    const Eigen::Vector2d pw(rx + x[0], ry + x[1]);
+    int which = -1;
+    Eigen::Vector2d q;
+    Eigen::Matrix2d J;
+    const double d2 = closest_of2(*targets_, as_[i].cand, as_[i].n, pw, &q, jrow || ob ? &J : nullptr, &which);
+    const double we = w_ * (which >= 0 ? double(as_[i].w[which]) : 1.0);
+    if (ob && which >= 0) {
+      // Segments: the signed offset from its line (also a little past an end: the wall as built may go on),
+      // U = (1 - t, t) with t clamped to the segment. Circles and arcs (points within the arc): the signed
+      // radial offset, U = the unit direction from the centre (a pillar displaced by its centre's offset).
+      const TargetGeom& e = (*targets_)[size_t(as_[i].cand[which])];
+      if (e.kind == ElementKind::kSegment && e.len > 0) {
+        const Eigen::Vector2d n(-e.u.y(), e.u.x());
+        ob->el = as_[i].cand[which];
+        ob->r = (pw - e.a).dot(n);
+        const double t = std::clamp((pw - e.a).dot(e.u) / e.len, 0.0, 1.0);
+        ob->U = Eigen::Vector2d(1 - t, t);
+        ob->w2 = we * we;
+        ob->j = Eigen::Vector3d(n.x(), n.y(), n.x() * -ry + n.y() * rx);
+        return false;
+      }
+      const Eigen::Vector2d dc = pw - e.c;
+      const double nd = dc.norm();
+      if (e.kind != ElementKind::kSegment && nd > 1e-9 && J.trace() < 1.5) {
+        const Eigen::Vector2d u = dc / nd;
+        ob->el = as_[i].cand[which];
+        ob->r = nd - e.r;
+        ob->U = u;
+        ob->w2 = we * we;
+        ob->j = Eigen::Vector3d(u.x(), u.y(), u.x() * -ry + u.y() * rx);
+        return false;
+      }
+    }
+    const double d = std::sqrt(d2);
+    double g, dg;
+    robust_scale(loss_, a_, d2, &g, &dg);
+    *res = we * g * d;
+    if (jrow) {
+      // n: from q to p'; at d = 0 the element's normal (segments/circles: the projection J's range).
+      Eigen::Vector2d n;
+      if (d > 1e-12) {
+        n = (pw - q) / d;
+      } else if (J.trace() < 1.5) {  // J = n n^T (interior of a segment / circle): its larger column
+        n = J.col(0).squaredNorm() >= J.col(1).squaredNorm() ? J.col(0) : J.col(1);
+        n.normalize();
+      } else {  // on an end point: no direction
+        n.setZero();
+      }
+      const double k = we * (g + 2 * dg * d2);
+      jrow[0] = k * n.x();
+      jrow[1] = k * n.y();
+      jrow[2] = k * (n.x() * -ry + n.y() * rx);
+    }
+    return true;
+  }
   // The per-point form: one residual (and Jacobian row) per assignment.
   bool evaluate_points(double const* const* params, double* residuals, double** jacobians) const {
     const double* x = params[0];
     const double c = std::cos(x[2]), s = std::sin(x[2]);
     double* jac = jacobians ? jacobians[0] : nullptr;
-    Eigen::Vector2d q;
-    Eigen::Matrix2d J;
-    for (size_t i = 0; i < as_.size(); ++i) {
-      const Eigen::Vector2d& p = pts_[i];
-      const double rx = c * p.x() - s * p.y(), ry = s * p.x() + c * p.y();
-      const Eigen::Vector2d pw(rx + x[0], ry + x[1]);
-      int which = -1;
-      const double d2 = closest_of2(*targets_, as_[i].cand, as_[i].n, pw, &q, jac ? &J : nullptr, &which);
-      const double d = std::sqrt(d2);
-      double g, dg;
-      robust_scale(loss_, a_, d2, &g, &dg);
-      const double we = w_ * (which >= 0 ? double(as_[i].w[which]) : 1.0);
-      residuals[i] = we * g * d;
-      if (jac) {
-        // n: from q to p'; at d = 0 the element's normal (segments/circles: the projection J's range).
-        Eigen::Vector2d n;
-        if (d > 1e-12) {
-          n = (pw - q) / d;
-        } else if (J.trace() < 1.5) {  // J = n n^T (interior of a segment / circle): its larger column
-          n = J.col(0).squaredNorm() >= J.col(1).squaredNorm() ? J.col(0) : J.col(1);
-          n.normalize();
-        } else {  // on an end point: no direction
-          n.setZero();
-        }
-        const double k = we * (g + 2 * dg * d2);
-        jac[3 * i] = k * n.x();
-        jac[3 * i + 1] = k * n.y();
-        jac[3 * i + 2] = k * (n.x() * -ry + n.y() * rx);
-      }
-    }
+    for (size_t i = 0; i < as_.size(); ++i) row(i, x, c, s, residuals + i, jac ? jac + 3 * i : nullptr, nullptr);
     return true;
+  }
+  // accumulate() of the as-built model with the weights prepare() fixed: one pass, the points summed per
+  // element (no grouping), then each element's offsets eliminated.
+  void accumulate_prepared(const double* x, Eigen::Matrix3d* H, Eigen::Vector3d* g, double* cost2) const {
+    struct ElemAcc {
+      double a00 = 0, a01 = 0, a11 = 0, b0 = 0, b1 = 0, rr = 0, w2 = 0;
+      Eigen::Matrix<double, 2, 3> B = Eigen::Matrix<double, 2, 3>::Zero();
+      bool used = false;
+    };
+    thread_local std::vector<ElemAcc> acc;
+    thread_local std::vector<int> used;
+    if (acc.size() < targets_->size()) acc.resize(targets_->size());
+    used.clear();
+    const double c = std::cos(x[2]), s = std::sin(x[2]);
+    Obs ob;
+    double res, jr[3];
+    for (size_t i = 0; i < as_.size(); ++i) {
+      if (!row(i, x, c, s, &res, jr, &ob)) {
+        ElemAcc& a = acc[size_t(ob.el)];
+        if (!a.used) {
+          a.used = true;
+          a.w2 = ob.w2;
+          used.push_back(ob.el);
+        }
+        const double w = ob.w2 * point_w_[i];
+        const double u0 = ob.U[0], u1 = ob.U[1];
+        a.a00 += w * u0 * u0;
+        a.a01 += w * u0 * u1;
+        a.a11 += w * u1 * u1;
+        a.b0 += w * ob.r * u0;
+        a.b1 += w * ob.r * u1;
+        a.rr += w * ob.r * ob.r;
+        a.B.row(0) += (w * u0) * ob.j.transpose();
+        a.B.row(1) += (w * u1) * ob.j.transpose();
+        H->noalias() += w * ob.j * ob.j.transpose();
+        *g += (w * ob.r) * ob.j;
+        continue;
+      }
+      const Eigen::Vector3d j(jr[0], jr[1], jr[2]);
+      H->noalias() += j * j.transpose();
+      *g += res * j;
+      *cost2 += res * res;
+    }
+    const double lam0 = (ab_.point_sigma_m / ab_.sigma_m) * (ab_.point_sigma_m / ab_.sigma_m);
+    for (int el : used) {
+      ElemAcc& a = acc[size_t(el)];
+      Eigen::Vector2d lw(1, 1);
+      const auto it = std::lower_bound(offset_w_.begin(), offset_w_.end(), el,
+                                       [](const std::pair<int, Eigen::Vector2d>& p, int v) { return p.first < v; });
+      if (it != offset_w_.end() && it->first == el) lw = it->second;
+      lw *= lam0 * a.w2;
+      Eigen::Matrix2d A;
+      A << a.a00 + lw[0], a.a01, a.a01, a.a11 + lw[1];
+      const Eigen::Vector2d bb(a.b0, a.b1);
+      const Eigen::LDLT<Eigen::Matrix2d> ldlt(A);
+      const Eigen::Vector2d o = ldlt.solve(bb);
+      H->noalias() -= a.B.transpose() * ldlt.solve(a.B);
+      *g -= a.B.transpose() * o;
+      *cost2 += a.rr - bb.dot(o);
+      a = ElemAcc();
+    }
+  }
+  // Gauss-Newton matrix H, gradient g and cost (sum of squared residuals) of the frame at x: the per-point
+  // form, or (as_built) the as-built model's with the segments' end offsets eliminated.
+  void accumulate(const double* x, bool as_built, Eigen::Matrix3d* H, Eigen::Vector3d* g, double* cost2) const {
+    thread_local std::vector<Obs> obs;
+    obs.clear();
+    H->setZero();
+    g->setZero();
+    *cost2 = 0;
+    const double c = std::cos(x[2]), s = std::sin(x[2]);
+    Obs ob;
+    double res, jr[3];
+    if (as_built && prepared_) {
+      accumulate_prepared(x, H, g, cost2);
+      return;
+    }
+    for (size_t i = 0; i < as_.size(); ++i) {
+      if (!row(i, x, c, s, &res, jr, as_built ? &ob : nullptr)) {
+        ob.i = int(i);
+        obs.push_back(ob);
+        continue;
+      }
+      const Eigen::Vector3d j(jr[0], jr[1], jr[2]);
+      H->noalias() += j * j.transpose();
+      *g += res * j;
+      *cost2 += res * res;
+    }
+    if (obs.empty()) return;
+    // Group by element: counting sort on the element id (stable: point order within an element).
+    thread_local std::vector<Obs> sorted;
+    thread_local std::vector<int> start;
+    start.assign(targets_->size() + 1, 0);
+    for (const Obs& o : obs) ++start[size_t(o.el) + 1];
+    for (size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
+    sorted.resize(obs.size());
+    for (const Obs& o : obs) sorted[size_t(start[size_t(o.el)]++)] = o;
+    const double lam0 = (ab_.point_sigma_m / ab_.sigma_m) * (ab_.point_sigma_m / ab_.sigma_m);
+    const double ce = ab_.loss_scale_m, ce2 = ce * ce;
+    auto rho1_e = [&](double o2) { return ce <= 0 ? 1.0 : 1.0 / (1.0 + o2 / ce2); };
+    if (!prepared_) {
+      point_w_.assign(as_.size(), 1.0f);
+      offset_w_.clear();
+    }
+    size_t wi = 0;
+    for (size_t b = 0; b < sorted.size();) {
+      size_t e = b;
+      const int el = sorted[b].el;
+      double w2max = 0;
+      for (; e < sorted.size() && sorted[e].el == el; ++e) w2max = std::max(w2max, sorted[e].w2);
+      const double lam = lam0 * w2max;
+      Eigen::Vector2d lw(lam, lam);  // the offsets' prior weights
+      if (!prepared_) {
+        // IRLS at the term's pose: the offsets under the points' loss and their own; then the weights.
+        Eigen::Vector2d o = Eigen::Vector2d::Zero();
+        for (int it = 0; it < 5; ++it) {
+          Eigen::Matrix2d A;
+          A << lam * rho1_e(o[0] * o[0]), 0, 0, lam * rho1_e(o[1] * o[1]);
+          Eigen::Vector2d bb = Eigen::Vector2d::Zero();
+          for (size_t k = b; k < e; ++k) {
+            const Eigen::Vector2d& U = sorted[k].U;
+            const double ee = sorted[k].r - U.dot(o);
+            const double w = sorted[k].w2 * robust_weight(loss_, a_, ee * ee);
+            A.noalias() += w * U * U.transpose();
+            bb += w * sorted[k].r * U;
+          }
+          o = A.ldlt().solve(bb);
+        }
+        for (size_t k = b; k < e; ++k) {
+          const double ee = sorted[k].r - sorted[k].U.dot(o);
+          point_w_[size_t(sorted[k].i)] = float(robust_weight(loss_, a_, ee * ee));
+        }
+        offset_w_.emplace_back(el, Eigen::Vector2d(rho1_e(o[0] * o[0]), rho1_e(o[1] * o[1])));
+        lw = lam * offset_w_.back().second;
+      } else {
+        while (wi < offset_w_.size() && offset_w_[wi].first < el) ++wi;
+        if (wi < offset_w_.size() && offset_w_[wi].first == el) lw = lam * offset_w_[wi].second;
+      }
+      // Weighted least squares in (x, o) with the weights fixed: o = A^-1 b eliminated exactly.
+      Eigen::Matrix2d A;
+      A << lw[0], 0, 0, lw[1];
+      Eigen::Vector2d bb = Eigen::Vector2d::Zero();
+      Eigen::Matrix<double, 2, 3> B = Eigen::Matrix<double, 2, 3>::Zero();
+      double rr = 0;
+      for (size_t k = b; k < e; ++k) {
+        const Eigen::Vector2d& U = sorted[k].U;
+        const double w = sorted[k].w2 * point_w_[size_t(sorted[k].i)];
+        A.noalias() += w * U * U.transpose();
+        B.noalias() += w * U * sorted[k].j.transpose();
+        bb += w * sorted[k].r * U;
+        H->noalias() += w * sorted[k].j * sorted[k].j.transpose();
+        *g += w * sorted[k].r * sorted[k].j;
+        rr += w * sorted[k].r * sorted[k].r;
+      }
+      const Eigen::LDLT<Eigen::Matrix2d> ldlt(A);
+      const Eigen::Vector2d o = ldlt.solve(bb);
+      H->noalias() -= B.transpose() * ldlt.solve(B);
+      *g -= B.transpose() * o;  // sum w e j with e = r - U o
+      *cost2 += rr - bb.dot(o);  // sum w e^2 + o^T L o at the optimal o
+      b = e;
+    }
   }
   // The compact form (square-root information): the same cost, gradient and Gauss-Newton matrix as the
   // per-point form in 4 residuals. With J (n x 3) and r (n) of the per-point form, H = J^T J = V L V^T:
@@ -178,20 +431,14 @@ class FrameCost : public ceres::CostFunction {
   // J~^T r~ = J^T r and |r~|^2 = |r|^2 (J^T r lies in H's range), so the trust-region steps and the
   // costs Ceres sees are those of the per-point form, without its n x 3 Jacobian and per-row work.
   bool evaluate_compact(const double* x, double* residuals, double* jac) const {
-    thread_local std::vector<double> r, J;  // scratch (Ceres evaluates one block at a time per thread)
-    r.resize(as_.size());
-    J.resize(3 * as_.size());
-    const double* xs[1] = {x};
-    double* js[1] = {J.data()};
-    evaluate_points(xs, r.data(), js);
-    Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d g = Eigen::Vector3d::Zero();
-    double cost2 = 0;
-    for (size_t i = 0; i < as_.size(); ++i) {
-      const Eigen::Vector3d j(J[3 * i], J[3 * i + 1], J[3 * i + 2]);
-      H.noalias() += j * j.transpose();
-      g += r[i] * j;
-      cost2 += r[i] * r[i];
+    Eigen::Matrix3d H;
+    Eigen::Vector3d g;
+    double cost2;
+    accumulate(x, ab_.on(), &H, &g, &cost2);
+    if (kappa_ != 1.0) {
+      H *= kappa_;
+      g *= kappa_;
+      cost2 *= kappa_;
     }
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(H);
     const double lmax = std::max(es.eigenvalues().maxCoeff(), 0.0);
@@ -222,6 +469,13 @@ class FrameCost : public ceres::CostFunction {
   LossKind loss_;
   double a_, w_;
   bool compact_;
+  AsBuiltModel ab_;  // off unless given
+  double kappa_ = 1.0;
+  // As-built model, fixed by prepare(): each assignment's robust weight, each element's offsets' weights
+  // (by element id; an element not met there keeps weight 1).
+  bool prepared_ = false;
+  mutable std::vector<float> point_w_;
+  mutable std::vector<std::pair<int, Eigen::Vector2d>> offset_w_;
 };
 
 }  // namespace
@@ -318,13 +572,17 @@ void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, 
 }
 
 void add_frame_term(ceres::Problem* problem, double* pose, const NearestLookup& lookup, const FeatureFrame& f,
-                    const std::vector<Assignment>& as, const std::string& loss, double scale, double weight, bool compact) {
+                    const std::vector<Assignment>& as, const std::string& loss, double scale, double weight, bool compact,
+                    const AsBuiltModel* as_built) {
   if (as.empty()) return;
   std::vector<Eigen::Vector2d> pts;
   pts.reserve(as.size());
   for (const auto& a : as) pts.push_back(f.points[size_t(a.point)].p);
-  problem->AddResidualBlock(
-      new FrameCost(&lookup.geometry(), as, std::move(pts), loss_kind(loss, scale), scale, weight, compact), nullptr, pose);
+  const bool ab = as_built && as_built->on() && lookup.element_targets();
+  auto* cost = new FrameCost(&lookup.geometry(), as, std::move(pts), loss_kind(loss, scale), scale, weight, compact,
+                             ab ? as_built : nullptr);
+  cost->prepare(pose);
+  problem->AddResidualBlock(cost, nullptr, pose);
 }
 
 Eigen::Matrix3d frame_information(const NearestLookup& lookup, const FeatureFrame& f, const std::vector<Assignment>& as,

@@ -275,7 +275,8 @@ void WindowOptimizer::solve() {
       // point) estimates that sum with weight stride, so the balance against the velocity terms does not
       // depend on the budget.
       const double w = cfg_.budget_weight ? std::sqrt(double(k.as_stride)) : 1.0;
-      matcher::add_frame_term(&problem, k.x, lookup_, k.deskewed, k.as, cfg_.loss, cfg_.loss_scale_m, w, cfg_.compact_terms);
+      matcher::add_frame_term(&problem, k.x, lookup_, k.deskewed, k.as, cfg_.loss, cfg_.loss_scale_m, w, cfg_.compact_terms,
+                              &cfg_.as_built);
     }
     for (size_t i = 0; i + 2 < chain.size(); ++i) {
       const double dt0 = (chain[i + 1].second - chain[i].second) * 1e-6;

@@ -412,6 +412,15 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
     if (expected[e] > 0) ++acc_[e].frames_expected;
 }
 
+// The uncertainty of an element's offset (the median of its scans' median offsets): the scans' robust spread
+// over at most moved_max_looks independent looks (consecutive scans see the same), plus the localizer's own
+// error along the normal (moved_pose_sigma_m), which does not average out over scans.
+double PlanDiff::offset_sigma(const ElementDiff& e) const {
+  const double n = std::min(double(e.frames_with_points), o_.moved_max_looks);
+  const double ss = 1.4826 * e.offset_spread_m;
+  return std::sqrt(o_.moved_pose_sigma_m * o_.moved_pose_sigma_m + (n > 0 ? ss * ss / n : ss * ss));
+}
+
 Diff PlanDiff::result() const {
   Diff d;
   d.frames = frames_;
@@ -458,11 +467,13 @@ Diff PlanDiff::result() const {
       std::vector<float> dev;
       for (float v : a.frame_offsets) dev.push_back(std::abs(v - float(e.offset_m)));
       e.offset_spread_m = median_of(dev);
+      e.offset_sigma_m = offset_sigma(e);
     }
     if (a.frames_expected >= o_.min_frames && a.expected >= o_.missing_min_expected &&
         e.seen_ratio() < o_.missing_seen_ratio)
       e.status = Status::kMissing;
     else if (e.frames_with_points >= o_.min_frames && std::abs(e.offset_m) >= o_.moved_min_m &&
+             std::abs(e.offset_m) - o_.moved_z * e.offset_sigma_m >= o_.moved_min_m &&
              e.offset_spread_m <= o_.moved_max_spread_m &&
              (plan_.elements[i].kind != ElementKind::kSegment ||
               (plan_.elements[i].b - plan_.elements[i].a).norm() >= o_.moved_min_length_m))

@@ -110,6 +110,32 @@ TEST(PlanDiff, FindsAKnownRenovation) {
   EXPECT_LE(int(r.diff.added.size()), 2 + 1);
 }
 
+// The moved verdict counts the offset's uncertainty: a wall 9 cm off whose scans disagree by +-4 cm (a wall
+// standing askew seen from different places, a localizer off by a few cm here and there) is not called moved
+// (it was before: >= 7 cm, spread <= 5 cm); 10 cm seen consistently is, and 15 cm with the same scatter too.
+TEST(PlanDiff, MovedOnlyBeyondItsUncertainty) {
+  FloorPlan plan;
+  plan.elements.push_back(Element::segment({-3, 2}, {3, 2}));  // left normal +y
+  auto run = [&](double offset, double scatter, double* sigma) {
+    plandiff::PlanDiff d(plan);
+    for (int f = 0; f < 60; ++f) {
+      const double o = offset + scatter * double(f % 3 - 1);  // median offset, MAD scatter
+      std::vector<Eigen::Vector2f> pts;
+      for (int i = 0; i < 20; ++i) pts.emplace_back(float(-2 + 0.2 * i), float(2 + o));
+      d.add_frame(0, 0, 0, pts);
+    }
+    const plandiff::Diff r = d.result();
+    *sigma = r.elements[0].offset_sigma_m;
+    return r.elements[0].status;
+  };
+  double s_scattered, s_consistent, s_far;
+  EXPECT_EQ(run(0.09, 0.04, &s_scattered), plandiff::Status::kSeen);
+  EXPECT_EQ(run(0.10, 0.005, &s_consistent), plandiff::Status::kMoved);
+  EXPECT_EQ(run(0.15, 0.04, &s_far), plandiff::Status::kMoved);
+  EXPECT_GT(s_scattered, s_consistent);
+  EXPECT_GE(s_consistent, 0.01);  // the localizer's own error never averages out
+}
+
 TEST(PlanDiff, CleanWorldHasNoFlags) {
   const DiffRun r = simulate_and_diff("crowd-15", 2);  // the plan is the world; 15 people walk about
   EXPECT_EQ(r.diff.count(plandiff::Status::kMissing), 0);

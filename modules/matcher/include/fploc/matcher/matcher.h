@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "fploc/matcher/as_built.h"
 #include "fploc/matcher/lookup.h"
 #include "fploc/matcher/types.h"
 
@@ -47,6 +48,7 @@ struct MatcherConfig {
   // Per plan element weight of its floor-plan terms (matcher/element_weights.h: from the plan-change
   // detector); null = all 1. Not owned: the caller keeps it alive and may change it between frames.
   const std::vector<float>* element_weight = nullptr;
+  AsBuiltModel as_built;          // per-wall end offsets eliminated (as_built.h); off by default
 };
 
 // A Gaussian prior on the registered pose (the motion model's prediction), as residuals

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "fploc/matcher/as_built.h"
 #include "fploc/matcher/assignment.h"
 #include "fploc/matcher/lookup.h"
 #include "fploc/matcher/types.h"
@@ -33,9 +34,10 @@ double closest_of(const std::vector<TargetGeom>& targets, const int* cand, int n
 // per point. Used by the matcher and the optimizer. The cost is weight^2 sum rho(|r|^2).
 // compact: the same cost, gradient and Gauss-Newton matrix in 4 residuals (square-root information form,
 // see FrameCost::evaluate_compact): the solver's steps are the same, without Ceres' per-row work.
+// as_built (on): the as-built model above, always in the compact form.
 void add_frame_term(ceres::Problem* problem, double* pose, const NearestLookup& lookup, const FeatureFrame& f,
                     const std::vector<Assignment>& a, const std::string& loss, double scale, double weight = 1.0,
-                    bool compact = false);
+                    bool compact = false, const AsBuiltModel* as_built = nullptr);
 
 // Gauss-Newton information J^T J of the frame term at x (robust weights included), for the covariance.
 Eigen::Matrix3d frame_information(const NearestLookup& lookup, const FeatureFrame& f, const std::vector<Assignment>& a,

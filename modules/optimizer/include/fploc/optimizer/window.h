@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "fploc/matcher/lookup.h"
+#include "fploc/matcher/as_built.h"
 #include "fploc/matcher/assignment.h"
 #include "fploc/matcher/types.h"
 
@@ -50,6 +51,7 @@ struct OptimizerConfig {
   // steps, 4 residuals per keyframe instead of one per point (then the dense solver is the cheaper one).
   bool compact_terms = true;
   const std::vector<float>* element_weight = nullptr;  // as MatcherConfig::element_weight
+  matcher::AsBuiltModel as_built;      // as MatcherConfig::as_built (with compact_terms or not: always compact)
   // Published covariance: FrameInput::covariance (of the frame's single-frame fix) plus d d^T, d the output
   // pose minus that fix (the window's pose is not the fix the covariance is about).
   bool covariance_offset = true;

@@ -44,6 +44,11 @@ struct Options {
   double moved_min_m = 0.07;        // |median offset| at least this: moved
   double moved_max_spread_m = 0.05; // ... and the per-frame offsets agree (MAD) within this
   double moved_min_length_m = 0.5;  // ... for segments at least this long (a door jamb's end is not a wall)
+  // ... and |offset| - moved_z sigma >= moved_min_m (sigma: PlanDiff::offset_sigma): a wall a few cm off as
+  // built, seen with a spread of offsets, is not called moved on an offset its uncertainty explains.
+  double moved_z = 2.0;
+  double moved_pose_sigma_m = 0.01;   // the localizer's error along the wall normal (does not average out)
+  double moved_max_looks = 30;        // the scans count as at most this many independent looks
   double new_cell_m = 0.05;         // grid of unexplained points
   int new_min_frames = 5;           // a cell hit in at least this many frames ...
   double new_min_hit_ratio = 0.3;   // ... and whose view cell was hit in this share of the scans that had it
@@ -89,6 +94,7 @@ struct ElementDiff {
   Status status = Status::kUnobserved;
   double offset_m = 0;        // median signed offset along the left normal (segments) / radially (circles)
   double offset_spread_m = 0; // MAD of the per-frame offsets
+  double offset_sigma_m = 0;  // its uncertainty (PlanDiff::offset_sigma)
   int frames_with_points = 0;
   int frames_expected = 0;    // frames in which at least one probe was expected visible
   int64_t probes_expected = 0, probes_seen = 0;
@@ -159,6 +165,7 @@ class PlanDiff {
   struct Cell {
     int frames = 0, last_frame = -1, points = 0, in_view = 0;
   };
+  double offset_sigma(const ElementDiff& e) const;
   int nearest(const Eigen::Vector2d& p, double* signed_offset, bool* inside, const Eigen::Vector2d* sensor) const;
   bool extends_beyond_end(const Eigen::Vector2d& p) const;
   int extended_element(const Eigen::Vector2d& a, const Eigen::Vector2d& b) const;
@@ -187,7 +194,7 @@ class PlanDiff {
 
 // {"frames", "summary": {"seen", "missing", "moved", "unobserved", "new"}, "scale": {"error", "sigma", "points"},
 //  "elements": [{"id", "status",
-//  "offset_m", "offset_spread_m", "seen_ratio", "frames_expected", "frames_with_points", "a", "b" | "c", "r"}],
+//  "offset_m", "offset_spread_m", "offset_sigma_m", "seen_ratio", "frames_expected", "frames_with_points", "a", "b" | "c", "r"}],
 //  "new": [{"a", "b", "length_m", "cells", "min_frames", "rms_m", "extends"}],
 //  "missing_parts": [{"id", "a", "b", "length_m", "seen_ratio", "through_ratio"}],
 //  "refined": [{"id", "offset_a", "offset_b", "frames"}]}   (elements: only those not

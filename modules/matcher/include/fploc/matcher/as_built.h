@@ -1,0 +1,28 @@
+// Options of the floor-plan terms' as-built model (plan_terms.h add_frame_term). No Ceres here: the
+// matcher's and the optimizer's configs hold one.
+#pragma once
+
+namespace fploc::matcher {
+
+// As-built walls: a building's walls stand a few cm from where the drawing puts them, each by its own
+// offset, so the points of one wall share one error and a wall seen with many points (a near one) pulls
+// the pose by its whole offset. With sigma_m > 0 every plan segment the frame's points lie on gets a
+// nuisance offset along its normal at each of its ends, o_a and o_b (a point at fraction t of the segment
+// is off by (1 - t) o_a + t o_b), with the prior o ~ N(0, sigma_m^2) under a Cauchy loss of scale
+// loss_scale_m (a wall moved by decimetres pulls as little as an outlier point does), against the
+// points' own noise point_sigma_m; the offsets are solved per evaluation (IRLS, closed form per segment)
+// and eliminated (Schur complement): what is left is the GLS cost of the pose with per-wall correlated
+// errors. A wall's pull saturates at about (point_sigma_m / sigma_m)^2 points, whatever its number of
+// points: every wall in view counts about the same, none beyond its bounded share. Points on segment
+// ends, circles and arcs stay plain. keep_information: the frame's term is scaled (once, at the pose it
+// is built at) to the plain term's translational information, so its balance against the other terms
+// (the matcher's prediction prior, the optimizer's velocity regularisation) stays what it was.
+struct AsBuiltModel {
+  double sigma_m = 0;           // 0: off (the paper's per-point terms)
+  double point_sigma_m = 0.04;  // (point_sigma_m / sigma_m)^2 = 4 points per wall end at sigma_m 2 cm
+  double loss_scale_m = 0.03;   // <= 0: no loss on the offsets (Gaussian prior)
+  bool keep_information = true;
+  bool on() const { return sigma_m > 0 && point_sigma_m > 0; }
+};
+
+}  // namespace fploc::matcher
