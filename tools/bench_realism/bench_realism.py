@@ -125,20 +125,12 @@ def solve3(a, b):
 
 def score_poses(poses, gt_rows):
     """Horizontal ATE, max, LOST, false OK, NEES (x, y, yaw) of pose_t records against the TUM truth."""
-    gt = {round(r[0] * 1e6): r for r in gt_rows}
-    gts = sorted(gt)
-    import bisect
+    truth = fploc_tools.Truth(gt_rows)
     errs, nees, lost, false_ok, poor, n = [], [], 0, 0, 0, 0
     for p in poses:
-        t = p["utime"]
-        k = bisect.bisect_left(gts, t)
-        cand = [gts[j] for j in (k - 1, k) if 0 <= j < len(gts)]
-        if not cand:
+        g = truth.nearest(p["utime"] * 1e-6, 0.005)
+        if g is None:
             continue
-        tg = min(cand, key=lambda c: abs(c - t))
-        if abs(tg - t) > 5000:
-            continue
-        g = gt[tg]
         n += 1
         ex, ey = p["p"][0] - g[1], p["p"][1] - g[2]
         e = math.hypot(ex, ey)
