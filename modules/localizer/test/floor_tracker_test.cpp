@@ -375,11 +375,13 @@ TEST(FloorTracker, ASegmenterZOffTheBuildingIsNotUsedAndSaid) {
     o.z = 1.2 + 0.003 * std::sin(0.3 * k) + (k >= 100 && k < 180 ? 0.15 : 0.0);
     EXPECT_FALSE(tr.update(o));
     EXPECT_NEAR(tr.pose_z(), 1.2, 0.01) << k << ": " << tr.z_source();
-    if (k == 120) {
-      EXPECT_NE(tr.z_source().find("building: nominal height 1.20 m"), std::string::npos) << tr.z_source();
+    if (k == 120) {  // gated for 2 s: the last good height above the floor
+      EXPECT_NE(tr.z_source().find("building: last good height 1.20 m"), std::string::npos) << tr.z_source();
       EXPECT_NE(tr.status_text().find("+0.15 m off"), std::string::npos) << tr.status_text();
       EXPECT_NEAR(tr.pose_z_sigma(0.005), 0.03, 1e-9);
     }
+    if (k == 170)  // gated for 7 s: the nominal height
+      EXPECT_NE(tr.z_source().find("building: nominal height 1.20 m"), std::string::npos) << tr.z_source();
   }
   EXPECT_NE(tr.status_text().find("the segmenter's again"), std::string::npos) << tr.status_text();
   EXPECT_NEAR(tr.nominal_z().value_or(0), 1.2, 0.005);  // the wrong z did not teach the nominal height

@@ -124,10 +124,16 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
   // last scan's). Then the accelerometer measures gravity alone: its tilt bias is learned fast. (A platform
   // moving at a steady speed or acceleration for a second without rotating or vibrating would pass: not a dolly.)
   bool still = false;
-  if (acc_ok && gyro_ok && have_prev_acc_) {
-    double w_max = 0;
+  double w_max = M_PI;
+  if (gyro_ok) {
+    w_max = 0;
     for (auto it = gyro_.rbegin(); it != gyro_.rend() && it->first > t - int64_t(dt * 1e6); ++it)
       w_max = std::max(w_max, (it->second - bias).norm());
+  }
+  // The gyro quiet over the interval: the sensor did not turn (planes that moved are another surface or a bad
+  // fit, e.g. inside a closed lift car).
+  const bool gyro_quiet = gyro_ok && w_max < cfg_.still_rate;
+  if (acc_ok && gyro_ok && have_prev_acc_) {
     still_ref_ = (Rt * still_ref_).normalized();
     const bool quiet = w_max < cfg_.still_rate && std::abs(accel->norm() - prev_acc_norm_) < cfg_.still_accel_norm;
     if (quiet && still_run_ > 0 && (ad_raw - still_ref_).norm() < cfg_.still_accel_dir) {
@@ -195,15 +201,21 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
       } else if (change < 0.5 * cfg_.change_deg * k::kDeg) {
         refused_ = false;
       }
-      if (mode_ == Mode::kLevel && nu.norm() > std::sin(cfg_.step_deg * k::kDeg) && held_ < cfg_.max_hold_scans &&
-          !refused_) {
+      if (mode_ == Mode::kLevel && nu.norm() > std::sin(cfg_.step_deg * k::kDeg) &&
+          (held_ < cfg_.max_hold_scans || (held_ > 0 && gyro_quiet)) && !refused_) {
         // One scan's planes off what the gyro carried (a compromise plane, another surface seen for a moment):
         // gravity carried by the gyro for a while; the planes again once they agree (or after max_hold_scans).
         if (held_ == 0) {
           r.text = fmt_deg("planes %.2f deg off the gyro's prediction: attitude carried by the gyro", angle_of(nu));
+        } else if (held_ == cfg_.max_hold_scans) {
+          r.text = fmt_deg("planes %.2f deg off the gyro, which is quiet (not turning): still carried by the gyro", angle_of(nu));
         }
         ++held_;
-        carry_by_gyro(g_pred, dt, r);
+        // Standing still the accelerometer measures gravity alone (its tilt bias calibrated): it keeps the
+        // gyro's bias from drifting a long hold.
+        Eigen::Vector3d gp = g_pred;
+        if (still && still_s_ > 0) gp = (gp + (1 - std::exp(-std::max(0.0, dt) / cfg_.accel_lp_tau_s)) * (ad - gp)).normalized();
+        carry_by_gyro(gp, dt, r);
         return r;
       }
       if (held_ > 0 && mode_ == Mode::kLevel)

@@ -38,6 +38,8 @@ struct GravityFusionConfig {
   double step_deg = 0.3;         // on a slope: a plane step larger than this (vs the gyro) is a surface change
   double level_deg = 0.4;        // on a slope: the surface tilt below this is level again
   int max_hold_scans = 3;        // level: planes off the gyro by more than step_deg: gyro-carried for at most this
+                                 // (longer while the gyro is quiet: the sensor is not turning; standing still
+                                 // the accelerometer holds it)
   double accel_tau_s = 10.0;     // on a slope: the accelerometer's pull on the surface tilt
   double accel_bias_tau_s = 30.0; // level floors: the accelerometer's tilt bias against the planes, low-passed
   double accel_bias_max_turn_rate = 0.02;  // rad/s: ... only while not turning (v w: 1.8 cm/s^2 at 0.9 m/s)
