@@ -263,13 +263,22 @@ void FloorTracker::resolve_z(const FloorObservation& o, const std::optional<Floo
   z_gated_ = false;
   if (z0_ && std::abs(h_ - want) > cfg_.z_gate_m + *z0_ * 0.5 * (inv_cos - 1)) {
     const double off = h_ - want;
-    h_ = want;
+    // The prediction: the sensor's last good height above the surface under it (the tripod's height changes
+    // slowly along the path) when it is recent, else the nominal one.
+    const bool recent = have_above_ && o.utime - above_utime_ < int64_t(cfg_.z_hold_s * 1e6);
+    h_ = recent ? g + above_ : want;
     z_gated_ = true;
-    z_source_ = "building: nominal height " + fmt("%.2f m", *z0_) + " above " + (refs.size() > 1 && g != 0 ? refs[1].name : refs[0].name) +
-                " (the segmenter's z is " + fmt("%+.2f m", off) + " off)";
+    z_source_ = "building: " + (recent ? "last good height " + fmt("%.2f m", above_) : "nominal height " + fmt("%.2f m", *z0_)) +
+                " above " + (refs.size() > 1 && g != 0 ? refs[1].name : refs[0].name) + " (the segmenter's z is " +
+                fmt("%+.2f m", off) + " off)";
     if (!was_gated) text_ = "z: " + z_source_;
   } else if (was_gated) {
     text_ = "z: the segmenter's again (" + fmt("%.2f m", h_ - (refs[best].kind == 1 ? g : 0.0)) + " above " + refs[best].name + ")";
+  }
+  if (!z_gated_) {
+    above_ = h_ - g;
+    above_utime_ = o.utime;
+    have_above_ = true;
   }
   if (!z_gated_ && g == 0) {
     good_h_ = h_;

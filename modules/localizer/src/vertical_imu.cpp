@@ -9,6 +9,37 @@ void VerticalImu::reset() {
   v_ = h_ = peak_ = 0;
   quiet_for_ = 0;
   lp_ = 0;
+  hist_.clear();
+  was_rest_ = false;
+  rest_tail_.clear();
+}
+
+void VerticalImu::restart_from_rest() {
+  // g0 from the rest just left (its last rest_window_s before the guard, at least 20 samples), else the
+  // running mean.
+  double sum = 0;
+  int n = 0;
+  const int64_t guard = hist_.empty() ? 0 : hist_.back().utime - int64_t(cfg_.rest_guard_s * 1e6);
+  for (const auto& r : rest_tail_)
+    if (r.utime <= guard) sum += r.n, ++n;
+  if (n >= 20) g0_ = sum / n;
+  // The last sample that was still (its low-passed acceleration well inside the quiet band): the ride began
+  // after it.
+  size_t start = hist_.size();
+  for (size_t i = hist_.size(); i-- > 0;) {
+    if (std::abs(hist_[i].lp) < cfg_.still_frac * cfg_.quiet_accel_mps2) {
+      start = i;
+      break;
+    }
+  }
+  v_ = h_ = peak_ = 0;
+  if (start >= hist_.size()) return;
+  for (size_t i = start + 1; i < hist_.size(); ++i) {
+    const double dt = (hist_[i].utime - hist_[i - 1].utime) * 1e-6;
+    v_ += (hist_[i].n - g0_) * dt;
+    h_ += v_ * dt;
+    peak_ = std::max(peak_, std::abs(v_));
+  }
 }
 
 std::optional<VerticalRide> VerticalImu::take_ride() {
@@ -41,12 +72,34 @@ void VerticalImu::add(int64_t utime, const Eigen::Vector3d& accel) {
   h_ += v_ * dt;
   peak_ = std::max(peak_, std::abs(v_));
   const bool rest = quiet_for_ >= cfg_.quiet_s && std::abs(v_) < cfg_.rest_speed_mps;
+  hist_.push_back({utime, n, lp_, rest});
+  while (hist_.size() > 2 && hist_.front().utime < utime - int64_t(cfg_.history_s * 1e6)) hist_.pop_front();
   if (!riding_) {
     if (rest) {
-      // Zero-velocity update; the running mean of |f| follows the bias (only while quiet).
+      // Zero-velocity update; the running mean of |f| follows the bias (only while quiet), and the mean over
+      // this rest (less its last rest_guard_s) is kept for the ride that may follow.
       v_ = h_ = peak_ = 0;
       g0_ += (n - g0_) * std::min(1.0, dt / cfg_.gravity_tau_s);
-    } else if (std::abs(v_) > cfg_.start_speed_mps || std::abs(h_) > cfg_.start_height_m) {
+      if (!was_rest_) {
+        // A new rest: its quiet stretch so far (the quiet_s that made it a rest) counts too.
+        rest_tail_.clear();
+        for (const auto& h : hist_)
+          if (h.utime > utime - int64_t(quiet_for_ * 1e6)) rest_tail_.push_back(h);
+      } else {
+        rest_tail_.push_back(hist_.back());
+      }
+      // rest_tail_: the rest's last rest_window_s + rest_guard_s; its part older than the guard is the mean.
+      while (!rest_tail_.empty() && rest_tail_.front().utime < utime - int64_t((cfg_.rest_window_s + cfg_.rest_guard_s) * 1e6))
+        rest_tail_.pop_front();
+      was_rest_ = true;
+      return;
+    }
+    if (was_rest_) {
+      // The rest ended: integrate from where the motion began, with the rest's own g0.
+      was_rest_ = false;
+      restart_from_rest();
+    }
+    if (std::abs(v_) > cfg_.start_speed_mps || std::abs(h_) > cfg_.start_height_m) {
       riding_ = true;
       ride_start_ = utime;
     }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "segmenter_constants.h"
 
@@ -34,17 +35,6 @@ void GravityFusion::add_gyro(const Eigen::Vector3d& w, int64_t utime) {
   while (gyro_.size() > 2 && gyro_.front().first < utime - 2 * k::kGyroKeepUs) gyro_.pop_front();
 }
 
-Eigen::Vector3d GravityFusion::rate_at(int64_t t, const Eigen::Vector3d& bias) const {
-  if (t <= gyro_.front().first) return gyro_.front().second - bias;
-  if (t >= gyro_.back().first) return gyro_.back().second - bias;
-  auto it = std::lower_bound(gyro_.begin(), gyro_.end(), t,
-                             [](const std::pair<int64_t, Eigen::Vector3d>& s, int64_t v) { return s.first < v; });
-  const auto& b = *it;
-  const auto& a = *(it - 1);
-  const double f = double(t - a.first) / double(std::max<int64_t>(1, b.first - a.first));
-  return (1 - f) * a.second + f * b.second - bias;
-}
-
 bool GravityFusion::rotation(int64_t ta, int64_t tb, const Eigen::Vector3d& bias, Eigen::Matrix3d* R) const {
   *R = Eigen::Matrix3d::Identity();
   if (gyro_.size() < 2) return false;
@@ -56,13 +46,32 @@ bool GravityFusion::rotation(int64_t ta, int64_t tb, const Eigen::Vector3d& bias
     if (g.first >= lo - k::kGyroMaxGapUs && g.first - prev > k::kGyroMaxGapUs) return false;
     prev = g.first;
   }
-  // Midpoint rule in steps of at most kGyroStepUs (negative dt when tb < ta).
-  const int steps = int(std::max<int64_t>(1, (hi - lo + k::kGyroStepUs - 1) / k::kGyroStepUs));
-  for (int s = 0; s < steps; ++s) {
-    const int64_t a = ta + (tb - ta) * s / steps, b = ta + (tb - ta) * (s + 1) / steps;
-    const Eigen::Vector3d th = rate_at(a + (b - a) / 2, bias) * (1e-6 * double(b - a));
+  // Each gyro sample is the mean rate over the interval since the previous sample (an IMU's band-limited output,
+  // as the OS-1's and the simulator's): the rotation is the sum of rate x overlap of [lo, hi] with each sample's
+  // interval (exact for a rate constant per interval; a short jolt inside an interval is neither lost nor
+  // over-weighted as with point samples interpolated). The first sample's interval: the next spacing.
+  auto it = std::lower_bound(gyro_.begin(), gyro_.end(), lo,
+                             [](const std::pair<int64_t, Eigen::Vector3d>& s, int64_t v) { return s.first < v; });
+  std::vector<Eigen::Vector3d> steps;
+  for (; it != gyro_.end(); ++it) {
+    const int64_t end = it->first;
+    const int64_t start = it == gyro_.begin() ? std::min(lo, end - ((it + 1) != gyro_.end() ? (it + 1)->first - end : 0))
+                                               : (it - 1)->first;
+    const int64_t a = std::max(lo, start), b = std::min(hi, end);
+    if (b > a) steps.push_back((it->second - bias) * (1e-6 * double(b - a)));
+    if (end >= hi) break;
+  }
+  if (it == gyro_.end() && gyro_.back().first < hi)  // beyond the last sample: its rate held
+    steps.push_back((gyro_.back().second - bias) * (1e-6 * double(hi - std::max(lo, gyro_.back().first))));
+  auto apply = [&](const Eigen::Vector3d& th) {
     const double ang = th.norm();
     if (ang > 0) *R = *R * Eigen::AngleAxisd(ang, th / ang).toRotationMatrix();
+  };
+  // Orientation at tb relative to ta: forward in time for tb > ta, the inverse (backward) otherwise.
+  if (tb >= ta) {
+    for (const auto& th : steps) apply(th);
+  } else {
+    for (auto r = steps.rbegin(); r != steps.rend(); ++r) apply(-*r);
   }
   return true;
 }
@@ -110,6 +119,39 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
   const Eigen::Vector3d g_pred = (Rt * g_).normalized();
   const Eigen::Vector3d o_pred = Rt * o_;
   u_ = std::exp(-std::max(0.0, dt) / cfg_.change_leak_s) * (Rt * u_);
+  // Standing still: for at least still_s the gyro quiet and the specific force unchanged (its direction within
+  // still_accel_dir of where the stretch began, carried by the gyro; its length within still_accel_norm of the
+  // last scan's). Then the accelerometer measures gravity alone: its tilt bias is learned fast. (A platform
+  // moving at a steady speed or acceleration for a second without rotating or vibrating would pass: not a dolly.)
+  bool still = false;
+  double w_max = M_PI;
+  if (gyro_ok) {
+    w_max = 0;
+    for (auto it = gyro_.rbegin(); it != gyro_.rend() && it->first > t - int64_t(dt * 1e6); ++it)
+      w_max = std::max(w_max, (it->second - bias).norm());
+  }
+  // The gyro quiet over the interval: the sensor did not turn (planes that moved are another surface or a bad
+  // fit, e.g. inside a closed lift car).
+  const bool gyro_quiet = gyro_ok && w_max < cfg_.still_rate;
+  if (acc_ok && gyro_ok && have_prev_acc_) {
+    still_ref_ = (Rt * still_ref_).normalized();
+    const bool quiet = w_max < cfg_.still_rate && std::abs(accel->norm() - prev_acc_norm_) < cfg_.still_accel_norm;
+    if (quiet && still_run_ > 0 && (ad_raw - still_ref_).norm() < cfg_.still_accel_dir) {
+      still_run_ += dt;
+    } else if (quiet) {
+      still_run_ = 1e-9;  // a stretch begins here
+      still_ref_ = ad_raw;
+      still_sum_.setZero();
+      still_n_ = 0;
+    } else {
+      still_run_ = 0;
+    }
+    still = still_run_ >= cfg_.still_s;
+  } else {
+    still_run_ = 0;
+  }
+  have_prev_acc_ = acc_ok;
+  if (acc_ok) prev_acc_norm_ = accel->norm();
   if (have_acc_lp_) acc_lp_ = (Rt * acc_lp_).normalized();
   if (acc_ok) {
     if (!have_acc_lp_) acc_lp_ = ad, have_acc_lp_ = true;
@@ -159,15 +201,21 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
       } else if (change < 0.5 * cfg_.change_deg * k::kDeg) {
         refused_ = false;
       }
-      if (mode_ == Mode::kLevel && nu.norm() > std::sin(cfg_.step_deg * k::kDeg) && held_ < cfg_.max_hold_scans &&
-          !refused_) {
+      if (mode_ == Mode::kLevel && nu.norm() > std::sin(cfg_.step_deg * k::kDeg) &&
+          (held_ < cfg_.max_hold_scans || (held_ > 0 && gyro_quiet)) && !refused_) {
         // One scan's planes off what the gyro carried (a compromise plane, another surface seen for a moment):
         // gravity carried by the gyro for a while; the planes again once they agree (or after max_hold_scans).
         if (held_ == 0) {
           r.text = fmt_deg("planes %.2f deg off the gyro's prediction: attitude carried by the gyro", angle_of(nu));
+        } else if (held_ == cfg_.max_hold_scans) {
+          r.text = fmt_deg("planes %.2f deg off the gyro, which is quiet (not turning): still carried by the gyro", angle_of(nu));
         }
         ++held_;
-        carry_by_gyro(g_pred, dt, r);
+        // Standing still the accelerometer measures gravity alone (its tilt bias calibrated): it keeps the
+        // gyro's bias from drifting a long hold.
+        Eigen::Vector3d gp = g_pred;
+        if (still && still_s_ > 0) gp = (gp + (1 - std::exp(-std::max(0.0, dt) / cfg_.accel_lp_tau_s)) * (ad - gp)).normalized();
+        carry_by_gyro(gp, dt, r);
         return r;
       }
       if (held_ > 0 && mode_ == Mode::kLevel)
@@ -176,12 +224,25 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
       held_ = 0;
     }
     if (mode_ == Mode::kLevel) {
-      if (acc_ok && held_ == 0) {
-        // Level floor: the planes are gravity; what the accelerometer says beside it is its bias (the
-        // platform's accelerations average out over accel_bias_tau_s).
-        const double kb = 1 - std::exp(-std::max(0.0, dt) / cfg_.accel_bias_tau_s);
+      const double turn_rate = gyro_ok && dt > 0 ? std::abs(Eigen::AngleAxisd(R).angle() * Eigen::AngleAxisd(R).axis().dot(p)) / dt : 0.0;
+      if (acc_ok && held_ == 0 && (still || turn_rate < cfg_.accel_bias_max_turn_rate)) {
+        // Level floor: the planes are gravity; what the accelerometer says beside it is its bias. Standing
+        // still it measures gravity alone (the mean over the still stretch); moving, the platform's
+        // accelerations average out over accel_bias_tau_s (not while turning: the centripetal acceleration of a
+        // path turning mostly one way does not), 10x slower once a standstill has calibrated it.
         Eigen::Vector3d d = ad_raw - p;
-        acc_bias_ += kb * (d - acc_bias_);
+        if (still_run_ > 0) still_sum_ += d, ++still_n_;
+        if (still) {
+          // The mean over the whole still stretch (its first scans included), sensor-fixed like the bias.
+          if (still_s_ == 0) r.text = fmt_deg("standing still: the accelerometer's tilt bias calibrated (%.2f deg)",
+                                              angle_of(still_sum_ / std::max(1, still_n_)));
+          still_s_ += dt;
+          acc_bias_ = still_sum_ / std::max(1, still_n_);
+        } else {
+          const double tau = (still_s_ > 0 ? 10 : 1) * cfg_.accel_bias_tau_s;
+          const double kb = 1 - std::exp(-std::max(0.0, dt) / tau);
+          acc_bias_ += kb * (d - acc_bias_);
+        }
       }
       g_ = p;
       sigma_ = plane_sigma;
@@ -210,9 +271,17 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
     o_sigma_ = std::max(0.05 * k::kDeg, o_sigma_ * (1 - 0.5 * kacc));
   }
   o_ -= o_.dot(p) * p;
-  if (angle_of(o_) < cfg_.level_deg * k::kDeg) {
+  // The accelerometer's gravity (low-passed ~1 s, bias-corrected) on the planes' up: the surfaces are level again
+  // (the fit left the ramp for the level floor past its head, a few tenths of a degree the gyro did not carry).
+  Eigen::Vector3d acc_off = have_acc_lp_ ? Eigen::Vector3d(acc_lp_ - p) : Eigen::Vector3d::Constant(1.0);
+  acc_off -= acc_off.dot(p) * p;
+  const bool acc_level = have_acc_lp_ && still_s_ > 0 && angle_of(o_) < cfg_.level_by_accel_deg * k::kDeg &&
+                         angle_of(acc_off) < 0.5 * cfg_.level_deg * k::kDeg;
+  if (angle_of(o_) < cfg_.level_deg * k::kDeg || acc_level) {
     r.text += std::string(r.text.empty() ? "" : "; ") +
-              fmt_deg("surface tilt %.2f deg: level again, attitude from the planes", angle_of(o_));
+              (acc_level ? fmt_deg("surface tilt %.2f deg but the accelerometer agrees with the planes within %.2f deg: level again, "
+                                   "attitude from the planes", angle_of(o_), angle_of(acc_off))
+                         : fmt_deg("surface tilt %.2f deg: level again, attitude from the planes", angle_of(o_)));
     mode_ = Mode::kLevel;
     o_.setZero();
     u_.setZero();

@@ -19,15 +19,15 @@ void GyroDeskew::add(const Eigen::Vector3d& w, int64_t utime) {
 }
 
 Eigen::Vector3d GyroDeskew::rate_at(int64_t t) const {
-  // Linear interpolation between samples; the nearest sample outside their span; minus the estimated bias.
+  // Each sample is the mean rate over the interval since the previous sample (a band-limited IMU output, as
+  // the OS-1's and the simulator's): the rate at t is the sample whose interval holds t (interpolating
+  // between samples would shift it by half an interval); the nearest sample outside their span; minus the
+  // estimated bias.
   if (t <= gyro_.front().first) return gyro_.front().second - gyro_bias_;
   if (t >= gyro_.back().first) return gyro_.back().second - gyro_bias_;
   auto it = std::lower_bound(gyro_.begin(), gyro_.end(), t,
                              [](const std::pair<int64_t, Eigen::Vector3d>& s, int64_t v) { return s.first < v; });
-  const auto& b = *it;
-  const auto& a = *(it - 1);
-  const double f = double(t - a.first) / double(std::max<int64_t>(1, b.first - a.first));
-  return (1 - f) * a.second + f * b.second - gyro_bias_;
+  return it->second - gyro_bias_;
 }
 
 bool GyroDeskew::covers(int64_t ta, int64_t tb) const {

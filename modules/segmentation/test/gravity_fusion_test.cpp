@@ -41,7 +41,7 @@ struct Result {
 };
 
 // Drives the trajectory pose(t) (t in s) for n scans of 0.1 s. The IMU (100 Hz, or 1 kHz with column times)
-// is differentiated from pose(t) (+ linear acceleration `acc(t)` along the sensor's x, noise, gyro bias).
+// is differentiated from pose(t) (the gyro averaged over each sample's interval) (+ linear acceleration `acc(t)` along the sensor's x, noise, gyro bias).
 // With `blocks` > 1 each scan is rendered in that many column blocks, each at its block's mid time, and
 // carries column times (a moving sensor; the segmenter de-skews with the gyro).
 Result drive(const synth::Room& room, const std::function<SensorPose(double)>& pose_at,
@@ -62,11 +62,11 @@ Result drive(const synth::Room& room, const std::function<SensorPose(double)>& p
     const double t_end = t0 + 0.1;
     // IMU samples up to the end of this sweep.
     for (; imu && t_imu <= t_end + 1e-9; t_imu += imu_dt) {
-      const double h = 1e-4;
-      const SensorPose a = pose_at(t_imu - h), b = pose_at(t_imu + h), c = pose_at(t_imu);
+      // The gyro: the mean rate over the interval since the last sample (an IMU's band-limited output).
+      const SensorPose a = pose_at(t_imu - imu_dt), b = pose_at(t_imu), c = pose_at(t_imu);
       const Eigen::Matrix3d Ra = rot(a), Rb = rot(b), Rc = rot(c);
       const Eigen::AngleAxisd d(Ra.transpose() * Rb);
-      const Eigen::Vector3d w = d.angle() / (2 * h) * d.axis() + gyro_bias + 0.0015 * Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng));
+      const Eigen::Vector3d w = d.angle() / imu_dt * d.axis() + gyro_bias + 0.0015 * Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng));
       // Specific force: R^T (a_world + g e_z); the platform accelerates along its heading.
       const Eigen::Vector3d a_world = acc(t_imu) * Eigen::Vector3d(std::cos(c.yaw), std::sin(c.yaw), 0.0);
       const Eigen::Vector3d f = Rc.transpose() * (a_world + kG * Eigen::Vector3d::UnitZ()) +

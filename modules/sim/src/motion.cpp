@@ -274,16 +274,30 @@ std::vector<ImuSample> simulate_imu(const SensorTrajectory& m, const ImuConfig& 
   for (int i = 0; i < 3; ++i) bg[i] = rng.normal(cfg.gyro_bias_sigma);
   const double dt = 1.0 / cfg.rate_hz;
   const int n = int(std::floor(m.duration() * cfg.rate_hz)) + 1;
+  const int sub = std::max(1, cfg.substeps);
+  const double h = dt / sub;
   std::vector<ImuSample> out;
   out.reserve(size_t(n));
   for (int k = 0; k < n; ++k) {
     const double t = k * dt;
-    const Eigen::Isometry3d T = m.pose(t);
     ImuSample s;
     s.t = t;
-    const Eigen::Vector3d f_world = m.acceleration(t) + Eigen::Vector3d(0, 0, kGravity);
-    s.accel = T.linear().transpose() * f_world + ba;
-    s.gyro = m.angular_velocity_body(t) + bg;
+    // A MEMS IMU's output is band-limited: each sample is the mean over the interval since the previous one
+    // (t - dt, t] (an anti-alias filter / delta-angle and delta-velocity output), not a point sample. Gyro: the
+    // rotation over the interval divided by dt (exact for any motion). Accelerometer: the mean specific force
+    // in the sensor frame, over `substeps` sub-intervals whose acceleration is the velocity change across them
+    // (so a short jolt inside the interval is neither missed nor over-weighted).
+    const double ta = t - dt;
+    const Eigen::Matrix3d dR = m.pose(ta).linear().transpose() * m.pose(t).linear();
+    const Eigen::AngleAxisd aa(dR);
+    s.gyro = aa.axis() * aa.angle() / dt + bg;
+    Eigen::Vector3d f = Eigen::Vector3d::Zero();
+    for (int j = 0; j < sub; ++j) {
+      const double tj = ta + (j + 0.5) * h;
+      const Eigen::Vector3d acc = (m.velocity(tj + 0.5 * h) - m.velocity(tj - 0.5 * h)) / h;
+      f += m.pose(tj).linear().transpose() * (acc + Eigen::Vector3d(0, 0, kGravity));
+    }
+    s.accel = f / sub + ba;
     for (int i = 0; i < 3; ++i) s.accel[i] += rng.normal(cfg.accel_noise);
     for (int i = 0; i < 3; ++i) s.gyro[i] += rng.normal(cfg.gyro_noise);
     for (int i = 0; i < 3; ++i) ba[i] += rng.normal(cfg.accel_bias_walk * std::sqrt(dt));

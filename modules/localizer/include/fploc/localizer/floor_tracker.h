@@ -68,7 +68,8 @@ struct FloorTrackerConfig {
   double max_ride_z_sigma_m = 0.5;     // ... at most (z stays "known": below 1 m)
   double z_reference_hysteresis_m = 0.02;  // the segmenter's z reference changes when better by this much
   double z_gate_m = 0.08;              // the segmenter's z this far from z0 above the surface: not used ...
-  double z_gated_sigma_m = 0.03;       // ... the prediction instead, with this sigma
+  double z_gated_sigma_m = 0.03;       // ... the prediction instead, with this sigma: the last good height above
+  double z_hold_s = 5.0;               // the surface when it is this recent, else the nominal z0
   // Plan mismatch in a lift area (floor switch without the IMU).
   double mismatch_ratio = 0.6;         // inlier ratio below this (or LOST): the plan does not match
   int mismatch_frames = 3;             // ... for this many frames in a row
@@ -213,6 +214,9 @@ class FloorTracker {
   double good_h_ = 0;                  // the last height above a flat floor the segmenter measured (not gated)
   int64_t good_h_utime_ = 0;
   bool have_good_h_ = false;
+  double above_ = 0;                   // the last good (not gated) height above the surface under the robot
+  int64_t above_utime_ = 0;
+  bool have_above_ = false;
   int64_t last_utime_ = 0;
   // Plan mismatch.
   int mismatch_ = 0, since_probe_ = 0;

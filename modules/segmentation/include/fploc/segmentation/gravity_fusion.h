@@ -38,8 +38,17 @@ struct GravityFusionConfig {
   double step_deg = 0.3;         // on a slope: a plane step larger than this (vs the gyro) is a surface change
   double level_deg = 0.4;        // on a slope: the surface tilt below this is level again
   int max_hold_scans = 3;        // level: planes off the gyro by more than step_deg: gyro-carried for at most this
+                                 // (longer while the gyro is quiet: the sensor is not turning; standing still
+                                 // the accelerometer holds it)
   double accel_tau_s = 10.0;     // on a slope: the accelerometer's pull on the surface tilt
   double accel_bias_tau_s = 30.0; // level floors: the accelerometer's tilt bias against the planes, low-passed
+  double accel_bias_max_turn_rate = 0.02;  // rad/s: ... only while not turning (v w: 1.8 cm/s^2 at 0.9 m/s)
+  double still_rate = 0.01;                // rad/s: every gyro sample of the interval below this (bias-corrected) ...
+  double still_accel_dir = 0.0015;         // ... the specific force's direction within this (rad) of the stretch's start
+  double still_accel_norm = 0.02;          // ... and its length within this (m/s^2) of the last scan's ...
+  double still_s = 0.5;                    // ... for this long: standing still (the bias = the stretch's mean)
+  double level_by_accel_deg = 2.0;         // on a slope of less than this, the low-passed accelerometer within
+                                           // level_deg / 2 of the planes means level again (needs a calibrated bias)
   double accel_lp_tau_s = 1.0;   // low-pass of the accelerometer's gravity for the entry check
   double accel_norm_tol = 0.3;   // m/s^2: |mean specific force| this close to g to be used
   double gyro_noise = 0.0015;    // rad/s white noise per sample (sigma growth without planes)
@@ -60,7 +69,8 @@ class GravityFusion {
 
   explicit GravityFusion(GravityFusionConfig cfg = {}) : cfg_(cfg) {}
 
-  // Gyro sample (rad/s, sensor frame) at utime [us]; out-of-order samples ignored, time going back resets.
+  // Gyro sample (rad/s, sensor frame) at utime [us]: the mean rate over the interval since the previous sample
+  // (a band-limited IMU output); out-of-order samples ignored, time going back resets.
   void add_gyro(const Eigen::Vector3d& rate, int64_t utime);
   bool has_gyro() const { return gyro_.size() >= 2; }
   // The sensor's rotation from time ta to tb (orientation at tb relative to ta, body frame; a world-fixed
@@ -79,7 +89,6 @@ class GravityFusion {
  private:
   GravityFusionConfig cfg_;
   std::deque<std::pair<int64_t, Eigen::Vector3d>> gyro_;
-  Eigen::Vector3d rate_at(int64_t t, const Eigen::Vector3d& bias) const;
   // Gravity carried by the gyro alone over dt: its sigma grows with the bias and noise; r gets it.
   void carry_by_gyro(const Eigen::Vector3d& g_pred, double dt, Result& r);
 
@@ -94,6 +103,13 @@ class GravityFusion {
   Eigen::Vector3d acc_bias_ = Eigen::Vector3d::Zero();  // accelerometer direction minus gravity on level floors
   int held_ = 0;             // scans carried by the gyro since the planes stepped (LEVEL)
   Eigen::Vector3d held_nu_ = Eigen::Vector3d::Zero();  // last scan's disagreement
+  bool have_prev_acc_ = false;
+  Eigen::Vector3d still_ref_ = Eigen::Vector3d::UnitZ();  // the specific force's direction when the stretch began
+  double prev_acc_norm_ = 0;
+  double still_run_ = 0;     // length of the current still stretch [s]
+  Eigen::Vector3d still_sum_ = Eigen::Vector3d::Zero();  // its accelerometer-minus-planes directions (level floors)
+  int still_n_ = 0;
+  double still_s_ = 0;       // time spent standing still on level floors (> 0: the accelerometer's bias calibrated)
   bool refused_ = false;     // a change without the accelerometer's agreement was said (once per episode)
   double sigma_ = M_PI;      // tilt sigma of g
   double o_sigma_ = 0;       // of the surface tilt

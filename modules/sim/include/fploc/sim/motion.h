@@ -117,10 +117,13 @@ struct ImuConfig {
   double gyro_bias_sigma = 0.002;
   double accel_bias_walk = 0.0005;  // random walk per sqrt(s)
   double gyro_bias_walk = 0.00005;
+  int substeps = 10;                // accelerometer: sub-intervals averaged per sample
 };
 
+// Each sample is the mean over the interval since the previous sample, (t - 1/rate, t] (a real MEMS IMU's
+// anti-alias filter / delta-angle output), not the value at the instant t.
 struct ImuSample {
-  double t = 0;  // motion time [s]
+  double t = 0;  // motion time [s]: the end of the sample's interval
   Eigen::Vector3d accel = Eigen::Vector3d::Zero();  // specific force in the sensor frame [m/s^2]
   Eigen::Vector3d gyro = Eigen::Vector3d::Zero();   // [rad/s]
 };
