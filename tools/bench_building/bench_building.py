@@ -42,7 +42,7 @@ ROOT = os.environ.get("FPLOC_ROOT") or os.path.abspath(os.path.join(os.path.dirn
 BIN = os.environ.get("FPLOC_BIN") or os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(ROOT, "tools", "pylib"))
 import fploc_tools  # noqa: E402
-from fploc_tools import log, read_tum, yaw_of  # noqa: E402
+from fploc_tools import log, pct, read_tum, yaw_of  # noqa: E402
 
 SCENARIOS = ["building-areas-medium", "building-atrium-medium", "building-clutter-medium", "building-mixed-medium",
              "auto-loop-medium"]
@@ -110,7 +110,7 @@ def score_floors(gt, est, gtf, pose_floor, changes, t0_abs):
         first = next((e[0] for e in est if e[0] >= c["t"] and pose_floor.get(round(e[0], 6), -1) == c["to_index"]), None)
         rec.append({"t": round(c["t"] - t0_abs, 2), "from": c["from"], "to": c["to"], "how": c["how"],
                     "recognised_after_s": None if first is None else round(first - c["t"], 2)})
-    ts = [g[0] for g in gt]
+    truth = fploc_tools.Truth(gt)
     lifts = []
     for c in changes:
         if not c["how"].startswith("lift"):
@@ -119,12 +119,10 @@ def score_floors(gt, est, gtf, pose_floor, changes, t0_abs):
         for e in est:
             if not (c["t"] <= e[0] <= c["t"] + 10.0):
                 continue
-            i = bisect.bisect_left(ts, e[0])
-            if i <= 0 or i >= len(gt):
+            at = truth.interpolated(e[0])
+            if at is None:
                 continue
-            a, b = gt[i - 1], gt[i]
-            f = (e[0] - a[0]) / (b[0] - a[0]) if b[0] > a[0] else 0.0
-            p = [a[k] + f * (b[k] - a[k]) for k in (1, 2, 3)]
+            p = at[0]
             dxy = (e[1] - p[0]) ** 2 + (e[2] - p[1]) ** 2
             exy.append(dxy)
             e3.append(dxy + (e[3] - p[2]) ** 2)
@@ -151,26 +149,19 @@ def roll_pitch(q):
     return roll, pitch
 
 
-def pct(v, q):
-    s = sorted(v)
-    return s[min(len(s) - 1, int(q * len(s)))] if s else None
-
-
 def score(gt, est):
     """Per pose: truth interpolated at the pose's time (roll/pitch from the nearer truth sample). Buildings:
     `est` z absolute as the truth (pose_t: the floor's elevation + the height above it)."""
-    ts = [g[0] for g in gt]
+    truth = fploc_tools.Truth(gt)
     t0 = gt[0][0]
     series, exy, ez, erp = [], [], [], []
     for e in est:
-        i = bisect.bisect_left(ts, e[0])
-        if i <= 0 or i >= len(gt):
+        at = truth.interpolated(e[0])
+        if at is None:
             continue
-        a, b = gt[i - 1], gt[i]
-        f = (e[0] - a[0]) / (b[0] - a[0]) if b[0] > a[0] else 0.0
-        p = [a[k] + f * (b[k] - a[k]) for k in (1, 2, 3)]
+        p, nearer = at
         r1, p1 = roll_pitch(e[4:8])
-        r0, p0 = roll_pitch((a if f < 0.5 else b)[4:8])
+        r0, p0 = roll_pitch(nearer[4:8])
         exy.append((e[1] - p[0]) ** 2 + (e[2] - p[1]) ** 2)
         ez.append(abs(e[3] - p[2]))
         erp.append(max(abs(r1 - r0), abs(p1 - p0)))
