@@ -76,6 +76,15 @@ bool GravityFusion::rotation(int64_t ta, int64_t tb, const Eigen::Vector3d& bias
   return true;
 }
 
+GravityFusion::Result& GravityFusion::take_planes(const Eigen::Vector3d& up, double plane_sigma, Result& r) {
+  g_ = up;
+  sigma_ = plane_sigma;
+  r.valid = r.from_planes = true;
+  r.up = up;
+  r.sigma = plane_sigma;
+  return r;
+}
+
 void GravityFusion::carry_by_gyro(const Eigen::Vector3d& g_pred, double dt, Result& r) {
   g_ = g_pred;
   const double grow = cfg_.gyro_bias_sigma * dt + cfg_.gyro_noise * std::sqrt(std::max(0.0, dt) * 0.01);
@@ -99,15 +108,10 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
     started_ = true;
     t_ = t;
     mode_ = Mode::kLevel;
-    g_ = *plane_up;
     o_.setZero();
     u_.setZero();
-    sigma_ = plane_sigma;
     if (acc_ok) acc_lp_ = ad, have_acc_lp_ = true;
-    r.valid = r.from_planes = true;
-    r.up = *plane_up;
-    r.sigma = plane_sigma;
-    return r;
+    return take_planes(*plane_up, plane_sigma, r);
   }
   const double dt = 1e-6 * double(t - t_);
   Eigen::Matrix3d R;
@@ -244,12 +248,7 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
           acc_bias_ += kb * (d - acc_bias_);
         }
       }
-      g_ = p;
-      sigma_ = plane_sigma;
-      r.valid = r.from_planes = true;
-      r.up = p;
-      r.sigma = plane_sigma;
-      return r;
+      return take_planes(p, plane_sigma, r);
     }
   } else if (gyro_ok) {
     Eigen::Vector3d nu = p - (g_pred - o_pred);
@@ -285,12 +284,7 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
     mode_ = Mode::kLevel;
     o_.setZero();
     u_.setZero();
-    g_ = p;
-    sigma_ = plane_sigma;
-    r.valid = r.from_planes = true;
-    r.up = p;
-    r.sigma = plane_sigma;
-    return r;
+    return take_planes(p, plane_sigma, r);
   }
   g_ = (p + o_).normalized();
   sigma_ = std::hypot(plane_sigma, o_sigma_);

@@ -91,6 +91,8 @@ class GravityFusion {
   std::deque<std::pair<int64_t, Eigen::Vector3d>> gyro_;
   // Gravity carried by the gyro alone over dt: its sigma grows with the bias and noise; r gets it.
   void carry_by_gyro(const Eigen::Vector3d& g_pred, double dt, Result& r);
+  // Gravity is the planes' up: the state takes it and r says so.
+  Result& take_planes(const Eigen::Vector3d& up, double plane_sigma, Result& r);
 
   bool started_ = false;
   int64_t t_ = 0;
