@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fploc/carmen/carmen.h"
+#include "log_scans.h"
 #include "fploc/floorplan/occupancy.h"
 #include "fploc/laser2d/grid_localizer.h"
 
@@ -27,13 +28,12 @@ int main(int argc, char** argv) {
   namespace cm = fploc::carmen;
   namespace l2 = fploc::laser2d;
   try {
-    const cm::Log log = cm::parse_log(cm::read_maybe_gz(log_path), log_path);
-    const float no_return = cm::no_return_range(log);
-    if (end == 0 || end > log.scans.size()) end = log.scans.size();
-    if (first >= end) throw std::runtime_error("--first-scan/--end-scan select no scans");
     l2::GridLocalizerConfig c;
     c.initial_sigma_xy_m = 0.1;
     c.initial_sigma_yaw_rad = 2.0 * M_PI / 180;
+    const fploc::bench_real::LogScans scans = fploc::bench_real::load_log_scans(log_path, first, end, c.max_range_m);
+    const cm::Log& log = scans.log;
+    end = scans.end;
     const auto field = std::make_shared<l2::DistanceField>(fploc::read_occupancy_map(map_path), c.field_max_m);
     l2::GridLocalizer loc(field, c);
     nlohmann::json rows = nlohmann::json::array();
@@ -41,7 +41,7 @@ int main(int argc, char** argv) {
       const auto& s = log.scans[k];
       const fploc::Pose2 ref{s.pose.x, s.pose.y, s.pose.theta};
       loc.set_initial_pose(ref);
-      const double rmax = std::isfinite(no_return) ? std::min<double>(c.max_range_m, no_return) : c.max_range_m;
+      const double rmax = scans.max_range_m;
       const auto pts = l2::scan_points(s.ranges, -M_PI / 2, cm::beam_increment(s.ranges.size()), c.min_range_m, rmax);
       const l2::GridResult r = loc.update(pts, std::nullopt);
       rows.push_back({{"scan", k}, {"x", r.pose.x}, {"y", r.pose.y}, {"yaw", r.pose.yaw}, {"dxy_m", std::hypot(r.pose.x - ref.x, r.pose.y - ref.y)},

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fploc/carmen/carmen.h"
+#include "log_scans.h"
 #include "fploc/floorplan/occupancy.h"
 #include "fploc/laser2d/grid_localizer.h"
 
@@ -46,17 +47,16 @@ int main(int argc, char** argv) {
   namespace cm = fploc::carmen;
   namespace l2 = fploc::laser2d;
   try {
-    const cm::Log log = cm::parse_log(cm::read_maybe_gz(log_path), log_path);
-    const float no_return = cm::no_return_range(log);
-    if (end == 0 || end > log.scans.size()) end = log.scans.size();
-    if (first >= end) throw std::runtime_error("--first-scan/--end-scan select no scans");
+    const fploc::bench_real::LogScans scans = fploc::bench_real::load_log_scans(log_path, first, end, c.max_range_m);
+    const cm::Log& log = scans.log;
+    end = scans.end;
     const auto field = std::make_shared<l2::DistanceField>(fploc::read_occupancy_map(map_path), c.field_max_m);
     l2::GridLocalizer loc(field, c);
     const auto& s0 = log.scans[first].pose;
     fploc::Pose2 p0{s0.x, s0.y, s0.theta};
     if (start == "off") p0 = {p0.x + std::cos(p0.yaw + M_PI / 4), p0.y + std::sin(p0.yaw + M_PI / 4), p0.yaw + 10 * M_PI / 180};
     loc.set_initial_pose(p0);
-    const double rmax = std::min<double>(c.max_range_m, std::isfinite(no_return) ? no_return : 1000.f);
+    const double rmax = scans.max_range_m;
     nlohmann::json rows = nlohmann::json::array();
     double total_ms = 0;
     for (size_t k = first; k < end; ++k) {
