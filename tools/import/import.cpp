@@ -13,7 +13,6 @@
 // A second topic that would go to the same channel gets CHANNEL_<topic>; --channel TOPIC=CH overrides.
 // Bad input: one error with the byte offset and record; the log holds everything read before it.
 #include <fploc/imu_t.hpp>
-#include <fploc/laser_scan_t.hpp>
 #include <fploc/point_cloud2_t.hpp>
 #include <fploc/scan_t.hpp>
 
@@ -33,6 +32,7 @@
 #include "fploc/recording/ouster_packets.h"
 #include "fploc/recording/recording.h"
 #include "fploc/recording/ros_msgs.h"
+#include "laser_encode.h"
 #include "lcm_log.h"
 #include "ouster_raw.h"
 #include "scan_encode.h"
@@ -266,6 +266,7 @@ int main(int argc, char** argv) {
   Scan cloud_scan;
   std::vector<uint8_t> cloud_header;  // point_cloud2_t up to its data; the points follow from the recording
   std::map<std::string, std::string> cloud_check_error;  // topic -> why its first cloud does not convert
+  LaserScanView laser;
   RawMessage m;
   while (rec->next(m)) {
     ++read_msgs;
@@ -365,22 +366,14 @@ int main(int argc, char** argv) {
         break;
       }
       case Kind::kLaser: {
-        LaserScan l;
-        if (!decode(m.data, m.size, c.encoding, l, &err)) { bad(c, err); break; }
+        // Encoded straight from the recording's bytes into the log's buffer (laser_encode.h): the bytes of
+        // laser_scan_t::encode, in one pass.
+        if (!decode(m.data, m.size, c.encoding, laser, &err)) { bad(c, err); break; }
         const std::string& ch = channel_for(c, k);
-        laser_scan_t ls;
-        ls.utime = l.header.stamp_ns / 1000;
-        ls.frame = l.header.frame_id;
-        ls.angle_min = l.angle_min;
-        ls.angle_increment = l.angle_increment;
-        ls.time_increment = l.time_increment;
-        ls.range_min = l.range_min;
-        ls.range_max = l.range_max;
-        ls.num_ranges = int32_t(l.ranges.size());
-        ls.ranges = std::move(l.ranges);
-        ls.num_intensities = int32_t(l.intensities.size());
-        ls.intensities = std::move(l.intensities);
-        if (!out.empty()) lcm_log.write(ch, m.time_ns / 1000, ls);
+        if (!out.empty()) {
+          const size_t n = fploc::import::laser_scan_encoded_size(laser);
+          if (uint8_t* p = lcm_log.begin_event(ch, m.time_ns / 1000, n)) fploc::import::encode_laser_scan(laser, p);
+        }
         ++written[ch];
         break;
       }

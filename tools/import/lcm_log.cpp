@@ -78,13 +78,8 @@ void LcmLog::hand_over() {
   cur_.clear();
 }
 
-bool LcmLog::write_parts(const std::string& channel, int64_t utime, const uint8_t* a, size_t na, const uint8_t* b,
-                         size_t nb, bool b_stable) {
-  if (!log_ || failed_) return false;
-  const size_t n = na + nb;
-  if (n > size_t(INT32_MAX)) return false;
-  const bool by_ref = b_stable && nb > 0;
-  const size_t copy = 28 + channel.size() + na + (by_ref ? 0 : nb);
+uint8_t* LcmLog::frame(const std::string& channel, int64_t utime, size_t n, size_t copy_data) {
+  const size_t copy = 28 + channel.size() + copy_data;
   if (cur_.fill + copy > cur_.bytes.size() || cur_.segs.size() + 2 > kMaxSegs || cur_.total >= kBatchBytes) {
     hand_over();
     if (copy > cur_.bytes.size()) cur_.bytes.resize(copy);  // a message larger than a buffer gets a larger buffer
@@ -101,18 +96,33 @@ bool LcmLog::write_parts(const std::string& channel, int64_t utime, const uint8_
   p += 28;
   std::memcpy(p, channel.data(), channel.size());
   p += channel.size();
-  if (na) std::memcpy(p, a, na);
-  if (nb && !by_ref) std::memcpy(p + na, b, nb);
   // The copied bytes extend the last segment when it is the one just before them.
   auto& segs = cur_.segs;
   if (!segs.empty() && !segs.back().p && segs.back().off + segs.back().len == cur_.fill) segs.back().len += copy;
   else segs.push_back({nullptr, cur_.fill, copy});
   cur_.fill += copy;
-  if (by_ref) segs.push_back({b, 0, nb});
   cur_.total += 28 + channel.size() + n;
   ++log_->eventcount;
   ++events_;
   bytes_ += n;
+  return p;
+}
+
+uint8_t* LcmLog::begin_event(const std::string& channel, int64_t utime, size_t n) {
+  if (!log_ || failed_ || n > size_t(INT32_MAX)) return nullptr;
+  return frame(channel, utime, n, n);
+}
+
+bool LcmLog::write_parts(const std::string& channel, int64_t utime, const uint8_t* a, size_t na, const uint8_t* b,
+                         size_t nb, bool b_stable) {
+  if (!log_ || failed_) return false;
+  const size_t n = na + nb;
+  if (n > size_t(INT32_MAX)) return false;
+  const bool by_ref = b_stable && nb > 0;
+  uint8_t* p = frame(channel, utime, n, na + (by_ref ? 0 : nb));
+  if (na) std::memcpy(p, a, na);
+  if (nb && !by_ref) std::memcpy(p + na, b, nb);
+  if (by_ref) cur_.segs.push_back({b, 0, nb});
   return true;
 }
 

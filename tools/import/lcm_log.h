@@ -39,6 +39,9 @@ class LcmLog {
   // is written from where it is. False once a write to the file has failed.
   bool write_parts(const std::string& channel, int64_t utime, const uint8_t* a, size_t na, const uint8_t* b, size_t nb,
                    bool b_stable = false);
+  // One event of n data bytes that the caller encodes in place, at the returned pointer, before the next
+  // call (no scratch buffer, no copy); nullptr once a write to the file has failed.
+  uint8_t* begin_event(const std::string& channel, int64_t utime, size_t n);
   // Writes what is buffered and closes the file; false when a write failed.
   bool close();
   ~LcmLog() { close(); }
@@ -61,6 +64,9 @@ class LcmLog {
     void clear() { fill = total = 0, segs.clear(); }
   };
   void hand_over();  // the current batch to the writer thread; takes a free one
+  // Frames one event of n data bytes of which `copy` are copied into the batch (n - copy follow as a
+  // stable segment); returns where the copied data go.
+  uint8_t* frame(const std::string& channel, int64_t utime, size_t n, size_t copy);
   void writer();
   bool write_batch(const Batch& b);
   lcm_eventlog_t* log_ = nullptr;

@@ -1,10 +1,11 @@
 // LcmLog (own framing, buffers handed to a writer thread) writes byte for byte what lcm's
 // lcm_eventlog_write_event writes, for events smaller and larger than its buffers, split in two parts, and
-// with payloads written from where they are (writev; more than a batch's iovecs in a row).
+// with payloads written from where they are (writev; more than a batch's iovecs in a row), and encoded in place.
 #include <gtest/gtest.h>
 #include <lcm/eventlog.h>
 
 #include <cstdio>
+#include <cstring>
 #include <deque>
 #include <filesystem>
 #include <fstream>
@@ -44,7 +45,11 @@ TEST(LcmLog, SameBytesAsLcmEventlog) {
     const size_t cut = n / 3;
     if (i % 4 == 1) ASSERT_TRUE(ours.write_parts(ch, t, d.data(), cut, d.data() + cut, n - cut));
     else if (i % 4 == 3 || (i > 1000 && i < 1700)) ASSERT_TRUE(ours.write_parts(ch, t, d.data(), cut, d.data() + cut, n - cut, true));
-    else ASSERT_TRUE(ours.write_raw(ch, t, d.data(), n));
+    else if (i % 8 == 2) {  // encoded in place
+      uint8_t* p = ours.begin_event(ch, t, n);
+      ASSERT_NE(p, nullptr);
+      if (n) std::memcpy(p, d.data(), n);
+    } else ASSERT_TRUE(ours.write_raw(ch, t, d.data(), n));
     lcm_eventlog_event_t e{};
     e.timestamp = t;
     e.channellen = int32_t(ch.size());

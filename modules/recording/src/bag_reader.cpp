@@ -10,15 +10,11 @@
 
 namespace fploc::rec {
 namespace {
+using bag::Field;
+using bag::Record;
 
 constexpr char kMagic[] = "#ROSBAG V2.0\n";
 constexpr size_t kMagicLen = 13;
-
-struct Field {
-  std::string_view name;
-  const uint8_t* v = nullptr;
-  size_t n = 0;
-};
 
 // Splits a header (or a connection record's data) into fields; false with *why when malformed.
 bool parse_fields(const uint8_t* p, size_t n, std::vector<Field>& out, std::string* why) {
@@ -44,13 +40,6 @@ const Field* find(const std::vector<Field>& fs, std::string_view name) {
     if (f.name == name) return &f;
   return nullptr;
 }
-
-struct Record {
-  uint8_t op = 0;
-  std::vector<Field> fields;
-  const uint8_t* data = nullptr;
-  size_t data_len = 0;
-};
 
 // One record at base[pos]; advances pos.
 bool read_record(const uint8_t* base, size_t n, size_t& pos, Record& r, std::string* why) {
@@ -128,7 +117,7 @@ BagReader::BagReader(std::unique_ptr<FileBytes> f, std::string name) : FileReade
 }
 
 bool BagReader::next(RawMessage& m) {
-  Record r;
+  Record& r = rec_;  // kept from call to call: its field list is not allocated again for every message
   std::string why;
   while (!done_) {
     if (in_chunk()) {

@@ -4,6 +4,7 @@
 #include <future>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "fploc/recording/recording.h"
@@ -53,6 +54,22 @@ class FileReader : public Recording {
   std::vector<uint8_t> buf_;
 };
 
+namespace bag {
+// One header field of a bag record ("name=value"), pointing into the record.
+struct Field {
+  std::string_view name;
+  const uint8_t* v = nullptr;
+  size_t n = 0;
+};
+// One bag record: op, header fields, data (pointers into the file or the chunk).
+struct Record {
+  uint8_t op = 0;
+  std::vector<Field> fields;
+  const uint8_t* data = nullptr;
+  size_t data_len = 0;
+};
+}  // namespace bag
+
 // ROS 1 bag format 2.0, read sequentially (the index at the end is not needed: an unindexed bag or one
 // cut short by a crash reads up to its last whole record). Chunks: none, bz2, lz4.
 // Compressed chunks: while one chunk's messages are read, the next chunk is decompressed on a second
@@ -69,6 +86,7 @@ class BagReader : public FileReader {
   std::future<std::pair<std::string, std::vector<uint8_t>>> ahead_;  // (error, bytes) of the chunk at ahead_at_
   size_t ahead_at_ = 0;
   std::vector<uint8_t> spare_;  // a chunk buffer for the next prefetch (no allocation per chunk)
+  bag::Record rec_;             // the record being read (its field list reused)
 };
 
 // MCAP (data section in file order: chunks none/zstd/lz4, or messages outside chunks; the summary

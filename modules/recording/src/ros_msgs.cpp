@@ -1,5 +1,7 @@
 #include "fploc/recording/ros_msgs.h"
 
+#include <cstring>
+
 #include "wire.h"
 
 namespace fploc::rec {
@@ -91,7 +93,7 @@ bool decode(const uint8_t* d, size_t n, Encoding e, Imu& m, std::string* err) {
   return done(w, "sensor_msgs/Imu", err);
 }
 
-bool decode(const uint8_t* d, size_t n, Encoding e, LaserScan& m, std::string* err) {
+bool decode(const uint8_t* d, size_t n, Encoding e, LaserScanView& m, std::string* err) {
   Wire w(d, n, e);
   header(w, m.header);
   w.field("angles");
@@ -103,10 +105,40 @@ bool decode(const uint8_t* d, size_t n, Encoding e, LaserScan& m, std::string* e
   m.range_min = w.get<float>();
   m.range_max = w.get<float>();
   w.field("ranges");
-  w.floats(m.ranges, w.count(4));
+  m.num_ranges = w.count(4);
+  m.ranges = w.float_bytes(m.num_ranges);
   w.field("intensities");
-  w.floats(m.intensities, w.count(4));
+  m.num_intensities = w.count(4);
+  m.intensities = w.float_bytes(m.num_intensities);
+  m.big_endian = w.big_endian();
+  if (!w.ok()) m.num_ranges = m.num_intensities = 0, m.ranges = m.intensities = nullptr;
   return done(w, "sensor_msgs/LaserScan", err);
+}
+
+namespace {
+// c floats from the message's bytes, swapped when the message is big-endian.
+void copy_floats(const uint8_t* p, uint32_t c, bool swap, std::vector<float>& out) {
+  out.resize(c);
+  if (c) std::memcpy(out.data(), p, size_t(c) * 4);
+  if (swap)
+    for (auto& f : out) {
+      uint32_t u;
+      std::memcpy(&u, &f, 4);
+      u = __builtin_bswap32(u);
+      std::memcpy(&f, &u, 4);
+    }
+}
+}  // namespace
+
+bool decode(const uint8_t* d, size_t n, Encoding e, LaserScan& m, std::string* err) {
+  LaserScanView v;
+  const bool ok = decode(d, n, e, v, err);
+  m.header = std::move(v.header);
+  m.angle_min = v.angle_min, m.angle_max = v.angle_max, m.angle_increment = v.angle_increment;
+  m.time_increment = v.time_increment, m.scan_time = v.scan_time, m.range_min = v.range_min, m.range_max = v.range_max;
+  copy_floats(v.ranges, v.num_ranges, v.big_endian, m.ranges);
+  copy_floats(v.intensities, v.num_intensities, v.big_endian, m.intensities);
+  return ok;
 }
 
 bool decode(const uint8_t* d, size_t n, Encoding e, Odometry& m, std::string* err) {

@@ -66,20 +66,14 @@ class Wire {
     if (ok_ && min_size > 0 && c > (n_ - i_) / min_size) return bad(cur_), 0;
     return c;
   }
-  // A float32[] of c elements (after its count), in one pass.
-  void floats(std::vector<float>& out, uint32_t c) {
+  // The bytes of a float32[] of c elements (after its count), in the message's byte order; nullptr
+  // (and not ok) when they run past the end.
+  const uint8_t* float_bytes(uint32_t c) {
     align(4);
-    if (!ok_ || c > (n_ - i_) / 4) return bad(cur_), out.clear();
-    out.resize(c);
-    if (c) std::memcpy(out.data(), d_ + i_, size_t(c) * 4);
-    if (swap_)
-      for (auto& f : out) {
-        uint32_t u;
-        std::memcpy(&u, &f, 4);
-        u = __builtin_bswap32(u);
-        std::memcpy(&f, &u, 4);
-      }
+    if (!ok_ || c > (n_ - i_) / 4) return bad(cur_), nullptr;
+    const uint8_t* p = d_ + i_;
     i_ += size_t(c) * 4;
+    return p;
   }
   // Raw bytes of a uint8[] (after its count).
   const uint8_t* bytes(size_t len) {

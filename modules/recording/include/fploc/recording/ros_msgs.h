@@ -47,6 +47,18 @@ struct LaserScan {
   std::vector<float> ranges, intensities;
 };
 
+// The same message without copying its arrays: ranges and intensities point into the message bytes
+// (4-byte floats in the message's byte order; big_endian only for big-endian CDR). What an importer
+// that re-encodes the scan in one pass reads (decode(LaserScan) is this plus the copy).
+struct LaserScanView {
+  Header header;
+  float angle_min = 0, angle_max = 0, angle_increment = 0, time_increment = 0, scan_time = 0, range_min = 0, range_max = 0;
+  uint32_t num_ranges = 0, num_intensities = 0;
+  const uint8_t* ranges = nullptr;
+  const uint8_t* intensities = nullptr;
+  bool big_endian = false;
+};
+
 struct Transform {
   Header header;
   std::string child_frame_id;
@@ -61,6 +73,7 @@ struct Odometry {
 bool decode(const uint8_t* d, size_t n, Encoding e, PointCloud2& out, std::string* err);
 bool decode(const uint8_t* d, size_t n, Encoding e, Imu& out, std::string* err);
 bool decode(const uint8_t* d, size_t n, Encoding e, LaserScan& out, std::string* err);
+bool decode(const uint8_t* d, size_t n, Encoding e, LaserScanView& out, std::string* err);
 bool decode(const uint8_t* d, size_t n, Encoding e, Odometry& out, std::string* err);
 bool decode_tf(const uint8_t* d, size_t n, Encoding e, std::vector<Transform>& out, std::string* err);
 // uint8[] buf (ouster_ros/PacketMsg) and std_msgs/String.
