@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 
 namespace fploc::import {
@@ -23,6 +24,7 @@ bool LcmLog::open(const std::string& path) {
     free_.back().bytes.resize(kBufBytes);
   }
   done_ = failed_ = false;
+  file_pos_ = 0;
   thread_ = std::thread([this] { writer(); });
   return true;
 }
@@ -34,12 +36,22 @@ bool LcmLog::write_batch(const Batch& b) {
   const int fd = fileno(log_->f);
   size_t i = 0;
   while (i < n) {
-    const ssize_t w = ::writev(fd, iov + i, int(n - i));
+    // Up to the next multiple of kWriteStep in the file.
+    const size_t room = kWriteStep - file_pos_ % kWriteStep;
+    size_t k = i, tot = 0, cut_len = 0;
+    while (k < n && iov[k].iov_len <= room - tot) tot += iov[k++].iov_len;
+    if (k < n && tot < room) {  // this iovec crosses the boundary: its first part now
+      cut_len = iov[k].iov_len;
+      iov[k++].iov_len = room - tot;
+    }
+    const ssize_t w = ::writev(fd, iov + i, int(k - i));
+    if (cut_len) iov[k - 1].iov_len = cut_len;
     if (w < 0) {
       if (errno == EINTR) continue;
       return false;
     }
     if (w == 0) return false;
+    file_pos_ += size_t(w);
     size_t left = size_t(w);
     while (i < n && left >= iov[i].iov_len) left -= iov[i++].iov_len;
     if (i < n) {  // a partial write: the rest of this iovec next

@@ -52,6 +52,12 @@ class LcmLog {
   static constexpr size_t kBufBytes = 256 << 10;
   static constexpr size_t kMaxSegs = 512;               // iovecs per writev (IOV_MAX is 1024)
   static constexpr size_t kBatchBytes = size_t(1) << 20;  // bytes per batch, stable payloads included
+  // Each writev ends at a multiple of 128 KiB in the file (what cat writes at a time), so the kernel
+  // puts the log in page-cache folios of at most 128 KiB. A write of 1 MiB or more lets it take 1-2 MiB
+  // folios, and on a VM whose free memory is handed back to the host (virtio-balloon free page
+  // reporting hands back the large free blocks) touching those costs 0.3-2.4 s of system time per GB
+  // instead of 0.25 s (bench: docs/notes/import.md, "Speed, fifth round").
+  static constexpr size_t kWriteStep = size_t(128) << 10;
   // What one writev writes: framing and copied data in `bytes`, stable payloads where they are.
   struct Batch {
     struct Seg {
@@ -80,6 +86,7 @@ class LcmLog {
   std::atomic<bool> failed_{false};
   std::thread thread_;
   uint64_t events_ = 0, bytes_ = 0;
+  size_t file_pos_ = 0;  // bytes written to the file (writer thread)
 };
 
 }  // namespace fploc::import
