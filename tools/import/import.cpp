@@ -232,7 +232,6 @@ int main(int argc, char** argv) {
   size_t frames_total = 0;
   struct FrameInfo { int32_t frame_id, height, width, missing; };
   std::vector<FrameInfo> frame_list;  // for the summary (the first 1000)
-  std::vector<uint8_t> scan_bytes;  // scan_t encoded straight from the Scan (same bytes as to_msg + encode)
   std::map<std::string, int64_t> seq;
   CloudStats cstats;
   std::map<std::string, CloudStats> cloud_info;
@@ -247,10 +246,9 @@ int main(int argc, char** argv) {
       s.seq = seq[ouster_scan_channel]++;
       const int64_t t = i < ouster.frame_times_ns.size() ? ouster.frame_times_ns[i] : fallback_ns;
       if (frame_list.size() < 1000) frame_list.push_back({s.frame_id, s.height, s.width, s.missing_columns});
-      if (!out.empty()) {
-        fploc::import::encode_scan(s, scan_bytes);
-        lcm_log.write_raw(ouster_scan_channel, t / 1000, scan_bytes.data(), scan_bytes.size());
-      }
+      if (!out.empty())
+        if (uint8_t* p = lcm_log.begin_event(ouster_scan_channel, t / 1000, fploc::import::encoded_scan_size(s)))
+          fploc::import::encode_scan(s, p);
       ++written[ouster_scan_channel];
     }
     frames_total += frames.size();
@@ -345,10 +343,9 @@ int main(int argc, char** argv) {
         s.frame_id = int32_t(s.seq & 0xFFFF);
         s.sensor = "PointCloud2 " + c.topic + " (" + std::to_string(s.height) + " rings)";
         cloud_info[c.topic] = cstats;
-        if (!out.empty()) {
-          fploc::import::encode_scan(s, scan_bytes);
-          lcm_log.write_raw(ch, m.time_ns / 1000, scan_bytes.data(), scan_bytes.size());
-        }
+        if (!out.empty())
+          if (uint8_t* p = lcm_log.begin_event(ch, m.time_ns / 1000, fploc::import::encoded_scan_size(s)))
+            fploc::import::encode_scan(s, p);
         ++written[ch];
         break;
       }

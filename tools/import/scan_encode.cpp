@@ -42,13 +42,22 @@ struct Put {
 
 }  // namespace
 
-void encode_scan(const Scan& s, std::vector<uint8_t>& out) {
+size_t encoded_scan_size(const Scan& s) {
   const size_t h = size_t(std::max(0, s.height)), w = size_t(std::max(0, s.width));
   const size_t n = h * w;
-  const size_t size = 8 + 8 + 8 + 4 + 4 + s.sensor.size() + 1 + 2 + 2 + 4 + n * (4 + 2 + 1) + w * (8 + 2 + 1) +
-                      h * (4 + 4 + 2) + 4 + 16 * 8 + 4 + 1;
-  out.resize(size);
-  Put o{out.data()};
+  return 8 + 8 + 8 + 4 + 4 + s.sensor.size() + 1 + 2 + 2 + 4 + n * (4 + 2 + 1) + w * (8 + 2 + 1) + h * (4 + 4 + 2) + 4 +
+         16 * 8 + 4 + 1;
+}
+
+void encode_scan(const Scan& s, std::vector<uint8_t>& out) {
+  out.resize(encoded_scan_size(s));
+  encode_scan(s, out.data());
+}
+
+void encode_scan(const Scan& s, uint8_t* out) {
+  const size_t h = size_t(std::max(0, s.height)), w = size_t(std::max(0, s.width));
+  const size_t n = h * w;
+  Put o{out};
   o.be64(uint64_t(scan_t::getHash()));
   o.be64(uint64_t(s.utime));
   o.be64(uint64_t(s.seq));
@@ -103,7 +112,6 @@ void encode_scan(const Scan& s, std::vector<uint8_t>& out) {
   for (double d : b.lidar_to_sensor) o.f64(d);
   o.be32(uint32_t(s.missing_columns));
   o.u8(uint8_t(int8_t(s.status)));
-  out.resize(size_t(o.p - out.data()));
 }
 
 }  // namespace fploc::import
