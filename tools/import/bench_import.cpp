@@ -1,5 +1,5 @@
-// fploc bench import [--size-mb 1024] [--kind ouster|cloud|laser|all] [--compression none|lz4|bz2] [--runs 3]
-//                    [--json] [--keep DIR]
+// fploc bench import [--size-mb 1024] [--kind ouster|cloud|laser|all] [--format bag|mcap]
+//                    [--compression none|lz4|bz2|zstd] [--runs 3] [--json] [--keep DIR]
 // Import speed as a ratio against `cat` of the same file, timed in the same run (target: <= 2x).
 // Writes a large bag into a temp dir (deleted afterwards), by content:
 //   ouster: the ouster_ros bag's packets (../shared/data/ouster/512x10_raw.bag; OS-0-128, 512x10,
@@ -10,8 +10,10 @@
 // then times, --runs times each, interleaved: `cat BAG > /dev/null` (after one warm-up read, so both run
 // from the page cache), `cat BAG > COPY` (read + write the same volume) and `fploc-import BAG --out
 // LOG.lcm`; and again with the bag's pages evicted before each run (cold). Medians are reported.
-// Compressed bags (--compression bz2|lz4): the same compressed chunks, concatenated into one file, are
-// also decompressed by the compression's own tool (`bzip2 -dc`, `lz4 -dc`; libbz2/liblz4 behind both),
+// --format mcap writes an MCAP file instead (ROS 1 message encoding, the same messages; chunks none, zstd
+// or lz4, with their CRC-32s and the data section's, as the MCAP libraries write them).
+// Compressed files (--compression bz2|lz4|zstd): the same compressed chunks, concatenated into one file, are
+// also decompressed by the compression's own tool (`bzip2 -dc`, `lz4 -dc`, `zstd -dc`; the same libraries),
 // to /dev/null and into a file, in the same runs: the decompressor's speed on the same data, the bound
 // an importer cannot beat (the `cat` ratio of a compressed bag includes all of the decompression).
 #include <fcntl.h>
@@ -30,6 +32,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fploc/recording/bag_writer.h"
+#include "fploc/recording/mcap_writer.h"
 #include "fploc/recording/recording.h"
 
 using namespace fploc::rec;
@@ -149,9 +152,31 @@ std::vector<uint8_t> laser_scan() {
   return b;
 }
 
+// The generated recording: a ROS 1 bag or an MCAP file (ROS 1 message encoding, the same message bytes).
+struct Recorder {
+  bool mcap = false;
+  BagWriter bag;
+  McapWriter mc;
+  bool open(const std::string& path, const std::string& compression) {
+    return mcap ? mc.open(path, compression) : bag.open(path, compression);
+  }
+  void copy_chunks_to(std::FILE* f) { (mcap ? mc.chunk_copy : bag.chunk_copy) = f; }
+  // type "pkg/Name" (MCAP: "pkg/msg/Name", as ROS 2 writes it).
+  uint32_t add(const std::string& topic, const std::string& type) {
+    if (!mcap) return bag.add_connection(topic, type);
+    const auto k = type.find('/');
+    return mc.add_channel(topic, type.substr(0, k) + "/msg" + type.substr(k), "ros1");
+  }
+  void write(uint32_t conn, int64_t t, const uint8_t* d, size_t n) {
+    if (mcap) mc.write(uint16_t(conn), t, d, n);
+    else bag.write(conn, t, d, n);
+  }
+  bool close() { return mcap ? mc.close() : bag.close(); }
+};
+
 // Copies of one message (a std_msgs/Header first: its stamp at bytes 4..11 set to the record time), one
 // every period_ns, until `target` bytes are written.
-void write_copies(BagWriter& w, uint32_t conn, std::vector<uint8_t> msg, int64_t period_ns, uint64_t target,
+void write_copies(Recorder& w, uint32_t conn, std::vector<uint8_t> msg, int64_t period_ns, uint64_t target,
                   uint64_t& written, uint64_t& messages) {
   for (int64_t i = 0; written < target; ++i) {
     const int64_t t = 1700000000LL * 1000000000LL + i * period_ns;
@@ -174,12 +199,13 @@ double median(std::vector<double> v) {
 int main(int argc, char** argv) {
   CLI::App app{"fploc bench import: import speed against cat of the same file (ratio)"};
   int size_mb = 1024, runs = 3;
-  std::string kind = "all", compression = "none", keep;
+  std::string kind = "all", compression = "none", keep, format = "bag";
   bool json = false;
   app.add_option("--size-mb", size_mb, "size of each generated bag");
   app.add_option("--kind", kind, "ouster, cloud, laser or all");
   app.add_option("--runs", runs, "timed runs of each command (medians reported)");
-  app.add_option("--compression", compression, "chunk compression of the generated bag: none, lz4, bz2");
+  app.add_option("--compression", compression, "chunk compression of the generated file: none, lz4, bz2 (bag), zstd (mcap)");
+  app.add_option("--format", format, "generated file: bag (ROS 1 bag 2.0) or mcap (MCAP, ROS 1 message encoding)");
   app.add_option("--keep", keep, "write the bags here and keep them");
   app.add_flag("--json", json, "JSON on stdout");
   CLI11_PARSE(app, argc, argv);
@@ -194,8 +220,13 @@ int main(int argc, char** argv) {
 
   for (const std::string k : {"ouster", "cloud", "laser"}) {
     if (kind != "all" && kind != k) continue;
-    const std::string bag = (dir / (k + ".bag")).string();
-    BagWriter w;
+    if ((format == "mcap") == (compression == "bz2") && compression != "none" && compression != "lz4") {
+      std::cerr << "fploc bench import: --compression " << compression << " is not for --format " << format << "\n";
+      return 2;
+    }
+    const std::string bag = (dir / (k + (format == "mcap" ? ".mcap" : ".bag"))).string();
+    Recorder w;
+    w.mcap = format == "mcap";
     if (!w.open(bag, compression)) {
       std::cerr << "cannot write " << bag << "\n";
       return 1;
@@ -204,7 +235,7 @@ int main(int argc, char** argv) {
     std::FILE* chunk_copy = nullptr;
     if (compression != "none") {
       chunk_copy = std::fopen(chunks.c_str(), "wb");
-      w.chunk_copy = chunk_copy;
+      w.copy_chunks_to(chunk_copy);
     }
     uint64_t written = 0, messages = 0;
     if (k == "ouster") {
@@ -221,7 +252,7 @@ int main(int argc, char** argv) {
       RawMessage m;
       while (r->next(m)) {
         const auto& c = r->connections().at(m.conn);
-        if (!conn.count(m.conn)) conn[m.conn] = w.add_connection(c.topic, c.type);
+        if (!conn.count(m.conn)) conn[m.conn] = w.add(c.topic, c.type);
         ms.push_back({conn[m.conn], m.time_ns, std::vector<uint8_t>(m.data, m.data + m.size), c.type});
       }
       for (int64_t copy = 0; written < target; ++copy) {
@@ -250,16 +281,16 @@ int main(int argc, char** argv) {
         }
       }
     } else if (k == "laser") {
-      write_copies(w, w.add_connection("/scan", "sensor_msgs/LaserScan"), laser_scan(), 25000000LL, target, written, messages);
+      write_copies(w, w.add("/scan", "sensor_msgs/LaserScan"), laser_scan(), 25000000LL, target, written, messages);
     } else {
-      write_copies(w, w.add_connection("/velodyne_points", "sensor_msgs/PointCloud2"), vlp16_cloud(), 100000000LL, target,
+      write_copies(w, w.add("/velodyne_points", "sensor_msgs/PointCloud2"), vlp16_cloud(), 100000000LL, target,
                    written, messages);
     }
     if (!w.close() || (chunk_copy && std::fclose(chunk_copy) != 0)) {
       std::cerr << "writing " << bag << " failed\n";
       return 1;
     }
-    const std::string tool = compression == "bz2" ? "bzip2 -dc" : compression == "lz4" ? "lz4 -dc" : "";
+    const std::string tool = compression == "bz2" ? "bzip2 -dc" : compression == "lz4" ? "lz4 -dc" : compression == "zstd" ? "zstd -dc" : "";
     const uint64_t bytes = fs::file_size(bag);
     const std::string lcm = (dir / (k + ".lcm")).string(), copy = (dir / (k + ".copy")).string();
     run("cat '" + bag + "' > /dev/null");  // warm-up: the page-cache timings below read from memory
@@ -299,7 +330,7 @@ int main(int argc, char** argv) {
     const double t_cat = median(cat_s), t_copy = median(copy_s), t_cat_cold = median(cat_cold_s), cpu_cat = median(cat_cpu);
     for (const auto& [name, flag] : variants) {
       const double t_import = median(imp_s[name]), t_import_cold = median(imp_cold_s[name]), cpu_import = median(imp_cpu[name]);
-      nlohmann::json j = {{"kind", name}, {"compression", compression}, {"bag_bytes", bytes}, {"messages", messages},
+      nlohmann::json j = {{"kind", name}, {"format", format}, {"compression", compression}, {"bag_bytes", bytes}, {"messages", messages},
                           {"lcm_bytes", lcm_bytes[name]}, {"runs", runs}, {"cat_s", t_cat}, {"cat_copy_s", t_copy},
                           {"import_s", t_import}, {"ratio_vs_cat", t_import / t_cat}, {"ratio_vs_cat_copy", t_import / t_copy},
                           {"import_MBps", bytes / 1e6 / t_import}, {"cold_cat_s", t_cat_cold}, {"cold_import_s", t_import_cold},
