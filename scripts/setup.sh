@@ -8,7 +8,7 @@ PKGS=(
   libprotobuf-dev protobuf-compiler
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libyaml-dev libpng-dev libcli11-dev libcpp-httplib-dev libssl-dev libpcap-dev libnanoflann-dev
-  libbz2-dev liblz4-dev libzstd-dev zlib1g-dev lz4
+  libbz2-dev liblz4-dev libzstd-dev zlib1g-dev libisal-dev lz4
   python3
   libboost-dev openssh-client openssh-server
   python3-ezdxf   # tests: `fploc map diff` DXF read back by a CAD library (ezdxf, strict read + audit)

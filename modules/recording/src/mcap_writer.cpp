@@ -1,6 +1,6 @@
 #include "fploc/recording/mcap_writer.h"
 
-#include <zlib.h>
+#include <isa-l/crc.h>
 
 #include <cstring>
 
@@ -28,14 +28,7 @@ std::vector<uint8_t> record(uint8_t op, const std::vector<uint8_t>& body) {
   r.insert(r.end(), body.begin(), body.end());
   return r;
 }
-uint32_t crc_of(const uint8_t* p, size_t n, unsigned long c = crc32(0L, Z_NULL, 0)) {
-  while (n > 0) {
-    const size_t k = n < (size_t(1) << 30) ? n : size_t(1) << 30;
-    c = crc32(c, p, uInt(k));
-    p += k, n -= k;
-  }
-  return uint32_t(c);
-}
+uint32_t crc_of(const uint8_t* p, size_t n, uint32_t c = 0) { return crc32_gzip_refl(c, p, n); }
 
 }  // namespace
 
@@ -50,7 +43,7 @@ bool McapWriter::open(const std::string& path, const std::string& compression, s
   if (!f_) return false;
   compression_ = compression == "none" ? "" : compression;
   chunk_bytes_ = chunk_bytes;
-  crc_ = crc32(0L, Z_NULL, 0);
+  crc_ = 0;
   put(std::vector<uint8_t>(kMagic, kMagic + 8));
   std::vector<uint8_t> h;
   str(h, "ros1");  // profile

@@ -91,12 +91,24 @@ class BagReader : public FileReader {
 
 // MCAP (data section in file order: chunks none/zstd/lz4, or messages outside chunks; the summary
 // section and indexes are not needed).
+// Compressed chunks are decompressed (and their CRC-32 computed) one ahead on a second thread, as in
+// BagReader; results and errors are taken in file order.
 class McapReader : public FileReader {
  public:
   McapReader(std::unique_ptr<FileBytes> f, std::string name);
+  ~McapReader() override;
   bool next(RawMessage& m) override;
 
  private:
+  struct Ahead {
+    std::string error;
+    std::vector<uint8_t> bytes;
+    uint32_t crc = 0;  // of bytes, when asked for
+  };
+  void prefetch_after(size_t pos);  // starts on the next compressed chunk after pos, if any
+  std::future<Ahead> ahead_;
+  size_t ahead_at_ = 0;
+  std::vector<uint8_t> spare_;
   // One record's content (opcode and body); false with *why on a bad record.
   bool on_record(uint8_t op, const uint8_t* b, size_t n, RawMessage* m, bool* is_message, std::string* why);
   std::map<uint16_t, std::pair<std::string, std::string>> schemas_;  // id -> (name, encoding)

@@ -35,7 +35,7 @@ class McapWriter {
   int64_t chunk_start_ = 0, chunk_end_ = 0;
   uint32_t seq_ = 0;
   uint16_t next_id_ = 1;
-  unsigned long crc_ = 0;  // zlib crc32 of everything written so far
+  uint32_t crc_ = 0;  // CRC-32 of everything written so far
   bool ok_ = true;
 };
 
