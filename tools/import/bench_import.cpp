@@ -1,5 +1,5 @@
 // fploc bench import [--size-mb 1024] [--kind ouster|cloud|laser|all] [--format bag|mcap]
-//                    [--compression none|lz4|bz2|zstd] [--runs 3] [--json] [--keep DIR]
+//                    [--compression none|lz4|bz2|zstd] [--runs 3] [--json] [--keep DIR] [--baseline-importer EXE]
 // Import speed as a ratio against `cat` of the same file, timed in the same run (target: <= 2x).
 // Writes a large bag into a temp dir (deleted afterwards), by content:
 //   ouster: the ouster_ros bag's packets (../shared/data/ouster/512x10_raw.bag; OS-0-128, 512x10,
@@ -208,6 +208,10 @@ int main(int argc, char** argv) {
   app.add_option("--format", format, "generated file: bag (ROS 1 bag 2.0) or mcap (MCAP, ROS 1 message encoding)");
   app.add_option("--keep", keep, "write the bags here and keep them");
   app.add_flag("--json", json, "JSON on stdout");
+  std::string baseline;
+  app.add_option("--baseline-importer", baseline,
+                 "another fploc-import binary (e.g. main's) timed in the same runs (kinds '... [baseline]'); the first "
+                 "run's logs of the two are compared byte for byte (same_bytes_as_baseline)");
   CLI11_PARSE(app, argc, argv);
   const std::string root = std::getenv("FPLOC_ROOT") ? std::getenv("FPLOC_ROOT") : ".";
   const std::string shared = std::getenv("FPLOC_SHARED_DIR") ? std::string(std::getenv("FPLOC_SHARED_DIR")) : root + "/../shared";
@@ -294,8 +298,15 @@ int main(int argc, char** argv) {
     const uint64_t bytes = fs::file_size(bag);
     const std::string lcm = (dir / (k + ".lcm")).string(), copy = (dir / (k + ".copy")).string();
     run("cat '" + bag + "' > /dev/null");  // warm-up: the page-cache timings below read from memory
-    std::vector<std::pair<std::string, std::string>> variants = {{k, ""}};
-    if (k == "ouster") variants.push_back({"ouster --decode", " --decode"});
+    struct Variant {
+      std::string name, flag, importer;
+    };
+    std::vector<Variant> variants = {{k, "", importer}};
+    if (k == "ouster") variants.push_back({"ouster --decode", " --decode", importer});
+    if (!baseline.empty())  // another importer (e.g. main's) timed in the same runs, its logs compared byte for byte
+      for (size_t v = 0, nv = variants.size(); v < nv; ++v)
+        variants.push_back({variants[v].name + " [baseline]", variants[v].flag, baseline});
+    std::map<std::string, bool> same_bytes;  // variant -> its log equals the baseline's (first run)
     std::vector<double> cat_s, cat_cpu, copy_s, cat_cold_s, tool_s, tool_file_s, tool_cpu;
     std::map<std::string, std::vector<double>> imp_s, imp_cpu, imp_cold_s;
     std::map<std::string, uint64_t> lcm_bytes;
@@ -310,10 +321,16 @@ int main(int argc, char** argv) {
         tool_file_s.push_back(run(tool + " '" + chunks + "' > '" + copy + "'"));
         fs::remove(copy);
       }
-      for (const auto& [name, flag] : variants) {
-        imp_s[name].push_back(run("'" + importer + "' '" + bag + "' --out '" + lcm + "' --quiet" + flag + " > /dev/null"));
+      for (const auto& [name, flag, exe] : variants) {
+        imp_s[name].push_back(run("'" + exe + "' '" + bag + "' --out '" + lcm + "' --quiet" + flag + " > /dev/null"));
         imp_cpu[name].push_back(last_cpu);
         lcm_bytes[name] = fs::file_size(lcm);
+        const std::string kept = (dir / (k + flag.substr(flag.empty() ? 0 : 1) + ".first.lcm")).string();
+        if (i == 0 && !baseline.empty() && exe != baseline) fs::rename(lcm, kept);  // compared with the baseline's below
+        else if (i == 0 && !baseline.empty()) {
+          same_bytes[name.substr(0, name.size() - 11)] = std::system(("cmp -s '" + kept + "' '" + lcm + "'").c_str()) == 0;
+          fs::remove(kept);
+        }
         fs::remove(lcm);
       }
     }
@@ -321,14 +338,14 @@ int main(int argc, char** argv) {
     for (int i = 0; i < runs; ++i) {
       evict(bag);
       cat_cold_s.push_back(run("cat '" + bag + "' > /dev/null"));
-      for (const auto& [name, flag] : variants) {
+      for (const auto& [name, flag, exe] : variants) {
         evict(bag);
-        imp_cold_s[name].push_back(run("'" + importer + "' '" + bag + "' --out '" + lcm + "' --quiet" + flag + " > /dev/null"));
+        imp_cold_s[name].push_back(run("'" + exe + "' '" + bag + "' --out '" + lcm + "' --quiet" + flag + " > /dev/null"));
         fs::remove(lcm);
       }
     }
     const double t_cat = median(cat_s), t_copy = median(copy_s), t_cat_cold = median(cat_cold_s), cpu_cat = median(cat_cpu);
-    for (const auto& [name, flag] : variants) {
+    for (const auto& [name, flag, exe] : variants) {
       const double t_import = median(imp_s[name]), t_import_cold = median(imp_cold_s[name]), cpu_import = median(imp_cpu[name]);
       nlohmann::json j = {{"kind", name}, {"format", format}, {"compression", compression}, {"bag_bytes", bytes}, {"messages", messages},
                           {"lcm_bytes", lcm_bytes[name]}, {"runs", runs}, {"cat_s", t_cat}, {"cat_copy_s", t_copy},
@@ -336,6 +353,10 @@ int main(int argc, char** argv) {
                           {"import_MBps", bytes / 1e6 / t_import}, {"cold_cat_s", t_cat_cold}, {"cold_import_s", t_import_cold},
                           {"cold_ratio_vs_cat", t_import_cold / t_cat_cold}, {"cat_cpu_s", cpu_cat}, {"import_cpu_s", cpu_import},
                           {"import_runs_s", imp_s[name]}, {"cat_runs_s", cat_s}};
+      if (!baseline.empty()) {
+        j["importer"] = exe;
+        if (same_bytes.count(name)) j["same_bytes_as_baseline"] = same_bytes[name];
+      }
       if (!tool.empty()) {
         const double t_tool = median(tool_s), t_tool_file = median(tool_file_s);
         j["decompressor"] = tool;
