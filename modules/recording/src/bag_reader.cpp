@@ -87,25 +87,15 @@ bool next_compressed_chunk(const uint8_t* base, size_t n, size_t pos, size_t& at
 
 }  // namespace
 
-BagReader::~BagReader() {
-  if (ahead_.valid()) ahead_.wait();
-}
-
 void BagReader::prefetch_after(size_t pos) {
-  if (ahead_.valid()) return;
+  if (ahead_.pending()) return;
   size_t at = 0;
   Record r;
   if (!next_compressed_chunk(f_->data(), size_, pos, at, r)) return;
   uint32_t usize = 0;
   std::string why;
   if (!field_u32(r, "size", usize, &why)) return;  // reported when the chunk is reached
-  ahead_at_ = at;
-  ahead_ = std::async(std::launch::async, [method = text(find(r.fields, "compression")), d = r.data, n = r.data_len, usize,
-                                           out = std::move(spare_)]() mutable {
-    std::string e = decompress(method, d, n, usize, out);
-    return std::make_pair(std::move(e), std::move(out));
-  });
-  spare_.clear();
+  ahead_.start({at, text(find(r.fields, "compression")), r.data, r.data_len, usize, false});
 }
 
 BagReader::BagReader(std::unique_ptr<FileBytes> f, std::string name) : FileReader(std::move(f), std::move(name), "bag 2.0") {
@@ -169,19 +159,9 @@ bool BagReader::next(RawMessage& m) {
         cn_ = r.data_len;
       } else {
         std::string e;
-        if (ahead_.valid()) {
-          auto res = ahead_.get();
-          if (ahead_at_ == at) {
-            e = std::move(res.first);
-            spare_ = std::move(buf_);  // the previous chunk's buffer: its messages are consumed
-            buf_ = std::move(res.second);
-          } else {
-            spare_ = std::move(res.second);
-            e = decompress(method, r.data, r.data_len, usize, buf_);
-          }
-        } else {
-          e = decompress(method, r.data, r.data_len, usize, buf_);
-        }
+        ChunkAhead::Result res;
+        if (ahead_.take(at, buf_, res)) e = std::move(res.error);
+        else e = decompress(method, r.data, r.data_len, usize, buf_);
         if (!e.empty()) return stop(chunk_what_ + ": " + e);
         cd_ = buf_.data();
         cn_ = buf_.size();

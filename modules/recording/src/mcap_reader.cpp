@@ -93,12 +93,8 @@ bool parse_chunk(const uint8_t* body, uint64_t len, ChunkHeader& h) {
 
 }  // namespace
 
-McapReader::~McapReader() {
-  if (ahead_.valid()) ahead_.wait();
-}
-
 void McapReader::prefetch_after(size_t pos) {
-  if (ahead_.valid()) return;
+  if (ahead_.pending()) return;
   const uint8_t* d = f_->data();
   for (int k = 0; k < 256 && size_ - pos >= 9; ++k) {  // message indexes and the like between chunks skipped
     const uint8_t op = d[pos];
@@ -107,15 +103,7 @@ void McapReader::prefetch_after(size_t pos) {
     if (op == 0x06) {
       ChunkHeader h;
       if (!parse_chunk(d + pos + 9, len, h) || h.method.empty()) return;  // reported when reached
-      ahead_at_ = pos;
-      ahead_ = std::async(std::launch::async, [h, out = std::move(spare_)]() mutable {
-        Ahead a;
-        a.error = decompress(h.method, h.records, h.rlen, h.usize, out);
-        if (a.error.empty() && kCheckCrc && h.crc != 0) a.crc = crc32_of(out.data(), out.size());
-        a.bytes = std::move(out);
-        return a;
-      });
-      spare_.clear();
+      ahead_.start({pos, h.method, h.records, size_t(h.rlen), size_t(h.usize), kCheckCrc && h.crc != 0});
       return;
     }
     pos += 9 + len;
@@ -225,17 +213,10 @@ bool McapReader::next(RawMessage& m) {
         cn_ = h.rlen;
       } else {
         std::string e;
-        if (ahead_.valid()) {
-          Ahead a = ahead_.get();
-          if (ahead_at_ == at) {
-            e = std::move(a.error);
-            spare_ = std::move(buf_);  // the previous chunk's buffer: its messages are consumed
-            buf_ = std::move(a.bytes);
-            got = a.crc, crc_known = e.empty() && kCheckCrc && h.crc != 0;
-          } else {
-            spare_ = std::move(a.bytes);
-            e = decompress(h.method, h.records, h.rlen, h.usize, buf_);
-          }
+        ChunkAhead::Result res;
+        if (ahead_.take(at, buf_, res)) {
+          e = std::move(res.error);
+          got = res.crc, crc_known = res.has_crc;
         } else {
           e = decompress(h.method, h.records, h.rlen, h.usize, buf_);
         }

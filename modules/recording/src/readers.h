@@ -1,12 +1,12 @@
 // The two readers behind open_recording() (internal).
 #pragma once
 #include <cstring>
-#include <future>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "chunk_ahead.h"
 #include "fploc/recording/recording.h"
 
 namespace fploc::rec {
@@ -73,20 +73,17 @@ struct Record {
 // ROS 1 bag format 2.0, read sequentially (the index at the end is not needed: an unindexed bag or one
 // cut short by a crash reads up to its last whole record). Chunks: none, bz2, lz4.
 // Compressed chunks: while one chunk's messages are read, the next chunk is decompressed on a second
-// thread (libbz2 decodes ~20-40 MB/s: the import's whole cost); results and errors are the sequential
-// ones, taken in file order.
+// thread when it gets a CPU (chunk_ahead.h; libbz2 decodes ~20-40 MB/s: the import's whole cost);
+// results and errors are the sequential ones, taken in file order.
 class BagReader : public FileReader {
  public:
   BagReader(std::unique_ptr<FileBytes> f, std::string name);
-  ~BagReader() override;
   bool next(RawMessage& m) override;
 
  private:
   void prefetch_after(size_t pos);  // starts decompressing the compressed chunk that follows pos, if any
-  std::future<std::pair<std::string, std::vector<uint8_t>>> ahead_;  // (error, bytes) of the chunk at ahead_at_
-  size_t ahead_at_ = 0;
-  std::vector<uint8_t> spare_;  // a chunk buffer for the next prefetch (no allocation per chunk)
-  bag::Record rec_;             // the record being read (its field list reused)
+  ChunkAhead ahead_;
+  bag::Record rec_;  // the record being read (its field list reused)
 };
 
 // MCAP (data section in file order: chunks none/zstd/lz4, or messages outside chunks; the summary
@@ -96,19 +93,11 @@ class BagReader : public FileReader {
 class McapReader : public FileReader {
  public:
   McapReader(std::unique_ptr<FileBytes> f, std::string name);
-  ~McapReader() override;
   bool next(RawMessage& m) override;
 
  private:
-  struct Ahead {
-    std::string error;
-    std::vector<uint8_t> bytes;
-    uint32_t crc = 0;  // of bytes, when asked for
-  };
   void prefetch_after(size_t pos);  // starts on the next compressed chunk after pos, if any
-  std::future<Ahead> ahead_;
-  size_t ahead_at_ = 0;
-  std::vector<uint8_t> spare_;
+  ChunkAhead ahead_;
   // One record's content (opcode and body); false with *why on a bad record.
   bool on_record(uint8_t op, const uint8_t* b, size_t n, RawMessage* m, bool* is_message, std::string* why);
   std::map<uint16_t, std::pair<std::string, std::string>> schemas_;  // id -> (name, encoding)
