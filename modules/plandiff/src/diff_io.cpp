@@ -28,6 +28,7 @@ void write_json(const Diff& d, const FloorPlan& plan, std::ostream& out, bool al
                      {"offset_m", e.offset_m},
                      {"offset_spread_m", e.offset_spread_m},
                      {"offset_sigma_m", e.offset_sigma_m},
+                     {"pose_sigma_m", e.pose_sigma_m},
                      {"seen_ratio", e.seen_ratio()},
                      {"frames_expected", e.frames_expected},
                      {"frames_with_points", e.frames_with_points}};

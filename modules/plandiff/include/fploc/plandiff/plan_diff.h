@@ -48,6 +48,10 @@ struct Options {
   // built, seen with a spread of offsets, is not called moved on an offset its uncertainty explains.
   double moved_z = 2.0;
   double moved_pose_sigma_m = 0.01;   // the localizer's error along the wall normal (does not average out)
+  // With the localizer's pose covariance (add_frame's pose_cov): the pose part of an element's offset sigma is
+  // the mean over its scans of the pose's variance along the wall's normal at its points (translation along
+  // the normal and yaw times the lever arm to the points), at least moved_pose_sigma_m; false: that alone.
+  bool moved_pose_covariance = true;
   double moved_max_looks = 30;        // the scans count as at most this many independent looks
   double new_cell_m = 0.05;         // grid of unexplained points
   int new_min_frames = 5;           // a cell hit in at least this many frames ...
@@ -95,6 +99,7 @@ struct ElementDiff {
   double offset_m = 0;        // median signed offset along the left normal (segments) / radially (circles)
   double offset_spread_m = 0; // MAD of the per-frame offsets
   double offset_sigma_m = 0;  // its uncertainty (PlanDiff::offset_sigma)
+  double pose_sigma_m = 0;    // the localizer's pose sigma along its normal (mean variance over its scans; 0: not given)
   int frames_with_points = 0;
   int frames_expected = 0;    // frames in which at least one probe was expected visible
   int64_t probes_expected = 0, probes_seen = 0;
@@ -144,8 +149,10 @@ struct Diff {
 class PlanDiff {
  public:
   explicit PlanDiff(FloorPlan plan, Options o = {});
-  // One registered scan: pose of the sensor on the plan, wall points in the sensor frame (metres).
-  void add_frame(double x, double y, double yaw, const std::vector<Eigen::Vector2f>& points);
+  // One registered scan: pose of the sensor on the plan, wall points in the sensor frame (metres); pose_cov:
+  // the pose's x, y, yaw covariance (the localizer's, optional: see Options::moved_pose_covariance).
+  void add_frame(double x, double y, double yaw, const std::vector<Eigen::Vector2f>& points,
+                 const Eigen::Matrix3d* pose_cov = nullptr);
   Diff result() const;
   int frames() const { return frames_; }
   const FloorPlan& plan() const { return plan_; }
@@ -159,6 +166,8 @@ class PlanDiff {
   };
   struct Acc {
     std::vector<float> frame_offsets;  // per-frame median offset
+    double pose_var = 0;               // sum over those frames (with a pose covariance) of the pose variance
+    int pose_frames = 0;               // along the normal, and how many
     int frames_expected = 0;
     int64_t expected = 0, seen = 0;
   };
