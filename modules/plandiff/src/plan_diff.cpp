@@ -239,6 +239,8 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
   std::vector<std::vector<Obs>> bins(static_cast<size_t>(nb));
   std::vector<float> min_range(size_t(nb), std::numeric_limits<float>::infinity());
   std::vector<std::vector<float>> offs(plan_.elements.size());
+  std::vector<std::vector<float>> half_offs[2] = {std::vector<std::vector<float>>(plan_.elements.size()),
+                                                  std::vector<std::vector<float>>(plan_.elements.size())};
   std::vector<V2> along_sum(plan_.elements.size(), V2::Zero());  // sum of (point - sensor) of the inside points
   Eigen::Matrix3d sA = Eigen::Matrix3d::Zero();
   Eigen::Vector3d sg = Eigen::Vector3d::Zero();
@@ -261,6 +263,12 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
       if (inside) {
         offs[size_t(e)].push_back(float(off));
         along_sum[size_t(e)] += p - s;
+        const Element& es = plan_.elements[size_t(e)];
+        if (es.kind == ElementKind::kSegment) {
+          const V2 d = es.b - es.a;
+          const double t = d.squaredNorm() > 0 ? (p - es.a).dot(d) / d.squaredNorm() : 0.0;
+          half_offs[t < 0.5 ? 0 : 1][size_t(e)].push_back(float(off));
+        }
       }
       const Element& el = plan_.elements[size_t(e)];
       if (inside && el.kind == ElementKind::kSegment && std::abs(off) < o_.scale_max_offset_m) {
@@ -293,6 +301,8 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
   for (size_t e = 0; e < offs.size(); ++e) {
     if (offs[e].size() < 5) continue;
     acc_[e].frame_offsets.push_back(float(median_of(offs[e])));
+    for (int h = 0; h < 2; ++h)
+      if (half_offs[h][e].size() >= 3) acc_[e].half_offsets[h].push_back(float(median_of(half_offs[h][e])));
     if (!cov_ok) continue;
     // The pose error (dx, dy, dyaw) moves the element's points along its normal n by
     // n . (dx, dy) + dyaw n . perp(rc) (rc: the mean point relative to the sensor, perp: +90 deg).
@@ -446,6 +456,16 @@ double PlanDiff::offset_sigma(const ElementDiff& e) const {
   return std::sqrt(pose2 + (n > 0 ? ss * ss / n : ss * ss));
 }
 
+// Both halves of a segment measured and each offset by as much as the whole must be (moved_both_halves).
+bool PlanDiff::halves_moved(const ElementDiff& e) const {
+  if (!o_.moved_both_halves) return true;
+  for (int h = 0; h < 2; ++h)
+    if (e.half_frames[h] < o_.min_frames || e.half_offset_m[h] * e.offset_m <= 0 ||
+        std::abs(e.half_offset_m[h]) - o_.moved_z * e.offset_sigma_m < o_.moved_min_m)
+      return false;
+  return true;
+}
+
 Diff PlanDiff::result() const {
   Diff d;
   d.frames = frames_;
@@ -494,6 +514,10 @@ Diff PlanDiff::result() const {
       e.offset_spread_m = median_of(dev);
       if (a.pose_frames > 0) e.pose_sigma_m = std::sqrt(a.pose_var / a.pose_frames);
       e.offset_sigma_m = offset_sigma(e);
+      for (int h = 0; h < 2; ++h) {
+        e.half_frames[h] = int(a.half_offsets[h].size());
+        if (e.half_frames[h] > 0) e.half_offset_m[h] = median_of(a.half_offsets[h]);
+      }
     }
     if (a.frames_expected >= o_.min_frames && a.expected >= o_.missing_min_expected &&
         e.seen_ratio() < o_.missing_seen_ratio)
@@ -502,7 +526,7 @@ Diff PlanDiff::result() const {
              std::abs(e.offset_m) - o_.moved_z * e.offset_sigma_m >= o_.moved_min_m &&
              e.offset_spread_m <= o_.moved_max_spread_m &&
              (plan_.elements[i].kind != ElementKind::kSegment ||
-              (plan_.elements[i].b - plan_.elements[i].a).norm() >= o_.moved_min_length_m))
+              ((plan_.elements[i].b - plan_.elements[i].a).norm() >= o_.moved_min_length_m && halves_moved(e))))
       e.status = Status::kMoved;
     else if (e.frames_with_points > 0 || a.seen > 0)
       e.status = Status::kSeen;

@@ -179,6 +179,37 @@ TEST(PlanDiff, MovedCountsThePoseCovariance) {
   EXPECT_NEAR(d.result().elements[0].pose_sigma_m, 1.5 * 0.02, 1e-3);
 }
 
+// Moved is a wall shifted as a whole: both halves measured and each offset as far. A wall standing askew (ends
+// 4 and 20 cm off: the whole's median 12 cm) or seen near one end only is not called moved; shifted by 12 cm it is.
+TEST(PlanDiff, MovedNeedsBothHalves) {
+  FloorPlan plan;
+  plan.elements.push_back(Element::segment({-3, 2}, {3, 2}));  // left normal +y
+  auto run = [&](double x0, double x1, double off_a, double off_b, plandiff::ElementDiff* out) {
+    plandiff::PlanDiff d(plan);
+    for (int f = 0; f < 40; ++f) {
+      std::vector<Eigen::Vector2f> pts;
+      for (int i = 0; i <= 20; ++i) {
+        const double x = x0 + (x1 - x0) * i / 20.0, t = (x + 3) / 6;
+        pts.emplace_back(float(x), float(2 + (1 - t) * off_a + t * off_b));
+      }
+      d.add_frame(0, 0, 0, pts);
+    }
+    *out = d.result().elements[0];
+    return out->status;
+  };
+  plandiff::ElementDiff e;
+  EXPECT_EQ(run(-2.5, 2.5, 0.12, 0.12, &e), plandiff::Status::kMoved);
+  EXPECT_NEAR(e.half_offset_m[0], 0.12, 1e-3);
+  EXPECT_NEAR(e.half_offset_m[1], 0.12, 1e-3);
+  EXPECT_EQ(run(-2.5, 2.5, 0.04, 0.20, &e), plandiff::Status::kSeen);  // askew
+  EXPECT_NEAR(e.offset_m, 0.12, 0.01);
+  EXPECT_LT(e.half_offset_m[0], 0.10);
+  EXPECT_GT(e.half_offset_m[1], 0.14);
+  EXPECT_EQ(run(0.5, 2.5, 0.12, 0.12, &e), plandiff::Status::kSeen);  // one half only
+  EXPECT_EQ(e.half_frames[0], 0);
+  EXPECT_EQ(e.half_frames[1], 40);
+}
+
 TEST(PlanDiff, CleanWorldHasNoFlags) {
   const DiffRun r = simulate_and_diff("crowd-15", 2);  // the plan is the world; 15 people walk about
   EXPECT_EQ(r.diff.count(plandiff::Status::kMissing), 0);

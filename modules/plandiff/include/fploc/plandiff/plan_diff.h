@@ -52,6 +52,10 @@ struct Options {
   // the mean over its scans of the pose's variance along the wall's normal at its points (translation along
   // the normal and yaw times the lever arm to the points), at least moved_pose_sigma_m; false: that alone.
   bool moved_pose_covariance = true;
+  // A segment is called moved only when each half of it (t < 0.5, t >= 0.5 along it) was measured in >= min_frames
+  // scans (>= 3 points of that half) and each half's median offset passes the same test as the whole: a wall
+  // standing askew (one end a few cm off, the other 10) or seen near one end only is not a wall moved as a whole.
+  bool moved_both_halves = true;
   double moved_max_looks = 30;        // the scans count as at most this many independent looks
   double new_cell_m = 0.05;         // grid of unexplained points
   int new_min_frames = 5;           // a cell hit in at least this many frames ...
@@ -100,6 +104,8 @@ struct ElementDiff {
   double offset_spread_m = 0; // MAD of the per-frame offsets
   double offset_sigma_m = 0;  // its uncertainty (PlanDiff::offset_sigma)
   double pose_sigma_m = 0;    // the localizer's pose sigma along its normal (mean variance over its scans; 0: not given)
+  double half_offset_m[2] = {0, 0};  // segments: the median offset of each half (a -> mid, mid -> b) ...
+  int half_frames[2] = {0, 0};       // ... over this many scans
   int frames_with_points = 0;
   int frames_expected = 0;    // frames in which at least one probe was expected visible
   int64_t probes_expected = 0, probes_seen = 0;
@@ -166,6 +172,7 @@ class PlanDiff {
   };
   struct Acc {
     std::vector<float> frame_offsets;  // per-frame median offset
+    std::vector<float> half_offsets[2];  // segments: per-frame median offset of each half
     double pose_var = 0;               // sum over those frames (with a pose covariance) of the pose variance
     int pose_frames = 0;               // along the normal, and how many
     int frames_expected = 0;
@@ -175,6 +182,7 @@ class PlanDiff {
     int frames = 0, last_frame = -1, points = 0, in_view = 0;
   };
   double offset_sigma(const ElementDiff& e) const;
+  bool halves_moved(const ElementDiff& e) const;
   int nearest(const Eigen::Vector2d& p, double* signed_offset, bool* inside, const Eigen::Vector2d* sensor) const;
   bool extends_beyond_end(const Eigen::Vector2d& p) const;
   int extended_element(const Eigen::Vector2d& a, const Eigen::Vector2d& b) const;
