@@ -35,6 +35,14 @@ pose_t make_pose_msg(int64_t utime, int64_t seq, const Pose2& p, double roll, do
   return m;
 }
 
+Eigen::Matrix3d xy_yaw_covariance(const pose_t& m) {
+  const int idx[3] = {0, 1, 5};
+  Eigen::Matrix3d c;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) c(i, j) = m.covariance[idx[i] * 6 + idx[j]];
+  return c;
+}
+
 pose_t to_msg(const optimizer::PoseOut& p, int64_t seq, int floor_index, const std::string& floor) {
   return make_pose_msg(p.utime, seq, p.pose, p.roll, p.pitch, p.z, p.covariance, p.z_sigma, p.roll_pitch_sigma,
                        int8_t(p.status), p.keyframe, p.final_estimate, floor_index, floor);

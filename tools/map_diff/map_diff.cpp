@@ -135,7 +135,11 @@ int main(int argc, char** argv) {
         const double yaw = std::atan2(2 * (q[3] * q[2] + q[0] * q[1]), 1 - 2 * (q[1] * q[1] + q[2] * q[2]));
         std::vector<Eigen::Vector2f> pts;
         for (int i = 0; i < it->second.num_points; ++i) pts.emplace_back(it->second.x[size_t(i)], it->second.y[size_t(i)]);
-        diff.add_frame(p.position[0], p.position[1], yaw, pts);
+        Eigen::Matrix3d cov;  // pose_t's covariance is x y z roll pitch yaw: (x, y, yaw) = indices 0, 1, 5
+        const int ix[3] = {0, 1, 5};
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) cov(r, c) = p.covariance[ix[r] * 6 + ix[c]];
+        diff.add_frame(p.position[0], p.position[1], yaw, pts, &cov);
         ++used;
       }
     }

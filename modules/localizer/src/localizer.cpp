@@ -11,6 +11,12 @@ Config with_uncertainty_defaults(Config c) {
   c.uncertainty.frame.loss_scale_m = c.matcher.loss_scale_m;
   c.uncertainty.frame.gate_m = c.matcher.min_correspondence_m;
   c.uncertainty.frame.group_rule = c.matcher.group_rule;
+  // The as-built model's loss on element offsets bounds what a wall far off pulls (the optimizer node's
+  // config carries it in the optimizer's, the matcher node's in the matcher's).
+  if (c.uncertainty.frame.element_loss_scale_m == 0) {
+    const matcher::AsBuiltModel& ab = c.optimizer.as_built.on() ? c.optimizer.as_built : c.matcher.as_built;
+    if (ab.on() && ab.loss_scale_m > 0) c.uncertainty.frame.element_loss_scale_m = ab.loss_scale_m;
+  }
   // The window publishes POOR where its pose's covariance (the fix's + the offset from it) says what the
   // tracker's status says for the fix's.
   if (c.uncertainty.enabled && c.optimizer.poor_sigma_m <= 0) c.optimizer.poor_sigma_m = c.uncertainty.poor_sigma_m;

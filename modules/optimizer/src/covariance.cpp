@@ -157,7 +157,14 @@ FrameUncertainty frame_uncertainty(const matcher::NearestLookup& lookup, const F
       auto it = own.find(id);
       const double o2 = it == own.end() ? 0.0 : it->second;
       // An element far off the others (a moved wall) keeps its own offset; the rest share the pooled one.
-      const double se2 = cfg.estimator == "model-max" ? std::max(floor2, o2) : (o2 > 4 * floor2 ? o2 : floor2);
+      double se2 = cfg.estimator == "model-max" ? std::max(floor2, o2) : (o2 > 4 * floor2 ? o2 : floor2);
+      if (cfg.element_loss_scale_m > 0 && se2 > floor2) {
+        // b2 = mean^2 * absorb * ends: back to the element's mean offset for its weight under the loss.
+        const double m2 = o2 / (absorb * (cfg.two_ends ? 2.0 : 1.0));
+        const double c2 = cfg.element_loss_scale_m * cfg.element_loss_scale_m;
+        const double w = c2 / (c2 + m2);
+        se2 = std::max(floor2, se2 * w * w);
+      }
       M += se2 * G * G.transpose();
     }
   }

@@ -28,6 +28,9 @@ void write_json(const Diff& d, const FloorPlan& plan, std::ostream& out, bool al
                      {"offset_m", e.offset_m},
                      {"offset_spread_m", e.offset_spread_m},
                      {"offset_sigma_m", e.offset_sigma_m},
+                     {"pose_sigma_m", e.pose_sigma_m},
+                     {"half_offset_m", {e.half_offset_m[0], e.half_offset_m[1]}},
+                     {"half_frames", {e.half_frames[0], e.half_frames[1]}},
                      {"seen_ratio", e.seen_ratio()},
                      {"frames_expected", e.frames_expected},
                      {"frames_with_points", e.frames_with_points}};

@@ -221,7 +221,8 @@ bool PlanDiff::plan_blocks(const V2& o, const V2& q, int skip) const {
   return false;
 }
 
-void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen::Vector2f>& points) {
+void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen::Vector2f>& points,
+                         const Eigen::Matrix3d* pose_cov) {
   const int frame = frames_++;
   const V2 s(x, y);
   const double c = std::cos(yaw), sn = std::sin(yaw);
@@ -238,6 +239,8 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
   std::vector<std::vector<Obs>> bins(static_cast<size_t>(nb));
   std::vector<float> min_range(size_t(nb), std::numeric_limits<float>::infinity());
   std::vector<std::vector<float>> offs(plan_.elements.size());
+  std::vector<std::vector<float>> half_offs[2] = {std::vector<std::vector<float>>(plan_.elements.size()),
+                                                  std::vector<std::vector<float>>(plan_.elements.size())};
   std::vector<V2> along_sum(plan_.elements.size(), V2::Zero());  // sum of (point - sensor) of the inside points
   Eigen::Matrix3d sA = Eigen::Matrix3d::Zero();
   Eigen::Vector3d sg = Eigen::Vector3d::Zero();
@@ -260,6 +263,12 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
       if (inside) {
         offs[size_t(e)].push_back(float(off));
         along_sum[size_t(e)] += p - s;
+        const Element& es = plan_.elements[size_t(e)];
+        if (es.kind == ElementKind::kSegment) {
+          const V2 d = es.b - es.a;
+          const double t = d.squaredNorm() > 0 ? (p - es.a).dot(d) / d.squaredNorm() : 0.0;
+          half_offs[t < 0.5 ? 0 : 1][size_t(e)].push_back(float(off));
+        }
       }
       const Element& el = plan_.elements[size_t(e)];
       if (inside && el.kind == ElementKind::kSegment && std::abs(off) < o_.scale_max_offset_m) {
@@ -287,8 +296,32 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
       }
     }
   }
-  for (size_t e = 0; e < offs.size(); ++e)
-    if (offs[e].size() >= 5) acc_[e].frame_offsets.push_back(float(median_of(offs[e])));
+  const bool cov_ok = pose_cov && o_.moved_pose_covariance && pose_cov->allFinite() && (*pose_cov)(0, 0) >= 0 &&
+                      (*pose_cov)(1, 1) >= 0 && (*pose_cov)(2, 2) >= 0;
+  for (size_t e = 0; e < offs.size(); ++e) {
+    if (offs[e].size() < 5) continue;
+    acc_[e].frame_offsets.push_back(float(median_of(offs[e])));
+    for (int h = 0; h < 2; ++h)
+      if (half_offs[h][e].size() >= 3) acc_[e].half_offsets[h].push_back(float(median_of(half_offs[h][e])));
+    if (!cov_ok) continue;
+    // The pose error (dx, dy, dyaw) moves the element's points along its normal n by
+    // n . (dx, dy) + dyaw n . perp(rc) (rc: the mean point relative to the sensor, perp: +90 deg).
+    const Element& el = plan_.elements[e];
+    const V2 rc = along_sum[e] / double(offs[e].size());
+    V2 n;
+    if (el.kind == ElementKind::kSegment) {
+      n = left_normal(el);
+    } else {
+      const V2 d = s + rc - el.c;
+      if (d.norm() < 1e-9) continue;
+      n = d.normalized();
+    }
+    const Eigen::Vector3d cv(n.x(), n.y(), n.y() * rc.x() - n.x() * rc.y());
+    const double v = cv.dot(*pose_cov * cv);
+    if (!(v >= 0)) continue;
+    acc_[e].pose_var += v;
+    ++acc_[e].pose_frames;
+  }
   // As-built refinement: median offset of each wall = (1 - t) o_a + t o_b + c . (bx, by, byaw) (c: how the
   // scan's registration error moves the wall's points along its normal); the scan's error is eliminated
   // (Schur complement) and the rest accumulated over the run.
@@ -415,10 +448,22 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
 // The uncertainty of an element's offset (the median of its scans' median offsets): the scans' robust spread
 // over at most moved_max_looks independent looks (consecutive scans see the same), plus the localizer's own
 // error along the normal (moved_pose_sigma_m), which does not average out over scans.
+// With the localizer's covariance, its mean variance along the normal over the element's scans, if larger.
 double PlanDiff::offset_sigma(const ElementDiff& e) const {
   const double n = std::min(double(e.frames_with_points), o_.moved_max_looks);
   const double ss = 1.4826 * e.offset_spread_m;
-  return std::sqrt(o_.moved_pose_sigma_m * o_.moved_pose_sigma_m + (n > 0 ? ss * ss / n : ss * ss));
+  const double pose2 = std::max(o_.moved_pose_sigma_m * o_.moved_pose_sigma_m, e.pose_sigma_m * e.pose_sigma_m);
+  return std::sqrt(pose2 + (n > 0 ? ss * ss / n : ss * ss));
+}
+
+// Both halves of a segment measured and each offset by as much as the whole must be (moved_both_halves).
+bool PlanDiff::halves_moved(const ElementDiff& e) const {
+  if (!o_.moved_both_halves) return true;
+  for (int h = 0; h < 2; ++h)
+    if (e.half_frames[h] < o_.min_frames || e.half_offset_m[h] * e.offset_m <= 0 ||
+        std::abs(e.half_offset_m[h]) - o_.moved_z * e.offset_sigma_m < o_.moved_min_m)
+      return false;
+  return true;
 }
 
 Diff PlanDiff::result() const {
@@ -467,7 +512,12 @@ Diff PlanDiff::result() const {
       std::vector<float> dev;
       for (float v : a.frame_offsets) dev.push_back(std::abs(v - float(e.offset_m)));
       e.offset_spread_m = median_of(dev);
+      if (a.pose_frames > 0) e.pose_sigma_m = std::sqrt(a.pose_var / a.pose_frames);
       e.offset_sigma_m = offset_sigma(e);
+      for (int h = 0; h < 2; ++h) {
+        e.half_frames[h] = int(a.half_offsets[h].size());
+        if (e.half_frames[h] > 0) e.half_offset_m[h] = median_of(a.half_offsets[h]);
+      }
     }
     if (a.frames_expected >= o_.min_frames && a.expected >= o_.missing_min_expected &&
         e.seen_ratio() < o_.missing_seen_ratio)
@@ -476,7 +526,7 @@ Diff PlanDiff::result() const {
              std::abs(e.offset_m) - o_.moved_z * e.offset_sigma_m >= o_.moved_min_m &&
              e.offset_spread_m <= o_.moved_max_spread_m &&
              (plan_.elements[i].kind != ElementKind::kSegment ||
-              (plan_.elements[i].b - plan_.elements[i].a).norm() >= o_.moved_min_length_m))
+              ((plan_.elements[i].b - plan_.elements[i].a).norm() >= o_.moved_min_length_m && halves_moved(e))))
       e.status = Status::kMoved;
     else if (e.frames_with_points > 0 || a.seen > 0)
       e.status = Status::kSeen;

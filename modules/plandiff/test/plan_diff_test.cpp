@@ -136,6 +136,80 @@ TEST(PlanDiff, MovedOnlyBeyondItsUncertainty) {
   EXPECT_GE(s_consistent, 0.01);  // the localizer's own error never averages out
 }
 
+// With the localizer's pose covariance the offset's sigma carries the pose's uncertainty along the wall's
+// normal: y (the wall's normal here) and yaw times the lever arm to the wall's points (they lie 2 m ahead
+// along +y, around x = 0: a yaw error moves them along x, not along the normal), not x (along the wall).
+// A wall 11 cm off seen consistently is moved from a pose good to 1 cm, not from one good to 3 cm only.
+TEST(PlanDiff, MovedCountsThePoseCovariance) {
+  FloorPlan plan;
+  plan.elements.push_back(Element::segment({-3, 2}, {3, 2}));  // left normal +y
+  auto run = [&](const Eigen::Matrix3d* cov, plandiff::ElementDiff* out) {
+    plandiff::PlanDiff d(plan);
+    for (int f = 0; f < 60; ++f) {
+      std::vector<Eigen::Vector2f> pts;
+      for (int i = 0; i < 21; ++i) pts.emplace_back(float(-2 + 0.2 * i), float(2 + 0.11));
+      d.add_frame(0, 0, 0, pts, cov);
+    }
+    *out = d.result().elements[0];
+  };
+  plandiff::ElementDiff e;
+  run(nullptr, &e);
+  EXPECT_EQ(e.status, plandiff::Status::kMoved);
+  EXPECT_EQ(e.pose_sigma_m, 0.0);
+  const Eigen::Matrix3d good = Eigen::Vector3d(0.01 * 0.01, 0.01 * 0.01, 1e-6).asDiagonal();
+  run(&good, &e);
+  EXPECT_EQ(e.status, plandiff::Status::kMoved);
+  EXPECT_NEAR(e.pose_sigma_m, 0.01, 1e-3);
+  const Eigen::Matrix3d loose_y = Eigen::Vector3d(0.01 * 0.01, 0.03 * 0.03, 1e-6).asDiagonal();
+  run(&loose_y, &e);
+  EXPECT_EQ(e.status, plandiff::Status::kSeen);
+  EXPECT_NEAR(e.pose_sigma_m, 0.03, 1e-3);
+  const Eigen::Matrix3d loose_x = Eigen::Vector3d(0.2 * 0.2, 0.01 * 0.01, 1e-6).asDiagonal();
+  run(&loose_x, &e);
+  EXPECT_EQ(e.status, plandiff::Status::kMoved);  // along the wall: no bearing on its offset
+  // Yaw: the points sit at x in [-2, 2] around the wall's foot, mean lever along the wall ~0: a yaw error of
+  // 0.02 rad moves the mean point 2 m * 0.02 = 4 cm along x only; off to the side the lever counts.
+  plandiff::PlanDiff d(plan);
+  const Eigen::Matrix3d yaw = Eigen::Vector3d(1e-8, 1e-8, 0.02 * 0.02).asDiagonal();
+  for (int f = 0; f < 10; ++f) {
+    std::vector<Eigen::Vector2f> pts;
+    for (int i = 0; i < 11; ++i) pts.emplace_back(float(1 + 0.1 * i), 2.0f);  // mean point (1.5, 2)
+    d.add_frame(0, 0, 0, pts, &yaw);
+  }
+  EXPECT_NEAR(d.result().elements[0].pose_sigma_m, 1.5 * 0.02, 1e-3);
+}
+
+// Moved is a wall shifted as a whole: both halves measured and each offset as far. A wall standing askew (ends
+// 4 and 20 cm off: the whole's median 12 cm) or seen near one end only is not called moved; shifted by 12 cm it is.
+TEST(PlanDiff, MovedNeedsBothHalves) {
+  FloorPlan plan;
+  plan.elements.push_back(Element::segment({-3, 2}, {3, 2}));  // left normal +y
+  auto run = [&](double x0, double x1, double off_a, double off_b, plandiff::ElementDiff* out) {
+    plandiff::PlanDiff d(plan);
+    for (int f = 0; f < 40; ++f) {
+      std::vector<Eigen::Vector2f> pts;
+      for (int i = 0; i <= 20; ++i) {
+        const double x = x0 + (x1 - x0) * i / 20.0, t = (x + 3) / 6;
+        pts.emplace_back(float(x), float(2 + (1 - t) * off_a + t * off_b));
+      }
+      d.add_frame(0, 0, 0, pts);
+    }
+    *out = d.result().elements[0];
+    return out->status;
+  };
+  plandiff::ElementDiff e;
+  EXPECT_EQ(run(-2.5, 2.5, 0.12, 0.12, &e), plandiff::Status::kMoved);
+  EXPECT_NEAR(e.half_offset_m[0], 0.12, 1e-3);
+  EXPECT_NEAR(e.half_offset_m[1], 0.12, 1e-3);
+  EXPECT_EQ(run(-2.5, 2.5, 0.04, 0.20, &e), plandiff::Status::kSeen);  // askew
+  EXPECT_NEAR(e.offset_m, 0.12, 0.01);
+  EXPECT_LT(e.half_offset_m[0], 0.10);
+  EXPECT_GT(e.half_offset_m[1], 0.14);
+  EXPECT_EQ(run(0.5, 2.5, 0.12, 0.12, &e), plandiff::Status::kSeen);  // one half only
+  EXPECT_EQ(e.half_frames[0], 0);
+  EXPECT_EQ(e.half_frames[1], 40);
+}
+
 TEST(PlanDiff, CleanWorldHasNoFlags) {
   const DiffRun r = simulate_and_diff("crowd-15", 2);  // the plan is the world; 15 people walk about
   EXPECT_EQ(r.diff.count(plandiff::Status::kMissing), 0);

@@ -46,6 +46,11 @@ struct CovarianceConfig {
   std::string loss = "cauchy";        // the estimator's robust loss ("cauchy", "huber", "none") ...
   double loss_scale_m = 0.05;         // ... and its scale: the weights w_i
   double max_variance = 1e4;          // variance [m^2, rad^2] of a direction nothing constrains
+  // The estimator's as-built model (matcher/as_built.h) with its Cauchy loss of this scale on the elements'
+  // offsets (0: no such model): an element far off the others (a moved wall, "model" keeps its own offset) then
+  // pulls the pose by its offset's influence o w(o), w = 1 / (1 + o^2 / c^2), not by its whole offset; its
+  // sigma_e is scaled by w (never below the pooled one).
+  double element_loss_scale_m = 0;
 };
 
 struct FrameUncertainty {

@@ -48,6 +48,14 @@ struct Options {
   // built, seen with a spread of offsets, is not called moved on an offset its uncertainty explains.
   double moved_z = 2.0;
   double moved_pose_sigma_m = 0.01;   // the localizer's error along the wall normal (does not average out)
+  // With the localizer's pose covariance (add_frame's pose_cov): the pose part of an element's offset sigma is
+  // the mean over its scans of the pose's variance along the wall's normal at its points (translation along
+  // the normal and yaw times the lever arm to the points), at least moved_pose_sigma_m; false: that alone.
+  bool moved_pose_covariance = true;
+  // A segment is called moved only when each half of it (t < 0.5, t >= 0.5 along it) was measured in >= min_frames
+  // scans (>= 3 points of that half) and each half's median offset passes the same test as the whole: a wall
+  // standing askew (one end a few cm off, the other 10) or seen near one end only is not a wall moved as a whole.
+  bool moved_both_halves = true;
   double moved_max_looks = 30;        // the scans count as at most this many independent looks
   double new_cell_m = 0.05;         // grid of unexplained points
   int new_min_frames = 5;           // a cell hit in at least this many frames ...
@@ -95,6 +103,9 @@ struct ElementDiff {
   double offset_m = 0;        // median signed offset along the left normal (segments) / radially (circles)
   double offset_spread_m = 0; // MAD of the per-frame offsets
   double offset_sigma_m = 0;  // its uncertainty (PlanDiff::offset_sigma)
+  double pose_sigma_m = 0;    // the localizer's pose sigma along its normal (mean variance over its scans; 0: not given)
+  double half_offset_m[2] = {0, 0};  // segments: the median offset of each half (a -> mid, mid -> b) ...
+  int half_frames[2] = {0, 0};       // ... over this many scans
   int frames_with_points = 0;
   int frames_expected = 0;    // frames in which at least one probe was expected visible
   int64_t probes_expected = 0, probes_seen = 0;
@@ -144,8 +155,10 @@ struct Diff {
 class PlanDiff {
  public:
   explicit PlanDiff(FloorPlan plan, Options o = {});
-  // One registered scan: pose of the sensor on the plan, wall points in the sensor frame (metres).
-  void add_frame(double x, double y, double yaw, const std::vector<Eigen::Vector2f>& points);
+  // One registered scan: pose of the sensor on the plan, wall points in the sensor frame (metres); pose_cov:
+  // the pose's x, y, yaw covariance (the localizer's, optional: see Options::moved_pose_covariance).
+  void add_frame(double x, double y, double yaw, const std::vector<Eigen::Vector2f>& points,
+                 const Eigen::Matrix3d* pose_cov = nullptr);
   Diff result() const;
   int frames() const { return frames_; }
   const FloorPlan& plan() const { return plan_; }
@@ -159,6 +172,9 @@ class PlanDiff {
   };
   struct Acc {
     std::vector<float> frame_offsets;  // per-frame median offset
+    std::vector<float> half_offsets[2];  // segments: per-frame median offset of each half
+    double pose_var = 0;               // sum over those frames (with a pose covariance) of the pose variance
+    int pose_frames = 0;               // along the normal, and how many
     int frames_expected = 0;
     int64_t expected = 0, seen = 0;
   };
@@ -166,6 +182,7 @@ class PlanDiff {
     int frames = 0, last_frame = -1, points = 0, in_view = 0;
   };
   double offset_sigma(const ElementDiff& e) const;
+  bool halves_moved(const ElementDiff& e) const;
   int nearest(const Eigen::Vector2d& p, double* signed_offset, bool* inside, const Eigen::Vector2d* sensor) const;
   bool extends_beyond_end(const Eigen::Vector2d& p) const;
   int extended_element(const Eigen::Vector2d& a, const Eigen::Vector2d& b) const;
