@@ -1,6 +1,8 @@
 // The feature extractor alone on fixed segmentations (issue 14 item 7): simulated OS-1-64 scans of a room
 // and a corridor (real beam angles from ../shared when present) are segmented once before any timing.
-//   build/bin/features_bench                       Google Benchmark, CPU time per scan
+//   build/bin/features_bench                       Google Benchmark, CPU time per scan: BM_Features cycles
+//                                                  through the 48 inputs (cold caches), BM_FeaturesFreshInput
+//                                                  copies each input just before (warm, as in the pipeline)
 //   build/bin/features_bench --hash                FNV-1a hash of every feature of every scan (x, y bits,
 //                                                  kind, group, t, source index, status, group count):
 //                                                  "optimised without changing results" for the features
@@ -45,6 +47,22 @@ void BM_Features(benchmark::State& st) {
   for (auto _ : st) benchmark::DoNotOptimize(fx.process(segs[k++ % segs.size()]).size());
 }
 BENCHMARK(BM_Features)->Unit(benchmark::kMicrosecond);
+
+// The input fresh in the cache, as after the segmenter that wrote it (BM_SegmenterPlusFeatures of
+// perception_ratio_bench): each scan's wall points are copied into the input before the (timed) extraction.
+void BM_FeaturesFreshInput(benchmark::State& st) {
+  const auto& segs = segmentations();
+  feat::FeatureExtractor fx;
+  seg::Segmentation in;
+  size_t k = 0;
+  for (auto _ : st) {
+    st.PauseTiming();
+    in = segs[k++ % segs.size()];
+    st.ResumeTiming();
+    benchmark::DoNotOptimize(fx.process(in).size());
+  }
+}
+BENCHMARK(BM_FeaturesFreshInput)->Unit(benchmark::kMicrosecond);
 
 int hash() {
   uint64_t h = 1469598103934665603ull;

@@ -1,5 +1,7 @@
 #include "fploc/features/features.h"
 
+#include "smoothness.h"
+
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -7,7 +9,7 @@
 #include <limits>
 #include <numeric>
 #if defined(__SSE2__)
-#include <emmintrin.h>
+#include <xmmintrin.h>
 #endif
 
 namespace fploc::feat {
@@ -82,188 +84,120 @@ FeatureStatus FeatureExtractor::extract(const seg::Segmentation& seg) {
   return out_.x.size() < 30 ? FeatureStatus::kFewFeatures : FeatureStatus::kOk;
 }
 
+namespace {
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// The largest of v[b .. e) and the first index holding it; -1 when every value is -inf (no candidate left).
+// The same pick as walking the candidates by decreasing value, ties by index.
+int argmax_first(const float* v, int b, int e) {
+  float m = -kInf;
+  int i = b;
+#if defined(__SSE2__)
+  __m128 vm = _mm_set1_ps(-kInf);
+  for (; i + 4 <= e; i += 4) vm = _mm_max_ps(vm, _mm_loadu_ps(v + i));
+  vm = _mm_max_ps(vm, _mm_shuffle_ps(vm, vm, _MM_SHUFFLE(1, 0, 3, 2)));
+  vm = _mm_max_ps(vm, _mm_shuffle_ps(vm, vm, _MM_SHUFFLE(2, 3, 0, 1)));
+  m = _mm_cvtss_f32(vm);
+#endif
+  for (; i < e; ++i) m = v[i] > m ? v[i] : m;
+  if (!(m > -kInf)) return -1;
+  i = b;
+#if defined(__SSE2__)
+  const __m128 mm = _mm_set1_ps(m);
+  for (; i + 4 <= e; i += 4)
+    if (const int bits = _mm_movemask_ps(_mm_cmpeq_ps(_mm_loadu_ps(v + i), mm))) return i + __builtin_ctz(unsigned(bits));
+#endif
+  for (; v[i] != m; ++i) {
+  }
+  return i;
+}
+
+// Appends the indices i in [b, e) with v[i] < +inf and !skip[i], in increasing order.
+void finite_indices(const float* v, const uint8_t* skip, int b, int e, std::vector<int>& out) {
+  int i = b;
+#if defined(__SSE2__)
+  const __m128 inf = _mm_set1_ps(kInf);
+  for (; i + 4 <= e; i += 4) {
+    int bits = _mm_movemask_ps(_mm_cmplt_ps(_mm_loadu_ps(v + i), inf));
+    while (bits) {
+      const int k = i + __builtin_ctz(unsigned(bits));
+      bits &= bits - 1;
+      if (!skip[k]) out.push_back(k);
+    }
+  }
+#endif
+  for (; i < e; ++i)
+    if (v[i] < kInf && !skip[i]) out.push_back(i);
+}
+}  // namespace
+
 void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t end) {
   const auto& w = seg.wall;
   const int n = int(end - begin);
   const int hw = std::max(1, cfg_.half_window);
   if (n < 2 * hw + 1) return;
-  const float *X = w.x.data() + begin, *Y = w.y.data() + begin, *Z = w.z.data() + begin;
-  const float* R = w.range.data() + begin;
-  const int16_t* C = w.column.data() + begin;
 
-  // Not cleared: curv_ is written wherever it is read ([hw, n-hw)), ok_ is written everywhere below.
-  curv_.resize(n);
-  ok_.resize(n);
-  picked_.assign(n, 0);
-  // One pass (issue 14 item 7; the same values as the earlier separate passes): the break prefix (brk[j] =
-  // number of column gaps among the first j neighbour pairs), the window sums by prefix sums (double: ring
-  // coordinates reach ~100 m; sum(X_j - X_i) = S - (2hw+1) X_i), and, hw points behind the prefix, the
-  // smoothness, the window/range test and the parallel-surface test of point i = j - hw. The prefix sums
-  // are a chain of dependent additions; the smoothness of earlier points fills the cycles between them.
-  // Occlusion boundaries (rare) are only recorded here and applied after the pass (the rules only clear
-  // ok_, so the order does not matter).
-  auto& brk = brk_;
-  brk.resize(n + 1);
-  brk[0] = 0;
-  const int gap = cfg_.max_column_gap;
-  const float rmin = float(cfg_.min_range_m), rmax = float(cfg_.max_range_m);
-  const float occ = float(cfg_.occlusion_ratio), par = float(cfg_.parallel_ratio);
-  prex_.resize(size_t(n) + 1);
-  prey_.resize(size_t(n) + 1);
-  prez_.resize(size_t(n) + 1);
-  double *px = prex_.data(), *py = prey_.data(), *pz = prez_.data();
-  px[0] = py[0] = pz[0] = 0.0;
-  const double win = double(2 * hw + 1);
-  const float den = float(2 * hw);
-  float* curv = curv_.data();
-  uint8_t* ok = ok_.data();
+  // Smoothness and candidates of every point (src/smoothness.h: vectorised, the plain rules' values).
+  corner_key_.resize(size_t(n));
+  surface_key_.resize(size_t(n));
+  picked_.assign(size_t(n), 0);
   occ_.clear();
-  auto prefix = [&](int j) __attribute__((always_inline)) {
-    const int step = j + 1 < n ? C[j + 1] - C[j] : gap + 1;
-    brk[j + 1] = brk[j] + int(step > gap);
-    px[j + 1] = px[j] + double(X[j]);
-    py[j + 1] = py[j] + double(Y[j]);
-    pz[j + 1] = pz[j] + double(Z[j]);
-    // LOAM's unreliable points, part 1: the far side of an occlusion boundary between neighbours j, j+1.
-    if (j + 1 < n) {
-      const float a = R[j], c = R[j + 1];
-      const float mn = a < c ? a : c;  // minss, no branch
-      if ((step <= gap) & (std::abs(a - c) > occ * mn)) occ_.push_back(a > c ? -(j + 1) : j + 1);
+  const detail::RingIn in{w.x.data() + begin, w.y.data() + begin, w.z.data() + begin, w.range.data() + begin,
+                          w.column.data() + begin, n};
+  const detail::RingRules rules{hw, cfg_.max_column_gap, float(cfg_.min_range_m), float(cfg_.max_range_m),
+                                float(cfg_.occlusion_ratio), float(cfg_.parallel_ratio),
+                                float(cfg_.corner_threshold), float(cfg_.surface_threshold)};
+  detail::RingScratch scratch{ring_d_, ring_brk_};
+  float* ck = corner_key_.data();
+  const float* sk = surface_key_.data();
+  detail::smoothness(in, rules, scratch, ck, surface_key_.data(), occ_);
+  uint8_t* picked = picked_.data();
+  // Taking points a..b out: no later corner or surface pick there (a pick's neighbours, occlusions).
+  auto suppress = [&](int a, int b) {
+    for (int k = std::max(0, a); k <= std::min(n - 1, b); ++k) {
+      picked[k] = 1;
+      ck[k] = -kInf;
     }
   };
-  auto point = [&](int i) {
-    // All of i-hw .. i+hw connected: no break between i-hw and i+hw-1. LOAM's unreliable points, part 2:
-    // surfaces parallel to the beam (range jumps to both sides).
-    const float ri = R[i];
-    const bool okw = (brk[i + hw] == brk[i - hw]) & !(ri < rmin) & !(ri > rmax);
-    const bool parallel = (std::abs(R[i - 1] - ri) > par * ri) & (std::abs(R[i + 1] - ri) > par * ri);
-    const double dx = (px[i + hw + 1] - px[i - hw]) - win * double(X[i]);
-    const double dy = (py[i + hw + 1] - py[i - hw]) - win * double(Y[i]);
-    const double dz = (pz[i + hw + 1] - pz[i - hw]) - win * double(Z[i]);
-    curv[i] = float(std::sqrt(dx * dx + dy * dy + dz * dz)) / (den * ri);  // LOAM's c = |sum(X_j - X_i)| / (|S| |X_i|)
-    ok[i] = uint8_t(okw & !parallel);
-  };
-  for (int i = 0; i < hw; ++i) ok[i] = 0;
-  for (int i = n - hw; i < n; ++i) ok[i] = 0;
-  for (int j = 0; j < 2 * hw; ++j) prefix(j);
-  int j = 2 * hw;
-#if defined(__SSE2__)
-  // Four points at a time: two sqrtpd (the same correctly rounded roots as one at a time) and one divps
-  // (the same quotients): the divider, shared by square roots and divisions, was the bottleneck.
-  const __m128d w2 = _mm_set1_pd(win);
-  const __m128 den4 = _mm_set1_ps(den);
-  auto ld = [](const double* p) { return _mm_loadu_pd(p); };
-  auto cvt2 = [](const float* p) { return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)))); };
-  auto norm2 = [&](int i) {  // |sum(X_j - X_i)| of points i, i+1
-    const __m128d dx = _mm_sub_pd(_mm_sub_pd(ld(px + i + hw + 1), ld(px + i - hw)), _mm_mul_pd(w2, cvt2(X + i)));
-    const __m128d dy = _mm_sub_pd(_mm_sub_pd(ld(py + i + hw + 1), ld(py + i - hw)), _mm_mul_pd(w2, cvt2(Y + i)));
-    const __m128d dz = _mm_sub_pd(_mm_sub_pd(ld(pz + i + hw + 1), ld(pz + i - hw)), _mm_mul_pd(w2, cvt2(Z + i)));
-    return _mm_cvtpd_ps(_mm_sqrt_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)), _mm_mul_pd(dz, dz))));
-  };
-  for (; j + 4 <= n; j += 4) {
-    for (int q = j; q < j + 4; ++q) prefix(q);
-    const int i = j - hw;  // points i .. i+3 need the prefix up to i + 3 + hw + 1 = j + 4
-    const __m128 nrm = _mm_movelh_ps(norm2(i), norm2(i + 2));
-    _mm_storeu_ps(curv + i, _mm_div_ps(nrm, _mm_mul_ps(den4, _mm_loadu_ps(R + i))));
-    for (int l = 0; l < 4; ++l) {
-      const int q = i + l;
-      const float rq = R[q];
-      const bool okw = (brk[q + hw] == brk[q - hw]) & !(rq < rmin) & !(rq > rmax);
-      const bool parallel = (std::abs(R[q - 1] - rq) > par * rq) & (std::abs(R[q + 1] - rq) > par * rq);
-      ok[q] = uint8_t(okw & !parallel);
-    }
-  }
-#endif
-  for (; j < n; ++j) {
-    prefix(j);
-    point(j - hw);  // needs the prefix up to j + 1 = i + hw + 1
-  }
-  for (const int e : occ_) {  // +(j+1): the near side is j (clear j+1 .. j+hw); -(j+1): clear j-hw+1 .. j
-    if (e < 0) {
-      const int j = -e - 1;
-      for (int k = std::max(0, j - hw + 1); k <= j; ++k) ok[k] = 0;
-    } else {
-      const int j = e - 1;
-      for (int k = j + 1; k <= std::min(n - 1, j + hw); ++k) ok[k] = 0;
-    }
+  for (const int e : occ_) {  // +(j+1): the near side is j (j+1 .. j+hw out); -(j+1): j-hw+1 .. j out
+    if (e < 0)
+      suppress(-e - 1 - hw + 1, -e - 1);
+    else
+      suppress(e, e - 1 + hw);
   }
 
-  // Per-sector selection (sectors split the ring's points evenly, as LOAM does).
-  sel_.clear();
-  auto& kind_of = kind_;
-  kind_of.resize(n);  // read only at the picks, which set it
+  // Per-sector selection (sectors split the ring's points evenly, as LOAM does): the sharpest corner
+  // candidates that no earlier pick suppressed, then the smoothest surface candidates, walked in the order
+  // (c, index).
+  sel_.clear();  // picks as 2 * index + (1 for a corner)
   const int S = std::max(1, cfg_.sectors);
-  const float cthr = float(cfg_.corner_threshold), sthr = float(cfg_.surface_threshold);
   const int max_corners = int(std::lround(cfg_.max_corners_per_sector * limit_scale_));
   const int max_surfaces = int(std::lround(cfg_.max_surfaces_per_sector * limit_scale_));
   for (int s = 0; s < S; ++s) {
     const int sb = hw + (n - 2 * hw) * s / S, se = hw + (n - 2 * hw) * (s + 1) / S;
     if (se <= sb) continue;
-    // Corners: the sharpest candidate that no earlier pick suppressed, max_corners_per_sector times (the
-    // same picks as walking the candidates sorted by decreasing c, ties by index; a branch-free scan per
-    // pick instead of a sort, which mispredicted on every comparison). Candidates are collected without
-    // a data-dependent branch too.
-    // Corner (c > corner threshold) and surface (c < surface threshold) candidates in one pass. Surface
-    // candidates a corner pick suppresses are skipped when walking them (the same picks as leaving them out).
-    order_.resize(size_t(se - sb));
-    surf_.resize(size_t(se - sb));
-    // The first corner pick is found in the same pass (picked_ holds only the earlier sectors' picks then).
-    size_t m = 0, ms = 0;
-    int best0 = -1;
-    float bv0 = -std::numeric_limits<float>::infinity();
-    for (int i = sb; i < se; ++i) {
-      const float ci = curv_[i];
-      order_[m] = i;
-      surf_[ms] = i;
-      const bool corner = ok_[i] & uint8_t(ci > cthr);
-      m += size_t(corner);
-      ms += size_t(ok_[i] & uint8_t(ci < sthr));
-      const bool take = corner & !picked_[i] & (ci > bv0);
-      bv0 = take ? ci : bv0;
-      best0 = take ? i : best0;
-    }
     for (int corners = 0; corners < max_corners; ++corners) {
-      int best = corners == 0 ? best0 : -1;
-      float bv = -std::numeric_limits<float>::infinity();
-      for (size_t j = 0; corners > 0 && j < m; ++j) {
-        const int i = order_[j];
-        const bool take = !picked_[i] & (curv_[i] > bv);
-        bv = take ? curv_[i] : bv;
-        best = take ? i : best;
-      }
+      const int best = argmax_first(ck, sb, se);
       if (best < 0) break;
-      kind_of[best] = kCorner;
-      sel_.push_back(best);
-      for (int k = std::max(0, best - hw); k <= std::min(n - 1, best + hw); ++k) picked_[k] = 1;
+      sel_.push_back(2 * best + 1);
+      suppress(best - hw, best + hw);
     }
-    // Surface candidates: only the smoothest few need ordering (partial sort, widened if the spacing
-    // rule rejects too many).
-    surf_.resize(ms);
-    auto less = [&](int a, int b) { return curv_[a] < curv_[b] || (curv_[a] == curv_[b] && a < b); };
-    size_t sorted = 0;
+    if (max_surfaces <= 0) continue;
+    surf_.clear();
+    finite_indices(sk, picked, sb, se, surf_);
+    std::sort(surf_.begin(), surf_.end(), [&](int a, int b) { return sk[a] < sk[b] || (sk[a] == sk[b] && a < b); });
     int surfaces = 0;
-    for (size_t j = 0; j < surf_.size() && surfaces < max_surfaces; ++j) {
-      if (j == sorted) {
-        // The next k smallest in order: selection then a sort of those k (the order is total, so the same
-        // elements in the same order as a partial sort).
-        const size_t k = std::min(surf_.size(), std::max<size_t>(sorted * 2, size_t(2 * max_surfaces)));
-        if (k < surf_.size()) std::nth_element(surf_.begin() + sorted, surf_.begin() + k, surf_.end(), less);
-        std::sort(surf_.begin() + sorted, surf_.begin() + k, less);
-        sorted = k;
-      }
-      const int i = surf_[j];
-      if (picked_[i]) continue;
-      kind_of[i] = kSurface;
-      sel_.push_back(i);
-      ++surfaces;
-      for (int k = std::max(0, i - cfg_.surface_spacing); k <= std::min(n - 1, i + cfg_.surface_spacing); ++k)
-        picked_[k] = 1;
+    for (const int i : surf_) {
+      if (picked[i]) continue;
+      sel_.push_back(2 * i);
+      suppress(i - cfg_.surface_spacing, i + cfg_.surface_spacing);
+      if (++surfaces == max_surfaces) break;
     }
   }
 
   // Emit in column order and group surface runs between corner anchors (or gaps) by PCA.
-  std::vector<int> run;
-  const size_t first_out = out_.x.size();
+  auto& run = run_;
+  run.clear();
   auto close_run = [&]() {
     if (int(run.size()) >= cfg_.min_group_points) {
       Eigen::Vector2d m = Eigen::Vector2d::Zero();
@@ -285,29 +219,31 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     run.clear();
   };
   std::sort(sel_.begin(), sel_.end());  // the picks in column order (not a scan of all n points)
-  for (const int i : sel_) {
-    const size_t src = begin + i;
+  const bool has_t = w.t.size() == w.x.size();
+  const float max_gap2 = float(cfg_.group_max_gap_m * cfg_.group_max_gap_m);
+  for (const int code : sel_) {
+    const size_t src = begin + size_t(code >> 1);
+    const bool corner = code & 1;
     const int o = int(out_.x.size());
     const Eigen::Vector3f q = R_ * Eigen::Vector3f(w.x[src], w.y[src], w.z[src]);
     out_.x.push_back(q.x());
     out_.y.push_back(q.y());
-    out_.kind.push_back(kind_of[i]);
+    out_.kind.push_back(corner ? kCorner : kSurface);
     out_.group.push_back(-1);
-    out_.t.push_back(w.t.size() == w.x.size() ? w.t[src] : 0.f);
+    out_.t.push_back(has_t ? w.t[src] : 0.f);
     out_.source.push_back(int32_t(src));
-    if (kind_of[i] == kCorner) {
+    if (corner) {
       close_run();
       continue;
     }
     if (!run.empty()) {
       const int p = run.back();
       const float dx = out_.x[o] - out_.x[p], dy = out_.y[o] - out_.y[p];
-      if (dx * dx + dy * dy > float(cfg_.group_max_gap_m * cfg_.group_max_gap_m)) close_run();
+      if (dx * dx + dy * dy > max_gap2) close_run();
     }
     run.push_back(o);
   }
   close_run();
-  (void)first_out;
 }
 
 }  // namespace fploc::feat

@@ -65,13 +65,13 @@ class FeatureExtractor {
   Picked out_;
   FeatureFrame frame_;
   std::vector<int32_t> source_;
-  std::vector<float> curv_;
-  std::vector<uint8_t> ok_, picked_;
-  std::vector<int> order_, surf_;
   Eigen::Matrix3f R_ = Eigen::Matrix3f::Identity();
-  std::vector<int> sel_, brk_, occ_;
-  std::vector<int8_t> kind_;
-  std::vector<double> prex_, prey_, prez_;
+  // Per-ring buffers, kept from scan to scan (src/smoothness.h).
+  std::vector<float> corner_key_, surface_key_;  // c of corner / surface candidates, -inf / +inf otherwise
+  std::vector<uint8_t> picked_;                  // suppressed by a pick or an occlusion boundary
+  std::vector<int> occ_, surf_, sel_, run_;
+  std::vector<double> ring_d_;
+  std::vector<int32_t> ring_brk_;
 };
 
 }  // namespace fploc::feat
