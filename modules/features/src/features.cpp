@@ -87,47 +87,40 @@ FeatureStatus FeatureExtractor::extract(const seg::Segmentation& seg) {
 namespace {
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-// The largest of v[b .. e) and the first index holding it; -1 when every value is -inf (no candidate left).
-// The same pick as walking the candidates by decreasing value, ties by index.
-int argmax_first(const float* v, int b, int e) {
+float max_of(const float* v, int b, int e) {
   float m = -kInf;
   int i = b;
 #if defined(__SSE2__)
-  __m128 vm = _mm_set1_ps(-kInf);
-  for (; i + 4 <= e; i += 4) vm = _mm_max_ps(vm, _mm_loadu_ps(v + i));
-  vm = _mm_max_ps(vm, _mm_shuffle_ps(vm, vm, _MM_SHUFFLE(1, 0, 3, 2)));
-  vm = _mm_max_ps(vm, _mm_shuffle_ps(vm, vm, _MM_SHUFFLE(2, 3, 0, 1)));
-  m = _mm_cvtss_f32(vm);
+  __m128 m0 = _mm_set1_ps(-kInf), m1 = m0;
+  for (; i + 8 <= e; i += 8) {
+    m0 = _mm_max_ps(m0, _mm_loadu_ps(v + i));
+    m1 = _mm_max_ps(m1, _mm_loadu_ps(v + i + 4));
+  }
+  m0 = _mm_max_ps(m0, m1);
+  m0 = _mm_max_ps(m0, _mm_shuffle_ps(m0, m0, _MM_SHUFFLE(1, 0, 3, 2)));
+  m0 = _mm_max_ps(m0, _mm_shuffle_ps(m0, m0, _MM_SHUFFLE(2, 3, 0, 1)));
+  m = _mm_cvtss_f32(m0);
 #endif
   for (; i < e; ++i) m = v[i] > m ? v[i] : m;
-  if (!(m > -kInf)) return -1;
-  i = b;
-#if defined(__SSE2__)
-  const __m128 mm = _mm_set1_ps(m);
-  for (; i + 4 <= e; i += 4)
-    if (const int bits = _mm_movemask_ps(_mm_cmpeq_ps(_mm_loadu_ps(v + i), mm))) return i + __builtin_ctz(unsigned(bits));
-#endif
-  for (; v[i] != m; ++i) {
-  }
-  return i;
+  return m;
 }
 
-// Appends the indices i in [b, e) with v[i] < +inf and !skip[i], in increasing order.
-void finite_indices(const float* v, const uint8_t* skip, int b, int e, std::vector<int>& out) {
+// Appends the indices i in [b, e) with v[i] >= t (t > -inf) and, when skip is given, !skip[i], in increasing order.
+void indices_at_least(const float* v, float t, const uint8_t* skip, int b, int e, std::vector<int>& out) {
   int i = b;
 #if defined(__SSE2__)
-  const __m128 inf = _mm_set1_ps(kInf);
+  const __m128 tt = _mm_set1_ps(t);
   for (; i + 4 <= e; i += 4) {
-    int bits = _mm_movemask_ps(_mm_cmplt_ps(_mm_loadu_ps(v + i), inf));
+    int bits = _mm_movemask_ps(_mm_cmpge_ps(_mm_loadu_ps(v + i), tt));
     while (bits) {
       const int k = i + __builtin_ctz(unsigned(bits));
       bits &= bits - 1;
-      if (!skip[k]) out.push_back(k);
+      if (!skip || !skip[k]) out.push_back(k);
     }
   }
 #endif
   for (; i < e; ++i)
-    if (v[i] < kInf && !skip[i]) out.push_back(i);
+    if (v[i] >= t && (!skip || !skip[i])) out.push_back(i);
 }
 }  // namespace
 
@@ -137,9 +130,11 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   const int hw = std::max(1, cfg_.half_window);
   if (n < 2 * hw + 1) return;
 
-  // Smoothness and candidates of every point (src/smoothness.h: vectorised, the plain rules' values).
-  corner_key_.resize(size_t(n));
-  surface_key_.resize(size_t(n));
+  // Smoothness bounds and candidates of every point (src/smoothness.h: vectorised, in float, with exact
+  // values wherever the bounds do not decide).
+  corner_lo_.resize(size_t(n));
+  corner_hi_.resize(size_t(n));
+  surface_.resize(size_t(n));
   picked_.assign(size_t(n), 0);
   occ_.clear();
   const detail::RingIn in{w.x.data() + begin, w.y.data() + begin, w.z.data() + begin, w.range.data() + begin,
@@ -147,16 +142,16 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   const detail::RingRules rules{hw, cfg_.max_column_gap, float(cfg_.min_range_m), float(cfg_.max_range_m),
                                 float(cfg_.occlusion_ratio), float(cfg_.parallel_ratio),
                                 float(cfg_.corner_threshold), float(cfg_.surface_threshold)};
-  detail::RingScratch scratch{ring_d_, ring_brk_};
-  float* ck = corner_key_.data();
-  const float* sk = surface_key_.data();
-  detail::smoothness(in, rules, scratch, ck, surface_key_.data(), occ_);
+  detail::RingScratch scratch{ring_w_, ring_brk_};
+  float *lo = corner_lo_.data(), *hi = corner_hi_.data();
+  const float* sk = surface_.data();
+  detail::smoothness(in, rules, scratch, lo, hi, surface_.data(), occ_);
   uint8_t* picked = picked_.data();
   // Taking points a..b out: no later corner or surface pick there (a pick's neighbours, occlusions).
   auto suppress = [&](int a, int b) {
     for (int k = std::max(0, a); k <= std::min(n - 1, b); ++k) {
       picked[k] = 1;
-      ck[k] = -kInf;
+      lo[k] = hi[k] = -kInf;
     }
   };
   for (const int e : occ_) {  // +(j+1): the near side is j (j+1 .. j+hw out); -(j+1): j-hw+1 .. j out
@@ -168,26 +163,54 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
 
   // Per-sector selection (sectors split the ring's points evenly, as LOAM does): the sharpest corner
   // candidates that no earlier pick suppressed, then the smoothest surface candidates, walked in the order
-  // (c, index).
+  // (c, index): the plain rules' picks.
   sel_.clear();  // picks as 2 * index + (1 for a corner)
   const int S = std::max(1, cfg_.sectors);
   const int max_corners = int(std::lround(cfg_.max_corners_per_sector * limit_scale_));
   const int max_surfaces = int(std::lround(cfg_.max_surfaces_per_sector * limit_scale_));
+  const float sthr = float(cfg_.surface_threshold);
+  auto& cand = surf_;
   for (int s = 0; s < S; ++s) {
     const int sb = hw + (n - 2 * hw) * s / S, se = hw + (n - 2 * hw) * (s + 1) / S;
     if (se <= sb) continue;
     for (int corners = 0; corners < max_corners; ++corners) {
-      const int best = argmax_first(ck, sb, se);
-      if (best < 0) break;
+      // The sharpest candidate is among those whose upper bound reaches the largest lower bound; when
+      // that is more than one, their exact c decide (ties: the first index).
+      const float top = max_of(lo, sb, se);
+      if (!(top > -kInf)) break;
+      cand.clear();
+      indices_at_least(hi, top, nullptr, sb, se, cand);
+      int best = cand.front();
+      if (cand.size() > 1) {
+        float bc = -kInf;
+        best = -1;
+        for (const int i : cand) {
+          const float c = lo[i] == hi[i] ? lo[i] : detail::exact_smoothness(in, hw, i);
+          if (best < 0 || c > bc) {
+            bc = c;
+            best = i;
+          }
+        }
+      }
       sel_.push_back(2 * best + 1);
       suppress(best - hw, best + hw);
     }
     if (max_surfaces <= 0) continue;
-    surf_.clear();
-    finite_indices(sk, picked, sb, se, surf_);
-    std::sort(surf_.begin(), surf_.end(), [&](int a, int b) { return sk[a] < sk[b] || (sk[a] == sk[b] && a < b); });
+    cand.clear();
+    indices_at_least(sk, 0.f, picked, sb, se, cand);  // sk = 0 where a candidate may be, -inf elsewhere
+    // Exact c of each; kept when below the threshold.
+    auto& sc = surface_c_;
+    sc.resize(size_t(n));
+    size_t m = 0;
+    for (const int i : cand) {
+      const float c = detail::exact_smoothness(in, hw, i);
+      sc[size_t(i)] = c;
+      if (c < sthr) cand[m++] = i;
+    }
+    cand.resize(m);
+    std::sort(cand.begin(), cand.end(), [&](int a, int b) { return sc[a] < sc[b] || (sc[a] == sc[b] && a < b); });
     int surfaces = 0;
-    for (const int i : surf_) {
+    for (const int i : cand) {
       if (picked[i]) continue;
       sel_.push_back(2 * i);
       suppress(i - cfg_.surface_spacing, i + cfg_.surface_spacing);

@@ -35,7 +35,7 @@ namespace fploc::feat::detail {
 #endif
 
 namespace {
-using Pass = void (*)(const RingIn&, const RingRules&, RingScratch&, float*, float*, std::vector<int>&);
+using Pass = void (*)(const RingIn&, const RingRules&, RingScratch&, float*, float*, float*, std::vector<int>&);
 struct Choice {
   Pass pass;
   const char* name;
@@ -61,9 +61,9 @@ const Choice& choice() {
 }
 }  // namespace
 
-void smoothness(const RingIn& in, const RingRules& rules, RingScratch& scratch, float* corner, float* surface,
-                std::vector<int>& occlusions) {
-  choice().pass(in, rules, scratch, corner, surface, occlusions);
+void smoothness(const RingIn& in, const RingRules& rules, RingScratch& scratch, float* corner_lo, float* corner_hi,
+                float* surface, std::vector<int>& occlusions) {
+  choice().pass(in, rules, scratch, corner_lo, corner_hi, surface, occlusions);
 }
 
 const char* smoothness_isa() { return choice().name; }

@@ -67,10 +67,12 @@ class FeatureExtractor {
   std::vector<int32_t> source_;
   Eigen::Matrix3f R_ = Eigen::Matrix3f::Identity();
   // Per-ring buffers, kept from scan to scan (src/smoothness.h).
-  std::vector<float> corner_key_, surface_key_;  // c of corner / surface candidates, -inf / +inf otherwise
+  std::vector<float> corner_lo_, corner_hi_;  // bounds on c of corner candidates, -inf otherwise
+  std::vector<float> surface_;                // 0 where a surface candidate may be, -inf otherwise
+  std::vector<float> surface_c_;              // exact c of the sector's surface candidates
   std::vector<uint8_t> picked_;                  // suppressed by a pick or an occlusion boundary
   std::vector<int> occ_, surf_, sel_, run_;
-  std::vector<double> ring_d_;
+  std::vector<float> ring_w_;
   std::vector<int32_t> ring_brk_;
 };
 
