@@ -105,8 +105,8 @@ float max_of(const float* v, int b, int e) {
   return m;
 }
 
-// Appends the indices i in [b, e) with v[i] >= t (t > -inf) and, when skip is given, !skip[i], in increasing order.
-void indices_at_least(const float* v, float t, const uint8_t* skip, int b, int e, std::vector<int>& out) {
+// Appends the indices i in [b, e) with v[i] >= t, in increasing order.
+void indices_at_least(const float* v, float t, int b, int e, std::vector<int>& out) {
   int i = b;
 #if defined(__SSE2__)
   const __m128 tt = _mm_set1_ps(t);
@@ -115,12 +115,12 @@ void indices_at_least(const float* v, float t, const uint8_t* skip, int b, int e
     while (bits) {
       const int k = i + __builtin_ctz(unsigned(bits));
       bits &= bits - 1;
-      if (!skip || !skip[k]) out.push_back(k);
+      out.push_back(k);
     }
   }
 #endif
   for (; i < e; ++i)
-    if (v[i] >= t && (!skip || !skip[i])) out.push_back(i);
+    if (v[i] >= t) out.push_back(i);
 }
 }  // namespace
 
@@ -134,7 +134,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   // values wherever the bounds do not decide).
   corner_lo_.resize(size_t(n));
   corner_hi_.resize(size_t(n));
-  surface_.resize(size_t(n));
+  surface_.assign(size_t(n) / 64 + 2, 0);
   picked_.assign(size_t(n), 0);
   occ_.clear();
   const detail::RingIn in{w.x.data() + begin, w.y.data() + begin, w.z.data() + begin, w.range.data() + begin,
@@ -144,7 +144,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
                                 float(cfg_.corner_threshold), float(cfg_.surface_threshold)};
   detail::RingScratch scratch{ring_w_, ring_brk_};
   float *lo = corner_lo_.data(), *hi = corner_hi_.data();
-  const float* sk = surface_.data();
+  const uint64_t* sk = surface_.data();
   detail::smoothness(in, rules, scratch, lo, hi, surface_.data(), occ_);
   uint8_t* picked = picked_.data();
   // Taking points a..b out: no later corner or surface pick there (a pick's neighbours, occlusions).
@@ -179,7 +179,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       const float top = max_of(lo, sb, se);
       if (!(top > -kInf)) break;
       cand.clear();
-      indices_at_least(hi, top, nullptr, sb, se, cand);
+      indices_at_least(hi, top, sb, se, cand);
       int best = cand.front();
       if (cand.size() > 1) {
         float bc = -kInf;
@@ -197,7 +197,16 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     }
     if (max_surfaces <= 0) continue;
     cand.clear();
-    indices_at_least(sk, 0.f, picked, sb, se, cand);  // sk = 0 where a candidate may be, -inf elsewhere
+    for (int wb = sb >> 6; wb <= (se - 1) >> 6; ++wb) {  // the bits of [sb, se)
+      uint64_t bits = sk[wb];
+      if (wb == sb >> 6) bits &= ~uint64_t(0) << (sb & 63);
+      if (wb == (se - 1) >> 6 && ((se - 1) & 63) < 63) bits &= (uint64_t(2) << ((se - 1) & 63)) - 1;
+      while (bits) {
+        const int i = (wb << 6) + __builtin_ctzll(bits);
+        bits &= bits - 1;
+        if (!picked[i]) cand.push_back(i);
+      }
+    }
     // Exact c of each; kept when below the threshold.
     auto& sc = surface_c_;
     sc.resize(size_t(n));

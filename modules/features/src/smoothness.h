@@ -34,7 +34,7 @@ struct RingRules {
 // Buffers kept from ring to ring and scan to scan (no allocation once they have grown).
 struct RingScratch {
   std::vector<float>& w;      // hw-point block sums of x, y, z
-  std::vector<int32_t>& brk;  // number of column breaks among the first j neighbour pairs
+  std::vector<int32_t>& brk;  // column breaks between neighbours, and their hw-pair block sums
 };
 
 // The smoothness of point i (hw <= i < n - hw) by the plain rules: LOAM's c = |sum_j (X_j - X_i)| /
@@ -56,13 +56,14 @@ inline float exact_smoothness(const RingIn& in, int hw, int i) {
 // parallel to the beam):
 //  - corner_lo[i] <= c_i <= corner_hi[i] when it is a corner candidate (c_i > corner threshold); equal
 //    bounds hold the exact c_i (where the bound could not decide the threshold); -inf / -inf otherwise;
-//  - surface[i] = 0 when it may be a surface candidate (its lower bound is below the surface threshold: the
-//    caller computes c exactly and keeps it when c < threshold), -inf otherwise.
+//  - bit i of `surface` (n + 64 bits, zeroed by the caller) is set when it may be a surface candidate (its
+//    lower bound is below the surface threshold: the caller computes c exactly and keeps it when c <
+//    threshold).
 // Occlusion boundaries (LOAM's unreliable points) are appended to `occlusions` as +(j + 1) when the far
 // side begins at j + 1 (points j+1 .. j+hw are unusable) and -(j + 1) when it ends at j (j-hw+1 .. j);
 // the caller applies them (they only take candidates away).
 void smoothness(const RingIn& in, const RingRules& rules, RingScratch& scratch, float* corner_lo, float* corner_hi,
-                float* surface, std::vector<int>& occlusions);
+                uint64_t* surface, std::vector<int>& occlusions);
 
 // The dispatch's choice, for the benchmark and the notes: "avx2", "sse2" or "generic".
 const char* smoothness_isa();
