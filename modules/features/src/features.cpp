@@ -87,22 +87,18 @@ FeatureStatus FeatureExtractor::extract(const seg::Segmentation& seg) {
 namespace {
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-float max_of(const float* v, int b, int e) {
-  float m = -kInf;
-  int i = b;
+// The largest of v[0 .. 8).
+float max8(const float* v) {
 #if defined(__SSE2__)
-  __m128 m0 = _mm_set1_ps(-kInf), m1 = m0;
-  for (; i + 8 <= e; i += 8) {
-    m0 = _mm_max_ps(m0, _mm_loadu_ps(v + i));
-    m1 = _mm_max_ps(m1, _mm_loadu_ps(v + i + 4));
-  }
-  m0 = _mm_max_ps(m0, m1);
-  m0 = _mm_max_ps(m0, _mm_shuffle_ps(m0, m0, _MM_SHUFFLE(1, 0, 3, 2)));
-  m0 = _mm_max_ps(m0, _mm_shuffle_ps(m0, m0, _MM_SHUFFLE(2, 3, 0, 1)));
-  m = _mm_cvtss_f32(m0);
-#endif
-  for (; i < e; ++i) m = v[i] > m ? v[i] : m;
+  __m128 m = _mm_max_ps(_mm_loadu_ps(v), _mm_loadu_ps(v + 4));
+  m = _mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
+  m = _mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1)));
+  return _mm_cvtss_f32(m);
+#else
+  float m = v[0];
+  for (int k = 1; k < 8; ++k) m = std::max(m, v[k]);
   return m;
+#endif
 }
 
 // Appends the indices i in [b, e) with v[i] >= t, in increasing order.
@@ -132,8 +128,9 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
 
   // Smoothness bounds and candidates of every point (src/smoothness.h: vectorised, in float, with exact
   // values wherever the bounds do not decide).
-  corner_lo_.resize(size_t(n));
-  corner_hi_.resize(size_t(n));
+  const int nb = (n + 7) / 8;  // 8-point blocks of the corner bounds
+  corner_lo_.resize(size_t(nb) * 8);
+  corner_hi_.resize(size_t(nb) * 8);
   surface_.assign(size_t(n) / 64 + 2, 0);
   picked_.assign(size_t(n), 0);
   occ_.clear();
@@ -146,13 +143,29 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   float *lo = corner_lo_.data(), *hi = corner_hi_.data();
   const uint64_t* sk = surface_.data();
   detail::smoothness(in, rules, scratch, lo, hi, surface_.data(), occ_);
+  for (int k = 0; k < hw; ++k) lo[k] = hi[k] = -kInf;  // no window: no candidate
+  for (int k = n - hw; k < nb * 8; ++k) lo[k] = hi[k] = -kInf;
   uint8_t* picked = picked_.data();
+  // The largest bounds of each block, kept up to date as points are taken out: the sector scans for the
+  // sharpest candidate read 1/8 of the points.
+  blo_.resize(size_t(nb));
+  bhi_.resize(size_t(nb));
+  float *blo = blo_.data(), *bhi = bhi_.data();
+  auto refresh = [&](int b) {
+    blo[b] = max8(lo + 8 * b);
+    bhi[b] = max8(hi + 8 * b);
+  };
+  bool blocks_ready = false;
   // Taking points a..b out: no later corner or surface pick there (a pick's neighbours, occlusions).
   auto suppress = [&](int a, int b) {
-    for (int k = std::max(0, a); k <= std::min(n - 1, b); ++k) {
+    a = std::max(0, a);
+    b = std::min(n - 1, b);
+    for (int k = a; k <= b; ++k) {
       picked[k] = 1;
       lo[k] = hi[k] = -kInf;
     }
+    if (blocks_ready && a <= b)
+      for (int q = a >> 3; q <= b >> 3; ++q) refresh(q);
   };
   for (const int e : occ_) {  // +(j+1): the near side is j (j+1 .. j+hw out); -(j+1): j-hw+1 .. j out
     if (e < 0)
@@ -160,6 +173,8 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     else
       suppress(e, e - 1 + hw);
   }
+  for (int q = 0; q < nb; ++q) refresh(q);
+  blocks_ready = true;
 
   // Per-sector selection (sectors split the ring's points evenly, as LOAM does): the sharpest corner
   // candidates that no earlier pick suppressed, then the smoothest surface candidates, walked in the order
@@ -176,10 +191,20 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     for (int corners = 0; corners < max_corners; ++corners) {
       // The sharpest candidate is among those whose upper bound reaches the largest lower bound; when
       // that is more than one, their exact c decide (ties: the first index).
-      const float top = max_of(lo, sb, se);
+      const int b0 = (sb + 7) >> 3, b1 = se >> 3;  // whole blocks b0 .. b1-1; single points around them
+      const int h = std::min(se, 8 * b0), t = std::max(h, 8 * b1);
+      float top = -kInf;
+      for (int k = sb; k < h; ++k) top = std::max(top, lo[k]);
+      for (int q = b0; q < b1; ++q) top = std::max(top, blo[q]);
+      for (int k = t; k < se; ++k) top = std::max(top, lo[k]);
       if (!(top > -kInf)) break;
       cand.clear();
-      indices_at_least(hi, top, sb, se, cand);
+      for (int k = sb; k < h; ++k)
+        if (hi[k] >= top) cand.push_back(k);
+      for (int q = b0; q < b1; ++q)
+        if (bhi[q] >= top) indices_at_least(hi, top, 8 * q, 8 * q + 8, cand);
+      for (int k = t; k < se; ++k)
+        if (hi[k] >= top) cand.push_back(k);
       int best = cand.front();
       if (cand.size() > 1) {
         float bc = -kInf;
