@@ -87,6 +87,29 @@ FeatureStatus FeatureExtractor::extract(const seg::Segmentation& seg) {
 namespace {
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
+// The largest of v[b .. e), -inf when empty.
+float max_range(const float* v, int b, int e) {
+  float m = -kInf;
+  int i = b;
+#if defined(__SSE2__)
+  __m128 m0 = _mm_set1_ps(-kInf), m1 = m0;
+  for (; i + 8 <= e; i += 8) {
+    m0 = _mm_max_ps(m0, _mm_loadu_ps(v + i));
+    m1 = _mm_max_ps(m1, _mm_loadu_ps(v + i + 4));
+  }
+  if (i + 4 <= e) {
+    m0 = _mm_max_ps(m0, _mm_loadu_ps(v + i));
+    i += 4;
+  }
+  m0 = _mm_max_ps(m0, m1);
+  m0 = _mm_max_ps(m0, _mm_shuffle_ps(m0, m0, _MM_SHUFFLE(1, 0, 3, 2)));
+  m0 = _mm_max_ps(m0, _mm_shuffle_ps(m0, m0, _MM_SHUFFLE(2, 3, 0, 1)));
+  m = _mm_cvtss_f32(m0);
+#endif
+  for (; i < e; ++i) m = v[i] > m ? v[i] : m;
+  return m;
+}
+
 // The largest of v[0 .. 8).
 float max8(const float* v) {
 #if defined(__SSE2__)
@@ -195,14 +218,15 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       const int h = std::min(se, 8 * b0), t = std::max(h, 8 * b1);
       float top = -kInf;
       for (int k = sb; k < h; ++k) top = std::max(top, lo[k]);
-      for (int q = b0; q < b1; ++q) top = std::max(top, blo[q]);
+      top = std::max(top, max_range(blo, b0, b1));
       for (int k = t; k < se; ++k) top = std::max(top, lo[k]);
       if (!(top > -kInf)) break;
       cand.clear();
       for (int k = sb; k < h; ++k)
         if (hi[k] >= top) cand.push_back(k);
-      for (int q = b0; q < b1; ++q)
-        if (bhi[q] >= top) indices_at_least(hi, top, 8 * q, 8 * q + 8, cand);
+      blocks_.clear();
+      indices_at_least(bhi, top, b0, b1, blocks_);
+      for (const int q : blocks_) indices_at_least(hi, top, 8 * q, 8 * q + 8, cand);
       for (int k = t; k < se; ++k)
         if (hi[k] >= top) cand.push_back(k);
       int best = cand.front();
