@@ -9,10 +9,83 @@
 #include <limits>
 #include <numeric>
 #if defined(__SSE2__)
-#include <xmmintrin.h>
+#include <emmintrin.h>
 #endif
 
 namespace fploc::feat {
+
+namespace {
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// The end of the run of equal values that starts at b (one ring of the ring-major wall points).
+size_t run_end(const int16_t* v, size_t b, size_t n) {
+  size_t i = b + 1;
+#if defined(__SSE2__)
+  const __m128i r = _mm_set1_epi16(v[b]);
+  for (; i + 8 <= n; i += 8) {
+    const int eq = _mm_movemask_epi8(_mm_cmpeq_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(v + i)), r));
+    if (eq != 0xffff) return i + size_t(__builtin_ctz(unsigned(~eq & 0xffff)) / 2);
+  }
+#endif
+  while (i < n && v[i] == v[b]) ++i;
+  return i;
+}
+
+// The largest of v[b .. e), -inf when empty.
+float max_range(const float* v, int b, int e) {
+  float m = -kInf;
+  int i = b;
+#if defined(__SSE2__)
+  __m128 m0 = _mm_set1_ps(-kInf), m1 = m0;
+  for (; i + 8 <= e; i += 8) {
+    m0 = _mm_max_ps(m0, _mm_loadu_ps(v + i));
+    m1 = _mm_max_ps(m1, _mm_loadu_ps(v + i + 4));
+  }
+  if (i + 4 <= e) {
+    m0 = _mm_max_ps(m0, _mm_loadu_ps(v + i));
+    i += 4;
+  }
+  m0 = _mm_max_ps(m0, m1);
+  m0 = _mm_max_ps(m0, _mm_shuffle_ps(m0, m0, _MM_SHUFFLE(1, 0, 3, 2)));
+  m0 = _mm_max_ps(m0, _mm_shuffle_ps(m0, m0, _MM_SHUFFLE(2, 3, 0, 1)));
+  m = _mm_cvtss_f32(m0);
+#endif
+  for (; i < e; ++i) m = v[i] > m ? v[i] : m;
+  return m;
+}
+
+// The largest of v[0 .. 8).
+float max8(const float* v) {
+#if defined(__SSE2__)
+  __m128 m = _mm_max_ps(_mm_loadu_ps(v), _mm_loadu_ps(v + 4));
+  m = _mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
+  m = _mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1)));
+  return _mm_cvtss_f32(m);
+#else
+  float m = v[0];
+  for (int k = 1; k < 8; ++k) m = std::max(m, v[k]);
+  return m;
+#endif
+}
+
+// Appends the indices i in [b, e) with v[i] >= t, in increasing order.
+void indices_at_least(const float* v, float t, int b, int e, std::vector<int>& out) {
+  int i = b;
+#if defined(__SSE2__)
+  const __m128 tt = _mm_set1_ps(t);
+  for (; i + 4 <= e; i += 4) {
+    int bits = _mm_movemask_ps(_mm_cmpge_ps(_mm_loadu_ps(v + i), tt));
+    while (bits) {
+      const int k = i + __builtin_ctz(unsigned(bits));
+      bits &= bits - 1;
+      out.push_back(k);
+    }
+  }
+#endif
+  for (; i < e; ++i)
+    if (v[i] >= t) out.push_back(i);
+}
+}  // namespace
 
 FeatureExtractor::FeatureExtractor(FeatureConfig cfg) : cfg_(cfg) {}
 
@@ -74,74 +147,14 @@ FeatureStatus FeatureExtractor::extract(const seg::Segmentation& seg) {
   const int H = std::max(1, seg.height);
   ring_step_ = std::max(1, int(std::lround(double(H) / kRefRings)));
   limit_scale_ = std::max(1.0, double(kRefRings) / H);
-  size_t b = 0;
-  for (size_t i = 1; i <= n; ++i) {
-    if (i == n || w.ring[i] != w.ring[b]) {
-      if (w.ring[b] % ring_step_ == 0) ring(seg, b, i);
-      b = i;
-    }
+  for (size_t b = 0; b < n;) {
+    const size_t e = run_end(w.ring.data(), b, n);
+    if (w.ring[b] % ring_step_ == 0) ring(seg, b, e);
+    b = e;
   }
   return out_.x.size() < 30 ? FeatureStatus::kFewFeatures : FeatureStatus::kOk;
 }
 
-namespace {
-constexpr float kInf = std::numeric_limits<float>::infinity();
-
-// The largest of v[b .. e), -inf when empty.
-float max_range(const float* v, int b, int e) {
-  float m = -kInf;
-  int i = b;
-#if defined(__SSE2__)
-  __m128 m0 = _mm_set1_ps(-kInf), m1 = m0;
-  for (; i + 8 <= e; i += 8) {
-    m0 = _mm_max_ps(m0, _mm_loadu_ps(v + i));
-    m1 = _mm_max_ps(m1, _mm_loadu_ps(v + i + 4));
-  }
-  if (i + 4 <= e) {
-    m0 = _mm_max_ps(m0, _mm_loadu_ps(v + i));
-    i += 4;
-  }
-  m0 = _mm_max_ps(m0, m1);
-  m0 = _mm_max_ps(m0, _mm_shuffle_ps(m0, m0, _MM_SHUFFLE(1, 0, 3, 2)));
-  m0 = _mm_max_ps(m0, _mm_shuffle_ps(m0, m0, _MM_SHUFFLE(2, 3, 0, 1)));
-  m = _mm_cvtss_f32(m0);
-#endif
-  for (; i < e; ++i) m = v[i] > m ? v[i] : m;
-  return m;
-}
-
-// The largest of v[0 .. 8).
-float max8(const float* v) {
-#if defined(__SSE2__)
-  __m128 m = _mm_max_ps(_mm_loadu_ps(v), _mm_loadu_ps(v + 4));
-  m = _mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
-  m = _mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1)));
-  return _mm_cvtss_f32(m);
-#else
-  float m = v[0];
-  for (int k = 1; k < 8; ++k) m = std::max(m, v[k]);
-  return m;
-#endif
-}
-
-// Appends the indices i in [b, e) with v[i] >= t, in increasing order.
-void indices_at_least(const float* v, float t, int b, int e, std::vector<int>& out) {
-  int i = b;
-#if defined(__SSE2__)
-  const __m128 tt = _mm_set1_ps(t);
-  for (; i + 4 <= e; i += 4) {
-    int bits = _mm_movemask_ps(_mm_cmpge_ps(_mm_loadu_ps(v + i), tt));
-    while (bits) {
-      const int k = i + __builtin_ctz(unsigned(bits));
-      bits &= bits - 1;
-      out.push_back(k);
-    }
-  }
-#endif
-  for (; i < e; ++i)
-    if (v[i] >= t) out.push_back(i);
-}
-}  // namespace
 
 void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t end) {
   const auto& w = seg.wall;
@@ -178,8 +191,10 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     blo[b] = max8(lo + 8 * b);
     bhi[b] = max8(hi + 8 * b);
   };
-  bool blocks_ready = false;
-  // Taking points a..b out: no later corner or surface pick there (a pick's neighbours, occlusions).
+  // Taking points a..b out: no later corner or surface pick there (a pick's neighbours, occlusions). The
+  // blocks' maxima are brought up to date when a sector reads them (dirty_).
+  dirty_.assign(size_t(nb), 1);
+  uint8_t* dirty = dirty_.data();
   auto suppress = [&](int a, int b) {
     a = std::max(0, a);
     b = std::min(n - 1, b);
@@ -187,8 +202,8 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       picked[k] = 1;
       lo[k] = hi[k] = -kInf;
     }
-    if (blocks_ready && a <= b)
-      for (int q = a >> 3; q <= b >> 3; ++q) refresh(q);
+    if (a <= b)
+      for (int q = a >> 3; q <= b >> 3; ++q) dirty[q] = 1;
   };
   for (const int e : occ_) {  // +(j+1): the near side is j (j+1 .. j+hw out); -(j+1): j-hw+1 .. j out
     if (e < 0)
@@ -196,8 +211,6 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     else
       suppress(e, e - 1 + hw);
   }
-  for (int q = 0; q < nb; ++q) refresh(q);
-  blocks_ready = true;
 
   // Per-sector selection (sectors split the ring's points evenly, as LOAM does): the sharpest corner
   // candidates that no earlier pick suppressed, then the smoothest surface candidates, walked in the order
@@ -216,6 +229,11 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       // that is more than one, their exact c decide (ties: the first index).
       const int b0 = (sb + 7) >> 3, b1 = se >> 3;  // whole blocks b0 .. b1-1; single points around them
       const int h = std::min(se, 8 * b0), t = std::max(h, 8 * b1);
+      for (int q = b0; q < b1; ++q)
+        if (dirty[q]) {
+          refresh(q);
+          dirty[q] = 0;
+        }
       float top = -kInf;
       for (int k = sb; k < h; ++k) top = std::max(top, lo[k]);
       top = std::max(top, max_range(blo, b0, b1));

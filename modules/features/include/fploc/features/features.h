@@ -72,6 +72,7 @@ class FeatureExtractor {
   std::vector<uint64_t> surface_;             // bit i: point i may be a surface candidate
   std::vector<float> surface_c_;              // exact c of the sector's surface candidates
   std::vector<uint8_t> picked_;                  // suppressed by a pick or an occlusion boundary
+  std::vector<uint8_t> dirty_;                   // blocks whose maxima are out of date
   std::vector<int> occ_, surf_, sel_, run_, blocks_;
   std::vector<float> ring_w_;
   std::vector<int32_t> ring_brk_;
