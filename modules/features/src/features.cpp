@@ -1,5 +1,7 @@
 #include "fploc/features/features.h"
 
+#include "smoothness.h"
+
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -11,6 +13,79 @@
 #endif
 
 namespace fploc::feat {
+
+namespace {
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// The end of the run of equal values that starts at b (one ring of the ring-major wall points).
+size_t run_end(const int16_t* v, size_t b, size_t n) {
+  size_t i = b + 1;
+#if defined(__SSE2__)
+  const __m128i r = _mm_set1_epi16(v[b]);
+  for (; i + 8 <= n; i += 8) {
+    const int eq = _mm_movemask_epi8(_mm_cmpeq_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(v + i)), r));
+    if (eq != 0xffff) return i + size_t(__builtin_ctz(unsigned(~eq & 0xffff)) / 2);
+  }
+#endif
+  while (i < n && v[i] == v[b]) ++i;
+  return i;
+}
+
+// The largest of v[b .. e), -inf when empty.
+float max_range(const float* v, int b, int e) {
+  float m = -kInf;
+  int i = b;
+#if defined(__SSE2__)
+  __m128 m0 = _mm_set1_ps(-kInf), m1 = m0;
+  for (; i + 8 <= e; i += 8) {
+    m0 = _mm_max_ps(m0, _mm_loadu_ps(v + i));
+    m1 = _mm_max_ps(m1, _mm_loadu_ps(v + i + 4));
+  }
+  if (i + 4 <= e) {
+    m0 = _mm_max_ps(m0, _mm_loadu_ps(v + i));
+    i += 4;
+  }
+  m0 = _mm_max_ps(m0, m1);
+  m0 = _mm_max_ps(m0, _mm_shuffle_ps(m0, m0, _MM_SHUFFLE(1, 0, 3, 2)));
+  m0 = _mm_max_ps(m0, _mm_shuffle_ps(m0, m0, _MM_SHUFFLE(2, 3, 0, 1)));
+  m = _mm_cvtss_f32(m0);
+#endif
+  for (; i < e; ++i) m = v[i] > m ? v[i] : m;
+  return m;
+}
+
+// The largest of v[0 .. 8).
+float max8(const float* v) {
+#if defined(__SSE2__)
+  __m128 m = _mm_max_ps(_mm_loadu_ps(v), _mm_loadu_ps(v + 4));
+  m = _mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
+  m = _mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1)));
+  return _mm_cvtss_f32(m);
+#else
+  float m = v[0];
+  for (int k = 1; k < 8; ++k) m = std::max(m, v[k]);
+  return m;
+#endif
+}
+
+// Appends the indices i in [b, e) with v[i] >= t, in increasing order.
+void indices_at_least(const float* v, float t, int b, int e, std::vector<int>& out) {
+  int i = b;
+#if defined(__SSE2__)
+  const __m128 tt = _mm_set1_ps(t);
+  for (; i + 4 <= e; i += 4) {
+    int bits = _mm_movemask_ps(_mm_cmpge_ps(_mm_loadu_ps(v + i), tt));
+    while (bits) {
+      const int k = i + __builtin_ctz(unsigned(bits));
+      bits &= bits - 1;
+      out.push_back(k);
+    }
+  }
+#endif
+  for (; i < e; ++i)
+    if (v[i] >= t) out.push_back(i);
+}
+}  // namespace
 
 FeatureExtractor::FeatureExtractor(FeatureConfig cfg) : cfg_(cfg) {}
 
@@ -72,198 +147,156 @@ FeatureStatus FeatureExtractor::extract(const seg::Segmentation& seg) {
   const int H = std::max(1, seg.height);
   ring_step_ = std::max(1, int(std::lround(double(H) / kRefRings)));
   limit_scale_ = std::max(1.0, double(kRefRings) / H);
-  size_t b = 0;
-  for (size_t i = 1; i <= n; ++i) {
-    if (i == n || w.ring[i] != w.ring[b]) {
-      if (w.ring[b] % ring_step_ == 0) ring(seg, b, i);
-      b = i;
-    }
+  for (size_t b = 0; b < n;) {
+    const size_t e = run_end(w.ring.data(), b, n);
+    if (w.ring[b] % ring_step_ == 0) ring(seg, b, e);
+    b = e;
   }
   return out_.x.size() < 30 ? FeatureStatus::kFewFeatures : FeatureStatus::kOk;
 }
+
 
 void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t end) {
   const auto& w = seg.wall;
   const int n = int(end - begin);
   const int hw = std::max(1, cfg_.half_window);
   if (n < 2 * hw + 1) return;
-  const float *X = w.x.data() + begin, *Y = w.y.data() + begin, *Z = w.z.data() + begin;
-  const float* R = w.range.data() + begin;
-  const int16_t* C = w.column.data() + begin;
 
-  // Not cleared: curv_ is written wherever it is read ([hw, n-hw)), ok_ is written everywhere below.
-  curv_.resize(n);
-  ok_.resize(n);
-  picked_.assign(n, 0);
-  // One pass (issue 14 item 7; the same values as the earlier separate passes): the break prefix (brk[j] =
-  // number of column gaps among the first j neighbour pairs), the window sums by prefix sums (double: ring
-  // coordinates reach ~100 m; sum(X_j - X_i) = S - (2hw+1) X_i), and, hw points behind the prefix, the
-  // smoothness, the window/range test and the parallel-surface test of point i = j - hw. The prefix sums
-  // are a chain of dependent additions; the smoothness of earlier points fills the cycles between them.
-  // Occlusion boundaries (rare) are only recorded here and applied after the pass (the rules only clear
-  // ok_, so the order does not matter).
-  auto& brk = brk_;
-  brk.resize(n + 1);
-  brk[0] = 0;
-  const int gap = cfg_.max_column_gap;
-  const float rmin = float(cfg_.min_range_m), rmax = float(cfg_.max_range_m);
-  const float occ = float(cfg_.occlusion_ratio), par = float(cfg_.parallel_ratio);
-  prex_.resize(size_t(n) + 1);
-  prey_.resize(size_t(n) + 1);
-  prez_.resize(size_t(n) + 1);
-  double *px = prex_.data(), *py = prey_.data(), *pz = prez_.data();
-  px[0] = py[0] = pz[0] = 0.0;
-  const double win = double(2 * hw + 1);
-  const float den = float(2 * hw);
-  float* curv = curv_.data();
-  uint8_t* ok = ok_.data();
+  // Smoothness bounds and candidates of every point (src/smoothness.h: vectorised, in float, with exact
+  // values wherever the bounds do not decide).
+  const int nb = (n + 7) / 8;  // 8-point blocks of the corner bounds
+  corner_lo_.resize(size_t(nb) * 8);
+  corner_hi_.resize(size_t(nb) * 8);
+  surface_.assign(size_t(n) / 64 + 2, 0);
+  picked_.assign(size_t(n), 0);
   occ_.clear();
-  auto prefix = [&](int j) __attribute__((always_inline)) {
-    const int step = j + 1 < n ? C[j + 1] - C[j] : gap + 1;
-    brk[j + 1] = brk[j] + int(step > gap);
-    px[j + 1] = px[j] + double(X[j]);
-    py[j + 1] = py[j] + double(Y[j]);
-    pz[j + 1] = pz[j] + double(Z[j]);
-    // LOAM's unreliable points, part 1: the far side of an occlusion boundary between neighbours j, j+1.
-    if (j + 1 < n) {
-      const float a = R[j], c = R[j + 1];
-      const float mn = a < c ? a : c;  // minss, no branch
-      if ((step <= gap) & (std::abs(a - c) > occ * mn)) occ_.push_back(a > c ? -(j + 1) : j + 1);
-    }
+  const detail::RingIn in{w.x.data() + begin, w.y.data() + begin, w.z.data() + begin, w.range.data() + begin,
+                          w.column.data() + begin, n};
+  const detail::RingRules rules{hw, cfg_.max_column_gap, float(cfg_.min_range_m), float(cfg_.max_range_m),
+                                float(cfg_.occlusion_ratio), float(cfg_.parallel_ratio),
+                                float(cfg_.corner_threshold), float(cfg_.surface_threshold)};
+  detail::RingScratch scratch{ring_w_, ring_brk_};
+  float *lo = corner_lo_.data(), *hi = corner_hi_.data();
+  const uint64_t* sk = surface_.data();
+  detail::smoothness(in, rules, scratch, lo, hi, surface_.data(), occ_);
+  for (int k = 0; k < hw; ++k) lo[k] = hi[k] = -kInf;  // no window: no candidate
+  for (int k = n - hw; k < nb * 8; ++k) lo[k] = hi[k] = -kInf;
+  uint8_t* picked = picked_.data();
+  // The largest bounds of each block, kept up to date as points are taken out: the sector scans for the
+  // sharpest candidate read 1/8 of the points.
+  blo_.resize(size_t(nb));
+  bhi_.resize(size_t(nb));
+  float *blo = blo_.data(), *bhi = bhi_.data();
+  auto refresh = [&](int b) {
+    blo[b] = max8(lo + 8 * b);
+    bhi[b] = max8(hi + 8 * b);
   };
-  auto point = [&](int i) {
-    // All of i-hw .. i+hw connected: no break between i-hw and i+hw-1. LOAM's unreliable points, part 2:
-    // surfaces parallel to the beam (range jumps to both sides).
-    const float ri = R[i];
-    const bool okw = (brk[i + hw] == brk[i - hw]) & !(ri < rmin) & !(ri > rmax);
-    const bool parallel = (std::abs(R[i - 1] - ri) > par * ri) & (std::abs(R[i + 1] - ri) > par * ri);
-    const double dx = (px[i + hw + 1] - px[i - hw]) - win * double(X[i]);
-    const double dy = (py[i + hw + 1] - py[i - hw]) - win * double(Y[i]);
-    const double dz = (pz[i + hw + 1] - pz[i - hw]) - win * double(Z[i]);
-    curv[i] = float(std::sqrt(dx * dx + dy * dy + dz * dz)) / (den * ri);  // LOAM's c = |sum(X_j - X_i)| / (|S| |X_i|)
-    ok[i] = uint8_t(okw & !parallel);
-  };
-  for (int i = 0; i < hw; ++i) ok[i] = 0;
-  for (int i = n - hw; i < n; ++i) ok[i] = 0;
-  for (int j = 0; j < 2 * hw; ++j) prefix(j);
-  int j = 2 * hw;
-#if defined(__SSE2__)
-  // Four points at a time: two sqrtpd (the same correctly rounded roots as one at a time) and one divps
-  // (the same quotients): the divider, shared by square roots and divisions, was the bottleneck.
-  const __m128d w2 = _mm_set1_pd(win);
-  const __m128 den4 = _mm_set1_ps(den);
-  auto ld = [](const double* p) { return _mm_loadu_pd(p); };
-  auto cvt2 = [](const float* p) { return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)))); };
-  auto norm2 = [&](int i) {  // |sum(X_j - X_i)| of points i, i+1
-    const __m128d dx = _mm_sub_pd(_mm_sub_pd(ld(px + i + hw + 1), ld(px + i - hw)), _mm_mul_pd(w2, cvt2(X + i)));
-    const __m128d dy = _mm_sub_pd(_mm_sub_pd(ld(py + i + hw + 1), ld(py + i - hw)), _mm_mul_pd(w2, cvt2(Y + i)));
-    const __m128d dz = _mm_sub_pd(_mm_sub_pd(ld(pz + i + hw + 1), ld(pz + i - hw)), _mm_mul_pd(w2, cvt2(Z + i)));
-    return _mm_cvtpd_ps(_mm_sqrt_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)), _mm_mul_pd(dz, dz))));
-  };
-  for (; j + 4 <= n; j += 4) {
-    for (int q = j; q < j + 4; ++q) prefix(q);
-    const int i = j - hw;  // points i .. i+3 need the prefix up to i + 3 + hw + 1 = j + 4
-    const __m128 nrm = _mm_movelh_ps(norm2(i), norm2(i + 2));
-    _mm_storeu_ps(curv + i, _mm_div_ps(nrm, _mm_mul_ps(den4, _mm_loadu_ps(R + i))));
-    for (int l = 0; l < 4; ++l) {
-      const int q = i + l;
-      const float rq = R[q];
-      const bool okw = (brk[q + hw] == brk[q - hw]) & !(rq < rmin) & !(rq > rmax);
-      const bool parallel = (std::abs(R[q - 1] - rq) > par * rq) & (std::abs(R[q + 1] - rq) > par * rq);
-      ok[q] = uint8_t(okw & !parallel);
+  // Taking points a..b out: no later corner or surface pick there (a pick's neighbours, occlusions). The
+  // blocks' maxima are brought up to date when a sector reads them (dirty_).
+  dirty_.assign(size_t(nb), 1);
+  uint8_t* dirty = dirty_.data();
+  auto suppress = [&](int a, int b) {
+    a = std::max(0, a);
+    b = std::min(n - 1, b);
+    for (int k = a; k <= b; ++k) {
+      picked[k] = 1;
+      lo[k] = hi[k] = -kInf;
     }
-  }
-#endif
-  for (; j < n; ++j) {
-    prefix(j);
-    point(j - hw);  // needs the prefix up to j + 1 = i + hw + 1
-  }
-  for (const int e : occ_) {  // +(j+1): the near side is j (clear j+1 .. j+hw); -(j+1): clear j-hw+1 .. j
-    if (e < 0) {
-      const int j = -e - 1;
-      for (int k = std::max(0, j - hw + 1); k <= j; ++k) ok[k] = 0;
-    } else {
-      const int j = e - 1;
-      for (int k = j + 1; k <= std::min(n - 1, j + hw); ++k) ok[k] = 0;
-    }
+    if (a <= b)
+      for (int q = a >> 3; q <= b >> 3; ++q) dirty[q] = 1;
+  };
+  for (const int e : occ_) {  // +(j+1): the near side is j (j+1 .. j+hw out); -(j+1): j-hw+1 .. j out
+    if (e < 0)
+      suppress(-e - 1 - hw + 1, -e - 1);
+    else
+      suppress(e, e - 1 + hw);
   }
 
-  // Per-sector selection (sectors split the ring's points evenly, as LOAM does).
-  sel_.clear();
-  auto& kind_of = kind_;
-  kind_of.resize(n);  // read only at the picks, which set it
+  // Per-sector selection (sectors split the ring's points evenly, as LOAM does): the sharpest corner
+  // candidates that no earlier pick suppressed, then the smoothest surface candidates, walked in the order
+  // (c, index): the plain rules' picks.
+  sel_.clear();  // picks as 2 * index + (1 for a corner)
   const int S = std::max(1, cfg_.sectors);
-  const float cthr = float(cfg_.corner_threshold), sthr = float(cfg_.surface_threshold);
   const int max_corners = int(std::lround(cfg_.max_corners_per_sector * limit_scale_));
   const int max_surfaces = int(std::lround(cfg_.max_surfaces_per_sector * limit_scale_));
+  const float sthr = float(cfg_.surface_threshold);
+  auto& cand = surf_;
   for (int s = 0; s < S; ++s) {
     const int sb = hw + (n - 2 * hw) * s / S, se = hw + (n - 2 * hw) * (s + 1) / S;
     if (se <= sb) continue;
-    // Corners: the sharpest candidate that no earlier pick suppressed, max_corners_per_sector times (the
-    // same picks as walking the candidates sorted by decreasing c, ties by index; a branch-free scan per
-    // pick instead of a sort, which mispredicted on every comparison). Candidates are collected without
-    // a data-dependent branch too.
-    // Corner (c > corner threshold) and surface (c < surface threshold) candidates in one pass. Surface
-    // candidates a corner pick suppresses are skipped when walking them (the same picks as leaving them out).
-    order_.resize(size_t(se - sb));
-    surf_.resize(size_t(se - sb));
-    // The first corner pick is found in the same pass (picked_ holds only the earlier sectors' picks then).
-    size_t m = 0, ms = 0;
-    int best0 = -1;
-    float bv0 = -std::numeric_limits<float>::infinity();
-    for (int i = sb; i < se; ++i) {
-      const float ci = curv_[i];
-      order_[m] = i;
-      surf_[ms] = i;
-      const bool corner = ok_[i] & uint8_t(ci > cthr);
-      m += size_t(corner);
-      ms += size_t(ok_[i] & uint8_t(ci < sthr));
-      const bool take = corner & !picked_[i] & (ci > bv0);
-      bv0 = take ? ci : bv0;
-      best0 = take ? i : best0;
-    }
     for (int corners = 0; corners < max_corners; ++corners) {
-      int best = corners == 0 ? best0 : -1;
-      float bv = -std::numeric_limits<float>::infinity();
-      for (size_t j = 0; corners > 0 && j < m; ++j) {
-        const int i = order_[j];
-        const bool take = !picked_[i] & (curv_[i] > bv);
-        bv = take ? curv_[i] : bv;
-        best = take ? i : best;
+      // The sharpest candidate is among those whose upper bound reaches the largest lower bound; when
+      // that is more than one, their exact c decide (ties: the first index).
+      const int b0 = (sb + 7) >> 3, b1 = se >> 3;  // whole blocks b0 .. b1-1; single points around them
+      const int h = std::min(se, 8 * b0), t = std::max(h, 8 * b1);
+      for (int q = b0; q < b1; ++q)
+        if (dirty[q]) {
+          refresh(q);
+          dirty[q] = 0;
+        }
+      float top = -kInf;
+      for (int k = sb; k < h; ++k) top = std::max(top, lo[k]);
+      top = std::max(top, max_range(blo, b0, b1));
+      for (int k = t; k < se; ++k) top = std::max(top, lo[k]);
+      if (!(top > -kInf)) break;
+      cand.clear();
+      for (int k = sb; k < h; ++k)
+        if (hi[k] >= top) cand.push_back(k);
+      blocks_.clear();
+      indices_at_least(bhi, top, b0, b1, blocks_);
+      for (const int q : blocks_) indices_at_least(hi, top, 8 * q, 8 * q + 8, cand);
+      for (int k = t; k < se; ++k)
+        if (hi[k] >= top) cand.push_back(k);
+      int best = cand.front();
+      if (cand.size() > 1) {
+        float bc = -kInf;
+        best = -1;
+        for (const int i : cand) {
+          const float c = lo[i] == hi[i] ? lo[i] : detail::exact_smoothness(in, hw, i);
+          if (best < 0 || c > bc) {
+            bc = c;
+            best = i;
+          }
+        }
       }
-      if (best < 0) break;
-      kind_of[best] = kCorner;
-      sel_.push_back(best);
-      for (int k = std::max(0, best - hw); k <= std::min(n - 1, best + hw); ++k) picked_[k] = 1;
+      sel_.push_back(2 * best + 1);
+      suppress(best - hw, best + hw);
     }
-    // Surface candidates: only the smoothest few need ordering (partial sort, widened if the spacing
-    // rule rejects too many).
-    surf_.resize(ms);
-    auto less = [&](int a, int b) { return curv_[a] < curv_[b] || (curv_[a] == curv_[b] && a < b); };
-    size_t sorted = 0;
-    int surfaces = 0;
-    for (size_t j = 0; j < surf_.size() && surfaces < max_surfaces; ++j) {
-      if (j == sorted) {
-        // The next k smallest in order: selection then a sort of those k (the order is total, so the same
-        // elements in the same order as a partial sort).
-        const size_t k = std::min(surf_.size(), std::max<size_t>(sorted * 2, size_t(2 * max_surfaces)));
-        if (k < surf_.size()) std::nth_element(surf_.begin() + sorted, surf_.begin() + k, surf_.end(), less);
-        std::sort(surf_.begin() + sorted, surf_.begin() + k, less);
-        sorted = k;
+    if (max_surfaces <= 0) continue;
+    cand.clear();
+    for (int wb = sb >> 6; wb <= (se - 1) >> 6; ++wb) {  // the bits of [sb, se)
+      uint64_t bits = sk[wb];
+      if (wb == sb >> 6) bits &= ~uint64_t(0) << (sb & 63);
+      if (wb == (se - 1) >> 6 && ((se - 1) & 63) < 63) bits &= (uint64_t(2) << ((se - 1) & 63)) - 1;
+      while (bits) {
+        const int i = (wb << 6) + __builtin_ctzll(bits);
+        bits &= bits - 1;
+        if (!picked[i]) cand.push_back(i);
       }
-      const int i = surf_[j];
-      if (picked_[i]) continue;
-      kind_of[i] = kSurface;
-      sel_.push_back(i);
-      ++surfaces;
-      for (int k = std::max(0, i - cfg_.surface_spacing); k <= std::min(n - 1, i + cfg_.surface_spacing); ++k)
-        picked_[k] = 1;
+    }
+    // Exact c of each; kept when below the threshold.
+    auto& sc = surface_c_;
+    sc.resize(size_t(n));
+    size_t m = 0;
+    for (const int i : cand) {
+      const float c = detail::exact_smoothness(in, hw, i);
+      sc[size_t(i)] = c;
+      if (c < sthr) cand[m++] = i;
+    }
+    cand.resize(m);
+    std::sort(cand.begin(), cand.end(), [&](int a, int b) { return sc[a] < sc[b] || (sc[a] == sc[b] && a < b); });
+    int surfaces = 0;
+    for (const int i : cand) {
+      if (picked[i]) continue;
+      sel_.push_back(2 * i);
+      suppress(i - cfg_.surface_spacing, i + cfg_.surface_spacing);
+      if (++surfaces == max_surfaces) break;
     }
   }
 
   // Emit in column order and group surface runs between corner anchors (or gaps) by PCA.
-  std::vector<int> run;
-  const size_t first_out = out_.x.size();
+  auto& run = run_;
+  run.clear();
   auto close_run = [&]() {
     if (int(run.size()) >= cfg_.min_group_points) {
       Eigen::Vector2d m = Eigen::Vector2d::Zero();
@@ -285,29 +318,31 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     run.clear();
   };
   std::sort(sel_.begin(), sel_.end());  // the picks in column order (not a scan of all n points)
-  for (const int i : sel_) {
-    const size_t src = begin + i;
+  const bool has_t = w.t.size() == w.x.size();
+  const float max_gap2 = float(cfg_.group_max_gap_m * cfg_.group_max_gap_m);
+  for (const int code : sel_) {
+    const size_t src = begin + size_t(code >> 1);
+    const bool corner = code & 1;
     const int o = int(out_.x.size());
     const Eigen::Vector3f q = R_ * Eigen::Vector3f(w.x[src], w.y[src], w.z[src]);
     out_.x.push_back(q.x());
     out_.y.push_back(q.y());
-    out_.kind.push_back(kind_of[i]);
+    out_.kind.push_back(corner ? kCorner : kSurface);
     out_.group.push_back(-1);
-    out_.t.push_back(w.t.size() == w.x.size() ? w.t[src] : 0.f);
+    out_.t.push_back(has_t ? w.t[src] : 0.f);
     out_.source.push_back(int32_t(src));
-    if (kind_of[i] == kCorner) {
+    if (corner) {
       close_run();
       continue;
     }
     if (!run.empty()) {
       const int p = run.back();
       const float dx = out_.x[o] - out_.x[p], dy = out_.y[o] - out_.y[p];
-      if (dx * dx + dy * dy > float(cfg_.group_max_gap_m * cfg_.group_max_gap_m)) close_run();
+      if (dx * dx + dy * dy > max_gap2) close_run();
     }
     run.push_back(o);
   }
   close_run();
-  (void)first_out;
 }
 
 }  // namespace fploc::feat

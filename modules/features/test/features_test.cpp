@@ -141,3 +141,116 @@ TEST(Features, BadAndEmptyInput) {
   s.roll = std::nan("");
   EXPECT_EQ(fx.process(s).status, FeatureStatus::kBadInput);
 }
+
+// ---- The fast extractor against the plain rules (reference_features.h), bit for bit ----
+#include "reference_features.h"
+
+namespace {
+void expect_same(const seg::Segmentation& s, const FeatureConfig& cfg, const std::string& what) {
+  FeatureExtractor fx(cfg);
+  const auto& f = fx.process(s);
+  const auto ref = reference::extract(s, cfg);
+  ASSERT_EQ(int(f.status), int(ref.status)) << what;
+  ASSERT_EQ(f.num_groups, ref.num_groups) << what;
+  ASSERT_EQ(f.size(), ref.points.size()) << what;
+  ASSERT_EQ(fx.source(), ref.source) << what;
+  for (size_t i = 0; i < f.size(); ++i) {
+    ASSERT_EQ(f.points[i].p.x(), ref.points[i].p.x()) << what << " feature " << i;
+    ASSERT_EQ(f.points[i].p.y(), ref.points[i].p.y()) << what << " feature " << i;
+    ASSERT_EQ(int(f.points[i].kind), int(ref.points[i].kind)) << what << " feature " << i;
+    ASSERT_EQ(f.points[i].group, ref.points[i].group) << what << " feature " << i;
+    ASSERT_EQ(f.points[i].t, ref.points[i].t) << what << " feature " << i;
+  }
+}
+
+seg::Segmentation segment(const synth::Room& room, const synth::SensorPose& pose, double noise, uint32_t seed,
+                          int beams = 64) {
+  auto s = synth::render(room, pose, synth::os1_like_beams(beams), 1024, noise, 0.01, seed);
+  seg::RingSegmenter sg(seg::SegmenterConfig{});
+  return sg.process(s.scan);
+}
+}  // namespace
+
+TEST(Features, ReferenceEqualOnSyntheticScans) {
+  const synth::Room rooms[] = {synth::Room{}, synth::furnished_room()};
+  uint32_t seed = 100;
+  for (const auto& room : rooms)
+    for (double noise : {0.0, 0.003, 0.01, 0.03})
+      for (const auto& pose : {synth::SensorPose{0.0, 0.0, 1.5, 0, 0, 0}, synth::SensorPose{2.5, -1.0, 1.2, 3 * kDeg, -2 * kDeg, 0.7},
+                               synth::SensorPose{-6.5, 4.0, 2.0, -1 * kDeg, 4 * kDeg, 2.0}}) {
+        const auto s = segment(room, pose, noise, ++seed);
+        ASSERT_GT(s.wall.size(), 1000u);
+        expect_same(s, FeatureConfig{}, "seed " + std::to_string(seed));
+      }
+}
+
+TEST(Features, ReferenceEqualWithOtherOptionsAndBeamCounts) {
+  const auto room = synth::furnished_room();
+  const synth::SensorPose pose{1.0, 0.5, 1.5, 1 * kDeg, 1 * kDeg, 0.3};
+  for (int beams : {16, 32, 128}) expect_same(segment(room, pose, 0.005, 7, beams), FeatureConfig{}, std::to_string(beams) + " beams");
+  const auto s = segment(room, pose, 0.005, 8);
+  auto cfg = [](auto edit) {
+    FeatureConfig c;
+    edit(c);
+    return c;
+  };
+  expect_same(s, cfg([](FeatureConfig& c) { c.half_window = 3; }), "hw 3");
+  expect_same(s, cfg([](FeatureConfig& c) { c.half_window = 8; c.max_column_gap = 3; }), "hw 8 gap 3");
+  expect_same(s, cfg([](FeatureConfig& c) { c.half_window = 1; }), "hw 1");
+  expect_same(s, cfg([](FeatureConfig& c) { c.sectors = 1; c.max_corners_per_sector = 20; c.max_surfaces_per_sector = 100; }), "one sector");
+  expect_same(s, cfg([](FeatureConfig& c) { c.sectors = 13; c.surface_spacing = 0; }), "13 sectors");
+  expect_same(s, cfg([](FeatureConfig& c) { c.corner_threshold = 0.02; c.surface_threshold = 0.01; }), "thresholds");
+  expect_same(s, cfg([](FeatureConfig& c) { c.corner_threshold = 0.0; c.surface_threshold = 1.0; }), "every point both");
+  expect_same(s, cfg([](FeatureConfig& c) { c.min_range_m = 3.0; c.max_range_m = 7.0; }), "range window");
+  expect_same(s, cfg([](FeatureConfig& c) { c.occlusion_ratio = 0.01; c.parallel_ratio = 0.005; }), "strict rules");
+}
+
+// Hand-made rings: ties, gaps, occlusion steps at the ring ends, NaN and zero ranges, rings shorter than the
+// window, a ring that is one long line (every smoothness equal up to rounding).
+TEST(Features, ReferenceEqualOnEdgeRings) {
+  seg::Segmentation s;
+  s.status = seg::SegStatus::kOk;
+  s.height = 64;
+  s.roll = 0.01;
+  s.pitch = -0.02;
+  auto& w = s.wall;
+  uint32_t state = 12345;
+  auto rnd = [&]() { state = state * 1664525u + 1013904223u; return float(state >> 8) / float(1 << 24); };
+  auto push = [&](int ring, int col, float x, float y, float z) {
+    w.x.push_back(x); w.y.push_back(y); w.z.push_back(z);
+    w.range.push_back(std::sqrt(x * x + y * y + z * z));
+    w.t.push_back(float(col) * 1e-4f);
+    w.ring.push_back(int16_t(ring)); w.column.push_back(int16_t(col));
+  };
+  int ring = 0;
+  // 0: a straight wall, exact coordinates (many equal smoothness values: ties by index).
+  for (int c = 0; c < 300; ++c) push(ring, c, 4.0f, -3.0f + 0.02f * float(c), 0.5f);
+  // 1: a zig-zag with steps (occlusions), a column gap, a NaN and a zero range.
+  ++ring;
+  for (int c = 0; c < 400; ++c) {
+    if (c == 150 || c == 151) continue;  // gap
+    float r = 3.0f + 0.3f * rnd();
+    if (c % 37 < 5) r += 2.0f;            // occlusion steps
+    if (c == 0 || c == 399) r = 9.0f;     // steps at the ring ends
+    const float a = 0.006f * float(c);
+    float x = r * std::cos(a), y = r * std::sin(a);
+    if (c == 200) x = std::nanf("");
+    if (c == 250) x = y = 0.0f;
+    push(ring, c, x, y, 0.3f);
+  }
+  // 2: shorter than a window; 3: exactly one window; 4: noisy circle, every ring type of the sensor
+  for (int c = 0; c < 5; ++c) push(++ring == 2 ? 2 : 2, c, 1.0f + 0.1f * float(c), 1.0f, 0.0f);
+  ring = 3;
+  for (int c = 0; c < 11; ++c) push(ring, c, 1.0f + 0.1f * rnd(), 1.0f + 0.1f * float(c), 0.0f);
+  for (ring = 4; ring < 64; ++ring)
+    for (int c = 0; c < 1024; ++c) {
+      if (rnd() < 0.05f) continue;
+      const float a = 2.0f * float(M_PI) * float(c) / 1024.f, r = 2.0f + float(ring % 5) + 0.05f * rnd();
+      push(ring, c, r * std::cos(a), r * std::sin(a), 0.02f * float(ring - 32));
+    }
+  expect_same(s, FeatureConfig{}, "edge rings");
+  FeatureConfig c;
+  c.half_window = 2;
+  c.max_column_gap = 2;
+  expect_same(s, c, "edge rings hw 2 gap 2");
+}

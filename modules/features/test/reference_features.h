@@ -1,0 +1,180 @@
+// The feature extractor's rules written the plain way (test only): one point at a time, window sums added
+// up point by point in double, every smoothness computed with its exact square root and division, corner and
+// surface candidates sorted (LOAM's order) and walked. The fast extractor must give the same frame, bit for
+// bit (features_test ReferenceEqual*): it may skip work, never change a pick.
+#pragma once
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+#include "fploc/features/features.h"
+
+namespace fploc::feat::reference {
+
+// The smoothness of point i of a ring (X, Y, Z, R the ring's arrays): LOAM's c = |sum_j (X_j - X_i)| /
+// (2 hw |X_i|), the sum in double (exact for float inputs), root in double, division in float.
+inline float smoothness(const float* X, const float* Y, const float* Z, const float* R, int i, int hw) {
+  double sx = 0, sy = 0, sz = 0;
+  for (int k = -hw; k <= hw; ++k) {
+    sx += X[i + k];
+    sy += Y[i + k];
+    sz += Z[i + k];
+  }
+  const double w = 2 * hw + 1;
+  const double dx = sx - w * double(X[i]), dy = sy - w * double(Y[i]), dz = sz - w * double(Z[i]);
+  return float(std::sqrt(dx * dx + dy * dy + dz * dz)) / (float(2 * hw) * R[i]);
+}
+
+struct Result {
+  std::vector<Feature2> points;
+  std::vector<int32_t> source;
+  int32_t num_groups = 0;
+  FeatureStatus status = FeatureStatus::kOk;
+};
+
+inline Result extract(const seg::Segmentation& seg, const FeatureConfig& cfg = {}) {
+  Result res;
+  if (seg.status == seg::SegStatus::kBadInput || seg.status == seg::SegStatus::kEmpty) {
+    res.status = FeatureStatus::kBadInput;
+    return res;
+  }
+  const auto& w = seg.wall;
+  const size_t N = w.x.size();
+  const Eigen::Matrix3f Rot = (Eigen::AngleAxisf(float(seg.pitch), Eigen::Vector3f::UnitY()) *
+                               Eigen::AngleAxisf(float(seg.roll), Eigen::Vector3f::UnitX()))
+                                  .toRotationMatrix();
+  const int H = std::max(1, seg.height);
+  const int ring_step = std::max(1, int(std::lround(double(H) / 64)));
+  const double limit_scale = std::max(1.0, 64.0 / H);
+  std::vector<float> ox, oy, ot;
+  std::vector<int8_t> okind;
+  std::vector<int32_t> ogroup, osrc;
+  int32_t groups = 0;
+  auto ring = [&](size_t begin, size_t end) {
+    const int n = int(end - begin), hw = std::max(1, cfg.half_window);
+    if (n < 2 * hw + 1) return;
+    const float *X = &w.x[begin], *Y = &w.y[begin], *Z = &w.z[begin], *R = &w.range[begin];
+    const int16_t* C = &w.column[begin];
+    std::vector<float> c(n, 0.f);
+    std::vector<bool> ok(n, false), picked(n, false);
+    for (int i = hw; i < n - hw; ++i) {
+      bool connected = true;
+      for (int j = i - hw; j < i + hw; ++j) connected = connected && C[j + 1] - C[j] <= cfg.max_column_gap;
+      const float r = R[i];
+      const bool in_range = !(r < float(cfg.min_range_m)) && !(r > float(cfg.max_range_m));
+      const float par = float(cfg.parallel_ratio);
+      const bool parallel = std::abs(R[i - 1] - r) > par * r && std::abs(R[i + 1] - r) > par * r;
+      c[i] = smoothness(X, Y, Z, R, i, hw);
+      ok[i] = connected && in_range && !parallel;
+    }
+    for (int j = 0; j + 1 < n; ++j) {  // occlusion boundaries: clear hw points on the far side
+      const float a = R[j], b = R[j + 1];
+      if (C[j + 1] - C[j] > cfg.max_column_gap || !(std::abs(a - b) > float(cfg.occlusion_ratio) * std::min(a, b))) continue;
+      if (a > b)
+        for (int k = std::max(0, j - hw + 1); k <= j; ++k) ok[k] = false;
+      else
+        for (int k = j + 1; k <= std::min(n - 1, j + hw); ++k) ok[k] = false;
+    }
+    std::vector<int> sel;
+    std::vector<int8_t> kind(n, 0);
+    const int S = std::max(1, cfg.sectors);
+    const int max_c = int(std::lround(cfg.max_corners_per_sector * limit_scale));
+    const int max_s = int(std::lround(cfg.max_surfaces_per_sector * limit_scale));
+    for (int s = 0; s < S; ++s) {
+      const int sb = hw + (n - 2 * hw) * s / S, se = hw + (n - 2 * hw) * (s + 1) / S;
+      std::vector<int> corners, surfaces;
+      for (int i = sb; i < se; ++i) {
+        if (ok[i] && c[i] > float(cfg.corner_threshold)) corners.push_back(i);
+        if (ok[i] && c[i] < float(cfg.surface_threshold)) surfaces.push_back(i);
+      }
+      std::stable_sort(corners.begin(), corners.end(), [&](int a, int b) { return c[a] > c[b]; });
+      int picks = 0;
+      for (int i : corners) {
+        if (picks >= max_c) break;
+        if (picked[i]) continue;
+        kind[i] = int8_t(FeatureKind::kCorner);
+        sel.push_back(i);
+        ++picks;
+        for (int k = std::max(0, i - hw); k <= std::min(n - 1, i + hw); ++k) picked[k] = true;
+      }
+      std::stable_sort(surfaces.begin(), surfaces.end(), [&](int a, int b) { return c[a] < c[b]; });
+      picks = 0;
+      for (int i : surfaces) {
+        if (picks >= max_s) break;
+        if (picked[i]) continue;
+        kind[i] = int8_t(FeatureKind::kSurface);
+        sel.push_back(i);
+        ++picks;
+        for (int k = std::max(0, i - cfg.surface_spacing); k <= std::min(n - 1, i + cfg.surface_spacing); ++k)
+          picked[k] = true;
+      }
+    }
+    std::sort(sel.begin(), sel.end());
+    std::vector<int> run;
+    auto close_run = [&]() {
+      if (int(run.size()) >= cfg.min_group_points) {
+        Eigen::Vector2d m = Eigen::Vector2d::Zero();
+        for (int o : run) m += Eigen::Vector2d(ox[o], oy[o]);
+        m /= double(run.size());
+        Eigen::Matrix2d Cv = Eigen::Matrix2d::Zero();
+        for (int o : run) {
+          const Eigen::Vector2d d = Eigen::Vector2d(ox[o], oy[o]) - m;
+          Cv += d * d.transpose();
+        }
+        Cv /= double(run.size());
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(Cv);
+        const double l0 = std::max(es.eigenvalues()[0], 0.0), l1 = es.eigenvalues()[1];
+        if (std::sqrt(l0) <= cfg.line_max_rms_m && l1 >= cfg.line_min_ratio * std::max(l0, 1e-12)) {
+          for (int o : run) ogroup[o] = groups;
+          ++groups;
+        }
+      }
+      run.clear();
+    };
+    for (int i : sel) {
+      const size_t src = begin + size_t(i);
+      const int o = int(ox.size());
+      const Eigen::Vector3f q = Rot * Eigen::Vector3f(w.x[src], w.y[src], w.z[src]);
+      ox.push_back(q.x());
+      oy.push_back(q.y());
+      okind.push_back(kind[i]);
+      ogroup.push_back(-1);
+      ot.push_back(w.t.size() == N ? w.t[src] : 0.f);
+      osrc.push_back(int32_t(src));
+      if (kind[i] == int8_t(FeatureKind::kCorner)) {
+        close_run();
+        continue;
+      }
+      if (!run.empty()) {
+        const float dx = ox[o] - ox[run.back()], dy = oy[o] - oy[run.back()];
+        if (dx * dx + dy * dy > float(cfg.group_max_gap_m * cfg.group_max_gap_m)) close_run();
+      }
+      run.push_back(o);
+    }
+    close_run();
+  };
+  size_t b = 0;
+  for (size_t i = 1; i <= N; ++i)
+    if (i == N || w.ring[i] != w.ring[b]) {
+      if (w.ring[b] % ring_step == 0) ring(b, i);
+      b = i;
+    }
+  res.status = ox.size() < 30 ? FeatureStatus::kFewFeatures : FeatureStatus::kOk;
+  res.num_groups = groups;
+  for (size_t i = 0; i < ox.size(); ++i) {
+    if (!std::isfinite(ox[i]) || !std::isfinite(oy[i])) continue;
+    Feature2 p;
+    p.p = {double(ox[i]), double(oy[i])};
+    p.kind = FeatureKind(okind[i]);
+    p.group = ogroup[i];
+    p.t = ot[i];
+    res.points.push_back(p);
+    res.source.push_back(osrc[i]);
+  }
+  return res;
+}
+
+}  // namespace fploc::feat::reference
