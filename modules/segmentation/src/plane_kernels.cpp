@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <type_traits>
 
 // The eight-lane helpers are inlined into the AVX2 functions only (no AVX vector crosses a call): the ABI
@@ -91,23 +92,53 @@ FPLOC_INLINE int32_t hsumi(typename V<L>::i v) {
 
 // The loops: the main part L points at a time, then (eight lanes, np = 4 mod 8) the last four.
 template <int L>
-FPLOC_INLINE void residual_hist_t(const float* x, const float* y, const float* z, size_t np, PlaneF pl, float inv_bin,
-                                  float cutf, Histogram& hist) {
+FPLOC_INLINE int residual_bins_t(const float* x, const float* y, const float* z, size_t np, PlaneF pl, float inv_bin,
+                                 float cutf, float* v) {
   using F = typename V<L>::f;
   using I = typename V<L>::i;
   const F nx = splat<L>(pl.nx), ny = splat<L>(pl.ny), nz = splat<L>(pl.nz), d = splat<L>(pl.d);
-  const F inv = splat<L>(inv_bin), cutv = splat<L>(cutf);
-  const I last = splati<L>(k::kScaleBins - 1), outside = splati<L>(k::kScaleBins);
+  const F inv = splat<L>(inv_bin), cutv = splat<L>(cutf), inf = splat<L>(std::numeric_limits<float>::infinity());
+  I cnt = splati<L>(0);
   for_lanes<L>(0, np, [&](size_t j, auto N) FPLOC_LAMBDA {
     constexpr size_t n = decltype(N)::value;
     const F a = vabs<L>(nx * load<L, n>(x + j) + ny * load<L, n>(y + j) + nz * load<L, n>(z + j) + d);
-    I b = __builtin_convertvector(a * inv, I);
-    b = b < last ? b : last;
-    b = (a < cutv) & first_lanes<L>(n) ? b : outside;
-    int32_t q[L];
-    std::memcpy(q, &b, sizeof q);
-    for (size_t l = 0; l < n; ++l) ++hist[l & 3][q[l]];
+    const I in = (a < cutv) & first_lanes<L>(n);
+    cnt -= in;
+    const F b = in ? a * inv : inf;
+    std::memcpy(v + j, &b, n * sizeof(float));
   });
+  return hsumi<L>(cnt);
+}
+
+template <int L>
+FPLOC_INLINE int count_below_t(const float* v, size_t np, float t) {
+  using F = typename V<L>::f;
+  using I = typename V<L>::i;
+  const F tv = splat<L>(t);
+  I c0 = splati<L>(0), c1 = splati<L>(0);
+  size_t j = 0;
+  for (; j + 2 * L <= np; j += 2 * L) {
+    c0 -= load<L>(v + j) < tv;
+    c1 -= load<L>(v + j + L) < tv;
+  }
+  for_lanes<L>(j, np, [&](size_t i, auto N) FPLOC_LAMBDA {
+    constexpr size_t n = decltype(N)::value;
+    c0 -= (load<L, n>(v + i) < tv) & first_lanes<L>(n);
+  });
+  return hsumi<L>(c0 + c1);
+}
+
+// The smallest bin B with 2 count(bin <= B) >= inside, by bisection over counts of v < B + 1 (for v >= 0,
+// floor(v) <= B exactly when v < B + 1); B = kScaleBins - 1 (the clamped last bin) when no smaller one.
+template <int L>
+FPLOC_INLINE int median_bin_t(const float* v, size_t np, int inside) {
+  int lo = 0, hi = k::kScaleBins - 1;
+  while (lo < hi) {
+    const int mid = (lo + hi) / 2;
+    if (2 * count_below_t<L>(v, np, float(mid + 1)) >= inside) hi = mid;
+    else lo = mid + 1;
+  }
+  return lo;
 }
 
 template <int L>
@@ -195,9 +226,10 @@ FPLOC_INLINE void inlier_moments_t(const float* x, const float* y, const float* 
 
 #if FPLOC_SEG_WIDE
 #define FPLOC_WIDE_TARGET __attribute__((target("avx2,fma")))
-FPLOC_WIDE_TARGET void residual_hist8(const float* x, const float* y, const float* z, size_t np, PlaneF pl,
-                                      float inv_bin, float cutf, Histogram& hist) {
-  residual_hist_t<8>(x, y, z, np, pl, inv_bin, cutf, hist);
+FPLOC_WIDE_TARGET int residual_scale8(const float* x, const float* y, const float* z, size_t np, PlaneF pl,
+                                      float inv_bin, float cutf, float* v, int& inside) {
+  inside = residual_bins_t<8>(x, y, z, np, pl, inv_bin, cutf, v);
+  return median_bin_t<8>(v, np, inside);
 }
 FPLOC_WIDE_TARGET void tukey_moments8(const float* x, const float* y, const float* z, size_t np, PlaneF pl,
                                       float inv_c2, double S[10]) {
@@ -232,12 +264,13 @@ bool g_wide = default_wide();
 bool wide() { return g_wide; }
 void set_wide(bool on) { g_wide = on && default_wide(); }
 
-void residual_hist(const float* x, const float* y, const float* z, size_t np, PlaneF pl, float inv_bin, float cutf,
-                   Histogram& hist) {
+int residual_scale(const float* x, const float* y, const float* z, size_t np, PlaneF pl, float inv_bin, float cutf,
+                   float* v, int& inside) {
 #if FPLOC_SEG_WIDE
-  if (g_wide) return residual_hist8(x, y, z, np, pl, inv_bin, cutf, hist);
+  if (g_wide) return residual_scale8(x, y, z, np, pl, inv_bin, cutf, v, inside);
 #endif
-  residual_hist_t<4>(x, y, z, np, pl, inv_bin, cutf, hist);
+  inside = residual_bins_t<4>(x, y, z, np, pl, inv_bin, cutf, v);
+  return median_bin_t<4>(v, np, inside);
 }
 
 void tukey_moments(const float* x, const float* y, const float* z, size_t np, PlaneF pl, float inv_c2, double S[10]) {

@@ -1,4 +1,4 @@
-// The point loops of the plane fit and plane quality (internal header): residual histogram, Tukey moments,
+// The point loops of the plane fit and plane quality (internal header): the residuals' median bin, Tukey moments,
 // soft support score, inlier moments. Each runs four lanes (SSE2 on any x86-64, NEON, or scalar), or eight
 // lanes with FMA (AVX2) where the CPU has them, chosen once at run time (no -march flags needed: the wide
 // versions are compiled for that target alone, see plane_kernels.cpp). The eight-lane sums add the same
@@ -22,12 +22,12 @@ bool wide();
 // Tests: force the four-lane versions (false) or the default choice (true).
 void set_wide(bool on);
 
-using Histogram = int[4][k::kScaleBins + 1];
-
-// Histogram of |r| over the np points (np a multiple of 4; padding points lie outside cutf): bin
-// floor(|r| * inv_bin) clamped to kScaleBins - 1 when |r| < cutf, else bin kScaleBins. Added into hist[lane % 4].
-void residual_hist(const float* x, const float* y, const float* z, size_t np, PlaneF pl, float inv_bin, float cutf,
-                   Histogram& hist);
+// The robust scale's bin: of the residuals |r| < cutf among the np points (np a multiple of 4; padding points
+// lie outside cutf), `inside` = their count, and the returned bin B is the smallest with
+// 2 #{floor(|r| inv_bin) <= B} >= inside (kScaleBins - 1 at most), i.e. the median's bin of a histogram with
+// kScaleBins bins. v (np floats) is scratch.
+int residual_scale(const float* x, const float* y, const float* z, size_t np, PlaneF pl, float inv_bin, float cutf,
+                   float* v, int& inside);
 
 // Tukey-weighted moments w, w x, w y, w z, w xx, w xy, w xz, w yy, w yz, w zz with w = (1 - r^2 inv_c2)^2 for
 // r^2 inv_c2 < 1, float sums over blocks of 256 points added in double. The padding must weigh 0 (finite

@@ -203,28 +203,19 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
   bool shrinking = !fixed;
   for (int it = 0; it < std::max(1, cfg_.irls_iterations); ++it) {
     const PointsSoa* src = shrinking ? &band_sub_ : &band_;
-    // Robust scale (1.4826 * median |r| inside the cut-off) from a histogram of the residuals: bins computed
-    // four at a time, residuals outside the cut-off go to an extra bin. `a < cut` is compared in float
-    // against the smallest float >= cut, which is the same test for every float a. Four interleaved
-    // histograms (neighbouring returns fall into the same bin: one histogram made every increment wait for
-    // the previous one's store), summed after; the counts are the same.
+    // Robust scale (1.4826 * median |r| inside the cut-off) from the median's bin of a 256-bin histogram of the
+    // residuals inside the cut-off, found by bisection over vectorised counts (no per-point increments).
+    // `a < cut` is compared in float against the smallest float >= cut, which is the same test for every
+    // float a; the padding points (1 km off the plane) are outside.
     const kern::PlaneF plf{float(cur[0]), float(cur[1]), float(cur[2]), float(cur.head<3>().dot(ref) + cur[3])};
-    kern::Histogram hist = {};
     const float inv_binf = float(k::kScaleBins / cut);
     float cutf = float(cut);
     if (double(cutf) < cut) cutf = std::nextafter(cutf, std::numeric_limits<float>::infinity());
-    // Bins and counts in one pass (no bins array written and read back); the padding points (1 km off the
-    // plane) land in the outside bin, which no count below reads.
-    kern::residual_hist(src->x.data(), src->y.data(), src->z.data(), src->padded(), plf, inv_binf, cutf, hist);
+    scratch_.resize(src->padded());
     int inside = 0;
-    for (int h = 0; h < 4; ++h)
-      for (int b = 0; b < k::kScaleBins; ++b) inside += hist[h][b];
+    const int bin = kern::residual_scale(src->x.data(), src->y.data(), src->z.data(), src->padded(), plf, inv_binf, cutf,
+                                         scratch_.data(), inside);
     if (inside < 3) return std::nullopt;
-    int acc = 0, bin = 0;
-    for (; bin < k::kScaleBins; ++bin) {
-      acc += hist[0][bin] + hist[1][bin] + hist[2][bin] + hist[3][bin];
-      if (2 * acc >= inside) break;
-    }
     const double sigma = k::kMadToSigma * (bin + 0.5) / inv_binf;
     last_sigma = sigma;
     const double next_cut = fixed ? cut : std::max({cut * 0.5, k::kTukeyC * sigma, min_cut});
