@@ -8,11 +8,72 @@
 #include <string>
 
 #include "fploc/segmentation/segmenter.h"
+#include "plane_kernels.h"
 #include "simd4.h"
 
 namespace fploc::seg {
 
 namespace {
+#if defined(__x86_64__) && defined(__GNUC__)
+#define FPLOC_PREP_WIDE 1
+// One scan row of the four-column pass below, eight columns at a time (AVX2, chosen at run time with the plane
+// fit's kernels: kern::wide()): the same arithmetic per point (no fused multiply-add), so the same
+// candidates. rng/okm/lut/rot point at the row's first column; returns the new candidate count.
+__attribute__((target("avx2"))) size_t ring_pass8(const uint32_t* rng, const int32_t* okm, const float* const lut[6],
+                                                  const float* const rot[9], int W, int32_t lo, int32_t hi,
+                                                  int32_t pix_row, float* cx, float* cy, float* cz, float* cr,
+                                                  int32_t* cp, size_t m) {
+  typedef float v8f __attribute__((vector_size(32)));
+  typedef int32_t v8i __attribute__((vector_size(32)));
+#define FPLOC_LD(p) ({ v8f v_; std::memcpy(&v_, (p), sizeof v_); v_; })
+  const v8i lov = {lo, lo, lo, lo, lo, lo, lo, lo}, hiv = {hi, hi, hi, hi, hi, hi, hi, hi};
+  const v8f mm = {1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f};
+  for (int c = 0; c < W; c += 8) {
+    v8i ri, ok;
+    std::memcpy(&ri, rng + c, sizeof ri);
+    std::memcpy(&ok, okm + c, sizeof ok);
+    const v8i inm = (ri >= lov) & (ri <= hiv) & ok;
+    const int in = __builtin_ia32_movmskps256(reinterpret_cast<v8f>(inm));
+    if (in == 0) continue;
+    const v8f fr = __builtin_convertvector(ri, v8f);
+    v8f x = FPLOC_LD(lut[0] + c) * fr + FPLOC_LD(lut[3] + c), y = FPLOC_LD(lut[1] + c) * fr + FPLOC_LD(lut[4] + c),
+        z = FPLOC_LD(lut[2] + c) * fr + FPLOC_LD(lut[5] + c);
+    if (rot) {
+      const v8f X = FPLOC_LD(rot[0] + c) * x + FPLOC_LD(rot[1] + c) * y + FPLOC_LD(rot[2] + c) * z;
+      const v8f Y = FPLOC_LD(rot[3] + c) * x + FPLOC_LD(rot[4] + c) * y + FPLOC_LD(rot[5] + c) * z;
+      const v8f Z = FPLOC_LD(rot[6] + c) * x + FPLOC_LD(rot[7] + c) * y + FPLOC_LD(rot[8] + c) * z;
+      x = X;
+      y = Y;
+      z = Z;
+    }
+    const v8f rm = fr * mm;
+    const int32_t p0 = pix_row + c;
+    if (in == 255) {
+      std::memcpy(cx + m, &x, sizeof x);
+      std::memcpy(cy + m, &y, sizeof y);
+      std::memcpy(cz + m, &z, sizeof z);
+      std::memcpy(cr + m, &rm, sizeof rm);
+      const v8i pv = {p0, p0 + 1, p0 + 2, p0 + 3, p0 + 4, p0 + 5, p0 + 6, p0 + 7};
+      std::memcpy(cp + m, &pv, sizeof pv);
+      m += 8;
+      continue;
+    }
+    for (int l = 0; l < 8; ++l) {
+      cx[m] = x[l];
+      cy[m] = y[l];
+      cz[m] = z[l];
+      cr[m] = rm[l];
+      cp[m] = p0 + l;
+      m += size_t((in >> l) & 1);
+    }
+  }
+#undef FPLOC_LD
+  return m;
+}
+#else
+#define FPLOC_PREP_WIDE 0
+#endif
+
 bool same_beams(const BeamIntrinsics& a, const BeamIntrinsics& b) {
   return a.altitude_deg == b.altitude_deg && a.azimuth_deg == b.azimuth_deg &&
          a.beam_offset_mm == b.beam_offset_mm && a.lidar_to_sensor == b.lidar_to_sensor;
@@ -187,7 +248,24 @@ bool Segmenter::prepare(const Scan& scan) {
     cs.n = m;
     cs.ring_start.push_back(int32_t(m));
   };
-  auto ring_pass = [&](int u, Candidates& cs) { identity ? ring_pass4(u, cs) : ring_pass1(u, cs); };
+#if FPLOC_PREP_WIDE
+  const bool wide8 = identity && W % 8 == 0 && kern::wide();
+  auto ring_pass8w = [&](int u, Candidates& cs) {
+    const size_t row = size_t(u) * W;
+    const float* lut[6];
+    for (int e = 0; e < 6; ++e) lut[e] = lut_soa_[e].data() + row;
+    const float* rot[9];
+    for (int e = 0; e < 9; ++e) rot[e] = deskew ? rot_soa_[e].data() : nullptr;
+    cs.n = ring_pass8(rng + row, col_okm_.data(), lut, deskew ? rot : nullptr, W, int32_t(std::min<uint32_t>(r_lo, 0x7fffffffu)),
+                      int32_t(std::min<uint32_t>(r_hi, 0x7fffffffu)), int32_t(row), cs.x.data(), cs.y.data(), cs.z.data(),
+                      cs.range.data(), cs.pixel.data(), cs.n);
+    cs.ring_start.push_back(int32_t(cs.n));
+  };
+#else
+  const bool wide8 = false;
+  auto ring_pass8w = [&](int, Candidates&) {};
+#endif
+  auto ring_pass = [&](int u, Candidates& cs) { wide8 ? ring_pass8w(u, cs) : identity ? ring_pass4(u, cs) : ring_pass1(u, cs); };
   const int half = H / 2;
   for (auto [cs, rings] : {std::pair{&upper_, half}, std::pair{&lower_, half}, std::pair{&middle_, H % 2}}) {
     const size_t cap = size_t(rings) * W + Candidates::kLanes;

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "fploc/segmentation/plane_fit.h"
+#include "plane_kernels.h"
 #include "plane_math.h"
 #include "segmenter_constants.h"
 #include "simd4.h"
@@ -58,22 +59,14 @@ void RingPlaneFit::pick_seeds(const Candidates& c, const Eigen::Vector3f& upf) {
 // (beyond > max_beyond_ratio x inliers) scores below zero. The soft count prefers the tight fit over a
 // loose plane that merely stays within T of a narrow ceiling strip.
 double RingPlaneFit::score_band(const PointsSoa& sub, size_t stride, const Eigen::Vector4d& pl, float band) const {
-  using namespace simd;
   const float beyond_thr = 2 * float(cfg_.inlier_threshold_m);
   const float beyond_weight = float(1.0 / std::max(k::kMinBeyondRatio, cfg_.max_beyond_ratio));
-  const v4f nx = splat(float(pl[0])), ny = splat(float(pl[1])), nz = splat(float(pl[2])), d = splat(float(pl[3]));
-  const v4f inv_b2 = splat(1.f / (band * band)), one = splat(1.f), bthr = splat(-beyond_thr);
-  // Four lanes (element i in lane i % 4; one float sum was a chain of dependent additions); the NaN
-  // padding adds nothing.
-  v4f soft = splat(0.f);
-  v4i beyond = splati(0);
-  const float *x = sub.x.data(), *y = sub.y.data(), *z = sub.z.data();
-  for (size_t i = 0, np = sub.padded(); i < np; i += 4) {
-    const v4f r = nx * load(x + i) + ny * load(y + i) + nz * load(z + i) + d;
-    soft += max0(one - r * r * inv_b2);
-    beyond -= (r < bthr);  // true = -1
-  }
-  return double(hsum(soft) - beyond_weight * float(hsum(beyond))) * double(stride);
+  // The NaN padding adds nothing.
+  float soft = 0;
+  int beyond = 0;
+  kern::soft_score(sub.x.data(), sub.y.data(), sub.z.data(), sub.padded(),
+                   {float(pl[0]), float(pl[1]), float(pl[2]), float(pl[3])}, 1.f / (band * band), -beyond_thr, soft, beyond);
+  return double(soft - beyond_weight * float(beyond)) * double(stride);
 }
 
 // The start with the most support on a subsample of all half-ring points: the seed regression, last
@@ -209,46 +202,20 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
   // (band_sub_); once it stops shrinking, every point (band_).
   bool shrinking = !fixed;
   for (int it = 0; it < std::max(1, cfg_.irls_iterations); ++it) {
-    const v4f nx = splat(float(cur[0])), ny = splat(float(cur[1])), nz = splat(float(cur[2]));
-    const v4f d = splat(float(cur.head<3>().dot(ref) + cur[3]));  // the plane's offset relative to ref
     const PointsSoa* src = shrinking ? &band_sub_ : &band_;
-    // Robust scale (1.4826 * median |r| inside the cut-off) from a histogram of the residuals: bins computed
-    // four at a time, residuals outside the cut-off go to an extra bin. `a < cut` is compared in float
-    // against the smallest float >= cut, which is the same test for every float a. Four interleaved
-    // histograms (neighbouring returns fall into the same bin: one histogram made every increment wait for
-    // the previous one's store), summed after; the counts are the same.
-    int hist[4][k::kScaleBins + 1] = {};
+    // Robust scale (1.4826 * median |r| inside the cut-off) from the median's bin of a 256-bin histogram of the
+    // residuals inside the cut-off, found by bisection over vectorised counts (no per-point increments).
+    // `a < cut` is compared in float against the smallest float >= cut, which is the same test for every
+    // float a; the padding points (1 km off the plane) are outside.
+    const kern::PlaneF plf{float(cur[0]), float(cur[1]), float(cur[2]), float(cur.head<3>().dot(ref) + cur[3])};
     const float inv_binf = float(k::kScaleBins / cut);
     float cutf = float(cut);
     if (double(cutf) < cut) cutf = std::nextafter(cutf, std::numeric_limits<float>::infinity());
-    {
-      const v4f inv_bin = splat(inv_binf), cutv = splat(cutf);
-      const v4i last = splati(k::kScaleBins - 1), outside = splati(k::kScaleBins);
-      const float *bx = src->x.data(), *by = src->y.data(), *bz = src->z.data();
-      // Bins and counts in one pass (no bins array written and read back); the padding points (1 km off
-      // the plane) land in the outside bin, which no count below reads.
-      for (size_t j = 0, np = src->padded(); j < np; j += 4) {
-        const v4f a = abs(nx * load(bx + j) + ny * load(by + j) + nz * load(bz + j) + d);
-        v4i b = __builtin_convertvector(a * inv_bin, v4i);
-        b = b < last ? b : last;
-        b = a < cutv ? b : outside;
-        int32_t q[4];
-        store(q, b);
-        ++hist[0][q[0]];
-        ++hist[1][q[1]];
-        ++hist[2][q[2]];
-        ++hist[3][q[3]];
-      }
-    }
+    scratch_.resize(src->padded());
     int inside = 0;
-    for (int h = 0; h < 4; ++h)
-      for (int b = 0; b < k::kScaleBins; ++b) inside += hist[h][b];
+    const int bin = kern::residual_scale(src->x.data(), src->y.data(), src->z.data(), src->padded(), plf, inv_binf, cutf,
+                                         scratch_.data(), inside);
     if (inside < 3) return std::nullopt;
-    int acc = 0, bin = 0;
-    for (; bin < k::kScaleBins; ++bin) {
-      acc += hist[0][bin] + hist[1][bin] + hist[2][bin] + hist[3][bin];
-      if (2 * acc >= inside) break;
-    }
     const double sigma = k::kMadToSigma * (bin + 0.5) / inv_binf;
     last_sigma = sigma;
     const double next_cut = fixed ? cut : std::max({cut * 0.5, k::kTukeyC * sigma, min_cut});
@@ -261,28 +228,9 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
       --it;
       continue;
     }
-    // Tukey-weighted moments, sums in float over blocks of 256 points (four lanes), added up in double.
-    const v4f inv_c2 = splat(float(1.0 / (cut * cut))), one = splat(1.f), zero = splat(0.f);
-    double S[10] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
-    const float *bx = src->x.data(), *by = src->y.data(), *bz = src->z.data();
-    for (size_t j0 = 0, np = src->padded(); j0 < np; j0 += 256) {
-      v4f sw = zero, sx = zero, sy = zero, sz = zero, sxx = zero, sxy = zero, sxz = zero, syy = zero, syz = zero,
-          szz = zero;
-      for (size_t j = j0, je = std::min(np, j0 + 256); j < je; j += 4) {
-        const v4f x = load(bx + j), y = load(by + j), z = load(bz + j);
-        const v4f r = nx * x + ny * y + nz * z + d;
-        const v4f t = r * r * inv_c2;
-        const v4f u = one - t;
-        const v4f w = t < one ? u * u : zero;
-        const v4f wx = w * x, wy = w * y, wz = w * z;
-        sw += w;
-        sx += wx; sy += wy; sz += wz;
-        sxx += wx * x; sxy += wx * y; sxz += wx * z;
-        syy += wy * y; syz += wy * z; szz += wz * z;
-      }
-      const v4f all[10] = {sw, sx, sy, sz, sxx, sxy, sxz, syy, syz, szz};
-      for (int q = 0; q < 10; ++q) S[q] += double(hsum(all[q]));
-    }
+    // Tukey-weighted moments, sums in float over blocks of 256 points, added up in double.
+    double S[10];
+    kern::tukey_moments(src->x.data(), src->y.data(), src->z.data(), src->padded(), plf, float(1.0 / (cut * cut)), S);
     Moments m;
     m.w = S[0];
     m.s << S[1], S[2], S[3];

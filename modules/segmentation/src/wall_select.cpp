@@ -116,12 +116,21 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
         std::memcpy(oy + o, cs.y.data() + j, 4 * sizeof(float));
         std::memcpy(oz + o, cs.z.data() + j, 4 * sizeof(float));
         std::memcpy(orng + o, cs.range.data() + j, 4 * sizeof(float));
-        for (int l = 0; l < 4; ++l) {
-          const int32_t pix = cs.pixel[j + l];
-          ot[o + l] = col_dt_[pix - row];
-          oring[o + l] = pc.u;
-          ocol[o + l] = int16_t(pix + pc.off);
+        const int32_t pix0 = cs.pixel[j];
+        if (cs.pixel[j + 3] == pix0 + 3) {  // four neighbouring columns (no dropout between): copied as a block
+          std::memcpy(ot + o, col_dt_.data() + (pix0 - row), 4 * sizeof(float));
+          const int16_t c0 = int16_t(pix0 + pc.off);
+          const int16_t cols[4] = {c0, int16_t(c0 + 1), int16_t(c0 + 2), int16_t(c0 + 3)};
+          std::memcpy(ocol + o, cols, sizeof cols);
+        } else {
+          for (int l = 0; l < 4; ++l) {
+            const int32_t pix = cs.pixel[j + l];
+            ot[o + l] = col_dt_[pix - row];
+            ocol[o + l] = int16_t(pix + pc.off);
+          }
         }
+        const int16_t rings[4] = {pc.u, pc.u, pc.u, pc.u};
+        std::memcpy(oring + o, rings, sizeof rings);
         o += 4;
         continue;
       }
