@@ -31,6 +31,11 @@ int main(int argc, char** argv) {
     l2::GridLocalizerConfig c;
     c.initial_sigma_xy_m = 0.1;
     c.initial_sigma_yaw_rad = 2.0 * M_PI / 180;
+    // The floor is the map's own best single-scan fit from the reference pose: the search's best refined, as
+    // before the odometry-consistent choice (which prefers the start pose and is a tracking rule, not a floor).
+    c.consistent_candidates = 0;
+    c.odometry_yaw_candidate = false;
+    c.retry_window_factor = 1.0;
     const fploc::bench_real::LogScans scans = fploc::bench_real::load_log_scans(log_path, first, end, c.max_range_m);
     const cm::Log& log = scans.log;
     end = scans.end;

@@ -41,6 +41,13 @@ int main(int argc, char** argv) {
   app.add_option("--reacquire-after", c.reacquire_after, "POOR scans after which jumps need confirmation");
   app.add_option("--follow-weak", c.follow_weak, "follow weak near fits while re-acquiring");
   app.add_option("--reacquire", c.reacquire, "re-acquisition with hypotheses");
+  app.add_option("--follow-weak-when-lost", c.follow_weak_when_lost, "follow weak near fits also once LOST");
+  app.add_option("--consistent-candidates", c.consistent_candidates, "odometry-consistent choice among this many candidates (0: off)");
+  app.add_option("--jump-inlier-margin", c.jump_inlier_margin, "inlier share a fit away from the prediction needs over the nearest");
+  app.add_option("--odometry-yaw-candidate", c.odometry_yaw_candidate, "also refine the prediction with its yaw held");
+  app.add_option("--retry-window-factor", c.retry_window_factor, "retry a failed tracking fit in a window this much wider (1: off)");
+  app.add_option("--dead-reckoning-motion-only", c.dead_reckoning_motion_only, "POOR scans: uncertainty grows with the motion only");
+  app.add_option("--reacquire-strong-ratio", c.reacquire_strong_ratio, "re-acquiring: a fit inside the window with this inlier share ends it");
   app.add_option("--confirm-inlier-ratio", c.confirm_inlier_ratio, "mean inlier share to take a hypothesis");
   app.add_option("--reacquire-xy", c.reacquire_xy_m, "re-acquisition window [m]");
   CLI11_PARSE(app, argc, argv);
@@ -75,6 +82,7 @@ int main(int argc, char** argv) {
                       {"status", int(r.status)}, {"inlier_ratio", r.inlier_ratio}, {"window_m", r.search_xy_m},
                       {"window_deg", r.search_yaw_rad * 180 / M_PI}, {"sigma_xy_m", std::sqrt(r.covariance(0, 0))},
                       {"hypotheses", r.hypotheses}, {"ms", ms}});
+      if (odom) rows.back().update({{"odom_x", odom->x}, {"odom_y", odom->y}, {"odom_yaw", odom->yaw}});
     }
     std::cout << nlohmann::json{{"log", log_path}, {"map", map_path}, {"start", start},
                                 {"ms_per_scan", total_ms / double(end - first)}, {"scans", rows}}

@@ -101,7 +101,8 @@ int main(int argc, char** argv) {
                  {"split", sp.split}, {"fraction", sp.fraction}, {"covered_share", sp.covered_share}, {"met", sp.met}};
     }
     if (e <= b) throw std::runtime_error("--begin/--end select no scans");
-    nlohmann::json j = {{"log", in}, {"scans_total", n}, {"odom_records", log.odom.size()}, {"first_scan", b},
+    nlohmann::json j = {{"log", in}, {"scans_total", n}, {"odom_records", log.odom.size()},
+                        {"odom_reanchors", log.odom_reanchors}, {"first_scan", b},
                         {"end_scan", e}, {"no_return_m", std::isfinite(no_return) ? double(no_return) : -1.0},
                         {"time_note", note}, {"beams", log.scans[0].ranges.size()}};
     for (const auto& [k, v] : log.skipped) j["skipped"][k] = v;
@@ -179,7 +180,9 @@ int main(int argc, char** argv) {
       j["coverage_ratio"] = ccfg.covered_ratio;
     }
     std::cerr << "fploc import-carmen: " << in << ": " << n << " scans (" << log.scans[0].ranges.size() << " beams), "
-              << log.odom.size() << " odometry records; wrote scans " << b << ".." << e
+              << log.odom.size() << " odometry records"
+              << (log.odom_reanchors ? " (+" + std::to_string(log.odom_reanchors) + " re-anchorings at scans: increments measured from them)" : "")
+              << "; wrote scans " << b << ".." << e
               << (note.empty() ? "" : "; " + note) << "\n";
     if (json) std::cout << j.dump(1) << "\n";
   } catch (const std::exception& ex) {

@@ -75,6 +75,18 @@ Log parse_log(const std::string& text, const std::string& source) {
   Log log;
   size_t line_no = 0, pos = 0;
   long last_odom = -1;  // index into log.odom
+  // The odometry chain: `chain_from` is the ODOM pose the next scan's increment is measured from (the last
+  // record before the previous scan, or the re-anchoring record after it); `chain` the dead-reckoned pose.
+  bool have_from = false, have_chain = false, after_flaser = false;
+  Pose2d chain_from, chain;
+  auto between = [](const Pose2d& a, const Pose2d& b) {
+    const double c = std::cos(a.theta), s = std::sin(a.theta), dx = b.x - a.x, dy = b.y - a.y;
+    return Pose2d{c * dx + s * dy, -s * dx + c * dy, std::remainder(b.theta - a.theta, 2 * M_PI)};
+  };
+  auto compose = [](const Pose2d& a, const Pose2d& d) {
+    const double c = std::cos(a.theta), s = std::sin(a.theta);
+    return Pose2d{a.x + c * d.x - s * d.y, a.y + s * d.x + c * d.y, std::remainder(a.theta + d.theta, 2 * M_PI)};
+  };
   while (pos < text.size()) {
     size_t e = text.find('\n', pos);
     if (e == std::string::npos) e = text.size();
@@ -108,10 +120,17 @@ Log parse_log(const std::string& text, const std::string& source) {
       r.ipc_timestamp = f.num(b + 6, "ipc_timestamp");
       if (t.size() > b + 8) r.logger_timestamp = f.num(b + 8, "logger_timestamp");
       if (last_odom >= 0) {
-        r.wheel_odom = log.odom[size_t(last_odom)].pose;
+        const Pose2d& o = log.odom[size_t(last_odom)].pose;
+        chain = have_chain && have_from ? compose(chain, between(chain_from, o)) : o;
+        have_chain = true;
+        chain_from = o;
+        have_from = true;
+        r.wheel_odom = chain;
         r.have_wheel_odom = true;
       }
       log.scans.push_back(std::move(r));
+      after_flaser = true;
+      continue;
     } else if (type == "ODOM") {
       OdomRecord o;
       o.line = line_no;
@@ -120,11 +139,22 @@ Log parse_log(const std::string& text, const std::string& source) {
       o.rv = f.num(5, "rv");
       o.accel = f.num(6, "accel");
       o.ipc_timestamp = f.num(7, "ipc_timestamp");
+      const Pose2d& fp = log.scans.empty() ? o.pose : log.scans.back().pose;
+      if (after_flaser && std::abs(o.pose.x - fp.x) < 1e-6 && std::abs(o.pose.y - fp.y) < 1e-6 &&
+          std::abs(o.pose.theta - fp.theta) < 1e-6) {
+        // Re-anchoring: the chain continues from here (the next increment is measured from this record).
+        ++log.odom_reanchors;
+        chain_from = o.pose;
+        have_from = have_chain;
+        after_flaser = false;
+        continue;
+      }
       log.odom.push_back(o);
       last_odom = long(log.odom.size()) - 1;
     } else {
       ++log.skipped[type];
     }
+    after_flaser = false;
   }
   if (log.scans.empty()) fail(source + ": no FLASER records (is this a CARMEN log?)");
   return log;

@@ -42,6 +42,40 @@ TEST(Carmen, ParsesFlaserAndOdom) {
   EXPECT_FLOAT_EQ(no_return_range(log), 81.91f);
 }
 
+// The Radish "corrected" logs restart the ODOM chain at every scan: an ODOM record right after a FLASER repeats
+// its corrected pose, and the wheels integrate from there. The scan's odometry increment is the wheels' own
+// motion (from the anchor), not the difference of two records of different chains (which would carry the
+// reference's increment of the previous step). Here: the reference moves 1 m per scan, the wheels report
+// 0.9 m per step (a 10 % scale error): the increments must be 0.9 m, and a log without anchors keeps the
+// plain differences.
+TEST(Carmen, OdometryReanchoredAtScansGivesTheWheelsIncrement) {
+  const char* kAnchored =
+      "ODOM 0 0 0 0 0 0 0.5 h 0.5\n"
+      "FLASER 2 1 1 0 0 0 0 0 0 1.0 h 1.0\n"
+      "ODOM 0 0 0 0 0 0 0 h 0\n"          // anchor = FLASER 0's pose
+      "ODOM 0.45 0 0 0 0 0 1.5 h 1.5\n"
+      "ODOM 0.9 0 0 0 0 0 2.0 h 2.0\n"
+      "FLASER 2 1 1 1 0 0 1 0 0 2.0 h 2.0\n"
+      "ODOM 1 0 0 0 0 0 0 h 0\n"          // anchor = FLASER 1's pose (the reference)
+      "ODOM 1.9 0 0 0 0 0 3.0 h 3.0\n"
+      "FLASER 2 1 1 2 0 0 2 0 0 3.0 h 3.0\n"
+      "ODOM 2 0 0 0 0 0 0 h 0\n"
+      "ODOM 2.9 0 0 0 0 0 4.0 h 4.0\n"
+      "FLASER 2 1 1 3 0 0 3 0 0 4.0 h 4.0\n";
+  const Log log = parse_log(kAnchored, "a.log");
+  ASSERT_EQ(log.scans.size(), 4u);
+  EXPECT_EQ(log.odom_reanchors, 3u);
+  EXPECT_EQ(log.odom.size(), 5u);
+  for (size_t k = 1; k < 4; ++k) {
+    ASSERT_TRUE(log.scans[k].have_wheel_odom);
+    EXPECT_NEAR(log.scans[k].wheel_odom.x - log.scans[k - 1].wheel_odom.x, 0.9, 1e-9) << "scan " << k;
+  }
+  // Without anchors (a plain odometry stream): the differences of the last records before each scan.
+  const Log plain = parse_log(kLog, "t.log");
+  EXPECT_EQ(plain.odom_reanchors, 0u);
+  EXPECT_DOUBLE_EQ(plain.scans[1].wheel_odom.x - plain.scans[0].wheel_odom.x, 0.2);
+}
+
 TEST(Carmen, ClearErrors) {
   EXPECT_NE(err_of([] { parse_log("FLASER 3 1 2\n", "a.log"); }).find("a.log:1: FLASER: 4 fields, expected at least 12"), std::string::npos);
   EXPECT_NE(err_of([] { parse_log("FLASER 2 1 x 0 0 0 0 0 0 1 h 1\n", "a.log"); }).find("a.log:1: FLASER: field 3 (range): expected a number, got 'x'"),

@@ -62,7 +62,7 @@ struct PriorCost {
 std::unique_ptr<ceres::Problem> refine_problem(const FieldInterp& interp, const DistanceField& df,
                                                const GridLocalizerConfig& cfg, const std::vector<Eigen::Vector2d>& pts,
                                                const Pose2& pred, double sxy, double syaw, double* x, double* cost,
-                                               int* iterations) {
+                                               int* iterations, bool fix_yaw = false) {
   ceres::Problem::Options po;
   po.loss_function_ownership = ceres::TAKE_OWNERSHIP;
   po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
@@ -72,6 +72,7 @@ std::unique_ptr<ceres::Problem> refine_problem(const FieldInterp& interp, const 
     problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PointCost, 1, 3>(new PointCost(&interp, &df, p, inv_sigma)),
                               new ceres::HuberLoss(cfg.huber_m * inv_sigma), x);
   problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, 3>(new PriorCost(pred, sxy, syaw)), nullptr, x);
+  if (fix_yaw) problem->SetManifold(x, new ceres::SubsetManifold(3, {2}));
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
   so.max_num_iterations = cfg.max_iterations;
@@ -88,8 +89,8 @@ std::unique_ptr<ceres::Problem> refine_problem(const FieldInterp& interp, const 
 
 struct GridLocalizer::Impl {
   std::unique_ptr<ceres::Problem> refine_at(const std::vector<Eigen::Vector2d>& pts, const Pose2& pred, double sxy,
-                                            double syaw, double* x, double* cost, int* iterations) const {
-    return refine_problem(interp, *df, cfg, pts, pred, sxy, syaw, x, cost, iterations);
+                                            double syaw, double* x, double* cost, int* iterations, bool fix_yaw = false) const {
+    return refine_problem(interp, *df, cfg, pts, pred, sxy, syaw, x, cost, iterations, fix_yaw);
   }
   std::shared_ptr<const DistanceField> df;
   FieldGrid grid;
@@ -183,53 +184,84 @@ GridLocalizer::Impl::Fit GridLocalizer::Impl::fit(const std::vector<Eigen::Vecto
   win.sigma_yaw_rad = syaw;
   win.prior_kappa = cfg.prior_weight_sigmas;
   SearchOptions sopt;
-  sopt.keep = std::max(1, keep);
+  sopt.keep = std::max({1, keep, cfg.consistent_candidates});
   sopt.min_ratio = cfg.candidate_ratio;
   SearchStats sst;
   const std::vector<SearchCandidate> cands = correlative_search(d, *pyramid, sp, win, sopt, &sst);
   f.leaves = int(sst.leaves);
   f.score = cands.empty() ? 0 : cands.front().score;
-  // Refinement of each candidate with the prediction as a prior; the least cost is the fit.
-  std::unique_ptr<ceres::Problem> problem;
+  // Refinement of each candidate with the prediction as a prior.
   std::vector<std::array<double, 3>> xs;  // parameter blocks (alive while their problem is)
   for (const auto& c : cands) xs.push_back({c.pose.x, c.pose.y, c.pose.yaw});
-  if (xs.empty()) xs.push_back({pred.x, pred.y, pred.yaw});
-  size_t bi = 0;
-  double best_cost = std::numeric_limits<double>::infinity();
+  const bool consistent = cfg.consistent_candidates > 0;
+  if (consistent || xs.empty()) xs.push_back({pred.x, pred.y, pred.yaw});
+  const size_t n_free = xs.size();
+  if (consistent && cfg.odometry_yaw_candidate) xs.push_back({pred.x, pred.y, pred.yaw});
+  std::vector<std::unique_ptr<ceres::Problem>> problems;
+  std::vector<double> costs(xs.size()), inl(xs.size()), sss(xs.size());
+  std::vector<int> ninl(xs.size());
   for (size_t i = 0; i < xs.size(); ++i) {
-    double cost = 0;
-    auto pb = refine_at(pts, pred, sxy, syaw, xs[i].data(), &cost, &f.iterations);
-    if (cost < best_cost) {
-      best_cost = cost;
-      problem = std::move(pb);
-      bi = i;
+    problems.push_back(refine_at(pts, pred, sxy, syaw, xs[i].data(), &costs[i], &f.iterations, i >= n_free));
+    // Inliers at the refined pose.
+    const double c = std::cos(xs[i][2]), s = std::sin(xs[i][2]);
+    int n = 0;
+    double ss = 0;
+    for (const auto& p : pts) {
+      const Eigen::Vector2d w(xs[i][0] + c * p.x() - s * p.y(), xs[i][1] + s * p.x() + c * p.y());
+      const double dd = d.nearest(w);
+      if (dd < cfg.inlier_m) {
+        ++n;
+        ss += dd * dd;
+      }
     }
+    ninl[i] = n;
+    sss[i] = ss;
+    inl[i] = pts.empty() ? 0 : double(n) / double(pts.size());
+  }
+  size_t bi = 0;
+  if (!consistent) {
+    // The least cost.
+    for (size_t i = 1; i < xs.size(); ++i)
+      if (costs[i] < costs[bi]) bi = i;
+  } else {
+    // The fit nearest the prediction, unless another is clearly better supported by the map.
+    auto m2 = [&](size_t i) {
+      const double ex = xs[i][0] - pred.x, ey = xs[i][1] - pred.y, eyaw = wrap_angle(xs[i][2] - pred.yaw);
+      return (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw);
+    };
+    size_t near = 0, best = 0;
+    for (size_t i = 1; i < xs.size(); ++i) {
+      if (m2(i) < m2(near)) near = i;
+      if (inl[i] > inl[best]) best = i;
+    }
+    // No conflict (the fit nearest the prediction is where the search's best refines to): the search's best.
+    auto same = [&](size_t a, size_t b) {
+      return std::hypot(xs[a][0] - xs[b][0], xs[a][1] - xs[b][1]) < cfg.same_place_xy_m &&
+             std::abs(wrap_angle(xs[a][2] - xs[b][2])) < cfg.same_place_yaw_rad;
+    };
+    if (same(near, 0)) bi = 0;
+    else bi = inl[best] >= inl[near] + cfg.jump_inlier_margin ? best : near;
+  }
+  std::unique_ptr<ceres::Problem> problem = std::move(problems[bi]);
+  if (bi >= n_free) {  // yaw held: the covariance from the full problem at that pose (no iterations)
+    GridLocalizerConfig c0 = cfg;
+    c0.max_iterations = 0;
+    double unused = 0;
+    problem = refine_problem(interp, d, c0, pts, pred, sxy, syaw, xs[bi].data(), &unused, nullptr);
   }
   f.refined = int(xs.size());
   const double* x = xs[bi].data();
   f.est = {x[0], x[1], wrap_angle(x[2])};
-  // Inliers at the refined pose.
-  double ss = 0;
-  {
-    const double c = std::cos(f.est.yaw), s = std::sin(f.est.yaw);
-    for (const auto& p : pts) {
-      const Eigen::Vector2d w(f.est.x + c * p.x() - s * p.y(), f.est.y + s * p.x() + c * p.y());
-      const double dd = d.nearest(w);
-      if (dd < cfg.inlier_m) {
-        ++f.inliers;
-        ss += dd * dd;
-      }
-    }
-  }
-  f.inlier_ratio = pts.empty() ? 0 : double(f.inliers) / double(pts.size());
-  f.rms = f.inliers > 0 ? std::sqrt(ss / f.inliers) : 0;
+  f.inliers = ninl[bi];
+  f.inlier_ratio = inl[bi];
+  f.rms = f.inliers > 0 ? std::sqrt(sss[bi] / f.inliers) : 0;
   const double ex = f.est.x - pred.x, ey = f.est.y - pred.y, eyaw = wrap_angle(f.est.yaw - pred.yaw);
   const double m2 = (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw);
   const bool near = m2 <= cfg.gate_sigmas * cfg.gate_sigmas;
   // The refinement may not leave the window searched (a scan of one flat wall fits anywhere along it).
   const bool inside = std::hypot(ex, ey) <= f.wxy + d.resolution() && std::abs(eyaw) <= f.wyaw + cfg.search_yaw_step_rad;
   f.accepted = (inside && f.inlier_ratio >= min_inlier_ratio) || (near && f.inlier_ratio >= cfg.min_inlier_ratio_near);
-  if (f.accepted) {
+  {
     // Covariance from the Jacobian at the solution (loss applied).
     ceres::CRSMatrix J;
     problem->Evaluate(ceres::Problem::EvaluateOptions(), nullptr, nullptr, nullptr, &J);
@@ -260,8 +292,10 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
     inc = between(*m.last_odom, *odom);
     const double step = std::hypot(inc->x, inc->y), turn = std::abs(wrap_angle(inc->yaw));
     pred = compose(m.pose, *inc);
-    qxy = cfg_.sigma_xy_m + cfg_.sigma_xy_per_m * step;
-    qyaw = cfg_.sigma_yaw_rad + cfg_.sigma_yaw_per_rad * turn + cfg_.sigma_yaw_per_m * step;
+    // After a fit: base + motion (the window around a fresh fit); while dead-reckoning: the motion only.
+    const bool base = !(cfg_.dead_reckoning_motion_only && m.poor_run > 0);
+    qxy = (base ? cfg_.sigma_xy_m : 0.0) + cfg_.sigma_xy_per_m * step;
+    qyaw = (base ? cfg_.sigma_yaw_rad : 0.0) + cfg_.sigma_yaw_per_rad * turn + cfg_.sigma_yaw_per_m * step;
     sxy = std::sqrt(sxy * sxy + qxy * qxy + step * step * syaw * syaw);
     syaw = std::sqrt(syaw * syaw + qyaw * qyaw);
   } else if (!m.first) {
@@ -321,7 +355,9 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
       const bool near = (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw) <= cfg_.gate_sigmas * cfg_.gate_sigmas;
       // (Tried: leaving LOST only with confirm_inlier_ratio here too: intel 18.1 -> 185 cm, more weak fits
       // followed; freiburg-079 86 -> 91 cm.)
-      if (f.accepted && near && f.inlier_ratio >= cfg_.min_inlier_ratio) {
+      const bool inside = std::hypot(ex, ey) <= f.wxy + df.resolution() && std::abs(eyaw) <= f.wyaw + cfg_.search_yaw_step_rad;
+      if ((f.accepted && near && f.inlier_ratio >= cfg_.min_inlier_ratio) ||
+          (inside && f.inlier_ratio >= cfg_.reacquire_strong_ratio)) {
         m.hyps.clear();
         m.pose = f.est;
         m.sxy = std::sqrt(std::max(f.cov(0, 0), f.cov(1, 1)));
@@ -337,7 +373,7 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
       }
       // Weak, near the prediction: follow it, but keep the dead-reckoned uncertainty (a weak fit does not
       // confirm the pose; shrinking it would narrow the re-acquisition search around a wrong place).
-      if (f.accepted && cfg_.follow_weak) pred = f.est;
+      if (f.accepted && cfg_.follow_weak && (cfg_.follow_weak_when_lost || m.poor_run < cfg_.lost_after)) pred = f.est;
     }
     std::vector<Impl::Hypothesis> kept;
     for (auto& h : m.hyps) {
@@ -382,9 +418,22 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
       const size_t sk = std::max<size_t>(1, pts.size() / 100);
       std::vector<Eigen::Vector2d> sp;
       for (size_t i = 0; i < pts.size(); i += sk) sp.push_back(pts[i]);
+      // A strong fit (>= reacquire_strong_ratio) within the dead-reckoned window (not yet LOST) that no other
+      // candidate comes close to (confirm_margin) ends POOR at once: the map explains the scan almost
+      // entirely there and nowhere else nearby (csail: a 30 deg odometry turn error beyond the tracking window).
+      std::optional<Impl::Fit> strong;
+      double runner_up = 0;
       for (const auto& c : correlative_search(df, *m.pyramid, sp, win, so)) {
         const double s0 = 2 * df.resolution(), y0 = 2 * cfg_.search_yaw_step_rad;
         const Impl::Fit f = m.fit(pts, c.pose, s0, y0, s0, y0, 1, cfg_.min_inlier_ratio);
+        if (!lost) {
+          if (!strong || f.inlier_ratio > strong->inlier_ratio) {
+            if (strong) runner_up = std::max(runner_up, strong->inlier_ratio);
+            strong = f;
+          } else {
+            runner_up = std::max(runner_up, f.inlier_ratio);
+          }
+        }
         if (!f.accepted || f.inlier_ratio < cfg_.min_inlier_ratio) continue;
         bool dup = false;
         for (const auto& h : m.hyps)
@@ -398,6 +447,20 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
         h.hits = 1;
         h.inlier_sum = f.inlier_ratio;
         m.hyps.push_back(h);
+      }
+      if (strong && strong->inlier_ratio >= cfg_.reacquire_strong_ratio &&
+          runner_up < strong->inlier_ratio - cfg_.confirm_margin) {
+        m.hyps.clear();
+        m.pose = strong->est;
+        m.sxy = std::sqrt(std::max(strong->cov(0, 0), strong->cov(1, 1)));
+        m.syaw = std::sqrt(strong->cov(2, 2));
+        m.poor_run = 0;
+        res.pose = strong->est;
+        res.status = GridStatus::kOk;
+        res.covariance = strong->cov;
+        res.inlier_ratio = strong->inlier_ratio;
+        res.reacquired = true;
+        return res;
       }
     }
     std::sort(m.hyps.begin(), m.hyps.end(), [](const auto& a, const auto& b) {
@@ -425,9 +488,16 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
   }
   m.hyps.clear();
 
-  // 3. Tracking: the local fit around the prediction.
-  const Impl::Fit f = m.fit(pts, pred, sxy, syaw, cfg_.max_window_xy_m, cfg_.max_window_yaw_rad,
-                            cfg_.refine_candidates, cfg_.min_inlier_ratio);
+  // 3. Tracking: the local fit around the prediction; a failed fit right after a good one is retried once in a
+  // wider window (an odometry error beyond the window), taken only when the map supports it on its own.
+  Impl::Fit f = m.fit(pts, pred, sxy, syaw, cfg_.max_window_xy_m, cfg_.max_window_yaw_rad,
+                      cfg_.refine_candidates, cfg_.min_inlier_ratio);
+  if (!f.accepted && m.poor_run == 0 && cfg_.retry_window_factor > 1) {
+    const double k = cfg_.retry_window_factor;
+    Impl::Fit g = m.fit(pts, pred, k * sxy, k * syaw, k * cfg_.max_window_xy_m, std::min(M_PI, k * cfg_.max_window_yaw_rad),
+                        cfg_.refine_candidates, cfg_.min_inlier_ratio);
+    if (g.accepted && g.inlier_ratio >= cfg_.min_inlier_ratio) f = std::move(g);
+  }
   res.search_xy_m = f.wxy;
   res.search_yaw_rad = f.wyaw;
   res.candidates = f.leaves;

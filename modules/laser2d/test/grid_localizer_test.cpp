@@ -229,3 +229,56 @@ TEST(GridLocalizer, ScanPointsDropInvalidAndApplyMount) {
 }
 
 }  // namespace
+
+// Dead reckoning: while the scans are unexplained (POOR) the uncertainty grows with the motion, not per scan:
+// a robot that stands still for many scans keeps its window; one that drives widens it. Control: the per-scan
+// bases added on every POOR scan (the earlier model) widen it while standing still.
+double poor_window_after_standing(bool motion_only, int scans) {
+  const OccupancyGrid map = make_room(), other = make_room(true);
+  l2::GridLocalizerConfig c;
+  c.dead_reckoning_motion_only = motion_only;
+  l2::GridLocalizer loc(std::make_shared<l2::DistanceField>(map, 1.0), c);
+  loc.set_initial_pose({1, 1, 0});
+  std::mt19937 rng(5);
+  EXPECT_EQ(loc.update(cast(map, {1, 1, 0}, rng), Pose2{0, 0, 0}).status, l2::GridStatus::kOk);
+  double w = 0;
+  for (int k = 0; k < scans; ++k) {
+    const auto r = loc.update(cast(other, {1, 1, 0}, rng), Pose2{0, 0, 0});
+    EXPECT_NE(r.status, l2::GridStatus::kOk);
+    w = std::sqrt(r.covariance(0, 0));
+  }
+  return w;
+}
+
+TEST(GridLocalizer, DeadReckoningUncertaintyGrowsWithMotionOnly) {
+  const double w1 = poor_window_after_standing(true, 1), w8 = poor_window_after_standing(true, 8);
+  EXPECT_NEAR(w8, w1, 1e-6) << "standing still widened the dead-reckoned uncertainty";
+  const double old8 = poor_window_after_standing(false, 8);
+  EXPECT_GT(old8, 2 * w1) << "control: the per-scan model should grow while standing";
+}
+
+// An odometry turn error beyond the tracking window (csail: 30 deg on a 1 m step): the first fit fails, the
+// retry in a window twice as wide finds the pose (>= min_inlier_ratio). Control: without the retry the scan is
+// POOR and the estimate the wrong prediction.
+l2::GridResult wrong_turn(double retry_factor, const Pose2& truth) {
+  const OccupancyGrid map = make_room();
+  l2::GridLocalizerConfig c;
+  c.retry_window_factor = retry_factor;
+  l2::GridLocalizer loc(std::make_shared<l2::DistanceField>(map, 1.0), c);
+  loc.set_initial_pose({1, 1, 0});
+  std::mt19937 rng(9);
+  EXPECT_EQ(loc.update(cast(map, {1, 1, 0}, rng), Pose2{0, 0, 0}).status, l2::GridStatus::kOk);
+  EXPECT_EQ(loc.update(cast(map, {2, 1, 0}, rng), Pose2{1, 0, 0}).status, l2::GridStatus::kOk);
+  // The robot drives 1 m on and turns 25 deg; the odometry reports a straight step.
+  return loc.update(cast(map, truth, rng), Pose2{2, 0, 0});
+}
+
+TEST(GridLocalizer, RetriesAFailedFitInAWiderWindow) {
+  const Pose2 truth{3, 1, 25 * M_PI / 180};
+  const auto r = wrong_turn(2.0, truth);
+  EXPECT_EQ(r.status, l2::GridStatus::kOk);
+  EXPECT_LT(std::hypot(r.pose.x - truth.x, r.pose.y - truth.y), 0.05);
+  EXPECT_LT(std::abs(fploc::wrap_angle(r.pose.yaw - truth.yaw)), 1 * M_PI / 180);
+  const auto c = wrong_turn(1.0, truth);
+  EXPECT_NE(c.status, l2::GridStatus::kOk) << "control: the pose was found without the retry; the test does not test it";
+}

@@ -27,7 +27,10 @@ struct LaserRecord {
   Pose2d pose;          // x y theta (corrected in the Radish logs)
   Pose2d odom;          // odom_x odom_y odom_theta
   double ipc_timestamp = 0, logger_timestamp = 0;
-  // The last ODOM record before this scan (valid when have_wheel_odom).
+  // The wheel odometry at this scan (valid when have_wheel_odom): a continuous dead-reckoned chain whose
+  // increment from the previous scan is the odometry's own motion between the two scans, i.e. between the last
+  // ODOM record before the previous scan and the last ODOM record before this one, unless the odometry was
+  // re-anchored in between (see Log::odom_reanchors): then from the re-anchoring record.
   Pose2d wheel_odom;
   bool have_wheel_odom = false;
 };
@@ -42,6 +45,13 @@ struct Log {
   std::vector<LaserRecord> scans;
   std::vector<OdomRecord> odom;
   std::map<std::string, size_t> skipped;  // record type -> count
+  // Re-anchorings of the ODOM stream: an ODOM record right after a FLASER that repeats the FLASER's (corrected)
+  // pose. The Radish "corrected" logs restart the odometry chain at every scan this way (the records after it
+  // integrate the wheels from the corrected pose), so the last ODOM record before a scan lies in a chain
+  // started at the previous scan's reference pose; differencing those records between scans would mix the
+  // reference's increment of the previous step into the odometry. The chain's own increment (from the anchor)
+  // is the wheels' motion alone. Anchor records are not part of `odom`.
+  size_t odom_reanchors = 0;
 };
 
 // Parses a whole log (text, already decompressed).

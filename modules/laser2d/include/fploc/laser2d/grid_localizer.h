@@ -49,6 +49,31 @@ struct GridLocalizerConfig {
   // least robust cost ignores the odometry's preference, so a better-fitting aliased candidate wins.
   // search_levels: pyramid levels of the branch-and-bound search (2^(levels-1) cells at the top).
   int refine_candidates = 1;
+  // Odometry-consistent choice (issue 13, fifth pass): besides the search's best, the fit refined from the
+  // prediction itself and up to consistent_candidates distinct search candidates are refined; the fit nearest
+  // the prediction (Mahalanobis) is kept unless another has at least jump_inlier_margin more inlier share
+  // (the map must clearly prefer a pose the odometry does not predict: in-place turns where a rotated fit
+  // matches a partly mapped room as well as the true one, corridors where a shifted fit matches as well).
+  // 0 candidates: off (the search's best only, the earlier behaviour).
+  int consistent_candidates = 4;
+  double jump_inlier_margin = 0.05;
+  // ... applied only when the nearest fit and the search's best are different places (farther apart than
+  // either); at the same place the search's best is kept (the odometry's own bias is not a conflict).
+  double same_place_xy_m = 0.1, same_place_yaw_rad = 3.0 * M_PI / 180;
+  // Among those candidates also the prediction refined in x, y only (the odometry's yaw kept): where the map
+  // constrains the yaw weakly (a partly mapped room during an in-place turn) the refinement otherwise rotates
+  // the scan 10-20 deg from an odometry turn that was right to a few degrees (intel scans 835-837).
+  bool odometry_yaw_candidate = true;
+  // While re-acquiring, a fit inside the searched window that explains at least this share of the scan ends
+  // it at once even outside gate_sigmas (a large odometry turn error right after the map was lost: csail).
+  double reacquire_strong_ratio = 0.9;
+  // A failed tracking fit is retried once with the window widened by this factor (an odometry turn error
+  // beyond the window: csail); the retry is taken only with min_inlier_ratio. 1: off.
+  double retry_window_factor = 2.0;
+  // Dead reckoning (POOR scans): the uncertainty grows with the motion only (sigma_*_per_*); the per-scan
+  // bases (sigma_xy_m, sigma_yaw_rad) size the search window after a fit but are not added again on every
+  // unmatched scan (a robot at 40 Hz that stands still for 150 scans is not 0.6 m / 25 deg less certain).
+  bool dead_reckoning_motion_only = false;
   double candidate_ratio = 0.8;
   int search_levels = 8;
   // Refinement.
@@ -76,6 +101,9 @@ struct GridLocalizerConfig {
   bool reacquire = true;
   double reacquire_xy_m = 10.0, reacquire_yaw_rad = M_PI;
   bool follow_weak = true;   // while re-acquiring, follow a weak fit near the prediction (else dead-reckon)
+  // ... also once LOST (lost_after POOR scans): off — after a long stretch the map does not explain, a weak fit
+  // within the grown gate is as likely a wrong place (intel scan 799: 1.5 m off with 41 % inliers).
+  bool follow_weak_when_lost = true;
   int reacquire_after = 1;  // POOR scans in a row after which a jump needs confirmation
   int reacquire_candidates = 4, max_hypotheses = 8, confirm_scans = 5;
   double confirm_margin = 0.1;
