@@ -186,12 +186,9 @@ TEST(Bag, WrittenBagsAllCompressionsAndDamage) {
       BagWriter w;
       ASSERT_TRUE(w.open(p, comp, 4000));
       const uint32_t a = w.add_connection("/a", "std_msgs/String"), b = w.add_connection("/b", "ouster_ros/PacketMsg");
-      for (int i = 0; i < 300; ++i) {
-        std::vector<uint8_t> d(4 + size_t(i % 50));
-        const uint32_t len = uint32_t(d.size() - 4);
-        std::memcpy(d.data(), &len, 4);
-        for (size_t k = 4; k < d.size(); ++k) d[k] = uint8_t('a' + (i + k) % 26);
-        w.write(i % 3 ? a : b, 1000000000LL * 100 + i * 1000000LL, d.data(), d.size());
+      for (int i = 0; i < kMixedMessages; ++i) {
+        const auto d = mixed_payload(i, 1);
+        w.write(i % 3 ? a : b, mixed_time_ns(i), d.data(), d.size());
       }
       ASSERT_TRUE(w.close());
     }
@@ -199,12 +196,7 @@ TEST(Bag, WrittenBagsAllCompressionsAndDamage) {
     std::string err;
     const auto msgs = read_all(bytes.data(), bytes.size(), &err, p);
     EXPECT_EQ(err, "") << comp;
-    ASSERT_EQ(msgs.size(), 300u) << comp;
-    for (int i = 0; i < 300; ++i) {
-      EXPECT_EQ(msgs[i].topic, i % 3 ? "/a" : "/b");
-      EXPECT_EQ(msgs[i].t, 1000000000LL * 100 + i * 1000000LL);
-      EXPECT_EQ(msgs[i].data.size(), 4u + size_t(i % 50));
-    }
+    expect_mixed(msgs, comp);
     // Unindexed (a recorder killed before writing the index): everything reads.
     uint64_t index_pos;
     const auto* h = bytes.data() + 13 + 4;
@@ -213,7 +205,7 @@ TEST(Bag, WrittenBagsAllCompressionsAndDamage) {
     std::memcpy(&index_pos, static_cast<const uint8_t*>(f) + 10, 8);
     const auto unindexed = read_all(bytes.data(), size_t(index_pos), &err);
     EXPECT_EQ(err, "");
-    EXPECT_EQ(unindexed.size(), 300u);
+    EXPECT_EQ(unindexed.size(), size_t(kMixedMessages));
     if (comp != "none") {
       // A damaged compressed chunk: one error naming the chunk and its byte offset.
       auto bad = bytes;
@@ -221,7 +213,7 @@ TEST(Bag, WrittenBagsAllCompressionsAndDamage) {
       bad[4096 + 201] ^= 0xA5;
       const auto some = read_all(bad.data(), bad.size(), &err, "bad.bag");
       EXPECT_NE(err.find("bad.bag: chunk at byte 4096 (" + comp + ")"), std::string::npos) << err;
-      EXPECT_LT(some.size(), 300u);
+      EXPECT_LT(some.size(), size_t(kMixedMessages));
 
       // A damaged later chunk (decompressed ahead, on the second thread, while the earlier ones are
       // read): the same one error naming that chunk, after every message of the chunks before it.
@@ -239,7 +231,7 @@ TEST(Bag, WrittenBagsAllCompressionsAndDamage) {
       const auto before = read_all(bad3.data(), bad3.size(), &err, "bad3.bag");
       EXPECT_NE(err.find("bad3.bag: chunk at byte " + std::to_string(chunk_at[2]) + " (" + comp + ")"), std::string::npos) << err;
       ASSERT_GT(before.size(), 0u);
-      ASSERT_LT(before.size(), 300u);
+      ASSERT_LT(before.size(), size_t(kMixedMessages));
       for (size_t i = 0; i < before.size(); ++i) EXPECT_EQ(before[i].data, msgs[i].data) << i;
       const auto upto2 = read_all(bytes.data(), chunk_at[2], &err);  // the file cut right before that chunk
       EXPECT_EQ(before.size(), upto2.size()) << comp;

@@ -163,10 +163,14 @@ TEST_P(Mcap, IndependentWriter) {
   bad[target] ^= 0x10;
   const auto got = read_all(bad.data(), bad.size(), &err, "bad.mcap");
   EXPECT_EQ(err.rfind("bad.mcap: " + want, 0), 0u) << err;
-  if (std::string(comp) == "none") EXPECT_NE(err.find("CRC-32"), std::string::npos) << err;
+  if (std::string(comp) == "none") {
+    EXPECT_NE(err.find("CRC-32"), std::string::npos) << err;
+  }
   // A damaged chunk stops before its messages; the data section CRC is only known at its end (the
   // messages were delivered, the import still ends with the error).
-  if (std::string(chunking) == "chunked") EXPECT_LT(got.size(), all.size());
+  if (std::string(chunking) == "chunked") {
+    EXPECT_LT(got.size(), all.size());
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Writers, Mcap,

@@ -1,6 +1,7 @@
 #pragma once
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -37,5 +38,26 @@ inline std::vector<Msg> read_all(const uint8_t* d, size_t n, std::string* error,
   while (r->next(m)) out.push_back({r->connections().at(m.conn).topic, m.time_ns, std::vector<uint8_t>(m.data, m.data + m.size)});
   *error = r->error();
   return out;
+}
+
+// The mixed-topic test recording of the bag and MCAP tests: message i on "/a" (i % 3 != 0) or "/b", at
+// 100 s + i ms, a ROS uint8[] (4-byte length, then 0..49 letters that depend on i and `stride`).
+constexpr int kMixedMessages = 300;
+inline int64_t mixed_time_ns(int i) { return 1000000000LL * 100 + i * 1000000LL; }
+inline std::vector<uint8_t> mixed_payload(int i, int stride) {
+  std::vector<uint8_t> d(4 + size_t(i % 50));
+  const uint32_t len = uint32_t(d.size() - 4);
+  std::memcpy(d.data(), &len, 4);
+  for (size_t k = 4; k < d.size(); ++k) d[k] = uint8_t('a' + (size_t(i * stride) + k) % 26);
+  return d;
+}
+// Every message of the mixed recording read back in order, with its topic, time and size.
+inline void expect_mixed(const std::vector<Msg>& msgs, const std::string& what) {
+  ASSERT_EQ(msgs.size(), size_t(kMixedMessages)) << what;
+  for (int i = 0; i < kMixedMessages; ++i) {
+    EXPECT_EQ(msgs[i].topic, i % 3 ? "/a" : "/b") << what;
+    EXPECT_EQ(msgs[i].t, mixed_time_ns(i)) << what;
+    EXPECT_EQ(msgs[i].data.size(), 4u + size_t(i % 50)) << what;
+  }
 }
 }  // namespace fploc::rec::test
