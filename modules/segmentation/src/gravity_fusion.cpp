@@ -264,9 +264,24 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
     }
   }
   if (acc_ok) {
-    // The accelerometer's gravity, slowly: the platform's accelerations average out.
+    // The accelerometer's gravity, slowly: the platform's accelerations average out. Across the slope (the
+    // tilt's component perpendicular to the slope's direction) faster while the sensor does not turn: a
+    // platform driving up or down a slope accelerates along it, and without turning there is no centripetal
+    // acceleration across it, so there the accelerometer (its tilt bias removed) measures gravity alone up
+    // to its noise.
     const double kacc = 1 - std::exp(-std::max(0.0, dt) / cfg_.accel_tau_s);
-    o_ += kacc * ((ad - p) - o_);
+    Eigen::Vector3d e = (ad - p) - o_;
+    e -= e.dot(p) * p;
+    const double turn_rate =
+        gyro_ok && dt > 0 ? std::abs(Eigen::AngleAxisd(R).angle() * Eigen::AngleAxisd(R).axis().dot(p)) / dt : M_PI;
+    if (turn_rate < cfg_.accel_bias_max_turn_rate && angle_of(o_) > cfg_.level_deg * k::kDeg) {
+      const Eigen::Vector3d along = o_.normalized();
+      const Eigen::Vector3d e_along = e.dot(along) * along;
+      const double kcross = 1 - std::exp(-std::max(0.0, dt) / k::kCrossSlopeAccelTauS);
+      o_ += kacc * e_along + kcross * (e - e_along);
+    } else {
+      o_ += kacc * e;
+    }
     o_sigma_ = std::max(0.05 * k::kDeg, o_sigma_ * (1 - 0.5 * kacc));
   }
   o_ -= o_.dot(p) * p;

@@ -51,6 +51,11 @@ constexpr double kMinGroundDistM = 0.1;
 constexpr double kMaxGroundTiltDeg = 5.0;   // ground normal vs the ceiling's (or prior) up
 constexpr double kCeilingPriorAgreeDeg = 2.0;  // ceiling this close to the prior: the ground is fitted around it
 
+// ---- gravity fusion (gravity_fusion.cpp) ----
+// On a slope, not turning: the accelerometer's pull on the tilt across the slope (no platform acceleration
+// there) [s]; along the slope it is accel_tau_s (the platform's accelerations along its path average out).
+constexpr double kCrossSlopeAccelTauS = 2.0;
+
 // ---- gyro de-skew (gyro_deskew.cpp) ----
 constexpr double kMaxGyroRate = 35.0;           // rad/s (> 2000 deg/s: not a rate an OS-1 IMU reports)
 constexpr int64_t kGyroKeepUs = 1000000;        // keep ~1 s of samples; time going back > 1 s: new log
