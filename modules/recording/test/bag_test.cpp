@@ -182,17 +182,9 @@ TEST(Bag, WrittenBagsAllCompressionsAndDamage) {
   const std::string dir = ::testing::TempDir();
   for (const std::string comp : {"none", "bz2", "lz4"}) {
     const std::string p = dir + "/w_" + comp + ".bag";
-    {
-      BagWriter w;
-      ASSERT_TRUE(w.open(p, comp, 4000));
-      const uint32_t a = w.add_connection("/a", "std_msgs/String"), b = w.add_connection("/b", "ouster_ros/PacketMsg");
-      for (int i = 0; i < kMixedMessages; ++i) {
-        const auto d = mixed_payload(i, 1);
-        w.write(i % 3 ? a : b, mixed_time_ns(i), d.data(), d.size());
-      }
-      ASSERT_TRUE(w.close());
-    }
-    const auto bytes = slurp(p);
+    const auto bytes = write_mixed<BagWriter>(p, comp, 1, [](BagWriter& w) {
+      return std::pair{w.add_connection("/a", "std_msgs/String"), w.add_connection("/b", "ouster_ros/PacketMsg")};
+    });
     std::string err;
     const auto msgs = read_all(bytes.data(), bytes.size(), &err, p);
     EXPECT_EQ(err, "") << comp;

@@ -30,17 +30,9 @@ TEST(McapWritten, ManyChunksReadAheadAndDamage) {
   const std::string dir = ::testing::TempDir();
   for (const std::string comp : {"none", "zstd", "lz4"}) {
     const std::string p = dir + "/w_" + comp + ".mcap";
-    {
-      McapWriter w;
-      ASSERT_TRUE(w.open(p, comp, 4000));
-      const uint16_t a = w.add_channel("/a", "std_msgs/msg/String"), b = w.add_channel("/b", "ouster_ros/msg/PacketMsg");
-      for (int i = 0; i < kMixedMessages; ++i) {
-        const auto d = mixed_payload(i, 7);
-        w.write(i % 3 ? a : b, mixed_time_ns(i), d.data(), d.size());
-      }
-      ASSERT_TRUE(w.close());
-    }
-    const auto bytes = slurp(p);
+    const auto bytes = write_mixed<McapWriter>(p, comp, 7, [](McapWriter& w) {
+      return std::pair{w.add_channel("/a", "std_msgs/msg/String"), w.add_channel("/b", "ouster_ros/msg/PacketMsg")};
+    });
     std::string err;
     const auto msgs = read_all(bytes.data(), bytes.size(), &err, p);
     EXPECT_EQ(err, "") << comp;

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fploc/recording/recording.h"
@@ -50,6 +51,22 @@ inline std::vector<uint8_t> mixed_payload(int i, int stride) {
   std::memcpy(d.data(), &len, 4);
   for (size_t k = 4; k < d.size(); ++k) d[k] = uint8_t('a' + (size_t(i * stride) + k) % 26);
   return d;
+}
+// Writes the mixed recording with writer W (BagWriter, McapWriter: open/write/close) and `compression`;
+// `add_topics(w)` adds "/a" and "/b" and returns their ids. Returns the file's bytes.
+template <class W, class AddTopics>
+std::vector<uint8_t> write_mixed(const std::string& path, const std::string& compression, int stride, AddTopics add_topics) {
+  {
+    W w;
+    EXPECT_TRUE(w.open(path, compression, 4000)) << path;
+    const auto [a, b] = add_topics(w);
+    for (int i = 0; i < kMixedMessages; ++i) {
+      const auto d = mixed_payload(i, stride);
+      w.write(i % 3 ? a : b, mixed_time_ns(i), d.data(), d.size());
+    }
+    EXPECT_TRUE(w.close()) << path;
+  }
+  return slurp(path);
 }
 // Every message of the mixed recording read back in order, with its topic, time and size.
 inline void expect_mixed(const std::vector<Msg>& msgs, const std::string& what) {
