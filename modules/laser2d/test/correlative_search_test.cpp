@@ -7,6 +7,7 @@
 
 #include "fploc/laser2d/correlative_search.h"
 #include "fploc/laser2d/grid_localizer.h"
+#include "synthetic_grid.h"
 
 namespace {
 
@@ -15,17 +16,8 @@ using fploc::Pose2;
 namespace l2 = fploc::laser2d;
 
 OccupancyGrid room() {
-  OccupancyGrid g;
-  g.width = 240;
-  g.height = 160;
-  g.resolution = 0.05;
-  g.origin_x = -1;
-  g.origin_y = -1;
-  g.data.assign(size_t(g.width) * g.height, 0);
-  auto occ = [&](double x, double y) {
-    const int i = int(std::floor((x - g.origin_x) / g.resolution)), j = int(std::floor((y - g.origin_y) / g.resolution));
-    if (i >= 0 && j >= 0 && i < g.width && j < g.height) g.data[size_t(j) * g.width + i] = 100;
-  };
+  OccupancyGrid g = l2::test::blank_grid(240, 160);
+  auto occ = [&](double x, double y) { l2::test::occupy(g, x, y); };
   for (double t = -0.5; t <= 10.5; t += 0.02) occ(t, -0.5), occ(t, 6.5);
   for (double t = -0.5; t <= 6.5; t += 0.02) occ(-0.5, t), occ(10.5, t);
   for (double t = 2.0; t <= 6.5; t += 0.02) occ(4.0, t);
@@ -39,15 +31,10 @@ std::vector<Eigen::Vector2d> scan_of(const OccupancyGrid& g, const Pose2& p, std
   std::vector<Eigen::Vector2d> out;
   for (int k = 0; k < 181; k += 2) {
     const double a = p.yaw - M_PI / 2 + k * M_PI / 180;
-    for (double d = 0.1; d < 12; d += 0.01) {
-      const double x = p.x + d * std::cos(a), y = p.y + d * std::sin(a);
-      const int i = int(std::floor((x - g.origin_x) / g.resolution)), j = int(std::floor((y - g.origin_y) / g.resolution));
-      if (i < 0 || j < 0 || i >= g.width || j >= g.height) break;
-      if (g.occupied(i, j)) {
-        const double r = d + n(rng), b = a - p.yaw;
-        out.emplace_back(r * std::cos(b), r * std::sin(b));
-        break;
-      }
+    const double d = l2::test::first_hit(g, p.x, p.y, a, 12);
+    if (std::isfinite(d)) {
+      const double r = d + n(rng), b = a - p.yaw;
+      out.emplace_back(r * std::cos(b), r * std::sin(b));
     }
   }
   return out;
@@ -99,7 +86,9 @@ TEST(CorrelativeSearch, KeepsDistinctCandidatesBestFirst) {
   ASSERT_GE(c.size(), 2u);
   EXPECT_LT(std::hypot(c[0].pose.x - truth.x, c[0].pose.y - truth.y), 0.06);
   for (size_t a = 0; a < c.size(); ++a) {
-    if (a > 0) EXPECT_LE(c[a].score, c[a - 1].score);
+    if (a > 0) {
+      EXPECT_LE(c[a].score, c[a - 1].score);
+    }
     for (size_t b = a + 1; b < c.size(); ++b)
       EXPECT_TRUE(std::hypot(c[a].pose.x - c[b].pose.x, c[a].pose.y - c[b].pose.y) >= o.sep_xy_m ||
                   std::abs(fploc::wrap_angle(c[a].pose.yaw - c[b].pose.yaw)) >= o.sep_yaw_rad);

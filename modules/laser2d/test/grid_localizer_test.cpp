@@ -9,6 +9,7 @@
 
 #include "fploc/laser2d/distance_field.h"
 #include "fploc/laser2d/grid_localizer.h"
+#include "synthetic_grid.h"
 
 namespace {
 
@@ -17,17 +18,8 @@ using fploc::Pose2;
 namespace l2 = fploc::laser2d;
 
 OccupancyGrid make_room(bool other_room = false) {
-  OccupancyGrid g;
-  g.width = 300;
-  g.height = 200;
-  g.resolution = 0.05;
-  g.origin_x = -1;
-  g.origin_y = -1;
-  g.data.assign(size_t(g.width) * g.height, 0);
-  auto occ = [&](double x, double y) {
-    const int i = int(std::floor((x - g.origin_x) / g.resolution)), j = int(std::floor((y - g.origin_y) / g.resolution));
-    if (i >= 0 && j >= 0 && i < g.width && j < g.height) g.data[size_t(j) * g.width + i] = 100;
-  };
+  OccupancyGrid g = l2::test::blank_grid(300, 200);
+  auto occ = [&](double x, double y) { l2::test::occupy(g, x, y); };
   // Outer walls of a 13 x 8 m room.
   if (!other_room)
     for (double t = -0.5; t <= 12.5; t += 0.02) occ(t, -0.5), occ(t, 7.5);
@@ -50,15 +42,8 @@ std::vector<Eigen::Vector2d> cast(const OccupancyGrid& g, const Pose2& p, std::m
   std::normal_distribution<double> n(0, 0.01);
   std::vector<float> r;
   for (int k = 0; k < 181; ++k) {
-    const double a = p.yaw - M_PI / 2 + k * M_PI / 180;
-    double d = 0.1;
-    for (; d < 30; d += 0.01) {
-      const double x = p.x + d * std::cos(a), y = p.y + d * std::sin(a);
-      const int i = int(std::floor((x - g.origin_x) / g.resolution)), j = int(std::floor((y - g.origin_y) / g.resolution));
-      if (i < 0 || j < 0 || i >= g.width || j >= g.height) { d = 1e9; break; }
-      if (g.occupied(i, j)) break;
-    }
-    r.push_back(d < 30 ? float(d + n(rng)) : std::numeric_limits<float>::infinity());
+    const double d = l2::test::first_hit(g, p.x, p.y, p.yaw - M_PI / 2 + k * M_PI / 180, 30);
+    r.push_back(std::isfinite(d) ? float(d + n(rng)) : std::numeric_limits<float>::infinity());
   }
   return l2::scan_points(r, -M_PI / 2, M_PI / 180, 0.1, 30);
 }
