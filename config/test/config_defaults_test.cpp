@@ -15,6 +15,7 @@
 
 #include "fploc/config/amcl.h"
 #include "fploc/config/laser2d.h"
+#include "fploc/config/recording.h"
 #include "fploc/config/localization.h"
 #include "fploc/config/perception.h"
 #include "fploc/config/relocalization.h"
@@ -184,6 +185,12 @@ TEST(ConfigDefaults, Grid2d) {
          {"field_max_m", c.field_max_m}, {"min_inlier_ratio_near", c.min_inlier_ratio_near},
          {"gate_sigmas", c.gate_sigmas}, {"sigma_xy_per_m", c.sigma_xy_per_m},
          {"sigma_yaw_per_rad", c.sigma_yaw_per_rad}, {"prior_weight_sigmas", c.prior_weight_sigmas}});
+}
+
+TEST(ConfigDefaults, CloudToScan) {
+  const fploc::rec::CloudOptions c = config_of(fploc::CloudToScanOptions{});
+  check("recording.proto", "CloudToScanOptions",
+        {{"rings", double(c.rings)}, {"columns", double(c.columns)}, {"gap_deg", c.gap_deg}});
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 
 #include "fploc/adapters/point_cloud2_t.h"
 #include "fploc/adapters/scan_t.h"
+#include "fploc/config/recording.h"
 #include "fploc/recording/cloud_to_scan.h"
 #include "fploc/runtime/node.h"
 #include "options/recording.pb.h"
@@ -25,10 +26,7 @@ class CloudToScanNode : public fploc::rt::Node {
 
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
-    const auto& o = ctx.options<fploc::CloudToScanOptions>();
-    opt_.rings = o.rings();
-    opt_.columns = o.columns();
-    if (o.gap_deg() > 0) opt_.gap_deg = o.gap_deg();
+    opt_ = fploc::config::config_of(ctx.options<fploc::CloudToScanOptions>());
     out_ = ctx.advertise<fploc::scan_t>("scan");
     ctx.subscribe<fploc::point_cloud2_t>("clouds", [this](const fploc::point_cloud2_t& m) { on_cloud(m); });
   }
