@@ -17,16 +17,6 @@ using nlohmann::json;
 
 namespace {
 json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
-double rate_over(std::deque<double>& times, double now_s, double window_s) {
-  while (!times.empty() && times.front() < now_s - window_s) times.pop_front();
-  return double(times.size()) / window_s;
-}
-
-void add_time(std::deque<double>& times, double now_s) {
-  times.push_back(now_s);
-  while (times.size() > 4096) times.pop_front();
-}
 }  // namespace
 
 Model::Model(ModelConfig cfg) : cfg_(cfg), ate_(cfg.ate_match_tolerance_s, cfg.max_trail * 2) {}
@@ -68,7 +58,7 @@ AteFigure Model::ate_figure(int64_t utime) const { return {ate_.error(utime), at
 void Model::on_pose(const fploc::pose_t& m, double now_s, int64_t wall_us) {
   const Rpy r = rpy_of(m.orientation);
   std::lock_guard<std::mutex> lk(mu_);
-  add_time(pose_times_, now_s);
+  pose_rate_.add(now_s);
   ate_.add_estimate(m.utime, m.position[0], m.position[1], m.position[2]);
   const AteFigure a = ate_figure(m.utime);
   TrailPoint p{m.utime, m.position[0], m.position[1], m.position[2], r.roll, r.pitch, r.yaw, bool(a.err),
@@ -106,16 +96,16 @@ void Model::on_ground_truth(const fploc::ground_truth_t& m, double, int64_t wall
 
 void Model::on_frame_pose(const fploc::frame_pose_t& m, double now_s, int64_t wall_us) {
   std::lock_guard<std::mutex> lk(mu_);
-  add_time(frame_times_, now_s);
+  frame_rate_.add(now_s);
   frame_pose_ = std::make_unique<fploc::frame_pose_t>(m);
-  hub_.set("frame_pose", frame_pose_view(m, rate_over(frame_times_, now_s, 2.0), wall_us));
+  hub_.set("frame_pose", frame_pose_view(m, frame_rate_.rate_hz(now_s), wall_us));
   // The features of this scan arrived first (the matcher consumes them): re-project them now.
   if (features_ && features_->scan_seq == m.scan_seq) publish_features();
 }
 
 void Model::on_features(const fploc::features_t& m, double now_s, int64_t) {
   std::lock_guard<std::mutex> lk(mu_);
-  add_time(feature_times_, now_s);
+  feature_rate_.add(now_s);
   features_ = std::make_unique<fploc::features_t>(m);
   publish_features();
 }
@@ -152,9 +142,9 @@ void Model::tick(double now_s, int64_t wall_us) {
   std::lock_guard<std::mutex> lk(mu_);
   rebuild_nodes(now_s, wall_us);
   for (auto& [r, f] : fleet_) rebuild_fleet_nodes(r, now_s, wall_us);
-  json s = {{"frame_rate_hz", num(r6(rate_over(frame_times_, now_s, 2.0)))},
-            {"pose_rate_hz", num(r6(rate_over(pose_times_, now_s, 2.0)))},
-            {"features_rate_hz", num(r6(rate_over(feature_times_, now_s, 2.0)))},
+  json s = {{"frame_rate_hz", num(r6(frame_rate_.rate_hz(now_s)))},
+            {"pose_rate_hz", num(r6(pose_rate_.rate_hz(now_s)))},
+            {"features_rate_hz", num(r6(feature_rate_.rate_hz(now_s)))},
             {"clients", clients_},
             {"pushes", hub_.pushes()},
             {"ate_rmse", num(r6(ate_.rmse()))},

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "fploc/eval/online_ate.h"
+#include "fploc/runtime/telemetry.h"
 #include "push_hub.h"
 #include "views.h"
 
@@ -98,7 +99,7 @@ class Model {
     bool seen = false;
   };
   std::map<std::string, NodeEntry> nodes_;
-  std::deque<double> frame_times_, pose_times_, feature_times_;
+  rt::RateMeter frame_rate_, pose_rate_, feature_rate_;  // arrivals (wall clock)
 
   // Latest features and frame pose for projection (features are in the sensor frame).
   std::unique_ptr<fploc::features_t> features_;

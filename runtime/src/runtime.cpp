@@ -133,6 +133,7 @@ void Context::publish_raw(const std::string& channel, const void* data, int size
   if (c) {
     ++c->messages;
     ++c->period_messages;
+    c->rate.add(now_s());
   }
 }
 
@@ -160,6 +161,7 @@ static void raw_handler(const lcm::ReceiveBuffer* rbuf, const std::string&, Hand
   }
   ++h->counters->messages;
   ++h->counters->period_messages;
+  h->counters->rate.add(t0);
   const double dt = now_s() - t0;
   // Live nodes: per-heartbeat window (reset every second). Composed replay: every call (the breakdown
   // of `fploc replay --json`); keeping both in a live node would grow without bound.
@@ -287,13 +289,14 @@ static fploc::node_status_t make_status(Context& ctx, const std::string& executa
   s.last_error = st.last_error;
   s.detail = st.detail;
   s.uptime_s = uptime;
-  for (const auto& p : st.ports) {
+  const double now = now_s();
+  for (auto& p : st.ports) {
     fploc::port_stats_t ps;
     ps.port = p.port;
     ps.channel = p.channel;
     ps.output = p.output;
     ps.messages = p.messages;
-    ps.rate_hz = double(p.period_messages);  // per 1 s period, corrected by the caller
+    ps.rate_hz = p.rate.rate_hz(now);
     ps.dropped = p.dropped;
     ps.undecodable = p.undecodable;
     ps.latency_p50_ms = p.latency.percentile(0.5);

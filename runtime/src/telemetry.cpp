@@ -39,6 +39,26 @@ double CpuMeter::sample_percent() {
   return dw > 0 ? 100.0 * dc / dw : 0.0;
 }
 
+void RateMeter::forget_before(double t_s) {
+  while (!times_.empty() && times_.front() < t_s) times_.pop_front();
+}
+
+void RateMeter::add(double t_s) {
+  times_.push_back(t_s);
+  forget_before(t_s - window_s_);
+}
+
+double RateMeter::rate_hz(double now_s) {
+  forget_before(now_s - window_s_);
+  if (times_.size() < 2) return 0.0;
+  const double n = double(times_.size() - 1);
+  // At least 1 s (or the whole window if shorter): the first burst of a stream is not a rate.
+  double span = std::max(times_.back() - times_.front(), std::min(window_s_, 1.0));
+  // Idle for longer than five mean intervals (at least 0.5 s): the stream stalled; count the idle time.
+  if (now_s - times_.back() > std::max(0.5, 5.0 * span / n)) span = now_s - times_.front();
+  return span > 0 ? n / span : 0.0;
+}
+
 PortCounters& NodeStats::port(const std::string& name, const std::string& channel, bool output) {
   for (auto& p : ports)
     if (p.port == name && p.output == output) return p;

@@ -46,3 +46,33 @@ TEST(Cpu, BusyLoopShowsLoad) {
   EXPECT_GT(pct, 10.0);
   EXPECT_LT(pct, 250.0);
 }
+
+// The window optimizer releases poses in bursts (a keyframe with the non-keyframes before it): at 10 Hz,
+// 3 poses every 0.3 s. The rate must read 10 Hz whatever the phase, which a count over the last 1-2 s
+// did not (7-13 Hz), nor may the first burst read as a spike.
+TEST(RateMeter, BurstsReadTheirMeanRateAtEveryPhase) {
+  for (double phase = 0; phase < 0.3; phase += 0.01) {
+    RateMeter r;
+    double t = 0;
+    for (int burst = 0; burst < 40; ++burst, t += 0.3)
+      for (int k = 0; k < 3; ++k) r.add(t + 1e-4 * k);
+    const double now = t - 0.3 + phase;
+    EXPECT_NEAR(r.rate_hz(now), 10.0, 0.45) << "phase " << phase;
+  }
+}
+
+TEST(RateMeter, SteadyStreamStalledStreamAndTooFew) {
+  RateMeter r(5.0);
+  EXPECT_EQ(r.rate_hz(0.0), 0.0);
+  for (int i = 0; i <= 100; ++i) r.add(0.1 * i);   // 10 Hz for 10 s
+  EXPECT_NEAR(r.rate_hz(10.05), 10.0, 1e-6);
+  const double stalled_1s = r.rate_hz(11.0);          // idle 1 s: reads lower than 10
+  EXPECT_LT(stalled_1s, 9.0);
+  EXPECT_GT(stalled_1s, 5.0);
+  EXPECT_EQ(r.rate_hz(15.1), 0.0);                   // every arrival left the window
+  r.add(20.0);
+  EXPECT_EQ(r.rate_hz(20.0), 0.0);                   // one arrival: no rate yet
+  r.add(20.0005);
+  r.add(20.001);
+  EXPECT_LE(r.rate_hz(20.002), 2.0);                 // a first burst is not a 2000 Hz stream
+}

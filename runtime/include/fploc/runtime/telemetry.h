@@ -21,11 +21,29 @@ class LatencyWindow {
   std::vector<double> samples_;
 };
 
+// Message rate over a sliding window, from the arrivals in it: (n - 1) / (newest - oldest). Counting the
+// arrivals of the last period instead jumps with bursts: the window optimizer releases the poses of
+// non-keyframes together with the next keyframe (3-4 poses every 0.3 s at 10 Hz), which a 1-2 s count
+// read as 7-13 Hz. A stream that stops reads lower with every idle interval and 0 once it left the window.
+class RateMeter {
+ public:
+  RateMeter() = default;
+  explicit RateMeter(double window_s) : window_s_(window_s) {}
+  void add(double t_s);
+  double rate_hz(double now_s);
+
+ private:
+  void forget_before(double t_s);
+  double window_s_ = 5.0;
+  std::deque<double> times_;
+};
+
 struct PortCounters {
   std::string port, channel;
   bool output = false;
   int64_t messages = 0;        // since start
   int64_t period_messages = 0; // since the last heartbeat
+  RateMeter rate;              // messages per second (node_status_t port rate_hz)
   int64_t dropped = 0;
   int64_t undecodable = 0;
   int64_t last_seq = -1;
