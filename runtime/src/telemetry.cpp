@@ -54,8 +54,9 @@ double RateMeter::rate_hz(double now_s) {
   const double n = double(times_.size() - 1);
   // At least 1 s (or the whole window if shorter): the first burst of a stream is not a rate.
   double span = std::max(times_.back() - times_.front(), std::min(window_s_, 1.0));
-  // Idle for longer than five mean intervals (at least 0.5 s): the stream stalled; count the idle time.
-  if (now_s - times_.back() > std::max(0.5, 5.0 * span / n)) span = now_s - times_.front();
+  // Idle for longer than five mean intervals and 1.5 s (a standing robot's final poses come once a second,
+  // with its keyframes): the stream stalled; count the idle time.
+  if (now_s - times_.back() > std::max(1.5, 5.0 * span / n)) span = now_s - times_.front();
   return span > 0 ? n / span : 0.0;
 }
 

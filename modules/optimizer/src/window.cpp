@@ -182,8 +182,10 @@ PoseOut WindowOptimizer::add(FrameInput in, std::vector<PoseOut>* finals) {
   if (key && have_last_key_) {
     const double d = std::hypot(fr.in.sfr.x - last_key_sfr_.x, fr.in.sfr.y - last_key_sfr_.y);
     const double a = std::abs(wrap_angle(fr.in.sfr.yaw - last_key_sfr_.yaw));
-    key = d >= cfg_.keyframe_distance_m || a >= cfg_.keyframe_angle_rad;
-    if (key && (t - last_key_utime_) * 1e-6 > cfg_.max_keyframe_gap_s) {
+    const double since_key_s = (t - last_key_utime_) * 1e-6;
+    key = d >= cfg_.keyframe_distance_m || a >= cfg_.keyframe_angle_rad ||
+          (cfg_.keyframe_interval_s > 0 && since_key_s >= cfg_.keyframe_interval_s - 1e-6);
+    if (key && since_key_s > cfg_.max_keyframe_gap_s) {
       flush(finals);  // a long gap: the velocities across it mean nothing
       finals_.clear();
     }

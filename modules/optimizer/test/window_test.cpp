@@ -123,20 +123,36 @@ TEST(WindowOptimizer, RegularisationSmoothsANoisySequence) {
   EXPECT_LT(e_wo, rms_err(pl, run.truth));
 }
 
-TEST(WindowOptimizer, StationarySensorMakesOneKeyframe) {
+TEST(WindowOptimizer, StationarySensorMakesAKeyframePerIntervalSoItsPosesKeepComing) {
+  // A robot standing still for 6 s: without a time rule its frames wait for a keyframe that never comes
+  // (no final pose until it moves); with keyframe_interval_s every second is a keyframe, and with a window
+  // of 3 the poses up to 2 s are final while it still stands at 5.9 s.
   auto map = matcher::make_localization_map(room_with_pillars(), "brute-force");
-  WindowOptimizer opt(*map.lookup, OptimizerConfig{});
-  std::vector<PoseOut> finals;
-  int keys = 0;
-  for (int k = 0; k < 20; ++k) {
-    FrameInput in;
-    in.features = synth_frame(*map.plan, {8, 3, 0.5}, SynthOptions{}, k * 100000);
-    in.sfr = {8, 3, 0.5};
-    keys += opt.add(in, &finals).keyframe;
+  for (const double interval : {0.0, 1.0}) {
+    OptimizerConfig cfg;
+    cfg.window = 3;
+    cfg.keyframe_interval_s = interval;
+    WindowOptimizer opt(*map.lookup, cfg);
+    std::vector<PoseOut> finals;
+    int keys = 0;
+    for (int k = 0; k < 60; ++k) {
+      FrameInput in;
+      in.features = synth_frame(*map.plan, {8, 3, 0.5}, SynthOptions{}, k * 100000);
+      in.sfr = {8, 3, 0.5};
+      keys += opt.add(in, &finals).keyframe;
+    }
+    const size_t before_flush = finals.size();
+    opt.flush(&finals);
+    EXPECT_EQ(finals.size(), 60u);
+    for (const auto& f : finals) EXPECT_NEAR(std::hypot(f.pose.x - 8, f.pose.y - 3), 0.0, 1e-3);
+    if (interval == 0) {
+      EXPECT_EQ(keys, 1);
+      EXPECT_EQ(before_flush, 0u);
+    } else {
+      EXPECT_EQ(keys, 6);                  // t = 0, 1, ..., 5 s
+      EXPECT_EQ(before_flush, 21u);        // keys at 0, 1, 2 s left the window of 3, and the frames up to the last
+    }
   }
-  opt.flush(&finals);
-  EXPECT_EQ(keys, 1);
-  EXPECT_EQ(finals.size(), 20u);
 }
 
 TEST(WindowOptimizer, PoorFramesAreNeverKeyframes) {

@@ -24,7 +24,7 @@ class LatencyWindow {
 // Message rate over a sliding window, from the arrivals in it: (n - 1) / (newest - oldest). Counting the
 // arrivals of the last period instead jumps with bursts: the window optimizer releases the poses of
 // non-keyframes together with the next keyframe (3-4 poses every 0.3 s at 10 Hz), which a 1-2 s count
-// read as 7-13 Hz. A stream that stops reads lower with every idle interval and 0 once it left the window.
+// read as 7-13 Hz. A stream idle for over 1.5 s reads lower as the idle time grows, 0 once it left the window.
 class RateMeter {
  public:
   RateMeter() = default;

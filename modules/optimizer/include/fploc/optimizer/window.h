@@ -46,6 +46,8 @@ struct OptimizerConfig {
   double relook_rad = 0.2 * M_PI / 180;  // ... or turned this much since the last look-up
   bool anchor_final = false;           // also regularise against the last two final key poses (held fixed)
   double max_keyframe_gap_s = 2.0;     // a longer gap (e.g. lost frames) restarts the window
+  double keyframe_interval_s = 1.0;    // also a keyframe when the last is this old, so a standing robot's
+                                       // final poses keep coming (they wait for keys); 0 = distance/angle only
   std::string linear_solver = "sparse";  // "sparse" (SPARSE_NORMAL_CHOLESKY) or "dense" (DENSE_NORMAL_CHOLESKY)
   // Each keyframe's floor-plan term in the compact square-root form (matcher::add_frame_term): the same
   // steps, 4 residuals per keyframe instead of one per point (then the dense solver is the cheaper one).
