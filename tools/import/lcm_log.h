@@ -10,14 +10,15 @@
 // recording's bytes is the kernel's into the log's page cache. close() (also on a bad input, where
 // the importer stops) writes everything before it.
 //
-// Direct I/O (open(path, true)): the log is written with O_DIRECT from 4 KiB-aligned 4 MiB buffers, at
+// Direct I/O (open(path, true)): the log is written with O_DIRECT from 4 KiB-aligned 16 MiB buffers, at
 // 4 KiB-aligned file offsets, so it never enters the page cache: no page-cache folios to allocate, fill
 // and write back later (on this VM: 0.21-0.26 s of system time per GB, about all of `cat`'s CPU for
 // the same GB, docs/notes/import.md). Payloads are copied into the buffer (no writev from the mapped
 // recording: O_DIRECT wants aligned memory); the bytes past the last aligned offset of a full buffer
 // move to the start of the next one; the last < 4 KiB of the log are written without O_DIRECT at
-// close(). Where the file system refuses O_DIRECT (open or first write: EINVAL), the same bytes go
-// through the page cache instead: the file is the same either way.
+// close(). Where the file system refuses O_DIRECT (open or a write: EINVAL), the same bytes go
+// through the page cache instead: the file is the same either way. Less CPU (no page cache to fill),
+// but the import then waits for the disk: an option (`fploc import --direct-io`), not the default.
 #pragma once
 #include <lcm/eventlog.h>
 
