@@ -1,5 +1,5 @@
 // fploc bench import [--size-mb 1024] [--kind ouster|cloud|laser|all] [--format bag|mcap]
-//                    [--compression none|lz4|bz2|zstd] [--runs 3] [--json] [--keep DIR] [--baseline-importer EXE]
+//                    [--compression none|lz4|bz2|zstd] [--runs 3] [--json] [--keep DIR] [--baseline-importer EXE] [--direct-io]
 // Import speed as a ratio against `cat` of the same file, timed in the same run (target: <= 2x).
 // Writes a large bag into a temp dir (deleted afterwards), by content:
 //   ouster: the ouster_ros bag's packets (../shared/data/ouster/512x10_raw.bag; OS-0-128, 512x10,
@@ -212,6 +212,8 @@ int main(int argc, char** argv) {
   app.add_option("--baseline-importer", baseline,
                  "another fploc-import binary (e.g. main's) timed in the same runs (kinds '... [baseline]'); the first "
                  "run's logs of the two are compared byte for byte (same_bytes_as_baseline)");
+  bool direct_io = false;
+  app.add_flag("--direct-io", direct_io, "this build's importer writes with --direct-io (the baseline importer without it)");
   CLI11_PARSE(app, argc, argv);
   const std::string root = std::getenv("FPLOC_ROOT") ? std::getenv("FPLOC_ROOT") : ".";
   const std::string shared = std::getenv("FPLOC_SHARED_DIR") ? std::string(std::getenv("FPLOC_SHARED_DIR")) : root + "/../shared";
@@ -322,7 +324,8 @@ int main(int argc, char** argv) {
         fs::remove(copy);
       }
       for (const auto& [name, flag, exe] : variants) {
-        imp_s[name].push_back(run("'" + exe + "' '" + bag + "' --out '" + lcm + "' --quiet" + flag + " > /dev/null"));
+        const std::string extra = exe == baseline ? "" : (direct_io ? " --direct-io" : "");
+        imp_s[name].push_back(run("'" + exe + "' '" + bag + "' --out '" + lcm + "' --quiet" + flag + extra + " > /dev/null"));
         imp_cpu[name].push_back(last_cpu);
         lcm_bytes[name] = fs::file_size(lcm);
         const std::string kept = (dir / (k + flag.substr(flag.empty() ? 0 : 1) + ".first.lcm")).string();
@@ -340,7 +343,8 @@ int main(int argc, char** argv) {
       cat_cold_s.push_back(run("cat '" + bag + "' > /dev/null"));
       for (const auto& [name, flag, exe] : variants) {
         evict(bag);
-        imp_cold_s[name].push_back(run("'" + exe + "' '" + bag + "' --out '" + lcm + "' --quiet" + flag + " > /dev/null"));
+        const std::string extra = exe == baseline ? "" : (direct_io ? " --direct-io" : "");
+        imp_cold_s[name].push_back(run("'" + exe + "' '" + bag + "' --out '" + lcm + "' --quiet" + flag + extra + " > /dev/null"));
         fs::remove(lcm);
       }
     }
@@ -353,6 +357,7 @@ int main(int argc, char** argv) {
                           {"import_MBps", bytes / 1e6 / t_import}, {"cold_cat_s", t_cat_cold}, {"cold_import_s", t_import_cold},
                           {"cold_ratio_vs_cat", t_import_cold / t_cat_cold}, {"cat_cpu_s", cpu_cat}, {"import_cpu_s", cpu_import},
                           {"import_runs_s", imp_s[name]}, {"cat_runs_s", cat_s}};
+      if (exe != baseline && direct_io) j["direct_io"] = true;
       if (!baseline.empty()) {
         j["importer"] = exe;
         if (same_bytes.count(name)) j["same_bytes_as_baseline"] = same_bytes[name];

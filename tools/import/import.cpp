@@ -99,6 +99,10 @@ int main(int argc, char** argv) {
   app.add_option("--tf-child", tf_child, "with --tum-out: the tf child frame (e.g. base_link)");
   app.add_option("--odom-topic", odom_topic, "with --tum-out: the nav_msgs/Odometry topic (default: the first one)");
   app.add_flag("--quiet", quiet, "no progress on stderr");
+  bool direct_io = false;
+  app.add_flag("--direct-io", direct_io,
+               "write the log with O_DIRECT (not through the page cache; the same bytes; the page cache where the file "
+               "system refuses it)");
   CLI11_PARSE(app, argc, argv);
   if (!list && out.empty() && tum_out.empty()) {
     std::cerr << "fploc import: give --list, --out LOG.lcm or --tum-out FILE\n";
@@ -201,7 +205,7 @@ int main(int argc, char** argv) {
   };
 
   LcmLog lcm_log;
-  if (!out.empty() && !lcm_log.open(out)) {
+  if (!out.empty() && !lcm_log.open(out, direct_io)) {
     std::cerr << "fploc import: cannot write " << out << "\n";
     return 1;
   }
@@ -397,6 +401,7 @@ int main(int argc, char** argv) {
   ouster.flush(frames);
   emit_frames(m.time_ns);
   if (!quiet && std::chrono::steady_clock::now() - t_start > std::chrono::seconds(1)) std::fprintf(stderr, "\n");
+  const bool log_direct = lcm_log.direct();
   const bool log_ok = lcm_log.close();
   tum.close();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
@@ -447,6 +452,7 @@ int main(int argc, char** argv) {
     j["channels"] = topic_channel;
     j["seconds"] = wall;
     j["events"] = lcm_log.events();
+    j["direct_io"] = log_direct;
     j["replay_graph"] = replay_graph;
     if (raw.has_metadata() && raw.lidar_packets + raw.imu_packets > 0)
       j["ouster"] = {{"mode", "packets"}, {"sensor", raw.sensor}, {"pixels_per_column", raw.pixels_per_column},

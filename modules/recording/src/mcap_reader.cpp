@@ -6,6 +6,7 @@
 // uncompressed records, and Data End's data_section_crc over every byte before the Data End record
 // (leading magic included). A mismatch is one error naming the chunk's / record's byte offset.
 #include <isa-l/crc.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -92,6 +93,12 @@ bool parse_chunk(const uint8_t* body, uint64_t len, ChunkHeader& h) {
 }
 
 }  // namespace
+
+void McapReader::crc_upto(size_t to) {
+  if (!kCheckCrc || to <= crc_at_) return;
+  data_crc_ = crc32_gzip_refl(data_crc_, f_->data() + crc_at_, to - crc_at_);
+  crc_at_ = to;
+}
 
 void McapReader::prefetch_after(size_t pos) {
   if (ahead_.pending()) return;
@@ -183,6 +190,7 @@ bool McapReader::next(RawMessage& m) {
     if (len > size_ - pos_ - 9) return stop("record (opcode " + std::to_string(op) + ") at byte " + std::to_string(at) + ": length " + std::to_string(len) + " runs past the end (file truncated?)");
     pos_ += 9 + len;
     const uint8_t* body = d + at + 9;
+    if (op != 0x06 && op != 0x0F) crc_upto(pos_);
     if (op == 0x02) {  // Footer: then the closing magic
       if (size_ - pos_ < 8 || std::memcmp(d + pos_, kMagic, 8) != 0) return stop("footer at byte " + std::to_string(at) + " is not followed by the MCAP magic");
       pos_ = size_;
@@ -194,7 +202,8 @@ bool McapReader::next(RawMessage& m) {
       const uint32_t crc = b.get<uint32_t>();
       if (!b.ok) return stop("data end record at byte " + std::to_string(at) + ": cut short");
       if (kCheckCrc && crc != 0) {
-        const uint32_t got = crc32_of(d, at);
+        crc_upto(at);
+        const uint32_t got = data_crc_;
         if (got != crc)
           return stop("data section (bytes 0.." + std::to_string(at) + "): CRC-32 " + hex32(got) + " != " + hex32(crc) +
                       " recorded in the data end record at byte " + std::to_string(at) + " (file damaged)");
@@ -211,6 +220,12 @@ bool McapReader::next(RawMessage& m) {
         if (h.usize != h.rlen) return stop(chunk_what_ + ": uncompressed size " + std::to_string(h.usize) + " != records length " + std::to_string(h.rlen));
         cd_ = h.records;
         cn_ = h.rlen;
+        if (kCheckCrc) {  // the records' CRC once, for the chunk and (combined) for the data section
+          crc_upto(size_t(h.records - d));
+          got = crc32_of(cd_, cn_), crc_known = true;
+          data_crc_ = uint32_t(crc32_combine(data_crc_, got, z_off_t(cn_)));
+          crc_at_ += cn_;
+        }
       } else {
         std::string e;
         ChunkAhead::Result res;
@@ -233,6 +248,7 @@ bool McapReader::next(RawMessage& m) {
                       ", the chunk says " + hex32(h.crc) + " (chunk damaged)");
         }
       }
+      crc_upto(pos_);
       cpos_ = 0;
       chunk_at_ = at;
       continue;

@@ -97,6 +97,11 @@ class McapReader : public FileReader {
 
  private:
   void prefetch_after(size_t pos);  // starts on the next compressed chunk after pos, if any
+  // The data section's CRC-32, kept up to byte crc_at_ as the records go by (an uncompressed chunk's
+  // records are read once for both CRCs: zlib's crc32_combine), so Data End needs no second pass.
+  void crc_upto(size_t to);
+  uint32_t data_crc_ = 0;
+  size_t crc_at_ = 0;
   ChunkAhead ahead_;
   // One record's content (opcode and body); false with *why on a bad record.
   bool on_record(uint8_t op, const uint8_t* b, size_t n, RawMessage* m, bool* is_message, std::string* why);

@@ -1,7 +1,7 @@
 // MCAP files written by McapWriter (none/zstd/lz4 chunks, CRCs) read back: every message, in order; a
 // damaged later chunk (decompressed ahead on the second thread while the earlier ones are read) and a
 // chunk whose recorded CRC does not match give the one sequential error naming that chunk, after exactly
-// the messages of the chunks before it.
+// the messages of the chunks before it; a byte outside every chunk's records fails the data section's CRC.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -49,6 +49,16 @@ TEST(McapWritten, ManyChunksReadAheadAndDamage) {
     auto before = read_all(badcrc.data(), badcrc.size(), &err, "crc.mcap");
     EXPECT_EQ(err.find("crc.mcap: " + third + ": CRC-32 of the"), 0u) << err;
     EXPECT_EQ(before.size(), upto2.size()) << comp;
+
+    // A byte that no chunk CRC covers (the third chunk's message_start_time) damaged: every message is
+    // read, then the data section's CRC (kept as the records go by, an uncompressed chunk's records
+    // combined from its own CRC) names the Data End record.
+    auto badhdr = bytes;
+    badhdr[chunks[2].first + 9] ^= 0x10;
+    const auto all = read_all(badhdr.data(), badhdr.size(), &err, "hdr.mcap");
+    EXPECT_EQ(err.find("hdr.mcap: data section (bytes 0.."), 0u) << comp << ": " << err;
+    EXPECT_NE(err.find("(file damaged)"), std::string::npos) << err;
+    EXPECT_EQ(all.size(), msgs.size()) << comp;
 
     if (comp == "none") continue;
     // Its compressed bytes damaged: the decompressor or the CRC catches it, naming that chunk.
