@@ -165,6 +165,7 @@ bool Segmenter::prepare(const Scan& scan) {
   // (most of a ring). The arithmetic is the same per point as the scalar pass.
   bool identity = W % 4 == 0;
   for (int c = 0; c < W && identity; ++c) identity = col_mid_[c] == c;
+  col_identity_ = identity && int(lut_soa_[0].size()) == W * H;
   if (identity) {
     col_okm_.resize(W);
     for (int c = 0; c < W; ++c) col_okm_[c] = col_ok_[c] ? -1 : 0;
@@ -268,7 +269,8 @@ bool Segmenter::prepare(const Scan& scan) {
   auto ring_pass = [&](int u, Candidates& cs) { wide8 ? ring_pass8w(u, cs) : identity ? ring_pass4(u, cs) : ring_pass1(u, cs); };
   const int half = H / 2;
   for (auto [cs, rings] : {std::pair{&upper_, half}, std::pair{&lower_, half}, std::pair{&middle_, H % 2}}) {
-    const size_t cap = size_t(rings) * W + Candidates::kLanes;
+    // (+ 8: wall selection's eight-lane loops read up to 7 entries past a ring's end)
+    const size_t cap = size_t(rings) * W + 2 * Candidates::kLanes;
     for (auto* v : {&cs->x, &cs->y, &cs->z, &cs->range}) v->resize(cap);
     cs->pixel.resize(cap);
     cs->p.clear();
