@@ -243,8 +243,10 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     if (double(cutf) < cut) cutf = std::nextafter(cutf, std::numeric_limits<float>::infinity());
     scratch_.resize(src->padded());
     int inside = 0;
+    // The last iteration's scale as the guess of the bin (the result does not depend on it).
+    const int hint = last_sigma > 0 ? int(std::min(double(k::kScaleBins), last_sigma / k::kMadToSigma * inv_binf)) : -1;
     const int bin = kern::residual_scale(src->x.data(), src->y.data(), src->z.data(), src->padded(), plf, inv_binf, cutf,
-                                         scratch_.data(), inside);
+                                         scratch_.data(), inside, hint);
     if (inside < 3) return std::nullopt;
     const double sigma = k::kMadToSigma * (bin + 0.5) / inv_binf;
     last_sigma = sigma;
