@@ -41,6 +41,15 @@ __attribute__((target("avx2"))) inline v8f ld(const float* p) {
   return v;
 }
 __attribute__((target("avx2"))) inline void st(float* p, v8f v) { std::memcpy(p, &v, sizeof v); }
+// src[0], src[3], ..., src[21] (perm: 0, 3, 6, 1, 4, 7, 2, 5).
+__attribute__((target("avx2"))) inline v8f every3(const float* p, __m256i perm) {
+  __m256 a, b, c;
+  std::memcpy(&a, p, sizeof a);
+  std::memcpy(&b, p + 8, sizeof b);
+  std::memcpy(&c, p + 16, sizeof c);
+  const __m256 t = _mm256_blend_ps(_mm256_blend_ps(a, b, 0x92), c, 0x24);
+  return reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(t, perm));
+}
 __attribute__((target("avx2"))) inline v8f splat(float a) { return v8f{a, a, a, a, a, a, a, a}; }
 }  // namespace
 
@@ -92,7 +101,14 @@ __attribute__((target("avx2"))) size_t band(const float* x, const float* y, cons
 __attribute__((target("avx2"))) void strided(const float* x, const float* y, const float* z, size_t m, size_t stride,
                                              float* ox, float* oy, float* oz) {
   size_t j = 0;
-  if (stride < (size_t(1) << 27)) {
+  if (stride == 3) {  // the reference sensor's support subsample: three loads, two blends, one permutation per 8
+    const __m256i perm = _mm256_setr_epi32(0, 3, 6, 1, 4, 7, 2, 5);
+    for (; j + 8 <= m && (j + 8) * 3 <= 3 * m - 2; j += 8) {  // reads src[3j .. 3j + 23] (all before 3(m-1)+1)
+      st(ox + j, every3(x + 3 * j, perm));
+      st(oy + j, every3(y + 3 * j, perm));
+      st(oz + j, every3(z + 3 * j, perm));
+    }
+  } else if (stride < (size_t(1) << 27)) {
     const int s = int(stride);
     const __m256i idx = _mm256_setr_epi32(0, s, 2 * s, 3 * s, 4 * s, 5 * s, 6 * s, 7 * s);
     for (; j + 8 <= m; j += 8) {
