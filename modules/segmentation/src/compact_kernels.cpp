@@ -56,8 +56,7 @@ __attribute__((target("avx2"))) inline v8f splat(float a) { return v8f{a, a, a, 
 bool available() { return true; }
 
 __attribute__((target("avx2"))) size_t band(const float* x, const float* y, const float* z, size_t n, size_t np,
-                                            const float pl[4], float cut, const float ref[3], int lanes, float* bx,
-                                            float* by, float* bz) {
+                                            const float pl[4], float cut, const float ref[3], float* bx, float* by, float* bz) {
   const v8f nx = splat(pl[0]), ny = splat(pl[1]), nz = splat(pl[2]), d = splat(pl[3]), cb = splat(cut);
   const v8f rx = splat(ref[0]), ry = splat(ref[1]), rz = splat(ref[2]);
   const v8i absm = {0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff};
@@ -79,7 +78,6 @@ __attribute__((target("avx2"))) size_t band(const float* x, const float* y, cons
     const v8f a = reinterpret_cast<v8f>(reinterpret_cast<v8i>(r) & absm);
     int in = _mm256_movemask_ps(reinterpret_cast<__m256>(a < cb));
     if (n - i < 8) in &= (1 << (n - i)) - 1;
-    in &= lanes;
     if (in == 0) continue;
     const v8f qx = px - rx, qy = py - ry, qz = pz - rz;
     if (in == 255) {
@@ -126,7 +124,7 @@ __attribute__((target("avx2"))) void strided(const float* x, const float* y, con
 }
 #else
 bool available() { return false; }
-size_t band(const float*, const float*, const float*, size_t, size_t, const float*, float, const float*, int, float*, float*, float*) {
+size_t band(const float*, const float*, const float*, size_t, size_t, const float*, float, const float*, float*, float*, float*) {
   return 0;
 }
 void strided(const float*, const float*, const float*, size_t, size_t, float*, float*, float*) {}

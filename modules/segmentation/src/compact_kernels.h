@@ -12,10 +12,9 @@ bool available();
 
 // The points i < n with |((nx x + ny y) + nz z) + d| < cut (float), minus ref, written to bx/by/bz in order;
 // returns their count. Reads the arrays up to np (n rounded up to a multiple of 4; the values past n are
-// ignored); writes up to 7 slots past the count. lanes: the lanes of each group of eight (points i % 8) that
-// may be taken (0xff all, 0x55 every second point).
+// ignored); writes up to 7 slots past the count.
 size_t band(const float* x, const float* y, const float* z, size_t n, size_t np, const float pl[4], float cut, const float ref[3],
-            int lanes, float* bx, float* by, float* bz);
+            float* bx, float* by, float* bz);
 
 // dst[j] = src[j * stride] for j < m (the three arrays).
 void strided(const float* x, const float* y, const float* z, size_t m, size_t stride, float* ox, float* oy, float* oz);

@@ -182,8 +182,8 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
   const Eigen::Vector3f reff = ref.cast<float>();
   double cut = first_cut;
   {
-    // The band's points (every kBandStride-th candidate) relative to ref, contiguous float arrays (streamed by
-    // every iteration); compacted without a branch (about one point in five is in the band, a branch on it mispredicted often).
+    // The band's points relative to ref, contiguous float arrays (streamed by every iteration); compacted
+    // without a branch (about one point in five is in the band, a branch on it mispredicted often).
     const v4f nx = splat(float(cur[0])), ny = splat(float(cur[1])), nz = splat(float(cur[2])), d = splat(float(cur[3]));
     const v4f cb = splat(float(cut));
     band_.resize(np_ + 8);  // (+ 8: the eight-lane compaction writes up to 7 slots past the count)
@@ -193,12 +193,11 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     if (wide) {
       const float plf[4] = {float(cur[0]), float(cur[1]), float(cur[2]), float(cur[3])};
       const float r3[3] = {reff.x(), reff.y(), reff.z()};
-      m = ck::band(xs_, ys_, zs_, n_, np_, plf, float(cut), r3, k::kBandStride == 2 ? 0x55 : 0xff, bx, by, bz);
+      m = ck::band(xs_, ys_, zs_, n_, np_, plf, float(cut), r3, bx, by, bz);
     }
     for (size_t i = 0; i < np_ && !wide; i += 4) {
       const v4f x = load(xs_ + i), y = load(ys_ + i), z = load(zs_ + i);
-      static_assert(k::kBandStride == 1 || k::kBandStride == 2);
-      const int in = movemask(abs(nx * x + ny * y + nz * z + d) < cb) & (k::kBandStride == 2 ? 0x5 : 0xf);  // NaN padding: false
+      const int in = movemask(abs(nx * x + ny * y + nz * z + d) < cb);  // NaN padding: false
       if (in == 0) continue;  // the band is a few contiguous runs per ring: mostly all or none of four
       const v4f qx = x - splat(reff.x()), qy = y - splat(reff.y()), qz = z - splat(reff.z());
       if (in == 15) {

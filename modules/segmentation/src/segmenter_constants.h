@@ -38,9 +38,6 @@ constexpr int kScaleBins = 256;             // histogram of |r| for the robust s
 constexpr double kTukeyC = 4.685;           // Tukey biweight cut-off in robust sigmas (95 % efficiency)
 constexpr double kMinCutM = 0.02;           // the shrinking cut-off stops here [m]
 constexpr size_t kShrinkSubsample = 3;      // while the cut-off shrinks, every 3rd band point
-// The IRLS band takes every kBandStride-th candidate (1 or 2): half the refinement work for a 1/sqrt(2) larger
-// noise of a plane fitted to ~6k ceiling returns (issue 14 item 7; the acceptance counts use every candidate).
-constexpr int kBandStride = 2;
 constexpr double kConvergedNormal = 1e-5;   // IRLS converged: normal change (0.0006 deg)
 constexpr double kConvergedDistM = 1e-4;    // and distance change (0.1 mm)
 constexpr double kSelectBandSigmas = 3.0;   // choosing between refinements: soft band at 3 robust sigmas
