@@ -29,6 +29,13 @@ __attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const i
   typedef float v8f __attribute__((vector_size(32)));
   typedef int32_t v8i __attribute__((vector_size(32)));
 #define FPLOC_LD(p) ({ v8f v_; std::memcpy(&v_, (p), sizeof v_); v_; })
+  // The table's rows in registers (restrict: the candidate stores cannot change them).
+  const float* __restrict l0 = lut[0];
+  const float* __restrict l1 = lut[1];
+  const float* __restrict l2 = lut[2];
+  const float* __restrict l3 = lut[3];
+  const float* __restrict l4 = lut[4];
+  const float* __restrict l5 = lut[5];
   const v8i lov = {lo, lo, lo, lo, lo, lo, lo, lo}, hiv = {hi, hi, hi, hi, hi, hi, hi, hi};
   const v8f mm = {1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f};
   for (int c = 0; c < W; c += 8) {
@@ -43,10 +50,10 @@ __attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const i
     const int in = __builtin_ia32_movmskps256(reinterpret_cast<v8f>(inm));
     if (in == 0) continue;
     const v8f fr = __builtin_convertvector(ri, v8f);
-    v8f x = FPLOC_LD(lut[0] + c) * fr + FPLOC_LD(lut[3] + c), y = FPLOC_LD(lut[1] + c) * fr + FPLOC_LD(lut[4] + c),
+    v8f x = FPLOC_LD(l0 + c) * fr + FPLOC_LD(l3 + c), y = FPLOC_LD(l1 + c) * fr + FPLOC_LD(l4 + c),
         z = kZRow ? v8f{zr[0], zr[0], zr[0], zr[0], zr[0], zr[0], zr[0], zr[0]} * fr +
                         v8f{zr[1], zr[1], zr[1], zr[1], zr[1], zr[1], zr[1], zr[1]}
-                  : FPLOC_LD(lut[2] + c) * fr + FPLOC_LD(lut[5] + c);
+                  : FPLOC_LD(l2 + c) * fr + FPLOC_LD(l5 + c);
     if (rot) {
       const v8f X = FPLOC_LD(rot[0] + c) * x + FPLOC_LD(rot[1] + c) * y + FPLOC_LD(rot[2] + c) * z;
       const v8f Y = FPLOC_LD(rot[3] + c) * x + FPLOC_LD(rot[4] + c) * y + FPLOC_LD(rot[5] + c) * z;

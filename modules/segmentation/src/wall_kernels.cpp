@@ -73,8 +73,19 @@ __attribute__((target("avx2"))) size_t masks8(const float* x, const float* y, co
 __attribute__((target("avx2"))) size_t copy8(const Source& s, int32_t a, int32_t b, int32_t row, int32_t off, int16_t u,
                                              const uint8_t* masks, const float* col_dt, const Measured* meas,
                                              const Out& out, size_t o) {
-  float *ox = out.x, *oy = out.y, *oz = out.z, *orng = out.range, *ot = out.t;
-  int16_t *oring = out.ring, *ocol = out.col;
+  // Every pointer in a register (restrict: the stores cannot change them, no reloads after each store).
+  float* __restrict ox = out.x;
+  float* __restrict oy = out.y;
+  float* __restrict oz = out.z;
+  float* __restrict orng = out.range;
+  float* __restrict ot = out.t;
+  int16_t* __restrict oring = out.ring;
+  int16_t* __restrict ocol = out.col;
+  const float* __restrict sx = s.x;
+  const float* __restrict sy = s.y;
+  const float* __restrict sz = s.z;
+  const float* __restrict srange = s.range;
+  const int32_t* __restrict spixel = s.pixel;
   const __m128i rings = _mm_set1_epi16(u);
   const __m256i shifts = _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28);
   const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
@@ -83,9 +94,9 @@ __attribute__((target("avx2"))) size_t copy8(const Source& s, int32_t a, int32_t
   for (int32_t j = a; j < b; j += 8) {
     const int mk = masks[g++];
     if (mk == 0) continue;
-    const int32_t pix0 = s.pixel[j];
+    const int32_t pix0 = spixel[j];
     _mm_storeu_si128(reinterpret_cast<__m128i*>(oring + o), rings);
-    if (mk == 255 && s.pixel[j + 7] == pix0 + 7) {  // eight neighbouring columns: blocks
+    if (mk == 255 && spixel[j + 7] == pix0 + 7) {  // eight neighbouring columns: blocks
       if (meas) {
         __m256i ri;
         std::memcpy(&ri, meas->range_mm + pix0, sizeof ri);
@@ -94,11 +105,11 @@ __attribute__((target("avx2"))) size_t copy8(const Source& s, int32_t a, int32_t
         st(oy + o, ld(meas->lut[1] + pix0) * fr + ld(meas->lut[4] + pix0));
         st(oz + o, ld(meas->lut[2] + pix0) * fr + ld(meas->lut[5] + pix0));
       } else {
-        st(ox + o, ld(s.x + j));
-        st(oy + o, ld(s.y + j));
-        st(oz + o, ld(s.z + j));
+        st(ox + o, ld(sx + j));
+        st(oy + o, ld(sy + j));
+        st(oz + o, ld(sz + j));
       }
-      st(orng + o, ld(s.range + j));
+      st(orng + o, ld(srange + j));
       st(ot + o, ld(col_dt + (pix0 - row)));
       _mm_storeu_si128(reinterpret_cast<__m128i*>(ocol + o), _mm_add_epi16(_mm_set1_epi16(int16_t(pix0 + off)), iota16));
       o += 8;
@@ -107,7 +118,7 @@ __attribute__((target("avx2"))) size_t copy8(const Source& s, int32_t a, int32_t
     // Compress the set lanes to the front (the slots after them are overwritten by the next group).
     const __m256i idx = _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int(kCompress.e[mk])), shifts), _mm256_set1_epi32(15));
     __m256i pix;
-    std::memcpy(&pix, s.pixel + j, sizeof pix);
+    std::memcpy(&pix, spixel + j, sizeof pix);
     pix = _mm256_permutevar8x32_epi32(pix, idx);
     const __m256i colv = _mm256_sub_epi32(pix, _mm256_set1_epi32(row));  // staggered column
     if (meas) {
@@ -119,11 +130,11 @@ __attribute__((target("avx2"))) size_t copy8(const Source& s, int32_t a, int32_t
       st(oz + o, g8(meas->lut[2]) * fr + g8(meas->lut[5]));
 #undef g8
     } else {
-      st(ox + o, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(ld(s.x + j)), idx)));
-      st(oy + o, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(ld(s.y + j)), idx)));
-      st(oz + o, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(ld(s.z + j)), idx)));
+      st(ox + o, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(ld(sx + j)), idx)));
+      st(oy + o, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(ld(sy + j)), idx)));
+      st(oz + o, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(ld(sz + j)), idx)));
     }
-    st(orng + o, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(ld(s.range + j)), idx)));
+    st(orng + o, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(ld(srange + j)), idx)));
     st(ot + o, reinterpret_cast<v8f>(_mm256_i32gather_ps(col_dt, colv, 4)));
     const __m256i cd = _mm256_add_epi32(pix, _mm256_set1_epi32(off));
     const __m256i packed = _mm256_packs_epi32(cd, cd);  // per 128-bit half: c0..c3 c0..c3 | c4..c7 c4..c7
