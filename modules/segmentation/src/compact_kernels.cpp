@@ -53,7 +53,11 @@ __attribute__((target("avx2"))) inline v8f every3(const float* p, __m256i perm) 
 __attribute__((target("avx2"))) inline v8f splat(float a) { return v8f{a, a, a, a, a, a, a, a}; }
 }  // namespace
 
-bool available() { return true; }
+namespace {
+bool g_enabled = true;
+}
+bool available() { return g_enabled; }
+void set_enabled(bool on) { g_enabled = on; }
 
 __attribute__((target("avx2"))) size_t band(const float* x, const float* y, const float* z, size_t n, size_t np,
                                             const float pl[4], float cut, const float ref[3], float* bx, float* by, float* bz) {
@@ -124,6 +128,7 @@ __attribute__((target("avx2"))) void strided(const float* x, const float* y, con
 }
 #else
 bool available() { return false; }
+void set_enabled(bool) {}
 size_t band(const float*, const float*, const float*, size_t, size_t, const float*, float, const float*, float*, float*, float*) {
   return 0;
 }

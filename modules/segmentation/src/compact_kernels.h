@@ -7,8 +7,11 @@
 
 namespace fploc::seg::ck {
 
-// Whether this build has the eight-lane loops (x86-64 with GCC/Clang); they run only where kern::wide().
+// Whether this build has the eight-lane loops (x86-64 with GCC/Clang) and they are not switched off; they run
+// only where kern::wide().
 bool available();
+// Tests: switch the eight-lane loops off (the four-lane ones run) or on again.
+void set_enabled(bool on);
 
 // The points i < n with |((nx x + ny y) + nz z) + d| < cut (float), minus ref, written to bx/by/bz in order;
 // returns their count. Reads the arrays up to np (n rounded up to a multiple of 4; the values past n are

@@ -46,7 +46,11 @@ __attribute__((target("avx2"))) inline v8f ld(const float* p) {
 __attribute__((target("avx2"))) inline void st(float* p, v8f v) { std::memcpy(p, &v, sizeof v); }
 }  // namespace
 
-bool available() { return true; }
+namespace {
+bool g_enabled = true;
+}
+bool available() { return g_enabled; }
+void set_enabled(bool on) { g_enabled = on; }
 
 __attribute__((target("avx2"))) size_t masks8(const float* x, const float* y, const float* z, int32_t a, int32_t b,
                                               const Bounds& bd, uint8_t* masks) {
@@ -147,6 +151,7 @@ __attribute__((target("avx2"))) size_t copy8(const Source& s, int32_t a, int32_t
 }
 #else
 bool available() { return false; }
+void set_enabled(bool) {}
 size_t masks8(const float*, const float*, const float*, int32_t, int32_t, const Bounds&, uint8_t*) { return 0; }
 size_t copy8(const Source&, int32_t, int32_t, int32_t, int32_t, int16_t, const uint8_t*, const float*, const Measured*,
              const Out&, size_t o) {

@@ -7,8 +7,11 @@
 
 namespace fploc::seg::wallk {
 
-// Whether this build has the eight-lane loops (x86-64 with GCC/Clang); they run only where kern::wide().
+// Whether this build has the eight-lane loops (x86-64 with GCC/Clang) and they are not switched off; they run
+// only where kern::wide().
 bool available();
+// Tests: switch the eight-lane loops off (the four-lane ones run) or on again.
+void set_enabled(bool on);
 
 // The two bounds: a wall point has nc.p > mdc (below the ceiling) and nf.p > mdf (above the floor), each sum
 // taken as (n.x x + n.y y) + n.z z in float.
