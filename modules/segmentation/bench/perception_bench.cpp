@@ -147,12 +147,55 @@ int profile(int n, bool with_features, bool sim) {
   return 0;
 }
 
+// --hash-all=N: every output of the segmenter over N scans of the simulated sequence, without and with the gyro
+// (de-skew), plus the synthetic scan: planes, status, roll/pitch/z and every wall array of EVERY scan (the
+// --profile hashes cover only the last scan's planes and wall x/y/z/range/t). "Optimised without changing results".
+int hash_all(int n) {
+  uint64_t h = 1469598103934665603ull;
+  auto mix = [&h](const void* p, size_t bytes) {
+    for (size_t i = 0; i < bytes; ++i) h = (h ^ static_cast<const uint8_t*>(p)[i]) * 1099511628211ull;
+  };
+  auto mix_seg = [&](const seg::Segmentation& s) {
+    mix(s.ceiling.coeffs.data(), sizeof(double) * 4);
+    mix(s.ground.coeffs.data(), sizeof(double) * 4);
+    for (const double v : {s.roll, s.pitch, s.z, s.roll_pitch_sigma, s.z_sigma, s.ceiling.rms_m, s.ground.rms_m,
+                           s.ceiling.tilt_sigma, s.ceiling.d_sigma})
+      mix(&v, sizeof v);
+    for (const int v : {int(s.status), s.ceiling.inliers, s.ceiling.beyond, s.ground.inliers, s.ground.beyond,
+                        int(s.ceiling.found), int(s.ground.found), int(s.deskewed)})
+      mix(&v, sizeof v);
+    for (const auto* v : {&s.wall.x, &s.wall.y, &s.wall.z, &s.wall.range, &s.wall.t}) mix(v->data(), v->size() * sizeof(float));
+    for (const auto* v : {&s.wall.ring, &s.wall.column}) mix(v->data(), v->size() * sizeof(int16_t));
+  };
+  size_t deskewed = 0, walls = 0;
+  for (const bool gyro : {false, true}) {
+    seg::RingSegmenter sg(seg::SegmenterConfig{});
+    for (int i = 0; i < n; ++i) {
+      const auto& f = sim_frames()[size_t(i) % sim_frames().size()];
+      if (gyro)
+        for (const auto& [t, w] : f.gyro) sg.add_gyro(w, t);
+      const auto& s = sg.process(f.scan);
+      mix_seg(s);
+      deskewed += s.deskewed;
+      walls += s.wall.size();
+    }
+  }
+  {
+    seg::RingSegmenter sg(seg::SegmenterConfig{});
+    for (int i = 0; i < 3; ++i) mix_seg(sg.process(scan().scan));
+  }
+  std::cout << "hashed 2 x " << n << " simulated scans (" << deskewed << " de-skewed, " << walls / size_t(2 * std::max(1, n))
+            << " wall points per scan) + 3 synthetic: hash " << std::hex << h << std::dec << "\n";
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (std::strncmp(argv[i], "--profile=", 10) == 0) return profile(std::atoi(argv[i] + 10), true, false);
     if (std::strncmp(argv[i], "--profile-sim=", 14) == 0) return profile(std::atoi(argv[i] + 14), true, true);
+    if (std::strncmp(argv[i], "--hash-all=", 11) == 0) return hash_all(std::atoi(argv[i] + 11));
     if (std::strncmp(argv[i], "--profile-segmenter=", 20) == 0) return profile(std::atoi(argv[i] + 20), false, false);
   }
   benchmark::Initialize(&argc, argv);

@@ -130,9 +130,39 @@ FPLOC_INLINE int count_below_t(const float* v, size_t np, float t) {
 
 // The smallest bin B with 2 count(bin <= B) >= inside, by bisection over counts of v < B + 1 (for v >= 0,
 // floor(v) <= B exactly when v < B + 1); B = kScaleBins - 1 (the clamped last bin) when no smaller one.
+// hint (>= 0): a guess of the bin (the last iteration's scale); the same bin is found from a bracket around
+// it (two counts when the guess is right) instead of from the whole range (eight counts).
 template <int L>
-FPLOC_INLINE int median_bin_t(const float* v, size_t np, int inside) {
-  int lo = 0, hi = k::kScaleBins - 1;
+FPLOC_INLINE int median_bin_t(const float* v, size_t np, int inside, int hint) {
+  // F(B): 2 count(v < B + 1) >= inside, true from the answer on (monotone); the last bin always true.
+  auto F = [&](int b) FPLOC_LAMBDA { return b >= k::kScaleBins - 1 || 2 * count_below_t<L>(v, np, float(b + 1)) >= inside; };
+  int lo = 0, hi = k::kScaleBins - 1;  // the answer lies in [lo, hi]
+  if (hint >= 0) {
+    const int h = std::min(hint, k::kScaleBins - 1);
+    if (F(h)) {  // answer <= h: find a false one below, doubling the step
+      hi = h;
+      for (int step = 1;; step *= 2) {
+        const int b = hi - step;
+        if (b < 0) break;
+        if (!F(b)) {
+          lo = b + 1;
+          break;
+        }
+        hi = b;
+      }
+    } else {  // answer > h: find a true one above
+      lo = h + 1;
+      for (int step = 1;; step *= 2) {
+        const int b = lo - 1 + step;
+        if (b >= k::kScaleBins - 1) break;
+        if (F(b)) {
+          hi = b;
+          break;
+        }
+        lo = b + 1;
+      }
+    }
+  }
   while (lo < hi) {
     const int mid = (lo + hi) / 2;
     if (2 * count_below_t<L>(v, np, float(mid + 1)) >= inside) hi = mid;
@@ -227,9 +257,9 @@ FPLOC_INLINE void inlier_moments_t(const float* x, const float* y, const float* 
 #if FPLOC_SEG_WIDE
 #define FPLOC_WIDE_TARGET __attribute__((target("avx2,fma")))
 FPLOC_WIDE_TARGET int residual_scale8(const float* x, const float* y, const float* z, size_t np, PlaneF pl,
-                                      float inv_bin, float cutf, float* v, int& inside) {
+                                      float inv_bin, float cutf, float* v, int& inside, int hint) {
   inside = residual_bins_t<8>(x, y, z, np, pl, inv_bin, cutf, v);
-  return median_bin_t<8>(v, np, inside);
+  return median_bin_t<8>(v, np, inside, hint);
 }
 FPLOC_WIDE_TARGET void tukey_moments8(const float* x, const float* y, const float* z, size_t np, PlaneF pl,
                                       float inv_c2, double S[10]) {
@@ -265,12 +295,12 @@ bool wide() { return g_wide; }
 void set_wide(bool on) { g_wide = on && default_wide(); }
 
 int residual_scale(const float* x, const float* y, const float* z, size_t np, PlaneF pl, float inv_bin, float cutf,
-                   float* v, int& inside) {
+                   float* v, int& inside, int hint) {
 #if FPLOC_SEG_WIDE
-  if (g_wide) return residual_scale8(x, y, z, np, pl, inv_bin, cutf, v, inside);
+  if (g_wide) return residual_scale8(x, y, z, np, pl, inv_bin, cutf, v, inside, hint);
 #endif
   inside = residual_bins_t<4>(x, y, z, np, pl, inv_bin, cutf, v);
-  return median_bin_t<4>(v, np, inside);
+  return median_bin_t<4>(v, np, inside, hint);
 }
 
 void tukey_moments(const float* x, const float* y, const float* z, size_t np, PlaneF pl, float inv_c2, double S[10]) {

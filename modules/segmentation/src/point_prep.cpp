@@ -19,25 +19,41 @@ namespace {
 // One scan row of the four-column pass below, eight columns at a time (AVX2, chosen at run time with the plane
 // fit's kernels: kern::wide()): the same arithmetic per point (no fused multiply-add), so the same
 // candidates. rng/okm/lut/rot point at the row's first column; returns the new candidate count.
-__attribute__((target("avx2"))) size_t ring_pass8(const uint32_t* rng, const int32_t* okm, const float* const lut[6],
-                                                  const float* const rot[9], int W, int32_t lo, int32_t hi,
-                                                  int32_t pix_row, float* cx, float* cy, float* cz, float* cr,
-                                                  int32_t* cp, size_t m) {
+// zrow: the row's z direction and offset are one value each (zr[0], zr[1]; the OS-1's, whose sensor z axis is
+// the lidar's: the same floats as the table's); okm null: every column valid.
+template <bool kZRow, bool kAllOk>
+__attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const int32_t* okm, const float* const lut[6],
+                                                    const float* zr, const float* const rot[9], int W, int32_t lo,
+                                                    int32_t hi, int32_t pix_row, float* cx, float* cy, float* cz,
+                                                    float* cr, int32_t* cp, size_t m) {
   typedef float v8f __attribute__((vector_size(32)));
   typedef int32_t v8i __attribute__((vector_size(32)));
 #define FPLOC_LD(p) ({ v8f v_; std::memcpy(&v_, (p), sizeof v_); v_; })
+  // The table's rows in registers (restrict: the candidate stores cannot change them).
+  const float* __restrict l0 = lut[0];
+  const float* __restrict l1 = lut[1];
+  const float* __restrict l2 = lut[2];
+  const float* __restrict l3 = lut[3];
+  const float* __restrict l4 = lut[4];
+  const float* __restrict l5 = lut[5];
   const v8i lov = {lo, lo, lo, lo, lo, lo, lo, lo}, hiv = {hi, hi, hi, hi, hi, hi, hi, hi};
   const v8f mm = {1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f};
   for (int c = 0; c < W; c += 8) {
-    v8i ri, ok;
+    v8i ri;
     std::memcpy(&ri, rng + c, sizeof ri);
-    std::memcpy(&ok, okm + c, sizeof ok);
-    const v8i inm = (ri >= lov) & (ri <= hiv) & ok;
+    v8i inm = (ri >= lov) & (ri <= hiv);
+    if constexpr (!kAllOk) {
+      v8i ok;
+      std::memcpy(&ok, okm + c, sizeof ok);
+      inm &= ok;
+    }
     const int in = __builtin_ia32_movmskps256(reinterpret_cast<v8f>(inm));
     if (in == 0) continue;
     const v8f fr = __builtin_convertvector(ri, v8f);
-    v8f x = FPLOC_LD(lut[0] + c) * fr + FPLOC_LD(lut[3] + c), y = FPLOC_LD(lut[1] + c) * fr + FPLOC_LD(lut[4] + c),
-        z = FPLOC_LD(lut[2] + c) * fr + FPLOC_LD(lut[5] + c);
+    v8f x = FPLOC_LD(l0 + c) * fr + FPLOC_LD(l3 + c), y = FPLOC_LD(l1 + c) * fr + FPLOC_LD(l4 + c),
+        z = kZRow ? v8f{zr[0], zr[0], zr[0], zr[0], zr[0], zr[0], zr[0], zr[0]} * fr +
+                        v8f{zr[1], zr[1], zr[1], zr[1], zr[1], zr[1], zr[1], zr[1]}
+                  : FPLOC_LD(l2 + c) * fr + FPLOC_LD(l5 + c);
     if (rot) {
       const v8f X = FPLOC_LD(rot[0] + c) * x + FPLOC_LD(rot[1] + c) * y + FPLOC_LD(rot[2] + c) * z;
       const v8f Y = FPLOC_LD(rot[3] + c) * x + FPLOC_LD(rot[4] + c) * y + FPLOC_LD(rot[5] + c) * z;
@@ -69,6 +85,15 @@ __attribute__((target("avx2"))) size_t ring_pass8(const uint32_t* rng, const int
   }
 #undef FPLOC_LD
   return m;
+}
+size_t ring_pass8(const uint32_t* rng, const int32_t* okm, const float* const lut[6], const float* zr,
+                  const float* const rot[9], int W, int32_t lo, int32_t hi, int32_t pix_row, float* cx, float* cy,
+                  float* cz, float* cr, int32_t* cp, size_t m) {
+  if (zr)
+    return okm ? ring_pass8_t<true, false>(rng, okm, lut, zr, rot, W, lo, hi, pix_row, cx, cy, cz, cr, cp, m)
+               : ring_pass8_t<true, true>(rng, okm, lut, zr, rot, W, lo, hi, pix_row, cx, cy, cz, cr, cp, m);
+  return okm ? ring_pass8_t<false, false>(rng, okm, lut, zr, rot, W, lo, hi, pix_row, cx, cy, cz, cr, cp, m)
+             : ring_pass8_t<false, true>(rng, okm, lut, zr, rot, W, lo, hi, pix_row, cx, cy, cz, cr, cp, m);
 }
 #else
 #define FPLOC_PREP_WIDE 0
@@ -115,6 +140,15 @@ bool Segmenter::prepare(const Scan& scan) {
       const auto& src = e < 3 ? lut_.direction : lut_.offset;
       lut_soa_[e].resize(size_t(src.rows()));
       for (Eigen::Index i = 0; i < src.rows(); ++i) lut_soa_[e][size_t(i)] = src(i, e % 3);
+    }
+    // Rows whose z direction and offset are one value each (the same floats in every column): their pair.
+    row_z_.assign(size_t(scan.height), {std::numeric_limits<float>::quiet_NaN(), 0.f});
+    for (int u = 0; u < scan.height; ++u) {
+      const float* dz = lut_soa_[2].data() + size_t(u) * scan.width;
+      const float* oz = lut_soa_[5].data() + size_t(u) * scan.width;
+      bool same = true;
+      for (int c = 1; c < scan.width && same; ++c) same = std::memcmp(dz + c, dz, 4) == 0 && std::memcmp(oz + c, oz, 4) == 0;
+      if (same) row_z_[size_t(u)] = {dz[0], oz[0]};
     }
     // Where each scan row's returns are among the candidates (see below): its set and ring there.
     const int Hh = scan.height, hh = Hh / 2;
@@ -165,6 +199,7 @@ bool Segmenter::prepare(const Scan& scan) {
   // (most of a ring). The arithmetic is the same per point as the scalar pass.
   bool identity = W % 4 == 0;
   for (int c = 0; c < W && identity; ++c) identity = col_mid_[c] == c;
+  col_identity_ = identity && int(lut_soa_[0].size()) == W * H;
   if (identity) {
     col_okm_.resize(W);
     for (int c = 0; c < W; ++c) col_okm_[c] = col_ok_[c] ? -1 : 0;
@@ -250,13 +285,16 @@ bool Segmenter::prepare(const Scan& scan) {
   };
 #if FPLOC_PREP_WIDE
   const bool wide8 = identity && W % 8 == 0 && kern::wide();
+  const bool all_ok = std::all_of(col_ok_.begin(), col_ok_.end(), [](uint8_t o) { return o != 0; });
   auto ring_pass8w = [&](int u, Candidates& cs) {
     const size_t row = size_t(u) * W;
     const float* lut[6];
     for (int e = 0; e < 6; ++e) lut[e] = lut_soa_[e].data() + row;
     const float* rot[9];
     for (int e = 0; e < 9; ++e) rot[e] = deskew ? rot_soa_[e].data() : nullptr;
-    cs.n = ring_pass8(rng + row, col_okm_.data(), lut, deskew ? rot : nullptr, W, int32_t(std::min<uint32_t>(r_lo, 0x7fffffffu)),
+    const bool zrow = !deskew && !std::isnan(row_z_[size_t(u)][0]);
+    cs.n = ring_pass8(rng + row, all_ok ? nullptr : col_okm_.data(), lut, zrow ? row_z_[size_t(u)].data() : nullptr,
+                      deskew ? rot : nullptr, W, int32_t(std::min<uint32_t>(r_lo, 0x7fffffffu)),
                       int32_t(std::min<uint32_t>(r_hi, 0x7fffffffu)), int32_t(row), cs.x.data(), cs.y.data(), cs.z.data(),
                       cs.range.data(), cs.pixel.data(), cs.n);
     cs.ring_start.push_back(int32_t(cs.n));
@@ -268,7 +306,8 @@ bool Segmenter::prepare(const Scan& scan) {
   auto ring_pass = [&](int u, Candidates& cs) { wide8 ? ring_pass8w(u, cs) : identity ? ring_pass4(u, cs) : ring_pass1(u, cs); };
   const int half = H / 2;
   for (auto [cs, rings] : {std::pair{&upper_, half}, std::pair{&lower_, half}, std::pair{&middle_, H % 2}}) {
-    const size_t cap = size_t(rings) * W + Candidates::kLanes;
+    // (+ 8: wall selection's eight-lane loops read up to 7 entries past a ring's end)
+    const size_t cap = size_t(rings) * W + 2 * Candidates::kLanes;
     for (auto* v : {&cs->x, &cs->y, &cs->z, &cs->range}) v->resize(cap);
     cs->pixel.resize(cap);
     cs->p.clear();

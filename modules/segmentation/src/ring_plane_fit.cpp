@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "fploc/segmentation/plane_fit.h"
+#include "compact_kernels.h"
 #include "plane_kernels.h"
 #include "plane_math.h"
 #include "segmenter_constants.h"
@@ -34,14 +35,37 @@ void RingPlaneFit::pick_seeds(const Candidates& c, const Eigen::Vector3f& upf) {
     sector_idx_.assign(S, -1);
     // A ring is one scan row: its column is the pixel index minus the row's first pixel (no division per point).
     const int row0 = c.ring_start[r] < c.ring_start[r + 1] ? c.pixel[c.ring_start[r]] / c.width * c.width : 0;
+    // The ring is in column order, so a sector's points are one run: its maximum is kept in registers
+    // (the first of equal ranges, as a strict > over the points in order) and stored when the sector changes.
+    // A point below the seed height counts as range -inf (never above the -1 start).
+    const float* px = c.x.data();
+    const float* py = c.y.data();
+    const float* pz = c.z.data();
+    const float* prange = c.range.data();
+    const int32_t* ppix = c.pixel.data();
+    const int* sec = sector_of_col_.data();
+    int cur_s = -1, cur_i = -1;
+    float cur_best = -1.f;
     for (int i = c.ring_start[r]; i < c.ring_start[r + 1]; ++i) {
-      if (upf.dot(c.point(size_t(i))) < k::kMinSeedHeightM) continue;
-      const int col = c.pixel[i] - row0;
-      const int s = sector_of_col_[size_t(col)];
-      if (c.range[i] > sector_best_[s]) {
-        sector_best_[s] = c.range[i];
-        sector_idx_[s] = i;
+      const bool low = upf.dot(Eigen::Vector3f(px[i], py[i], pz[i])) < k::kMinSeedHeightM;
+      const int s = sec[ppix[i] - row0];
+      if (s != cur_s) {
+        if (cur_s >= 0) {
+          sector_best_[size_t(cur_s)] = cur_best;
+          sector_idx_[size_t(cur_s)] = cur_i;
+        }
+        cur_s = s;
+        cur_best = sector_best_[size_t(s)];
+        cur_i = sector_idx_[size_t(s)];
       }
+      const float rv = low ? -std::numeric_limits<float>::infinity() : prange[i];
+      const bool better = rv > cur_best;
+      cur_i = better ? i : cur_i;
+      cur_best = better ? rv : cur_best;
+    }
+    if (cur_s >= 0) {
+      sector_best_[size_t(cur_s)] = cur_best;
+      sector_idx_[size_t(cur_s)] = cur_i;
     }
     std::vector<int> cand;
     for (int s = 0; s < S; ++s)
@@ -162,10 +186,16 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     // without a branch (about one point in five is in the band, a branch on it mispredicted often).
     const v4f nx = splat(float(cur[0])), ny = splat(float(cur[1])), nz = splat(float(cur[2])), d = splat(float(cur[3]));
     const v4f cb = splat(float(cut));
-    band_.resize(np_);
+    band_.resize(np_ + 8);  // (+ 8: the eight-lane compaction writes up to 7 slots past the count)
     float *bx = band_.x.data(), *by = band_.y.data(), *bz = band_.z.data();
     size_t m = 0;
-    for (size_t i = 0; i < np_; i += 4) {
+    const bool wide = ck::available() && kern::wide();
+    if (wide) {
+      const float plf[4] = {float(cur[0]), float(cur[1]), float(cur[2]), float(cur[3])};
+      const float r3[3] = {reff.x(), reff.y(), reff.z()};
+      m = ck::band(xs_, ys_, zs_, n_, np_, plf, float(cut), r3, bx, by, bz);
+    }
+    for (size_t i = 0; i < np_ && !wide; i += 4) {
       const v4f x = load(xs_ + i), y = load(ys_ + i), z = load(zs_ + i);
       const int in = movemask(abs(nx * x + ny * y + nz * z + d) < cb);  // NaN padding: false
       if (in == 0) continue;  // the band is a few contiguous runs per ring: mostly all or none of four
@@ -213,8 +243,10 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     if (double(cutf) < cut) cutf = std::nextafter(cutf, std::numeric_limits<float>::infinity());
     scratch_.resize(src->padded());
     int inside = 0;
+    // The last iteration's scale as the guess of the bin (the result does not depend on it).
+    const int hint = last_sigma > 0 ? int(std::min(double(k::kScaleBins), last_sigma / k::kMadToSigma * inv_binf)) : -1;
     const int bin = kern::residual_scale(src->x.data(), src->y.data(), src->z.data(), src->padded(), plf, inv_binf, cutf,
-                                         scratch_.data(), inside);
+                                         scratch_.data(), inside, hint);
     if (inside < 3) return std::nullopt;
     const double sigma = k::kMadToSigma * (bin + 0.5) / inv_binf;
     last_sigma = sigma;
@@ -257,8 +289,14 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
   ys_ = c.y.data();
   zs_ = c.z.data();
   np_ = (n + 3) & ~size_t(3);  // NaN-padded (Candidates)
+  n_ = n;
   for (auto [sub, stride] : {std::pair{&sub_start_, start_stride_}, std::pair{&sub_final_, final_stride_}}) {
     sub->resize((n + stride - 1) / stride);
+    if (ck::available() && kern::wide()) {
+      ck::strided(xs_, ys_, zs_, sub->n, stride, sub->x.data(), sub->y.data(), sub->z.data());
+      sub->pad();
+      continue;
+    }
     for (size_t i = 0, j = 0; i < n; i += stride, ++j) {
       sub->x[j] = xs_[i];
       sub->y[j] = ys_[i];

@@ -4,8 +4,10 @@
 #include <cstring>
 
 #include "fploc/segmentation/segmenter.h"
+#include "plane_kernels.h"
 #include "segmenter_constants.h"
 #include "simd4.h"
+#include "wall_kernels.h"
 
 namespace fploc::seg {
 
@@ -75,6 +77,42 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
     pieces_.push_back({&cs, sp, re, -row - v0, int16_t(u)});
     pieces_.push_back({&cs, rs, sp, -row - v0 + W, int16_t(u)});
   }
+  auto& w = out_.wall;
+  const bool deskewed = out_.deskewed;
+  // Eight candidates at a time (AVX2 CPUs): the same tests and copies (wall_kernels.h); de-skewed scans only
+  // when the look-up column is the scan's own (the per-pixel table lut_soa_).
+  if (wallk::available() && kern::wide() && (!deskewed || col_identity_)) {
+    const wallk::Bounds bd{nc.x(), nc.y(), nc.z(), -dc, nf.x(), nf.y(), nf.z(), -df};
+    size_t groups = 0;
+    for (const Piece& pc : pieces_) groups += size_t((pc.b - pc.a + 7) / 8);
+    masks_.resize(groups);
+    size_t m = 0, g = 0;
+    for (const Piece& pc : pieces_) {
+      m += wallk::masks8(pc.cs->x.data(), pc.cs->y.data(), pc.cs->z.data(), pc.a, pc.b, bd, masks_.data() + g);
+      g += size_t((pc.b - pc.a + 7) / 8);
+    }
+    for (auto* v : {&w.x, &w.y, &w.z, &w.range, &w.t}) v->resize(m + 8);  // 8 slots of slack for the block stores
+    w.ring.resize(m + 8);
+    w.column.resize(m + 8);
+    const wallk::Out out{w.x.data(), w.y.data(), w.z.data(), w.range.data(), w.t.data(), w.ring.data(), w.column.data()};
+    wallk::Measured meas{};
+    if (deskewed) {
+      for (int e = 0; e < 6; ++e) meas.lut[e] = lut_soa_[e].data();
+      meas.range_mm = scan.range_mm.data();
+    }
+    size_t o = 0;
+    g = 0;
+    for (const Piece& pc : pieces_) {
+      const Candidates& cs = *pc.cs;
+      const wallk::Source src{cs.x.data(), cs.y.data(), cs.z.data(), cs.range.data(), cs.pixel.data()};
+      o = wallk::copy8(src, pc.a, pc.b, int32_t(pc.u) * W, pc.off, pc.u, masks_.data() + g, col_dt_.data(),
+                       deskewed ? &meas : nullptr, out, o);
+      g += size_t((pc.b - pc.a + 7) / 8);
+    }
+    for (auto* v : {&w.x, &w.y, &w.z, &w.range, &w.t}) v->resize(m);
+    w.ring.resize(m);
+    w.column.resize(m);
+  } else {
   auto mask = [&](const Candidates& cs, int32_t j, int32_t b) {
     const v4f x = load(cs.x.data() + j), y = load(cs.y.data() + j), z = load(cs.z.data() + j);
     const v4i in = (ncx * x + ncy * y + ncz * z > mdc) & (nfx * x + nfy * y + nfz * z > mdf);
@@ -95,13 +133,11 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
         m += size_t(kBits[mk]);
       }
   }
-  auto& w = out_.wall;
   for (auto* v : {&w.x, &w.y, &w.z, &w.range, &w.t}) v->resize(m);
   w.ring.resize(m);
   w.column.resize(m);
   float *ox = w.x.data(), *oy = w.y.data(), *oz = w.z.data(), *orng = w.range.data(), *ot = w.t.data();
   int16_t *oring = w.ring.data(), *ocol = w.column.data();
-  const bool deskewed = out_.deskewed;
   const float* dir = lut_.direction.data();
   const float* lut_off = lut_.offset.data();
   size_t o = 0, g = 0;
@@ -157,6 +193,7 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
         ++o;
       }
     }
+  }
   }
   if (keep_labels_) {  // bench/tests: 1 ceiling inlier, 2 ground inlier, 3 wall point
     const float cin = float(ceil[3] - cfg_.inlier_threshold_m), fin = float(floor[3] - cfg_.inlier_threshold_m);

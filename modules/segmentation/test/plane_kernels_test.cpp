@@ -84,6 +84,14 @@ TEST_P(PlaneKernels, MedianBinIsTheHistogramsMedianBin) {
         EXPECT_NEAR(got_inside, inside, 2) << n << " " << cut;
         EXPECT_NEAR(got, bin, 1) << n << " " << cut;
       }
+      // A guess of the bin (the last IRLS iteration's scale) changes only the search, never the bin.
+      for (int hint : {0, 1, got - 3, got - 1, got, got + 1, got + 2, got + 40, 254, 255, 300}) {
+        int hinted_inside = -1;
+        EXPECT_EQ(kern::residual_scale(c.x.data(), c.y.data(), c.z.data(), c.np, kPlane, inv_bin, cut, scratch.data(),
+                                       hinted_inside, std::max(0, hint)),
+                  got)
+            << n << " " << cut << " hint " << hint;
+      }
     }
   }
 }

@@ -1,0 +1,138 @@
+// The plane fit's compaction and strided copies eight points at a time (see compact_kernels.h), compiled for
+// AVX2 alone (no -march flag; without FMA the band test rounds as the four-lane loop's).
+#include "compact_kernels.h"
+
+#include <cstring>
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define FPLOC_CK_WIDE 1
+#else
+#define FPLOC_CK_WIDE 0
+#endif
+
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace fploc::seg::ck {
+
+#if FPLOC_CK_WIDE
+namespace {
+typedef float v8f __attribute__((vector_size(32)));
+typedef int32_t v8i __attribute__((vector_size(32)));
+
+// For each 8-bit lane mask: the source lane of each output slot (4 bits per slot), the set lanes first.
+struct CompressTable {
+  uint32_t e[256];
+  constexpr CompressTable() : e{} {
+    for (int m = 0; m < 256; ++m) {
+      uint32_t v = 0;
+      int k = 0;
+      for (int l = 0; l < 8; ++l)
+        if ((m >> l) & 1) v |= uint32_t(l) << (4 * k++);
+      e[m] = v;
+    }
+  }
+};
+constexpr CompressTable kCompress;
+
+__attribute__((target("avx2"))) inline v8f ld(const float* p) {
+  v8f v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+__attribute__((target("avx2"))) inline void st(float* p, v8f v) { std::memcpy(p, &v, sizeof v); }
+// src[0], src[3], ..., src[21] (perm: 0, 3, 6, 1, 4, 7, 2, 5).
+__attribute__((target("avx2"))) inline v8f every3(const float* p, __m256i perm) {
+  __m256 a, b, c;
+  std::memcpy(&a, p, sizeof a);
+  std::memcpy(&b, p + 8, sizeof b);
+  std::memcpy(&c, p + 16, sizeof c);
+  const __m256 t = _mm256_blend_ps(_mm256_blend_ps(a, b, 0x92), c, 0x24);
+  return reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(t, perm));
+}
+__attribute__((target("avx2"))) inline v8f splat(float a) { return v8f{a, a, a, a, a, a, a, a}; }
+}  // namespace
+
+namespace {
+bool g_enabled = true;
+}
+bool available() { return g_enabled; }
+void set_enabled(bool on) { g_enabled = on; }
+
+__attribute__((target("avx2"))) size_t band(const float* x, const float* y, const float* z, size_t n, size_t np,
+                                            const float pl[4], float cut, const float ref[3], float* bx, float* by, float* bz) {
+  const v8f nx = splat(pl[0]), ny = splat(pl[1]), nz = splat(pl[2]), d = splat(pl[3]), cb = splat(cut);
+  const v8f rx = splat(ref[0]), ry = splat(ref[1]), rz = splat(ref[2]);
+  const v8i absm = {0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff};
+  const __m256i shifts = _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28);
+  size_t m = 0;
+  for (size_t i = 0; i < n; i += 8) {
+    v8f px, py, pz;
+    if (i + 8 <= np) {
+      px = ld(x + i);
+      py = ld(y + i);
+      pz = ld(z + i);
+    } else {  // the last four of np (the arrays may end there)
+      px = py = pz = v8f{};
+      std::memcpy(&px, x + i, 4 * sizeof(float));
+      std::memcpy(&py, y + i, 4 * sizeof(float));
+      std::memcpy(&pz, z + i, 4 * sizeof(float));
+    }
+    const v8f r = nx * px + ny * py + nz * pz + d;
+    const v8f a = reinterpret_cast<v8f>(reinterpret_cast<v8i>(r) & absm);
+    int in = _mm256_movemask_ps(reinterpret_cast<__m256>(a < cb));
+    if (n - i < 8) in &= (1 << (n - i)) - 1;
+    if (in == 0) continue;
+    const v8f qx = px - rx, qy = py - ry, qz = pz - rz;
+    if (in == 255) {
+      st(bx + m, qx);
+      st(by + m, qy);
+      st(bz + m, qz);
+      m += 8;
+      continue;
+    }
+    const __m256i idx = _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int(kCompress.e[in])), shifts), _mm256_set1_epi32(15));
+    st(bx + m, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(qx), idx)));
+    st(by + m, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(qy), idx)));
+    st(bz + m, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(qz), idx)));
+    m += size_t(__builtin_popcount(unsigned(in)));
+  }
+  return m;
+}
+
+__attribute__((target("avx2"))) void strided(const float* x, const float* y, const float* z, size_t m, size_t stride,
+                                             float* ox, float* oy, float* oz) {
+  size_t j = 0;
+  if (stride == 3) {  // the reference sensor's support subsample: three loads, two blends, one permutation per 8
+    const __m256i perm = _mm256_setr_epi32(0, 3, 6, 1, 4, 7, 2, 5);
+    for (; j + 8 <= m && (j + 8) * 3 <= 3 * m - 2; j += 8) {  // reads src[3j .. 3j + 23] (all before 3(m-1)+1)
+      st(ox + j, every3(x + 3 * j, perm));
+      st(oy + j, every3(y + 3 * j, perm));
+      st(oz + j, every3(z + 3 * j, perm));
+    }
+  } else if (stride < (size_t(1) << 27)) {
+    const int s = int(stride);
+    const __m256i idx = _mm256_setr_epi32(0, s, 2 * s, 3 * s, 4 * s, 5 * s, 6 * s, 7 * s);
+    for (; j + 8 <= m; j += 8) {
+      const size_t i = j * stride;
+      st(ox + j, reinterpret_cast<v8f>(_mm256_i32gather_ps(x + i, idx, 4)));
+      st(oy + j, reinterpret_cast<v8f>(_mm256_i32gather_ps(y + i, idx, 4)));
+      st(oz + j, reinterpret_cast<v8f>(_mm256_i32gather_ps(z + i, idx, 4)));
+    }
+  }
+  for (; j < m; ++j) {
+    ox[j] = x[j * stride];
+    oy[j] = y[j * stride];
+    oz[j] = z[j * stride];
+  }
+}
+#else
+bool available() { return false; }
+void set_enabled(bool) {}
+size_t band(const float*, const float*, const float*, size_t, size_t, const float*, float, const float*, float*, float*, float*) {
+  return 0;
+}
+void strided(const float*, const float*, const float*, size_t, size_t, float*, float*, float*) {}
+#endif
+
+}  // namespace fploc::seg::ck
