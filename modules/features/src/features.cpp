@@ -54,20 +54,6 @@ float max_range(const float* v, int b, int e) {
   return m;
 }
 
-// The largest of v[0 .. 8).
-float max8(const float* v) {
-#if defined(__SSE2__)
-  __m128 m = _mm_max_ps(_mm_loadu_ps(v), _mm_loadu_ps(v + 4));
-  m = _mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
-  m = _mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1)));
-  return _mm_cvtss_f32(m);
-#else
-  float m = v[0];
-  for (int k = 1; k < 8; ++k) m = std::max(m, v[k]);
-  return m;
-#endif
-}
-
 // Appends the indices i in [b, e) with v[i] >= t, in increasing order.
 void indices_at_least(const float* v, float t, int b, int e, std::vector<int>& out) {
   int i = b;
@@ -182,19 +168,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   for (int k = 0; k < hw; ++k) lo[k] = hi[k] = -kInf;  // no window: no candidate
   for (int k = n - hw; k < nb * 8; ++k) lo[k] = hi[k] = -kInf;
   uint8_t* picked = picked_.data();
-  // The largest bounds of each block, kept up to date as points are taken out: the sector scans for the
-  // sharpest candidate read 1/8 of the points.
-  blo_.resize(size_t(nb));
-  bhi_.resize(size_t(nb));
-  float *blo = blo_.data(), *bhi = bhi_.data();
-  auto refresh = [&](int b) {
-    blo[b] = max8(lo + 8 * b);
-    bhi[b] = max8(hi + 8 * b);
-  };
-  // Taking points a..b out: no later corner or surface pick there (a pick's neighbours, occlusions). The
-  // blocks' maxima are brought up to date when a sector reads them (dirty_).
-  dirty_.assign(size_t(nb), 1);
-  uint8_t* dirty = dirty_.data();
+  // Taking points a..b out: no later corner or surface pick there (a pick's neighbours, occlusions).
   auto suppress = [&](int a, int b) {
     a = std::max(0, a);
     b = std::min(n - 1, b);
@@ -202,8 +176,6 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       picked[k] = 1;
       lo[k] = hi[k] = -kInf;
     }
-    if (a <= b)
-      for (int q = a >> 3; q <= b >> 3; ++q) dirty[q] = 1;
   };
   for (const int e : occ_) {  // +(j+1): the near side is j (j+1 .. j+hw out); -(j+1): j-hw+1 .. j out
     if (e < 0)
@@ -226,27 +198,12 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     if (se <= sb) continue;
     for (int corners = 0; corners < max_corners; ++corners) {
       // The sharpest candidate is among those whose upper bound reaches the largest lower bound; when
-      // that is more than one, their exact c decide (ties: the first index).
-      const int b0 = (sb + 7) >> 3, b1 = se >> 3;  // whole blocks b0 .. b1-1; single points around them
-      const int h = std::min(se, 8 * b0), t = std::max(h, 8 * b1);
-      for (int q = b0; q < b1; ++q)
-        if (dirty[q]) {
-          refresh(q);
-          dirty[q] = 0;
-        }
-      float top = -kInf;
-      for (int k = sb; k < h; ++k) top = std::max(top, lo[k]);
-      top = std::max(top, max_range(blo, b0, b1));
-      for (int k = t; k < se; ++k) top = std::max(top, lo[k]);
+      // that is more than one, their exact c decide (ties: the first index). A sector is ~n/6 points: two
+      // vector scans of the bounds are cheaper than keeping block maxima up to date.
+      const float top = max_range(lo, sb, se);
       if (!(top > -kInf)) break;
       cand.clear();
-      for (int k = sb; k < h; ++k)
-        if (hi[k] >= top) cand.push_back(k);
-      blocks_.clear();
-      indices_at_least(bhi, top, b0, b1, blocks_);
-      for (const int q : blocks_) indices_at_least(hi, top, 8 * q, 8 * q + 8, cand);
-      for (int k = t; k < se; ++k)
-        if (hi[k] >= top) cand.push_back(k);
+      indices_at_least(hi, top, sb, se, cand);
       int best = cand.front();
       if (cand.size() > 1) {
         float bc = -kInf;
