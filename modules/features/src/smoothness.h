@@ -34,7 +34,7 @@ struct RingRules {
 // Buffers kept from ring to ring and scan to scan (no allocation once they have grown).
 struct RingScratch {
   std::vector<float>& w;      // hw-point block sums of x, y, z
-  std::vector<int32_t>& brk;  // column breaks between neighbours, and their hw-pair block sums
+  std::vector<uint64_t>& brk;  // column breaks between neighbours as bits, and broken windows as bits
 };
 
 // The smoothness of point i (hw <= i < n - hw) by the plain rules: LOAM's c = |sum_j (X_j - X_i)| /

@@ -73,7 +73,7 @@ class FeatureExtractor {
   std::vector<uint8_t> picked_;                  // suppressed by a pick or an occlusion boundary
   std::vector<int> occ_, surf_, sel_, run_;
   std::vector<float> ring_w_;
-  std::vector<int32_t> ring_brk_;
+  std::vector<uint64_t> ring_brk_;
 };
 
 }  // namespace fploc::feat
