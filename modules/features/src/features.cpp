@@ -31,12 +31,14 @@ size_t run_end(const int16_t* v, size_t b, size_t n) {
   return i;
 }
 
-// Asks for the cache lines of points [b, e) of the arrays the ring pass reads.
+// Asks for the cache lines of points [b, e) of the arrays the ring pass and the picks read.
 void prefetch_next(const seg::WallPoints& w, size_t b, size_t e) {
 #if defined(__SSE2__)
   if (b >= e) return;
   for (const float* a : {w.x.data(), w.y.data(), w.z.data(), w.range.data()})
     for (size_t i = b; i < e; i += 16) _mm_prefetch(reinterpret_cast<const char*>(a + i), _MM_HINT_T0);
+  if (w.t.size() == w.x.size())  // read at the picks (about one per cache line)
+    for (size_t i = b; i < e; i += 16) _mm_prefetch(reinterpret_cast<const char*>(w.t.data() + i), _MM_HINT_T0);
   for (const int16_t* a : {w.column.data(), w.ring.data()})
     for (size_t i = b; i < e; i += 32) _mm_prefetch(reinterpret_cast<const char*>(a + i), _MM_HINT_T0);
 #else
@@ -171,6 +173,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   corner_lo_.resize(size_t(nb) * 8);
   corner_hi_.resize(size_t(nb) * 8);
   surface_.assign(size_t(n) / 64 + 2, 0);
+  surface_sure_.assign(size_t(n) / 64 + 2, 0);
   picked_.assign(size_t(n), 0);
   occ_.clear();
   const detail::RingIn in{w.x.data() + begin, w.y.data() + begin, w.z.data() + begin, w.range.data() + begin,
@@ -180,8 +183,8 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
                                 float(cfg_.corner_threshold), float(cfg_.surface_threshold)};
   detail::RingScratch scratch{ring_w_, ring_brk_};
   float *lo = corner_lo_.data(), *hi = corner_hi_.data();
-  const uint64_t* sk = surface_.data();
-  detail::smoothness(in, rules, scratch, lo, hi, surface_.data(), occ_);
+  const uint64_t *sk = surface_.data(), *sure = surface_sure_.data();
+  detail::smoothness(in, rules, scratch, lo, hi, surface_.data(), surface_sure_.data(), occ_);
   for (int k = 0; k < hw; ++k) lo[k] = hi[k] = -kInf;  // no window: no candidate
   for (int k = n - hw; k < nb * 8; ++k) lo[k] = hi[k] = -kInf;
   uint8_t* picked = picked_.data();
@@ -248,7 +251,27 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
         if (!picked[i]) cand.push_back(i);
       }
     }
-    // Exact c of each; kept when below the threshold.
+    // When the sector's candidates are no more than its limit, every one that no other candidate's pick
+    // can suppress (none within the spacing) and whose bound puts it surely below the threshold is picked
+    // whatever the order: no exact c for those.
+    const int sp = cfg_.surface_spacing;
+    auto& direct = sel_;
+    if (int(cand.size()) <= max_surfaces) {
+      size_t m = 0;
+      const size_t nc = cand.size();
+      for (size_t k = 0; k < nc; ++k) {
+        const int i = cand[k];
+        const bool near = (k > 0 && i - cand[k - 1] <= sp) || (k + 1 < nc && cand[k + 1] - i <= sp);
+        if (!near && (sure[i >> 6] >> (i & 63) & 1)) {
+          direct.push_back(2 * i);
+          suppress(i - sp, i + sp);
+        } else {
+          cand[m++] = i;
+        }
+      }
+      cand.resize(m);
+    }
+    // Exact c of the others; kept when below the threshold.
     auto& sc = surface_c_;
     sc.resize(size_t(n));
     size_t m = 0;
@@ -259,7 +282,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     }
     cand.resize(m);
     std::sort(cand.begin(), cand.end(), [&](int a, int b) { return sc[a] < sc[b] || (sc[a] == sc[b] && a < b); });
-    int surfaces = 0;
+    int surfaces = 0;  // (the direct picks above only happen when the limit cannot be reached)
     for (const int i : cand) {
       if (picked[i]) continue;
       sel_.push_back(2 * i);
@@ -294,17 +317,27 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   std::sort(sel_.begin(), sel_.end());  // the picks in column order (not a scan of all n points)
   const bool has_t = w.t.size() == w.x.size();
   const float max_gap2 = float(cfg_.group_max_gap_m * cfg_.group_max_gap_m);
-  for (const int code : sel_) {
-    const size_t src = begin + size_t(code >> 1);
-    const bool corner = code & 1;
-    const int o = int(out_.x.size());
+  // The picks' output first (independent iterations, written in place), then the runs.
+  const size_t o0 = out_.x.size(), m = sel_.size();
+  out_.x.resize(o0 + m);
+  out_.y.resize(o0 + m);
+  out_.kind.resize(o0 + m);
+  out_.group.resize(o0 + m, -1);
+  out_.t.resize(o0 + m);
+  out_.source.resize(o0 + m);
+  for (size_t k = 0; k < m; ++k) {
+    const int code = sel_[k];
+    const size_t src = begin + size_t(code >> 1), o = o0 + k;
     const Eigen::Vector3f q = R_ * Eigen::Vector3f(w.x[src], w.y[src], w.z[src]);
-    out_.x.push_back(q.x());
-    out_.y.push_back(q.y());
-    out_.kind.push_back(corner ? kCorner : kSurface);
-    out_.group.push_back(-1);
-    out_.t.push_back(has_t ? w.t[src] : 0.f);
-    out_.source.push_back(int32_t(src));
+    out_.x[o] = q.x();
+    out_.y[o] = q.y();
+    out_.kind[o] = code & 1 ? kCorner : kSurface;
+    out_.t[o] = has_t ? w.t[src] : 0.f;
+    out_.source[o] = int32_t(src);
+  }
+  for (size_t k = 0; k < m; ++k) {
+    const bool corner = sel_[k] & 1;
+    const int o = int(o0 + k);
     if (corner) {
       close_run();
       continue;

@@ -35,7 +35,7 @@ namespace fploc::feat::detail {
 #endif
 
 namespace {
-using Pass = void (*)(const RingIn&, const RingRules&, RingScratch&, float*, float*, uint64_t*, std::vector<int>&);
+using Pass = void (*)(const RingIn&, const RingRules&, RingScratch&, float*, float*, uint64_t*, uint64_t*, std::vector<int>&);
 struct Choice {
   Pass pass;
   const char* name;
@@ -62,8 +62,8 @@ const Choice& choice() {
 }  // namespace
 
 void smoothness(const RingIn& in, const RingRules& rules, RingScratch& scratch, float* corner_lo, float* corner_hi,
-                uint64_t* surface, std::vector<int>& occlusions) {
-  choice().pass(in, rules, scratch, corner_lo, corner_hi, surface, occlusions);
+                uint64_t* surface, uint64_t* surface_sure, std::vector<int>& occlusions) {
+  choice().pass(in, rules, scratch, corner_lo, corner_hi, surface, surface_sure, occlusions);
 }
 
 const char* smoothness_isa() { return choice().name; }

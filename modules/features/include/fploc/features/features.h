@@ -69,6 +69,7 @@ class FeatureExtractor {
   // Per-ring buffers, kept from scan to scan (src/smoothness.h).
   std::vector<float> corner_lo_, corner_hi_;  // bounds on c of corner candidates, -inf otherwise
   std::vector<uint64_t> surface_;             // bit i: point i may be a surface candidate
+  std::vector<uint64_t> surface_sure_;        // bit i: point i surely is one (c below the threshold)
   std::vector<float> surface_c_;              // exact c of the sector's surface candidates
   std::vector<uint8_t> picked_;                  // suppressed by a pick or an occlusion boundary
   std::vector<int> occ_, surf_, sel_, run_;
