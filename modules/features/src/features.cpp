@@ -46,46 +46,6 @@ void prefetch_next(const seg::WallPoints& w, size_t b, size_t e) {
 #endif
 }
 
-// The largest of v[b .. e), -inf when empty.
-float max_range(const float* v, int b, int e) {
-  float m = -kInf;
-  int i = b;
-#if defined(__SSE2__)
-  __m128 m0 = _mm_set1_ps(-kInf), m1 = m0;
-  for (; i + 8 <= e; i += 8) {
-    m0 = _mm_max_ps(m0, _mm_loadu_ps(v + i));
-    m1 = _mm_max_ps(m1, _mm_loadu_ps(v + i + 4));
-  }
-  if (i + 4 <= e) {
-    m0 = _mm_max_ps(m0, _mm_loadu_ps(v + i));
-    i += 4;
-  }
-  m0 = _mm_max_ps(m0, m1);
-  m0 = _mm_max_ps(m0, _mm_shuffle_ps(m0, m0, _MM_SHUFFLE(1, 0, 3, 2)));
-  m0 = _mm_max_ps(m0, _mm_shuffle_ps(m0, m0, _MM_SHUFFLE(2, 3, 0, 1)));
-  m = _mm_cvtss_f32(m0);
-#endif
-  for (; i < e; ++i) m = v[i] > m ? v[i] : m;
-  return m;
-}
-
-// Appends the indices i in [b, e) with v[i] >= t, in increasing order.
-void indices_at_least(const float* v, float t, int b, int e, std::vector<int>& out) {
-  int i = b;
-#if defined(__SSE2__)
-  const __m128 tt = _mm_set1_ps(t);
-  for (; i + 4 <= e; i += 4) {
-    int bits = _mm_movemask_ps(_mm_cmpge_ps(_mm_loadu_ps(v + i), tt));
-    while (bits) {
-      const int k = i + __builtin_ctz(unsigned(bits));
-      bits &= bits - 1;
-      out.push_back(k);
-    }
-  }
-#endif
-  for (; i < e; ++i)
-    if (v[i] >= t) out.push_back(i);
-}
 }  // namespace
 
 FeatureExtractor::FeatureExtractor(FeatureConfig cfg) : cfg_(cfg) {}
@@ -220,10 +180,10 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       // The sharpest candidate is among those whose upper bound reaches the largest lower bound; when
       // that is more than one, their exact c decide (ties: the first index). A sector is ~n/6 points: two
       // vector scans of the bounds are cheaper than keeping block maxima up to date.
-      const float top = max_range(lo, sb, se);
+      const float top = detail::range_max(lo, sb, se);
       if (!(top > -kInf)) break;
       cand.clear();
-      indices_at_least(hi, top, sb, se, cand);
+      detail::indices_at_least(hi, top, sb, se, cand);
       int best = cand.front();
       if (cand.size() > 1) {
         float bc = -kInf;

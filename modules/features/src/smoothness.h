@@ -66,6 +66,11 @@ inline float exact_smoothness(const RingIn& in, int hw, int i) {
 void smoothness(const RingIn& in, const RingRules& rules, RingScratch& scratch, float* corner_lo, float* corner_hi,
                 uint64_t* surface, uint64_t* surface_sure, std::vector<int>& occlusions);
 
+// Sector scans of the corner bounds, with the same instruction set as the pass: the largest of v[b .. e)
+// (-inf when empty; v holds no NaN), and the indices i in [b, e) with v[i] >= t appended in increasing order.
+float range_max(const float* v, int b, int e);
+void indices_at_least(const float* v, float t, int b, int e, std::vector<int>& out);
+
 // The dispatch's choice, for the benchmark and the notes: "avx2", "sse2" or "generic".
 const char* smoothness_isa();
 
