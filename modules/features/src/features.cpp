@@ -167,7 +167,14 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   // Per-sector selection (sectors split the ring's points evenly, as LOAM does): the sharpest corner
   // candidates that no earlier pick suppressed, then the smoothest surface candidates, walked in the order
   // (c, index): the plain rules' picks.
-  sel_.clear();  // picks as 2 * index + (1 for a corner)
+  // The picks as bits (points in column order without a sort): bit i of feat, and of corner for a corner.
+  const size_t words = size_t(n) / 64 + 1;
+  pick_bits_.assign(2 * words, 0);
+  uint64_t *feat = pick_bits_.data(), *corner_bit = feat + words;
+  auto pick = [&](int i, bool corner) {
+    feat[i >> 6] |= uint64_t(1) << (i & 63);
+    if (corner) corner_bit[i >> 6] |= uint64_t(1) << (i & 63);
+  };
   const int S = std::max(1, cfg_.sectors);
   const int max_corners = int(std::lround(cfg_.max_corners_per_sector * limit_scale_));
   const int max_surfaces = int(std::lround(cfg_.max_surfaces_per_sector * limit_scale_));
@@ -196,7 +203,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
           }
         }
       }
-      sel_.push_back(2 * best + 1);
+      pick(best, true);
       suppress(best - hw, best + hw);
     }
     if (max_surfaces <= 0) continue;
@@ -215,7 +222,6 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     // can suppress (none within the spacing) and whose bound puts it surely below the threshold is picked
     // whatever the order: no exact c for those.
     const int sp = cfg_.surface_spacing;
-    auto& direct = sel_;
     if (int(cand.size()) <= max_surfaces) {
       size_t m = 0;
       const size_t nc = cand.size();
@@ -223,7 +229,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
         const int i = cand[k];
         const bool near = (k > 0 && i - cand[k - 1] <= sp) || (k + 1 < nc && cand[k + 1] - i <= sp);
         if (!near && (sure[i >> 6] >> (i & 63) & 1)) {
-          direct.push_back(2 * i);
+          pick(i, false);
           suppress(i - sp, i + sp);
         } else {
           cand[m++] = i;
@@ -245,7 +251,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     int surfaces = 0;  // (the direct picks above only happen when the limit cannot be reached)
     for (const int i : cand) {
       if (picked[i]) continue;
-      sel_.push_back(2 * i);
+      pick(i, false);
       suppress(i - cfg_.surface_spacing, i + cfg_.surface_spacing);
       if (++surfaces == max_surfaces) break;
     }
@@ -274,7 +280,12 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     }
     run.clear();
   };
-  std::sort(sel_.begin(), sel_.end());  // the picks in column order (not a scan of all n points)
+  sel_.clear();  // the picks in column order, as 2 * index + (1 for a corner)
+  for (size_t q = 0; q < words; ++q)
+    for (uint64_t b = feat[q]; b; b &= b - 1) {
+      const int i = int(q * 64) + __builtin_ctzll(b);
+      sel_.push_back(2 * i + int(corner_bit[q] >> (i & 63) & 1));
+    }
   const bool has_t = w.t.size() == w.x.size();
   const float max_gap2 = float(cfg_.group_max_gap_m * cfg_.group_max_gap_m);
   // The picks' output first (independent iterations, written in place), then the runs.

@@ -72,6 +72,7 @@ class FeatureExtractor {
   std::vector<uint64_t> surface_sure_;        // bit i: point i surely is one (c below the threshold)
   std::vector<float> surface_c_;              // exact c of the sector's surface candidates
   std::vector<uint8_t> picked_;                  // suppressed by a pick or an occlusion boundary
+  std::vector<uint64_t> pick_bits_;              // the ring's picks (features, corners) as bits
   std::vector<int> occ_, surf_, sel_, run_;
   std::vector<float> ring_w_;
   std::vector<uint64_t> ring_brk_;
