@@ -31,21 +31,6 @@ size_t run_end(const int16_t* v, size_t b, size_t n) {
   return i;
 }
 
-// Asks for the cache lines of points [b, e) of the arrays the ring pass and the picks read.
-void prefetch_next(const seg::WallPoints& w, size_t b, size_t e) {
-#if defined(__SSE2__)
-  if (b >= e) return;
-  for (const float* a : {w.x.data(), w.y.data(), w.z.data(), w.range.data()})
-    for (size_t i = b; i < e; i += 16) _mm_prefetch(reinterpret_cast<const char*>(a + i), _MM_HINT_T0);
-  if (w.t.size() == w.x.size())  // read at the picks (about one per cache line)
-    for (size_t i = b; i < e; i += 16) _mm_prefetch(reinterpret_cast<const char*>(w.t.data() + i), _MM_HINT_T0);
-  for (const int16_t* a : {w.column.data(), w.ring.data()})
-    for (size_t i = b; i < e; i += 32) _mm_prefetch(reinterpret_cast<const char*>(a + i), _MM_HINT_T0);
-#else
-  (void)w, (void)b, (void)e;
-#endif
-}
-
 }  // namespace
 
 FeatureExtractor::FeatureExtractor(FeatureConfig cfg) : cfg_(cfg) {}
@@ -108,12 +93,8 @@ FeatureStatus FeatureExtractor::extract(const seg::Segmentation& seg) {
   const int H = std::max(1, seg.height);
   ring_step_ = std::max(1, int(std::lround(double(H) / kRefRings)));
   limit_scale_ = std::max(1.0, double(kRefRings) / H);
-  prefetch_next(w, 0, std::min(n, size_t(1024)));
   for (size_t b = 0; b < n;) {
     const size_t e = run_end(w.ring.data(), b, n);
-    // The next ring's points are fetched while this one is worked on (a scan's wall points, ~1 MB, come
-    // from memory after the segmenter; the hardware prefetchers ramp up too slowly on ~3 KB runs).
-    prefetch_next(w, e, std::min(n, e + (e - b) + 64));
     if (w.ring[b] % ring_step_ == 0) ring(seg, b, e);
     b = e;
   }
