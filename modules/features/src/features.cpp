@@ -252,9 +252,24 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
         C += d * d.transpose();
       }
       C /= double(run.size());
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(C);
-      const double l0 = std::max(es.eigenvalues()[0], 0.0), l1 = es.eigenvalues()[1];
-      if (std::sqrt(l0) <= cfg_.line_max_rms_m && l1 >= cfg_.line_min_ratio * std::max(l0, 1e-12)) {
+      // A line when sqrt(l0) <= rms and l1 >= ratio l0 (l0 <= l1 the eigenvalues, l0 clamped at 0 and 1e-12).
+      // The test is monotone (harder as l0 grows or l1 shrinks), so the closed-form eigenvalues decide it
+      // whenever it comes out the same at both ends of their error interval (+-1e-12 |C|, hundreds of times
+      // the backward errors of either computation); otherwise Eigen's solver (the plain rules') decides.
+      auto line = [&](double e0, double e1) {
+        const double l0 = std::max(e0, 0.0);
+        return std::sqrt(l0) <= cfg_.line_max_rms_m && e1 >= cfg_.line_min_ratio * std::max(l0, 1e-12);
+      };
+      const double a = C(0, 0), b = C(0, 1), c = C(1, 1);
+      const double t = 0.5 * (a + c), h = 0.5 * (a - c), d = std::sqrt(h * h + b * b);
+      const double e0 = t - d, e1 = t + d, tol = 1e-12 * (std::abs(a) + std::abs(b) + std::abs(c)) + 1e-300;
+      const bool finite = std::isfinite(e0) && std::isfinite(e1);
+      bool is_line = finite && line(e0 + tol, e1 - tol);
+      if (!is_line && (!finite || line(e0 - tol, e1 + tol))) {
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(C);
+        is_line = line(es.eigenvalues()[0], es.eigenvalues()[1]);
+      }
+      if (is_line) {
         const int32_t g = out_.num_groups++;
         for (int o : run) out_.group[o] = g;
       }
