@@ -263,7 +263,8 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       const double a = C(0, 0), b = C(0, 1), c = C(1, 1);
       const double t = 0.5 * (a + c), h = 0.5 * (a - c), d = std::sqrt(h * h + b * b);
       const double e0 = t - d, e1 = t + d, tol = 1e-12 * (std::abs(a) + std::abs(b) + std::abs(c)) + 1e-300;
-      const bool finite = std::isfinite(e0) && std::isfinite(e1);
+      // (monotone needs ratio >= 0; otherwise always the solver)
+      const bool finite = std::isfinite(e0) && std::isfinite(e1) && cfg_.line_min_ratio >= 0;
       bool is_line = finite && line(e0 + tol, e1 - tol);
       if (!is_line && (!finite || line(e0 - tol, e1 + tol))) {
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(C);
