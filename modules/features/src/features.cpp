@@ -31,60 +31,6 @@ size_t run_end(const int16_t* v, size_t b, size_t n) {
   return i;
 }
 
-// The largest of v[b .. e), -inf when empty.
-float max_range(const float* v, int b, int e) {
-  float m = -kInf;
-  int i = b;
-#if defined(__SSE2__)
-  __m128 m0 = _mm_set1_ps(-kInf), m1 = m0;
-  for (; i + 8 <= e; i += 8) {
-    m0 = _mm_max_ps(m0, _mm_loadu_ps(v + i));
-    m1 = _mm_max_ps(m1, _mm_loadu_ps(v + i + 4));
-  }
-  if (i + 4 <= e) {
-    m0 = _mm_max_ps(m0, _mm_loadu_ps(v + i));
-    i += 4;
-  }
-  m0 = _mm_max_ps(m0, m1);
-  m0 = _mm_max_ps(m0, _mm_shuffle_ps(m0, m0, _MM_SHUFFLE(1, 0, 3, 2)));
-  m0 = _mm_max_ps(m0, _mm_shuffle_ps(m0, m0, _MM_SHUFFLE(2, 3, 0, 1)));
-  m = _mm_cvtss_f32(m0);
-#endif
-  for (; i < e; ++i) m = v[i] > m ? v[i] : m;
-  return m;
-}
-
-// The largest of v[0 .. 8).
-float max8(const float* v) {
-#if defined(__SSE2__)
-  __m128 m = _mm_max_ps(_mm_loadu_ps(v), _mm_loadu_ps(v + 4));
-  m = _mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
-  m = _mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1)));
-  return _mm_cvtss_f32(m);
-#else
-  float m = v[0];
-  for (int k = 1; k < 8; ++k) m = std::max(m, v[k]);
-  return m;
-#endif
-}
-
-// Appends the indices i in [b, e) with v[i] >= t, in increasing order.
-void indices_at_least(const float* v, float t, int b, int e, std::vector<int>& out) {
-  int i = b;
-#if defined(__SSE2__)
-  const __m128 tt = _mm_set1_ps(t);
-  for (; i + 4 <= e; i += 4) {
-    int bits = _mm_movemask_ps(_mm_cmpge_ps(_mm_loadu_ps(v + i), tt));
-    while (bits) {
-      const int k = i + __builtin_ctz(unsigned(bits));
-      bits &= bits - 1;
-      out.push_back(k);
-    }
-  }
-#endif
-  for (; i < e; ++i)
-    if (v[i] >= t) out.push_back(i);
-}
 }  // namespace
 
 FeatureExtractor::FeatureExtractor(FeatureConfig cfg) : cfg_(cfg) {}
@@ -168,6 +114,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   corner_lo_.resize(size_t(nb) * 8);
   corner_hi_.resize(size_t(nb) * 8);
   surface_.assign(size_t(n) / 64 + 2, 0);
+  surface_sure_.assign(size_t(n) / 64 + 2, 0);
   picked_.assign(size_t(n), 0);
   occ_.clear();
   const detail::RingIn in{w.x.data() + begin, w.y.data() + begin, w.z.data() + begin, w.range.data() + begin,
@@ -177,24 +124,12 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
                                 float(cfg_.corner_threshold), float(cfg_.surface_threshold)};
   detail::RingScratch scratch{ring_w_, ring_brk_};
   float *lo = corner_lo_.data(), *hi = corner_hi_.data();
-  const uint64_t* sk = surface_.data();
-  detail::smoothness(in, rules, scratch, lo, hi, surface_.data(), occ_);
+  const uint64_t *sk = surface_.data(), *sure = surface_sure_.data();
+  detail::smoothness(in, rules, scratch, lo, hi, surface_.data(), surface_sure_.data(), occ_);
   for (int k = 0; k < hw; ++k) lo[k] = hi[k] = -kInf;  // no window: no candidate
   for (int k = n - hw; k < nb * 8; ++k) lo[k] = hi[k] = -kInf;
   uint8_t* picked = picked_.data();
-  // The largest bounds of each block, kept up to date as points are taken out: the sector scans for the
-  // sharpest candidate read 1/8 of the points.
-  blo_.resize(size_t(nb));
-  bhi_.resize(size_t(nb));
-  float *blo = blo_.data(), *bhi = bhi_.data();
-  auto refresh = [&](int b) {
-    blo[b] = max8(lo + 8 * b);
-    bhi[b] = max8(hi + 8 * b);
-  };
-  // Taking points a..b out: no later corner or surface pick there (a pick's neighbours, occlusions). The
-  // blocks' maxima are brought up to date when a sector reads them (dirty_).
-  dirty_.assign(size_t(nb), 1);
-  uint8_t* dirty = dirty_.data();
+  // Taking points a..b out: no later corner or surface pick there (a pick's neighbours, occlusions).
   auto suppress = [&](int a, int b) {
     a = std::max(0, a);
     b = std::min(n - 1, b);
@@ -202,8 +137,6 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       picked[k] = 1;
       lo[k] = hi[k] = -kInf;
     }
-    if (a <= b)
-      for (int q = a >> 3; q <= b >> 3; ++q) dirty[q] = 1;
   };
   for (const int e : occ_) {  // +(j+1): the near side is j (j+1 .. j+hw out); -(j+1): j-hw+1 .. j out
     if (e < 0)
@@ -215,7 +148,14 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   // Per-sector selection (sectors split the ring's points evenly, as LOAM does): the sharpest corner
   // candidates that no earlier pick suppressed, then the smoothest surface candidates, walked in the order
   // (c, index): the plain rules' picks.
-  sel_.clear();  // picks as 2 * index + (1 for a corner)
+  // The picks as bits (points in column order without a sort): bit i of feat, and of corner for a corner.
+  const size_t words = size_t(n) / 64 + 1;
+  pick_bits_.assign(2 * words, 0);
+  uint64_t *feat = pick_bits_.data(), *corner_bit = feat + words;
+  auto pick = [&](int i, bool corner) {
+    feat[i >> 6] |= uint64_t(1) << (i & 63);
+    if (corner) corner_bit[i >> 6] |= uint64_t(1) << (i & 63);
+  };
   const int S = std::max(1, cfg_.sectors);
   const int max_corners = int(std::lround(cfg_.max_corners_per_sector * limit_scale_));
   const int max_surfaces = int(std::lround(cfg_.max_surfaces_per_sector * limit_scale_));
@@ -226,27 +166,12 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     if (se <= sb) continue;
     for (int corners = 0; corners < max_corners; ++corners) {
       // The sharpest candidate is among those whose upper bound reaches the largest lower bound; when
-      // that is more than one, their exact c decide (ties: the first index).
-      const int b0 = (sb + 7) >> 3, b1 = se >> 3;  // whole blocks b0 .. b1-1; single points around them
-      const int h = std::min(se, 8 * b0), t = std::max(h, 8 * b1);
-      for (int q = b0; q < b1; ++q)
-        if (dirty[q]) {
-          refresh(q);
-          dirty[q] = 0;
-        }
-      float top = -kInf;
-      for (int k = sb; k < h; ++k) top = std::max(top, lo[k]);
-      top = std::max(top, max_range(blo, b0, b1));
-      for (int k = t; k < se; ++k) top = std::max(top, lo[k]);
+      // that is more than one, their exact c decide (ties: the first index). A sector is ~n/6 points: two
+      // vector scans of the bounds are cheaper than keeping block maxima up to date.
+      const float top = detail::range_max(lo, sb, se);
       if (!(top > -kInf)) break;
       cand.clear();
-      for (int k = sb; k < h; ++k)
-        if (hi[k] >= top) cand.push_back(k);
-      blocks_.clear();
-      indices_at_least(bhi, top, b0, b1, blocks_);
-      for (const int q : blocks_) indices_at_least(hi, top, 8 * q, 8 * q + 8, cand);
-      for (int k = t; k < se; ++k)
-        if (hi[k] >= top) cand.push_back(k);
+      detail::indices_at_least(hi, top, sb, se, cand);
       int best = cand.front();
       if (cand.size() > 1) {
         float bc = -kInf;
@@ -259,7 +184,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
           }
         }
       }
-      sel_.push_back(2 * best + 1);
+      pick(best, true);
       suppress(best - hw, best + hw);
     }
     if (max_surfaces <= 0) continue;
@@ -274,7 +199,26 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
         if (!picked[i]) cand.push_back(i);
       }
     }
-    // Exact c of each; kept when below the threshold.
+    // When the sector's candidates are no more than its limit, every one that no other candidate's pick
+    // can suppress (none within the spacing) and whose bound puts it surely below the threshold is picked
+    // whatever the order: no exact c for those.
+    const int sp = cfg_.surface_spacing;
+    if (int(cand.size()) <= max_surfaces) {
+      size_t m = 0;
+      const size_t nc = cand.size();
+      for (size_t k = 0; k < nc; ++k) {
+        const int i = cand[k];
+        const bool near = (k > 0 && i - cand[k - 1] <= sp) || (k + 1 < nc && cand[k + 1] - i <= sp);
+        if (!near && (sure[i >> 6] >> (i & 63) & 1)) {
+          pick(i, false);
+          suppress(i - sp, i + sp);
+        } else {
+          cand[m++] = i;
+        }
+      }
+      cand.resize(m);
+    }
+    // Exact c of the others; kept when below the threshold.
     auto& sc = surface_c_;
     sc.resize(size_t(n));
     size_t m = 0;
@@ -285,10 +229,10 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     }
     cand.resize(m);
     std::sort(cand.begin(), cand.end(), [&](int a, int b) { return sc[a] < sc[b] || (sc[a] == sc[b] && a < b); });
-    int surfaces = 0;
+    int surfaces = 0;  // (the direct picks above only happen when the limit cannot be reached)
     for (const int i : cand) {
       if (picked[i]) continue;
-      sel_.push_back(2 * i);
+      pick(i, false);
       suppress(i - cfg_.surface_spacing, i + cfg_.surface_spacing);
       if (++surfaces == max_surfaces) break;
     }
@@ -308,29 +252,60 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
         C += d * d.transpose();
       }
       C /= double(run.size());
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(C);
-      const double l0 = std::max(es.eigenvalues()[0], 0.0), l1 = es.eigenvalues()[1];
-      if (std::sqrt(l0) <= cfg_.line_max_rms_m && l1 >= cfg_.line_min_ratio * std::max(l0, 1e-12)) {
+      // A line when sqrt(l0) <= rms and l1 >= ratio l0 (l0 <= l1 the eigenvalues, l0 clamped at 0 and 1e-12).
+      // The test is monotone (harder as l0 grows or l1 shrinks), so the closed-form eigenvalues decide it
+      // whenever it comes out the same at both ends of their error interval (+-1e-12 |C|, hundreds of times
+      // the backward errors of either computation); otherwise Eigen's solver (the plain rules') decides.
+      auto line = [&](double e0, double e1) {
+        const double l0 = std::max(e0, 0.0);
+        return std::sqrt(l0) <= cfg_.line_max_rms_m && e1 >= cfg_.line_min_ratio * std::max(l0, 1e-12);
+      };
+      const double a = C(0, 0), b = C(0, 1), c = C(1, 1);
+      const double t = 0.5 * (a + c), h = 0.5 * (a - c), d = std::sqrt(h * h + b * b);
+      const double e0 = t - d, e1 = t + d, tol = 1e-12 * (std::abs(a) + std::abs(b) + std::abs(c)) + 1e-300;
+      // (monotone needs ratio >= 0; otherwise always the solver)
+      const bool finite = std::isfinite(e0) && std::isfinite(e1) && cfg_.line_min_ratio >= 0;
+      bool is_line = finite && line(e0 + tol, e1 - tol);
+      if (!is_line && (!finite || line(e0 - tol, e1 + tol))) {
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(C);
+        is_line = line(es.eigenvalues()[0], es.eigenvalues()[1]);
+      }
+      if (is_line) {
         const int32_t g = out_.num_groups++;
         for (int o : run) out_.group[o] = g;
       }
     }
     run.clear();
   };
-  std::sort(sel_.begin(), sel_.end());  // the picks in column order (not a scan of all n points)
+  sel_.clear();  // the picks in column order, as 2 * index + (1 for a corner)
+  for (size_t q = 0; q < words; ++q)
+    for (uint64_t b = feat[q]; b; b &= b - 1) {
+      const int i = int(q * 64) + __builtin_ctzll(b);
+      sel_.push_back(2 * i + int(corner_bit[q] >> (i & 63) & 1));
+    }
   const bool has_t = w.t.size() == w.x.size();
   const float max_gap2 = float(cfg_.group_max_gap_m * cfg_.group_max_gap_m);
-  for (const int code : sel_) {
-    const size_t src = begin + size_t(code >> 1);
-    const bool corner = code & 1;
-    const int o = int(out_.x.size());
+  // The picks' output first (independent iterations, written in place), then the runs.
+  const size_t o0 = out_.x.size(), m = sel_.size();
+  out_.x.resize(o0 + m);
+  out_.y.resize(o0 + m);
+  out_.kind.resize(o0 + m);
+  out_.group.resize(o0 + m, -1);
+  out_.t.resize(o0 + m);
+  out_.source.resize(o0 + m);
+  for (size_t k = 0; k < m; ++k) {
+    const int code = sel_[k];
+    const size_t src = begin + size_t(code >> 1), o = o0 + k;
     const Eigen::Vector3f q = R_ * Eigen::Vector3f(w.x[src], w.y[src], w.z[src]);
-    out_.x.push_back(q.x());
-    out_.y.push_back(q.y());
-    out_.kind.push_back(corner ? kCorner : kSurface);
-    out_.group.push_back(-1);
-    out_.t.push_back(has_t ? w.t[src] : 0.f);
-    out_.source.push_back(int32_t(src));
+    out_.x[o] = q.x();
+    out_.y[o] = q.y();
+    out_.kind[o] = code & 1 ? kCorner : kSurface;
+    out_.t[o] = has_t ? w.t[src] : 0.f;
+    out_.source[o] = int32_t(src);
+  }
+  for (size_t k = 0; k < m; ++k) {
+    const bool corner = sel_[k] & 1;
+    const int o = int(o0 + k);
     if (corner) {
       close_run();
       continue;

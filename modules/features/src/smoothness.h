@@ -34,7 +34,7 @@ struct RingRules {
 // Buffers kept from ring to ring and scan to scan (no allocation once they have grown).
 struct RingScratch {
   std::vector<float>& w;      // hw-point block sums of x, y, z
-  std::vector<int32_t>& brk;  // column breaks between neighbours, and their hw-pair block sums
+  std::vector<uint64_t>& brk;  // column breaks between neighbours as bits, and broken windows as bits
 };
 
 // The smoothness of point i (hw <= i < n - hw) by the plain rules: LOAM's c = |sum_j (X_j - X_i)| /
@@ -58,12 +58,18 @@ inline float exact_smoothness(const RingIn& in, int hw, int i) {
 //    bounds hold the exact c_i (where the bound could not decide the threshold); -inf / -inf otherwise;
 //  - bit i of `surface` (n + 64 bits, zeroed by the caller) is set when it may be a surface candidate (its
 //    lower bound is below the surface threshold: the caller computes c exactly and keeps it when c <
-//    threshold).
+//    threshold); bit i of `surface_sure` (zeroed by the caller) when its upper bound is below the threshold
+//    (c_i surely is).
 // Occlusion boundaries (LOAM's unreliable points) are appended to `occlusions` as +(j + 1) when the far
 // side begins at j + 1 (points j+1 .. j+hw are unusable) and -(j + 1) when it ends at j (j-hw+1 .. j);
 // the caller applies them (they only take candidates away).
 void smoothness(const RingIn& in, const RingRules& rules, RingScratch& scratch, float* corner_lo, float* corner_hi,
-                uint64_t* surface, std::vector<int>& occlusions);
+                uint64_t* surface, uint64_t* surface_sure, std::vector<int>& occlusions);
+
+// Sector scans of the corner bounds, with the same instruction set as the pass: the largest of v[b .. e)
+// (-inf when empty; v holds no NaN), and the indices i in [b, e) with v[i] >= t appended in increasing order.
+float range_max(const float* v, int b, int e);
+void indices_at_least(const float* v, float t, int b, int e, std::vector<int>& out);
 
 // The dispatch's choice, for the benchmark and the notes: "avx2", "sse2" or "generic".
 const char* smoothness_isa();

@@ -203,6 +203,13 @@ TEST(Features, ReferenceEqualWithOtherOptionsAndBeamCounts) {
   expect_same(s, cfg([](FeatureConfig& c) { c.corner_threshold = 0.0; c.surface_threshold = 1.0; }), "every point both");
   expect_same(s, cfg([](FeatureConfig& c) { c.min_range_m = 3.0; c.max_range_m = 7.0; }), "range window");
   expect_same(s, cfg([](FeatureConfig& c) { c.occlusion_ratio = 0.01; c.parallel_ratio = 0.005; }), "strict rules");
+  // Surface picks without exact c (isolated candidates below the limit) and with it (spacing conflicts,
+  // the limit reached); line groups whose test is close to the thresholds (closed form vs Eigen's solver).
+  expect_same(s, cfg([](FeatureConfig& c) { c.surface_threshold = 0.003; c.surface_spacing = 4; }), "wide spacing");
+  expect_same(s, cfg([](FeatureConfig& c) { c.surface_threshold = 0.003; c.max_surfaces_per_sector = 3; }), "few surfaces");
+  expect_same(s, cfg([](FeatureConfig& c) { c.surface_spacing = -1; }), "no spacing");
+  expect_same(s, cfg([](FeatureConfig& c) { c.line_max_rms_m = 0.002; c.line_min_ratio = 500; }), "tight lines");
+  expect_same(s, cfg([](FeatureConfig& c) { c.min_group_points = 2; c.line_min_ratio = 1.0; c.line_max_rms_m = 1.0; }), "loose lines");
 }
 
 // Hand-made rings: ties, gaps, occlusion steps at the ring ends, NaN and zero ranges, rings shorter than the

@@ -68,14 +68,14 @@ class FeatureExtractor {
   Eigen::Matrix3f R_ = Eigen::Matrix3f::Identity();
   // Per-ring buffers, kept from scan to scan (src/smoothness.h).
   std::vector<float> corner_lo_, corner_hi_;  // bounds on c of corner candidates, -inf otherwise
-  std::vector<float> blo_, bhi_;              // their largest values per 8-point block
   std::vector<uint64_t> surface_;             // bit i: point i may be a surface candidate
+  std::vector<uint64_t> surface_sure_;        // bit i: point i surely is one (c below the threshold)
   std::vector<float> surface_c_;              // exact c of the sector's surface candidates
   std::vector<uint8_t> picked_;                  // suppressed by a pick or an occlusion boundary
-  std::vector<uint8_t> dirty_;                   // blocks whose maxima are out of date
-  std::vector<int> occ_, surf_, sel_, run_, blocks_;
+  std::vector<uint64_t> pick_bits_;              // the ring's picks (features, corners) as bits
+  std::vector<int> occ_, surf_, sel_, run_;
   std::vector<float> ring_w_;
-  std::vector<int32_t> ring_brk_;
+  std::vector<uint64_t> ring_brk_;
 };
 
 }  // namespace fploc::feat
