@@ -100,6 +100,9 @@ struct GridLocalizer::Impl {
   Pose2 pose;
   double sxy = 0, syaw = 0;  // current uncertainty of `pose`
   std::optional<Pose2> last_odom;
+  std::optional<Pose2> raw_inc;  // this scan's odometry increment as measured (before the calibration)
+  OdometryCalibration calib;
+  std::optional<Pose2> prev_fit;  // the previous scan's pose when it was a good fit (calibration pairs)
   int poor_run = 0;
   bool first = true;
   // Re-acquisition hypotheses (while LOST): each tracked by odometry and its own local fit.
@@ -128,6 +131,7 @@ struct GridLocalizer::Impl {
       : df(std::move(f)), grid(df->data().data(), 0, df->height(), 0, df->width()), interp(grid) {
     pyramid = std::make_unique<ScorePyramid>(*df, c.score_sigma_m, c.search_levels);
     cfg = c;
+    calib = OdometryCalibration(c.calibration);
   }
 };
 
@@ -143,6 +147,7 @@ void GridLocalizer::set_initial_pose(const Pose2& pose) {
   impl_->sxy = cfg_.initial_sigma_xy_m;
   impl_->syaw = cfg_.initial_sigma_yaw_rad;
   impl_->last_odom.reset();
+  impl_->prev_fit.reset();
   impl_->poor_run = 0;
   impl_->first = true;
   have_pose_ = true;
@@ -277,7 +282,25 @@ GridLocalizer::Impl::Fit GridLocalizer::Impl::fit(const std::vector<Eigen::Vecto
   return f;
 }
 
-GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, const std::optional<Pose2>& odom) {
+GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points, const std::optional<Pose2>& odom) {
+  Impl& m = *impl_;
+  m.raw_inc.reset();
+  GridResult res = step(points, odom);
+  // Calibration: a pair of consecutive good fits (>= min_inlier_ratio, from tracking; a confirmed
+  // re-acquisition starts a new pair but is not one) measures the wheels' error over that step.
+  const bool good = res.status == GridStatus::kOk && res.inlier_ratio >= cfg_.min_inlier_ratio;
+  if (cfg_.calibrate_odometry && good && !res.reacquired && m.prev_fit && m.raw_inc)
+    m.calib.observe(*m.raw_inc, between(*m.prev_fit, res.pose));
+  if (good) m.prev_fit = res.pose;
+  else m.prev_fit.reset();
+  res.odom_bias_rad_per_m = m.calib.bias_rad_per_m();
+  res.odom_turn_scale_error = m.calib.turn_scale_error();
+  res.odom_scale = m.calib.scale();
+  res.odom_pairs = m.calib.pairs();
+  return res;
+}
+
+GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, const std::optional<Pose2>& odom) {
   GridResult res;
   if (!have_pose_) return res;
   Impl& m = *impl_;
@@ -289,7 +312,8 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
   double qxy = 0, qyaw = 0;
   std::optional<Pose2> inc;
   if (odom && m.last_odom) {
-    inc = between(*m.last_odom, *odom);
+    m.raw_inc = between(*m.last_odom, *odom);
+    inc = cfg_.calibrate_odometry ? m.calib.correct(*m.raw_inc) : *m.raw_inc;
     const double step = std::hypot(inc->x, inc->y), turn = std::abs(wrap_angle(inc->yaw));
     pred = compose(m.pose, *inc);
     // After a fit: base + motion (the window around a fresh fit); while dead-reckoning: the motion only.
@@ -391,9 +415,10 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
     // POOR: +-window_sigmas sigma of the dead-reckoned pose; LOST: the whole re-acquisition window (a LOST
     // tracker's own uncertainty is no longer to be trusted: it may have been confirmed at a wrong place).
     const bool lost = m.poor_run >= cfg_.lost_after;
-    const double wide_xy = lost ? cfg_.reacquire_xy_m
+    const bool whole = lost && !cfg_.lost_window_from_sigma;
+    const double wide_xy = whole ? cfg_.reacquire_xy_m
                                 : std::clamp(cfg_.window_sigmas * sxy, 2 * df.resolution(), cfg_.reacquire_xy_m);
-    const double wide_yaw = lost ? cfg_.reacquire_yaw_rad
+    const double wide_yaw = whole ? cfg_.reacquire_yaw_rad
                                  : std::clamp(cfg_.window_sigmas * syaw, cfg_.search_yaw_step_rad, cfg_.reacquire_yaw_rad);
     res.search_xy_m = wide_xy;
     res.search_yaw_rad = wide_yaw;

@@ -24,6 +24,7 @@
 
 #include "fploc/core/pose.h"
 #include "fploc/laser2d/distance_field.h"
+#include "fploc/laser2d/odometry_calibration.h"
 
 namespace fploc::laser2d {
 
@@ -104,11 +105,22 @@ struct GridLocalizerConfig {
   // ... also once LOST (lost_after POOR scans): off — after a long stretch the map does not explain, a weak fit
   // within the grown gate is as likely a wrong place (intel scan 799: 1.5 m off with 41 % inliers).
   bool follow_weak_when_lost = true;
+  // LOST (lost_after POOR scans) searches +-window_sigmas sigma of the dead-reckoned pose (capped at
+  // reacquire_xy_m / reacquire_yaw_rad) as POOR does, the sigma growing with the motion since the last fit: with
+  // the calibrated odometry the dead-reckoned pose stays near the truth through unmapped ground, and a wider
+  // window only adds wrong places (intel scan 805: a lock 3.8 m off in ground the map does not cover, from a
+  // dead-reckoned pose 1.5 m off). Off: LOST searches the whole re-acquisition window (the earlier behaviour).
+  bool lost_window_from_sigma = false;
   int reacquire_after = 1;  // POOR scans in a row after which a jump needs confirmation
   int reacquire_candidates = 4, max_hypotheses = 8, confirm_scans = 5;
   double confirm_margin = 0.1;
   double confirm_inlier_ratio = 0.7;  // mean inlier share a hypothesis needs to be taken (a jump needs more than tracking)
   double field_max_m = 1.0;  // distance field truncation (the map's DistanceField)
+  // Online odometry calibration (odometry_calibration.h): every pair of consecutive scans both fitted with
+  // >= min_inlier_ratio calibrates the wheels (yaw bias per metre, turn scale, translation scale); every
+  // prediction (tracking, dead reckoning, hypotheses) uses the corrected increment. Off: the raw wheels.
+  bool calibrate_odometry = true;
+  OdometryCalibrationConfig calibration;
 };
 
 enum class GridStatus { kOk = 0, kPoor = 1, kLost = 2, kNotInitialised = 3 };
@@ -126,6 +138,9 @@ struct GridResult {
   int refined = 0;  // candidates refined
   int hypotheses = 0;      // re-acquisition hypotheses tracked after this scan (while LOST)
   bool reacquired = false;  // this scan ended LOST with a confirmed hypothesis
+  // The odometry calibration after this scan (yaw bias [rad/m], turn scale error, translation scale, pairs used).
+  double odom_bias_rad_per_m = 0, odom_turn_scale_error = 0, odom_scale = 1;
+  int odom_pairs = 0;
 };
 
 class GridLocalizer {
@@ -141,6 +156,7 @@ class GridLocalizer {
   const GridLocalizerConfig& config() const { return cfg_; }
 
  private:
+  GridResult step(const std::vector<Eigen::Vector2d>& points, const std::optional<Pose2>& odom);
   struct Impl;
   std::unique_ptr<Impl> impl_;
   GridLocalizerConfig cfg_;
