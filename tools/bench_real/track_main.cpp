@@ -57,6 +57,8 @@ int main(int argc, char** argv) {
   app.add_option("--prior-bias", c.calibration.prior_bias_m2, "calibration ridge on the yaw bias [m^2]");
   app.add_option("--prior-turn", c.calibration.prior_turn_rad2, "calibration ridge on the turn scale [rad^2]");
   app.add_option("--prior-scale", c.calibration.prior_scale_m2, "calibration ridge on the scale [m^2]");
+  app.add_option("--reacquire-search-every-m", c.reacquire_search_every_m, "wide re-acquisition search after this much travel (0: every scan)");
+  app.add_option("--confirm-within-sigmas", c.confirm_within_sigmas, "a hypothesis is taken within this many sigma of the dead-reckoned pose (0: off)");
   CLI11_PARSE(app, argc, argv);
   namespace cm = fploc::carmen;
   namespace l2 = fploc::laser2d;
@@ -88,7 +90,7 @@ int main(int argc, char** argv) {
                       {"err_yaw_deg", fploc::wrap_angle(r.pose.yaw - s.pose.theta) * 180 / M_PI},
                       {"status", int(r.status)}, {"inlier_ratio", r.inlier_ratio}, {"window_m", r.search_xy_m},
                       {"window_deg", r.search_yaw_rad * 180 / M_PI}, {"sigma_xy_m", std::sqrt(r.covariance(0, 0))},
-                      {"hypotheses", r.hypotheses}, {"ms", ms},
+                      {"hypotheses", r.hypotheses}, {"ms", ms}, {"wide_search", r.wide_search},
                       {"odom_bias_deg_per_m", r.odom_bias_rad_per_m * 180 / M_PI},
                       {"odom_turn_scale_error", r.odom_turn_scale_error}, {"odom_scale", r.odom_scale}});
       if (odom) rows.back().update({{"odom_x", odom->x}, {"odom_y", odom->y}, {"odom_yaw", odom->yaw}});

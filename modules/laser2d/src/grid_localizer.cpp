@@ -105,6 +105,8 @@ struct GridLocalizer::Impl {
   std::optional<Pose2> prev_fit;  // the previous scan's pose when it was a good fit (calibration pairs)
   int poor_run = 0;
   bool first = true;
+  // Motion since the last wide re-acquisition search (negative: none yet in this episode).
+  double search_moved_m = -1, search_turned_rad = 0;
   // Re-acquisition hypotheses (while LOST): each tracked by odometry and its own local fit.
   struct Hypothesis {
     Pose2 pose;
@@ -148,6 +150,7 @@ void GridLocalizer::set_initial_pose(const Pose2& pose) {
   impl_->syaw = cfg_.initial_sigma_yaw_rad;
   impl_->last_odom.reset();
   impl_->prev_fit.reset();
+  impl_->search_moved_m = -1;
   impl_->poor_run = 0;
   impl_->first = true;
   have_pose_ = true;
@@ -387,6 +390,7 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
         m.sxy = std::sqrt(std::max(f.cov(0, 0), f.cov(1, 1)));
         m.syaw = std::sqrt(f.cov(2, 2));
         m.poor_run = 0;
+        m.search_moved_m = -1;
         res.pose = f.est;
         res.status = GridStatus::kOk;
         res.covariance = f.cov;
@@ -423,8 +427,18 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
     res.search_xy_m = wide_xy;
     res.search_yaw_rad = wide_yaw;
     res.inlier_ratio = f.inlier_ratio;
-    // New hypotheses: the wide search's distinct candidates, each refined on its own.
-    {
+    // New hypotheses: the wide search's distinct candidates, each refined on its own (throttled by the motion
+    // since the last one).
+    if (inc && m.search_moved_m >= 0) {
+      m.search_moved_m += std::hypot(inc->x, inc->y);
+      m.search_turned_rad += std::abs(wrap_angle(inc->yaw));
+    }
+    const bool search_now = m.search_moved_m < 0 || m.search_moved_m >= cfg_.reacquire_search_every_m ||
+                            m.search_turned_rad >= cfg_.reacquire_search_every_rad;
+    if (search_now) {
+      m.search_moved_m = 0;
+      m.search_turned_rad = 0;
+      res.wide_search = true;
       SearchWindow win;
       win.center = pred;
       win.xy_m = wide_xy;
@@ -480,6 +494,7 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
         m.sxy = std::sqrt(std::max(strong->cov(0, 0), strong->cov(1, 1)));
         m.syaw = std::sqrt(strong->cov(2, 2));
         m.poor_run = 0;
+        m.search_moved_m = -1;
         res.pose = strong->est;
         res.status = GridStatus::kOk;
         res.covariance = strong->cov;
@@ -492,7 +507,16 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
       return a.hits != b.hits ? a.hits > b.hits : a.mean() > b.mean();
     });
     if (int(m.hyps.size()) > cfg_.max_hypotheses) m.hyps.resize(size_t(cfg_.max_hypotheses));
+    // A hypothesis is taken only where the calibrated dead reckoning can be (within confirm_within_sigmas of its
+    // grown uncertainty): a place the map explains as well but the odometry cannot have reached is a wrong lock.
+    auto agrees = [&](const Impl::Hypothesis& h) {
+      if (cfg_.confirm_within_sigmas <= 0) return true;
+      const double ex = h.pose.x - pred.x, ey = h.pose.y - pred.y, eyaw = wrap_angle(h.pose.yaw - pred.yaw);
+      return (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw) <=
+             cfg_.confirm_within_sigmas * cfg_.confirm_within_sigmas;
+    };
     if (!m.hyps.empty() && m.hyps[0].hits >= cfg_.confirm_scans && m.hyps[0].mean() >= cfg_.confirm_inlier_ratio &&
+        agrees(m.hyps[0]) &&
         (m.hyps.size() == 1 || m.hyps[1].hits < cfg_.confirm_scans - 1 ||
          m.hyps[0].mean() >= m.hyps[1].mean() + cfg_.confirm_margin)) {
       const Impl::Hypothesis h = m.hyps[0];
@@ -501,6 +525,7 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
       m.sxy = h.sxy;
       m.syaw = h.syaw;
       m.poor_run = 0;
+      m.search_moved_m = -1;
       res.pose = h.pose;
       res.status = GridStatus::kOk;
       res.covariance = Eigen::Vector3d(h.sxy * h.sxy, h.sxy * h.sxy, h.syaw * h.syaw).asDiagonal();
@@ -512,6 +537,7 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
     return res;
   }
   m.hyps.clear();
+  m.search_moved_m = -1;
 
   // 3. Tracking: the local fit around the prediction; a failed fit right after a good one is retried once in a
   // wider window (an odometry error beyond the window), taken only when the map supports it on its own.

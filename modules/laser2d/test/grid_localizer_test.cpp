@@ -316,3 +316,28 @@ TEST(GridLocalizer, CalibratedOdometryCarriesThroughUnmappedGround) {
   std::cerr << "raw: " << std::hypot(raw.x, raw.y) << " m " << raw.yaw * 180 / M_PI << " deg\n";
   EXPECT_GT(std::abs(raw.yaw), 15 * M_PI / 180) << "control: the raw odometry kept the yaw; the test does not test it";
 }
+
+// CPU while re-acquiring: the wide search runs again only after 0.5 m (or 15 deg) of motion since the last one;
+// at 10 cm per scan that is every fifth unexplained scan (freiburg-079's 10 Hz scans: 100-400 ms each before).
+// Control: with the throttle off it runs on every scan.
+int wide_searches(double every_m, int scans) {
+  const OccupancyGrid map = make_room(), other = make_room(true);
+  l2::GridLocalizerConfig c;
+  c.reacquire_search_every_m = every_m;
+  l2::GridLocalizer loc(std::make_shared<l2::DistanceField>(map, 1.0), c);
+  loc.set_initial_pose({1, 1, 0});
+  std::mt19937 rng(5);
+  EXPECT_EQ(loc.update(cast(map, {1, 1, 0}, rng), Pose2{0, 0, 0}).status, l2::GridStatus::kOk);
+  int n = 0;
+  for (int k = 1; k <= scans; ++k) {
+    const auto r = loc.update(cast(other, {1 + 0.1 * k, 1, 0}, rng), Pose2{0.1 * k, 0, 0});
+    EXPECT_NE(r.status, l2::GridStatus::kOk);
+    n += r.wide_search;
+  }
+  return n;
+}
+
+TEST(GridLocalizer, WideSearchWhileLostIsThrottledByMotion) {
+  EXPECT_LE(wide_searches(0.5, 20), 5);
+  EXPECT_GE(wide_searches(0, 20), 15) << "control: without the throttle (nearly) every scan searches";
+}
