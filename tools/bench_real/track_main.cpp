@@ -50,6 +50,15 @@ int main(int argc, char** argv) {
   app.add_option("--reacquire-strong-ratio", c.reacquire_strong_ratio, "re-acquiring: a fit inside the window with this inlier share ends it");
   app.add_option("--confirm-inlier-ratio", c.confirm_inlier_ratio, "mean inlier share to take a hypothesis");
   app.add_option("--reacquire-xy", c.reacquire_xy_m, "re-acquisition window [m]");
+  app.add_option("--calibrate-odometry", c.calibrate_odometry, "learn the wheels' yaw bias / turn scale / scale from good fits");
+  app.add_option("--calibration-memory", c.calibration.memory_m, "calibration forgetting distance [m]");
+  app.add_option("--lost-after", c.lost_after, "POOR scans before LOST");
+  app.add_option("--lost-window-from-sigma", c.lost_window_from_sigma, "LOST searches +-3 sigma of the dead-reckoned pose, not the whole window");
+  app.add_option("--prior-bias", c.calibration.prior_bias_m2, "calibration ridge on the yaw bias [m^2]");
+  app.add_option("--prior-turn", c.calibration.prior_turn_rad2, "calibration ridge on the turn scale [rad^2]");
+  app.add_option("--prior-scale", c.calibration.prior_scale_m2, "calibration ridge on the scale [m^2]");
+  app.add_option("--reacquire-search-every-m", c.reacquire_search_every_m, "wide re-acquisition search after this much travel (0: every scan)");
+  app.add_option("--confirm-within-sigmas", c.confirm_within_sigmas, "a hypothesis is taken within this many sigma of the dead-reckoned pose (0: off)");
   CLI11_PARSE(app, argc, argv);
   namespace cm = fploc::carmen;
   namespace l2 = fploc::laser2d;
@@ -81,7 +90,9 @@ int main(int argc, char** argv) {
                       {"err_yaw_deg", fploc::wrap_angle(r.pose.yaw - s.pose.theta) * 180 / M_PI},
                       {"status", int(r.status)}, {"inlier_ratio", r.inlier_ratio}, {"window_m", r.search_xy_m},
                       {"window_deg", r.search_yaw_rad * 180 / M_PI}, {"sigma_xy_m", std::sqrt(r.covariance(0, 0))},
-                      {"hypotheses", r.hypotheses}, {"ms", ms}});
+                      {"hypotheses", r.hypotheses}, {"ms", ms}, {"wide_search", r.wide_search},
+                      {"odom_bias_deg_per_m", r.odom_bias_rad_per_m * 180 / M_PI},
+                      {"odom_turn_scale_error", r.odom_turn_scale_error}, {"odom_scale", r.odom_scale}});
       if (odom) rows.back().update({{"odom_x", odom->x}, {"odom_y", odom->y}, {"odom_yaw", odom->yaw}});
     }
     std::cout << nlohmann::json{{"log", log_path}, {"map", map_path}, {"start", start},

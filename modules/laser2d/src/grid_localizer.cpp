@@ -100,8 +100,13 @@ struct GridLocalizer::Impl {
   Pose2 pose;
   double sxy = 0, syaw = 0;  // current uncertainty of `pose`
   std::optional<Pose2> last_odom;
+  std::optional<Pose2> raw_inc;  // this scan's odometry increment as measured (before the calibration)
+  OdometryCalibration calib;
+  std::optional<Pose2> prev_fit;  // the previous scan's pose when it was a good fit (calibration pairs)
   int poor_run = 0;
   bool first = true;
+  // Motion since the last wide re-acquisition search (negative: none yet in this episode).
+  double search_moved_m = -1, search_turned_rad = 0;
   // Re-acquisition hypotheses (while LOST): each tracked by odometry and its own local fit.
   struct Hypothesis {
     Pose2 pose;
@@ -128,6 +133,7 @@ struct GridLocalizer::Impl {
       : df(std::move(f)), grid(df->data().data(), 0, df->height(), 0, df->width()), interp(grid) {
     pyramid = std::make_unique<ScorePyramid>(*df, c.score_sigma_m, c.search_levels);
     cfg = c;
+    calib = OdometryCalibration(c.calibration);
   }
 };
 
@@ -143,6 +149,8 @@ void GridLocalizer::set_initial_pose(const Pose2& pose) {
   impl_->sxy = cfg_.initial_sigma_xy_m;
   impl_->syaw = cfg_.initial_sigma_yaw_rad;
   impl_->last_odom.reset();
+  impl_->prev_fit.reset();
+  impl_->search_moved_m = -1;
   impl_->poor_run = 0;
   impl_->first = true;
   have_pose_ = true;
@@ -277,7 +285,25 @@ GridLocalizer::Impl::Fit GridLocalizer::Impl::fit(const std::vector<Eigen::Vecto
   return f;
 }
 
-GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, const std::optional<Pose2>& odom) {
+GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points, const std::optional<Pose2>& odom) {
+  Impl& m = *impl_;
+  m.raw_inc.reset();
+  GridResult res = step(points, odom);
+  // Calibration: a pair of consecutive good fits (>= min_inlier_ratio, from tracking; a confirmed
+  // re-acquisition starts a new pair but is not one) measures the wheels' error over that step.
+  const bool good = res.status == GridStatus::kOk && res.inlier_ratio >= cfg_.min_inlier_ratio;
+  if (cfg_.calibrate_odometry && good && !res.reacquired && m.prev_fit && m.raw_inc)
+    m.calib.observe(*m.raw_inc, between(*m.prev_fit, res.pose));
+  if (good) m.prev_fit = res.pose;
+  else m.prev_fit.reset();
+  res.odom_bias_rad_per_m = m.calib.bias_rad_per_m();
+  res.odom_turn_scale_error = m.calib.turn_scale_error();
+  res.odom_scale = m.calib.scale();
+  res.odom_pairs = m.calib.pairs();
+  return res;
+}
+
+GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, const std::optional<Pose2>& odom) {
   GridResult res;
   if (!have_pose_) return res;
   Impl& m = *impl_;
@@ -289,7 +315,8 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
   double qxy = 0, qyaw = 0;
   std::optional<Pose2> inc;
   if (odom && m.last_odom) {
-    inc = between(*m.last_odom, *odom);
+    m.raw_inc = between(*m.last_odom, *odom);
+    inc = cfg_.calibrate_odometry ? m.calib.correct(*m.raw_inc) : *m.raw_inc;
     const double step = std::hypot(inc->x, inc->y), turn = std::abs(wrap_angle(inc->yaw));
     pred = compose(m.pose, *inc);
     // After a fit: base + motion (the window around a fresh fit); while dead-reckoning: the motion only.
@@ -363,6 +390,7 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
         m.sxy = std::sqrt(std::max(f.cov(0, 0), f.cov(1, 1)));
         m.syaw = std::sqrt(f.cov(2, 2));
         m.poor_run = 0;
+        m.search_moved_m = -1;
         res.pose = f.est;
         res.status = GridStatus::kOk;
         res.covariance = f.cov;
@@ -391,15 +419,26 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
     // POOR: +-window_sigmas sigma of the dead-reckoned pose; LOST: the whole re-acquisition window (a LOST
     // tracker's own uncertainty is no longer to be trusted: it may have been confirmed at a wrong place).
     const bool lost = m.poor_run >= cfg_.lost_after;
-    const double wide_xy = lost ? cfg_.reacquire_xy_m
+    const bool whole = lost && !cfg_.lost_window_from_sigma;
+    const double wide_xy = whole ? cfg_.reacquire_xy_m
                                 : std::clamp(cfg_.window_sigmas * sxy, 2 * df.resolution(), cfg_.reacquire_xy_m);
-    const double wide_yaw = lost ? cfg_.reacquire_yaw_rad
+    const double wide_yaw = whole ? cfg_.reacquire_yaw_rad
                                  : std::clamp(cfg_.window_sigmas * syaw, cfg_.search_yaw_step_rad, cfg_.reacquire_yaw_rad);
     res.search_xy_m = wide_xy;
     res.search_yaw_rad = wide_yaw;
     res.inlier_ratio = f.inlier_ratio;
-    // New hypotheses: the wide search's distinct candidates, each refined on its own.
-    {
+    // New hypotheses: the wide search's distinct candidates, each refined on its own (throttled by the motion
+    // since the last one).
+    if (inc && m.search_moved_m >= 0) {
+      m.search_moved_m += std::hypot(inc->x, inc->y);
+      m.search_turned_rad += std::abs(wrap_angle(inc->yaw));
+    }
+    const bool search_now = m.search_moved_m < 0 || m.search_moved_m >= cfg_.reacquire_search_every_m ||
+                            m.search_turned_rad >= cfg_.reacquire_search_every_rad;
+    if (search_now) {
+      m.search_moved_m = 0;
+      m.search_turned_rad = 0;
+      res.wide_search = true;
       SearchWindow win;
       win.center = pred;
       win.xy_m = wide_xy;
@@ -455,6 +494,7 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
         m.sxy = std::sqrt(std::max(strong->cov(0, 0), strong->cov(1, 1)));
         m.syaw = std::sqrt(strong->cov(2, 2));
         m.poor_run = 0;
+        m.search_moved_m = -1;
         res.pose = strong->est;
         res.status = GridStatus::kOk;
         res.covariance = strong->cov;
@@ -467,7 +507,16 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
       return a.hits != b.hits ? a.hits > b.hits : a.mean() > b.mean();
     });
     if (int(m.hyps.size()) > cfg_.max_hypotheses) m.hyps.resize(size_t(cfg_.max_hypotheses));
+    // A hypothesis is taken only where the calibrated dead reckoning can be (within confirm_within_sigmas of its
+    // grown uncertainty): a place the map explains as well but the odometry cannot have reached is a wrong lock.
+    auto agrees = [&](const Impl::Hypothesis& h) {
+      if (cfg_.confirm_within_sigmas <= 0) return true;
+      const double ex = h.pose.x - pred.x, ey = h.pose.y - pred.y, eyaw = wrap_angle(h.pose.yaw - pred.yaw);
+      return (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw) <=
+             cfg_.confirm_within_sigmas * cfg_.confirm_within_sigmas;
+    };
     if (!m.hyps.empty() && m.hyps[0].hits >= cfg_.confirm_scans && m.hyps[0].mean() >= cfg_.confirm_inlier_ratio &&
+        agrees(m.hyps[0]) &&
         (m.hyps.size() == 1 || m.hyps[1].hits < cfg_.confirm_scans - 1 ||
          m.hyps[0].mean() >= m.hyps[1].mean() + cfg_.confirm_margin)) {
       const Impl::Hypothesis h = m.hyps[0];
@@ -476,6 +525,7 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
       m.sxy = h.sxy;
       m.syaw = h.syaw;
       m.poor_run = 0;
+      m.search_moved_m = -1;
       res.pose = h.pose;
       res.status = GridStatus::kOk;
       res.covariance = Eigen::Vector3d(h.sxy * h.sxy, h.sxy * h.sxy, h.syaw * h.syaw).asDiagonal();
@@ -487,6 +537,7 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points_in, 
     return res;
   }
   m.hyps.clear();
+  m.search_moved_m = -1;
 
   // 3. Tracking: the local fit around the prediction; a failed fit right after a good one is retried once in a
   // wider window (an odometry error beyond the window), taken only when the map supports it on its own.

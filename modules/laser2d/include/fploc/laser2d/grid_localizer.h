@@ -24,6 +24,7 @@
 
 #include "fploc/core/pose.h"
 #include "fploc/laser2d/distance_field.h"
+#include "fploc/laser2d/odometry_calibration.h"
 
 namespace fploc::laser2d {
 
@@ -104,11 +105,35 @@ struct GridLocalizerConfig {
   // ... also once LOST (lost_after POOR scans): off — after a long stretch the map does not explain, a weak fit
   // within the grown gate is as likely a wrong place (intel scan 799: 1.5 m off with 41 % inliers).
   bool follow_weak_when_lost = true;
+  // LOST (lost_after POOR scans) searches +-window_sigmas sigma of the dead-reckoned pose (capped at
+  // reacquire_xy_m / reacquire_yaw_rad) as POOR does, the sigma growing with the motion since the last fit: with
+  // the calibrated odometry the dead-reckoned pose stays near the truth through unmapped ground, and a wider
+  // window only adds wrong places (intel scan 805: a lock 3.8 m off in ground the map does not cover, from a
+  // dead-reckoned pose 1.5 m off). Off: LOST searches the whole re-acquisition window (the earlier behaviour).
+  bool lost_window_from_sigma = false;
+  // CPU while re-acquiring: the wide search (+-10 m / +-180 deg: 100-400 ms on the Radish logs) proposes new
+  // hypotheses only after the robot has moved reacquire_search_every_m or turned reacquire_search_every_rad since
+  // the last one (a scan from nearly the same pose proposes the same places); the hypotheses already held and the
+  // fit around the dead-reckoned pose are still tried on every scan. 0 (default): every scan. Measured with 0.5 m /
+  // 15 deg (fploc-real-track, covered ATE cm / ms per scan): freiburg-079 23.5 / 38.1 -> 39.0 / 10.6, fhw 5.9 /
+  // 35.9 -> 5.9 / 25.2, csail 4.3 / 26.8 -> 4.3 / 20.7, intel and aces unchanged (9.9, 7.4): the CPU bound costs
+  // freiburg-079 one more wrong lock in ground the map does not cover (scans 4440-4605), so it is off.
+  double reacquire_search_every_m = 0, reacquire_search_every_rad = 15.0 * M_PI / 180;
   int reacquire_after = 1;  // POOR scans in a row after which a jump needs confirmation
   int reacquire_candidates = 4, max_hypotheses = 8, confirm_scans = 5;
   double confirm_margin = 0.1;
+  // ... and lies within this many sigma (Mahalanobis, x y yaw) of the dead-reckoned pose and its grown
+  // uncertainty (0, default: no such check). Measured with 3: freiburg-079 23.5 -> 173.3 cm (after the wrong
+  // near-fit at scan 4545 the dead-reckoned pose itself is wrong and the check keeps out the right place); the
+  // other four logs unchanged.
+  double confirm_within_sigmas = 0;
   double confirm_inlier_ratio = 0.7;  // mean inlier share a hypothesis needs to be taken (a jump needs more than tracking)
   double field_max_m = 1.0;  // distance field truncation (the map's DistanceField)
+  // Online odometry calibration (odometry_calibration.h): every pair of consecutive scans both fitted with
+  // >= min_inlier_ratio calibrates the wheels (yaw bias per metre, turn scale, translation scale); every
+  // prediction (tracking, dead reckoning, hypotheses) uses the corrected increment. Off: the raw wheels.
+  bool calibrate_odometry = true;
+  OdometryCalibrationConfig calibration;
 };
 
 enum class GridStatus { kOk = 0, kPoor = 1, kLost = 2, kNotInitialised = 3 };
@@ -121,11 +146,15 @@ struct GridResult {
   double inlier_ratio = 0, rms_m = 0;
   double search_xy_m = 0, search_yaw_rad = 0;  // the window searched
   int candidates = 0;
+  bool wide_search = false;  // the wide re-acquisition search ran on this scan
   double score = 0;  // the best candidate's correlative score (0..1, prior-weighted)
   int iterations = 0;
   int refined = 0;  // candidates refined
   int hypotheses = 0;      // re-acquisition hypotheses tracked after this scan (while LOST)
   bool reacquired = false;  // this scan ended LOST with a confirmed hypothesis
+  // The odometry calibration after this scan (yaw bias [rad/m], turn scale error, translation scale, pairs used).
+  double odom_bias_rad_per_m = 0, odom_turn_scale_error = 0, odom_scale = 1;
+  int odom_pairs = 0;
 };
 
 class GridLocalizer {
@@ -141,6 +170,7 @@ class GridLocalizer {
   const GridLocalizerConfig& config() const { return cfg_; }
 
  private:
+  GridResult step(const std::vector<Eigen::Vector2d>& points, const std::optional<Pose2>& odom);
   struct Impl;
   std::unique_ptr<Impl> impl_;
   GridLocalizerConfig cfg_;
