@@ -7,17 +7,19 @@
 // out, so the patch "under the robot" cannot be fitted on its own; what separates the two surfaces is where
 // they are seen: the ramp in some azimuth sectors, the floor or landing in others.
 //
-// So: the returns near the fitted plane are split into cells (azimuth sector x horizontal-distance band), each
-// fits its own plane (a "sector" below). When
-// all sectors agree (a level floor, the paper's sequences) nothing changes. When they split into two groups
-// whose normals differ by more than kKinkDeg (and 3 sigmas; at least two sectors each), each group's pooled returns give a plane, and:
-//  - F, the group whose normal is nearest the last scan's ground carried by the gyro (the same surface as
-//    before), and O, the sectors kinked against it;
-//  - the height (Plane::under_m) is the distance to the surface under the robot: of the two, the one on the
-//    sensor's side of the line where the two planes meet; with one surface seen, F when the ring fit is off it
-//    (a compromise over F and a surface too sparse to fit: the landing far ahead of a ramp's head);
-//  - the attitude keeps the ring fit's plane (tried: F's; it toggled the attitude between the level floor
-//    beside a ramp and the ceiling over it, and the slope estimate lost 1 deg).
+// So (with a gyro; without one the ring fit stays as it is): the returns near the fitted plane are split into
+// cells (azimuth sector x horizontal-distance band, "sectors" below), each fits its own plane (Tukey IRLS from
+// the ring fit's plane, the cut-off shrinking). Then:
+//  - F, the sectors on the surface followed since the last scans (the last F's normal carried by the gyro);
+//    when it has left the view (past a ramp's head), the surface of the largest sector if others agree;
+//    O, the sectors kinked against F by more than kKinkDeg (and 3 sigmas);
+//  - the height (Plane::under_m) is the distance to the surface under the robot: of F and O, the one on the
+//    sensor's side of the line where the two planes meet (each group's sectors all on one side of it); F
+//    when that is unclear or O is missing;
+//  - where the ground gives the attitude (no ceiling, or one that disagrees with the ring fit), F's plane
+//    replaces the ring fit, so that GravityFusion sees one surface (its own rotation) or a clean step to
+//    another, never a compromise sliding between them. With all sectors on the ring fit's plane (a level
+//    floor, the paper's sequences) nothing changes.
 // Said in status_text. Transport-free, part of Segmenter::process.
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -55,10 +57,9 @@ struct Group {
 void Segmenter::split_ground_at_kink(int64_t t) {
   Plane& g = out_.ground;
   g.under_m = 0;
-  if (!g.found || lower_.n < 100) {
-    follow_t_ = 0;  // nothing followed
-    return;
-  }
+  // The followed surface is carried from scan to scan by the gyro: without one, the ring fit as it is.
+  if (!cfg_.imu_attitude || !fusion_.has_gyro()) return;
+  if (!g.found || lower_.n < 100) return;  // (the followed surface is kept for up to 1 s)
   const Eigen::Vector3f n0 = g.coeffs.head<3>().cast<float>();
   const float d0 = float(g.coeffs[3]);
   const Eigen::Vector3d up = g.coeffs.head<3>();  // the ground's normal points up (into the room)
@@ -112,11 +113,9 @@ void Segmenter::split_ground_at_kink(int64_t t) {
   }
   // The ground to follow: the last scan's, carried by the gyro.
   Eigen::Vector3d prev = up;
-  if (follow_t_ != 0 && t - follow_t_ < 1'000'000) {
-    prev = follow_up_;
-    Eigen::Matrix3d R;
-    if (fusion_.rotation(follow_t_, t, deskew_.bias(), &R)) prev = (R.transpose() * prev).normalized();
-  }
+  Eigen::Matrix3d R;
+  if (follow_t_ != 0 && t - follow_t_ < 1'000'000 && fusion_.rotation(follow_t_, t, deskew_.bias(), &R))
+    prev = (R.transpose() * follow_up_).normalized();
   // Until a surface is found below: the ring fit's.
   follow_up_ = up;
   follow_t_ = t;
@@ -133,6 +132,19 @@ void Segmenter::split_ground_at_kink(int64_t t) {
   };
   for (int s = 0; s < kSectors; ++s)
     if (ok[s] && angle(spl[s].head<3>(), prev) < kFollowDeg * k::kDeg) pool(F, s);
+  if (F.sectors < 2 || F.m.w < 4 * kMinSectorPoints) {
+    // The surface seen before has left the view (past a ramp's head): the surface of the largest sector, if
+    // others agree with it.
+    int big = -1;
+    for (int s = 0; s < kSectors; ++s)
+      if (ok[s] && (big < 0 || sm[s].w > sm[big].w)) big = s;
+    F = Group{};
+    if (big >= 0) {
+      prev = spl[big].head<3>();
+      for (int s = 0; s < kSectors; ++s)
+        if (ok[s] && angle(spl[s].head<3>(), prev) < kFollowDeg * k::kDeg) pool(F, s);
+    }
+  }
   if (F.sectors < 2 || F.m.w < 4 * kMinSectorPoints || !F.m.plane(ref, -up, F.pl)) return;  // the ring fit as it is
   follow_up_ = F.pl.head<3>();
   int seed = -1;
@@ -174,9 +186,23 @@ void Segmenter::split_ground_at_kink(int64_t t) {
   followed.coeffs = F.pl;
   quality(lower_, followed);
   if (followed.inliers < scale_.min_plane_inliers) return;  // too little of it: the ring fit as it is
-  // The attitude keeps the ring fit (GravityFusion tells its steps from the sensor's rotation); the height is
-  // the distance to the surface under the robot.
-  g.under_m = under == 1 ? O.pl[3] : F.pl[3];
+  // The height is the distance to the surface under the robot. Where the ground gives the attitude (no
+  // ceiling, or one that disagrees with the ring fit: AttitudeHeight then takes the ground), the followed
+  // surface replaces the ring fit, so that GravityFusion sees one surface (its own rotation) or a clean step
+  // to another, never a compromise sliding between them. Where the ceiling agrees with the ring fit, the ring
+  // fit stays (tried: always F; at a ramp's foot F is the level floor beside the ramp while the ceiling follows
+  // the ramp, the attitude source toggled between them and the slope estimate lost 1 deg).
+  const bool ground_attitude =
+      !out_.ceiling.found ||
+      angle(-out_.ceiling.coeffs.head<3>(), up) > cfg_.attitude_consistency_deg * k::kDeg;
+  if (ground_attitude) {
+    const double under_d = under == 1 ? O.pl[3] : 0.0;
+    g = followed;
+    g.found = true;
+    g.under_m = under_d;
+  } else {
+    g.under_m = under == 1 ? O.pl[3] : F.pl[3];
+  }
   const double kink = O.sectors > 0 ? angle(F.pl.head<3>(), O.pl.head<3>()) : 0.0;
   char buf[240];
   if (O.sectors > 0)
