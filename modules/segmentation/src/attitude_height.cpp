@@ -228,7 +228,7 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
       measured = true;
     }
   } else if (g && (ground_level || !have_prev_z_)) {
-    out.z = out.ground.distance();
+    out.z = out.ground.height();  // the surface under the robot (at a ramp's foot or head, ground_kink.cpp)
     out.z_sigma = out.ground.d_sigma;
     out.z_source = HeightSource::kGround;
     measured = true;

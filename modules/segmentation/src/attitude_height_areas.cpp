@@ -217,7 +217,7 @@ void AttitudeHeight::area_z(Segmentation& out, const Eigen::Vector3d& up, bool g
     }
   }
   if (g) {
-    accept_z(out, out.ground.distance(), out.ground.d_sigma, HeightSource::kGround);
+    accept_z(out, out.ground.height(), out.ground.d_sigma, HeightSource::kGround);
   } else {
     predict_z(out);
   }

@@ -156,6 +156,8 @@ const Segmentation& Segmenter::process(const Scan& scan) {
   // else around the prior: a sloped ceiling patch taken as the ceiling must not drag the floor's gate along.
   const double ceiling_vs_prior = std::acos(std::clamp(up.dot(init_up.normalized()), -1.0, 1.0));
   fit_ground(ceiling_vs_prior < k::kCeilingPriorAgreeDeg * k::kDeg ? up : init_up.normalized());
+  const int64_t t_mid = scan.utime + std::llround(out_.attitude_t * 1e6);
+  split_ground_at_kink(t_mid);
 
   if (height_.has_areas() && upper_.p.size() != upper_.size()) upper_.fill_points();  // the area census reads p
   const Eigen::Vector3d plane_up = height_.update(out_, imu, &upper_);

@@ -48,7 +48,8 @@ constexpr double kMinBeyondRatio = 1e-3;    // guards 1 / max_beyond_ratio
 // ---- acceptance of planes (segmenter.cpp) ----
 constexpr double kMinCeilingDistM = 0.2;    // a ceiling closer than this to the sensor is not one
 constexpr double kMinGroundDistM = 0.1;
-constexpr double kMaxGroundTiltDeg = 5.0;   // ground normal vs the ceiling's (or prior) up
+constexpr double kMaxGroundTiltDeg = 5.0;
+constexpr double kKinkFitOffDeg = 0.3;       // ground_kink.cpp: the ring fit this far off the followed surface: replaced   // ground normal vs the ceiling's (or prior) up
 constexpr double kCeilingPriorAgreeDeg = 2.0;  // ceiling this close to the prior: the ground is fitted around it
 
 // ---- gravity fusion (gravity_fusion.cpp) ----

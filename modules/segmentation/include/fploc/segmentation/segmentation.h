@@ -29,6 +29,10 @@ struct Plane {
   double tilt_sigma = 0.0;  // 1-sigma of the normal direction [rad] (from the inlier spread)
   double d_sigma = 0.0;     // 1-sigma of the distance [m]
   double distance() const { return coeffs[3]; }       // origin to plane [m] (n points away from it)
+  // Ground only: the sensor's height above the surface under it when the plane is another surface seen beside
+  // it (a ramp's foot or head, ground_kink.cpp); 0: the plane's own distance.
+  double under_m = 0.0;
+  double height() const { return under_m > 0 ? under_m : coeffs[3]; }
 };
 
 // Wall points, ring-major (scan row order), each ring in increasing destaggered column.

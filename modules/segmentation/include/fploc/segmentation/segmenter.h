@@ -67,6 +67,9 @@ class Segmenter {
   void quality(const Candidates& c, Plane& pl) const;
   void fit_ceiling(const Eigen::Vector3d& init_up, const Eigen::Vector3d& gate_up);
   void fit_ground(const Eigen::Vector3d& up);
+  // Two surfaces under the lower rings (a ramp's foot or head): the ground the attitude follows and the height
+  // above the one under the robot (ground_kink.cpp). t: the planes' time (mid-sweep).
+  void split_ground_at_kink(int64_t t);
   void select_walls(const Scan& scan, const Eigen::Vector3d& up);
   // The IMU's part of roll/pitch (segmenter_imu.cpp): gravity vs the planes' up, then the attitude moved from
   // mid-sweep to the scan's time with the gyro.
@@ -108,6 +111,9 @@ class Segmenter {
   // Plane tracking (priors for the next scan's fits and wall bounds).
   bool have_prev_ceiling_ = false, have_prev_ground_ = false;
   Eigen::Vector4d prev_ceiling_, prev_ground_;
+  // The ground surface followed across a kink (ground_kink.cpp): its normal at its mid-sweep time.
+  Eigen::Vector3d follow_up_ = Eigen::Vector3d::UnitZ();
+  int64_t follow_t_ = 0;
   Eigen::Vector3d accel_sum_ = Eigen::Vector3d::Zero();
   double accel_sq_ = 0;  // sum of |a|^2 (the spread: is the IMU measuring gravity alone?)
   int accel_n_ = 0;

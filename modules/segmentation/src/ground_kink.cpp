@@ -1,0 +1,221 @@
+// The ground at a kink (a ramp's foot or head): which returns go into the ground plane.
+//
+// Near a ramp's foot or head the lower rings see two surfaces: the ramp and the level floor or landing beside,
+// behind or ahead of it. The ring fit then settles on a compromise over both (a plane that is neither, tilted
+// by a fraction of the ramp's slope and moving in steps the gyro does not see), and its distance is the
+// sensor's height above no surface at all. The lowest ring of an OS-1 at 1.2 m reaches the floor only ~4 m
+// out, so the patch "under the robot" cannot be fitted on its own; what separates the two surfaces is where
+// they are seen: the ramp in some azimuth sectors, the floor or landing in others.
+//
+// So (with a gyro; without one the ring fit stays as it is): the returns near the fitted plane are split into
+// cells (azimuth sector x horizontal-distance band, "sectors" below), each fits its own plane (Tukey IRLS from
+// the ring fit's plane, the cut-off shrinking). Then:
+//  - F, the sectors on the surface followed since the last scans (the last F's normal carried by the gyro);
+//    when it has left the view (past a ramp's head), the surface of the largest sector if others agree;
+//    O, the sectors kinked against F by more than kKinkDeg (and 3 sigmas);
+//  - the height (Plane::under_m) is the distance to the surface under the robot: of F and O, the one on the
+//    sensor's side of the line where the two planes meet (each group's sectors all on one side of it); F
+//    when that is unclear or O is missing;
+//  - where the ground gives the attitude (no ceiling, or one that disagrees with the ring fit), F's plane
+//    replaces the ring fit, so that GravityFusion sees one surface (its own rotation) or a clean step to
+//    another, never a compromise sliding between them. With all sectors on the ring fit's plane (a level
+//    floor, the paper's sequences) nothing changes.
+// Said in status_text. Transport-free, part of Segmenter::process.
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "fploc/segmentation/segmenter.h"
+#include "plane_math.h"
+#include "segmenter_constants.h"
+
+namespace fploc::seg {
+
+namespace {
+constexpr int kAzimuths = 24;             // azimuth sectors of 15 deg (a 2.5 m ramp 4 m ahead: 35 deg) ...
+constexpr std::array<float, 3> kBandEdgesM{6.f, 9.f, 14.f};  // ... times horizontal-distance bands (a kink ahead)
+constexpr int kSectors = kAzimuths * int(kBandEdgesM.size() + 1);
+constexpr float kSectorBandM = 0.3f;      // returns this near the ring fit's plane ...
+constexpr float kSectorTightM = 0.05f;    // ... and at the end this near the sector's own plane
+constexpr int kMinSectorPoints = 40;      // a sector with fewer returns says nothing
+constexpr double kSectorMaxRmsM = 0.02;   // a sector's rms about its plane (one surface)
+constexpr double kKinkDeg = 3.0;          // another surface: this far from the followed one
+constexpr double kSideShare = 0.9;        // of a group's returns on one side of the kink line
+constexpr double kFollowDeg = 1.5;        // a sector this near a surface is on it
+constexpr size_t kStride = 1;             // every candidate
+
+struct Group {
+  detail::Moments m;
+  Eigen::Vector4d pl = Eigen::Vector4d::Zero();
+  int sectors = 0;
+};
+}  // namespace
+
+void Segmenter::split_ground_at_kink(int64_t t) {
+  Plane& g = out_.ground;
+  g.under_m = 0;
+  // The followed surface is carried from scan to scan by the gyro: without one, the ring fit as it is.
+  if (!cfg_.imu_attitude || !fusion_.has_gyro()) return;
+  if (!g.found || lower_.n < 100) return;  // (the followed surface is kept for up to 1 s)
+  const Eigen::Vector3f n0 = g.coeffs.head<3>().cast<float>();
+  const float d0 = float(g.coeffs[3]);
+  const Eigen::Vector3d up = g.coeffs.head<3>();  // the ground's normal points up (into the room)
+  const Eigen::Vector3d ref = -g.coeffs[3] * up;  // numerics: moments relative to the point under the sensor
+  const Eigen::Vector3f reff = ref.cast<float>();
+  // Per sector: three least-squares passes (a wide band around the ring fit, then tight around its own plane).
+  std::array<Eigen::Vector4d, kSectors> spl;
+  std::array<detail::Moments, kSectors> sm;
+  std::array<bool, kSectors> ok{};
+  std::array<double, kSectors> ssig{};  // the sector normal's 1-sigma [rad]
+  std::vector<int16_t> sector(lower_.n, -1);
+  for (size_t i = 0; i < lower_.n; i += kStride) {
+    const Eigen::Vector3f p = lower_.point(i);
+    if (!p.allFinite() || std::abs(n0.dot(p) + d0) > kSectorBandM) continue;
+    const double a = std::atan2(double(p.y()), double(p.x())) + M_PI;
+    const Eigen::Vector3f h = p - n0.dot(p) * n0;  // horizontal part
+    int band = 0;
+    while (band < int(kBandEdgesM.size()) && h.norm() >= kBandEdgesM[size_t(band)]) ++band;
+    sector[i] = int16_t(band * kAzimuths + std::min(kAzimuths - 1, int(a / (2 * M_PI) * kAzimuths)));
+  }
+  for (int s = 0; s < kSectors; ++s) spl[s] = g.coeffs;
+  // Tukey IRLS per sector from the ring fit's plane, the cut-off shrinking (a wall's foot, clutter on the
+  // floor drop out; a surface kinked against the ring fit's compromise is followed).
+  constexpr std::array<float, 4> kCut{0.3f, 0.15f, 0.08f, 0.05f};
+  for (size_t pass = 0; pass <= kCut.size(); ++pass) {
+    const bool last = pass == kCut.size();
+    for (auto& m : sm) m = detail::Moments{};
+    for (size_t i = 0; i < lower_.n; i += kStride) {
+      const int s = sector[i];
+      if (s < 0) continue;
+      const Eigen::Vector3f p = lower_.point(i);
+      const float r = spl[s].head<3>().cast<float>().dot(p) + float(spl[s][3]);
+      const float c = last ? kSectorTightM : kCut[pass];
+      if (std::abs(r) >= c) continue;
+      const float u = r / c;
+      sm[s].add((p - reff).cast<double>(), last ? 1.0 : double((1 - u * u) * (1 - u * u)));
+    }
+    for (int s = 0; s < kSectors; ++s) {
+      Eigen::Vector3d ev;
+      ok[s] = sm[s].w >= (last ? kMinSectorPoints : 0.25 * kMinSectorPoints) && sm[s].plane(ref, -up, spl[s], &ev);
+      if (ok[s] && last) {
+        // One surface: a sector seeing only a strip (one ring's arc, a wall's foot) has no second in-plane
+        // direction; its rms must be that of one surface.
+        const double rms = std::sqrt(std::max(ev[0], 0.0) / sm[s].w);
+        ok[s] = ev[1] > 0.05 * sm[s].w && rms < kSectorMaxRmsM &&
+                std::acos(std::clamp(spl[s].head<3>().dot(up), -1.0, 1.0)) < k::kMaxGroundTiltDeg * k::kDeg * 3;
+        ssig[s] = std::max(rms, 1e-3) / std::sqrt(std::max(ev[1], 1e-9));
+      }
+      if (!ok[s]) spl[s] = g.coeffs;
+    }
+  }
+  // The ground to follow: the last scan's, carried by the gyro.
+  Eigen::Vector3d prev = up;
+  Eigen::Matrix3d R;
+  if (follow_t_ != 0 && t - follow_t_ < 1'000'000 && fusion_.rotation(follow_t_, t, deskew_.bias(), &R))
+    prev = (R.transpose() * follow_up_).normalized();
+  // Until a surface is found below: the ring fit's.
+  follow_up_ = up;
+  follow_t_ = t;
+  const auto angle = [](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+    return std::acos(std::clamp(u.dot(v), -1.0, 1.0));
+  };
+  // F: the sectors on that surface; O: those on another one (kinked against F's plane by more than kKinkDeg).
+  Group F, O;
+  const auto pool = [&](Group& grp, int s) {
+    grp.m.w += sm[s].w;
+    grp.m.s += sm[s].s;
+    grp.m.ss += sm[s].ss;
+    ++grp.sectors;
+  };
+  for (int s = 0; s < kSectors; ++s)
+    if (ok[s] && angle(spl[s].head<3>(), prev) < kFollowDeg * k::kDeg) pool(F, s);
+  if (F.sectors < 2 || F.m.w < 4 * kMinSectorPoints) {
+    // The surface seen before has left the view (past a ramp's head): the surface of the largest sector, if
+    // others agree with it.
+    int big = -1;
+    for (int s = 0; s < kSectors; ++s)
+      if (ok[s] && (big < 0 || sm[s].w > sm[big].w)) big = s;
+    F = Group{};
+    if (big >= 0) {
+      prev = spl[big].head<3>();
+      for (int s = 0; s < kSectors; ++s)
+        if (ok[s] && angle(spl[s].head<3>(), prev) < kFollowDeg * k::kDeg) pool(F, s);
+    }
+  }
+  if (F.sectors < 2 || F.m.w < 4 * kMinSectorPoints || !F.m.plane(ref, -up, F.pl)) return;  // the ring fit as it is
+  follow_up_ = F.pl.head<3>();
+  int seed = -1;
+  double far = kKinkDeg * k::kDeg;
+  for (int s = 0; s < kSectors; ++s)
+    if (ok[s] && angle(spl[s].head<3>(), F.pl.head<3>()) > std::max(far, 3 * ssig[s])) far = angle(spl[s].head<3>(), F.pl.head<3>()), seed = s;
+  if (seed >= 0) {
+    for (int s = 0; s < kSectors; ++s)
+      if (ok[s] && angle(spl[s].head<3>(), spl[seed].head<3>()) < kFollowDeg * k::kDeg) pool(O, s);
+    if (O.m.w < 4 * kMinSectorPoints || !O.m.plane(ref, -up, O.pl)) O.sectors = 0;
+  }
+  const double off_fit = angle(F.pl.head<3>(), up);
+  if (O.sectors == 0 && off_fit < k::kKinkFitOffDeg * k::kDeg) return;  // one surface, the ring fit on it
+  // The surface under the robot: the one on the sensor's side of the line where the two planes meet. Each
+  // group's sectors lie on one side of that line (the other plane is below them: its height of them has one
+  // sign, for nearly all of their returns); at the sensor the same sign of (height above the other - height
+  // above this one) puts the sensor over this one. A group seen all around the robot (the line passes near
+  // it, or the "other surface" is a patch inside it) has no side: the followed surface.
+  int under = 0;  // 0: F, 1: O, -1: unclear
+  if (O.sectors > 0) {
+    const auto side = [&](const Group& A, const Group& B, bool in_o) {  // +1/-1: A's sectors all on one side; 0: mixed
+      double pos = 0, neg = 0;
+      for (int s = 0; s < kSectors; ++s) {
+        if (!ok[s] || sm[s].w <= 0) continue;
+        const bool in_f = angle(spl[s].head<3>(), prev) < kFollowDeg * k::kDeg;
+        const bool in_os = seed >= 0 && angle(spl[s].head<3>(), spl[seed].head<3>()) < kFollowDeg * k::kDeg;
+        if (in_o ? !in_os : !in_f) continue;
+        const Eigen::Vector3d c = sm[s].s / sm[s].w + ref;
+        (B.pl.head<3>().dot(c) + B.pl[3] > 0 ? pos : neg) += sm[s].w;
+      }
+      return pos >= kSideShare * (pos + neg) ? 1 : neg >= kSideShare * (pos + neg) ? -1 : 0;
+    };
+    const int sf = side(F, O, false), so = side(O, F, true);
+    const double at_sensor = O.pl[3] - F.pl[3];  // height above O - height above F, at the sensor
+    if (sf != 0 && so != 0) under = sf * at_sensor > 0 ? 0 : so * -at_sensor > 0 ? 1 : -1;
+    else under = -1;
+  }
+  Plane followed = g;
+  followed.coeffs = F.pl;
+  quality(lower_, followed);
+  if (followed.inliers < scale_.min_plane_inliers) return;  // too little of it: the ring fit as it is
+  // The height is the distance to the surface under the robot. Where the ground gives the attitude (no
+  // ceiling, or one that disagrees with the ring fit: AttitudeHeight then takes the ground), the followed
+  // surface replaces the ring fit, so that GravityFusion sees one surface (its own rotation) or a clean step
+  // to another, never a compromise sliding between them. Where the ceiling agrees with the ring fit, the ring
+  // fit stays (tried: always F; at a ramp's foot F is the level floor beside the ramp while the ceiling follows
+  // the ramp, the attitude source toggled between them and the slope estimate lost 1 deg).
+  const bool ground_attitude =
+      !out_.ceiling.found ||
+      angle(-out_.ceiling.coeffs.head<3>(), up) > cfg_.attitude_consistency_deg * k::kDeg;
+  if (ground_attitude) {
+    const double under_d = under == 1 ? O.pl[3] : 0.0;
+    g = followed;
+    g.found = true;
+    g.under_m = under_d;
+  } else {
+    g.under_m = under == 1 ? O.pl[3] : F.pl[3];
+  }
+  const double kink = O.sectors > 0 ? angle(F.pl.head<3>(), O.pl.head<3>()) : 0.0;
+  char buf[240];
+  if (O.sectors > 0)
+    std::snprintf(buf, sizeof buf,
+                  "ground: two surfaces %.2f deg apart (sectors %d / %d; the one seen before %.2f deg off the ring fit): "
+                  "height above %s",
+                  kink / k::kDeg, F.sectors, O.sectors, off_fit / k::kDeg,
+                  under < 0 ? "it (which is under the robot unclear)" : under == 0 ? "it (under the robot)" : "the other (under the robot)");
+  else
+    std::snprintf(buf, sizeof buf, "ground: the ring fit %.2f deg off the surface seen before (%d sectors): height above that surface", off_fit / k::kDeg,
+                  F.sectors);
+  if (!out_.status_text.empty()) out_.status_text += "; ";
+  out_.status_text += buf;
+}
+
+}  // namespace fploc::seg
