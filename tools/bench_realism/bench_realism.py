@@ -26,7 +26,9 @@ fploc+downweight), NDT = ndt, AMCL = features + odometry + amcl). Per family: ch
 recall. --jobs N simulates and replays N families at once (CPU times are per thread, so unaffected).
 
 Prints one JSON document on stdout (progress on stderr):
-  {"rows": [{"family", "method", "ate_m", "max_m", "lost", "false_ok", "false_ok_poses", "poor", "nees_median", "nees_poses",
+  {"rows": [{"family", "method", "ate_m", "ate_aligned_m" (after the best rigid alignment of the whole trajectory, as
+             TUM / evo ATE), "ate_floor_m" (the family's floor: the rigid part of the walls' as-built offsets along the
+             truth path, see gauge_floor; same for every method), "max_m", "lost", "false_ok", "false_ok_poses", "poor", "nees_median", "nees_poses",
              "ms_per_scan", "ms_per_scan_localizer", "poses"}],
    "detection": [{"family", "removed", "removed_found", "moved", "moved_found", "added", "added_found",
                   "doors_moved", "doors_moved_found" (both pieces), "door_opened_found" (the wall piece the new
@@ -127,6 +129,7 @@ def score_poses(poses, gt_rows):
     """Horizontal ATE, max, LOST, false OK, NEES (x, y, yaw) of pose_t records against the TUM truth."""
     truth = fploc_tools.Truth(gt_rows)
     errs, nees, lost, false_ok, poor, n = [], [], 0, 0, 0, 0
+    pairs = []
     for p in poses:
         g = truth.nearest(p["utime"] * 1e-6, 0.005)
         if g is None:
@@ -142,6 +145,7 @@ def score_poses(poses, gt_rows):
         if p["status"] == 0 and e > FALSE_OK_M:
             false_ok += 1
         errs.append(e)
+        pairs.append((p["p"][0], p["p"][1], g[1], g[2]))
         c = p["cov"]
         idx = (0, 1, 5)
         S = [[c[i * 6 + j] for j in idx] for i in idx]
@@ -156,7 +160,84 @@ def score_poses(poses, gt_rows):
     nees.sort()
     return {"poses": n, "ate_m": math.sqrt(sum(e * e for e in errs) / n), "max_m": max(errs),
             "lost": lost / n, "false_ok": false_ok / n, "false_ok_poses": false_ok, "poor": poor / n,
-            "nees_median": nees[len(nees) // 2] if nees else None, "nees_poses": len(nees)}
+            "nees_median": nees[len(nees) // 2] if nees else None, "nees_poses": len(nees),
+            "ate_aligned_m": aligned_ate(pairs)}
+
+
+def aligned_ate(pairs):
+    """Horizontal ATE after the best rigid alignment (rotation + translation, no scale) of the estimated positions
+    onto the truth, as TUM's / evo's ATE aligns (Horn / Umeyama; in 2D the angle is closed form). pairs: (ex, ey, gx, gy)."""
+    n = len(pairs)
+    if not n:
+        return None
+    mex = sum(p[0] for p in pairs) / n
+    mey = sum(p[1] for p in pairs) / n
+    mgx = sum(p[2] for p in pairs) / n
+    mgy = sum(p[3] for p in pairs) / n
+    sc = ss = 0.0
+    for ex, ey, gx, gy in pairs:
+        ax, ay, bx, by = ex - mex, ey - mey, gx - mgx, gy - mgy
+        sc += ax * bx + ay * by
+        ss += ax * by - ay * bx
+    th = math.atan2(ss, sc)
+    c, s = math.cos(th), math.sin(th)
+    e2 = 0.0
+    for ex, ey, gx, gy in pairs:
+        ax, ay = ex - mex, ey - mey
+        dx = c * ax - s * ay + mgx - gx
+        dy = s * ax + c * ay + mgy - gy
+        e2 += dx * dx + dy * dy
+    return math.sqrt(e2 / n)
+
+
+def gauge_floor(plan_path, truth, gt_rows):
+    """The ATE floor of a world whose walls stand off their drawn place (as-built offsets): the rigid motion
+    (dx, dy, dyaw) of the whole building that best explains the walls' own offsets (length-weighted least squares
+    over every unchanged segment, its offset and rotation sampled at 10 points along it) cannot be told from the
+    robot's own pose error by anything measured against the plan alone; its rms displacement along the truth
+    path is what a localizer that knew every wall's offset up to that motion would still be off. None without
+    as-built offsets (0 on the plan itself)."""
+    with open(plan_path) as f:
+        plan = json.load(f)["elements"]
+    segs = [e for e in plan if e.get("type") == "segment"]
+    if not segs or not truth or len(truth.get("elements", [])) != len(plan):
+        return None
+    cx = sum(e["a"][0] for e in segs) / len(segs)
+    cy = sum(e["a"][1] for e in segs) / len(segs)
+    A = [[0.0] * 3 for _ in range(3)]
+    b = [0.0] * 3
+    any_offset = False
+    for e, te in zip(plan, truth["elements"]):
+        if e.get("type") != "segment" or te.get("change") != "unchanged" or te.get("kind") != "segment":
+            continue
+        (ax, ay), (bx, by) = e["a"], e["b"]
+        L = math.hypot(bx - ax, by - ay)
+        if L < 1e-9:
+            continue
+        nx, ny = -(by - ay) / L, (bx - ax) / L
+        rot = math.radians(te.get("rotation_deg", 0.0))
+        any_offset |= abs(te.get("offset_m", 0.0)) > 0 or abs(rot) > 0
+        for k in range(10):
+            sfrac = 0.05 + 0.1 * k
+            px, py = ax + sfrac * (bx - ax), ay + sfrac * (by - ay)
+            off = te.get("offset_m", 0.0) + (sfrac - 0.5) * L * math.tan(rot)
+            row = [nx, ny, -nx * (py - cy) + ny * (px - cx)]
+            w = L / 10
+            for i in range(3):
+                b[i] += w * row[i] * off
+                for j in range(3):
+                    A[i][j] += w * row[i] * row[j]
+    if not any_offset:
+        return 0.0
+    x = solve3(A, b)
+    if x is None:
+        return None
+    e2 = 0.0
+    for r in gt_rows:
+        rx, ry = r[1] - cx, r[2] - cy
+        dx, dy = x[0] - x[2] * ry, x[1] + x[2] * rx
+        e2 += dx * dx + dy * dy
+    return math.sqrt(e2 / max(1, len(gt_rows)))
 
 
 # ---- change detection against the truth ------------------------------------------------------------------
@@ -378,6 +459,7 @@ class Bench:
         self.ndt_graph = os.path.join(ROOT, "graphs", "ndt.pbtxt")
         self.have_ndt = os.path.exists(os.path.join(BIN, "fploc-ndt")) and os.path.exists(self.ndt_graph)
         self.methods = [m for m in a.methods.split(",") if m]
+        self.floors = {}  # family -> gauge_floor (families run in threads: one key each)
 
     def family(self, fam):
         d = os.path.join(self.work, fam)
@@ -418,6 +500,7 @@ class Bench:
         log(f"[{fam}] replaying fploc + AMCL + plan diff ...")
         rep = json.loads(run(cmd)[0].strip().splitlines()[-1])
         rows = []
+        self.floors[fam] = gauge_floor(plan, truth, g) if truth is not None else None
         scans = next((n["messages"] for n in rep["nodes"] if n["name"] == "features"), len(g))
         for m in ("fploc", "amcl"):
             if m not in self.methods:
@@ -503,13 +586,16 @@ class Bench:
                     os.remove(f)
         return rows, det
 
+    def floor_of(self, fam):
+        return self.floors.get(fam)
+
     def row(self, fam, method, poses, g, rep, nodes, scans):
         s = score_poses(poses, g) or {"poses": 0}
         cpu = sum(n.get("cpu_ms", n["total_ms"]) for n in rep["nodes"] if n["name"] in nodes)
         own = sum(n.get("cpu_ms", n["total_ms"]) for n in rep["nodes"] if n["name"] in nodes and n["name"] not in SHARED_NODES)
         r = {"family": fam, "method": method, **s, "ms_per_scan": round(cpu / max(scans, 1), 3),
-             "ms_per_scan_localizer": round(own / max(scans, 1), 3)}
-        log(f"[{fam}] {method}: ATE {fmt(r.get('ate_m'))} max {fmt(r.get('max_m'))} LOST {pct(r.get('lost'))} "
+             "ms_per_scan_localizer": round(own / max(scans, 1), 3), "ate_floor_m": self.floor_of(fam)}
+        log(f"[{fam}] {method}: ATE {fmt(r.get('ate_m'))} (aligned {fmt(r.get('ate_aligned_m'))}, floor {fmt(r.get('ate_floor_m'))}) max {fmt(r.get('max_m'))} LOST {pct(r.get('lost'))} "
             f"false-OK {pct(r.get('false_ok'))} POOR {pct(r.get('poor'))} NEES {fmt(r.get('nees_median'), 2)} {r['ms_per_scan']} ms/scan "
             f"({r['ms_per_scan_localizer']} without the segmenter)")
         return r
@@ -575,11 +661,18 @@ def markdown(res, cmdline):
          "Localization (horizontal, every pose of the method against the truth of the same scan, no alignment; "
          "false OK = status OK with error > 0.3 m; NEES = median of (x, y, yaw) NEES from pose_t's covariance, "
          "3 for a consistent covariance; POOR = share of poses published POOR; ms/scan = thread CPU of the method's "
-         "nodes on one core, with and without the segmenter every method shares):", "",
-         "| world | method | ATE [cm] | max [cm] | LOST | POOR | false OK | NEES | ms/scan | ms/scan w/o segmenter |",
-         "|---|---|---|---|---|---|---|---|---|---|"]
+         "nodes on one core, with and without the segmenter every method shares). ATE aligned = the same after the best "
+         "rigid alignment (rotation + translation) of the whole estimated trajectory onto the truth, as TUM's / evo's ATE "
+         "(what is left once a constant offset of the whole run is removed); floor = the rms, along the truth path, of the "
+         "rigid motion of the whole building that best explains the walls' as-built offsets (sim.world.json): against "
+         "the plan alone a localizer cannot tell it from its own error, so the unaligned ATE of any method is about "
+         "this far from 0 at best (0 where the walls stand where drawn):", "",
+         "| world | method | ATE [cm] | ATE aligned [cm] | floor [cm] | max [cm] | LOST | POOR | false OK | NEES | ms/scan | ms/scan w/o segmenter |",
+         "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in res["rows"]:
+        cm = lambda v, nd=2: fmt(100 * v if v is not None else None, nd)  # noqa: E731
         L.append(f"| {r['family']} | {r['method']} | {fmt(100 * r['ate_m'] if r.get('ate_m') is not None else None, 2)} | "
+                 f"{cm(r.get('ate_aligned_m'))} | {cm(r.get('ate_floor_m'))} | "
                  f"{fmt(100 * r['max_m'] if r.get('max_m') is not None else None, 1)} | {pct(r.get('lost'))} | "
                  f"{pct(r.get('poor'))} | {pct(r.get('false_ok'))} | {fmt(r.get('nees_median'), 1)} | {r['ms_per_scan']} | "
                  f"{r.get('ms_per_scan_localizer', '-')} |")

@@ -177,6 +177,7 @@ class FrameCost : public ceres::CostFunction {
     double c2;
     accumulate(x, true, &Ha, &g, &c2);
     prepared_ = true;
+    if (ab_.per_wall) aggregate_walls(x);
     if (!ab_.keep_information) return;
     accumulate(x, false, &Hp, &g, &c2);
     const double tp = Hp(0, 0) + Hp(1, 1), ta = Ha(0, 0) + Ha(1, 1);
@@ -264,8 +265,94 @@ class FrameCost : public ceres::CostFunction {
     for (size_t i = 0; i < as_.size(); ++i) row(i, x, c, s, residuals + i, jac ? jac + 3 * i : nullptr, nullptr);
     return true;
   }
-  // accumulate() of the as-built model with the weights prepare() fixed: one pass, the points summed per
-  // element (no grouping), then each element's offsets eliminated.
+  // Per wall instead of per point (the weights prepare() fixed make this exact but for U): a point of a single
+  // candidate segment (the PCA group rule gives every grouped point one) has r = n . (R p + t - a) = c alpha +
+  // s beta + k with alpha = n . p, beta = n . perp(p), k = n . t - n . a, and Jacobian row j = (n, c beta - s alpha),
+  // so every sum the elimination needs (A, b, B, r^2, H, g) is a polynomial of degree <= 2 in (c, s, k) whose
+  // coefficients are weighted moments of the wall's points. They are summed once here; an evaluation then costs
+  // one pass over the walls instead of one closest-point query per point. U = (1 - t, t) (where along the wall
+  // the point lies) is taken at the term's pose: within one solve a point slides along its wall by the pose's
+  // change (cm), a change of U of cm / wall length; the look-up rounds re-build it. Points with several
+  // candidates (the closest is chosen per evaluation), circles, arcs and plain rows stay per point (dyn_).
+  struct WallAgg {
+    int el = -1;
+    double w2 = 0, na = 0;
+    Eigen::Vector2d n = Eigen::Vector2d::Zero();
+    double S = 0, Sa = 0, Sb = 0, Saa = 0, Sab = 0, Sbb = 0;  // sum W, W alpha, W beta, W alpha^2, ...
+    double A00 = 0, A01 = 0, A11 = 0;                          // sum W U U^T
+    Eigen::Vector2d SU = Eigen::Vector2d::Zero(), SUa = Eigen::Vector2d::Zero(), SUb = Eigen::Vector2d::Zero();
+  };
+  static constexpr double kFreezeMargin = 0.10;
+  void aggregate_walls(const double* x) {
+    walls_.clear();
+    dyn_.clear();
+    thread_local std::vector<int> slot;
+    if (slot.size() < targets_->size()) slot.assign(targets_->size(), -1);
+    const double c = std::cos(x[2]), s = std::sin(x[2]);
+    for (size_t i = 0; i < as_.size(); ++i) {
+      const Eigen::Vector2d& p = pts_[i];
+      const Eigen::Vector2d pw(c * p.x() - s * p.y() + x[0], s * p.x() + c * p.y() + x[1]);
+      // The candidate the point is on: its only one, or the closest when the next is >= kFreezeMargin farther
+      // (a point 10 cm nearer one wall than any other stays with it while the pose moves by a few cm).
+      int k_on = as_[i].n == 1 ? 0 : -1;
+      if (as_[i].n > 1) {
+        double d1 = std::numeric_limits<double>::infinity(), d2 = d1;
+        int k1 = -1;
+        Eigen::Vector2d q;
+        for (int k = 0; k < as_[i].n; ++k) {
+          const double d = std::sqrt(closest_one((*targets_)[size_t(as_[i].cand[k])], pw, &q, nullptr));
+          if (d < d1) {
+            d2 = d1;
+            d1 = d;
+            k1 = k;
+          } else if (d < d2) {
+            d2 = d;
+          }
+        }
+        if (k1 >= 0 && d2 - d1 >= kFreezeMargin) k_on = k1;
+      }
+      const TargetGeom* e = k_on >= 0 ? &(*targets_)[size_t(as_[i].cand[k_on])] : nullptr;
+      if (!e || e->kind != ElementKind::kSegment || !(e->len > 0)) {
+        dyn_.push_back(int(i));
+        continue;
+      }
+      const int el = as_[i].cand[k_on];
+      if (slot[size_t(el)] < 0) {
+        slot[size_t(el)] = int(walls_.size());
+        WallAgg w;
+        w.el = el;
+        w.n = Eigen::Vector2d(-e->u.y(), e->u.x());
+        w.na = w.n.dot(e->a);
+        const double we = w_ * double(as_[i].w[k_on]);
+        w.w2 = we * we;
+        walls_.push_back(w);
+      }
+      WallAgg& w = walls_[size_t(slot[size_t(el)])];
+      const double t = std::clamp((pw - e->a).dot(e->u) / e->len, 0.0, 1.0);
+      const Eigen::Vector2d U(1 - t, t);
+      const double we = w_ * double(as_[i].w[k_on]);
+      const double W = we * we * double(point_w_[i]);
+      const double al = w.n.dot(p), be = w.n.x() * -p.y() + w.n.y() * p.x();
+      w.S += W;
+      w.Sa += W * al;
+      w.Sb += W * be;
+      w.Saa += W * al * al;
+      w.Sab += W * al * be;
+      w.Sbb += W * be * be;
+      w.A00 += W * U[0] * U[0];
+      w.A01 += W * U[0] * U[1];
+      w.A11 += W * U[1] * U[1];
+      w.SU += W * U;
+      w.SUa += (W * al) * U;
+      w.SUb += (W * be) * U;
+    }
+    for (const WallAgg& w : walls_) slot[size_t(w.el)] = -1;
+    std::sort(walls_.begin(), walls_.end(), [](const WallAgg& a, const WallAgg& b) { return a.el < b.el; });
+    aggregated_ = true;
+  }
+  // accumulate() of the as-built model with the weights prepare() fixed: the walls' moments (aggregate_walls)
+  // and one pass over the other points, summed per element (no grouping), then each element's offsets
+  // eliminated.
   void accumulate_prepared(const double* x, Eigen::Matrix3d* H, Eigen::Vector3d* g, double* cost2) const {
     struct ElemAcc {
       double a00 = 0, a01 = 0, a11 = 0, b0 = 0, b1 = 0, rr = 0, w2 = 0;
@@ -277,9 +364,42 @@ class FrameCost : public ceres::CostFunction {
     if (acc.size() < targets_->size()) acc.resize(targets_->size());
     used.clear();
     const double c = std::cos(x[2]), s = std::sin(x[2]);
+    const double cc = c * c, cs = c * s, ss = s * s;
+    for (const WallAgg& w : walls_) {
+      ElemAcc& a = acc[size_t(w.el)];
+      a.used = true;
+      a.w2 = w.w2;
+      used.push_back(w.el);
+      const double k = w.n.x() * x[0] + w.n.y() * x[1] - w.na;
+      const double ra = c * w.Sa + s * w.Sb;            // sum W (c alpha + s beta)
+      const double rj = c * w.Sb - s * w.Sa;            // sum W (c beta - s alpha): sum W j_yaw
+      const double sr = ra + k * w.S;                   // sum W r
+      a.a00 += w.A00;
+      a.a01 += w.A01;
+      a.a11 += w.A11;
+      const Eigen::Vector2d bu = c * w.SUa + s * w.SUb + k * w.SU;  // sum W r U
+      a.b0 += bu[0];
+      a.b1 += bu[1];
+      a.rr += cc * w.Saa + 2 * cs * w.Sab + ss * w.Sbb + 2 * k * ra + k * k * w.S;
+      const Eigen::Vector2d ju = c * w.SUb - s * w.SUa;  // sum W U j_yaw
+      a.B(0, 0) += w.SU[0] * w.n.x();
+      a.B(0, 1) += w.SU[0] * w.n.y();
+      a.B(0, 2) += ju[0];
+      a.B(1, 0) += w.SU[1] * w.n.x();
+      a.B(1, 1) += w.SU[1] * w.n.y();
+      a.B(1, 2) += ju[1];
+      H->topLeftCorner<2, 2>().noalias() += w.S * w.n * w.n.transpose();
+      H->block<2, 1>(0, 2) += rj * w.n;
+      H->block<1, 2>(2, 0) += rj * w.n.transpose();
+      (*H)(2, 2) += cc * w.Sbb - 2 * cs * w.Sab + ss * w.Saa;
+      g->head<2>() += sr * w.n;
+      (*g)[2] += cc * w.Sab - cs * w.Saa + cs * w.Sbb - ss * w.Sab + k * rj;
+    }
     Obs ob;
     double res, jr[3];
-    for (size_t i = 0; i < as_.size(); ++i) {
+    const size_t n_dyn = aggregated_ ? dyn_.size() : as_.size();
+    for (size_t di = 0; di < n_dyn; ++di) {
+      const size_t i = aggregated_ ? size_t(dyn_[di]) : di;
       if (!row(i, x, c, s, &res, jr, &ob)) {
         ElemAcc& a = acc[size_t(ob.el)];
         if (!a.used) {
@@ -314,12 +434,21 @@ class FrameCost : public ceres::CostFunction {
                                        [](const std::pair<int, Eigen::Vector2d>& p, int v) { return p.first < v; });
       if (it != offset_w_.end() && it->first == el) lw = it->second;
       lw *= lam0 * a.w2;
-      Eigen::Matrix2d A;
-      A << a.a00 + lw[0], a.a01, a.a01, a.a11 + lw[1];
+      // The 2x2 block A = [a00 + lw0, a01; a01, a11 + lw1] (positive definite: lw > 0) inverted in closed form.
+      const double A00 = a.a00 + lw[0], A11 = a.a11 + lw[1], A01 = a.a01;
+      const double det = A00 * A11 - A01 * A01;
+      Eigen::Matrix2d Ai;
+      if (det > 1e-300 && A00 > 0) {
+        Ai << A11 / det, -A01 / det, -A01 / det, A00 / det;
+      } else {
+        Eigen::Matrix2d A;
+        A << A00, A01, A01, A11;
+        Ai = A.ldlt().solve(Eigen::Matrix2d::Identity());
+      }
       const Eigen::Vector2d bb(a.b0, a.b1);
-      const Eigen::LDLT<Eigen::Matrix2d> ldlt(A);
-      const Eigen::Vector2d o = ldlt.solve(bb);
-      H->noalias() -= a.B.transpose() * ldlt.solve(a.B);
+      const Eigen::Vector2d o = Ai * bb;
+      const Eigen::Matrix<double, 2, 3> AiB = Ai * a.B;
+      H->noalias() -= a.B.transpose() * AiB;
       *g -= a.B.transpose() * o;
       *cost2 += a.rr - bb.dot(o);
       a = ElemAcc();
@@ -474,6 +603,10 @@ class FrameCost : public ceres::CostFunction {
   // As-built model, fixed by prepare(): each assignment's robust weight, each element's offsets' weights
   // (by element id; an element not met there keeps weight 1).
   bool prepared_ = false;
+  // aggregate_walls(): the walls' moments (sorted by element) and the assignments evaluated per point.
+  bool aggregated_ = false;
+  std::vector<WallAgg> walls_;
+  std::vector<int> dyn_;
   mutable std::vector<float> point_w_;
   mutable std::vector<std::pair<int, Eigen::Vector2d>> offset_w_;
 };
@@ -571,18 +704,32 @@ void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, 
     std::sort(out->begin(), out->end(), [](const Assignment& a, const Assignment& b) { return a.point < b.point; });
 }
 
-void add_frame_term(ceres::Problem* problem, double* pose, const NearestLookup& lookup, const FeatureFrame& f,
-                    const std::vector<Assignment>& as, const std::string& loss, double scale, double weight, bool compact,
-                    const AsBuiltModel* as_built) {
-  if (as.empty()) return;
-  std::vector<Eigen::Vector2d> pts;
-  pts.reserve(as.size());
-  for (const auto& a : as) pts.push_back(f.points[size_t(a.point)].p);
+namespace {
+FrameCost* new_frame_cost(const double* pose, const NearestLookup& lookup, const FeatureFrame& f,
+                          const std::vector<Assignment>& as, const std::string& loss, double scale, double weight,
+                          bool compact, const AsBuiltModel* as_built) {
+  std::vector<Eigen::Vector2d> pts(as.size());
+  for (size_t i = 0; i < as.size(); ++i) pts[i] = f.points[size_t(as[i].point)].p;
   const bool ab = as_built && as_built->on() && lookup.element_targets();
   auto* cost = new FrameCost(&lookup.geometry(), as, std::move(pts), loss_kind(loss, scale), scale, weight, compact,
                              ab ? as_built : nullptr);
   cost->prepare(pose);
-  problem->AddResidualBlock(cost, nullptr, pose);
+  return cost;
+}
+}  // namespace
+
+void add_frame_term(ceres::Problem* problem, double* pose, const NearestLookup& lookup, const FeatureFrame& f,
+                    const std::vector<Assignment>& as, const std::string& loss, double scale, double weight, bool compact,
+                    const AsBuiltModel* as_built) {
+  if (as.empty()) return;
+  problem->AddResidualBlock(new_frame_cost(pose, lookup, f, as, loss, scale, weight, compact, as_built), nullptr, pose);
+}
+
+std::shared_ptr<ceres::CostFunction> make_frame_term(const double* pose, const NearestLookup& lookup, const FeatureFrame& f,
+                                                     const std::vector<Assignment>& as, const std::string& loss,
+                                                     double scale, double weight, bool compact, const AsBuiltModel* as_built) {
+  if (as.empty()) return nullptr;
+  return std::shared_ptr<ceres::CostFunction>(new_frame_cost(pose, lookup, f, as, loss, scale, weight, compact, as_built));
 }
 
 Eigen::Matrix3d frame_information(const NearestLookup& lookup, const FeatureFrame& f, const std::vector<Assignment>& as,

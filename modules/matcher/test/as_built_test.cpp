@@ -8,6 +8,7 @@
 
 #include "fploc/matcher/map.h"
 #include "fploc/matcher/matcher.h"
+#include "fploc/matcher/plan_terms.h"
 #include "synthetic.h"
 
 using namespace fploc;
@@ -72,5 +73,52 @@ TEST(AsBuilt, WorldAsDrawnUnchanged) {
     ASSERT_EQ(ab.status, FitStatus::kOk);
     EXPECT_LT(std::hypot(ab.pose.x - truth.x, ab.pose.y - truth.y), 0.003);
     EXPECT_LT(std::abs(ab.pose.yaw - truth.yaw), 0.002);
+  }
+}
+
+// The as-built term evaluated through the walls' moments (AsBuiltModel::per_wall) gives the cost, gradient
+// and Gauss-Newton matrix of the per-point evaluation: exactly at the pose it was prepared at, and within
+// what the points' frozen position along their wall allows 2 cm / 0.5 deg away from it.
+TEST(AsBuilt, PerWallEvaluationMatchesPerPoint) {
+  const FloorPlan plan = fploc::testing::room_with_pillars();
+  const FloorPlan world = moved(moved(plan, 1, 0.04), 3, -0.03);
+  auto map = make_localization_map(plan, "annf-exact");
+  fploc::testing::SynthOptions so;
+  so.beams = 720;
+  so.noise_sigma = 0.005;
+  so.clutter_fraction = 0.1;
+  const Pose2 truth{10.0, 4.0, 0.4};
+  const FeatureFrame f = fploc::testing::synth_frame(world, truth, so);
+  AssignOptions ao;
+  std::vector<Assignment> as;
+  assign(*map.lookup, f, truth, ao, &as);
+  ASSERT_GT(as.size(), 100u);
+  AsBuiltModel per_point, per_wall;
+  per_point.sigma_m = per_wall.sigma_m = 0.02;
+  per_point.per_wall = false;
+  const double x0[3] = {truth.x + 0.01, truth.y - 0.01, truth.yaw + 0.002};
+  auto tp = make_frame_term(x0, *map.lookup, f, as, "cauchy", 0.05, 1.0, true, &per_point);
+  auto tw = make_frame_term(x0, *map.lookup, f, as, "cauchy", 0.05, 1.0, true, &per_wall);
+  ASSERT_TRUE(tp && tw);
+  auto eval = [](ceres::CostFunction* c, const double* x, Eigen::Matrix3d* H, Eigen::Vector3d* g) {
+    double r[4], j[12];
+    const double* params[1] = {x};
+    double* jac[1] = {j};
+    EXPECT_TRUE(c->Evaluate(params, r, jac));
+    Eigen::Map<const Eigen::Matrix<double, 4, 3, Eigen::RowMajor>> J(j);
+    const Eigen::Map<const Eigen::Vector4d> R(r);
+    *H = J.transpose() * J;
+    *g = J.transpose() * R;
+    return R.squaredNorm();
+  };
+  for (const double dx : {0.0, 0.02}) {
+    const double x[3] = {x0[0] + dx, x0[1] - dx, x0[2] + (dx > 0 ? 0.5 * M_PI / 180 : 0.0)};
+    Eigen::Matrix3d Hp, Hw;
+    Eigen::Vector3d gp, gw;
+    const double cp = eval(tp.get(), x, &Hp, &gp), cw = eval(tw.get(), x, &Hw, &gw);
+    const double tol = dx == 0 ? 1e-9 : 0.02;  // relative
+    EXPECT_NEAR(cw, cp, tol * cp + 1e-12) << "dx " << dx;
+    EXPECT_LT((Hw - Hp).norm(), tol * Hp.norm()) << "dx " << dx;
+    EXPECT_LT((gw - gp).norm(), tol * (gp.norm() + 1e-3 * Hp.norm())) << "dx " << dx;
   }
 }

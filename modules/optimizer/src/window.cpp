@@ -218,6 +218,7 @@ PoseOut WindowOptimizer::add(FrameInput in, std::vector<PoseOut>* finals) {
 void WindowOptimizer::solve() {
   ceres::Problem::Options po;
   po.disable_all_safety_checks = true;
+  po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Solver::Options so;
   // Each keyframe's floor-plan block touches only its own 3 parameters: the normal equations of the
   // window are block-sparse (band of 3x3 blocks from the velocity terms). The dense solver forms
@@ -268,8 +269,11 @@ void WindowOptimizer::solve() {
       k.as_pose = xk;
       k.as_valid = true;
       k.as_stride = aok.stride;
+      k.term.reset();
     }
     if (!changed) break;
+    // The keys' terms are theirs (kept across rounds and solves), the velocity terms this round's.
+    std::vector<std::unique_ptr<ceres::CostFunction>> owned;
     ceres::Problem problem(po);
     for (auto& k : window_) {
       problem.AddParameterBlock(k.x, 3);
@@ -277,8 +281,12 @@ void WindowOptimizer::solve() {
       // point) estimates that sum with weight stride, so the balance against the velocity terms does not
       // depend on the budget.
       const double w = cfg_.budget_weight ? std::sqrt(double(k.as_stride)) : 1.0;
-      matcher::add_frame_term(&problem, k.x, lookup_, k.deskewed, k.as, cfg_.loss, cfg_.loss_scale_m, w, cfg_.compact_terms,
-                              &cfg_.as_built);
+      if (!k.term) {
+        const double xa[3] = {k.as_pose.x, k.as_pose.y, k.as_pose.yaw};
+        k.term = matcher::make_frame_term(xa, lookup_, k.deskewed, k.as, cfg_.loss, cfg_.loss_scale_m, w,
+                                          cfg_.compact_terms, &cfg_.as_built);
+      }
+      if (k.term) problem.AddResidualBlock(k.term.get(), nullptr, k.x);
     }
     for (size_t i = 0; i + 2 < chain.size(); ++i) {
       const double dt0 = (chain[i + 1].second - chain[i].second) * 1e-6;
@@ -290,6 +298,7 @@ void WindowOptimizer::solve() {
               ? static_cast<ceres::CostFunction*>(new ceres::AutoDiffCostFunction<BodyVelocityReg, 3, 3, 3, 3>(
                     new BodyVelocityReg{dt0, dt1, sa, sb}))
               : new ceres::AutoDiffCostFunction<VelocityReg, 3, 3, 3, 3>(new VelocityReg{dt0, dt1, sa, sb});
+      owned.emplace_back(cost);
       problem.AddResidualBlock(cost, nullptr, chain[i].first, chain[i + 1].first, chain[i + 2].first);
     }
     if (cfg_.anchor_final)

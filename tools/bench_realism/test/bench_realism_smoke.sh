@@ -13,6 +13,9 @@ f = rows["fploc"]
 for k in ("ate_m", "max_m", "lost", "false_ok", "false_ok_poses", "poor", "nees_median", "ms_per_scan", "ms_per_scan_localizer", "poses"):
     assert k in f, k
 assert 0 < f["ms_per_scan_localizer"] < f["ms_per_scan"], f
+# Aligned ATE: the best rigid alignment can only lower the rms; the floor of a world without as-built offsets is 0.
+assert f["ate_aligned_m"] is not None and f["ate_aligned_m"] <= f["ate_m"] + 1e-12, f
+assert f["ate_floor_m"] == 0.0, f
 dw = rows["fploc+downweight"]
 assert dw["poses"] == f["poses"] and dw["lost"] == 0 and dw["ate_m"] < 0.5, dw
 assert f["poses"] >= 90, f

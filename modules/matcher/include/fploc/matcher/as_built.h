@@ -22,6 +22,11 @@ struct AsBuiltModel {
   double point_sigma_m = 0.04;  // (point_sigma_m / sigma_m)^2 = 4 points per wall end at sigma_m 2 cm
   double loss_scale_m = 0.03;   // <= 0: no loss on the offsets (Gaussian prior)
   bool keep_information = true;
+  // Evaluate the points of a wall through the wall's moments (plan_terms.cpp aggregate_walls: one pass over
+  // the walls per evaluation instead of a closest-point query per point; the same cost, gradient and
+  // Gauss-Newton matrix at the pose the term is prepared at, the points' position along their wall held
+  // there). false: every point at every evaluation.
+  bool per_wall = true;
   bool on() const { return sigma_m > 0 && point_sigma_m > 0; }
 };
 

@@ -9,6 +9,7 @@
 #pragma once
 #include <ceres/ceres.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,16 @@ double closest_of(const std::vector<TargetGeom>& targets, const int* cand, int n
 void add_frame_term(ceres::Problem* problem, double* pose, const NearestLookup& lookup, const FeatureFrame& f,
                     const std::vector<Assignment>& a, const std::string& loss, double scale, double weight = 1.0,
                     bool compact = false, const AsBuiltModel* as_built = nullptr);
+
+// The same term as a cost function of its own (one 3-parameter block: the pose), prepared at `pose` (the
+// as-built model's robust weights and the walls' moments are fixed there), for a caller that keeps it across
+// solves while the assignment holds (the optimizer's keys) and adds it to problems that do not take ownership
+// (ceres::Problem::Options::cost_function_ownership = DO_NOT_TAKE_OWNERSHIP). Null when `a` is empty. The
+// term refers to lookup.geometry(): the lookup must outlive it.
+std::shared_ptr<ceres::CostFunction> make_frame_term(const double* pose, const NearestLookup& lookup, const FeatureFrame& f,
+                                                     const std::vector<Assignment>& a, const std::string& loss,
+                                                     double scale, double weight = 1.0, bool compact = false,
+                                                     const AsBuiltModel* as_built = nullptr);
 
 // Gauss-Newton information J^T J of the frame term at x (robust weights included), for the covariance.
 Eigen::Matrix3d frame_information(const NearestLookup& lookup, const FeatureFrame& f, const std::vector<Assignment>& a,

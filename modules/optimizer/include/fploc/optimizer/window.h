@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <deque>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,10 @@
 #include "fploc/matcher/as_built.h"
 #include "fploc/matcher/assignment.h"
 #include "fploc/matcher/types.h"
+
+namespace ceres {
+class CostFunction;
+}  // namespace ceres
 
 namespace fploc::optimizer {
 
@@ -120,6 +125,9 @@ class WindowOptimizer {
     Pose2 as_pose;
     bool as_valid = false;
     int as_stride = 1;
+    // The floor-plan term of `as`, prepared at as_pose (matcher::make_frame_term): kept across rounds and
+    // solves while the correspondences hold, re-built with them.
+    std::shared_ptr<ceres::CostFunction> term;
   };
   struct Final {
     int64_t tau;
