@@ -20,6 +20,13 @@ if [ "${FPLOC_MH_INNER:-}" != "1" ]; then
 fi
 [ -f "$ROOT/data/plans/room.json" ] || skip "$ROOT/data/plans/room.json missing"
 mount --make-rprivate /
+# A remote node starts through the user's shell on its host (ssh runs `$SHELL -c`), and bash started by sshd
+# reads ~/.bashrc. A developer machine's may be slow (version-manager init that also locks against parallel
+# shells: 10-50 s for eight sessions at once here). The launcher copes (a session has 60 s to start its node;
+# the heartbeat grace counts from the node's start), but the figures below are about the launcher, so the
+# test's hosts get a plain shell: an empty ~/.bashrc in this test's mount namespace only.
+ROOT_HOME="$(getent passwd root | cut -d: -f6)"
+[ -f "$ROOT_HOME/.bashrc" ] && mount --bind /dev/null "$ROOT_HOME/.bashrc"
 mkdir -p /run/netns && mount -t tmpfs fploc-mh-netns /run/netns   # named namespaces private to this test
 mkdir -p /run/sshd
 T="$(mktemp -d /tmp/fploc-mh-XXXXXX)"

@@ -245,6 +245,7 @@ class Launcher : public Effects {
     for (const auto& l : table_.read_lines(i, eof))
       std::cerr << "[" << table_[i].name << "@" << table_[i].host->spec.name() << "] " << l << "\n";
     std::cerr.flush();
+    if (table_.io(i).remote_pid > 0) sup_.on_remote_started(i, now_s());
     if (eof && table_.io(i).out >= 0) {
       ::close(table_.io(i).out);
       table_.io(i).out = -1;
@@ -291,6 +292,7 @@ class Launcher : public Effects {
       p.restart = n.restart();
       p.heartbeat_timeout_s = policy_or(n.heartbeat_timeout_s(), 3.0);
       p.supervised = rn.desc.describable;
+      p.remote = !n.host().empty();
       for (const auto& s : rn.desc.spec.ports) (s.output ? p.outputs : p.inputs).push_back(channel_of(n, s));
       out.push_back(std::move(p));
     }

@@ -68,7 +68,15 @@ void Supervisor::start(size_t i, double t) {
   n.state = State::Running;
   n.last_beat = 0;
   n.hung = false;
+  n.remote_started = false;
   publish(i, "starting", "");
+}
+
+void Supervisor::on_remote_started(size_t i, double t) {
+  auto& n = nodes_[i];
+  if (n.remote_started || n.state != State::Running) return;
+  n.remote_started = true;
+  n.started_at = t;
 }
 
 // Stop order for the whole graph: a node's rank is one more than the highest rank of the nodes that
@@ -172,6 +180,14 @@ void Supervisor::on_heartbeat(const std::string& name, pid_t pid, double t) {
 
 void Supervisor::check_heartbeat(size_t i, double t) {
   auto& n = nodes_[i];
+  if (n.policy.remote && !n.remote_started) {
+    const double waited = t - n.started_at;
+    if (waited <= cfg_.remote_start_s) return;
+    kill_hung(i, t, "its ssh session did not start the node within " + fmt2(waited) +
+                        " s (the host's login shell or fploc-remote hangs)",
+              "ssh session did not start the node within " + fmt2(waited) + " s");
+    return;
+  }
   // Until the first heartbeat the node may still be loading (maps): allow a longer grace period.
   const double since = n.last_beat > 0 ? t - n.last_beat : t - n.started_at;
   const double limit = n.last_beat > 0 ? n.policy.heartbeat_timeout_s
@@ -184,10 +200,14 @@ void Supervisor::check_heartbeat(size_t i, double t) {
     transport_warned_ = true;
     return;
   }
-  fx_.log("node '" + n.policy.name + "' (pid " + std::to_string(n.pid) + ") hung: no heartbeat for " + fmt2(since) +
-          " s; killing it");
+  kill_hung(i, t, "hung: no heartbeat for " + fmt2(since) + " s", "no heartbeat for " + fmt2(since) + " s");
+}
+
+void Supervisor::kill_hung(size_t i, double t, const std::string& why, const std::string& error) {
+  auto& n = nodes_[i];
+  fx_.log("node '" + n.policy.name + "' (pid " + std::to_string(n.pid) + ") " + why + "; killing it");
   n.hung = true;
-  publish(i, "hung", "no heartbeat for " + fmt2(since) + " s");
+  publish(i, "hung", error);
   fx_.signal(i, n.pid, SIGKILL);
   n.state = State::Stopping;
   n.stop_stage = 2;

@@ -27,6 +27,11 @@ struct NodePolicy {
   bool supervised = false;           // sends heartbeats (an fploc node); foreign programs are not watched
   std::vector<std::string> inputs;   // channels it consumes (for the stop order)
   std::vector<std::string> outputs;  // channels it produces
+  // Runs on another host through ssh: the process the launcher starts is the ssh session, and the node
+  // itself exists only once the far end says so (on_remote_started). The login shell there may take
+  // seconds (slow rc files, a loaded host), so until then the session-start bound applies, not the
+  // heartbeat grace.
+  bool remote = false;
 };
 
 // How a process ended (from waitpid).
@@ -55,6 +60,7 @@ struct SupervisorConfig {
   double shutdown_timeout_s = 2.0;  // SIGINT ... SIGTERM after this, SIGKILL 1 s later
   double stage_gap_s = 0.25;        // graph-wide stop: next rank after this even if the previous still runs
   double first_beat_grace_s = 10.0; // until its first heartbeat a node may be loading (maps)
+  double remote_start_s = 60.0;     // a remote node's ssh session must start the node within this
   double report_period_s = 1.0;     // dead/restarting nodes are re-published this often
   std::vector<std::string> ignored_channels;  // telemetry/control: not part of the stop order
 };
@@ -67,6 +73,9 @@ class Supervisor {
   void start_all(double t);
   // A process ended (reaped). Returns false when the pid is not one of ours.
   bool on_exit(pid_t pid, const ExitStatus& st, double t);
+  // The far end of remote node i started the node process (fploc-remote reported its pid): the
+  // heartbeat grace counts from here.
+  void on_remote_started(size_t i, double t);
   // A heartbeat (node_status_t with reporter "node") arrived from `pid` of node `name`.
   void on_heartbeat(const std::string& name, pid_t pid, double t);
   // Any telemetry arrived (the launcher's own too): the transport works here.
@@ -105,12 +114,14 @@ class Supervisor {
     double next_start = 0, started_at = 0, last_beat = 0, stop_deadline = 0;
     int stop_stage = 0;  // 0 SIGINT sent, 1 SIGTERM sent, 2 SIGKILL sent
     bool restart_after_stop = false, hung = false;
+    bool remote_started = false;  // remote nodes: the far end has started the node process
     int stop_rank = 0;
   };
   void start(size_t i, double t);
   void begin_stop(size_t i, bool restart_after, double t);
   void escalate(size_t i, double t);
   void check_heartbeat(size_t i, double t);
+  void kill_hung(size_t i, double t, const std::string& why, const std::string& error);
   void apply_restart(size_t i, const fploc::rt::RestartDecision& d, const std::string& why, double t);
   void advance_shutdown(double t);
   void rank_for_shutdown();

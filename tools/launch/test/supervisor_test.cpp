@@ -288,3 +288,35 @@ TEST(Supervisor, FailedStartIsRetriedWithBackoff) {
   s.tick(0.2);
   EXPECT_EQ(s.state(0), State::Running);
 }
+
+// A remote node: the launcher's process is the ssh session; the host's login shell may take long
+// (a slow rc file, a loaded host) before fploc-remote starts the node. The heartbeat grace counts from
+// the node's start; a session that never starts it is killed after remote_start_s.
+TEST(Supervisor, RemoteNodeGraceCountsFromTheNodesStartNotTheSessions) {
+  FakeWorld w;
+  auto p = node("r");
+  p.remote = true;
+  SupervisorConfig cfg;
+  cfg.first_beat_grace_s = 10;
+  cfg.remote_start_s = 60;
+  Supervisor s({p, p}, cfg, w);
+  s.start_all(0);
+  s.on_transport_ok();
+  const pid_t pid0 = s.pid(0);
+  s.tick(25);  // node 0's shell still starting after 25 s: not a hang
+  EXPECT_EQ(s.state(0), State::Running);
+  s.on_remote_started(0, 25);
+  s.tick(34.9);  // 9.9 s after the node started, no heartbeat yet: still the grace
+  EXPECT_EQ(s.state(0), State::Running);
+  s.on_heartbeat("r", pid0, 34.9);
+  s.tick(37.8);
+  EXPECT_EQ(s.state(0), State::Running);
+  s.tick(38.0);  // silent 3.1 s after its first heartbeat: hung
+  EXPECT_EQ(s.state(0), State::Stopping);
+  // Node 1's session never starts the node: killed once remote_start_s has passed, with its reason.
+  EXPECT_EQ(s.state(1), State::Running);
+  s.tick(60.5);
+  EXPECT_EQ(s.state(1), State::Stopping);
+  ASSERT_FALSE(w.logs.empty());
+  EXPECT_NE(w.logs.back().find("ssh session did not start the node"), std::string::npos) << w.logs.back();
+}
