@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Errors of a bench building run against time, as a PNG: where a p99 comes from.
 
     tools/bench_building/plot_errors.py OUT.png RUN_DIR [RUN_DIR2 [RUN_DIR3]]
@@ -69,6 +69,7 @@ def main():
     axes[-1].set_xlabel("time [s]")
     fig.tight_layout()
     fig.savefig(path, dpi=90)
+    t1 = max(s[0] for r in runs for s in r)
     for d, r in zip(dirs, runs):
         print(d)
         for t in range(0, int(t1) + 1, 5):

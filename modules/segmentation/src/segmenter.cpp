@@ -85,16 +85,44 @@ void Segmenter::fit_ceiling(const Eigen::Vector3d& init_up, const Eigen::Vector3
   }
 }
 
-void Segmenter::fit_ground(const Eigen::Vector3d& up) {
+void Segmenter::fit_ground(const Eigen::Vector3d& up, bool from_previous) {
   // The same fit on the lower rings, flipped.
   Eigen::Vector4d pl;
-  if (!fit_->fit(lower_, -up, have_prev_ground_ ? &prev_ground_ : nullptr, PlaneRole::kGround, pl)) return;
+  if (!fit_->fit(lower_, -up, have_prev_ground_ && from_previous ? &prev_ground_ : nullptr, PlaneRole::kGround, pl))
+    return;
   out_.ground.coeffs = pl;
   quality(lower_, out_.ground);
   const double tilt = std::acos(std::clamp(pl.head<3>().dot(up), -1.0, 1.0));
   out_.ground.found = tilt < std::min(cfg_.max_tilt_deg * k::kDeg, k::kMaxGroundTiltDeg * k::kDeg) &&
                       pl[3] > k::kMinGroundDistM && out_.ground.inliers >= scale_.min_plane_inliers &&
                       out_.ground.beyond <= cfg_.max_beyond_ratio * out_.ground.inliers;
+}
+
+void Segmenter::refit_ground_around_gravity() {
+  // Off a slope (a ramp's head, a landing) without an IMU prior the ground is searched around the last
+  // attitude, the slope's, and started from the last ground, the slope's: a level floor lies outside that
+  // gate, or loses the start. No ground, so the fusion keeps the slope and can take a sloped ceiling ahead
+  // for the surface (40 s at 8.5 deg in the demo building's lobby, z from that ceiling 10-16 cm off).
+  // Floors are level more often: when no ground was found, search around gravity as the gyro carries it.
+  Eigen::Vector3d g;
+  if (out_.ground.found || !fusion_.gravity_up(&g)) return;
+  const Plane kept = out_.ground;
+  fit_ground(g, false);  // not started from the last ground (the slope's): it would win the start again
+  // At a ramp's head the ramp behind is below the landing: its returns count as "beyond" the level plane,
+  // often more than the usual share. Level within 1 deg of gravity with most returns on it is the floor;
+  // the kink split (ground_kink.cpp) then sees the two surfaces.
+  Plane& gr = out_.ground;
+  const bool level = std::acos(std::clamp(gr.coeffs.head<3>().dot(g), -1.0, 1.0)) < k::kRefitLevelDeg * k::kDeg;
+  if (!gr.found && level && gr.coeffs[3] > k::kMinGroundDistM && gr.inliers >= scale_.min_plane_inliers &&
+      gr.beyond < gr.inliers)
+    gr.found = true;
+  if (!gr.found) {
+    gr = kept;
+    return;
+  }
+  if (!out_.status_text.empty()) out_.status_text += "; ";
+  out_.status_text += "ground: none around the prior, a level one around gravity (" +
+                      std::to_string(gr.beyond) + " returns below it)";
 }
 
 const Segmentation& Segmenter::process(const Scan& scan) {
@@ -156,6 +184,7 @@ const Segmentation& Segmenter::process(const Scan& scan) {
   // else around the prior: a sloped ceiling patch taken as the ceiling must not drag the floor's gate along.
   const double ceiling_vs_prior = std::acos(std::clamp(up.dot(init_up.normalized()), -1.0, 1.0));
   fit_ground(ceiling_vs_prior < k::kCeilingPriorAgreeDeg * k::kDeg ? up : init_up.normalized());
+  refit_ground_around_gravity();
   const int64_t t_mid = scan.utime + std::llround(out_.attitude_t * 1e6);
   split_ground_at_kink(t_mid);
 

@@ -51,6 +51,7 @@ constexpr double kMinGroundDistM = 0.1;
 constexpr double kMaxGroundTiltDeg = 5.0;
 constexpr double kKinkFitOffDeg = 0.3;       // ground_kink.cpp: the ring fit this far off the followed surface: replaced   // ground normal vs the ceiling's (or prior) up
 constexpr double kCeilingPriorAgreeDeg = 2.0;  // ceiling this close to the prior: the ground is fitted around it
+constexpr double kRefitLevelDeg = 1.0;  // a ground found around gravity off a slope: within this of level
 
 // ---- gravity fusion (gravity_fusion.cpp) ----
 // On a slope, not turning: the accelerometer's pull on the tilt across the slope (no platform acceleration

@@ -64,7 +64,10 @@ double hit_ramp_ceiling(const Room::Ramp& r, double h, const Eigen::Vector3d& o,
   if (d.z() > 0) {
     const double t0 = (h - o.z()) / d.z();
     if (t0 > 1e-6 && o.x() + t0 * d.x() <= r.x0) best = std::min(best, t0);
-    const double t2 = (h + r.rise - o.z()) / d.z();
+  }
+  const double ls = r.landing_ceiling_slope, den2 = d.z() - ls * d.x();  // the landing's ceiling, maybe sloped
+  if (den2 > 0) {
+    const double t2 = (h + r.rise + ls * (o.x() - r.x1) - o.z()) / den2;
     if (t2 > 1e-6 && o.x() + t2 * d.x() >= r.x1) best = std::min(best, t2);
   }
   const double s = r.rise / (r.x1 - r.x0), den = d.z() - s * d.x();

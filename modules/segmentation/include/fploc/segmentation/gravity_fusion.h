@@ -83,6 +83,12 @@ class GravityFusion {
                 const Eigen::Vector3d& bias);
 
   Mode mode() const { return mode_; }
+  // Gravity up in the sensor frame as of the last update (false before the first).
+  bool gravity_up(Eigen::Vector3d* up) const {
+    if (!started_) return false;
+    *up = g_;
+    return true;
+  }
   // The surface's tilt against gravity [deg] (0 on level floors): the floor's slope when the planes are the floor's.
   double slope_deg() const;
 

@@ -28,6 +28,7 @@ struct Room {
   struct Ramp {
     double x0 = 0, x1 = 0, rise = 0;
     bool ceiling_follows = false;  // the ceiling `height` above the floor everywhere (rises with the ramp)
+    double landing_ceiling_slope = 0;  // with ceiling_follows: over the landing the ceiling rises this much per m of x
   } ramp;
   double floor_at(double x) const;  // floor height under x
 };
