@@ -6,6 +6,8 @@
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
+
+#include "lane8.h"
 #define FPLOC_CK_WIDE 1
 #else
 #define FPLOC_CK_WIDE 0
@@ -17,30 +19,12 @@ namespace fploc::seg::ck {
 
 #if FPLOC_CK_WIDE
 namespace {
-typedef float v8f __attribute__((vector_size(32)));
-typedef int32_t v8i __attribute__((vector_size(32)));
-
-// For each 8-bit lane mask: the source lane of each output slot (4 bits per slot), the set lanes first.
-struct CompressTable {
-  uint32_t e[256];
-  constexpr CompressTable() : e{} {
-    for (int m = 0; m < 256; ++m) {
-      uint32_t v = 0;
-      int k = 0;
-      for (int l = 0; l < 8; ++l)
-        if ((m >> l) & 1) v |= uint32_t(l) << (4 * k++);
-      e[m] = v;
-    }
-  }
-};
-constexpr CompressTable kCompress;
-
-__attribute__((target("avx2"))) inline v8f ld(const float* p) {
-  v8f v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-__attribute__((target("avx2"))) inline void st(float* p, v8f v) { std::memcpy(p, &v, sizeof v); }
+using lane8::ld;
+using lane8::splat;
+using lane8::st;
+using lane8::v8f;
+using lane8::v8i;
+constexpr lane8::CompressTable<false> kCompress;
 // src[0], src[3], ..., src[21] (perm: 0, 3, 6, 1, 4, 7, 2, 5).
 __attribute__((target("avx2"))) inline v8f every3(const float* p, __m256i perm) {
   __m256 a, b, c;
@@ -50,7 +34,6 @@ __attribute__((target("avx2"))) inline v8f every3(const float* p, __m256i perm) 
   const __m256 t = _mm256_blend_ps(_mm256_blend_ps(a, b, 0x92), c, 0x24);
   return reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(t, perm));
 }
-__attribute__((target("avx2"))) inline v8f splat(float a) { return v8f{a, a, a, a, a, a, a, a}; }
 }  // namespace
 
 namespace {

@@ -5,6 +5,8 @@
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
+
+#include "lane8.h"
 #define FPLOC_WALL_WIDE 1
 #else
 #define FPLOC_WALL_WIDE 0
@@ -16,34 +18,11 @@ namespace fploc::seg::wallk {
 
 #if FPLOC_WALL_WIDE
 namespace {
-typedef float v8f __attribute__((vector_size(32)));
-typedef int32_t v8i __attribute__((vector_size(32)));
-
-// For each 8-bit lane mask: the source lane of each output slot (4 bits per slot), the set lanes first in
-// order; the slots after them repeat the first set lane (always a valid candidate).
-struct CompressTable {
-  uint32_t e[256];
-  constexpr CompressTable() : e{} {
-    for (int m = 0; m < 256; ++m) {
-      uint32_t v = 0;
-      int k = 0, first = 0;
-      for (int l = 7; l >= 0; --l)
-        if ((m >> l) & 1) first = l;
-      for (int l = 0; l < 8; ++l)
-        if ((m >> l) & 1) v |= uint32_t(l) << (4 * k++);
-      for (; k < 8; ++k) v |= uint32_t(first) << (4 * k);
-      e[m] = v;
-    }
-  }
-};
-constexpr CompressTable kCompress;
-
-__attribute__((target("avx2"))) inline v8f ld(const float* p) {
-  v8f v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-__attribute__((target("avx2"))) inline void st(float* p, v8f v) { std::memcpy(p, &v, sizeof v); }
+using lane8::ld;
+using lane8::st;
+using lane8::v8f;
+using lane8::v8i;
+constexpr lane8::CompressTable<true> kCompress;
 }  // namespace
 
 namespace {
