@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Scores a floor change: score_floors.py REC.lcm GT.tum FLOORS.txt [LAUNCH.log]
+"""Scores a floor change: score_floors.py EST GT.tum FLOORS.txt [LAUNCH.log]
 
-REC.lcm: lcm-logger's recording of FPLOC_POSE (pose_t, with floor_index/floor) and FPLOC_FRAME_POSE;
+EST: the final poses, either EST.tum as fploc-pose-logger writes it with its floor_file at EST.tum.floors
+("t floor_index floor" per pose), or an LCM log with FPLOC_POSE (pose_t, with floor_index/floor);
 GT.tum the ground truth; FLOORS.txt "utime floor" per ground-truth pose plus "# arrival UTIME" and
 "# ride_start UTIME" (tests/floors/make_lift_log). Prints the time from the arrival to the first pose
 on the new floor, the poses on the wrong floor (all, and from 3 s after the arrival), the horizontal
@@ -40,10 +41,22 @@ def main():
             gt.append((int(round(t * 1e6)), x, y, z))
     gt_t = [g[0] for g in gt]
     poses = {}
-    for _ts, ch, buf in events(rec, with_time=True):
-        if ch == "FPLOC_POSE":
-            p = decode_pose_t(buf)
-            poses[p["utime"]] = p
+    if rec.endswith(".tum"):
+        floor_of = {}
+        for line in open(rec + ".floors"):
+            if line.strip() and not line.startswith("#"):
+                t, _i, name = line.split()[:3]
+                floor_of[int(round(float(t) * 1e6))] = name
+        for line in open(rec):
+            if line.strip() and not line.startswith("#"):
+                t, x, y, z = map(float, line.split()[:4])
+                u = int(round(t * 1e6))
+                poses[u] = {"utime": u, "x": x, "y": y, "z": z, "floor": floor_of.get(u, "")}
+    else:
+        for _ts, ch, buf in events(rec, with_time=True):
+            if ch == "FPLOC_POSE":
+                p = decode_pose_t(buf)
+                poses[p["utime"]] = p
     poses = [poses[t] for t in sorted(poses)]
     if not poses:
         print("FAIL: no FPLOC_POSE recorded")
