@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """fploc bench building: height and attitude under real buildings' ceilings, through the real graph.
 
 For every (plan, scenario): `fploc sim` writes an LCM log (OS-1 scans + IMU) and the ground truth;
@@ -26,8 +26,8 @@ changes recognised within 2 s, no pose on the wrong floor 3 s after arriving, AT
 lift ride <= 5 cm.
 
 Prints one JSON document on stdout ({"rows": [...], "targets": {...}}); progress on stderr. With --plots DIR
-writes z against ground truth over time per row (SVG with axes and legend, and a text-free PNG:
-grid lines every 1 cm and 10 s, truth green, estimate red).
+writes z against ground truth over time per row (SVG with axes and legend, and the same as a PNG drawn
+by matplotlib: truth green, estimate red).
 """
 import argparse
 import bisect
@@ -207,49 +207,25 @@ def plot_z(series, title, path, marks=()):
         f.write("\n".join(out))
 
 
-def plot_png(series, path, W=900, H=300, marks=()):
-    """The same plot as a PNG without text (for image viewers): grey grid every 1 cm of z (0.5 m across
-    floors) and every 10 s, truth green, estimate red, floor changes (`marks`, s) blue. Written with zlib
-    only."""
-    import struct
-    import zlib
-    t1 = max(s[0] for s in series) or 1.0
-    zs = [s[1] for s in series] + [s[2] for s in series]
-    z0, z1 = min(zs) - 0.005, max(zs) + 0.005
-    img = [bytearray(b"\xff" * (3 * W)) for _ in range(H)]
-
-    def px(x, y, c):
-        if 0 <= x < W and 0 <= y < H:
-            img[y][3 * x:3 * x + 3] = bytes(c)
-    X = lambda t: int((W - 1) * t / t1)  # noqa: E731
-    Y = lambda z: int((H - 1) * (z1 - z) / (z1 - z0))  # noqa: E731
-    step = 0.01 if z1 - z0 < 0.5 else 0.5  # 1 cm grid, or 0.5 m for runs across floors
-    z = math.ceil(z0 / step) * step
-    while z < z1:
-        for x in range(W):
-            px(x, Y(z), (225, 225, 225))
-        z += step
-    for t in range(0, int(t1) + 1, 10):
-        for y in range(H):
-            px(X(t), y, (225, 225, 225))
+def plot_png(series, path, title, marks=()):
+    """The same plot as a PNG (for image viewers), drawn by matplotlib (Debian's python3-matplotlib):
+    truth green, estimate red, floor changes (`marks`, s) dashed blue."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(10, 3.3))
+    ax.plot([s[0] for s in series], [s[2] for s in series], color="tab:green", linewidth=0.9, label="ground truth z")
+    ax.plot([s[0] for s in series], [s[1] for s in series], color="tab:red", linewidth=0.9, label="estimate z (WO)")
     for t in marks:
-        for y in range(0, H, 2):
-            px(X(t), y, (60, 90, 220))
-
-    def line(a, b, c):
-        (x0, y0), (x1, y1) = a, b
-        n = max(abs(x1 - x0), abs(y1 - y0), 1)
-        for i in range(n + 1):
-            px(x0 + (x1 - x0) * i // n, y0 + (y1 - y0) * i // n, c)
-    for idx, c in ((2, (30, 160, 80)), (1, (200, 30, 30))):
-        pts = [(X(s[0]), Y(s[idx])) for s in series]
-        for a, b in zip(pts, pts[1:]):
-            line(a, b, c)
-    raw = b"".join(b"\x00" + bytes(r) for r in img)
-    chunk = lambda tag, data: struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data))  # noqa: E731
-    with open(path, "wb") as f:
-        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", W, H, 8, 2, 0, 0, 0)) +
-                chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
+        ax.axvline(t, color="tab:blue", linestyle="--", linewidth=0.8)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("z [m]")
+    ax.set_title(title, fontsize="medium")
+    ax.grid(True, color="0.9")
+    ax.legend(loc="upper right", fontsize="small")
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
 
 
 def bench(a, work, plan, layers, scenario):
@@ -343,10 +319,11 @@ def bench(a, work, plan, layers, scenario):
     if a.plots and series:
         path = os.path.join(a.plots, name.replace(":", "-") + "-z.svg")
         marks = [c["t"] - gt[0][0] for c in (changes if building else [])]
-        plot_z(series, f"{name}: z p99 {100 * m['z_err_p99_m']:.2f} cm, rp p99 {m['rp_err_p99_deg']:.3f} deg"
-               + (" (dashed: floor changes)" if marks else ""), path, marks)
+        title = (f"{name}: z p99 {100 * m['z_err_p99_m']:.2f} cm, rp p99 {m['rp_err_p99_deg']:.3f} deg"
+                 + (" (dashed: floor changes)" if marks else ""))
+        plot_z(series, title, path, marks)
         row["plot"] = path
-        plot_png(series, path[:-4] + ".png", marks=marks)
+        plot_png(series, path[:-4] + ".png", title, marks=marks)
         row["plot_png"] = path[:-4] + ".png"
     log(f"[{name}] ATE xy {100 * row.get('ate_xy_m', float('nan')):.2f} cm, z med/p99 "
         f"{100 * row.get('z_err_median_m', float('nan')):.2f}/{100 * row.get('z_err_p99_m', float('nan')):.2f} cm, "

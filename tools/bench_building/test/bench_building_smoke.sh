@@ -20,6 +20,7 @@ for r in d["rows"]:
     assert r["nees_median"] is not None and r["nees_median"] > 0 and r["false_ok"] == 0, r
     assert set(r["ms_per_scan"]) == {"segmenter", "features", "matcher", "optimizer"}, r
     assert os.path.getsize(r["plot"]) > 1000 and open(r["plot"]).read().startswith("<svg"), r
+    assert open(r["plot_png"], "rb").read(8) == b"\x89PNG\r\n\x1a\n" and os.path.getsize(r["plot_png"]) > 5000, r
 assert "ceilings: mixed" in " ".join(d["rows"][0]["sim"]), d["rows"][0]
 # building-*: the segmenter got the simulated ceilings as a building file (segmenter.building + pose feedback).
 assert d["rows"][0]["segmenter_building"] is True and d["rows"][1]["segmenter_building"] is False, d["rows"]
