@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <iostream>
 #include <random>
 
@@ -221,20 +222,27 @@ TEST(GridLocalizer, ScanPointsDropInvalidAndApplyMount) {
 // Dead reckoning: while the scans are unexplained (POOR) the uncertainty grows with the motion, not per scan:
 // a robot that stands still for many scans keeps its window; one that drives widens it. Control: the per-scan
 // bases added on every POOR scan (the earlier model) widen it while standing still.
-double poor_window_after_standing(bool motion_only, int scans) {
+// Tracked once at (1, 1, 0) in the room, then `scans` scans of another room (unexplained), scan k at
+// k * step m along x with the odometry saying so; `each` sees every result.
+void tracked_then_unexplained(const l2::GridLocalizerConfig& c, int scans, double step,
+                              const std::function<void(const l2::GridResult&)>& each) {
   const OccupancyGrid map = make_room(), other = make_room(true);
-  l2::GridLocalizerConfig c;
-  c.dead_reckoning_motion_only = motion_only;
   l2::GridLocalizer loc(std::make_shared<l2::DistanceField>(map, 1.0), c);
   loc.set_initial_pose({1, 1, 0});
   std::mt19937 rng(5);
   EXPECT_EQ(loc.update(cast(map, {1, 1, 0}, rng), Pose2{0, 0, 0}).status, l2::GridStatus::kOk);
-  double w = 0;
-  for (int k = 0; k < scans; ++k) {
-    const auto r = loc.update(cast(other, {1, 1, 0}, rng), Pose2{0, 0, 0});
+  for (int k = 1; k <= scans; ++k) {
+    const auto r = loc.update(cast(other, {1 + step * k, 1, 0}, rng), Pose2{step * k, 0, 0});
     EXPECT_NE(r.status, l2::GridStatus::kOk);
-    w = std::sqrt(r.covariance(0, 0));
+    each(r);
   }
+}
+
+double poor_window_after_standing(bool motion_only, int scans) {
+  l2::GridLocalizerConfig c;
+  c.dead_reckoning_motion_only = motion_only;
+  double w = 0;
+  tracked_then_unexplained(c, scans, 0.0, [&](const l2::GridResult& r) { w = std::sqrt(r.covariance(0, 0)); });
   return w;
 }
 
@@ -321,19 +329,10 @@ TEST(GridLocalizer, CalibratedOdometryCarriesThroughUnmappedGround) {
 // at 10 cm per scan that is every fifth unexplained scan (freiburg-079's 10 Hz scans: 100-400 ms each before).
 // Control: with the throttle off it runs on every scan.
 int wide_searches(double every_m, int scans) {
-  const OccupancyGrid map = make_room(), other = make_room(true);
   l2::GridLocalizerConfig c;
   c.reacquire_search_every_m = every_m;
-  l2::GridLocalizer loc(std::make_shared<l2::DistanceField>(map, 1.0), c);
-  loc.set_initial_pose({1, 1, 0});
-  std::mt19937 rng(5);
-  EXPECT_EQ(loc.update(cast(map, {1, 1, 0}, rng), Pose2{0, 0, 0}).status, l2::GridStatus::kOk);
   int n = 0;
-  for (int k = 1; k <= scans; ++k) {
-    const auto r = loc.update(cast(other, {1 + 0.1 * k, 1, 0}, rng), Pose2{0.1 * k, 0, 0});
-    EXPECT_NE(r.status, l2::GridStatus::kOk);
-    n += r.wide_search;
-  }
+  tracked_then_unexplained(c, scans, 0.1, [&](const l2::GridResult& r) { n += r.wide_search; });
   return n;
 }
 
