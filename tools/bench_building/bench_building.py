@@ -42,7 +42,7 @@ ROOT = os.environ.get("FPLOC_ROOT") or os.path.abspath(os.path.join(os.path.dirn
 BIN = os.environ.get("FPLOC_BIN") or os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(ROOT, "tools", "pylib"))
 import fploc_tools  # noqa: E402
-from fploc_tools import log, pct, read_tum, yaw_of  # noqa: E402
+from fploc_tools import log, pct, read_tum, roll_pitch, yaw_of  # noqa: E402
 
 SCENARIOS = ["building-areas-medium", "building-atrium-medium", "building-clutter-medium", "building-mixed-medium",
              "auto-loop-medium"]
@@ -140,13 +140,6 @@ def score_floors(gt, est, gtf, pose_floor, changes, t0_abs):
 
 def run(cmd):
     return fploc_tools.run(cmd, "fploc bench building")
-
-
-def roll_pitch(q):
-    x, y, z, w = q
-    roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
-    pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
-    return roll, pitch
 
 
 def score(gt, est):

@@ -64,6 +64,14 @@ def pct(values, q):
     return s[min(len(s) - 1, int(q * len(s)))] if s else None
 
 
+def roll_pitch(q):
+    """Roll and pitch [rad] of a quaternion (x, y, z, w), as in a TUM row's last four columns."""
+    x, y, z, w = q
+    roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+    pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
+    return roll, pitch
+
+
 def yaw_of(row):
     qx, qy, qz, qw = row[4:8]
     return math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
