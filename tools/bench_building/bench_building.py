@@ -275,7 +275,8 @@ def bench(a, work, plan, layers, scenario):
             sets.append(f"segmenter.building.floor={simj.get('start_floor', '')}")
     log(f"[{name}] replaying {len(gt)} scans ...")
     nodes, scans, ms = fploc_tools.replay(BIN, a.graph, logf, sets, PIPELINE, "fploc bench building")
-    os.remove(logf)
+    if not a.keep:
+        os.remove(logf)  # --keep keeps the simulated log too (replay it with other options)
     row = {"plan": os.path.relpath(plan, ROOT), "scenario": scenario, "scans": scans, "sim": info,
            "segmenter_building": seg_building is not None,
            "lost": nodes.get("matcher", {}).get("errors", 0), "ms_per_scan": ms}

@@ -97,7 +97,8 @@ void GravityFusion::carry_by_gyro(const Eigen::Vector3d& g_pred, double dt, Resu
 double GravityFusion::slope_deg() const { return mode_ == Mode::kSlope ? angle_of(o_) / k::kDeg : 0.0; }
 
 GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* plane_up, double plane_sigma,
-                                            const Eigen::Vector3d* accel, const Eigen::Vector3d& bias) {
+                                            const Eigen::Vector3d* accel, const Eigen::Vector3d& bias,
+                                            bool plane_repeated) {
   Result r;
   const bool acc_ok = accel && accel->allFinite() && std::abs(accel->norm() - k::kGravityMs2) < cfg_.accel_norm_tol;
   // The accelerometer's direction, less its tilt bias (learned on level floors; sensor-fixed, like the bias).
@@ -162,8 +163,16 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
     else acc_lp_ = (acc_lp_ + (1 - std::exp(-std::max(0.0, dt) / cfg_.accel_lp_tau_s)) * (ad - acc_lp_)).normalized();
   }
 
+  if (plane_up && plane_repeated && mode_ == Mode::kSlope && gyro_ok) {
+    // Last scan's planes again, in last scan's axes: on a slope the plane step the gyro did not see would be
+    // taken for another surface (the tilt moved by the sensor's pitch over one scan). Carried by the gyro.
+    plane_up = nullptr;
+    if (!r.text.empty()) r.text += "; ";
+    r.text += "planes are last scan's (the fit kept its start): attitude carried by the gyro";
+  }
   if (!plane_up) {
     if (!gyro_ok) return r;  // no source: the caller holds with a grown sigma
+    o_ = o_pred;  // (world-fixed, in this scan's axes)
     carry_by_gyro(g_pred, dt, r);
     return r;
   }
@@ -302,6 +311,12 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
     return take_planes(p, plane_sigma, r);
   }
   g_ = (p + o_).normalized();
+  if (gyro_ok && cfg_.slope_plane_tau_s > 0) {
+    // On a slope the planes are a measurement of gravity (through the tilt), the gyro's carry the prediction: a
+    // first-order blend, so one scan's plane fit does not pass into the attitude as it is.
+    const double kp = 1 - std::exp(-std::max(0.0, dt) / cfg_.slope_plane_tau_s);
+    g_ = (g_pred + kp * (g_ - g_pred)).normalized();
+  }
   sigma_ = std::hypot(plane_sigma, o_sigma_);
   r.valid = true;
   r.up = g_;

@@ -98,14 +98,14 @@ void Segmenter::fit_ground(const Eigen::Vector3d& up, bool from_previous) {
                       out_.ground.beyond <= cfg_.max_beyond_ratio * out_.ground.inliers;
 }
 
-void Segmenter::refit_ground_around_gravity() {
+void Segmenter::refit_ground_around_gravity(int64_t t) {
   // Off a slope (a ramp's head, a landing) without an IMU prior the ground is searched around the last
   // attitude, the slope's, and started from the last ground, the slope's: a level floor lies outside that
   // gate, or loses the start. No ground, so the fusion keeps the slope and can take a sloped ceiling ahead
   // for the surface (40 s at 8.5 deg in the demo building's lobby, z from that ceiling 10-16 cm off).
   // Floors are level more often: when no ground was found, search around gravity as the gyro carries it.
   Eigen::Vector3d g;
-  if (out_.ground.found || !fusion_.gravity_up(&g)) return;
+  if (out_.ground.found || !fusion_.gravity_up_at(t, deskew_.bias(), &g)) return;
   const Plane kept = out_.ground;
   fit_ground(g, false);  // not started from the last ground (the slope's): it would win the start again
   // At a ramp's head the ramp behind is below the landing: its returns count as "beyond" the level plane,
@@ -184,8 +184,8 @@ const Segmentation& Segmenter::process(const Scan& scan) {
   // else around the prior: a sloped ceiling patch taken as the ceiling must not drag the floor's gate along.
   const double ceiling_vs_prior = std::acos(std::clamp(up.dot(init_up.normalized()), -1.0, 1.0));
   fit_ground(ceiling_vs_prior < k::kCeilingPriorAgreeDeg * k::kDeg ? up : init_up.normalized());
-  refit_ground_around_gravity();
   const int64_t t_mid = scan.utime + std::llround(out_.attitude_t * 1e6);
+  refit_ground_around_gravity(t_mid);
   split_ground_at_kink(t_mid);
 
   if (height_.has_areas() && upper_.p.size() != upper_.size()) upper_.fill_points();  // the area census reads p

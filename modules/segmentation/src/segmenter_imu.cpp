@@ -21,8 +21,12 @@ void Segmenter::fuse_imu(const Scan& scan, const Eigen::Vector3d& plane_up) {
   if (!cfg_.imu_attitude || !fusion_.has_gyro()) return;
   const int64_t tm = scan.utime + std::llround(out_.attitude_t * 1e6);
   const bool plane = out_.attitude_source == AttitudeSource::kCeiling || out_.attitude_source == AttitudeSource::kGround;
+  // The plane taken is last scan's as it was (the fit kept its start, prev_*_ not yet replaced by this scan's).
+  const bool repeated =
+      (out_.attitude_source == AttitudeSource::kCeiling && have_prev_ceiling_ && out_.ceiling.coeffs == prev_ceiling_) ||
+      (out_.attitude_source == AttitudeSource::kGround && have_prev_ground_ && out_.ground.coeffs == prev_ground_);
   const GravityFusion::Result r = fusion_.update(tm, plane ? &plane_up : nullptr, out_.roll_pitch_sigma,
-                                                 accel_this_scan_ ? &accel_mean_ : nullptr, deskew_.bias());
+                                                 accel_this_scan_ ? &accel_mean_ : nullptr, deskew_.bias(), repeated);
   if (!r.text.empty()) note(out_, r.text);
   if (!r.valid || r.from_planes) return;  // level: the planes' attitude as it is
   roll_pitch_from_up(r.up, out_.roll, out_.pitch);

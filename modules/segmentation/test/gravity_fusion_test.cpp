@@ -321,3 +321,65 @@ TEST(GravityFusion, ErrorAcrossTheSlopeIsPulledOutByTheAccelerometer) {
   ASSERT_GE(err_at_6s, 0.0);
   EXPECT_LT(err_at_6s, 0.06 * kDeg) << "tilt error 6 s after entering the slope [deg]: " << err_at_6s / kDeg;
 }
+
+// GravityFusion alone, on a slope: the sensor enters a 6 deg ramp as above (exact gyro and accelerometer), then
+// bobs on it (pitch +-0.3 deg at 0.7 Hz). Each scan's planes are the ramp's surfaces with 0.07 deg of noise per
+// axis (a fit where the surfaces change under the robot), and every fourth scan's are last scan's again, in last
+// scan's axes (a fit that kept its start: `plane_repeated`). Gravity must follow the sensor with less than the
+// planes' own error: the gyro carries it, the planes pull it (slope_plane_tau_s), a repeated plane is no
+// measurement. Taken as they came (tau 0, repeats not flagged), the planes' error passes into the attitude.
+TEST(GravityFusion, NoisyAndRepeatedPlanesOnASlopeAreSmoothedByTheGyro) {
+  const auto run = [](double tau, bool flag_repeats, double* rms_planes) {
+    GravityFusionConfig cfg;
+    cfg.slope_plane_tau_s = tau;
+    GravityFusion fus(cfg);
+    std::mt19937 rng(11);
+    std::normal_distribution<double> gauss(0.0, 0.07 * kDeg);
+    const Eigen::Vector3d zero = Eigen::Vector3d::Zero(), z = Eigen::Vector3d::UnitZ();
+    const double t_up0 = 2.0, t_up1 = 3.2, pitch_rate = 5.0 * kDeg;
+    const Eigen::Vector3d n_ramp = Eigen::AngleAxisd(6.0 * kDeg, Eigen::Vector3d::UnitY()) * z;  // world
+    double pitch = 0, sum_sq = 0, sum_sq_planes = 0;
+    int n = 0;
+    Eigen::Vector3d last_planes = z;
+    for (int k = 1; k <= 1300; ++k) {  // 100 Hz gyro, a scan every 10th sample
+      const double t = k * 0.01;
+      double rate = t > t_up0 && t <= t_up1 ? pitch_rate : 0.0;
+      if (t > t_up1) rate = 0.3 * kDeg * 2 * M_PI * 0.7 * std::cos(2 * M_PI * 0.7 * (t - t_up1));
+      pitch += rate * 0.01;
+      const int64_t ut = 1000000 + std::llround(t * 1e6);
+      fus.add_gyro(Eigen::Vector3d(0, rate, 0), ut);
+      if (k % 10) continue;
+      const Eigen::Matrix3d R = Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()).toRotationMatrix();
+      const Eigen::Vector3d up_true = R.transpose() * z, accel = kG * up_true;
+      Eigen::Vector3d planes = t <= t_up0 ? z : Eigen::Vector3d(R.transpose() * n_ramp);
+      bool repeated = false;
+      if (t > t_up1 + 0.5) {
+        repeated = (k / 10) % 4 == 0;
+        planes = repeated ? last_planes : Eigen::Vector3d((planes + Eigen::Vector3d(gauss(rng), gauss(rng), 0)).normalized());
+      }
+      last_planes = planes;
+      const bool seen = t <= t_up0 || t > t_up1;
+      const auto r = fus.update(ut, seen ? &planes : nullptr, 0.02 * kDeg, &accel, zero, flag_repeats && repeated);
+      if (t > t_up1 + 1.5) {  // on the ramp, the slope taken
+        const double e = std::acos(std::clamp(r.up.normalized().dot(up_true), -1.0, 1.0));
+        // The planes' own error: gravity from them with the true surface tilt.
+        const Eigen::Vector3d o_true = up_true - R.transpose() * n_ramp;
+        const double ep = std::acos(std::clamp((planes + o_true).normalized().dot(up_true), -1.0, 1.0));
+        sum_sq += e * e;
+        sum_sq_planes += ep * ep;
+        ++n;
+      }
+    }
+    EXPECT_EQ(fus.mode(), GravityFusion::Mode::kSlope);
+    *rms_planes = std::sqrt(sum_sq_planes / std::max(1, n)) / kDeg;
+    return std::sqrt(sum_sq / std::max(1, n)) / kDeg;
+  };
+  double rms_planes = 0;
+  const double smoothed = run(GravityFusionConfig{}.slope_plane_tau_s, true, &rms_planes);
+  double unused = 0;
+  const double as_they_came = run(0.0, false, &unused);
+  if (std::getenv("FPLOC_TEST_VERBOSE"))
+    std::printf("rms tilt error [deg]: planes %.3f, smoothed %.3f, as they came %.3f\n", rms_planes, smoothed, as_they_came);
+  EXPECT_LT(smoothed, 0.5 * rms_planes) << "rms tilt error [deg]: smoothed " << smoothed << ", planes + true tilt " << rms_planes;
+  EXPECT_GT(as_they_came, 0.8 * rms_planes) << "control: the planes as they came " << as_they_came;
+}

@@ -41,6 +41,9 @@ struct GravityFusionConfig {
                                  // (longer while the gyro is quiet: the sensor is not turning; standing still
                                  // the accelerometer holds it)
   double accel_tau_s = 10.0;     // on a slope: the accelerometer's pull on the surface tilt
+  double slope_plane_tau_s = 0.25;  // on a slope: gravity is the gyro's prediction pulled towards planes + tilt with
+                                   // this time constant (one scan's plane fit is a few tenths of a degree off where
+                                   // the surfaces change under the robot; the gyro drifts ~0.03 deg/s)
   double accel_bias_tau_s = 30.0; // level floors: the accelerometer's tilt bias against the planes, low-passed
   double accel_bias_max_turn_rate = 0.02;  // rad/s: ... only while not turning (v w: 1.8 cm/s^2 at 0.9 m/s)
   double still_rate = 0.01;                // rad/s: every gyro sample of the interval below this (bias-corrected) ...
@@ -79,14 +82,24 @@ class GravityFusion {
 
   // One scan at time t (the planes' time, mid-sweep): `plane_up` the planes' up (nullptr: no plane accepted),
   // its sigma; `accel` the mean specific force since the last scan (nullptr: none); `bias` the gyro bias.
+  // `plane_repeated`: the planes are last scan's as they were (a fit that kept its start), in last scan's axes:
+  // on a slope they are not a measurement of this scan (gravity carried by the gyro); level, taken as they are.
   Result update(int64_t t, const Eigen::Vector3d* plane_up, double plane_sigma, const Eigen::Vector3d* accel,
-                const Eigen::Vector3d& bias);
+                const Eigen::Vector3d& bias, bool plane_repeated = false);
 
   Mode mode() const { return mode_; }
   // Gravity up in the sensor frame as of the last update (false before the first).
   bool gravity_up(Eigen::Vector3d* up) const {
     if (!started_) return false;
     *up = g_;
+    return true;
+  }
+  // ... carried by the gyro to time t (this scan's mid-sweep; the sensor pitches a degree per scan over a ramp's
+  // head); as of the last update where the gyro does not cover the interval.
+  bool gravity_up_at(int64_t t, const Eigen::Vector3d& bias, Eigen::Vector3d* up) const {
+    if (!started_) return false;
+    Eigen::Matrix3d R;
+    *up = t > t_ && t - t_ <= 1'000'000 && rotation(t_, t, bias, &R) ? Eigen::Vector3d((R.transpose() * g_).normalized()) : g_;
     return true;
   }
   // The surface's tilt against gravity [deg] (0 on level floors): the floor's slope when the planes are the floor's.

@@ -70,8 +70,8 @@ class Segmenter {
   // Two surfaces under the lower rings (a ramp's foot or head): the ground the attitude follows and the height
   // above the one under the robot (ground_kink.cpp). t: the planes' time (mid-sweep).
   void split_ground_at_kink(int64_t t);
-  // No ground found: the ground fitted around gravity as the gyro carries it (segmenter.cpp).
-  void refit_ground_around_gravity();
+  // No ground found: the ground fitted around gravity as the gyro carries it to t, the planes' time (segmenter.cpp).
+  void refit_ground_around_gravity(int64_t t);
   void select_walls(const Scan& scan, const Eigen::Vector3d& up);
   // The IMU's part of roll/pitch (segmenter_imu.cpp): gravity vs the planes' up, then the attitude moved from
   // mid-sweep to the scan's time with the gyro.
