@@ -74,6 +74,7 @@ optimizer::OptimizerConfig config_of(const OptimizerOptions& o) {
   if (o.max_points() != 0) c.max_points = o.max_points() < 0 ? 0 : o.max_points();
   if (o.max_keyframe_gap_s() > 0) c.max_keyframe_gap_s = o.max_keyframe_gap_s();
   if (o.keyframe_interval_s() != 0) c.keyframe_interval_s = std::max(0.0, o.keyframe_interval_s());
+  if (o.max_final_delay_s() != 0) c.max_final_delay_s = std::max(0.0, o.max_final_delay_s());
   c.anchor_final = o.anchor_final();
   c.body_frame_velocity = o.body_frame_velocity();
   if (o.relook_m() > 0) {

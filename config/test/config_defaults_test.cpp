@@ -114,6 +114,7 @@ TEST(ConfigDefaults, Optimizer) {
          {"keyframe_angle_deg", c.keyframe_angle_rad * kDeg}, {"gate_m", c.gate_m}, {"loss_scale_m", c.loss_scale_m},
          {"max_iterations", c.max_iterations}, {"rounds", c.rounds}, {"stride", c.stride},
          {"max_keyframe_gap_s", c.max_keyframe_gap_s}, {"keyframe_interval_s", c.keyframe_interval_s},
+         {"max_final_delay_s", c.max_final_delay_s},
          {"max_points", c.max_points}, {"relook_m", c.relook_m},
          {"as_built_sigma_m", c.as_built.sigma_m}, {"as_built_point_sigma_m", c.as_built.point_sigma_m},
          {"as_built_loss_scale_m", c.as_built.loss_scale_m}});

@@ -1,7 +1,7 @@
 // fploc-optimizer: FPLOC_FEATURES + FPLOC_FRAME_POSE (paired by scan_seq) -> windowed optimisation ->
-// FPLOC_POSE (6-DoF, final estimates: poses that left the window, every frame, in time order) and
-// FPLOC_POSE_LATEST (the current window estimate of each frame, low latency): the WO step of
-// fploc::localizer::Localizer. A building (.pbtxt/.ifc) loads every floor; the window follows the floor
+// FPLOC_POSE (6-DoF, final estimates: poses that left the window or are max_final_delay_s old, every
+// frame, in time order) and FPLOC_POSE_LATEST (the current window estimate of each frame, low latency):
+// the WO step of fploc::localizer::Localizer. A building (.pbtxt/.ifc) loads every floor; the window follows the floor
 // of the matcher's frames (frame_pose_t.floor_index): a new floor flushes the window (those poses are
 // final on the old floor) and starts one on the new floor's plan.
 #include <fploc/features_t.hpp>

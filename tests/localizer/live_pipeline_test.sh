@@ -49,7 +49,7 @@ pids=()
 cat "$T/ip.txt"
 frames=$(grep -c . "$T/gt.tum")
 fail=0
-# Final windowed poses: all but the last window (W keyframes, about 1.7 s here), which becomes final only
+# Final windowed poses: all but the last second (the optimizer's max_final_delay_s), which becomes final only
 # when the optimizer shuts down, at the same time as the logger.
 for k in sfr latest wo; do
   n=$(grep -c . "$T/$k.tum" 2>/dev/null || echo 0)

@@ -67,6 +67,17 @@ struct BodyVelocityReg {
 Eigen::Vector3d diff(const Pose2& a, const Pose2& b) { return {a.x - b.x, a.y - b.y, wrap_angle(a.yaw - b.yaw)}; }
 Pose2 plus(const Pose2& a, const Eigen::Vector3d& c) { return {a.x + c[0], a.y + c[1], wrap_angle(a.yaw + c[2])}; }
 
+// A non-keyframe's correction (pose - single-frame pose) at tau: interpolated in time between a key's (ca at
+// ta) and the next key's (cb at tb).
+Eigen::Vector3d interpolate_correction(int64_t tau, int64_t ta, const Eigen::Vector3d& ca, int64_t tb,
+                                       const Eigen::Vector3d& cb) {
+  const double span = double(tb - ta);
+  const double s = span > 0 ? std::clamp(double(tau - ta) / span, 0.0, 1.0) : 1.0;
+  Eigen::Vector3d d = cb - ca;
+  d[2] = wrap_angle(d[2]);
+  return ca + s * d;
+}
+
 }  // namespace
 
 WindowOptimizer::WindowOptimizer(const matcher::NearestLookup& lookup, OptimizerConfig cfg) : lookup_(lookup), cfg_(std::move(cfg)) {
@@ -212,6 +223,7 @@ PoseOut WindowOptimizer::add(FrameInput in, std::vector<PoseOut>* finals) {
     o = make_out(nk.f, Pose2{nk.x[0], nk.x[1], nk.x[2]}, true, &last_latest_);
     o.optimised = nk.optimised;
   }
+  if (cfg_.max_final_delay_s > 0) finalize_until(t - std::llround(cfg_.max_final_delay_s * 1e6), finals);
   return o;
 }
 
@@ -311,21 +323,21 @@ void WindowOptimizer::solve() {
   ++solves_;
 }
 
+void WindowOptimizer::emit_final(const Frame& f, const Pose2& pose_tau, bool key, int optimised,
+                                 std::vector<PoseOut>* finals) {
+  PoseOut o = make_out(f, pose_tau, key, &last_final_);
+  o.final_estimate = true;
+  o.optimised = optimised;
+  if (finals) finals->push_back(std::move(o));
+}
+
 void WindowOptimizer::emit_pending_until(int64_t tau, const Eigen::Vector3d& corr_next, std::vector<PoseOut>* finals) {
   while (!pending_.empty() && pending_.front().tau < tau) {
     const Frame& f = pending_.front();
-    Eigen::Vector3d c = corr_next;
-    if (!finals_.empty()) {
-      const Final& prev = finals_.back();
-      const double span = double(tau - prev.tau);
-      const double s = span > 0 ? std::clamp(double(f.tau - prev.tau) / span, 0.0, 1.0) : 1.0;
-      Eigen::Vector3d d = corr_next - prev.correction;
-      d[2] = wrap_angle(d[2]);
-      c = prev.correction + s * d;
-    }
-    PoseOut o = make_out(f, plus(f.sfr_tau, c), false, &last_final_);
-    o.final_estimate = true;
-    if (finals) finals->push_back(o);
+    const Eigen::Vector3d c =
+        finals_.empty() ? corr_next
+                        : interpolate_correction(f.tau, finals_.back().tau, finals_.back().correction, tau, corr_next);
+    emit_final(f, plus(f.sfr_tau, c), false, 0, finals);
     pending_.pop_front();
   }
 }
@@ -335,13 +347,38 @@ void WindowOptimizer::finalize_front(std::vector<PoseOut>* finals) {
   window_.pop_front();
   const Pose2 p_tau{k.x[0], k.x[1], wrap_angle(k.x[2])};
   const Eigen::Vector3d corr = diff(p_tau, k.f.sfr_tau);
-  emit_pending_until(k.f.tau, corr, finals);
-  PoseOut o = make_out(k.f, p_tau, true, &last_final_);
-  o.final_estimate = true;
-  o.optimised = k.optimised;
-  if (finals) finals->push_back(o);
+  emit_pending_until(k.f.tau, corr, finals);  // none left when k is out (they went out before it)
+  if (!k.out) emit_final(k.f, p_tau, true, k.optimised, finals);
   finals_.push_back({k.f.tau, p_tau, corr});
   while (finals_.size() > 2) finals_.pop_front();
+}
+
+void WindowOptimizer::finalize_until(int64_t until, std::vector<PoseOut>* finals) {
+  auto correction = [](const Key& k) { return diff(Pose2{k.x[0], k.x[1], k.x[2]}, k.f.sfr_tau); };
+  size_t next = 0;  // the first key not out (those out lead the window: frames go out in time order)
+  while (next < window_.size() && window_[next].out) ++next;
+  for (;;) {
+    Key* k = next < window_.size() ? &window_[next] : nullptr;
+    if (!pending_.empty() && (!k || pending_.front().tau < k->f.tau)) {
+      const Frame& f = pending_.front();
+      if (f.in.features.utime > until) return;
+      // Between the key before it (out, in the window or final) and the key after it, when there is one yet.
+      const Key* a = next > 0 ? &window_[next - 1] : nullptr;
+      const bool have_a = a || !finals_.empty();
+      const int64_t ta = a ? a->f.tau : have_a ? finals_.back().tau : 0;
+      const Eigen::Vector3d ca = a ? correction(*a) : have_a ? finals_.back().correction : Eigen::Vector3d::Zero();
+      const Eigen::Vector3d c = !k ? ca : have_a ? interpolate_correction(f.tau, ta, ca, k->f.tau, correction(*k))
+                                                 : correction(*k);
+      emit_final(f, plus(f.sfr_tau, c), false, 0, finals);
+      pending_.pop_front();
+    } else if (k && k->f.in.features.utime <= until) {
+      emit_final(k->f, Pose2{k->x[0], k->x[1], wrap_angle(k->x[2])}, true, k->optimised, finals);
+      k->out = true;
+      ++next;
+    } else {
+      return;
+    }
+  }
 }
 
 void WindowOptimizer::flush(std::vector<PoseOut>* finals) {

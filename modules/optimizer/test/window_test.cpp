@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "fploc/matcher/map.h"
 #include "fploc/matcher/matcher.h"
@@ -72,6 +74,7 @@ TEST(WindowOptimizer, EveryFrameBecomesFinalOnceInOrderAndKeysAreOptimisedWTimes
   so.noise_sigma = 0.02;
   const SeqRun run = make_run(*map.lookup, *map.plan, 60, so);
   OptimizerConfig cfg;
+  cfg.max_final_delay_s = 0;           // keys final when they leave the window (10 keys span 2 s here)
   const auto finals = optimise(*map.lookup, run, cfg);
   ASSERT_EQ(finals.size(), run.frames.size());
   int keys = 0, keys_w = 0;
@@ -132,6 +135,7 @@ TEST(WindowOptimizer, StationarySensorMakesAKeyframePerIntervalSoItsPosesKeepCom
     OptimizerConfig cfg;
     cfg.window = 3;
     cfg.keyframe_interval_s = interval;
+    cfg.max_final_delay_s = 0;         // finals only from keys leaving the window (the next test: with it)
     WindowOptimizer opt(*map.lookup, cfg);
     std::vector<PoseOut> finals;
     int keys = 0;
@@ -153,6 +157,57 @@ TEST(WindowOptimizer, StationarySensorMakesAKeyframePerIntervalSoItsPosesKeepCom
       EXPECT_EQ(before_flush, 21u);        // keys at 0, 1, 2 s left the window of 3, and the frames up to the last
     }
   }
+}
+
+TEST(WindowOptimizer, FinalPosesLagTheNewestFrameByAtMostMaxFinalDelay) {
+  // A robot that stands 6 s (before a lift), moves off at 0.2 m/s for 4 s and stands again: keys every 1 s
+  // (keyframe_interval_s) and every 0.5 s (0.1 m), so W = 10 keys span 5-10 s. Without max_final_delay_s a
+  // frame is final when its key leaves the window: FPLOC_POSE up to ~W keyframe intervals behind the sensor.
+  // With it every frame is final max_final_delay_s after it (at the newest frame's time), once, in order,
+  // and where the window would have put it later.
+  auto map = matcher::make_localization_map(room_with_pillars(), "brute-force");
+  auto truth = [](int k) { return Pose2{8.0 + 0.2 * std::clamp(0.1 * k - 6.0, 0.0, 4.0), 3.0, 0.5}; };
+  const int n = 150;
+  std::vector<std::vector<PoseOut>> runs;
+  for (const double max_delay : {0.0, 1.0}) {
+    OptimizerConfig cfg;
+    cfg.max_final_delay_s = max_delay;
+    WindowOptimizer opt(*map.lookup, cfg);
+    std::vector<PoseOut> finals;
+    double worst_s = 0;
+    for (int k = 0; k < n; ++k) {
+      FrameInput in;
+      in.features = synth_frame(*map.plan, truth(k), SynthOptions{}, k * 100000);
+      in.features.scan_seq = k;
+      in.sfr = truth(k);
+      const size_t had = finals.size();
+      opt.add(in, &finals);
+      for (size_t i = had; i < finals.size(); ++i) worst_s = std::max(worst_s, (k * 100000 - finals[i].utime) * 1e-6);
+    }
+    const size_t before_flush = finals.size();
+    opt.flush(&finals);
+    ASSERT_EQ(finals.size(), size_t(n));
+    for (int k = 0; k < n; ++k) {
+      EXPECT_EQ(finals[k].utime, k * 100000);
+      EXPECT_TRUE(finals[k].final_estimate);
+    }
+    std::printf("max_final_delay_s %.1f: final poses up to %.1f s behind the newest frame\n", max_delay, worst_s);
+    if (max_delay == 0) {
+      EXPECT_GT(worst_s, 5.0);
+    } else {
+      EXPECT_LE(worst_s, max_delay + 1e-9);  // frames every 0.1 s: out exactly when the frame 1 s newer comes
+      EXPECT_EQ(before_flush, size_t(n - 10));
+    }
+    runs.push_back(std::move(finals));
+  }
+  // The same window (keys) either way; a pose out early is the window's estimate of it then, not after W
+  // solves: here about 5 mm from it at most (the regularisation's pull where the robot moves off and stops).
+  double worst_m = 0;
+  for (int k = 0; k < n; ++k) {
+    EXPECT_EQ(runs[0][k].keyframe, runs[1][k].keyframe) << k;
+    worst_m = std::max(worst_m, std::hypot(runs[1][k].pose.x - runs[0][k].pose.x, runs[1][k].pose.y - runs[0][k].pose.y));
+  }
+  EXPECT_LT(worst_m, 0.01);
 }
 
 TEST(WindowOptimizer, PoorFramesAreNeverKeyframes) {

@@ -5,6 +5,10 @@
 // beta ||w^{m+1} - w^m||^2. Each key pose is optimised W times and becomes final when it leaves the
 // window. Non-keyframes are passed on with the correction (final - single-frame) of the surrounding
 // keyframes interpolated in time, so the final trajectory has every frame.
+// A fixed lag in time besides (max_final_delay_s): a frame whose key has not left the window when the
+// newest frame is max_final_delay_s newer is made final then, with the window's current estimate (the key
+// stays in the window for the keys after it; only its published pose stops changing). W keys span W
+// keyframe intervals: 9-10 s for a standing robot, 2-5 s at the paper's 0.3-1 m/s.
 //
 // Motion compensation, as in the matcher: a key pose is the pose at its sweep's reference time
 // tau = utime + t_ref (t_ref = the mean point time; the sweep is de-skewed there with the matcher's twist),
@@ -53,6 +57,12 @@ struct OptimizerConfig {
   double max_keyframe_gap_s = 2.0;     // a longer gap (e.g. lost frames) restarts the window
   double keyframe_interval_s = 1.0;    // also a keyframe when the last is this old, so a standing robot's
                                        // final poses keep coming (they wait for keys); 0 = distance/angle only
+  // A frame's final pose is out at the latest when the newest frame is this much newer (FPLOC_POSE lags the
+  // sensor by at most this plus the time to the next frame): a key still in the window goes out with its
+  // current estimate (optimised fewer than W times), a non-keyframe with the correction interpolated between
+  // its keys' current estimates (held from the key before it while none follows). 0 = when its key leaves
+  // the window (W keyframe intervals: 9-10 s standing).
+  double max_final_delay_s = 1.0;
   std::string linear_solver = "sparse";  // "sparse" (SPARSE_NORMAL_CHOLESKY) or "dense" (DENSE_NORMAL_CHOLESKY)
   // Each keyframe's floor-plan term in the compact square-root form (matcher::add_frame_term): the same
   // steps, 4 residuals per keyframe instead of one per point (then the dense solver is the cheaper one).
@@ -121,6 +131,7 @@ class WindowOptimizer {
     FeatureFrame deskewed;             // features de-skewed to t_ref
     double x[3];                       // pose at tau
     int optimised = 0;
+    bool out = false;                  // its final pose is out (max_final_delay_s) while it is still in the window
     std::vector<matcher::Assignment> as;        // correspondences, looked up at as_pose
     Pose2 as_pose;
     bool as_valid = false;
@@ -142,6 +153,10 @@ class WindowOptimizer {
   void solve();
   void finalize_front(std::vector<PoseOut>* finals);
   void emit_pending_until(int64_t tau, const Eigen::Vector3d& corr_next, std::vector<PoseOut>* finals);
+  // Makes the frames up to utime `until` final that are not yet (keys still in the window: their current
+  // estimate), in time order.
+  void finalize_until(int64_t until, std::vector<PoseOut>* finals);
+  void emit_final(const Frame& f, const Pose2& pose_tau, bool key, int optimised, std::vector<PoseOut>* finals);
   // The output pose at utime from the pose at tau and the previous output's pose at its tau (`prev`,
   // updated), which closes the interval [prev.tau, tau] containing utime; without one (start, gap) the
   // matcher's twist carries the pose back.
