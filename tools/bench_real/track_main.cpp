@@ -35,6 +35,9 @@ int main(int argc, char** argv) {
   app.add_option("--end-scan", end, "end scan index (exclusive; 0 = the log's end)");
   app.add_option("--start", start, "ref: the reference pose of the first scan; off: 1 m / 10 deg off (as the bench)")
       ->check(CLI::IsMember({"ref", "off"}));
+  std::vector<double> start_pose;
+  app.add_option("--start-pose", start_pose, "X Y YAW: start here instead (e.g. the bench's start as read back from TUM)")
+      ->expected(3);
   fploc::laser2d::GridLocalizerConfig c;
   app.add_option("--refine-candidates", c.refine_candidates, "distinct search candidates refined per scan");
   app.add_option("--candidate-ratio", c.candidate_ratio, "kept when >= this share of the best score");
@@ -59,6 +62,10 @@ int main(int argc, char** argv) {
   app.add_option("--prior-scale", c.calibration.prior_scale_m2, "calibration ridge on the scale [m^2]");
   app.add_option("--reacquire-search-every-m", c.reacquire_search_every_m, "wide re-acquisition search after this much travel (0: every scan)");
   app.add_option("--confirm-within-sigmas", c.confirm_within_sigmas, "a hypothesis is taken within this many sigma of the dead-reckoned pose (0: off)");
+  app.add_option("--rival-margin", c.rival_margin, "re-acquiring: a near fit ends POOR/LOST only without a rival within this inlier share (< 0: off)");
+  app.add_option("--weak-follow-step-only", c.weak_follow_step_only, "re-acquiring: follow a weak fit only within this step's own odometry sigma");
+  app.add_option("--confirm-scans", c.confirm_scans, "scans a hypothesis must match in a row");
+  app.add_option("--confirm-margin", c.confirm_margin, "mean inlier share a hypothesis needs over its runner-up");
   CLI11_PARSE(app, argc, argv);
   namespace cm = fploc::carmen;
   namespace l2 = fploc::laser2d;
@@ -71,6 +78,7 @@ int main(int argc, char** argv) {
     const auto& s0 = log.scans[first].pose;
     fploc::Pose2 p0{s0.x, s0.y, s0.theta};
     if (start == "off") p0 = {p0.x + std::cos(p0.yaw + M_PI / 4), p0.y + std::sin(p0.yaw + M_PI / 4), p0.yaw + 10 * M_PI / 180};
+    if (start_pose.size() == 3) p0 = {start_pose[0], start_pose[1], start_pose[2]};
     loc.set_initial_pose(p0);
     const double rmax = scans.max_range_m;
     nlohmann::json rows = nlohmann::json::array();

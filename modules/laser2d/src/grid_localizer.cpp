@@ -125,6 +125,12 @@ struct GridLocalizer::Impl {
     double inlier_ratio = 0, rms = 0, score = 0, wxy = 0, wyaw = 0;
     int inliers = 0, leaves = 0, iterations = 0, refined = 0;
     Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();
+    // Every refined candidate (the chosen one included): the rivals of the chosen fit.
+    struct Alt {
+      Pose2 pose;
+      double inlier_ratio = 0;
+    };
+    std::vector<Alt> alts;
   };
   Fit fit(const std::vector<Eigen::Vector2d>& pts, const Pose2& pred, double sxy, double syaw, double max_xy,
           double max_yaw, int keep, double min_inlier_ratio) const;
@@ -258,6 +264,7 @@ GridLocalizer::Impl::Fit GridLocalizer::Impl::fit(const std::vector<Eigen::Vecto
     problem = refine_problem(interp, d, c0, pts, pred, sxy, syaw, xs[bi].data(), &unused, nullptr);
   }
   f.refined = int(xs.size());
+  for (size_t i = 0; i < xs.size(); ++i) f.alts.push_back({{xs[i][0], xs[i][1], wrap_angle(xs[i][2])}, inl[i]});
   const double* x = xs[bi].data();
   f.est = {x[0], x[1], wrap_angle(x[2])};
   f.inliers = ninl[bi];
@@ -383,8 +390,19 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
       // (Tried: leaving LOST only with confirm_inlier_ratio here too: intel 18.1 -> 185 cm, more weak fits
       // followed; freiburg-079 86 -> 91 cm.)
       const bool inside = std::hypot(ex, ey) <= f.wxy + df.resolution() && std::abs(eyaw) <= f.wyaw + cfg_.search_yaw_step_rad;
-      if ((f.accepted && near && f.inlier_ratio >= cfg_.min_inlier_ratio) ||
-          (inside && f.inlier_ratio >= cfg_.reacquire_strong_ratio)) {
+      // Rivals: the best inlier share of a refined candidate at another place.
+      double rival = 0;
+      for (const auto& a : f.alts)
+        if (std::hypot(a.pose.x - f.est.x, a.pose.y - f.est.y) > cfg_.rival_sep_xy_m ||
+            std::abs(wrap_angle(a.pose.yaw - f.est.yaw)) > cfg_.rival_sep_yaw_rad)
+          rival = std::max(rival, a.inlier_ratio);
+      const bool unrivalled = cfg_.rival_margin < 0 || rival < f.inlier_ratio - cfg_.rival_margin;
+      // Within gate_sigmas of this step's own odometry uncertainty (not the accumulated one).
+      const double step_xy = std::max(qxy, cfg_.sigma_xy_m), step_yaw = std::max(qyaw, cfg_.sigma_yaw_rad);
+      const bool one_step = (ex * ex + ey * ey) / (step_xy * step_xy) + eyaw * eyaw / (step_yaw * step_yaw) <=
+                            cfg_.gate_sigmas * cfg_.gate_sigmas;
+      if (((f.accepted && near && f.inlier_ratio >= cfg_.min_inlier_ratio) ||
+           (inside && f.inlier_ratio >= cfg_.reacquire_strong_ratio)) && unrivalled) {
         m.hyps.clear();
         m.pose = f.est;
         m.sxy = std::sqrt(std::max(f.cov(0, 0), f.cov(1, 1)));
@@ -401,7 +419,10 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
       }
       // Weak, near the prediction: follow it, but keep the dead-reckoned uncertainty (a weak fit does not
       // confirm the pose; shrinking it would narrow the re-acquisition search around a wrong place).
-      if (f.accepted && cfg_.follow_weak && (cfg_.follow_weak_when_lost || m.poor_run < cfg_.lost_after)) pred = f.est;
+      // Only a correction of this step's odometry, and only when the scan does not also fit elsewhere.
+      if (f.accepted && cfg_.follow_weak && (cfg_.follow_weak_when_lost || m.poor_run < cfg_.lost_after) &&
+          (!cfg_.weak_follow_step_only || (one_step && unrivalled)))
+        pred = f.est;
     }
     std::vector<Impl::Hypothesis> kept;
     for (auto& h : m.hyps) {

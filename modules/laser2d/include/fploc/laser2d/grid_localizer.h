@@ -105,6 +105,23 @@ struct GridLocalizerConfig {
   // ... also once LOST (lost_after POOR scans): off — after a long stretch the map does not explain, a weak fit
   // within the grown gate is as likely a wrong place (intel scan 799: 1.5 m off with 41 % inliers).
   bool follow_weak_when_lost = true;
+  // Re-acquisition must not be a lottery (issue 13, seventh pass: intel's covered ATE was 155 or 9.9 cm depending
+  // on a 5 mm difference in the start pose). Two rules while re-acquiring (POOR or LOST):
+  // (1) a weak fit (accepted only for being near the dead-reckoned pose) is followed only when it corrects the
+  //     prediction by what this one step's odometry can have got wrong: within gate_sigmas of the step's own
+  //     sigma (sigma_* of this increment), not of the uncertainty accumulated while dead-reckoning. A weak fit
+  //     1.1 m / 0 deg from the prediction with 43 % inliers (intel scan 806) moved a dead-reckoned pose that was
+  //     0.2 m from the truth 1.2 m away, and which place was re-acquired after that was decided by millimetres.
+  //     false: the earlier behaviour (any weak fit within gate_sigmas of the accumulated uncertainty).
+  bool weak_follow_step_only = true;
+  // (2) a fit near the dead-reckoned pose ends POOR/LOST at once only when unrivalled: no other refined
+  //     candidate of the same search, at another place (farther than rival_sep_xy_m or rival_sep_yaw_rad),
+  //     explains nearly as much of the scan (within rival_margin of its inlier share; the margin the hypotheses
+  //     need over their runner-up, confirm_margin). A comparable rival means the scan does not decide where the
+  //     robot is: it stays POOR (dead-reckons), is not followed either, and the wide search's hypotheses compete
+  //     over the next scans. < 0: off.
+  double rival_margin = 0.1;
+  double rival_sep_xy_m = 0.3, rival_sep_yaw_rad = 10.0 * M_PI / 180;
   // LOST (lost_after POOR scans) searches +-window_sigmas sigma of the dead-reckoned pose (capped at
   // reacquire_xy_m / reacquire_yaw_rad) as POOR does, the sigma growing with the motion since the last fit: with
   // the calibrated odometry the dead-reckoned pose stays near the truth through unmapped ground, and a wider
