@@ -345,7 +345,7 @@ void WindowOptimizer::emit_pending_until(int64_t tau, const Eigen::Vector3d& cor
 void WindowOptimizer::finalize_front(std::vector<PoseOut>* finals) {
   Key k = std::move(window_.front());
   window_.pop_front();
-  const Pose2 p_tau{k.x[0], k.x[1], wrap_angle(k.x[2])};
+  const Pose2 p_tau = k.pose_tau();
   const Eigen::Vector3d corr = diff(p_tau, k.f.sfr_tau);
   emit_pending_until(k.f.tau, corr, finals);  // none left when k is out (they went out before it)
   if (!k.out) emit_final(k.f, p_tau, true, k.optimised, finals);
@@ -354,7 +354,7 @@ void WindowOptimizer::finalize_front(std::vector<PoseOut>* finals) {
 }
 
 void WindowOptimizer::finalize_until(int64_t until, std::vector<PoseOut>* finals) {
-  auto correction = [](const Key& k) { return diff(Pose2{k.x[0], k.x[1], k.x[2]}, k.f.sfr_tau); };
+  auto correction = [](const Key& k) { return diff(k.pose_tau(), k.f.sfr_tau); };
   size_t next = 0;  // the first key not out (those out lead the window: frames go out in time order)
   while (next < window_.size() && window_[next].out) ++next;
   for (;;) {
@@ -372,7 +372,7 @@ void WindowOptimizer::finalize_until(int64_t until, std::vector<PoseOut>* finals
       emit_final(f, plus(f.sfr_tau, c), false, 0, finals);
       pending_.pop_front();
     } else if (k && k->f.in.features.utime <= until) {
-      emit_final(k->f, Pose2{k->x[0], k->x[1], wrap_angle(k->x[2])}, true, k->optimised, finals);
+      emit_final(k->f, k->pose_tau(), true, k->optimised, finals);
       k->out = true;
       ++next;
     } else {

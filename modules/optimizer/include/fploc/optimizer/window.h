@@ -130,6 +130,7 @@ class WindowOptimizer {
     Frame f;
     FeatureFrame deskewed;             // features de-skewed to t_ref
     double x[3];                       // pose at tau
+    Pose2 pose_tau() const { return {x[0], x[1], wrap_angle(x[2])}; }  // the current estimate, yaw wrapped
     int optimised = 0;
     bool out = false;                  // its final pose is out (max_final_delay_s) while it is still in the window
     std::vector<matcher::Assignment> as;        // correspondences, looked up at as_pose

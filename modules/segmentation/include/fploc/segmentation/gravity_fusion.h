@@ -88,14 +88,9 @@ class GravityFusion {
                 const Eigen::Vector3d& bias, bool plane_repeated = false);
 
   Mode mode() const { return mode_; }
-  // Gravity up in the sensor frame as of the last update (false before the first).
-  bool gravity_up(Eigen::Vector3d* up) const {
-    if (!started_) return false;
-    *up = g_;
-    return true;
-  }
-  // ... carried by the gyro to time t (this scan's mid-sweep; the sensor pitches a degree per scan over a ramp's
-  // head); as of the last update where the gyro does not cover the interval.
+  // Gravity up in the sensor frame (false before the first update), carried by the gyro from the last update to
+  // time t (this scan's mid-sweep: the sensor pitches a degree per scan over a ramp's head); as of the last update
+  // where the gyro does not cover the interval (or it is over 1 s, as update() allows).
   bool gravity_up_at(int64_t t, const Eigen::Vector3d& bias, Eigen::Vector3d* up) const {
     if (!started_) return false;
     Eigen::Matrix3d R;
