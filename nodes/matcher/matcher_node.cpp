@@ -140,6 +140,7 @@ class MatcherNode : public fploc::rt::Node {
     ob.inlier_ratio = fp->match.fit.inlier_ratio;
     ob.z = fp->z;
     ob.z_known = fploc::z_known(f);
+    ob.z_sigma = f.z_sigma;
     ob.roll = f.roll, ob.pitch = f.pitch;
     ob.roll_pitch_known = fploc::roll_pitch_known(f);
     ob.attitude_t = std::isfinite(f.attitude_t) ? f.attitude_t : 0.0;

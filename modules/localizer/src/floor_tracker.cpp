@@ -188,6 +188,18 @@ double FloorTracker::pose_z_sigma(double segmenter_sigma) const {
   return std::sqrt(segmenter_sigma * segmenter_sigma + r * r);
 }
 
+std::optional<FloorTracker::InclineAt> FloorTracker::incline_under(const Eigen::Vector2d& p) const {
+  const double e = building_->floors[size_t(floor_)].elevation;
+  for (const auto& in : inclines_) {
+    if ((in.from_floor != floor_ && in.to_floor != floor_) || !in.contains(p)) continue;
+    const double run = (in.head - in.foot).norm();
+    return InclineAt{std::clamp(in.z_at(p), std::min(in.z_foot, in.z_head), std::max(in.z_foot, in.z_head)) - e,
+                     std::hypot(run, in.z_head - in.z_foot) / run,
+                     std::string(to_string(in.kind)) + " '" + in.name + "' surface"};
+  }
+  return std::nullopt;
+}
+
 void FloorTracker::resolve_z(const FloorObservation& o, const std::optional<FloorSwitch>& s) {
   const BuildingFloor& fl = building_->floors[size_t(floor_)];
   const double e = fl.elevation;
@@ -206,18 +218,39 @@ void FloorTracker::resolve_z(const FloorObservation& o, const std::optional<Floo
     h_ = ride_base_ + vertical_.height() - vertical_.velocity() * ahead;
     have_h_ = true;
     z_gated_ = false;
+    // Above the car's floor the sensor stays where it stood: that is the last good height on arrival (the
+    // segmenter may still see only the car, whose ceiling it has not learned).
+    above_ = ride_base_;
+    above_utime_ = o.utime;
+    have_above_ = true;
     pose_z_ = e + h_;
     z_source_ = "lift ride (IMU)";
     return;
   }
   const bool ride_ended = ride_active_;
   ride_active_ = false;
-  if (!o.z_known) {
-    // Held: the same absolute z (a switch changes the floor, not where the sensor is).
-    if (have_h_) h_ = pose_z_ - e;
-    else pose_z_ = e + o.z;
-    z_source_ = "held";
-    return;
+  const Eigen::Vector2d p(o.pose.x, o.pose.y);
+  const auto incline = incline_under(p);
+  // A z the segmenter only predicted (its last measurement, held while it sees no plane: sigma above what the
+  // building's own prediction has) does not follow a climb; on a ramp or stairs the surface under the sensor
+  // does, so there the last good height above that surface is kept, as for no z at all.
+  const bool predicted = o.z_known && o.z_sigma > cfg_.z_gated_sigma_m;
+  if (!o.z_known || (predicted && incline)) {
+    // Held: the same absolute z (a switch changes the floor, not where the sensor is), or on an incline the
+    // last good height above its surface.
+    if (incline && have_above_ && o.utime - above_utime_ < int64_t(cfg_.z_hold_s * 1e6)) {
+      h_ = incline->g + above_;
+      have_h_ = true;
+      pose_z_ = e + h_;
+      z_source_ = "held (" + fmt("%.2f m", above_) + " above " + incline->name + ")";
+      return;
+    }
+    if (!o.z_known) {
+      if (have_h_) h_ = pose_z_ - e;
+      else pose_z_ = e + o.z;
+      z_source_ = "held";
+      return;
+    }
   }
   struct Ref {
     int kind;
@@ -226,16 +259,8 @@ void FloorTracker::resolve_z(const FloorObservation& o, const std::optional<Floo
     double scale = 1;  // a height measured across an incline's plane: vertically it is z / cos(slope)
   };
   std::vector<Ref> refs{{0, 0.0, "floor '" + fl.name + "'"}};
-  const Eigen::Vector2d p(o.pose.x, o.pose.y);
-  double g = 0, inv_cos = 1;
-  for (const auto& in : inclines_) {
-    if ((in.from_floor != floor_ && in.to_floor != floor_) || !in.contains(p)) continue;
-    g = std::clamp(in.z_at(p), std::min(in.z_foot, in.z_head), std::max(in.z_foot, in.z_head)) - e;
-    const double run = (in.head - in.foot).norm();
-    inv_cos = std::hypot(run, in.z_head - in.z_foot) / run;
-    refs.push_back({1, g, std::string(to_string(in.kind)) + " '" + in.name + "' surface", inv_cos});
-    break;
-  }
+  const double g = incline ? incline->g : 0.0, inv_cos = incline ? incline->inv_cos : 1.0;
+  if (incline) refs.push_back({1, g, incline->name, inv_cos});
   if (z_offset_ != 0) refs.push_back({2, -z_offset_, "floor left (" + fmt("%+.2f m", -z_offset_) + ")"});
   size_t best = 0;
   // The sensor's nominal height above the surface under it, vertically: z0 on flat floor; on an incline
@@ -272,8 +297,26 @@ void FloorTracker::resolve_z(const FloorObservation& o, const std::optional<Floo
                 " above " + (refs.size() > 1 && g != 0 ? refs[1].name : refs[0].name) + " (the segmenter's z is " +
                 fmt("%+.2f m", off) + " off)";
     if (!was_gated) text_ = "z: " + z_source_;
-  } else if (was_gated) {
-    text_ = "z: the segmenter's again (" + fmt("%.2f m", h_ - (refs[best].kind == 1 ? g : 0.0)) + " above " + refs[best].name + ")";
+  } else if (have_above_ && o.utime - above_utime_ < int64_t(cfg_.z_step_window_s * 1e6) &&
+             std::abs(h_ - g - above_) > cfg_.z_step_gate_m) {
+    // A step in the height above the surface under the sensor since the last good frame (the segmenter took
+    // another surface for the one under the robot, a ramp's kink for a floor, ...): not used until frames in
+    // a row agree on the new height.
+    const double a = h_ - g;
+    step_frames_ = step_frames_ > 0 && std::abs(a - step_above_) <= cfg_.z_step_gate_m ? step_frames_ + 1 : 1;
+    step_above_ = a;
+    if (step_frames_ < cfg_.z_step_confirm_frames) {
+      h_ = g + above_;
+      z_gated_ = true;
+      z_source_ = "building: last good height " + fmt("%.2f m", above_) + " above " + (g != 0 ? refs[1].name : refs[0].name) +
+                  " (the segmenter's jumped " + fmt("%+.3f m", a - above_) + ")";
+    } else {
+      step_frames_ = 0;
+    }
+  } else {
+    step_frames_ = 0;
+    if (was_gated)
+      text_ = "z: the segmenter's again (" + fmt("%.2f m", h_ - (refs[best].kind == 1 ? g : 0.0)) + " above " + refs[best].name + ")";
   }
   if (!z_gated_) {
     above_ = h_ - g;

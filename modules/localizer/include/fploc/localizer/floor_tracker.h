@@ -70,6 +70,13 @@ struct FloorTrackerConfig {
   double z_gate_m = 0.08;              // the segmenter's z this far from z0 above the surface: not used ...
   double z_gated_sigma_m = 0.03;       // ... the prediction instead, with this sigma: the last good height above
   double z_hold_s = 5.0;               // the surface when it is this recent, else the nominal z0
+  // A step: the segmenter's height above the surface under the sensor further than z_step_gate_m from the
+  // last good one (at most z_step_window_s old) is not used (the last good height instead, z_gated_sigma_m)
+  // until z_step_confirm_frames frames in a row agree on the new height (within the gate). A door sill
+  // lifts the sensor by less in a frame; the height of a robot's mast changes by ~1 cm/s at most.
+  double z_step_gate_m = 0.03;
+  double z_step_window_s = 1.5;
+  int z_step_confirm_frames = 3;
   // Plan mismatch in a lift area (floor switch without the IMU).
   double mismatch_ratio = 0.6;         // inlier ratio below this (or LOST): the plan does not match
   int mismatch_frames = 3;             // ... for this many frames in a row
@@ -87,6 +94,7 @@ struct FloorObservation {
   double inlier_ratio = 1;             // the matcher's inlier ratio (0..1): how well the plan matches
   double z = 0;                        // the segmenter's z (its own reference)
   bool z_known = false;
+  double z_sigma = 0;                  // ... and its sigma (a held prediction's is large)
   double roll = 0, pitch = 0;          // the frame's attitude (used when there is no IMU)
   bool roll_pitch_known = false;
   double attitude_t = 0;               // z holds at utime + this (mid-sweep; the lift ride's z is given there)
@@ -167,6 +175,13 @@ class FloorTracker {
   std::optional<FloorSwitch> check_climb(const FloorObservation& o);
   std::optional<FloorSwitch> update_floor(const FloorObservation& o);
   void resolve_z(const FloorObservation& o, const std::optional<FloorSwitch>& s);
+  // The ramp/stairs of the current floor under p: its surface's height above the floor's level there, and
+  // 1 / cos of its slope.
+  struct InclineAt {
+    double g = 0, inv_cos = 1;
+    std::string name;
+  };
+  std::optional<InclineAt> incline_under(const Eigen::Vector2d& p) const;
   void check_mismatch(const FloorObservation& o, bool switched);
   std::vector<int> lift_reachable(const Eigen::Vector2d& p, std::vector<int>* via) const;
   FloorSwitch make_switch(int to, const FloorConnection& via, const std::string& reason);
@@ -209,6 +224,8 @@ class FloorTracker {
   int z_ref_kind_ = 0;
   bool z_gated_ = false;                 // 0 floor level, 1 incline surface, 2 level of the floor left
   std::string z_source_ = "floor";
+  int step_frames_ = 0;                // frames in a row whose height stepped away from the last good one
+  double step_above_ = 0;              // ... the last one's height above the surface
   double ride_base_ = 0;               // lift: the height above the floor when the ride started
   bool ride_active_ = false;
   double good_h_ = 0;                  // the last height above a flat floor the segmenter measured (not gated)
