@@ -110,22 +110,24 @@ class OptimizerNode : public fploc::rt::Node {
       ctx_->error("frame_pose scan_seq " + std::to_string(m.scan_seq) + ": non-finite pose (dropped)");
       return;
     }
-    std::vector<fploc::localizer::Pose> finals;
-    if (m.floor_index >= 0 && size_t(m.floor_index) < plan_.floors().maps.size() && m.floor_index != plan_.floor()) {
-      // The matcher changed floor: the window's poses are final on the old floor.
-      loc_->flush(&finals);
-      publish_finals(finals);
-      finals.clear();
-      plan_.set_floor(m.floor_index);
-      loc_ = plan_.make_localizer(cfg_);
-      std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << ": window on floor '" << m.floor << "'\n";
-    }
     // The matcher's z is absolute (its floor's elevation + the height above it; the segmenter's z carries
     // no floor), its sigma grown while a lift ride is integrated from the IMU.
     fploc::FeatureFrame fz = f;
     if (fploc::z_known(f)) {
       fz.z = m.z;
       if (std::isfinite(m.z_sigma) && m.z_sigma > fz.z_sigma && m.z_sigma < fploc::kZUnknownFromSigmaM) fz.z_sigma = m.z_sigma;
+    }
+    std::vector<fploc::localizer::Pose> finals;
+    if (m.floor_index >= 0 && size_t(m.floor_index) < plan_.floors().maps.size() && m.floor_index != plan_.floor()) {
+      // The matcher changed floor: the window's poses are final on the old floor (the arriving frame's z
+      // first ends a lift ride's IMU-integrated z in them).
+      loc_->end_z_stretch(fz);
+      loc_->flush(&finals);
+      publish_finals(finals);
+      finals.clear();
+      plan_.set_floor(m.floor_index);
+      loc_ = plan_.make_localizer(cfg_);
+      std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << ": window on floor '" << m.floor << "'\n";
     }
     const auto latest = loc_->optimize(fz, fploc::adapters::from_msg(m), &finals);
     // The floor of each frame is the matcher's (frame_pose_t); kept until the frame's pose is final.

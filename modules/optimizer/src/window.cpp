@@ -163,7 +163,10 @@ void WindowOptimizer::fill_gravity(PoseOut* o, const FeatureFrame& f) const {
     if (before && after) {
       const double s = double(f.utime - before->t) / double(after->t - before->t);
       *out = get(*before) + s * (get(*after) - get(*before));
-    } else if (!self_known && (before || after)) {
+    } else if (self_known) {
+      // Its own entry when it holds at utime (end_z_stretch may have moved its z).
+      if (before && before->t == f.utime + std::llround(f.attitude_t * 1e6)) *out = get(*before);
+    } else if (before || after) {
       *out = get(before ? *before : *after);
     }
   };
@@ -172,11 +175,26 @@ void WindowOptimizer::fill_gravity(PoseOut* o, const FeatureFrame& f) const {
   fill(&Gravity::rp_known, rp_ok, [](const Gravity& g) { return g.pitch; }, &o->pitch);
 }
 
+void WindowOptimizer::end_z_stretch(const FeatureFrame& f) {
+  if (cfg_.z_stretch_ratio <= 0 || !z_known(f)) return;
+  auto last = std::find_if(gravity_.rbegin(), gravity_.rend(), [](const Gravity& g) { return g.z_known; });
+  if (last == gravity_.rend()) return;
+  const double s_end = last->z_sigma, s = f.z_sigma;
+  if (!(s_end > cfg_.z_stretch_ratio * s && s_end > cfg_.z_stretch_min_sigma_m)) return;
+  const double e = f.z - last->z;
+  for (auto it = last; it != gravity_.rend(); ++it) {
+    if (!it->z_known) continue;
+    if (it->z_sigma <= s) break;  // the stretch began after this frame
+    it->z += e * (it->z_sigma - s) / (s_end - s);
+    it->z_sigma = s;              // (said once: the next frame does not end it again)
+  }
+}
+
 PoseOut WindowOptimizer::add(FrameInput in, std::vector<PoseOut>* finals) {
   {
     const FeatureFrame& f = in.features;
     gravity_.push_back({f.utime + std::llround(f.attitude_t * 1e6), f.roll, f.pitch, f.z,
-                        roll_pitch_known(f), z_known(f)});
+                        roll_pitch_known(f), z_known(f), f.z_sigma});
     // Keep what the frames still to be output may need (and a little before).
     int64_t oldest = f.utime;
     if (!pending_.empty()) oldest = std::min(oldest, pending_.front().in.features.utime);

@@ -324,3 +324,48 @@ TEST(WindowOptimizer, PoseFarFromItsFixIsPublishedPoor) {
     }
   }
 }
+
+TEST(WindowOptimizer, ARideEndingOnAFloorMovesTheRidesFramesNotYetFinal) {
+  // A robot stands in a lift car for a 6 s ride: its z is the IMU's double integral, off by 0.5 d t^2 (a
+  // residual acceleration d = 0.002 m/s^2: 3.5 cm at the end), its sigma growing as 0.5 a t^2 (the floor
+  // tracker's). The arrival's z (the new floor + the height in the car, 5 mm) ends the stretch: the frames
+  // not final yet (the last max_final_delay_s = 1 s) move by the share of the 3.6 cm their sigma had grown;
+  // the frames already out keep theirs. Control: without end_z_stretch the last second keeps its 3 cm.
+  auto map = matcher::make_localization_map(room_with_pillars(), "brute-force");
+  const Pose2 at{8.0, 3.0, 0.5};
+  const int start = 20, end = 80;  // ride frames [start, end); frame `end` is the arrival
+  auto ride_t = [&](int k) { return std::max(0, k - start) * 0.1; };
+  // The car moves for 5 s (smooth start and stop) and stands 1 s before the IMU calls it a rest (the arrival).
+  auto truth_z = [&](int k) { return 4.4 - 3.2 * 0.5 * (1 - std::cos(M_PI * std::min(1.0, ride_t(k) / 5.0))); };
+  auto err = [&](int k) { return k < end ? 0.5 * 0.002 * ride_t(k) * ride_t(k) : 0.0; };
+  for (const bool end_stretch : {false, true}) {
+    WindowOptimizer opt(*map.lookup, OptimizerConfig{});
+    std::vector<PoseOut> finals;
+    for (int k = 0; k <= end + 5; ++k) {
+      FrameInput in;
+      in.features = synth_frame(*map.plan, at, SynthOptions{}, k * 100000);
+      in.features.scan_seq = k;
+      in.features.z = truth_z(k) + err(k);
+      const double r = k >= start && k < end ? 0.5 * 0.02 * ride_t(k) * ride_t(k) : 0.0;
+      in.features.z_sigma = std::hypot(0.005, r);
+      in.sfr = at;
+      if (k == end && end_stretch) {
+        opt.end_z_stretch(in.features);  // (the node, when the matcher says the floor changed)
+        opt.flush(&finals);
+      }
+      opt.add(in, &finals);
+    }
+    opt.flush(&finals);
+    ASSERT_EQ(finals.size(), size_t(end + 6));
+    for (int k = 0; k <= end + 5; ++k) {
+      const double e = finals[k].z - truth_z(k);
+      if (k < end - 10 || k >= end) {
+        EXPECT_NEAR(e, err(k), 1e-9) << k;  // final before the arrival (or after it): as it came
+      } else if (end_stretch) {
+        EXPECT_LT(std::abs(e), 0.25 * err(k)) << k;  // 2.6-3.5 cm -> under a quarter
+      } else {
+        EXPECT_GT(e, 0.024) << k;
+      }
+    }
+  }
+}

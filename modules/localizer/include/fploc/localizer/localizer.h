@@ -73,6 +73,8 @@ class Localizer {
   std::optional<Pose> optimize(const FeatureFrame& f, const FramePose& sfr, std::vector<Pose>* finals);
   // Makes every pose still in the window final (end of a sequence).
   void flush(std::vector<Pose>* finals) { window_.flush(finals); }
+  // A frame's z ends a dead-reckoned stretch before a flush (optimizer::WindowOptimizer::end_z_stretch).
+  void end_z_stretch(const FeatureFrame& f) { window_.end_z_stretch(f); }
 
   // Both steps in one process.
   struct Step {

@@ -63,6 +63,14 @@ struct OptimizerConfig {
   // its keys' current estimates (held from the key before it while none follows). 0 = when its key leaves
   // the window (W keyframe intervals: 9-10 s standing).
   double max_final_delay_s = 1.0;
+  // z at the end of a dead-reckoned stretch (end_z_stretch: a lift ride's z integrated from the IMU, whose
+  // sigma grew): a frame whose z is known with a sigma below 1 / z_stretch_ratio of the previous known one's
+  // (which is above z_stretch_min_sigma_m) moves the stretch's frames that are not final yet by its innovation
+  // (its z - the previous z), each by the share its own sigma had grown (0 at the stretch's start, all of it at
+  // its end: the error of an integrated bias grows as the sigma the IMU's height is given). A fixed-lag
+  // smoother's correction, within max_final_delay_s. Internal; z_stretch_ratio 0 = off.
+  double z_stretch_ratio = 3;
+  double z_stretch_min_sigma_m = 0.02;
   std::string linear_solver = "sparse";  // "sparse" (SPARSE_NORMAL_CHOLESKY) or "dense" (DENSE_NORMAL_CHOLESKY)
   // Each keyframe's floor-plan term in the compact square-root form (matcher::add_frame_term): the same
   // steps, 4 residuals per keyframe instead of one per point (then the dense solver is the cheaper one).
@@ -114,6 +122,10 @@ class WindowOptimizer {
   PoseOut add(FrameInput in, std::vector<PoseOut>* finals);
   // Makes everything still in the window final (end of a sequence).
   void flush(std::vector<PoseOut>* finals);
+  // The z of a frame about to come ends a dead-reckoned stretch of z (OptimizerConfig::z_stretch_ratio): the
+  // optimizer node calls it when a lift ride ends on another floor, before the window is made final there.
+  // (Not in add(): a held prediction's sigma grows too, but its error is no integrated bias.)
+  void end_z_stretch(const FeatureFrame& f);
   size_t window_size() const { return window_.size(); }
   int solves() const { return solves_; }
   const OptimizerConfig& config() const { return cfg_; }
@@ -177,6 +189,7 @@ class WindowOptimizer {
     int64_t t;                         // when roll/pitch/z hold (utime + attitude_t)
     double roll, pitch, z;
     bool rp_known, z_known;
+    double z_sigma;
   };
   std::deque<Gravity> gravity_;        // recent frames' roll/pitch/z
   bool have_last_key_ = false;
