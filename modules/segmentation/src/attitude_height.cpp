@@ -105,11 +105,15 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
 
   // ---- roll / pitch ----
   bool use_ceiling = c, use_ground = !c && g;
+  // Ceiling and floor parallel: only then is ceiling + ground distance a floor-to-ceiling height (a sloped
+  // ceiling's distance is along its own normal and holds nowhere but at its foot).
+  bool parallel = c && g;
   if (c && g) {
     const double ang = std::acos(std::clamp(up_c.dot(up_g), -1.0, 1.0));
     const double gate = std::max(cfg_.attitude_consistency_deg * k::kDeg,
                                  3.0 * std::hypot(out.ceiling.tilt_sigma, out.ground.tilt_sigma));
     if (ang > gate) {
+      parallel = false;
       // One of them is not level (a sloped ceiling under a roof or stairs, a compromise over two ceiling
       // surfaces, a ramp under the sensor): the IMU decides when given, else the floor (floors are level
       // far more often than the ceilings above them).
@@ -185,7 +189,7 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
     }
   }
   if (areas_on) {
-    if (c && ground_level && !known) update_room_height(out.ceiling.distance() + out.ground.distance());  // wall selection
+    if (parallel && ground_level && !known) update_room_height(out.ceiling.distance() + out.ground.distance());  // wall selection
     area_z(out, up, ground_level);
     return up;
   }
@@ -194,7 +198,10 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
     // distance is not the height above the area's floor.
     note(out, "floor tilted under the robot (a ramp): z from the ceiling");
   }
-  if (c && ground_level && !known) {
+  // A ceiling not parallel to the floor (a sloped roof, a compromise over two surfaces) gave no attitude and
+  // gives no z (use_ceiling is off), and no room height either: learning its distances would shift the running
+  // median by a few cm, under the consistency gate, and the next level ceiling would put z off by that much.
+  if (parallel && ground_level && !known) {
     const double h = out.ceiling.distance() + out.ground.distance();
     if (room_height_ > 0 && std::abs(h - room_height_) > std::max(cfg_.z_consistency_m, 3.0 * (out.ceiling.d_sigma + out.ground.d_sigma))) {
       // The ceiling over the sensor is not the area's (yet): z from the floor; the running median follows
