@@ -203,12 +203,22 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
   // median by a few cm, under the consistency gate, and the next level ceiling would put z off by that much.
   if (parallel && ground_level && !known) {
     const double h = out.ceiling.distance() + out.ground.distance();
-    if (room_height_ > 0 && std::abs(h - room_height_) > std::max(cfg_.z_consistency_m, 3.0 * (out.ceiling.d_sigma + out.ground.d_sigma))) {
+    const double tol = 3.0 * (out.ceiling.d_sigma + out.ground.d_sigma);
+    if (room_height_ > 0 && std::abs(h - room_height_) > std::max(cfg_.z_consistency_m, tol)) {
       // The ceiling over the sensor is not the area's (yet): z from the floor; the running median follows
       // when the new height persists (another area).
       char buf[160];
       std::snprintf(buf, sizeof buf, "ceiling %.3f m above the floor vs the area's %.3f m: z from the ground", h,
                     room_height_);
+      note(out, buf);
+      use_ceiling = false;
+    } else if (room_height_ > 0 && std::abs(h - room_height_) > tol) {
+      // The same area, but the ceiling's z (the area's height - its distance) and the floor's differ by
+      // h - height: more than 3 of their sigmas, so the ceiling's distance is off by more than its fit says
+      // (a far patch, its tilt a little off: a lever of metres). The floor's distance is the direct one.
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "ceiling's z %.1f cm off the floor's (> 3 sigmas, %.1f cm): z from the ground",
+                    100 * (room_height_ - h), 100 * tol);
       note(out, buf);
       use_ceiling = false;
     }
