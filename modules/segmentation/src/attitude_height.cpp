@@ -105,11 +105,15 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
 
   // ---- roll / pitch ----
   bool use_ceiling = c, use_ground = !c && g;
+  // Ceiling and floor parallel: only then is ceiling + ground distance a floor-to-ceiling height (a sloped
+  // ceiling's distance is along its own normal and holds nowhere but at its foot).
+  bool parallel = c && g;
   if (c && g) {
     const double ang = std::acos(std::clamp(up_c.dot(up_g), -1.0, 1.0));
     const double gate = std::max(cfg_.attitude_consistency_deg * k::kDeg,
                                  3.0 * std::hypot(out.ceiling.tilt_sigma, out.ground.tilt_sigma));
     if (ang > gate) {
+      parallel = false;
       // One of them is not level (a sloped ceiling under a roof or stairs, a compromise over two ceiling
       // surfaces, a ramp under the sensor): the IMU decides when given, else the floor (floors are level
       // far more often than the ceilings above them).
@@ -185,7 +189,7 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
     }
   }
   if (areas_on) {
-    if (c && ground_level && !known) update_room_height(out.ceiling.distance() + out.ground.distance());  // wall selection
+    if (parallel && ground_level && !known) update_room_height(out.ceiling.distance() + out.ground.distance());  // wall selection
     area_z(out, up, ground_level);
     return up;
   }
@@ -194,14 +198,27 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
     // distance is not the height above the area's floor.
     note(out, "floor tilted under the robot (a ramp): z from the ceiling");
   }
-  if (c && ground_level && !known) {
+  // A ceiling not parallel to the floor (a sloped roof, a compromise over two surfaces) gave no attitude and
+  // gives no z (use_ceiling is off), and no room height either: learning its distances would shift the running
+  // median by a few cm, under the consistency gate, and the next level ceiling would put z off by that much.
+  if (parallel && ground_level && !known) {
     const double h = out.ceiling.distance() + out.ground.distance();
-    if (room_height_ > 0 && std::abs(h - room_height_) > std::max(cfg_.z_consistency_m, 3.0 * (out.ceiling.d_sigma + out.ground.d_sigma))) {
+    const double tol = 3.0 * (out.ceiling.d_sigma + out.ground.d_sigma);
+    if (room_height_ > 0 && std::abs(h - room_height_) > std::max(cfg_.z_consistency_m, tol)) {
       // The ceiling over the sensor is not the area's (yet): z from the floor; the running median follows
       // when the new height persists (another area).
       char buf[160];
       std::snprintf(buf, sizeof buf, "ceiling %.3f m above the floor vs the area's %.3f m: z from the ground", h,
                     room_height_);
+      note(out, buf);
+      use_ceiling = false;
+    } else if (room_height_ > 0 && std::abs(h - room_height_) > tol) {
+      // The same area, but the ceiling's z (the area's height - its distance) and the floor's differ by
+      // h - height: more than 3 of their sigmas, so the ceiling's distance is off by more than its fit says
+      // (a far patch, its tilt a little off: a lever of metres). The floor's distance is the direct one.
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "ceiling's z %.1f cm off the floor's (> 3 sigmas, %.1f cm): z from the ground",
+                    100 * (room_height_ - h), 100 * tol);
       note(out, buf);
       use_ceiling = false;
     }
