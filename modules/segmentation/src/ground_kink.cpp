@@ -166,8 +166,17 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     const double rate = (d_now - follow_d_) / dt;
     if (std::abs(rate) > k::kFollowRateMaxMs) {
       follow_rate_ok_ = false;
+    } else if (follow_rate_ok_) {
+      // Exponentially weighted mean and variance of the raw rates (each scan's distance is a few millimetres off:
+      // more where the surface is seen only far away).
+      follow_rate_gain_ = 1 - std::exp(-dt / k::kFollowRateTauS);
+      const double e = rate - follow_rate_;
+      follow_rate_ += follow_rate_gain_ * e;
+      follow_rate_var_ = (1 - follow_rate_gain_) * (follow_rate_var_ + follow_rate_gain_ * e * e);
     } else {
-      follow_rate_ = follow_rate_ok_ ? follow_rate_ + (1 - std::exp(-dt / k::kFollowRateTauS)) * (rate - follow_rate_) : rate;
+      follow_rate_ = rate;
+      follow_rate_var_ = rate * rate;  // nothing known of its spread yet
+      follow_rate_gain_ = 1;
       follow_rate_ok_ = true;
     }
   } else {
@@ -179,7 +188,10 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   // fitted as measured and moved back by rate x tau, the difference of the two fits added to it (the plane
   // keeps its own fit's weighting; only the skew is removed). Returns the tilt removed [rad] (0: not possible).
   const int W = scan.width;
-  const bool can_deskew = follow_rate_ok_ && W > 0 && int(scan.column_utime.size()) == W && lower_.width == W;
+  // Only a rate that stands out of its own noise (2 sigmas of the weighted mean): a wrong one would skew the fit.
+  const double rate_sigma = std::sqrt(follow_rate_var_ * follow_rate_gain_ / (2 - follow_rate_gain_));
+  const bool can_deskew = follow_rate_ok_ && std::abs(follow_rate_) > 2 * rate_sigma && W > 0 &&
+                          int(scan.column_utime.size()) == W && lower_.width == W;
   const auto sweep_corrected = [&](const Eigen::Vector4d& pl, auto&& use, Eigen::Vector4d* out) {
     const Eigen::Vector3f n = pl.head<3>().cast<float>();
     const Eigen::Vector3f shift = float(follow_rate_) * n;

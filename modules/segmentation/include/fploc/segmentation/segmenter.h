@@ -119,7 +119,7 @@ class Segmenter {
   int64_t follow_t_ = 0;
   // ... its distance from the sensor then, and the rate of that distance (the sensor's speed off the surface,
   // low-passed; valid while the same surface is followed scan after scan).
-  double follow_d_ = 0, follow_rate_ = 0;
+  double follow_d_ = 0, follow_rate_ = 0, follow_rate_var_ = 0, follow_rate_gain_ = 1;  // (var: of the raw rates)
   int64_t follow_d_t_ = 0;
   bool follow_rate_ok_ = false;
   Eigen::Vector3d accel_sum_ = Eigen::Vector3d::Zero();
