@@ -262,15 +262,33 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
   } else if (gyro_ok) {
     Eigen::Vector3d nu = p - (g_pred - o_pred);
     nu -= nu.dot(p) * p;
+    if (nu.norm() > std::sin(cfg_.step_deg * k::kDeg) && nu.norm() < std::sin(cfg_.change_deg * k::kDeg) &&
+        held_ < cfg_.max_hold_scans) {
+      // The planes stepped by less than another surface's change (change_deg; the fit moving between the ramp
+      // and the floor or landing is a clean step of the slope, ground_kink.cpp), the sensor did not: one scan's
+      // fit off the surface (a compromise over the ramp and the landing beyond, a few returns). Taken as another
+      // surface only when the planes stay off for max_hold_scans scans: a step taken from one scan's fit stays
+      // in the tilt when the planes come back by less than step_deg (0.3 deg of attitude error for seconds).
+      // Meanwhile gravity and the tilt are carried by the gyro (world-fixed: the sensor's own rotation only).
+      if (held_ == 0)
+        r.text = fmt_deg("plane step of %.2f deg the gyro did not see: attitude carried by the gyro until it persists",
+                         angle_of(nu));
+      ++held_;
+      o_ = o_pred;
+      carry_by_gyro(g_pred, dt, r);
+      return r;
+    }
     if (nu.norm() > std::sin(cfg_.step_deg * k::kDeg)) {
-      // The planes stepped, the sensor did not: the fit is on another surface. Gravity carried by the gyro.
+      // The planes stepped and stayed: the fit is on another surface. Gravity carried by the gyro.
       o_ = g_pred - p;
       o_sigma_ += 0.02 * nu.norm();
       r.text = fmt_deg("plane step of %.2f deg the gyro did not see: another surface, its slope %.2f deg", angle_of(nu),
                        angle_of(o_));
     } else {
+      if (held_ > 0) r.text = fmt_deg("planes on the surface followed again (%.2f deg): the step was one fit's", angle_of(nu));
       o_ = o_pred;  // the same surfaces: the planes carry the sensor's rotation
     }
+    held_ = 0;
   }
   if (acc_ok) {
     // The accelerometer's gravity, slowly: the platform's accelerations average out. Across the slope (the
@@ -308,6 +326,7 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
     mode_ = Mode::kLevel;
     o_.setZero();
     u_.setZero();
+    held_ = 0;
     return take_planes(p, plane_sigma, r);
   }
   g_ = (p + o_).normalized();

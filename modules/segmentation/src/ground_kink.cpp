@@ -54,7 +54,7 @@ struct Group {
 };
 }  // namespace
 
-void Segmenter::split_ground_at_kink(int64_t t) {
+void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   Plane& g = out_.ground;
   g.under_m = 0;
   // The followed surface is carried from scan to scan by the gyro: without one, the ring fit as it is.
@@ -132,9 +132,11 @@ void Segmenter::split_ground_at_kink(int64_t t) {
   };
   for (int s = 0; s < kSectors; ++s)
     if (ok[s] && angle(spl[s].head<3>(), prev) < kFollowDeg * k::kDeg) pool(F, s);
+  bool same_surface = true;  // F is the surface followed in the last scan
   if (F.sectors < 2 || F.m.w < 4 * kMinSectorPoints) {
     // The surface seen before has left the view (past a ramp's head): the surface of the largest sector, if
     // others agree with it.
+    same_surface = false;
     int big = -1;
     for (int s = 0; s < kSectors; ++s)
       if (ok[s] && (big < 0 || sm[s].w > sm[big].w)) big = s;
@@ -145,7 +147,82 @@ void Segmenter::split_ground_at_kink(int64_t t) {
         if (ok[s] && angle(spl[s].head<3>(), prev) < kFollowDeg * k::kDeg) pool(F, s);
     }
   }
-  if (F.sectors < 2 || F.m.w < 4 * kMinSectorPoints || !F.m.plane(ref, -up, F.pl)) return;  // the ring fit as it is
+  if (F.sectors < 2 || F.m.w < 4 * kMinSectorPoints || !F.m.plane(ref, -up, F.pl)) {
+    follow_rate_ok_ = false;
+    return;  // the ring fit as it is
+  }
+  // The sweep's translation. The gyro de-skews rotation only: a return measured tau seconds from the planes'
+  // time lies off the surface by the sensor's speed off it (the rate of the surface's distance) x tau. For a
+  // surface the sensor moves parallel to (a floor from the floor, a ramp from the ramp) that is nothing; for the
+  // level floor seen from a ramp (12 cm/s at 0.9 m/s on a 7 deg ramp) the sweep's first and last columns, both
+  // behind the sensor, differ by a centimetre, and where the floor is seen only there (behind, the ramp ahead
+  // and the walls beside) its fit is rolled by a few tenths of a degree. The rate is the change of the
+  // followed surface's distance from scan to scan (low-passed); the returns moved back by rate x tau along
+  // the surface's normal and the surface fitted again. Used only where it tilts the fit by more than a plane
+  // fit's own noise (kSweepSkewDeg): a robot driving on the surface it sees is left as it is.
+  const double d_now = F.pl[3];
+  if (same_surface && follow_d_t_ != 0 && t > follow_d_t_ && t - follow_d_t_ < 300'000) {
+    const double dt = 1e-6 * double(t - follow_d_t_);
+    const double rate = (d_now - follow_d_) / dt;
+    if (std::abs(rate) > k::kFollowRateMaxMs) {
+      follow_rate_ok_ = false;
+    } else if (follow_rate_ok_) {
+      // Exponentially weighted mean and variance of the raw rates (each scan's distance is a few millimetres off:
+      // more where the surface is seen only far away).
+      follow_rate_gain_ = 1 - std::exp(-dt / k::kFollowRateTauS);
+      const double e = rate - follow_rate_;
+      follow_rate_ += follow_rate_gain_ * e;
+      follow_rate_var_ = (1 - follow_rate_gain_) * (follow_rate_var_ + follow_rate_gain_ * e * e);
+    } else {
+      follow_rate_ = rate;
+      follow_rate_var_ = rate * rate;  // nothing known of its spread yet
+      follow_rate_gain_ = 1;
+      follow_rate_ok_ = true;
+    }
+  } else {
+    follow_rate_ok_ = false;
+  }
+  follow_d_ = d_now;
+  follow_d_t_ = t;
+  // A plane corrected for the sweep's translation: its returns (those `use` takes, within kSectorTightM of it)
+  // fitted as measured and moved back by rate x tau, the difference of the two fits added to it (the plane
+  // keeps its own fit's weighting; only the skew is removed). Returns the tilt removed [rad] (0: not possible).
+  const int W = scan.width;
+  // Only a rate that stands out of its own noise (2 sigmas of the weighted mean): a wrong one would skew the fit.
+  const double rate_sigma = std::sqrt(follow_rate_var_ * follow_rate_gain_ / (2 - follow_rate_gain_));
+  const bool can_deskew = follow_rate_ok_ && std::abs(follow_rate_) > 2 * rate_sigma && W > 0 &&
+                          int(scan.column_utime.size()) == W && lower_.width == W;
+  const auto sweep_corrected = [&](const Eigen::Vector4d& pl, auto&& use, Eigen::Vector4d* out) {
+    const Eigen::Vector3f n = pl.head<3>().cast<float>();
+    const Eigen::Vector3f shift = float(follow_rate_) * n;
+    detail::Moments m0, m1;
+    for (size_t i = 0; i < lower_.n; i += kStride) {
+      if (!use(i)) continue;
+      const int64_t tc = scan.column_utime[size_t(lower_.pixel[i] % W)];
+      const Eigen::Vector3f p = lower_.point(i);
+      if (tc == 0 || !p.allFinite() || std::abs(n.dot(p) + float(pl[3])) >= kSectorTightM) continue;
+      m0.add((p - reff).cast<double>(), 1.0);
+      m1.add((p + float(1e-6 * double(tc - t)) * shift - reff).cast<double>(), 1.0);
+    }
+    Eigen::Vector4d p0, p1;
+    if (m0.w < 4 * kMinSectorPoints || !m0.plane(ref, -up, p0) || !m1.plane(ref, -up, p1)) return 0.0;
+    const Eigen::Vector3d nc = (pl.head<3>() + p1.head<3>() - p0.head<3>()).normalized();
+    *out = Eigen::Vector4d(nc.x(), nc.y(), nc.z(), pl[3] + p1[3] - p0[3]);
+    return angle(nc, pl.head<3>());
+  };
+  bool sweep_deskewed = false;
+  double sweep_skew = 0;
+  if (can_deskew) {
+    Eigen::Vector4d Fc;
+    sweep_skew = sweep_corrected(F.pl, [&](size_t i) {
+      const int s = sector[i];
+      return s >= 0 && ok[s] && angle(spl[s].head<3>(), prev) < kFollowDeg * k::kDeg;
+    }, &Fc);
+    if (sweep_skew > k::kSweepSkewDeg * k::kDeg) {
+      F.pl = Fc;
+      sweep_deskewed = true;
+    }
+  }
   follow_up_ = F.pl.head<3>();
   int seed = -1;
   double far = kKinkDeg * k::kDeg;
@@ -157,7 +234,20 @@ void Segmenter::split_ground_at_kink(int64_t t) {
     if (O.m.w < 4 * kMinSectorPoints || !O.m.plane(ref, -up, O.pl)) O.sectors = 0;
   }
   const double off_fit = angle(F.pl.head<3>(), up);
-  if (O.sectors == 0 && off_fit < k::kKinkFitOffDeg * k::kDeg) return;  // one surface, the ring fit on it
+  if (O.sectors == 0 && off_fit < k::kKinkFitOffDeg * k::kDeg) {
+    // One surface, the ring fit on it: corrected for the sweep's translation as the followed surface was.
+    Eigen::Vector4d gc;
+    const double skew = sweep_deskewed ? sweep_corrected(g.coeffs, [](size_t) { return true; }, &gc) : 0.0;
+    if (skew > k::kSweepSkewDeg * k::kDeg) {
+      g.coeffs = gc;
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "ground: the sensor moving %.3f m/s off it, de-skewed for the sweep's translation (%.2f deg)",
+                    follow_rate_, skew / k::kDeg);
+      if (!out_.status_text.empty()) out_.status_text += "; ";
+      out_.status_text += buf;
+    }
+    return;
+  }
   // The surface under the robot: the one on the sensor's side of the line where the two planes meet. Each
   // group's sectors lie on one side of that line (the other plane is below them: its height of them has one
   // sign, for nearly all of their returns); at the sensor the same sign of (height above the other - height
@@ -216,6 +306,11 @@ void Segmenter::split_ground_at_kink(int64_t t) {
                   F.sectors);
   if (!out_.status_text.empty()) out_.status_text += "; ";
   out_.status_text += buf;
+  if (sweep_deskewed) {
+    std::snprintf(buf, sizeof buf, " (the sensor moving %.3f m/s off it: de-skewed for the sweep's translation, %.2f deg)",
+                  follow_rate_, sweep_skew / k::kDeg);
+    out_.status_text += buf;
+  }
 }
 
 }  // namespace fploc::seg

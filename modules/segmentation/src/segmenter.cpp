@@ -186,7 +186,7 @@ const Segmentation& Segmenter::process(const Scan& scan) {
   fit_ground(ceiling_vs_prior < k::kCeilingPriorAgreeDeg * k::kDeg ? up : init_up.normalized());
   const int64_t t_mid = scan.utime + std::llround(out_.attitude_t * 1e6);
   refit_ground_around_gravity(t_mid);
-  split_ground_at_kink(t_mid);
+  split_ground_at_kink(t_mid, scan);
 
   if (height_.has_areas() && upper_.p.size() != upper_.size()) upper_.fill_points();  // the area census reads p
   const Eigen::Vector3d plane_up = height_.update(out_, imu, &upper_);

@@ -50,6 +50,10 @@ constexpr double kMinCeilingDistM = 0.2;    // a ceiling closer than this to the
 constexpr double kMinGroundDistM = 0.1;
 constexpr double kMaxGroundTiltDeg = 5.0;
 constexpr double kKinkFitOffDeg = 0.3;       // ground_kink.cpp: the ring fit this far off the followed surface: replaced   // ground normal vs the ceiling's (or prior) up
+constexpr double kSweepSkewDeg = 0.05;       // ground_kink.cpp: the sweep's translation tilts the followed surface's fit
+                                             // this much (plane fits of a floor: a few hundredths): de-skewed
+constexpr double kFollowRateTauS = 0.3;      // ground_kink.cpp: low-pass of the sensor's speed off the followed surface
+constexpr double kFollowRateMaxMs = 1.0;     // ... a faster change of its distance is a jump (another fit), not motion
 constexpr double kCeilingPriorAgreeDeg = 2.0;  // ceiling this close to the prior: the ground is fitted around it
 constexpr double kRefitLevelDeg = 1.0;  // a ground found around gravity off a slope: within this of level
 

@@ -15,7 +15,8 @@
 //    change the gyro carried across).
 //  - SLOPE: g = p + o. While the planes move as the gyro says (the same surfaces), the planes carry the
 //    robot's rotation and o stays; a step of the planes the gyro does not see (a fit moving to another
-//    surface: the ramp's foot or head, the ceiling beyond) is carried by the gyro (o absorbs it). The
+//    surface: the ramp's foot or head, the ceiling beyond) is carried by the gyro (o absorbs it); a step
+//    smaller than change_deg (one scan's compromise fit) only once it persists max_hold_scans scans. The
 //    accelerometer pulls o slowly (`accel_tau_s`) towards its gravity (platform accelerations average out).
 //    o below `level_deg` again: back to LEVEL (said, never a silent jump).
 //  - No plane: g carried by the gyro (sigma grows with the gyro's noise and bias); no gyro: not handled
@@ -39,7 +40,8 @@ struct GravityFusionConfig {
   double level_deg = 0.4;        // on a slope: the surface tilt below this is level again
   int max_hold_scans = 3;        // level: planes off the gyro by more than step_deg: gyro-carried for at most this
                                  // (longer while the gyro is quiet: the sensor is not turning; standing still
-                                 // the accelerometer holds it)
+                                 // the accelerometer holds it); slope: a plane step between step_deg and
+                                 // change_deg is taken for another surface only after this many scans
   double accel_tau_s = 10.0;     // on a slope: the accelerometer's pull on the surface tilt
   double slope_plane_tau_s = 0.25;  // on a slope: gravity is the gyro's prediction pulled towards planes + tilt with
                                    // this time constant (one scan's plane fit is a few tenths of a degree off where

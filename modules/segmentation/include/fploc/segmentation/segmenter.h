@@ -69,7 +69,8 @@ class Segmenter {
   void fit_ground(const Eigen::Vector3d& up, bool from_previous = true);  // from_previous: start from last scan's ground
   // Two surfaces under the lower rings (a ramp's foot or head): the ground the attitude follows and the height
   // above the one under the robot (ground_kink.cpp). t: the planes' time (mid-sweep).
-  void split_ground_at_kink(int64_t t);
+  // scan: its column times (the sweep's translation, which the gyro de-skew leaves in the points).
+  void split_ground_at_kink(int64_t t, const Scan& scan);
   // No ground found: the ground fitted around gravity as the gyro carries it to t, the planes' time (segmenter.cpp).
   void refit_ground_around_gravity(int64_t t);
   void select_walls(const Scan& scan, const Eigen::Vector3d& up);
@@ -116,6 +117,11 @@ class Segmenter {
   // The ground surface followed across a kink (ground_kink.cpp): its normal at its mid-sweep time.
   Eigen::Vector3d follow_up_ = Eigen::Vector3d::UnitZ();
   int64_t follow_t_ = 0;
+  // ... its distance from the sensor then, and the rate of that distance (the sensor's speed off the surface,
+  // low-passed; valid while the same surface is followed scan after scan).
+  double follow_d_ = 0, follow_rate_ = 0, follow_rate_var_ = 0, follow_rate_gain_ = 1;  // (var: of the raw rates)
+  int64_t follow_d_t_ = 0;
+  bool follow_rate_ok_ = false;
   Eigen::Vector3d accel_sum_ = Eigen::Vector3d::Zero();
   double accel_sq_ = 0;  // sum of |a|^2 (the spread: is the IMU measuring gravity alone?)
   int accel_n_ = 0;
