@@ -322,6 +322,34 @@ TEST(GravityFusion, ErrorAcrossTheSlopeIsPulledOutByTheAccelerometer) {
   EXPECT_LT(err_at_6s, 0.06 * kDeg) << "tilt error 6 s after entering the slope [deg]: " << err_at_6s / kDeg;
 }
 
+// The sensor of the two slope tests below: level until 2.0 s, pitching onto a 6 deg ramp at 5 deg/s until 3.2 s,
+// then bobbing on it (pitch +-0.3 deg at 0.7 Hz); exact 100 Hz gyro fed to `fus`, and every 10th sample a scan:
+// scan(t, utime, R, up_true, accel, planes) with R the sensor's attitude and planes the level floor's / the ramp's
+// normal in the sensor's axes.
+struct RampEntry {
+  static constexpr double t_up0 = 2.0, t_up1 = 3.2;
+  template <class Scan>
+  static void run(GravityFusion& fus, int samples, Scan scan) {
+    const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d n_ramp = Eigen::AngleAxisd(6.0 * kDeg, Eigen::Vector3d::UnitY()) * z;  // world
+    double pitch = 0;
+    for (int k = 1; k <= samples; ++k) {
+      const double t = k * 0.01;
+      double rate = t > t_up0 && t <= t_up1 ? 5.0 * kDeg : 0.0;
+      if (t > t_up1) rate = 0.3 * kDeg * 2 * M_PI * 0.7 * std::cos(2 * M_PI * 0.7 * (t - t_up1));
+      pitch += rate * 0.01;
+      const int64_t ut = 1000000 + std::llround(t * 1e6);
+      fus.add_gyro(Eigen::Vector3d(0, rate, 0), ut);
+      if (k % 10) continue;
+      const Eigen::Matrix3d R = Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()).toRotationMatrix();
+      const Eigen::Vector3d up_true = R.transpose() * z, accel = kG * up_true;
+      const Eigen::Vector3d planes = t <= t_up0 ? z : Eigen::Vector3d(R.transpose() * n_ramp);
+      scan(t, ut, R, up_true, accel, planes);
+    }
+  }
+  static Eigen::Vector3d ramp_normal() { return Eigen::AngleAxisd(6.0 * kDeg, Eigen::Vector3d::UnitY()) * Eigen::Vector3d::UnitZ(); }
+};
+
 // GravityFusion alone, on a slope: the sensor enters a 6 deg ramp as above (exact gyro and accelerometer), then
 // bobs on it (pitch +-0.3 deg at 0.7 Hz). Each scan's planes are the ramp's surfaces with 0.07 deg of noise per
 // axis (a fit where the surfaces change under the robot), and every fourth scan's are last scan's again, in last
@@ -335,41 +363,30 @@ TEST(GravityFusion, NoisyAndRepeatedPlanesOnASlopeAreSmoothedByTheGyro) {
     GravityFusion fus(cfg);
     std::mt19937 rng(11);
     std::normal_distribution<double> gauss(0.0, 0.07 * kDeg);
-    const Eigen::Vector3d zero = Eigen::Vector3d::Zero(), z = Eigen::Vector3d::UnitZ();
-    const double t_up0 = 2.0, t_up1 = 3.2, pitch_rate = 5.0 * kDeg;
-    const Eigen::Vector3d n_ramp = Eigen::AngleAxisd(6.0 * kDeg, Eigen::Vector3d::UnitY()) * z;  // world
-    double pitch = 0, sum_sq = 0, sum_sq_planes = 0;
+    const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+    double sum_sq = 0, sum_sq_planes = 0;
     int n = 0;
-    Eigen::Vector3d last_planes = z;
-    for (int k = 1; k <= 1300; ++k) {  // 100 Hz gyro, a scan every 10th sample
-      const double t = k * 0.01;
-      double rate = t > t_up0 && t <= t_up1 ? pitch_rate : 0.0;
-      if (t > t_up1) rate = 0.3 * kDeg * 2 * M_PI * 0.7 * std::cos(2 * M_PI * 0.7 * (t - t_up1));
-      pitch += rate * 0.01;
-      const int64_t ut = 1000000 + std::llround(t * 1e6);
-      fus.add_gyro(Eigen::Vector3d(0, rate, 0), ut);
-      if (k % 10) continue;
-      const Eigen::Matrix3d R = Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()).toRotationMatrix();
-      const Eigen::Vector3d up_true = R.transpose() * z, accel = kG * up_true;
-      Eigen::Vector3d planes = t <= t_up0 ? z : Eigen::Vector3d(R.transpose() * n_ramp);
+    Eigen::Vector3d last_planes = Eigen::Vector3d::UnitZ();
+    RampEntry::run(fus, 1300, [&](double t, int64_t ut, const Eigen::Matrix3d& R, const Eigen::Vector3d& up_true,
+                                  const Eigen::Vector3d& accel, Eigen::Vector3d planes) {
       bool repeated = false;
-      if (t > t_up1 + 0.5) {
-        repeated = (k / 10) % 4 == 0;
+      if (t > RampEntry::t_up1 + 0.5) {
+        repeated = (std::lround(t * 10)) % 4 == 0;
         planes = repeated ? last_planes : Eigen::Vector3d((planes + Eigen::Vector3d(gauss(rng), gauss(rng), 0)).normalized());
       }
       last_planes = planes;
-      const bool seen = t <= t_up0 || t > t_up1;
+      const bool seen = t <= RampEntry::t_up0 || t > RampEntry::t_up1;
       const auto r = fus.update(ut, seen ? &planes : nullptr, 0.02 * kDeg, &accel, zero, flag_repeats && repeated);
-      if (t > t_up1 + 1.5) {  // on the ramp, the slope taken
+      if (t > RampEntry::t_up1 + 1.5) {  // on the ramp, the slope taken
         const double e = std::acos(std::clamp(r.up.normalized().dot(up_true), -1.0, 1.0));
         // The planes' own error: gravity from them with the true surface tilt.
-        const Eigen::Vector3d o_true = up_true - R.transpose() * n_ramp;
+        const Eigen::Vector3d o_true = up_true - R.transpose() * RampEntry::ramp_normal();
         const double ep = std::acos(std::clamp((planes + o_true).normalized().dot(up_true), -1.0, 1.0));
         sum_sq += e * e;
         sum_sq_planes += ep * ep;
         ++n;
       }
-    }
+    });
     EXPECT_EQ(fus.mode(), GravityFusion::Mode::kSlope);
     *rms_planes = std::sqrt(sum_sq_planes / std::max(1, n)) / kDeg;
     return std::sqrt(sum_sq / std::max(1, n)) / kDeg;
@@ -396,28 +413,18 @@ TEST(GravityFusion, OneScansPlaneStepOnASlopeIsHeldUntilItPersists) {
     GravityFusionConfig cfg;
     cfg.max_hold_scans = max_hold_scans;
     GravityFusion fus(cfg);
-    const Eigen::Vector3d zero = Eigen::Vector3d::Zero(), z = Eigen::Vector3d::UnitZ();
-    const double t_up0 = 2.0, t_up1 = 3.2, pitch_rate = 5.0 * kDeg, t_blip = 6.0;
-    const Eigen::Vector3d n_ramp = Eigen::AngleAxisd(6.0 * kDeg, Eigen::Vector3d::UnitY()) * z;  // world
-    double pitch = 0, worst = 0;
-    for (int k = 1; k <= 1000; ++k) {  // 100 Hz gyro, a scan every 10th sample
-      const double t = k * 0.01;
-      double rate = t > t_up0 && t <= t_up1 ? pitch_rate : 0.0;
-      if (t > t_up1) rate = 0.3 * kDeg * 2 * M_PI * 0.7 * std::cos(2 * M_PI * 0.7 * (t - t_up1));
-      pitch += rate * 0.01;
-      const int64_t ut = 1000000 + std::llround(t * 1e6);
-      fus.add_gyro(Eigen::Vector3d(0, rate, 0), ut);
-      if (k % 10) continue;
-      const Eigen::Matrix3d R = Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()).toRotationMatrix();
-      const Eigen::Vector3d up_true = R.transpose() * z, accel = kG * up_true;
-      Eigen::Vector3d planes = t <= t_up0 ? z : Eigen::Vector3d(R.transpose() * n_ramp);
+    const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+    const double t_blip = 6.0;
+    double worst = 0;
+    RampEntry::run(fus, 1000, [&](double t, int64_t ut, const Eigen::Matrix3d&, const Eigen::Vector3d& up_true,
+                                  const Eigen::Vector3d& accel, Eigen::Vector3d planes) {
       const double off = std::abs(t - t_blip) < 1e-6 ? 0.35 : std::abs(t - t_blip - 0.1) < 1e-6 ? 0.1 : 0.0;
       planes = Eigen::AngleAxisd(off * kDeg, Eigen::Vector3d::UnitY()) * planes;
-      const bool seen = t <= t_up0 || t > t_up1;
+      const bool seen = t <= RampEntry::t_up0 || t > RampEntry::t_up1;
       const auto r = fus.update(ut, seen ? &planes : nullptr, 0.02 * kDeg, &accel, zero);
       if (t > t_blip + 0.05)
         worst = std::max(worst, std::acos(std::clamp(r.up.normalized().dot(up_true), -1.0, 1.0)) / kDeg);
-    }
+    });
     EXPECT_EQ(fus.mode(), GravityFusion::Mode::kSlope);
     return worst;
   };
