@@ -46,11 +46,6 @@ void AttitudeHeight::relearn_room_height(double h) {
   update_room_height(h);
 }
 
-void AttitudeHeight::note(Segmentation& out, const std::string& what) const {
-  if (!out.status_text.empty()) out.status_text += "; ";
-  out.status_text += what;
-}
-
 void AttitudeHeight::predict_z(Segmentation& out) {
   // The last estimate (the platform's height changes slowly), its sigma doubling per predicted scan.
   if (have_prev_z_) {
@@ -98,7 +93,7 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
     if (corr > 0) {
       char buf[120];
       std::snprintf(buf, sizeof buf, "ceiling sloped %.2f deg per the building: its normal turned by that", corr / k::kDeg);
-      note(out, buf);
+      out.note(buf);
       up_c = level;
     }
   }
@@ -147,7 +142,7 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
       char buf[240];
       std::snprintf(buf, sizeof buf, "ceiling and ground normals %.2f deg apart: attitude from the %s (%s)", ang / k::kDeg,
                     ground_better ? "ground" : "ceiling", by);
-      note(out, buf);
+      out.note(buf);
     }
   }
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
@@ -181,7 +176,7 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
   if (imu.valid || have_areas_) {
     const double off = std::acos(std::clamp(up.dot(level_up_), -1.0, 1.0));
     if (have_level_up_ && off > k::kOnSlopeDeg * k::kDeg && (use_ceiling || imu.trusted)) {
-      if (ground_level) note(out, "robot tilted on a ramp or threshold: the floor is not the area's level");
+      if (ground_level) out.note("robot tilted on a ramp or threshold: the floor is not the area's level");
       ground_level = false;
     } else if (ground_level && off < k::kOnSlopeDeg * k::kDeg) {
       level_up_ = have_level_up_ ? (level_up_ + k::kLevelUpGain * (up - level_up_)).normalized() : up;
@@ -196,7 +191,7 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
   if (g && !ground_level && use_ceiling && known_room_height() > 0) {
     // A ramp (or a tilted floor patch) under the robot, the ceiling level: z from the ceiling, the floor's
     // distance is not the height above the area's floor.
-    note(out, "floor tilted under the robot (a ramp): z from the ceiling");
+    out.note("floor tilted under the robot (a ramp): z from the ceiling");
   }
   // A ceiling not parallel to the floor (a sloped roof, a compromise over two surfaces) gave no attitude and
   // gives no z (use_ceiling is off), and no room height either: learning its distances would shift the running
@@ -210,7 +205,7 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
       char buf[160];
       std::snprintf(buf, sizeof buf, "ceiling %.3f m above the floor vs the area's %.3f m: z from the ground", h,
                     room_height_);
-      note(out, buf);
+      out.note(buf);
       use_ceiling = false;
     } else if (room_height_ > 0 && std::abs(h - room_height_) > tol) {
       // The same area, but the ceiling's z (the area's height - its distance) and the floor's differ by
@@ -219,7 +214,7 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
       char buf[160];
       std::snprintf(buf, sizeof buf, "ceiling's z %.1f cm off the floor's (> 3 sigmas, %.1f cm): z from the ground",
                     100 * (room_height_ - h), 100 * tol);
-      note(out, buf);
+      out.note(buf);
       use_ceiling = false;
     }
     update_room_height(h);
@@ -235,7 +230,7 @@ Eigen::Vector3d AttitudeHeight::update(Segmentation& out, const ImuPrior& imu, c
       char buf[160];
       std::snprintf(buf, sizeof buf, "ceiling step of %.3f m without a floor to confirm it: z predicted, area height re-learned",
                     z - prev_z_);
-      note(out, buf);
+      out.note(buf);
       predict_z(out);
       if (!known) relearn_room_height(prev_z_ + out.ceiling.distance());
     } else {

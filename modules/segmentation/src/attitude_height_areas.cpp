@@ -187,28 +187,28 @@ void AttitudeHeight::area_z(Segmentation& out, const Eigen::Vector3d& up, bool g
                        (any_learned ? out.ground.d_sigma / std::sqrt(double(std::max(1, area_h_.samples(A)))) : 0.0);
     if (spread > std::max(cfg_.z_consistency_m, 3.0 * out.ceiling.rms_m)) {
       std::snprintf(buf, sizeof buf, "ceiling points disagree with their areas' heights (spread %.3f m): ", spread);
-      note(out, std::string(buf) + (g ? "z from the ground" : "z predicted"));
+      out.note(std::string(buf) + (g ? "z from the ground" : "z predicted"));
     } else if (g && ground_level && std::abs(zc - out.ground.distance()) > gate_cg) {
       std::snprintf(buf, sizeof buf, "ceiling of area '%s' gives z %.3f m, the floor %.3f m: z from the ground", an.c_str(), zc,
                     out.ground.distance());
-      note(out, buf);
+      out.note(buf);
     } else if (!g && have_prev_z_ && std::abs(zc - prev_z_) > cfg_.z_jump_m) {
       std::snprintf(buf, sizeof buf, "ceiling of area '%s' steps z by %.3f m without a floor to confirm it: z predicted",
                     an.c_str(), zc - prev_z_);
-      note(out, buf);
+      out.note(buf);
       predict_z(out);
       if (!area_h_.known(A) && cs.dominant_fraction >= k::kAreaLearnFraction) area_h_.learn(A, prev_z_ + out.ceiling.distance());
       return;
     } else {
       std::snprintf(buf, sizeof buf, "z: ceiling, area '%s' (%s height)", an.c_str(),
                     area_h_.known(A) ? "building" : "learned");
-      note(out, buf);
+      out.note(buf);
       accept_z(out, zc, sig, HeightSource::kCeiling);
       return;
     }
   } else if (c) {
     std::snprintf(buf, sizeof buf, "ceiling over area '%s' of unknown height (%d samples): ", an.c_str(), area_h_.samples(A));
-    note(out, std::string(buf) + (g ? "z from the ground" : "z predicted, height learned from it"));
+    out.note(std::string(buf) + (g ? "z from the ground" : "z predicted, height learned from it"));
     if (!g) {
       predict_z(out);
       if (have_prev_z_ && !area_h_.known(A) && cs.dominant_fraction >= k::kAreaLearnFraction)

@@ -243,8 +243,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
       char buf[200];
       std::snprintf(buf, sizeof buf, "ground: the sensor moving %.3f m/s off it, de-skewed for the sweep's translation (%.2f deg)",
                     follow_rate_, skew / k::kDeg);
-      if (!out_.status_text.empty()) out_.status_text += "; ";
-      out_.status_text += buf;
+      out_.note(buf);
     }
     return;
   }
@@ -304,8 +303,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   else
     std::snprintf(buf, sizeof buf, "ground: the ring fit %.2f deg off the surface seen before (%d sectors): height above that surface", off_fit / k::kDeg,
                   F.sectors);
-  if (!out_.status_text.empty()) out_.status_text += "; ";
-  out_.status_text += buf;
+  out_.note(buf);
   if (sweep_deskewed) {
     std::snprintf(buf, sizeof buf, " (the sensor moving %.3f m/s off it: de-skewed for the sweep's translation, %.2f deg)",
                   follow_rate_, sweep_skew / k::kDeg);

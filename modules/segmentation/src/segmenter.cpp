@@ -120,9 +120,8 @@ void Segmenter::refit_ground_around_gravity(int64_t t) {
     gr = kept;
     return;
   }
-  if (!out_.status_text.empty()) out_.status_text += "; ";
-  out_.status_text += "ground: none around the prior, a level one around gravity (" +
-                      std::to_string(gr.beyond) + " returns below it)";
+  out_.note("ground: none around the prior, a level one around gravity (" + std::to_string(gr.beyond) +
+            " returns below it)");
 }
 
 const Segmentation& Segmenter::process(const Scan& scan) {

@@ -10,13 +10,6 @@
 
 namespace fploc::seg {
 
-namespace {
-void note(Segmentation& out, const std::string& what) {
-  if (!out.status_text.empty()) out.status_text += "; ";
-  out.status_text += what;
-}
-}  // namespace
-
 void Segmenter::fuse_imu(const Scan& scan, const Eigen::Vector3d& plane_up) {
   if (!cfg_.imu_attitude || !fusion_.has_gyro()) return;
   const int64_t tm = scan.utime + std::llround(out_.attitude_t * 1e6);
@@ -27,7 +20,7 @@ void Segmenter::fuse_imu(const Scan& scan, const Eigen::Vector3d& plane_up) {
       (out_.attitude_source == AttitudeSource::kGround && have_prev_ground_ && out_.ground.coeffs == prev_ground_);
   const GravityFusion::Result r = fusion_.update(tm, plane ? &plane_up : nullptr, out_.roll_pitch_sigma,
                                                  accel_this_scan_ ? &accel_mean_ : nullptr, deskew_.bias(), repeated);
-  if (!r.text.empty()) note(out_, r.text);
+  if (!r.text.empty()) out_.note(r.text);
   if (!r.valid || r.from_planes) return;  // level: the planes' attitude as it is
   roll_pitch_from_up(r.up, out_.roll, out_.pitch);
   out_.roll_pitch_sigma = r.sigma;
@@ -39,7 +32,7 @@ void Segmenter::fuse_imu(const Scan& scan, const Eigen::Vector3d& plane_up) {
     out_.attitude_source = AttitudeSource::kSlope;
     std::snprintf(buf, sizeof buf, "attitude: planes + surface slope %.2f deg (gyro/IMU gravity)", fusion_.slope_deg());
   }
-  note(out_, buf);
+  out_.note(buf);
 }
 
 void Segmenter::attitude_to_scan_time(const Scan& scan) {

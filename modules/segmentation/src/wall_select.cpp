@@ -26,11 +26,9 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
     mc *= k::kHeldPlaneMarginGrowth;
   } else if (out_.ground.found) {
     ceil << -out_.ground.coeffs.head<3>(), std::max(k::kNoCeilingWallTopM - out_.ground.distance(), k::kMinCeilingDistM);
-    if (!out_.status_text.empty()) out_.status_text += "; ";
-    out_.status_text += "no ceiling known: wall points up to 2 m above the floor";
+    out_.note("no ceiling known: wall points up to 2 m above the floor");
   } else {
-    if (!out_.status_text.empty()) out_.status_text += "; ";
-    out_.status_text += "no ceiling known: no wall points";
+    out_.note("no ceiling known: no wall points");
     out_.wall.clear();
     return;
   }

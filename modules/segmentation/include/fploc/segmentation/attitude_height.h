@@ -57,7 +57,6 @@ class AttitudeHeight {
   void update_room_height(double h);
   void relearn_room_height(double h);
   void predict_z(Segmentation& out);
-  void note(Segmentation& out, const std::string& what) const;
   // The building path of z (attitude_height_areas.cpp); false when it cannot say (no fresh pose): the
   // single-height path runs instead.
   // The ceiling inliers' areas (under the plan pose at the scan's time); false without a fresh pose.

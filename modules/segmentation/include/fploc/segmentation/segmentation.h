@@ -54,6 +54,11 @@ struct Segmentation {
   int64_t utime = 0, seq = 0;
   SegStatus status = SegStatus::kEmpty;
   std::string status_text;
+  // Appends what was noticed to status_text ("; " between notes).
+  void note(const std::string& what) {
+    if (!status_text.empty()) status_text += "; ";
+    status_text += what;
+  }
   Plane ceiling, ground;
   double roll = 0, pitch = 0;        // [rad], R = Rz(yaw) Ry(pitch) Rx(roll) (sensor -> world)
   double z = 0;                      // sensor height above the floor [m]
