@@ -85,6 +85,18 @@ GravityFusion::Result& GravityFusion::take_planes(const Eigen::Vector3d& up, dou
   return r;
 }
 
+GravityFusion::Result& GravityFusion::settle_to_planes(const Eigen::Vector3d& g_pred, const Eigen::Vector3d& up,
+                                                      double plane_sigma, double dt, Result& r) {
+  const double kp = 1 - std::exp(-std::max(0.0, dt) / cfg_.slope_plane_tau_s);
+  g_ = (g_pred + kp * (up - g_pred)).normalized();
+  sigma_ = std::hypot(plane_sigma, angle_of(up - g_));
+  r.valid = true;
+  r.up = g_;
+  r.sigma = sigma_;
+  r.settling = true;
+  return r;
+}
+
 void GravityFusion::carry_by_gyro(const Eigen::Vector3d& g_pred, double dt, Result& r) {
   g_ = g_pred;
   const double grow = cfg_.gyro_bias_sigma * dt + cfg_.gyro_noise * std::sqrt(std::max(0.0, dt) * 0.01);
@@ -108,6 +120,7 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
     if (!plane_up) return r;  // nothing to carry yet
     started_ = true;
     t_ = t;
+    settle_until_ = 0;
     mode_ = Mode::kLevel;
     o_.setZero();
     u_.setZero();
@@ -177,6 +190,7 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
     return r;
   }
   const Eigen::Vector3d& p = *plane_up;
+  bool stepped = false;  // slope: the planes stepped to another surface in this scan
 
   if (mode_ == Mode::kLevel) {
     if (gyro_ok) {
@@ -257,6 +271,7 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
           acc_bias_ += kb * (d - acc_bias_);
         }
       }
+      if (gyro_ok && t < settle_until_ && cfg_.slope_plane_tau_s > 0) return settle_to_planes(g_pred, p, plane_sigma, dt, r);
       return take_planes(p, plane_sigma, r);
     }
   } else if (gyro_ok) {
@@ -280,6 +295,7 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
     }
     if (nu.norm() > std::sin(cfg_.step_deg * k::kDeg)) {
       // The planes stepped and stayed: the fit is on another surface. Gravity carried by the gyro.
+      stepped = true;
       o_ = g_pred - p;
       o_sigma_ += 0.02 * nu.norm();
       r.text = fmt_deg("plane step of %.2f deg the gyro did not see: another surface, its slope %.2f deg", angle_of(nu),
@@ -327,6 +343,10 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
     o_.setZero();
     u_.setZero();
     held_ = 0;
+    if (stepped && gyro_ok && cfg_.level_settle_s > 0 && cfg_.slope_plane_tau_s > 0) {
+      settle_until_ = t + std::llround(1e6 * cfg_.level_settle_s);
+      return settle_to_planes(g_pred, p, plane_sigma, dt, r);
+    }
     return take_planes(p, plane_sigma, r);
   }
   g_ = (p + o_).normalized();

@@ -16,10 +16,13 @@
 //  - the height (Plane::under_m) is the distance to the surface under the robot: of F and O, the one on the
 //    sensor's side of the line where the two planes meet (each group's sectors all on one side of it); F
 //    when that is unclear or O is missing;
+//  - F's plane is fitted again from its own returns (Tukey, the cut-off shrinking to 2 cm): a sector the kink
+//    line passes through is a compromise that still counts as F, its returns on the other surface do not;
 //  - where the ground gives the attitude (no ceiling, or one that disagrees with the ring fit), F's plane
 //    replaces the ring fit, so that GravityFusion sees one surface (its own rotation) or a clean step to
-//    another, never a compromise sliding between them. With all sectors on the ring fit's plane (a level
-//    floor, the paper's sequences) nothing changes.
+//    another, never a compromise sliding between them (nor the ring fit's pull towards a ramp, a hole or
+//    clutter beside the floor). Where the ceiling gives the attitude (the paper's sequences) the ring fit
+//    stays when F is on it.
 // Said in status_text. Transport-free, part of Segmenter::process.
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -27,6 +30,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "fploc/segmentation/segmenter.h"
 #include "plane_math.h"
@@ -46,6 +50,7 @@ constexpr double kKinkDeg = 3.0;          // another surface: this far from the 
 constexpr double kSideShare = 0.9;        // of a group's returns on one side of the kink line
 constexpr double kFollowDeg = 1.5;        // a sector this near a surface is on it
 constexpr size_t kStride = 1;             // every candidate
+constexpr std::array<float, 3> kRefineCutM{0.05f, 0.03f, 0.02f};  // the followed surface's own fit (Tukey cut-offs)
 
 struct Group {
   detail::Moments m;
@@ -151,6 +156,37 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     follow_rate_ok_ = false;
     return;  // the ring fit as it is
   }
+  // F's plane from its returns, each weighed by its distance to that plane (Tukey, the cut-off shrinking). A
+  // sector the kink line passes through (the level floor and the ramp's first metre behind the robot, the
+  // landing and the ramp's last metre ahead of it) fits a compromise between the two surfaces that can still be
+  // within kFollowDeg of the followed one: pooled as it is, it tilts F by a few tenths of a degree. Its returns
+  // on the other surface lie centimetres off F's plane and drop out here.
+  std::array<bool, kSectors> in_f{};  // the sectors on F
+  for (int s = 0; s < kSectors; ++s) in_f[s] = ok[s] && angle(spl[s].head<3>(), prev) < kFollowDeg * k::kDeg;
+  {
+    std::vector<Eigen::Vector3f> near;  // F's returns within the first cut-off of its pooled plane (sensor frame - ref)
+    const Eigen::Vector3f n0f = F.pl.head<3>().cast<float>();
+    const float d0f = float(F.pl[3]) + n0f.dot(reff);
+    for (size_t i = 0; i < lower_.n; i += kStride) {
+      if (sector[i] < 0 || !in_f[sector[i]]) continue;
+      const Eigen::Vector3f p = lower_.point(i) - reff;
+      if (std::abs(n0f.dot(p) + d0f) < kRefineCutM[0]) near.push_back(p);
+    }
+    Eigen::Vector4d pl = F.pl;
+    for (const float c : kRefineCutM) {
+      detail::Moments m;
+      const Eigen::Vector3f n = pl.head<3>().cast<float>();
+      const float d = float(pl[3]) + n.dot(reff);
+      for (const Eigen::Vector3f& p : near) {
+        const float r = n.dot(p) + d;
+        if (!(std::abs(r) < c)) continue;
+        const float u = r / c;
+        m.add(p.cast<double>(), double((1 - u * u) * (1 - u * u)));
+      }
+      if (m.w < 2 * kMinSectorPoints || !m.plane(ref, -up, pl)) break;
+      F.pl = pl;
+    }
+  }
   // The sweep's translation. The gyro de-skews rotation only: a return measured tau seconds from the planes'
   // time lies off the surface by the sensor's speed off it (the rate of the surface's distance) x tau. For a
   // surface the sensor moves parallel to (a floor from the floor, a ramp from the ramp) that is nothing; for the
@@ -215,8 +251,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   if (can_deskew) {
     Eigen::Vector4d Fc;
     sweep_skew = sweep_corrected(F.pl, [&](size_t i) {
-      const int s = sector[i];
-      return s >= 0 && ok[s] && angle(spl[s].head<3>(), prev) < kFollowDeg * k::kDeg;
+      return sector[i] >= 0 && in_f[sector[i]];
     }, &Fc);
     if (sweep_skew > k::kSweepSkewDeg * k::kDeg) {
       F.pl = Fc;
@@ -234,8 +269,13 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     if (O.m.w < 4 * kMinSectorPoints || !O.m.plane(ref, -up, O.pl)) O.sectors = 0;
   }
   const double off_fit = angle(F.pl.head<3>(), up);
-  if (O.sectors == 0 && off_fit < k::kKinkFitOffDeg * k::kDeg) {
-    // One surface, the ring fit on it: corrected for the sweep's translation as the followed surface was.
+  const bool ground_attitude =
+      !out_.ceiling.found ||
+      angle(-out_.ceiling.coeffs.head<3>(), up) > cfg_.attitude_consistency_deg * k::kDeg;
+  if (O.sectors == 0 && off_fit < k::kKinkFitOffDeg * k::kDeg && !ground_attitude) {
+    // One surface, the ring fit on it, and the ceiling gives the attitude: the ring fit corrected for the sweep's
+    // translation as the followed surface was. (Where the ground gives the attitude, F's own fit replaces the ring
+    // fit below: on the demo building's first floor the ring fit was 0.1-0.3 deg off where F was within 0.03.)
     Eigen::Vector4d gc;
     const double skew = sweep_deskewed ? sweep_corrected(g.coeffs, [](size_t) { return true; }, &gc) : 0.0;
     if (skew > k::kSweepSkewDeg * k::kDeg) {
@@ -258,9 +298,8 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
       double pos = 0, neg = 0;
       for (int s = 0; s < kSectors; ++s) {
         if (!ok[s] || sm[s].w <= 0) continue;
-        const bool in_f = angle(spl[s].head<3>(), prev) < kFollowDeg * k::kDeg;
         const bool in_os = seed >= 0 && angle(spl[s].head<3>(), spl[seed].head<3>()) < kFollowDeg * k::kDeg;
-        if (in_o ? !in_os : !in_f) continue;
+        if (in_o ? !in_os : !in_f[s]) continue;
         const Eigen::Vector3d c = sm[s].s / sm[s].w + ref;
         (B.pl.head<3>().dot(c) + B.pl[3] > 0 ? pos : neg) += sm[s].w;
       }
@@ -281,9 +320,6 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   // to another, never a compromise sliding between them. Where the ceiling agrees with the ring fit, the ring
   // fit stays (tried: always F; at a ramp's foot F is the level floor beside the ramp while the ceiling follows
   // the ramp, the attitude source toggled between them and the slope estimate lost 1 deg).
-  const bool ground_attitude =
-      !out_.ceiling.found ||
-      angle(-out_.ceiling.coeffs.head<3>(), up) > cfg_.attitude_consistency_deg * k::kDeg;
   if (ground_attitude) {
     const double under_d = under == 1 ? O.pl[3] : 0.0;
     g = followed;

@@ -28,6 +28,9 @@ void Segmenter::fuse_imu(const Scan& scan, const Eigen::Vector3d& plane_up) {
   if (r.predicted) {
     out_.attitude_source = AttitudeSource::kGyro;
     std::snprintf(buf, sizeof buf, "attitude: no plane, gravity carried by the gyro (sigma %.2f deg)", r.sigma / k::kDeg);
+  } else if (r.settling) {
+    out_.attitude_source = AttitudeSource::kSlope;
+    std::snprintf(buf, sizeof buf, "attitude: level again, the planes blended in with the gyro (sigma %.2f deg)", r.sigma / k::kDeg);
   } else {
     out_.attitude_source = AttitudeSource::kSlope;
     std::snprintf(buf, sizeof buf, "attitude: planes + surface slope %.2f deg (gyro/IMU gravity)", fusion_.slope_deg());

@@ -18,7 +18,10 @@
 //    surface: the ramp's foot or head, the ceiling beyond) is carried by the gyro (o absorbs it); a step
 //    smaller than change_deg (one scan's compromise fit) only once it persists max_hold_scans scans. The
 //    accelerometer pulls o slowly (`accel_tau_s`) towards its gravity (platform accelerations average out).
-//    o below `level_deg` again: back to LEVEL (said, never a silent jump).
+//    o below `level_deg` again: back to LEVEL (said, never a silent jump). When that comes with a step of the
+//    planes to another surface (the level floor behind the ramp's foot, the landing past its head: one
+//    scan's fit of a surface often seen far away), gravity is the gyro's prediction pulled towards the planes
+//    for `level_settle_s` (as on a slope), not the new planes as they are.
 //  - No plane: g carried by the gyro (sigma grows with the gyro's noise and bias); no gyro: not handled
 //    here (the caller holds the last estimate with a grown sigma).
 // The disagreement between the planes and gravity is the floor's slope: slope_deg() (0 on level floors).
@@ -43,6 +46,9 @@ struct GravityFusionConfig {
                                  // the accelerometer holds it); slope: a plane step between step_deg and
                                  // change_deg is taken for another surface only after this many scans
   double accel_tau_s = 10.0;     // on a slope: the accelerometer's pull on the surface tilt
+  double level_settle_s = 1.0;   // level again after a step of the planes to another surface (the ramp's foot or head):
+                                 // for this long gravity is the gyro's prediction pulled towards the planes
+                                 // (slope_plane_tau_s) instead of the planes as they are (0: at once)
   double slope_plane_tau_s = 0.25;  // on a slope: gravity is the gyro's prediction pulled towards planes + tilt with
                                    // this time constant (one scan's plane fit is a few tenths of a degree off where
                                    // the surfaces change under the robot; the gyro drifts ~0.03 deg/s)
@@ -69,6 +75,7 @@ class GravityFusion {
     double sigma = M_PI;      // 1-sigma of the tilt [rad]
     bool from_planes = false; // the planes' own attitude (level surfaces), bit-identical
     bool predicted = false;   // no plane: carried by the gyro
+    bool settling = false;    // level again after a step to another surface: the planes blended in
     std::string text;         // what happened (empty: nothing new)
   };
 
@@ -109,6 +116,10 @@ class GravityFusion {
   void carry_by_gyro(const Eigen::Vector3d& g_pred, double dt, Result& r);
   // Gravity is the planes' up: the state takes it and r says so.
   Result& take_planes(const Eigen::Vector3d& up, double plane_sigma, Result& r);
+  // Level again after a step to another surface: gravity the gyro's prediction pulled towards the planes (as on a
+  // slope) until settle_until_, so that one scan's plane of the new surface does not pass into the attitude as it is.
+  Result& settle_to_planes(const Eigen::Vector3d& g_pred, const Eigen::Vector3d& up, double plane_sigma, double dt,
+                           Result& r);
 
   bool started_ = false;
   int64_t t_ = 0;
@@ -131,6 +142,7 @@ class GravityFusion {
   bool refused_ = false;     // a change without the accelerometer's agreement was said (once per episode)
   double sigma_ = M_PI;      // tilt sigma of g
   double o_sigma_ = 0;       // of the surface tilt
+  int64_t settle_until_ = 0; // LEVEL again after a step to another surface: the planes blended in until then
 };
 
 const char* to_string(GravityFusion::Mode m);
