@@ -139,6 +139,11 @@ TEST(BuildingCeilings, SimulatedCeilingsReadBackAsTheRaysSeeThem) {
       // The plan the file names is the plan the world was built from (same frame, same units).
       const Box2 pb = load_floor_plan(b, fl.name).bounds();
       EXPECT_LT((pb.min - s.world().bounds().min).norm() + (pb.max - s.world().bounds().max).norm(), 1e-9);
+      // The plan's layer globs and units override go along (fploc sim --layers/--units).
+      const Building bl = parse_building(sim::ceiling_map_building_text(s.ceiling_map(), plan_file, "0", {"walls", "col*"}, "m"), file);
+      EXPECT_EQ(bl.floors[0].layers, (std::vector<std::string>{"walls", "col*"}));
+      EXPECT_EQ(bl.floors[0].units, "m");
+      EXPECT_EQ(bl.floors[0].areas.size(), fl.areas.size());
       int blocked_grid = 0, blocked_path = 0;
       const auto grid = grid_hits(s.world(), 0.25, &blocked_grid);
       const auto path = path_hits(s.world(), s.motion(), &blocked_path);
