@@ -139,9 +139,14 @@ int main(int argc, char** argv) {
     if (!ceilings_building.empty()) {
       if (sim.ceiling_map().areas.empty() && sim.ceiling_map().objects.empty())
         throw std::runtime_error("--ceilings-building: scenario " + scenario + " has no ceiling map (building-* scenarios)");
+      // On a building's floor the world has the building's own areas too (first), which the map does not
+      // hold, and a building cannot be a floor's plan: the file would not say what the rays see.
+      if (is_building)
+        throw std::runtime_error("--ceilings-building: the plan is a building (" + plan_file +
+                                 "); give one floor's plan file (or give the segmenter the building itself)");
       std::ofstream cb(ceilings_building);
       const std::string pf = plan_file.empty() ? "" : std::filesystem::absolute(plan_file).string();
-      cb << fploc::sim::ceiling_map_building_text(sim.ceiling_map(), pf);
+      cb << fploc::sim::ceiling_map_building_text(sim.ceiling_map(), pf, "0", layers, units);
       if (!cb) throw std::runtime_error(ceilings_building + ": cannot write");
     }
     std::cerr << "fploc sim: path " << sim.motion().length() << " m, " << sim.motion().moving_time() << " s moving, avg "

@@ -192,6 +192,14 @@ void AttitudeHeight::area_z(Segmentation& out, const Eigen::Vector3d& up, bool g
       std::snprintf(buf, sizeof buf, "ceiling of area '%s' gives z %.3f m, the floor %.3f m: z from the ground", an.c_str(), zc,
                     out.ground.distance());
       out.note(buf);
+    } else if (g && ground_level &&
+               std::abs(zc - out.ground.distance()) > std::max(k::kAreaFloorGateMinM, 3.0 * (sig + out.ground.d_sigma))) {
+      // Inside the consistency gate, but more than 3 of their sigmas (and 1 cm) apart: the ceiling's distance is
+      // off by more than its fit says (a far patch seen by the upper rings, its tilt a little off over a lever
+      // of metres; a compromise plane across two areas). The level floor's distance is the direct one.
+      std::snprintf(buf, sizeof buf, "ceiling of area '%s' gives z %.1f cm off the floor's (> 3 sigmas and 1 cm): z from the ground", an.c_str(),
+                    100 * (zc - out.ground.distance()));
+      out.note(buf);
     } else if (!g && have_prev_z_ && std::abs(zc - prev_z_) > cfg_.z_jump_m) {
       std::snprintf(buf, sizeof buf, "ceiling of area '%s' steps z by %.3f m without a floor to confirm it: z predicted",
                     an.c_str(), zc - prev_z_);

@@ -84,6 +84,7 @@ constexpr double kUnknownZSigmaM = 1e3;             // z unknown
 constexpr size_t kAreaMaxPoints = 3000;             // ceiling inliers looked up per scan (subsampled)
 constexpr double kAreaKnownMin = 0.5;               // >= half of them with a height (the building's or learned)
 constexpr double kAreaLearnFraction = 0.9;          // learn an area's height from a ceiling >= 90 % in it
+constexpr double kAreaFloorGateMinM = 0.01;         // the ceiling's z vs a level floor's: > 3 sigmas and > 1 cm: the floor
 constexpr double kPoseMaxAgeS = 1.0;                // a plan pose older than this is not used
 constexpr double kPoseMaxExtrapolateS = 0.3;        // extrapolated from the last two poses at most this far
 constexpr double kImuTrustNormTolMs2 = 0.4;         // IMU trusted: |mean accel| within this of g

@@ -137,15 +137,30 @@ CeilingMap make_ceiling_map(const std::string& kind, const Box2& bounds, double 
   return m;
 }
 
-std::string ceiling_map_building_text(const CeilingMap& m, const std::string& plan_file, const std::string& floor) {
+namespace {
+// A protobuf text-format string literal.
+std::string quoted(const std::string& s) {
+  std::string q = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') q += '\\';
+    q += c;
+  }
+  return q + "\"";
+}
+}  // namespace
+
+std::string ceiling_map_building_text(const CeilingMap& m, const std::string& plan_file, const std::string& floor,
+                                      const std::vector<std::string>& layers, const std::string& units) {
   std::ostringstream o;
   o.precision(10);
   o << "# The simulated floor's ceilings (fploc::sim::ceiling_map_building_text).\n";
-  o << "name: \"simulated\"\nfloor {\n  name: \"" << floor << "\"\n  plan { file: \"" << plan_file << "\" }\n"
-    << "  elevation_m: 0\n  ceiling_height_m: " << m.default_height_m << "\n";
+  o << "name: \"simulated\"\nfloor {\n  name: " << quoted(floor) << "\n  plan { file: " << quoted(plan_file);
+  for (const auto& l : layers) o << " layers: " << quoted(l);
+  if (!units.empty()) o << " units: " << quoted(units);
+  o << " }\n  elevation_m: 0\n  ceiling_height_m: " << m.default_height_m << "\n";
   for (const auto& a : m.areas) {
     if (a.open) continue;
-    o << "  area {\n    name: \"" << a.name << "\"\n";
+    o << "  area {\n    name: " << quoted(a.name) << "\n";
     if (a.slope.squaredNorm() > 0)
       o << "    sloped_ceiling { height_m: " << a.height_m << " x: " << a.box.min.x() << " y: " << a.box.min.y()
         << " slope_x: " << a.slope.x() << " slope_y: " << a.slope.y() << " }\n";

@@ -225,14 +225,20 @@ double World::ceiling_t(const Eigen::Vector3d& o, const Eigen::Vector3d& d, doub
       }
     }
   }
-  for (const auto& p : patches_) {
+  for (size_t pi = 0; pi < patches_.size(); ++pi) {
+    const CeilingPatch& p = patches_[pi];
     if (p.open) continue;
     const double den = d.z() - p.slope.x() * d.x() - p.slope.y() * d.y();
     if (std::abs(den) < 1e-12) continue;
     const double t = (p.h0 + p.slope.x() * (o.x() - p.box.min.x()) + p.slope.y() * (o.y() - p.box.min.y()) - o.z()) / den;
     if (t > kEps && t < std::min(tmax, best)) {
       const double x = o.x() + t * d.x(), y = o.y() + t * d.y();
-      if (p.contains(x, y) && inside(bounds_, x, y)) best = t;
+      if (!p.contains(x, y) || !inside(bounds_, x, y)) continue;
+      // Overlapping patches: the first one containing the point owns it (as ceiling_at, and as a building's
+      // areas: BuildingFloor::area_at), not the lowest plane.
+      bool first = true;
+      for (size_t k = 0; k < pi && first; ++k) first = !patches_[k].contains(x, y);
+      if (first) best = t;
     }
   }
   return best;

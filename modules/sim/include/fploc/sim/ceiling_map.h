@@ -48,10 +48,15 @@ struct CeilingMap {
 // Throws std::invalid_argument naming the valid kinds.
 CeilingMap make_ceiling_map(const std::string& kind, const Box2& bounds, double default_height_m, uint64_t seed);
 std::vector<std::string> ceiling_map_kinds();
-// The map as one floor of a building description (proto/building.proto text): the default height and the
-// areas (boxes as polygons; sloped ones as sloped_ceiling; openings left out: no ceiling to look up). The
-// hanging objects are not part of a building file. For benches: the segmenter given the building's heights.
-std::string ceiling_map_building_text(const CeilingMap& m, const std::string& plan_file, const std::string& floor = "0");
+// The map as one floor of a building description (proto/building.proto text): the plan the world was built
+// from (its file, layer globs and units override: the areas are in that plan's frame, metres), elevation 0,
+// the default height and the areas in their order (boxes as polygons; sloped ones as sloped_ceiling with the
+// box's min corner as origin; openings left out: no ceiling to look up). Read back with load_building, every
+// point under the ceiling gets the height the rays hit (segmentation building_ceilings_test). The hanging
+// objects (lamps, beams, ducts, grid T-bars) are not part of a building file: the segmenter must cope with
+// them. For benches: the segmenter given the building's heights.
+std::string ceiling_map_building_text(const CeilingMap& m, const std::string& plan_file, const std::string& floor = "0",
+                                      const std::vector<std::string>& layers = {}, const std::string& units = "");
 // Adds the areas (as ceiling patches) and the objects (as clutter boxes) to the world.
 void apply_ceiling_map(const CeilingMap& m, World& world);
 

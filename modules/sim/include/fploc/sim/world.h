@@ -36,6 +36,7 @@ Box2 polygon_bounds(const std::vector<Eigen::Vector2d>& poly);
 
 // A ceiling region (axis-aligned box in the plan frame, or a polygon when `polygon` is set: then `box`
 // is its bounding box) that is either missing (rays pass) or a plane z = h0 + slope.dot(xy - box.min).
+// Where patches overlap, the first one added that contains a point owns it (ceiling_at and the rays alike).
 struct CeilingPatch {
   Box2 box;
   bool open = false;
