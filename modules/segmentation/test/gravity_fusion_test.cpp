@@ -347,6 +347,22 @@ struct RampEntry {
       scan(t, ut, R, up_true, accel, planes);
     }
   }
+  // The same with each scan's planes replaced by planes_at(t, up_true, planes), fed to `fus` (no plane while the
+  // sensor pitches onto the ramp); returns the worst tilt error [deg] of its gravity after t_from (its texts in said).
+  template <class PlanesAt>
+  static double worst_after(GravityFusion& fus, int samples, double t_from, PlanesAt planes_at, std::string* said = nullptr) {
+    const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+    double worst = 0;
+    run(fus, samples, [&](double t, int64_t ut, const Eigen::Matrix3d&, const Eigen::Vector3d& up_true,
+                          const Eigen::Vector3d& accel, const Eigen::Vector3d& planes_true) {
+      const Eigen::Vector3d planes = planes_at(t, up_true, planes_true);
+      const bool seen = t <= t_up0 || t > t_up1;
+      const auto r = fus.update(ut, seen ? &planes : nullptr, 0.02 * kDeg, &accel, zero);
+      if (said) *said += r.text;
+      if (t > t_from) worst = std::max(worst, std::acos(std::clamp(r.up.normalized().dot(up_true), -1.0, 1.0)) / kDeg);
+    });
+    return worst;
+  }
   static Eigen::Vector3d ramp_normal() { return Eigen::AngleAxisd(6.0 * kDeg, Eigen::Vector3d::UnitY()) * Eigen::Vector3d::UnitZ(); }
 };
 
@@ -413,17 +429,10 @@ TEST(GravityFusion, OneScansPlaneStepOnASlopeIsHeldUntilItPersists) {
     GravityFusionConfig cfg;
     cfg.max_hold_scans = max_hold_scans;
     GravityFusion fus(cfg);
-    const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
     const double t_blip = 6.0;
-    double worst = 0;
-    RampEntry::run(fus, 1000, [&](double t, int64_t ut, const Eigen::Matrix3d&, const Eigen::Vector3d& up_true,
-                                  const Eigen::Vector3d& accel, Eigen::Vector3d planes) {
+    const double worst = RampEntry::worst_after(fus, 1000, t_blip + 0.05, [&](double t, const Eigen::Vector3d&, const Eigen::Vector3d& planes) {
       const double off = std::abs(t - t_blip) < 1e-6 ? 0.35 : std::abs(t - t_blip - 0.1) < 1e-6 ? 0.1 : 0.0;
-      planes = Eigen::AngleAxisd(off * kDeg, Eigen::Vector3d::UnitY()) * planes;
-      const bool seen = t <= RampEntry::t_up0 || t > RampEntry::t_up1;
-      const auto r = fus.update(ut, seen ? &planes : nullptr, 0.02 * kDeg, &accel, zero);
-      if (t > t_blip + 0.05)
-        worst = std::max(worst, std::acos(std::clamp(r.up.normalized().dot(up_true), -1.0, 1.0)) / kDeg);
+      return Eigen::Vector3d(Eigen::AngleAxisd(off * kDeg, Eigen::Vector3d::UnitY()) * planes);
     });
     EXPECT_EQ(fus.mode(), GravityFusion::Mode::kSlope);
     return worst;
@@ -462,19 +471,12 @@ TEST(GravityFusion, LevelAgainAfterAStepIsBlendedInFromTheGyro) {
     GravityFusionConfig cfg;
     cfg.level_settle_s = settle_s;
     GravityFusion fus(cfg);
-    const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
     const double t_step = 6.0;
-    double worst = 0;
-    RampEntry::run(fus, 900, [&](double t, int64_t ut, const Eigen::Matrix3d&, const Eigen::Vector3d& up_true,
-                                 const Eigen::Vector3d& accel, Eigen::Vector3d planes) {
-      if (t > t_step - 1e-6 && t < t_step + 0.15)
-        planes = Eigen::AngleAxisd(0.2 * kDeg, Eigen::Vector3d::UnitX()) * up_true;  // the level floor, 0.2 deg off
-      const bool seen = t <= RampEntry::t_up0 || t > RampEntry::t_up1;
-      const auto r = fus.update(ut, seen ? &planes : nullptr, 0.02 * kDeg, &accel, zero);
-      *said += r.text;
-      if (t > t_step - 1e-6)
-        worst = std::max(worst, std::acos(std::clamp(r.up.normalized().dot(up_true), -1.0, 1.0)) / kDeg);
-    });
+    const double worst = RampEntry::worst_after(fus, 900, t_step - 1e-6, [&](double t, const Eigen::Vector3d& up_true, const Eigen::Vector3d& planes) {
+      if (t > t_step - 1e-6 && t < t_step + 0.15)  // the level floor, 0.2 deg off
+        return Eigen::Vector3d(Eigen::AngleAxisd(0.2 * kDeg, Eigen::Vector3d::UnitX()) * up_true);
+      return planes;
+    }, said);
     EXPECT_EQ(fus.mode(), GravityFusion::Mode::kSlope) << *said;
     return worst;
   };
