@@ -56,6 +56,7 @@ struct Group {
   detail::Moments m;
   Eigen::Vector4d pl = Eigen::Vector4d::Zero();
   int sectors = 0;
+  std::array<bool, kSectors> member{};  // the sectors pooled
 };
 }  // namespace
 
@@ -129,14 +130,19 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   };
   // F: the sectors on that surface; O: those on another one (kinked against F's plane by more than kKinkDeg).
   Group F, O;
-  const auto pool = [&](Group& grp, int s) {
-    grp.m.w += sm[s].w;
-    grp.m.s += sm[s].s;
-    grp.m.ss += sm[s].ss;
-    ++grp.sectors;
+  // The sectors within kFollowDeg of a surface's normal, pooled.
+  const auto gather = [&](const Eigen::Vector3d& normal, Group& grp) {
+    grp = Group{};
+    for (int s = 0; s < kSectors; ++s) {
+      grp.member[s] = ok[s] && angle(spl[s].head<3>(), normal) < kFollowDeg * k::kDeg;
+      if (!grp.member[s]) continue;
+      grp.m.w += sm[s].w;
+      grp.m.s += sm[s].s;
+      grp.m.ss += sm[s].ss;
+      ++grp.sectors;
+    }
   };
-  for (int s = 0; s < kSectors; ++s)
-    if (ok[s] && angle(spl[s].head<3>(), prev) < kFollowDeg * k::kDeg) pool(F, s);
+  gather(prev, F);
   bool same_surface = true;  // F is the surface followed in the last scan
   if (F.sectors < 2 || F.m.w < 4 * kMinSectorPoints) {
     // The surface seen before has left the view (past a ramp's head): the surface of the largest sector, if
@@ -148,8 +154,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     F = Group{};
     if (big >= 0) {
       prev = spl[big].head<3>();
-      for (int s = 0; s < kSectors; ++s)
-        if (ok[s] && angle(spl[s].head<3>(), prev) < kFollowDeg * k::kDeg) pool(F, s);
+      gather(prev, F);
     }
   }
   if (F.sectors < 2 || F.m.w < 4 * kMinSectorPoints || !F.m.plane(ref, -up, F.pl)) {
@@ -161,8 +166,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   // landing and the ramp's last metre ahead of it) fits a compromise between the two surfaces that can still be
   // within kFollowDeg of the followed one: pooled as it is, it tilts F by a few tenths of a degree. Its returns
   // on the other surface lie centimetres off F's plane and drop out here.
-  std::array<bool, kSectors> in_f{};  // the sectors on F
-  for (int s = 0; s < kSectors; ++s) in_f[s] = ok[s] && angle(spl[s].head<3>(), prev) < kFollowDeg * k::kDeg;
+  const std::array<bool, kSectors>& in_f = F.member;
   {
     std::vector<Eigen::Vector3f> near;  // F's returns within the first cut-off of its pooled plane (sensor frame - ref)
     const Eigen::Vector3f n0f = F.pl.head<3>().cast<float>();
@@ -264,8 +268,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   for (int s = 0; s < kSectors; ++s)
     if (ok[s] && angle(spl[s].head<3>(), F.pl.head<3>()) > std::max(far, 3 * ssig[s])) far = angle(spl[s].head<3>(), F.pl.head<3>()), seed = s;
   if (seed >= 0) {
-    for (int s = 0; s < kSectors; ++s)
-      if (ok[s] && angle(spl[s].head<3>(), spl[seed].head<3>()) < kFollowDeg * k::kDeg) pool(O, s);
+    gather(spl[seed].head<3>(), O);
     if (O.m.w < 4 * kMinSectorPoints || !O.m.plane(ref, -up, O.pl)) O.sectors = 0;
   }
   const double off_fit = angle(F.pl.head<3>(), up);
@@ -294,18 +297,17 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   // it, or the "other surface" is a patch inside it) has no side: the followed surface.
   int under = 0;  // 0: F, 1: O, -1: unclear
   if (O.sectors > 0) {
-    const auto side = [&](const Group& A, const Group& B, bool in_o) {  // +1/-1: A's sectors all on one side; 0: mixed
+    const auto side = [&](const Group& A, const Group& B) {  // +1/-1: A's sectors all on one side; 0: mixed
       double pos = 0, neg = 0;
       for (int s = 0; s < kSectors; ++s) {
         if (!ok[s] || sm[s].w <= 0) continue;
-        const bool in_os = seed >= 0 && angle(spl[s].head<3>(), spl[seed].head<3>()) < kFollowDeg * k::kDeg;
-        if (in_o ? !in_os : !in_f[s]) continue;
+        if (!A.member[s]) continue;
         const Eigen::Vector3d c = sm[s].s / sm[s].w + ref;
         (B.pl.head<3>().dot(c) + B.pl[3] > 0 ? pos : neg) += sm[s].w;
       }
       return pos >= kSideShare * (pos + neg) ? 1 : neg >= kSideShare * (pos + neg) ? -1 : 0;
     };
-    const int sf = side(F, O, false), so = side(O, F, true);
+    const int sf = side(F, O), so = side(O, F);
     const double at_sensor = O.pl[3] - F.pl[3];  // height above O - height above F, at the sensor
     if (sf != 0 && so != 0) under = sf * at_sensor > 0 ? 0 : so * -at_sensor > 0 ? 1 : -1;
     else under = -1;
