@@ -42,6 +42,9 @@ insensor() { nsenter -t "$SNS" -n "$@"; }
 
 SENSOR=10.77.0.2:8080
 start_sensor() {  # args for fake_sensor.py
+  # Empty the log here, not in the background job's redirection: that runs in the child, and until it does
+  # the previous sensor's "fake sensor" line is still there for the wait below to find.
+  : > "$T/sensor.txt"
   nsenter -t "$SNS" -n python3 "$HERE/fake_sensor.py" --bind 10.77.0.2 --port 8080 --metadata "$META" "$@" > "$T/sensor.txt" 2>&1 &
   FS=$!
   for _ in $(seq 200); do grep -q "fake sensor" "$T/sensor.txt" && return 0; sleep 0.05; done
