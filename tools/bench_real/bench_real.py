@@ -12,7 +12,9 @@ The rest is imported as an LCM log (laser_scan_t + wheel odometry) and run throu
 started from the reference pose (row "ref") and from a pose 1 m / 10 deg off (row "off"), and scored against
 the reference poses (time association, no alignment). Scored: the scans the map covers (>= 50 % of the returns
 within 10 cm of an occupied cell at the reference pose); the others are reported separately ("uncovered", and
-"all"). LOST %: share of scans whose position error exceeds --lost-m (0.5 m). ms per scan: the nodes' thread
+"all"). LOST %: share of scans whose position error exceeds --lost-m (0.5 m). What each method said of itself
+(fploc-pose-logger's uncertainty_file): false OK = poses published OK with a horizontal error > 0.3 m (count and
+%), POOR % and the median x/y/yaw NEES of its covariance (3 when consistent). ms per scan: the nodes' thread
 CPU time (grid2d; laser2d + matcher + optimizer for the plan path; AMCL's own) over the scans, from replay's
 --json. "floor": the RMSE over the covered scans of the map fit started at each scan's own reference pose
 (fploc-real-floor): how far the map and the reference poses of the rest disagree. Plots per row: ROW.png (reference green, fploc blue, AMCL orange) and ROW-fploc.png (without AMCL).
@@ -26,6 +28,7 @@ BUILD = os.environ.get("FPLOC_BUILD_DIR", os.path.join(ROOT, "build"))
 SHARED = os.environ.get("FPLOC_SHARED_DIR", os.path.join(ROOT, "..", "shared"))
 BIN = os.path.join(BUILD, "bin")
 LOGS = ["intel", "aces", "fhw", "csail", "freiburg-079"]
+FALSE_OK_M = 0.3  # a pose published OK with a larger horizontal error is a false OK (as in fploc bench realism)
 
 
 def run(cmd, **kw):
@@ -47,18 +50,70 @@ def read_tum(path):
     return out
 
 
-def score(gt_path, est_path, lost_m, keep=None):
+def read_status(path):
+    """Status (0 OK, 1 POOR, 2 LOST) and x/y/yaw covariance per pose time: fploc-pose-logger's uncertainty_file
+    ("t status xx xy xyaw yy yyaw yawyaw", modules/eval/uncertainty.h). {} when the file is absent."""
+    out = {}
+    if not path or not os.path.exists(path):
+        return out
+    with open(path) as f:
+        for line in f:
+            v = line.split()
+            if not v or v[0].startswith("#") or len(v) < 8:
+                continue
+            out[round(float(v[0]), 4)] = (int(v[1]), [float(x) for x in v[2:8]])
+    return out
+
+
+def nees3(e, c):
+    """e^T P^-1 e for e = (dx, dy, dyaw) and P from (xx, xy, xyaw, yy, yyaw, yawyaw); None when P is not positive
+    definite."""
+    xx, xy, xa, yy, ya, aa = c
+    P = [[xx, xy, xa], [xy, yy, ya], [xa, ya, aa]]
+    m = [row[:] + [b] for row, b in zip(P, e)]
+    for col in range(3):
+        piv = max(range(col, 3), key=lambda r: abs(m[r][col]))
+        if not math.isfinite(m[piv][col]) or abs(m[piv][col]) < 1e-15:
+            return None
+        m[col], m[piv] = m[piv], m[col]
+        for r in range(3):
+            if r != col:
+                f = m[r][col] / m[col][col]
+                for k in range(col, 4):
+                    m[r][k] -= f * m[col][k]
+    v = sum(e[i] * m[i][3] / m[i][i] for i in range(3))
+    return v if v >= 0 else None
+
+
+def score(gt_path, est_path, lost_m, keep=None, status_path=None):
     """ATE (RMSE of the position error, no alignment: both in the map frame, the reference pose associated by time
     with fploc eval's association), max, LOST % (position error > lost_m; a scan without an estimate counts as
     LOST and as its own entry in "missing"). keep: the reference times to score (None: all); the others are
     reported as "uncovered" with their own ATE."""
-    gt, est = read_tum(gt_path), read_tum(est_path)
+    gt, est, st = read_tum(gt_path), read_tum(est_path), read_status(status_path)
     def part(times):
         errs = [math.hypot(est[k][0] - gt[k][0], est[k][1] - gt[k][1]) if k in est else float("inf") for k in times]
         fin = [e for e in errs if math.isfinite(e)]
-        return {"scans": len(times), "ate_m": math.sqrt(sum(e * e for e in fin) / len(fin)) if fin else float("nan"),
-                "max_m": max(fin) if fin else float("nan"), "missing": len(errs) - len(fin),
-                "lost_pct": 100.0 * sum(e > lost_m for e in errs) / max(1, len(errs))}
+        out = {"scans": len(times), "ate_m": math.sqrt(sum(e * e for e in fin) / len(fin)) if fin else float("nan"),
+               "max_m": max(fin) if fin else float("nan"), "missing": len(errs) - len(fin),
+               "lost_pct": 100.0 * sum(e > lost_m for e in errs) / max(1, len(errs))}
+        if st:  # what the method said of itself: false OK (status OK, error > FALSE_OK_M), POOR/LOST shares, NEES
+            said = [(k, e) for k, e in zip(times, errs) if k in st and math.isfinite(e)]
+            nees = []
+            for k, e in said:
+                dyaw = (est[k][2] - gt[k][2] + math.pi) % (2 * math.pi) - math.pi
+                v = nees3((est[k][0] - gt[k][0], est[k][1] - gt[k][1], dyaw), st[k][1])
+                if v is not None:
+                    nees.append(v)
+            nees.sort()
+            n = max(1, len(said))
+            out.update({"status_poses": len(said),
+                        "false_ok_poses": sum(st[k][0] == 0 and e > FALSE_OK_M for k, e in said),
+                        "false_ok_pct": 100.0 * sum(st[k][0] == 0 and e > FALSE_OK_M for k, e in said) / n,
+                        "poor_pct": 100.0 * sum(st[k][0] == 1 for k, _ in said) / n,
+                        "said_lost_pct": 100.0 * sum(st[k][0] == 2 for k, _ in said) / n,
+                        "nees_median": nees[len(nees) // 2] if nees else None})
+        return out
     times = sorted(gt)
     covered = [k for k in times if keep is None or k in keep]
     out = part(covered)
@@ -136,15 +191,18 @@ def main():
             for n in ("matcher", "amcl", "grid2d"):
                 sets += ["--set", f"{n}.initial_pose.x={x}", "--set", f"{n}.initial_pose.y={y}", "--set", f"{n}.initial_pose.yaw={yaw}"]
             est = {k: os.path.abspath(os.path.join(d, f"{row}-{k}.tum")) for k in ("wo", "sfr", "amcl", "grid")}
+            unc = {k: os.path.abspath(os.path.join(d, f"{row}-{k}.status")) for k in ("wo", "amcl", "grid")}
             sets += ["--set", f"wo_logger.file={est['wo']}", "--set", f"sfr_logger.file={est['sfr']}",
                      "--set", f"amcl_logger.file={est['amcl']}", "--set", f"grid_logger.file={est['grid']}"]
+            for k in unc:
+                sets += ["--set", f"{k}_logger.uncertainty_file={unc[k]}"]
             rep = json.loads(run([os.path.join(BIN, "fploc-replay"), "--graph", a.graph, "--log", lcm, "--json"] + sets).stdout)
             cpu = {n["name"]: n.get("cpu_ms", 0.0) for n in rep["nodes"]}
             scans = imp["end_scan"] - imp["first_scan"]
             plan_ms = (cpu.get("laser2d", 0) + cpu.get("matcher", 0) + cpu.get("optimizer", 0)) / max(1, scans)
             grid_ms = cpu.get("grid2d", 0) / max(1, scans)
             amcl_ms = cpu.get("amcl", 0) / max(1, scans)
-            g, p, am = (score(ref, est[k], a.lost_m, keep) for k in ("grid", "wo", "amcl"))
+            g, p, am = (score(ref, est[k], a.lost_m, keep, unc[k]) for k in ("grid", "wo", "amcl"))
             f, fploc_ms = (g, grid_ms) if a.fploc == "grid" else (p, plan_ms)
             png = os.path.join(d, f"{row}.png")
             run([os.path.join(BIN, "fploc-occupancy"), plan, "--png", png, "--tum", ref, "--tum", est[a.fploc], "--tum", est["amcl"]])
@@ -159,7 +217,7 @@ def main():
                  "fploc_half_of_amcl": f["ate_m"] <= 0.5 * am["ate_m"], "plot": png, "plot_fploc": png_f}
             rows.append(r)
             print(f"{name:13s} {row:3s} split {r['split']['fraction']:.2f} scans {scans:5d} covered {len(keep):5d}  fploc ATE {f['ate_m']*100:8.1f} cm max {f['max_m']*100:8.1f} cm "
-                  f"LOST {f['lost_pct']:5.1f} % {fploc_ms:6.2f} ms | AMCL ATE {am['ate_m']*100:8.1f} cm max {am['max_m']*100:8.1f} cm "
+                  f"LOST {f['lost_pct']:5.1f} % false OK {f.get('false_ok_poses', '-')} POOR {f.get('poor_pct', float('nan')):4.1f} % {fploc_ms:6.2f} ms | AMCL ATE {am['ate_m']*100:8.1f} cm max {am['max_m']*100:8.1f} cm "
                   f"LOST {am['lost_pct']:5.1f} % {amcl_ms:6.2f} ms | other fploc ({'wo' if a.fploc == 'grid' else 'grid'}) "
                   f"ATE {(p if a.fploc == 'grid' else g)['ate_m']*100:8.1f} cm | all scans: fploc {f['all']['ate_m']*100:.1f} cm "
                   f"LOST {f['all']['lost_pct']:.1f} %, AMCL {am['all']['ate_m']*100:.1f} cm | floor {floor['ate_m']*100:.1f} cm", file=sys.stderr)
