@@ -99,6 +99,7 @@ struct GridLocalizer::Impl {
   GridLocalizerConfig cfg;
   Pose2 pose;
   double sxy = 0, syaw = 0;  // current uncertainty of `pose`
+  std::vector<double> ranges;  // scratch: the scan's ranges (median for the published covariance)
   std::optional<Pose2> last_odom;
   std::optional<Pose2> raw_inc;  // this scan's odometry increment as measured (before the calibration)
   OdometryCalibration calib;
@@ -307,6 +308,17 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points, con
   res.odom_turn_scale_error = m.calib.turn_scale_error();
   res.odom_scale = m.calib.scale();
   res.odom_pairs = m.calib.pairs();
+  // What is published: the weak fit's status and the map's share of the covariance (see the config).
+  if (cfg_.weak_fit_is_poor && res.status == GridStatus::kOk && res.inlier_ratio < cfg_.min_inlier_ratio)
+    res.status = GridStatus::kPoor;
+  if (cfg_.map_sigma_cells > 0 && res.status != GridStatus::kNotInitialised && !points.empty()) {
+    m.ranges.clear();
+    for (const auto& p : points) m.ranges.push_back(p.norm());
+    auto mid = m.ranges.begin() + m.ranges.size() / 2;
+    std::nth_element(m.ranges.begin(), mid, m.ranges.end());
+    const double sxy = cfg_.map_sigma_cells * m.df->resolution(), syaw = sxy / std::max(*mid, 1.0);
+    res.covariance += Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
+  }
   return res;
 }
 

@@ -416,3 +416,83 @@ TEST(GridLocalizer, WeakFitCorrectsOnlyOneStepOfDeadReckoning) {
   const auto ctl = reacquire_in_boxes(c, false, far, 200);
   EXPECT_LT(std::hypot(ctl.pose.x - 0.5, ctl.pose.y - 0.4), 0.05) << "control: the weak fit was not followed without the rule";
 }
+
+namespace {
+
+// Every scan of the loop above, with a given config; `clutter` replaces that share of each scan's returns
+// by points 1-3 m in front of the robot's left half, where the map has nothing (people, furniture).
+std::vector<l2::GridResult> track_all(const l2::GridLocalizerConfig& c, double clutter = 0) {
+  const OccupancyGrid g = make_room();
+  auto df = std::make_shared<l2::DistanceField>(g, 1.0);
+  l2::GridLocalizer loc(df, c);
+  loc.set_initial_pose({1, 1, 0});
+  std::mt19937 rng(7), crng(11);
+  std::uniform_real_distribution<double> u(0, 1);
+  const auto truth = trajectory();
+  const auto odo = odometry(truth);
+  std::vector<l2::GridResult> out;
+  for (size_t k = 0; k < truth.size(); ++k) {
+    auto pts = cast(g, truth[k], rng);
+    for (size_t i = 0; i < pts.size(); ++i)
+      if (u(crng) < clutter) {
+        const double a = u(crng) * M_PI / 2, r = 1 + 2 * u(crng);
+        pts[i] = {r * std::cos(a), r * std::sin(a)};
+      }
+    out.push_back(loc.update(pts, odo[k]));
+  }
+  return out;
+}
+
+TEST(GridLocalizer, PublishedCovarianceHoldsTheMapsCellAndLeavesTheTrackAlone) {
+  l2::GridLocalizerConfig fit_only;
+  fit_only.map_sigma_cells = 0;
+  const auto a = track_all(fit_only), b = track_all({});
+  ASSERT_EQ(a.size(), b.size());
+  const double cell = 0.05 / std::sqrt(12.0);  // the synthetic grid's 5 cm cell, uniform within it
+  for (size_t k = 0; k < a.size(); ++k) {
+    // The track is the same to the last bit: the map's share is published, not fed back.
+    EXPECT_EQ(a[k].pose.x, b[k].pose.x) << k;
+    EXPECT_EQ(a[k].pose.yaw, b[k].pose.yaw) << k;
+    EXPECT_EQ(a[k].status, b[k].status) << k;
+    const Eigen::Matrix3d d = b[k].covariance - a[k].covariance;
+    EXPECT_NEAR(d(0, 0), cell * cell, 1e-12) << k;
+    EXPECT_NEAR(d(1, 1), cell * cell, 1e-12) << k;
+    EXPECT_EQ(d(0, 1), 0) << k;
+    // In yaw: the cell over the scan's median range (the room's walls are 0.5-13 m away).
+    EXPECT_GT(d(2, 2), std::pow(cell / 13, 2)) << k;
+    EXPECT_LT(d(2, 2), std::pow(cell / 1.0, 2)) << k;
+  }
+  // The fit alone typically claims less than the cell in x: that is what the map's share corrects.
+  std::vector<double> fit_xx;
+  for (const auto& r : a)
+    if (r.status == l2::GridStatus::kOk) fit_xx.push_back(r.covariance(0, 0));
+  ASSERT_FALSE(fit_xx.empty());
+  std::nth_element(fit_xx.begin(), fit_xx.begin() + fit_xx.size() / 2, fit_xx.end());
+  EXPECT_LT(fit_xx[fit_xx.size() / 2], cell * cell);
+}
+
+TEST(GridLocalizer, WeakFitIsFollowedButPublishedPoor) {
+  // 55 % of every scan is clutter the map does not explain: the fits are weak (inliers 35-50 %), near the
+  // odometry's prediction, so the tracker follows them; published, they are POOR, not OK.
+  l2::GridLocalizerConfig old_rule;
+  old_rule.weak_fit_is_poor = false;
+  const auto a = track_all(old_rule, 0.55), b = track_all({}, 0.55);
+  const auto truth = trajectory();
+  int weak = 0, weak_ok_before = 0, weak_ok_now = 0;
+  for (size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].pose.x, b[k].pose.x) << k;  // the same track either way
+    if (b[k].inlier_ratio > 0 && b[k].inlier_ratio < l2::GridLocalizerConfig{}.min_inlier_ratio) {
+      ++weak;
+      weak_ok_before += a[k].status == l2::GridStatus::kOk;
+      weak_ok_now += b[k].status == l2::GridStatus::kOk;
+    }
+    EXPECT_LT(std::hypot(b[k].pose.x - truth[k].x, b[k].pose.y - truth[k].y), 0.15) << k;
+  }
+  std::cout << "weak fits " << weak << " of " << b.size() << ", published OK before " << weak_ok_before
+            << ", now " << weak_ok_now << "\n";
+  EXPECT_GE(weak, 5);
+  EXPECT_GT(weak_ok_before, 0);  // the old rule published them OK
+  EXPECT_EQ(weak_ok_now, 0);
+}
+
+}  // namespace

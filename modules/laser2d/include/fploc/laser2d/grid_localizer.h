@@ -146,6 +146,19 @@ struct GridLocalizerConfig {
   double confirm_within_sigmas = 0;
   double confirm_inlier_ratio = 0.7;  // mean inlier share a hypothesis needs to be taken (a jump needs more than tracking)
   double field_max_m = 1.0;  // distance field truncation (the map's DistanceField)
+  // The published covariance (GridResult::covariance) is the fit's own (the inverse Hessian of the refinement:
+  // every point an independent measurement with point_sigma_m) plus the map's, which every point of a scan
+  // shares and which therefore does not average out over them: a wall lies somewhere in its cell, so
+  // map_sigma_cells x the raster's resolution in x and y (1/sqrt(12): a uniform position within one cell), and
+  // that over the scan's median range in yaw. Published only: the tracker's search windows and gates keep the
+  // fit's covariance (the map's error is the same on the next scan, not a random walk to accumulate). 0: the
+  // fit's alone (the earlier behaviour: x/y/yaw NEES median 23-75 against the Radish reference poses, ~3 when
+  // consistent; the fit alone says 5-8 mm where the reference disagrees by several cm).
+  double map_sigma_cells = 0.28867513459481287;  // 1 / sqrt(12)
+  // A weak fit (inliers < min_inlier_ratio, followed only because it agrees with the prediction) is published
+  // POOR: the map does not confirm the track there (the tracker follows it as before and counts it towards
+  // LOST). false: published OK until lost_after of them in a row (the earlier behaviour).
+  bool weak_fit_is_poor = true;
   // Online odometry calibration (odometry_calibration.h): every pair of consecutive scans both fitted with
   // >= min_inlier_ratio calibrates the wheels (yaw bias per metre, turn scale, translation scale); every
   // prediction (tracking, dead reckoning, hypotheses) uses the corrected increment. Off: the raw wheels.
