@@ -24,6 +24,12 @@ for k in ("all", "uncovered", "missing"):
 assert r["fploc"]["all"]["scans"] == 91 and r["fploc"]["missing"] == 0, r["fploc"]
 assert 0 < r["covered_scans"] <= 91 and r["fploc"]["uncovered"]["scans"] == 91 - r["covered_scans"], r
 assert r["fploc"]["ate_m"] < 0.3 and r["fploc"]["lost_pct"] < 10, r["fploc"]
+# What each method said of itself (its loggers' uncertainty files): every covered pose has a status.
+for m in ("fploc", "amcl"):
+    for k in ("status_poses", "false_ok_poses", "false_ok_pct", "poor_pct", "said_lost_pct", "nees_median"):
+        assert k in r[m] and k in r[m]["all"], (m, k)
+    assert r[m]["status_poses"] == r["covered_scans"] - r[m]["missing"], r[m]
+assert r["fploc"]["nees_median"] > 0, r["fploc"]
 PY
 test -s "$T/intel/ref.png"
 test -s "$T/intel/ref-fploc.png"
