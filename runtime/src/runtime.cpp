@@ -499,8 +499,12 @@ int node_main(int argc, char** argv) {
         if (next_beat < now_s()) next_beat = now_s() + 1.0;
       }
     }
-    // Deliver what is already queued, then stop.
-    while (bus.lcm().handleTimeout(0) > 0) {
+    // Deliver what is queued and what is still on its way, then stop: in a graph-wide stop the producers
+    // stopped just before (fploc launch stops them first) and published their last messages (a flushed
+    // window, a frame in progress) a moment ago, and under CPU load LCM's receive thread may not have read
+    // them from the socket yet (handleTimeout(0) sees only its queue: a pose logger lost the optimizer's
+    // last poses so). Until 100 ms pass without a message, at most 1 s.
+    for (const double drain_end = now_s() + 1.0; now_s() < drain_end && bus.lcm().handleTimeout(100) > 0;) {
     }
     node->shutdown();
     beat("stopped");
