@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <cstring>
 #include <filesystem>
@@ -457,7 +458,9 @@ int node_main(int argc, char** argv) {
       std::vector<pollfd> pfds;
       pfds.push_back({lcm_fd, POLLIN, 0});
       for (auto& [c, fe] : L.fds) pfds.push_back({fe.fd, POLLIN, 0});
-      const int timeout_ms = std::max(0, int((wake - t) * 1000.0));
+      // Rounded up: truncated, the last millisecond before each timer was a busy loop of poll(0) (the
+      // simulator's 2 ms timer: a third of its CPU, taken from the pipeline on a loaded machine).
+      const int timeout_ms = std::max(0, int(std::ceil((wake - t) * 1000.0)));
       const int r = poll(pfds.data(), pfds.size(), std::min(timeout_ms, 100));
       if (r < 0 && errno != EINTR) {
         ctx.error(std::string("poll: ") + strerror(errno));
