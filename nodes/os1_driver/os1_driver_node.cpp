@@ -102,6 +102,9 @@ class Os1DriverNode : public fploc::rt::Node {
 
   void shutdown() override {
     session_.reset();  // stops the worker thread
+    // What the socket still holds (under CPU load the loop may lag the packets; a simulator stopped just
+    // before sent its frame in flight), then the frame in progress.
+    udp_.drain([this](uint16_t p, const uint8_t* d, size_t n) { on_datagram(p, d, n); });
     if (assembler_) {
       assembler_->flush(frames_);
       publish_frames();

@@ -118,6 +118,16 @@ class SimSensorNode : public fploc::rt::Node {
     ctx.every(0.002, [this] { tick(); });
   }
 
+  // The frame in flight: its ground truth is out (start_frame), so its remaining packets go too, at once
+  // (their column times are in the packets). The launcher stops the drivers after the simulator (they
+  // listen on its ports), so they receive it: every ground-truth frame is a complete scan.
+  void shutdown() override {
+    if (fd_ < 0) return;
+    for (; next_pkt_ < int(pkts_.size()); ++next_pkt_) send(lidar_addr_, pkts_[size_t(next_pkt_)].data(), pkts_[size_t(next_pkt_)].size());
+    if (!pkts_.empty()) ++k_;
+    pkts_.clear();
+  }
+
  private:
   void send(const sockaddr_in& a, const uint8_t* d, size_t n) {
     if (::sendto(fd_, d, n, 0, reinterpret_cast<const sockaddr*>(&a), sizeof(a)) != ssize_t(n))
@@ -141,7 +151,11 @@ class SimSensorNode : public fploc::rt::Node {
     const double ts = clock0_s_ + (wall_now() - wall0_) * rate_;
     const double period = 1.0 / so_.rate_hz;
     const int W = so_.width;
-    for (int guard = 0; guard < 1000; ++guard) {
+    // At most ~50 ms of work per call: behind schedule (a loaded machine: each new frame is ray-cast), the
+    // catch-up continues in the next call, and the node's loop meanwhile sees a stop request (the stop
+    // waited for the whole catch-up, and the drivers stopped meanwhile lost the frames sent).
+    const double t_call = wall_now();
+    for (int guard = 0; guard < 1000 && wall_now() - t_call < 0.05; ++guard) {
       if (k_ >= frames_per_loop()) {
         if (!loop_) {
           std::cerr << "[" << ctx_->name() << "] scenario finished (" << frame_counter_ << " frames sent)\n";

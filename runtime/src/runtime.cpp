@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <cstring>
 #include <filesystem>
@@ -457,7 +458,9 @@ int node_main(int argc, char** argv) {
       std::vector<pollfd> pfds;
       pfds.push_back({lcm_fd, POLLIN, 0});
       for (auto& [c, fe] : L.fds) pfds.push_back({fe.fd, POLLIN, 0});
-      const int timeout_ms = std::max(0, int((wake - t) * 1000.0));
+      // Rounded up: truncated, the last millisecond before each timer was a busy loop of poll(0) (the
+      // simulator's 2 ms timer: a third of its CPU, taken from the pipeline on a loaded machine).
+      const int timeout_ms = std::max(0, int(std::ceil((wake - t) * 1000.0)));
       const int r = poll(pfds.data(), pfds.size(), std::min(timeout_ms, 100));
       if (r < 0 && errno != EINTR) {
         ctx.error(std::string("poll: ") + strerror(errno));
@@ -499,8 +502,12 @@ int node_main(int argc, char** argv) {
         if (next_beat < now_s()) next_beat = now_s() + 1.0;
       }
     }
-    // Deliver what is already queued, then stop.
-    while (bus.lcm().handleTimeout(0) > 0) {
+    // Deliver what is queued and what is still on its way, then stop: in a graph-wide stop the producers
+    // stopped just before (fploc launch stops them first) and published their last messages (a flushed
+    // window, a frame in progress) a moment ago, and under CPU load LCM's receive thread may not have read
+    // them from the socket yet (handleTimeout(0) sees only its queue: a pose logger lost the optimizer's
+    // last poses so). Until 100 ms pass without a message, at most 1 s.
+    for (const double drain_end = now_s() + 1.0; now_s() < drain_end && bus.lcm().handleTimeout(100) > 0;) {
     }
     node->shutdown();
     beat("stopped");
