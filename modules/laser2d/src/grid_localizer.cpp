@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <deque>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -99,6 +100,8 @@ struct GridLocalizer::Impl {
   GridLocalizerConfig cfg;
   Pose2 pose;
   double sxy = 0, syaw = 0;  // current uncertainty of `pose`
+  bool reconfirming = false;            // published POOR until the track is re-confirmed (reconfirm_after_poor)
+  std::deque<double> recent_inliers;    // the inlier shares of the fits since it left POOR/LOST (last confirm_scans)
   std::vector<double> ranges;  // scratch: the scan's ranges (median for the published covariance)
   std::optional<Pose2> last_odom;
   std::optional<Pose2> raw_inc;  // this scan's odometry increment as measured (before the calibration)
@@ -159,6 +162,8 @@ void GridLocalizer::set_initial_pose(const Pose2& pose) {
   impl_->prev_fit.reset();
   impl_->search_moved_m = -1;
   impl_->poor_run = 0;
+  impl_->reconfirming = false;  // the pose given is taken as it is
+  impl_->recent_inliers.clear();
   impl_->first = true;
   have_pose_ = true;
 }
@@ -308,7 +313,24 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points, con
   res.odom_turn_scale_error = m.calib.turn_scale_error();
   res.odom_scale = m.calib.scale();
   res.odom_pairs = m.calib.pairs();
-  // What is published: the weak fit's status and the map's share of the covariance (see the config).
+  // What is published: the status of a track not yet re-confirmed and of a weak fit, and the map's share of the
+  // covariance (see the config).
+  if (cfg_.reconfirm_after_poor) {
+    if (res.status == GridStatus::kPoor || res.status == GridStatus::kLost) {
+      m.reconfirming = true;
+      m.recent_inliers.clear();
+    } else if (res.status == GridStatus::kOk && m.reconfirming) {
+      m.recent_inliers.push_back(res.inlier_ratio);
+      if (int(m.recent_inliers.size()) > cfg_.confirm_scans) m.recent_inliers.pop_front();
+      double mean = 0;
+      for (double r : m.recent_inliers) mean += r;
+      mean /= double(m.recent_inliers.size());
+      if (res.reacquired || (int(m.recent_inliers.size()) >= cfg_.confirm_scans && mean >= cfg_.confirm_inlier_ratio))
+        m.reconfirming = false;
+      else
+        res.status = GridStatus::kPoor;
+    }
+  }
   if (cfg_.weak_fit_is_poor && res.status == GridStatus::kOk && res.inlier_ratio < cfg_.min_inlier_ratio)
     res.status = GridStatus::kPoor;
   if (cfg_.map_sigma_cells > 0 && res.status != GridStatus::kNotInitialised && !points.empty()) {
