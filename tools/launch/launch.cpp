@@ -39,6 +39,7 @@
 #include "hosts.h"
 #include "process_table.h"
 #include "supervisor.h"
+#include "udp_links.h"
 
 using namespace fploc::rt;
 using namespace fploc::launch;
@@ -298,25 +299,6 @@ class Launcher : public Effects {
       out.push_back(std::move(p));
     }
     return out;
-  }
-  // The OS-1 packets a simulated sensor sends the drivers over UDP are no LCM channel, so the stop order
-  // would not see them: as the pseudo-channels "udp:PORT" the simulator stops before the drivers that
-  // listen on its ports, and the drivers still receive (and publish) what it sends while it stops. With
-  // both in the first rank, a simulator slow to stop under CPU load (a frame's ray casting takes a while)
-  // sent frames, and published their ground truth, after the drivers had exited: poses "missing".
-  static void add_udp_links(const fploc::Node& n, const std::string& type, NodePolicy& p) {
-    auto udp = [](int port, int dflt) { return "udp:" + std::to_string(port > 0 ? port : dflt); };
-    if (type == "sim_sensor") {
-      p.outputs.push_back(udp(n.sim().lidar_port(), 7502));
-      p.outputs.push_back(udp(n.sim().imu_port(), 7503));
-    } else if (type == "os1_driver") {
-      bool packets_from_lcm = false;
-      for (const auto& in : n.input()) packets_from_lcm |= in.port() == "packets" && !in.channel().empty();
-      if (n.os1_driver().pcap().empty() && !packets_from_lcm) p.inputs.push_back(udp(n.os1_driver().lidar_port(), 7502));
-    } else if (type == "imu_driver") {
-      const auto& o = n.imu_driver();
-      if ((o.source().empty() || o.source() == "os1") && o.pcap().empty()) p.inputs.push_back(udp(o.imu_port(), 7503));
-    }
   }
   static SupervisorConfig config(const LoadedGraph& g) {
     SupervisorConfig c;

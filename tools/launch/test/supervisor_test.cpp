@@ -1,10 +1,12 @@
 // The launcher's supervision policy with a fake clock and fake processes: restart policy and backoff,
 // giving up, heartbeat timeout, ordered shutdown with escalation, control requests.
 #include "supervisor.h"
+#include "udp_links.h"
 
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <google/protobuf/text_format.h>
 #include <map>
 
 using namespace fploc::launch;
@@ -237,6 +239,41 @@ TEST(Supervisor, ShutdownStopsProducersBeforeConsumers) {
   // Nothing restarts during a shutdown.
   s.tick(20);
   EXPECT_EQ(w.starts.size(), 3u);
+}
+
+// The demo's sensor side: the simulator sends OS-1 packets over UDP to the drivers (no LCM channel between
+// them). Its ports are links of the stop order, so it stops before the drivers listening on them; a driver
+// reading a pcap, or packets from LCM, or another port, is not linked to it.
+TEST(Supervisor, SimulatedSensorStopsBeforeTheDriversOnItsPorts) {
+  auto policy = [](const std::string& text, const std::string& type) {
+    fploc::Node n;
+    EXPECT_TRUE(google::protobuf::TextFormat::ParseFromString(text, &n)) << text;
+    NodePolicy p = node(n.name());
+    add_udp_links(n, type, p);
+    return p;
+  };
+  const auto sim = policy(R"(name: "sim" sim { imu_port: 17503 })", "sim_sensor");
+  EXPECT_EQ(sim.outputs, (std::vector<std::string>{"udp:7502", "udp:17503"}));
+  auto os1 = policy(R"(name: "os1" os1_driver { lidar_port: 7502 })", "os1_driver");
+  EXPECT_EQ(os1.inputs, std::vector<std::string>{"udp:7502"});
+  auto imu = policy(R"(name: "imu" imu_driver { source: "os1" imu_port: 17503 })", "imu_driver");
+  EXPECT_EQ(imu.inputs, std::vector<std::string>{"udp:17503"});
+  EXPECT_TRUE(policy(R"(name: "p" os1_driver { pcap: "x.pcap" })", "os1_driver").inputs.empty());
+  EXPECT_TRUE(policy(R"(name: "l" input { port: "packets" channel: "OS1_PACKETS" } os1_driver {})", "os1_driver").inputs.empty());
+  EXPECT_TRUE(policy(R"(name: "m" matcher {})", "matcher").inputs.empty());
+  // The drivers' LCM output to a consumer, as in the demo.
+  os1.outputs = {"OS1_SCAN"};
+  imu.outputs = {"OS1_IMU"};
+  auto seg = node("segmenter");
+  seg.inputs = {"OS1_SCAN", "OS1_IMU"};
+  auto other = policy(R"(name: "other" os1_driver { lidar_port: 9999 })", "os1_driver");
+  FakeWorld w;
+  Supervisor s({seg, imu, os1, sim, other}, {}, w);
+  EXPECT_EQ(s.stop_rank(3), 0);  // the simulator first
+  EXPECT_EQ(s.stop_rank(2), 1);  // then the drivers on its ports
+  EXPECT_EQ(s.stop_rank(1), 1);
+  EXPECT_EQ(s.stop_rank(0), 2);  // then their consumer
+  EXPECT_EQ(s.stop_rank(4), 0);  // a driver on another port produces nothing the simulator's order sees
 }
 
 TEST(Supervisor, CrashDuringShutdownIsNotRestarted) {
