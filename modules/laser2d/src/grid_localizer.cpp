@@ -100,8 +100,8 @@ struct GridLocalizer::Impl {
   GridLocalizerConfig cfg;
   Pose2 pose;
   double sxy = 0, syaw = 0;  // current uncertainty of `pose`
-  bool reconfirming = false;            // published POOR until the track is re-confirmed (reconfirm_after_poor)
-  std::deque<double> recent_inliers;    // the inlier shares of the fits since it left POOR/LOST (last confirm_scans)
+  bool reconfirming = false;            // published POOR until the track is re-confirmed (reconfirm_after_lost)
+  std::deque<double> recent_inliers;    // the inlier shares of the fits since it left LOST (last confirm_scans)
   std::vector<double> ranges;  // scratch: the scan's ranges (median for the published covariance)
   std::optional<Pose2> last_odom;
   std::optional<Pose2> raw_inc;  // this scan's odometry increment as measured (before the calibration)
@@ -315,10 +315,12 @@ GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points, con
   res.odom_pairs = m.calib.pairs();
   // What is published: the status of a track not yet re-confirmed and of a weak fit, and the map's share of the
   // covariance (see the config).
-  if (cfg_.reconfirm_after_poor) {
-    if (res.status == GridStatus::kPoor || res.status == GridStatus::kLost) {
+  if (cfg_.reconfirm_after_lost) {
+    if (res.status == GridStatus::kLost) {
       m.reconfirming = true;
       m.recent_inliers.clear();
+    } else if (res.status == GridStatus::kPoor) {
+      m.recent_inliers.clear();  // "in a row"
     } else if (res.status == GridStatus::kOk && m.reconfirming) {
       m.recent_inliers.push_back(res.inlier_ratio);
       if (int(m.recent_inliers.size()) > cfg_.confirm_scans) m.recent_inliers.pop_front();
