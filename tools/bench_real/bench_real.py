@@ -27,6 +27,8 @@ ROOT = os.environ.get("FPLOC_ROOT", os.path.abspath(os.path.join(os.path.dirname
 BUILD = os.environ.get("FPLOC_BUILD_DIR", os.path.join(ROOT, "build"))
 SHARED = os.environ.get("FPLOC_SHARED_DIR", os.path.join(ROOT, "..", "shared"))
 BIN = os.path.join(BUILD, "bin")
+sys.path.insert(0, os.path.join(ROOT, "tools", "pylib"))
+import fploc_tools  # noqa: E402
 LOGS = ["intel", "aces", "fhw", "csail", "freiburg-079"]
 FALSE_OK_M = 0.3  # a pose published OK with a larger horizontal error is a false OK (as in fploc bench realism)
 
@@ -65,26 +67,6 @@ def read_status(path):
     return out
 
 
-def nees3(e, c):
-    """e^T P^-1 e for e = (dx, dy, dyaw) and P from (xx, xy, xyaw, yy, yyaw, yawyaw); None when P is not positive
-    definite."""
-    xx, xy, xa, yy, ya, aa = c
-    P = [[xx, xy, xa], [xy, yy, ya], [xa, ya, aa]]
-    m = [row[:] + [b] for row, b in zip(P, e)]
-    for col in range(3):
-        piv = max(range(col, 3), key=lambda r: abs(m[r][col]))
-        if not math.isfinite(m[piv][col]) or abs(m[piv][col]) < 1e-15:
-            return None
-        m[col], m[piv] = m[piv], m[col]
-        for r in range(3):
-            if r != col:
-                f = m[r][col] / m[col][col]
-                for k in range(col, 4):
-                    m[r][k] -= f * m[col][k]
-    v = sum(e[i] * m[i][3] / m[i][i] for i in range(3))
-    return v if v >= 0 else None
-
-
 def score(gt_path, est_path, lost_m, keep=None, status_path=None):
     """ATE (RMSE of the position error, no alignment: both in the map frame, the reference pose associated by time
     with fploc eval's association), max, LOST % (position error > lost_m; a scan without an estimate counts as
@@ -102,7 +84,7 @@ def score(gt_path, est_path, lost_m, keep=None, status_path=None):
             nees = []
             for k, e in said:
                 dyaw = (est[k][2] - gt[k][2] + math.pi) % (2 * math.pi) - math.pi
-                v = nees3((est[k][0] - gt[k][0], est[k][1] - gt[k][1], dyaw), st[k][1])
+                v = fploc_tools.nees3((est[k][0] - gt[k][0], est[k][1] - gt[k][1], dyaw), st[k][1])
                 if v is not None:
                     nees.append(v)
             nees.sort()

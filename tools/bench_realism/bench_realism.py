@@ -109,22 +109,6 @@ def quat_yaw(q):
     return math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
 
 
-def solve3(a, b):
-    """x with a x = b for a 3x3 (list of rows); None when singular."""
-    m = [row[:] + [bb] for row, bb in zip(a, b)]
-    for c in range(3):
-        piv = max(range(c, 3), key=lambda r: abs(m[r][c]))
-        if abs(m[piv][c]) < 1e-15:
-            return None
-        m[c], m[piv] = m[piv], m[c]
-        for r in range(3):
-            if r != c:
-                f = m[r][c] / m[c][c]
-                for k in range(c, 4):
-                    m[r][k] -= f * m[c][k]
-    return [m[r][3] / m[r][r] for r in range(3)]
-
-
 def score_poses(poses, gt_rows):
     """Horizontal ATE, max, LOST, false OK, NEES (x, y, yaw) of pose_t records against the TUM truth."""
     truth = fploc_tools.Truth(gt_rows)
@@ -150,7 +134,7 @@ def score_poses(poses, gt_rows):
         idx = (0, 1, 5)
         S = [[c[i * 6 + j] for j in idx] for i in idx]
         if all(math.isfinite(x) for row in S for x in row):
-            sol = solve3(S, [ex, ey, eyaw])
+            sol = fploc_tools.solve3(S, [ex, ey, eyaw])
             if sol is not None:
                 v = ex * sol[0] + ey * sol[1] + eyaw * sol[2]
                 if v >= 0:

@@ -115,3 +115,32 @@ def replay(bin_dir, graph, log_path, sets, pipeline, who):
     scans = nodes.get("features", {}).get("messages", 1) or 1
     ms = {n: round(nodes[n].get("cpu_ms", nodes[n]["total_ms"]) / scans, 3) for n in pipeline if n in nodes}
     return nodes, scans, ms
+
+
+def solve3(a, b):
+    """x with a x = b for a 3x3 (list of rows); None when singular."""
+    m = [row[:] + [bb] for row, bb in zip(a, b)]
+    for c in range(3):
+        piv = max(range(c, 3), key=lambda r: abs(m[r][c]))
+        if abs(m[piv][c]) < 1e-15:
+            return None
+        m[c], m[piv] = m[piv], m[c]
+        for r in range(3):
+            if r != c:
+                f = m[r][c] / m[c][c]
+                for k in range(c, 4):
+                    m[r][k] -= f * m[c][k]
+    return [m[r][3] / m[r][r] for r in range(3)]
+
+
+def nees3(e, c):
+    """e^T P^-1 e for e = (dx, dy, dyaw) and P from its upper triangle (xx, xy, xyaw, yy, yyaw, yawyaw), as in a
+    fploc-pose-logger uncertainty_file; None when P is singular or the result negative (not positive definite)."""
+    xx, xy, xa, yy, ya, aa = c
+    if not all(math.isfinite(v) for v in c):
+        return None
+    sol = solve3([[xx, xy, xa], [xy, yy, ya], [xa, ya, aa]], list(e))
+    if sol is None:
+        return None
+    v = sum(ei * si for ei, si in zip(e, sol))
+    return v if v >= 0 else None
