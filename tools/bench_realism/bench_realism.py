@@ -213,7 +213,7 @@ def gauge_floor(plan_path, truth, gt_rows):
                     A[i][j] += w * row[i] * row[j]
     if not any_offset:
         return 0.0
-    x = solve3(A, b)
+    x = fploc_tools.solve3(A, b)
     if x is None:
         return None
     e2 = 0.0
