@@ -18,6 +18,9 @@ function(fploc_add_test NAME)
   if(A_LABELS)
     set_tests_properties(${NAME} PROPERTIES LABELS "${A_LABELS}")
   endif()
+  if(A_SERIAL)  # parsed but never applied before: demo_live_swap shared the 2 cores with demo_building_live
+    set_tests_properties(${NAME} PROPERTIES RUN_SERIAL TRUE)
+  endif()
 endfunction()
 
 # fploc_add_benchmark(NAME SOURCES ... DEPS ...) -> Google Benchmark executable (not a test)
