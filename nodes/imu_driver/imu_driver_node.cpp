@@ -17,6 +17,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "fploc/os1/ports.h"
 #include "fploc/adapters/imu_t.h"
 #include "fploc/os1/packet.h"
 #include "fploc/os1/source.h"
@@ -46,7 +47,7 @@ class Os1ImuSource : public ImuSource {
   void setup(fploc::rt::Context& ctx, const fploc::ImuDriverOptions& opt, SampleFn emit) override {
     ctx_ = &ctx;
     emit_ = std::move(emit);
-    const int port = opt.imu_port() > 0 ? opt.imu_port() : 7503;
+    const int port = fploc::os1::port_or_default(opt.imu_port(), fploc::os1::kDefaultImuPort);
     if (!opt.pcap().empty()) {
       pcap_port_ = opt.imu_port();  // 0: any port, IMU packets recognised by size
       std::string err;

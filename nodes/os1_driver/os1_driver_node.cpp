@@ -14,6 +14,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "fploc/os1/ports.h"
 #include "fploc/adapters/scan_t.h"
 #include "fploc/os1/metadata.h"
 #include "fploc/os1/sensor_http.h"
@@ -41,7 +42,7 @@ class Os1DriverNode : public fploc::rt::Node {
     ctx_ = &ctx;
     const auto& opt = ctx.options<fploc::Os1DriverOptions>();
     out_ = ctx.advertise<fploc::scan_t>("scan");
-    port_ = opt.lidar_port() > 0 ? opt.lidar_port() : 7502;
+    port_ = fploc::os1::port_or_default(opt.lidar_port(), fploc::os1::kDefaultLidarPort);
     pcap_mode_ = !opt.pcap().empty();
     metadata_path_ = opt.metadata().empty() ? std::string() : ctx.resolve_path(opt.metadata());
     sensor_host_ = opt.sensor_hostname();
@@ -55,7 +56,7 @@ class Os1DriverNode : public fploc::rt::Node {
       SensorConfigRequest req;
       req.udp_dest = opt.udp_dest();
       req.udp_port_lidar = port_;
-      req.udp_port_imu = opt.sensor_imu_port() > 0 ? opt.sensor_imu_port() : 7503;
+      req.udp_port_imu = fploc::os1::port_or_default(opt.sensor_imu_port(), fploc::os1::kDefaultImuPort);
       req.lidar_mode = opt.lidar_mode();
       req.udp_profile_lidar = opt.udp_profile_lidar();
       req.timestamp_mode = opt.timestamp_mode();
@@ -304,7 +305,7 @@ class Os1DriverNode : public fploc::rt::Node {
   bool published_in_poll_ = false;
   bool pcap_mode_ = false;
   bool packets_mode_ = false;
-  int port_ = 7502;
+  int port_ = fploc::os1::kDefaultLidarPort;
   std::string metadata_path_;
   std::string metadata_error_;  // last load error (reported once)
   std::string sensor_host_;

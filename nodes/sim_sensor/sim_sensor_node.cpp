@@ -18,6 +18,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "fploc/os1/ports.h"
 #include "fploc/floorplan/building.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/adapters/ground_truth_t.h"
@@ -111,8 +112,8 @@ class SimSensorNode : public fploc::rt::Node {
       if (::inet_pton(AF_INET, host.c_str(), &a.sin_addr) != 1) throw std::runtime_error("sim: udp_host '" + host + "' is not an IPv4 address");
       return a;
     };
-    lidar_addr_ = make_addr(opt.lidar_port() > 0 ? opt.lidar_port() : 7502);
-    imu_addr_ = make_addr(opt.imu_port() > 0 ? opt.imu_port() : 7503);
+    lidar_addr_ = make_addr(fploc::os1::port_or_default(opt.lidar_port(), fploc::os1::kDefaultLidarPort));
+    imu_addr_ = make_addr(fploc::os1::port_or_default(opt.imu_port(), fploc::os1::kDefaultImuPort));
     if (opt.start_delay_s() < 0) throw std::runtime_error("sim.start_delay_s: must be >= 0");
     wall0_ = wall_now() + opt.start_delay_s();
     ctx.every(0.002, [this] { tick(); });

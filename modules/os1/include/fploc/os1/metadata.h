@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "fploc/os1/ports.h"
 #include "fploc/core/scan.h"
 
 namespace fploc::os1 {
@@ -30,8 +31,8 @@ struct SensorInfo {
   std::string serial;               // prod_sn
   std::string firmware;             // build_rev / image_rev
   UdpProfile profile = UdpProfile::kLegacy;
-  int udp_port_lidar = 7502;
-  int udp_port_imu = 7503;
+  int udp_port_lidar = kDefaultLidarPort;
+  int udp_port_imu = kDefaultImuPort;
   // Row-major 4x4, translation in mm (SDK default for OS-1 when absent).
   std::array<double, 16> imu_to_sensor{1, 0, 0, 6.253, 0, 1, 0, -11.775, 0, 0, 1, 7.645, 0, 0, 0, 1};
   std::vector<std::string> defaulted;  // fields that were absent and took a default (for logs)
