@@ -18,6 +18,8 @@ laser2d::GridLocalizerConfig config_of(const Grid2dOptions& o) {
   if (o.sigma_xy_per_m() > 0) c.sigma_xy_per_m = o.sigma_xy_per_m();
   if (o.sigma_yaw_per_rad() > 0) c.sigma_yaw_per_rad = o.sigma_yaw_per_rad();
   if (o.prior_weight_sigmas() > 0) c.prior_weight_sigmas = o.prior_weight_sigmas();
+  if (o.has_laser_odometry()) c.laser_odometry = o.laser_odometry();
+  if (o.laser_map_scans() > 0) c.laser.map_scans = o.laser_map_scans();
   return c;
 }
 

@@ -186,7 +186,8 @@ TEST(ConfigDefaults, Grid2d) {
          {"min_range_m", c.min_range_m}, {"max_range_m", c.max_range_m}, {"min_inlier_ratio", c.min_inlier_ratio},
          {"field_max_m", c.field_max_m}, {"min_inlier_ratio_near", c.min_inlier_ratio_near},
          {"gate_sigmas", c.gate_sigmas}, {"sigma_xy_per_m", c.sigma_xy_per_m},
-         {"sigma_yaw_per_rad", c.sigma_yaw_per_rad}, {"prior_weight_sigmas", c.prior_weight_sigmas}});
+         {"sigma_yaw_per_rad", c.sigma_yaw_per_rad}, {"prior_weight_sigmas", c.prior_weight_sigmas},
+         {"laser_map_scans", double(c.laser.map_scans)}});
 }
 
 TEST(ConfigDefaults, CloudToScan) {

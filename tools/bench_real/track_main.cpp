@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   CLI::App app{"fploc real-track: grid2d's tracker over a CARMEN log's scans, in-process, per-scan JSON"};
   std::string log_path, map_path, start = "ref";
   size_t first = 0, end = 0;
+  double laser_sigma_yaw_deg = -1;
   app.add_option("log", log_path, "CARMEN log (.log or .log.gz)")->required();
   app.add_option("--map", map_path, "map_server occupancy map (.yaml)")->required();
   app.add_option("--first-scan", first, "first scan index")->required();
@@ -66,7 +67,15 @@ int main(int argc, char** argv) {
   app.add_option("--weak-follow-step-only", c.weak_follow_step_only, "re-acquiring: follow a weak fit only within this step's own odometry sigma");
   app.add_option("--confirm-scans", c.confirm_scans, "scans a hypothesis must match in a row");
   app.add_option("--confirm-margin", c.confirm_margin, "mean inlier share a hypothesis needs over its runner-up");
+  app.add_option("--laser-odometry", c.laser_odometry, "predict with the scan-to-recent-scans increment where it matches");
+  app.add_option("--laser-map-scans", c.laser.map_scans, "laser odometry: scans in the local map");
+  app.add_option("--laser-sigma-xy", c.laser_sigma_xy_m, "laser odometry: per-step sigma base [m]");
+  app.add_option("--laser-sigma-xy-per-m", c.laser_sigma_xy_per_m, "laser odometry: sigma per metre of step");
+  app.add_option("--laser-sigma-yaw-deg", laser_sigma_yaw_deg, "laser odometry: per-step yaw sigma base [deg]");
+  app.add_option("--laser-min-inlier-ratio", c.laser.min_inlier_ratio, "laser odometry: share of the scan the local map must explain");
+  app.add_option("--laser-wide-retry", c.laser_wide_retry, "laser odometry: re-acquiring, a strong fit in the wheels' window");
   CLI11_PARSE(app, argc, argv);
+  if (laser_sigma_yaw_deg >= 0) c.laser_sigma_yaw_rad = laser_sigma_yaw_deg * M_PI / 180;
   namespace cm = fploc::carmen;
   namespace l2 = fploc::laser2d;
   try {
@@ -98,7 +107,8 @@ int main(int argc, char** argv) {
                       {"err_yaw_deg", fploc::wrap_angle(r.pose.yaw - s.pose.theta) * 180 / M_PI},
                       {"status", int(r.status)}, {"inlier_ratio", r.inlier_ratio}, {"window_m", r.search_xy_m},
                       {"window_deg", r.search_yaw_rad * 180 / M_PI}, {"sigma_xy_m", std::sqrt(r.covariance(0, 0))},
-                      {"hypotheses", r.hypotheses}, {"ms", ms}, {"wide_search", r.wide_search},
+                      {"hypotheses", r.hypotheses}, {"ms", ms}, {"laser_step", r.laser_step},
+                      {"laser_inlier_ratio", r.laser_inlier_ratio}, {"wide_search", r.wide_search},
                       {"odom_bias_deg_per_m", r.odom_bias_rad_per_m * 180 / M_PI},
                       {"odom_turn_scale_error", r.odom_turn_scale_error}, {"odom_scale", r.odom_scale}});
       if (odom) rows.back().update({{"odom_x", odom->x}, {"odom_y", odom->y}, {"odom_yaw", odom->yaw}});

@@ -1,8 +1,5 @@
 #include "fploc/laser2d/grid_localizer.h"
 
-#include <ceres/ceres.h>
-#include <ceres/cubic_interpolation.h>
-
 #include <algorithm>
 #include <array>
 #include <deque>
@@ -10,80 +7,21 @@
 #include <limits>
 #include <stdexcept>
 
+#include "field_fit.h"
 #include "fploc/laser2d/correlative_search.h"
 
 namespace fploc::laser2d {
 
 namespace {
 
-using FieldGrid = ceres::Grid2D<float, 1>;
-using FieldInterp = ceres::BiCubicInterpolator<FieldGrid>;
+using detail::FieldFitOptions;
 
-// Residual of one point: the distance field at the transformed point [in point_sigma units].
-struct PointCost {
-  PointCost(const FieldInterp* f, const DistanceField* df, const Eigen::Vector2d& p, double inv_sigma)
-      : f_(f), df_(df), p_(p), inv_sigma_(inv_sigma) {}
-  template <class T>
-  bool operator()(const T* pose, T* r) const {
-    const T c = cos(pose[2]), s = sin(pose[2]);
-    const T wx = pose[0] + c * p_.x() - s * p_.y();
-    const T wy = pose[1] + s * p_.x() + c * p_.y();
-    // World -> continuous cell coordinates (cell centre (i, j) at (i, j)).
-    const double oc = std::cos(df_->origin_yaw()), os = std::sin(df_->origin_yaw());
-    const T dx = wx - df_->origin_x(), dy = wy - df_->origin_y();
-    const T ci = (oc * dx + os * dy) / df_->resolution() - 0.5;
-    const T cj = (-os * dx + oc * dy) / df_->resolution() - 0.5;
-    T d;
-    f_->Evaluate(cj, ci, &d);  // Grid2D: row = j, column = i
-    r[0] = d * inv_sigma_;
-    return true;
-  }
-  const FieldInterp* f_;
-  const DistanceField* df_;
-  Eigen::Vector2d p_;
-  double inv_sigma_;
-};
-
-struct PriorCost {
-  PriorCost(const Pose2& p, double sxy, double syaw) : p_(p), ixy_(1 / sxy), iyaw_(1 / syaw) {}
-  template <class T>
-  bool operator()(const T* pose, T* r) const {
-    r[0] = (pose[0] - p_.x) * ixy_;
-    r[1] = (pose[1] - p_.y) * ixy_;
-    const T d = pose[2] - p_.yaw;
-    r[2] = atan2(sin(d), cos(d)) * iyaw_;
-    return true;
-  }
-  Pose2 p_;
-  double ixy_, iyaw_;
-};
-
-// Ceres refinement of x (in/out) on the distance field, the prediction as a prior; returns the problem (for the
-// covariance) and its final cost.
-std::unique_ptr<ceres::Problem> refine_problem(const FieldInterp& interp, const DistanceField& df,
-                                               const GridLocalizerConfig& cfg, const std::vector<Eigen::Vector2d>& pts,
-                                               const Pose2& pred, double sxy, double syaw, double* x, double* cost,
-                                               int* iterations, bool fix_yaw = false) {
-  ceres::Problem::Options po;
-  po.loss_function_ownership = ceres::TAKE_OWNERSHIP;
-  po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
-  auto problem = std::make_unique<ceres::Problem>(po);
-  const double inv_sigma = 1 / cfg.point_sigma_m;
-  for (const auto& p : pts)
-    problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PointCost, 1, 3>(new PointCost(&interp, &df, p, inv_sigma)),
-                              new ceres::HuberLoss(cfg.huber_m * inv_sigma), x);
-  problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, 3>(new PriorCost(pred, sxy, syaw)), nullptr, x);
-  if (fix_yaw) problem->SetManifold(x, new ceres::SubsetManifold(3, {2}));
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
-  so.max_num_iterations = cfg.max_iterations;
-  so.num_threads = 1;
-  so.logging_type = ceres::SILENT;
-  ceres::Solver::Summary sum;
-  ceres::Solve(so, problem.get(), &sum);
-  if (iterations) *iterations += int(sum.iterations.size());
-  *cost = sum.final_cost;
-  return problem;
+FieldFitOptions fit_options(const GridLocalizerConfig& cfg) {
+  FieldFitOptions o;
+  o.point_sigma_m = cfg.point_sigma_m;
+  o.huber_m = cfg.huber_m;
+  o.max_iterations = cfg.max_iterations;
+  return o;
 }
 
 }  // namespace
@@ -91,11 +29,10 @@ std::unique_ptr<ceres::Problem> refine_problem(const FieldInterp& interp, const 
 struct GridLocalizer::Impl {
   std::unique_ptr<ceres::Problem> refine_at(const std::vector<Eigen::Vector2d>& pts, const Pose2& pred, double sxy,
                                             double syaw, double* x, double* cost, int* iterations, bool fix_yaw = false) const {
-    return refine_problem(interp, *df, cfg, pts, pred, sxy, syaw, x, cost, iterations, fix_yaw);
+    return detail::refine_on_field(field, fit_options(cfg), pts, pred, sxy, syaw, x, cost, iterations, fix_yaw);
   }
+  detail::InterpolatedField field;
   std::shared_ptr<const DistanceField> df;
-  FieldGrid grid;
-  FieldInterp interp;
   std::unique_ptr<ScorePyramid> pyramid;  // exp(-d^2 / 2 s^2) per cell and its max-pooled levels
   GridLocalizerConfig cfg;
   Pose2 pose;
@@ -106,8 +43,11 @@ struct GridLocalizer::Impl {
   std::optional<Pose2> last_odom;
   std::optional<Pose2> raw_inc;  // this scan's odometry increment as measured (before the calibration)
   OdometryCalibration calib;
+  LaserOdometry laser;
   std::optional<Pose2> prev_fit;  // the previous scan's pose when it was a good fit (calibration pairs)
   int poor_run = 0;
+  // Since the last fit on laser steps: the variance the wheels' model would have added beyond the laser steps'.
+  double wheel_extra_xy2 = 0, wheel_extra_yaw2 = 0;
   bool first = true;
   // Motion since the last wide re-acquisition search (negative: none yet in this episode).
   double search_moved_m = -1, search_turned_rad = 0;
@@ -140,10 +80,11 @@ struct GridLocalizer::Impl {
           double max_yaw, int keep, double min_inlier_ratio) const;
 
   Impl(std::shared_ptr<const DistanceField> f, const GridLocalizerConfig& c)
-      : df(std::move(f)), grid(df->data().data(), 0, df->height(), 0, df->width()), interp(grid) {
+      : field(std::move(f)), df(field.df) {
     pyramid = std::make_unique<ScorePyramid>(*df, c.score_sigma_m, c.search_levels);
     cfg = c;
     calib = OdometryCalibration(c.calibration);
+    laser = LaserOdometry(c.laser);
   }
 };
 
@@ -159,6 +100,7 @@ void GridLocalizer::set_initial_pose(const Pose2& pose) {
   impl_->sxy = cfg_.initial_sigma_xy_m;
   impl_->syaw = cfg_.initial_sigma_yaw_rad;
   impl_->last_odom.reset();
+  impl_->laser.reset();
   impl_->prev_fit.reset();
   impl_->search_moved_m = -1;
   impl_->poor_run = 0;
@@ -223,20 +165,8 @@ GridLocalizer::Impl::Fit GridLocalizer::Impl::fit(const std::vector<Eigen::Vecto
   for (size_t i = 0; i < xs.size(); ++i) {
     problems.push_back(refine_at(pts, pred, sxy, syaw, xs[i].data(), &costs[i], &f.iterations, i >= n_free));
     // Inliers at the refined pose.
-    const double c = std::cos(xs[i][2]), s = std::sin(xs[i][2]);
-    int n = 0;
-    double ss = 0;
-    for (const auto& p : pts) {
-      const Eigen::Vector2d w(xs[i][0] + c * p.x() - s * p.y(), xs[i][1] + s * p.x() + c * p.y());
-      const double dd = d.nearest(w);
-      if (dd < cfg.inlier_m) {
-        ++n;
-        ss += dd * dd;
-      }
-    }
-    ninl[i] = n;
-    sss[i] = ss;
-    inl[i] = pts.empty() ? 0 : double(n) / double(pts.size());
+    ninl[i] = detail::count_inliers(d, pts, xs[i].data(), cfg.inlier_m, &sss[i]);
+    inl[i] = pts.empty() ? 0 : double(ninl[i]) / double(pts.size());
   }
   size_t bi = 0;
   if (!consistent) {
@@ -267,7 +197,7 @@ GridLocalizer::Impl::Fit GridLocalizer::Impl::fit(const std::vector<Eigen::Vecto
     GridLocalizerConfig c0 = cfg;
     c0.max_iterations = 0;
     double unused = 0;
-    problem = refine_problem(interp, d, c0, pts, pred, sxy, syaw, xs[bi].data(), &unused, nullptr);
+    problem = detail::refine_on_field(field, fit_options(c0), pts, pred, sxy, syaw, xs[bi].data(), &unused, nullptr);
   }
   f.refined = int(xs.size());
   for (size_t i = 0; i < xs.size(); ++i) f.alts.push_back({{xs[i][0], xs[i][1], wrap_angle(xs[i][2])}, inl[i]});
@@ -282,19 +212,8 @@ GridLocalizer::Impl::Fit GridLocalizer::Impl::fit(const std::vector<Eigen::Vecto
   // The refinement may not leave the window searched (a scan of one flat wall fits anywhere along it).
   const bool inside = std::hypot(ex, ey) <= f.wxy + d.resolution() && std::abs(eyaw) <= f.wyaw + cfg.search_yaw_step_rad;
   f.accepted = (inside && f.inlier_ratio >= min_inlier_ratio) || (near && f.inlier_ratio >= cfg.min_inlier_ratio_near);
-  {
-    // Covariance from the Jacobian at the solution (loss applied).
-    ceres::CRSMatrix J;
-    problem->Evaluate(ceres::Problem::EvaluateOptions(), nullptr, nullptr, nullptr, &J);
-    Eigen::Matrix3d Hm = Eigen::Matrix3d::Zero();
-    for (int r = 0; r < J.num_rows; ++r) {
-      Eigen::Vector3d row = Eigen::Vector3d::Zero();
-      for (int k = J.rows[r]; k < J.rows[r + 1]; ++k) row[J.cols[k]] = J.values[k];
-      Hm += row * row.transpose();
-    }
-    f.cov = Hm.inverse();
-    if (!f.cov.allFinite()) f.cov = Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
-  }
+  // Covariance from the Jacobian at the solution (loss applied).
+  f.cov = detail::covariance_of(*problem, Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal());
   return f;
 }
 
@@ -352,14 +271,58 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
   Impl& m = *impl_;
   const DistanceField& df = *m.df;
 
+  // Points: every k-th so that at most max_points remain.
+  std::vector<Eigen::Vector2d> pts;
+  {
+    const size_t n = points_in.size();
+    const size_t k = cfg_.max_points > 0 ? std::max<size_t>(1, (n + size_t(cfg_.max_points) - 1) / size_t(cfg_.max_points)) : 1;
+    for (size_t i = 0; i < n; i += k) {
+      const double r = points_in[i].norm();
+      if (r >= cfg_.min_range_m && r <= cfg_.max_range_m) pts.push_back(points_in[i]);
+    }
+  }
   // 1. Prediction and its uncertainty (also of every re-acquisition hypothesis).
   Pose2 pred = m.pose;
   double sxy = m.sxy, syaw = m.syaw;
   double qxy = 0, qyaw = 0;
   std::optional<Pose2> inc;
-  if (odom && m.last_odom) {
+  const bool wheels = odom && m.last_odom;
+  if (wheels) {
     m.raw_inc = between(*m.last_odom, *odom);
     inc = cfg_.calibrate_odometry ? m.calib.correct(*m.raw_inc) : *m.raw_inc;
+  }
+  // The laser odometry's increment where it matches, the wheels' (or none) otherwise; the first scan starts it.
+  std::optional<LaserOdometryStep> laser;
+  if (cfg_.laser_odometry) {
+    const double step = inc ? std::hypot(inc->x, inc->y) : 0, turn = inc ? std::abs(wrap_angle(inc->yaw)) : 0;
+    const double wxy = inc ? cfg_.sigma_xy_m + cfg_.sigma_xy_per_m * step : cfg_.no_odom_sigma_xy_m;
+    const double wyaw = inc ? cfg_.sigma_yaw_rad + cfg_.sigma_yaw_per_rad * turn + cfg_.sigma_yaw_per_m * step
+                            : cfg_.no_odom_sigma_yaw_rad;
+    laser = m.laser.update(pts, inc ? *inc : Pose2{}, wxy, wyaw);
+    if (m.first) laser.reset();
+  }
+  if (laser) {
+    const Pose2 wheel_inc = inc ? *inc : Pose2{};  // (the calibrated wheels' increment, when wheels)
+    inc = laser->increment;
+    res.laser_step = true;
+    res.laser_inlier_ratio = laser->inlier_ratio;
+    const double step = std::hypot(inc->x, inc->y), turn = std::abs(wrap_angle(inc->yaw));
+    pred = compose(m.pose, *inc);
+    const bool base = !(cfg_.dead_reckoning_motion_only && m.poor_run > 0);
+    qxy = (base ? cfg_.laser_sigma_xy_m : 0.0) + cfg_.laser_sigma_xy_per_m * step;
+    qyaw = (base ? cfg_.laser_sigma_yaw_rad : 0.0) + cfg_.laser_sigma_yaw_per_rad * turn + cfg_.laser_sigma_yaw_per_m * step;
+    // What the wheels' model would have added since the last fit (the wide retry's window while re-acquiring).
+    if (m.poor_run == 0) m.wheel_extra_xy2 = m.wheel_extra_yaw2 = 0;
+    if (wheels) {
+      const double ws = std::hypot(wheel_inc.x, wheel_inc.y), wt = std::abs(wrap_angle(wheel_inc.yaw));
+      const double wq = (base ? cfg_.sigma_xy_m : 0.0) + cfg_.sigma_xy_per_m * ws;
+      const double wqy = (base ? cfg_.sigma_yaw_rad : 0.0) + cfg_.sigma_yaw_per_rad * wt + cfg_.sigma_yaw_per_m * ws;
+      m.wheel_extra_xy2 += std::max(0.0, wq * wq - qxy * qxy);
+      m.wheel_extra_yaw2 += std::max(0.0, wqy * wqy - qyaw * qyaw);
+    }
+    sxy = std::sqrt(sxy * sxy + qxy * qxy + step * step * syaw * syaw);
+    syaw = std::sqrt(syaw * syaw + qyaw * qyaw);
+  } else if (wheels) {
     const double step = std::hypot(inc->x, inc->y), turn = std::abs(wrap_angle(inc->yaw));
     pred = compose(m.pose, *inc);
     // After a fit: base + motion (the window around a fresh fit); while dead-reckoning: the motion only.
@@ -383,16 +346,6 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
   m.first = false;
   if (odom) m.last_odom = odom;
 
-  // Points: every k-th so that at most max_points remain.
-  std::vector<Eigen::Vector2d> pts;
-  {
-    const size_t n = points_in.size();
-    const size_t k = cfg_.max_points > 0 ? std::max<size_t>(1, (n + size_t(cfg_.max_points) - 1) / size_t(cfg_.max_points)) : 1;
-    for (size_t i = 0; i < n; i += k) {
-      const double r = points_in[i].norm();
-      if (r >= cfg_.min_range_m && r <= cfg_.max_range_m) pts.push_back(points_in[i]);
-    }
-  }
   res.num_points = int(pts.size());
   auto keep_prediction = [&]() {
     m.pose = pred;
@@ -419,7 +372,8 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
   if (cfg_.reacquire && m.poor_run >= cfg_.reacquire_after) {
     // The fit around the dead-reckoned prediction: a strong fit that agrees with it (within gate_sigmas) ends
     // LOST at once (the map and the odometry agree; nothing to confirm); a weak one near it is followed (POOR).
-    const Impl::Fit f = m.fit(pts, pred, sxy, syaw, cfg_.max_window_xy_m, cfg_.max_window_yaw_rad, 1, 1.1);
+    const Impl::Fit this_fit = m.fit(pts, pred, sxy, syaw, cfg_.max_window_xy_m, cfg_.max_window_yaw_rad, 1, 1.1);
+    const Impl::Fit& f = this_fit;
     {
       const double ex = f.est.x - pred.x, ey = f.est.y - pred.y, eyaw = wrap_angle(f.est.yaw - pred.yaw);
       const bool near = (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw) <= cfg_.gate_sigmas * cfg_.gate_sigmas;
@@ -437,8 +391,29 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
       const double step_xy = std::max(qxy, cfg_.sigma_xy_m), step_yaw = std::max(qyaw, cfg_.sigma_yaw_rad);
       const bool one_step = (ex * ex + ey * ey) / (step_xy * step_xy) + eyaw * eyaw / (step_yaw * step_yaw) <=
                             cfg_.gate_sigmas * cfg_.gate_sigmas;
-      if (((f.accepted && near && f.inlier_ratio >= cfg_.min_inlier_ratio) ||
-           (inside && f.inlier_ratio >= cfg_.reacquire_strong_ratio)) && unrivalled) {
+      // On laser steps: also the window the wheels' model would have searched, where only a scan the map
+      // explains almost entirely (reacquire_strong_ratio), and unrivalled, may move the pose (the pose the last
+      // fits left can be off by more than their covariance says: csail 400, 23 deg).
+      std::optional<Impl::Fit> wide;
+      if (cfg_.laser_wide_retry && res.laser_step && (m.wheel_extra_xy2 > 0 || m.wheel_extra_yaw2 > 0) &&
+          !(((f.accepted && near && f.inlier_ratio >= cfg_.min_inlier_ratio) ||
+             (inside && f.inlier_ratio >= cfg_.reacquire_strong_ratio)) && unrivalled)) {
+        const double wxy = std::sqrt(sxy * sxy + m.wheel_extra_xy2), wyaw = std::sqrt(syaw * syaw + m.wheel_extra_yaw2);
+        Impl::Fit g = m.fit(pts, pred, wxy, wyaw, cfg_.max_window_xy_m, cfg_.max_window_yaw_rad, 1, 1.1);
+        const double gx = g.est.x - pred.x, gy = g.est.y - pred.y, gyaw = wrap_angle(g.est.yaw - pred.yaw);
+        const bool g_inside = std::hypot(gx, gy) <= g.wxy + df.resolution() && std::abs(gyaw) <= g.wyaw + cfg_.search_yaw_step_rad;
+        double g_rival = 0;
+        for (const auto& a : g.alts)
+          if (std::hypot(a.pose.x - g.est.x, a.pose.y - g.est.y) > cfg_.rival_sep_xy_m ||
+              std::abs(wrap_angle(a.pose.yaw - g.est.yaw)) > cfg_.rival_sep_yaw_rad)
+            g_rival = std::max(g_rival, a.inlier_ratio);
+        if (g_inside && g.inlier_ratio >= cfg_.reacquire_strong_ratio &&
+            (cfg_.rival_margin < 0 || g_rival < g.inlier_ratio - cfg_.rival_margin))
+          wide = std::move(g);
+      }
+      if (wide || (((f.accepted && near && f.inlier_ratio >= cfg_.min_inlier_ratio) ||
+                    (inside && f.inlier_ratio >= cfg_.reacquire_strong_ratio)) && unrivalled)) {
+        const Impl::Fit& f = wide ? *wide : this_fit;
         m.hyps.clear();
         m.pose = f.est;
         m.sxy = std::sqrt(std::max(f.cov(0, 0), f.cov(1, 1)));

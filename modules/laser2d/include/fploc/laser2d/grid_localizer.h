@@ -2,7 +2,8 @@
 // odometry as the motion prior. Per scan:
 //  1. prediction: the previous estimate composed with the odometry increment between the two scans (no
 //     odometry: the previous estimate), and its uncertainty: sigma_xy = base + k_xy * step, sigma_yaw =
-//     base + k_yaw * turn (+ k_yaw_per_m * step), added to what is left of the previous one;
+//     base + k_yaw * turn (+ k_yaw_per_m * step), added to what is left of the previous one; where the scan
+//     matches the last few scans (laser_odometry.h) their increment replaces the odometry's, with its own sigmas;
 //  2. a correlative search (Olson's correlative scan matching, as Cartographer's real-time matcher does it)
 //     over a window of +-3 sigma around the prediction: every yaw step rotates the points once, every cell
 //     offset sums the points' scores exp(-d^2 / 2 s^2) (d from the distance field); the score is weighted by a
@@ -24,6 +25,7 @@
 
 #include "fploc/core/pose.h"
 #include "fploc/laser2d/distance_field.h"
+#include "fploc/laser2d/laser_odometry.h"
 #include "fploc/laser2d/odometry_calibration.h"
 
 namespace fploc::laser2d {
@@ -172,6 +174,23 @@ struct GridLocalizerConfig {
   // prediction (tracking, dead reckoning, hypotheses) uses the corrected increment. Off: the raw wheels.
   bool calibrate_odometry = true;
   OdometryCalibrationConfig calibration;
+  // Laser odometry (laser_odometry.h): the increment between two scans measured by matching the scan to the
+  // last few scans (a local map of the robot's own), used for the prediction instead of the (calibrated)
+  // wheels' whenever the match holds; without wheel odometry it replaces the no-odometry prediction. Where the
+  // building map does not explain the scans (rooms it saw only through a door) the dead-reckoned pose then
+  // follows the walls the robot sees instead of the wheels' drift, so the place to re-acquire stays near the
+  // prediction. A matched step's uncertainty: laser_sigma_* (base + k * |increment|); a failed match: the
+  // wheels' sigma_*. Off: the wheels alone (the earlier behaviour). Radish, fploc-real-track, covered ATE cm
+  // intel / aces / fhw / csail / freiburg-079: off 10.7 / 7.4 / 23.4 / 4.3 / 21.1, on (with laser_wide_retry)
+  // 7.4 / 5.9 / 5.9 / 6.4 / 8.8 (docs/notes/real2d.md, ninth pass).
+  bool laser_odometry = true;
+  LaserOdometryConfig laser;
+  double laser_sigma_xy_m = 0.02, laser_sigma_xy_per_m = 0.05;
+  double laser_sigma_yaw_rad = 0.5 * M_PI / 180, laser_sigma_yaw_per_rad = 0.05, laser_sigma_yaw_per_m = 0.5 * M_PI / 180;
+  // While re-acquiring on laser steps, the fit around the prediction is also tried in the window the wheels'
+  // model would have grown since the last fit; there only an unrivalled fit with reacquire_strong_ratio of the
+  // scan explained is taken (the pose the last fits left can be off by more than their covariance says).
+  bool laser_wide_retry = true;
 };
 
 enum class GridStatus { kOk = 0, kPoor = 1, kLost = 2, kNotInitialised = 3 };
@@ -190,6 +209,8 @@ struct GridResult {
   int refined = 0;  // candidates refined
   int hypotheses = 0;      // re-acquisition hypotheses tracked after this scan (while LOST)
   bool reacquired = false;  // this scan ended LOST with a confirmed hypothesis
+  bool laser_step = false;  // the prediction came from the laser odometry (else the wheels)
+  double laser_inlier_ratio = 0;  // the laser odometry's match (0 when it did not match)
   // The odometry calibration after this scan (yaw bias [rad/m], turn scale error, translation scale, pairs used).
   double odom_bias_rad_per_m = 0, odom_turn_scale_error = 0, odom_scale = 1;
   int odom_pairs = 0;
