@@ -78,6 +78,20 @@ struct GridLocalizer::Impl {
   };
   Fit fit(const std::vector<Eigen::Vector2d>& pts, const Pose2& pred, double sxy, double syaw, double max_xy,
           double max_yaw, int keep, double min_inlier_ratio) const;
+  // The fit lies inside the window searched around pred (the refinement may slide out of it along a flat wall).
+  bool inside(const Fit& f, const Pose2& pred) const {
+    return std::hypot(f.est.x - pred.x, f.est.y - pred.y) <= f.wxy + df->resolution() &&
+           std::abs(wrap_angle(f.est.yaw - pred.yaw)) <= f.wyaw + cfg.search_yaw_step_rad;
+  }
+  // The best inlier share of a refined candidate at another place than the fit's.
+  double rival(const Fit& f) const {
+    double r = 0;
+    for (const auto& a : f.alts)
+      if (std::hypot(a.pose.x - f.est.x, a.pose.y - f.est.y) > cfg.rival_sep_xy_m ||
+          std::abs(wrap_angle(a.pose.yaw - f.est.yaw)) > cfg.rival_sep_yaw_rad)
+        r = std::max(r, a.inlier_ratio);
+    return r;
+  }
 
   Impl(std::shared_ptr<const DistanceField> f, const GridLocalizerConfig& c)
       : field(std::move(f)), df(field.df) {
@@ -210,7 +224,7 @@ GridLocalizer::Impl::Fit GridLocalizer::Impl::fit(const std::vector<Eigen::Vecto
   const double m2 = (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw);
   const bool near = m2 <= cfg.gate_sigmas * cfg.gate_sigmas;
   // The refinement may not leave the window searched (a scan of one flat wall fits anywhere along it).
-  const bool inside = std::hypot(ex, ey) <= f.wxy + d.resolution() && std::abs(eyaw) <= f.wyaw + cfg.search_yaw_step_rad;
+  const bool inside = this->inside(f, pred);
   f.accepted = (inside && f.inlier_ratio >= min_inlier_ratio) || (near && f.inlier_ratio >= cfg.min_inlier_ratio_near);
   // Covariance from the Jacobian at the solution (loss applied).
   f.cov = detail::covariance_of(*problem, Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal());
@@ -379,14 +393,8 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
       const bool near = (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw) <= cfg_.gate_sigmas * cfg_.gate_sigmas;
       // (Tried: leaving LOST only with confirm_inlier_ratio here too: intel 18.1 -> 185 cm, more weak fits
       // followed; freiburg-079 86 -> 91 cm.)
-      const bool inside = std::hypot(ex, ey) <= f.wxy + df.resolution() && std::abs(eyaw) <= f.wyaw + cfg_.search_yaw_step_rad;
-      // Rivals: the best inlier share of a refined candidate at another place.
-      double rival = 0;
-      for (const auto& a : f.alts)
-        if (std::hypot(a.pose.x - f.est.x, a.pose.y - f.est.y) > cfg_.rival_sep_xy_m ||
-            std::abs(wrap_angle(a.pose.yaw - f.est.yaw)) > cfg_.rival_sep_yaw_rad)
-          rival = std::max(rival, a.inlier_ratio);
-      const bool unrivalled = cfg_.rival_margin < 0 || rival < f.inlier_ratio - cfg_.rival_margin;
+      const bool inside = m.inside(f, pred);
+      const bool unrivalled = cfg_.rival_margin < 0 || m.rival(f) < f.inlier_ratio - cfg_.rival_margin;
       // Within gate_sigmas of this step's own odometry uncertainty (not the accumulated one).
       const double step_xy = std::max(qxy, cfg_.sigma_xy_m), step_yaw = std::max(qyaw, cfg_.sigma_yaw_rad);
       const bool one_step = (ex * ex + ey * ey) / (step_xy * step_xy) + eyaw * eyaw / (step_yaw * step_yaw) <=
@@ -400,15 +408,8 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
              (inside && f.inlier_ratio >= cfg_.reacquire_strong_ratio)) && unrivalled)) {
         const double wxy = std::sqrt(sxy * sxy + m.wheel_extra_xy2), wyaw = std::sqrt(syaw * syaw + m.wheel_extra_yaw2);
         Impl::Fit g = m.fit(pts, pred, wxy, wyaw, cfg_.max_window_xy_m, cfg_.max_window_yaw_rad, 1, 1.1);
-        const double gx = g.est.x - pred.x, gy = g.est.y - pred.y, gyaw = wrap_angle(g.est.yaw - pred.yaw);
-        const bool g_inside = std::hypot(gx, gy) <= g.wxy + df.resolution() && std::abs(gyaw) <= g.wyaw + cfg_.search_yaw_step_rad;
-        double g_rival = 0;
-        for (const auto& a : g.alts)
-          if (std::hypot(a.pose.x - g.est.x, a.pose.y - g.est.y) > cfg_.rival_sep_xy_m ||
-              std::abs(wrap_angle(a.pose.yaw - g.est.yaw)) > cfg_.rival_sep_yaw_rad)
-            g_rival = std::max(g_rival, a.inlier_ratio);
-        if (g_inside && g.inlier_ratio >= cfg_.reacquire_strong_ratio &&
-            (cfg_.rival_margin < 0 || g_rival < g.inlier_ratio - cfg_.rival_margin))
+        if (m.inside(g, pred) && g.inlier_ratio >= cfg_.reacquire_strong_ratio &&
+            (cfg_.rival_margin < 0 || m.rival(g) < g.inlier_ratio - cfg_.rival_margin))
           wide = std::move(g);
       }
       if (wide || (((f.accepted && near && f.inlier_ratio >= cfg_.min_inlier_ratio) ||
