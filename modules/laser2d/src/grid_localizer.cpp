@@ -16,6 +16,22 @@ namespace {
 
 using detail::FieldFitOptions;
 
+// A step's prediction sigmas (xy, yaw) by the model base + k * |increment|: the wheels' (sigma_*) or the laser
+// odometry's (laser_sigma_*); without the base while dead-reckoning with dead_reckoning_motion_only.
+struct StepSigma {
+  double xy = 0, yaw = 0;
+};
+StepSigma wheel_step_sigma(const GridLocalizerConfig& c, const Pose2& inc, bool base) {
+  const double step = std::hypot(inc.x, inc.y), turn = std::abs(wrap_angle(inc.yaw));
+  return {(base ? c.sigma_xy_m : 0.0) + c.sigma_xy_per_m * step,
+          (base ? c.sigma_yaw_rad : 0.0) + c.sigma_yaw_per_rad * turn + c.sigma_yaw_per_m * step};
+}
+StepSigma laser_step_sigma(const GridLocalizerConfig& c, const Pose2& inc, bool base) {
+  const double step = std::hypot(inc.x, inc.y), turn = std::abs(wrap_angle(inc.yaw));
+  return {(base ? c.laser_sigma_xy_m : 0.0) + c.laser_sigma_xy_per_m * step,
+          (base ? c.laser_sigma_yaw_rad : 0.0) + c.laser_sigma_yaw_per_rad * turn + c.laser_sigma_yaw_per_m * step};
+}
+
 FieldFitOptions fit_options(const GridLocalizerConfig& cfg) {
   FieldFitOptions o;
   o.point_sigma_m = cfg.point_sigma_m;
@@ -308,41 +324,34 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
   // The laser odometry's increment where it matches, the wheels' (or none) otherwise; the first scan starts it.
   std::optional<LaserOdometryStep> laser;
   if (cfg_.laser_odometry) {
-    const double step = inc ? std::hypot(inc->x, inc->y) : 0, turn = inc ? std::abs(wrap_angle(inc->yaw)) : 0;
-    const double wxy = inc ? cfg_.sigma_xy_m + cfg_.sigma_xy_per_m * step : cfg_.no_odom_sigma_xy_m;
-    const double wyaw = inc ? cfg_.sigma_yaw_rad + cfg_.sigma_yaw_per_rad * turn + cfg_.sigma_yaw_per_m * step
-                            : cfg_.no_odom_sigma_yaw_rad;
-    laser = m.laser.update(pts, inc ? *inc : Pose2{}, wxy, wyaw);
+    const StepSigma w = inc ? wheel_step_sigma(cfg_, *inc, true) : StepSigma{cfg_.no_odom_sigma_xy_m, cfg_.no_odom_sigma_yaw_rad};
+    laser = m.laser.update(pts, inc ? *inc : Pose2{}, w.xy, w.yaw);
     if (m.first) laser.reset();
   }
+  // After a fit: base + motion (the window around a fresh fit); while dead-reckoning: the motion only.
+  const bool base = !(cfg_.dead_reckoning_motion_only && m.poor_run > 0);
   if (laser) {
-    const Pose2 wheel_inc = inc ? *inc : Pose2{};  // (the calibrated wheels' increment, when wheels)
+    // What the wheels' model would have added since the last fit (the wide retry's window while re-acquiring).
+    const StepSigma q = laser_step_sigma(cfg_, laser->increment, base);
+    if (m.poor_run == 0) m.wheel_extra_xy2 = m.wheel_extra_yaw2 = 0;
+    if (wheels) {
+      const StepSigma w = wheel_step_sigma(cfg_, *inc, base);
+      m.wheel_extra_xy2 += std::max(0.0, w.xy * w.xy - q.xy * q.xy);
+      m.wheel_extra_yaw2 += std::max(0.0, w.yaw * w.yaw - q.yaw * q.yaw);
+    }
     inc = laser->increment;
     res.laser_step = true;
     res.laser_inlier_ratio = laser->inlier_ratio;
-    const double step = std::hypot(inc->x, inc->y), turn = std::abs(wrap_angle(inc->yaw));
-    pred = compose(m.pose, *inc);
-    const bool base = !(cfg_.dead_reckoning_motion_only && m.poor_run > 0);
-    qxy = (base ? cfg_.laser_sigma_xy_m : 0.0) + cfg_.laser_sigma_xy_per_m * step;
-    qyaw = (base ? cfg_.laser_sigma_yaw_rad : 0.0) + cfg_.laser_sigma_yaw_per_rad * turn + cfg_.laser_sigma_yaw_per_m * step;
-    // What the wheels' model would have added since the last fit (the wide retry's window while re-acquiring).
-    if (m.poor_run == 0) m.wheel_extra_xy2 = m.wheel_extra_yaw2 = 0;
-    if (wheels) {
-      const double ws = std::hypot(wheel_inc.x, wheel_inc.y), wt = std::abs(wrap_angle(wheel_inc.yaw));
-      const double wq = (base ? cfg_.sigma_xy_m : 0.0) + cfg_.sigma_xy_per_m * ws;
-      const double wqy = (base ? cfg_.sigma_yaw_rad : 0.0) + cfg_.sigma_yaw_per_rad * wt + cfg_.sigma_yaw_per_m * ws;
-      m.wheel_extra_xy2 += std::max(0.0, wq * wq - qxy * qxy);
-      m.wheel_extra_yaw2 += std::max(0.0, wqy * wqy - qyaw * qyaw);
-    }
-    sxy = std::sqrt(sxy * sxy + qxy * qxy + step * step * syaw * syaw);
-    syaw = std::sqrt(syaw * syaw + qyaw * qyaw);
+    qxy = q.xy;
+    qyaw = q.yaw;
   } else if (wheels) {
-    const double step = std::hypot(inc->x, inc->y), turn = std::abs(wrap_angle(inc->yaw));
+    const StepSigma q = wheel_step_sigma(cfg_, *inc, base);
+    qxy = q.xy;
+    qyaw = q.yaw;
+  }
+  if (laser || wheels) {
+    const double step = std::hypot(inc->x, inc->y);
     pred = compose(m.pose, *inc);
-    // After a fit: base + motion (the window around a fresh fit); while dead-reckoning: the motion only.
-    const bool base = !(cfg_.dead_reckoning_motion_only && m.poor_run > 0);
-    qxy = (base ? cfg_.sigma_xy_m : 0.0) + cfg_.sigma_xy_per_m * step;
-    qyaw = (base ? cfg_.sigma_yaw_rad : 0.0) + cfg_.sigma_yaw_per_rad * turn + cfg_.sigma_yaw_per_m * step;
     sxy = std::sqrt(sxy * sxy + qxy * qxy + step * step * syaw * syaw);
     syaw = std::sqrt(syaw * syaw + qyaw * qyaw);
   } else if (!m.first) {
@@ -386,8 +395,7 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
   if (cfg_.reacquire && m.poor_run >= cfg_.reacquire_after) {
     // The fit around the dead-reckoned prediction: a strong fit that agrees with it (within gate_sigmas) ends
     // LOST at once (the map and the odometry agree; nothing to confirm); a weak one near it is followed (POOR).
-    const Impl::Fit this_fit = m.fit(pts, pred, sxy, syaw, cfg_.max_window_xy_m, cfg_.max_window_yaw_rad, 1, 1.1);
-    const Impl::Fit& f = this_fit;
+    const Impl::Fit f = m.fit(pts, pred, sxy, syaw, cfg_.max_window_xy_m, cfg_.max_window_yaw_rad, 1, 1.1);
     {
       const double ex = f.est.x - pred.x, ey = f.est.y - pred.y, eyaw = wrap_angle(f.est.yaw - pred.yaw);
       const bool near = (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw) <= cfg_.gate_sigmas * cfg_.gate_sigmas;
@@ -402,31 +410,30 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
       // On laser steps: also the window the wheels' model would have searched, where only a scan the map
       // explains almost entirely (reacquire_strong_ratio), and unrivalled, may move the pose (the pose the last
       // fits left can be off by more than their covariance says: csail 400, 23 deg).
+      const bool ends = ((f.accepted && near && f.inlier_ratio >= cfg_.min_inlier_ratio) ||
+                         (inside && f.inlier_ratio >= cfg_.reacquire_strong_ratio)) && unrivalled;
       std::optional<Impl::Fit> wide;
-      if (cfg_.laser_wide_retry && res.laser_step && (m.wheel_extra_xy2 > 0 || m.wheel_extra_yaw2 > 0) &&
-          !(((f.accepted && near && f.inlier_ratio >= cfg_.min_inlier_ratio) ||
-             (inside && f.inlier_ratio >= cfg_.reacquire_strong_ratio)) && unrivalled)) {
+      if (!ends && cfg_.laser_wide_retry && res.laser_step && (m.wheel_extra_xy2 > 0 || m.wheel_extra_yaw2 > 0)) {
         const double wxy = std::sqrt(sxy * sxy + m.wheel_extra_xy2), wyaw = std::sqrt(syaw * syaw + m.wheel_extra_yaw2);
         Impl::Fit g = m.fit(pts, pred, wxy, wyaw, cfg_.max_window_xy_m, cfg_.max_window_yaw_rad, 1, 1.1);
         if (m.inside(g, pred) && g.inlier_ratio >= cfg_.reacquire_strong_ratio &&
             (cfg_.rival_margin < 0 || m.rival(g) < g.inlier_ratio - cfg_.rival_margin))
           wide = std::move(g);
       }
-      if (wide || (((f.accepted && near && f.inlier_ratio >= cfg_.min_inlier_ratio) ||
-                    (inside && f.inlier_ratio >= cfg_.reacquire_strong_ratio)) && unrivalled)) {
-        const Impl::Fit& f = wide ? *wide : this_fit;
+      if (ends || wide) {
+        const Impl::Fit& t = wide ? *wide : f;
         m.hyps.clear();
-        m.pose = f.est;
-        m.sxy = std::sqrt(std::max(f.cov(0, 0), f.cov(1, 1)));
-        m.syaw = std::sqrt(f.cov(2, 2));
+        m.pose = t.est;
+        m.sxy = std::sqrt(std::max(t.cov(0, 0), t.cov(1, 1)));
+        m.syaw = std::sqrt(t.cov(2, 2));
         m.poor_run = 0;
         m.search_moved_m = -1;
-        res.pose = f.est;
+        res.pose = t.est;
         res.status = GridStatus::kOk;
-        res.covariance = f.cov;
-        res.inlier_ratio = f.inlier_ratio;
-        res.search_xy_m = f.wxy;
-        res.search_yaw_rad = f.wyaw;
+        res.covariance = t.cov;
+        res.inlier_ratio = t.inlier_ratio;
+        res.search_xy_m = t.wxy;
+        res.search_yaw_rad = t.wyaw;
         return res;
       }
       // Weak, near the prediction: follow it, but keep the dead-reckoned uncertainty (a weak fit does not
