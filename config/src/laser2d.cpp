@@ -20,6 +20,8 @@ laser2d::GridLocalizerConfig config_of(const Grid2dOptions& o) {
   if (o.prior_weight_sigmas() > 0) c.prior_weight_sigmas = o.prior_weight_sigmas();
   if (o.has_laser_odometry()) c.laser_odometry = o.laser_odometry();
   if (o.laser_map_scans() > 0) c.laser.map_scans = o.laser_map_scans();
+  if (o.confirm_within_sigmas() != 0) c.confirm_within_sigmas = o.confirm_within_sigmas();
+  if (o.far_confirm_travel_m() != 0) c.far_confirm_travel_m = o.far_confirm_travel_m();
   return c;
 }
 

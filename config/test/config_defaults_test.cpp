@@ -187,7 +187,8 @@ TEST(ConfigDefaults, Grid2d) {
          {"field_max_m", c.field_max_m}, {"min_inlier_ratio_near", c.min_inlier_ratio_near},
          {"gate_sigmas", c.gate_sigmas}, {"sigma_xy_per_m", c.sigma_xy_per_m},
          {"sigma_yaw_per_rad", c.sigma_yaw_per_rad}, {"prior_weight_sigmas", c.prior_weight_sigmas},
-         {"laser_map_scans", double(c.laser.map_scans)}});
+         {"laser_map_scans", double(c.laser.map_scans)}, {"confirm_within_sigmas", c.confirm_within_sigmas},
+         {"far_confirm_travel_m", c.far_confirm_travel_m}});
 }
 
 TEST(ConfigDefaults, CloudToScan) {

@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
   app.add_option("--follow-weak", c.follow_weak, "follow weak near fits while re-acquiring");
   app.add_option("--reacquire", c.reacquire, "re-acquisition with hypotheses");
   app.add_option("--follow-weak-when-lost", c.follow_weak_when_lost, "follow weak near fits also once LOST");
-  app.add_option("--consistent-candidates", c.consistent_candidates, "odometry-consistent choice among this many candidates (0: off)");
+  app.add_option("--consistent-candidates", c.consistent_candidates, "odometry-consistent choice among this many candidates (<= 0: off)");
   app.add_option("--jump-inlier-margin", c.jump_inlier_margin, "inlier share a fit away from the prediction needs over the nearest");
   app.add_option("--odometry-yaw-candidate", c.odometry_yaw_candidate, "also refine the prediction with its yaw held");
   app.add_option("--retry-window-factor", c.retry_window_factor, "retry a failed tracking fit in a window this much wider (1: off)");
@@ -62,7 +62,8 @@ int main(int argc, char** argv) {
   app.add_option("--prior-turn", c.calibration.prior_turn_rad2, "calibration ridge on the turn scale [rad^2]");
   app.add_option("--prior-scale", c.calibration.prior_scale_m2, "calibration ridge on the scale [m^2]");
   app.add_option("--reacquire-search-every-m", c.reacquire_search_every_m, "wide re-acquisition search after this much travel (0: every scan)");
-  app.add_option("--confirm-within-sigmas", c.confirm_within_sigmas, "a hypothesis is taken within this many sigma of the dead-reckoned pose (0: off)");
+  app.add_option("--confirm-within-sigmas", c.confirm_within_sigmas, "a hypothesis is taken within this many sigma of the dead-reckoned pose (<= 0: off)");
+  app.add_option("--far-confirm-travel", c.far_confirm_travel_m, "a hypothesis beyond --confirm-within-sigmas is taken after this much travel (< 0: never)");
   app.add_option("--rival-margin", c.rival_margin, "re-acquiring: a near fit ends POOR/LOST only without a rival within this inlier share (< 0: off)");
   app.add_option("--weak-follow-step-only", c.weak_follow_step_only, "re-acquiring: follow a weak fit only within this step's own odometry sigma");
   app.add_option("--confirm-scans", c.confirm_scans, "scans a hypothesis must match in a row");

@@ -73,6 +73,7 @@ struct GridLocalizer::Impl {
     double sxy = 0, syaw = 0;
     int hits = 0;
     double inlier_sum = 0;
+    double travel_m = 0;  // the odometry's travel since it was proposed
     double mean() const { return hits > 0 ? inlier_sum / hits : 0; }
   };
   std::vector<Hypothesis> hyps;
@@ -363,6 +364,7 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
   for (auto& h : m.hyps) {
     const double step = inc ? std::hypot(inc->x, inc->y) : 0;
     if (inc) h.pose = compose(h.pose, *inc);
+    h.travel_m += step;
     h.sxy = std::sqrt(h.sxy * h.sxy + qxy * qxy + step * step * h.syaw * h.syaw);
     h.syaw = std::sqrt(h.syaw * h.syaw + qyaw * qyaw);
   }
@@ -549,11 +551,16 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
     if (int(m.hyps.size()) > cfg_.max_hypotheses) m.hyps.resize(size_t(cfg_.max_hypotheses));
     // A hypothesis is taken only where the calibrated dead reckoning can be (within confirm_within_sigmas of its
     // grown uncertainty): a place the map explains as well but the odometry cannot have reached is a wrong lock.
+    // On laser steps the bound is the wheels' model's (the dead-reckoned uncertainty plus what the wheels would
+    // have added since the last fit): laser steps that follow a wrong place are self-consistent, so their own
+    // sigma says nothing of how far off the dead-reckoned pose may be.
     auto agrees = [&](const Impl::Hypothesis& h) {
       if (cfg_.confirm_within_sigmas <= 0) return true;
+      const double gxy2 = sxy * sxy + (res.laser_step ? m.wheel_extra_xy2 : 0.0);
+      const double gyaw2 = syaw * syaw + (res.laser_step ? m.wheel_extra_yaw2 : 0.0);
       const double ex = h.pose.x - pred.x, ey = h.pose.y - pred.y, eyaw = wrap_angle(h.pose.yaw - pred.yaw);
-      return (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw) <=
-             cfg_.confirm_within_sigmas * cfg_.confirm_within_sigmas;
+      return (ex * ex + ey * ey) / gxy2 + eyaw * eyaw / gyaw2 <= cfg_.confirm_within_sigmas * cfg_.confirm_within_sigmas ||
+             (cfg_.far_confirm_travel_m >= 0 && h.travel_m >= cfg_.far_confirm_travel_m);
     };
     if (!m.hyps.empty() && m.hyps[0].hits >= cfg_.confirm_scans && m.hyps[0].mean() >= cfg_.confirm_inlier_ratio &&
         agrees(m.hyps[0]) &&

@@ -612,3 +612,64 @@ TEST(GridLocalizer, LaserOdometryCarriesThroughAnUnmappedRoom) {
   std::cerr << "wheels: " << std::hypot(w.x, w.y) << " m " << w.yaw * 180 / M_PI << " deg\n";
   EXPECT_GT(std::hypot(w.x, w.y), 1.0) << "control: the wheels kept the pose; the test does not test the laser odometry";
 }
+
+// A hypothesis far beyond what dead reckoning allows needs travel to be taken (freiburg-079 scan 4150: while the
+// robot turned in place in a room the map covers in part, an aliased room 4.4 m away kept fitting and was
+// taken). The map holds one box (x in [6, 7], open at the bottom); the tracker starts at (0.5, 0.4), 6 m to its
+// left. (1) The robot is in an unmapped box of the same shape at the start pose and turns back and forth in
+// place: every scan fits the mapped box as well as its own. With the rule the tracker stays where it is
+// (dead-reckoned, never OK); control (the bound off): it is carried to the mapped box. (2) The robot is in the
+// mapped box (a start 6 m off) and drives back and forth: the far hypothesis keeps matching over
+// far_confirm_travel_m of travel and is taken; control (-1: never), it is not.
+struct AliasRun {
+  int ok = 0;
+  double max_x = 0;  // the largest x the tracker published
+};
+AliasRun run_in_box(const l2::GridLocalizerConfig& c, bool in_mapped_box, int scans) {
+  OccupancyGrid world = l2::test::blank_grid(200, 60), map = l2::test::blank_grid(200, 60);
+  auto box = [](OccupancyGrid& g, double x0) {
+    for (double t = 0; t <= 1.0; t += 0.01) {
+      l2::test::occupy(g, x0 - 0.05, t);
+      l2::test::occupy(g, x0 + 1.05, t);
+      l2::test::occupy(g, x0 - 0.05 + 1.1 * t, 1.05);
+    }
+  };
+  box(world, in_mapped_box ? 6 : 0);
+  box(map, 6);
+  l2::GridLocalizer loc(std::make_shared<l2::DistanceField>(map, 1.0), c);
+  loc.set_initial_pose({0.5, 0.4, M_PI / 2});
+  std::mt19937 rng(23);
+  AliasRun out;
+  for (int k = 0; k < scans; ++k) {
+    // Turning in place (+-20 deg), or driving 0.1 m per scan between y = 0.2 and 0.7 in the mapped box.
+    const Pose2 t = in_mapped_box ? Pose2{6.5, 0.2 + 0.1 * std::abs((k + 5) % 10 - 5), M_PI / 2}
+                                  : Pose2{0.5, 0.4, M_PI / 2 + 0.35 * std::sin(k / 3.0)};
+    const auto r = loc.update(cast(world, t, rng), Pose2{t.y, 0, t.yaw});  // wheels: the truth's increments
+    out.ok += r.status == l2::GridStatus::kOk;
+    out.max_x = std::max(out.max_x, r.pose.x);
+  }
+  return out;
+}
+
+TEST(GridLocalizer, FarHypothesisNeedsTravelToBeTaken) {
+  l2::GridLocalizerConfig c;
+  ASSERT_GT(c.confirm_within_sigmas, 0);
+  // Test time (every unmatched scan searches wide, 0.4-1 s here): LOST after 3 scans, then 5 to confirm (control);
+  // the wide search over the map's extent and +-30 deg.
+  c.lost_after = 3;
+  c.reacquire_xy_m = 7;
+  c.reacquire_yaw_rad = 30 * M_PI / 180;
+  const AliasRun r = run_in_box(c, false, 14);
+  EXPECT_EQ(r.ok, 0);
+  EXPECT_LT(r.max_x, 1.0) << "carried to the aliased box while turning in place";
+  const AliasRun drive = run_in_box(c, true, 18);
+  EXPECT_GT(drive.max_x, 6.0) << "the robot driving in the mapped box was not found";
+  EXPECT_GE(drive.ok, 2);
+  auto c0 = c;
+  c0.confirm_within_sigmas = 0;
+  const AliasRun ctl = run_in_box(c0, false, 14);
+  EXPECT_GT(ctl.max_x, 6.0) << "control: the aliased box was not taken without the bound; the test tests nothing";
+  c.far_confirm_travel_m = -1;
+  const AliasRun never = run_in_box(c, true, 18);
+  EXPECT_LT(never.max_x, 1.0) << "control: found without the travel rule; the test does not test it";
+}
