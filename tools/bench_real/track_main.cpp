@@ -75,6 +75,7 @@ int main(int argc, char** argv) {
   app.add_option("--laser-sigma-yaw-deg", laser_sigma_yaw_deg, "laser odometry: per-step yaw sigma base [deg]");
   app.add_option("--laser-min-inlier-ratio", c.laser.min_inlier_ratio, "laser odometry: share of the scan the local map must explain");
   app.add_option("--laser-wide-retry", c.laser_wide_retry, "laser odometry: re-acquiring, a strong fit in the wheels' window");
+  app.add_option("--laser-track-retry", c.laser_track_retry, "laser odometry: a failed tracking fit, a strong fit in the wheels' window");
   CLI11_PARSE(app, argc, argv);
   if (laser_sigma_yaw_deg >= 0) c.laser_sigma_yaw_rad = laser_sigma_yaw_deg * M_PI / 180;
   namespace cm = fploc::carmen;

@@ -560,7 +560,8 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
       const double gyaw2 = syaw * syaw + (res.laser_step ? m.wheel_extra_yaw2 : 0.0);
       const double ex = h.pose.x - pred.x, ey = h.pose.y - pred.y, eyaw = wrap_angle(h.pose.yaw - pred.yaw);
       return (ex * ex + ey * ey) / gxy2 + eyaw * eyaw / gyaw2 <= cfg_.confirm_within_sigmas * cfg_.confirm_within_sigmas ||
-             (cfg_.far_confirm_travel_m >= 0 && h.travel_m >= cfg_.far_confirm_travel_m);
+             (cfg_.far_confirm_travel_m >= 0 && h.travel_m >= cfg_.far_confirm_travel_m &&
+              h.mean() >= cfg_.reacquire_strong_ratio);
     };
     if (!m.hyps.empty() && m.hyps[0].hits >= cfg_.confirm_scans && m.hyps[0].mean() >= cfg_.confirm_inlier_ratio &&
         agrees(m.hyps[0]) &&
@@ -595,6 +596,19 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
     Impl::Fit g = m.fit(pts, pred, k * sxy, k * syaw, k * cfg_.max_window_xy_m, std::min(M_PI, k * cfg_.max_window_yaw_rad),
                         cfg_.refine_candidates, cfg_.min_inlier_ratio);
     if (g.accepted && g.inlier_ratio >= cfg_.min_inlier_ratio) f = std::move(g);
+  }
+  // On a laser step, a failed fit is also tried in the window the wheels' model gives this step (a laser
+  // increment can be wrong by more than its sigma: a large turn); as while re-acquiring, only an unrivalled fit
+  // that explains almost the whole scan (reacquire_strong_ratio) is taken.
+  if (!f.accepted && m.poor_run == 0 && cfg_.laser_wide_retry && cfg_.laser_track_retry && res.laser_step &&
+      (m.wheel_extra_xy2 > 0 || m.wheel_extra_yaw2 > 0)) {
+    const double wxy = std::sqrt(sxy * sxy + m.wheel_extra_xy2), wyaw = std::sqrt(syaw * syaw + m.wheel_extra_yaw2);
+    Impl::Fit g = m.fit(pts, pred, wxy, wyaw, cfg_.max_window_xy_m, cfg_.max_window_yaw_rad, 1, 1.1);
+    if (m.inside(g, pred) && g.inlier_ratio >= cfg_.reacquire_strong_ratio &&
+        (cfg_.rival_margin < 0 || m.rival(g) < g.inlier_ratio - cfg_.rival_margin)) {
+      g.accepted = true;
+      f = std::move(g);
+    }
   }
   res.search_xy_m = f.wxy;
   res.search_yaw_rad = f.wyaw;

@@ -150,9 +150,10 @@ struct GridLocalizerConfig {
   // of the bound and cost freiburg-079 23.5 -> 173.3 cm; that was before the laser odometry and the wheels' bound).
   // The other four logs unchanged in both rows.
   double confirm_within_sigmas = 3;
-  // ... unless it has kept matching while the robot travelled far_confirm_travel_m since it was proposed (a
-  // kidnapped robot is found again; a robot turning in place, whose scans keep fitting an aliased room, is not
-  // carried off). < 0: never (a hypothesis beyond the bound is not taken).
+  // ... unless it has kept matching while the robot travelled far_confirm_travel_m since it was proposed, with a
+  // mean inlier share of at least reacquire_strong_ratio (a kidnapped robot in mapped ground is found again; a
+  // robot in ground the map covers in part, whose scans also half fit an aliased room, is not carried off).
+  // < 0: never (a hypothesis beyond the bound is not taken).
   double far_confirm_travel_m = 1.0;
   double confirm_inlier_ratio = 0.7;  // mean inlier share a hypothesis needs to be taken (a jump needs more than tracking)
   double field_max_m = 1.0;  // distance field truncation (the map's DistanceField)
@@ -199,6 +200,8 @@ struct GridLocalizerConfig {
   // model would have grown since the last fit; there only an unrivalled fit with reacquire_strong_ratio of the
   // scan explained is taken (the pose the last fits left can be off by more than their covariance says).
   bool laser_wide_retry = true;
+  // ... and so is a failed tracking fit right after a good one (with laser_wide_retry).
+  bool laser_track_retry = true;
 };
 
 enum class GridStatus { kOk = 0, kPoor = 1, kLost = 2, kNotInitialised = 3 };
