@@ -63,7 +63,7 @@ int main(int argc, char** argv) {
   app.add_option("--prior-scale", c.calibration.prior_scale_m2, "calibration ridge on the scale [m^2]");
   app.add_option("--reacquire-search-every-m", c.reacquire_search_every_m, "wide re-acquisition search after this much travel (0: every scan)");
   app.add_option("--confirm-within-sigmas", c.confirm_within_sigmas, "a hypothesis is taken within this many sigma of the dead-reckoned pose (<= 0: off)");
-  app.add_option("--far-confirm-travel", c.far_confirm_travel_m, "a hypothesis beyond --confirm-within-sigmas is taken after this much travel (< 0: never)");
+  app.add_option("--far-confirm-travel", c.far_confirm_travel_m, "a hypothesis beyond --confirm-within-sigmas is taken after this much travel with --reacquire-strong-ratio mean inliers (< 0: never)");
   app.add_option("--rival-margin", c.rival_margin, "re-acquiring: a near fit ends POOR/LOST only without a rival within this inlier share (< 0: off)");
   app.add_option("--weak-follow-step-only", c.weak_follow_step_only, "re-acquiring: follow a weak fit only within this step's own odometry sigma");
   app.add_option("--confirm-scans", c.confirm_scans, "scans a hypothesis must match in a row");
