@@ -110,6 +110,22 @@ struct GridLocalizer::Impl {
     return r;
   }
 
+  // On a laser step: the fit in the window the wheels' model would have grown since the last fit (the laser
+  // steps' own window can be too small: a laser increment wrong by more than its sigma, or a pose the last fits
+  // left further off than their covariance says). Only an unrivalled fit that explains almost the whole scan
+  // (reacquire_strong_ratio) is returned.
+  std::optional<Fit> wheel_window_fit(const std::vector<Eigen::Vector2d>& pts, const Pose2& pred, double sxy,
+                                      double syaw) const {
+    if (wheel_extra_xy2 <= 0 && wheel_extra_yaw2 <= 0) return std::nullopt;
+    Fit g = fit(pts, pred, std::sqrt(sxy * sxy + wheel_extra_xy2), std::sqrt(syaw * syaw + wheel_extra_yaw2),
+                cfg.max_window_xy_m, cfg.max_window_yaw_rad, 1, 1.1);
+    if (!inside(g, pred) || g.inlier_ratio < cfg.reacquire_strong_ratio ||
+        (cfg.rival_margin >= 0 && rival(g) >= g.inlier_ratio - cfg.rival_margin))
+      return std::nullopt;
+    g.accepted = true;
+    return g;
+  }
+
   Impl(std::shared_ptr<const DistanceField> f, const GridLocalizerConfig& c)
       : field(std::move(f)), df(field.df) {
     pyramid = std::make_unique<ScorePyramid>(*df, c.score_sigma_m, c.search_levels);
@@ -415,13 +431,7 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
       const bool ends = ((f.accepted && near && f.inlier_ratio >= cfg_.min_inlier_ratio) ||
                          (inside && f.inlier_ratio >= cfg_.reacquire_strong_ratio)) && unrivalled;
       std::optional<Impl::Fit> wide;
-      if (!ends && cfg_.laser_wide_retry && res.laser_step && (m.wheel_extra_xy2 > 0 || m.wheel_extra_yaw2 > 0)) {
-        const double wxy = std::sqrt(sxy * sxy + m.wheel_extra_xy2), wyaw = std::sqrt(syaw * syaw + m.wheel_extra_yaw2);
-        Impl::Fit g = m.fit(pts, pred, wxy, wyaw, cfg_.max_window_xy_m, cfg_.max_window_yaw_rad, 1, 1.1);
-        if (m.inside(g, pred) && g.inlier_ratio >= cfg_.reacquire_strong_ratio &&
-            (cfg_.rival_margin < 0 || m.rival(g) < g.inlier_ratio - cfg_.rival_margin))
-          wide = std::move(g);
-      }
+      if (!ends && cfg_.laser_wide_retry && res.laser_step) wide = m.wheel_window_fit(pts, pred, sxy, syaw);
       if (ends || wide) {
         const Impl::Fit& t = wide ? *wide : f;
         m.hyps.clear();
@@ -598,18 +608,9 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
     if (g.accepted && g.inlier_ratio >= cfg_.min_inlier_ratio) f = std::move(g);
   }
   // On a laser step, a failed fit is also tried in the window the wheels' model gives this step (a laser
-  // increment can be wrong by more than its sigma: a large turn); as while re-acquiring, only an unrivalled fit
-  // that explains almost the whole scan (reacquire_strong_ratio) is taken.
-  if (!f.accepted && m.poor_run == 0 && cfg_.laser_wide_retry && cfg_.laser_track_retry && res.laser_step &&
-      (m.wheel_extra_xy2 > 0 || m.wheel_extra_yaw2 > 0)) {
-    const double wxy = std::sqrt(sxy * sxy + m.wheel_extra_xy2), wyaw = std::sqrt(syaw * syaw + m.wheel_extra_yaw2);
-    Impl::Fit g = m.fit(pts, pred, wxy, wyaw, cfg_.max_window_xy_m, cfg_.max_window_yaw_rad, 1, 1.1);
-    if (m.inside(g, pred) && g.inlier_ratio >= cfg_.reacquire_strong_ratio &&
-        (cfg_.rival_margin < 0 || m.rival(g) < g.inlier_ratio - cfg_.rival_margin)) {
-      g.accepted = true;
-      f = std::move(g);
-    }
-  }
+  // increment can be wrong by more than its sigma: a large turn), as while re-acquiring.
+  if (!f.accepted && m.poor_run == 0 && cfg_.laser_wide_retry && cfg_.laser_track_retry && res.laser_step)
+    if (auto g = m.wheel_window_fit(pts, pred, sxy, syaw)) f = std::move(*g);
   res.search_xy_m = f.wxy;
   res.search_yaw_rad = f.wyaw;
   res.candidates = f.leaves;
