@@ -114,6 +114,8 @@ int main(int argc, char** argv) {
                       {"odom_bias_deg_per_m", r.odom_bias_rad_per_m * 180 / M_PI},
                       {"odom_turn_scale_error", r.odom_turn_scale_error}, {"odom_scale", r.odom_scale}});
       if (odom) rows.back().update({{"odom_x", odom->x}, {"odom_y", odom->y}, {"odom_yaw", odom->yaw}});
+      if (r.laser_step)
+        rows.back()["laser_increment"] = {r.laser_increment.x, r.laser_increment.y, r.laser_increment.yaw};
     }
     std::cout << nlohmann::json{{"log", log_path}, {"map", map_path}, {"start", start},
                                 {"ms_per_scan", total_ms / double(end - first)}, {"scans", rows}}

@@ -359,6 +359,7 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
     inc = laser->increment;
     res.laser_step = true;
     res.laser_inlier_ratio = laser->inlier_ratio;
+    res.laser_increment = laser->increment;
     qxy = q.xy;
     qyaw = q.yaw;
   } else if (wheels) {

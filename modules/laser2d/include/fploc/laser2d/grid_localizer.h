@@ -225,6 +225,7 @@ struct GridResult {
   bool reacquired = false;  // this scan ended LOST with a confirmed hypothesis
   bool laser_step = false;  // the prediction came from the laser odometry (else the wheels)
   double laser_inlier_ratio = 0;  // the laser odometry's match (0 when it did not match)
+  Pose2 laser_increment;          // its increment since the previous scan (on laser steps)
   // The odometry calibration after this scan (yaw bias [rad/m], turn scale error, translation scale, pairs used).
   double odom_bias_rad_per_m = 0, odom_turn_scale_error = 0, odom_scale = 1;
   int odom_pairs = 0;
