@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
-# scripts/demo-screenshot.sh [OUT.png] [SECONDS]: runs the README's demo (graphs/demo.pbtxt) in a private
-# network namespace and saves a screenshot of its dashboard after SECONDS (default 35), e.g. for the
-# README (docs/img/demo.png). Needs the browser-test dependencies (scripts/setup-web.sh).
+# scripts/demo-screenshot.sh [OUT.png] [SECONDS] [GRAPH]: runs the README's demo (graphs/demo.pbtxt, or GRAPH,
+# e.g. graphs/demo-building.pbtxt) in a private network namespace and saves a screenshot of its dashboard after
+# SECONDS (default 35), e.g. for the README (docs/img/demo.png). Needs the browser-test dependencies
+# (scripts/setup-web.sh).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 OUT="$(realpath -m "${1:-$ROOT/docs/img/demo.png}")"
 WAIT="${2:-35}"
-if [ "${FPLOC_IN_NETNS:-}" != "1" ]; then exec "$ROOT/scripts/netns-run" "$0" "$OUT" "$WAIT"; fi
-"$ROOT/bin/fploc" launch "$ROOT/graphs/demo.pbtxt" --duration "$((WAIT + 15))" 2> /tmp/fploc-demo-screenshot.log &
+GRAPH="$(realpath -m "${3:-$ROOT/graphs/demo.pbtxt}")"
+[ -f "$GRAPH" ] || { echo "demo-screenshot.sh: no graph file $GRAPH" >&2; exit 2; }
+if [ "${FPLOC_IN_NETNS:-}" != "1" ]; then exec "$ROOT/scripts/netns-run" "$0" "$OUT" "$WAIT" "$GRAPH"; fi
+"$ROOT/bin/fploc" launch "$GRAPH" --duration "$((WAIT + 15))" 2> /tmp/fploc-demo-screenshot.log &
 L=$!
 # Until the dashboard answers (bin/fploc may first bring the build up to date), at most 10 minutes.
 for _ in $(seq 3000); do
