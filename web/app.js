@@ -35,7 +35,7 @@ const plots = {
 // Other robots on the same plan (fleet): trail and pose in their colour, named.
 map.layers.push((c, v) => {
   for (const [name, r] of Object.entries(S.fleet)) {
-    v.polyline(c, r.trail, r.color, 2);
+    drawOnShownFloor(c, v, r.trail, r.color, (q) => q[3]);
     if (r.pose && r.pose.x !== null) {
       v.arrow(c, r.pose.x, r.pose.y, r.pose.yaw, r.color, true);
       const [sx, sy] = v.toScreen(r.pose.x, r.pose.y);
@@ -48,9 +48,31 @@ map.layers.push((c, v) => {
     c.fillStyle = COL.est; c.font = 'bold 13px sans-serif'; c.fillText(own.name, sx + 12, sy - 12);
   }
 });
+// In a building, a trail is drawn only where it is on the floor the map shows (a point of unknown floor counts as
+// on it); the ground truth, which names no floor, takes the floor of the estimate at its time.
+function floorAt(trail, utime) {
+  let lo = 0, hi = trail.length - 1, f = null;
+  while (lo <= hi) {
+    const m = (lo + hi) >> 1;
+    if (trail[m][2] <= utime) { f = trail[m][3]; lo = m + 1; } else hi = m - 1;
+  }
+  return f;
+}
+function drawOnShownFloor(c, v, trail, color, floorOf) {
+  const shown = floors.shown;
+  if (floors.floors.length < 2 || !shown) { v.polyline(c, trail, color, 2); return; }
+  let run = [];
+  for (const q of trail) {
+    const f = floorOf(q);
+    if (!f || f === shown) { run.push(q); continue; }
+    v.polyline(c, run, color, 2);
+    run = [];
+  }
+  v.polyline(c, run, color, 2);
+}
 map.layers.push((c, v) => {
-  v.polyline(c, S.gtTrail, COL.gt, 2);
-  v.polyline(c, S.trail, COL.est, 2);
+  drawOnShownFloor(c, v, S.gtTrail, COL.gt, (q) => floorAt(S.trail, q[2]));
+  drawOnShownFloor(c, v, S.trail, COL.est, (q) => q[3]);
   const f = S.features;
   // Project with the frame pose of the same scan when it is here (it arrives just after the features).
   const fpose = f && (S.frame && S.frame.scan_seq === f.scan_seq && S.frame.x !== null ? S.frame : f.pose);
@@ -95,14 +117,16 @@ map.layers.push((c, v) => {
 map.layers.push(planDiffLayer(S));  // where the building no longer matches the plan (fploc-plan-diff)
 
 // ---- trail handling (the optimiser re-publishes poses of its window: replace by utime) --------
-function addToTrail(trail, utime, x, y) {
+// A trail point is [x, y, utime, floor] (floor: the pose's floor name, null when unknown).
+function addToTrail(trail, utime, x, y, floor = null) {
   if (x === null || y === null) return;
+  const q = [x, y, utime, floor || null];
   for (let k = trail.length - 1; k >= 0 && k >= trail.length - 200; k--) {
-    if (trail[k][2] === utime) { trail[k] = [x, y, utime]; return; }
+    if (trail[k][2] === utime) { trail[k] = q; return; }
     if (trail[k][2] < utime) break;
   }
   if (trail.length && trail[trail.length - 1][2] > utime) return;  // late and outside the window: ignore
-  trail.push([x, y, utime]);
+  trail.push(q);
   if (trail.length > MAX_TRAIL) trail.splice(0, trail.length - MAX_TRAIL);
 }
 
@@ -199,7 +223,7 @@ function fillGap(since) {
       const from = fillSince; fillSince = null;
       try {
         const h = await (await fetch(`/api/history?since=${from}`, { cache: 'no-store' })).json();
-        S.trail = mergeTrail(S.trail, h.est.map(([u, x, y]) => [x, y, u]));
+        S.trail = mergeTrail(S.trail, h.est.map(([u, x, y, , , , , , f]) => [x, y, u, f || null]));
         S.gtTrail = mergeTrail(S.gtTrail, h.gt.map(([u, x, y]) => [x, y, u]));
         S.gapFills = (S.gapFills || 0) + 1;
         map.invalidate();
@@ -219,7 +243,7 @@ function onPose(p) {
   S.lastPoseSeq = p.seq;
   S.pose = p;
   floors.setRobotFloor(p.floor);
-  addToTrail(S.trail, p.utime, p.x, p.y);
+  addToTrail(S.trail, p.utime, p.x, p.y, p.floor);
   const lat = Date.now() - p.utime / 1000;
   if (lat > -50 && lat < 10000) {  // only when the stamp is this machine's wall clock (live runs)
     S.latencies.push(lat);
@@ -257,8 +281,8 @@ async function loadStatic() {
   S.trail = []; S.gtTrail = []; t0 = null; S.lastPoseSeq = undefined; S.lastGtSeq = undefined;
   Object.values(plots).forEach((p) => p.clear());
   let sq = 0, n = 0;
-  for (const [utime, x, y, z, roll, pitch, , err] of hist.est) {
-    addToTrail(S.trail, utime, x, y);
+  for (const [utime, x, y, z, roll, pitch, , err, floor] of hist.est) {
+    addToTrail(S.trail, utime, x, y, floor);
     const t = tsec(utime);
     if (err !== null) { sq += err * err; n++; }
     plots.ate.push(t, [n ? Math.sqrt(sq / n) : null, err]);
@@ -321,10 +345,10 @@ function onRobots(list, on) {
   for (const r of list) {
     if (r.own || S.fleet[r.name]) continue;
     const f = S.fleet[r.name] = { color: r.color, trail: [], pose: null, nodes: null };
-    on(`pose@${r.name}`, (p) => { f.pose = p; addToTrail(f.trail, p.utime, p.x, p.y); map.invalidate(); if (S.selected === r.name) schedulePoseBox(); });
+    on(`pose@${r.name}`, (p) => { f.pose = p; addToTrail(f.trail, p.utime, p.x, p.y, p.floor); map.invalidate(); if (S.selected === r.name) schedulePoseBox(); });
     on(`nodes@${r.name}`, (m) => { f.nodes = m; if (S.selected === r.name) renderNodeTable(m); });
     fetch(`/api/history?robot=${encodeURIComponent(r.name)}`, { cache: 'no-store' }).then((x) => x.json())
-      .then((h) => { f.trail = mergeTrail(f.trail, h.est.map(([u, x, y]) => [x, y, u])); map.invalidate(); })
+      .then((h) => { f.trail = mergeTrail(f.trail, h.est.map(([u, x, y, , , , , , f]) => [x, y, u, f || null])); map.invalidate(); })
       .catch(() => {});
   }
   const sel = $('robot');

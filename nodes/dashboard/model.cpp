@@ -17,6 +17,7 @@ using nlohmann::json;
 
 namespace {
 json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+json floor_or_null(const std::string& f) { return f.empty() ? json(nullptr) : json(f); }
 }  // namespace
 
 Model::Model(ModelConfig cfg) : cfg_(cfg), ate_(cfg.ate_match_tolerance_s, cfg.max_trail * 2) {}
@@ -62,7 +63,7 @@ void Model::on_pose(const fploc::pose_t& m, double now_s, int64_t wall_us) {
   ate_.add_estimate(m.utime, m.position[0], m.position[1], m.position[2]);
   const AteFigure a = ate_figure(m.utime);
   TrailPoint p{m.utime, m.position[0], m.position[1], m.position[2], r.roll, r.pitch, r.yaw, bool(a.err),
-               a.err.value_or(0.0)};
+               a.err.value_or(0.0), m.floor};
   // The optimiser re-publishes poses inside its window: replace the entry with the same time.
   bool replaced = false;
   for (size_t k = 0; k < est_.size() && k < 200; ++k) {
@@ -179,7 +180,7 @@ void Model::on_fleet_pose(const std::string& robot, const fploc::pose_t& m, doub
   auto it = fleet_.find(robot);
   if (it == fleet_.end()) return;
   auto& est = it->second.est;
-  TrailPoint p{m.utime, m.position[0], m.position[1], m.position[2], r.roll, r.pitch, r.yaw, false, 0};
+  TrailPoint p{m.utime, m.position[0], m.position[1], m.position[2], r.roll, r.pitch, r.yaw, false, 0, m.floor};
   if (!est.empty() && est.back().utime == m.utime) est.back() = p;
   else if (est.empty() || est.back().utime < m.utime) est.push_back(p);
   while (est.size() > cfg_.max_trail) est.pop_front();
@@ -213,8 +214,8 @@ std::string Model::fleet_history_json(const std::string& robot, int64_t since) c
     for (const auto& p : it->second.est)
       if (p.utime > since)
         est.push_back({p.utime, num(r6(p.x)), num(r6(p.y)), num(r6(p.z)), num(r6(p.roll)), num(r6(p.pitch)),
-                       num(r6(p.yaw)), nullptr});
-  json j = {{"robot", robot}, {"fields_est", {"utime", "x", "y", "z", "roll", "pitch", "yaw", "err"}},
+                       num(r6(p.yaw)), nullptr, floor_or_null(p.floor)});
+  json j = {{"robot", robot}, {"fields_est", {"utime", "x", "y", "z", "roll", "pitch", "yaw", "err", "floor"}},
             {"est", est}, {"gt", json::array()}};
   return j.dump();
 }
@@ -239,10 +240,10 @@ std::string Model::history_json(int64_t since) const {
   for (const auto& p : est_)
     if (p.utime > since)
       est.push_back({p.utime, num(r6(p.x)), num(r6(p.y)), num(r6(p.z)), num(r6(p.roll)), num(r6(p.pitch)),
-                     num(r6(p.yaw)), p.has_err ? num(r6(p.err)) : json(nullptr)});
+                     num(r6(p.yaw)), p.has_err ? num(r6(p.err)) : json(nullptr), floor_or_null(p.floor)});
   for (const auto& p : gt_)
     if (p.utime > since) gt.push_back({p.utime, num(r6(p.x)), num(r6(p.y)), num(r6(p.z))});
-  json j = {{"fields_est", {"utime", "x", "y", "z", "roll", "pitch", "yaw", "err"}},
+  json j = {{"fields_est", {"utime", "x", "y", "z", "roll", "pitch", "yaw", "err", "floor"}},
             {"fields_gt", {"utime", "x", "y", "z"}},
             {"est", est},
             {"gt", gt},

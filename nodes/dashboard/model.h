@@ -89,6 +89,7 @@ class Model {
     double x, y, z, roll, pitch, yaw;
     bool has_err;
     double err;
+    std::string floor;  // the pose's floor (pose_t.floor; "" unknown, and for the ground truth)
   };
   std::deque<TrailPoint> est_, gt_;
   fploc::eval::OnlineAte ate_;

@@ -56,6 +56,27 @@ TEST(DashboardModel, AteMatchesByUtimeInEitherOrder) {
   EXPECT_EQ(h["gt"].size(), 2u);
 }
 
+// The history keeps each pose's floor (the page draws only the trail on the floor it shows): the floor's name as
+// the row's last field, null when the pose did not say.
+TEST(DashboardModel, HistoryKeepsEachPosesFloor) {
+  Model m;
+  auto on = [&](int64_t t, const char* floor) {
+    fploc::pose_t p = pose(t, 1, 2);
+    p.floor = floor;
+    m.on_pose(p, 0, 0);
+  };
+  on(1000000, "ground");
+  on(2000000, "first");
+  on(3000000, "");
+  auto h = json::parse(m.history_json());
+  ASSERT_EQ(h["fields_est"].back(), "floor");
+  ASSERT_EQ(h["est"].size(), 3u);
+  const size_t k = h["fields_est"].size() - 1;
+  EXPECT_EQ(h["est"][0][k], "ground");
+  EXPECT_EQ(h["est"][1][k], "first");
+  EXPECT_TRUE(h["est"][2][k].is_null());
+}
+
 TEST(DashboardModel, NodeTurnsRedWhenSilentOrRestartingAndGreenAgain) {
   ModelConfig cfg;
   cfg.silent_after_s = 2.0;
