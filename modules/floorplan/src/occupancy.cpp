@@ -388,16 +388,19 @@ FloorPlan vectorise_occupancy(const OccupancyGrid& g, const VectoriseOptions& o,
       for (int i = 0; i < W; ++i) {
         if (!is_free_boundary(i, j) || (pass == 0 && degree(i, j) > 1)) continue;
         pts.clear();
-        int ci = i, cj = j;
+        int ci = i, cj = j, dir = -1;
         for (;;) {
           boundary[size_t(cj) * W + ci] = 2;
           pts.push_back(g.cell_centre(ci, cj));
-          int next = -1;
+          // The walk keeps its direction while it can: in a wall two cells thick every cell is a boundary cell,
+          // and a fixed neighbour order alone zigzags through both columns (a segment per cell).
+          int next = dir >= 0 && is_free_boundary(ci + kDi[dir], cj + kDj[dir]) ? dir : -1;
           for (int k = 0; k < 8 && next < 0; ++k)
             if (is_free_boundary(ci + kDi[k], cj + kDj[k])) next = k;
           if (next < 0) break;
           ci += kDi[next];
           cj += kDj[next];
+          dir = next;
         }
         ++st.chains;
         if (pts.size() == 1) {

@@ -127,6 +127,28 @@ TEST(Occupancy, ModesAndOrientation) {
   EXPECT_TRUE(r.cell_centre(0, 0).isApprox(Eigen::Vector2d(0.95, 2.05)));
 }
 
+// A wall two cells thick (every cell of it is a boundary cell) becomes its two faces, not a serpentine through
+// both columns (seen on data/plans/room.yaml: 587 of 639 segments were such 5 cm zigzags).
+TEST(Occupancy, TwoCellWallGivesStraightFaces) {
+  OccupancyGrid g;
+  g.width = 20;
+  g.height = 60;
+  g.resolution = 0.05;
+  g.data.assign(size_t(g.width) * g.height, 0);
+  for (int j = 5; j < 55; ++j) g.data[size_t(j) * g.width + 9] = g.data[size_t(j) * g.width + 10] = 100;
+  // A one-cell stub on top: the chain starts at its end and walks down the wall (the serpentine came from walking
+  // towards -y or -x, where the +x / +y neighbours were tried first).
+  g.data[size_t(55) * g.width + 9] = g.data[size_t(56) * g.width + 9] = 100;
+  VectoriseStats st;
+  const FloorPlan v = vectorise_occupancy(g, {}, &st);
+  EXPECT_EQ(st.boundary_cells, 102u);
+  EXPECT_LE(st.max_error_m, 0.5 * g.resolution + 1e-9);
+  double longest = 0;
+  for (const auto& e : v.elements) longest = std::max(longest, (e.b - e.a).norm());
+  EXPECT_LE(v.elements.size(), 5u) << "the wall's two faces, its ends and the stub";
+  EXPECT_GT(longest, 2.0) << "no segment runs along the wall";
+}
+
 // Rasterise a plan with straight, diagonal and short walls, vectorise, and compare both ways: every wall
 // point is within one cell of the vectorised plan and vice versa; the chain error is within tolerance.
 TEST(Occupancy, RoundTripWithinOneCell) {
