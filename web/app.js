@@ -49,14 +49,14 @@ map.layers.push((c, v) => {
   }
 });
 // In a building, a trail is drawn only where it is on the floor the map shows (a point of unknown floor counts as
-// on it); the ground truth, which names no floor, takes the floor of the estimate at its time.
-function floorAt(trail, utime) {
-  let lo = 0, hi = trail.length - 1, f = null;
-  while (lo <= hi) {
-    const m = (lo + hi) >> 1;
-    if (trail[m][2] <= utime) { f = trail[m][3]; lo = m + 1; } else hi = m - 1;
-  }
-  return f;
+// on it); the ground truth, which names no floor, takes the floor of the estimate at its time: both trails are in
+// time order, so one cursor walks the estimate along the ground truth.
+function floorOfEstimateAt(trail) {
+  let k = -1;
+  return (q) => {
+    while (k + 1 < trail.length && trail[k + 1][2] <= q[2]) k++;
+    return k >= 0 ? trail[k][3] : null;
+  };
 }
 function drawOnShownFloor(c, v, trail, color, floorOf) {
   const shown = floors.shown;
@@ -71,7 +71,7 @@ function drawOnShownFloor(c, v, trail, color, floorOf) {
   v.polyline(c, run, color, 2);
 }
 map.layers.push((c, v) => {
-  drawOnShownFloor(c, v, S.gtTrail, COL.gt, (q) => floorAt(S.trail, q[2]));
+  drawOnShownFloor(c, v, S.gtTrail, COL.gt, floorOfEstimateAt(S.trail));
   drawOnShownFloor(c, v, S.trail, COL.est, (q) => q[3]);
   const f = S.features;
   // Project with the frame pose of the same scan when it is here (it arrives just after the features).
@@ -117,7 +117,9 @@ map.layers.push((c, v) => {
 map.layers.push(planDiffLayer(S));  // where the building no longer matches the plan (fploc-plan-diff)
 
 // ---- trail handling (the optimiser re-publishes poses of its window: replace by utime) --------
-// A trail point is [x, y, utime, floor] (floor: the pose's floor name, null when unknown).
+// A trail point is [x, y, utime, floor] (floor: the pose's floor name, null when unknown); from an /api/history
+// est row [utime, x, y, z, roll, pitch, yaw, err, floor]:
+const trailPoint = ([u, x, y, , , , , , f]) => [x, y, u, f || null];
 function addToTrail(trail, utime, x, y, floor = null) {
   if (x === null || y === null) return;
   const q = [x, y, utime, floor || null];
@@ -223,7 +225,7 @@ function fillGap(since) {
       const from = fillSince; fillSince = null;
       try {
         const h = await (await fetch(`/api/history?since=${from}`, { cache: 'no-store' })).json();
-        S.trail = mergeTrail(S.trail, h.est.map(([u, x, y, , , , , , f]) => [x, y, u, f || null]));
+        S.trail = mergeTrail(S.trail, h.est.map(trailPoint));
         S.gtTrail = mergeTrail(S.gtTrail, h.gt.map(([u, x, y]) => [x, y, u]));
         S.gapFills = (S.gapFills || 0) + 1;
         map.invalidate();
@@ -348,7 +350,7 @@ function onRobots(list, on) {
     on(`pose@${r.name}`, (p) => { f.pose = p; addToTrail(f.trail, p.utime, p.x, p.y, p.floor); map.invalidate(); if (S.selected === r.name) schedulePoseBox(); });
     on(`nodes@${r.name}`, (m) => { f.nodes = m; if (S.selected === r.name) renderNodeTable(m); });
     fetch(`/api/history?robot=${encodeURIComponent(r.name)}`, { cache: 'no-store' }).then((x) => x.json())
-      .then((h) => { f.trail = mergeTrail(f.trail, h.est.map(([u, x, y, , , , , , f]) => [x, y, u, f || null])); map.invalidate(); })
+      .then((h) => { f.trail = mergeTrail(f.trail, h.est.map(trailPoint)); map.invalidate(); })
       .catch(() => {});
   }
   const sel = $('robot');

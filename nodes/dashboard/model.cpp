@@ -17,7 +17,13 @@ using nlohmann::json;
 
 namespace {
 json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-json floor_or_null(const std::string& f) { return f.empty() ? json(nullptr) : json(f); }
+// An /api/history est row: utime, x, y, z, roll, pitch, yaw, err (null without one), floor (null when unknown).
+const json kEstFields = {"utime", "x", "y", "z", "roll", "pitch", "yaw", "err", "floor"};
+template <class TrailPoint>
+json est_row(const TrailPoint& p) {
+  return {p.utime, num(r6(p.x)), num(r6(p.y)), num(r6(p.z)), num(r6(p.roll)), num(r6(p.pitch)), num(r6(p.yaw)),
+          p.has_err ? num(r6(p.err)) : json(nullptr), p.floor.empty() ? json(nullptr) : json(p.floor)};
+}
 }  // namespace
 
 Model::Model(ModelConfig cfg) : cfg_(cfg), ate_(cfg.ate_match_tolerance_s, cfg.max_trail * 2) {}
@@ -88,7 +94,7 @@ void Model::on_ground_truth(const fploc::ground_truth_t& m, double, int64_t wall
   const Rpy r = rpy_of(m.orientation);
   std::lock_guard<std::mutex> lk(mu_);
   ate_.add_truth(m.utime, m.position[0], m.position[1], m.position[2]);
-  TrailPoint p{m.utime, m.position[0], m.position[1], m.position[2], r.roll, r.pitch, r.yaw, false, 0};
+  TrailPoint p{m.utime, m.position[0], m.position[1], m.position[2], r.roll, r.pitch, r.yaw, false, 0, {}};
   if (!gt_.empty() && gt_.back().utime == m.utime) gt_.back() = p;
   else if (gt_.empty() || gt_.back().utime < m.utime) gt_.push_back(p);
   while (gt_.size() > cfg_.max_trail) gt_.pop_front();
@@ -213,9 +219,8 @@ std::string Model::fleet_history_json(const std::string& robot, int64_t since) c
   if (it != fleet_.end())
     for (const auto& p : it->second.est)
       if (p.utime > since)
-        est.push_back({p.utime, num(r6(p.x)), num(r6(p.y)), num(r6(p.z)), num(r6(p.roll)), num(r6(p.pitch)),
-                       num(r6(p.yaw)), nullptr, floor_or_null(p.floor)});
-  json j = {{"robot", robot}, {"fields_est", {"utime", "x", "y", "z", "roll", "pitch", "yaw", "err", "floor"}},
+        est.push_back(est_row(p));
+  json j = {{"robot", robot}, {"fields_est", kEstFields},
             {"est", est}, {"gt", json::array()}};
   return j.dump();
 }
@@ -239,11 +244,10 @@ std::string Model::history_json(int64_t since) const {
   json est = json::array(), gt = json::array();
   for (const auto& p : est_)
     if (p.utime > since)
-      est.push_back({p.utime, num(r6(p.x)), num(r6(p.y)), num(r6(p.z)), num(r6(p.roll)), num(r6(p.pitch)),
-                     num(r6(p.yaw)), p.has_err ? num(r6(p.err)) : json(nullptr), floor_or_null(p.floor)});
+      est.push_back(est_row(p));
   for (const auto& p : gt_)
     if (p.utime > since) gt.push_back({p.utime, num(r6(p.x)), num(r6(p.y)), num(r6(p.z))});
-  json j = {{"fields_est", {"utime", "x", "y", "z", "roll", "pitch", "yaw", "err", "floor"}},
+  json j = {{"fields_est", kEstFields},
             {"fields_gt", {"utime", "x", "y", "z"}},
             {"est", est},
             {"gt", gt},
