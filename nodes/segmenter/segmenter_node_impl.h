@@ -6,6 +6,7 @@
 #include <fploc/scan_t.hpp>
 #include <fploc/segments_t.hpp>
 
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -18,6 +19,7 @@
 #include "fploc/config/perception.h"
 #include "fploc/floorplan/building.h"
 #include "fploc/runtime/node.h"
+#include "fploc/segmentation/scan_imu_sync.h"
 
 namespace fploc {
 
@@ -50,14 +52,30 @@ class SegmenterNodeT : public rt::Node {
         ctx_->error("imu seq " + std::to_string(m.seq) + ": non-finite gyro (ignored)");
       else
         seg_->add_gyro(w, m.gyro_utime != 0 ? m.gyro_utime : m.utime);  // de-skew of the sweep's rotation
-      if (!use_imu_) return;
-      const Eigen::Vector3d a(m.accel[0], m.accel[1], m.accel[2]);
-      if (!a.allFinite()) {
-        ctx_->error("imu seq " + std::to_string(m.seq) + ": non-finite accel (ignored)");
-        return;
+      // A scan held for its sweep's IMU samples (scan_imu_sync.h) goes once they reach the sweep's end.
+      sync_.on_imu(m.gyro_utime != 0 ? m.gyro_utime : m.utime);
+      if (use_imu_) {
+        const Eigen::Vector3d a(m.accel[0], m.accel[1], m.accel[2]);
+        if (!a.allFinite())
+          ctx_->error("imu seq " + std::to_string(m.seq) + ": non-finite accel (ignored)");
+        else
+          seg_->add_accel(a);
       }
-      seg_->add_accel(a);
+      if (held_ && sync_.ready(scan_.utime, held_end_)) release();
     });
+    // Live: a scan whose IMU samples are later than any lag seen goes as it is (replay is lock-step, its
+    // order fixed: the next sample or scan releases it there).
+    if (!ctx.composed())
+      ctx.every(0.02, [this] {
+        if (held_ && std::chrono::duration<double>(std::chrono::steady_clock::now() - held_since_).count() >
+                         seg::ScanImuSync::kMaxHoldS)
+          release();
+      });
+  }
+
+  // The last scan, when it was still waiting for its IMU samples.
+  void shutdown() override {
+    if (held_) release();
   }
 
  private:
@@ -95,6 +113,8 @@ class SegmenterNodeT : public rt::Node {
   }
 
   void on_scan(const scan_t& m) {
+    // The scan before, still waiting for its IMU samples: the IMU is more than a sweep late, it goes as it is.
+    if (held_) release();
     segments_t msg;
     try {
       adapters::from_msg(m, scan_);
@@ -117,9 +137,26 @@ class SegmenterNodeT : public rt::Node {
       out_.publish(msg);
       return;
     }
+    held_end_ = seg::ScanImuSync::sweep_end(scan_);
+    if (!sync_.ready(scan_.utime, held_end_)) {
+      held_ = true;
+      held_since_ = std::chrono::steady_clock::now();
+      return;
+    }
+    segment();
+  }
+
+  void release() {
+    held_ = false;
+    segment();
+  }
+
+  // scan_ through the segmenter, published.
+  void segment() {
+    segments_t msg;
     const auto& s = seg_->process(scan_);
     if (s.status == seg::SegStatus::kBadInput || s.status == seg::SegStatus::kEmpty)
-      ctx_->error("scan seq " + std::to_string(m.seq) + " on " + ctx_->channel("scan") + ": " + seg::to_string(s.status) +
+      ctx_->error("scan seq " + std::to_string(scan_.seq) + " on " + ctx_->channel("scan") + ": " + seg::to_string(s.status) +
                   ": " + s.status_text);
     adapters::to_msg(s, seq_++, msg);
     out_.publish(msg);
@@ -128,7 +165,11 @@ class SegmenterNodeT : public rt::Node {
   rt::Context* ctx_ = nullptr;
   std::unique_ptr<seg::Segmenter> seg_;
   rt::Publisher<segments_t> out_;
-  Scan scan_;
+  Scan scan_;  // the scan being segmented, or held (held_) until its sweep's IMU samples are in
+  bool held_ = false;
+  int64_t held_end_ = 0;  // its sweep's end
+  std::chrono::steady_clock::time_point held_since_;
+  seg::ScanImuSync sync_;
   int64_t seq_ = 0;
   bool use_imu_ = false;
   std::vector<seg::AreaCeilingMap> floors_;  // option building: every floor's ceilings

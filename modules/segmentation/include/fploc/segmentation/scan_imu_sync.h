@@ -1,0 +1,51 @@
+#pragma once
+// When a scan may be segmented: once the IMU samples of its sweep are in.
+//
+// The segmenter de-skews a sweep with the gyro and carries gravity from scan to scan with it
+// (gyro_deskew.h, gravity_fusion.h); both need gyro samples up to the sweep's end. A log written by the
+// simulator or a recorder has every IMU sample before the scan that ends after it, but live the two streams
+// come through different processes and sockets: on a busy machine the IMU samples of a whole sweep (10 at
+// 100 Hz) arrived 50-100 ms after the scan. Segmented at once, such a scan had no gyro for its sweep: no
+// de-skew, and a plane change on a ramp taken as level (the sensor's pitch 7 deg off for 50 s in a live demo
+// run; the same log replayed in lock-step gave the same error).
+//
+// ScanImuSync holds a scan back while the IMU stream is live (a sample within live_window of the scan's
+// start) and has not reached the scan's sweep end (within the 20 ms the de-skew and the fusion accept beyond
+// the last sample, segmenter_constants.h kGyroEdgeUs: a log in the simulator's order is never held); the
+// caller releases it when a sample reaches it, when the
+// next scan arrives, or live after kMaxHoldS of wall time (the IMU is then later than any lag seen: the scan
+// goes as it is, as before). Without an IMU, or with a stream that stopped, scans are never held. No transport
+// here: the segmenter node calls it.
+#include <cstdint>
+
+#include "fploc/core/scan.h"
+
+namespace fploc::seg {
+
+class ScanImuSync {
+ public:
+  // Live, a held scan goes after this long (wall time) even without its samples (the lag seen: up to 0.1 s).
+  static constexpr double kMaxHoldS = 0.2;
+
+  explicit ScanImuSync(int64_t live_window_us = 1000000) : live_window_us_(live_window_us) {}
+
+  // An IMU sample's time (the gyro's stamp, as the segmenter gets it).
+  void on_imu(int64_t utime) {
+    if (utime > last_imu_) last_imu_ = utime;
+  }
+  int64_t last_imu() const { return last_imu_; }
+
+  // The sweep's end: the last valid column's time, else the scan's time (no column times: nothing to wait for).
+  static int64_t sweep_end(const Scan& scan);
+
+  // True when a scan whose sweep ends at end_utime (and starts at start_utime) can be segmented now: no IMU
+  // seen, the stream silent for longer than live_window before the sweep, or a sample within the de-skew's
+  // tolerance of its end.
+  bool ready(int64_t start_utime, int64_t end_utime) const;
+
+ private:
+  int64_t live_window_us_;
+  int64_t last_imu_ = 0;
+};
+
+}  // namespace fploc::seg

@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# The IMU later than the scans, as it arrives live on a busy machine (a whole sweep's samples 50-100 ms after
+# the scan): the segmenter must wait for its sweep's samples (nodes/segmenter, scan_imu_sync.h) and give the
+# same segments as with every sample before the scan. A short simulated sequence is written once in the
+# simulator's order and once with every IMU event moved 100 ms later; both replayed in lock-step through
+# graphs/paper.pbtxt, the segments recorded: roll, pitch and height must agree per scan. (Before
+# the wait, the late log's scans had no gyro for their sweep: no de-skew, and on a ramp the fusion took the
+# ramp for level, 7 deg of pitch for 50 s in a live demo run.)
+set -euo pipefail
+BIN="${FPLOC_BUILD_DIR:?}/bin"
+ROOT="${FPLOC_ROOT:?}"
+W="$(mktemp -d "${TMPDIR:-/tmp}/fploc-imu-late-XXXXXX")"
+trap 'rm -rf "$W"' EXIT
+"$BIN/fploc-sim" --scenario room-small-loop-fast --seed 5 --duration 4 --out "$W/log.lcm" --gt "$W/gt.tum" 2>"$W/sim.err"
+PYTHONPATH="$ROOT/tools/pylib" python3 - "$W/log.lcm" "$W/late.lcm" <<'PY'
+import struct, sys
+from lcm_log import SYNC, events
+ev = [(t + (100000 if ch == "OS1_IMU" else 0), k, ch, d) for k, (t, ch, d) in enumerate(events(sys.argv[1], with_time=True))]
+ev.sort()
+with open(sys.argv[2], "wb") as f:
+    for n, (t, _, ch, d) in enumerate(ev):
+        f.write(struct.pack(">IqqII", SYNC, n, t, len(ch), len(d)) + ch.encode() + d)
+late, last_imu = 0, 0
+for _, _, ch, d in ev:  # scans whose sweep (0.1 s from the scan's utime) the samples before them do not cover
+    utime = struct.unpack(">q", d[8:16])[0]
+    if ch == "OS1_IMU":
+        last_imu = utime
+    elif ch == "OS1_SCAN":
+        late += last_imu < utime + 90000
+print(f"{len(ev)} events, every IMU sample 100 ms later: {late} scans now come before their sweep's samples")
+assert late >= 30, late
+PY
+PLAN="$ROOT/data/plans/room.json"
+for run in ordered late; do
+  log="$W/log.lcm"; [ "$run" = late ] && log="$W/late.lcm"
+  "$BIN/fploc-replay" --graph "$ROOT/graphs/paper.pbtxt" --log "$log" --json \
+    --set matcher.plan.file="$PLAN" --set optimizer.plan.file="$PLAN" \
+    --set sfr_logger.file="$W/$run-sfr.tum" --set wo_logger.file="$W/$run-wo.tum" --set odom_logger.file="$W/$run-odom.tum" \
+    --set odom_map_logger.file="$W/$run-odom_map.tum" --record "$W/$run-seg.lcm" --record-channels '^FPLOC_SEGMENTS$' \
+    >"$W/$run.json" 2>"$W/$run.err" || { cat "$W/$run.err" >&2; exit 1; }
+done
+PYTHONPATH="$ROOT/tools/pylib" python3 - "$W/ordered-seg.lcm" "$W/late-seg.lcm" "$(grep -c . "$W/gt.tum")" <<'PY'
+import math, struct, sys
+from lcm_log import events
+
+def segments(path):
+    """segments_t (messages/segments_t.lcm) by scan_seq: roll, pitch, z, both planes (and found flags)."""
+    out = {}
+    for ch, d in events(path):
+        o = 8
+        _, _, sseq = struct.unpack(">qqq", d[o:o + 24]); o += 25
+        (n,) = struct.unpack(">i", d[o:o + 4]); o += 4 + n
+        cf = d[o]; cp = struct.unpack(">4d", d[o + 1:o + 33]); o += 33 + 12
+        gf = d[o]; gp = struct.unpack(">4d", d[o + 1:o + 33]); o += 33 + 12
+        roll, pitch, z = struct.unpack(">3d", d[o:o + 24])
+        out[sseq] = (roll, pitch, z, cf, cp, gf, gp)
+    return out
+
+a, b, frames = segments(sys.argv[1]), segments(sys.argv[2]), int(sys.argv[3])
+assert len(a) == frames and len(b) == frames, f"segments for {len(a)} / {len(b)} of {frames} scans"
+rp = max(math.degrees(max(abs(a[k][0] - b[k][0]), abs(a[k][1] - b[k][1]))) for k in a)
+dz = max(abs(a[k][2] - b[k][2]) for k in a)
+found = sum(a[k][3] == b[k][3] and a[k][5] == b[k][5] for k in a)
+print(f"{frames} scans: largest roll/pitch difference {rp:.4f} deg, z {dz * 1000:.2f} mm; planes found alike on {found}")
+# Released 20 ms before its sweep's end (what the de-skew accepts) and with the accelerometer's samples split
+# between scans a little differently, a scan is segmented almost as in order (0.004 deg, 0.4 mm); segmented at
+# once, without its samples: 0.11 deg and 6 mm off here.
+assert found == frames, "a plane found in one order and not in the other"
+assert rp < 0.05 and dz < 0.001, f"the IMU late changed roll/pitch by {rp:.3f} deg, z by {dz * 1000:.2f} mm"
+PY
