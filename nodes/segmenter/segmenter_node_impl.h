@@ -6,6 +6,7 @@
 #include <fploc/scan_t.hpp>
 #include <fploc/segments_t.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -61,7 +62,7 @@ class SegmenterNodeT : public rt::Node {
         else
           seg_->add_accel(a);
       }
-      if (held_ && sync_.ready(scan_.utime, held_end_)) release();
+      if (held_ && sync_.ready(scan_.utime, held_end_)) release(true);
     });
     // Live: a scan whose IMU samples are later than any lag seen goes as it is (replay is lock-step, its
     // order fixed: the next sample or scan releases it there).
@@ -69,13 +70,13 @@ class SegmenterNodeT : public rt::Node {
       ctx.every(0.02, [this] {
         if (held_ && std::chrono::duration<double>(std::chrono::steady_clock::now() - held_since_).count() >
                          seg::ScanImuSync::kMaxHoldS)
-          release();
+          release(false);
       });
   }
 
   // The last scan, when it was still waiting for its IMU samples.
   void shutdown() override {
-    if (held_) release();
+    if (held_) release(false);
   }
 
  private:
@@ -114,7 +115,7 @@ class SegmenterNodeT : public rt::Node {
 
   void on_scan(const scan_t& m) {
     // The scan before, still waiting for its IMU samples: the IMU is more than a sweep late, it goes as it is.
-    if (held_) release();
+    if (held_) release(false);
     segments_t msg;
     try {
       adapters::from_msg(m, scan_);
@@ -146,8 +147,20 @@ class SegmenterNodeT : public rt::Node {
     segment();
   }
 
-  void release() {
+  // The held scan goes: with its sweep's samples, or without them (the IMU too late). The counts are the node's
+  // telemetry detail (the dashboard's "state detail"): a live IMU that lags the scans shows there.
+  void release(bool with_samples) {
     held_ = false;
+    ++held_count_;
+    if (!with_samples) ++without_samples_;
+    std::string d = "IMU late: " + std::to_string(held_count_) + " scans waited for their sweep's samples";
+    if (!ctx_->composed()) {
+      const double w = std::chrono::duration<double>(std::chrono::steady_clock::now() - held_since_).count();
+      max_wait_s_ = std::max(max_wait_s_, w);
+      d += " (longest " + std::to_string(int(std::lround(1000 * max_wait_s_))) + " ms)";
+    }
+    if (without_samples_ > 0) d += ", " + std::to_string(without_samples_) + " went without them";
+    ctx_->set_detail(d);
     segment();
   }
 
@@ -170,6 +183,8 @@ class SegmenterNodeT : public rt::Node {
   int64_t held_end_ = 0;  // its sweep's end
   std::chrono::steady_clock::time_point held_since_;
   seg::ScanImuSync sync_;
+  int64_t held_count_ = 0, without_samples_ = 0;  // scans held, and of those released without their samples
+  double max_wait_s_ = 0;                         // live: the longest hold (wall time)
   int64_t seq_ = 0;
   bool use_imu_ = false;
   std::vector<seg::AreaCeilingMap> floors_;  // option building: every floor's ceilings

@@ -39,6 +39,14 @@ for run in ordered late; do
     --set odom_map_logger.file="$W/$run-odom_map.tum" --record "$W/$run-seg.lcm" --record-channels '^FPLOC_SEGMENTS$' \
     >"$W/$run.json" 2>"$W/$run.err" || { cat "$W/$run.err" >&2; exit 1; }
 done
+# The segmenter says so in its telemetry detail (the dashboard's "state detail"), only when the IMU was late.
+python3 - "$W/ordered.json" "$W/late.json" <<'PY'
+import json, sys
+seg = [[n for n in json.loads(open(p).read().strip().splitlines()[-1])["nodes"] if n["name"] == "segmenter"][0] for p in sys.argv[1:3]]
+print(f"segmenter detail: in order '{seg[0]['detail']}', IMU late '{seg[1]['detail']}'")
+assert seg[0]["detail"] == "", seg[0]
+assert seg[1]["detail"].startswith("IMU late: 40 scans waited"), seg[1]
+PY
 PYTHONPATH="$ROOT/tools/pylib" python3 - "$W/ordered-seg.lcm" "$W/late-seg.lcm" "$(grep -c . "$W/gt.tum")" <<'PY'
 import math, struct, sys
 from lcm_log import events

@@ -184,7 +184,8 @@ int main(int argc, char** argv) {
                        {"cpu_ms", st.cpu_s_total * 1e3},
                        {"share", total_ms > 0 ? sum / total_ms : 0.0},
                        {"errors", st.errors},
-                       {"last_error", st.last_error}});
+                       {"last_error", st.last_error},
+                       {"detail", st.detail}});
     }
     std::cerr << "fploc replay: " << published << " of " << events << " log events fed in " << wall << " s (log span "
               << span << " s, real-time factor " << (wall > 0 ? span / wall : 0.0) << ")"
