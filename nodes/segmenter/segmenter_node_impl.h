@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -62,21 +63,21 @@ class SegmenterNodeT : public rt::Node {
         else
           seg_->add_accel(a);
       }
-      if (held_ && sync_.ready(scan_.utime, held_end_)) release(true);
+      while (!held_.empty() && sync_.ready(held_.front().scan.utime, held_.front().end)) release(true);
     });
-    // Live: a scan whose IMU samples are later than any lag seen goes as it is (replay is lock-step, its
-    // order fixed: the next sample or scan releases it there).
+    // Live: a scan whose IMU samples are later than kMaxHoldS goes as it is, also when no scan follows (replay
+    // is lock-step, its order fixed: samples, later scans or the end release it there).
     if (!ctx.composed())
       ctx.every(0.02, [this] {
-        if (held_ && std::chrono::duration<double>(std::chrono::steady_clock::now() - held_since_).count() >
-                         seg::ScanImuSync::kMaxHoldS)
+        while (!held_.empty() && std::chrono::duration<double>(std::chrono::steady_clock::now() - held_.front().since)
+                                         .count() > seg::ScanImuSync::kMaxHoldS)
           release(false);
       });
   }
 
   // The last scan, when it was still waiting for its IMU samples.
   void shutdown() override {
-    if (held_) release(false);
+    while (!held_.empty()) release(false);
   }
 
  private:
@@ -114,13 +115,17 @@ class SegmenterNodeT : public rt::Node {
   }
 
   void on_scan(const scan_t& m) {
-    // The scan before, still waiting for its IMU samples: the IMU is more than a sweep late, it goes as it is.
-    if (held_) release(false);
-    segments_t msg;
+    Scan scan;
+    if (!spare_.empty()) {  // a recycled scan: its arrays keep their capacity
+      scan = std::move(spare_.back());
+      spare_.pop_back();
+    }
     try {
-      adapters::from_msg(m, scan_);
+      adapters::from_msg(m, scan);
     } catch (const std::exception& e) {
-      // Bad message: say so downstream (status BAD_INPUT) and keep running.
+      // Bad message: say so downstream (status BAD_INPUT) and keep running; the scans before it go first.
+      while (!held_.empty()) release(false);
+      segments_t msg;
       seg::Segmentation bad;
       bad.utime = m.utime;
       bad.seq = m.seq;
@@ -136,52 +141,63 @@ class SegmenterNodeT : public rt::Node {
       ctx_->error(std::string("scan: ") + e.what());
       adapters::to_msg(bad, seq_++, msg);
       out_.publish(msg);
+      spare_.push_back(std::move(scan));
       return;
     }
-    held_end_ = seg::ScanImuSync::sweep_end(scan_);
-    if (!sync_.ready(scan_.utime, held_end_)) {
-      held_ = true;
-      held_since_ = std::chrono::steady_clock::now();
+    const int64_t end = seg::ScanImuSync::sweep_end(scan);
+    if (held_.empty() && sync_.ready(scan.utime, end)) {
+      segment(scan);
+      spare_.push_back(std::move(scan));
       return;
     }
-    segment();
+    held_.push_back({std::move(scan), end, std::chrono::steady_clock::now()});
+    // Scans held longer than kMaxHoldS in sensor time (the newest's start after the oldest's end by more): the IMU
+    // is later than any lag seen, the oldest go as they are.
+    while (held_.size() > 1 && held_.back().scan.utime - held_.front().end > seg::ScanImuSync::kMaxHoldUs) release(false);
   }
 
-  // The held scan goes: with its sweep's samples, or without them (the IMU too late). The counts are the node's
-  // telemetry detail (the dashboard's "state detail"): a live IMU that lags the scans shows there.
+  // The oldest held scan goes: with its sweep's samples, or without them (the IMU too late). The counts are the
+  // node's telemetry detail (the dashboard's "state detail"): a live IMU that lags the scans shows there.
   void release(bool with_samples) {
-    held_ = false;
+    Held h = std::move(held_.front());
+    held_.pop_front();
     ++held_count_;
     if (!with_samples) ++without_samples_;
     std::string d = "IMU late: " + std::to_string(held_count_) + " scans waited for their sweep's samples";
     if (!ctx_->composed()) {
-      const double w = std::chrono::duration<double>(std::chrono::steady_clock::now() - held_since_).count();
+      const double w = std::chrono::duration<double>(std::chrono::steady_clock::now() - h.since).count();
       max_wait_s_ = std::max(max_wait_s_, w);
       d += " (longest " + std::to_string(int(std::lround(1000 * max_wait_s_))) + " ms)";
     }
     if (without_samples_ > 0) d += ", " + std::to_string(without_samples_) + " went without them";
     ctx_->set_detail(d);
-    segment();
+    segment(h.scan);
+    spare_.push_back(std::move(h.scan));
   }
 
-  // scan_ through the segmenter, published.
-  void segment() {
+  // A scan through the segmenter, published.
+  void segment(const Scan& scan) {
     segments_t msg;
-    const auto& s = seg_->process(scan_);
+    const auto& s = seg_->process(scan);
     if (s.status == seg::SegStatus::kBadInput || s.status == seg::SegStatus::kEmpty)
-      ctx_->error("scan seq " + std::to_string(scan_.seq) + " on " + ctx_->channel("scan") + ": " + seg::to_string(s.status) +
+      ctx_->error("scan seq " + std::to_string(scan.seq) + " on " + ctx_->channel("scan") + ": " + seg::to_string(s.status) +
                   ": " + s.status_text);
     adapters::to_msg(s, seq_++, msg);
     out_.publish(msg);
   }
 
+  // A scan waiting for its sweep's IMU samples (scan_imu_sync.h).
+  struct Held {
+    Scan scan;
+    int64_t end = 0;  // its sweep's end
+    std::chrono::steady_clock::time_point since;
+  };
+
   rt::Context* ctx_ = nullptr;
   std::unique_ptr<seg::Segmenter> seg_;
   rt::Publisher<segments_t> out_;
-  Scan scan_;  // the scan being segmented, or held (held_) until its sweep's IMU samples are in
-  bool held_ = false;
-  int64_t held_end_ = 0;  // its sweep's end
-  std::chrono::steady_clock::time_point held_since_;
+  std::deque<Held> held_;    // in arrival order, until their sweep's IMU samples are in
+  std::vector<Scan> spare_;  // scans segmented, for reuse
   seg::ScanImuSync sync_;
   int64_t held_count_ = 0, without_samples_ = 0;  // scans held, and of those released without their samples
   double max_wait_s_ = 0;                         // live: the longest hold (wall time)

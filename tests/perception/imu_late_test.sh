@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The IMU later than the scans, as it arrives live on a busy machine (a whole sweep's samples 50-100 ms after
-# the scan): the segmenter must wait for its sweep's samples (nodes/segmenter, scan_imu_sync.h) and give the
-# same segments as with every sample before the scan. A short simulated sequence is written once in the
-# simulator's order and once with every IMU event moved 100 ms later; both replayed in lock-step through
+# the scan, up to ~0.5 s): the segmenter must wait for its sweep's samples (nodes/segmenter, scan_imu_sync.h)
+# and give the same segments as with every sample before the scan. A short simulated sequence is written once
+# in the simulator's order and with every IMU event moved 100 ms and 300 ms later (one held scan, three at a
+# time); each replayed in lock-step through
 # graphs/paper.pbtxt, the segments recorded: roll, pitch and height must agree per scan. (Before
 # the wait, the late log's scans had no gyro for their sweep: no de-skew, and on a ramp the fusion took the
 # ramp for level, 7 deg of pitch for 50 s in a live demo run.)
@@ -12,10 +13,12 @@ ROOT="${FPLOC_ROOT:?}"
 W="$(mktemp -d "${TMPDIR:-/tmp}/fploc-imu-late-XXXXXX")"
 trap 'rm -rf "$W"' EXIT
 "$BIN/fploc-sim" --scenario room-small-loop-fast --seed 5 --duration 4 --out "$W/log.lcm" --gt "$W/gt.tum" 2>"$W/sim.err"
-PYTHONPATH="$ROOT/tools/pylib" python3 - "$W/log.lcm" "$W/late.lcm" <<'PY'
+for ms in 100 300; do
+PYTHONPATH="$ROOT/tools/pylib" python3 - "$W/log.lcm" "$W/late$ms.lcm" "$ms" <<'PY'
 import struct, sys
 from lcm_log import SYNC, events
-ev = [(t + (100000 if ch == "OS1_IMU" else 0), k, ch, d) for k, (t, ch, d) in enumerate(events(sys.argv[1], with_time=True))]
+delay = int(sys.argv[3]) * 1000
+ev = [(t + (delay if ch == "OS1_IMU" else 0), k, ch, d) for k, (t, ch, d) in enumerate(events(sys.argv[1], with_time=True))]
 ev.sort()
 with open(sys.argv[2], "wb") as f:
     for n, (t, _, ch, d) in enumerate(ev):
@@ -27,27 +30,31 @@ for _, _, ch, d in ev:  # scans whose sweep (0.1 s from the scan's utime) the sa
         last_imu = utime
     elif ch == "OS1_SCAN":
         late += last_imu < utime + 90000
-print(f"{len(ev)} events, every IMU sample 100 ms later: {late} scans now come before their sweep's samples")
+print(f"{len(ev)} events, every IMU sample {sys.argv[3]} ms later: {late} scans now come before their sweep's samples")
 assert late >= 30, late
 PY
+done
 PLAN="$ROOT/data/plans/room.json"
-for run in ordered late; do
-  log="$W/log.lcm"; [ "$run" = late ] && log="$W/late.lcm"
+for run in ordered late100 late300; do
+  log="$W/log.lcm"; [ "$run" != ordered ] && log="$W/$run.lcm"
   "$BIN/fploc-replay" --graph "$ROOT/graphs/paper.pbtxt" --log "$log" --json \
     --set matcher.plan.file="$PLAN" --set optimizer.plan.file="$PLAN" \
     --set sfr_logger.file="$W/$run-sfr.tum" --set wo_logger.file="$W/$run-wo.tum" --set odom_logger.file="$W/$run-odom.tum" \
     --set odom_map_logger.file="$W/$run-odom_map.tum" --record "$W/$run-seg.lcm" --record-channels '^FPLOC_SEGMENTS$' \
     >"$W/$run.json" 2>"$W/$run.err" || { cat "$W/$run.err" >&2; exit 1; }
 done
+for late in late100 late300; do
 # The segmenter says so in its telemetry detail (the dashboard's "state detail"), only when the IMU was late.
-python3 - "$W/ordered.json" "$W/late.json" <<'PY'
+python3 - "$W/ordered.json" "$W/$late.json" <<'PY'
 import json, sys
 seg = [[n for n in json.loads(open(p).read().strip().splitlines()[-1])["nodes"] if n["name"] == "segmenter"][0] for p in sys.argv[1:3]]
 print(f"segmenter detail: in order '{seg[0]['detail']}', IMU late '{seg[1]['detail']}'")
 assert seg[0]["detail"] == "", seg[0]
-assert seg[1]["detail"].startswith("IMU late: 40 scans waited"), seg[1]
+# (300 ms: the first scans come before any IMU sample, so without a stream to wait for.)
+d = seg[1]["detail"]
+assert d.startswith("IMU late: ") and d.endswith(" scans waited for their sweep's samples") and int(d.split()[2]) >= 37, seg[1]
 PY
-PYTHONPATH="$ROOT/tools/pylib" python3 - "$W/ordered-seg.lcm" "$W/late-seg.lcm" "$(grep -c . "$W/gt.tum")" <<'PY'
+PYTHONPATH="$ROOT/tools/pylib" python3 - "$W/ordered-seg.lcm" "$W/$late-seg.lcm" "$(grep -c . "$W/gt.tum")" <<'PY'
 import math, struct, sys
 from lcm_log import events
 
@@ -76,3 +83,4 @@ print(f"{frames} scans: largest roll/pitch difference {rp:.4f} deg, z {dz * 1000
 assert found == frames, "a plane found in one order and not in the other"
 assert rp < 0.05 and dz < 0.001, f"the IMU late changed roll/pitch by {rp:.3f} deg, z by {dz * 1000:.2f} mm"
 PY
+done

@@ -12,10 +12,10 @@
 // ScanImuSync holds a scan back while the IMU stream is live (a sample within live_window of the scan's
 // start) and has not reached the scan's sweep end (within the 20 ms the de-skew and the fusion accept beyond
 // the last sample, segmenter_constants.h kGyroEdgeUs: a log in the simulator's order is never held); the
-// caller releases it when a sample reaches it, when the
-// next scan arrives, or live after kMaxHoldS of wall time (the IMU is then later than any lag seen: the scan
-// goes as it is, as before). Without an IMU, or with a stream that stopped, scans are never held. No transport
-// here: the segmenter node calls it.
+// caller releases it, in order, when a sample reaches it, or as it is once later scans start more than
+// kMaxHoldUs after its end or (live) after kMaxHoldS of wall time: the IMU is then later than any lag seen.
+// Without an IMU, or with a stream that stopped, scans are never held. No transport here: the segmenter node
+// calls it.
 #include <cstdint>
 
 #include "fploc/core/scan.h"
@@ -24,8 +24,11 @@ namespace fploc::seg {
 
 class ScanImuSync {
  public:
-  // Live, a held scan goes after this long (wall time) even without its samples (the lag seen: up to 0.1 s).
-  static constexpr double kMaxHoldS = 0.2;
+  // A held scan goes without its samples after this long: wall time (live), and sensor time between its sweep's
+  // end and the newest scan's start. The IMU's arrival delay in live runs on a busy machine: p99 150-270 ms,
+  // at most 480 ms (docs/notes/height.md, "Eleventh round").
+  static constexpr double kMaxHoldS = 0.5;
+  static constexpr int64_t kMaxHoldUs = 500000;
 
   explicit ScanImuSync(int64_t live_window_us = 1000000) : live_window_us_(live_window_us) {}
 
