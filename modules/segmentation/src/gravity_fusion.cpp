@@ -130,6 +130,23 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
   const double dt = 1e-6 * double(t - t_);
   Eigen::Matrix3d R;
   const bool gyro_ok = dt >= 0 && dt <= 1.0 && rotation(t_, t, bias, &R);
+  // The gyro live but late for this scan (late_gyro_hold_s): without planes nothing is carried yet, and level
+  // planes that turned are held off, both without an update, until the gyro covers the interval.
+  const bool late = !gyro_ok && dt > 0 && dt < cfg_.late_gyro_hold_s && !gyro_.empty() &&
+                    gyro_.back().first >= t_ - k::kGyroMaxGapUs;
+  if (late && !plane_up) return r;
+  if (late && mode_ == Mode::kLevel) {
+    Eigen::Vector3d nu = *plane_up - g_;
+    nu -= nu.dot(*plane_up) * *plane_up;
+    if (angle_of(nu) > cfg_.change_deg * k::kDeg) {
+      r.valid = r.held = true;
+      r.up = g_;
+      r.sigma = std::min(M_PI, sigma_ + cfg_.gyro_bias_sigma * dt + cfg_.gyro_noise * std::sqrt(dt * 0.01));
+      r.text = fmt_deg("the gyro has not reached this scan (IMU late) and the planes are %.2f deg off the last gravity: "
+                       "that gravity held, the planes not taken", angle_of(nu));
+      return r;  // nothing updated: the next scan's gyro covers this interval too
+    }
+  }
   if (!gyro_ok) R.setIdentity();
   t_ = t;
   const Eigen::Matrix3d Rt = R.transpose();

@@ -25,7 +25,10 @@ void Segmenter::fuse_imu(const Scan& scan, const Eigen::Vector3d& plane_up) {
   roll_pitch_from_up(r.up, out_.roll, out_.pitch);
   out_.roll_pitch_sigma = r.sigma;
   char buf[160];
-  if (r.predicted) {
+  if (r.held) {
+    out_.attitude_source = AttitudeSource::kPrevious;
+    std::snprintf(buf, sizeof buf, "attitude: the last gravity held (sigma %.2f deg)", r.sigma / k::kDeg);
+  } else if (r.predicted) {
     out_.attitude_source = AttitudeSource::kGyro;
     std::snprintf(buf, sizeof buf, "attitude: no plane, gravity carried by the gyro (sigma %.2f deg)", r.sigma / k::kDeg);
   } else if (r.settling) {

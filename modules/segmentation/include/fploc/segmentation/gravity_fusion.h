@@ -64,6 +64,12 @@ struct GravityFusionConfig {
   double accel_norm_tol = 0.3;   // m/s^2: |mean specific force| this close to g to be used
   double gyro_noise = 0.0015;    // rad/s white noise per sample (sigma growth without planes)
   double gyro_bias_sigma = 0.0005;  // rad/s left after the bias estimate (sigma growth without planes)
+  // A scan the gyro has not reached yet (its samples late, the stream live: some reach the last update): without
+  // planes, and level with planes off the last gravity by more than change_deg (that gravity held for it),
+  // nothing is updated, so the next scan's gyro spans both intervals and tells another surface from the sensor's
+  // turn. Taken as level instead, a ramp's surface became gravity for the whole ramp. Up to this long after the
+  // last update; beyond, as before (the IMU stopped).
+  double late_gyro_hold_s = 0.5;
 };
 
 class GravityFusion {
@@ -76,6 +82,7 @@ class GravityFusion {
     bool from_planes = false; // the planes' own attitude (level surfaces), bit-identical
     bool predicted = false;   // no plane: carried by the gyro
     bool settling = false;    // level again after a step to another surface: the planes blended in
+    bool held = false;        // the gyro late for this scan, the planes off the last gravity: that gravity held
     std::string text;         // what happened (empty: nothing new)
   };
 
