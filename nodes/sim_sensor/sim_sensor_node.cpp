@@ -156,6 +156,7 @@ class SimSensorNode : public fploc::rt::Node {
     // catch-up continues in the next call, and the node's loop meanwhile sees a stop request (the stop
     // waited for the whole catch-up, and the drivers stopped meanwhile lost the frames sent).
     const double t_call = wall_now();
+    send_imu(ts);  // measured by now: before this call's lidar packets
     for (int guard = 0; guard < 1000 && wall_now() - t_call < 0.05; ++guard) {
       if (k_ >= frames_per_loop()) {
         if (!loop_) {
@@ -172,6 +173,10 @@ class SimSensorNode : public fploc::rt::Node {
       }
       if (pkts_.empty()) {
         if (sim_->frame_time(k_) > ts) break;
+        // (After a loop's restart: the new pass's samples.) The IMU samples due go before the frame is ray-cast
+        // (tens of ms on a busy machine) and before its packets: a sweep's last packet does not overtake the IMU
+        // samples of its sweep, as from the sensor.
+        send_imu(ts);
         start_frame();
       }
       // A packet goes out when its last column has been measured.
@@ -184,6 +189,11 @@ class SimSensorNode : public fploc::rt::Node {
         ++k_;
       }
     }
+    send_imu(ts);
+  }
+
+  // The IMU samples measured up to sensor time ts, as IMU packets.
+  void send_imu(double ts) {
     const auto& imu = sim_->imu();
     const double imu_end = sim_->frame_time(frames_per_loop());
     for (; imu_k_ < imu.size() && so_.t0_s + imu[imu_k_].t <= ts && so_.t0_s + imu[imu_k_].t < imu_end; ++imu_k_) {
