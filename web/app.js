@@ -193,7 +193,10 @@ function renderNodeTable(msg) {
       td.textContent = text;
       if (i === 0) td.title = `${n.executable} pid ${n.pid}`;
       if (i >= 3 && i <= 5) td.title = portLatencies(n);
-      if (i === cells.length - 1) td.title = text;
+      if (i === cells.length - 1) {
+        td.title = text;
+        if (n.last_error) td.className = 'err';  // a node's own state line (detail) alone is not an error
+      }
       tr.append(td);
     }
     return tr;
