@@ -163,7 +163,8 @@ class SegmenterNodeT : public rt::Node {
     held_.pop_front();
     ++held_count_;
     if (!with_samples) ++without_samples_;
-    std::string d = "IMU late: " + std::to_string(held_count_) + " scans waited for their sweep's samples";
+    std::string d = "IMU late: " + std::to_string(held_count_) + (held_count_ == 1 ? " scan" : " scans") +
+                    " waited for their sweep's samples";
     if (!ctx_->composed()) {
       const double w = std::chrono::duration<double>(std::chrono::steady_clock::now() - h.since).count();
       max_wait_s_ = std::max(max_wait_s_, w);
