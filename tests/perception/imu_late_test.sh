@@ -16,21 +16,16 @@ trap 'rm -rf "$W"' EXIT
 for ms in 100 300; do
 PYTHONPATH="$ROOT/tools/pylib" python3 - "$W/log.lcm" "$W/late$ms.lcm" "$ms" <<'PY'
 import struct, sys
-from lcm_log import SYNC, events
-delay = int(sys.argv[3]) * 1000
-ev = [(t + (delay if ch == "OS1_IMU" else 0), k, ch, d) for k, (t, ch, d) in enumerate(events(sys.argv[1], with_time=True))]
-ev.sort()
-with open(sys.argv[2], "wb") as f:
-    for n, (t, _, ch, d) in enumerate(ev):
-        f.write(struct.pack(">IqqII", SYNC, n, t, len(ch), len(d)) + ch.encode() + d)
+from lcm_log import delay_channel, events
+n = delay_channel(sys.argv[1], sys.argv[2], "OS1_IMU", int(sys.argv[3]) * 1000)
 late, last_imu = 0, 0
-for _, _, ch, d in ev:  # scans whose sweep (0.1 s from the scan's utime) the samples before them do not cover
+for ch, d in events(sys.argv[2]):  # scans whose sweep (0.1 s from the scan's utime) the samples before them do not cover
     utime = struct.unpack(">q", d[8:16])[0]
     if ch == "OS1_IMU":
         last_imu = utime
     elif ch == "OS1_SCAN":
         late += last_imu < utime + 90000
-print(f"{len(ev)} events, every IMU sample {sys.argv[3]} ms later: {late} scans now come before their sweep's samples")
+print(f"{n} events, every IMU sample {sys.argv[3]} ms later: {late} scans now come before their sweep's samples")
 assert late >= 30, late
 PY
 done

@@ -42,6 +42,7 @@ ROOT = os.environ.get("FPLOC_ROOT") or os.path.abspath(os.path.join(os.path.dirn
 BIN = os.environ.get("FPLOC_BIN") or os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(ROOT, "tools", "pylib"))
 import fploc_tools  # noqa: E402
+import lcm_log  # noqa: E402
 from fploc_tools import log, pct, read_tum, roll_pitch, yaw_of  # noqa: E402
 
 SCENARIOS = ["building-areas-medium", "building-atrium-medium", "building-clutter-medium", "building-mixed-medium",
@@ -273,13 +274,23 @@ def bench(a, work, plan, layers, scenario):
         sets.append(f"segmenter.building.file={seg_building}")
         if building:
             sets.append(f"segmenter.building.floor={simj.get('start_floor', '')}")
-    log(f"[{name}] replaying {len(gt)} scans ...")
-    nodes, scans, ms = fploc_tools.replay(BIN, a.graph, logf, sets, PIPELINE, "fploc bench building")
+    replay_log = logf
+    if a.imu_late_ms:
+        # The IMU later than the scans, as live on a busy machine (docs/notes/height.md, "Eleventh round").
+        replay_log = os.path.join(d, f"log-imu-late-{a.imu_late_ms:g}ms.lcm")
+        lcm_log.delay_channel(logf, replay_log, "OS1_IMU", int(round(a.imu_late_ms * 1000)))
+    log(f"[{name}] replaying {len(gt)} scans{f' with the IMU {a.imu_late_ms:g} ms late' if a.imu_late_ms else ''} ...")
+    nodes, scans, ms = fploc_tools.replay(BIN, a.graph, replay_log, sets, PIPELINE, "fploc bench building")
+    if replay_log != logf:
+        os.remove(replay_log)
     if not a.keep:
         os.remove(logf)  # --keep keeps the simulated log too (replay it with other options)
     row = {"plan": os.path.relpath(plan, ROOT), "scenario": scenario, "scans": scans, "sim": info,
            "segmenter_building": seg_building is not None,
            "lost": nodes.get("matcher", {}).get("errors", 0), "ms_per_scan": ms}
+    if a.imu_late_ms:
+        row["imu_late_ms"] = a.imu_late_ms
+        row["segmenter_detail"] = nodes.get("segmenter", {}).get("detail", "")
     est = read_tum(wo) if os.path.exists(wo) else []
     floors = None
     if building:
@@ -346,6 +357,9 @@ def main():
                     help="give the segmenter the building (segmenter.building: area heights looked up per ceiling point "
                          "with the pose feedback): the plan when it is a building, else for building-* scenarios the "
                          "simulated floor's ceilings (fploc sim --ceilings-building)")
+    ap.add_argument("--imu-late-ms", type=float, default=0,
+                    help="replay with every IMU event this much later than the scans in the log (live on a busy machine: "
+                         "50-500 ms); the row says so (imu_late_ms)")
     ap.add_argument("--json", action="store_true", help="(JSON is always printed on stdout)")
     a = ap.parse_args()
     plans = [os.path.abspath(p) for p in (a.plan or [os.path.join(ROOT, "data", "plans", "room.json"),

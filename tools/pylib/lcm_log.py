@@ -22,6 +22,24 @@ def events(path, with_time=False):
         o += dl
 
 
+def write_events(path, events_with_time):
+    """Writes (utime, channel, data) events as an LCM log (event numbers from 0, in the order given)."""
+    with open(path, "wb") as f:
+        for n, (utime, ch, d) in enumerate(events_with_time):
+            c = ch.encode()
+            f.write(struct.pack(">IqqII", SYNC, n, utime, len(c), len(d)) + c + d)
+
+
+def delay_channel(src, dst, channel, delay_us):
+    """Copies the log src to dst with every event of `channel` moved delay_us later in the event order (its
+    log time + delay; ties keep the source order): e.g. an IMU that arrives after the scans, as live on a busy
+    machine. Returns the number of events."""
+    ev = [(t + (delay_us if ch == channel else 0), k, ch, d) for k, (t, ch, d) in enumerate(events(src, with_time=True))]
+    ev.sort(key=lambda e: (e[0], e[1]))
+    write_events(dst, ((t, ch, d) for t, _, ch, d in ev))
+    return len(ev)
+
+
 def decode_pose_t(buf):
     """fploc.pose_t (messages/pose_t.lcm) -> dict: utime, status, final, p (x y z), q (x y z w), cov (36),
     x, y, z, and floor_index/floor when the message carries them (older logs do not)."""
