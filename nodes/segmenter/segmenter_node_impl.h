@@ -6,10 +6,7 @@
 #include <fploc/scan_t.hpp>
 #include <fploc/segments_t.hpp>
 
-#include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -50,12 +47,11 @@ class SegmenterNodeT : public rt::Node {
     ctx.subscribe<imu_t>("imu", [this](const imu_t& m) {
       // IMU axes = sensor axes (OS-1: imu_to_sensor is a pure translation).
       const Eigen::Vector3d w(m.gyro[0], m.gyro[1], m.gyro[2]);
+      const int64_t t = m.gyro_utime != 0 ? m.gyro_utime : m.utime;
       if (!w.allFinite())
         ctx_->error("imu seq " + std::to_string(m.seq) + ": non-finite gyro (ignored)");
       else
-        seg_->add_gyro(w, m.gyro_utime != 0 ? m.gyro_utime : m.utime);  // de-skew of the sweep's rotation
-      // A scan held for its sweep's IMU samples (scan_imu_sync.h) goes once they reach the sweep's end.
-      sync_.on_imu(m.gyro_utime != 0 ? m.gyro_utime : m.utime);
+        seg_->add_gyro(w, t);  // de-skew of the sweep's rotation
       if (use_imu_) {
         const Eigen::Vector3d a(m.accel[0], m.accel[1], m.accel[2]);
         if (!a.allFinite())
@@ -63,22 +59,21 @@ class SegmenterNodeT : public rt::Node {
         else
           seg_->add_accel(a);
       }
-      while (!held_.empty() && sync_.ready(held_.front().scan.utime, held_.front().end)) release(true);
+      // A scan held for its sweep's IMU samples (scan_imu_sync.h) goes once they reach the sweep's end.
+      sync_.on_imu(t, seg::ScanImuSync::Clock::now());
+      show_holds();
     });
-    // Live: a scan whose IMU samples are later than kMaxHoldS goes as it is, also when no scan follows (replay
-    // is lock-step, its order fixed: samples, later scans or the end release it there).
+    // Live: scans whose IMU samples are later than kMaxHoldS go as they are, also when no scan follows (replay is
+    // lock-step, its order fixed: samples, later scans or the end release them there).
     if (!ctx.composed())
       ctx.every(0.02, [this] {
-        while (!held_.empty() && std::chrono::duration<double>(std::chrono::steady_clock::now() - held_.front().since)
-                                         .count() > seg::ScanImuSync::kMaxHoldS)
-          release(false);
+        sync_.on_clock(seg::ScanImuSync::Clock::now());
+        show_holds();
       });
   }
 
-  // The last scan, when it was still waiting for its IMU samples.
-  void shutdown() override {
-    while (!held_.empty()) release(false);
-  }
+  // The last scans, when they were still waiting for their IMU samples.
+  void shutdown() override { sync_.flush(seg::ScanImuSync::Clock::now()); }
 
  private:
   // The floor's area ceilings from the building file, and the pose feedback that places the ceiling points.
@@ -115,16 +110,13 @@ class SegmenterNodeT : public rt::Node {
   }
 
   void on_scan(const scan_t& m) {
-    Scan scan;
-    if (!spare_.empty()) {  // a recycled scan: its arrays keep their capacity
-      scan = std::move(spare_.back());
-      spare_.pop_back();
-    }
+    Scan scan = sync_.take_spare();
     try {
       adapters::from_msg(m, scan);
     } catch (const std::exception& e) {
       // Bad message: say so downstream (status BAD_INPUT) and keep running; the scans before it go first.
-      while (!held_.empty()) release(false);
+      sync_.flush(seg::ScanImuSync::Clock::now());
+      show_holds();
       segments_t msg;
       seg::Segmentation bad;
       bad.utime = m.utime;
@@ -141,42 +133,13 @@ class SegmenterNodeT : public rt::Node {
       ctx_->error(std::string("scan: ") + e.what());
       adapters::to_msg(bad, seq_++, msg);
       out_.publish(msg);
-      spare_.push_back(std::move(scan));
       return;
     }
-    const int64_t end = seg::ScanImuSync::sweep_end(scan);
-    if (held_.empty() && sync_.ready(scan.utime, end)) {
-      segment(scan);
-      spare_.push_back(std::move(scan));
-      return;
-    }
-    held_.push_back({std::move(scan), end, std::chrono::steady_clock::now()});
-    // Scans held longer than kMaxHoldS in sensor time (the newest's start after the oldest's end by more): the IMU
-    // is later than any lag seen, the oldest go as they are.
-    while (held_.size() > 1 && held_.back().scan.utime - held_.front().end > seg::ScanImuSync::kMaxHoldUs) release(false);
+    sync_.on_scan(std::move(scan), seg::ScanImuSync::Clock::now());
+    show_holds();
   }
 
-  // The oldest held scan goes: with its sweep's samples, or without them (the IMU too late). The counts are the
-  // node's telemetry detail (the dashboard's "state detail"): a live IMU that lags the scans shows there.
-  void release(bool with_samples) {
-    Held h = std::move(held_.front());
-    held_.pop_front();
-    ++held_count_;
-    if (!with_samples) ++without_samples_;
-    std::string d = "IMU late: " + std::to_string(held_count_) + (held_count_ == 1 ? " scan" : " scans") +
-                    " waited for their sweep's samples";
-    if (!ctx_->composed()) {
-      const double w = std::chrono::duration<double>(std::chrono::steady_clock::now() - h.since).count();
-      max_wait_s_ = std::max(max_wait_s_, w);
-      d += " (longest " + std::to_string(int(std::lround(1000 * max_wait_s_))) + " ms)";
-    }
-    if (without_samples_ > 0) d += ", " + std::to_string(without_samples_) + " went without them";
-    ctx_->set_detail(d);
-    segment(h.scan);
-    spare_.push_back(std::move(h.scan));
-  }
-
-  // A scan through the segmenter, published.
+  // A scan through the segmenter, published (ScanImuSync calls it when the scan may go).
   void segment(const Scan& scan) {
     segments_t msg;
     const auto& s = seg_->process(scan);
@@ -187,21 +150,20 @@ class SegmenterNodeT : public rt::Node {
     out_.publish(msg);
   }
 
-  // A scan waiting for its sweep's IMU samples (scan_imu_sync.h).
-  struct Held {
-    Scan scan;
-    int64_t end = 0;  // its sweep's end
-    std::chrono::steady_clock::time_point since;
-  };
+  // The holds in the node's telemetry detail (the dashboard's "state detail"): a live IMU that lags the scans
+  // shows there (the longest wait only live: replay has no wall time).
+  void show_holds() {
+    if (sync_.held() != shown_holds_) {
+      shown_holds_ = sync_.held();
+      ctx_->set_detail(sync_.describe(!ctx_->composed()));
+    }
+  }
 
   rt::Context* ctx_ = nullptr;
   std::unique_ptr<seg::Segmenter> seg_;
   rt::Publisher<segments_t> out_;
-  std::deque<Held> held_;    // in arrival order, until their sweep's IMU samples are in
-  std::vector<Scan> spare_;  // scans segmented, for reuse
-  seg::ScanImuSync sync_;
-  int64_t held_count_ = 0, without_samples_ = 0;  // scans held, and of those released without their samples
-  double max_wait_s_ = 0;                         // live: the longest hold (wall time)
+  seg::ScanImuSync sync_{[this](const Scan& scan) { segment(scan); }};  // scans wait for their IMU samples
+  int64_t shown_holds_ = 0;
   int64_t seq_ = 0;
   bool use_imu_ = false;
   std::vector<seg::AreaCeilingMap> floors_;  // option building: every floor's ceilings

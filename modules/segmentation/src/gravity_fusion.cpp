@@ -97,10 +97,13 @@ GravityFusion::Result& GravityFusion::settle_to_planes(const Eigen::Vector3d& g_
   return r;
 }
 
+double GravityFusion::sigma_after(double dt) const {
+  return std::min(M_PI, sigma_ + cfg_.gyro_bias_sigma * dt + cfg_.gyro_noise * std::sqrt(std::max(0.0, dt) * 0.01));
+}
+
 void GravityFusion::carry_by_gyro(const Eigen::Vector3d& g_pred, double dt, Result& r) {
   g_ = g_pred;
-  const double grow = cfg_.gyro_bias_sigma * dt + cfg_.gyro_noise * std::sqrt(std::max(0.0, dt) * 0.01);
-  sigma_ = std::min(M_PI, sigma_ + grow);
+  sigma_ = sigma_after(dt);
   r.valid = r.predicted = true;
   r.up = g_;
   r.sigma = sigma_;
@@ -141,7 +144,7 @@ GravityFusion::Result GravityFusion::update(int64_t t, const Eigen::Vector3d* pl
     if (angle_of(nu) > cfg_.change_deg * k::kDeg) {
       r.valid = r.held = true;
       r.up = g_;
-      r.sigma = std::min(M_PI, sigma_ + cfg_.gyro_bias_sigma * dt + cfg_.gyro_noise * std::sqrt(dt * 0.01));
+      r.sigma = sigma_after(dt);
       r.text = fmt_deg("the gyro has not reached this scan (IMU late) and the planes are %.2f deg off the last gravity: "
                        "that gravity held, the planes not taken", angle_of(nu));
       return r;  // nothing updated: the next scan's gyro covers this interval too

@@ -121,6 +121,8 @@ class GravityFusion {
   std::deque<std::pair<int64_t, Eigen::Vector3d>> gyro_;
   // Gravity carried by the gyro alone over dt: its sigma grows with the bias and noise; r gets it.
   void carry_by_gyro(const Eigen::Vector3d& g_pred, double dt, Result& r);
+  // The tilt's sigma after dt seconds without planes (gyro bias and noise).
+  double sigma_after(double dt) const;
   // Gravity is the planes' up: the state takes it and r says so.
   Result& take_planes(const Eigen::Vector3d& up, double plane_sigma, Result& r);
   // Level again after a step to another surface: gravity the gyro's prediction pulled towards the planes (as on a
