@@ -82,6 +82,38 @@ const std::vector<SimFrame>& sim_frames() {
   return frames;
 }
 
+// Consecutive frames of the same sequence from frame 100 on (moving) with every IMU sample (gyro and
+// accelerometer) up to each sweep's end, as the segmenter node feeds them: the IMU's whole path (gyro de-skew,
+// gravity fusion, the ground at a kink).
+struct ImuFrame {
+  Scan scan;
+  std::vector<std::pair<int64_t, sim::ImuSample>> imu;  // (utime, sample)
+};
+const std::vector<ImuFrame>& imu_frames() {
+  static const auto frames = [] {
+    sim::SimulatorOptions o;
+    o.scenario = "room-small-loop-medium";
+    o.shared_dir = FPLOC_SHARED_DIR;
+    sim::Simulator sim(FloorPlan{}, o);
+    std::vector<ImuFrame> out;
+    sim::SimScan f;
+    const auto& imu = sim.imu();
+    size_t next = 0;
+    while (next < imu.size() && imu[next].t < sim.frame_time(100) - o.t0_s - 0.2) ++next;
+    for (int k = 100; k < sim.num_frames() && out.size() < 48; ++k) {
+      sim.frame(k, f);
+      ImuFrame fr;
+      fr.scan = f.scan;
+      const double end = sim.frame_time(k) - o.t0_s + 1.0 / o.rate_hz;
+      for (; next < imu.size() && imu[next].t <= end; ++next)
+        fr.imu.emplace_back(int64_t(std::llround((o.t0_s + imu[next].t) * 1e6)), imu[next]);
+      out.push_back(std::move(fr));
+    }
+    return out;
+  }();
+  return frames;
+}
+
 // Segmenter + features on the simulated sequence, one scan per iteration (cycling through 24 scans);
 // with_gyro: the IMU gyro samples of each sweep are fed first (rotation de-skew).
 void sim_sequence(benchmark::State& st, bool with_gyro) {
@@ -184,8 +216,27 @@ int hash_all(int n) {
     seg::RingSegmenter sg(seg::SegmenterConfig{});
     for (int i = 0; i < 3; ++i) mix_seg(sg.process(scan().scan));
   }
+  // With the whole IMU (gyro and accelerometer) on consecutive frames, as in the pipeline.
+  size_t with_imu = 0, kink = 0;
+  {
+    seg::RingSegmenter sg(seg::SegmenterConfig{});
+    for (const auto& f : imu_frames()) {
+      if (int(with_imu) == n) break;
+      for (const auto& [t, smp] : f.imu) {
+        sg.add_gyro(smp.gyro, t);
+        sg.add_accel(smp.accel);
+      }
+      const auto& s = sg.process(f.scan);
+      mix_seg(s);
+      mix(&s.ground.under_m, sizeof(double));
+      mix(s.status_text.data(), s.status_text.size());
+      kink += s.status_text.find("ground:") != std::string::npos;
+      ++with_imu;
+    }
+  }
   std::cout << "hashed 2 x " << n << " simulated scans (" << deskewed << " de-skewed, " << walls / size_t(2 * std::max(1, n))
-            << " wall points per scan) + 3 synthetic: hash " << std::hex << h << std::dec << "\n";
+            << " wall points per scan) + 3 synthetic + " << with_imu << " consecutive scans with the IMU (" << kink
+            << " with a ground note): hash " << std::hex << h << std::dec << "\n";
   return 0;
 }
 

@@ -3,12 +3,16 @@
 // present, noise, clutter, ceiling patches), encoded into legacy OS-1 packets once; per iteration one frame
 // is decoded from its packets and turned into XYZ (the driver's work), or segmented and its features
 // extracted (the perception front end's work). Prints both and their ratio (CPU time per frame).
+// The pipeline's segmenter also takes the IMU (graphs/paper.pbtxt: gyro de-skew, gravity fusion, the ground at a
+// kink): BM_SegmenterPlusFeaturesImu runs it so, on 48 consecutive frames of the same sequence with each sweep's
+// IMU samples fed before its scan, and its ratio is printed beside the one without the IMU.
 //   build/bin/perception_ratio_bench [--benchmark_repetitions=N]
 #include <benchmark/benchmark.h>
 
 #include <cstring>
 #include <iostream>
 #include <map>
+#include <memory>
 
 #include "fploc/core/xyz.h"
 #include "fploc/features/features.h"
@@ -22,6 +26,12 @@ using namespace fploc;
 
 struct Frames {
   std::vector<Scan> scans;
+  // Consecutive frames with their IMU samples (those up to each sweep's end, fed before its scan).
+  struct ImuFrame {
+    Scan scan;
+    std::vector<std::pair<int64_t, sim::ImuSample>> imu;  // (utime, sample)
+  };
+  std::vector<ImuFrame> consecutive;
   os1::SensorInfo info;
   std::vector<std::vector<std::vector<uint8_t>>> packets;  // per frame
 };
@@ -37,6 +47,20 @@ const Frames& frames() {
     for (int k = 0; k < sim.num_frames() && out.scans.size() < 24; k += 5) {
       sim.frame(k, s);
       out.scans.push_back(s.scan);
+    }
+    // 48 consecutive frames from frame 100 on (moving), with every IMU sample up to each sweep's end.
+    const auto& imu = sim.imu();
+    size_t next = 0;
+    const double first = sim.frame_time(100) - o.t0_s - 0.2;  // 0.2 s of samples before the first sweep
+    while (next < imu.size() && imu[next].t < first) ++next;
+    for (int k = 100; k < sim.num_frames() && out.consecutive.size() < 48; ++k) {
+      sim.frame(k, s);
+      Frames::ImuFrame fr;
+      fr.scan = s.scan;
+      const double end = sim.frame_time(k) - o.t0_s + 0.1;
+      for (; next < imu.size() && imu[next].t <= end; ++next)
+        fr.imu.emplace_back(int64_t(std::llround((o.t0_s + imu[next].t) * 1e6)), imu[next]);
+      out.consecutive.push_back(std::move(fr));
     }
     const Scan& s0 = out.scans.front();
     out.info = os1::make_sensor_info(s0.beams.altitude_deg, s0.beams.azimuth_deg);
@@ -84,6 +108,30 @@ void BM_SegmenterPlusFeatures(benchmark::State& st) {
 }
 BENCHMARK(BM_SegmenterPlusFeatures)->Unit(benchmark::kMicrosecond);
 
+// As in the pipeline: the segmenter with the IMU (each sweep's samples fed before its scan, as the segmenter
+// node does), then the features. The 48 frames are consecutive; at the wrap a new segmenter (outside the timing).
+void BM_SegmenterPlusFeaturesImu(benchmark::State& st) {
+  const auto& f = frames();
+  auto sg = std::make_unique<seg::RingSegmenter>(seg::SegmenterConfig{});
+  feat::FeatureExtractor fx;
+  size_t k = 0;
+  for (auto _ : st) {
+    if (k == f.consecutive.size()) {
+      st.PauseTiming();
+      sg = std::make_unique<seg::RingSegmenter>(seg::SegmenterConfig{});
+      k = 0;
+      st.ResumeTiming();
+    }
+    const auto& fr = f.consecutive[k++];
+    for (const auto& [ut, smp] : fr.imu) {
+      sg->add_gyro(smp.gyro, ut);
+      sg->add_accel(smp.accel);
+    }
+    benchmark::DoNotOptimize(fx.process(sg->process(fr.scan)).size());
+  }
+}
+BENCHMARK(BM_SegmenterPlusFeaturesImu)->Unit(benchmark::kMicrosecond);
+
 // The two stages alone (breakdown; not part of the ratio): the segmenter, and the features of segmentations
 // computed once before the timing.
 void BM_SegmenterOnly(benchmark::State& st) {
@@ -123,9 +171,13 @@ int main(int argc, char** argv) {
   RatioReporter rep;
   benchmark::RunSpecifiedBenchmarks(&rep);
   benchmark::Shutdown();
-  const double d = rep.cpu_["BM_DecodeAndXyz"], s = rep.cpu_["BM_SegmenterPlusFeatures"];
+  const double d = rep.cpu_["BM_DecodeAndXyz"], s = rep.cpu_["BM_SegmenterPlusFeatures"],
+               si = rep.cpu_["BM_SegmenterPlusFeaturesImu"];
   if (d > 0 && s > 0)
     std::cout << "segmenter + features / (decode + XYZ) on the same frames: " << s << " us / " << d
               << " us = " << s / d << "x (target <= 2x)\n";
+  if (d > 0 && si > 0)
+    std::cout << "with the IMU, as in the pipeline (consecutive frames of the same sequence): " << si << " us / " << d
+              << " us = " << si / d << "x (target <= 2x)\n";
   return 0;
 }

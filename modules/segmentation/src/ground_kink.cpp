@@ -29,10 +29,12 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "fploc/segmentation/segmenter.h"
+#include "plane_kernels.h"
 #include "plane_math.h"
 #include "segmenter_constants.h"
 
@@ -51,6 +53,32 @@ constexpr double kSideShare = 0.9;        // of a group's returns on one side of
 constexpr double kFollowDeg = 1.5;        // a sector this near a surface is on it
 constexpr size_t kStride = 1;             // every candidate
 constexpr std::array<float, 3> kRefineCutM{0.05f, 0.03f, 0.02f};  // the followed surface's own fit (Tukey cut-offs)
+
+constexpr int32_t kPad = 8;              // the kernels' lanes
+
+// Moments of the points (relative to ref; np a multiple of kPad, the padding far off the plane) within c of
+// the plane pl (sensor frame): Tukey-weighted ((1 - (r/c)^2)^2), or each weighing 1 (unweighted).
+detail::Moments moments_near(const float* x, const float* y, const float* z, size_t np, const Eigen::Vector4d& pl,
+                             const Eigen::Vector3d& ref, float c, bool unweighted) {
+  const kern::PlaneF plf{float(pl[0]), float(pl[1]), float(pl[2]), float(pl.head<3>().dot(ref) + pl[3])};
+  detail::Moments m;
+  if (unweighted) {
+    double S[9], r2 = 0;
+    int count = 0, beyond = 0;
+    const float zero[3] = {0.f, 0.f, 0.f};
+    kern::inlier_moments(x, y, z, np, plf, c, std::numeric_limits<float>::infinity(), zero, S, r2, count, beyond);
+    m.w = count;
+    m.s << S[0], S[1], S[2];
+    m.ss << S[3], S[4], S[5], S[4], S[6], S[7], S[5], S[7], S[8];
+  } else {
+    double S[10];
+    kern::tukey_moments(x, y, z, np, plf, 1.f / (c * c), S);
+    m.w = S[0];
+    m.s << S[1], S[2], S[3];
+    m.ss << S[4], S[5], S[6], S[5], S[7], S[8], S[6], S[8], S[9];
+  }
+  return m;
+}
 
 struct Group {
   detail::Moments m;
@@ -76,7 +104,10 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   std::array<detail::Moments, kSectors> sm;
   std::array<bool, kSectors> ok{};
   std::array<double, kSectors> ssig{};  // the sector normal's 1-sigma [rad]
-  std::vector<int16_t> sector(lower_.n, -1);
+  std::vector<int16_t>& sector = kink_sector_;
+  sector.assign(lower_.n, -1);
+  std::vector<int32_t>& start = kink_start_;  // sector s's points: [start[s], start[s + 1])
+  start.assign(kSectors + 1, 0);
   for (size_t i = 0; i < lower_.n; i += kStride) {
     const Eigen::Vector3f p = lower_.point(i);
     if (!p.allFinite() || std::abs(n0.dot(p) + d0) > kSectorBandM) continue;
@@ -85,23 +116,44 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     int band = 0;
     while (band < int(kBandEdgesM.size()) && h.norm() >= kBandEdgesM[size_t(band)]) ++band;
     sector[i] = int16_t(band * kAzimuths + std::min(kAzimuths - 1, int(a / (2 * M_PI) * kAzimuths)));
+    ++start[size_t(sector[i]) + 1];
+  }
+  // The points grouped by sector (relative to ref), each sector's block padded to a multiple of kPad with a
+  // point 1 km above the ground (outside every cut-off), for the vectorised moments (plane_kernels.h).
+  for (int s = 0; s < kSectors; ++s) start[size_t(s) + 1] += start[size_t(s)];
+  std::array<int32_t, kSectors + 1> block;  // sector s's padded block: [block[s], block[s + 1])
+  block[0] = 0;
+  for (int s = 0; s < kSectors; ++s) {
+    const int32_t m = start[size_t(s) + 1] - start[size_t(s)];
+    block[size_t(s) + 1] = block[size_t(s)] + (m + kPad - 1) / kPad * kPad;
+  }
+  const size_t padded = size_t(block[kSectors]);
+  const Eigen::Vector3f pad_point = 1e3f * n0;  // 1 km above the ground
+  kink_x_.assign(padded, pad_point.x());
+  kink_y_.assign(padded, pad_point.y());
+  kink_z_.assign(padded, pad_point.z());
+  {
+    std::array<int32_t, kSectors> at;
+    std::copy(block.begin(), block.begin() + kSectors, at.begin());
+    for (size_t i = 0; i < lower_.n; i += kStride) {
+      if (sector[i] < 0) continue;
+      const size_t o = size_t(at[size_t(sector[i])]++);
+      kink_x_[o] = lower_.x[i] - reff.x();
+      kink_y_[o] = lower_.y[i] - reff.y();
+      kink_z_[o] = lower_.z[i] - reff.z();
+    }
   }
   for (int s = 0; s < kSectors; ++s) spl[s] = g.coeffs;
   // Tukey IRLS per sector from the ring fit's plane, the cut-off shrinking (a wall's foot, clutter on the
-  // floor drop out; a surface kinked against the ring fit's compromise is followed).
+  // floor drop out; a surface kinked against the ring fit's compromise is followed); the last pass: every
+  // return within kSectorTightM, unweighted.
   constexpr std::array<float, 4> kCut{0.3f, 0.15f, 0.08f, 0.05f};
   for (size_t pass = 0; pass <= kCut.size(); ++pass) {
     const bool last = pass == kCut.size();
-    for (auto& m : sm) m = detail::Moments{};
-    for (size_t i = 0; i < lower_.n; i += kStride) {
-      const int s = sector[i];
-      if (s < 0) continue;
-      const Eigen::Vector3f p = lower_.point(i);
-      const float r = spl[s].head<3>().cast<float>().dot(p) + float(spl[s][3]);
-      const float c = last ? kSectorTightM : kCut[pass];
-      if (std::abs(r) >= c) continue;
-      const float u = r / c;
-      sm[s].add((p - reff).cast<double>(), last ? 1.0 : double((1 - u * u) * (1 - u * u)));
+    const float c = last ? kSectorTightM : kCut[pass];
+    for (int s = 0; s < kSectors; ++s) {
+      const size_t b = size_t(block[size_t(s)]), np = size_t(block[size_t(s) + 1]) - b;
+      sm[s] = np == 0 ? detail::Moments{} : moments_near(kink_x_.data() + b, kink_y_.data() + b, kink_z_.data() + b, np, spl[s], ref, c, last);
     }
     for (int s = 0; s < kSectors; ++s) {
       Eigen::Vector3d ev;
@@ -168,25 +220,30 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   // on the other surface lie centimetres off F's plane and drop out here.
   const std::array<bool, kSectors>& in_f = F.member;
   {
-    std::vector<Eigen::Vector3f> near;  // F's returns within the first cut-off of its pooled plane (sensor frame - ref)
+    // F's returns within the first cut-off of its pooled plane (relative to ref), padded as the sectors' blocks.
     const Eigen::Vector3f n0f = F.pl.head<3>().cast<float>();
     const float d0f = float(F.pl[3]) + n0f.dot(reff);
-    for (size_t i = 0; i < lower_.n; i += kStride) {
-      if (sector[i] < 0 || !in_f[sector[i]]) continue;
-      const Eigen::Vector3f p = lower_.point(i) - reff;
-      if (std::abs(n0f.dot(p) + d0f) < kRefineCutM[0]) near.push_back(p);
+    near_x_.clear();
+    near_y_.clear();
+    near_z_.clear();
+    for (int s = 0; s < kSectors; ++s) {
+      if (!in_f[s]) continue;
+      for (int32_t j = block[size_t(s)]; j < block[size_t(s)] + (start[size_t(s) + 1] - start[size_t(s)]); ++j) {
+        const Eigen::Vector3f p(kink_x_[size_t(j)], kink_y_[size_t(j)], kink_z_[size_t(j)]);
+        if (!(std::abs(n0f.dot(p) + d0f) < kRefineCutM[0])) continue;
+        near_x_.push_back(p.x());
+        near_y_.push_back(p.y());
+        near_z_.push_back(p.z());
+      }
+    }
+    while (near_x_.size() % kPad) {
+      near_x_.push_back(pad_point.x());
+      near_y_.push_back(pad_point.y());
+      near_z_.push_back(pad_point.z());
     }
     Eigen::Vector4d pl = F.pl;
     for (const float c : kRefineCutM) {
-      detail::Moments m;
-      const Eigen::Vector3f n = pl.head<3>().cast<float>();
-      const float d = float(pl[3]) + n.dot(reff);
-      for (const Eigen::Vector3f& p : near) {
-        const float r = n.dot(p) + d;
-        if (!(std::abs(r) < c)) continue;
-        const float u = r / c;
-        m.add(p.cast<double>(), double((1 - u * u) * (1 - u * u)));
-      }
+      const detail::Moments m = moments_near(near_x_.data(), near_y_.data(), near_z_.data(), near_x_.size(), pl, ref, c, false);
       if (m.w < 2 * kMinSectorPoints || !m.plane(ref, -up, pl)) break;
       F.pl = pl;
     }
