@@ -36,6 +36,7 @@
 #include "fploc/segmentation/segmenter.h"
 #include "plane_kernels.h"
 #include "plane_math.h"
+#include "simd4.h"
 #include "segmenter_constants.h"
 
 namespace fploc::seg {
@@ -51,7 +52,6 @@ constexpr double kSectorMaxRmsM = 0.02;   // a sector's rms about its plane (one
 constexpr double kKinkDeg = 3.0;          // another surface: this far from the followed one
 constexpr double kSideShare = 0.9;        // of a group's returns on one side of the kink line
 constexpr double kFollowDeg = 1.5;        // a sector this near a surface is on it
-constexpr size_t kStride = 1;             // every candidate
 constexpr std::array<float, 3> kRefineCutM{0.05f, 0.03f, 0.02f};  // the followed surface's own fit (Tukey cut-offs)
 
 constexpr int32_t kPad = 8;              // the kernels' lanes
@@ -80,6 +80,44 @@ detail::Moments moments_near(const float* x, const float* y, const float* z, siz
   return m;
 }
 
+// Each point's sector (-1: not within kSectorBandM of the plane n0.p + d0 = 0, or not finite): azimuth sector
+// (kAzimuths of them from -180 deg, as floor((atan2(y, x) + pi) / (2 pi) kAzimuths)) x horizontal-distance band.
+// The azimuth by its quadrant and the tangents of the sector edges within it (no atan2; a point within float
+// rounding of an edge may fall on either side), four points at a time over the NaN-padded candidates
+// (`sector` holds the padding's -1 too).
+void assign_sectors(const float* xs, const float* ys, const float* zs, size_t n, const Eigen::Vector3f& n0, float d0,
+                    int16_t* sector) {
+  using namespace simd;
+  static_assert(kAzimuths % 4 == 0, "whole sectors per quadrant");
+  constexpr int kPerQuadrant = kAzimuths / 4;
+  std::array<v4f, kPerQuadrant - 1> tan_edge;
+  for (int k = 1; k < kPerQuadrant; ++k) tan_edge[size_t(k - 1)] = splat(float(std::tan(k * M_PI / 2 / kPerQuadrant)));
+  std::array<v4f, kBandEdgesM.size()> edge2;
+  for (size_t b = 0; b < kBandEdgesM.size(); ++b) edge2[b] = splat(kBandEdgesM[b] * kBandEdgesM[b]);
+  const v4f nx = splat(n0.x()), ny = splat(n0.y()), nz = splat(n0.z()), d = splat(d0), band_m = splat(kSectorBandM);
+  const v4f zero = splat(0.f);
+  const v4i none = splati(-1);
+  for (size_t i = 0; i < n; i += 4) {
+    const v4f x = load(xs + i), y = load(ys + i), z = load(zs + i);
+    const v4f r = nx * x + ny * y + nz * z;
+    const v4i in = abs(r + d) <= band_m;  // false for NaN
+    // The angle from -180 deg: that of (X, Y) = (-x, -y) from 0; its quadrant q turned onto the first (a > 0, b >= 0).
+    const v4f X = -x, Y = -y;
+    const v4i q0 = (X > zero) & (Y >= zero), q1 = (X <= zero) & (Y > zero), q2 = (X < zero) & (Y <= zero);
+    const v4f a = q0 ? X : q1 ? Y : q2 ? -X : -Y;
+    const v4f b = q0 ? Y : q1 ? -X : q2 ? -Y : X;
+    const v4i q = q0 ? splati(0) : q1 ? splati(1) : q2 ? splati(2) : splati(3);
+    v4i j = splati(0);
+    for (const v4f& te : tan_edge) j -= b >= te * a;  // (a true comparison is -1)
+    const v4f hx = x - r * nx, hy = y - r * ny, hz = z - r * nz;  // horizontal part
+    const v4f h2 = hx * hx + hy * hy + hz * hz;
+    v4i band = splati(0);
+    for (const v4f& e2 : edge2) band -= h2 >= e2;
+    const v4i sec = in ? band * kAzimuths + q * kPerQuadrant + j : none;
+    for (int l = 0; l < 4; ++l) sector[i + size_t(l)] = int16_t(sec[l]);
+  }
+}
+
 struct Group {
   detail::Moments m;
   Eigen::Vector4d pl = Eigen::Vector4d::Zero();
@@ -105,19 +143,12 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   std::array<bool, kSectors> ok{};
   std::array<double, kSectors> ssig{};  // the sector normal's 1-sigma [rad]
   std::vector<int16_t>& sector = kink_sector_;
-  sector.assign(lower_.n, -1);
+  sector.assign((lower_.n + 3) & ~size_t(3), -1);
   std::vector<int32_t>& start = kink_start_;  // sector s's points: [start[s], start[s + 1])
   start.assign(kSectors + 1, 0);
-  for (size_t i = 0; i < lower_.n; i += kStride) {
-    const Eigen::Vector3f p = lower_.point(i);
-    if (!p.allFinite() || std::abs(n0.dot(p) + d0) > kSectorBandM) continue;
-    const double a = std::atan2(double(p.y()), double(p.x())) + M_PI;
-    const Eigen::Vector3f h = p - n0.dot(p) * n0;  // horizontal part
-    int band = 0;
-    while (band < int(kBandEdgesM.size()) && h.norm() >= kBandEdgesM[size_t(band)]) ++band;
-    sector[i] = int16_t(band * kAzimuths + std::min(kAzimuths - 1, int(a / (2 * M_PI) * kAzimuths)));
-    ++start[size_t(sector[i]) + 1];
-  }
+  assign_sectors(lower_.x.data(), lower_.y.data(), lower_.z.data(), lower_.n, n0, d0, sector.data());
+  for (size_t i = 0; i < lower_.n; ++i)
+    if (sector[i] >= 0) ++start[size_t(sector[i]) + 1];
   // The points grouped by sector (relative to ref), each sector's block padded to a multiple of kPad with a
   // point 1 km above the ground (outside every cut-off), for the vectorised moments (plane_kernels.h).
   for (int s = 0; s < kSectors; ++s) start[size_t(s) + 1] += start[size_t(s)];
@@ -135,7 +166,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   {
     std::array<int32_t, kSectors> at;
     std::copy(block.begin(), block.begin() + kSectors, at.begin());
-    for (size_t i = 0; i < lower_.n; i += kStride) {
+    for (size_t i = 0; i < lower_.n; ++i) {
       if (sector[i] < 0) continue;
       const size_t o = size_t(at[size_t(sector[i])]++);
       kink_x_[o] = lower_.x[i] - reff.x();
@@ -293,7 +324,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     const Eigen::Vector3f n = pl.head<3>().cast<float>();
     const Eigen::Vector3f shift = float(follow_rate_) * n;
     detail::Moments m0, m1;
-    for (size_t i = 0; i < lower_.n; i += kStride) {
+    for (size_t i = 0; i < lower_.n; ++i) {
       if (!use(i)) continue;
       const int64_t tc = scan.column_utime[size_t(lower_.pixel[i] % W)];
       const Eigen::Vector3f p = lower_.point(i);
