@@ -180,8 +180,11 @@ int profile(int n, bool with_features, bool sim) {
 }
 
 // --hash-all=N: every output of the segmenter over N scans of the simulated sequence, without and with the gyro
-// (de-skew), plus the synthetic scan: planes, status, roll/pitch/z and every wall array of EVERY scan (the
-// --profile hashes cover only the last scan's planes and wall x/y/z/range/t). "Optimised without changing results".
+// (de-skew), plus the synthetic scan, plus up to 48 consecutive scans with gyro and accelerometer (the IMU's whole
+// path, as the pipeline runs it; with the ground's height and the status text): planes, status, roll/pitch/z and
+// every wall array of EVERY scan (the --profile hashes cover only the last scan's planes and wall x/y/z/range/t).
+// "Optimised without changing results". The room's flat floor leaves the ground-at-a-kink code without effect on
+// these outputs: check a change there on the building journeys (`fploc bench building`, their poses).
 int hash_all(int n) {
   uint64_t h = 1469598103934665603ull;
   auto mix = [&h](const void* p, size_t bytes) {
