@@ -17,6 +17,7 @@
 #include "fploc/segmentation/segmenter.h"
 #include "fploc/segmentation/synthetic.h"
 #include "fploc/sim/simulator.h"
+#include "sim_sequence.h"
 
 namespace {
 using namespace fploc;
@@ -62,9 +63,7 @@ struct SimFrame {
 };
 const std::vector<SimFrame>& sim_frames() {
   static const auto frames = [] {
-    sim::SimulatorOptions o;
-    o.scenario = "room-small-loop-medium";
-    o.shared_dir = FPLOC_SHARED_DIR;
+    const sim::SimulatorOptions o = bench::sequence_options();
     sim::Simulator sim(FloorPlan{}, o);
     std::vector<SimFrame> out;
     sim::SimScan f;
@@ -82,35 +81,10 @@ const std::vector<SimFrame>& sim_frames() {
   return frames;
 }
 
-// Consecutive frames of the same sequence from frame 100 on (moving) with every IMU sample (gyro and
-// accelerometer) up to each sweep's end, as the segmenter node feeds them: the IMU's whole path (gyro de-skew,
-// gravity fusion, the ground at a kink).
-struct ImuFrame {
-  Scan scan;
-  std::vector<std::pair<int64_t, sim::ImuSample>> imu;  // (utime, sample)
-};
-const std::vector<ImuFrame>& imu_frames() {
-  static const auto frames = [] {
-    sim::SimulatorOptions o;
-    o.scenario = "room-small-loop-medium";
-    o.shared_dir = FPLOC_SHARED_DIR;
-    sim::Simulator sim(FloorPlan{}, o);
-    std::vector<ImuFrame> out;
-    sim::SimScan f;
-    const auto& imu = sim.imu();
-    size_t next = 0;
-    while (next < imu.size() && imu[next].t < sim.frame_time(100) - o.t0_s - 0.2) ++next;
-    for (int k = 100; k < sim.num_frames() && out.size() < 48; ++k) {
-      sim.frame(k, f);
-      ImuFrame fr;
-      fr.scan = f.scan;
-      const double end = sim.frame_time(k) - o.t0_s + 1.0 / o.rate_hz;
-      for (; next < imu.size() && imu[next].t <= end; ++next)
-        fr.imu.emplace_back(int64_t(std::llround((o.t0_s + imu[next].t) * 1e6)), imu[next]);
-      out.push_back(std::move(fr));
-    }
-    return out;
-  }();
+// Consecutive frames with every IMU sample (gyro and accelerometer): the IMU's whole path (gyro de-skew, gravity
+// fusion, the ground at a kink), as in the pipeline.
+const std::vector<bench::ImuFrame>& imu_frames() {
+  static const auto frames = bench::imu_frames(100, 48);
   return frames;
 }
 

@@ -20,18 +20,14 @@
 #include "fploc/os1/packet.h"
 #include "fploc/segmentation/segmenter.h"
 #include "fploc/sim/simulator.h"
+#include "sim_sequence.h"
 
 namespace {
 using namespace fploc;
 
 struct Frames {
   std::vector<Scan> scans;
-  // Consecutive frames with their IMU samples (those up to each sweep's end, fed before its scan).
-  struct ImuFrame {
-    Scan scan;
-    std::vector<std::pair<int64_t, sim::ImuSample>> imu;  // (utime, sample)
-  };
-  std::vector<ImuFrame> consecutive;
+  std::vector<bench::ImuFrame> consecutive;  // with their IMU samples (sim_sequence.h)
   os1::SensorInfo info;
   std::vector<std::vector<std::vector<uint8_t>>> packets;  // per frame
 };
@@ -39,29 +35,13 @@ struct Frames {
 const Frames& frames() {
   static const Frames f = [] {
     Frames out;
-    sim::SimulatorOptions o;
-    o.scenario = "room-small-loop-medium";
-    o.shared_dir = FPLOC_SHARED_DIR;
-    sim::Simulator sim(FloorPlan{}, o);
+    sim::Simulator sim(FloorPlan{}, bench::sequence_options());
     sim::SimScan s;
     for (int k = 0; k < sim.num_frames() && out.scans.size() < 24; k += 5) {
       sim.frame(k, s);
       out.scans.push_back(s.scan);
     }
-    // 48 consecutive frames from frame 100 on (moving), with every IMU sample up to each sweep's end.
-    const auto& imu = sim.imu();
-    size_t next = 0;
-    const double first = sim.frame_time(100) - o.t0_s - 0.2;  // 0.2 s of samples before the first sweep
-    while (next < imu.size() && imu[next].t < first) ++next;
-    for (int k = 100; k < sim.num_frames() && out.consecutive.size() < 48; ++k) {
-      sim.frame(k, s);
-      Frames::ImuFrame fr;
-      fr.scan = s.scan;
-      const double end = sim.frame_time(k) - o.t0_s + 0.1;
-      for (; next < imu.size() && imu[next].t <= end; ++next)
-        fr.imu.emplace_back(int64_t(std::llround((o.t0_s + imu[next].t) * 1e6)), imu[next]);
-      out.consecutive.push_back(std::move(fr));
-    }
+    out.consecutive = bench::imu_frames(100, 48);  // moving
     const Scan& s0 = out.scans.front();
     out.info = os1::make_sensor_info(s0.beams.altitude_deg, s0.beams.azimuth_deg);
     const auto fmt = os1::PacketFormat::from(out.info);
