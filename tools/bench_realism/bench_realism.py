@@ -29,7 +29,7 @@ Prints one JSON document on stdout (progress on stderr):
   {"rows": [{"family", "method", "ate_m", "ate_aligned_m" (after the best rigid alignment of the whole trajectory, as
              TUM / evo ATE), "ate_floor_m" (the family's floor: the rigid part of the walls' as-built offsets along the
              truth path, see gauge_floor; same for every method), "max_m", "lost", "false_ok", "false_ok_poses", "poor", "nees_median", "nees_poses",
-             "ms_per_scan", "ms_per_scan_localizer", "poses"}],
+             "ms_per_scan", "ms_per_scan_localizer", "scans" (what the CPU is divided by), "poses"}],
    "detection": [{"family", "removed", "removed_found", "moved", "moved_found", "added", "added_found",
                   "doors_moved", "doors_moved_found" (both pieces), "door_opened_found" (the wall piece the new
                   opening took: a missing part), "door_closed_found" (the old opening's piece that is wall now:
@@ -583,7 +583,7 @@ class Bench:
         s = score_poses(poses, g) or {"poses": 0}
         cpu = sum(n.get("cpu_ms", n["total_ms"]) for n in rep["nodes"] if n["name"] in nodes)
         own = sum(n.get("cpu_ms", n["total_ms"]) for n in rep["nodes"] if n["name"] in nodes and n["name"] not in SHARED_NODES)
-        r = {"family": fam, "method": method, **s, "ms_per_scan": round(cpu / max(scans, 1), 3),
+        r = {"family": fam, "method": method, **s, "scans": scans, "ms_per_scan": round(cpu / max(scans, 1), 3),
              "ms_per_scan_localizer": round(own / max(scans, 1), 3), "ate_floor_m": self.floor_of(fam)}
         log(f"[{fam}] {method}: ATE {fmt(r.get('ate_m'))} (aligned {fmt(r.get('ate_aligned_m'))}, floor {fmt(r.get('ate_floor_m'))}) max {fmt(r.get('max_m'))} LOST {pct(r.get('lost'))} "
             f"false-OK {pct(r.get('false_ok'))} POOR {pct(r.get('poor'))} NEES {fmt(r.get('nees_median'), 2)} {r['ms_per_scan']} ms/scan "

@@ -3,12 +3,17 @@
 # errors of a localizer that is on the plan, not lost), the detector's rates are fractions.
 set -euo pipefail
 B="${FPLOC_BUILD_DIR:?}/bin"
-out="$("$B/fploc-bench-realism" --families renovated --duration 10 --seed 2 --methods fploc,fploc+downweight,amcl --json 2>/dev/null)"
-python3 - "$out" <<'PY'
+methods=fploc,fploc+downweight,amcl
+[ -x "$B/fploc-ndt" ] && methods="$methods,ndt"
+out="$("$B/fploc-bench-realism" --families renovated --duration 10 --seed 2 --methods "$methods" --json 2>/dev/null)"
+python3 - "$out" "$methods" <<'PY'
 import json, sys
 r = json.loads(sys.argv[1])
 rows = {x["method"]: x for x in r["rows"]}
-assert {"fploc", "fploc+downweight", "amcl"} <= set(rows), rows.keys()
+assert set(sys.argv[2].split(",")) <= set(rows), rows.keys()
+# Every method's CPU is divided by the scans, one pose each (NDT's once counted its segmenter's IMU samples too).
+for m, x in rows.items():
+    assert abs(x["scans"] - x["poses"]) <= 2, (m, x["scans"], x["poses"])
 f = rows["fploc"]
 for k in ("ate_m", "max_m", "lost", "false_ok", "false_ok_poses", "poor", "nees_median", "ms_per_scan", "ms_per_scan_localizer", "poses"):
     assert k in f, k
