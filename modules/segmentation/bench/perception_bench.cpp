@@ -199,10 +199,7 @@ int hash_all(int n) {
     seg::RingSegmenter sg(seg::SegmenterConfig{});
     for (const auto& f : imu_frames()) {
       if (int(with_imu) == n) break;
-      for (const auto& [t, smp] : f.imu) {
-        sg.add_gyro(smp.gyro, t);
-        sg.add_accel(smp.accel);
-      }
+      bench::feed_imu(sg, f);
       const auto& s = sg.process(f.scan);
       mix_seg(s);
       mix(&s.ground.under_m, sizeof(double));

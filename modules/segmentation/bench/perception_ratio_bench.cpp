@@ -103,10 +103,7 @@ void BM_SegmenterPlusFeaturesImu(benchmark::State& st) {
       st.ResumeTiming();
     }
     const auto& fr = f.consecutive[k++];
-    for (const auto& [ut, smp] : fr.imu) {
-      sg->add_gyro(smp.gyro, ut);
-      sg->add_accel(smp.accel);
-    }
+    bench::feed_imu(*sg, fr);
     benchmark::DoNotOptimize(fx.process(sg->process(fr.scan)).size());
   }
 }

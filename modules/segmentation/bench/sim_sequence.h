@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "fploc/segmentation/segmenter.h"
 #include "fploc/sim/simulator.h"
 
 namespace fploc::bench {
@@ -43,6 +44,14 @@ inline std::vector<ImuFrame> imu_frames(int first, size_t count) {
     out.push_back(std::move(fr));
   }
   return out;
+}
+
+// A frame's IMU samples into the segmenter, as the segmenter node gives them (before the frame's scan).
+inline void feed_imu(seg::Segmenter& sg, const ImuFrame& f) {
+  for (const auto& [utime, smp] : f.imu) {
+    sg.add_gyro(smp.gyro, utime);
+    sg.add_accel(smp.accel);
+  }
 }
 
 }  // namespace fploc::bench

@@ -61,23 +61,16 @@ constexpr int32_t kPad = 8;              // the kernels' lanes
 detail::Moments moments_near(const float* x, const float* y, const float* z, size_t np, const Eigen::Vector4d& pl,
                              const Eigen::Vector3d& ref, float c, bool unweighted) {
   const kern::PlaneF plf{float(pl[0]), float(pl[1]), float(pl[2]), float(pl.head<3>().dot(ref) + pl[3])};
-  detail::Moments m;
   if (unweighted) {
     double S[9], r2 = 0;
     int count = 0, beyond = 0;
     const float zero[3] = {0.f, 0.f, 0.f};
     kern::inlier_moments(x, y, z, np, plf, c, std::numeric_limits<float>::infinity(), zero, S, r2, count, beyond);
-    m.w = count;
-    m.s << S[0], S[1], S[2];
-    m.ss << S[3], S[4], S[5], S[4], S[6], S[7], S[5], S[7], S[8];
-  } else {
-    double S[10];
-    kern::tukey_moments(x, y, z, np, plf, 1.f / (c * c), S);
-    m.w = S[0];
-    m.s << S[1], S[2], S[3];
-    m.ss << S[4], S[5], S[6], S[5], S[7], S[8], S[6], S[8], S[9];
+    return detail::Moments::from_inliers(S, count);
   }
-  return m;
+  double S[10];
+  kern::tukey_moments(x, y, z, np, plf, 1.f / (c * c), S);
+  return detail::Moments::from_weighted(S);
 }
 
 // Each point's sector (-1: not within kSectorBandM of the plane n0.p + d0 = 0, or not finite): azimuth sector
@@ -144,20 +137,15 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   std::array<double, kSectors> ssig{};  // the sector normal's 1-sigma [rad]
   std::vector<int16_t>& sector = kink_sector_;
   sector.assign((lower_.n + 3) & ~size_t(3), -1);
-  std::vector<int32_t>& start = kink_start_;  // sector s's points: [start[s], start[s + 1])
-  start.assign(kSectors + 1, 0);
   assign_sectors(lower_.x.data(), lower_.y.data(), lower_.z.data(), lower_.n, n0, d0, sector.data());
+  std::array<int32_t, kSectors> count{};  // returns per sector
   for (size_t i = 0; i < lower_.n; ++i)
-    if (sector[i] >= 0) ++start[size_t(sector[i]) + 1];
+    if (sector[i] >= 0) ++count[size_t(sector[i])];
   // The points grouped by sector (relative to ref), each sector's block padded to a multiple of kPad with a
   // point 1 km above the ground (outside every cut-off), for the vectorised moments (plane_kernels.h).
-  for (int s = 0; s < kSectors; ++s) start[size_t(s) + 1] += start[size_t(s)];
   std::array<int32_t, kSectors + 1> block;  // sector s's padded block: [block[s], block[s + 1])
   block[0] = 0;
-  for (int s = 0; s < kSectors; ++s) {
-    const int32_t m = start[size_t(s) + 1] - start[size_t(s)];
-    block[size_t(s) + 1] = block[size_t(s)] + (m + kPad - 1) / kPad * kPad;
-  }
+  for (int s = 0; s < kSectors; ++s) block[size_t(s) + 1] = block[size_t(s)] + (count[size_t(s)] + kPad - 1) / kPad * kPad;
   const size_t padded = size_t(block[kSectors]);
   const Eigen::Vector3f pad_point = 1e3f * n0;  // 1 km above the ground
   kink_x_.assign(padded, pad_point.x());
@@ -259,7 +247,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     near_z_.clear();
     for (int s = 0; s < kSectors; ++s) {
       if (!in_f[s]) continue;
-      for (int32_t j = block[size_t(s)]; j < block[size_t(s)] + (start[size_t(s) + 1] - start[size_t(s)]); ++j) {
+      for (int32_t j = block[size_t(s)]; j < block[size_t(s)] + count[size_t(s)]; ++j) {
         const Eigen::Vector3f p(kink_x_[size_t(j)], kink_y_[size_t(j)], kink_z_[size_t(j)]);
         if (!(std::abs(n0f.dot(p) + d0f) < kRefineCutM[0])) continue;
         near_x_.push_back(p.x());

@@ -23,6 +23,22 @@ struct Moments {
   double w = 0;
   Eigen::Vector3d s = Eigen::Vector3d::Zero();
   Eigen::Matrix3d ss = Eigen::Matrix3d::Zero();
+  // From the point kernels' sums (plane_kernels.h): tukey_moments' S = w, w x, w y, w z, w xx, w xy, w xz, w yy,
+  // w yz, w zz; inlier_moments' S = x, y, z, xx, xy, xz, yy, yz, zz of `count` points weighing 1.
+  static Moments from_weighted(const double S[10]) {
+    Moments m;
+    m.w = S[0];
+    m.s << S[1], S[2], S[3];
+    m.ss << S[4], S[5], S[6], S[5], S[7], S[8], S[6], S[8], S[9];
+    return m;
+  }
+  static Moments from_inliers(const double S[9], int count) {
+    Moments m;
+    m.w = count;
+    m.s << S[0], S[1], S[2];
+    m.ss << S[3], S[4], S[5], S[4], S[6], S[7], S[5], S[7], S[8];
+    return m;
+  }
   void add(const Eigen::Vector3d& p, double wi) {
     w += wi;
     s += wi * p;

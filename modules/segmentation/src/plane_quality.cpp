@@ -23,11 +23,7 @@ void Segmenter::quality(const Candidates& c, Plane& pl) const {
   const float ref3[3] = {reff.x(), reff.y(), reff.z()};
   kern::inlier_moments(c.x.data(), c.y.data(), c.z.data(), (c.n + 3) & ~size_t(3), {n.x(), n.y(), n.z(), d}, thr, beyond_thr,
                        ref3, S, r2, cnt, beyond);
-  const double sx = S[0], sy = S[1], sz = S[2], sxx = S[3], sxy = S[4], sxz = S[5], syy = S[6], syz = S[7], szz = S[8];
-  detail::Moments m;
-  m.w = cnt;
-  m.s << sx, sy, sz;
-  m.ss << sxx, sxy, sxz, sxy, syy, syz, sxz, syz, szz;
+  const detail::Moments m = detail::Moments::from_inliers(S, cnt);
   const Eigen::Vector3d ref = reff.cast<double>();
   pl.inliers = cnt;
   pl.beyond = beyond;

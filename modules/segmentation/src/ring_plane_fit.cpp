@@ -263,10 +263,7 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     // Tukey-weighted moments, sums in float over blocks of 256 points, added up in double.
     double S[10];
     kern::tukey_moments(src->x.data(), src->y.data(), src->z.data(), src->padded(), plf, float(1.0 / (cut * cut)), S);
-    Moments m;
-    m.w = S[0];
-    m.s << S[1], S[2], S[3];
-    m.ss << S[4], S[5], S[6], S[5], S[7], S[8], S[6], S[8], S[9];
+    const Moments m = Moments::from_weighted(S);
     Eigen::Vector4d next;
     if (!m.plane(ref, up, next)) return std::nullopt;
     const double dn = (next.head<3>() - cur.head<3>()).norm(), dd = std::abs(next[3] - cur[3]);

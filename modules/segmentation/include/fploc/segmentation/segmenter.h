@@ -125,7 +125,6 @@ class Segmenter {
   // ground_kink.cpp's scratch, kept from scan to scan: each lower candidate's sector (-1: none), and the
   // sectors' points grouped (sector by sector, relative to the plane's reference point), the followed surface's.
   std::vector<int16_t> kink_sector_;
-  std::vector<int32_t> kink_start_;
   std::vector<float> kink_x_, kink_y_, kink_z_, near_x_, near_y_, near_z_;
   Eigen::Vector3d accel_sum_ = Eigen::Vector3d::Zero();
   double accel_sq_ = 0;  // sum of |a|^2 (the spread: is the IMU measuring gravity alone?)
