@@ -113,10 +113,20 @@ bool GyroDeskew::prepare(const Scan& scan) {
   col_rot_.resize(W);
   int cm = c0;
   while (cm < c1 && col_t_[cm] < tm) ++cm;
+  // Columns are evenly spaced and the gyro's rate holds over a sample's interval: most consecutive steps rotate
+  // by the same angle vector, whose matrix (a sine and a cosine) is kept from the last step.
+  Eigen::Vector3d last_th = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d last_inc = Eigen::Matrix3d::Identity();
+  bool last_turns = false;  // (a zero angle vector: no rotation)
   auto step = [&](const Eigen::Matrix3d& R, int64_t ta, int64_t tb) {
     const Eigen::Vector3d th = rate_at(ta + (tb - ta) / 2) * (1e-6 * double(tb - ta));
-    const double a = th.norm();
-    return a > 0 ? Eigen::Matrix3d(R * Eigen::AngleAxisd(a, th / a).toRotationMatrix()) : R;
+    if (th != last_th) {
+      const double a = th.norm();
+      last_th = th;
+      last_turns = a > 0;
+      if (last_turns) last_inc = Eigen::AngleAxisd(a, th / a).toRotationMatrix();
+    }
+    return last_turns ? Eigen::Matrix3d(R * last_inc) : R;
   };
   const Eigen::Matrix3d Rm = step(Eigen::Matrix3d::Identity(), tm, col_t_[cm]);
   Eigen::Matrix3d R = Rm;
