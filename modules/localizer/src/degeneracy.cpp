@@ -57,6 +57,12 @@ double weakest_horizontal(const Eigen::Matrix3d& P, double* direction_rad) {
   return std::sqrt(std::max(0.0, es.eigenvalues()[1]));
 }
 
+double strongest_horizontal(const Eigen::Matrix3d& P) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(0.5 * (P.topLeftCorner<2, 2>() + P.topLeftCorner<2, 2>().transpose()),
+                                                    Eigen::EigenvaluesOnly);
+  return std::sqrt(std::max(0.0, es.eigenvalues()[0]));
+}
+
 double chi2_3dof_of_sigmas(double k) {
   // P(chi2_3 <= x) = erf(sqrt(x/2)) - sqrt(2x/pi) exp(-x/2): bisection for the probability erf(k/sqrt2).
   const double p = std::erf(k / std::sqrt(2.0));
@@ -76,6 +82,8 @@ void UncertaintyTracker::reset(double sigma_m, double sigma_rad) {
   have_ = false;
   have_initial_ = true;
   have_mean_ = false;
+  confirming_ = false;
+  agreeing_ = 0;
 }
 
 UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d& frame_cov_in, bool frame_valid,
@@ -161,6 +169,16 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
   s.text = matcher_text;
   s.innovation_sigma = innovation_sigma;
   s.refused = refused;
+  // Re-acquisition (confirm_fixes): a fix accepted where the track was unknown arms it; then accepted fixes in a
+  // row are counted.
+  if (frame_ok && !confirming_ && cfg_.confirm_fixes > 0 && strongest_horizontal(P_pred) > cfg_.reacquire_sigma_m) {
+    confirming_ = true;
+    agreeing_ = 0;
+  }
+  if (confirming_) {
+    agreeing_ = frame_ok ? agreeing_ + 1 : 0;
+    if (agreeing_ >= cfg_.confirm_fixes) confirming_ = false;
+  }
   if (matcher_status == matcher::FitStatus::kOk) {
     char b[200];
     if (refused) {
@@ -175,6 +193,10 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
       s.text = b;
     } else if (s.sigma_yaw_rad > cfg_.poor_sigma_rad) {
       std::snprintf(b, sizeof b, "heading weakly constrained (1 sigma %.1f deg)", s.sigma_yaw_rad * 180 / M_PI);
+      s.status = matcher::FitStatus::kPoor;
+      s.text = b;
+    } else if (confirming_) {
+      std::snprintf(b, sizeof b, "re-acquired: %d of %d fixes agreeing", agreeing_, cfg_.confirm_fixes);
       s.status = matcher::FitStatus::kPoor;
       s.text = b;
     }

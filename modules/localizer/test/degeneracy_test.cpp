@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "fploc/localizer/degeneracy.h"
 #include "fploc/localizer/localizer.h"
@@ -55,6 +56,7 @@ TEST(Degeneracy, CorridorGrowsPoorNamesTheDirectionThenRecovers) {
   cfg.accel_sigma_mps2 = 0.5;
   cfg.max_velocity_error_mps = 1.5;
   cfg.poor_sigma_m = 0.1;
+  cfg.confirm_fixes = 0;  // (the start is a re-acquisition: ReacquiredTrackIsPoorUntilFixesAgree)
   UncertaintyTracker tr(cfg);
   const int64_t dt = 100000;  // 10 Hz
   int64_t t = 0;
@@ -163,7 +165,8 @@ TEST(Degeneracy, RefusesAConfidentFixFarFromThePrediction) {
   Pose2 p{1.0, 2.0, 0.0};
   for (int k = 0; k < 20; ++k, t += 100000, p.x += 0.05) {
     const auto s = tr.update(t, fixed, true, FitStatus::kOk, {}, &p, &v);
-    ASSERT_EQ(s.status, FitStatus::kOk) << k << " " << s.text;
+    // (no initial pose: the first fixes are a re-acquisition, confirmed by the fifth)
+    ASSERT_EQ(s.status, k < 4 ? FitStatus::kPoor : FitStatus::kOk) << k << " " << s.text;
     EXPECT_LT(s.innovation_sigma, 1.0);
   }
   // 0.3 m sideways in one frame, with a 1 cm fix.
@@ -185,9 +188,10 @@ TEST(Degeneracy, RefusesAConfidentFixFarFromThePrediction) {
 }
 
 TEST(Degeneracy, GateOffOrWithoutAFixChangesNothing) {
-  UncertaintyConfig off;
+  UncertaintyConfig off, on;
   off.gate_sigma = 0;
-  UncertaintyTracker a(off), b;
+  off.confirm_fixes = on.confirm_fixes = 0;  // (the gate alone)
+  UncertaintyTracker a(off), b(on);
   const Eigen::Matrix3d fixed = diag(0.01, 0.01, 0.002);
   Pose2 p{0, 0, 0};
   a.update(0, fixed, true, FitStatus::kOk, {}, &p);
@@ -195,4 +199,48 @@ TEST(Degeneracy, GateOffOrWithoutAFixChangesNothing) {
   Pose2 jump{1.0, 0, 0};
   EXPECT_EQ(a.update(100000, fixed, true, FitStatus::kOk, {}, &jump).status, FitStatus::kOk);
   EXPECT_EQ(b.update(100000, fixed, true, FitStatus::kOk).status, FitStatus::kOk);
+}
+
+// Re-acquisition: a fix taken where the position was unknown (after LOST) is POOR until confirm_fixes accepted
+// fixes agree in a row; a POOR frame starts the count again; with confirm_fixes 0 a single fix is OK. A
+// corridor (fixed across) is not a re-acquisition: CorridorGrowsPoorNamesTheDirectionThenRecovers.
+TEST(Degeneracy, ReacquiredTrackIsPoorUntilFixesAgree) {
+  UncertaintyConfig cfg, off;
+  off.confirm_fixes = 0;
+  ASSERT_EQ(cfg.confirm_fixes, 5);
+  UncertaintyTracker tr(cfg), single(off);
+  const Eigen::Matrix3d fixed = diag(0.01, 0.01, 0.002);
+  matcher::Twist2 v;
+  v.vx = 0.5;
+  int64_t t = 0;
+  Pose2 p{1.0, 2.0, 0.0};
+  auto step = [&](UncertaintyTracker& u, FitStatus st) { return u.update(t, fixed, true, st, {}, &p, &v); };
+  for (int k = 0; k < 10; ++k, t += 100000, p.x += 0.05) {
+    step(tr, FitStatus::kOk);
+    step(single, FitStatus::kOk);
+  }
+  ASSERT_EQ(step(tr, FitStatus::kOk).status, FitStatus::kOk);
+  // LOST, then a fix 3 m away (a parallel corridor): the gate cannot refuse it (the position is unknown).
+  step(tr, FitStatus::kLost);
+  step(single, FitStatus::kLost);
+  t += 100000;
+  p.y += 3.0;
+  std::vector<FitStatus> seen;
+  for (int k = 0; k < 7; ++k, t += 100000, p.x += 0.05) {
+    if (k == 2) {  // one POOR frame: the count starts again
+      const auto s = step(tr, FitStatus::kPoor);
+      EXPECT_EQ(s.status, FitStatus::kPoor);
+      step(single, FitStatus::kPoor);
+      continue;
+    }
+    const auto s = step(tr, FitStatus::kOk);
+    seen.push_back(s.status);
+    if (s.status == FitStatus::kPoor) EXPECT_NE(s.text.find("re-acquired"), std::string::npos) << s.text;
+    const auto s1 = step(single, FitStatus::kOk);
+    EXPECT_EQ(s1.status, FitStatus::kOk) << k << " " << s1.text;  // off: every fix OK
+  }
+  // Fixes 1, 2 | POOR | 1, 2, 3, 4: still POOR; the fifth in a row is OK.
+  ASSERT_EQ(seen.size(), 6u);
+  for (size_t k = 0; k < seen.size(); ++k) EXPECT_EQ(seen[k], FitStatus::kPoor) << k;
+  EXPECT_EQ(step(tr, FitStatus::kOk).status, FitStatus::kOk);
 }

@@ -49,6 +49,15 @@ struct UncertaintyConfig {
   // rate; covariance P- + P_f) exceeds gate_sigma (as the 3-DoF chi-square quantile of that many sigmas:
   // 3 -> 14.2) is refused: status POOR, the prediction and P- go on. 0: off.
   double gate_sigma = 3.0;
+  // Re-acquisition: a fix taken where the position was unknown (the predicted 1-sigma above reacquire_sigma_m
+  // in every horizontal direction: the start from an uncertain initial pose, after LOST, after a long POOR
+  // stretch; not a corridor, which the frames kept fixing across) is one registration's answer in a wide search, and a wrong place that explains the scan (a
+  // parallel corridor, a twin room) gives one as readily as the right one. Published POOR ("re-acquired: k of
+  // N fixes agreeing") until confirm_fixes accepted fixes in a row, each within the innovation gate of the track
+  // the ones before it started; a POOR/LOST or refused frame starts the count again. As the grid localizer's
+  // confirm_scans. 0: off (a single fix is OK).
+  int confirm_fixes = 5;
+  double reacquire_sigma_m = 0.3;      // (3 sigma: a region of about 2 m, where office aliases lie)
 };
 
 struct UncertaintyState {
@@ -89,6 +98,8 @@ class UncertaintyTracker {
   bool have_mean_ = false;                             // the tracked pose and twist (innovation gate)
   Pose2 mean_;
   matcher::Twist2 twist_;
+  bool confirming_ = false;                            // re-acquired: fixes in a row still to agree (confirm_fixes)
+  int agreeing_ = 0;                                   // accepted fixes in a row since the re-acquisition
 };
 
 // The 3-DoF chi-square quantile with the probability of a 1-D Gaussian within k sigma (k = 3: 14.16).
@@ -102,5 +113,7 @@ Eigen::Matrix3d add_sigmas(const Eigen::Matrix3d& P, const Eigen::Matrix3d& Q);
 Eigen::Matrix3d grow_linear(const Eigen::Matrix3d& P, const Eigen::Vector3d& a);
 // Largest 1-sigma of the x/y block and its direction [rad, (-pi/2, pi/2]].
 double weakest_horizontal(const Eigen::Matrix3d& P, double* direction_rad);
+// Smallest 1-sigma of the x/y block.
+double strongest_horizontal(const Eigen::Matrix3d& P);
 
 }  // namespace fploc::localizer
