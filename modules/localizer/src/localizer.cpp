@@ -104,7 +104,7 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
     const Pose2 at_ref = compose(sfr.match.pose, matcher::exp_twist(sfr.match.twist, t_ref));
     const auto fu = optimizer::frame_uncertainty(lookup_, deskewed_, at_ref, cfg_.uncertainty.frame);
     uncertainty_ = tracker_.update(f.utime, fu.covariance, fu.valid, sfr.match.status, sfr.match.text, &sfr.match.pose,
-                                   &sfr.match.twist);
+                                   &sfr.match.twist, sfr.match.fit.inlier_ratio);
     in.covariance = uncertainty_.covariance;
     in.published_status = uncertainty_.status;
     in.status_text = uncertainty_.text;

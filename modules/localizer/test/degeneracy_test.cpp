@@ -244,3 +244,25 @@ TEST(Degeneracy, ReacquiredTrackIsPoorUntilFixesAgree) {
   for (size_t k = 0; k < seen.size(); ++k) EXPECT_EQ(seen[k], FitStatus::kPoor) << k;
   EXPECT_EQ(step(tr, FitStatus::kOk).status, FitStatus::kOk);
 }
+
+// A weak fix (under weak_fit_ratio of its points on the plan) is published POOR, naming its share; the covariance
+// and the track are as for any fix (the next strong one is OK at once); weak_fit_ratio 0: OK.
+TEST(Degeneracy, WeakFitIsPublishedPoor) {
+  UncertaintyConfig cfg, off;
+  cfg.confirm_fixes = off.confirm_fixes = 0;
+  off.weak_fit_ratio = 0;
+  ASSERT_EQ(cfg.weak_fit_ratio, 0.5);
+  UncertaintyTracker tr(cfg), keep(off);
+  const Eigen::Matrix3d fixed = diag(0.01, 0.01, 0.002);
+  Pose2 p{0, 0, 0};
+  matcher::Twist2 v;
+  int64_t t = 0;
+  for (double ratio : {0.9, 0.46, 0.5, 0.9}) {
+    const auto s = tr.update(t, fixed, true, FitStatus::kOk, {}, &p, &v, ratio);
+    EXPECT_EQ(s.status, ratio < 0.5 ? FitStatus::kPoor : FitStatus::kOk) << ratio;
+    if (ratio < 0.5) EXPECT_NE(s.text.find("weak fit: 46 %"), std::string::npos) << s.text;
+    EXPECT_NEAR(s.sigma_max_m, 0.01, 1e-6);
+    EXPECT_EQ(keep.update(t, fixed, true, FitStatus::kOk, {}, &p, &v, ratio).status, FitStatus::kOk);
+    t += 100000;
+  }
+}

@@ -58,6 +58,11 @@ struct UncertaintyConfig {
   // confirm_scans. 0: off (a single fix is OK).
   int confirm_fixes = 5;
   double reacquire_sigma_m = 0.3;      // (3 sigma: a region of about 2 m, where office aliases lie)
+  // A weak fix (a share of its points within the matcher's inlier distance of the plan below weak_fit_ratio,
+  // kept by the matcher, whose own limit is lower) is published POOR ("weak fit: k % of the points on the plan"):
+  // the plan explains less than half of what the sensor sees there. The grid localizer's min_inlier_ratio and
+  // weak_fit_is_poor. Status only. 0: off.
+  double weak_fit_ratio = 0.5;
 };
 
 struct UncertaintyState {
@@ -79,10 +84,11 @@ class UncertaintyTracker {
   // One frame, in time order: its own covariance (frame_valid false: the frame fixes nothing) and the
   // matcher's status/text. Returns what to publish with the frame's pose.
   // With `fix` (the frame's own pose, that P_f is about) and the matcher's body twist of the frame (its
-  // motion model, carried to the next frame) the innovation gate applies (see gate_sigma).
+  // motion model, carried to the next frame) the innovation gate applies (see gate_sigma); inlier_ratio is the
+  // fix's share of points on the plan (weak_fit_ratio).
   UncertaintyState update(int64_t utime, const Eigen::Matrix3d& frame_cov, bool frame_valid, matcher::FitStatus matcher_status,
                           const std::string& matcher_text = {}, const Pose2* fix = nullptr,
-                          const matcher::Twist2* twist = nullptr);
+                          const matcher::Twist2* twist = nullptr, double inlier_ratio = 1.0);
   // A new initial pose with its uncertainty (1-sigma x/y and yaw); the velocity is unknown.
   void reset(double sigma_m, double sigma_rad);
   void reset() { have_ = false; }
