@@ -21,7 +21,9 @@
 // Status: OK while the published 1-sigma along the weakest horizontal direction (the largest eigenvalue
 // of the x/y block) stays below poor_sigma_m and the heading's below poor_sigma_rad; otherwise POOR, with
 // a text naming the direction ("position open along 87 deg (1 sigma 0.31 m): the plan does not constrain
-// it here"). The matcher's POOR/LOST stay as they are (LOST means lost, not merely uncertain).
+// it here"). The matcher's POOR/LOST stay as they are (LOST means lost, not merely uncertain). A fix is also
+// published POOR when the innovation gate refuses it, while a re-acquired track is being confirmed
+// (confirm_fixes) and when under half of its points lie on the plan (weak_fit_ratio).
 #pragma once
 #include <Eigen/Core>
 #include <cstdint>
@@ -51,11 +53,11 @@ struct UncertaintyConfig {
   double gate_sigma = 3.0;
   // Re-acquisition: a fix taken where the position was unknown (the predicted 1-sigma above reacquire_sigma_m
   // in every horizontal direction: the start from an uncertain initial pose, after LOST, after a long POOR
-  // stretch; not a corridor, which the frames kept fixing across) is one registration's answer in a wide search, and a wrong place that explains the scan (a
-  // parallel corridor, a twin room) gives one as readily as the right one. Published POOR ("re-acquired: k of
-  // N fixes agreeing") until confirm_fixes accepted fixes in a row, each within the innovation gate of the track
-  // the ones before it started; a POOR/LOST or refused frame starts the count again. As the grid localizer's
-  // confirm_scans. 0: off (a single fix is OK).
+  // stretch; not a corridor, which the frames kept fixing across) is one registration's answer in a wide
+  // search, and a wrong place that explains the scan (a parallel corridor, a twin room) gives one as readily as
+  // the right one. Published POOR ("re-acquired: k of N fixes agreeing") until confirm_fixes accepted fixes in a
+  // row, each within the innovation gate of the track the ones before it started; a POOR/LOST or refused frame
+  // starts the count again. As the grid localizer's confirm_scans. 0: off (a single fix is OK).
   int confirm_fixes = 5;
   double reacquire_sigma_m = 0.3;      // (3 sigma: a region of about 2 m, where office aliases lie)
   // A weak fix (a share of its points within the matcher's inlier distance of the plan below weak_fit_ratio,
