@@ -29,14 +29,10 @@ print(f"{n} events, every IMU sample {sys.argv[3]} ms later: {late} scans now co
 assert late >= 30, late
 PY
 done
-PLAN="$ROOT/data/plans/room.json"
+source "$ROOT/tests/support/paper_replay.sh"
 for run in ordered late100 late300; do
   log="$W/log.lcm"; [ "$run" != ordered ] && log="$W/$run.lcm"
-  "$BIN/fploc-replay" --graph "$ROOT/graphs/paper.pbtxt" --log "$log" --json \
-    --set matcher.plan.file="$PLAN" --set optimizer.plan.file="$PLAN" \
-    --set sfr_logger.file="$W/$run-sfr.tum" --set wo_logger.file="$W/$run-wo.tum" --set odom_logger.file="$W/$run-odom.tum" \
-    --set odom_map_logger.file="$W/$run-odom_map.tum" --record "$W/$run-seg.lcm" --record-channels '^FPLOC_SEGMENTS$' \
-    >"$W/$run.json" 2>"$W/$run.err" || { cat "$W/$run.err" >&2; exit 1; }
+  paper_replay "$log" "$W/$run" --record "$W/$run-seg.lcm" --record-channels '^FPLOC_SEGMENTS$'
 done
 for late in late100 late300; do
 # The segmenter says so in its telemetry detail (the dashboard's "state detail"), only when the IMU was late.

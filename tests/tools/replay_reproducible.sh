@@ -13,16 +13,12 @@ import math
 r=list(map(float,open('$W/gt.tum').readline().split()))
 qx,qy,qz,qw=r[4:8]
 print(repr(r[1]),repr(r[2]),repr(math.atan2(2*(qw*qz+qx*qy),1-2*(qy*qy+qz*qz))))")
-PLAN="$ROOT/data/plans/room.json"
+source "$ROOT/tests/support/paper_replay.sh"
 for run in a b; do
-  "$BIN/fploc-replay" --graph "$ROOT/graphs/paper.pbtxt" --log "$W/log.lcm" --json \
-    --set matcher.plan.file="$PLAN" --set optimizer.plan.file="$PLAN" \
+  paper_replay "$W/log.lcm" "$W/$run" \
     --set matcher.initial_pose.x="$X" --set matcher.initial_pose.y="$Y" --set matcher.initial_pose.yaw="$YAW" \
     --set odometry.initial_pose.x="$X" --set odometry.initial_pose.y="$Y" --set odometry.initial_pose.yaw="$YAW" \
-    --set odometry_map.initial_pose.x="$X" --set odometry_map.initial_pose.y="$Y" --set odometry_map.initial_pose.yaw="$YAW" \
-    --set sfr_logger.file="$W/$run-sfr.tum" --set wo_logger.file="$W/$run-wo.tum" --set odom_logger.file="$W/$run-odom.tum" \
-    --set odom_map_logger.file="$W/$run-odom_map.tum" \
-    >"$W/$run.json" 2>"$W/$run.err" || { cat "$W/$run.err" >&2; exit 1; }
+    --set odometry_map.initial_pose.x="$X" --set odometry_map.initial_pose.y="$Y" --set odometry_map.initial_pose.yaw="$YAW"
 done
 frames=$(grep -c . "$W/gt.tum")
 fail=0
