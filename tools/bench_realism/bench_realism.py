@@ -491,14 +491,13 @@ class Bench:
         rep = json.loads(run(cmd)[0].strip().splitlines()[-1])
         rows = []
         self.floors[fam] = gauge_floor(plan, truth, g) if truth is not None else None
-        scans = scans_of(rep, len(g))
         for m in ("fploc", "amcl"):
             if m not in self.methods:
                 continue
             ch, nodes = METHODS[m]
             if m == "fploc" and self.a.online_scale:
                 nodes = nodes + ("plan_diff",)
-            rows.append(self.row(fam, m, poses_of(rec, ch), g, rep, nodes, scans))
+            rows.append(self.row(fam, m, poses_of(rec, ch), g, rep, nodes))
         if "fploc+downweight" in self.methods:
             gdw = os.path.join(d, "realism-downweight.pbtxt")
             downweight_graph(os.path.join(ROOT, "graphs", "realism.pbtxt"), gdw)
@@ -512,7 +511,7 @@ class Bench:
             log(f"[{fam}] replaying fploc with the plan diff's down-weighting (weight {self.a.downweight}) ...")
             repd = json.loads(run(cmdd)[0].strip().splitlines()[-1])
             rows.append(self.row(fam, "fploc+downweight", poses_of(recd, "FPLOC_POSE"), g, repd,
-                                 METHODS["fploc+downweight"][1], scans))
+                                 METHODS["fploc+downweight"][1]))
             os.remove(recd)
         if self.have_ndt and "ndt" in self.methods:
             nrec = os.path.join(d, "ndt.lcm")
@@ -523,8 +522,7 @@ class Bench:
             log(f"[{fam}] replaying NDT ...")
             try:
                 nrep = json.loads(run(cmd)[0].strip().splitlines()[-1])
-                nscans = scans_of(nrep, len(g))
-                rows.append(self.row(fam, "ndt", poses_of(nrec, METHODS["ndt"][0]), g, nrep, METHODS["ndt"][1], nscans))
+                rows.append(self.row(fam, "ndt", poses_of(nrec, METHODS["ndt"][0]), g, nrep, METHODS["ndt"][1]))
             except SystemExit:
                 log(f"[{fam}] NDT run failed (left out)")
         det = None
@@ -550,7 +548,7 @@ class Bench:
                     cmd2 += ["--set", x]
                 log(f"[{fam}] scale estimate {100 * est:.3f} %: replaying fploc against the rescaled plan ...")
                 rep2 = json.loads(run(cmd2)[0].strip().splitlines()[-1])
-                rows.append(self.row(fam, "fploc+scale", poses_of(rec2, "FPLOC_POSE"), g, rep2, METHODS["fploc"][1], scans))
+                rows.append(self.row(fam, "fploc+scale", poses_of(rec2, "FPLOC_POSE"), g, rep2, METHODS["fploc"][1]))
                 os.remove(rec2)
             flagged = [e["id"] for e in diff["elements"] if e["status"] in ("missing", "moved")]
             if flagged and "fploc+diff" in self.methods:
@@ -565,7 +563,7 @@ class Bench:
                     cmd3 += ["--set", x]
                 log(f"[{fam}] {len(flagged)} elements missing/moved: replaying fploc against the plan the diff corrected ...")
                 rep3 = json.loads(run(cmd3)[0].strip().splitlines()[-1])
-                rows.append(self.row(fam, "fploc+diff", poses_of(rec3, "FPLOC_POSE"), g, rep3, METHODS["fploc"][1], scans))
+                rows.append(self.row(fam, "fploc+diff", poses_of(rec3, "FPLOC_POSE"), g, rep3, METHODS["fploc"][1]))
                 os.remove(rec3)
             log(f"[{fam}] detection: removed {det['removed_found']}/{det['removed']}, moved {det['moved_found']}/{det['moved']}, "
                 f"added {det['added_found']}/{det['added']}, false flags {det['false_flags']} "
@@ -579,8 +577,9 @@ class Bench:
     def floor_of(self, fam):
         return self.floors.get(fam)
 
-    def row(self, fam, method, poses, g, rep, nodes, scans):
+    def row(self, fam, method, poses, g, rep, nodes):
         s = score_poses(poses, g) or {"poses": 0}
+        scans = scans_of(rep, len(g))  # this replay's own
         cpu = sum(n.get("cpu_ms", n["total_ms"]) for n in rep["nodes"] if n["name"] in nodes)
         own = sum(n.get("cpu_ms", n["total_ms"]) for n in rep["nodes"] if n["name"] in nodes and n["name"] not in SHARED_NODES)
         r = {"family": fam, "method": method, **s, "scans": scans, "ms_per_scan": round(cpu / max(scans, 1), 3),

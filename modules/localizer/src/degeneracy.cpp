@@ -46,7 +46,7 @@ Eigen::Matrix3d grow_linear(const Eigen::Matrix3d& P, const Eigen::Vector3d& a) 
 }
 
 double weakest_horizontal(const Eigen::Matrix3d& P, double* direction_rad) {
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(0.5 * (P.topLeftCorner<2, 2>() + P.topLeftCorner<2, 2>().transpose()));
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(sym(P).topLeftCorner<2, 2>());
   const Eigen::Vector2d v = es.eigenvectors().col(1);  // largest eigenvalue last
   if (direction_rad) {
     double a = std::atan2(v.y(), v.x());
@@ -58,8 +58,7 @@ double weakest_horizontal(const Eigen::Matrix3d& P, double* direction_rad) {
 }
 
 double strongest_horizontal(const Eigen::Matrix3d& P) {
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(0.5 * (P.topLeftCorner<2, 2>() + P.topLeftCorner<2, 2>().transpose()),
-                                                    Eigen::EigenvaluesOnly);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(sym(P).topLeftCorner<2, 2>(), Eigen::EigenvaluesOnly);
   return std::sqrt(std::max(0.0, es.eigenvalues()[0]));
 }
 
@@ -108,7 +107,7 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
     // The velocity error grows by accel * dt (capped at the platform's speed), the pose's by it * dt.
     const double a = cfg_.accel_sigma_mps2 * dt;
     W_pred = grow_linear(W_, Eigen::Vector3d(a, a, 0.0));
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> ev(0.5 * (W_pred.topLeftCorner<2, 2>() + W_pred.topLeftCorner<2, 2>().transpose()));
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> ev(sym(W_pred).topLeftCorner<2, 2>());
     W_pred.topLeftCorner<2, 2>() =
         ev.eigenvectors() * ev.eigenvalues().cwiseMin(v2).cwiseMax(0.0).asDiagonal() * ev.eigenvectors().transpose();
     W_pred.block<2, 1>(0, 2).setZero();
@@ -144,7 +143,7 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
   if (frame_ok) {
     P_ = tighter_of(P_pred, frame_cov);
     // What the frame observes of the velocity: along the directions it fixes, consecutive fixes give it.
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> ef(0.5 * (frame_cov.topLeftCorner<2, 2>() + frame_cov.topLeftCorner<2, 2>().transpose()));
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> ef(sym(frame_cov).topLeftCorner<2, 2>());
     Eigen::Vector2d vo;
     for (int i = 0; i < 2; ++i)
       vo[i] = std::sqrt(std::max(0.0, ef.eigenvalues()[i])) < cfg_.poor_sigma_m ? cfg_.velocity_sigma_mps * cfg_.velocity_sigma_mps : v2;
