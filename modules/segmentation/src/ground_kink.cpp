@@ -36,16 +36,14 @@
 #include "fploc/segmentation/segmenter.h"
 #include "plane_kernels.h"
 #include "plane_math.h"
-#include "simd4.h"
+#include "kink_cells.h"
 #include "segmenter_constants.h"
 
 namespace fploc::seg {
 
 namespace {
-constexpr int kAzimuths = 24;             // azimuth sectors of 15 deg (a 2.5 m ramp 4 m ahead: 35 deg) ...
-constexpr std::array<float, 3> kBandEdgesM{6.f, 9.f, 14.f};  // ... times horizontal-distance bands (a kink ahead)
-constexpr int kSectors = kAzimuths * int(kBandEdgesM.size() + 1);
-constexpr float kSectorBandM = 0.3f;      // returns this near the ring fit's plane ...
+using kink::kSectorBandM;
+constexpr int kSectors = kink::kCells;    // the cells of kink_cells.h ("sectors" below)
 constexpr float kSectorTightM = 0.05f;    // ... and at the end this near the sector's own plane
 constexpr int kMinSectorPoints = 40;      // a sector with fewer returns says nothing
 constexpr double kSectorMaxRmsM = 0.02;   // a sector's rms about its plane (one surface)
@@ -73,44 +71,6 @@ detail::Moments moments_near(const float* x, const float* y, const float* z, siz
   return detail::Moments::from_weighted(S);
 }
 
-// Each point's sector (-1: not within kSectorBandM of the plane n0.p + d0 = 0, or not finite): azimuth sector
-// (kAzimuths of them from -180 deg, as floor((atan2(y, x) + pi) / (2 pi) kAzimuths)) x horizontal-distance band.
-// The azimuth by its quadrant and the tangents of the sector edges within it (no atan2; a point within float
-// rounding of an edge may fall on either side), four points at a time over the NaN-padded candidates
-// (`sector` holds the padding's -1 too).
-void assign_sectors(const float* xs, const float* ys, const float* zs, size_t n, const Eigen::Vector3f& n0, float d0,
-                    int16_t* sector) {
-  using namespace simd;
-  static_assert(kAzimuths % 4 == 0, "whole sectors per quadrant");
-  constexpr int kPerQuadrant = kAzimuths / 4;
-  std::array<v4f, kPerQuadrant - 1> tan_edge;
-  for (int k = 1; k < kPerQuadrant; ++k) tan_edge[size_t(k - 1)] = splat(float(std::tan(k * M_PI / 2 / kPerQuadrant)));
-  std::array<v4f, kBandEdgesM.size()> edge2;
-  for (size_t b = 0; b < kBandEdgesM.size(); ++b) edge2[b] = splat(kBandEdgesM[b] * kBandEdgesM[b]);
-  const v4f nx = splat(n0.x()), ny = splat(n0.y()), nz = splat(n0.z()), d = splat(d0), band_m = splat(kSectorBandM);
-  const v4f zero = splat(0.f);
-  const v4i none = splati(-1);
-  for (size_t i = 0; i < n; i += 4) {
-    const v4f x = load(xs + i), y = load(ys + i), z = load(zs + i);
-    const v4f r = nx * x + ny * y + nz * z;
-    const v4i in = abs(r + d) <= band_m;  // false for NaN
-    // The angle from -180 deg: that of (X, Y) = (-x, -y) from 0; its quadrant q turned onto the first (a > 0, b >= 0).
-    const v4f X = -x, Y = -y;
-    const v4i q0 = (X > zero) & (Y >= zero), q1 = (X <= zero) & (Y > zero), q2 = (X < zero) & (Y <= zero);
-    const v4f a = q0 ? X : q1 ? Y : q2 ? -X : -Y;
-    const v4f b = q0 ? Y : q1 ? -X : q2 ? -Y : X;
-    const v4i q = q0 ? splati(0) : q1 ? splati(1) : q2 ? splati(2) : splati(3);
-    v4i j = splati(0);
-    for (const v4f& te : tan_edge) j -= b >= te * a;  // (a true comparison is -1)
-    const v4f hx = x - r * nx, hy = y - r * ny, hz = z - r * nz;  // horizontal part
-    const v4f h2 = hx * hx + hy * hy + hz * hz;
-    v4i band = splati(0);
-    for (const v4f& e2 : edge2) band -= h2 >= e2;
-    const v4i sec = in ? band * kAzimuths + q * kPerQuadrant + j : none;
-    for (int l = 0; l < 4; ++l) sector[i + size_t(l)] = int16_t(sec[l]);
-  }
-}
-
 struct Group {
   detail::Moments m;
   Eigen::Vector4d pl = Eigen::Vector4d::Zero();
@@ -135,12 +95,14 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   std::array<detail::Moments, kSectors> sm;
   std::array<bool, kSectors> ok{};
   std::array<double, kSectors> ssig{};  // the sector normal's 1-sigma [rad]
-  std::vector<int16_t>& sector = kink_sector_;
-  sector.assign((lower_.n + 3) & ~size_t(3), -1);
-  assign_sectors(lower_.x.data(), lower_.y.data(), lower_.z.data(), lower_.n, n0, d0, sector.data());
+  // The returns near the ring fit's plane: their indices and sectors (kink_cells.h), in order.
   std::array<int32_t, kSectors> count{};  // returns per sector
-  for (size_t i = 0; i < lower_.n; ++i)
-    if (sector[i] >= 0) ++count[size_t(sector[i])];
+  kink_index_.resize((lower_.n + 7) & ~size_t(7));
+  kink_sector_.resize(kink_index_.size());
+  const size_t near = kink::cells(lower_.x.data(), lower_.y.data(), lower_.z.data(), lower_.n, n0, d0,
+                                  kink_index_.data(), kink_sector_.data(), count);
+  const int32_t* index = kink_index_.data();
+  const int16_t* sector = kink_sector_.data();
   // The points grouped by sector (relative to ref), each sector's block padded to a multiple of kPad with a
   // point 1 km above the ground (outside every cut-off), for the vectorised moments (plane_kernels.h).
   std::array<int32_t, kSectors + 1> block;  // sector s's padded block: [block[s], block[s + 1])
@@ -154,9 +116,8 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   {
     std::array<int32_t, kSectors> at;
     std::copy(block.begin(), block.begin() + kSectors, at.begin());
-    for (size_t i = 0; i < lower_.n; ++i) {
-      if (sector[i] < 0) continue;
-      const size_t o = size_t(at[size_t(sector[i])]++);
+    for (size_t k = 0; k < near; ++k) {
+      const size_t i = size_t(index[k]), o = size_t(at[size_t(sector[k])]++);
       kink_x_[o] = lower_.x[i] - reff.x();
       kink_y_[o] = lower_.y[i] - reff.y();
       kink_z_[o] = lower_.z[i] - reff.z();
@@ -312,8 +273,9 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     const Eigen::Vector3f n = pl.head<3>().cast<float>();
     const Eigen::Vector3f shift = float(follow_rate_) * n;
     detail::Moments m0, m1;
-    for (size_t i = 0; i < lower_.n; ++i) {
-      if (!use(i)) continue;
+    for (size_t k = 0; k < near; ++k) {  // (a return within kSectorTightM of pl is one near the ring fit)
+      if (!use(sector[k])) continue;
+      const size_t i = size_t(index[k]);
       const int64_t tc = scan.column_utime[size_t(lower_.pixel[i] % W)];
       const Eigen::Vector3f p = lower_.point(i);
       if (tc == 0 || !p.allFinite() || std::abs(n.dot(p) + float(pl[3])) >= kSectorTightM) continue;
@@ -330,8 +292,8 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   double sweep_skew = 0;
   if (can_deskew) {
     Eigen::Vector4d Fc;
-    sweep_skew = sweep_corrected(F.pl, [&](size_t i) {
-      return sector[i] >= 0 && in_f[sector[i]];
+    sweep_skew = sweep_corrected(F.pl, [&](int16_t s) {
+      return in_f[size_t(s)];
     }, &Fc);
     if (sweep_skew > k::kSweepSkewDeg * k::kDeg) {
       F.pl = Fc;
@@ -356,7 +318,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     // translation as the followed surface was. (Where the ground gives the attitude, F's own fit replaces the ring
     // fit below: on the demo building's first floor the ring fit was 0.1-0.3 deg off where F was within 0.03.)
     Eigen::Vector4d gc;
-    const double skew = sweep_deskewed ? sweep_corrected(g.coeffs, [](size_t) { return true; }, &gc) : 0.0;
+    const double skew = sweep_deskewed ? sweep_corrected(g.coeffs, [](int16_t) { return true; }, &gc) : 0.0;
     if (skew > k::kSweepSkewDeg * k::kDeg) {
       g.coeffs = gc;
       char buf[200];

@@ -30,6 +30,15 @@ Eigen::Vector3d GyroDeskew::rate_at(int64_t t) const {
   return it->second - gyro_bias_;
 }
 
+Eigen::Vector3d GyroDeskew::rate_walk(int64_t t, size_t& at) const {
+  // The first sample at or after t (the last one when none is), as rate_at's search finds it.
+  const size_t n = gyro_.size();
+  at = std::min(at, n - 1);
+  while (at + 1 < n && gyro_[at].first < t) ++at;
+  while (at > 0 && gyro_[at - 1].first >= t) --at;
+  return gyro_[at].second - gyro_bias_;
+}
+
 bool GyroDeskew::covers(int64_t ta, int64_t tb) const {
   // Samples from before ta to after tb (within kGyroEdgeUs) without a gap longer than kGyroMaxGapUs.
   if (gyro_.size() < 2 || gyro_.front().first > ta + k::kGyroEdgeUs || gyro_.back().first < tb - k::kGyroEdgeUs)
@@ -118,8 +127,9 @@ bool GyroDeskew::prepare(const Scan& scan) {
   Eigen::Vector3d last_th = Eigen::Vector3d::Zero();
   Eigen::Matrix3d last_inc = Eigen::Matrix3d::Identity();
   bool last_turns = false;  // (a zero angle vector: no rotation)
+  size_t at = 0;  // the gyro sample of the last step
   auto step = [&](const Eigen::Matrix3d& R, int64_t ta, int64_t tb) {
-    const Eigen::Vector3d th = rate_at(ta + (tb - ta) / 2) * (1e-6 * double(tb - ta));
+    const Eigen::Vector3d th = rate_walk(ta + (tb - ta) / 2, at) * (1e-6 * double(tb - ta));
     if (th != last_th) {
       const double a = th.norm();
       last_th = th;

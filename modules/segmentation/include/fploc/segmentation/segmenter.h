@@ -122,8 +122,10 @@ class Segmenter {
   double follow_d_ = 0, follow_rate_ = 0, follow_rate_var_ = 0, follow_rate_gain_ = 1;  // (var: of the raw rates)
   int64_t follow_d_t_ = 0;
   bool follow_rate_ok_ = false;
-  // ground_kink.cpp's scratch, kept from scan to scan: each lower candidate's sector (-1: none), and the
-  // sectors' points grouped (sector by sector, relative to the plane's reference point), the followed surface's.
+  // ground_kink.cpp's scratch, kept from scan to scan: the lower candidates near the ring fit's plane (their
+  // indices and sectors), and the sectors' points grouped (sector by sector, relative to the plane's reference
+  // point), the followed surface's.
+  std::vector<int32_t> kink_index_;
   std::vector<int16_t> kink_sector_;
   std::vector<float> kink_x_, kink_y_, kink_z_, near_x_, near_y_, near_z_;
   Eigen::Vector3d accel_sum_ = Eigen::Vector3d::Zero();
