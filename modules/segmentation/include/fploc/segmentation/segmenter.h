@@ -5,7 +5,8 @@
 // One scan goes through: point preparation (point_prep.cpp: XYZ, range gate, gyro de-skew by GyroDeskew,
 // the upper/lower half-ring candidates) -> the plane fit strategy (PlaneFit: RingPlaneFit, the paper's, or
 // RansacPlaneFit) for the ceiling and the ground -> plane quality and acceptance (plane_quality.cpp,
-// segmenter.cpp) -> attitude and height (AttitudeHeight) -> wall selection (wall_select.cpp).
+// segmenter.cpp) -> with a gyro, the ground at a kink (ground_kink.cpp; its cells in kink_cells.cpp) ->
+// attitude and height (AttitudeHeight) -> wall selection (wall_select.cpp).
 #pragma once
 #include <Eigen/Core>
 #include <cstdint>
