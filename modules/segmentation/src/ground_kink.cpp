@@ -44,7 +44,7 @@ namespace fploc::seg {
 namespace {
 using kink::kSectorBandM;
 constexpr int kSectors = kink::kCells;    // the cells of kink_cells.h ("sectors" below)
-constexpr float kSectorTightM = 0.05f;    // ... and at the end this near the sector's own plane
+constexpr float kSectorTightM = 0.05f;    // at the end, returns this near the sector's own plane (kSectorBandM: near the ring fit's)
 constexpr int kMinSectorPoints = 40;      // a sector with fewer returns says nothing
 constexpr double kSectorMaxRmsM = 0.02;   // a sector's rms about its plane (one surface)
 constexpr double kKinkDeg = 3.0;          // another surface: this far from the followed one
