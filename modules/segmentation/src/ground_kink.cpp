@@ -97,7 +97,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   std::array<double, kSectors> ssig{};  // the sector normal's 1-sigma [rad]
   // The returns near the ring fit's plane: their indices and sectors (kink_cells.h), in order.
   std::array<int32_t, kSectors> count{};  // returns per sector
-  kink_index_.resize((lower_.n + 7) & ~size_t(7));
+  kink_index_.resize(((lower_.n + 7) & ~size_t(7)) + 8);
   kink_sector_.resize(kink_index_.size());
   const size_t near = kink::cells(lower_.x.data(), lower_.y.data(), lower_.z.data(), lower_.n, n0, d0,
                                   kink_index_.data(), kink_sector_.data(), count);
@@ -110,17 +110,32 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   for (int s = 0; s < kSectors; ++s) block[size_t(s) + 1] = block[size_t(s)] + (count[size_t(s)] + kPad - 1) / kPad * kPad;
   const size_t padded = size_t(block[kSectors]);
   const Eigen::Vector3f pad_point = 1e3f * n0;  // 1 km above the ground
-  kink_x_.assign(padded, pad_point.x());
-  kink_y_.assign(padded, pad_point.y());
-  kink_z_.assign(padded, pad_point.z());
+  kink_x_.resize(padded);
+  kink_y_.resize(padded);
+  kink_z_.resize(padded);
+  for (int s = 0; s < kSectors; ++s)
+    for (size_t o = size_t(block[size_t(s)] + count[size_t(s)]); o < size_t(block[size_t(s) + 1]); ++o) {
+      kink_x_[o] = pad_point.x();
+      kink_y_[o] = pad_point.y();
+      kink_z_[o] = pad_point.z();
+    }
   {
+    // (a ring's returns come sector after sector: the slot is kept in a register along a run of one sector)
     std::array<int32_t, kSectors> at;
     std::copy(block.begin(), block.begin() + kSectors, at.begin());
+    int16_t cur = near > 0 ? sector[0] : 0;
+    size_t o = near > 0 ? size_t(at[size_t(cur)]) : 0;
     for (size_t k = 0; k < near; ++k) {
-      const size_t i = size_t(index[k]), o = size_t(at[size_t(sector[k])]++);
+      if (sector[k] != cur) {
+        at[size_t(cur)] = int32_t(o);
+        cur = sector[k];
+        o = size_t(at[size_t(cur)]);
+      }
+      const size_t i = size_t(index[k]);
       kink_x_[o] = lower_.x[i] - reff.x();
       kink_y_[o] = lower_.y[i] - reff.y();
       kink_z_[o] = lower_.z[i] - reff.z();
+      ++o;
     }
   }
   for (int s = 0; s < kSectors; ++s) spl[s] = g.coeffs;
@@ -203,24 +218,23 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     // F's returns within the first cut-off of its pooled plane (relative to ref), padded as the sectors' blocks.
     const Eigen::Vector3f n0f = F.pl.head<3>().cast<float>();
     const float d0f = float(F.pl[3]) + n0f.dot(reff);
-    near_x_.clear();
-    near_y_.clear();
-    near_z_.clear();
+    size_t room = kPad;  // (the kernel writes up to 7 slots past its count)
+    for (int s = 0; s < kSectors; ++s)
+      if (in_f[s]) room += size_t(count[size_t(s)]);
+    for (auto* v : {&near_x_, &near_y_, &near_z_}) v->resize(room + kPad);
+    size_t m = 0;
     for (int s = 0; s < kSectors; ++s) {
       if (!in_f[s]) continue;
-      for (int32_t j = block[size_t(s)]; j < block[size_t(s)] + count[size_t(s)]; ++j) {
-        const Eigen::Vector3f p(kink_x_[size_t(j)], kink_y_[size_t(j)], kink_z_[size_t(j)]);
-        if (!(std::abs(n0f.dot(p) + d0f) < kRefineCutM[0])) continue;
-        near_x_.push_back(p.x());
-        near_y_.push_back(p.y());
-        near_z_.push_back(p.z());
-      }
+      const size_t b = size_t(block[size_t(s)]);
+      m = kink::near_plane(kink_x_.data() + b, kink_y_.data() + b, kink_z_.data() + b, size_t(count[size_t(s)]), n0f,
+                           d0f, kRefineCutM[0], near_x_.data(), near_y_.data(), near_z_.data(), m);
     }
-    while (near_x_.size() % kPad) {
-      near_x_.push_back(pad_point.x());
-      near_y_.push_back(pad_point.y());
-      near_z_.push_back(pad_point.z());
+    for (; m % kPad; ++m) {
+      near_x_[m] = pad_point.x();
+      near_y_[m] = pad_point.y();
+      near_z_[m] = pad_point.z();
     }
+    for (auto* v : {&near_x_, &near_y_, &near_z_}) v->resize(m);
     Eigen::Vector4d pl = F.pl;
     for (const float c : kRefineCutM) {
       const detail::Moments m = moments_near(near_x_.data(), near_y_.data(), near_z_.data(), near_x_.size(), pl, ref, c, false);

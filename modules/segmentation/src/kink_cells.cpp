@@ -10,6 +10,8 @@
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
+
+#include "lane8.h"
 #define FPLOC_KINK_WIDE 1
 #else
 #define FPLOC_KINK_WIDE 0
@@ -67,17 +69,21 @@ __attribute__((always_inline)) inline I lanes(V x, V y, V z, V nx, V ny, V nz, V
   return in ? band * kAzimuths + q * kPerQuadrant + j : zi - 1;
 }
 
-template <int L, typename I>
-__attribute__((always_inline)) inline size_t keep(const I& sec, size_t i, size_t n, size_t m, int32_t* index, int16_t* cell,
-                   std::array<int32_t, kCells>& count) {
-  for (int l = 0; l < L; ++l) {
-    if (sec[l] < 0 || i + size_t(l) >= n) continue;
-    index[m] = int32_t(i + size_t(l));
-    cell[m] = int16_t(sec[l]);
-    ++count[size_t(sec[l])];
-    ++m;
+// The points per cell: a ring's returns come cell after cell, so runs of one cell are added at once (an
+// increment per point would wait for the last one's store).
+void count_runs(const int16_t* cell, size_t m, std::array<int32_t, kCells>& count) {
+  if (m == 0) return;
+  int16_t cur = cell[0];
+  int32_t run = 0;
+  for (size_t k = 0; k < m; ++k) {
+    if (cell[k] != cur) {
+      count[size_t(cur)] += run;
+      cur = cell[k];
+      run = 0;
+    }
+    ++run;
   }
-  return m;
+  count[size_t(cur)] += run;
 }
 
 size_t cells4(const float* xs, const float* ys, const float* zs, size_t n, const Eigen::Vector3f& n0, float d0,
@@ -86,15 +92,22 @@ size_t cells4(const float* xs, const float* ys, const float* zs, size_t n, const
   const Edges& e = edges();
   const v4f nx = splat(n0.x()), ny = splat(n0.y()), nz = splat(n0.z()), d = splat(d0);
   size_t m = 0;
-  for (size_t i = 0; i < n; i += 4)
-    m = keep<4>(lanes<v4f, v4i>(load(xs + i), load(ys + i), load(zs + i), nx, ny, nz, d, e), i, n, m, index, cell,
-                count);
+  for (size_t i = 0; i < n; i += 4) {
+    const v4i sec = lanes<v4f, v4i>(load(xs + i), load(ys + i), load(zs + i), nx, ny, nz, d, e);
+    for (int l = 0; l < 4; ++l) {
+      if (sec[l] < 0 || i + size_t(l) >= n) continue;
+      index[m] = int32_t(i + size_t(l));
+      cell[m++] = int16_t(sec[l]);
+    }
+  }
+  count_runs(cell, m, count);
   return m;
 }
 
 #if FPLOC_KINK_WIDE
-typedef float v8f __attribute__((vector_size(32)));
-typedef int32_t v8i __attribute__((vector_size(32)));
+using lane8::v8f;
+using lane8::v8i;
+constexpr lane8::CompressTable<false> kCompress;
 
 __attribute__((target("avx2"))) size_t cells8(const float* xs, const float* ys, const float* zs, size_t n,
                                               const Eigen::Vector3f& n0, float d0, int32_t* index, int16_t* cell,
@@ -103,6 +116,8 @@ __attribute__((target("avx2"))) size_t cells8(const float* xs, const float* ys, 
   const v8f zero{};
   const v8f nx = zero + n0.x(), ny = zero + n0.y(), nz = zero + n0.z(), d = zero + d0;
   const size_t np = (n + 3) & ~size_t(3);  // readable
+  const v8i iota{0, 1, 2, 3, 4, 5, 6, 7};
+  const __m256i shifts = _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28);
   size_t m = 0;
   for (size_t i = 0; i < n; i += 8) {
     v8f x = zero, y = zero, z = zero;
@@ -116,9 +131,59 @@ __attribute__((target("avx2"))) size_t cells8(const float* xs, const float* ys, 
       std::memcpy(&y, ys + i, 4 * sizeof(float));
       std::memcpy(&z, zs + i, 4 * sizeof(float));
     }
-    const v8i sec = lanes<v8f, v8i>(x, y, z, nx, ny, nz, d, e);
-    if (_mm256_movemask_ps(reinterpret_cast<__m256>(sec >= 0)) == 0) continue;
-    m = keep<8>(sec, i, n, m, index, cell, count);
+    v8i sec = lanes<v8f, v8i>(x, y, z, nx, ny, nz, d, e);
+    int in = _mm256_movemask_ps(reinterpret_cast<__m256>(sec >= 0));
+    if (n - i < 8) in &= (1 << (n - i)) - 1;  // (the lanes past n)
+    if (in == 0) continue;
+    v8i idx = iota + int32_t(i);
+    if (in != 255) {  // the kept lanes to the front
+      const __m256i perm =
+          _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int(kCompress.e[in])), shifts), _mm256_set1_epi32(15));
+      idx = reinterpret_cast<v8i>(_mm256_permutevar8x32_epi32(reinterpret_cast<__m256i>(idx), perm));
+      sec = reinterpret_cast<v8i>(_mm256_permutevar8x32_epi32(reinterpret_cast<__m256i>(sec), perm));
+    }
+    std::memcpy(index + m, &idx, sizeof idx);
+    const __m256i s = reinterpret_cast<__m256i>(sec);
+    const __m128i s16 = _mm_packs_epi32(_mm256_castsi256_si128(s), _mm256_extracti128_si256(s, 1));  // (cells < 2^15)
+    std::memcpy(cell + m, &s16, sizeof s16);
+    m += size_t(__builtin_popcount(unsigned(in)));
+  }
+  count_runs(cell, m, count);
+  return m;
+}
+
+__attribute__((target("avx2"))) size_t near_plane8(const float* x, const float* y, const float* z, size_t n,
+                                                   const Eigen::Vector3f& nrm, float d, float cut, float* ox, float* oy,
+                                                   float* oz, size_t m) {
+  const v8f zero{};
+  const v8f nx = zero + nrm.x(), ny = zero + nrm.y(), nz = zero + nrm.z(), dv = zero + d, cv = zero + cut;
+  const __m256i shifts = _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28);
+  for (size_t i = 0; i < n; i += 8) {
+    v8f px, py, pz;
+    std::memcpy(&px, x + i, sizeof px);
+    std::memcpy(&py, y + i, sizeof py);
+    std::memcpy(&pz, z + i, sizeof pz);
+    v8f r = px * nx + (py * ny + pz * nz) + dv;  // (Eigen's order)
+    {
+      v8i b;
+      std::memcpy(&b, &r, sizeof b);
+      b &= 0x7fffffff;
+      std::memcpy(&r, &b, sizeof b);
+    }
+    int in = _mm256_movemask_ps(reinterpret_cast<__m256>(r < cv));  // false for NaN
+    if (n - i < 8) in &= (1 << (n - i)) - 1;
+    if (in == 0) continue;
+    if (in != 255) {  // the kept lanes to the front
+      const __m256i perm =
+          _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int(kCompress.e[in])), shifts), _mm256_set1_epi32(15));
+      px = reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(px), perm));
+      py = reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(py), perm));
+      pz = reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(pz), perm));
+    }
+    std::memcpy(ox + m, &px, sizeof px);
+    std::memcpy(oy + m, &py, sizeof py);
+    std::memcpy(oz + m, &pz, sizeof pz);
+    m += size_t(__builtin_popcount(unsigned(in)));
   }
   return m;
 }
@@ -130,6 +195,22 @@ bool g_wide_enabled = true;
 }
 bool wide_available() { return FPLOC_KINK_WIDE && g_wide_enabled; }
 void set_wide_enabled(bool on) { g_wide_enabled = on; }
+
+size_t near_plane(const float* x, const float* y, const float* z, size_t n, const Eigen::Vector3f& nrm, float d,
+                  float cut, float* ox, float* oy, float* oz, size_t m) {
+#if FPLOC_KINK_WIDE
+  if (g_wide_enabled && kern::wide()) return near_plane8(x, y, z, n, nrm, d, cut, ox, oy, oz, m);
+#endif
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3f p(x[i], y[i], z[i]);
+    if (!(std::abs(nrm.dot(p) + d) < cut)) continue;
+    ox[m] = p.x();
+    oy[m] = p.y();
+    oz[m] = p.z();
+    ++m;
+  }
+  return m;
+}
 
 size_t cells(const float* x, const float* y, const float* z, size_t n, const Eigen::Vector3f& n0, float d0,
              int32_t* index, int16_t* cell, std::array<int32_t, kCells>& count) {

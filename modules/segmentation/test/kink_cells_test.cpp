@@ -114,3 +114,36 @@ TEST(KinkCells, AzimuthAndDistanceDecideTheCell) {
   }
   kink::set_wide_enabled(true);
 }
+
+TEST(KinkCells, NearPlaneEightLanesKeepTheSamePoints) {
+  if (!kink::wide_available() || !kern::wide()) GTEST_SKIP() << "no eight-lane loop here (not x86-64 with AVX2, or FPLOC_SIMD=sse2)";
+  // Points around a tilted plane, some exactly at the cut-off (as float), some NaN; blocks of a multiple of 8 as
+  // the grouped cells are, the tail of each padded with far points.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-3.f, 3.f), off(-0.08f, 0.08f);
+  const Eigen::Vector3f nrm = Eigen::Vector3f(0.05f, -0.03f, 1.f).normalized();
+  const float d = 0.02f, cut = 0.05f;
+  for (const size_t n : {size_t(0), size_t(5), size_t(8), size_t(13), size_t(3001)}) {
+    const size_t np = (n + 7) & ~size_t(7);
+    std::vector<float> x(np, 0.f), y(np, 0.f), z(np, 1e3f);
+    for (size_t i = 0; i < n; ++i) {
+      x[i] = u(rng);
+      y[i] = u(rng);
+      const float h = i % 17 == 0 ? cut : i % 19 == 0 ? -cut : off(rng);
+      z[i] = (h - d - nrm.x() * x[i] - nrm.y() * y[i]) / nrm.z();
+      if (i % 23 == 0) y[i] = std::numeric_limits<float>::quiet_NaN();
+    }
+    std::vector<float> a(np + 16), b(np + 16), c(np + 16), a8(np + 16), b8(np + 16), c8(np + 16);
+    kink::set_wide_enabled(false);
+    const size_t m4 = kink::near_plane(x.data(), y.data(), z.data(), n, nrm, d, cut, a.data(), b.data(), c.data(), 3);
+    kink::set_wide_enabled(true);
+    const size_t m8 = kink::near_plane(x.data(), y.data(), z.data(), n, nrm, d, cut, a8.data(), b8.data(), c8.data(), 3);
+    ASSERT_EQ(m4, m8) << n;
+    for (size_t k = 3; k < m4; ++k) {
+      EXPECT_EQ(a[k], a8[k]) << n << " " << k;
+      EXPECT_EQ(b[k], b8[k]) << n << " " << k;
+      EXPECT_EQ(c[k], c8[k]) << n << " " << k;
+    }
+    if (n > 1000) EXPECT_GT(m4, n / 2);
+  }
+}
