@@ -1,4 +1,4 @@
-// The ground-at-a-kink's cells (kink_cells.h): four lanes, or eight with AVX2.
+// The ground-at-a-kink's point loops (kink_cells.h): four lanes or scalar, or eight with AVX2.
 #include "kink_cells.h"
 
 #include <algorithm>

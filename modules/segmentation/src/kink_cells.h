@@ -1,7 +1,8 @@
-// The ground-at-a-kink's cells (ground_kink.cpp): which lower candidates lie near the ring fit's plane, and in
-// which azimuth sector x horizontal-distance band (internal header). Four lanes (simd4.h), or eight with AVX2
-// where kern::wide() (compiled for AVX2 alone, no fused multiply-add: the same floats and comparisons, so the
-// same cells bit for bit).
+// The ground-at-a-kink's point loops (ground_kink.cpp): which lower candidates lie near the ring fit's plane and
+// in which azimuth sector x horizontal-distance band (cells()), and which grouped returns lie near a plane
+// (near_plane()); internal header. Four lanes (simd4.h) or scalar, or eight with AVX2 where kern::wide()
+// (compiled for AVX2 alone, no fused multiply-add: the same floats and comparisons, so the same points bit
+// for bit).
 #pragma once
 #include <Eigen/Core>
 #include <array>
