@@ -47,7 +47,6 @@ __attribute__((target("avx2"))) size_t band(const float* x, const float* y, cons
   const v8f nx = splat(pl[0]), ny = splat(pl[1]), nz = splat(pl[2]), d = splat(pl[3]), cb = splat(cut);
   const v8f rx = splat(ref[0]), ry = splat(ref[1]), rz = splat(ref[2]);
   const v8i absm = {0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff};
-  const __m256i shifts = _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28);
   size_t m = 0;
   for (size_t i = 0; i < n; i += 8) {
     v8f px, py, pz;
@@ -74,7 +73,7 @@ __attribute__((target("avx2"))) size_t band(const float* x, const float* y, cons
       m += 8;
       continue;
     }
-    const __m256i idx = _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int(kCompress.e[in])), shifts), _mm256_set1_epi32(15));
+    const __m256i idx = lane8::to_front(kCompress, in);
     st(bx + m, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(qx), idx)));
     st(by + m, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(qy), idx)));
     st(bz + m, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(qz), idx)));

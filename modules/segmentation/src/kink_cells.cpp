@@ -117,7 +117,6 @@ __attribute__((target("avx2"))) size_t cells8(const float* xs, const float* ys, 
   const v8f nx = zero + n0.x(), ny = zero + n0.y(), nz = zero + n0.z(), d = zero + d0;
   const size_t np = (n + 3) & ~size_t(3);  // readable
   const v8i iota{0, 1, 2, 3, 4, 5, 6, 7};
-  const __m256i shifts = _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28);
   size_t m = 0;
   for (size_t i = 0; i < n; i += 8) {
     v8f x = zero, y = zero, z = zero;
@@ -137,8 +136,7 @@ __attribute__((target("avx2"))) size_t cells8(const float* xs, const float* ys, 
     if (in == 0) continue;
     v8i idx = iota + int32_t(i);
     if (in != 255) {  // the kept lanes to the front
-      const __m256i perm =
-          _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int(kCompress.e[in])), shifts), _mm256_set1_epi32(15));
+      const __m256i perm = lane8::to_front(kCompress, in);
       idx = reinterpret_cast<v8i>(_mm256_permutevar8x32_epi32(reinterpret_cast<__m256i>(idx), perm));
       sec = reinterpret_cast<v8i>(_mm256_permutevar8x32_epi32(reinterpret_cast<__m256i>(sec), perm));
     }
@@ -157,7 +155,6 @@ __attribute__((target("avx2"))) size_t near_plane8(const float* x, const float* 
                                                    float* oz, size_t m) {
   const v8f zero{};
   const v8f nx = zero + nrm.x(), ny = zero + nrm.y(), nz = zero + nrm.z(), dv = zero + d, cv = zero + cut;
-  const __m256i shifts = _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28);
   for (size_t i = 0; i < n; i += 8) {
     v8f px, py, pz;
     std::memcpy(&px, x + i, sizeof px);
@@ -174,8 +171,7 @@ __attribute__((target("avx2"))) size_t near_plane8(const float* x, const float* 
     if (n - i < 8) in &= (1 << (n - i)) - 1;
     if (in == 0) continue;
     if (in != 255) {  // the kept lanes to the front
-      const __m256i perm =
-          _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int(kCompress.e[in])), shifts), _mm256_set1_epi32(15));
+      const __m256i perm = lane8::to_front(kCompress, in);
       px = reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(px), perm));
       py = reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(py), perm));
       pz = reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(pz), perm));

@@ -42,4 +42,12 @@ __attribute__((target("avx2"))) inline v8f ld(const float* p) {
 __attribute__((target("avx2"))) inline void st(float* p, v8f v) { std::memcpy(p, &v, sizeof v); }
 __attribute__((target("avx2"))) inline v8f splat(float a) { return v8f{a, a, a, a, a, a, a, a}; }
 
+// The lane permutation (for _mm256_permutevar8x32_*) that moves the set lanes of an 8-bit mask to the front, from
+// the table's entry for the mask.
+template <bool kRepeatFirst>
+__attribute__((target("avx2"))) inline __m256i to_front(const CompressTable<kRepeatFirst>& table, int mask) {
+  const __m256i shifts = _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28);
+  return _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int(table.e[mask])), shifts), _mm256_set1_epi32(15));
+}
+
 }  // namespace fploc::seg::lane8

@@ -70,7 +70,6 @@ __attribute__((target("avx2"))) size_t copy8(const Source& s, int32_t a, int32_t
   const float* __restrict srange = s.range;
   const int32_t* __restrict spixel = s.pixel;
   const __m128i rings = _mm_set1_epi16(u);
-  const __m256i shifts = _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28);
   const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   const __m128i iota16 = _mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7);
   size_t g = 0;
@@ -99,7 +98,7 @@ __attribute__((target("avx2"))) size_t copy8(const Source& s, int32_t a, int32_t
       continue;
     }
     // Compress the set lanes to the front (the slots after them are overwritten by the next group).
-    const __m256i idx = _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int(kCompress.e[mk])), shifts), _mm256_set1_epi32(15));
+    const __m256i idx = lane8::to_front(kCompress, mk);
     __m256i pix;
     std::memcpy(&pix, spixel + j, sizeof pix);
     pix = _mm256_permutevar8x32_epi32(pix, idx);
