@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fploc/carmen/carmen.h"
+#include "fit_loss_option.h"
 #include "log_scans.h"
 #include "fploc/floorplan/occupancy.h"
 #include "fploc/laser2d/grid_localizer.h"
@@ -76,6 +77,9 @@ int main(int argc, char** argv) {
   app.add_option("--laser-min-inlier-ratio", c.laser.min_inlier_ratio, "laser odometry: share of the scan the local map must explain");
   app.add_option("--laser-wide-retry", c.laser_wide_retry, "laser odometry: re-acquiring, a strong fit in the wheels' window");
   app.add_option("--laser-track-retry", c.laser_track_retry, "laser odometry: a failed tracking fit, a strong fit in the wheels' window");
+  fploc::bench_real::add_fit_loss_option(app, c.fit_loss);
+  app.add_option("--huber", c.huber_m, "scale of the map fit's robust loss [m]");
+  app.add_option("--huber-first-above", c.huber_first_above_sigma_m, "redescending loss: Huber first when the prediction's sigma x/y exceeds this [m]");
   CLI11_PARSE(app, argc, argv);
   if (laser_sigma_yaw_deg >= 0) c.laser_sigma_yaw_rad = laser_sigma_yaw_deg * M_PI / 180;
   namespace cm = fploc::carmen;
@@ -109,6 +113,9 @@ int main(int argc, char** argv) {
                       {"err_yaw_deg", fploc::wrap_angle(r.pose.yaw - s.pose.theta) * 180 / M_PI},
                       {"status", int(r.status)}, {"inlier_ratio", r.inlier_ratio}, {"window_m", r.search_xy_m},
                       {"window_deg", r.search_yaw_rad * 180 / M_PI}, {"sigma_xy_m", std::sqrt(r.covariance(0, 0))},
+                      {"cov", {r.covariance(0, 0), r.covariance(0, 1), r.covariance(0, 2), r.covariance(1, 1),
+                               r.covariance(1, 2), r.covariance(2, 2)}},
+                      {"rms_m", r.rms_m}, {"num_points", r.num_points},
                       {"hypotheses", r.hypotheses}, {"ms", ms}, {"laser_step", r.laser_step},
                       {"laser_inlier_ratio", r.laser_inlier_ratio}, {"wide_search", r.wide_search},
                       {"odom_bias_deg_per_m", r.odom_bias_rad_per_m * 180 / M_PI},

@@ -45,21 +45,25 @@ struct PriorCost {
   double ixy_, iyaw_;
 };
 
-}  // namespace
-
-std::unique_ptr<ceres::Problem> refine_on_field(const InterpolatedField& f, const FieldFitOptions& o,
-                                                const std::vector<Eigen::Vector2d>& pts, const Pose2& pred,
-                                                double sxy, double syaw, double* x, double* cost, int* iterations,
-                                                bool fix_yaw) {
+std::unique_ptr<ceres::Problem> solve(const InterpolatedField& f, const FieldFitOptions& o, FitLoss kind,
+                                      const std::vector<Eigen::Vector2d>& pts, const Pose2& pred, double sxy,
+                                      double syaw, double* x, double* cost, int* iterations, bool fix_yaw) {
   ceres::Problem::Options po;
   po.loss_function_ownership = ceres::TAKE_OWNERSHIP;
   po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
   auto problem = std::make_unique<ceres::Problem>(po);
   const double inv_sigma = 1 / o.point_sigma_m;
-  for (const auto& p : pts)
+  const double a = o.huber_m * inv_sigma;  // the loss's scale in residual units
+  for (const auto& p : pts) {
+    ceres::LossFunction* loss = nullptr;
+    switch (kind) {
+      case FitLoss::kHuber: loss = new ceres::HuberLoss(a); break;
+      case FitLoss::kCauchy: loss = new ceres::CauchyLoss(a); break;
+      case FitLoss::kTukey: loss = new ceres::TukeyLoss(a); break;
+    }
     problem->AddResidualBlock(
-        new ceres::AutoDiffCostFunction<PointCost, 1, 3>(new PointCost(&f.interp, f.df.get(), p, inv_sigma)),
-        new ceres::HuberLoss(o.huber_m * inv_sigma), x);
+        new ceres::AutoDiffCostFunction<PointCost, 1, 3>(new PointCost(&f.interp, f.df.get(), p, inv_sigma)), loss, x);
+  }
   problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, 3>(new PriorCost(pred, sxy, syaw)), nullptr, x);
   if (fix_yaw) problem->SetManifold(x, new ceres::SubsetManifold(3, {2}));
   ceres::Solver::Options so;
@@ -72,6 +76,16 @@ std::unique_ptr<ceres::Problem> refine_on_field(const InterpolatedField& f, cons
   if (iterations) *iterations += int(sum.iterations.size());
   *cost = sum.final_cost;
   return problem;
+}
+
+}  // namespace
+
+std::unique_ptr<ceres::Problem> refine_on_field(const InterpolatedField& f, const FieldFitOptions& o,
+                                                const std::vector<Eigen::Vector2d>& pts, const Pose2& pred,
+                                                double sxy, double syaw, double* x, double* cost, int* iterations,
+                                                bool fix_yaw) {
+  if (o.huber_first && o.loss != FitLoss::kHuber) solve(f, o, FitLoss::kHuber, pts, pred, sxy, syaw, x, cost, iterations, fix_yaw);
+  return solve(f, o, o.loss, pts, pred, sxy, syaw, x, cost, iterations, fix_yaw);
 }
 
 Eigen::Matrix3d covariance_of(ceres::Problem& problem, const Eigen::Matrix3d& fallback) {

@@ -11,6 +11,7 @@
 
 #include "fploc/core/pose.h"
 #include "fploc/laser2d/distance_field.h"
+#include "fploc/laser2d/grid_localizer.h"
 
 namespace fploc::laser2d::detail {
 
@@ -28,6 +29,10 @@ struct InterpolatedField {
 
 struct FieldFitOptions {
   double point_sigma_m = 0.05, huber_m = 0.05;
+  FitLoss loss = FitLoss::kHuber;
+  // A redescending loss (Cauchy, Tukey) only pulls from where the points already nearly lie: refine with Huber
+  // first (its wider basin), then with `loss` from there (graduated non-convexity, two steps).
+  bool huber_first = false;
   int max_iterations = 20;
 };
 

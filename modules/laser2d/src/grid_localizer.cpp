@@ -36,6 +36,7 @@ FieldFitOptions fit_options(const GridLocalizerConfig& cfg) {
   FieldFitOptions o;
   o.point_sigma_m = cfg.point_sigma_m;
   o.huber_m = cfg.huber_m;
+  o.loss = cfg.fit_loss;
   o.max_iterations = cfg.max_iterations;
   return o;
 }
@@ -45,7 +46,9 @@ FieldFitOptions fit_options(const GridLocalizerConfig& cfg) {
 struct GridLocalizer::Impl {
   std::unique_ptr<ceres::Problem> refine_at(const std::vector<Eigen::Vector2d>& pts, const Pose2& pred, double sxy,
                                             double syaw, double* x, double* cost, int* iterations, bool fix_yaw = false) const {
-    return detail::refine_on_field(field, fit_options(cfg), pts, pred, sxy, syaw, x, cost, iterations, fix_yaw);
+    FieldFitOptions o = fit_options(cfg);
+    o.huber_first = cfg.huber_first_above_sigma_m > 0 && sxy > cfg.huber_first_above_sigma_m;
+    return detail::refine_on_field(field, o, pts, pred, sxy, syaw, x, cost, iterations, fix_yaw);
   }
   detail::InterpolatedField field;
   std::shared_ptr<const DistanceField> df;

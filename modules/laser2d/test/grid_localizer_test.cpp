@@ -11,6 +11,7 @@
 
 #include "fploc/laser2d/distance_field.h"
 #include "fploc/laser2d/grid_localizer.h"
+#include "../src/field_fit.h"
 #include "synthetic_grid.h"
 
 namespace {
@@ -672,4 +673,38 @@ TEST(GridLocalizer, FarHypothesisNeedsTravelToBeTaken) {
   c.far_confirm_travel_m = -1;
   const AliasRun never = run_in_box(c, true, 18);
   EXPECT_LT(never.max_x, 1.0) << "control: found without the travel rule; the test does not test it";
+}
+
+// The refinement's robust loss, alone (no search, no tracking): a scan of the room at a known pose, the map's
+// walls hit exactly (points on the occupied cells' centre lines), plus 40 returns of structure the map lacks, 30 cm
+// in front of the east wall. Huber gives each of those a constant pull towards the wall; Cauchy's influence falls
+// off with the residual (its pull at 6 sigma is 0.16 of Huber's), Tukey's to nothing.
+TEST(FieldFit, RedescendingLossesPullLessTowardsUnmappedStructure) {
+  const OccupancyGrid map = make_room();
+  auto df = std::make_shared<l2::DistanceField>(map, 1.0);
+  const l2::detail::InterpolatedField field(df);
+  const Pose2 truth{9.5, 3.5, 0.1};
+  std::vector<Eigen::Vector2d> world;  // wall cell centres: east wall x = 12.525, south y = -0.475, north y = 7.525
+  for (double y = 0.0; y <= 7.0; y += 0.1) world.push_back({12.525, y});
+  for (double x = 9.0; x <= 12.0; x += 0.1) world.push_back({x, -0.475}), world.push_back({x, 7.525});
+  for (double y = 2.5; y <= 4.5; y += 0.05) world.push_back({12.225, y});  // 40 unmapped returns
+  const double c = std::cos(truth.yaw), s = std::sin(truth.yaw);
+  std::vector<Eigen::Vector2d> pts;  // in the robot frame
+  for (const auto& w : world) {
+    const Eigen::Vector2d d = w - Eigen::Vector2d(truth.x, truth.y);
+    pts.push_back({c * d.x() + s * d.y(), -s * d.x() + c * d.y()});
+  }
+  auto shift = [&](l2::FitLoss loss) {
+    l2::detail::FieldFitOptions o;
+    o.loss = loss;
+    double x[3] = {truth.x, truth.y, truth.yaw}, cost = 0;
+    l2::detail::refine_on_field(field, o, pts, truth, 10.0, 1.0, x, &cost, nullptr);  // a prior that holds nothing
+    return std::hypot(x[0] - truth.x, x[1] - truth.y);
+  };
+  const double huber = shift(l2::FitLoss::kHuber), cauchy = shift(l2::FitLoss::kCauchy), tukey = shift(l2::FitLoss::kTukey);
+  std::cout << "shift by the unmapped returns: Huber " << huber * 100 << " cm, Cauchy " << cauchy * 100 << " cm, Tukey "
+            << tukey * 100 << " cm\n";
+  EXPECT_GT(huber, 0.01);
+  EXPECT_LT(cauchy, 0.6 * huber);
+  EXPECT_LT(tukey, 0.1 * huber);
 }

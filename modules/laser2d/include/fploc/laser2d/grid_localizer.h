@@ -30,6 +30,10 @@
 
 namespace fploc::laser2d {
 
+// The robust loss of the Ceres refinement's point residuals (scale huber_m): Huber's influence stays constant
+// beyond the scale, Cauchy's and Tukey's fall off (points on structure the map lacks pull less).
+enum class FitLoss { kHuber, kCauchy, kTukey };
+
 struct GridLocalizerConfig {
   // Odometry (prediction) uncertainty per scan step: sigma = base + k * |increment|.
   double sigma_xy_m = 0.05, sigma_xy_per_m = 0.3;
@@ -81,6 +85,10 @@ struct GridLocalizerConfig {
   int search_levels = 8;
   // Refinement.
   double huber_m = 0.05;
+  FitLoss fit_loss = FitLoss::kHuber;
+  // With a redescending fit_loss: a refinement whose prediction is less certain than this (sigma x/y) runs Huber
+  // first (field_fit.h, huber_first). <= 0: never.
+  double huber_first_above_sigma_m = 0;
   double point_sigma_m = 0.05;
   int max_iterations = 20;
   // Points: returns within [min_range_m, max_range_m]; at most max_points (every k-th).
