@@ -17,6 +17,7 @@ for k in ("ate_m", "max_m", "lost_pct", "ms_per_scan"):
     assert k in r["fploc"] and k in r["amcl"], k
 assert r["scans"] == 91, r["scans"]
 assert 0 < r["floor"]["ate_m"] < 0.2, r["floor"]
+assert 0 < r["floor"]["cauchy"]["ate_m"] < 0.2, r["floor"]
 for k in ("covered_scans", "split", "floor"):
     assert k in r, k
 for k in ("all", "uncovered", "missing"):
