@@ -1,6 +1,8 @@
 #include "fploc/config/laser2d.h"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace fploc::config {
 
@@ -22,6 +24,14 @@ laser2d::GridLocalizerConfig config_of(const Grid2dOptions& o) {
   if (o.laser_map_scans() > 0) c.laser.map_scans = o.laser_map_scans();
   if (o.confirm_within_sigmas() != 0) c.confirm_within_sigmas = o.confirm_within_sigmas();
   if (o.far_confirm_travel_m() != 0) c.far_confirm_travel_m = o.far_confirm_travel_m();
+  if (!o.fit_loss().empty()) {
+    const auto loss = laser2d::fit_loss_from_name(o.fit_loss());
+    if (!loss)
+      throw std::runtime_error("grid2d.fit_loss: unknown loss '" + o.fit_loss() + "' (use \"huber\", \"cauchy\" or \"tukey\")");
+    c.fit_loss = *loss;
+  }
+  if (o.huber_m() > 0) c.huber_m = o.huber_m();
+  if (o.huber_first_above_sigma_m() > 0) c.huber_first_above_sigma_m = o.huber_first_above_sigma_m();
   return c;
 }
 

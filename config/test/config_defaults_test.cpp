@@ -188,7 +188,25 @@ TEST(ConfigDefaults, Grid2d) {
          {"gate_sigmas", c.gate_sigmas}, {"sigma_xy_per_m", c.sigma_xy_per_m},
          {"sigma_yaw_per_rad", c.sigma_yaw_per_rad}, {"prior_weight_sigmas", c.prior_weight_sigmas},
          {"laser_map_scans", double(c.laser.map_scans)}, {"confirm_within_sigmas", c.confirm_within_sigmas},
-         {"far_confirm_travel_m", c.far_confirm_travel_m}});
+         {"far_confirm_travel_m", c.far_confirm_travel_m}, {"huber_m", c.huber_m},
+         {"huber_first_above_sigma_m", c.huber_first_above_sigma_m}});
+  EXPECT_EQ(c.fit_loss, fploc::laser2d::FitLoss::kHuber);
+}
+
+// The grid localizer's fit loss by name; an unknown name is one error naming the option.
+TEST(ConfigMapping, Grid2dFitLoss) {
+  fploc::Grid2dOptions o;
+  o.set_fit_loss("cauchy");
+  EXPECT_EQ(config_of(o).fit_loss, fploc::laser2d::FitLoss::kCauchy);
+  o.set_fit_loss("tukey");
+  EXPECT_EQ(config_of(o).fit_loss, fploc::laser2d::FitLoss::kTukey);
+  o.set_fit_loss("Cauchy");
+  try {
+    (void)config_of(o);
+    ADD_FAILURE() << "no error for fit_loss 'Cauchy'";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("grid2d.fit_loss: unknown loss 'Cauchy'"), std::string::npos) << e.what();
+  }
 }
 
 TEST(ConfigDefaults, CloudToScan) {

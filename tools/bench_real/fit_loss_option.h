@@ -2,7 +2,6 @@
 // the grid localizer's map fit (GridLocalizerConfig::fit_loss).
 #pragma once
 #include <CLI/CLI.hpp>
-#include <map>
 #include <string>
 
 #include "fploc/laser2d/grid_localizer.h"
@@ -10,10 +9,14 @@
 namespace fploc::bench_real {
 
 inline void add_fit_loss_option(CLI::App& app, laser2d::FitLoss& loss) {
-  static const std::map<std::string, laser2d::FitLoss> names{
-      {"huber", laser2d::FitLoss::kHuber}, {"cauchy", laser2d::FitLoss::kCauchy}, {"tukey", laser2d::FitLoss::kTukey}};
-  app.add_option("--fit-loss", loss, "robust loss of the map fit (huber: the default)")
-      ->transform(CLI::CheckedTransformer(names, CLI::ignore_case));
+  app.add_option_function<std::string>(
+      "--fit-loss",
+      [&loss](const std::string& name) {
+        const auto l = laser2d::fit_loss_from_name(name);
+        if (!l) throw CLI::ValidationError("--fit-loss", "unknown loss '" + name + "' (use huber, cauchy or tukey)");
+        loss = *l;
+      },
+      "robust loss of the map fit: huber (the default), cauchy or tukey");
 }
 
 }  // namespace fploc::bench_real

@@ -138,6 +138,13 @@ struct GridLocalizer::Impl {
   }
 };
 
+std::optional<FitLoss> fit_loss_from_name(const std::string& name) {
+  if (name == "huber") return FitLoss::kHuber;
+  if (name == "cauchy") return FitLoss::kCauchy;
+  if (name == "tukey") return FitLoss::kTukey;
+  return std::nullopt;
+}
+
 GridLocalizer::GridLocalizer(std::shared_ptr<const DistanceField> field, GridLocalizerConfig cfg) : cfg_(cfg) {
   if (!field || field->width() <= 0) throw std::invalid_argument("grid localizer: empty distance field");
   impl_ = std::make_unique<Impl>(std::move(field), cfg_);

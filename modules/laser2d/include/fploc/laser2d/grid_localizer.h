@@ -21,6 +21,7 @@
 #include <Eigen/Core>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "fploc/core/pose.h"
@@ -33,6 +34,8 @@ namespace fploc::laser2d {
 // The robust loss of the Ceres refinement's point residuals (scale huber_m): Huber's influence stays constant
 // beyond the scale, Cauchy's and Tukey's fall off (points on structure the map lacks pull less).
 enum class FitLoss { kHuber, kCauchy, kTukey };
+// "huber", "cauchy", "tukey" (the names of graph options and tools); nullopt for any other.
+std::optional<FitLoss> fit_loss_from_name(const std::string& name);
 
 struct GridLocalizerConfig {
   // Odometry (prediction) uncertainty per scan step: sigma = base + k * |increment|.
