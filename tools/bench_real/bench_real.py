@@ -193,10 +193,10 @@ def main():
             g, p, am = (score(ref, est[k], a.lost_m, keep, unc[k]) for k in ("grid", "wo", "amcl"))
             f, fploc_ms = (g, grid_ms) if a.fploc == "grid" else (p, plan_ms)
             png = os.path.join(d, f"{row}.png")
-            run([os.path.join(BIN, "fploc-occupancy"), plan, "--png", png, "--tum", ref, "--tum", est[a.fploc], "--tum", est["amcl"]])
+            run([os.path.join(BIN, "fploc-occupancy"), plan, "--png", png, "--scale", "2", "--crop-margin", "1", "--tum", ref, "--tum", est[a.fploc], "--tum", est["amcl"]])
             # AMCL's jumps hide fploc's track in the picture of all three: fploc alone (blue) on the reference (green).
             png_f = os.path.join(d, f"{row}-fploc.png")
-            run([os.path.join(BIN, "fploc-occupancy"), plan, "--png", png_f, "--tum", ref, "--tum", est[a.fploc]])
+            run([os.path.join(BIN, "fploc-occupancy"), plan, "--png", png_f, "--scale", "2", "--crop-margin", "1", "--tum", ref, "--tum", est[a.fploc]])
             r = {"log": name, "start": row, "scans": scans, "map_scans": imp["map"]["end_scan"],
                  "split": imp["split"] if "split" in imp else {"fraction": float(a.split)}, "covered_scans": len(keep),
                  "floor": floor,

@@ -1,5 +1,5 @@
 // fploc occupancy MAP.yaml [--tolerance CELLS] [--out PLAN.json|.csv] [--compare PLAN] [--json]
-//                 [--png OUT.png [--scale N] [--tum T.tum ...]]
+//                 [--png OUT.png [--scale N] [--tum T.tum ...] [--crop-margin M]]
 // A ROS map_server occupancy map (YAML + PGM/PNG) vectorised into a plan (fploc/floorplan/occupancy.h):
 // prints the grid, the vectorisation's error (boundary cell centres to their segments) and, with --compare,
 // the two-way distance between the vectorised plan and another plan (e.g. the one `fploc map export-pgm` was
@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -52,9 +53,11 @@ std::vector<Eigen::Vector2d> read_tum_xy(const std::string& path) {
 }
 
 // PNG: the grid (occupied black, free white, unknown grey), the vectorised segments in red and any TUM
-// trajectories on top (colours in order: green, blue, orange, magenta), `scale` pixels per cell.
+// trajectories on top (colours in order: green, blue, orange, magenta), `scale` pixels per cell. crop_margin_m
+// >= 0: only the box around the occupied cells and the trajectories, that much wider on each side (a log's map
+// is mostly the free space its longest beams swept).
 void write_png(const std::string& out, const fploc::OccupancyGrid& g, const fploc::FloorPlan& plan,
-               const std::vector<std::vector<Eigen::Vector2d>>& tracks, int scale) {
+               const std::vector<std::vector<Eigen::Vector2d>>& tracks, int scale, double crop_margin_m) {
   const int W = g.width * scale, H = g.height * scale;
   std::vector<uint8_t> img(size_t(W) * H * 3);
   for (int y = 0; y < H; ++y)
@@ -87,7 +90,30 @@ void write_png(const std::string& out, const fploc::OccupancyGrid& g, const fplo
   for (const auto& e : plan.elements) line(e.a, e.b, red, 0);
   for (size_t t = 0; t < tracks.size(); ++t)
     for (size_t k = 1; k < tracks[t].size(); ++k) line(tracks[t][k - 1], tracks[t][k], cols[t % 4], 1);
-  fploc::write_rgb_png(out, W, H, img);
+  if (crop_margin_m < 0) {
+    fploc::write_rgb_png(out, W, H, img);
+    return;
+  }
+  // The box in pixels: occupied cells and trajectory points, widened by the margin, clamped to the image.
+  double x0 = W, y0 = H, x1 = -1, y1 = -1;
+  auto grow = [&](double x, double y) { x0 = std::min(x0, x), y0 = std::min(y0, y), x1 = std::max(x1, x), y1 = std::max(y1, y); };
+  for (int j = 0; j < g.height; ++j)
+    for (int i = 0; i < g.width; ++i)
+      if (g.at(i, j) > 100 * g.occupied_thresh) grow(double(i) * scale, double(g.height - 1 - j) * scale);
+  for (const auto& t : tracks)
+    for (const auto& p : t) grow(px(p).x(), px(p).y());
+  if (x1 < 0) {  // nothing to frame
+    fploc::write_rgb_png(out, W, H, img);
+    return;
+  }
+  const double m = crop_margin_m / g.resolution * scale;
+  const int cx0 = std::max(0, int(x0 - m)), cy0 = std::max(0, int(y0 - m));
+  const int cx1 = std::min(W, int(x1 + m) + scale), cy1 = std::min(H, int(y1 + m) + scale);
+  const int cw = cx1 - cx0, ch = cy1 - cy0;
+  std::vector<uint8_t> crop(size_t(cw) * ch * 3);
+  for (int y = 0; y < ch; ++y)
+    std::copy_n(img.begin() + (size_t(cy0 + y) * W + cx0) * 3, size_t(cw) * 3, crop.begin() + size_t(y) * cw * 3);
+  fploc::write_rgb_png(out, cw, ch, crop);
 }
 }  // namespace
 
@@ -98,6 +124,7 @@ int main(int argc, char** argv) {
   bool json = false;
   std::string png_out;
   int scale = 1;
+  double crop_margin = -1;
   std::vector<std::string> tums;
   app.add_option("map", map, "map_server YAML")->required();
   app.add_option("--tolerance", tol, "Douglas-Peucker tolerance [cells] (0.5)");
@@ -107,6 +134,7 @@ int main(int argc, char** argv) {
   app.add_option("--png", png_out, "picture: grid, segments (red), --tum trajectories (green, blue, orange, magenta)");
   app.add_option("--scale", scale, "PNG pixels per cell (1)")->check(CLI::Range(1, 16));
   app.add_option("--tum", tums, "trajectory (TUM) to draw on the PNG; repeatable");
+  app.add_option("--crop-margin", crop_margin, "PNG: only the occupied cells and trajectories, this much [m] around them (default: the whole grid)");
   CLI11_PARSE(app, argc, argv);
   try {
     const fploc::OccupancyGrid g = fploc::read_occupancy_map(map);
@@ -132,7 +160,7 @@ int main(int argc, char** argv) {
     if (!png_out.empty()) {
       std::vector<std::vector<Eigen::Vector2d>> tracks;
       for (const auto& t : tums) tracks.push_back(read_tum_xy(t));
-      write_png(png_out, g, plan, tracks, scale);
+      write_png(png_out, g, plan, tracks, scale, crop_margin);
     }
     std::cerr << "fploc occupancy: " << g.width << " x " << g.height << " cells at " << g.resolution << " m, "
               << st.boundary_cells << " boundary cells -> " << st.segments << " segments (max error "

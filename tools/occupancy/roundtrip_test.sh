@@ -16,6 +16,21 @@ assert j['map_to_plan_max_m'] <= r, j
 assert j['max_error_m'] <= 0.5 * r + 1e-9, j
 PY
 done
+# The picture: the whole grid, and cropped to the occupied cells and a trajectory 0.5 m around them (the room plan
+# exported with a margin around it: the crop is smaller in both directions and frames the walls).
+printf '0 1.0 1.0 0 0 0 0 1\n1 2.0 1.5 0 0 0 0 1\n' > "$T/t.tum"
+"$OCC" "$T/m0.05/map.yaml" --png "$T/full.png" --tum "$T/t.tum" 2>/dev/null || fail "png"
+"$OCC" "$T/m0.05/map.yaml" --png "$T/crop.png" --tum "$T/t.tum" --crop-margin 0.5 2>/dev/null || fail "png --crop-margin"
+python3 - "$T/full.png" "$T/crop.png" <<'PY' || fail "crop"
+import struct, sys
+def size(p):
+    d = open(p, "rb").read(24)
+    assert d[:8] == b"\x89PNG\r\n\x1a\n", p
+    return struct.unpack(">II", d[16:24])
+(fw, fh), (cw, ch) = size(sys.argv[1]), size(sys.argv[2])
+print(f"png {fw}x{fh}, cropped {cw}x{ch}")
+assert 0 < cw <= fw and 0 < ch <= fh and (cw, ch) != (fw, fh), (fw, fh, cw, ch)
+PY
 # A corrupt YAML: one clear error naming file and field, exit 1.
 printf 'image: map.pgm\nresolution: -1\norigin: [0, 0, 0]\n' > "$T/bad.yaml"
 if "$OCC" "$T/bad.yaml" 2> "$T/err"; then fail "bad yaml accepted"; fi
