@@ -31,7 +31,9 @@ int main(int argc, char** argv) {
   fploc::laser2d::GridLocalizerConfig c;
   fploc::bench_real::add_fit_loss_option(app, c.fit_loss);
   double offset_m = 0;
-  app.add_option("--start-offset", offset_m, "start each fit this far [m] from the reference, in a direction that turns by 137.5 deg per scan (a check that the fit's optimum, not its start, sets the floor)");
+  app.add_option("--start-offset", offset_m,
+                 "start each fit this far [m] from the reference, in a direction that turns by 137.5 deg per scan "
+                 "(a check that the fit's optimum, not its start, sets the floor)");
   CLI11_PARSE(app, argc, argv);
   namespace cm = fploc::carmen;
   namespace l2 = fploc::laser2d;

@@ -79,7 +79,8 @@ int main(int argc, char** argv) {
   app.add_option("--laser-track-retry", c.laser_track_retry, "laser odometry: a failed tracking fit, a strong fit in the wheels' window");
   fploc::bench_real::add_fit_loss_option(app, c.fit_loss);
   app.add_option("--huber", c.huber_m, "scale of the map fit's robust loss [m]");
-  app.add_option("--huber-first-above", c.huber_first_above_sigma_m, "redescending loss: Huber first when the prediction's sigma x/y exceeds this [m]");
+  app.add_option("--huber-first-above", c.huber_first_above_sigma_m,
+                 "redescending loss: Huber first when the prediction's sigma x/y exceeds this [m]");
   CLI11_PARSE(app, argc, argv);
   if (laser_sigma_yaw_deg >= 0) c.laser_sigma_yaw_rad = laser_sigma_yaw_deg * M_PI / 180;
   namespace cm = fploc::carmen;

@@ -96,7 +96,9 @@ void write_png(const std::string& out, const fploc::OccupancyGrid& g, const fplo
   }
   // The box in pixels: occupied cells and trajectory points, widened by the margin, clamped to the image.
   double x0 = W, y0 = H, x1 = -1, y1 = -1;
-  auto grow = [&](double x, double y) { x0 = std::min(x0, x), y0 = std::min(y0, y), x1 = std::max(x1, x), y1 = std::max(y1, y); };
+  auto grow = [&](double x, double y) {
+    x0 = std::min(x0, x), y0 = std::min(y0, y), x1 = std::max(x1, x), y1 = std::max(y1, y);
+  };
   for (int j = 0; j < g.height; ++j)
     for (int i = 0; i < g.width; ++i)
       if (g.at(i, j) > 100 * g.occupied_thresh) grow(double(i) * scale, double(g.height - 1 - j) * scale);
@@ -134,7 +136,8 @@ int main(int argc, char** argv) {
   app.add_option("--png", png_out, "picture: grid, segments (red), --tum trajectories (green, blue, orange, magenta)");
   app.add_option("--scale", scale, "PNG pixels per cell (1)")->check(CLI::Range(1, 16));
   app.add_option("--tum", tums, "trajectory (TUM) to draw on the PNG; repeatable");
-  app.add_option("--crop-margin", crop_margin, "PNG: only the occupied cells and trajectories, this much [m] around them (default: the whole grid)");
+  app.add_option("--crop-margin", crop_margin,
+                 "PNG: only the occupied cells and trajectories, this much [m] around them (default: the whole grid)");
   CLI11_PARSE(app, argc, argv);
   try {
     const fploc::OccupancyGrid g = fploc::read_occupancy_map(map);

@@ -84,7 +84,8 @@ std::unique_ptr<ceres::Problem> refine_on_field(const InterpolatedField& f, cons
                                                 const std::vector<Eigen::Vector2d>& pts, const Pose2& pred,
                                                 double sxy, double syaw, double* x, double* cost, int* iterations,
                                                 bool fix_yaw) {
-  if (o.huber_first && o.loss != FitLoss::kHuber) solve(f, o, FitLoss::kHuber, pts, pred, sxy, syaw, x, cost, iterations, fix_yaw);
+  if (o.huber_first && o.loss != FitLoss::kHuber)
+    solve(f, o, FitLoss::kHuber, pts, pred, sxy, syaw, x, cost, iterations, fix_yaw);
   return solve(f, o, o.loss, pts, pred, sxy, syaw, x, cost, iterations, fix_yaw);
 }
 

@@ -701,7 +701,8 @@ TEST(FieldFit, RedescendingLossesPullLessTowardsUnmappedStructure) {
     l2::detail::refine_on_field(field, o, pts, truth, 10.0, 1.0, x, &cost, nullptr);  // a prior that holds nothing
     return std::hypot(x[0] - truth.x, x[1] - truth.y);
   };
-  const double huber = shift(l2::FitLoss::kHuber), cauchy = shift(l2::FitLoss::kCauchy), tukey = shift(l2::FitLoss::kTukey);
+  const double huber = shift(l2::FitLoss::kHuber), cauchy = shift(l2::FitLoss::kCauchy);
+  const double tukey = shift(l2::FitLoss::kTukey);
   std::cout << "shift by the unmapped returns: Huber " << huber * 100 << " cm, Cauchy " << cauchy * 100 << " cm, Tukey "
             << tukey * 100 << " cm\n";
   EXPECT_GT(huber, 0.01);
