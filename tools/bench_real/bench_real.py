@@ -18,7 +18,9 @@ within 10 cm of an occupied cell at the reference pose); the others are reported
 CPU time (grid2d; laser2d + matcher + optimizer for the plan path; AMCL's own) over the scans, from replay's
 --json. "floor": the RMSE over the covered scans of the map fit started at each scan's own reference pose
 (fploc-real-floor): how far the map and the reference poses of the rest disagree; "floor.cauchy" the same with
-the fit's Cauchy loss instead of Huber (lower on every log: part of the Huber floor is the loss's bias). Plots per row: ROW.png (reference green, fploc blue, AMCL orange) and ROW-fploc.png (without AMCL).
+the fit's Cauchy loss instead of Huber (lower on every log: part of the Huber floor is the loss's bias). Plots
+per row, framed on the map's walls and the tracks: ROW.png (reference green, fploc blue, AMCL orange) and
+ROW-fploc.png (without AMCL).
 
   fploc bench real [--json] [--logs intel,aces] [--split auto|F] [--end 0.6] [--out DIR] [--rows ref,off]
 """
