@@ -32,7 +32,7 @@ class GyroDeskew {
  private:
   Eigen::Vector3d rate_at(int64_t utime) const;
   // rate_at(utime), searched from sample `at` on (a sweep's columns are walked in time order: a step or two
-  // instead of a search); `at` is left at the sample taken.
+  // instead of a search); `at` is left at the sample taken. Both need at least one sample (prepare() checks).
   Eigen::Vector3d rate_walk(int64_t utime, size_t& at) const;
   bool covers(int64_t ta, int64_t tb) const;
   Eigen::Matrix3d rotation(int64_t ta, int64_t tb) const;
