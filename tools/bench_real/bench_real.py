@@ -18,7 +18,13 @@ within 10 cm of an occupied cell at the reference pose); the others are reported
 CPU time (grid2d; laser2d + matcher + optimizer for the plan path; AMCL's own) over the scans, from replay's
 --json. "floor": the RMSE over the covered scans of the map fit started at each scan's own reference pose
 (fploc-real-floor): how far the map and the reference poses of the rest disagree; "floor.cauchy" the same with
-the fit's Cauchy loss instead of Huber (lower on every log: part of the Huber floor is the loss's bias). Plots
+the fit's Cauchy loss instead of Huber (lower on every log: part of the Huber floor is the loss's bias).
+"reference_noise": how noisy the reference poses are themselves, by the three-cornered hat of the reference, fploc's
+estimate and the wheel odometry (`fploc eval --hat`, modules/eval/reference_noise.h): each one's noise from the
+increments between consecutive scans (and 2 scans apart: white noise gives the same). Against a reference with
+per-pose noise sigma even a perfect localizer scores an ATE of ~sigma, so each method's "ate_less_reference_noise_m"
+(sqrt(ATE^2 - sigma^2), an estimate of its own error) and "nees_median_with_reference_noise" (the reference's
+variance added to the published covariance) are given beside ATE and NEES. Plots
 per row, framed on the map's walls and the tracks: ROW.png (reference green, fploc blue, AMCL orange) and
 ROW-fploc.png (without AMCL).
 
@@ -70,11 +76,29 @@ def read_status(path):
     return out
 
 
-def score(gt_path, est_path, lost_m, keep=None, status_path=None):
+def reference_noise(ref, est, odom):
+    """The three-cornered hat of the reference, an estimate and the wheel odometry (fploc eval --hat), at lags 1 and
+    2: {"pose_sigma_xy_m", "pose_sigma_yaw_rad"} of the reference at lag 1 (per pose, if white), the same at lag 2,
+    and the estimate's and odometry's at lag 1."""
+    out = {}
+    for lag in (1, 2):
+        h = json.loads(run([os.path.join(BIN, "fploc-eval"), "--gt", ref, "--est", est, "--hat", odom, "--hat-lag",
+                            str(lag), "--max-dt", "0.001", "--json"]).stdout)["hat"]
+        if lag == 1:
+            out = {"pose_sigma_xy_m": h["gt"]["pose_sigma_xy_m"], "pose_sigma_yaw_rad": h["gt"]["pose_sigma_yaw_rad"],
+                   "increments": h["increments"], "estimate": est, "estimate_pose_sigma_xy_m": h["est"]["pose_sigma_xy_m"],
+                   "odometry_pose_sigma_xy_m": h["third"]["pose_sigma_xy_m"]}
+        else:
+            out["lag2"] = {"pose_sigma_xy_m": h["gt"]["pose_sigma_xy_m"], "pose_sigma_yaw_rad": h["gt"]["pose_sigma_yaw_rad"]}
+    return out
+
+
+def score(gt_path, est_path, lost_m, keep=None, status_path=None, ref_noise=None):
     """ATE (RMSE of the position error, no alignment: both in the map frame, the reference pose associated by time
     with fploc eval's association), max, LOST % (position error > lost_m; a scan without an estimate counts as
     LOST and as its own entry in "missing"). keep: the reference times to score (None: all); the others are
-    reported as "uncovered" with their own ATE."""
+    reported as "uncovered" with their own ATE. ref_noise (reference_noise()): also the ATE less the reference's
+    noise and the NEES with the reference's variance added to the covariance."""
     gt, est, st = read_tum(gt_path), read_tum(est_path), read_status(status_path)
     def part(times):
         errs = [math.hypot(est[k][0] - gt[k][0], est[k][1] - gt[k][1]) if k in est else float("inf") for k in times]
@@ -82,15 +106,30 @@ def score(gt_path, est_path, lost_m, keep=None, status_path=None):
         out = {"scans": len(times), "ate_m": math.sqrt(sum(e * e for e in fin) / len(fin)) if fin else float("nan"),
                "max_m": max(fin) if fin else float("nan"), "missing": len(errs) - len(fin),
                "lost_pct": 100.0 * sum(e > lost_m for e in errs) / max(1, len(errs))}
+        rn = ref_noise if ref_noise and ref_noise["pose_sigma_xy_m"] > 0 else None
+        if rn and fin:
+            out["ate_less_reference_noise_m"] = math.sqrt(max(0.0, out["ate_m"] ** 2 - rn["pose_sigma_xy_m"] ** 2))
         if st:  # what the method said of itself: false OK (status OK, error > FALSE_OK_M), POOR/LOST shares, NEES
             said = [(k, e) for k, e in zip(times, errs) if k in st and math.isfinite(e)]
-            nees = []
+            nees, nees_rn = [], []
             for k, e in said:
                 dyaw = (est[k][2] - gt[k][2] + math.pi) % (2 * math.pi) - math.pi
-                v = fploc_tools.nees3((est[k][0] - gt[k][0], est[k][1] - gt[k][1], dyaw), st[k][1])
+                err = (est[k][0] - gt[k][0], est[k][1] - gt[k][1], dyaw)
+                v = fploc_tools.nees3(err, st[k][1])
                 if v is not None:
                     nees.append(v)
+                if rn:  # the reference's per-axis variance (half the horizontal) and yaw variance added
+                    c, a2 = list(st[k][1]), rn["pose_sigma_xy_m"] ** 2 / 2
+                    c[0] += a2
+                    c[3] += a2
+                    c[5] += max(0.0, rn["pose_sigma_yaw_rad"]) ** 2
+                    v = fploc_tools.nees3(err, c)
+                    if v is not None:
+                        nees_rn.append(v)
             nees.sort()
+            nees_rn.sort()
+            if rn:
+                out["nees_median_with_reference_noise"] = nees_rn[len(nees_rn) // 2] if nees_rn else None
             n = max(1, len(said))
             out.update({"status_poses": len(said),
                         "false_ok_poses": sum(st[k][0] == 0 and e > FALSE_OK_M for k, e in said),
@@ -145,8 +184,9 @@ def main():
         d = os.path.join(a.out, name)
         os.makedirs(d, exist_ok=True)
         lcm, ref, mapdir = os.path.join(d, "rest.lcm"), os.path.join(d, "ref.tum"), os.path.join(d, "map")
+        odom = os.path.join(d, "odom.tum")
         split = ["--auto-split"] if a.split == "auto" else ["--begin", a.split, "--map-begin", "0", "--map-end", a.split]
-        imp = json.loads(run([os.path.join(BIN, "fploc-import-carmen"), src, "--out", lcm, "--tum", ref, "--end", str(a.end),
+        imp = json.loads(run([os.path.join(BIN, "fploc-import-carmen"), src, "--out", lcm, "--tum", ref, "--odom-tum", odom, "--end", str(a.end),
                               "--map", mapdir] + split + [
                               "--resolution", str(a.resolution), "--min-hits", str(a.min_hits), "--occupied-ratio",
                               str(a.occupied_ratio), "--hit-clearance", str(a.hit_clearance), "--json"]).stdout)
@@ -192,7 +232,9 @@ def main():
             plan_ms = (cpu.get("laser2d", 0) + cpu.get("matcher", 0) + cpu.get("optimizer", 0)) / max(1, scans)
             grid_ms = cpu.get("grid2d", 0) / max(1, scans)
             amcl_ms = cpu.get("amcl", 0) / max(1, scans)
-            g, p, am = (score(ref, est[k], a.lost_m, keep, unc[k]) for k in ("grid", "wo", "amcl"))
+            # The reference's own noise, from fploc's estimate (the one scored as "fploc") and the wheels.
+            rnoise = reference_noise(ref, est[a.fploc if a.fploc == "wo" else "grid"], odom)
+            g, p, am = (score(ref, est[k], a.lost_m, keep, unc[k], rnoise) for k in ("grid", "wo", "amcl"))
             f, fploc_ms = (g, grid_ms) if a.fploc == "grid" else (p, plan_ms)
             png = os.path.join(d, f"{row}.png")
             run([os.path.join(BIN, "fploc-occupancy"), plan, "--png", png, "--scale", "2", "--crop-margin", "1", "--tum", ref, "--tum", est[a.fploc], "--tum", est["amcl"]])
@@ -201,7 +243,7 @@ def main():
             run([os.path.join(BIN, "fploc-occupancy"), plan, "--png", png_f, "--scale", "2", "--crop-margin", "1", "--tum", ref, "--tum", est[a.fploc]])
             r = {"log": name, "start": row, "scans": scans, "map_scans": imp["map"]["end_scan"],
                  "split": imp["split"] if "split" in imp else {"fraction": float(a.split)}, "covered_scans": len(keep),
-                 "floor": floor,
+                 "floor": floor, "reference_noise": rnoise,
                  "fploc": {**f, "ms_per_scan": fploc_ms, "estimator": a.fploc}, "amcl": {**am, "ms_per_scan": amcl_ms},
                  "fploc_grid": {**g, "ms_per_scan": grid_ms}, "fploc_plan": {**p, "ms_per_scan": plan_ms},
                  "fploc_half_of_amcl": f["ate_m"] <= 0.5 * am["ate_m"], "plot": png, "plot_fploc": png_f}
@@ -210,7 +252,8 @@ def main():
                   f"LOST {f['lost_pct']:5.1f} % false OK {f.get('false_ok_poses', '-')} POOR {f.get('poor_pct', float('nan')):4.1f} % {fploc_ms:6.2f} ms | AMCL ATE {am['ate_m']*100:8.1f} cm max {am['max_m']*100:8.1f} cm "
                   f"LOST {am['lost_pct']:5.1f} % {amcl_ms:6.2f} ms | other fploc ({'wo' if a.fploc == 'grid' else 'grid'}) "
                   f"ATE {(p if a.fploc == 'grid' else g)['ate_m']*100:8.1f} cm | all scans: fploc {f['all']['ate_m']*100:.1f} cm "
-                  f"LOST {f['all']['lost_pct']:.1f} %, AMCL {am['all']['ate_m']*100:.1f} cm | floor {floor['ate_m']*100:.1f} cm (Cauchy fit {floor['cauchy']['ate_m']*100:.1f} cm)", file=sys.stderr)
+                  f"LOST {f['all']['lost_pct']:.1f} %, AMCL {am['all']['ate_m']*100:.1f} cm | floor {floor['ate_m']*100:.1f} cm (Cauchy fit {floor['cauchy']['ate_m']*100:.1f} cm) | reference noise {rnoise['pose_sigma_xy_m']*100:.1f} cm "
+                  f"(lag 2: {rnoise['lag2']['pose_sigma_xy_m']*100:.1f}), fploc less it {f.get('ate_less_reference_noise_m', float('nan'))*100:.1f} cm", file=sys.stderr)
     if a.json:
         print(json.dumps({"bench": "real", "protocol": {"split": a.split, "scored": "scans covered by the map", "end": a.end, "resolution_m": a.resolution,
                                                         "map": {"min_hits": a.min_hits, "occupied_ratio": a.occupied_ratio,

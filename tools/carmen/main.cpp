@@ -7,6 +7,8 @@
 // corrected laser poses: the reference) as TUM. --begin/--end select scans by index fraction (e.g. the second
 // half); --map writes a map_server occupancy map (DIR/map.{pgm,yaml}) built from the scans and reference poses
 // of --map-begin..--map-end (e.g. the first half): the non-circular protocol of `fploc bench real`.
+// --odom-tum writes the WHEEL_ODOM poses as TUM too (the odometry's own frame; e.g. the third trajectory of
+// `fploc eval --hat`, which estimates the reference's own noise).
 #include <fploc/laser_scan_t.hpp>
 #include <fploc/pose_t.hpp>
 #include <lcm/lcm-cpp.hpp>
@@ -37,7 +39,7 @@ void quat_of_yaw(double yaw, double q[4]) {
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc import-carmen: CARMEN log (Radish) -> LCM log (laser_scan_t + odometry) + reference TUM"};
-  std::string in, out, tum, map_dir;
+  std::string in, out, tum, odom_tum, map_dir;
   double begin = 0, end = 1, map_begin = 0, map_end = 0.5, resolution = 0.05;
   bool json = false;
   fploc::carmen::GridConfig gcfg;
@@ -48,6 +50,7 @@ int main(int argc, char** argv) {
   app.add_option("log", in, "CARMEN log (.log or .log.gz)")->required();
   app.add_option("--out", out, "LCM log to write");
   app.add_option("--tum", tum, "reference (FLASER poses) as TUM");
+  app.add_option("--odom-tum", odom_tum, "the odometry of the WHEEL_ODOM events (--odom-from) as TUM, at the scans' times");
   app.add_option("--begin", begin, "first scan, as a fraction of the log's scans (0)")->check(CLI::Range(0.0, 1.0));
   app.add_option("--end", end, "end (exclusive), fraction (1)")->check(CLI::Range(0.0, 1.0));
   app.add_option("--map", map_dir, "write DIR/map.pgm + DIR/map.yaml from --map-begin..--map-end");
@@ -148,17 +151,31 @@ int main(int argc, char** argv) {
       j["out"] = out;
       j["odom_events"] = odom;
     }
-    if (!tum.empty()) {
-      std::ofstream f(tum);
-      if (!f) throw std::runtime_error(tum + ": cannot write");
-      f << "# fploc import-carmen " << in << ": FLASER (corrected) laser poses, scans " << b << ".." << e << "\n";
+    // Poses of scans [b, e) as TUM, at the scans' times (skip: scans without such a pose).
+    auto write_tum = [&](const std::string& path, const std::string& what, auto pose_of, auto has) {
+      std::ofstream f(path);
+      if (!f) throw std::runtime_error(path + ": cannot write");
+      f << "# fploc import-carmen " << in << ": " << what << ", scans " << b << ".." << e << "\n";
       f << std::fixed << std::setprecision(6);
       for (size_t k = b; k < e; ++k) {
-        const auto& p = log.scans[k].pose;
+        if (!has(log.scans[k])) continue;
+        const auto& p = pose_of(log.scans[k]);
         f << double(utime_of(k)) * 1e-6 << " " << p.x << " " << p.y << " 0 0 0 " << std::sin(p.theta / 2) << " "
           << std::cos(p.theta / 2) << "\n";
       }
+      if (!f) throw std::runtime_error(path + ": write failed");
+    };
+    if (!tum.empty()) {
+      write_tum(tum, "FLASER (corrected) laser poses", [](const auto& s) -> const auto& { return s.pose; },
+                [](const auto&) { return true; });
       j["tum"] = tum;
+    }
+    if (!odom_tum.empty()) {
+      const bool flaser = odom_from == "flaser";
+      write_tum(odom_tum, flaser ? "FLASER odom columns" : "wheel odometry (the last ODOM record before each scan)",
+                [&](const auto& s) -> const auto& { return flaser ? s.odom : s.wheel_odom; },
+                [&](const auto& s) { return flaser || s.have_wheel_odom; });
+      j["odom_tum"] = odom_tum;
     }
     if (!map_dir.empty()) {
       const size_t mb = auto_split ? 0 : idx(map_begin), me = auto_split ? b : idx(map_end);

@@ -1,16 +1,18 @@
 // fploc eval --gt GT.tum --est EST.tum [--plot FILE.svg [--plan P [--layers A,B] [--units U]]] [--json]
 //            [--align none|se2|se3] [--max-dt S] [--offset S] [--delta D] [--delta-unit s|f]
-//            [--uncertainty EST.unc [--false-ok-m M]]
+//            [--uncertainty EST.unc [--false-ok-m M]] [--hat THIRD.tum [--hat-lag N]]
 // ATE and RPE as in Sturm et al. 2012 (see modules/eval). No alignment by default: fploc poses are in
 // the floor-plan frame, like the ground truth. With --uncertainty (fploc-pose-logger's uncertainty_file):
 // NEES of x, y, yaw and the false-OK count (modules/eval/uncertainty.h). JSON on stdout with --json, a
-// summary on stderr.
+// summary on stderr. With --hat: the three-cornered hat of GT, EST and a third trajectory (e.g. wheel odometry):
+// each one's increment noise, i.e. how noisy the reference itself is (modules/eval/reference_noise.h).
 #include <cmath>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "fploc/eval/eval.h"
+#include "fploc/eval/reference_noise.h"
 #include "fploc/eval/uncertainty.h"
 #include "fploc/floorplan/io.h"
 
@@ -23,11 +25,14 @@ static void usage() {
                "       [--delta D] [--delta-unit s|f] (RPE delta, default 1 s; f = frames)\n"
                "       [--plan FILE [--layers A,B] [--units U]] (drawn under the trajectories of --plot)\n"
                "       [--uncertainty FILE] (status + x/y/yaw covariance per pose: NEES and false OK)\n"
-               "       [--false-ok-m M] (horizontal error of a false OK, default 0.3)\n";
+               "       [--false-ok-m M] (horizontal error of a false OK, default 0.3)\n"
+               "       [--hat THIRD.tum [--hat-lag N]] (three-cornered hat of gt, est and THIRD: the noise of each,\n"
+               "       the reference's own included, from their increments N poses of gt apart, default 1)\n";
 }
 
 int main(int argc, char** argv) {
-  std::string gt_path, est_path, plot, align_s = "none", unit = "s", plan_path, layers, units, unc_path;
+  std::string gt_path, est_path, plot, align_s = "none", unit = "s", plan_path, layers, units, unc_path, hat_path;
+  int hat_lag = 1;
   bool json = false;
   double max_dt = 0.02, offset = 0, delta = 1.0, false_ok_m = 0.3;
   for (int i = 1; i < argc; ++i) {
@@ -54,6 +59,8 @@ int main(int argc, char** argv) {
       else if (a == "--units") units = next();
       else if (a == "--uncertainty") unc_path = next();
       else if (a == "--false-ok-m") false_ok_m = std::stod(next());
+      else if (a == "--hat") hat_path = next();
+      else if (a == "--hat-lag") hat_lag = std::stoi(next());
       else if (a == "-h" || a == "--help") { usage(); return 0; }
       else { std::cerr << "fploc eval: unexpected argument '" << a << "'\n"; usage(); return 2; }
     } catch (const std::exception&) {
@@ -62,7 +69,7 @@ int main(int argc, char** argv) {
     }
   }
   if (gt_path.empty() || est_path.empty() || (unit != "s" && unit != "f") || !(delta > 0) || !(max_dt >= 0) ||
-      !(false_ok_m > 0)) {
+      !(false_ok_m > 0) || hat_lag < 1) {
     usage();
     return 2;
   }
@@ -138,6 +145,22 @@ int main(int argc, char** argv) {
                 << c.nees.median << ", mean " << c.nees.mean << " over " << c.nees_poses << "; 1-DoF medians x "
                 << c.nees_x.median << ", y " << c.nees_y.median << ", yaw " << c.nees_yaw.median << "; " << c.ok
                 << " OK, " << c.false_ok << " false OK (horizontal error > " << c.false_ok_m << " m)\n";
+    }
+    if (!hat_path.empty()) {
+      const auto h = eval::three_cornered_hat(gt, est, read_tum(hat_path), max_dt, hat_lag);
+      auto src = [&](const eval::HatSource& s) {
+        return nlohmann::json{{"increment_sigma_xy_m", eval::signed_sqrt(s.increment_var_xy_m2)},
+                              {"increment_sigma_yaw_rad", eval::signed_sqrt(s.increment_var_yaw_rad2)},
+                              {"pose_sigma_xy_m", s.pose_sigma_xy_m},
+                              {"pose_sigma_yaw_rad", s.pose_sigma_yaw_rad}};
+      };
+      j["hat"] = {{"third_file", hat_path}, {"lag", hat_lag}, {"increments", h.increments},
+                  {"gt", src(h.ref)}, {"est", src(h.est)}, {"third", src(h.third)}};
+      std::cerr << "fploc eval: three-cornered hat over " << h.increments << " increments (lag " << hat_lag
+                << "): per-pose noise (if white) gt " << h.ref.pose_sigma_xy_m << " m / "
+                << h.ref.pose_sigma_yaw_rad * 180 / M_PI << " deg, est " << h.est.pose_sigma_xy_m << " m / "
+                << h.est.pose_sigma_yaw_rad * 180 / M_PI << " deg, " << hat_path << " " << h.third.pose_sigma_xy_m
+                << " m / " << h.third.pose_sigma_yaw_rad * 180 / M_PI << " deg\n";
     }
     std::cerr << "fploc eval: " << pairs.size() << " associated poses (gt " << gt.size() << ", est " << est.size()
               << "); ATE rmse " << a.trans.rmse << " m, mean " << a.trans.mean << " m, max " << a.trans.max

@@ -1,0 +1,88 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+#include "fploc/eval/reference_noise.h"
+
+using namespace fploc;
+using namespace fploc::eval;
+
+namespace {
+
+// A wandering planar path: 0.3 m steps, slowly turning.
+std::vector<Pose2> truth(int n) {
+  std::vector<Pose2> t;
+  Pose2 p;
+  for (int i = 0; i < n; ++i) {
+    t.push_back(p);
+    p = compose(p, {0.3, 0.0, 0.05 * std::sin(0.01 * i)});
+  }
+  return t;
+}
+
+// The truth with white noise: sigma_axis in x and y, sigma_yaw in yaw; time stamps 0.1 s apart (+ jitter below the
+// association's window).
+Trajectory noisy(const std::vector<Pose2>& t, double sigma_axis, double sigma_yaw, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> nd;
+  Trajectory out;
+  for (size_t i = 0; i < t.size(); ++i) {
+    const double time = 0.1 * double(i) + 0.002 * nd(rng) * 0.1;
+    out.push_back(StampedPose::from_rpy(time, Eigen::Vector3d(t[i].x + sigma_axis * nd(rng), t[i].y + sigma_axis * nd(rng), 0),
+                                        0, 0, t[i].yaw + sigma_yaw * nd(rng)));
+  }
+  return out;
+}
+
+}  // namespace
+
+// Three copies of one path with known, different white noise: each source's per-pose sigma comes back (horizontal:
+// sqrt(2) x the per-axis sigma), at lag 1 and lag 3 alike (white noise), whichever order they are passed in.
+TEST(ReferenceNoise, ThreeCorneredHatRecoversEachSourcesWhiteNoise) {
+  const auto t = truth(20000);
+  const Trajectory a = noisy(t, 0.01, 0.002, 1), b = noisy(t, 0.03, 0.004, 2), c = noisy(t, 0.05, 0.001, 3);
+  for (int lag : {1, 3}) {
+    const HatResult r = three_cornered_hat(a, b, c, 0.02, lag);
+    EXPECT_EQ(r.increments, t.size() - size_t(lag));
+    // The yaw noise also turns each increment (0.3 m x a few mrad), a few per cent of the position's.
+    EXPECT_NEAR(r.ref.pose_sigma_xy_m, std::sqrt(2.0) * 0.01, 0.003 + 0.3 * 0.002 * lag) << lag;
+    EXPECT_NEAR(r.est.pose_sigma_xy_m, std::sqrt(2.0) * 0.03, 0.003 + 0.3 * 0.004 * lag) << lag;
+    EXPECT_NEAR(r.third.pose_sigma_xy_m, std::sqrt(2.0) * 0.05, 0.003) << lag;
+    EXPECT_NEAR(r.ref.pose_sigma_yaw_rad, 0.002, 0.0002) << lag;
+    EXPECT_NEAR(r.est.pose_sigma_yaw_rad, 0.004, 0.0002) << lag;
+    EXPECT_NEAR(r.third.pose_sigma_yaw_rad, 0.001, 0.0002) << lag;
+  }
+  const HatResult swapped = three_cornered_hat(c, a, b);
+  EXPECT_NEAR(swapped.ref.pose_sigma_xy_m, std::sqrt(2.0) * 0.05, 0.003);
+  EXPECT_NEAR(swapped.est.pose_sigma_xy_m, std::sqrt(2.0) * 0.01, 0.003);
+}
+
+// A random walk (drift) is not white: its increment variance grows with the lag, while a white source's does not.
+TEST(ReferenceNoise, DriftGrowsWithTheLagWhiteNoiseDoesNot) {
+  const auto t = truth(20000);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> nd;
+  std::vector<Pose2> walk = t;
+  double ox = 0, oy = 0;
+  for (auto& p : walk) {
+    ox += 0.01 * nd(rng), oy += 0.01 * nd(rng);
+    p.x += ox, p.y += oy;
+  }
+  const Trajectory ref = noisy(t, 0.02, 0, 4), est = noisy(t, 0.02, 0, 5), drift = noisy(walk, 0, 0, 6);
+  const HatResult r1 = three_cornered_hat(ref, est, drift, 0.02, 1), r4 = three_cornered_hat(ref, est, drift, 0.02, 4);
+  EXPECT_NEAR(r1.third.increment_var_xy_m2, 2 * 0.01 * 0.01, 0.3 * 2 * 0.01 * 0.01);
+  EXPECT_NEAR(r4.third.increment_var_xy_m2, 4 * r1.third.increment_var_xy_m2, 0.3 * 4 * r1.third.increment_var_xy_m2);
+  EXPECT_NEAR(r4.ref.pose_sigma_xy_m, r1.ref.pose_sigma_xy_m, 0.004);
+}
+
+// Trajectories that do not overlap in time: one clear error, not a division by zero.
+TEST(ReferenceNoise, TooFewCommonIncrementsIsAnError) {
+  const auto t = truth(50);
+  Trajectory a = noisy(t, 0.01, 0, 1), b = noisy(t, 0.01, 0, 2), c = noisy(t, 0.01, 0, 3);
+  for (auto& p : c) p.t += 100;
+  EXPECT_THROW(three_cornered_hat(a, b, c), std::invalid_argument);
+  EXPECT_THROW(three_cornered_hat(a, b, b, 0.02, 0), std::invalid_argument);
+  EXPECT_DOUBLE_EQ(signed_sqrt(-4), -2);
+}
