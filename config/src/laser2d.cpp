@@ -33,6 +33,7 @@ laser2d::GridLocalizerConfig config_of(const Grid2dOptions& o) {
   }
   if (o.huber_m() > 0) c.huber_m = o.huber_m();
   if (o.huber_first_above_sigma_m() > 0) c.huber_first_above_sigma_m = o.huber_first_above_sigma_m();
+  if (o.laser_conflict_inlier_ratio() != 0) c.laser_conflict_inlier_ratio = o.laser_conflict_inlier_ratio();
   return c;
 }
 

@@ -189,11 +189,21 @@ TEST(ConfigDefaults, Grid2d) {
          {"sigma_yaw_per_rad", c.sigma_yaw_per_rad}, {"prior_weight_sigmas", c.prior_weight_sigmas},
          {"laser_map_scans", double(c.laser.map_scans)}, {"confirm_within_sigmas", c.confirm_within_sigmas},
          {"far_confirm_travel_m", c.far_confirm_travel_m}, {"huber_m", c.huber_m},
-         {"huber_first_above_sigma_m", c.huber_first_above_sigma_m}});
+         {"huber_first_above_sigma_m", c.huber_first_above_sigma_m},
+         {"laser_conflict_inlier_ratio", c.laser_conflict_inlier_ratio}});
   EXPECT_EQ(c.fit_loss, fploc::laser2d::FitLoss::kHuber);
 }
 
 // The grid localizer's fit loss by name; an unknown name is one error naming the option.
+// laser_conflict_inlier_ratio: zero is the default, a negative value turns the rule off.
+TEST(ConfigMapping, Grid2dLaserConflictOff) {
+  fploc::Grid2dOptions o;
+  o.set_laser_conflict_inlier_ratio(-1);
+  EXPECT_LE(config_of(o).laser_conflict_inlier_ratio, 0);
+  o.set_laser_conflict_inlier_ratio(0.8);
+  EXPECT_EQ(config_of(o).laser_conflict_inlier_ratio, 0.8);
+}
+
 TEST(ConfigMapping, Grid2dFitLoss) {
   fploc::Grid2dOptions o;
   o.set_fit_loss("cauchy");
