@@ -147,7 +147,13 @@ int main(int argc, char** argv) {
                 << " OK, " << c.false_ok << " false OK (horizontal error > " << c.false_ok_m << " m)\n";
     }
     if (!hat_path.empty()) {
-      const auto h = eval::three_cornered_hat(gt, est, read_tum(hat_path), max_dt, hat_lag);
+      const Trajectory third = read_tum(hat_path);
+      eval::HatResult h;
+      try {
+        h = eval::three_cornered_hat(gt, est, third, max_dt, hat_lag);
+      } catch (const std::invalid_argument& e) {
+        throw std::runtime_error("--hat " + hat_path + " (" + std::to_string(third.size()) + " poses): " + e.what());
+      }
       auto src = [&](const eval::HatSource& s) {
         return nlohmann::json{{"increment_sigma_xy_m", eval::signed_sqrt(s.increment_var_xy_m2)},
                               {"increment_sigma_yaw_rad", eval::signed_sqrt(s.increment_var_yaw_rad2)},
