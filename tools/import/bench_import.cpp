@@ -24,6 +24,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <map>
+#include <utility>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -40,18 +41,22 @@ namespace fs = std::filesystem;
 
 namespace {
 
-double children_cpu() {
+// CPU seconds of the finished children: user, system.
+std::pair<double, double> children_cpu() {
   rusage u{};
   getrusage(RUSAGE_CHILDREN, &u);
-  return u.ru_utime.tv_sec + u.ru_stime.tv_sec + 1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+  return {u.ru_utime.tv_sec + 1e-6 * u.ru_utime.tv_usec, u.ru_stime.tv_sec + 1e-6 * u.ru_stime.tv_usec};
 }
 double last_cpu = 0;  // CPU seconds (user + sys) of the last run(): what a busy shared machine does not inflate
+double last_user = 0, last_sys = 0;  // the same, split
 
 double run(const std::string& cmd) {
   const auto t0 = std::chrono::steady_clock::now();
-  const double c0 = children_cpu();
+  const auto c0 = children_cpu();
   const int rc = std::system(cmd.c_str());
-  last_cpu = children_cpu() - c0;
+  const auto c1 = children_cpu();
+  last_user = c1.first - c0.first, last_sys = c1.second - c0.second;
+  last_cpu = last_user + last_sys;
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (rc != 0) {
     std::cerr << "fploc bench import: '" << cmd << "' failed (" << rc << ")\n";
@@ -310,12 +315,14 @@ int main(int argc, char** argv) {
         variants.push_back({variants[v].name + " [baseline]", variants[v].flag, baseline});
     std::map<std::string, bool> same_bytes;  // variant -> its log equals the baseline's (first run)
     std::vector<double> cat_s, cat_cpu, copy_s, cat_cold_s, tool_s, tool_file_s, tool_cpu;
-    std::map<std::string, std::vector<double>> imp_s, imp_cpu, imp_cold_s;
+    std::map<std::string, std::vector<double>> imp_s, imp_cpu, imp_user, imp_sys, imp_cold_s;
+    std::vector<double> copy_cpu;
     std::map<std::string, uint64_t> lcm_bytes;
     for (int i = 0; i < runs; ++i) {  // interleaved, so a change in the machine's load hits every command
       cat_s.push_back(run("cat '" + bag + "' > /dev/null"));
       cat_cpu.push_back(last_cpu);
       copy_s.push_back(run("cat '" + bag + "' > '" + copy + "'"));
+      copy_cpu.push_back(last_cpu);
       fs::remove(copy);
       if (!tool.empty()) {
         tool_s.push_back(run(tool + " '" + chunks + "' > /dev/null"));
@@ -327,6 +334,8 @@ int main(int argc, char** argv) {
         const std::string extra = exe == baseline ? "" : (direct_io ? " --direct-io" : "");
         imp_s[name].push_back(run("'" + exe + "' '" + bag + "' --out '" + lcm + "' --quiet" + flag + extra + " > /dev/null"));
         imp_cpu[name].push_back(last_cpu);
+        imp_user[name].push_back(last_user);
+        imp_sys[name].push_back(last_sys);
         lcm_bytes[name] = fs::file_size(lcm);
         const std::string kept = (dir / (k + flag.substr(flag.empty() ? 0 : 1) + ".first.lcm")).string();
         if (i == 0 && !baseline.empty() && exe != baseline) fs::rename(lcm, kept);  // compared with the baseline's below
@@ -356,6 +365,8 @@ int main(int argc, char** argv) {
                           {"import_s", t_import}, {"ratio_vs_cat", t_import / t_cat}, {"ratio_vs_cat_copy", t_import / t_copy},
                           {"import_MBps", bytes / 1e6 / t_import}, {"cold_cat_s", t_cat_cold}, {"cold_import_s", t_import_cold},
                           {"cold_ratio_vs_cat", t_import_cold / t_cat_cold}, {"cat_cpu_s", cpu_cat}, {"import_cpu_s", cpu_import},
+                          {"import_user_s", median(imp_user[name])}, {"import_sys_s", median(imp_sys[name])},
+                          {"cat_copy_cpu_s", median(copy_cpu)},
                           {"import_runs_s", imp_s[name]}, {"cat_runs_s", cat_s}};
       if (exe != baseline && direct_io) j["direct_io"] = true;
       if (!baseline.empty()) {

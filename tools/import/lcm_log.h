@@ -7,7 +7,9 @@
 // be written from two parts (its header and a payload that stays where it is) without assembling it
 // first; a payload that stays valid until close() (`stable`: the recording's mapped bytes) is not
 // copied at all: the writer thread hands it to writev() beside the framing, so the only copy of the
-// recording's bytes is the kernel's into the log's page cache. close() (also on a bad input, where
+// recording's bytes is the kernel's into the log's page cache. (The readers now read a file with pread
+// into a reused buffer, not stable: only records over 64 MiB and recordings in memory still come from
+// a mapping; docs/notes/import.md, "Sequential reads with pread".) close() (also on a bad input, where
 // the importer stops) writes everything before it.
 //
 // Direct I/O (open(path, true)): the log is written with O_DIRECT from 4 KiB-aligned 16 MiB buffers, at

@@ -2,6 +2,7 @@
 // u32 data_len, data. op: 0x02 message data, 0x03 bag header, 0x04 index data, 0x05 chunk, 0x06 chunk
 // info, 0x07 connection. Chunks hold connection and message records; their "size" field is the
 // uncompressed size.
+#include <algorithm>
 #include <cstring>
 #include <string_view>
 
@@ -57,6 +58,30 @@ bool read_record(const uint8_t* base, size_t n, size_t& pos, Record& r, std::str
   r.data = base + dpos + 4;
   r.data_len = dl;
   pos = dpos + 4 + dl;
+  return true;
+}
+
+// The record at byte `at` of the file, as read_record reads it, through the sequential reads
+// (f.seq()): each part is read once the length before it has been checked against the end of the file,
+// so a bad length fails the same check, with the same message, without reading further. *p: the
+// record's first byte (valid until the next seq()).
+bool read_file_record(FileBytes& f, size_t at, size_t& pos, Record& r, const uint8_t** p, std::string* why) {
+  const size_t rem = f.size() - at;
+  size_t need = std::min<size_t>(rem, 4);
+  if (!(*p = f.seq(at, need))) return *why = f.read_error(), false;
+  if (rem >= 4) {
+    const uint32_t hl = rd<uint32_t>(*p);
+    if (hl <= rem - 4) {
+      need = std::min(rem, size_t(hl) + 8);
+      if (!(*p = f.seq(at, need))) return *why = f.read_error(), false;
+      const uint32_t dl = need == size_t(hl) + 8 ? rd<uint32_t>(*p + 4 + hl) : 0;
+      if (dl <= rem - need) need += dl;
+    }
+  }
+  if (!(*p = f.seq(at, need))) return *why = f.read_error(), false;
+  size_t end = 0;
+  if (!read_record(*p, rem, end, r, why)) return false;
+  pos = at + end;
   return true;
 }
 
@@ -143,7 +168,8 @@ bool BagReader::next(RawMessage& m) {
     }
     const size_t at = pos_;
     f_->read_ahead(at);
-    if (!read_record(f_->data(), size_, pos_, r, &why)) {
+    const uint8_t* rp = nullptr;  // the record's bytes
+    if (!read_file_record(*f_, at, pos_, r, &rp, &why)) {
       pos_ = at;
       return stop("record at byte " + std::to_string(at) + ": " + why);
     }
@@ -172,7 +198,7 @@ bool BagReader::next(RawMessage& m) {
     } else if (r.op == 0x07 || r.op == 0x02) {
       // Outside chunks (allowed, rare): handle through the chunk path with a one-record "chunk".
       chunk_what_ = "top level";
-      cd_ = f_->data() + at;
+      cd_ = rp;
       cn_ = pos_ - at;
       cpos_ = 0;
     }

@@ -96,7 +96,7 @@ bool parse_chunk(const uint8_t* body, uint64_t len, ChunkHeader& h) {
 
 void McapReader::crc_upto(size_t to) {
   if (!kCheckCrc || to <= crc_at_) return;
-  data_crc_ = crc32_gzip_refl(data_crc_, f_->data() + crc_at_, to - crc_at_);
+  data_crc_ = crc32_gzip_refl(data_crc_, f_->view(crc_at_, to - crc_at_), to - crc_at_);
   crc_at_ = to;
 }
 
@@ -184,15 +184,19 @@ bool McapReader::next(RawMessage& m) {
     const size_t at = pos_;
     f_->read_ahead(at);
     if (size_ - pos_ < 9) return stop("record at byte " + std::to_string(at) + ": cut off (file truncated? no footer)");
-    const uint8_t* d = f_->data();
-    const uint8_t op = d[pos_];
-    const uint64_t len = rd<uint64_t>(d + pos_ + 1);
+    const uint8_t* d = f_->seq(at, 9);  // the record's header, then (its length checked) the whole record
+    if (!d) return stop("record at byte " + std::to_string(at) + ": " + f_->read_error());
+    const uint8_t op = d[0];
+    const uint64_t len = rd<uint64_t>(d + 1);
     if (len > size_ - pos_ - 9) return stop("record (opcode " + std::to_string(op) + ") at byte " + std::to_string(at) + ": length " + std::to_string(len) + " runs past the end (file truncated?)");
+    if (!(d = f_->seq(at, 9 + size_t(len)))) return stop("record at byte " + std::to_string(at) + ": " + f_->read_error());
     pos_ += 9 + len;
-    const uint8_t* body = d + at + 9;
+    const uint8_t* body = d + 9;
     if (op != 0x06 && op != 0x0F) crc_upto(pos_);
     if (op == 0x02) {  // Footer: then the closing magic
-      if (size_ - pos_ < 8 || std::memcmp(d + pos_, kMagic, 8) != 0) return stop("footer at byte " + std::to_string(at) + " is not followed by the MCAP magic");
+      const uint8_t* magic = size_ - pos_ < 8 ? nullptr : f_->seq(pos_, 8);
+      if (!magic && size_ - pos_ >= 8) return stop("footer at byte " + std::to_string(at) + ": " + f_->read_error());
+      if (!magic || std::memcmp(magic, kMagic, 8) != 0) return stop("footer at byte " + std::to_string(at) + " is not followed by the MCAP magic");
       pos_ = size_;
       done_ = true;
       return false;
@@ -221,7 +225,7 @@ bool McapReader::next(RawMessage& m) {
         cd_ = h.records;
         cn_ = h.rlen;
         if (kCheckCrc) {  // the records' CRC once, for the chunk and (combined) for the data section
-          crc_upto(size_t(h.records - d));
+          crc_upto(at + 9 + size_t(h.records - body));
           got = crc32_of(cd_, cn_), crc_known = true;
           data_crc_ = uint32_t(crc32_combine(data_crc_, got, z_off_t(cn_)));
           crc_at_ += cn_;

@@ -19,8 +19,9 @@ T rd(const uint8_t* p) {
   return v;
 }
 
-// What both readers share: the mapped file, the position, the first error (which stops the stream,
-// prefixed with the file name), and the chunk being read (in the file, or decompressed into buf_).
+// What both readers share: the file (read in order with FileBytes::seq(); its mapping for the look-ahead),
+// the position, the first error (which stops the stream, prefixed with the file name), and the chunk
+// being read (in seq()'s buffer, or decompressed into buf_).
 class FileReader : public Recording {
  public:
   uint64_t position() const override { return pos_; }

@@ -9,16 +9,19 @@
 #include <cerrno>
 #include <cstring>
 
+#include "read_window.h"
 #include "readers.h"
 
 namespace fploc::rec {
+
+FileBytes::FileBytes() = default;
 
 FileBytes::~FileBytes() {
   if (mapped_) munmap(mapped_, size_);
 }
 
-bool FileBytes::map(const std::string& path, std::string* err) {
-  const int fd = ::open(path.c_str(), O_RDONLY);
+bool FileBytes::map(const std::string& path, std::string* err, size_t read_bytes) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return *err = path + ": " + std::strerror(errno), false;
   struct stat st {};
   if (fstat(fd, &st) != 0) {
@@ -34,12 +37,30 @@ bool FileBytes::map(const std::string& path, std::string* err) {
       ::close(fd);
       return false;
     }
-    madvise(p, size_, MADV_SEQUENTIAL);
+    madvise(p, size_, MADV_SEQUENTIAL);  // the look-ahead and the compressed chunks go forward through it
     mapped_ = p;
     data_ = static_cast<const uint8_t*>(p);
   }
-  ::close(fd);
+  posix_fadvise(fd, 0, 0, POSIX_FADV_SEQUENTIAL);  // a larger readahead window for the preads
+  window_ = std::make_unique<ReadWindow>(read_bytes ? read_bytes : ReadWindow::kDefaultReadBytes);
+  window_->open(fd, size_);  // the window closes fd
   return true;
+}
+
+const uint8_t* FileBytes::seq(size_t off, size_t n) {
+  constexpr size_t kMaxWindowRecord = size_t(64) << 20;
+  if (!window_ || (n > kMaxWindowRecord && data_)) return data_ + off;
+  return window_->get(off, n);
+}
+
+const uint8_t* FileBytes::view(size_t off, size_t n) const {
+  const uint8_t* p = window_ ? window_->peek(off, n) : nullptr;
+  return p ? p : data_ + off;
+}
+
+const std::string& FileBytes::read_error() const {
+  static const std::string none;
+  return window_ ? window_->error() : none;
 }
 
 void FileBytes::read_ahead(size_t pos) {
@@ -50,14 +71,6 @@ void FileBytes::read_ahead(size_t pos) {
   const size_t to = std::min(size_, pos + kAhead);
   if (to > from) madvise(static_cast<uint8_t*>(mapped_) + from, to - from, MADV_WILLNEED);
   advised_ = to;
-  // The part read next (asked for one step ago, so normally in the page cache by now) is mapped in one
-  // call instead of a page fault per 64 KiB; the log writer copies straight from it (writev). Linux >= 5.14;
-  // elsewhere (EINVAL) the reads fault the pages in as before.
-#ifndef MADV_POPULATE_READ
-#define MADV_POPULATE_READ 22
-#endif
-  const size_t here = (pos & ~(page - 1)), upto = std::min(size_, pos + kStep);
-  if (upto > here) madvise(static_cast<uint8_t*>(mapped_) + here, upto - here, MADV_POPULATE_READ);
 }
 
 namespace {
@@ -78,9 +91,9 @@ std::unique_ptr<Recording> by_magic(std::unique_ptr<FileBytes> f, const std::str
 }
 }  // namespace
 
-std::unique_ptr<Recording> open_recording(const std::string& path, std::string* err) {
+std::unique_ptr<Recording> open_recording(const std::string& path, std::string* err, size_t read_bytes) {
   auto f = std::make_unique<FileBytes>();
-  if (!f->map(path, err)) return nullptr;
+  if (!f->map(path, err, read_bytes)) return nullptr;
   return by_magic(std::move(f), path, err);
 }
 

@@ -45,8 +45,9 @@ class Recording {
   virtual uint64_t position() const = 0;
   uint64_t size() const { return size_; }
   const std::string& format() const { return format_; }  // "bag 2.0" or "mcap"
-  // True when [p, p + n) lies in the recording's own bytes (an uncompressed chunk or record: not a
-  // decompressed copy), which stay valid and unchanged until the Recording is destroyed.
+  // True when [p, p + n) lies in the recording's mapped (or borrowed) bytes, which stay valid and
+  // unchanged until the Recording is destroyed: not a decompressed copy, and not the bytes of a file's
+  // sequential reads (FileBytes::seq(), reused), which is where a file's records are read from.
   virtual bool stable(const uint8_t* p, size_t n) const {
     (void)p, (void)n;
     return false;
@@ -63,20 +64,34 @@ class Recording {
   std::string format_;
 };
 
-// A read-only view of the whole file (mmap), or of memory the caller owns (fuzzing, tests).
+class ReadWindow;
+
+// A read-only view of the whole file (mmap), or of memory the caller owns (fuzzing, tests). The readers'
+// sequential pass takes the file's bytes with seq() (pread into a reused buffer: read_window.h says why);
+// the mapping stays for random access (the look-ahead for the next compressed chunk, whose bytes the
+// decompressing thread reads from it).
 class FileBytes {
  public:
-  FileBytes() = default;
+  FileBytes();
   FileBytes(const FileBytes&) = delete;
   FileBytes& operator=(const FileBytes&) = delete;
   ~FileBytes();
-  bool map(const std::string& path, std::string* err);
+  // read_bytes: the size of the sequential reads (0: the default, 1 MiB; tests use small ones).
+  bool map(const std::string& path, std::string* err, size_t read_bytes = 0);
   void borrow(const uint8_t* data, size_t size) { data_ = data, size_ = size; }
   const uint8_t* data() const { return data_; }
   size_t size() const { return size_; }
+  // The bytes [off, off + n) (within the file) for the sequential pass: valid until the next seq() call;
+  // nullptr when a read fails (read_error()). Borrowed memory and records of more than 64 MiB (a huge or
+  // corrupt length: no buffer of that size) come from the mapping.
+  const uint8_t* seq(size_t off, size_t n);
+  // The same bytes without reading: from seq()'s buffer when they are in it, else from the mapping
+  // (pointers seq() gave out stay valid).
+  const uint8_t* view(size_t off, size_t n) const;
+  const std::string& read_error() const;
   // Readers call this with their position: the kernel is asked (MADV_WILLNEED, asynchronous) to read
   // the next 64 MiB of a mapped file ahead, 32 MiB at a time, so a cold file streams from the disk
-  // the way `cat` reads it instead of waiting at every page fault for its small readahead window.
+  // the way `cat` reads it instead of waiting for its small readahead window at every read.
   void read_ahead(size_t pos);
 
  private:
@@ -84,11 +99,13 @@ class FileBytes {
   const uint8_t* data_ = nullptr;
   size_t size_ = 0;
   void* mapped_ = nullptr;
+  std::unique_ptr<ReadWindow> window_;  // set when the file is mapped
 };
 
 // Opens a bag or an MCAP file by its magic bytes. Returns nullptr with *err set when the file cannot be
 // read or is neither; a reader is returned even when its stream ends early (its error() says why).
-std::unique_ptr<Recording> open_recording(const std::string& path, std::string* err);
+// read_bytes: FileBytes::map's (0: the default).
+std::unique_ptr<Recording> open_recording(const std::string& path, std::string* err, size_t read_bytes = 0);
 // Same over memory (the name is used in messages).
 std::unique_ptr<Recording> open_recording_memory(const uint8_t* data, size_t size, const std::string& name,
                                                  std::string* err);
