@@ -194,7 +194,6 @@ TEST(ConfigDefaults, Grid2d) {
   EXPECT_EQ(c.fit_loss, fploc::laser2d::FitLoss::kHuber);
 }
 
-// The grid localizer's fit loss by name; an unknown name is one error naming the option.
 // laser_conflict_inlier_ratio: zero is the default, a negative value turns the rule off.
 TEST(ConfigMapping, Grid2dLaserConflictOff) {
   fploc::Grid2dOptions o;
@@ -204,6 +203,7 @@ TEST(ConfigMapping, Grid2dLaserConflictOff) {
   EXPECT_EQ(config_of(o).laser_conflict_inlier_ratio, 0.8);
 }
 
+// The grid localizer's fit loss by name; an unknown name is one error naming the option.
 TEST(ConfigMapping, Grid2dFitLoss) {
   fploc::Grid2dOptions o;
   o.set_fit_loss("cauchy");

@@ -20,8 +20,8 @@ CPU time (grid2d; laser2d + matcher + optimizer for the plan path; AMCL's own) o
 (fploc-real-floor): how far the map and the reference poses of the rest disagree; "floor.cauchy" the same with
 the fit's Cauchy loss instead of Huber (lower on every log: part of the Huber floor is the loss's bias).
 "reference_noise": how noisy the reference poses are themselves, by the three-cornered hat of the reference, fploc's
-estimate and the wheel odometry (`fploc eval --hat`, modules/eval/reference_noise.h): each one's noise from the
-increments between consecutive scans (and 2 scans apart: white noise gives the same). Against a reference with
+estimate (its poses published OK) and the wheel odometry (`fploc eval --hat`, modules/eval/reference_noise.h): each
+one's noise from the increments between consecutive scans (and 2 scans apart: white noise gives the same). Against a reference with
 per-pose noise sigma even a perfect localizer scores an ATE of ~sigma, so each method's "ate_less_reference_noise_m"
 (sqrt(ATE^2 - sigma^2), an estimate of its own error) and "nees_median_with_reference_noise" (the reference's
 variance added to the published covariance) are given beside ATE and NEES. Plots
@@ -76,17 +76,25 @@ def read_status(path):
     return out
 
 
-def reference_noise(ref, est, odom):
+def reference_noise(ref, est, status, odom, ok_path):
     """The three-cornered hat of the reference, an estimate and the wheel odometry (fploc eval --hat), at lags 1 and
-    2: {"pose_sigma_xy_m", "pose_sigma_yaw_rad"} of the reference at lag 1 (per pose, if white), the same at lag 2,
-    and the estimate's and odometry's at lag 1."""
+    2, over the increments whose two poses the estimate published OK (its POOR/LOST stretches, errors of the estimate
+    up to metres, would only add noise to the split): {"pose_sigma_xy_m", "pose_sigma_yaw_rad"} of the reference at
+    lag 1 (per pose, if white; a negative value means the assumptions fail there), the same at lag 2, and the
+    estimate's and odometry's at lag 1."""
+    st = read_status(status)
+    with open(est) as f, open(ok_path, "w") as g:
+        for line in f:
+            v = line.split()
+            if v and not v[0].startswith("#") and st.get(round(float(v[0]), 4), (1,))[0] == 0:
+                g.write(line)
     out = {}
     for lag in (1, 2):
-        h = json.loads(run([os.path.join(BIN, "fploc-eval"), "--gt", ref, "--est", est, "--hat", odom, "--hat-lag",
+        h = json.loads(run([os.path.join(BIN, "fploc-eval"), "--gt", ref, "--est", ok_path, "--hat", odom, "--hat-lag",
                             str(lag), "--max-dt", "0.001", "--json"]).stdout)["hat"]
         if lag == 1:
             out = {"pose_sigma_xy_m": h["gt"]["pose_sigma_xy_m"], "pose_sigma_yaw_rad": h["gt"]["pose_sigma_yaw_rad"],
-                   "increments": h["increments"], "estimate": est, "estimate_pose_sigma_xy_m": h["est"]["pose_sigma_xy_m"],
+                   "increments": h["increments"], "estimate": ok_path, "estimate_pose_sigma_xy_m": h["est"]["pose_sigma_xy_m"],
                    "odometry_pose_sigma_xy_m": h["third"]["pose_sigma_xy_m"]}
         else:
             out["lag2"] = {"pose_sigma_xy_m": h["gt"]["pose_sigma_xy_m"], "pose_sigma_yaw_rad": h["gt"]["pose_sigma_yaw_rad"]}
@@ -106,9 +114,12 @@ def score(gt_path, est_path, lost_m, keep=None, status_path=None, ref_noise=None
         out = {"scans": len(times), "ate_m": math.sqrt(sum(e * e for e in fin) / len(fin)) if fin else float("nan"),
                "max_m": max(fin) if fin else float("nan"), "missing": len(errs) - len(fin),
                "lost_pct": 100.0 * sum(e > lost_m for e in errs) / max(1, len(errs))}
+        # A negative sigma (the hat's assumptions fail) gives no figure: the keys are null. A negative yaw sigma alone
+        # counts as no yaw noise.
         rn = ref_noise if ref_noise and ref_noise["pose_sigma_xy_m"] > 0 else None
-        if rn and fin:
-            out["ate_less_reference_noise_m"] = math.sqrt(max(0.0, out["ate_m"] ** 2 - rn["pose_sigma_xy_m"] ** 2))
+        if ref_noise is not None:
+            out["ate_less_reference_noise_m"] = (math.sqrt(max(0.0, out["ate_m"] ** 2 - rn["pose_sigma_xy_m"] ** 2))
+                                                 if rn and fin else None)
         if st:  # what the method said of itself: false OK (status OK, error > FALSE_OK_M), POOR/LOST shares, NEES
             said = [(k, e) for k, e in zip(times, errs) if k in st and math.isfinite(e)]
             nees, nees_rn = [], []
@@ -128,7 +139,7 @@ def score(gt_path, est_path, lost_m, keep=None, status_path=None, ref_noise=None
                         nees_rn.append(v)
             nees.sort()
             nees_rn.sort()
-            if rn:
+            if ref_noise is not None:
                 out["nees_median_with_reference_noise"] = nees_rn[len(nees_rn) // 2] if nees_rn else None
             n = max(1, len(said))
             out.update({"status_poses": len(said),
@@ -233,7 +244,7 @@ def main():
             grid_ms = cpu.get("grid2d", 0) / max(1, scans)
             amcl_ms = cpu.get("amcl", 0) / max(1, scans)
             # The reference's own noise, from fploc's estimate (the one scored as "fploc") and the wheels.
-            rnoise = reference_noise(ref, est[a.fploc if a.fploc == "wo" else "grid"], odom)
+            rnoise = reference_noise(ref, est[a.fploc], unc[a.fploc], odom, os.path.join(d, f"{row}-{a.fploc}-ok.tum"))
             g, p, am = (score(ref, est[k], a.lost_m, keep, unc[k], rnoise) for k in ("grid", "wo", "amcl"))
             f, fploc_ms = (g, grid_ms) if a.fploc == "grid" else (p, plan_ms)
             png = os.path.join(d, f"{row}.png")
@@ -253,7 +264,7 @@ def main():
                   f"LOST {am['lost_pct']:5.1f} % {amcl_ms:6.2f} ms | other fploc ({'wo' if a.fploc == 'grid' else 'grid'}) "
                   f"ATE {(p if a.fploc == 'grid' else g)['ate_m']*100:8.1f} cm | all scans: fploc {f['all']['ate_m']*100:.1f} cm "
                   f"LOST {f['all']['lost_pct']:.1f} %, AMCL {am['all']['ate_m']*100:.1f} cm | floor {floor['ate_m']*100:.1f} cm (Cauchy fit {floor['cauchy']['ate_m']*100:.1f} cm) | reference noise {rnoise['pose_sigma_xy_m']*100:.1f} cm "
-                  f"(lag 2: {rnoise['lag2']['pose_sigma_xy_m']*100:.1f}), fploc less it {f.get('ate_less_reference_noise_m', float('nan'))*100:.1f} cm", file=sys.stderr)
+                  f"(lag 2: {rnoise['lag2']['pose_sigma_xy_m']*100:.1f}), fploc less it {(f['ate_less_reference_noise_m'] if f['ate_less_reference_noise_m'] is not None else float('nan'))*100:.1f} cm", file=sys.stderr)
     if a.json:
         print(json.dumps({"bench": "real", "protocol": {"split": a.split, "scored": "scans covered by the map", "end": a.end, "resolution_m": a.resolution,
                                                         "map": {"min_hits": a.min_hits, "occupied_ratio": a.occupied_ratio,

@@ -60,7 +60,15 @@ int main(int argc, char** argv) {
       else if (a == "--uncertainty") unc_path = next();
       else if (a == "--false-ok-m") false_ok_m = std::stod(next());
       else if (a == "--hat") hat_path = next();
-      else if (a == "--hat-lag") hat_lag = std::stoi(next());
+      else if (a == "--hat-lag") {
+        const std::string v = next();
+        size_t used = 0;
+        hat_lag = std::stoi(v, &used);
+        if (used != v.size() || hat_lag < 1) {
+          std::cerr << "fploc eval: --hat-lag " << v << ": not a whole number >= 1\n";
+          return 2;
+        }
+      }
       else if (a == "-h" || a == "--help") { usage(); return 0; }
       else { std::cerr << "fploc eval: unexpected argument '" << a << "'\n"; usage(); return 2; }
     } catch (const std::exception&) {
@@ -69,8 +77,12 @@ int main(int argc, char** argv) {
     }
   }
   if (gt_path.empty() || est_path.empty() || (unit != "s" && unit != "f") || !(delta > 0) || !(max_dt >= 0) ||
-      !(false_ok_m > 0) || hat_lag < 1) {
+      !(false_ok_m > 0)) {
     usage();
+    return 2;
+  }
+  if (hat_lag != 1 && hat_path.empty()) {
+    std::cerr << "fploc eval: --hat-lag needs --hat THIRD.tum\n";
     return 2;
   }
   try {
@@ -150,7 +162,7 @@ int main(int argc, char** argv) {
       const Trajectory third = read_tum(hat_path);
       eval::HatResult h;
       try {
-        h = eval::three_cornered_hat(gt, est, third, max_dt, hat_lag);
+        h = eval::three_cornered_hat(gt, est, third, max_dt, hat_lag, offset);
       } catch (const std::invalid_argument& e) {
         throw std::runtime_error("--hat " + hat_path + " (" + std::to_string(third.size()) + " poses): " + e.what());
       }

@@ -13,9 +13,9 @@ namespace {
 Pose2 planar(const StampedPose& p) { return {p.p.x(), p.p.y(), p.rpy().z()}; }
 
 // For each reference index, the index of the associated pose of `other` (-1: none).
-std::vector<long> partner_of_ref(const Trajectory& ref, const Trajectory& other, double max_dt) {
+std::vector<long> partner_of_ref(const Trajectory& ref, const Trajectory& other, double max_dt, double offset) {
   std::vector<long> out(ref.size(), -1);
-  for (const auto& [g, e] : associate(ref, other, max_dt)) out[g] = long(e);
+  for (const auto& [g, e] : associate(ref, other, max_dt, offset)) out[g] = long(e);
   return out;
 }
 
@@ -29,9 +29,9 @@ std::array<double, 3> split(double ab, double ac, double bc) {
 double signed_sqrt(double v) { return std::copysign(std::sqrt(std::fabs(v)), v); }
 
 HatResult three_cornered_hat(const Trajectory& ref, const Trajectory& est, const Trajectory& third, double max_dt,
-                             int lag) {
+                             int lag, double est_offset) {
   if (lag < 1) throw std::invalid_argument("three-cornered hat: lag must be >= 1");
-  const auto pe = partner_of_ref(ref, est, max_dt), pt = partner_of_ref(ref, third, max_dt);
+  const auto pe = partner_of_ref(ref, est, max_dt, est_offset), pt = partner_of_ref(ref, third, max_dt, 0);
   // Differences of the increments, accumulated for the three pairs: sums of squares and sums (for the mean).
   struct Acc {
     double s[3] = {0, 0, 0}, ss = 0, ssyaw = 0;  // x, y, yaw sums; sum of x^2 + y^2; sum of yaw^2

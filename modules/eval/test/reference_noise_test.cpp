@@ -86,3 +86,41 @@ TEST(ReferenceNoise, TooFewCommonIncrementsIsAnError) {
   EXPECT_THROW(three_cornered_hat(a, b, b, 0.02, 0), std::invalid_argument);
   EXPECT_DOUBLE_EQ(signed_sqrt(-4), -2);
 }
+
+// The estimate and the third trajectory need not share the reference's poses or clock: every 7th estimate pose
+// dropped (an unreliable pose left out), the estimate stamped 0.55 s late (eval's --offset takes it back), and
+// the third trajectory at twice the rate and starting later. The increments are those where all three have both
+// poses, and each source's sigma still comes back.
+TEST(ReferenceNoise, AssociatesByTimeWithGapsOffsetsAndOtherRates) {
+  const auto t = truth(20000);
+  const Trajectory ref = noisy(t, 0.01, 0.002, 1);
+  const Trajectory est = noisy(t, 0.03, 0.004, 2);
+  Trajectory gapped;  // every 7th pose dropped, the rest stamped 0.55 s late
+  for (size_t i = 0; i < est.size(); ++i)
+    if (i % 7 != 3) {
+      StampedPose q = est[i];
+      q.t += 0.55;
+      gapped.push_back(q);
+    }
+  std::vector<Pose2> fine;  // the truth at twice the rate: the path's poses and midpoints between them
+  for (size_t i = 0; i + 1 < t.size(); ++i) {
+    fine.push_back(t[i]);
+    fine.push_back(compose(t[i], {0.15, 0.0, 0.0}));
+  }
+  Trajectory third;
+  for (const auto& p : noisy(fine, 0.05, 0.001, 3)) {
+    StampedPose q = p;
+    q.t /= 2;  // 0.05 s apart: on the reference's times every other pose
+    if (q.t >= 100) third.push_back(q);
+  }
+  const HatResult r = three_cornered_hat(ref, gapped, third, 0.02, 1, -0.55);
+  // Reference increments (i, i + 1) from t = 100 s where neither end is a dropped estimate pose.
+  size_t expect = 0;
+  for (size_t i = 1000; i + 1 < t.size() - 1; ++i) expect += (i % 7 != 3) && ((i + 1) % 7 != 3);
+  EXPECT_NEAR(double(r.increments), double(expect), 2);
+  EXPECT_NEAR(r.ref.pose_sigma_xy_m, std::sqrt(2.0) * 0.01, 0.003 + 0.3 * 0.002);
+  EXPECT_NEAR(r.est.pose_sigma_xy_m, std::sqrt(2.0) * 0.03, 0.003 + 0.3 * 0.004);
+  EXPECT_NEAR(r.third.pose_sigma_xy_m, std::sqrt(2.0) * 0.05, 0.003);
+  // Without the offset the estimate matches nothing.
+  EXPECT_THROW(three_cornered_hat(ref, gapped, third, 0.02, 1, 0), std::invalid_argument);
+}

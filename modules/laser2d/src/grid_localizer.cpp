@@ -87,7 +87,6 @@ struct GridLocalizer::Impl {
     Pose2 est;
     bool accepted = false;
     double inlier_ratio = 0, rms = 0, score = 0, wxy = 0, wyaw = 0;
-    double m2 = 0;  // squared Mahalanobis distance of the fit from the prediction (x, y, yaw)
     int inliers = 0, leaves = 0, iterations = 0, refined = 0;
     Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();
     // Every refined candidate (the chosen one included): the rivals of the chosen fit.
@@ -267,7 +266,6 @@ GridLocalizer::Impl::Fit GridLocalizer::Impl::fit(const std::vector<Eigen::Vecto
   const double ex = f.est.x - pred.x, ey = f.est.y - pred.y, eyaw = wrap_angle(f.est.yaw - pred.yaw);
   const double m2 = (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw);
   const bool near = m2 <= cfg.gate_sigmas * cfg.gate_sigmas;
-  f.m2 = m2;
   // The refinement may not leave the window searched (a scan of one flat wall fits anywhere along it).
   const bool inside = this->inside(f, pred);
   f.accepted = (inside && f.inlier_ratio >= min_inlier_ratio) || (near && f.inlier_ratio >= cfg.min_inlier_ratio_near);
@@ -633,10 +631,14 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
   res.num_inliers = f.inliers;
   res.inlier_ratio = f.inlier_ratio;
   res.rms_m = f.rms;
-  // A matched laser step and a weakly supported map fit far from it disagree: the step is trusted.
+  // A matched laser step and a weakly supported map fit far from it disagree: the step is trusted (the fit counts
+  // as failed, POOR, towards LOST like any). Far in this step's own sigmas: a retry fit's were widened.
   if (f.accepted && res.laser_step && cfg_.laser_conflict_inlier_ratio > 0 &&
-      f.m2 > cfg_.gate_sigmas * cfg_.gate_sigmas && f.inlier_ratio < cfg_.laser_conflict_inlier_ratio)
-    f.accepted = false;
+      f.inlier_ratio < cfg_.laser_conflict_inlier_ratio) {
+    const double ex = f.est.x - pred.x, ey = f.est.y - pred.y, eyaw = wrap_angle(f.est.yaw - pred.yaw);
+    const double m2 = (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw);
+    if (m2 > cfg_.gate_sigmas * cfg_.gate_sigmas) f.accepted = false;
+  }
   if (f.accepted) {
     res.covariance = f.cov;
     m.pose = f.est;

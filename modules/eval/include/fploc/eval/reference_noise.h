@@ -33,9 +33,11 @@ struct HatResult {
 };
 
 // Increments between reference poses `lag` apart (in index), each of est and third associated to the
-// reference pose by time (within max_dt). Throws std::invalid_argument with fewer than 3 increments.
+// reference pose by time (within max_dt; est_offset is added to est's times, as eval's --offset). An increment
+// counts only where both trajectories have both of its poses (drop an estimate's unreliable poses to leave them
+// out). Throws std::invalid_argument with fewer than 3 increments.
 HatResult three_cornered_hat(const Trajectory& ref, const Trajectory& est, const Trajectory& third, double max_dt = 0.02,
-                             int lag = 1);
+                             int lag = 1, double est_offset = 0);
 
 // sign(v) * sqrt(|v|): a standard deviation that keeps a negative variance visible.
 double signed_sqrt(double v);

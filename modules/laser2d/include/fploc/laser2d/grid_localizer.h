@@ -217,7 +217,8 @@ struct GridLocalizerConfig {
   // csail covered ATE ref / off: 6.4 / 7.6 -> 5.0 / 3.4 cm; intel, aces, fhw unchanged, freiburg-079 ref unchanged.
   bool laser_track_retry = true;
   // While tracking on a matched laser step: a map fit farther than gate_sigmas from the laser prediction with an
-  // inlier share below this is not taken (the prediction is kept, POOR): where the map is wrong in part, a fit that
+  // inlier share below this is not taken (the prediction is kept, POOR, counting towards LOST as a failed fit; the
+  // distance in this step's sigmas, also for a fit of the widened retry): where the map is wrong in part, a fit that
   // explains only part of the scan can pull the track off a laser step that is right (intel scans 703-706: 0.34 m,
   // published OK). Radish (fploc-real-track, covered ATE cm ref / off, intel / aces / fhw / csail / freiburg-079):
   // off 7.4/7.2, 5.9/6.0, 5.9/5.9, 5.0/3.4, 8.8/7.1 with 3 false OK; 0.6: 6.1/6.1, 6.2/6.3, 5.9/5.9, 5.0/3.4,
