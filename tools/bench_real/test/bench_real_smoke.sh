@@ -5,7 +5,11 @@
 set -e
 if [ ! -d "$FPLOC_SHARED_DIR/data/recordings/radish" ]; then echo "SKIP: shared data absent"; exit 0; fi
 T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
-"$FPLOC_BUILD_DIR/bin/fploc-bench-real" --json --logs intel --split 0.5 --end 0.6 --rows ref --out "$T" > "$T/r.json"
+"$FPLOC_BUILD_DIR/bin/fploc-bench-real" --json --logs intel --split 0.5 --end 0.6 --rows ref --out "$T" --markdown "$T/r.md" > "$T/r.json"
+# The Markdown tables: one row per run row in each table, and the same again from the JSON alone.
+test "$(grep -c '^| intel | ref |' "$T/r.md")" = 2
+"$FPLOC_BUILD_DIR/bin/fploc-bench-real" --from-json "$T/r.json" --markdown "$T/r2.md"
+test "$(grep -c '^| intel | ref |' "$T/r2.md")" = 2
 python3 - "$T/r.json" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
