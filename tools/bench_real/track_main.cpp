@@ -69,6 +69,7 @@ int main(int argc, char** argv) {
   app.add_option("--weak-follow-step-only", c.weak_follow_step_only, "re-acquiring: follow a weak fit only within this step's own odometry sigma");
   app.add_option("--confirm-scans", c.confirm_scans, "scans a hypothesis must match in a row");
   app.add_option("--confirm-margin", c.confirm_margin, "mean inlier share a hypothesis needs over its runner-up");
+  app.add_option("--point-sigma", c.point_sigma_m, "the map fit's per-return sigma [m] (its weight against the prediction)");
   app.add_option("--laser-conflict-inlier-ratio", c.laser_conflict_inlier_ratio, "tracking: a fit beyond the gate of a laser step needs this inlier share (0: off)");
   app.add_option("--laser-odometry", c.laser_odometry, "predict with the scan-to-recent-scans increment where it matches");
   app.add_option("--laser-map-scans", c.laser.map_scans, "laser odometry: scans in the local map");
