@@ -3,9 +3,9 @@
 # start): with the default, no pose of the covered scans is published OK more than 0.3 m from the reference (false
 # OK); with the rule off (control) some are (scans 591 and 705: weak map fits that left a matched laser step).
 set -e
-if [ ! -d "$FPLOC_SHARED_DIR/data/recordings/radish" ]; then echo "SKIP: shared data absent"; exit 0; fi
-T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
 LOG="$FPLOC_SHARED_DIR/data/recordings/radish/intel-corrected.log.gz"
+if [ ! -f "$LOG" ]; then echo "SKIP: $LOG absent (shared data)"; exit 0; fi
+T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
 "$FPLOC_BUILD_DIR/bin/fploc-import-carmen" "$LOG" --auto-split --map "$T/map" --min-hits 1 --occupied-ratio 0.1 \
   --hit-clearance 0.1 --json > "$T/imp.json"
 F=$(python3 -c "import json,sys; j=json.load(open(sys.argv[1])); print(j['first_scan'], j['end_scan'])" "$T/imp.json")
