@@ -21,6 +21,12 @@ using detail::FieldFitOptions;
 struct StepSigma {
   double xy = 0, yaw = 0;
 };
+// Squared Mahalanobis distance of pose a from b, independent sigmas in x/y (sxy) and yaw (syaw).
+double mahalanobis2(const Pose2& a, const Pose2& b, double sxy, double syaw) {
+  const double ex = a.x - b.x, ey = a.y - b.y, eyaw = wrap_angle(a.yaw - b.yaw);
+  return (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw);
+}
+
 StepSigma wheel_step_sigma(const GridLocalizerConfig& c, const Pose2& inc, bool base) {
   const double step = std::hypot(inc.x, inc.y), turn = std::abs(wrap_angle(inc.yaw));
   return {(base ? c.sigma_xy_m : 0.0) + c.sigma_xy_per_m * step,
@@ -232,10 +238,7 @@ GridLocalizer::Impl::Fit GridLocalizer::Impl::fit(const std::vector<Eigen::Vecto
       if (costs[i] < costs[bi]) bi = i;
   } else {
     // The fit nearest the prediction, unless another is clearly better supported by the map.
-    auto m2 = [&](size_t i) {
-      const double ex = xs[i][0] - pred.x, ey = xs[i][1] - pred.y, eyaw = wrap_angle(xs[i][2] - pred.yaw);
-      return (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw);
-    };
+    auto m2 = [&](size_t i) { return mahalanobis2({xs[i][0], xs[i][1], xs[i][2]}, pred, sxy, syaw); };
     size_t near = 0, best = 0;
     for (size_t i = 1; i < xs.size(); ++i) {
       if (m2(i) < m2(near)) near = i;
@@ -263,9 +266,7 @@ GridLocalizer::Impl::Fit GridLocalizer::Impl::fit(const std::vector<Eigen::Vecto
   f.inliers = ninl[bi];
   f.inlier_ratio = inl[bi];
   f.rms = f.inliers > 0 ? std::sqrt(sss[bi] / f.inliers) : 0;
-  const double ex = f.est.x - pred.x, ey = f.est.y - pred.y, eyaw = wrap_angle(f.est.yaw - pred.yaw);
-  const double m2 = (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw);
-  const bool near = m2 <= cfg.gate_sigmas * cfg.gate_sigmas;
+  const bool near = mahalanobis2(f.est, pred, sxy, syaw) <= cfg.gate_sigmas * cfg.gate_sigmas;
   // The refinement may not leave the window searched (a scan of one flat wall fits anywhere along it).
   const bool inside = this->inside(f, pred);
   f.accepted = (inside && f.inlier_ratio >= min_inlier_ratio) || (near && f.inlier_ratio >= cfg.min_inlier_ratio_near);
@@ -426,16 +427,14 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
     // LOST at once (the map and the odometry agree; nothing to confirm); a weak one near it is followed (POOR).
     const Impl::Fit f = m.fit(pts, pred, sxy, syaw, cfg_.max_window_xy_m, cfg_.max_window_yaw_rad, 1, 1.1);
     {
-      const double ex = f.est.x - pred.x, ey = f.est.y - pred.y, eyaw = wrap_angle(f.est.yaw - pred.yaw);
-      const bool near = (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw) <= cfg_.gate_sigmas * cfg_.gate_sigmas;
+      const bool near = mahalanobis2(f.est, pred, sxy, syaw) <= cfg_.gate_sigmas * cfg_.gate_sigmas;
       // (Tried: leaving LOST only with confirm_inlier_ratio here too: intel 18.1 -> 185 cm, more weak fits
       // followed; freiburg-079 86 -> 91 cm.)
       const bool inside = m.inside(f, pred);
       const bool unrivalled = cfg_.rival_margin < 0 || m.rival(f) < f.inlier_ratio - cfg_.rival_margin;
       // Within gate_sigmas of this step's own odometry uncertainty (not the accumulated one).
       const double step_xy = std::max(qxy, cfg_.sigma_xy_m), step_yaw = std::max(qyaw, cfg_.sigma_yaw_rad);
-      const bool one_step = (ex * ex + ey * ey) / (step_xy * step_xy) + eyaw * eyaw / (step_yaw * step_yaw) <=
-                            cfg_.gate_sigmas * cfg_.gate_sigmas;
+      const bool one_step = mahalanobis2(f.est, pred, step_xy, step_yaw) <= cfg_.gate_sigmas * cfg_.gate_sigmas;
       // On laser steps: also the window the wheels' model would have searched, where only a scan the map
       // explains almost entirely (reacquire_strong_ratio), and unrivalled, may move the pose (the pose the last
       // fits left can be off by more than their covariance says: csail 400, 23 deg).
@@ -635,9 +634,7 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
   // as failed, POOR, towards LOST like any). Far in this step's own sigmas: a retry fit's were widened.
   if (f.accepted && res.laser_step && cfg_.laser_conflict_inlier_ratio > 0 &&
       f.inlier_ratio < cfg_.laser_conflict_inlier_ratio) {
-    const double ex = f.est.x - pred.x, ey = f.est.y - pred.y, eyaw = wrap_angle(f.est.yaw - pred.yaw);
-    const double m2 = (ex * ex + ey * ey) / (sxy * sxy) + eyaw * eyaw / (syaw * syaw);
-    if (m2 > cfg_.gate_sigmas * cfg_.gate_sigmas) f.accepted = false;
+    if (mahalanobis2(f.est, pred, sxy, syaw) > cfg_.gate_sigmas * cfg_.gate_sigmas) f.accepted = false;
   }
   if (f.accepted) {
     res.covariance = f.cov;
