@@ -93,9 +93,7 @@ int main(int argc, char** argv) {
     end = scans.end;
     const auto field = std::make_shared<l2::DistanceField>(fploc::read_occupancy_map(map_path), c.field_max_m);
     l2::GridLocalizer loc(field, c);
-    const auto& s0 = log.scans[first].pose;
-    fploc::Pose2 p0{s0.x, s0.y, s0.theta};
-    if (start == "off") p0 = {p0.x + std::cos(p0.yaw + M_PI / 4), p0.y + std::sin(p0.yaw + M_PI / 4), p0.yaw + 10 * M_PI / 180};
+    fploc::Pose2 p0 = fploc::bench_real::start_pose(log, first, start);
     if (start_pose.size() == 3) p0 = {start_pose[0], start_pose[1], start_pose[2]};
     loc.set_initial_pose(p0);
     const double rmax = scans.max_range_m;

@@ -44,6 +44,20 @@ for m in ("fploc", "amcl"):
     assert r[m]["nees_median_with_reference_noise"] < r[m]["nees_median"], r[m]
 PY
 test -s "$T/intel/ref.png"
+# The plan path in-process (fploc-real-plan-track: laser2d features -> one Localizer) over the same slice and map
+# scores what the graph's two processes scored (the same code; the window feeds the matcher in both).
+first=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['rows'][0]['map_scans'])" "$T/r.json")
+"$FPLOC_BUILD_DIR/bin/fploc-real-plan-track" "$FPLOC_SHARED_DIR/data/recordings/radish/intel-corrected.log.gz" \
+  --map "$T/intel/map/map.yaml" --first-scan "$first" --end-scan $((first + 91)) > "$T/plan.json"
+python3 - "$T/plan.json" "$T/r.json" <<'PY'
+import json, math, sys
+s = json.load(open(sys.argv[1]))["scans"]
+g = json.load(open(sys.argv[2]))["rows"][0]["fploc_plan"]["all"]["ate_m"]
+assert len(s) == 91, len(s)
+ate = math.sqrt(sum(r["err_m"] ** 2 for r in s) / len(s))
+print("plan path in-process ATE", ate, "graph", g)
+assert abs(ate - g) <= 0.2 * g + 0.01, (ate, g)
+PY
 test -s "$T/intel/ref-fploc.png"
 # The split rule on a whole log: the JSON states the rule, the split and the covered share it reached.
 "$FPLOC_BUILD_DIR/bin/fploc-import-carmen" "$FPLOC_SHARED_DIR/data/recordings/radish/aces-corrected.log.gz" --auto-split \

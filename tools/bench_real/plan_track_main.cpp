@@ -1,0 +1,117 @@
+// fploc-real-plan-track LOG[.gz] --map MAP.yaml --first-scan S [--end-scan E] [--start ref|off] : the lidar2d
+// graph's plan path (fploc-laser2d's features -> the Localizer: matcher + window optimizer, with the wheel
+// odometry's increments as the prediction) run in-process over scans [S, E) of a CARMEN log against the
+// vectorised occupancy map, without LCM: per scan the window's estimate, the reference, the published status and
+// the single-frame fit, as JSON. `fploc bench real` scores the same path through `fploc replay` of the graph
+// (its `fploc_plan` rows); this one is for looking at a log scan by scan and for trying options.
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "fploc/carmen/carmen.h"
+#include "fploc/config/localization.h"
+#include "fploc/config/plan_source.h"
+#include "fploc/laser2d/distance_field.h"
+#include "fploc/laser2d/laser2d.h"
+#include "fploc/localizer/localizer.h"
+#include "log_scans.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"fploc real-plan-track: the lidar2d graph's plan path over a CARMEN log's scans, in-process"};
+  std::string log_path, map_path, start = "ref";
+  size_t first = 0, end = 0;
+  fploc::MatcherOptions mo;
+  mo.set_lookup("annf-exact");
+  mo.set_max_correspondence_m(0.5);  // as graphs/lidar2d.pbtxt
+  double gate = 0;
+  app.add_option("log", log_path, "CARMEN log (.log or .log.gz)")->required();
+  app.add_option("--map", map_path, "map_server occupancy map (.yaml) or any plan")->required();
+  app.add_option("--first-scan", first, "first scan index")->required();
+  app.add_option("--end-scan", end, "end scan index (exclusive; 0 = the log's end)");
+  app.add_option("--start", start, "ref: the reference pose of the first scan; off: 1 m / 10 deg off (as the bench)")
+      ->check(CLI::IsMember({"ref", "off"}));
+  app.add_option("--gate", gate, "matcher.max_correspondence_m (default: the lidar2d graph's 0.5)");
+  bool no_group_rule = false, at_ref = false;
+  app.add_flag("--at-reference", at_ref, "also register each frame alone from its reference pose (diagnostics)");
+  app.add_flag("--no-group-rule", no_group_rule, "PCA line groups match independently (both steps)");
+  CLI11_PARSE(app, argc, argv);
+  if (gate > 0) mo.set_max_correspondence_m(gate);
+  fploc::OptimizerOptions oo;
+  mo.set_disable_group_rule(no_group_rule);
+  oo.set_disable_group_rule(no_group_rule);
+  namespace cm = fploc::carmen;
+  try {
+    const fploc::bench_real::LogScans scans = fploc::bench_real::load_log_scans(log_path, first, end, 1000.0);
+    const cm::Log& log = scans.log;
+    end = scans.end;
+    const std::vector<double> times = cm::scan_times(log);
+    fploc::PlanSource ps;
+    ps.set_file(map_path);
+    const fploc::matcher::LocalizationMap map =
+        fploc::config::load_map(ps, mo.lookup(), [](const std::string& p) { return p; }, "--map");
+    fploc::localizer::Config cfg = fploc::config::localizer_config(mo);
+    cfg.optimizer = fploc::config::localizer_config(oo).optimizer;
+    fploc::localizer::Localizer loc(*map.lookup, cfg);
+    // --at-reference on an occupancy map: the same share on its raster (the grid localizer's view of it).
+    const bool raster = at_ref && map_path.size() > 5 && map_path.substr(map_path.size() - 5) == ".yaml";
+    const fploc::laser2d::DistanceField df =
+        raster ? fploc::laser2d::DistanceField(fploc::read_occupancy_map(map_path), 1.0) : fploc::laser2d::DistanceField();
+    fploc::laser2d::Laser2dFeatures l2{fploc::laser2d::Laser2dConfig{}};
+    fploc::Pose2 p0 = fploc::bench_real::start_pose(log, first, start);
+    loc.set_pose(p0);
+    nlohmann::json rows = nlohmann::json::array();
+    std::vector<fploc::localizer::Pose> finals;
+    for (size_t k = first; k < end; ++k) {
+      const auto& s = log.scans[k];
+      fploc::laser2d::PlanarScan ps2;
+      ps2.utime = int64_t(std::llround((times[k] - times[0]) * 1e6)) + 1000000;
+      ps2.seq = int64_t(k);
+      ps2.angle_min = float(-M_PI / 2);
+      ps2.angle_increment = float(cm::beam_increment(s.ranges.size()));
+      ps2.range_max = float(std::min(scans.max_range_m, 1000.0));
+      ps2.ranges = s.ranges;
+      if (s.have_wheel_odom) loc.add_odometry(ps2.utime, {s.wheel_odom.x, s.wheel_odom.y, s.wheel_odom.theta});
+      const fploc::FeatureFrame& f = l2.process(ps2);
+      const auto step = loc.process(f, &finals);
+      const auto& m = step.sfr.match;
+      const fploc::Pose2 est = step.latest ? step.latest->pose : m.pose;
+      nlohmann::json row = {{"scan", k}, {"x", est.x}, {"y", est.y}, {"yaw", est.yaw}, {"ref_x", s.pose.x},
+                            {"ref_y", s.pose.y}, {"ref_yaw", s.pose.theta},
+                            {"err_m", std::hypot(est.x - s.pose.x, est.y - s.pose.y)},
+                            {"err_yaw_deg", fploc::wrap_angle(est.yaw - s.pose.theta) * 180 / M_PI},
+                            {"sfr_err_m", std::hypot(m.pose.x - s.pose.x, m.pose.y - s.pose.y)},
+                            {"sfr_status", fploc::matcher::to_string(m.status)}, {"sfr_text", m.text},
+                            {"points", m.fit.num_points}, {"inlier_ratio", m.fit.inlier_ratio}, {"rms_m", m.fit.rms_m},
+                            {"status", int(loc.uncertainty().status)}, {"why", loc.uncertainty().text}};
+      if (at_ref) {
+        // The frame registered alone from its reference pose: how well the plan explains it there.
+        const auto rf = fploc::matcher::register_frame(*map.lookup, f, {s.pose.x, s.pose.y, s.pose.theta}, loc.config().matcher);
+        row["ref_fit_inlier_ratio"] = rf.fit.inlier_ratio;
+        row["ref_fit_err_m"] = std::hypot(rf.pose.x - s.pose.x, rf.pose.y - s.pose.y);
+        row["ref_fit_status"] = fploc::matcher::to_string(rf.status);
+        // The points at the reference pose itself: share within the inlier distance of their nearest element.
+        int near = 0, n = 0, near_df = 0;
+        const double c = std::cos(s.pose.theta), sn = std::sin(s.pose.theta);
+        for (const auto& q : f.points) {
+          const Eigen::Vector2d w(s.pose.x + c * q.p.x() - sn * q.p.y(), s.pose.y + sn * q.p.x() + c * q.p.y());
+          int ids[8];
+          const int k = map.lookup->candidates(w, ids, 8);
+          double best = 1e9;
+          for (int i = 0; i < k; ++i) best = std::min(best, fploc::distance(map.lookup->targets()[size_t(ids[i])], w));
+          near += best <= loc.config().matcher.inlier_m;
+          if (raster) near_df += df.nearest(w) <= loc.config().matcher.inlier_m;
+          ++n;
+        }
+        row["ref_inliers_at_ref"] = n ? double(near) / n : 0.0;
+        if (raster) row["ref_inliers_at_ref_grid"] = n ? double(near_df) / n : 0.0;
+      }
+      rows.push_back(row);
+    }
+    std::cout << nlohmann::json{{"log", log_path}, {"map", map_path}, {"start", start}, {"scans", rows}}.dump() << "\n";
+  } catch (const std::exception& ex) {
+    std::cerr << "fploc real-plan-track: " << ex.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
