@@ -56,4 +56,10 @@ Pose2 pose2_of(const pose_t& m) {
   return {m.position[0], m.position[1], sp.rpy()[2]};
 }
 
+std::optional<Pose2> finite_pose2_of(const pose_t& m) {
+  const Pose2 p = pose2_of(m);
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.yaw)) return std::nullopt;
+  return p;
+}
+
 }  // namespace fploc::adapters

@@ -103,7 +103,8 @@ TEST(ConfigDefaults, Matcher) {
          {"min_inliers", c.min_inliers}, {"lost_after", c.lost_after}, {"max_jump_m", c.max_jump_m},
          {"max_jump_deg", c.max_jump_rad * kDeg}, {"stride", c.stride}, {"max_points", c.max_points},
          {"prediction_sigma_m", c.prediction_sigma_m}, {"prediction_sigma_deg", c.prediction_sigma_rad * kDeg},
-         {"as_built_sigma_m", c.as_built.sigma_m}, {"as_built_point_sigma_m", c.as_built.point_sigma_m},
+         {"odom_gate_sigmas", c.odom_gate_sigmas}, {"as_built_sigma_m", c.as_built.sigma_m},
+         {"as_built_point_sigma_m", c.as_built.point_sigma_m},
          {"as_built_loss_scale_m", c.as_built.loss_scale_m}});
 }
 
@@ -242,4 +243,14 @@ TEST(ConfigMapping, UnknownLossNamesTheOption) {
   EXPECT_EQ(fploc::config::config_of(o).loss, "geman-mcclure");
   o.set_loss("L2");
   EXPECT_THROW((void)fploc::config::config_of(o), std::runtime_error);
+}
+
+// The matcher's odometry window: a negative option turns it off (max_jump_* only), zero keeps the default.
+TEST(ConfigMapping, MatcherOdometryWindowOff) {
+  fploc::MatcherOptions m;
+  EXPECT_EQ(fploc::config::config_of(m).odom_gate_sigmas, fploc::matcher::MatcherConfig{}.odom_gate_sigmas);
+  m.set_odom_gate_sigmas(-1);
+  EXPECT_EQ(fploc::config::config_of(m).odom_gate_sigmas, 0.0);
+  m.set_odom_gate_sigmas(4);
+  EXPECT_EQ(fploc::config::config_of(m).odom_gate_sigmas, 4.0);
 }

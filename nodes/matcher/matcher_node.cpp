@@ -102,12 +102,8 @@ class MatcherNode : public fploc::rt::Node {
       loc_->set_pose(p, std::isfinite(var) && var > 0 ? std::optional<double>(3 * std::sqrt(var)) : std::nullopt);
     });
     ctx.subscribe<fploc::pose_t>("odom", [this](const fploc::pose_t& m) {
-      const fploc::Pose2 p = fploc::adapters::pose2_of(m);
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.yaw)) {
-        ctx_->error("odom seq " + std::to_string(m.seq) + ": non-finite pose (ignored)");
-        return;
-      }
-      loc_->add_odometry(m.utime, p);
+      if (const auto p = fploc::adapters::finite_pose2_of(m)) loc_->add_odometry(m.utime, *p);
+      else ctx_->error("odom seq " + std::to_string(m.seq) + ": non-finite pose (ignored)");
     });
     ctx.subscribe<fploc::plan_diff_t>("plan_diff", [this](const fploc::plan_diff_t& m) { on_plan_diff(m); });
     ctx.subscribe<fploc::pose_t>("refined", [this](const fploc::pose_t& m) {

@@ -39,6 +39,9 @@ class OptimizerNode : public fploc::rt::Node {
              fploc::rt::input<fploc::frame_pose_t>("frame_pose", "FPLOC_FRAME_POSE"),
              // Optional: the plan-change detector's verdicts (FPLOC_PLAN_DIFF), as the matcher's.
              fploc::rt::input<fploc::plan_diff_t>("plan_diff", ""),
+             // Optional wheel odometry, as the matcher's `odom`: its increments predict the published
+             // uncertainty's track (the innovation gate) between frames.
+             fploc::rt::input<fploc::pose_t>("odom", ""),
              fploc::rt::output<fploc::pose_t>("pose", "FPLOC_POSE"),
              fploc::rt::output<fploc::pose_t>("latest", "FPLOC_POSE_LATEST")}};
   }
@@ -66,6 +69,10 @@ class OptimizerNode : public fploc::rt::Node {
       try_pair(m.scan_seq);
     });
     ctx.subscribe<fploc::plan_diff_t>("plan_diff", [this](const fploc::plan_diff_t& m) { on_plan_diff(m); });
+    ctx.subscribe<fploc::pose_t>("odom", [this](const fploc::pose_t& m) {
+      if (const auto p = fploc::adapters::finite_pose2_of(m)) loc_->add_odometry(m.utime, *p);
+      else ctx_->error("odom seq " + std::to_string(m.seq) + ": non-finite pose (ignored)");
+    });
     ctx.subscribe<fploc::frame_pose_t>("frame_pose", [this](const fploc::frame_pose_t& m) {
       frame_poses_[m.scan_seq] = m;
       trim(frame_poses_);

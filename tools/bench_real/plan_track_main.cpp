@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   fploc::MatcherOptions mo;
   mo.set_lookup("annf-exact");
   mo.set_max_correspondence_m(0.5);  // as graphs/lidar2d.pbtxt
+  double initial_search = 0;
   double gate = 0;
   app.add_option("log", log_path, "CARMEN log (.log or .log.gz)")->required();
   app.add_option("--map", map_path, "map_server occupancy map (.yaml) or any plan")->required();
@@ -32,11 +33,13 @@ int main(int argc, char** argv) {
   app.add_option("--start", start, "ref: the reference pose of the first scan; off: 1 m / 10 deg off (as the bench)")
       ->check(CLI::IsMember({"ref", "off"}));
   app.add_option("--gate", gate, "matcher.max_correspondence_m (default: the lidar2d graph's 0.5)");
+  app.add_option("--initial-search", initial_search, "matcher.initial_search_m: the start's uncertainty [m]");
   bool no_group_rule = false, at_ref = false;
   app.add_flag("--at-reference", at_ref, "also register each frame alone from its reference pose (diagnostics)");
   app.add_flag("--no-group-rule", no_group_rule, "PCA line groups match independently (both steps)");
   CLI11_PARSE(app, argc, argv);
   if (gate > 0) mo.set_max_correspondence_m(gate);
+  if (initial_search > 0) mo.set_initial_search_m(initial_search);
   fploc::OptimizerOptions oo;
   mo.set_disable_group_rule(no_group_rule);
   oo.set_disable_group_rule(no_group_rule);

@@ -87,7 +87,8 @@ void UncertaintyTracker::reset(double sigma_m, double sigma_rad) {
 
 UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d& frame_cov_in, bool frame_valid,
                                             matcher::FitStatus matcher_status, const std::string& matcher_text,
-                                            const Pose2* fix, const matcher::Twist2* twist, double inlier_ratio) {
+                                            const Pose2* fix, const matcher::Twist2* twist, double inlier_ratio,
+                                            const Pose2* motion) {
   const double vmax = cfg_.frame.max_variance;
   const double v2 = cfg_.max_velocity_error_mps * cfg_.max_velocity_error_mps;
   const double w2 = cfg_.yaw_rate_sigma_rps * cfg_.yaw_rate_sigma_rps;
@@ -96,10 +97,11 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
   const double dt = (utime - last_utime_) * 1e-6;
   const Eigen::Matrix3d unknown_velocity = Eigen::Vector3d(v2, v2, w2).asDiagonal();
   Eigen::Matrix3d P_pred, W_pred;
+  const Eigen::Matrix3d P_before = P_;
   if (matcher_status == matcher::FitStatus::kLost) {
     P_pred = Eigen::Matrix3d::Identity() * vmax;
     W_pred = unknown_velocity;
-  } else if (!have_ || !(dt >= 0) || dt > cfg_.max_gap_s) {
+  } else if (!have_ || !(dt >= 0) || (dt > cfg_.max_gap_s && !motion)) {
     // Start (from reset()'s initial uncertainty, if any) or restart after a gap: the frame alone.
     P_pred = have_initial_ && !have_ ? P_ : Eigen::Matrix3d::Identity() * vmax;
     W_pred = have_initial_ && !have_ ? W_ : unknown_velocity;
@@ -113,13 +115,23 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
     W_pred.block<2, 1>(0, 2).setZero();
     W_pred.block<1, 2>(2, 0).setZero();
     W_pred(2, 2) = std::min(W_pred(2, 2), w2);
-    P_pred = clamp_spd(add_sigmas(P_, W_pred * dt * dt), 1e-14, vmax);
+    if (motion) {
+      // The odometry carries the pose over the step: its own error, not the velocity model's.
+      const double step = std::hypot(motion->x, motion->y), turn = std::abs(wrap_angle(motion->yaw));
+      const double sxy = cfg_.odom_sigma_m + cfg_.odom_sigma_per_m * step;
+      const double syaw = cfg_.odom_sigma_rad + cfg_.odom_sigma_per_rad * turn + cfg_.odom_sigma_rad_per_m * step;
+      P_pred = clamp_spd(grow_linear(P_, Eigen::Vector3d(sxy, sxy, syaw)), 1e-14, vmax);
+    } else {
+      P_pred = clamp_spd(add_sigmas(P_, W_pred * dt * dt), 1e-14, vmax);
+    }
   }
   // The tracked prediction: the last fix (or, after a refused one, the last prediction) carried on with
-  // the matcher's body twist (its constant velocity and the IMU's yaw rate), as the matcher predicts.
-  const bool continuing = have_ && have_mean_ && dt >= 0 && dt <= cfg_.max_gap_s && matcher_status != matcher::FitStatus::kLost;
+  // the matcher's body twist (its constant velocity and the IMU's yaw rate), or with the odometry's increment,
+  // as the matcher predicts.
+  const bool continuing = have_ && have_mean_ && dt >= 0 && (dt <= cfg_.max_gap_s || motion) &&
+                          matcher_status != matcher::FitStatus::kLost;
   Pose2 mean_pred = mean_;
-  if (continuing) mean_pred = compose(mean_, matcher::exp_twist(twist_, dt));
+  if (continuing) mean_pred = motion ? compose(mean_, *motion) : compose(mean_, matcher::exp_twist(twist_, dt));
   mean_pred.yaw = wrap_angle(mean_pred.yaw);
   double innovation_sigma = 0;
   bool refused = false;
@@ -170,7 +182,10 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
   s.refused = refused;
   // Re-acquisition (confirm_fixes): a fix accepted where the track was unknown arms it; then accepted fixes in a
   // row are counted.
-  if (frame_ok && !confirming_ && cfg_.confirm_fixes > 0 && strongest_horizontal(P_pred) > cfg_.reacquire_sigma_m) {
+  // With odometry, what the frames before left (P_ before this step): one odometry step of a metre is itself
+  // decimetres uncertain without the position being unknown.
+  const double before = strongest_horizontal(motion && continuing ? P_before : P_pred);
+  if (frame_ok && !confirming_ && cfg_.confirm_fixes > 0 && before > cfg_.reacquire_sigma_m) {
     confirming_ = true;
     agreeing_ = 0;
   }

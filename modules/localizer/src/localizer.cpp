@@ -11,6 +11,12 @@ Config with_uncertainty_defaults(Config c) {
   c.uncertainty.frame.loss_scale_m = c.matcher.loss_scale_m;
   c.uncertainty.frame.gate_m = c.matcher.min_correspondence_m;
   c.uncertainty.frame.group_rule = c.matcher.group_rule;
+  // The odometry's error model is the matcher's (its window and the tracker's prediction agree).
+  c.uncertainty.odom_sigma_m = c.matcher.odom_sigma_m;
+  c.uncertainty.odom_sigma_per_m = c.matcher.odom_sigma_per_m;
+  c.uncertainty.odom_sigma_rad = c.matcher.odom_sigma_rad;
+  c.uncertainty.odom_sigma_per_rad = c.matcher.odom_sigma_per_rad;
+  c.uncertainty.odom_sigma_rad_per_m = c.matcher.odom_sigma_rad_per_m;
   // The as-built model's loss on element offsets bounds what a wall far off pulls (the optimizer node's
   // config carries it in the optimizer's, the matcher node's in the matcher's).
   if (c.uncertainty.frame.element_loss_scale_m == 0) {
@@ -65,11 +71,7 @@ FramePose Localizer::register_frame(const FeatureFrame& f) {
       if (auto w = imu_.mean_rate(f.utime, f.utime + std::llround(sweep * 1e6))) held_.sweep_yaw_rate = *w;
     imu_.drop_before(std::min(f.utime, have_prev_ ? prev_utime_ : f.utime));
   }
-  std::optional<Pose2> motion;
-  if (have_prev_ && !odom_.empty()) {
-    auto a = odom_.find(prev_utime_), b = odom_.find(f.utime);
-    if (a != odom_.end() && b != odom_.end()) motion = between(a->second, b->second);
-  }
+  const std::optional<Pose2> motion = have_prev_ ? odometry_between(prev_utime_, f.utime) : std::nullopt;
   FramePose out;
   out.utime = f.utime;
   out.scan_seq = f.scan_seq;
@@ -86,8 +88,19 @@ FramePose Localizer::register_frame(const FeatureFrame& f) {
   return out;
 }
 
+std::optional<Pose2> Localizer::odometry_between(int64_t from_utime, int64_t to_utime) const {
+  const auto a = odom_.find(from_utime), b = odom_.find(to_utime);
+  if (a == odom_.end() || b == odom_.end()) return std::nullopt;
+  return between(a->second, b->second);
+}
+
 std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& sfr, std::vector<Pose>* finals) {
   if (sfr.match.status == matcher::FitStatus::kNotInitialised) return std::nullopt;
+  // The odometry's increment since the previous optimized frame predicts this one in the tracker, as in the
+  // matcher (in the optimizer node the odometry arrives on its own `odom` input).
+  const std::optional<Pose2> motion = have_prev_optimized_ ? odometry_between(prev_optimized_utime_, f.utime) : std::nullopt;
+  prev_optimized_utime_ = f.utime;
+  have_prev_optimized_ = true;
   optimizer::FrameInput in;
   in.features = f;
   in.sfr = sfr.match.pose;
@@ -104,7 +117,7 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
     const Pose2 at_ref = compose(sfr.match.pose, matcher::exp_twist(sfr.match.twist, t_ref));
     const auto fu = optimizer::frame_uncertainty(lookup_, deskewed_, at_ref, cfg_.uncertainty.frame);
     uncertainty_ = tracker_.update(f.utime, fu.covariance, fu.valid, sfr.match.status, sfr.match.text, &sfr.match.pose,
-                                   &sfr.match.twist, sfr.match.fit.inlier_ratio);
+                                   &sfr.match.twist, sfr.match.fit.inlier_ratio, motion ? &*motion : nullptr);
     in.covariance = uncertainty_.covariance;
     in.published_status = uncertainty_.status;
     in.status_text = uncertainty_.text;

@@ -266,3 +266,42 @@ TEST(Degeneracy, WeakFitIsPublishedPoor) {
     t += 100000;
   }
 }
+
+// With odometry (2D laser logs: frames a metre and tens of degrees apart, seconds between them), the tracked
+// prediction is the last fix composed with the odometry's increment: fixes that follow a 1 m / 30 degree step
+// 2 s apart are taken (OK, not a re-acquisition after the first confirmation), where the twist's constant
+// velocity would refuse every one of them; a fix 2 m beside where the odometry says (its 1-sigma over the step
+// is 0.35 m) is still refused.
+TEST(Degeneracy, OdometryPredictsTheTrackBetweenDistantFrames) {
+  const Eigen::Matrix3d fixed = diag(0.0004, 0.0004, 0.0001);  // 2 cm, 0.6 deg
+  const Pose2 step{1.0, 0.0, 30 * M_PI / 180};
+  for (bool with_odometry : {true, false}) {  // (the control: the same fixes without it)
+    UncertaintyTracker tr;
+    tr.reset(0.05, 0.02);
+    matcher::Twist2 still;
+    Pose2 p{1.0, 2.0, 0.0};
+    int refused = 0, ok = 0;
+    for (int k = 0; k < 12; ++k) {
+      const auto s = tr.update(int64_t(k) * 2'000'000, fixed, true, FitStatus::kOk, {}, &p, &still, 1.0,
+                               with_odometry && k > 0 ? &step : nullptr);
+      refused += s.refused;
+      ok += s.status == FitStatus::kOk;
+      p = compose(p, step);
+    }
+    if (with_odometry) {
+      EXPECT_EQ(refused, 0);
+      EXPECT_EQ(ok, 12);
+    } else {
+      EXPECT_GE(refused, 10);
+    }
+  }
+  UncertaintyTracker tr;
+  tr.reset(0.05, 0.02);
+  Pose2 p{1.0, 2.0, 0.0};
+  tr.update(0, fixed, true, FitStatus::kOk, {}, &p, nullptr, 1.0, nullptr);
+  Pose2 beside = compose(p, step);
+  beside.y += 2.0;
+  const auto s = tr.update(2'000'000, fixed, true, FitStatus::kOk, {}, &beside, nullptr, 1.0, &step);
+  EXPECT_TRUE(s.refused) << s.text;
+  EXPECT_EQ(s.status, FitStatus::kPoor);
+}

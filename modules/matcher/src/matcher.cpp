@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "fploc/matcher/plan_terms.h"
 
@@ -101,6 +102,60 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
 
 Matcher::Matcher(const NearestLookup& lookup, MatcherConfig cfg) : lookup_(lookup), cfg_(std::move(cfg)) {}
 
+MatchResult Matcher::search_grid(const FeatureFrame& in, const Pose2& centre, double s_in, double a_in,
+                                 const MatcherConfig& cfg, const Eigen::Vector2d* window) const {
+  // One registration converges from about half a metre / a few degrees: starts 2/3 of the half-width apart.
+  const double s = s_in * 2 / 3, a = a_in * 2 / 3;
+  MatcherConfig c = cfg;
+  c.max_correspondence_m = std::max(s, cfg_.min_correspondence_m);
+  std::vector<MatchResult> fits;
+  fits.reserve(27);
+  int iterations = 0;
+  for (double dyaw : {0.0, -a, a})
+    for (double dx : {0.0, -s, s})
+      for (double dy : {0.0, -s, s}) {
+        MatchResult ri = register_frame(lookup_, in, Pose2{centre.x + dx, centre.y + dy, wrap_angle(centre.yaw + dyaw)}, c);
+        iterations += ri.iterations;
+        if (window && ri.status == FitStatus::kOk &&
+            (std::hypot(ri.solved.x - centre.x, ri.solved.y - centre.y) > (*window)[0] ||
+             std::abs(wrap_angle(ri.solved.yaw - centre.yaw)) > (*window)[1]))
+          continue;  // converged out of the window: not a candidate
+        fits.push_back(std::move(ri));
+      }
+  MatchResult r;
+  if (fits.empty()) {  // every start converged out of the window
+    r = register_frame(lookup_, in, centre, cfg);
+    r.status = FitStatus::kPoor;
+    r.text = "no fit within the odometry's window";
+    r.iterations = iterations;
+    return r;
+  }
+  // The fit with the most inliers (then the lower rms), OK ones first. Within an odometry window each fit's
+  // inliers are weighted by a prior on its offset from the prediction (the half-widths being 3 sigma):
+  // exp(-m^2 / 2 kappa^2) of the Mahalanobis offset m, kappa 1.5, as the grid localizer's correlative search
+  // weighs its scores, so that of two places the scan fits about as well the one the odometry supports wins
+  // (an office's twin rooms, a room the map covers in part).
+  const double sm = std::max(s_in / 3, 1e-3), sa = std::max(a_in / 3, 1e-4);
+  auto score = [&](const MatchResult& m) {
+    if (!window) return double(m.fit.num_inliers);
+    const double dx = (m.solved.x - centre.x) / sm, dy = (m.solved.y - centre.y) / sm;
+    const double da = wrap_angle(m.solved.yaw - centre.yaw) / sa;
+    return double(m.fit.num_inliers) * std::exp(-(dx * dx + dy * dy + da * da) / (2 * cfg_.search_prior_kappa * cfg_.search_prior_kappa));
+  };
+  auto better = [&](const MatchResult& x, const MatchResult& y) {
+    if ((x.status == FitStatus::kOk) != (y.status == FitStatus::kOk)) return x.status == FitStatus::kOk;
+    const double sx = score(x), sy = score(y);
+    if (sx != sy) return sx > sy;
+    return x.fit.rms_m < y.fit.rms_m;
+  };
+  size_t best = 0;
+  for (size_t i = 1; i < fits.size(); ++i)
+    if (better(fits[i], fits[best])) best = i;
+  r = std::move(fits[best]);
+  r.iterations = iterations;
+  return r;
+}
+
 void Matcher::set_pose(const Pose2& p, std::optional<double> search_m, std::optional<double> search_yaw) {
   pose_ = p;
   search_m_ = search_m && *search_m > 0 ? *search_m : cfg_.max_correspondence_m;
@@ -110,6 +165,7 @@ void Matcher::set_pose(const Pose2& p, std::optional<double> search_m, std::opti
   have_velocity_ = false;
   twist_ = {};
   poor_count_ = 0;
+  dead_reckoned_m_ = dead_reckoned_rad_ = 0;
   refine_armed_ = false;
 }
 
@@ -176,26 +232,27 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
   if (comp) deskew(f, tw, t_ref, &deskewed_);
   const FeatureFrame& in = comp ? deskewed_ : f;
   MatchResult r;
+  // Odometry mode: the window the fit must lie in (the step's sigma, plus what POOR frames accumulated).
+  const bool odom_window = motion && have_last_ && cfg_.odom_gate_sigmas > 0;
+  double win_m = 0, win_rad = 0;
+  if (odom_window) {
+    const double step = std::hypot(motion->x, motion->y), turn = std::abs(wrap_angle(motion->yaw));
+    const double sm = cfg_.odom_sigma_m + cfg_.odom_sigma_per_m * step;
+    const double sa = cfg_.odom_sigma_rad + cfg_.odom_sigma_per_rad * turn + cfg_.odom_sigma_rad_per_m * step;
+    win_m = std::min(cfg_.odom_gate_sigmas * (dead_reckoned_m_ + sm), cfg_.odom_max_search_m);
+    win_rad = std::min(cfg_.odom_gate_sigmas * (dead_reckoned_rad_ + sa), cfg_.odom_max_search_rad);
+    if (tracking) dead_reckoned_m_ = dead_reckoned_rad_ = 0;
+    dead_reckoned_m_ += sm;
+    dead_reckoned_rad_ += sa;
+  }
+  const Eigen::Vector2d window(win_m, win_rad);
   if (!have_last_ && search_m_ > 2 * cfg_.gate_tracking_m) {
     // First frame from a pose known only to within search_m / search_yaw: one registration converges
-    // from about half a metre / a few degrees, so start from a grid over the uncertainty (spacing 2/3 of
-    // it, the given pose first) and keep the fit with the most inliers (then the lower rms).
-    const double s = search_m_ * 2 / 3, a = search_yaw_ * 2 / 3;
-    MatcherConfig c = cfg;
-    c.max_correspondence_m = std::max(s, cfg_.min_correspondence_m);
-    bool have = false;
-    for (double dyaw : {0.0, -a, a})
-      for (double dx : {0.0, -s, s})
-        for (double dy : {0.0, -s, s}) {
-          MatchResult ri = register_frame(lookup_, in, Pose2{pred.x + dx, pred.y + dy, wrap_angle(pred.yaw + dyaw)}, c);
-          const int it = r.iterations + ri.iterations;
-          const bool better = !have || (ri.status == FitStatus::kOk && r.status != FitStatus::kOk) ||
-                              (ri.status == r.status && (ri.fit.num_inliers > r.fit.num_inliers ||
-                                                         (ri.fit.num_inliers == r.fit.num_inliers && ri.fit.rms_m < r.fit.rms_m)));
-          if (better) r = ri;
-          r.iterations = it;
-          have = true;
-        }
+    // from about half a metre / a few degrees, so start from a grid over the uncertainty.
+    r = search_grid(in, pred, search_m_, search_yaw_, cfg);
+  } else if (odom_window && !tracking && win_m > 2 * cfg_.gate_tracking_m) {
+    // Dead reckoning with the odometry for a while: the prediction is known only to within the window.
+    r = search_grid(in, pred, win_m, win_rad, cfg, &window);
   } else {
     PosePrior prior;
     const double dt = (tau - tau_) * 1e-6;
@@ -221,7 +278,22 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
   const Pose2 solved_ref = r.solved;
   const double jump = std::hypot(solved_ref.x - pred.x, solved_ref.y - pred.y);
   const double jump_yaw = std::abs(wrap_angle(solved_ref.yaw - pred.yaw));
-  if (r.status == FitStatus::kOk && have_last_ && !lost && (jump > cfg_.max_jump_m || jump_yaw > cfg_.max_jump_rad)) {
+  if (odom_window) {
+    if (r.status == FitStatus::kOk && (jump > win_m || jump_yaw > win_rad)) {
+      char b[160];
+      std::snprintf(b, sizeof b, "outside the odometry's window: %.2f m / %.1f deg from the prediction (window %.2f m / %.1f deg)",
+                    jump, jump_yaw * 180 / M_PI, win_m, win_rad * 180 / M_PI);
+      r.status = FitStatus::kPoor;
+      r.text = b;
+    } else if (r.status == FitStatus::kOk && r.fit.inlier_ratio < cfg_.odom_far_inlier_ratio &&
+               std::hypot(jump / (win_m / 3), jump_yaw / (win_rad / 3)) > 2) {
+      char b[160];
+      std::snprintf(b, sizeof b, "%.0f %% inliers %.2f m / %.1f deg from the prediction (beyond 2 sigma: %.0f %% needed)",
+                    100 * r.fit.inlier_ratio, jump, jump_yaw * 180 / M_PI, 100 * cfg_.odom_far_inlier_ratio);
+      r.status = FitStatus::kPoor;
+      r.text = b;
+    }
+  } else if (r.status == FitStatus::kOk && have_last_ && !lost && (jump > cfg_.max_jump_m || jump_yaw > cfg_.max_jump_rad)) {
     r.status = FitStatus::kPoor;
     r.text = "refused jump of " + std::to_string(jump) + " m";
   }
@@ -233,6 +305,7 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
     }
     pose_ = solved_ref;
     poor_count_ = 0;
+    dead_reckoned_m_ = dead_reckoned_rad_ = 0;
     last_rms_ = r.fit.rms_m;
   } else {
     ++poor_count_;

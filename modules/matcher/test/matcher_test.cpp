@@ -467,3 +467,56 @@ TEST(Matcher, RefinedPosesHoldWhatTheFloorPlanLeavesOpen) {
   EXPECT_TRUE(m.refine(0, {0.1, 1, 0.01}));
   EXPECT_TRUE(m.refine(0, {0.6, 1, 0.01})) << "once one agreed, the optimizer's estimate is taken as it is";
 }
+
+// With odometry (2D laser logs), a fit must lie within the odometry's window around the prediction: one that
+// converged 0.8 m away after a 0.1 m step is refused (POOR, the pose stays the prediction); without the window
+// only max_jump_m (1.5 m) applies and the same fit is taken.
+TEST(Matcher, OdometryWindowRefusesAFitTheOdometryDoesNotSupport) {
+  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  SynthOptions so;
+  const Pose2 start{6, 4, 0.2};
+  const Pose2 step{0.1, 0, 0};                        // what the odometry says
+  const Pose2 seen = compose(start, Pose2{0.9, 0, 0});  // where the scan was taken (the fit converges there)
+  for (double sigmas : {3.0, 0.0}) {
+    MatcherConfig cfg;
+    cfg.odom_gate_sigmas = sigmas;
+    Matcher m(*map.lookup, cfg);
+    m.set_pose(start, 0.3);
+    ASSERT_EQ(m.process(synth_frame(*map.plan, start, so, 1'000'000)).status, FitStatus::kOk);
+    const MatchResult r = m.process(synth_frame(*map.plan, seen, so, 2'000'000), std::nullopt, step);
+    EXPECT_LT(pos_err(r.solved, seen), 0.01) << "the registration itself converged to the scan's pose";
+    if (sigmas > 0) {
+      EXPECT_EQ(r.status, FitStatus::kPoor) << r.text;
+      EXPECT_NE(r.text.find("odometry's window"), std::string::npos) << r.text;
+      EXPECT_LT(pos_err(r.pose, compose(start, step)), 1e-6) << "a refused fit must not move the pose";
+    } else {
+      EXPECT_EQ(r.status, FitStatus::kOk) << r.text;
+    }
+  }
+}
+
+// After POOR frames the window grows with the odometry's accumulated uncertainty, and once it exceeds twice the
+// tracking gate the frame is registered from a grid of starts over it: an odometry step 20 degrees wrong (a
+// single registration from the prediction, gate 0.5 m, does not reach that) is re-acquired at the next frame,
+// and no frame is called OK anywhere else on the way.
+TEST(Matcher, OdometryWindowReacquiresAfterABadOdometryStep) {
+  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  SynthOptions so;
+  MatcherConfig cfg;
+  cfg.max_correspondence_m = 0.5;  // as graphs/lidar2d.pbtxt
+  Matcher m(*map.lookup, cfg);
+  Pose2 truth{4, 5, 0.0};
+  m.set_pose(truth, 0.3);
+  ASSERT_EQ(m.process(synth_frame(*map.plan, truth, so, 1'000'000)).status, FitStatus::kOk);
+  int first_ok_after = -1;
+  for (int k = 1; k <= 6; ++k) {
+    const Pose2 motion{0.3, 0, 0.05};
+    truth = compose(truth, motion);
+    // The odometry is right except at frame 1, where it says the robot turned 20 degrees less than it did.
+    const Pose2 said = k == 1 ? Pose2{0.3, 0, 0.05 - 0.35} : motion;
+    const MatchResult r = m.process(synth_frame(*map.plan, truth, so, 1'000'000 + k * 1'000'000), std::nullopt, said);
+    if (r.status == FitStatus::kOk && first_ok_after < 0) first_ok_after = k;
+    if (r.status == FitStatus::kOk) EXPECT_LT(pos_err(r.pose, truth), 0.01) << "frame " << k << ": " << r.text;
+  }
+  EXPECT_EQ(first_ok_after, 2);
+}

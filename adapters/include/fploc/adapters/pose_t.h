@@ -3,6 +3,7 @@
 #include <fploc/pose_t.hpp>
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 
 #include "fploc/core/pose.h"
@@ -20,6 +21,8 @@ pose_t make_pose_msg(int64_t utime, int64_t seq, const Pose2& p, double roll, do
 pose_t to_msg(const optimizer::PoseOut& p, int64_t seq, int floor_index, const std::string& floor);
 // Pose2 from a pose_t (yaw of its quaternion; a zero quaternion is the identity).
 Pose2 pose2_of(const pose_t& m);
+// pose2_of when the pose is finite, else nullopt (the caller names the channel and drops it).
+std::optional<Pose2> finite_pose2_of(const pose_t& m);
 // The (x, y, yaw) block of a pose_t's 6x6 covariance (indices 0, 1, 5).
 Eigen::Matrix3d xy_yaw_covariance(const pose_t& m);
 

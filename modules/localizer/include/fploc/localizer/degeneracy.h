@@ -26,6 +26,7 @@
 // (confirm_fixes) and when under half of its points lie on the plan (weak_fit_ratio).
 #pragma once
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -65,6 +66,12 @@ struct UncertaintyConfig {
   // the plan explains less than half of what the sensor sees there. The grid localizer's min_inlier_ratio and
   // weak_fit_is_poor. Status only. 0: off.
   double weak_fit_ratio = 0.5;
+  // Odometry (the robot's own, e.g. its wheels: update()'s `motion`): the prediction is the tracked pose composed
+  // with the increment, as the matcher predicts with it, whatever the time between frames (2D laser logs have
+  // frames seconds and a metre apart), and P grows by the step's own 1-sigma instead of the velocity model's
+  // (x/y, yaw as MatcherConfig::odom_sigma_*: the Localizer copies the matcher's).
+  double odom_sigma_m = 0.05, odom_sigma_per_m = 0.3;
+  double odom_sigma_rad = 2.0 * M_PI / 180, odom_sigma_per_rad = 0.3, odom_sigma_rad_per_m = 3.0 * M_PI / 180;
 };
 
 struct UncertaintyState {
@@ -87,10 +94,12 @@ class UncertaintyTracker {
   // matcher's status/text. Returns what to publish with the frame's pose.
   // With `fix` (the frame's own pose, that P_f is about) and the matcher's body twist of the frame (its
   // motion model, carried to the next frame) the innovation gate applies (see gate_sigma); inlier_ratio is the
-  // fix's share of points on the plan (weak_fit_ratio).
+  // fix's share of points on the plan (weak_fit_ratio). motion: the robot's odometry increment since the
+  // previous update (in that frame's body frame), if any: it predicts instead of the twist (odom_sigma_*).
   UncertaintyState update(int64_t utime, const Eigen::Matrix3d& frame_cov, bool frame_valid, matcher::FitStatus matcher_status,
                           const std::string& matcher_text = {}, const Pose2* fix = nullptr,
-                          const matcher::Twist2* twist = nullptr, double inlier_ratio = 1.0);
+                          const matcher::Twist2* twist = nullptr, double inlier_ratio = 1.0,
+                          const Pose2* motion = nullptr);
   // A new initial pose with its uncertainty (1-sigma x/y and yaw); the velocity is unknown.
   void reset(double sigma_m, double sigma_rad);
   void reset() { have_ = false; }

@@ -57,7 +57,8 @@ class Localizer {
   void add_imu(int64_t utime, double gyro_z);
   // The robot's own odometry pose at utime (e.g. wheel odometry of a 2D-LiDAR robot); when the poses at
   // the previous and the current frame's utime are both known, their increment predicts the frame
-  // (Matcher::process's `motion`). The last 256 are kept.
+  // (Matcher::process's `motion`), and the published uncertainty's track in optimize() (the tracker's
+  // innovation gate, degeneracy.h). The last 256 are kept.
   void add_odometry(int64_t utime, const Pose2& p);
   // (Re)initialises the single-frame tracker at p, searching within search_m (default: cfg.initial_search_m).
   void set_pose(const Pose2& p, std::optional<double> search_m = std::nullopt);
@@ -89,6 +90,8 @@ class Localizer {
   const UncertaintyState& uncertainty() const { return uncertainty_; }
 
  private:
+  // The odometry increment between two frames' times (both poses known), in the first one's body frame.
+  std::optional<Pose2> odometry_between(int64_t from_utime, int64_t to_utime) const;
   Config cfg_;
   const matcher::NearestLookup& lookup_;
   matcher::Matcher matcher_;
@@ -99,6 +102,8 @@ class Localizer {
   std::optional<double> last_z_;
   std::optional<std::pair<double, double>> last_rp_;
   std::map<int64_t, Pose2> odom_;    // odometry poses by utime (add_odometry)
+  bool have_prev_optimized_ = false;  // optimize() saw a frame (prev_optimized_utime_ valid)
+  int64_t prev_optimized_utime_ = 0;
   FeatureFrame held_;                // scratch: the frame with the IMU's sweep rate and the held attitude
   FeatureFrame deskewed_;            // scratch: the frame de-skewed as the matcher registered it
   UncertaintyTracker tracker_;

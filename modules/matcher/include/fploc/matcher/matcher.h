@@ -48,6 +48,26 @@ struct MatcherConfig {
   // Per plan element weight of its floor-plan terms (matcher/element_weights.h: from the plan-change
   // detector); null = all 1. Not owned: the caller keeps it alive and may change it between frames.
   const std::vector<float>* element_weight = nullptr;
+  // With the robot's odometry (process()'s `motion`; 2D laser logs: frames a metre and tens of degrees apart)
+  // the fit must lie within odom_gate_sigmas of the prediction, with the odometry's 1-sigma over the step
+  // odom_sigma_m + odom_sigma_per_m * step in x/y and odom_sigma_rad + odom_sigma_per_rad * turn +
+  // odom_sigma_rad_per_m * step in yaw (the grid localizer's wheel model, measured against the Radish
+  // references; laser2d GridLocalizerConfig::sigma_*), and these add up over POOR frames (dead reckoning). A
+  // fit outside is refused (POOR: the pose is the prediction), as the grid localizer's fit must stay in its
+  // search window; once the window exceeds twice the tracking gate the frame is registered from a grid of
+  // starts over it (capped at odom_max_search_m / _rad), as after set_pose. max_jump_* do not apply then.
+  // 0: off (max_jump_* only).
+  double odom_gate_sigmas = 3.0;
+  double odom_sigma_m = 0.05, odom_sigma_per_m = 0.3;
+  double odom_sigma_rad = 2.0 * M_PI / 180, odom_sigma_per_rad = 0.3, odom_sigma_rad_per_m = 3.0 * M_PI / 180;
+  double odom_max_search_m = 2.5, odom_max_search_rad = 45.0 * M_PI / 180;
+  // ... and a fit more than 2 sigma from the prediction needs this share of its points within inlier_m of the
+  // plan (nearer ones min_inlier_ratio), as the grid localizer's (50 % / 40 % near): a place the odometry does
+  // not support must explain the scan well to be taken.
+  double odom_far_inlier_ratio = 0.5;
+  // ... and the window search's fits are ranked by their inliers times exp(-m^2 / 2 kappa^2) of their
+  // Mahalanobis offset m from the prediction (the grid localizer's prior, SearchWindow::prior_kappa).
+  double search_prior_kappa = 1.5;
   AsBuiltModel as_built;          // per-wall end offsets eliminated (as_built.h); off by default
 };
 
@@ -125,7 +145,14 @@ class Matcher {
   double last_rms_ = 0;         // fit rms of the last OK frame
   double search_m_ = 0;         // uncertainty of the pose given by set_pose
   double search_yaw_ = 0;
+  double dead_reckoned_m_ = 0;  // odometry mode: 1-sigma x/y / yaw accumulated over the POOR frames since the last OK
+  double dead_reckoned_rad_ = 0;
   FeatureFrame deskewed_;       // scratch
+  // Registration from a grid of starts over +-s / +-a around `centre` (spacing 2/3 of it, the centre first):
+  // the fit with the most inliers (then the lower rms), OK ones first; with `window` only fits within it,
+  // their inliers weighted by the prior on the offset (search_prior_kappa).
+  MatchResult search_grid(const FeatureFrame& in, const Pose2& centre, double s, double a, const MatcherConfig& cfg,
+                          const Eigen::Vector2d* window = nullptr) const;
 };
 
 }  // namespace fploc::matcher
