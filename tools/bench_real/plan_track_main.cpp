@@ -34,6 +34,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"ref", "off"}));
   app.add_option("--gate", gate, "matcher.max_correspondence_m (default: the lidar2d graph's 0.5)");
   app.add_option("--initial-search", initial_search, "matcher.initial_search_m: the start's uncertainty [m]");
+  double plan_sigma = 0;
+  app.add_option("--plan-sigma", plan_sigma, "the published covariance's floor on each plan element's offset sigma [m]");
   bool no_group_rule = false, at_ref = false;
   app.add_flag("--at-reference", at_ref, "also register each frame alone from its reference pose (diagnostics)");
   app.add_flag("--no-group-rule", no_group_rule, "PCA line groups match independently (both steps)");
@@ -55,6 +57,7 @@ int main(int argc, char** argv) {
         fploc::config::load_map(ps, mo.lookup(), [](const std::string& p) { return p; }, "--map");
     fploc::localizer::Config cfg = fploc::config::localizer_config(mo);
     cfg.optimizer = fploc::config::localizer_config(oo).optimizer;
+    cfg.uncertainty.frame.plan_sigma_m = plan_sigma;
     fploc::localizer::Localizer loc(*map.lookup, cfg);
     // --at-reference on an occupancy map: the same share on its raster (the grid localizer's view of it).
     const bool raster = at_ref && map_path.size() > 5 && map_path.substr(map_path.size() - 5) == ".yaml";
@@ -87,6 +90,10 @@ int main(int argc, char** argv) {
                             {"sfr_status", fploc::matcher::to_string(m.status)}, {"sfr_text", m.text},
                             {"points", m.fit.num_points}, {"inlier_ratio", m.fit.inlier_ratio}, {"rms_m", m.fit.rms_m},
                             {"status", int(loc.uncertainty().status)}, {"why", loc.uncertainty().text}};
+      if (step.latest) {
+        const Eigen::Matrix3d& c = step.latest->covariance;
+        row["cov"] = {c(0, 0), c(0, 1), c(0, 2), c(1, 1), c(1, 2), c(2, 2)};
+      }
       if (at_ref) {
         // The frame registered alone from its reference pose: how well the plan explains it there.
         const auto rf = fploc::matcher::register_frame(*map.lookup, f, {s.pose.x, s.pose.y, s.pose.theta}, loc.config().matcher);

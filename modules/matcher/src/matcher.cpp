@@ -286,7 +286,7 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
       r.status = FitStatus::kPoor;
       r.text = b;
     } else if (r.status == FitStatus::kOk && r.fit.inlier_ratio < cfg_.odom_far_inlier_ratio &&
-               std::hypot(jump / (win_m / 3), jump_yaw / (win_rad / 3)) > 2) {
+               std::hypot(jump / std::max(win_m / 3, 1e-6), jump_yaw / std::max(win_rad / 3, 1e-9)) > 2) {
       char b[160];
       std::snprintf(b, sizeof b, "%.0f %% inliers %.2f m / %.1f deg from the prediction (beyond 2 sigma: %.0f %% needed)",
                     100 * r.fit.inlier_ratio, jump, jump_yaw * 180 / M_PI, 100 * cfg_.odom_far_inlier_ratio);
