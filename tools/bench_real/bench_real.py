@@ -189,15 +189,15 @@ def markdown(doc, cmdline):
     out += ["", "What each estimator said of itself (covered scans): NEES = median x/y/yaw NEES of its covariance (3 when "
             "consistent), and with the reference's noise added to it; false OK = published OK more than 0.3 m off.", "",
             "| log | start | fploc NEES | with the reference's noise | fploc false OK | plan path (matcher + optimizer) ATE | "
-            "plan path max | plan path POOR | plan path LOST | plan path false OK | plan path NEES | plan path ms | AMCL NEES |",
-            "|" + "---|" * 13]
+            "plan path max | plan path POOR | plan path LOST | plan path false OK | plan path NEES | with the reference's noise | "
+            "plan path ms | AMCL NEES |", "|" + "---|" * 14]
     for r in doc["rows"]:
         f, a, pl = r["fploc"], r["amcl"], r["fploc_plan"]
         nees = lambda m, k="nees_median": "-" if m.get(k) is None else f"{m[k]:.1f}"
         out.append(f"| {r['log']} | {r['start']} | {nees(f)} | {nees(f, 'nees_median_with_reference_noise')} | "
                    f"{f.get('false_ok_poses', '-')} | {cm(pl['ate_m'])} | {pl['max_m'] * 100:.0f} | "
                    f"{pl.get('poor_pct', float('nan')):.1f} % | {pl['lost_pct']:.1f} % | {pl.get('false_ok_poses', '-')} | "
-                   f"{nees(pl)} | {pl['ms_per_scan']:.1f} | {nees(a)} |")
+                   f"{nees(pl)} | {nees(pl, 'nees_median_with_reference_noise')} | {pl['ms_per_scan']:.1f} | {nees(a)} |")
     out += ["", "Plots (reference green, fploc blue, AMCL orange; `-fploc.png` without AMCL):", ""]
     out += [f"- {r['log']} {r['start']}: `{r['plot']}`, `{r['plot_fploc']}`" for r in doc["rows"]]
     return "\n".join(out) + "\n"
