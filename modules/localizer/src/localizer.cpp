@@ -88,10 +88,23 @@ FramePose Localizer::register_frame(const FeatureFrame& f) {
   return out;
 }
 
+std::optional<Pose2> Localizer::odometry_at(int64_t utime) const {
+  auto hi = odom_.lower_bound(utime);  // the first sample at or after utime
+  if (hi != odom_.end() && hi->first == utime) return hi->second;
+  if (hi == odom_.begin()) return std::nullopt;  // every sample is newer
+  const auto lo = std::prev(hi);
+  if (hi == odom_.end())  // the newest sample is older: it stands for utime while recent
+    return double(utime - lo->first) * 1e-6 <= cfg_.odometry_max_age_s ? std::optional<Pose2>(lo->second) : std::nullopt;
+  // Between two samples: the increment from the older one, scaled linearly in time.
+  const double f = double(utime - lo->first) / double(hi->first - lo->first);
+  const Pose2 d = between(lo->second, hi->second);
+  return compose(lo->second, Pose2{f * d.x, f * d.y, f * d.yaw});
+}
+
 std::optional<Pose2> Localizer::odometry_between(int64_t from_utime, int64_t to_utime) const {
-  const auto a = odom_.find(from_utime), b = odom_.find(to_utime);
-  if (a == odom_.end() || b == odom_.end()) return std::nullopt;
-  return between(a->second, b->second);
+  const auto a = odometry_at(from_utime), b = odometry_at(to_utime);
+  if (!a || !b) return std::nullopt;
+  return between(*a, *b);
 }
 
 std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& sfr, std::vector<Pose>* finals) {

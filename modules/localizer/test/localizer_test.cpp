@@ -140,3 +140,36 @@ TEST_F(LocalizerTest, TwoStepsEqualOneProcessWithoutFeedback) {
 }
 
 }  // namespace
+
+// Odometry at its own rate (20 Hz, not at the scans' times): a frame's odometry pose is interpolated between the
+// samples around it, so frames a second apart (too far for the constant-velocity model) are predicted by the
+// odometry's increment to millimetres; without odometry the prediction is the previous pose, 0.6 m behind.
+TEST_F(LocalizerTest, OdometryAtItsOwnRatePredictsTheFrame) {
+  for (bool with_odometry : {true, false}) {
+    localizer::Config cfg;
+    cfg.use_imu = false;
+    localizer::Localizer loc(*map_.lookup, cfg);
+    if (with_odometry)
+      for (double t = -0.037; t < 6.0; t += 0.05) {
+        // In the odometry's own frame: the truth moved by 5 m and turned by 1 rad.
+        const Pose2 p = compose(Pose2{5, -2, 1}, truth_at(t));
+        loc.add_odometry(int64_t(std::llround(t * 1e6)), p);
+      }
+    loc.set_pose(truth_at(0.0));
+    std::vector<localizer::Pose> finals;
+    for (int k : {0, 10, 20, 30}) {
+      // A planar laser's scan: no sweep to de-skew (the pose is the one at utime).
+      SynthOptions so;
+      so.seed = uint32_t(k + 1);
+      so.noise_sigma = 0.01;
+      const FeatureFrame f = synth_frame(*map_.plan, truth_at(0.1 * k), so, int64_t(std::llround(0.1 * k * 1e6)));
+      const auto s = loc.process(f, &finals);
+      const Pose2 truth = truth_at(0.1 * k);
+      const double miss = std::hypot(s.sfr.match.predicted.x - truth.x, s.sfr.match.predicted.y - truth.y);
+      if (k == 0) continue;
+      if (with_odometry) EXPECT_LT(miss, 0.005) << "frame " << k;
+      else EXPECT_GT(miss, 0.3) << "frame " << k;
+      EXPECT_EQ(s.sfr.match.status, matcher::FitStatus::kOk) << k << " " << s.sfr.match.text;
+    }
+  }
+}

@@ -25,6 +25,9 @@ struct Config {
   bool use_imu = true;               // the IMU's yaw rate: prediction (yaw change) + sweep yaw rate (de-skew)
   double initial_search_m = 0;       // set_pose without an uncertainty: search this far (0: matcher.max_correspondence_m)
   bool refine_from_window = true;    // process(): the WO estimate of a frame predicts the next one
+  // add_odometry: a frame's odometry pose is the sample at its utime, else interpolated between the two around
+  // it, else the newest one when no older than this (odometry at its own rate, e.g. a robot's 50 Hz).
+  double odometry_max_age_s = 0.25;
   // The published covariance and status (degeneracy.h); its frame loss/gate follow `matcher` unless
   // set apart (Localizer's constructor copies them).
   UncertaintyConfig uncertainty;
@@ -55,8 +58,9 @@ class Localizer {
 
   // IMU gyro z sample (out-of-order or non-finite samples are ignored). Ignored unless cfg.use_imu.
   void add_imu(int64_t utime, double gyro_z);
-  // The robot's own odometry pose at utime (e.g. wheel odometry of a 2D-LiDAR robot); when the poses at
-  // the previous and the current frame's utime are both known, their increment predicts the frame
+  // The robot's own odometry pose at utime (e.g. wheel odometry of a 2D-LiDAR robot, at its own rate or at
+  // the scans' times); when the poses at the previous and the current frame's utime are both known (a sample
+  // there, or interpolated: odometry_max_age_s), their increment predicts the frame
   // (Matcher::process's `motion`), and the published uncertainty's track in optimize() (the tracker's
   // innovation gate, degeneracy.h). The last 256 are kept.
   void add_odometry(int64_t utime, const Pose2& p);
@@ -90,7 +94,9 @@ class Localizer {
   const UncertaintyState& uncertainty() const { return uncertainty_; }
 
  private:
-  // The odometry increment between two frames' times (both poses known), in the first one's body frame.
+  // The odometry pose at a frame's time (see Config::odometry_max_age_s), and the increment between two
+  // frames' times in the first one's body frame.
+  std::optional<Pose2> odometry_at(int64_t utime) const;
   std::optional<Pose2> odometry_between(int64_t from_utime, int64_t to_utime) const;
   Config cfg_;
   const matcher::NearestLookup& lookup_;
