@@ -9,11 +9,14 @@
 //       converted to scan_t on replay by the cloud-to-scan node (graphs/replay-clouds.pbtxt); with --decode:
 //       scan_t on OS1_SCAN converted here by the same code (rings from the ring field or the elevations)
 //   sensor_msgs/Imu -> imu_t on OS1_IMU;  sensor_msgs/LaserScan -> laser_scan_t on LASER_SCAN
+//   nav_msgs/Odometry -> pose_t on WHEEL_ODOM (the odometry input of graphs/lidar2d.pbtxt's matcher, optimizer,
+//       grid2d and AMCL; in its own odometry frame, floor_index -1)
 //   nav_msgs/Odometry, tf2_msgs/TFMessage -> a TUM file (--tum-out, --tf-parent/--tf-child or --odom-topic)
 // A second topic that would go to the same channel gets CHANNEL_<topic>; --channel TOPIC=CH overrides.
 // Bad input: one error with the byte offset and record; the log holds everything read before it.
 #include <fploc/imu_t.hpp>
 #include <fploc/point_cloud2_t.hpp>
+#include <fploc/pose_t.hpp>
 #include <fploc/scan_t.hpp>
 
 #include <CLI/CLI.hpp>
@@ -194,6 +197,7 @@ int main(int argc, char** argv) {
       ch = topic_channel[c.topic];
     } else {
       const std::string base = k == Kind::kLaser ? "LASER_SCAN"
+                               : k == Kind::kOdom ? "WHEEL_ODOM"
                                : k == Kind::kImu ? "OS1_IMU"
                                : (k == Kind::kCloud && !decode_ouster) ? "POINT_CLOUD"
                                                                        : "OS1_SCAN";
@@ -379,11 +383,20 @@ int main(int argc, char** argv) {
         break;
       }
       case Kind::kOdom: {
-        if (tum_out.empty() || !tf_parent.empty()) { ++skipped_types[c.type]; break; }
-        if (!odom_chosen) odom_topic = c.topic, odom_chosen = true;
-        if (c.topic != odom_topic) break;
         Odometry o;
         if (!decode(m.data, m.size, c.encoding, o, &err)) { bad(c, err); break; }
+        const std::string& ch = channel_for(c, k);
+        pose_t p{};
+        p.utime = o.pose.header.stamp_ns / 1000;
+        p.seq = seq[ch]++;
+        p.floor_index = -1;  // the odometry frame: no floor
+        for (int i = 0; i < 3; ++i) p.position[i] = o.pose.t[size_t(i)];
+        for (int i = 0; i < 4; ++i) p.orientation[i] = o.pose.q[size_t(i)];
+        if (!out.empty()) lcm_log.write(ch, m.time_ns / 1000, p);
+        ++written[ch];
+        if (tum_out.empty() || !tf_parent.empty()) break;
+        if (!odom_chosen) odom_topic = c.topic, odom_chosen = true;
+        if (c.topic != odom_topic) break;
         tum.odometry(o);
         ++written["(tum " + c.topic + ")"];
         break;

@@ -19,6 +19,11 @@ Pose2 compose(const Pose2& a, const Pose2& b) {
   return {a.x + c * b.x - s * b.y, a.y + s * b.x + c * b.y, wrap_angle(a.yaw + b.yaw)};
 }
 
+Pose2 interpolate(const Pose2& a, const Pose2& b, double f) {
+  const Pose2 d = between(a, b);
+  return compose(a, Pose2{f * d.x, f * d.y, f * d.yaw});
+}
+
 Pose2 inverse(const Pose2& a) {
   const double c = std::cos(a.yaw), s = std::sin(a.yaw);
   return {-c * a.x - s * a.y, s * a.x - c * a.y, wrap_angle(-a.yaw)};

@@ -45,3 +45,17 @@ TEST(Tum, BadRowNamesLine) {
     EXPECT_NE(std::string(e.what()).find("bad.tum:3:"), std::string::npos) << e.what();
   }
 }
+
+TEST(Pose, InterpolateScalesTheIncrement) {
+  const Pose2 a{1, 2, 3.0}, b = compose(a, Pose2{0.4, -0.2, 0.5});
+  for (double f : {0.0, 0.25, 1.0}) {
+    const Pose2 p = interpolate(a, b, f);
+    const Pose2 d = between(a, p);
+    EXPECT_NEAR(d.x, 0.4 * f, 1e-12);
+    EXPECT_NEAR(d.y, -0.2 * f, 1e-12);
+    EXPECT_NEAR(d.yaw, 0.5 * f, 1e-12);
+  }
+  // Across +-pi the short way round.
+  const Pose2 c{0, 0, 3.1}, e{0, 0, -3.1};
+  EXPECT_NEAR(std::abs(interpolate(c, e, 0.5).yaw), M_PI, 1e-9);
+}

@@ -96,9 +96,7 @@ std::optional<Pose2> Localizer::odometry_at(int64_t utime) const {
   if (hi == odom_.end())  // the newest sample is older: it stands for utime while recent
     return double(utime - lo->first) * 1e-6 <= cfg_.odometry_max_age_s ? std::optional<Pose2>(lo->second) : std::nullopt;
   // Between two samples: the increment from the older one, scaled linearly in time.
-  const double f = double(utime - lo->first) / double(hi->first - lo->first);
-  const Pose2 d = between(lo->second, hi->second);
-  return compose(lo->second, Pose2{f * d.x, f * d.y, f * d.yaw});
+  return interpolate(lo->second, hi->second, double(utime - lo->first) / double(hi->first - lo->first));
 }
 
 std::optional<Pose2> Localizer::odometry_between(int64_t from_utime, int64_t to_utime) const {

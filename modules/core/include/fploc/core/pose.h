@@ -19,6 +19,9 @@ double wrap_angle(double a);
 Pose2 compose(const Pose2& a, const Pose2& b);
 Pose2 inverse(const Pose2& a);
 inline Pose2 between(const Pose2& a, const Pose2& b) { return compose(inverse(a), b); }
+// The pose a share f in [0, 1] of the way from a to b: a (+) f * (a^-1 (+) b) (the increment scaled
+// linearly, e.g. odometry between two samples).
+Pose2 interpolate(const Pose2& a, const Pose2& b, double f);
 
 struct StampedPose {
   double t = 0;  // seconds
