@@ -10,7 +10,8 @@
 //  - "simulated-wheel": ground_truth_t on the `ground_truth` port (the simulator's FPLOC_GROUND_TRUTH)
 //    turned into wheel odometry with scale error, yaw drift and noise (modules/amcl/odometry.h). The
 //    filter only ever sees that odometry's increments, never the ground truth itself.
-// Scans and odometry are paired by utime (both carry the scan's start time). Everything depends on the
+// Scans and odometry are paired by utime: the sample at the scan's start time, else the two around it
+// interpolated (when at most Settings::odometry_max_gap_s apart). Everything depends on the
 // messages only (seeded random numbers, no wall clock), so `fploc replay` stays byte-reproducible; the
 // thread CPU time per scan goes to stderr and the optional stats file, never into a pose.
 #include <fploc/features_t.hpp>
@@ -25,6 +26,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <vector>
 
@@ -79,6 +81,7 @@ class AmclNode : public fploc::rt::Node {
     range_min_ = s.scan.range_min_m;
     range_max_ = s.scan.range_max_m;
     guard_ = am::OdometryGuard(s.guard);
+    max_gap_s_ = s.odometry_max_gap_s;
     stats_file_ = o.stats_file();
     wheel_mode_ = s.odometry == am::OdometrySource::kSimulatedWheel;
     if (wheel_mode_) {
@@ -262,23 +265,40 @@ class AmclNode : public fploc::rt::Node {
     std::cerr << "[" << ctx_->name() << "] re-initialised at " << p.x << " " << p.y << " " << p.yaw << "\n";
   }
 
-  // Pairs scans and odometry by utime, oldest first.
+  // Pairs scans and odometry by utime, oldest first: the sample at a scan's utime, else the two samples around
+  // it interpolated when at most odometry_max_gap_s apart (odometry at its own rate, e.g. a robot's 20-50 Hz
+  // nav_msgs/Odometry imported from a bag); a scan with no such pair is dropped with one error naming it.
   void match() {
     while (!frames_.empty() && !odoms_.empty()) {
-      const int64_t tf = frames_.front().utime, to = odoms_.front().first;
-      if (to < tf) {
-        odoms_.pop_front();  // odometry between scans (or of a dropped scan): not needed
-      } else if (tf < to) {
-        ctx_->error("scan " + std::to_string(frames_.front().scan_seq) + ": no odometry at utime " + std::to_string(tf) +
-                    " (next odometry is " + std::to_string(to) + "; dropped)");
-        ++unmatched_;
-        frames_.pop_front();
-      } else {
-        process(frames_.front(), odoms_.front().second);
-        frames_.pop_front();
+      const Frame& f = frames_.front();
+      const int64_t tf = f.utime;
+      while (!odoms_.empty() && odoms_.front().first < tf) {  // the newest sample before the scan is kept
+        before_ = odoms_.front();
         odoms_.pop_front();
       }
+      if (odoms_.empty()) return;  // wait for a sample at or after the scan
+      const auto [to, po] = odoms_.front();
+      if (to == tf) {
+        process(f, po);
+        before_ = odoms_.front();
+        odoms_.pop_front();
+      } else if (before_ && double(to - before_->first) * 1e-6 <= max_gap_s_) {
+        process(f, fploc::interpolate(before_->second, po, double(tf - before_->first) / double(to - before_->first)));
+      } else {
+        ctx_->error("scan " + std::to_string(f.scan_seq) + ": no odometry at utime " + std::to_string(tf) +
+                    (before_ ? " (samples at " + std::to_string(before_->first) + " and " + std::to_string(to) + ", more than " +
+                                   fmt_s(max_gap_s_) + " s apart; dropped)"
+                             : " (next odometry is " + std::to_string(to) + ", none before it; dropped)"));
+        ++unmatched_;
+      }
+      frames_.pop_front();
     }
+  }
+
+  static std::string fmt_s(double s) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", s);
+    return b;
   }
 
   void process(const Frame& f, const Pose2& raw_odom) {
@@ -344,6 +364,8 @@ class AmclNode : public fploc::rt::Node {
   fploc::rt::Publisher<fploc::pose_t> out_, odom_out_;
   std::deque<Frame> frames_;
   std::deque<std::pair<int64_t, Pose2>> odoms_;
+  std::optional<std::pair<int64_t, Pose2>> before_;  // the newest sample before the oldest pending scan
+  double max_gap_s_ = 0.25;
   bool have_truth_ = false, done_ = false, have_odom_ = false, have_frame_ = false;
   int64_t last_truth_utime_ = 0, last_odom_utime_ = 0, last_frame_utime_ = 0, seq_ = 0, odom_seq_ = 0;
   int64_t scans_ = 0, updates_ = 0, resamples_ = 0, particles_sum_ = 0, beams_sum_ = 0, unmatched_ = 0, converged_ = 0;

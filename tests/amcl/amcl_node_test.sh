@@ -35,8 +35,8 @@ def check(cond, msg):
     global ok
     if not cond:
         print("FAIL:", msg); ok = False
-# Scan 150 (non-finite odometry) and 170 (no odometry) give no pose; every other scan one.
-check(len(est) == len(gt) - 2, f"{len(est)} poses for {len(gt)} scans (want {len(gt) - 2})")
+# Scan 150 (non-finite odometry) and 170-172 (no odometry within 0.25 s) give no pose; every other scan one.
+check(len(est) == len(gt) - 4, f"{len(est)} poses for {len(gt)} scans (want {len(gt) - 4})")
 check(all(all(math.isfinite(v) for v in r) for r in est), "non-finite pose in the output")
 steps = [math.dist(a[1:3], b[1:3]) for a, b in zip(est, est[1:])]
 check(max(steps) < 0.5, f"output jumps {max(steps):.2f} m between consecutive poses (the 5 m odometry jump leaked?)")
@@ -48,10 +48,29 @@ check(max(err) < 0.4, "lost track (error >= 0.4 m = 2 sigma_hit)")
 # Every defect is reported (the first few errors are printed, all are counted; the node's summary names them).
 for what in ("non-finite points dropped", "no usable beam", "odometry jump", "non-finite odometry"):
     check(what in log, f"no error message containing '{what}'")
-for what in ("2 frames with non-finite features", "6 scans without usable beams", "1 scans without odometry",
+for what in ("2 frames with non-finite features", "6 scans without usable beams", "3 scans without odometry",
              "1 non-finite odometry poses", "1 odometry jumps", "1 messages out of order"):
     check(what in log, f"summary does not say '{what}'")
-check(amcl["errors"] == 12, f"{amcl['errors']} errors counted in telemetry (want 12: 2 + 6 + 1 + 1 + 1 + 1)")
+check(amcl["errors"] == 14, f"{amcl['errors']} errors counted in telemetry (want 14: 2 + 6 + 3 + 1 + 1 + 1)")
+sys.exit(0 if ok else 1)
+PY
+
+echo "--- 1b. odometry at its own times (halfway between the scans): interpolated, one pose per scan"
+mkdir -p "$T/between"
+"$BIN/amcl_make_log" "$T/between" --odom-between
+"$BIN/fploc-replay" --graph "$ROOT/tests/amcl/amcl-test.pbtxt" --log "$T/between/log.lcm" --json \
+  --set amcl.plan.file="$T/between/plan.json" --set logger.file="$T/between/est.tum" > "$T/between/r.json" 2> "$T/between/r.log"
+python3 - "$T/between" <<'PY'
+import json, math, sys
+T = sys.argv[1]
+rd = lambda p: [list(map(float, l.split())) for l in open(p) if l.strip()]
+gt, est = rd(f"{T}/gt.tum"), rd(f"{T}/est.tum")
+amcl = next(n for n in json.load(open(f"{T}/r.json"))["nodes"] if n["name"] == "amcl")
+g = {round(r[0], 3): r for r in gt}
+err = [math.dist(r[1:3], g[round(r[0], 3)][1:3]) for r in est]
+print(f"{len(est)} poses for {len(gt)} scans, ATE xy {math.sqrt(sum(e * e for e in err) / len(err)):.3f} m (max {max(err):.3f}), {amcl['errors']} errors")
+ok = len(est) == len(gt) and amcl["errors"] == 0 and max(err) < 0.4
+if not ok: print("FAIL: want one pose per scan, no error, tracking (max error < 0.4 m)")
 sys.exit(0 if ok else 1)
 PY
 

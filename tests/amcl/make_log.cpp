@@ -51,8 +51,12 @@ pose_t pose_msg(int64_t utime, int64_t seq, const Pose2& p) {
 
 int main(int argc, char** argv) {
   const bool clean = argc == 3 && std::string(argv[2]) == "--clean";
-  if (argc != 2 && !clean) {
-    std::cerr << "usage: amcl_make_log OUT_DIR [--clean]   (--clean: no defects)\n";
+  // --odom-between: no defects, and the odometry at its own times, halfway between the scans (as a robot's
+  // odometry at its own rate): AMCL interpolates it at each scan.
+  const bool between_scans = argc == 3 && std::string(argv[2]) == "--odom-between";
+  if (argc != 2 && !clean && !between_scans) {
+    std::cerr << "usage: amcl_make_log OUT_DIR [--clean | --odom-between]   (--clean: no defects; --odom-between: no "
+                 "defects, odometry halfway between the scans)\n";
     return 2;
   }
   const std::string dir = argv[1];
@@ -78,6 +82,9 @@ int main(int argc, char** argv) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const int64_t t0 = 1700000000000000;
   int64_t fseq = 0, oseq = 0;
+  std::vector<Pose2> odom;  // the wheel odometry at each scan
+  for (const Pose2& p : path) odom.push_back(odo.update(p));
+  if (between_scans) write(log, "FPLOC_ODOM_POSE", t0 - 50000, pose_msg(t0 - 50000, oseq++, odom[0]));
   for (size_t k = 0; k < path.size(); ++k) {
     const int64_t utime = t0 + int64_t(k) * 100000;
     StampedPose sp = StampedPose::from_rpy(double(utime) * 1e-6, Eigen::Vector3d(path[k].x, path[k].y, 1.2), 0, 0, path[k].yaw);
@@ -91,10 +98,10 @@ int main(int argc, char** argv) {
     m.z = 1.2;
     m.roll_pitch_sigma = 0.001;
     m.z_sigma = 0.01;
-    const bool empty = !clean && k >= 51 && k <= 55;
+    const bool empty = !clean && !between_scans && k >= 51 && k <= 55;
     for (size_t i = 0; !empty && i < f.points.size(); ++i) {
       float x = float(f.points[i].p.x()), y = float(f.points[i].p.y());
-      if (!clean && (k == 50 || (k == 80 && i % 2 == 0))) x = y = nan;
+      if (!clean && !between_scans && (k == 50 || (k == 80 && i % 2 == 0))) x = y = nan;
       m.x.push_back(x);
       m.y.push_back(y);
       m.kind.push_back(int8_t(f.points[i].kind));
@@ -104,18 +111,23 @@ int main(int argc, char** argv) {
     m.num_points = int32_t(m.x.size());
     m.status = m.num_points ? 0 : 1;
     write(log, "FPLOC_FEATURES", utime, m);
-    Pose2 o = odo.update(path[k]);
+    Pose2 o = odom[k];
+    if (between_scans) {
+      const Pose2 mid = k + 1 < path.size() ? interpolate(o, odom[k + 1], 0.5) : o;
+      write(log, "FPLOC_ODOM_POSE", utime + 50000, pose_msg(utime + 50000, oseq++, mid));
+      continue;
+    }
     if (clean) {
       write(log, "FPLOC_ODOM_POSE", utime, pose_msg(utime, oseq++, o));
       continue;
     }
     if (k >= 120) o.x += 5.0;  // the odometry frame jumps by 5 m (e.g. an odometry reset)
     if (k == 150) o.y = std::numeric_limits<double>::quiet_NaN();
-    if (k == 170) continue;    // no odometry for this scan
+    if (k >= 170 && k <= 172) continue;  // no odometry for these scans: 0.4 s between the samples around them
     write(log, "FPLOC_ODOM_POSE", utime, pose_msg(utime, oseq++, o));
     if (k == 200) write(log, "FPLOC_ODOM_POSE", utime, pose_msg(utime - 300000, oseq++, o));  // back in time
   }
   std::cout << path.size() << " scans; defects: 50 non-finite features, 51-55 empty, 80 half non-finite, "
-            << "120 odometry jump 5 m, 150 non-finite odometry, 170 no odometry, 200 odometry back in time\n";
+            << "120 odometry jump 5 m, 150 non-finite odometry, 170-172 no odometry, 200 odometry back in time\n";
   return 0;
 }

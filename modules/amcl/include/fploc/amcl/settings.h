@@ -31,6 +31,9 @@ struct Settings {
   OdometrySource odometry = OdometrySource::kPose;
   WheelOdometryConfig wheel;   // used with kSimulatedWheel
   OdometryGuardConfig guard;
+  // A scan without an odometry sample at its utime gets the interpolation of the two samples around it when
+  // they are at most this far apart (odometry at its own rate); otherwise it is dropped with an error.
+  double odometry_max_gap_s = 0.25;
 };
 
 }  // namespace fploc::amcl
