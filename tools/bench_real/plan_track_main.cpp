@@ -13,6 +13,8 @@
 #include "fploc/config/localization.h"
 #include "fploc/config/plan_source.h"
 #include "fploc/laser2d/distance_field.h"
+#include "fploc/laser2d/grid_localizer.h"
+#include "fploc/laser2d/laser_odometry.h"
 #include "fploc/laser2d/laser2d.h"
 #include "fploc/localizer/localizer.h"
 #include "log_scans.h"
@@ -39,6 +41,17 @@ int main(int argc, char** argv) {
   bool no_group_rule = false, at_ref = false;
   app.add_flag("--at-reference", at_ref, "also register each frame alone from its reference pose (diagnostics)");
   app.add_flag("--no-group-rule", no_group_rule, "PCA line groups match independently (both steps)");
+  bool laser_odom = false;
+  app.add_flag("--laser-odometry", laser_odom,
+               "the odometry is the scans' own increments (laser2d::LaserOdometry: each scan matched to the last scans, "
+               "the wheels predicting; the wheels' step where a match fails), as grid2d uses; rows get odom_inc");
+  // The matcher's odometry model (MatcherConfig::odom_sigma_*; default: the wheel model), e.g. for --laser-odometry.
+  double osm = -1, ospm = -1, osr = -1, ospr = -1, osrpm = -1;
+  app.add_option("--odom-sigma", osm, "odometry 1-sigma per step: base [m]");
+  app.add_option("--odom-sigma-per-m", ospm, "... plus this share of the step");
+  app.add_option("--odom-sigma-deg", osr, "odometry yaw 1-sigma per step: base [deg]");
+  app.add_option("--odom-sigma-per-rad", ospr, "... plus this share of the turn");
+  app.add_option("--odom-sigma-deg-per-m", osrpm, "... plus this many deg per metre of the step");
   CLI11_PARSE(app, argc, argv);
   if (gate > 0) mo.set_max_correspondence_m(gate);
   if (initial_search > 0) mo.set_initial_search_m(initial_search);
@@ -58,6 +71,16 @@ int main(int argc, char** argv) {
     fploc::localizer::Config cfg = fploc::config::localizer_config(mo);
     cfg.optimizer = fploc::config::localizer_config(oo).optimizer;
     cfg.uncertainty.frame.plan_sigma_m = plan_sigma;
+    if (osm >= 0) cfg.matcher.odom_sigma_m = osm;
+    if (ospm >= 0) cfg.matcher.odom_sigma_per_m = ospm;
+    if (osr >= 0) cfg.matcher.odom_sigma_rad = osr * M_PI / 180;
+    if (ospr >= 0) cfg.matcher.odom_sigma_per_rad = ospr;
+    if (osrpm >= 0) cfg.matcher.odom_sigma_rad_per_m = osrpm * M_PI / 180;
+    fploc::laser2d::LaserOdometry lodo;
+    std::optional<fploc::Pose2> last_wheel;
+    fploc::Pose2 lo_pose{};
+    int lo_kept = 0, lo_n = 0;
+    std::optional<fploc::Pose2> lo_row_inc;  // this scan's odometry increment (laser or wheels), for the row
     fploc::localizer::Localizer loc(*map.lookup, cfg);
     // --at-reference on an occupancy map: the same share on its raster (the grid localizer's view of it).
     const bool raster = at_ref && map_path.size() > 5 && map_path.substr(map_path.size() - 5) == ".yaml";
@@ -77,7 +100,20 @@ int main(int argc, char** argv) {
       ps2.angle_increment = float(cm::beam_increment(s.ranges.size()));
       ps2.range_max = float(std::min(scans.max_range_m, 1000.0));
       ps2.ranges = s.ranges;
-      if (s.have_wheel_odom) loc.add_odometry(ps2.utime, {s.wheel_odom.x, s.wheel_odom.y, s.wheel_odom.theta});
+      if (laser_odom && s.have_wheel_odom) {
+        const fploc::Pose2 w{s.wheel_odom.x, s.wheel_odom.y, s.wheel_odom.theta};
+        const fploc::Pose2 inc = last_wheel ? fploc::between(*last_wheel, w) : fploc::Pose2{};
+        const double step = std::hypot(inc.x, inc.y), turn = std::abs(inc.yaw);
+        const auto pts = fploc::laser2d::scan_points(s.ranges, -M_PI / 2, cm::beam_increment(s.ranges.size()), 0.05,
+                                                     std::min(scans.max_range_m, 1000.0) - 0.01);
+        const auto st = lodo.update(pts, inc, 0.05 + 0.3 * step, 2 * M_PI / 180 + 0.3 * turn + 3 * M_PI / 180 * step);
+        ++lo_n;
+        if (st) ++lo_kept;
+        if (last_wheel) lo_pose = fploc::compose(lo_pose, st ? st->increment : inc);
+        lo_row_inc = last_wheel ? std::optional<fploc::Pose2>(st ? st->increment : inc) : std::nullopt;
+        last_wheel = w;
+        loc.add_odometry(ps2.utime, lo_pose);
+      } else if (s.have_wheel_odom) loc.add_odometry(ps2.utime, {s.wheel_odom.x, s.wheel_odom.y, s.wheel_odom.theta});
       const fploc::FeatureFrame& f = l2.process(ps2);
       const auto step = loc.process(f, &finals);
       const auto& m = step.sfr.match;
@@ -90,6 +126,7 @@ int main(int argc, char** argv) {
                             {"sfr_status", fploc::matcher::to_string(m.status)}, {"sfr_text", m.text},
                             {"points", m.fit.num_points}, {"inlier_ratio", m.fit.inlier_ratio}, {"rms_m", m.fit.rms_m},
                             {"status", int(loc.uncertainty().status)}, {"why", loc.uncertainty().text}};
+      if (lo_row_inc) row["odom_inc"] = {lo_row_inc->x, lo_row_inc->y, lo_row_inc->yaw};
       if (step.latest) {
         const Eigen::Matrix3d& c = step.latest->covariance;
         row["cov"] = {c(0, 0), c(0, 1), c(0, 2), c(1, 1), c(1, 2), c(2, 2)};
@@ -118,6 +155,7 @@ int main(int argc, char** argv) {
       }
       rows.push_back(row);
     }
+    if (laser_odom) std::cerr << "laser odometry: " << lo_kept << " of " << lo_n << " steps matched\n";
     std::cout << nlohmann::json{{"log", log_path}, {"map", map_path}, {"start", start}, {"scans", rows}}.dump() << "\n";
   } catch (const std::exception& ex) {
     std::cerr << "fploc real-plan-track: " << ex.what() << "\n";
