@@ -46,7 +46,7 @@ class Grid2dNode : public fploc::rt::Node {
       throw std::runtime_error("grid2d.plan.file: '" + path + "' is not a map_server occupancy map (.yaml)");
     const l2::GridLocalizerConfig c = fploc::config::config_of(o);
     const fploc::OccupancyGrid g = fploc::read_occupancy_map(path);
-    auto field = std::make_shared<l2::DistanceField>(g, c.field_max_m);
+    auto field = std::make_shared<fploc::DistanceField>(g, c.field_max_m);
     loc_ = std::make_unique<l2::GridLocalizer>(field, c);
     mount_ = {o.mount_x_m(), o.mount_y_m(), o.mount_yaw_deg() * M_PI / 180};
     z_ = o.z_m();

@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
     const fploc::bench_real::LogScans scans = fploc::bench_real::load_log_scans(log_path, first, end, c.max_range_m);
     const cm::Log& log = scans.log;
     end = scans.end;
-    const auto field = std::make_shared<l2::DistanceField>(fploc::read_occupancy_map(map_path), c.field_max_m);
+    const auto field = std::make_shared<fploc::DistanceField>(fploc::read_occupancy_map(map_path), c.field_max_m);
     l2::GridLocalizer loc(field, c);
     nlohmann::json rows = nlohmann::json::array();
     for (size_t k = first; k < end; ++k) {

@@ -12,7 +12,7 @@
 #include "fploc/carmen/carmen.h"
 #include "fploc/config/localization.h"
 #include "fploc/config/plan_source.h"
-#include "fploc/laser2d/distance_field.h"
+#include "fploc/floorplan/distance_field.h"
 #include "fploc/laser2d/grid_localizer.h"
 #include "fploc/laser2d/laser_odometry.h"
 #include "fploc/laser2d/laser2d.h"
@@ -71,6 +71,7 @@ int main(int argc, char** argv) {
     fploc::localizer::Config cfg = fploc::config::localizer_config(mo);
     cfg.optimizer = fploc::config::localizer_config(oo).optimizer;
     cfg.uncertainty.frame.plan_sigma_m = plan_sigma;
+    cfg.free_space = map.free_space.get();
     if (osm >= 0) cfg.matcher.odom_sigma_m = osm;
     if (ospm >= 0) cfg.matcher.odom_sigma_per_m = ospm;
     if (osr >= 0) cfg.matcher.odom_sigma_rad = osr * M_PI / 180;
@@ -84,8 +85,23 @@ int main(int argc, char** argv) {
     fploc::localizer::Localizer loc(*map.lookup, cfg);
     // --at-reference on an occupancy map: the same share on its raster (the grid localizer's view of it).
     const bool raster = at_ref && map_path.size() > 5 && map_path.substr(map_path.size() - 5) == ".yaml";
-    const fploc::laser2d::DistanceField df =
-        raster ? fploc::laser2d::DistanceField(fploc::read_occupancy_map(map_path), 1.0) : fploc::laser2d::DistanceField();
+    const fploc::OccupancyGrid grid = raster ? fploc::read_occupancy_map(map_path) : fploc::OccupancyGrid{};
+    const fploc::DistanceField df = raster ? fploc::DistanceField(grid, 1.0) : fploc::DistanceField();
+    // The share of a frame's points at pose p that land in the map's known free space (a free cell farther than
+    // the inlier distance from any occupied cell: what the map says is empty) and in unknown space / off the map.
+    auto free_unknown = [&](const fploc::FeatureFrame& f, const fploc::Pose2& p) {
+      int fr = 0, un = 0;
+      const double c = std::cos(p.yaw), sn = std::sin(p.yaw);
+      for (const auto& q : f.points) {
+        const Eigen::Vector2d w(p.x + c * q.p.x() - sn * q.p.y(), p.y + sn * q.p.x() + c * q.p.y());
+        const Eigen::Vector2d cc = df.to_cell(w);
+        const int i = int(std::lround(cc.x())), j = int(std::lround(cc.y()));
+        if (i < 0 || j < 0 || i >= grid.width || j >= grid.height || grid.at(i, j) < 0) ++un;
+        else if (!grid.occupied(i, j) && df.nearest(w) > loc.config().matcher.inlier_m) ++fr;
+      }
+      const double n = std::max<size_t>(1, f.points.size());
+      return std::pair<double, double>(fr / n, un / n);
+    };
     fploc::laser2d::Laser2dFeatures l2{fploc::laser2d::Laser2dConfig{}};
     fploc::Pose2 p0 = fploc::bench_real::start_pose(log, first, start);
     loc.set_pose(p0);
@@ -151,6 +167,14 @@ int main(int argc, char** argv) {
           ++n;
         }
         row["ref_inliers_at_ref"] = n ? double(near) / n : 0.0;
+        if (raster) {
+          const auto [fe, ue] = free_unknown(f, est);
+          const auto [fr, ur] = free_unknown(f, {s.pose.x, s.pose.y, s.pose.theta});
+          row["free_at_est"] = fe;
+          row["unknown_at_est"] = ue;
+          row["free_at_ref"] = fr;
+          row["unknown_at_ref"] = ur;
+        }
         if (raster) row["ref_inliers_at_ref_grid"] = n ? double(near_df) / n : 0.0;
       }
       rows.push_back(row);

@@ -91,7 +91,7 @@ int main(int argc, char** argv) {
     const fploc::bench_real::LogScans scans = fploc::bench_real::load_log_scans(log_path, first, end, c.max_range_m);
     const cm::Log& log = scans.log;
     end = scans.end;
-    const auto field = std::make_shared<l2::DistanceField>(fploc::read_occupancy_map(map_path), c.field_max_m);
+    const auto field = std::make_shared<fploc::DistanceField>(fploc::read_occupancy_map(map_path), c.field_max_m);
     l2::GridLocalizer loc(field, c);
     fploc::Pose2 p0 = fploc::bench_real::start_pose(log, first, start);
     if (start_pose.size() == 3) p0 = {start_pose[0], start_pose[1], start_pose[2]};

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "fploc/floorplan/io.h"
+#include "fploc/floorplan/free_space.h"
 #include "fploc/floorplan/occupancy.h"
 
 using namespace fploc;
@@ -226,4 +227,38 @@ TEST(Occupancy, MutatedInputsNeverCrash) {
   }
   EXPECT_GT(ok, 0);
   EXPECT_GT(err, 0);
+}
+
+// The free space of a grid: a wall column, free cells on one side, unknown on the other. A point is free only in a
+// known free cell farther than the clearance from the wall's cell centres; unknown cells, occupied cells and points
+// off the map are not (the map has no opinion there); a rotated origin is honoured.
+TEST(FreeSpace, KnownFreeBeyondTheClearanceOnly) {
+  OccupancyGrid g;
+  g.width = 40;
+  g.height = 20;
+  g.resolution = 0.05;
+  g.origin_x = 1.0;
+  g.origin_y = 2.0;
+  g.data.assign(size_t(g.width) * g.height, 0);
+  for (int j = 0; j < g.height; ++j) {
+    g.data[size_t(j) * g.width + 20] = 100;                                    // wall: x = 1.0 + 20.5 * 0.05 = 2.025
+    for (int i = 21; i < g.width; ++i) g.data[size_t(j) * g.width + i] = -1;  // unknown beyond it
+  }
+  const FreeSpace fs(g);
+  EXPECT_EQ(fs.free_cells(), 20u * 20u);
+  const double y = 2.5, wall_x = 2.025;
+  EXPECT_TRUE(fs.free({wall_x - 0.5, y}, 0.1));
+  EXPECT_TRUE(fs.free({wall_x - 0.2, y}, 0.1));
+  EXPECT_FALSE(fs.free({wall_x - 0.2, y}, 0.3)) << "within the clearance";
+  EXPECT_FALSE(fs.free({wall_x - 0.05, y}, 0.1)) << "next to the wall";
+  EXPECT_FALSE(fs.free({wall_x, y}, 0.1)) << "on the wall";
+  EXPECT_FALSE(fs.free({wall_x + 0.5, y}, 0.1)) << "unknown";
+  EXPECT_FALSE(fs.free({0.5, y}, 0.1)) << "off the map";
+  EXPECT_FALSE(fs.free({wall_x - 0.5, 5.0}, 0.1)) << "off the map";
+  EXPECT_FALSE(FreeSpace().free({0, 0}, 0.1)) << "no map";
+  // The same map rotated by 90 degrees about its origin: map x runs along world y, map y along world -x.
+  g.origin_yaw = M_PI / 2;
+  const FreeSpace rot(g);
+  EXPECT_TRUE(rot.free({1.0 - 0.5, 2.0 + (wall_x - 1.0) - 0.5}, 0.1));
+  EXPECT_FALSE(rot.free({1.0 - 0.5, 2.0 + (wall_x - 1.0) + 0.5}, 0.1)) << "unknown side";
 }

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "fploc/core/pose.h"
-#include "fploc/laser2d/distance_field.h"
+#include "fploc/floorplan/distance_field.h"
 #include "fploc/laser2d/grid_localizer.h"
 
 namespace fploc::laser2d::detail {

@@ -5,7 +5,7 @@
 
 #include "field_fit.h"
 #include "fploc/floorplan/occupancy.h"
-#include "fploc/laser2d/distance_field.h"
+#include "fploc/floorplan/distance_field.h"
 
 namespace fploc::laser2d {
 

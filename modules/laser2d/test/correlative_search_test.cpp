@@ -42,7 +42,7 @@ std::vector<Eigen::Vector2d> scan_of(const OccupancyGrid& g, const Pose2& p, std
 
 TEST(CorrelativeSearch, BranchAndBoundFindsTheExhaustiveBest) {
   const OccupancyGrid g = room();
-  const l2::DistanceField df(g, 1.0);
+  const fploc::DistanceField df(g, 1.0);
   const l2::ScorePyramid pyr(df, 0.1);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> ux(1, 9), uy(0.5, 5.5), uyaw(-M_PI, M_PI), uoff(-0.4, 0.4);
@@ -70,7 +70,7 @@ TEST(CorrelativeSearch, BranchAndBoundFindsTheExhaustiveBest) {
 
 TEST(CorrelativeSearch, KeepsDistinctCandidatesBestFirst) {
   const OccupancyGrid g = room();
-  const l2::DistanceField df(g, 1.0);
+  const fploc::DistanceField df(g, 1.0);
   const l2::ScorePyramid pyr(df, 0.1);
   std::mt19937 rng(5);
   const Pose2 truth{2.0, 3.0, 0.3};

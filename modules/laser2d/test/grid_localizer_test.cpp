@@ -9,7 +9,7 @@
 #include <iostream>
 #include <random>
 
-#include "fploc/laser2d/distance_field.h"
+#include "fploc/floorplan/distance_field.h"
 #include "fploc/laser2d/grid_localizer.h"
 #include "../src/field_fit.h"
 #include "synthetic_grid.h"
@@ -90,7 +90,7 @@ struct TrackRun {
 
 TrackRun track(const Pose2& start) {
   const OccupancyGrid g = make_room();
-  auto df = std::make_shared<l2::DistanceField>(g, 1.0);
+  auto df = std::make_shared<fploc::DistanceField>(g, 1.0);
   l2::GridLocalizer loc(df);
   loc.set_initial_pose(start);
   std::mt19937 rng(7);
@@ -119,7 +119,7 @@ TEST(DistanceField, ExactWithinTruncation) {
   g.origin_y = -1;
   g.data.assign(size_t(g.width) * g.height, 0);
   g.data[size_t(10) * g.width + 20] = 100;  // cell (20, 10): centre (4.05, 0.05)
-  const l2::DistanceField df(g, 1.0);
+  const fploc::DistanceField df(g, 1.0);
   EXPECT_EQ(df.occupied_cells(), 1u);
   EXPECT_FLOAT_EQ(df.at(20, 10), 0.f);
   EXPECT_NEAR(df.at(23, 14), 0.5, 1e-6);                             // 3-4-5 cells
@@ -146,7 +146,7 @@ TEST(GridLocalizer, UnexplainedScanIsPoorAndKeepsTheOdometry) {
   const OccupancyGrid map = make_room(), other = make_room(true);
   l2::GridLocalizerConfig c;
   c.calibrate_odometry = false;  // the raw odometry's prediction (the first good pair would already correct it)
-  l2::GridLocalizer loc(std::make_shared<l2::DistanceField>(map, 1.0), c);
+  l2::GridLocalizer loc(std::make_shared<fploc::DistanceField>(map, 1.0), c);
   loc.set_initial_pose({1, 1, 0});
   std::mt19937 rng(3);
   ASSERT_EQ(loc.update(cast(map, {1, 1, 0}, rng), Pose2{0, 0, 0}).status, l2::GridStatus::kOk);
@@ -170,7 +170,7 @@ double kidnap_run(bool reacquire, int* reacquired, int* ok_tail, double* tail_ma
   const OccupancyGrid g = make_room();
   l2::GridLocalizerConfig c;
   c.reacquire = reacquire;
-  l2::GridLocalizer loc(std::make_shared<l2::DistanceField>(g, 1.0), c);
+  l2::GridLocalizer loc(std::make_shared<fploc::DistanceField>(g, 1.0), c);
   const auto lap = trajectory();
   std::vector<Pose2> base;
   for (int k = 0; k < 3; ++k) base.insert(base.end(), lap.begin(), lap.end());
@@ -228,7 +228,7 @@ TEST(GridLocalizer, ScanPointsDropInvalidAndApplyMount) {
 void tracked_then_unexplained(const l2::GridLocalizerConfig& c, int scans, double step,
                               const std::function<void(const l2::GridResult&)>& each) {
   const OccupancyGrid map = make_room(), other = make_room(true);
-  l2::GridLocalizer loc(std::make_shared<l2::DistanceField>(map, 1.0), c);
+  l2::GridLocalizer loc(std::make_shared<fploc::DistanceField>(map, 1.0), c);
   loc.set_initial_pose({1, 1, 0});
   std::mt19937 rng(5);
   EXPECT_EQ(loc.update(cast(map, {1, 1, 0}, rng), Pose2{0, 0, 0}).status, l2::GridStatus::kOk);
@@ -262,7 +262,7 @@ l2::GridResult wrong_turn(double retry_factor, const Pose2& truth) {
   const OccupancyGrid map = make_room();
   l2::GridLocalizerConfig c;
   c.retry_window_factor = retry_factor;
-  l2::GridLocalizer loc(std::make_shared<l2::DistanceField>(map, 1.0), c);
+  l2::GridLocalizer loc(std::make_shared<fploc::DistanceField>(map, 1.0), c);
   loc.set_initial_pose({1, 1, 0});
   std::mt19937 rng(9);
   EXPECT_EQ(loc.update(cast(map, {1, 1, 0}, rng), Pose2{0, 0, 0}).status, l2::GridStatus::kOk);
@@ -290,7 +290,7 @@ Pose2 dead_reckoning_error(bool calibrate) {
   const OccupancyGrid g = make_room();
   l2::GridLocalizerConfig c;
   c.calibrate_odometry = calibrate;
-  l2::GridLocalizer loc(std::make_shared<l2::DistanceField>(g, 1.0), c);
+  l2::GridLocalizer loc(std::make_shared<fploc::DistanceField>(g, 1.0), c);
   const auto lap = trajectory();
   std::vector<Pose2> truth;
   for (int k = 0; k < 3; ++k) truth.insert(truth.end(), lap.begin(), lap.end());
@@ -365,7 +365,7 @@ OccupancyGrid boxes(bool second) {
 // explain (a weak fit); the odometry reports no motion.
 l2::GridResult reacquire_in_boxes(const l2::GridLocalizerConfig& c, bool second, const Pose2& start, int clutter) {
   const OccupancyGrid g = boxes(second);
-  l2::GridLocalizer loc(std::make_shared<l2::DistanceField>(g, 1.0), c);
+  l2::GridLocalizer loc(std::make_shared<fploc::DistanceField>(g, 1.0), c);
   loc.set_initial_pose(start);
   EXPECT_EQ(loc.update({}, Pose2{0, 0, 0}).status, l2::GridStatus::kPoor);
   std::mt19937 rng(17);
@@ -407,7 +407,7 @@ TEST(GridLocalizer, TrackIsPublishedOkAgainOnlyOnceReconfirmedAfterLost) {
   for (const auto& [unexplained, clutter] :
        std::vector<std::pair<int, double>>{{lost_after + 2, 0.0}, {lost_after + 2, 0.45}, {2, 0.0}}) {
     const OccupancyGrid map = make_room(), other = make_room(true);
-    l2::GridLocalizer loc(std::make_shared<l2::DistanceField>(map, 1.0));
+    l2::GridLocalizer loc(std::make_shared<fploc::DistanceField>(map, 1.0));
     loc.set_initial_pose({1, 1, 0});
     std::mt19937 rng(5), crng(3);
     std::uniform_real_distribution<double> u(0, 1);
@@ -462,7 +462,7 @@ namespace {
 // by points 1-3 m in front of the robot's left half, where the map has nothing (people, furniture).
 std::vector<l2::GridResult> track_all(const l2::GridLocalizerConfig& c, double clutter = 0) {
   const OccupancyGrid g = make_room();
-  auto df = std::make_shared<l2::DistanceField>(g, 1.0);
+  auto df = std::make_shared<fploc::DistanceField>(g, 1.0);
   l2::GridLocalizer loc(df, c);
   loc.set_initial_pose({1, 1, 0});
   std::mt19937 rng(7), crng(11);
@@ -583,7 +583,7 @@ Pose2 dead_reckoned_through_unmapped_room(bool laser) {
   const OccupancyGrid world = make_room(), map = make_room(true);
   l2::GridLocalizerConfig c;
   c.laser_odometry = laser;
-  l2::GridLocalizer loc(std::make_shared<l2::DistanceField>(map, 1.0), c);
+  l2::GridLocalizer loc(std::make_shared<fploc::DistanceField>(map, 1.0), c);
   const auto truth = trajectory();
   const auto odo = odometry(truth);
   loc.set_initial_pose(truth[0]);
@@ -637,7 +637,7 @@ AliasRun run_in_box(const l2::GridLocalizerConfig& c, bool in_mapped_box, int sc
   };
   box(world, in_mapped_box ? 6 : 0);
   box(map, 6);
-  l2::GridLocalizer loc(std::make_shared<l2::DistanceField>(map, 1.0), c);
+  l2::GridLocalizer loc(std::make_shared<fploc::DistanceField>(map, 1.0), c);
   loc.set_initial_pose({0.5, 0.4, M_PI / 2});
   std::mt19937 rng(23);
   AliasRun out;
@@ -681,7 +681,7 @@ TEST(GridLocalizer, FarHypothesisNeedsTravelToBeTaken) {
 // off with the residual (its pull at 6 sigma is 0.16 of Huber's), Tukey's to nothing.
 TEST(FieldFit, RedescendingLossesPullLessTowardsUnmappedStructure) {
   const OccupancyGrid map = make_room();
-  auto df = std::make_shared<l2::DistanceField>(map, 1.0);
+  auto df = std::make_shared<fploc::DistanceField>(map, 1.0);
   const l2::detail::InterpolatedField field(df);
   const Pose2 truth{9.5, 3.5, 0.1};
   std::vector<Eigen::Vector2d> world;  // wall cell centres: east wall x = 12.525, south y = -0.475, north y = 7.525

@@ -88,7 +88,7 @@ void UncertaintyTracker::reset(double sigma_m, double sigma_rad) {
 UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d& frame_cov_in, bool frame_valid,
                                             matcher::FitStatus matcher_status, const std::string& matcher_text,
                                             const Pose2* fix, const matcher::Twist2* twist, double inlier_ratio,
-                                            const Pose2* motion) {
+                                            const Pose2* motion, double contradicted) {
   const double vmax = cfg_.frame.max_variance;
   const double v2 = cfg_.max_velocity_error_mps * cfg_.max_velocity_error_mps;
   const double w2 = cfg_.yaw_rate_sigma_rps * cfg_.yaw_rate_sigma_rps;
@@ -215,6 +215,10 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
       s.text = b;
     } else if (inlier_ratio < cfg_.weak_fit_ratio) {
       std::snprintf(b, sizeof b, "weak fit: %.0f %% of the points on the plan", 100 * inlier_ratio);
+      s.status = matcher::FitStatus::kPoor;
+      s.text = b;
+    } else if (cfg_.max_contradicted > 0 && contradicted > cfg_.max_contradicted) {
+      std::snprintf(b, sizeof b, "the map says empty where %.0f %% of the points it knows lie", 100 * contradicted);
       s.status = matcher::FitStatus::kPoor;
       s.text = b;
     }

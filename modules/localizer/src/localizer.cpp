@@ -105,6 +105,18 @@ std::optional<Pose2> Localizer::odometry_between(int64_t from_utime, int64_t to_
   return between(*a, *b);
 }
 
+double Localizer::contradicted(const FeatureFrame& f, const Pose2& x, double inlier_ratio) const {
+  if (!cfg_.free_space || f.points.empty()) return 0.0;
+  const double c = std::cos(x.yaw), s = std::sin(x.yaw);
+  size_t in_free = 0;
+  for (const auto& q : f.points) {
+    const Eigen::Vector2d w(x.x + c * q.p.x() - s * q.p.y(), x.y + s * q.p.x() + c * q.p.y());
+    in_free += cfg_.free_space->free(w, cfg_.matcher.inlier_m);
+  }
+  const double free_share = double(in_free) / double(f.points.size());
+  return free_share + inlier_ratio > 0 ? free_share / (free_share + inlier_ratio) : 0.0;
+}
+
 std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& sfr, std::vector<Pose>* finals) {
   if (sfr.match.status == matcher::FitStatus::kNotInitialised) return std::nullopt;
   // The odometry's increment since the previous optimized frame predicts this one in the tracker, as in the
@@ -128,7 +140,8 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
     const Pose2 at_ref = compose(sfr.match.pose, matcher::exp_twist(sfr.match.twist, t_ref));
     const auto fu = optimizer::frame_uncertainty(lookup_, deskewed_, at_ref, cfg_.uncertainty.frame);
     uncertainty_ = tracker_.update(f.utime, fu.covariance, fu.valid, sfr.match.status, sfr.match.text, &sfr.match.pose,
-                                   &sfr.match.twist, sfr.match.fit.inlier_ratio, motion ? &*motion : nullptr);
+                                   &sfr.match.twist, sfr.match.fit.inlier_ratio, motion ? &*motion : nullptr,
+                                   contradicted(deskewed_, at_ref, sfr.match.fit.inlier_ratio));
     in.covariance = uncertainty_.covariance;
     in.published_status = uncertainty_.status;
     in.status_text = uncertainty_.text;

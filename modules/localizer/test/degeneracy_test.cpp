@@ -267,6 +267,27 @@ TEST(Degeneracy, WeakFitIsPublishedPoor) {
   }
 }
 
+// A fix whose points land where the map says it is empty (more than a quarter of those the map knows about) is
+// published POOR with the share; at or below a quarter, or with the check off, it stays OK.
+TEST(Degeneracy, FixContradictingTheMapsFreeSpaceIsPublishedPoor) {
+  UncertaintyConfig cfg, off;
+  cfg.confirm_fixes = off.confirm_fixes = 0;
+  off.max_contradicted = 0;
+  ASSERT_EQ(cfg.max_contradicted, 0.25);
+  UncertaintyTracker tr(cfg), keep(off);
+  const Eigen::Matrix3d fixed = diag(0.01, 0.01, 0.002);
+  Pose2 p{0, 0, 0};
+  matcher::Twist2 v;
+  int64_t t = 0;
+  for (double c : {0.0, 0.3, 0.25, 0.1, 0.6}) {
+    const auto s = tr.update(t, fixed, true, FitStatus::kOk, {}, &p, &v, 0.9, nullptr, c);
+    EXPECT_EQ(s.status, c > 0.25 ? FitStatus::kPoor : FitStatus::kOk) << c;
+    if (c == 0.3) EXPECT_NE(s.text.find("the map says empty where 30 %"), std::string::npos) << s.text;
+    EXPECT_EQ(keep.update(t, fixed, true, FitStatus::kOk, {}, &p, &v, 0.9, nullptr, c).status, FitStatus::kOk);
+    t += 100000;
+  }
+}
+
 // With odometry (2D laser logs: frames a metre and tens of degrees apart, seconds between them), the tracked
 // prediction is the last fix composed with the odometry's increment: fixes that follow a 1 m / 30 degree step
 // 2 s apart are taken (OK, not a re-acquisition after the first confirmation), where the twist's constant

@@ -2,9 +2,15 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
+#include <unistd.h>
 
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "fploc/floorplan/free_space.h"
 #include "fploc/matcher/map.h"
+#include "fploc/matcher/plan_terms.h"
 #include "synthetic.h"
 
 using namespace fploc;
@@ -172,4 +178,65 @@ TEST_F(LocalizerTest, OdometryAtItsOwnRatePredictsTheFrame) {
       EXPECT_EQ(s.sfr.match.status, matcher::FitStatus::kOk) << k << " " << s.sfr.match.text;
     }
   }
+}
+
+// A plan that is an occupancy map also says where it is empty. The room rasterised at 5 cm (occupied within half
+// a cell diagonal of an element, else free): a frame at its true pose puts almost none of its points in the free
+// space; the same frame 0.6 m off puts its unmatched points on empty floor (contradicted > a quarter, the
+// published POOR); a whole run with the free space publishes no such POOR. A plan loaded from a map_server file
+// carries its free space, a JSON plan none.
+TEST_F(LocalizerTest, FreeSpaceOfAnOccupancyMapContradictsAFixOnEmptyFloor) {
+  const Box2 box = map_.plan->bounds();
+  OccupancyGrid g;
+  g.resolution = 0.05;
+  g.origin_x = box.min.x() - 1.0;
+  g.origin_y = box.min.y() - 1.0;
+  g.width = int(std::ceil((box.size().x() + 2.0) / g.resolution));
+  g.height = int(std::ceil((box.size().y() + 2.0) / g.resolution));
+  g.data.assign(size_t(g.width) * size_t(g.height), 0);
+  for (int j = 0; j < g.height; ++j)
+    for (int i = 0; i < g.width; ++i) {
+      const Eigen::Vector2d c = g.cell_centre(i, j);
+      for (const auto& e : map_.plan->elements)
+        if (distance(e, c) <= 0.5 * std::sqrt(2.0) * g.resolution) g.data[size_t(j) * size_t(g.width) + size_t(i)] = 100;
+    }
+  const FreeSpace fs(g);
+  localizer::Config cfg;
+  cfg.free_space = &fs;
+  const localizer::Localizer probe(*map_.lookup, cfg);
+  const Pose2 truth = truth_at(2.0), off{truth.x + 0.6, truth.y, truth.yaw};
+  SynthOptions so;  // one instant (no sweep to de-skew), 1 cm noise
+  so.noise_sigma = 0.01;
+  const FeatureFrame f = synth_frame(*map_.plan, truth, so);
+  const double in_m = cfg.matcher.inlier_m;
+  const double at_truth = probe.contradicted(f, truth, matcher::evaluate_fit(*map_.lookup, f, truth, in_m, 1).inlier_ratio);
+  const double at_off = probe.contradicted(f, off, matcher::evaluate_fit(*map_.lookup, f, off, in_m, 1).inlier_ratio);
+  EXPECT_LT(at_truth, 0.05);
+  EXPECT_GT(at_off, 0.25);
+  localizer::Localizer loc(*map_.lookup, cfg);
+  loc.set_pose(truth_at(0.0));
+  std::vector<localizer::Pose> finals;
+  int poor_free = 0;
+  for (size_t k = 0; k < frames_.size(); ++k) {
+    feed_imu(loc, 0.1 * k - 0.1, 0.1 * k + 0.11);
+    loc.process(frames_[k], &finals);
+    poor_free += loc.uncertainty().text.find("the map says empty") != std::string::npos;
+  }
+  EXPECT_EQ(poor_free, 0);
+  // Loaded from files: the occupancy map keeps its free space.
+  const auto dir = std::filesystem::temp_directory_path() / ("fploc_loc_free_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream pgm(dir / "m.pgm", std::ios::binary);
+    pgm << "P5\n" << g.width << " " << g.height << "\n255\n";
+    for (int row = g.height - 1; row >= 0; --row)  // PGM rows top first; the grid's row 0 is the bottom
+      for (int i = 0; i < g.width; ++i) pgm << char(g.at(i, row) == 100 ? 0 : 254);
+    std::ofstream(dir / "m.yaml") << "image: m.pgm\nresolution: 0.05\norigin: [" << g.origin_x << ", " << g.origin_y
+                                  << ", 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+  }
+  const auto from_yaml = matcher::load_localization_map((dir / "m.yaml").string(), {}, "", "annf-exact");
+  ASSERT_NE(from_yaml.free_space, nullptr);
+  EXPECT_EQ(from_yaml.free_space->free_cells(), fs.free_cells());
+  EXPECT_EQ(map_.free_space, nullptr);
+  std::filesystem::remove_all(dir);
 }

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "fploc/floorplan/io.h"
+#include "fploc/floorplan/occupancy.h"
 #include "fploc/annf/annf.h"
 #include "fploc/annf/cache.h"
 
@@ -102,6 +103,8 @@ LocalizationMap load_localization_map(const std::string& path, const std::vector
   }
   m.plan = std::make_shared<const FloorPlan>(load_floor_plan(path, layers, units));
   m.note = "loaded " + path;
+  if (ends_with(path, ".yaml") || ends_with(path, ".yml"))
+    m.free_space = std::make_shared<const FreeSpace>(read_occupancy_map(path));
   return finish(std::move(m), lookup, annf);
 }
 

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "fploc/core/pose.h"
-#include "fploc/laser2d/distance_field.h"
+#include "fploc/floorplan/distance_field.h"
 
 namespace fploc::laser2d {
 

@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "fploc/core/pose.h"
-#include "fploc/laser2d/distance_field.h"
+#include "fploc/floorplan/distance_field.h"
 #include "fploc/laser2d/laser_odometry.h"
 #include "fploc/laser2d/odometry_calibration.h"
 

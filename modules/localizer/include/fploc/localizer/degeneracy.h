@@ -23,7 +23,8 @@
 // a text naming the direction ("position open along 87 deg (1 sigma 0.31 m): the plan does not constrain
 // it here"). The matcher's POOR/LOST stay as they are (LOST means lost, not merely uncertain). A fix is also
 // published POOR when the innovation gate refuses it, while a re-acquired track is being confirmed
-// (confirm_fixes) and when under half of its points lie on the plan (weak_fit_ratio).
+// (confirm_fixes), when under half of its points lie on the plan (weak_fit_ratio) and when the map says empty
+// where many of them lie (max_contradicted; occupancy-map plans only).
 #pragma once
 #include <Eigen/Core>
 #include <cmath>
@@ -66,6 +67,15 @@ struct UncertaintyConfig {
   // the plan explains less than half of what the sensor sees there. The grid localizer's min_inlier_ratio and
   // weak_fit_is_poor. Status only. 0: off.
   double weak_fit_ratio = 0.5;
+  // Free-space contradiction (a plan from an occupancy map, which also says where it is empty: update()'s
+  // `contradicted`): of the fix's points the map has an opinion about, those on the plan (within the inlier
+  // distance) and those in its known free space (farther than that from any occupied cell), the share in free
+  // space. Above max_contradicted the fix is published POOR ("the map says empty where k % of the points it
+  // knows lie"). Points in unknown space or off the map count for neither: a room the map saw only in part
+  // leaves the fix a weak fit, not a contradicted one; a fix slid onto a wrong place puts its unmatched points
+  // where the map saw nothing. A quarter: a correct pose's contradictions are the few people, doors and
+  // furniture moved since the map was made. Status only. 0 or above 1: off.
+  double max_contradicted = 0.25;
   // Odometry (the robot's own, e.g. its wheels: update()'s `motion`): the prediction is the tracked pose composed
   // with the increment, as the matcher predicts with it, whatever the time between frames (2D laser logs have
   // frames seconds and a metre apart), and P grows by the step's own 1-sigma instead of the velocity model's
@@ -96,10 +106,11 @@ class UncertaintyTracker {
   // motion model, carried to the next frame) the innovation gate applies (see gate_sigma); inlier_ratio is the
   // fix's share of points on the plan (weak_fit_ratio). motion: the robot's odometry increment since the
   // previous update (in that frame's body frame), if any: it predicts instead of the twist (odom_sigma_*).
+  // contradicted: the fix's free-space contradiction share (max_contradicted; 0 without a free space).
   UncertaintyState update(int64_t utime, const Eigen::Matrix3d& frame_cov, bool frame_valid, matcher::FitStatus matcher_status,
                           const std::string& matcher_text = {}, const Pose2* fix = nullptr,
                           const matcher::Twist2* twist = nullptr, double inlier_ratio = 1.0,
-                          const Pose2* motion = nullptr);
+                          const Pose2* motion = nullptr, double contradicted = 0.0);
   // A new initial pose with its uncertainty (1-sigma x/y and yaw); the velocity is unknown.
   void reset(double sigma_m, double sigma_rad);
   void reset() { have_ = false; }

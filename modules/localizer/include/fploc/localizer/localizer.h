@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "fploc/floorplan/free_space.h"
 #include "fploc/localizer/degeneracy.h"
 #include "fploc/matcher/imu_yaw.h"
 #include "fploc/matcher/matcher.h"
@@ -31,6 +32,10 @@ struct Config {
   // The published covariance and status (degeneracy.h); its frame loss/gate follow `matcher` unless
   // set apart (Localizer's constructor copies them).
   UncertaintyConfig uncertainty;
+  // The map's free space when the plan is an occupancy map (LocalizationMap::free_space; not owned: the caller
+  // keeps it alive, as ActivePlan does): the published status checks each fix against it
+  // (UncertaintyConfig::max_contradicted). Null: no such check.
+  const FreeSpace* free_space = nullptr;
 };
 
 // The SFR step's result for one frame (what FPLOC_FRAME_POSE carries).
@@ -92,6 +97,10 @@ class Localizer {
   const matcher::Matcher& matcher() const { return matcher_; }
   // The uncertainty published with the last optimize()d frame.
   const UncertaintyState& uncertainty() const { return uncertainty_; }
+  // Of the frame's points at x that the map has an opinion about (inliers: inlier_ratio of them; and those in
+  // cfg.free_space beyond the matcher's inlier distance), the share in free space (0 without a free space).
+  // The published status checks each fix with it (UncertaintyConfig::max_contradicted).
+  double contradicted(const FeatureFrame& f, const Pose2& x, double inlier_ratio) const;
 
  private:
   // The odometry pose at a frame's time (see Config::odometry_max_age_s), and the increment between two

@@ -1,12 +1,14 @@
 // The localization map a node loads: the floor plan, the ANNF when the look-up needs one, and the
 // selected correspondence look-up. Look-up names: "annf-exact" (default), "annf-paper" (the leaf's two
 // stored candidates, the closer one used), "annf-paper-first" (only the leaf's first element),
-// "kdtree" (points sampled on the plan), "brute-force".
+// "kdtree" (points sampled on the plan), "brute-force". A plan loaded from an occupancy map (map_server
+// .yaml) also keeps the map's free space (floorplan/free_space.h), which the published status checks.
 #pragma once
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "fploc/floorplan/free_space.h"
 #include "fploc/floorplan/plan.h"
 #include "fploc/matcher/lookup.h"
 
@@ -20,6 +22,7 @@ struct LocalizationMap {
   std::shared_ptr<const FloorPlan> plan;
   std::shared_ptr<const annf::Annf> annf;  // null unless an ANNF look-up is used
   std::unique_ptr<NearestLookup> lookup;
+  std::shared_ptr<const FreeSpace> free_space;  // null unless the plan is an occupancy map
   std::string note;                  // what was loaded/built (for logs)
 };
 

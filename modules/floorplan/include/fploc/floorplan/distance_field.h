@@ -1,8 +1,8 @@
-// A raster map for matching planar scans directly: the Euclidean distance from every cell of an occupancy
-// grid (ROS map_server, modules/floorplan) to the nearest occupied cell centre, truncated at max_m. The 2D
-// mode's grid localizer (grid_localizer.h) scores and refines scans on it, instead of on the plan that the
-// vectorisation of the same grid gives (its segments cut corners by up to half a cell and split at every
-// unknown cell; the field keeps every occupied cell as it was measured).
+// A raster of an occupancy grid (ROS map_server, occupancy.h): the Euclidean distance from every cell to the
+// nearest occupied cell centre, truncated at max_m. The 2D mode's grid localizer (laser2d/grid_localizer.h)
+// scores and refines planar scans on it, instead of on the plan that the vectorisation of the same grid gives
+// (its segments cut corners by up to half a cell and split at every unknown cell; the field keeps every
+// occupied cell as it was measured); FreeSpace (free_space.h) measures clearances on it.
 //
 // Built by stamping: every occupied cell writes its distance into the cells of a disc of radius max_m
 // around it (min over stamps), i.e. exact within the truncation. Row 0 is the bottom row (y = origin_y), as
@@ -14,7 +14,7 @@
 
 #include "fploc/floorplan/occupancy.h"
 
-namespace fploc::laser2d {
+namespace fploc {
 
 class DistanceField {
  public:
@@ -47,4 +47,4 @@ class DistanceField {
   std::vector<float> d_;
 };
 
-}  // namespace fploc::laser2d
+}  // namespace fploc

@@ -1,10 +1,10 @@
-#include "fploc/laser2d/distance_field.h"
+#include "fploc/floorplan/distance_field.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
-namespace fploc::laser2d {
+namespace fploc {
 
 DistanceField::DistanceField(const OccupancyGrid& g, double max_m)
     : w_(g.width), h_(g.height), res_(g.resolution), max_m_(max_m), ox_(g.origin_x), oy_(g.origin_y),
@@ -50,4 +50,4 @@ float DistanceField::nearest(const Eigen::Vector2d& p) const {
   return at(int(std::lround(c.x())), int(std::lround(c.y())));
 }
 
-}  // namespace fploc::laser2d
+}  // namespace fploc
