@@ -1,5 +1,7 @@
 #include "fploc/localizer/localizer.h"
 
+#include "fploc/matcher/free_space_check.h"
+
 #include <cmath>
 
 namespace fploc::localizer {
@@ -106,15 +108,7 @@ std::optional<Pose2> Localizer::odometry_between(int64_t from_utime, int64_t to_
 }
 
 double Localizer::contradicted(const FeatureFrame& f, const Pose2& x, double inlier_ratio) const {
-  if (!cfg_.free_space || f.points.empty()) return 0.0;
-  const double c = std::cos(x.yaw), s = std::sin(x.yaw);
-  size_t in_free = 0;
-  for (const auto& q : f.points) {
-    const Eigen::Vector2d w(x.x + c * q.p.x() - s * q.p.y(), x.y + s * q.p.x() + c * q.p.y());
-    in_free += cfg_.free_space->free(w, cfg_.matcher.inlier_m);
-  }
-  const double free_share = double(in_free) / double(f.points.size());
-  return free_share + inlier_ratio > 0 ? free_share / (free_share + inlier_ratio) : 0.0;
+  return cfg_.free_space ? matcher::contradicted_share(*cfg_.free_space, f, x, cfg_.matcher.inlier_m, inlier_ratio) : 0.0;
 }
 
 std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& sfr, std::vector<Pose>* finals) {
