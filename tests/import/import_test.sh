@@ -59,6 +59,9 @@ SHIP="$(ls "$D"/recordings/ship-interior/*.bag 2>/dev/null | head -1 || true)"
 if [ -n "$SHIP" ]; then
   "$B/fploc-import" "$SHIP" --out "$T/ship.lcm" --tum-out "$T/odom.tum" --json > "$T/ship.json"
   check "$T/ship.json" "j['written']['LASER_SCAN']==421 and j['written']['LASER_SCAN_GUARDIAN_LASER_HORIZONTAL_BACK']==418 and j['written']['(tum /guardian/odom)']==839 and j['written']['WHEEL_ODOM']==839"
+  # --channel picks which laser is LASER_SCAN; the other one moves to its suffixed name instead of sharing it.
+  "$B/fploc-import" "$SHIP" --out "$T/ship2.lcm" --channel /guardian/laser_horizontal_back=LASER_SCAN --json --quiet > "$T/ship2.json"
+  check "$T/ship2.json" "j['written']['LASER_SCAN']==418 and j['written']['LASER_SCAN_GUARDIAN_LASER_TILT_FRONT']==421"
   [ "$(wc -l < "$T/odom.tum")" -ge 800 ] || { echo "odom.tum too short"; exit 1; }
   "$B/fploc-import" "$SHIP" --tum-out "$T/tf.tum" --tf-parent odom --tf-child base_footprint --start 10 --end 20 --quiet > /dev/null
   python3 - "$T/tf.tum" <<'PY'

@@ -185,7 +185,10 @@ int main(int argc, char** argv) {
   const std::set<std::string> wanted(topics.begin(), topics.end());
   std::map<uint32_t, std::string> channel_of;  // connection -> LCM channel
   std::map<std::string, std::string> topic_channel;
+  // A channel named by --channel is not also a default: another topic of the same kind gets the suffixed name
+  // (e.g. --channel /scan_front=LASER_SCAN puts a second laser on LASER_SCAN_SCAN_BACK, not on LASER_SCAN too).
   std::set<std::string> used_channels;
+  for (const auto& [topic, ch] : channel_override) used_channels.insert(ch);
   auto channel_for = [&](const Connection& c, Kind k) -> const std::string& {
     auto it = channel_of.find(c.id);
     if (it != channel_of.end()) return it->second;
