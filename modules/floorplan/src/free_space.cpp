@@ -17,8 +17,9 @@ FreeSpace::FreeSpace(const OccupancyGrid& g) : field_(g, kMaxClearanceM) {
 bool FreeSpace::free(const Eigen::Vector2d& p, double clearance_m) const {
   if (known_free_.empty()) return false;
   const Eigen::Vector2d c = field_.to_cell(p);
+  if (!c.allFinite()) return false;
   const long i = std::lround(c.x()), j = std::lround(c.y());
-  if (!(c.allFinite()) || i < 0 || j < 0 || i >= field_.width() || j >= field_.height()) return false;
+  if (i < 0 || j < 0 || i >= field_.width() || j >= field_.height()) return false;
   if (!known_free_[size_t(j) * size_t(field_.width()) + size_t(i)]) return false;
   return field_.nearest(p) > clearance_m;
 }

@@ -256,6 +256,8 @@ TEST(FreeSpace, KnownFreeBeyondTheClearanceOnly) {
   EXPECT_FALSE(fs.free({0.5, y}, 0.1)) << "off the map";
   EXPECT_FALSE(fs.free({wall_x - 0.5, 5.0}, 0.1)) << "off the map";
   EXPECT_FALSE(FreeSpace().free({0, 0}, 0.1)) << "no map";
+  EXPECT_FALSE(fs.free({std::nan(""), y}, 0.1)) << "not a point";
+  EXPECT_FALSE(fs.free({1e30, y}, 0.1)) << "far off the map";
   // The same map rotated by 90 degrees about its origin: map x runs along world y, map y along world -x.
   g.origin_yaw = M_PI / 2;
   const FreeSpace rot(g);
