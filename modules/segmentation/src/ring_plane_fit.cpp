@@ -233,8 +233,13 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
   // (band_sub_); once it stops shrinking, every point (band_).
   bool shrinking = !fixed;
   auto joins = [&]() {
-    return join && (cur.head<3>() - join->pl.head<3>()).norm() < k::kJoinNormal &&
-           std::abs(cur[3] - join->pl[3]) < k::kJoinDistM;
+    return join && join->cut > 0 && cut <= k::kJoinCutRatio * join->cut &&
+           (cur.head<3>() - join->pl.head<3>()).norm() < k::kJoinNormal && std::abs(cur[3] - join->pl[3]) < k::kJoinDistM;
+  };
+  auto joined_fit = [&]() {
+    Fit f = *join;
+    f.joined = true;
+    return f;
   };
   for (int it = 0; it < std::max(1, cfg_.irls_iterations); ++it) {
     const PointsSoa* src = shrinking ? &band_sub_ : &band_;
@@ -265,7 +270,7 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     if (final_scale && shrinking && it > 0) {
       // Unless this is already the other refinement's plane: then the iterations on every point would
       // converge to it (see kJoinNormal).
-      if (joins()) return Fit{join->pl, join->sigma, true};
+      if (joins()) return joined_fit();
       shrinking = false;
       --it;
       continue;
@@ -279,9 +284,11 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     const double dn = (next.head<3>() - cur.head<3>()).norm(), dd = std::abs(next[3] - cur[3]);
     cur = next;
     if (final_scale && dn < k::kConvergedNormal && dd < k::kConvergedDistM) break;
-    if (final_scale && !shrinking && joins()) return Fit{join->pl, join->sigma, true};
+    // Already at the other refinement's plane: also while the cut-off, near its final value, still creeps
+    // down by a percent per iteration on the subsample (two to three iterations before it stops).
+    if (joins()) return joined_fit();
   }
-  return Fit{cur, last_sigma};
+  return Fit{cur, last_sigma, false, cut};
 }
 
 bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const Eigen::Vector4d* previous,
