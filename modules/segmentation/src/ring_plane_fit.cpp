@@ -287,6 +287,12 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     // Already at the other refinement's plane: also while the cut-off, near its final value, still creeps
     // down by a percent per iteration on the subsample (two to three iterations before it stops).
     if (joins()) return joined_fit();
+    // A fixed cut-off's refit (the ceiling's tight refit) from `join`'s plane whose first step is this small
+    // ends within kJoinNormal / kJoinDistM of it (the steps shrink geometrically, by <= 2/3 measured): it is
+    // that plane.
+    if (fixed && join && it == 0 && dn < k::kJoinNormal * k::kStillStepFraction &&
+        dd < k::kJoinDistM * k::kStillStepFraction)
+      return joined_fit();
   }
   return Fit{cur, last_sigma, false, cut};
 }
@@ -360,7 +366,8 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
   // surface keeps its support. The tighter of the two wins on the narrow-band support.
   if (res1 && role == PlaneRole::kCeiling && cfg_.tight_refit_sigmas > 0) {
     const double ct = std::max(cfg_.tight_refit_sigmas * res1->sigma, k::kTightMinCutM);
-    if (const auto tight = refine(up, res1->pl, ct, ct, true)) {
+    // (joined: its first step showed it stays at res1's plane, within 0.01 deg / 1 mm: nothing to choose)
+    if (const auto tight = refine(up, res1->pl, ct, ct, true, &*res1); tight && !tight->joined) {
       const float t_sel = select_band(res1->sigma, tight->sigma);
       if (score_band(sub_final_, final_stride_, tight->pl, t_sel) > score_band(sub_final_, final_stride_, res1->pl, t_sel)) res1 = tight;
     }

@@ -47,6 +47,7 @@ constexpr double kConvergedDistM = 1e-4;    // and distance change (0.1 mm)
 constexpr double kJoinNormal = 1.75e-4;     // normal difference (0.01 deg)
 constexpr double kJoinDistM = 1e-3;         // and distance difference (1 mm)
 constexpr double kJoinCutRatio = 1.25;      // with a cut-off at most this times the one the first ended with
+constexpr double kStillStepFraction = 1.0 / 3;  // a refit's first step below this x kJoin*: it stays (see refine)
 constexpr double kSelectBandSigmas = 3.0;   // choosing between refinements: soft band at 3 robust sigmas
 constexpr double kSelectBandMinM = 0.01;    // of at least 1 cm
 constexpr double kTightMinCutM = 0.01;      // tight ceiling refit cut-off at least 1 cm

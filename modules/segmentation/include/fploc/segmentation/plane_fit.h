@@ -51,7 +51,8 @@ class RingPlaneFit : public PlaneFit {
   // IRLS from `start` over the candidates (xs_/ys_/zs_); the cut-off shrinks from first_cut down to min_cut
   // (fixed: stays at first_cut). With `join` (another refinement's result on the same candidates): once the
   // cut-off is near the one `join` ended with and the iterate lies within kJoinNormal / kJoinDistM of it, the
-  // refinement stops and returns `join` with joined set (from there it converges to the same plane).
+  // refinement stops and returns `join` with joined set (from there it converges to the same plane). A fixed
+  // cut-off's refit started at `join`'s plane returns it joined when its first step is tiny (it stays there).
   std::optional<Fit> refine(const Eigen::Vector3d& up, Eigen::Vector4d start, double first_cut, double min_cut,
                             bool fixed, const Fit* join = nullptr);
 
