@@ -232,8 +232,9 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
   // While the cut-off still shrinks, the scale and the weighted fit use every kShrinkSubsample-th band point
   // (band_sub_); once it stops shrinking, every point (band_).
   bool shrinking = !fixed;
+  // (A refinement whose cut-off shrinks; the fixed cut-off's refit has its own test below.)
   auto joins = [&]() {
-    return join && join->cut > 0 && cut <= k::kJoinCutRatio * join->cut &&
+    return !fixed && join && join->cut > 0 && cut <= k::kJoinCutRatio * join->cut &&
            (cur.head<3>() - join->pl.head<3>()).norm() < k::kJoinNormal && std::abs(cur[3] - join->pl[3]) < k::kJoinDistM;
   };
   auto joined_fit = [&]() {
