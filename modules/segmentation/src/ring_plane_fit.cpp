@@ -175,7 +175,8 @@ bool RingPlaneFit::choose_start(const Candidates& c, const Eigen::Vector3d& up, 
 // of wall returns below a corridor ceiling (10x the ceiling returns there) dominate the first weighted fit,
 // which then converges to a plane through the walls.
 std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up, Eigen::Vector4d cur,
-                                                      double first_cut, double min_cut, bool fixed) {
+                                                      double first_cut, double min_cut, bool fixed,
+                                                      const Fit* join) {
   using namespace simd;
   double last_sigma = 0;  // robust residual scale of the final iteration
   const Eigen::Vector3d ref = -cur[3] * cur.head<3>();  // a point of the plane (numerics)
@@ -231,6 +232,16 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
   // While the cut-off still shrinks, the scale and the weighted fit use every kShrinkSubsample-th band point
   // (band_sub_); once it stops shrinking, every point (band_).
   bool shrinking = !fixed;
+  // (A refinement whose cut-off shrinks; the fixed cut-off's refit has its own test below.)
+  auto joins = [&]() {
+    return !fixed && join && join->cut > 0 && cut <= k::kJoinCutRatio * join->cut &&
+           (cur.head<3>() - join->pl.head<3>()).norm() < k::kJoinNormal && std::abs(cur[3] - join->pl[3]) < k::kJoinDistM;
+  };
+  auto joined_fit = [&]() {
+    Fit f = *join;
+    f.joined = true;
+    return f;
+  };
   for (int it = 0; it < std::max(1, cfg_.irls_iterations); ++it) {
     const PointsSoa* src = shrinking ? &band_sub_ : &band_;
     // Robust scale (1.4826 * median |r| inside the cut-off) from the median's bin of a 256-bin histogram of the
@@ -253,9 +264,14 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     const double next_cut = fixed ? cut : std::max({cut * 0.5, k::kTukeyC * sigma, min_cut});
     const bool final_scale = next_cut >= cut;
     cut = std::min(cut, next_cut);
-    if (final_scale && shrinking) {
-      // The cut-off stopped shrinking on the subsample's scale: from now on every point (scale re-estimated
-      // on all of them, this iteration's fit on all of them).
+    // The cut-off stopped shrinking on the subsample's scale: from now on every point (scale re-estimated
+    // on all of them, this iteration's fit on all of them). Not at the first iteration: a start a few tenths
+    // of a degree off the surface (last frame's plane) spreads the residuals so that the scale asks for a
+    // cut-off above the first one; that start needs the wide iterations, and they need only the subsample.
+    if (final_scale && shrinking && it > 0) {
+      // Unless this is already the other refinement's plane: then the iterations on every point would
+      // converge to it (see kJoinNormal).
+      if (joins()) return joined_fit();
       shrinking = false;
       --it;
       continue;
@@ -269,8 +285,17 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     const double dn = (next.head<3>() - cur.head<3>()).norm(), dd = std::abs(next[3] - cur[3]);
     cur = next;
     if (final_scale && dn < k::kConvergedNormal && dd < k::kConvergedDistM) break;
+    // Already at the other refinement's plane: also while the cut-off, near its final value, still creeps
+    // down by a percent per iteration on the subsample (two to three iterations before it stops).
+    if (joins()) return joined_fit();
+    // A fixed cut-off's refit (the ceiling's tight refit) from `join`'s plane whose first step is this small
+    // ends within kJoinNormal / kJoinDistM of it (the steps shrink geometrically, by <= 2/3 measured): it is
+    // that plane.
+    if (fixed && join && it == 0 && dn < k::kJoinNormal * k::kStillStepFraction &&
+        dd < k::kJoinDistM * k::kStillStepFraction)
+      return joined_fit();
   }
-  return Fit{cur, last_sigma};
+  return Fit{cur, last_sigma, false, cut};
 }
 
 bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const Eigen::Vector4d* previous,
@@ -316,15 +341,20 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
   auto select_band = [&](double s1, double s2) {
     return float(std::clamp(k::kSelectBandSigmas * std::min(s1, s2), k::kSelectBandMinM, cfg_.inlier_threshold_m));
   };
-  auto refine_guarded = [&](const Eigen::Vector4d& start) -> std::optional<Fit> {
-    const auto r = refine(up, start, cfg_.irls_initial_scale_m, k::kMinCutM, false);
-    if (r && score(r->pl) >= score(start)) return r;
+  auto refine_guarded = [&](const Eigen::Vector4d& start, const Fit* join) -> std::optional<Fit> {
+    const auto r = refine(up, start, cfg_.irls_initial_scale_m, k::kMinCutM, false, join);
+    if (r && (r->joined || score(r->pl) >= score(start))) return r;
     return Fit{start, cfg_.inlier_threshold_m / 3};
   };
-  std::optional<Fit> res1 = refine_guarded(cur);
+  std::optional<Fit> res1 = refine_guarded(cur, nullptr);
   if (previous && (cur - *previous).norm() > 1e-9) {
-    const std::optional<Fit> res2 = refine_guarded(*previous);
-    if (res2 && res1) {
+    // When the first refinement moved its start (it passed the guard), the second stops once it reaches that
+    // plane: the usual case, both starts lie in the same plane's basin.
+    const bool res1_refined = res1 && res1->pl != cur;
+    const std::optional<Fit> res2 = refine_guarded(*previous, res1_refined ? &*res1 : nullptr);
+    if (res2 && res2->joined) {
+      // the same plane: nothing to choose
+    } else if (res2 && res1) {
       const float t_sel = select_band(res1->sigma, res2->sigma);
       if (score_band(sub_final_, final_stride_, res2->pl, t_sel) > score_band(sub_final_, final_stride_, res1->pl, t_sel)) res1 = res2;
     } else if (res2) {
@@ -337,7 +367,8 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
   // surface keeps its support. The tighter of the two wins on the narrow-band support.
   if (res1 && role == PlaneRole::kCeiling && cfg_.tight_refit_sigmas > 0) {
     const double ct = std::max(cfg_.tight_refit_sigmas * res1->sigma, k::kTightMinCutM);
-    if (const auto tight = refine(up, res1->pl, ct, ct, true)) {
+    // (joined: its first step showed it stays at res1's plane, within 0.01 deg / 1 mm: nothing to choose)
+    if (const auto tight = refine(up, res1->pl, ct, ct, true, &*res1); tight && !tight->joined) {
       const float t_sel = select_band(res1->sigma, tight->sigma);
       if (score_band(sub_final_, final_stride_, tight->pl, t_sel) > score_band(sub_final_, final_stride_, res1->pl, t_sel)) res1 = tight;
     }

@@ -40,6 +40,8 @@ class RingPlaneFit : public PlaneFit {
   struct Fit {
     Eigen::Vector4d pl;
     double sigma;
+    bool joined = false;  // stopped on reaching the other refinement's result (refine's `join`): pl is that one
+    double cut = 0;       // the IRLS cut-off it ended with (0: not a refinement)
   };
   void pick_seeds(const Candidates& c, const Eigen::Vector3f& up);
   bool choose_start(const Candidates& c, const Eigen::Vector3d& up, const Eigen::Vector4d* previous,
@@ -47,9 +49,12 @@ class RingPlaneFit : public PlaneFit {
   // Support of `pl` on `sub`, a subsample of the candidates (every stride-th), scaled by the stride.
   double score_band(const PointsSoa& sub, size_t stride, const Eigen::Vector4d& pl, float band) const;
   // IRLS from `start` over the candidates (xs_/ys_/zs_); the cut-off shrinks from first_cut down to min_cut
-  // (fixed: stays at first_cut).
+  // (fixed: stays at first_cut). With `join` (another refinement's result on the same candidates): once the
+  // cut-off is near the one `join` ended with and the iterate lies within kJoinNormal / kJoinDistM of it, the
+  // refinement stops and returns `join` with joined set (from there it converges to the same plane). A fixed
+  // cut-off's refit started at `join`'s plane returns it joined when its first step is tiny (it stays there).
   std::optional<Fit> refine(const Eigen::Vector3d& up, Eigen::Vector4d start, double first_cut, double min_cut,
-                            bool fixed);
+                            bool fixed, const Fit* join = nullptr);
 
   SegmenterConfig cfg_;
   std::vector<int> seeds_, all_seeds_;
