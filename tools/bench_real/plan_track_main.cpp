@@ -85,19 +85,17 @@ int main(int argc, char** argv) {
     fploc::localizer::Localizer loc(*map.lookup, cfg);
     // --at-reference on an occupancy map: the same share on its raster (the grid localizer's view of it).
     const bool raster = at_ref && map_path.size() > 5 && map_path.substr(map_path.size() - 5) == ".yaml";
-    const fploc::OccupancyGrid grid = raster ? fploc::read_occupancy_map(map_path) : fploc::OccupancyGrid{};
-    const fploc::DistanceField df = raster ? fploc::DistanceField(grid, 1.0) : fploc::DistanceField();
-    // The share of a frame's points at pose p that land in the map's known free space (a free cell farther than
-    // the inlier distance from any occupied cell: what the map says is empty) and in unknown space / off the map.
+    const fploc::DistanceField df =
+        raster ? fploc::DistanceField(fploc::read_occupancy_map(map_path), 1.0) : fploc::DistanceField();
+    // The share of a frame's points at pose p that land in the map's known free space (beyond the inlier distance
+    // from any occupied cell: what the map says is empty) and in unknown space / off the map.
     auto free_unknown = [&](const fploc::FeatureFrame& f, const fploc::Pose2& p) {
       int fr = 0, un = 0;
       const double c = std::cos(p.yaw), sn = std::sin(p.yaw);
       for (const auto& q : f.points) {
         const Eigen::Vector2d w(p.x + c * q.p.x() - sn * q.p.y(), p.y + sn * q.p.x() + c * q.p.y());
-        const Eigen::Vector2d cc = df.to_cell(w);
-        const int i = int(std::lround(cc.x())), j = int(std::lround(cc.y()));
-        if (i < 0 || j < 0 || i >= grid.width || j >= grid.height || grid.at(i, j) < 0) ++un;
-        else if (!grid.occupied(i, j) && df.nearest(w) > loc.config().matcher.inlier_m) ++fr;
+        un += !map.free_space->known(w);
+        fr += map.free_space->free(w, loc.config().matcher.inlier_m);
       }
       const double n = std::max<size_t>(1, f.points.size());
       return std::pair<double, double>(fr / n, un / n);
@@ -167,7 +165,7 @@ int main(int argc, char** argv) {
           ++n;
         }
         row["ref_inliers_at_ref"] = n ? double(near) / n : 0.0;
-        if (raster) {
+        if (map.free_space) {
           const auto [fe, ue] = free_unknown(f, est);
           const auto [fr, ur] = free_unknown(f, {s.pose.x, s.pose.y, s.pose.theta});
           row["free_at_est"] = fe;

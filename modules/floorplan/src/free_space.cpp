@@ -5,23 +5,30 @@
 namespace fploc {
 
 FreeSpace::FreeSpace(const OccupancyGrid& g) : field_(g, kMaxClearanceM) {
-  known_free_.assign(size_t(g.width) * size_t(g.height), 0);
+  state_.assign(size_t(g.width) * size_t(g.height), kUnknown);
   for (int j = 0; j < g.height; ++j)
     for (int i = 0; i < g.width; ++i) {
-      const bool f = g.at(i, j) >= 0 && !g.occupied(i, j);
-      known_free_[size_t(j) * size_t(g.width) + size_t(i)] = f;
-      free_cells_ += f;
+      const CellState c = g.at(i, j) < 0 ? kUnknown : g.occupied(i, j) ? kOccupied : kFree;
+      state_[size_t(j) * size_t(g.width) + size_t(i)] = c;
+      free_cells_ += c == kFree;
     }
 }
 
-bool FreeSpace::free(const Eigen::Vector2d& p, double clearance_m) const {
-  if (known_free_.empty()) return false;
+FreeSpace::CellState FreeSpace::state(const Eigen::Vector2d& p, size_t* cell) const {
+  if (state_.empty()) return kUnknown;
   const Eigen::Vector2d c = field_.to_cell(p);
-  if (!c.allFinite()) return false;
+  if (!c.allFinite()) return kUnknown;
   const long i = std::lround(c.x()), j = std::lround(c.y());
-  if (i < 0 || j < 0 || i >= field_.width() || j >= field_.height()) return false;
-  if (!known_free_[size_t(j) * size_t(field_.width()) + size_t(i)]) return false;
-  return field_.nearest(p) > clearance_m;
+  if (i < 0 || j < 0 || i >= field_.width() || j >= field_.height()) return kUnknown;
+  const size_t k = size_t(j) * size_t(field_.width()) + size_t(i);
+  if (cell) *cell = k;
+  return CellState(state_[k]);
+}
+
+bool FreeSpace::free(const Eigen::Vector2d& p, double clearance_m) const {
+  size_t k = 0;
+  if (state(p, &k) != kFree) return false;
+  return field_.data()[k] > clearance_m;  // the field's cell of p (the same rounding), without a second look-up
 }
 
 }  // namespace fploc

@@ -253,6 +253,10 @@ TEST(FreeSpace, KnownFreeBeyondTheClearanceOnly) {
   EXPECT_FALSE(fs.free({wall_x - 0.05, y}, 0.1)) << "next to the wall";
   EXPECT_FALSE(fs.free({wall_x, y}, 0.1)) << "on the wall";
   EXPECT_FALSE(fs.free({wall_x + 0.5, y}, 0.1)) << "unknown";
+  EXPECT_FALSE(fs.known({wall_x + 0.5, y})) << "unknown";
+  EXPECT_TRUE(fs.known({wall_x, y})) << "occupied: known";
+  EXPECT_TRUE(fs.known({wall_x - 0.5, y})) << "free: known";
+  EXPECT_FALSE(fs.known({0.5, y})) << "off the map";
   EXPECT_FALSE(fs.free({0.5, y}, 0.1)) << "off the map";
   EXPECT_FALSE(fs.free({wall_x - 0.5, 5.0}, 0.1)) << "off the map";
   EXPECT_FALSE(FreeSpace().free({0, 0}, 0.1)) << "no map";

@@ -29,11 +29,16 @@ class FreeSpace {
   // Whether the map says the world point p is empty: its cell is known free and p is more than clearance_m
   // (<= kMaxClearanceM) from every occupied cell centre. False off the map and in unknown cells.
   bool free(const Eigen::Vector2d& p, double clearance_m) const;
+  // Whether the map has an opinion at p at all: its cell is known (free or occupied), not unknown or off the map.
+  bool known(const Eigen::Vector2d& p) const { return state(p) != kUnknown; }
   size_t free_cells() const { return free_cells_; }
 
  private:
+  enum CellState : uint8_t { kUnknown = 0, kOccupied = 1, kFree = 2 };
+  // p's cell (index into state_) and its state; kUnknown off the map or for a non-finite p.
+  CellState state(const Eigen::Vector2d& p, size_t* cell = nullptr) const;
   DistanceField field_;
-  std::vector<uint8_t> known_free_;  // row-major, row 0 bottom (as the grid)
+  std::vector<uint8_t> state_;  // CellState per cell, row-major, row 0 bottom (as the grid)
   size_t free_cells_ = 0;
 };
 
