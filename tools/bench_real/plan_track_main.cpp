@@ -37,6 +37,8 @@ int main(int argc, char** argv) {
   app.add_option("--gate", gate, "matcher.max_correspondence_m (default: the lidar2d graph's 0.5)");
   app.add_option("--initial-search", initial_search, "matcher.initial_search_m: the start's uncertainty [m]");
   double plan_sigma = 0;
+  double map_sigma = -1;
+  app.add_option("--map-sigma", map_sigma, "the published covariance's map term [m] (default: the map's, an occupancy map's cell / sqrt(12); 0: none)");
   app.add_option("--plan-sigma", plan_sigma, "the published covariance's floor on each plan element's offset sigma [m]");
   bool no_group_rule = false, at_ref = false;
   app.add_flag("--at-reference", at_ref, "also register each frame alone from its reference pose (diagnostics)");
@@ -71,7 +73,8 @@ int main(int argc, char** argv) {
     fploc::localizer::Config cfg = fploc::config::localizer_config(mo);
     cfg.optimizer = fploc::config::localizer_config(oo).optimizer;
     cfg.uncertainty.frame.plan_sigma_m = plan_sigma;
-    cfg.free_space = map.free_space.get();
+    fploc::localizer::use_map(cfg, map);
+    if (map_sigma >= 0) cfg.map_sigma_m = map_sigma;
     if (osm >= 0) cfg.matcher.odom_sigma_m = osm;
     if (ospm >= 0) cfg.matcher.odom_sigma_per_m = ospm;
     if (osr >= 0) cfg.matcher.odom_sigma_rad = osr * M_PI / 180;

@@ -14,7 +14,7 @@ std::unique_ptr<Localizer> ActivePlan::make_localizer(Config cfg) const {
   cfg.matcher.element_weight = weights_->weights();
   cfg.optimizer.element_weight = weights_->weights();
   const matcher::LocalizationMap& map = corrected_ ? *corrected_ : floors_.maps[size_t(floor_)];
-  cfg.free_space = map.free_space.get();
+  use_map(cfg, map);
   return std::make_unique<Localizer>(*map.lookup, cfg);
 }
 

@@ -2,6 +2,7 @@
 
 #include "fploc/matcher/free_space_check.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace fploc::localizer {
@@ -31,6 +32,11 @@ Config with_uncertainty_defaults(Config c) {
   return c;
 }
 }  // namespace
+
+void use_map(Config& cfg, const matcher::LocalizationMap& map) {
+  cfg.free_space = map.free_space.get();
+  cfg.map_sigma_m = map.map_sigma_m;
+}
 
 Localizer::Localizer(const matcher::NearestLookup& lookup, Config cfg)
     : cfg_(with_uncertainty_defaults(std::move(cfg))),
@@ -140,7 +146,18 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
     in.published_status = uncertainty_.status;
     in.status_text = uncertainty_.text;
   }
+  add_map_error(f, &in.covariance);
   return window_.add(std::move(in), finals);
+}
+
+void Localizer::add_map_error(const FeatureFrame& f, Eigen::Matrix3d* covariance) {
+  if (!(cfg_.map_sigma_m > 0) || f.points.empty()) return;
+  ranges_.clear();
+  for (const auto& p : f.points) ranges_.push_back(p.p.norm());
+  const auto mid = ranges_.begin() + std::ptrdiff_t(ranges_.size() / 2);
+  std::nth_element(ranges_.begin(), mid, ranges_.end());
+  const double sxy = cfg_.map_sigma_m, syaw = sxy / std::max(*mid, 1.0);
+  *covariance += Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
 }
 
 Localizer::Step Localizer::process(const FeatureFrame& f, std::vector<Pose>* finals) {

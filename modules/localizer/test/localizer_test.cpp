@@ -238,5 +238,48 @@ TEST_F(LocalizerTest, FreeSpaceOfAnOccupancyMapContradictsAFixOnEmptyFloor) {
   ASSERT_NE(from_yaml.free_space, nullptr);
   EXPECT_EQ(from_yaml.free_space->free_cells(), fs.free_cells());
   EXPECT_EQ(map_.free_space, nullptr);
+  // ... and its cell's position error (a wall somewhere in its 5 cm cell); a drawn plan has none.
+  EXPECT_NEAR(from_yaml.map_sigma_m, 0.05 / std::sqrt(12.0), 1e-12);
+  EXPECT_EQ(map_.map_sigma_m, 0.0);
+  localizer::Config used;
+  localizer::use_map(used, from_yaml);
+  EXPECT_EQ(used.free_space, from_yaml.free_space.get());
+  EXPECT_EQ(used.map_sigma_m, from_yaml.map_sigma_m);
   std::filesystem::remove_all(dir);
+}
+
+// The map's own error (Config::map_sigma_m) is in the published covariance and nowhere else: the same run with
+// and without it gives the same poses and statuses, and every published covariance differs by exactly
+// map_sigma^2 in x and y and (map_sigma / the frame's median point range)^2 in yaw.
+TEST_F(LocalizerTest, MapSigmaWidensThePublishedCovarianceOnly) {
+  localizer::Config with;
+  with.map_sigma_m = 0.05 / std::sqrt(12.0);
+  localizer::Localizer a(*map_.lookup, {}), b(*map_.lookup, with);
+  a.set_pose(truth_at(0.0));
+  b.set_pose(truth_at(0.0));
+  std::vector<localizer::Pose> fa, fb;
+  int compared = 0;
+  for (size_t k = 0; k < frames_.size(); ++k) {
+    feed_imu(a, 0.1 * k - 0.1, 0.1 * k + 0.11);
+    feed_imu(b, 0.1 * k - 0.1, 0.1 * k + 0.11);
+    const auto sa = a.process(frames_[k], &fa), sb = b.process(frames_[k], &fb);
+    ASSERT_EQ(sa.latest.has_value(), sb.latest.has_value());
+    if (!sa.latest) continue;
+    EXPECT_EQ(sa.latest->pose.x, sb.latest->pose.x);
+    EXPECT_EQ(sa.latest->pose.yaw, sb.latest->pose.yaw);
+    EXPECT_EQ(sa.latest->status, sb.latest->status);
+    std::vector<double> r;
+    for (const auto& p : frames_[k].points) r.push_back(p.p.norm());
+    std::nth_element(r.begin(), r.begin() + std::ptrdiff_t(r.size() / 2), r.end());
+    const double s = with.map_sigma_m, syaw = s / std::max(r[r.size() / 2], 1.0);
+    const Eigen::Matrix3d d = sb.latest->covariance - sa.latest->covariance;
+    EXPECT_NEAR(d(0, 0), s * s, 1e-12);
+    EXPECT_NEAR(d(1, 1), s * s, 1e-12);
+    EXPECT_NEAR(d(2, 2), syaw * syaw, 1e-15);
+    EXPECT_NEAR(d(0, 1), 0.0, 1e-15);
+    ++compared;
+  }
+  EXPECT_GT(compared, 50);
+  ASSERT_EQ(fa.size(), fb.size());
+  for (size_t i = 0; i < fa.size(); ++i) EXPECT_EQ(fa[i].pose.y, fb[i].pose.y);
 }

@@ -1,6 +1,7 @@
 #include "fploc/matcher/map.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 #include "fploc/floorplan/io.h"
@@ -103,8 +104,11 @@ LocalizationMap load_localization_map(const std::string& path, const std::vector
   }
   m.plan = std::make_shared<const FloorPlan>(load_floor_plan(path, layers, units));
   m.note = "loaded " + path;
-  if (ends_with(path, ".yaml") || ends_with(path, ".yml"))
-    m.free_space = std::make_shared<const FreeSpace>(read_occupancy_map(path));
+  if (ends_with(path, ".yaml") || ends_with(path, ".yml")) {
+    const OccupancyGrid grid = read_occupancy_map(path);
+    m.free_space = std::make_shared<const FreeSpace>(grid);
+    m.map_sigma_m = grid.resolution / std::sqrt(12.0);
+  }
   return finish(std::move(m), lookup, annf);
 }
 

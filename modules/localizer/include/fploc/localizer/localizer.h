@@ -15,6 +15,7 @@
 #include "fploc/floorplan/free_space.h"
 #include "fploc/localizer/degeneracy.h"
 #include "fploc/matcher/imu_yaw.h"
+#include "fploc/matcher/map.h"
 #include "fploc/matcher/matcher.h"
 #include "fploc/optimizer/window.h"
 
@@ -36,7 +37,18 @@ struct Config {
   // keeps it alive, as ActivePlan does): the published status checks each fix against it
   // (UncertaintyConfig::max_contradicted). Null: no such check.
   const FreeSpace* free_space = nullptr;
+  // The plan's own position error shared by every point of a frame (LocalizationMap::map_sigma_m: an occupancy
+  // map's cell): added to the published covariance, map_sigma_m in x and y and that over the frame's median
+  // point range in yaw, as the grid localizer does. Published only: the tracker's gates and the window keep the
+  // fit's own covariance (the map's error is the same on the next frame, not a random walk to accumulate).
+  // Without it the plan path on the Radish logs' vectorised maps published covariances that its errors against
+  // the reference exceeded by NEES 70-198 (3 when consistent). 0: none (drawn plans).
+  double map_sigma_m = 0;
 };
+
+// What a Config takes from the map it runs on: its free space and its own position error (ActivePlan and the
+// tools that build a Localizer on a LocalizationMap call this; the map must outlive the Localizer).
+void use_map(Config& cfg, const matcher::LocalizationMap& map);
 
 // The SFR step's result for one frame (what FPLOC_FRAME_POSE carries).
 struct FramePose {
@@ -107,6 +119,8 @@ class Localizer {
   // frames' times in the first one's body frame.
   std::optional<Pose2> odometry_at(int64_t utime) const;
   std::optional<Pose2> odometry_between(int64_t from_utime, int64_t to_utime) const;
+  // Adds cfg_.map_sigma_m's term (see Config) for frame f to a published covariance.
+  void add_map_error(const FeatureFrame& f, Eigen::Matrix3d* covariance);
   Config cfg_;
   const matcher::NearestLookup& lookup_;
   matcher::Matcher matcher_;
@@ -121,6 +135,7 @@ class Localizer {
   int64_t prev_optimized_utime_ = 0;
   FeatureFrame held_;                // scratch: the frame with the IMU's sweep rate and the held attitude
   FeatureFrame deskewed_;            // scratch: the frame de-skewed as the matcher registered it
+  std::vector<double> ranges_;       // scratch: the frame's point ranges (add_map_error)
   UncertaintyTracker tracker_;
   UncertaintyState uncertainty_;
 };

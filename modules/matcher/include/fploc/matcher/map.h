@@ -2,7 +2,8 @@
 // selected correspondence look-up. Look-up names: "annf-exact" (default), "annf-paper" (the leaf's two
 // stored candidates, the closer one used), "annf-paper-first" (only the leaf's first element),
 // "kdtree" (points sampled on the plan), "brute-force". A plan loaded from an occupancy map (map_server
-// .yaml) also keeps the map's free space (floorplan/free_space.h), which the published status checks.
+// .yaml) also keeps the map's free space (floorplan/free_space.h), which the published status checks, and
+// its cell's position error (map_sigma_m), which the published covariance adds.
 #pragma once
 #include <memory>
 #include <string>
@@ -23,6 +24,10 @@ struct LocalizationMap {
   std::shared_ptr<const annf::Annf> annf;  // null unless an ANNF look-up is used
   std::unique_ptr<NearestLookup> lookup;
   std::shared_ptr<const FreeSpace> free_space;  // null unless the plan is an occupancy map
+  // The plan's own position error that every point of a frame shares, so that it does not average out over
+  // them: for an occupancy map a wall lies somewhere in its cell, resolution / sqrt(12) (a uniform position
+  // within the cell); 0 for a drawn plan (its accuracy is unknown; CovarianceConfig::plan_sigma_m sets one).
+  double map_sigma_m = 0;
   std::string note;                  // what was loaded/built (for logs)
 };
 
