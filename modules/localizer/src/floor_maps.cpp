@@ -12,6 +12,7 @@ FloorMaps load_floor_maps(const std::string& path, const std::vector<std::string
   o.units_override = units;
   for (const auto& f : b->floors) {
     matcher::LocalizationMap lm = matcher::make_localization_map(load_floor_plan(*b, f.name, o), lookup.empty() ? "annf-exact" : lookup);
+    if (!f.plan) matcher::add_occupancy_extras(lm, f.plan_file);  // a floor drawn as a map_server map
     lm.note = "floor '" + f.name + "'" + (lm.note.empty() ? "" : ": " + lm.note);
     m.maps.push_back(std::move(lm));
   }

@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "fploc/floorplan/free_space.h"
+#include "fploc/localizer/floor_maps.h"
 #include "fploc/matcher/map.h"
 #include "fploc/matcher/plan_terms.h"
 #include "synthetic.h"
@@ -245,6 +246,17 @@ TEST_F(LocalizerTest, FreeSpaceOfAnOccupancyMapContradictsAFixOnEmptyFloor) {
   localizer::use_map(used, from_yaml);
   EXPECT_EQ(used.free_space, from_yaml.free_space.get());
   EXPECT_EQ(used.map_sigma_m, from_yaml.map_sigma_m);
+  // A building whose floor is drawn as a map_server map: that floor's map keeps them too, a JSON floor none.
+  std::filesystem::copy_file(std::string(FPLOC_SOURCE_DIR) + "/data/plans/room.json", dir / "room.json");
+  std::ofstream(dir / "b.pbtxt") << "name: \"b\"\nfloor { name: \"scan\" plan { file: \"m.yaml\" } elevation_m: 0 ceiling_height_m: 3 }\n"
+                                 << "floor { name: \"drawn\" plan { file: \"room.json\" } elevation_m: 4 ceiling_height_m: 3 }\n";
+  const auto floors = localizer::load_floor_maps((dir / "b.pbtxt").string(), {}, "", "scan", "annf-exact");
+  ASSERT_EQ(floors.maps.size(), 2u);
+  ASSERT_NE(floors.maps[0].free_space, nullptr);
+  EXPECT_EQ(floors.maps[0].free_space->free_cells(), fs.free_cells());
+  EXPECT_NEAR(floors.maps[0].map_sigma_m, 0.05 / std::sqrt(12.0), 1e-12);
+  EXPECT_EQ(floors.maps[1].free_space, nullptr);
+  EXPECT_EQ(floors.maps[1].map_sigma_m, 0.0);
   std::filesystem::remove_all(dir);
 }
 

@@ -85,6 +85,13 @@ bool ends_with(std::string s, const std::string& suf) {
 
 }  // namespace
 
+void add_occupancy_extras(LocalizationMap& m, const std::string& path) {
+  if (!ends_with(path, ".yaml") && !ends_with(path, ".yml")) return;
+  const OccupancyGrid grid = read_occupancy_map(path);
+  m.free_space = std::make_shared<const FreeSpace>(grid);
+  m.map_sigma_m = grid.resolution / std::sqrt(12.0);
+}
+
 LocalizationMap make_localization_map(FloorPlan plan, const std::string& lookup) {
   LocalizationMap m;
   m.plan = std::make_shared<const FloorPlan>(std::move(plan));
@@ -104,11 +111,7 @@ LocalizationMap load_localization_map(const std::string& path, const std::vector
   }
   m.plan = std::make_shared<const FloorPlan>(load_floor_plan(path, layers, units));
   m.note = "loaded " + path;
-  if (ends_with(path, ".yaml") || ends_with(path, ".yml")) {
-    const OccupancyGrid grid = read_occupancy_map(path);
-    m.free_space = std::make_shared<const FreeSpace>(grid);
-    m.map_sigma_m = grid.resolution / std::sqrt(12.0);
-  }
+  add_occupancy_extras(m, path);
   return finish(std::move(m), lookup, annf);
 }
 

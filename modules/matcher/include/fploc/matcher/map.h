@@ -31,6 +31,11 @@ struct LocalizationMap {
   std::string note;                  // what was loaded/built (for logs)
 };
 
+// What a plan loaded from path keeps beside its elements when path is an occupancy map (a map_server .yaml /
+// .yml): its free space and map_sigma_m. Nothing for any other file. load_localization_map calls it, and so
+// does every loader of a plan file (a building's floors).
+void add_occupancy_extras(LocalizationMap& m, const std::string& path);
+
 // Known look-up names.
 const std::vector<std::string>& lookup_names();
 
