@@ -35,7 +35,7 @@ namespace fploc::feat::detail {
 #endif
 
 namespace {
-using Pass = void (*)(const RingIn&, const RingRules&, RingScratch&, float*, float*, uint64_t*, uint64_t*, std::vector<int>&);
+using Pass = void (*)(const RingIn&, const RingRules&, RingScratch&, float*, uint64_t*, float*, std::vector<int>&);
 struct Choice {
   Pass pass;
   float (*range_max)(const float*, int, int);
@@ -63,9 +63,9 @@ const Choice& choice() {
 }
 }  // namespace
 
-void smoothness(const RingIn& in, const RingRules& rules, RingScratch& scratch, float* corner_lo, float* corner_hi,
-                uint64_t* surface, uint64_t* surface_sure, std::vector<int>& occlusions) {
-  choice().pass(in, rules, scratch, corner_lo, corner_hi, surface, surface_sure, occlusions);
+void smoothness(const RingIn& in, const RingRules& rules, RingScratch& scratch, float* corner, uint64_t* surface,
+                float* surface_c, std::vector<int>& occlusions) {
+  choice().pass(in, rules, scratch, corner, surface, surface_c, occlusions);
 }
 
 float range_max(const float* v, int b, int e) { return choice().range_max(v, b, e); }
