@@ -172,13 +172,10 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     const int sb = hw + (n - 2 * hw) * s / S, se = hw + (n - 2 * hw) * (s + 1) / S;
     if (se <= sb) continue;
     for (int corners = 0; corners < max_corners; ++corners) {
-      // The sharpest candidate: the first index with the largest c (two vector scans of the sector's c: a
-      // sector is ~n/6 points, cheaper than keeping block maxima up to date).
-      const float top = detail::range_max(lo, sb, se);
-      if (!(top > -kInf)) break;
-      cand.clear();
-      detail::indices_at_least(lo, top, sb, se, cand);
-      const int best = cand.front();
+      // The sharpest candidate: the first index with the largest c (one vector scan of the sector: a sector
+      // is ~n/6 points, cheaper than keeping block maxima up to date).
+      const int best = detail::first_argmax(lo, sb, se);
+      if (best < 0) break;
       pick(best, true);
       suppress(best - hw, best + hw);
     }

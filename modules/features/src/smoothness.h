@@ -69,10 +69,9 @@ inline float float_smoothness(const RingIn& in, int hw, int i) {
 void smoothness(const RingIn& in, const RingRules& rules, RingScratch& scratch, float* corner, uint64_t* surface,
                 float* surface_c, std::vector<int>& occlusions);
 
-// Sector scans of the corner values, with the same instruction set as the pass: the largest of v[b .. e)
-// (-inf when empty; v holds no NaN), and the indices i in [b, e) with v[i] >= t appended in increasing order.
-float range_max(const float* v, int b, int e);
-void indices_at_least(const float* v, float t, int b, int e, std::vector<int>& out);
+// Sector scan of the corner values, with the same instruction set as the pass: the first index of the
+// largest of v[b .. e), -1 when that is -inf or the range is empty (v holds no NaN).
+int first_argmax(const float* v, int b, int e);
 
 // The dispatch's choice, for the benchmark and the notes: "avx2", "sse2" or "generic".
 const char* smoothness_isa();

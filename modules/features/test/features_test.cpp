@@ -227,6 +227,30 @@ TEST(Features, ReferenceEqualSmoothnessPass) {
   EXPECT_GT(checked, 50000u);
 }
 
+// A ring that repeats a 6-point pattern exactly: the windows at the same phase hold the same floats in the same
+// order, so their c are equal, above the corner threshold: the corner picks are ties, decided by the first index.
+TEST(Features, ReferenceEqualOnPeriodicRing) {
+  seg::Segmentation s;
+  s.status = seg::SegStatus::kOk;
+  s.height = 64;
+  auto& w = s.wall;
+  const float px[6] = {4.0f, 4.0f, 4.5f, 4.0f, 3.75f, 4.0f}, py[6] = {0.0f, 0.5f, 0.25f, -0.5f, 0.0f, 0.75f};
+  for (int r = 0; r < 2; ++r)
+    for (int c = 0; c < 300; ++c) {
+      const float x = px[c % 6], y = py[c % 6], z = 0.5f;
+      w.x.push_back(x); w.y.push_back(y); w.z.push_back(z);
+      w.range.push_back(std::sqrt(x * x + y * y + z * z));
+      w.t.push_back(0.f);
+      w.ring.push_back(int16_t(r)); w.column.push_back(int16_t(c));
+    }
+  FeatureConfig c;
+  c.occlusion_ratio = 1.0;  // (the pattern's range steps are not occlusions)
+  c.parallel_ratio = 1.0;
+  expect_same(s, c, "periodic ring");
+  c.max_corners_per_sector = 5;
+  expect_same(s, c, "periodic ring, 5 corners");
+}
+
 TEST(Features, ReferenceEqualWithOtherOptionsAndBeamCounts) {
   const auto room = synth::furnished_room();
   const synth::SensorPose pose{1.0, 0.5, 1.5, 1 * kDeg, 1 * kDeg, 0.3};
