@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numeric>
 #if defined(__SSE2__)
@@ -29,6 +30,14 @@ size_t run_end(const int16_t* v, size_t b, size_t n) {
 #endif
   while (i < n && v[i] == v[b]) ++i;
   return i;
+}
+
+// Bits of a non-NaN float whose unsigned order is the float order (-0 taken as +0, equal as floats).
+inline uint32_t order_bits(float f) {
+  f += 0.f;  // -0 -> +0
+  uint32_t u;
+  std::memcpy(&u, &f, sizeof u);
+  return u & 0x80000000u ? ~u : u | 0x80000000u;
 }
 
 }  // namespace
@@ -108,13 +117,11 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   const int hw = std::max(1, cfg_.half_window);
   if (n < 2 * hw + 1) return;
 
-  // Smoothness bounds and candidates of every point (src/smoothness.h: vectorised, in float, with exact
-  // values wherever the bounds do not decide).
-  const int nb = (n + 7) / 8;  // 8-point blocks of the corner bounds
-  corner_lo_.resize(size_t(nb) * 8);
-  corner_hi_.resize(size_t(nb) * 8);
+  // Smoothness and candidates of every point (src/smoothness.h: vectorised, in float).
+  const int nb = (n + 7) / 8;
+  corner_c_.resize(size_t(nb) * 8);
+  surface_c_.resize(size_t(nb) * 8);
   surface_.assign(size_t(n) / 64 + 2, 0);
-  surface_sure_.assign(size_t(n) / 64 + 2, 0);
   picked_.assign(size_t(n), 0);
   occ_.clear();
   const detail::RingIn in{w.x.data() + begin, w.y.data() + begin, w.z.data() + begin, w.range.data() + begin,
@@ -123,11 +130,12 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
                                 float(cfg_.occlusion_ratio), float(cfg_.parallel_ratio),
                                 float(cfg_.corner_threshold), float(cfg_.surface_threshold)};
   detail::RingScratch scratch{ring_w_, ring_brk_};
-  float *lo = corner_lo_.data(), *hi = corner_hi_.data();
-  const uint64_t *sk = surface_.data(), *sure = surface_sure_.data();
-  detail::smoothness(in, rules, scratch, lo, hi, surface_.data(), surface_sure_.data(), occ_);
-  for (int k = 0; k < hw; ++k) lo[k] = hi[k] = -kInf;  // no window: no candidate
-  for (int k = n - hw; k < nb * 8; ++k) lo[k] = hi[k] = -kInf;
+  float* lo = corner_c_.data();
+  const float* sc = surface_c_.data();
+  const uint64_t* sk = surface_.data();
+  detail::smoothness(in, rules, scratch, lo, surface_.data(), surface_c_.data(), occ_);
+  for (int k = 0; k < hw; ++k) lo[k] = -kInf;  // no window: no candidate
+  for (int k = n - hw; k < nb * 8; ++k) lo[k] = -kInf;
   uint8_t* picked = picked_.data();
   // Taking points a..b out: no later corner or surface pick there (a pick's neighbours, occlusions).
   auto suppress = [&](int a, int b) {
@@ -135,7 +143,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     b = std::min(n - 1, b);
     for (int k = a; k <= b; ++k) {
       picked[k] = 1;
-      lo[k] = hi[k] = -kInf;
+      lo[k] = -kInf;
     }
   };
   for (const int e : occ_) {  // +(j+1): the near side is j (j+1 .. j+hw out); -(j+1): j-hw+1 .. j out
@@ -146,8 +154,8 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   }
 
   // Per-sector selection (sectors split the ring's points evenly, as LOAM does): the sharpest corner
-  // candidates that no earlier pick suppressed, then the smoothest surface candidates, walked in the order
-  // (c, index): the plain rules' picks.
+  // candidates that no earlier pick suppressed (the first index among equal c), then the smoothest surface
+  // candidates, walked in the order (c, index): the plain rules' picks.
   // The picks as bits (points in column order without a sort): bit i of feat, and of corner for a corner.
   const size_t words = size_t(n) / 64 + 1;
   pick_bits_.assign(2 * words, 0);
@@ -159,31 +167,15 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   const int S = std::max(1, cfg_.sectors);
   const int max_corners = int(std::lround(cfg_.max_corners_per_sector * limit_scale_));
   const int max_surfaces = int(std::lround(cfg_.max_surfaces_per_sector * limit_scale_));
-  const float sthr = float(cfg_.surface_threshold);
   auto& cand = surf_;
   for (int s = 0; s < S; ++s) {
     const int sb = hw + (n - 2 * hw) * s / S, se = hw + (n - 2 * hw) * (s + 1) / S;
     if (se <= sb) continue;
     for (int corners = 0; corners < max_corners; ++corners) {
-      // The sharpest candidate is among those whose upper bound reaches the largest lower bound; when
-      // that is more than one, their exact c decide (ties: the first index). A sector is ~n/6 points: two
-      // vector scans of the bounds are cheaper than keeping block maxima up to date.
-      const float top = detail::range_max(lo, sb, se);
-      if (!(top > -kInf)) break;
-      cand.clear();
-      detail::indices_at_least(hi, top, sb, se, cand);
-      int best = cand.front();
-      if (cand.size() > 1) {
-        float bc = -kInf;
-        best = -1;
-        for (const int i : cand) {
-          const float c = lo[i] == hi[i] ? lo[i] : detail::exact_smoothness(in, hw, i);
-          if (best < 0 || c > bc) {
-            bc = c;
-            best = i;
-          }
-        }
-      }
+      // The sharpest candidate: the first index with the largest c (one vector scan of the sector: a sector
+      // is ~n/6 points, cheaper than keeping block maxima up to date).
+      const int best = detail::first_argmax(lo, sb, se);
+      if (best < 0) break;
       pick(best, true);
       suppress(best - hw, best + hw);
     }
@@ -200,8 +192,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       }
     }
     // When the sector's candidates are no more than its limit, every one that no other candidate's pick
-    // can suppress (none within the spacing) and whose bound puts it surely below the threshold is picked
-    // whatever the order: no exact c for those.
+    // can suppress (none within the spacing) is picked whatever the order: no sort for those.
     const int sp = cfg_.surface_spacing;
     if (int(cand.size()) <= max_surfaces) {
       size_t m = 0;
@@ -209,7 +200,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       for (size_t k = 0; k < nc; ++k) {
         const int i = cand[k];
         const bool near = (k > 0 && i - cand[k - 1] <= sp) || (k + 1 < nc && cand[k + 1] - i <= sp);
-        if (!near && (sure[i >> 6] >> (i & 63) & 1)) {
+        if (!near) {
           pick(i, false);
           suppress(i - sp, i + sp);
         } else {
@@ -218,19 +209,14 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       }
       cand.resize(m);
     }
-    // Exact c of the others; kept when below the threshold.
-    auto& sc = surface_c_;
-    sc.resize(size_t(n));
-    size_t m = 0;
-    for (const int i : cand) {
-      const float c = detail::exact_smoothness(in, hw, i);
-      sc[size_t(i)] = c;
-      if (c < sthr) cand[m++] = i;
-    }
-    cand.resize(m);
-    std::sort(cand.begin(), cand.end(), [&](int a, int b) { return sc[a] < sc[b] || (sc[a] == sc[b] && a < b); });
+    // The others in the order (c, index), sorted as 64-bit keys: order_bits(c) above the index.
+    auto& keys = surf_keys_;
+    keys.clear();
+    for (const int i : cand) keys.push_back(uint64_t(order_bits(sc[i])) << 32 | uint32_t(i));
+    std::sort(keys.begin(), keys.end());
     int surfaces = 0;  // (the direct picks above only happen when the limit cannot be reached)
-    for (const int i : cand) {
+    for (const uint64_t key : keys) {
+      const int i = int(uint32_t(key));
       if (picked[i]) continue;
       pick(i, false);
       suppress(i - cfg_.surface_spacing, i + cfg_.surface_spacing);

@@ -35,11 +35,10 @@ namespace fploc::feat::detail {
 #endif
 
 namespace {
-using Pass = void (*)(const RingIn&, const RingRules&, RingScratch&, float*, float*, uint64_t*, uint64_t*, std::vector<int>&);
+using Pass = void (*)(const RingIn&, const RingRules&, RingScratch&, float*, uint64_t*, float*, std::vector<int>&);
 struct Choice {
   Pass pass;
-  float (*range_max)(const float*, int, int);
-  void (*at_least)(const float*, float, int, int, std::vector<int>&);
+  int (*argmax)(const float*, int, int);
   const char* name;
 };
 // FPLOC_FEATURES_ISA=base forces the baseline copy (tests run both copies against the plain rules).
@@ -47,14 +46,14 @@ Choice choose() {
   const char* force = std::getenv("FPLOC_FEATURES_ISA");
   const bool base_only = force && std::strcmp(force, "base") == 0;
 #if FPLOC_FEAT_AVX2_COPY
-  if (!base_only && __builtin_cpu_supports("avx2")) return {&avx2::pass, &avx2::range_max, &avx2::indices_at_least, "avx2"};
+  if (!base_only && __builtin_cpu_supports("avx2")) return {&avx2::pass, &avx2::first_argmax, "avx2"};
 #else
   (void)base_only;
 #endif
 #if defined(__SSE2__)
-  return {&base::pass, &base::range_max, &base::indices_at_least, "sse2"};
+  return {&base::pass, &base::first_argmax, "sse2"};
 #else
-  return {&base::pass, &base::range_max, &base::indices_at_least, "generic"};
+  return {&base::pass, &base::first_argmax, "generic"};
 #endif
 }
 const Choice& choice() {
@@ -63,16 +62,12 @@ const Choice& choice() {
 }
 }  // namespace
 
-void smoothness(const RingIn& in, const RingRules& rules, RingScratch& scratch, float* corner_lo, float* corner_hi,
-                uint64_t* surface, uint64_t* surface_sure, std::vector<int>& occlusions) {
-  choice().pass(in, rules, scratch, corner_lo, corner_hi, surface, surface_sure, occlusions);
+void smoothness(const RingIn& in, const RingRules& rules, RingScratch& scratch, float* corner, uint64_t* surface,
+                float* surface_c, std::vector<int>& occlusions) {
+  choice().pass(in, rules, scratch, corner, surface, surface_c, occlusions);
 }
 
-float range_max(const float* v, int b, int e) { return choice().range_max(v, b, e); }
-
-void indices_at_least(const float* v, float t, int b, int e, std::vector<int>& out) {
-  choice().at_least(v, t, b, e, out);
-}
+int first_argmax(const float* v, int b, int e) { return choice().argmax(v, b, e); }
 
 const char* smoothness_isa() { return choice().name; }
 

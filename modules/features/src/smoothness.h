@@ -4,13 +4,13 @@
 // NEON on arm64; scalar code elsewhere), and on x86-64 a second copy of the same code built for AVX2, chosen
 // at run time when the CPU has it.
 //
-// Exact picks from float arithmetic: the pass computes c~ in float (window sums of hw-point blocks, one
-// root, one reciprocal) and a bound B with |c~ - c| <= B, c being the smoothness of the plain rules
-// (exact_smoothness below: window sums in double, root in double rounded to float, one float division).
-// The bound follows from the float rounding errors (see smoothness_kernel.inc); where it cannot decide a
-// threshold test the pass computes c exactly, and the caller computes c exactly wherever an order between
-// candidates is needed and the bounds overlap. So the picks are those of the plain rules, bit for bit
-// (test/reference_features.h, features_test ReferenceEqual*).
+// The smoothness is defined by its float computation (float_smoothness below: hw-point block sums in float,
+// one root, one reciprocal), the same operations in the same order in every copy and in the scalar function,
+// so every copy gives the same c, bit for bit (no fused multiply-adds: neither copy is built with FMA). Until
+// the seventh speed round c was LOAM's value with the window sum in double and picks ordered by that exact
+// value; the float value differs from it by ~1e-6 relative (the rounding of 12 float sums), which changes
+// the order of two candidates only where their c agree to that precision (test/reference_features.h holds
+// the plain rules with this c).
 #pragma once
 #include <cmath>
 #include <cstdint>
@@ -37,39 +37,41 @@ struct RingScratch {
   std::vector<uint64_t>& brk;  // column breaks between neighbours as bits, and broken windows as bits
 };
 
-// The smoothness of point i (hw <= i < n - hw) by the plain rules: LOAM's c = |sum_j (X_j - X_i)| /
-// (2 hw |X_i|), the window sum in double (exact for float inputs), the root in double rounded to float, one
-// float division.
-inline float exact_smoothness(const RingIn& in, int hw, int i) {
-  double sx = 0, sy = 0, sz = 0;
-  for (int k = -hw; k <= hw; ++k) {
-    sx += in.x[i + k];
-    sy += in.y[i + k];
-    sz += in.z[i + k];
+// The smoothness of point i (hw <= i < n - hw): c = |sum_j (X_j - X_i)| / (2 hw |X_i|) in float, as the
+// vector pass computes it: block sums A = X_{i-hw} + ... + X_{i-1} and B = X_{i+1} + ... + X_{i+hw} added in
+// index order, d = (A + B) - 2hw X_i per coordinate, c = sqrt((dx dx + dy dy) + dz dz) * (1 / (2hw r_i)).
+inline float float_smoothness(const RingIn& in, int hw, int i) {
+  float ax = in.x[i - hw], ay = in.y[i - hw], az = in.z[i - hw];
+  float bx = in.x[i + 1], by = in.y[i + 1], bz = in.z[i + 1];
+  for (int q = 1; q < hw; ++q) {
+    ax += in.x[i - hw + q];
+    ay += in.y[i - hw + q];
+    az += in.z[i - hw + q];
+    bx += in.x[i + 1 + q];
+    by += in.y[i + 1 + q];
+    bz += in.z[i + 1 + q];
   }
-  const double w = 2 * hw + 1;
-  const double dx = sx - w * double(in.x[i]), dy = sy - w * double(in.y[i]), dz = sz - w * double(in.z[i]);
-  return float(std::sqrt(dx * dx + dy * dy + dz * dz)) / (float(2 * hw) * in.r[i]);
+  const float den = float(2 * hw);
+  const float dx = (ax + bx) - den * in.x[i], dy = (ay + by) - den * in.y[i], dz = (az + bz) - den * in.z[i];
+  return std::sqrt((dx * dx + dy * dy) + dz * dz) * (1.f / (den * in.r[i]));
 }
 
 // For every point i in [hw, n - hw) that is usable (window unbroken, range within limits, not on a surface
-// parallel to the beam):
-//  - corner_lo[i] <= c_i <= corner_hi[i] when it is a corner candidate (c_i > corner threshold); equal
-//    bounds hold the exact c_i (where the bound could not decide the threshold); -inf / -inf otherwise;
-//  - bit i of `surface` (n + 64 bits, zeroed by the caller) is set when it may be a surface candidate (its
-//    lower bound is below the surface threshold: the caller computes c exactly and keeps it when c <
-//    threshold); bit i of `surface_sure` (zeroed by the caller) when its upper bound is below the threshold
-//    (c_i surely is).
+// parallel to the beam), c_i = float_smoothness:
+//  - corner[i] = c_i when it is a corner candidate (c_i > corner threshold), -inf otherwise (and for
+//    unusable points); entries outside [hw, n - hw) untouched;
+//  - bit i of `surface` (n + 64 bits, zeroed by the caller) set when it is a surface candidate (c_i <
+//    surface threshold), and then surface_c[i] = c_i (other entries unspecified; surface_c holds room for
+//    the ring's points rounded up to eight). A NaN c_i is neither.
 // Occlusion boundaries (LOAM's unreliable points) are appended to `occlusions` as +(j + 1) when the far
 // side begins at j + 1 (points j+1 .. j+hw are unusable) and -(j + 1) when it ends at j (j-hw+1 .. j);
 // the caller applies them (they only take candidates away).
-void smoothness(const RingIn& in, const RingRules& rules, RingScratch& scratch, float* corner_lo, float* corner_hi,
-                uint64_t* surface, uint64_t* surface_sure, std::vector<int>& occlusions);
+void smoothness(const RingIn& in, const RingRules& rules, RingScratch& scratch, float* corner, uint64_t* surface,
+                float* surface_c, std::vector<int>& occlusions);
 
-// Sector scans of the corner bounds, with the same instruction set as the pass: the largest of v[b .. e)
-// (-inf when empty; v holds no NaN), and the indices i in [b, e) with v[i] >= t appended in increasing order.
-float range_max(const float* v, int b, int e);
-void indices_at_least(const float* v, float t, int b, int e, std::vector<int>& out);
+// Sector scan of the corner values, with the same instruction set as the pass: the first index of the
+// largest of v[b .. e), -1 when that is -inf or the range is empty (v holds no NaN).
+int first_argmax(const float* v, int b, int e);
 
 // The dispatch's choice, for the benchmark and the notes: "avx2", "sse2" or "generic".
 const char* smoothness_isa();

@@ -1,11 +1,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <map>
 
 #include "fploc/features/features.h"
 #include "fploc/segmentation/segmenter.h"
 #include "fploc/segmentation/synthetic.h"
+#include "../src/smoothness.h"
 
 using namespace fploc;
 using namespace fploc::feat;
@@ -182,6 +185,70 @@ TEST(Features, ReferenceEqualOnSyntheticScans) {
         ASSERT_GT(s.wall.size(), 1000u);
         expect_same(s, FeatureConfig{}, "seed " + std::to_string(seed));
       }
+}
+
+// The pass's c (both instruction-set copies: features_test_base runs this with the baseline one) equals the
+// definition (the reference's float_smoothness written out) bit for bit at every usable point of every ring,
+// with thresholds that make every point both a corner and a surface candidate; half windows 5 (compiled
+// constant) and 3, rings of every length. (The picks alone would not show a last-bit change of c.)
+TEST(Features, ReferenceEqualSmoothnessPass) {
+  const auto s = segment(synth::furnished_room(), synth::SensorPose{1.0, 0.5, 1.5, 1 * kDeg, 1 * kDeg, 0.3}, 0.01, 9);
+  const auto& w = s.wall;
+  std::vector<float> w_scratch, corner, sc;
+  std::vector<uint64_t> brk, bits;
+  std::vector<int> occ;
+  size_t checked = 0;
+  for (int hw : {5, 3}) {
+    for (size_t b = 0; b < w.size();) {
+      size_t e = b;
+      while (e < w.size() && w.ring[e] == w.ring[b]) ++e;
+      for (size_t len : {e - b, size_t(2 * hw + 1), size_t(2 * hw + 8), size_t(2 * hw + 9)}) {
+        const int n = int(std::min(len, e - b));
+        if (n < 2 * hw + 1) continue;
+        const detail::RingIn in{&w.x[b], &w.y[b], &w.z[b], &w.range[b], &w.column[b], n};
+        const detail::RingRules ru{hw, 1, 0.f, 1e9f, 1e9f, 1e9f, -1.f, std::numeric_limits<float>::infinity()};
+        corner.assign(size_t(n + 8), 0.f);
+        sc.assign(size_t(n + 8), 0.f);
+        bits.assign(size_t(n) / 64 + 2, 0);
+        occ.clear();
+        detail::RingScratch scratch{w_scratch, brk};
+        detail::smoothness(in, ru, scratch, corner.data(), bits.data(), sc.data(), occ);
+        for (int i = hw; i < n - hw; ++i) {
+          const float c = reference::smoothness(in.x, in.y, in.z, in.r, i, hw);
+          if (!(bits[size_t(i) >> 6] >> (i & 63) & 1)) continue;  // a broken window (column gap)
+          ASSERT_EQ(std::memcmp(&c, &sc[size_t(i)], 4), 0) << "ring " << w.ring[b] << " point " << i << " hw " << hw;
+          ASSERT_EQ(std::memcmp(&c, &corner[size_t(i)], 4), 0) << "ring " << w.ring[b] << " point " << i;
+          ++checked;
+        }
+      }
+      b = e;
+    }
+  }
+  EXPECT_GT(checked, 50000u);
+}
+
+// A ring that repeats a 6-point pattern exactly: the windows at the same phase hold the same floats in the same
+// order, so their c are equal, above the corner threshold: the corner picks are ties, decided by the first index.
+TEST(Features, ReferenceEqualOnPeriodicRing) {
+  seg::Segmentation s;
+  s.status = seg::SegStatus::kOk;
+  s.height = 64;
+  auto& w = s.wall;
+  const float px[6] = {4.0f, 4.0f, 4.5f, 4.0f, 3.75f, 4.0f}, py[6] = {0.0f, 0.5f, 0.25f, -0.5f, 0.0f, 0.75f};
+  for (int r = 0; r < 2; ++r)
+    for (int c = 0; c < 300; ++c) {
+      const float x = px[c % 6], y = py[c % 6], z = 0.5f;
+      w.x.push_back(x); w.y.push_back(y); w.z.push_back(z);
+      w.range.push_back(std::sqrt(x * x + y * y + z * z));
+      w.t.push_back(0.f);
+      w.ring.push_back(int16_t(r)); w.column.push_back(int16_t(c));
+    }
+  FeatureConfig c;
+  c.occlusion_ratio = 1.0;  // (the pattern's range steps are not occlusions)
+  c.parallel_ratio = 1.0;
+  expect_same(s, c, "periodic ring");
+  c.max_corners_per_sector = 5;
+  expect_same(s, c, "periodic ring, 5 corners");
 }
 
 TEST(Features, ReferenceEqualWithOtherOptionsAndBeamCounts) {

@@ -1,6 +1,6 @@
-// The feature extractor's rules written the plain way (test only): one point at a time, window sums added
-// up point by point in double, every smoothness computed with its exact square root and division, corner and
-// surface candidates sorted (LOAM's order) and walked. The fast extractor must give the same frame, bit for
+// The feature extractor's rules written the plain way (test only): one point at a time, every smoothness
+// computed on its own (its float definition, below), corner and surface candidates sorted (LOAM's order) and
+// walked. The fast extractor must give the same frame, bit for
 // bit (features_test ReferenceEqual*): it may skip work, never change a pick.
 #pragma once
 #include <Eigen/Eigenvalues>
@@ -15,17 +15,23 @@
 namespace fploc::feat::reference {
 
 // The smoothness of point i of a ring (X, Y, Z, R the ring's arrays): LOAM's c = |sum_j (X_j - X_i)| /
-// (2 hw |X_i|), the sum in double (exact for float inputs), root in double, division in float.
+// (2 hw |X_i|), defined by its float computation (src/smoothness.h float_smoothness, written out here): the
+// hw points before i and the hw points after i each added up in index order, d = (A + B) - 2hw X_i, one
+// root, one reciprocal.
 inline float smoothness(const float* X, const float* Y, const float* Z, const float* R, int i, int hw) {
-  double sx = 0, sy = 0, sz = 0;
-  for (int k = -hw; k <= hw; ++k) {
-    sx += X[i + k];
-    sy += Y[i + k];
-    sz += Z[i + k];
+  float ax = 0, ay = 0, az = 0, bx = 0, by = 0, bz = 0;
+  for (int q = 0; q < hw; ++q) {
+    ax = q == 0 ? X[i - hw] : ax + X[i - hw + q];
+    ay = q == 0 ? Y[i - hw] : ay + Y[i - hw + q];
+    az = q == 0 ? Z[i - hw] : az + Z[i - hw + q];
+    bx = q == 0 ? X[i + 1] : bx + X[i + 1 + q];
+    by = q == 0 ? Y[i + 1] : by + Y[i + 1 + q];
+    bz = q == 0 ? Z[i + 1] : bz + Z[i + 1 + q];
   }
-  const double w = 2 * hw + 1;
-  const double dx = sx - w * double(X[i]), dy = sy - w * double(Y[i]), dz = sz - w * double(Z[i]);
-  return float(std::sqrt(dx * dx + dy * dy + dz * dz)) / (float(2 * hw) * R[i]);
+  const float den = float(2 * hw);
+  const float dx = (ax + bx) - den * X[i], dy = (ay + by) - den * Y[i], dz = (az + bz) - den * Z[i];
+  const float inv = 1.f / (den * R[i]);
+  return std::sqrt((dx * dx + dy * dy) + dz * dz) * inv;
 }
 
 struct Result {

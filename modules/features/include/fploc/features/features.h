@@ -67,10 +67,10 @@ class FeatureExtractor {
   std::vector<int32_t> source_;
   Eigen::Matrix3f R_ = Eigen::Matrix3f::Identity();
   // Per-ring buffers, kept from scan to scan (src/smoothness.h).
-  std::vector<float> corner_lo_, corner_hi_;  // bounds on c of corner candidates, -inf otherwise
-  std::vector<uint64_t> surface_;             // bit i: point i may be a surface candidate
-  std::vector<uint64_t> surface_sure_;        // bit i: point i surely is one (c below the threshold)
-  std::vector<float> surface_c_;              // exact c of the sector's surface candidates
+  std::vector<float> corner_c_;               // c of corner candidates, -inf otherwise
+  std::vector<uint64_t> surface_;             // bit i: point i is a surface candidate
+  std::vector<float> surface_c_;              // c of the surface candidates
+  std::vector<uint64_t> surf_keys_;           // a sector's surface candidates: (c, index) as sort keys
   std::vector<uint8_t> picked_;                  // suppressed by a pick or an occlusion boundary
   std::vector<uint64_t> pick_bits_;              // the ring's picks (features, corners) as bits
   std::vector<int> occ_, surf_, sel_, run_;
