@@ -24,6 +24,8 @@ static void usage() {
                "       [--max-dt S] (association, default 0.02) [--offset S] (added to est times)\n"
                "       [--delta D] [--delta-unit s|f] (RPE delta, default 1 s; f = frames)\n"
                "       [--plan FILE [--layers A,B] [--units U]] (drawn under the trajectories of --plot)\n"
+               "       [--plot-frame all|trajectories] (the plot's axes frame the trajectories and the whole plan\n"
+               "       (default), or the trajectories with a 3 m margin, the plan clipped: a map with stray specks)\n"
                "       [--uncertainty FILE] (status + x/y/yaw covariance per pose: NEES and false OK)\n"
                "       [--false-ok-m M] (horizontal error of a false OK, default 0.3)\n"
                "       [--hat THIRD.tum [--hat-lag N]] (three-cornered hat of gt, est and THIRD: the noise of each,\n"
@@ -32,6 +34,7 @@ static void usage() {
 
 int main(int argc, char** argv) {
   std::string gt_path, est_path, plot, align_s = "none", unit = "s", plan_path, layers, units, unc_path, hat_path;
+  std::string plot_frame = "all";
   int hat_lag = 1;
   bool json = false;
   double max_dt = 0.02, offset = 0, delta = 1.0, false_ok_m = 0.3;
@@ -55,6 +58,7 @@ int main(int argc, char** argv) {
       else if (a == "--delta") delta = std::stod(next());
       else if (a == "--delta-unit") unit = next();
       else if (a == "--plan") plan_path = next();
+      else if (a == "--plot-frame") plot_frame = next();
       else if (a == "--layers") layers = next();
       else if (a == "--units") units = next();
       else if (a == "--uncertainty") unc_path = next();
@@ -98,6 +102,9 @@ int main(int argc, char** argv) {
     const auto r = eval::rpe(gt, est, pairs, delta, unit == "f");
     if (!plot.empty()) {
       eval::PlotOptions po;
+      if (plot_frame != "all" && plot_frame != "trajectories")
+        throw std::runtime_error("--plot-frame: '" + plot_frame + "' is not one of all, trajectories");
+      po.frame_trajectories = plot_frame == "trajectories";
       if (!plan_path.empty()) {
         const FloorPlan plan = load_floor_plan(plan_path, {layers}, units);
         for (const auto& e : plan.elements) {

@@ -67,10 +67,11 @@ std::string plot_svg(const Trajectory& gt, const Trajectory& est, const std::str
   };
   for (const auto* v : {&a, &b})
     for (const auto& p : *v) grow(p);
-  for (const auto& l : o.plan)
-    for (const auto& p : l) grow(p);
+  if (!o.frame_trajectories)
+    for (const auto& l : o.plan)
+      for (const auto& p : l) grow(p);
   if (x0 > x1) x0 = y0 = -1, x1 = y1 = 1;
-  const double pad = 0.03 * std::max(x1 - x0, y1 - y0);
+  const double pad = o.frame_trajectories ? std::max(0.0, o.frame_margin_m) : 0.03 * std::max(x1 - x0, y1 - y0);
   x0 -= pad, y0 -= pad, x1 += pad, y1 += pad;
   // Equal scale on both axes; the plot area is at most 820 x 760 px.
   const double span_x = std::max(x1 - x0, 1e-3), span_y = std::max(y1 - y0, 1e-3);
@@ -116,7 +117,10 @@ std::string plot_svg(const Trajectory& gt, const Trajectory& est, const std::str
   s << buf;
   // The plan.
   if (!o.plan.empty()) {
-    s << "<g fill=\"none\" stroke=\"#9a9a9a\" stroke-width=\"1.6\"><title>floor plan</title>\n";
+    // Clipped to the axes (a plan reaching beyond them when the frame is the trajectories').
+    std::snprintf(buf, sizeof buf, "<clipPath id=\"axes\"><rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/></clipPath>\n",
+                  X(x0), Y(y1), PW, PH);
+    s << buf << "<g fill=\"none\" stroke=\"#9a9a9a\" stroke-width=\"1.6\" clip-path=\"url(#axes)\"><title>floor plan</title>\n";
     for (const auto& l : o.plan) {
       if (l.size() < 2) continue;
       s << "<polyline points=\"";

@@ -193,3 +193,18 @@ TEST(Plot, PlanAxesLegendAndErrorColours) {
   EXPECT_EQ(last.substr(3), "0000") << last;  // jet(~1): red only
   EXPECT_GT(std::stoi(last.substr(1, 2), nullptr, 16), 0x80) << last;
 }
+
+// A map with a stray speck far from the building: by default the axes take it in (the building shrinks to a
+// corner of the plot); framed on the trajectories they keep to the path and its margin, and the plan is clipped.
+TEST(Plot, FramedOnTheTrajectoriesAFarSpeckIsLeftOut) {
+  const auto gt = loop(30);
+  PlotOptions o;
+  o.plan = {{Eigen::Vector2d(-3, -3), Eigen::Vector2d(3, -3)}, {Eigen::Vector2d(500, 500), Eigen::Vector2d(500.1, 500)}};
+  const auto all = plot_svg(gt, gt, "t", Eigen::Isometry3d::Identity(), o);
+  EXPECT_NE(all.find(">500</text>"), std::string::npos);
+  o.frame_trajectories = true;
+  const auto framed = plot_svg(gt, gt, "t", Eigen::Isometry3d::Identity(), o);
+  EXPECT_EQ(framed.find(">500</text>"), std::string::npos);
+  EXPECT_EQ(framed.find(">100</text>"), std::string::npos);
+  EXPECT_NE(framed.find("clip-path=\"url(#axes)\""), std::string::npos);
+}

@@ -58,6 +58,11 @@ struct PlotOptions {
   // Per estimate pose (same order as `est`), its error [m]; NaN = not associated. Non-empty: the
   // estimate is coloured by error (as evo's --plot_mode xy with colour mapping) with a colour bar.
   std::vector<double> est_error;
+  // The axes frame the trajectories and the whole plan (false), or the trajectories only, with a margin of
+  // frame_margin_m (true: a map with stray specks far from the building, or a campus plan around one corridor);
+  // the plan is clipped to the axes either way.
+  bool frame_trajectories = false;
+  double frame_margin_m = 3.0;
 };
 
 // SVG (x-y plane, metres, equal axes, ticks and axis labels in metres, legend) of the ground truth and
