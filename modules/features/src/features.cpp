@@ -130,12 +130,12 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
                                 float(cfg_.occlusion_ratio), float(cfg_.parallel_ratio),
                                 float(cfg_.corner_threshold), float(cfg_.surface_threshold)};
   detail::RingScratch scratch{ring_w_, ring_brk_};
-  float* lo = corner_c_.data();
+  float* corner_c = corner_c_.data();  // c of corner candidates, -inf elsewhere
   const float* sc = surface_c_.data();
   const uint64_t* sk = surface_.data();
-  detail::smoothness(in, rules, scratch, lo, surface_.data(), surface_c_.data(), occ_);
-  for (int k = 0; k < hw; ++k) lo[k] = -kInf;  // no window: no candidate
-  for (int k = n - hw; k < nb * 8; ++k) lo[k] = -kInf;
+  detail::smoothness(in, rules, scratch, corner_c, surface_.data(), surface_c_.data(), occ_);
+  for (int k = 0; k < hw; ++k) corner_c[k] = -kInf;  // no window: no candidate
+  for (int k = n - hw; k < nb * 8; ++k) corner_c[k] = -kInf;
   uint8_t* picked = picked_.data();
   // Taking points a..b out: no later corner or surface pick there (a pick's neighbours, occlusions).
   auto suppress = [&](int a, int b) {
@@ -143,7 +143,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     b = std::min(n - 1, b);
     for (int k = a; k <= b; ++k) {
       picked[k] = 1;
-      lo[k] = -kInf;
+      corner_c[k] = -kInf;
     }
   };
   for (const int e : occ_) {  // +(j+1): the near side is j (j+1 .. j+hw out); -(j+1): j-hw+1 .. j out
@@ -174,7 +174,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     for (int corners = 0; corners < max_corners; ++corners) {
       // The sharpest candidate: the first index with the largest c (one vector scan of the sector: a sector
       // is ~n/6 points, cheaper than keeping block maxima up to date).
-      const int best = detail::first_argmax(lo, sb, se);
+      const int best = detail::first_argmax(corner_c, sb, se);
       if (best < 0) break;
       pick(best, true);
       suppress(best - hw, best + hw);
