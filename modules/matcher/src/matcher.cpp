@@ -299,7 +299,12 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
   }
   const double dt = (tau - tau_) * 1e-6;
   if (r.status == FitStatus::kOk) {
-    if (have_last_ && dt > 0 && dt < 1.0) {
+    // The velocity is measured between two registered frames only: after a POOR frame pose_ is the
+    // prediction (the twist that made it stays), after LOST it is a stale dead-reckoned pose, and the
+    // difference to a re-acquired fit is the correction, not motion (the corridor's renovated world:
+    // 1-4 m corrections after LOST read as 20-60 m/s, and the POOR frames after them flew 50 m off the
+    // building). Until two frames in a row register, the motion model predicts no motion.
+    if (tracking && dt > 0 && dt < 1.0) {
       twist_ = log_twist(pose_, solved_ref, dt);
       have_velocity_ = true;
     }

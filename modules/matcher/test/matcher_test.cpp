@@ -144,6 +144,40 @@ TEST(Matcher, FeaturesThatDoNotMatchArePoorThenLost) {
   EXPECT_LT(pos_err(r.pose, Pose2{10.1, 5.05, 0.42}), 1e-3);
 }
 
+TEST(Matcher, ReacquiredAfterLostTheCorrectionIsNotReadAsVelocity) {
+  // Tracking at 0.5 m/s, then frames that match nothing (LOST: the pose is held), then, on the next frame,
+  // the sensor is registered 1 m from the held pose. That correction (1 m in 0.1 s) is not a velocity: the
+  // next prediction must stay at the re-acquired pose (no velocity known yet), not run on at 10 m/s, and
+  // two registered frames in a row give the velocity back.
+  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  MatcherConfig cfg;
+  cfg.lost_after = 3;
+  Matcher m(*map.lookup, cfg);
+  double x0 = 4.0;  // where the sensor is at t = 0 (moves to 5.0 while the track is lost)
+  auto truth = [&x0](double t) { return Pose2{x0 + 0.5 * t, 3.0, 0.2}; };
+  m.set_pose(truth(0), 0.3);
+  SynthOptions so;
+  int k = 0;
+  for (; k < 5; ++k) ASSERT_EQ(m.process(synth_frame(*map.plan, truth(0.1 * k), so, int64_t(k) * 100'000)).status, FitStatus::kOk);
+  for (; k < 9; ++k) {
+    auto bad = fploc::testing::random_frame(300, 6.0, uint32_t(200 + k));
+    bad.utime = int64_t(k) * 100'000;
+    EXPECT_NE(m.process(bad).status, FitStatus::kOk);
+  }
+  x0 = 5.0;
+  const MatchResult back = m.process(synth_frame(*map.plan, truth(0.1 * k), so, int64_t(k) * 100'000));
+  ASSERT_EQ(back.status, FitStatus::kOk) << back.text;
+  EXPECT_LT(pos_err(back.pose, truth(0.1 * k)), 0.01);
+  ++k;
+  const MatchResult next = m.process(synth_frame(*map.plan, truth(0.1 * k), so, int64_t(k) * 100'000));
+  ASSERT_EQ(next.status, FitStatus::kOk) << next.text;
+  EXPECT_LT(pos_err(next.predicted, back.pose), 0.01) << "the correction after LOST was read as a velocity";
+  ++k;
+  const MatchResult third = m.process(synth_frame(*map.plan, truth(0.1 * k), so, int64_t(k) * 100'000));
+  ASSERT_EQ(third.status, FitStatus::kOk) << third.text;
+  EXPECT_LT(pos_err(third.predicted, truth(0.1 * k)), 0.01) << "two registered frames give the velocity again";
+}
+
 TEST(Matcher, NotInitialisedWithoutAPose) {
   auto map = make_localization_map(room_with_pillars(), "brute-force");
   Matcher m(*map.lookup, {});
