@@ -23,12 +23,36 @@ PY
 "$B/fploc-import" --list --json "$BAG" > "$T/list.json"
 check "$T/list.json" "j['topics']['/os_node0/lidar_packets']['count']==32 and j['topics']['/os_node0/imu_packets']['count']==10 and j['topics']['/os_node0/metadata']['type']=='std_msgs/String' and 0.05<j['duration_s']<0.2"
 
+# Lidar packets and no metadata (its topic left out, no --metadata): they cannot be written; one error saying so and
+# exit 1 (it was exit 0 with a log of the IMU packets only), the IMU packets still written.
+set +e
+"$B/fploc-import" "$BAG" --topics /os_node0/lidar_packets,/os_node0/imu_packets --out "$T/nometa.lcm" --json \
+  > "$T/nometa.json" 2> "$T/nometa.err"
+rc=$?
+set -e
+[ "$rc" = 1 ] || { echo "lidar packets without metadata: exit $rc, expected 1"; exit 1; }
+grep -q "32 Ouster lidar packets without metadata .*--metadata FILE" "$T/nometa.err" || { cat "$T/nometa.err"; exit 1; }
+[ "$(grep -c . "$T/nometa.err")" = 1 ] || { echo "more than one error line"; cat "$T/nometa.err"; exit 1; }
+check "$T/nometa.json" "j['written']=={'OS1_IMU_PACKETS':10}"
+
 # Default: the packets as they are, decoded on replay by the OS-1 and IMU drivers (graphs/replay-packets.pbtxt).
 "$B/fploc-import" "$BAG" --out "$T/p.lcm" --json > "$T/importp.json"
 check "$T/importp.json" "j['replay_graph']=='graphs/replay-packets.pbtxt' and j['written']['OS1_LIDAR_PACKETS']==32 and j['written']['OS1_IMU_PACKETS']==10 and j['written']['OS1_METADATA']==1 and 'OS1_SCAN' not in j['written'] and j['ouster']['mode']=='packets' and j['ouster']['pixels_per_column']==128 and j['errors']==[]"
 "$B/fploc-replay" --graph "$FPLOC_ROOT/graphs/replay-packets.pbtxt" --log "$T/p.lcm" --json --out "$T/p.tum" \
   --record "$T/p_rec.lcm" --record-channels 'OS1_SCAN|OS1_IMU' > "$T/replayp.json" 2> "$T/replayp.err"
 check "$T/replayp.json" "j['channels_fed']=={'OS1_LIDAR_PACKETS':32,'OS1_IMU_PACKETS':10,'OS1_METADATA':1} and [n['messages_out'] for n in j['nodes'] if n['name'] in ('os1_driver','imu_driver','segmenter')]==[1,10,1] and all(n['errors']==0 for n in j['nodes'] if n['name'] in ('os1_driver','imu_driver'))"
+
+# --start/--end that are no time span: one error naming the option, exit 2, nothing written (NaN and negative ones
+# were ignored; an END before START wrote an empty log, exit 0).
+for bad in "--start nan" "--end -1" "--start 5 --end 1"; do
+  set +e
+  "$B/fploc-import" "$BAG" $bad --out "$T/span.lcm" > /dev/null 2> "$T/span.err"
+  rc=$?
+  set -e
+  [ "$rc" = 2 ] || { echo "import $bad: exit $rc, expected 2"; exit 1; }
+  grep -q "^fploc import: --" "$T/span.err" || { cat "$T/span.err"; exit 1; }
+  [ ! -e "$T/span.lcm" ] || { echo "import $bad wrote a log"; exit 1; }
+done
 
 # --decode: scan_t and imu_t written by the importer, byte for byte what the drivers give on replay.
 "$B/fploc-import" "$BAG" --decode --out "$T/x.lcm" --json > "$T/import.json"
