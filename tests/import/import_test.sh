@@ -54,6 +54,17 @@ for bad in "--start nan" "--end -1" "--start 5 --end 1"; do
   [ ! -e "$T/span.lcm" ] || { echo "import $bad wrote a log"; exit 1; }
 done
 
+# Not an LCM log, or one cut short: one error naming the file and exit 1 (both replayed "0 of 0 log events", exit 0).
+for bad in bag cut; do
+  if [ $bad = bag ]; then L="$BAG"; else L="$T/p_cut.lcm"; head -c $(( $(stat -c %s "$T/p.lcm") - 100 )) "$T/p.lcm" > "$L"; fi
+  set +e
+  "$B/fploc-replay" --graph "$FPLOC_ROOT/graphs/replay-packets.pbtxt" --log "$L" > /dev/null 2> "$T/bad.err"
+  rc=$?
+  set -e
+  [ "$rc" = 1 ] || { echo "replay of a $bad log: exit $rc, expected 1"; exit 1; }
+  grep -q "^fploc replay: $L: " "$T/bad.err" || { echo "replay of a $bad log:"; cat "$T/bad.err"; exit 1; }
+done
+
 # --decode: scan_t and imu_t written by the importer, byte for byte what the drivers give on replay.
 "$B/fploc-import" "$BAG" --decode --out "$T/x.lcm" --json > "$T/import.json"
 PYTHONPATH="$FPLOC_ROOT/tools/pylib" python3 - "$T/x.lcm" "$T/p_rec.lcm" <<'PY'
@@ -87,6 +98,26 @@ if [ -n "$SHIP" ]; then
   "$B/fploc-import" "$SHIP" --out "$T/ship2.lcm" --channel /guardian/laser_horizontal_back=LASER_SCAN --json --quiet > "$T/ship2.json"
   check "$T/ship2.json" "j['written']['LASER_SCAN']==418 and j['written']['LASER_SCAN_GUARDIAN_LASER_TILT_FRONT']==421"
   [ "$(wc -l < "$T/odom.tum")" -ge 800 ] || { echo "odom.tum too short"; exit 1; }
+  # README's recipe for a 2D laser: graphs/lidar2d.pbtxt on the map_server map, --out EST.tum. Its four pose
+  # loggers all wrote EST.tum (overwriting each other's bytes: a torn last line); now EST.tum is the pipeline's
+  # pose (FPLOC_POSE) and the others write EST.NODE.tum beside it.
+  MAP="$(ls "$D"/recordings/ship-interior/*.yaml | head -1)"
+  "$B/fploc-import" "$SHIP" --end 6 --out "$T/ship6.lcm" --quiet > /dev/null
+  "$B/fploc-replay" --graph "$FPLOC_ROOT/graphs/lidar2d.pbtxt" --log "$T/ship6.lcm" --out "$T/est.tum" \
+    --set matcher.plan.file="$MAP" --set optimizer.plan.file="$MAP" --set grid2d.plan.file="$MAP" \
+    --set amcl.plan.file="$MAP" --set matcher.initial_pose.x=0.5 --set matcher.initial_pose.y=0.5 \
+    > /dev/null 2> "$T/est.err"
+  grep -q "wo_logger -> $T/est.tum" "$T/est.err" || { cat "$T/est.err"; exit 1; }
+  python3 - "$T" <<'PY'
+import sys
+d = sys.argv[1]
+for f in ("est.tum", "est.sfr_logger.tum", "est.grid_logger.tum", "est.amcl_logger.tum"):
+    rows = [l.split() for l in open(f"{d}/{f}")]
+    assert rows and all(len(r) == 8 for r in rows), f"{f}: {len(rows)} rows, not all of 8 columns"
+    t = [float(r[0]) for r in rows]
+    assert t == sorted(t), f"{f}: times not increasing"
+    print(f"{f}: ok", len(rows), "poses")
+PY
   "$B/fploc-import" "$SHIP" --tum-out "$T/tf.tum" --tf-parent odom --tf-child base_footprint --start 10 --end 20 --quiet > /dev/null
   python3 - "$T/tf.tum" <<'PY'
 import sys
