@@ -6,6 +6,8 @@
 #include <google/protobuf/util/json_util.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -49,6 +51,36 @@ class Collector : public google::protobuf::io::ErrorCollector {
   std::vector<GraphError>& errors_;
 };
 
+// Float and double fields (nested and repeated ones too) that are NaN or infinite: "path is nan", with the
+// field's line when the parse tree has it (else `line`).
+void non_finite(const Message& m, const std::string& prefix, const TextFormat::ParseInfoTree* tree, int line,
+                std::vector<std::pair<std::string, int>>& out) {
+  const auto* r = m.GetReflection();
+  std::vector<const FieldDescriptor*> fields;
+  r->ListFields(m, &fields);
+  for (const auto* f : fields) {
+    const int n = f->is_repeated() ? r->FieldSize(m, f) : 1;
+    for (int k = 0; k < n; ++k) {
+      const int index = f->is_repeated() ? k : -1;
+      const std::string path = prefix + f->name() + (f->is_repeated() ? "[" + std::to_string(k) + "]" : "");
+      int at = line;
+      if (tree) {
+        const auto loc = tree->GetLocation(f, index);
+        if (loc.line >= 0) at = loc.line + 1;
+      }
+      if (f->cpp_type() == FieldDescriptor::CPPTYPE_DOUBLE || f->cpp_type() == FieldDescriptor::CPPTYPE_FLOAT) {
+        const double v = f->cpp_type() == FieldDescriptor::CPPTYPE_DOUBLE
+                             ? (f->is_repeated() ? r->GetRepeatedDouble(m, f, k) : r->GetDouble(m, f))
+                             : (f->is_repeated() ? r->GetRepeatedFloat(m, f, k) : r->GetFloat(m, f));
+        if (!std::isfinite(v)) out.push_back({path + " is " + (std::isnan(v) ? "nan" : v > 0 ? "inf" : "-inf"), at});
+      } else if (f->cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE) {
+        non_finite(f->is_repeated() ? r->GetRepeatedMessage(m, f, k) : r->GetMessage(m, f), path + ".",
+                   tree ? tree->GetTreeForNested(f, index) : nullptr, at, out);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 bool parse_graph_text(const std::string& text, const std::string& name, LoadedGraph& out,
@@ -62,7 +94,23 @@ bool parse_graph_text(const std::string& text, const std::string& name, LoadedGr
   parser.WriteLocationsTo(out.tree.get());
   parser.AllowUnknownField(true);
   const bool ok = parser.ParseFromString(text, &out.graph);
-  return ok && collector.count == 0;
+  if (!ok || collector.count) return false;
+  const size_t before = errors.size();
+  // NaN and inf parse as numbers; in an option they are never meant (a NaN initial pose).
+  std::vector<std::pair<std::string, int>> bad;
+  const auto* node_field = fploc::Graph::descriptor()->FindFieldByName("node");
+  for (int i = 0; i < out.graph.node_size(); ++i) {
+    const auto& n = out.graph.node(i);
+    bad.clear();
+    non_finite(n, "", out.tree->GetTreeForNested(node_field, i), out.tree->GetLocation(node_field, i).line + 1, bad);
+    for (const auto& [what, line] : bad) errors.push_back({name, line, "node '" + n.name() + "': " + what + " (not a finite number)"});
+  }
+  fploc::Graph rest = out.graph;  // the graph's own fields
+  rest.clear_node();
+  bad.clear();
+  non_finite(rest, "", out.tree.get(), 0, bad);
+  for (const auto& [what, line] : bad) errors.push_back({name, line, what + " (not a finite number)"});
+  return errors.size() == before;
 }
 
 bool load_graph(const std::string& path, LoadedGraph& out, std::vector<GraphError>& errors) {
@@ -152,10 +200,22 @@ bool apply_overrides(Message& opts, const std::vector<std::string>& overrides, s
     Collector c("--set", errs);
     TextFormat::Parser parser;
     parser.RecordErrorsTo(&c);
-    if (!parser.MergeFromString(text, &opts) || c.count) {
+    // Merged into a copy: a value that is not finite (nan, inf parse as numbers) leaves the options as they were.
+    std::unique_ptr<Message> merged(opts.New());
+    merged->CopyFrom(opts);
+    if (!parser.MergeFromString(text, merged.get()) || c.count) {
       error = "override '" + kv + "': " + (errs.empty() ? std::string("cannot parse value") : errs.front().message);
       return false;
     }
+    std::vector<std::pair<std::string, int>> before, after;
+    non_finite(opts, "", nullptr, 0, before);
+    non_finite(*merged, "", nullptr, 0, after);
+    for (const auto& b : after)
+      if (std::find(before.begin(), before.end(), b) == before.end()) {
+        error = "override '" + kv + "': " + b.first + " (not a finite number)";
+        return false;
+      }
+    opts.CopyFrom(*merged);
   }
   return true;
 }

@@ -75,3 +75,39 @@ TEST(Overrides, SetsNestedAndRejectsUnknown) {
   EXPECT_NE(err.find("lokup"), std::string::npos);
   EXPECT_FALSE(apply_overrides(*o, {"max_iterations=lots"}, err));
 }
+
+// NaN and infinity parse as numbers in text format; in an option they are a typo or a broken generator, never a
+// setting (a NaN initial pose started the matcher nowhere). One error each, naming the node, the option and its line.
+TEST(Graph, NonFiniteOptionIsAnErrorWithItsLine) {
+  const std::string text = R"pb(name: "t"
+shutdown_timeout_s: 2
+node {
+  name: "m"
+  executable: "fploc-matcher"
+  matcher { plan { file: "p.json" }
+            initial_pose { x: nan y: 1 yaw: 0 } }
+}
+node {
+  name: "o"
+  executable: "fploc-optimizer"
+  optimizer { alpha: -inf beta: 0.9 }
+}
+)pb";
+  LoadedGraph g;
+  std::vector<GraphError> errors;
+  EXPECT_FALSE(parse_graph_text(text, "t.pbtxt", g, errors));
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[0].str(), "t.pbtxt:7: node 'm': matcher.initial_pose.x is nan (not a finite number)");
+  EXPECT_EQ(errors[1].str(), "t.pbtxt:12: node 'o': optimizer.alpha is -inf (not a finite number)");
+}
+
+TEST(Overrides, NonFiniteValueIsRejected) {
+  auto o = default_options("matcher");
+  ASSERT_TRUE(o);
+  std::string err;
+  EXPECT_FALSE(apply_overrides(*o, {"initial_pose.x=nan"}, err));
+  EXPECT_EQ(err, "override 'initial_pose.x=nan': initial_pose.x is nan (not a finite number)");
+  EXPECT_FALSE(apply_overrides(*o, {"max_correspondence_m=inf"}, err));
+  EXPECT_NE(err.find("max_correspondence_m is inf"), std::string::npos) << err;
+  EXPECT_TRUE(apply_overrides(*o, {"initial_pose.x=1e300"}, err)) << err;
+}

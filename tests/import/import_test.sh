@@ -23,12 +23,47 @@ PY
 "$B/fploc-import" --list --json "$BAG" > "$T/list.json"
 check "$T/list.json" "j['topics']['/os_node0/lidar_packets']['count']==32 and j['topics']['/os_node0/imu_packets']['count']==10 and j['topics']['/os_node0/metadata']['type']=='std_msgs/String' and 0.05<j['duration_s']<0.2"
 
+# Lidar packets and no metadata (its topic left out, no --metadata): they cannot be written; one error saying so and
+# exit 1 (it was exit 0 with a log of the IMU packets only), the IMU packets still written.
+set +e
+"$B/fploc-import" "$BAG" --topics /os_node0/lidar_packets,/os_node0/imu_packets --out "$T/nometa.lcm" --json \
+  > "$T/nometa.json" 2> "$T/nometa.err"
+rc=$?
+set -e
+[ "$rc" = 1 ] || { echo "lidar packets without metadata: exit $rc, expected 1"; exit 1; }
+grep -q "32 Ouster lidar packets without metadata .*--metadata FILE" "$T/nometa.err" || { cat "$T/nometa.err"; exit 1; }
+[ "$(grep -c . "$T/nometa.err")" = 1 ] || { echo "more than one error line"; cat "$T/nometa.err"; exit 1; }
+check "$T/nometa.json" "j['written']=={'OS1_IMU_PACKETS':10}"
+
 # Default: the packets as they are, decoded on replay by the OS-1 and IMU drivers (graphs/replay-packets.pbtxt).
 "$B/fploc-import" "$BAG" --out "$T/p.lcm" --json > "$T/importp.json"
 check "$T/importp.json" "j['replay_graph']=='graphs/replay-packets.pbtxt' and j['written']['OS1_LIDAR_PACKETS']==32 and j['written']['OS1_IMU_PACKETS']==10 and j['written']['OS1_METADATA']==1 and 'OS1_SCAN' not in j['written'] and j['ouster']['mode']=='packets' and j['ouster']['pixels_per_column']==128 and j['errors']==[]"
 "$B/fploc-replay" --graph "$FPLOC_ROOT/graphs/replay-packets.pbtxt" --log "$T/p.lcm" --json --out "$T/p.tum" \
   --record "$T/p_rec.lcm" --record-channels 'OS1_SCAN|OS1_IMU' > "$T/replayp.json" 2> "$T/replayp.err"
 check "$T/replayp.json" "j['channels_fed']=={'OS1_LIDAR_PACKETS':32,'OS1_IMU_PACKETS':10,'OS1_METADATA':1} and [n['messages_out'] for n in j['nodes'] if n['name'] in ('os1_driver','imu_driver','segmenter')]==[1,10,1] and all(n['errors']==0 for n in j['nodes'] if n['name'] in ('os1_driver','imu_driver'))"
+
+# --start/--end that are no time span: one error naming the option, exit 2, nothing written (NaN and negative ones
+# were ignored; an END before START wrote an empty log, exit 0).
+for bad in "--start nan" "--end -1" "--start 5 --end 1"; do
+  set +e
+  "$B/fploc-import" "$BAG" $bad --out "$T/span.lcm" > /dev/null 2> "$T/span.err"
+  rc=$?
+  set -e
+  [ "$rc" = 2 ] || { echo "import $bad: exit $rc, expected 2"; exit 1; }
+  grep -q "^fploc import: --" "$T/span.err" || { cat "$T/span.err"; exit 1; }
+  [ ! -e "$T/span.lcm" ] || { echo "import $bad wrote a log"; exit 1; }
+done
+
+# Not an LCM log, or one cut short: one error naming the file and exit 1 (both replayed "0 of 0 log events", exit 0).
+for bad in bag cut; do
+  if [ $bad = bag ]; then L="$BAG"; else L="$T/p_cut.lcm"; head -c $(( $(stat -c %s "$T/p.lcm") - 100 )) "$T/p.lcm" > "$L"; fi
+  set +e
+  "$B/fploc-replay" --graph "$FPLOC_ROOT/graphs/replay-packets.pbtxt" --log "$L" > /dev/null 2> "$T/bad.err"
+  rc=$?
+  set -e
+  [ "$rc" = 1 ] || { echo "replay of a $bad log: exit $rc, expected 1"; exit 1; }
+  grep -q "^fploc replay: $L: " "$T/bad.err" || { echo "replay of a $bad log:"; cat "$T/bad.err"; exit 1; }
+done
 
 # --decode: scan_t and imu_t written by the importer, byte for byte what the drivers give on replay.
 "$B/fploc-import" "$BAG" --decode --out "$T/x.lcm" --json > "$T/import.json"
@@ -63,6 +98,26 @@ if [ -n "$SHIP" ]; then
   "$B/fploc-import" "$SHIP" --out "$T/ship2.lcm" --channel /guardian/laser_horizontal_back=LASER_SCAN --json --quiet > "$T/ship2.json"
   check "$T/ship2.json" "j['written']['LASER_SCAN']==418 and j['written']['LASER_SCAN_GUARDIAN_LASER_TILT_FRONT']==421"
   [ "$(wc -l < "$T/odom.tum")" -ge 800 ] || { echo "odom.tum too short"; exit 1; }
+  # README's recipe for a 2D laser: graphs/lidar2d.pbtxt on the map_server map, --out EST.tum. Its four pose
+  # loggers all wrote EST.tum (overwriting each other's bytes: a torn last line); now EST.tum is the pipeline's
+  # pose (FPLOC_POSE) and the others write EST.NODE.tum beside it.
+  MAP="$(ls "$D"/recordings/ship-interior/*.yaml | head -1)"
+  "$B/fploc-import" "$SHIP" --end 6 --out "$T/ship6.lcm" --quiet > /dev/null
+  "$B/fploc-replay" --graph "$FPLOC_ROOT/graphs/lidar2d.pbtxt" --log "$T/ship6.lcm" --out "$T/est.tum" \
+    --set matcher.plan.file="$MAP" --set optimizer.plan.file="$MAP" --set grid2d.plan.file="$MAP" \
+    --set amcl.plan.file="$MAP" --set matcher.initial_pose.x=0.5 --set matcher.initial_pose.y=0.5 \
+    > /dev/null 2> "$T/est.err"
+  grep -q "wo_logger -> $T/est.tum" "$T/est.err" || { cat "$T/est.err"; exit 1; }
+  python3 - "$T" <<'PY'
+import sys
+d = sys.argv[1]
+for f in ("est.tum", "est.sfr_logger.tum", "est.grid_logger.tum", "est.amcl_logger.tum"):
+    rows = [l.split() for l in open(f"{d}/{f}")]
+    assert rows and all(len(r) == 8 for r in rows), f"{f}: {len(rows)} rows, not all of 8 columns"
+    t = [float(r[0]) for r in rows]
+    assert t == sorted(t), f"{f}: times not increasing"
+    print(f"{f}: ok", len(rows), "poses")
+PY
   "$B/fploc-import" "$SHIP" --tum-out "$T/tf.tum" --tf-parent odom --tf-child base_footprint --start 10 --end 20 --quiet > /dev/null
   python3 - "$T/tf.tum" <<'PY'
 import sys

@@ -47,22 +47,30 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
+    // A whole, finite number ("1x", "nan", "inf" are not: a NaN --offset associated nothing and blamed --max-dt).
+    auto number = [&]() {
+      const std::string v = next();
+      size_t used = 0;
+      const double d = std::stod(v, &used);
+      if (used != v.size() || !std::isfinite(d)) throw std::invalid_argument(v);
+      return d;
+    };
     try {
       if (a == "--gt") gt_path = next();
       else if (a == "--est") est_path = next();
       else if (a == "--plot") plot = next();
       else if (a == "--json") json = true;
       else if (a == "--align") align_s = next();
-      else if (a == "--max-dt") max_dt = std::stod(next());
-      else if (a == "--offset") offset = std::stod(next());
-      else if (a == "--delta") delta = std::stod(next());
+      else if (a == "--max-dt") max_dt = number();
+      else if (a == "--offset") offset = number();
+      else if (a == "--delta") delta = number();
       else if (a == "--delta-unit") unit = next();
       else if (a == "--plan") plan_path = next();
       else if (a == "--plot-frame") plot_frame = next();
       else if (a == "--layers") layers = next();
       else if (a == "--units") units = next();
       else if (a == "--uncertainty") unc_path = next();
-      else if (a == "--false-ok-m") false_ok_m = std::stod(next());
+      else if (a == "--false-ok-m") false_ok_m = number();
       else if (a == "--hat") hat_path = next();
       else if (a == "--hat-lag") {
         const std::string v = next();
@@ -76,7 +84,7 @@ int main(int argc, char** argv) {
       else if (a == "-h" || a == "--help") { usage(); return 0; }
       else { std::cerr << "fploc eval: unexpected argument '" << a << "'\n"; usage(); return 2; }
     } catch (const std::exception&) {
-      std::cerr << "fploc eval: " << a << ": not a number\n";
+      std::cerr << "fploc eval: " << a << " " << argv[i] << ": not a number\n";
       return 2;
     }
   }

@@ -88,8 +88,8 @@ int main(int argc, char** argv) {
   app.add_flag("--json", json, "machine-readable summary on stdout");
   app.add_option("--out", out, "LCM log to write");
   app.add_option("--topics", topics, "import only these topics (comma separated or repeated)")->delimiter(',');
-  app.add_option("--start", start, "skip messages before START seconds after the first message");
-  app.add_option("--end", end, "stop at END seconds after the first message");
+  auto* start_opt = app.add_option("--start", start, "skip messages before START seconds after the first message");
+  auto* end_opt = app.add_option("--end", end, "stop at END seconds after the first message");
   app.add_option("--metadata", metadata_file, "Ouster sensor metadata JSON (when the recording has no metadata topic)");
   app.add_flag("--decode", decode_ouster,
                "decode here: Ouster packets -> scan_t (OS1_SCAN) and imu_t (OS1_IMU), PointCloud2 -> scan_t (OS1_SCAN), "
@@ -109,6 +109,16 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   if (!list && out.empty() && tum_out.empty()) {
     std::cerr << "fploc import: give --list, --out LOG.lcm or --tum-out FILE\n";
+    return 2;
+  }
+  // Seconds >= 0, END not before START: a NaN or negative one was ignored, an END before START imported nothing.
+  for (auto [opt, v] : {std::pair{start_opt, start}, std::pair{end_opt, end}})
+    if (opt->count() && !(std::isfinite(v) && v >= 0)) {
+      std::cerr << "fploc import: " << opt->get_name() << " " << v << ": expected seconds >= 0\n";
+      return 2;
+    }
+  if (start_opt->count() && end_opt->count() && end < start) {
+    std::cerr << "fploc import: --end " << end << " is before --start " << start << "\n";
     return 2;
   }
   if (!tum_out.empty() && (tf_parent.empty() != tf_child.empty())) {
@@ -426,6 +436,10 @@ int main(int argc, char** argv) {
   if (!log_ok) problems.push_back(out + ": writing failed (disk full?); the log is cut short");
   if (!rec->error().empty()) problems.push_back(rec->error() + " (the output holds everything before it)");
   for (const auto& [t, n] : decode_errors) problems.push_back(t + ": " + std::to_string(n) + " messages not decoded; first: " + first_decode_error[t]);
+  // Lidar packets that could not be written (no metadata to decode them, or too many before it): the log lacks
+  // the lidar, so the import failed (exit 1), as for a damaged file.
+  const bool lidar_lost = (ouster.lidar_packets > 0 && !ouster.has_metadata()) ||
+                          (raw.lidar_packets > 0 && !raw.has_metadata()) || raw.waiting_dropped > 0;
   if (ouster.lidar_packets > 0 && !ouster.has_metadata())
     problems.push_back(std::to_string(ouster.lidar_packets) + " Ouster lidar packets without metadata (no metadata topic; give --metadata FILE)");
   if (raw.lidar_packets > 0 && !raw.has_metadata())
@@ -517,5 +531,5 @@ int main(int argc, char** argv) {
     if (!tum_out.empty()) std::printf("  %s: %llu poses\n", tum_out.c_str(), (unsigned long long)tum.poses());
   }
   for (const auto& p : problems) std::cerr << "fploc import: " << p << "\n";
-  return rec->error().empty() && log_ok ? 0 : 1;
+  return rec->error().empty() && log_ok && !lidar_lost ? 0 : 1;
 }

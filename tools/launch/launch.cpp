@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -388,7 +389,16 @@ int main(int argc, char** argv) {
     const std::string a = argv[i];
     if (a == "--check") check = true;
     else if (a == "--skip-hosts") skip_hosts = true;
-    else if (a == "--duration" && i + 1 < argc) duration = std::atof(argv[++i]);
+    else if (a == "--duration" && i + 1 < argc) {
+      // Strictly a number > 0: atof read "ten" or "nan" as 0, which ran the graph until Ctrl-C.
+      const std::string v = argv[++i];
+      char* end = nullptr;
+      duration = std::strtod(v.c_str(), &end);
+      if (v.empty() || *end != '\0' || !std::isfinite(duration) || !(duration > 0)) {
+        std::cerr << "fploc launch: --duration " << v << ": expected a number of seconds > 0\n";
+        return 2;
+      }
+    }
     else if (a == "--lcm-url" && i + 1 < argc) url = argv[++i];
     else if (a == "--set" && i + 1 < argc) sets.push_back(argv[++i]);
     else if (a == "-h" || a == "--help") { usage(); return 0; }

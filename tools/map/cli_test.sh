@@ -43,4 +43,13 @@ if "$MAP" validate --plan "$B" --floor roof --no-baselines 2> "$T/err"; then fai
 grep -q "no floor 'roof' (floors: ground, first)" "$T/err" || fail "unknown floor message: $(cat "$T/err")"
 if "$MAP" render --plan "$T/p.json" --floor first --out "$T/x.svg" 2> "$T/err"; then fail "floor of a single plan accepted"; fi
 grep -q "a single plan has one floor" "$T/err" || fail "single plan floor message: $(cat "$T/err")"
+# A number option that is nan or inf: one error naming it, exit 1, nothing written (--resolution inf wrote a 0 x 0
+# map whose YAML its own reader rejects).
+for bad in "export-pgm --resolution inf" "export-pgm --margin nan --resolution 0.1" "validate --root inf --no-baselines"; do
+  set -- $bad
+  out=""; [ "$1" = export-pgm ] && out="--out $T/n"
+  if "$MAP" $bad --plan "$T/p.json" $out 2> "$T/err"; then fail "$bad accepted"; fi
+  grep -q "^fploc map: error: $2 .*: not a finite number" "$T/err" || fail "$bad: $(cat "$T/err")"
+  [ ! -e "$T/n" ] && [ ! -e "$T/n.svg" ] || fail "$bad: wrote output"
+done
 echo "fploc-map CLI checks passed"

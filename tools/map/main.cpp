@@ -1,5 +1,6 @@
 // fploc map build|validate|render|export-pgm  (contracts in docs/DESIGN.md)
 #include <CLI/CLI.hpp>
+#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -204,6 +205,19 @@ int main(int argc, char** argv) {
   compare->add_flag("--json", as_json, "JSON on stdout");
 
   CLI11_PARSE(app, argc, argv);
+  // CLI11 reads "nan" and "inf" as numbers; no option of these commands means them (--resolution inf wrote a 0 x 0
+  // map). One error naming the option.
+  for (const CLI::App* sub : app.get_subcommands())
+    for (const CLI::Option* o : sub->get_options())
+      if (o->count() && o->get_type_name().find("FLOAT") != std::string::npos)
+        for (const std::string& r : o->results()) {
+          char* end = nullptr;
+          const double v = std::strtod(r.c_str(), &end);
+          if (!std::isfinite(v)) {
+            std::cerr << "fploc map: error: " << o->get_name() << " " << r << ": not a finite number\n";
+            return 1;
+          }
+        }
   try {
     if (*build) return cmd_build(b_plan, b_annf, b_out, as_json);
     if (*validate) return cmd_validate(v_plan.load(), v, as_json);

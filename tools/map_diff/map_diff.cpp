@@ -5,7 +5,7 @@
 // `fploc replay --graph G --log SIM.lcm --record LOG.lcm`. The plan and the detector's options come from
 // the graph's plan_diff node (or, without one, the plan of its matcher). Writes JSON and/or DXF (layers
 // FPLOC-MISSING, FPLOC-MOVED, FPLOC-NEW, FPLOC-PLAN) by the --out extension; --json prints the JSON diff on stdout; --all lists
-// every element (also those seen where expected).
+// every element (also those seen where expected); --set NODE.field=value as for fploc replay (the run's plan).
 #include <fploc/features_t.hpp>
 #include <fploc/pose_t.hpp>
 #include <lcm/lcm-cpp.hpp>
@@ -26,7 +26,8 @@ namespace {
 
 void usage() {
   std::cerr << "usage: fploc map diff --graph GRAPH --log LOG.lcm --out DIFF.json|DIFF.dxf [--out ...] [--json]\n"
-               "       [--features-channel C] [--pose-channel C] [--all (every element in the JSON, also those seen)]\n";
+               "       [--features-channel C] [--pose-channel C] [--all (every element in the JSON, also those seen)]\n"
+               "       [--set NODE.field=value ...] (as given to fploc replay: e.g. matcher.plan.file=PLAN)\n";
 }
 
 std::string lower_ext(const std::string& p) {
@@ -39,7 +40,7 @@ std::string lower_ext(const std::string& p) {
 
 int main(int argc, char** argv) {
   std::string graph_path, log_path, feat_ch, pose_ch;
-  std::vector<std::string> outs;
+  std::vector<std::string> outs, sets;
   bool json = false, all = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -55,6 +56,7 @@ int main(int argc, char** argv) {
     else if (a == "--out") outs.push_back(next());
     else if (a == "--features-channel") feat_ch = next();
     else if (a == "--pose-channel") pose_ch = next();
+    else if (a == "--set") sets.push_back(next());
     else if (a == "--json") json = true;
     else if (a == "--all") all = true;
     else if (a == "-h" || a == "--help") { usage(); return 0; }
@@ -75,6 +77,12 @@ int main(int argc, char** argv) {
     if (!fploc::rt::load_graph(graph_path, g, errors)) {
       for (const auto& e : errors) std::cerr << e.str() << "\n";
       return 1;
+    }
+    // The run's --set (its plan above all: without it the diff was against the graph file's plan, not the run's).
+    std::string set_error;
+    if (!fploc::rt::apply_node_overrides(g.graph, sets, {}, set_error)) {
+      std::cerr << "fploc map diff: " << set_error << "\n";
+      return 2;
     }
     const fploc::Node* node = nullptr;
     const fploc::PlanSource* src = nullptr;

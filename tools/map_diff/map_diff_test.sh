@@ -36,4 +36,12 @@ if "$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/sim.lcm" --ou
 fi
 grep -q "no FPLOC_FEATURES (features_t) events" "$T/err" || { cat "$T/err"; exit 1; }
 test "$(wc -l < "$T/err")" -eq 1 || { cat "$T/err"; exit 1; }
+# The run's --set reaches the diff (a run replayed with --set matcher.plan.file=PLAN was diffed against the graph
+# file's plan): the plan named by --set is the one diffed against; a --set naming no node is one error, exit 2.
+"$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/run.lcm" --out "$T/c.json" \
+  --set plan_diff.plan.file="$R/data/plans/corridor.json" 2> "$T/err"
+grep -q "against $R/data/plans/corridor.json:" "$T/err" || { cat "$T/err"; exit 1; }
+rc=0
+"$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/run.lcm" --out "$T/c.json" --set nonode.plan.file=x 2> "$T/err" || rc=$?
+[ "$rc" = 2 ] && grep -q "nonode.plan.file=x" "$T/err" || { echo "exit $rc"; cat "$T/err"; exit 1; }
 echo "map diff: ok"

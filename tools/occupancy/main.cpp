@@ -139,6 +139,15 @@ int main(int argc, char** argv) {
   app.add_option("--crop-margin", crop_margin,
                  "PNG: only the occupied cells and trajectories, this much [m] around them (default: the whole grid)");
   CLI11_PARSE(app, argc, argv);
+  // CLI11 takes "nan" and "inf" as numbers: a NaN tolerance vectorised the map into a few long wrong segments.
+  if (!(std::isfinite(tol) && tol >= 0)) {
+    std::cerr << "fploc occupancy: --tolerance " << tol << ": expected a number of cells >= 0\n";
+    return 1;
+  }
+  if (!std::isfinite(crop_margin)) {
+    std::cerr << "fploc occupancy: --crop-margin " << crop_margin << ": expected a finite number of metres\n";
+    return 1;
+  }
   try {
     const fploc::OccupancyGrid g = fploc::read_occupancy_map(map);
     fploc::VectoriseOptions o;

@@ -35,4 +35,13 @@ PY
 printf 'image: map.pgm\nresolution: -1\norigin: [0, 0, 0]\n' > "$T/bad.yaml"
 if "$OCC" "$T/bad.yaml" 2> "$T/err"; then fail "bad yaml accepted"; fi
 grep -q "bad.yaml: resolution: must be > 0" "$T/err" || { cat "$T/err"; fail "error text"; }
+# Bad numbers on the command line: one error naming the option, exit 1, nothing written (a NaN tolerance gave a
+# plan of a few long segments 1.6 m off the walls; a NaN crop margin "cannot create std::vector larger than max_size()").
+for bad in "--tolerance nan" "--tolerance -1" "--tolerance inf" "--crop-margin nan --png $T/n.png" "--crop-margin inf --png $T/n.png"; do
+  set -- $bad
+  if "$OCC" "$T/m0.05/map.yaml" $bad --out "$T/n.json" 2> "$T/err"; then fail "$bad accepted"; fi
+  grep -q "^fploc occupancy: $1 " "$T/err" || { cat "$T/err"; fail "$bad: error does not name $1"; }
+  [ "$(grep -c . "$T/err")" = 1 ] || { cat "$T/err"; fail "$bad: more than one line"; }
+  [ ! -e "$T/n.json" ] && [ ! -e "$T/n.png" ] || fail "$bad: wrote output"
+done
 echo OK

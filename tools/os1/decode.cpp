@@ -294,5 +294,5 @@ int main(int argc, char** argv) {
   std::cerr << lidar_packets << " lidar packets, " << st.frames << " frames (" << st.complete_frames << " complete), "
             << imu_packets << " IMU packets\n";
   if (as_json) std::cout << out.dump(2) << "\n";
-  return 0;
+  return errors.empty() ? 0 : 1;  // a capture cut short, a PCD or digest that failed: the summary above, then exit 1
 }

@@ -3,8 +3,9 @@
 // one process over memq://. Events of the log are published in file order, but only on the graph's
 // external inputs (channels some composed node subscribes to and none publishes); after each event the
 // queue is drained completely (lock-step), so the run is deterministic and as fast as the CPU allows.
-// --out sets the file of the graph's pose logger. --json prints per-node timing (wall clock and the
-// handlers' thread CPU time, which is what a shared machine does not distort) and the real-time factor.
+// --out sets the file of the graph's pose logger (with several: the one on FPLOC_POSE; the others write
+// OUT-STEM.NODE.tum beside it). --json prints per-node timing (wall clock and the handlers' thread CPU time,
+// which is what a shared machine does not distort) and the real-time factor.
 // --record FILE writes what the composed nodes publish on channels matching --record-channels (an LCM
 // regex; default every FPLOC_ channel but FPLOC_SEGMENTS) into an LCM log, stamped with the log time of
 // the event that caused it (for `fploc map diff`, metrics on pose_t status and covariance, lcm-logplayer).
@@ -12,6 +13,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <cstring>
 #include <iostream>
 #include <map>
@@ -76,19 +78,32 @@ int main(int argc, char** argv) {
   }
   // --robot: the log's channels are that robot's ("R/FPLOC_SCAN", ...), whatever the graph says.
   if (robot_given) g.graph.set_robot(robot);
-  // Overrides: --out for every pose logger, --set NODE.field=value for one node.
-  int loggers = 0;
+  // Overrides: --out for the pose logger, --set NODE.field=value for one node. With several pose loggers (a
+  // graph logging several estimators), --out is the one of the pipeline's pose (FPLOC_POSE; else the first) and
+  // each other one writes beside it, OUT-STEM.NODE.tum: all writing OUT overwrote each other's bytes.
+  std::vector<fploc::Node*> loggers;
   for (int i = 0; i < g.graph.node_size(); ++i) {
     auto* n = g.graph.mutable_node(i);
-    if (n->disabled() || type_from_executable(n->executable()) != "pose_logger") continue;
-    ++loggers;
-    if (!out.empty()) n->mutable_pose_logger()->set_file(out);
+    if (!n->disabled() && type_from_executable(n->executable()) == "pose_logger") loggers.push_back(n);
   }
-  if (!out.empty() && loggers == 0) {
+  if (!out.empty() && loggers.empty()) {
     std::cerr << graph_path << ": --out given but the graph has no enabled pose logger node\n";
     return 1;
   }
-  if (!out.empty() && loggers > 1) std::cerr << "fploc replay: warning: " << loggers << " pose loggers all write " << out << "\n";
+  if (!out.empty()) {
+    fploc::Node* main_logger = nullptr;
+    for (auto* n : loggers)
+      for (const auto& in : n->input())
+        if (!main_logger && in.port() == "pose" && in.channel() == "FPLOC_POSE") main_logger = n;
+    if (!main_logger) main_logger = loggers.front();
+    const std::filesystem::path o(out);
+    for (auto* n : loggers) {
+      const std::string file =
+          n == main_logger ? out : (o.parent_path() / (o.stem().string() + "." + n->name() + ".tum")).string();
+      n->mutable_pose_logger()->set_file(file);
+      if (loggers.size() > 1) std::cerr << "fploc replay: " << n->name() << " -> " << file << "\n";
+    }
+  }
   std::string set_error;
   if (!apply_node_overrides(g.graph, sets, [](const fploc::Node& n) {
         const auto* reg = find_registration(type_from_executable(n.executable()));
@@ -148,8 +163,12 @@ int main(int argc, char** argv) {
     }
     std::map<std::string, int64_t> per_channel;
     const double w0 = now_s();
+    // The bytes the events account for: the LCM reader skips what is not an event (a ROS bag given as the log, a
+    // damaged stretch) and stops at a cut event without a word; the file's size says whether it did.
+    uint64_t event_bytes = 0;
     while (const lcm::LogEvent* ev = log.readNextEvent()) {
       ++events;
+      event_bytes += 28 + ev->channel.size() + uint64_t(ev->datalen);  // sync, number, time, two lengths, channel, data
       if (!ext.count(ev->channel)) continue;
       if (t_first < 0) t_first = ev->timestamp;
       t_last = ev->timestamp;
@@ -202,6 +221,18 @@ int main(int argc, char** argv) {
                        {"nodes", nodes}};
       if (!out.empty()) j["out"] = out;
       std::cout << j.dump() << std::endl;
+    }
+    std::error_code ec;
+    const uint64_t size = std::filesystem::file_size(log_path, ec);
+    if (!ec && events == 0 && size > 0) {
+      std::cerr << "fploc replay: " << log_path << ": no LCM event in its " << size
+                << " B (not an LCM event log; a ROS bag or MCAP goes through `fploc import` first)\n";
+      return 1;
+    }
+    if (!ec && event_bytes != size) {
+      std::cerr << "fploc replay: " << log_path << ": " << events << " events are " << event_bytes << " of its " << size
+                << " B; the rest is not an LCM event (truncated or damaged?); the events read were replayed\n";
+      return 1;
     }
     return 0;
   } catch (const std::exception& e) {

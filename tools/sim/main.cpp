@@ -78,6 +78,14 @@ int main(int argc, char** argv) {
                  "building-* scenarios: write the simulated ceilings as a one-floor building file (.pbtxt) for the segmenter");
   app.add_option("--write-demo-plans", demo_dir, "write the demo plans (room.json, corridor.json) into DIR and exit");
   CLI11_PARSE(app, argc, argv);
+  // CLI11 reads "nan" and "inf" as numbers; no option here means them (--noise nan wrote NaN ranges).
+  for (const CLI::Option* o : app.get_options())
+    if (o->count() && o->get_type_name().find("FLOAT") != std::string::npos)
+      for (const std::string& r : o->results())
+        if (!std::isfinite(std::strtod(r.c_str(), nullptr))) {
+          std::cerr << "fploc sim: " << o->get_name() << " " << r << ": not a finite number\n";
+          return 1;
+        }
 
   try {
     if (!demo_dir.empty()) {

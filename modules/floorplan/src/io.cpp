@@ -325,15 +325,15 @@ void write_plan_csv(const FloorPlan& plan, std::ostream& out, double chord_toler
 
 void save_floor_plan(const FloorPlan& plan, const std::string& path) {
   const std::string ext = extension(path);
+  // The extension first: opening the file empties it (a user's building.dxf given as --out).
+  if (ext != ".json" && ext != ".csv") fail(path + ": unsupported extension '" + ext + "' (use .json or .csv)");
   std::ofstream f(path);
   if (!f) fail(path + ": cannot write (" + std::strerror(errno) + ")");
   try {
     if (ext == ".json")
       write_plan_json(plan, f);
-    else if (ext == ".csv")
-      write_plan_csv(plan, f);
     else
-      fail("unsupported extension '" + ext + "' (use .json or .csv)");
+      write_plan_csv(plan, f);
   } catch (const std::runtime_error& e) {
     fail(path + ": " + e.what());
   }

@@ -123,3 +123,28 @@ TEST(PlanIo, UnknownExtensionAndMissingFile) {
   EXPECT_NE(error_of([] { load_floor_plan("/nonexistent/p.csv"); }).find("/nonexistent/p.csv: cannot open"),
             std::string::npos);
 }
+
+// Saving to an extension it cannot write (e.g. `fploc occupancy map.yaml --out building.dxf`): one error naming
+// the file, and the file that was there is left as it was (it used to be emptied before the extension was checked).
+TEST(PlanIo, SaveWithUnsupportedExtensionLeavesTheFileAlone) {
+  const std::string dir = ::testing::TempDir();
+  FloorPlan plan;
+  Element e;
+  e.a = {0, 0};
+  e.b = {1, 0};
+  plan.elements.push_back(e);
+  for (const std::string name : {"building.dxf", "notes.txt", "noext"}) {
+    const std::string path = dir + "/" + name;
+    { std::ofstream(path) << "the user's own file\n"; }
+    const std::string err = error_of([&] { save_floor_plan(plan, path); });
+    EXPECT_NE(err.find(path + ": unsupported extension"), std::string::npos) << err;
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    EXPECT_EQ(s.str(), "the user's own file\n") << name;
+  }
+  const std::string fresh = dir + "/fresh.svg";
+  std::filesystem::remove(fresh);
+  EXPECT_NE(error_of([&] { save_floor_plan(plan, fresh); }), "");
+  EXPECT_FALSE(std::filesystem::exists(fresh)) << "an empty file left behind";
+}

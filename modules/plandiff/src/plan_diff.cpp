@@ -223,6 +223,8 @@ bool PlanDiff::plan_blocks(const V2& o, const V2& q, int skip) const {
 
 void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen::Vector2f>& points,
                          const Eigen::Matrix3d* pose_cov) {
+  // A pose that is not finite is no registered scan (its points all fell into one "new" cell at INT_MIN).
+  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(yaw)) return;
   const int frame = frames_++;
   const V2 s(x, y);
   const double c = std::cos(yaw), sn = std::sin(yaw);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "fploc/floorplan/io.h"
@@ -330,4 +331,28 @@ TEST(PlanDiff, RefinesAsBuiltWalls) {
     EXPECT_LT(std::abs(rs.offset_a), 0.01) << "element " << rs.element;
     EXPECT_LT(std::abs(rs.offset_b), 0.01) << "element " << rs.element;
   }
+}
+
+// A pose that is not finite (a logged NaN, a broken estimator): the scan is not used, and the diff is the one
+// without it (its points landed in one "new" cell at INT_MIN and counted as frames that saw nothing).
+TEST(PlanDiff, NonFinitePoseIsNotAScan) {
+  const FloorPlan plan = sim::demo_room_plan();
+  plandiff::PlanDiff clean(plan), with_nan(plan);
+  std::vector<Eigen::Vector2f> pts;
+  for (int i = 0; i < 200; ++i) pts.emplace_back(1.0f + 0.01f * float(i), 0.5f);
+  const double nan = std::nan("");
+  for (int k = 0; k < 12; ++k) {
+    const double x = 3.0 + 0.05 * k, y = 2.0, yaw = 0.1;
+    clean.add_frame(x, y, yaw, pts);
+    with_nan.add_frame(x, y, yaw, pts);
+    with_nan.add_frame(nan, y, yaw, pts);
+    with_nan.add_frame(x, std::numeric_limits<double>::infinity(), yaw, pts);
+    with_nan.add_frame(x, y, nan, pts);
+  }
+  EXPECT_EQ(with_nan.frames(), clean.frames());
+  const auto a = clean.result(), b = with_nan.result();
+  EXPECT_EQ(b.frames, a.frames);
+  EXPECT_EQ(b.added.size(), a.added.size());
+  ASSERT_EQ(b.elements.size(), a.elements.size());
+  for (size_t i = 0; i < a.elements.size(); ++i) EXPECT_EQ(int(b.elements[i].status), int(a.elements[i].status)) << i;
 }

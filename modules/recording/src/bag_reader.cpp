@@ -163,6 +163,12 @@ bool BagReader::next(RawMessage& m) {
       continue;
     }
     if (pos_ >= size_) {
+      // Cut between two records: nothing is cut in two, but a bag without its header record, or whose header
+      // puts the index past the end, lost what came after the cut.
+      if (!header_seen_) return stop("no bag header record after the '#ROSBAG V2.0' line (file truncated?)");
+      if (index_pos_ > size_)
+        return stop("ends at byte " + std::to_string(size_) + ", before its index at byte " + std::to_string(index_pos_) +
+                    " (the bag header's index_pos): file truncated? (the messages up to the cut are read)");
       done_ = true;
       return false;
     }
@@ -201,8 +207,12 @@ bool BagReader::next(RawMessage& m) {
       cd_ = rp;
       cn_ = pos_ - at;
       cpos_ = 0;
+    } else if (r.op == 0x03) {
+      header_seen_ = true;
+      const Field* ip = find(r.fields, "index_pos");
+      if (ip && ip->n == 8) std::memcpy(&index_pos_, ip->v, 8);  // 0: unindexed (a recording still open)
     }
-    // 0x03 bag header, 0x04 index data, 0x06 chunk info and unknown ops: skipped.
+    // 0x04 index data, 0x06 chunk info and unknown ops: skipped.
   }
   return false;
 }

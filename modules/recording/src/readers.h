@@ -85,6 +85,8 @@ class BagReader : public FileReader {
   void prefetch_after(size_t pos);  // starts decompressing the compressed chunk that follows pos, if any
   ChunkAhead ahead_;
   bag::Record rec_;  // the record being read (its field list reused)
+  bool header_seen_ = false;  // the bag header record (op 0x03) was read
+  uint64_t index_pos_ = 0;    // its index_pos (0: none written yet)
 };
 
 // MCAP (data section in file order: chunks none/zstd/lz4, or messages outside chunks; the summary

@@ -29,6 +29,11 @@ bool FileBytes::map(const std::string& path, std::string* err, size_t read_bytes
     ::close(fd);
     return false;
   }
+  if (!S_ISREG(st.st_mode)) {  // a directory, a FIFO: mmap said "No such device"
+    *err = path + (S_ISDIR(st.st_mode) ? ": is a directory" : ": not a regular file");
+    ::close(fd);
+    return false;
+  }
   size_ = size_t(st.st_size);
   if (size_ > 0) {
     void* p = mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd, 0);
@@ -77,8 +82,20 @@ namespace {
 std::unique_ptr<Recording> by_magic(std::unique_ptr<FileBytes> f, const std::string& name, std::string* err) {
   const uint8_t* d = f->data();
   const size_t n = f->size();
+  if (n == 0) {
+    *err = name + ": empty file (0 B)";
+    return nullptr;
+  }
+  if (n < 8 && std::memcmp(d, "\x89MCAP0\r\n", n) == 0) {
+    *err = name + ": " + std::to_string(n) + " B, cut inside the MCAP magic (file truncated?)";
+    return nullptr;
+  }
   if (n >= 8 && d[0] == 0x89 && std::memcmp(d + 1, "MCAP", 4) == 0) return std::make_unique<McapReader>(std::move(f), name);
   if (n >= 9 && std::memcmp(d, "#ROSBAG V", 9) == 0) {
+    if (n < 13 && std::memcmp(d, "#ROSBAG V2.0\n", n) == 0) {
+      *err = name + ": " + std::to_string(n) + " B, cut inside the '#ROSBAG V2.0' line (file truncated?)";
+      return nullptr;
+    }
     if (n < 13 || std::memcmp(d, "#ROSBAG V2.0\n", 13) != 0) {
       *err = name + ": ROS bag version " + std::string(reinterpret_cast<const char*>(d) + 9, std::min<size_t>(n - 9, 3)) +
              " is not supported (only 2.0; `rosbag fix` converts 1.2)";

@@ -178,6 +178,53 @@ TEST(Bag, TruncatedFileKeepsWhatCameBefore) {
   }
 }
 
+// Cut at a record boundary before the index (a copy stopped between two chunks, or right after the bag header):
+// no record is cut in two, but the bag header's index_pos lies past the end, so messages are missing. One error
+// saying so, after every message before the cut; a bag of only the magic line is truncated too.
+TEST(Bag, CutBetweenRecordsBeforeTheIndexIsTruncated) {
+  const std::string path = ship_bag();
+  FPLOC_REQUIRE_FILE(path);
+  const auto bytes = slurp(path);
+  std::string err;
+  const auto all = read_all(bytes.data(), bytes.size(), &err);
+  ASSERT_EQ(err, "");
+  // Record boundaries: after the bag header (byte 13 + its record) and after the second chunk record.
+  std::vector<size_t> ends;
+  for (size_t pos = 13; pos + 8 <= bytes.size();) {
+    uint32_t hl, dl;
+    std::memcpy(&hl, &bytes[pos], 4);
+    std::memcpy(&dl, &bytes[pos + 4 + hl], 4);
+    pos += 8 + size_t(hl) + dl;
+    ends.push_back(pos);
+  }
+  ASSERT_GT(ends.size(), 10u);
+  for (const size_t cut : {ends[0], ends[3]}) {
+    const auto part = read_all(bytes.data(), cut, &err, "cut.bag");
+    EXPECT_NE(err.find("cut.bag: "), std::string::npos) << cut << ": " << err;
+    EXPECT_NE(err.find("truncated"), std::string::npos) << cut << ": " << err;
+    ASSERT_LT(part.size(), all.size());
+    for (size_t i = 0; i < part.size(); ++i) ASSERT_EQ(part[i].data, all[i].data);
+  }
+  const auto none = read_all(bytes.data(), 13, &err, "magic.bag");
+  EXPECT_TRUE(none.empty());
+  EXPECT_NE(err.find("magic.bag: "), std::string::npos) << err;
+  EXPECT_NE(err.find("truncated"), std::string::npos) << err;
+  // Cut inside the magic line: truncated, not "version 2.0 is not supported".
+  for (const size_t n : {size_t(9), size_t(12)}) {
+    EXPECT_TRUE(read_all(bytes.data(), n, &err, "short.bag").empty());
+    EXPECT_NE(err.find("short.bag: "), std::string::npos) << err;
+    EXPECT_NE(err.find("truncated"), std::string::npos) << n << ": " << err;
+    EXPECT_EQ(err.find("not supported"), std::string::npos) << n << ": " << err;
+  }
+  // The same for the MCAP magic, and an empty file says so.
+  const uint8_t mcap[8] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
+  EXPECT_TRUE(read_all(mcap, 7, &err, "short.mcap").empty());
+  EXPECT_NE(err.find("short.mcap: "), std::string::npos) << err;
+  EXPECT_NE(err.find("truncated"), std::string::npos) << err;
+  EXPECT_TRUE(read_all(mcap, 0, &err, "empty.bag").empty());
+  EXPECT_NE(err.find("empty.bag: empty file"), std::string::npos) << err;
+}
+
 TEST(Bag, WrittenBagsAllCompressionsAndDamage) {
   const std::string dir = ::testing::TempDir();
   for (const std::string comp : {"none", "bz2", "lz4"}) {
@@ -238,4 +285,8 @@ TEST(Bag, NotABag) {
   EXPECT_NE(err.find("old.bag: ROS bag version 1.2 is not supported"), std::string::npos) << err;
   EXPECT_FALSE(open_recording_memory(reinterpret_cast<const uint8_t*>("hello"), 5, "x", &err));
   EXPECT_NE(err.find("neither"), std::string::npos);
+  // A directory given as the recording: said so (it was "mmap: No such device").
+  const std::string dir = ::testing::TempDir();
+  EXPECT_FALSE(open_recording(dir, &err));
+  EXPECT_EQ(err, dir + ": is a directory");
 }

@@ -24,4 +24,12 @@ t = json.load(open(sys.argv[1]))
 assert t["elements"][2]["change"] == "removed", t["elements"][2]
 assert [a["kind"] for a in t["added"]] == ["partition", "door-closed"], t["added"]
 PY
+# A number option given nan or inf: one error naming it, exit 1, nothing written (--noise nan wrote a log of NaN
+# ranges; --duration nan simulated the whole scenario).
+for bad in "--noise nan" "--duration nan" "--dropout inf"; do
+  if "$B/fploc-sim" --scenario room-small-loop-medium $bad --out "$T/n.lcm" --gt "$T/n.tum" 2> "$T/err"; then
+    echo "$bad accepted"; exit 1; fi
+  grep -qx "fploc sim: $bad: not a finite number" "$T/err" || { cat "$T/err"; exit 1; }
+  test ! -e "$T/n.lcm"
+done
 echo "world cli: ok"

@@ -156,7 +156,8 @@ class PlanDiff {
  public:
   explicit PlanDiff(FloorPlan plan, Options o = {});
   // One registered scan: pose of the sensor on the plan, wall points in the sensor frame (metres); pose_cov:
-  // the pose's x, y, yaw covariance (the localizer's, optional: see Options::moved_pose_covariance).
+  // the pose's x, y, yaw covariance (the localizer's, optional: see Options::moved_pose_covariance). A pose that is
+  // not finite is ignored (no frame).
   void add_frame(double x, double y, double yaw, const std::vector<Eigen::Vector2f>& points,
                  const Eigen::Matrix3d* pose_cov = nullptr);
   Diff result() const;

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# `fploc help` names every command that README.md says it lists ("`bin/fploc help` lists the commands (...)"),
+# subcommands included (map compare/diff, import-carmen and occupancy were missing), each with a built executable.
+set -euo pipefail
+R="${FPLOC_ROOT:?run through ctest}"
+B="${FPLOC_BUILD_DIR:?run through ctest}/bin"
+H="$(mktemp)"
+trap 'rm -f "$H"' EXIT
+"$R/bin/fploc" help 2> "$H"  # the usage goes to stderr
+python3 - "$R/README.md" "$H" "$B" <<'PY'
+import os, re, sys
+readme, help_text, bindir = open(sys.argv[1]).read(), open(sys.argv[2]).read(), sys.argv[3]
+m = re.search(r"`bin/fploc help` lists the commands \(([^)]*)\)", readme)
+assert m, "README.md: no '`bin/fploc help` lists the commands (...)'"
+lines = [l.strip() for l in help_text.splitlines()]
+bad = []
+for item in (x.strip() for x in m.group(1).replace("\n", " ").split(",")):
+    words = item.split()
+    cmd, subs = words[0], (words[1].split("/") if len(words) > 1 else [])
+    line = next((l for l in lines if l.split(" ", 1)[0] == cmd), None)
+    if line is None:
+        bad.append(f"'{cmd}' not in fploc help")
+        continue
+    named = set(re.split(r"[\s|]+", line.split("  ")[0]))
+    for s in subs:
+        if s not in named:
+            bad.append(f"'{cmd} {s}' not on help's line '{line}'")
+        exe = f"fploc-{cmd}-{s}"
+        if not (os.path.exists(os.path.join(bindir, exe)) or os.path.exists(os.path.join(bindir, f"fploc-{cmd}"))):
+            bad.append(f"no {exe} or fploc-{cmd} in {bindir}")
+    if not subs and not os.path.exists(os.path.join(bindir, f"fploc-{cmd}")):
+        bad.append(f"no fploc-{cmd} in {bindir}")
+for b in bad:
+    print("FAIL:", b)
+sys.exit(1 if bad else 0)
+PY
+echo OK

@@ -1,0 +1,18 @@
+#!/bin/sh
+# fploc import-carmen's number options given nan or inf: one error naming the option, exit 1, nothing written
+# (CLI11's Range/PositiveNumber checks let NaN through: --resolution nan wrote a map.yaml saying "resolution: nan").
+set -e
+IMP="$1"
+T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+for k in 0 1 2 3 4 5 6 7; do
+  printf 'ODOM %s 0 0 0 0 0 %s.0 h %s.0\nFLASER 4 1.0 2.0 3.0 2.5 %s 0 0 %s 0 0 %s.5 h %s.5\n' "0.$k" "$k" "$k" "0.$k" "0.$k" "$k" "$k"
+done > "$T/a.log"
+"$IMP" "$T/a.log" --out "$T/ok.lcm" 2>/dev/null || fail "good log"
+for bad in "--resolution nan" "--begin nan" "--coverage-radius nan"; do
+  set -- $bad
+  if "$IMP" "$T/a.log" --out "$T/n.lcm" --map "$T/m" $bad 2> "$T/err"; then fail "$bad accepted"; fi
+  grep -qx "fploc import-carmen: $1 $2: not a finite number" "$T/err" || { cat "$T/err"; fail "$bad: error text"; }
+  [ ! -e "$T/n.lcm" ] && [ ! -e "$T/m" ] || fail "$bad: wrote output"
+done
+echo OK

@@ -1,0 +1,20 @@
+#!/bin/sh
+# fploc eval's command line: numbers that are not whole finite numbers are one error naming the option and
+# the value, exit 2 ("--delta 1x" was read as 1; "--offset nan" associated nothing and blamed --max-dt).
+set -e
+EVAL="$1"
+T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+printf '0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n2 2 0 0 0 0 0 1\n' > "$T/gt.tum"
+printf '0 0 0.1 0 0 0 0 1\n1 1 0.1 0 0 0 0 1\n2 2 0.1 0 0 0 0 1\n' > "$T/est.tum"
+"$EVAL" --gt "$T/gt.tum" --est "$T/est.tum" --json > "$T/ok.json" 2>/dev/null || fail "good input"
+grep -q "\"ate_rmse_m\":0.1," "$T/ok.json" || fail "no ate in $(cat "$T/ok.json")"
+for bad in "--delta 1x" "--offset nan" "--max-dt inf" "--false-ok-m -nan" "--offset 0.5s"; do
+  set -- $bad
+  rc=0
+  "$EVAL" --gt "$T/gt.tum" --est "$T/est.tum" $bad > "$T/out" 2> "$T/err" || rc=$?
+  [ "$rc" = 2 ] || fail "$bad: exit $rc, expected 2"
+  grep -qx "fploc eval: $1 $2: not a number" "$T/err" || { cat "$T/err"; fail "$bad: error text"; }
+  [ "$(grep -c . "$T/err")" = 1 ] || { cat "$T/err"; fail "$bad: more than one line"; }
+done
+echo OK
