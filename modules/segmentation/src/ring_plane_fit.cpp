@@ -220,7 +220,8 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     band_.pad(1e3f * float(cur[0]), 1e3f * float(cur[1]), 1e3f * float(cur[2]));
     // Every kShrinkSubsample-th band point (the subsample of the iterations whose cut-off still shrinks).
     band_sub_.resize((m + k::kShrinkSubsample - 1) / k::kShrinkSubsample);
-    for (size_t j = 0, o = 0; j < m; j += k::kShrinkSubsample, ++o) {
+    if (wide) ck::strided(bx, by, bz, band_sub_.n, k::kShrinkSubsample, band_sub_.x.data(), band_sub_.y.data(), band_sub_.z.data());
+    for (size_t j = 0, o = 0; j < m && !wide; j += k::kShrinkSubsample, ++o) {
       band_sub_.x[o] = bx[j];
       band_sub_.y[o] = by[j];
       band_sub_.z[o] = bz[j];
