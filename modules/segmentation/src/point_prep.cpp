@@ -8,6 +8,7 @@
 #include <string>
 
 #include "fploc/segmentation/segmenter.h"
+#include "compact_kernels.h"
 #include "plane_kernels.h"
 #include "simd4.h"
 #if defined(__x86_64__) && defined(__GNUC__)
@@ -335,6 +336,15 @@ bool Segmenter::prepare(const Scan& scan) {
   if (H % 2 == 1) ring_pass(ring_order_[half], middle_);
   for (Candidates* cs : {&upper_, &lower_, &middle_})
     for (auto* v : {&cs->x, &cs->y, &cs->z}) std::fill(v->begin() + cs->n, v->begin() + cs->n + Candidates::kLanes, std::numeric_limits<float>::quiet_NaN());
+  // The plane fits' candidates' bounding boxes per block (the band and the plane quality skip blocks by them).
+  for (Candidates* cs : {&upper_, &lower_}) {
+    cs->box_stride = (cs->n + Candidates::kBoxPoints - 1) / Candidates::kBoxPoints;
+    if (cs->box.size() < 6 * cs->box_stride) cs->box.resize(6 * cs->box_stride);
+    cs->box_r = ck::available() && kern::wide()
+                    ? ck::boxes(cs->x.data(), cs->y.data(), cs->z.data(), cs->n, cs->box.data(), cs->box_stride)
+                    : ck::boxes_scalar(cs->x.data(), cs->y.data(), cs->z.data(), cs->n, cs->box.data(), cs->box_stride);
+    cs->box_n = cs->n;
+  }
   const size_t valid = upper_.n + lower_.n + middle_.n;
   if (valid == 0) return fail(SegStatus::kEmpty, "no valid returns in the scan");
   return true;

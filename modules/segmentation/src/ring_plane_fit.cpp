@@ -194,7 +194,8 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     if (wide) {
       const float plf[4] = {float(cur[0]), float(cur[1]), float(cur[2]), float(cur[3])};
       const float r3[3] = {reff.x(), reff.y(), reff.z()};
-      m = ck::band(xs_, ys_, zs_, n_, np_, plf, float(cut), r3, bx, by, bz);
+      const ck::BoxRange br(cand_->box.data(), cand_->box_stride, cand_->box_r, plf);
+      m = ck::band(xs_, ys_, zs_, n_, np_, plf, float(cut), r3, bx, by, bz, cand_->has_boxes() ? &br : nullptr);
     }
     for (size_t i = 0; i < np_ && !wide; i += 4) {
       const v4f x = load(xs_ + i), y = load(ys_ + i), z = load(zs_ + i);
@@ -313,6 +314,7 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
   zs_ = c.z.data();
   np_ = (n + 3) & ~size_t(3);  // NaN-padded (Candidates)
   n_ = n;
+  cand_ = &c;
   for (auto [sub, stride] : {std::pair{&sub_start_, start_stride_}, std::pair{&sub_final_, final_stride_}}) {
     sub->resize((n + stride - 1) / stride);
     if (ck::available() && kern::wide()) {
