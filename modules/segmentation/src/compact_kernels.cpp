@@ -2,7 +2,11 @@
 // AVX2 alone (no -march flag; without FMA the band test rounds as the four-lane loop's).
 #include "compact_kernels.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
+
+#include "fploc/segmentation/candidates.h"
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
@@ -16,6 +20,27 @@
 #pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace fploc::seg::ck {
+
+float boxes_scalar(const float* x, const float* y, const float* z, size_t n, float* box, size_t stride) {
+  constexpr size_t B = Candidates::kBoxPoints;
+  float m = 0;
+  for (size_t k0 = 0, k = 0; k0 < n; k0 += B, ++k) {
+    float r[6] = {x[k0], y[k0], z[k0], x[k0], y[k0], z[k0]};
+    for (size_t i = k0 + 1; i < n && i < k0 + B; ++i) {
+      r[0] = std::min(r[0], x[i]);
+      r[1] = std::min(r[1], y[i]);
+      r[2] = std::min(r[2], z[i]);
+      r[3] = std::max(r[3], x[i]);
+      r[4] = std::max(r[4], y[i]);
+      r[5] = std::max(r[5], z[i]);
+    }
+    for (int a = 0; a < 6; ++a) {
+      box[size_t(a) * stride + k] = r[a];
+      m = std::max(m, std::abs(r[a]));
+    }
+  }
+  return m;
+}
 
 #if FPLOC_CK_WIDE
 namespace {
@@ -43,12 +68,17 @@ bool available() { return g_enabled; }
 void set_enabled(bool on) { g_enabled = on; }
 
 __attribute__((target("avx2"))) size_t band(const float* x, const float* y, const float* z, size_t n, size_t np,
-                                            const float pl[4], float cut, const float ref[3], float* bx, float* by, float* bz) {
+                                            const float pl[4], float cut, const float ref[3], float* bx, float* by, float* bz,
+                                            const BoxRange* box) {
   const v8f nx = splat(pl[0]), ny = splat(pl[1]), nz = splat(pl[2]), d = splat(pl[3]), cb = splat(cut);
   const v8f rx = splat(ref[0]), ry = splat(ref[1]), rz = splat(ref[2]);
   const v8i absm = {0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff};
   size_t m = 0;
-  for (size_t i = 0; i < n; i += 8) {
+  constexpr size_t B = Candidates::kBoxPoints;
+  for (size_t k0 = 0; k0 < n; k0 += B) {
+  if (box && (box->lo(k0 / B) >= cut || box->hi(k0 / B) <= -cut)) continue;  // no |r| < cut in this block
+  const size_t ke = std::min(n, k0 + B);
+  for (size_t i = k0; i < ke; i += 8) {
     v8f px, py, pz;
     if (i + 8 <= np) {
       px = ld(x + i);
@@ -78,6 +108,55 @@ __attribute__((target("avx2"))) size_t band(const float* x, const float* y, cons
     st(by + m, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(qy), idx)));
     st(bz + m, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(qz), idx)));
     m += size_t(__builtin_popcount(unsigned(in)));
+  }
+  }
+  return m;
+}
+
+// The smallest lane of v (exact: a minimum).
+__attribute__((target("avx2"))) inline float hmin(__m256 v) {
+  __m128 a = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+  a = _mm_min_ps(a, _mm_movehl_ps(a, a));
+  a = _mm_min_ss(a, _mm_shuffle_ps(a, a, 1));
+  return _mm_cvtss_f32(a);
+}
+
+__attribute__((target("avx2"))) float boxes(const float* x, const float* y, const float* z, size_t n, float* box,
+                                            size_t stride) {
+  constexpr size_t B = Candidates::kBoxPoints;
+  const size_t full = n / B;
+  const __m256 sign = _mm256_set1_ps(-0.f);
+  __m256 mx = _mm256_setzero_ps();  // largest |coordinate| (max of -min and max)
+  for (size_t k = 0; k < full; ++k) {
+    const size_t k0 = k * B;
+    __m256 lx = _mm256_loadu_ps(x + k0), ly = _mm256_loadu_ps(y + k0), lz = _mm256_loadu_ps(z + k0);
+    __m256 hx = lx, hy = ly, hz = lz;
+    for (size_t i = k0 + 8; i < k0 + B; i += 8) {
+      const __m256 px = _mm256_loadu_ps(x + i), py = _mm256_loadu_ps(y + i), pz = _mm256_loadu_ps(z + i);
+      lx = _mm256_min_ps(lx, px);
+      ly = _mm256_min_ps(ly, py);
+      lz = _mm256_min_ps(lz, pz);
+      hx = _mm256_max_ps(hx, px);
+      hy = _mm256_max_ps(hy, py);
+      hz = _mm256_max_ps(hz, pz);
+    }
+    // maxima as minima of the negated values (negation is exact)
+    box[k] = hmin(lx);
+    box[stride + k] = hmin(ly);
+    box[2 * stride + k] = hmin(lz);
+    box[3 * stride + k] = -hmin(_mm256_xor_ps(hx, sign));
+    box[4 * stride + k] = -hmin(_mm256_xor_ps(hy, sign));
+    box[5 * stride + k] = -hmin(_mm256_xor_ps(hz, sign));
+    mx = _mm256_max_ps(mx, _mm256_max_ps(_mm256_max_ps(_mm256_xor_ps(lx, sign), hx),
+                                         _mm256_max_ps(_mm256_max_ps(_mm256_xor_ps(ly, sign), hy),
+                                                       _mm256_max_ps(_mm256_xor_ps(lz, sign), hz))));
+  }
+  float m = -hmin(_mm256_xor_ps(mx, sign));
+  if (full * B < n) {  // the last, partial block
+    float tail[6];
+    const float t = boxes_scalar(x + full * B, y + full * B, z + full * B, n - full * B, tail, 1);
+    for (int a = 0; a < 6; ++a) box[size_t(a) * stride + full] = tail[a];
+    m = std::max(m, t);
   }
   return m;
 }
@@ -111,8 +190,12 @@ __attribute__((target("avx2"))) void strided(const float* x, const float* y, con
 #else
 bool available() { return false; }
 void set_enabled(bool) {}
-size_t band(const float*, const float*, const float*, size_t, size_t, const float*, float, const float*, float*, float*, float*) {
+size_t band(const float*, const float*, const float*, size_t, size_t, const float*, float, const float*, float*, float*, float*,
+            const BoxRange*) {
   return 0;
+}
+float boxes(const float* x, const float* y, const float* z, size_t n, float* box, size_t stride) {
+  return boxes_scalar(x, y, z, n, box, stride);
 }
 void strided(const float*, const float*, const float*, size_t, size_t, float*, float*, float*) {}
 #endif

@@ -2,6 +2,9 @@
 // compiled for that target alone and chosen at run time), from one template body (see plane_kernels.h).
 #include "plane_kernels.h"
 
+#include "compact_kernels.h"
+#include "fploc/segmentation/candidates.h"
+
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
@@ -223,7 +226,7 @@ FPLOC_INLINE void soft_score_t(const float* x, const float* y, const float* z, s
 template <int L>
 FPLOC_INLINE void inlier_moments_t(const float* x, const float* y, const float* z, size_t np, PlaneF pl, float thr,
                                    float bthr, const float ref[3], double S[9], double& r2, int& count,
-                                   int& beyond_count) {
+                                   int& beyond_count, size_t n, const ck::BoxRange* box) {
   using F = typename V<L>::f;
   using I = typename V<L>::i;
   const F nx = splat<L>(pl.nx), ny = splat<L>(pl.ny), nz = splat<L>(pl.nz), dv = splat<L>(pl.d), zero = splat<L>(0.f);
@@ -231,9 +234,25 @@ FPLOC_INLINE void inlier_moments_t(const float* x, const float* y, const float* 
   for (int q = 0; q < 9; ++q) S[q] = 0;
   r2 = 0;
   I cntv = splati<L>(0), beyondv = splati<L>(0);
+  int beyond_boxed = 0;  // the points of blocks wholly beyond (box)
+  constexpr size_t B = Candidates::kBoxPoints;
+  static_assert(256 % B == 0 && B % 8 == 0);
   for (size_t j0 = 0; j0 < np; j0 += 256) {
     F sx = zero, sy = zero, sz = zero, sxx = zero, sxy = zero, sxz = zero, syy = zero, syz = zero, szz = zero, sr2 = zero;
-    for_lanes<L>(j0, std::min(np, j0 + 256), [&](size_t j, auto N) FPLOC_LAMBDA {
+    // A block of the box without inliers adds zeros to every sum (the same sums without it); its beyond count is
+    // all its points or none when its residual range says so.
+    for (size_t k0 = j0; k0 < std::min(np, j0 + 256); k0 += B) {
+    if (box) {
+      const float lo = box->lo(k0 / B), hi = box->hi(k0 / B);
+      if (lo >= thr || hi <= -thr) {
+        if (lo >= -bthr) continue;
+        if (hi < -bthr) {
+          beyond_boxed += int(std::min(n, k0 + B) - k0);
+          continue;
+        }
+      }
+    }
+    for_lanes<L>(k0, std::min(np, k0 + B), [&](size_t j, auto N) FPLOC_LAMBDA {
       constexpr size_t n = decltype(N)::value;
       const I valid = first_lanes<L>(n);
       const F px = load<L, n>(x + j), py = load<L, n>(y + j), pz = load<L, n>(z + j);
@@ -246,12 +265,13 @@ FPLOC_INLINE void inlier_moments_t(const float* x, const float* y, const float* 
       sxx += qx * qx; sxy += qx * qy; sxz += qx * qz; syy += qy * qy; syz += qy * qz; szz += qz * qz;
       sr2 += qr * qr;
     });
+    }
     const F all[9] = {sx, sy, sz, sxx, sxy, sxz, syy, syz, szz};
     for (int q = 0; q < 9; ++q) S[q] += double(hsum<L>(all[q]));
     r2 += double(hsum<L>(sr2));
   }
   count = hsumi<L>(cntv);
-  beyond_count = hsumi<L>(beyondv);
+  beyond_count = hsumi<L>(beyondv) + beyond_boxed;
 }
 
 #if FPLOC_SEG_WIDE
@@ -271,8 +291,8 @@ FPLOC_WIDE_TARGET void soft_score8(const float* x, const float* y, const float* 
 }
 FPLOC_WIDE_TARGET void inlier_moments8(const float* x, const float* y, const float* z, size_t np, PlaneF pl, float thr,
                                        float bthr, const float ref[3], double S[9], double& r2, int& count,
-                                       int& beyond_count) {
-  inlier_moments_t<8>(x, y, z, np, pl, thr, bthr, ref, S, r2, count, beyond_count);
+                                       int& beyond_count, size_t n, const ck::BoxRange* box) {
+  inlier_moments_t<8>(x, y, z, np, pl, thr, bthr, ref, S, r2, count, beyond_count, n, box);
 }
 #endif
 
@@ -319,11 +339,12 @@ void soft_score(const float* x, const float* y, const float* z, size_t np, Plane
 }
 
 void inlier_moments(const float* x, const float* y, const float* z, size_t np, PlaneF pl, float thr, float bthr,
-                    const float ref[3], double S[9], double& r2, int& count, int& beyond_count) {
+                    const float ref[3], double S[9], double& r2, int& count, int& beyond_count, size_t n,
+                    const ck::BoxRange* box) {
 #if FPLOC_SEG_WIDE
-  if (g_wide) return inlier_moments8(x, y, z, np, pl, thr, bthr, ref, S, r2, count, beyond_count);
+  if (g_wide) return inlier_moments8(x, y, z, np, pl, thr, bthr, ref, S, r2, count, beyond_count, n, box);
 #endif
-  inlier_moments_t<4>(x, y, z, np, pl, thr, bthr, ref, S, r2, count, beyond_count);
+  inlier_moments_t<4>(x, y, z, np, pl, thr, bthr, ref, S, r2, count, beyond_count, n, box);
 }
 
 }  // namespace fploc::seg::kern

@@ -10,6 +10,10 @@
 
 #include "segmenter_constants.h"
 
+namespace fploc::seg::ck {
+struct BoxRange;
+}
+
 namespace fploc::seg::kern {
 
 // A plane n.p + d = 0 as floats (the residual r = n.p + d).
@@ -40,8 +44,11 @@ void soft_score(const float* x, const float* y, const float* z, size_t np, Plane
                 float& soft, int& beyond_count);
 
 // Inliers |r| < thr: count, moments of (p - ref) (x, y, z, xx, xy, xz, yy, yz, zz) and sum r^2; returns r < -bthr
-// counted in beyond_count. NaN padding counts nowhere.
+// counted in beyond_count. NaN padding counts nowhere. box (or null): the plane's residual range over the
+// bounding boxes of the n points (the rest is padding) per block of Candidates::kBoxPoints; a block whose range
+// has no inlier and is wholly beyond or wholly not is not read (the same results: it adds zeros to the sums).
 void inlier_moments(const float* x, const float* y, const float* z, size_t np, PlaneF pl, float thr, float bthr,
-                    const float ref[3], double S[9], double& r2, int& count, int& beyond_count);
+                    const float ref[3], double S[9], double& r2, int& count, int& beyond_count, size_t n = 0,
+                    const ck::BoxRange* box = nullptr);
 
 }  // namespace fploc::seg::kern

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "fploc/segmentation/segmenter.h"
+#include "compact_kernels.h"
 #include "plane_kernels.h"
 #include "plane_math.h"
 
@@ -21,8 +22,10 @@ void Segmenter::quality(const Candidates& c, Plane& pl) const {
   double S[9], r2 = 0;
   int cnt = 0, beyond = 0;
   const float ref3[3] = {reff.x(), reff.y(), reff.z()};
+  const float plf[4] = {n.x(), n.y(), n.z(), d};
+  const ck::BoxRange br(c.box.data(), c.box_stride, c.box_r, plf);
   kern::inlier_moments(c.x.data(), c.y.data(), c.z.data(), (c.n + 3) & ~size_t(3), {n.x(), n.y(), n.z(), d}, thr, beyond_thr,
-                       ref3, S, r2, cnt, beyond);
+                       ref3, S, r2, cnt, beyond, c.n, c.has_boxes() ? &br : nullptr);
   const detail::Moments m = detail::Moments::from_inliers(S, cnt);
   const Eigen::Vector3d ref = reff.cast<double>();
   pl.inliers = cnt;

@@ -8,14 +8,22 @@
 #include <string>
 
 #include "fploc/segmentation/segmenter.h"
+#include "compact_kernels.h"
 #include "plane_kernels.h"
 #include "simd4.h"
+#if defined(__x86_64__) && defined(__GNUC__)
+#include "lane8.h"
+#endif
+
+// (the eight-lane vectors stay inside the AVX2 functions: GCC's ABI note for them does not apply)
+#pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace fploc::seg {
 
 namespace {
 #if defined(__x86_64__) && defined(__GNUC__)
 #define FPLOC_PREP_WIDE 1
+constexpr lane8::CompressTable<false> kCompress;
 // One scan row of the four-column pass below, eight columns at a time (AVX2, chosen at run time with the plane
 // fit's kernels: kern::wide()): the same arithmetic per point (no fused multiply-add), so the same
 // candidates. rng/okm/lut/rot point at the row's first column; returns the new candidate count.
@@ -64,24 +72,29 @@ __attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const i
     }
     const v8f rm = fr * mm;
     const int32_t p0 = pix_row + c;
+    const v8i pv = v8i{p0, p0, p0, p0, p0, p0, p0, p0} + v8i{0, 1, 2, 3, 4, 5, 6, 7};
     if (in == 255) {
       std::memcpy(cx + m, &x, sizeof x);
       std::memcpy(cy + m, &y, sizeof y);
       std::memcpy(cz + m, &z, sizeof z);
       std::memcpy(cr + m, &rm, sizeof rm);
-      const v8i pv = {p0, p0 + 1, p0 + 2, p0 + 3, p0 + 4, p0 + 5, p0 + 6, p0 + 7};
       std::memcpy(cp + m, &pv, sizeof pv);
       m += 8;
       continue;
     }
-    for (int l = 0; l < 8; ++l) {
-      cx[m] = x[l];
-      cy[m] = y[l];
-      cz[m] = z[l];
-      cr[m] = rm[l];
-      cp[m] = p0 + l;
-      m += size_t((in >> l) & 1);
-    }
+    // Some lanes out: the kept ones moved to the front by one permutation each, eight slots stored (the slots
+    // past the kept ones are free: the next group or ring writes there, the padding after the last ring).
+    const __m256i idx = lane8::to_front(kCompress, in);
+#define FPLOC_PERM(v) reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(v), idx))
+    const v8f qx = FPLOC_PERM(x), qy = FPLOC_PERM(y), qz = FPLOC_PERM(z), qr = FPLOC_PERM(rm);
+#undef FPLOC_PERM
+    const v8i qp = reinterpret_cast<v8i>(_mm256_permutevar8x32_epi32(reinterpret_cast<__m256i>(pv), idx));
+    std::memcpy(cx + m, &qx, sizeof qx);
+    std::memcpy(cy + m, &qy, sizeof qy);
+    std::memcpy(cz + m, &qz, sizeof qz);
+    std::memcpy(cr + m, &qr, sizeof qr);
+    std::memcpy(cp + m, &qp, sizeof qp);
+    m += size_t(__builtin_popcount(unsigned(in)));
   }
 #undef FPLOC_LD
   return m;
@@ -323,6 +336,15 @@ bool Segmenter::prepare(const Scan& scan) {
   if (H % 2 == 1) ring_pass(ring_order_[half], middle_);
   for (Candidates* cs : {&upper_, &lower_, &middle_})
     for (auto* v : {&cs->x, &cs->y, &cs->z}) std::fill(v->begin() + cs->n, v->begin() + cs->n + Candidates::kLanes, std::numeric_limits<float>::quiet_NaN());
+  // The plane fits' candidates' bounding boxes per block (the band and the plane quality skip blocks by them).
+  for (Candidates* cs : {&upper_, &lower_}) {
+    cs->box_stride = (cs->n + Candidates::kBoxPoints - 1) / Candidates::kBoxPoints;
+    if (cs->box.size() < 6 * cs->box_stride) cs->box.resize(6 * cs->box_stride);
+    cs->box_r = ck::available() && kern::wide()
+                    ? ck::boxes(cs->x.data(), cs->y.data(), cs->z.data(), cs->n, cs->box.data(), cs->box_stride)
+                    : ck::boxes_scalar(cs->x.data(), cs->y.data(), cs->z.data(), cs->n, cs->box.data(), cs->box_stride);
+    cs->box_n = cs->n;
+  }
   const size_t valid = upper_.n + lower_.n + middle_.n;
   if (valid == 0) return fail(SegStatus::kEmpty, "no valid returns in the scan");
   return true;

@@ -194,7 +194,8 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     if (wide) {
       const float plf[4] = {float(cur[0]), float(cur[1]), float(cur[2]), float(cur[3])};
       const float r3[3] = {reff.x(), reff.y(), reff.z()};
-      m = ck::band(xs_, ys_, zs_, n_, np_, plf, float(cut), r3, bx, by, bz);
+      const ck::BoxRange br(cand_->box.data(), cand_->box_stride, cand_->box_r, plf);
+      m = ck::band(xs_, ys_, zs_, n_, np_, plf, float(cut), r3, bx, by, bz, cand_->has_boxes() ? &br : nullptr);
     }
     for (size_t i = 0; i < np_ && !wide; i += 4) {
       const v4f x = load(xs_ + i), y = load(ys_ + i), z = load(zs_ + i);
@@ -220,7 +221,8 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     band_.pad(1e3f * float(cur[0]), 1e3f * float(cur[1]), 1e3f * float(cur[2]));
     // Every kShrinkSubsample-th band point (the subsample of the iterations whose cut-off still shrinks).
     band_sub_.resize((m + k::kShrinkSubsample - 1) / k::kShrinkSubsample);
-    for (size_t j = 0, o = 0; j < m; j += k::kShrinkSubsample, ++o) {
+    if (wide) ck::strided(bx, by, bz, band_sub_.n, k::kShrinkSubsample, band_sub_.x.data(), band_sub_.y.data(), band_sub_.z.data());
+    for (size_t j = 0, o = 0; j < m && !wide; j += k::kShrinkSubsample, ++o) {
       band_sub_.x[o] = bx[j];
       band_sub_.y[o] = by[j];
       band_sub_.z[o] = bz[j];
@@ -312,6 +314,7 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
   zs_ = c.z.data();
   np_ = (n + 3) & ~size_t(3);  // NaN-padded (Candidates)
   n_ = n;
+  cand_ = &c;
   for (auto [sub, stride] : {std::pair{&sub_start_, start_stride_}, std::pair{&sub_final_, final_stride_}}) {
     sub->resize((n + stride - 1) / stride);
     if (ck::available() && kern::wide()) {

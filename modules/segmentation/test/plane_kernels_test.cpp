@@ -8,7 +8,11 @@
 #include <random>
 #include <vector>
 
+#include <Eigen/Core>
+
+#include "../src/compact_kernels.h"
 #include "../src/plane_kernels.h"
+#include "fploc/segmentation/candidates.h"
 
 using namespace fploc::seg;
 
@@ -155,3 +159,69 @@ INSTANTIATE_TEST_SUITE_P(Lanes, PlaneKernels, ::testing::Values(false, true),
                          [](const auto& info) { return info.param ? "Wide" : "FourLanes"; });
 
 }  // namespace
+
+// The band compaction and the inlier moments skip the blocks whose bounding box (Candidates' boxes) lies wholly
+// outside what they look for: the same points and bit-identical sums as without the boxes. Runs of points along
+// lines (as rings are: tight boxes) at many heights, and planes tilted through them so that blocks lie inside,
+// outside and across the band, with points a hair inside and outside the cut-off.
+TEST(PlaneKernels, BoxSkipsChangeNothing) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-1.f, 1.f);
+  for (size_t n : {size_t(1), size_t(63), size_t(64), size_t(1000), size_t(4101)}) {
+    std::vector<float> x, y, z;
+    for (size_t i = 0; i < n; ++i) {
+      const float t = float(i % 97) * 0.1f, h = float(i / 97) * 0.07f - 1.f;
+      x.push_back(3.f * std::cos(t) + 0.01f * u(rng));
+      y.push_back(3.f * std::sin(t) + 0.01f * u(rng));
+      z.push_back(h + (i % 13 == 0 ? 0.5f * u(rng) : 0.f));
+    }
+    const size_t np = (n + 3) & ~size_t(3);
+    for (size_t i = n; i < np + 8; ++i) {
+      x.push_back(std::numeric_limits<float>::quiet_NaN());
+      y.push_back(std::numeric_limits<float>::quiet_NaN());
+      z.push_back(std::numeric_limits<float>::quiet_NaN());
+    }
+    const size_t stride = (n + Candidates::kBoxPoints - 1) / Candidates::kBoxPoints;
+    std::vector<float> box(6 * stride), box2(6 * stride);
+    const float r = ck::boxes_scalar(x.data(), y.data(), z.data(), n, box.data(), stride);
+    if (ck::available() && kern::wide()) {
+      EXPECT_EQ(ck::boxes(x.data(), y.data(), z.data(), n, box2.data(), stride), r);
+      EXPECT_EQ(box2, box);
+    }
+    for (int k = 0; k < 40; ++k) {
+      Eigen::Vector3f nn(0.05f * u(rng), 0.05f * u(rng), 1.f);
+      nn.normalize();
+      // d such that the plane passes through a point of the cloud, moved by +-cut (within float rounding)
+      const size_t i0 = size_t(k * 37) % n;
+      const float cut = k % 3 == 0 ? 0.2f : k % 3 == 1 ? 0.05f : 0.013f;
+      const float d = -(nn.x() * x[i0] + nn.y() * y[i0] + nn.z() * z[i0]) + (k % 2 ? cut : -cut) * (1.f + 1e-7f * float(k % 5));
+      const float pl[4] = {nn.x(), nn.y(), nn.z(), d};
+      const ck::BoxRange br(box.data(), stride, r, pl);
+      for (bool wide : {false, true}) {
+        kern::set_wide(wide);
+        double S1[9], S2[9], r21, r22;
+        int c1, c2, b1, b2;
+        const float ref[3] = {x[0], y[0], z[0]};
+        kern::inlier_moments(x.data(), y.data(), z.data(), np, {pl[0], pl[1], pl[2], pl[3]}, cut, 2 * cut, ref, S1, r21, c1, b1);
+        kern::inlier_moments(x.data(), y.data(), z.data(), np, {pl[0], pl[1], pl[2], pl[3]}, cut, 2 * cut, ref, S2, r22, c2, b2,
+                             n, &br);
+        EXPECT_EQ(c1, c2);
+        EXPECT_EQ(b1, b2);
+        EXPECT_EQ(r21, r22);
+        for (int q = 0; q < 9; ++q) EXPECT_EQ(S1[q], S2[q]);
+      }
+      kern::set_wide(true);
+      if (!(ck::available() && kern::wide())) continue;
+      std::vector<float> bx1(np + 8), by1(np + 8), bz1(np + 8), bx2(np + 8), by2(np + 8), bz2(np + 8);
+      const float ref[3] = {0.f, 0.f, 1.f};
+      const size_t m1 = ck::band(x.data(), y.data(), z.data(), n, np, pl, cut, ref, bx1.data(), by1.data(), bz1.data());
+      const size_t m2 = ck::band(x.data(), y.data(), z.data(), n, np, pl, cut, ref, bx2.data(), by2.data(), bz2.data(), &br);
+      ASSERT_EQ(m1, m2);
+      for (size_t j = 0; j < m1; ++j) {
+        EXPECT_EQ(bx1[j], bx2[j]);
+        EXPECT_EQ(by1[j], by2[j]);
+        EXPECT_EQ(bz1[j], bz2[j]);
+      }
+    }
+  }
+}

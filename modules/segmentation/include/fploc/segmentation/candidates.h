@@ -52,6 +52,16 @@ struct Candidates {
   // The same points as vectors: filled only by fill_points() (the RANSAC fit and the building-area census
   // read them; the ring fit does not).
   std::vector<Eigen::Vector3f> p;
+  // Bounding boxes of the points in blocks of kBoxPoints (block k: points [k kBoxPoints, (k+1) kBoxPoints) below
+  // n), as six arrays of box_stride floats: min x, y, z, max x, y, z of each block; box_r: the largest |x|,
+  // |y|, |z| of the points. Valid only while box_n == n (the preparation computes them; push() and clear() drop
+  // them). The plane fit's band and the plane quality skip the blocks whose box lies wholly outside what they
+  // look for (the same results; see compact_kernels.h).
+  static constexpr size_t kBoxPoints = 64;
+  std::vector<float> box;
+  size_t box_stride = 0, box_n = size_t(-1);
+  float box_r = 0;
+  bool has_boxes() const { return box_n == n && n > 0; }
 
   size_t size() const { return n; }
   int rings() const { return int(ring_start.size()) - 1; }
@@ -62,6 +72,7 @@ struct Candidates {
   }
   // Appends one point (tests and tools building candidates by hand; keeps the padding).
   void push(const Eigen::Vector3f& q, float r, int32_t pix) {
+    box_n = size_t(-1);
     for (auto* v : {&x, &y, &z}) v->resize(n + kLanes, std::numeric_limits<float>::quiet_NaN());
     x[n] = q.x();
     y[n] = q.y();
@@ -74,6 +85,7 @@ struct Candidates {
   }
   void clear(int w) {
     n = 0;
+    box_n = size_t(-1);
     p.clear();
     x.assign(kLanes, std::numeric_limits<float>::quiet_NaN());
     y.assign(kLanes, std::numeric_limits<float>::quiet_NaN());

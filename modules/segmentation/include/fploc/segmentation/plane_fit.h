@@ -65,6 +65,7 @@ class RingPlaneFit : public PlaneFit {
   // The current fit's candidates (Candidates' float arrays, NaN-padded to np_, a multiple of 4).
   const float *xs_ = nullptr, *ys_ = nullptr, *zs_ = nullptr;
   size_t np_ = 0, n_ = 0;
+  const Candidates* cand_ = nullptr;  // them (for their bounding boxes)
   PointsSoa band_, band_sub_, sub_start_, sub_final_;  // band_: relative to the refinement's reference point
   std::vector<float> scratch_;  // refine: the band's residuals in histogram bins
   size_t start_stride_ = 1, final_stride_ = 1;  // of the current fit (Candidates, else the reference strides)
