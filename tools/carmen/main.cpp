@@ -21,6 +21,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "fploc/runtime/cli_numbers.h"
 #include "fploc/carmen/carmen.h"
 #include "fploc/carmen/coverage.h"
 #include "fploc/runtime/log_writer.h"
@@ -81,15 +82,7 @@ int main(int argc, char** argv) {
   app.add_option("--coverage-ratio", ccfg.covered_ratio, "a scan is covered when this share of its returns is (0.5)")
       ->check(CLI::Range(0.0, 1.0));
   CLI11_PARSE(app, argc, argv);
-  // CLI11 reads "nan" and "inf" as numbers and its Range/PositiveNumber checks let NaN through (--resolution nan
-  // wrote a map.yaml saying "resolution: nan").
-  for (const CLI::Option* o : app.get_options())
-    if (o->count() && o->get_type_name().find("FLOAT") != std::string::npos)
-      for (const std::string& r : o->results())
-        if (!std::isfinite(std::strtod(r.c_str(), nullptr))) {
-          std::cerr << "fploc import-carmen: " << o->get_name() << " " << r << ": not a finite number\n";
-          return 1;
-        }
+  if (!fploc::rt::check_finite_options(app, "fploc import-carmen", std::cerr)) return 1;  // nan, inf: one error naming the option
   namespace cm = fploc::carmen;
   try {
     const cm::Log log = cm::parse_log(cm::read_maybe_gz(in), in);

@@ -18,6 +18,7 @@
 #include <memory>
 #include <cstdio>
 
+#include "fploc/runtime/cli_numbers.h"
 #include "fploc/floorplan/building.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/adapters/ground_truth_t.h"
@@ -78,14 +79,7 @@ int main(int argc, char** argv) {
                  "building-* scenarios: write the simulated ceilings as a one-floor building file (.pbtxt) for the segmenter");
   app.add_option("--write-demo-plans", demo_dir, "write the demo plans (room.json, corridor.json) into DIR and exit");
   CLI11_PARSE(app, argc, argv);
-  // CLI11 reads "nan" and "inf" as numbers; no option here means them (--noise nan wrote NaN ranges).
-  for (const CLI::Option* o : app.get_options())
-    if (o->count() && o->get_type_name().find("FLOAT") != std::string::npos)
-      for (const std::string& r : o->results())
-        if (!std::isfinite(std::strtod(r.c_str(), nullptr))) {
-          std::cerr << "fploc sim: " << o->get_name() << " " << r << ": not a finite number\n";
-          return 1;
-        }
+  if (!fploc::rt::check_finite_options(app, "fploc sim", std::cerr)) return 1;  // nan, inf: one error naming the option
 
   try {
     if (!demo_dir.empty()) {
