@@ -11,6 +11,7 @@
 #include <random>
 #include <sstream>
 
+#include "fploc/runtime/cli_numbers.h"
 #include "fploc/annf/ablation.h"
 #include "fploc/annf/annf.h"
 #include "fploc/annf/baselines.h"
@@ -205,19 +206,8 @@ int main(int argc, char** argv) {
   compare->add_flag("--json", as_json, "JSON on stdout");
 
   CLI11_PARSE(app, argc, argv);
-  // CLI11 reads "nan" and "inf" as numbers; no option of these commands means them (--resolution inf wrote a 0 x 0
-  // map). One error naming the option.
-  for (const CLI::App* sub : app.get_subcommands())
-    for (const CLI::Option* o : sub->get_options())
-      if (o->count() && o->get_type_name().find("FLOAT") != std::string::npos)
-        for (const std::string& r : o->results()) {
-          char* end = nullptr;
-          const double v = std::strtod(r.c_str(), &end);
-          if (!std::isfinite(v)) {
-            std::cerr << "fploc map: error: " << o->get_name() << " " << r << ": not a finite number\n";
-            return 1;
-          }
-        }
+  // nan, inf: one error naming the option (--resolution inf wrote a 0 x 0 map).
+  if (!fploc::rt::check_finite_options(app, "fploc map: error", std::cerr)) return 1;
   try {
     if (*build) return cmd_build(b_plan, b_annf, b_out, as_json);
     if (*validate) return cmd_validate(v_plan.load(), v, as_json);

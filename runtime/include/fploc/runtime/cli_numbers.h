@@ -11,16 +11,18 @@
 
 namespace fploc::rt {
 
-// After CLI11_PARSE: false (and one line "TOOL: --option VALUE: not a finite number" on err) when a given
-// floating-point option's value is not finite.
-inline bool check_finite_options(const CLI::App& app, const std::string& tool, std::ostream& err) {
+// After CLI11_PARSE: false (and one line "PREFIX: --option VALUE: not a finite number" on err) when a given
+// floating-point option's value, of the app or of a subcommand it ran, is not finite.
+inline bool check_finite_options(const CLI::App& app, const std::string& prefix, std::ostream& err) {
   for (const CLI::Option* o : app.get_options())
     if (o->count() && o->get_type_name().find("FLOAT") != std::string::npos)
       for (const std::string& r : o->results())
         if (!std::isfinite(std::strtod(r.c_str(), nullptr))) {
-          err << tool << ": " << o->get_name() << " " << r << ": not a finite number\n";
+          err << prefix << ": " << o->get_name() << " " << r << ": not a finite number\n";
           return false;
         }
+  for (const CLI::App* sub : app.get_subcommands())
+    if (!check_finite_options(*sub, prefix, err)) return false;
   return true;
 }
 
