@@ -214,7 +214,7 @@ TEST(Features, ReferenceEqualSmoothnessPass) {
         detail::RingScratch scratch{w_scratch, brk};
         detail::smoothness(in, ru, scratch, corner.data(), bits.data(), sc.data(), occ);
         for (int i = hw; i < n - hw; ++i) {
-          const float c = reference::smoothness(in.x, in.y, in.z, in.r, i, hw);
+          const float c = reference::smoothness(in.x, in.y, in.z, i, hw);
           if (!(bits[size_t(i) >> 6] >> (i & 63) & 1)) continue;  // a broken window (column gap)
           ASSERT_EQ(std::memcmp(&c, &sc[size_t(i)], 4), 0) << "ring " << w.ring[b] << " point " << i << " hw " << hw;
           ASSERT_EQ(std::memcmp(&c, &corner[size_t(i)], 4), 0) << "ring " << w.ring[b] << " point " << i;
@@ -327,4 +327,31 @@ TEST(Features, ReferenceEqualOnEdgeRings) {
   c.half_window = 2;
   c.max_column_gap = 2;
   expect_same(s, c, "edge rings hw 2 gap 2");
+}
+
+// Under range noise the corner picks on flat walls are noise extremes; their mean offset from the wall must be
+// about zero. LOAM's c (divided by the point's own range) scores a return nearer than the surface higher than
+// one as far beyond it, and the sector's largest c was mostly a near one. Here (long walls 1.2 m from the sensor,
+// 2 cm noise; ~5000 picks, the mean's sigma ~0.5 mm): -4.2 mm with LOAM's c, +1.0 mm with the neighbours' range
+// (docs/notes/perception.md; in the simulator's corridor the picks at 1-2 m stood 15-20 mm in front).
+TEST(Features, CornerPicksOnNoisyWallsAreNotBiasedTowardTheSensor) {
+  synth::Room room;
+  room.half_x = 6.0;
+  room.half_y = 1.2;  // a corridor: the long walls 1.2 m from the sensor
+  double sum = 0;
+  int n = 0;
+  for (uint32_t seed = 1; seed <= 8; ++seed) {
+    const synth::SensorPose pose{0.3 * seed - 1.2, 0.0, 1.3, 0, 0, 0};
+    const auto r = run(room, pose, 0.02, seed);
+    ASSERT_EQ(r.f.status, FeatureStatus::kOk);
+    for (const auto& p : r.f.points) {
+      if (p.kind != FeatureKind::kCorner) continue;
+      const double wx = p.p.x() + pose.x, wy = p.p.y() + pose.y;
+      if (std::abs(wx) > room.half_x - 1.0 || std::abs(std::abs(wy) - room.half_y) > 0.15) continue;  // long walls only
+      sum += std::abs(wy) - room.half_y;  // < 0: in front of the wall (toward the sensor)
+      ++n;
+    }
+  }
+  ASSERT_GT(n, 200);
+  EXPECT_LT(std::abs(sum / n), 0.0025) << n << " corner features on the long walls, mean offset " << 1000 * sum / n << " mm";
 }

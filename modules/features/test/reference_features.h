@@ -14,11 +14,11 @@
 
 namespace fploc::feat::reference {
 
-// The smoothness of point i of a ring (X, Y, Z, R the ring's arrays): LOAM's c = |sum_j (X_j - X_i)| /
-// (2 hw |X_i|), defined by its float computation (src/smoothness.h float_smoothness, written out here): the
-// hw points before i and the hw points after i each added up in index order, d = (A + B) - 2hw X_i, one
-// root, one reciprocal.
-inline float smoothness(const float* X, const float* Y, const float* Z, const float* R, int i, int hw) {
+// The smoothness of point i of a ring (X, Y, Z the ring's arrays): c = |sum_j (X_j - X_i)| / |sum_j X_j|
+// (LOAM's with the neighbours' range for the point's own, see src/smoothness.h), defined by its float
+// computation (float_smoothness, written out here): the hw points before i and the hw points after i each
+// added up in index order, S = A + B, d = S - 2hw X_i, one division, one root.
+inline float smoothness(const float* X, const float* Y, const float* Z, int i, int hw) {
   float ax = 0, ay = 0, az = 0, bx = 0, by = 0, bz = 0;
   for (int q = 0; q < hw; ++q) {
     ax = q == 0 ? X[i - hw] : ax + X[i - hw + q];
@@ -29,9 +29,9 @@ inline float smoothness(const float* X, const float* Y, const float* Z, const fl
     bz = q == 0 ? Z[i + 1] : bz + Z[i + 1 + q];
   }
   const float den = float(2 * hw);
-  const float dx = (ax + bx) - den * X[i], dy = (ay + by) - den * Y[i], dz = (az + bz) - den * Z[i];
-  const float inv = 1.f / (den * R[i]);
-  return std::sqrt((dx * dx + dy * dy) + dz * dz) * inv;
+  const float sx = ax + bx, sy = ay + by, sz = az + bz;
+  const float dx = sx - den * X[i], dy = sy - den * Y[i], dz = sz - den * Z[i];
+  return std::sqrt(((dx * dx + dy * dy) + dz * dz) / ((sx * sx + sy * sy) + sz * sz));
 }
 
 struct Result {
@@ -73,7 +73,7 @@ inline Result extract(const seg::Segmentation& seg, const FeatureConfig& cfg = {
       const bool in_range = !(r < float(cfg.min_range_m)) && !(r > float(cfg.max_range_m));
       const float par = float(cfg.parallel_ratio);
       const bool parallel = std::abs(R[i - 1] - r) > par * r && std::abs(R[i + 1] - r) > par * r;
-      c[i] = smoothness(X, Y, Z, R, i, hw);
+      c[i] = smoothness(X, Y, Z, i, hw);
       ok[i] = connected && in_range && !parallel;
     }
     for (int j = 0; j + 1 < n; ++j) {  // occlusion boundaries: clear hw points on the far side

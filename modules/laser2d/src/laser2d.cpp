@@ -16,8 +16,8 @@ feat::FeatureConfig Laser2dConfig::default_features() {
   // 0.5-1 degree beams (SICK, Hokuyo) see a wall at 60-70 degrees incidence with range steps of a few per cent per
   // beam: LOAM's 2 % "parallel to the beam" rule (made for 0.1-0.35 degree spacing) would drop most walls.
   c.parallel_ratio = 0.15;
-  // LOAM's smoothness c = |sum(X_j - X_i)| / (2 hw |X_i|) of a flat wall is not zero when the beams fall on it
-  // unevenly: it grows with the square of the beam spacing (about 0.005 at 45 degrees incidence for 1 degree
+  // The smoothness c = |sum(X_j - X_i)| / |sum X_j| (LOAM's, with the neighbours' range: features/src/smoothness.h)
+  // of a flat wall is not zero when the beams fall on it unevenly: it grows with the square of the beam spacing (about 0.005 at 45 degrees incidence for 1 degree
   // beams, 30x the OS-1's), while a real corner's grows only linearly (about 2 x spacing). Thresholds for
   // 0.25-1 degree scanners:
   c.corner_threshold = 0.03;

@@ -18,7 +18,7 @@ struct FeatureConfig {
   int sectors = 6;                  // per-ring sectors for the feature limits
   int max_corners_per_sector = 2;
   int max_surfaces_per_sector = 12;
-  double corner_threshold = 0.002;  // smoothness c (dimensionless, see below) above which a point is a corner
+  double corner_threshold = 0.002;  // smoothness c (dimensionless, src/smoothness.h) above which a point is a corner
   double surface_threshold = 0.0005;// smoothness below which a point is a surface point
   double max_range_m = 60.0;
   double min_range_m = 0.5;
