@@ -11,10 +11,6 @@
 #include <limits>
 #include <type_traits>
 
-#if defined(__x86_64__) && defined(__GNUC__)
-#include <immintrin.h>
-#endif
-
 // The eight-lane helpers are inlined into the AVX2 functions only (no AVX vector crosses a call): the ABI
 // note GCC gives for them does not apply.
 #pragma GCC diagnostic ignored "-Wpsabi"
@@ -139,11 +135,10 @@ FPLOC_INLINE int count_below_t(const float* v, size_t np, float t) {
 // floor(v) <= B exactly when v < B + 1); B = kScaleBins - 1 (the clamped last bin) when no smaller one.
 // hint (>= 0): a guess of the bin (the last iteration's scale); the same bin is found from a bracket around
 // it (two counts when the guess is right) instead of from the whole range (eight counts).
-// count_le(B): the number of inside residuals whose bin is <= B (B < kScaleBins - 1).
-template <class CountLe>
-FPLOC_INLINE int median_bin_f(CountLe&& count_le, int inside, int hint) {
+template <int L>
+FPLOC_INLINE int median_bin_t(const float* v, size_t np, int inside, int hint) {
   // F(B): 2 count(v < B + 1) >= inside, true from the answer on (monotone); the last bin always true.
-  auto F = [&](int b) FPLOC_LAMBDA { return b >= k::kScaleBins - 1 || 2 * count_le(b) >= inside; };
+  auto F = [&](int b) FPLOC_LAMBDA { return b >= k::kScaleBins - 1 || 2 * count_below_t<L>(v, np, float(b + 1)) >= inside; };
   int lo = 0, hi = k::kScaleBins - 1;  // the answer lies in [lo, hi]
   if (hint >= 0) {
     const int h = std::min(hint, k::kScaleBins - 1);
@@ -173,15 +168,10 @@ FPLOC_INLINE int median_bin_f(CountLe&& count_le, int inside, int hint) {
   }
   while (lo < hi) {
     const int mid = (lo + hi) / 2;
-    if (2 * count_le(mid) >= inside) hi = mid;
+    if (2 * count_below_t<L>(v, np, float(mid + 1)) >= inside) hi = mid;
     else lo = mid + 1;
   }
   return lo;
-}
-
-template <int L>
-FPLOC_INLINE int median_bin_t(const float* v, size_t np, int inside, int hint) {
-  return median_bin_f([&](int b) FPLOC_LAMBDA { return count_below_t<L>(v, np, float(b + 1)); }, inside, hint);
 }
 
 template <int L>
@@ -286,82 +276,10 @@ FPLOC_INLINE void inlier_moments_t(const float* x, const float* y, const float* 
 
 #if FPLOC_SEG_WIDE
 #define FPLOC_WIDE_TARGET __attribute__((target("avx2,fma")))
-FPLOC_WIDE_TARGET int residual_scale8_float(const float* x, const float* y, const float* z, size_t np, PlaneF pl,
-                                            float inv_bin, float cutf, float* v, int& inside, int hint) {
-  inside = residual_bins_t<8>(x, y, z, np, pl, inv_bin, cutf, v);
-  return median_bin_t<8>(v, np, inside, hint);
-}
-
-// The bins as bytes: q = min(floor(|r| inv_bin), 255) for |r| < cutf, else 255, so that for B < 255 (the only
-// bins counted) q <= B exactly when the float value of residual_bins_t (|r| inv_bin, or inf) is < B + 1. The
-// residual and |r| inv_bin are the same float operations as residual_bins_t<8>; floor is the truncation of a
-// value in [0, 255]. Writes np bytes, then 255 up to the next multiple of 32 (the counting loops' step).
-template <size_t n>
-FPLOC_WIDE_TARGET FPLOC_INLINE void residual_bytes_step(const float* x, const float* y, const float* z, size_t j, PlaneF pl,
-                                                        float inv_bin, float cutf, uint8_t* q, V<8>::i& cnt) {
-  using F = V<8>::f;
-  using I = V<8>::i;
-  const F nx = splat<8>(pl.nx), ny = splat<8>(pl.ny), nz = splat<8>(pl.nz), d = splat<8>(pl.d);
-  const F inv = splat<8>(inv_bin), cutv = splat<8>(cutf), top = splat<8>(255.f);
-  // byte 0 of each 32-bit lane to the front of its 128-bit half, then the two halves' first words together
-  const __m256i pick = _mm256_setr_epi8(0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,
-                                        0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
-  const __m256i join = _mm256_setr_epi32(0, 4, 1, 1, 1, 1, 1, 1);
-  const F a = vabs<8>(nx * load<8, n>(x + j) + ny * load<8, n>(y + j) + nz * load<8, n>(z + j) + d);
-  const I in = (a < cutv) & first_lanes<8>(n);
-  cnt -= in;
-  const F b = a * inv;
-  const F c = in ? (b < top ? b : top) : top;
-  const __m256i bytes = _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(_mm256_cvttps_epi32(reinterpret_cast<__m256>(c)), pick), join);
-  const uint64_t w = uint64_t(_mm_cvtsi128_si64(_mm256_castsi256_si128(bytes)));
-  std::memcpy(q + j, &w, n);
-}
-
-FPLOC_WIDE_TARGET int residual_bytes8(const float* x, const float* y, const float* z, size_t np, PlaneF pl,
-                                      float inv_bin, float cutf, uint8_t* q) {
-  V<8>::i cnt = splati<8>(0);
-  size_t j = 0;
-  for (; j + 8 <= np; j += 8) residual_bytes_step<8>(x, y, z, j, pl, inv_bin, cutf, q, cnt);
-  if (j < np) residual_bytes_step<4>(x, y, z, j, pl, inv_bin, cutf, q, cnt);  // (np is a multiple of 4)
-  const size_t pe = (np + 31) & ~size_t(31);
-  if (pe > np) std::memset(q + np, 255, pe - np);
-  return hsumi<8>(cnt);
-}
-
-// The number of bytes <= B among q[0 .. n32) (n32 a multiple of 32): per 32 bytes a maximum, a compare and a
-// subtraction into byte counters, added up (sad) before they can wrap.
-FPLOC_WIDE_TARGET int count_le_bytes8(const uint8_t* q, size_t n32, int B) {
-  const __m256i bv = _mm256_set1_epi8(char(uint8_t(B))), zero = _mm256_setzero_si256();
-  __m256i acc = zero;
-  for (size_t j = 0; j < n32;) {
-    __m256i c0 = zero, c1 = zero;
-    const size_t je = std::min(n32, j + 2 * 32 * 255);
-    for (; j + 64 <= je; j += 64) {
-      const __m256i a = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(q + j));
-      const __m256i b = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(q + j + 32));
-      c0 = _mm256_sub_epi8(c0, _mm256_cmpeq_epi8(_mm256_max_epu8(a, bv), bv));
-      c1 = _mm256_sub_epi8(c1, _mm256_cmpeq_epi8(_mm256_max_epu8(b, bv), bv));
-    }
-    if (j < je) {  // the last 32
-      const __m256i a = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(q + j));
-      c0 = _mm256_sub_epi8(c0, _mm256_cmpeq_epi8(_mm256_max_epu8(a, bv), bv));
-      j += 32;
-    }
-    acc = _mm256_add_epi64(acc, _mm256_add_epi64(_mm256_sad_epu8(c0, zero), _mm256_sad_epu8(c1, zero)));
-  }
-  return int(_mm256_extract_epi64(acc, 0) + _mm256_extract_epi64(acc, 1) + _mm256_extract_epi64(acc, 2) +
-             _mm256_extract_epi64(acc, 3));
-}
-
-bool g_byte_bins = true;
-
 FPLOC_WIDE_TARGET int residual_scale8(const float* x, const float* y, const float* z, size_t np, PlaneF pl,
                                       float inv_bin, float cutf, float* v, int& inside, int hint) {
-  if (!g_byte_bins) return residual_scale8_float(x, y, z, np, pl, inv_bin, cutf, v, inside, hint);
-  uint8_t* q = reinterpret_cast<uint8_t*>(v);  // (np + 8 floats: 4 np + 32 >= np + 31 bytes)
-  inside = residual_bytes8(x, y, z, np, pl, inv_bin, cutf, q);
-  const size_t n32 = (np + 31) & ~size_t(31);
-  return median_bin_f([&](int b) FPLOC_LAMBDA { return count_le_bytes8(q, n32, b); }, inside, hint);
+  inside = residual_bins_t<8>(x, y, z, np, pl, inv_bin, cutf, v);
+  return median_bin_t<8>(v, np, inside, hint);
 }
 FPLOC_WIDE_TARGET void tukey_moments8(const float* x, const float* y, const float* z, size_t np, PlaneF pl,
                                       float inv_c2, double S[10]) {
@@ -394,13 +312,6 @@ bool g_wide = default_wide();
 }  // namespace
 
 bool wide() { return g_wide; }
-void set_byte_bins(bool on) {
-#if FPLOC_SEG_WIDE
-  g_byte_bins = on;
-#else
-  (void)on;
-#endif
-}
 void set_wide(bool on) { g_wide = on && default_wide(); }
 
 int residual_scale(const float* x, const float* y, const float* z, size_t np, PlaneF pl, float inv_bin, float cutf,

@@ -29,15 +29,10 @@ void set_wide(bool on);
 // The robust scale's bin: of the residuals |r| < cutf among the np points (np a multiple of 4; padding points
 // lie outside cutf), `inside` = their count, and the returned bin B is the smallest with
 // 2 #{floor(|r| inv_bin) <= B} >= inside (kScaleBins - 1 at most), i.e. the median's bin of a histogram with
-// kScaleBins bins. v (np + 8 floats) is scratch. hint >= 0: a guess of the bin (fewer counting passes when it is
-// near; the result does not depend on it). The eight-lane version counts bins stored as bytes (32 per step),
-// the same counts as of the float values.
+// kScaleBins bins. v (np floats) is scratch. hint >= 0: a guess of the bin (fewer counting passes when it is
+// near; the result does not depend on it).
 int residual_scale(const float* x, const float* y, const float* z, size_t np, PlaneF pl, float inv_bin, float cutf,
                    float* v, int& inside, int hint = -1);
-
-// Tests: the eight-lane residual scale with its bins as bytes (true, the default) or as floats (the same bin and
-// count).
-void set_byte_bins(bool on);
 
 // Tukey-weighted moments w, w x, w y, w z, w xx, w xy, w xz, w yy, w yz, w zz with w = (1 - r^2 inv_c2)^2 for
 // r^2 inv_c2 < 1, float sums over blocks of 256 points added in double. The padding must weigh 0 (finite
