@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <limits>
 
 #include "fploc/segmentation/candidates.h"
 
@@ -41,34 +40,6 @@ float boxes_scalar(const float* x, const float* y, const float* z, size_t n, flo
     }
   }
   return m;
-}
-
-void sector_max_scalar(const SeedRing& r, float* best, int* idx) {
-  // A sector's points are mostly one run (the ring in column order): its maximum is kept in registers and stored
-  // when the sector changes.
-  int cur_s = -1, cur_i = -1;
-  float cur_best = -1.f;
-  for (int32_t i = r.a; i < r.b; ++i) {
-    const bool low = r.ux * r.x[i] + (r.uy * r.y[i] + r.uz * r.z[i]) < r.hmin;
-    const int s = r.sector[r.pixel[i] - r.row0];
-    if (s != cur_s) {
-      if (cur_s >= 0) {
-        best[cur_s] = cur_best;
-        idx[cur_s] = cur_i;
-      }
-      cur_s = s;
-      cur_best = best[s];
-      cur_i = idx[s];
-    }
-    const float rv = low ? -std::numeric_limits<float>::infinity() : r.range[i];
-    const bool better = rv > cur_best;
-    cur_i = better ? i : cur_i;
-    cur_best = better ? rv : cur_best;
-  }
-  if (cur_s >= 0) {
-    best[cur_s] = cur_best;
-    idx[cur_s] = cur_i;
-  }
 }
 
 #if FPLOC_CK_WIDE
@@ -216,45 +187,7 @@ __attribute__((target("avx2"))) void strided(const float* x, const float* y, con
     oz[j] = z[j * stride];
   }
 }
-// Eight points at a time: their seed ranges (NaN as -inf: neither is ever taken) and sectors (one gather); for each
-// distinct sector among them, the largest range of its lanes (exact: a maximum) and, when it beats the sector's
-// best, its first lane. Per sector that is the scalar loop's result: its points are taken in index order.
-__attribute__((target("avx2"))) void sector_max(const SeedRing& r, float* best, int* idx) {
-  const v8f ux = splat(r.ux), uy = splat(r.uy), uz = splat(r.uz), hm = splat(r.hmin);
-  const v8f ninf = splat(-std::numeric_limits<float>::infinity());
-  const __m256i row0 = _mm256_set1_epi32(r.row0);
-  int32_t i = r.a;
-  for (; i + 8 <= r.b; i += 8) {
-    const v8f h = ux * ld(r.x + i) + (uy * ld(r.y + i) + uz * ld(r.z + i));
-    v8f rv = ld(r.range + i);
-    rv = (h < hm) ? ninf : rv;
-    rv = (rv == rv) ? rv : ninf;
-    const __m256i col = _mm256_sub_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(r.pixel + i)), row0);
-    const __m256i sec = _mm256_i32gather_epi32(r.sector, col, 4);
-    int rem = 0xff;
-    while (rem) {
-      const int s = _mm256_extract_epi32(_mm256_permutevar8x32_epi32(sec, _mm256_set1_epi32(__builtin_ctz(unsigned(rem)))), 0);
-      const __m256i same = _mm256_cmpeq_epi32(sec, _mm256_set1_epi32(s));
-      rem &= ~_mm256_movemask_ps(_mm256_castsi256_ps(same));
-      const __m256 rs = _mm256_blendv_ps(reinterpret_cast<__m256>(ninf), reinterpret_cast<__m256>(rv), _mm256_castsi256_ps(same));
-      __m256 mx = _mm256_max_ps(rs, _mm256_permute2f128_ps(rs, rs, 1));
-      mx = _mm256_max_ps(mx, _mm256_permute_ps(mx, 0x4e));
-      mx = _mm256_max_ps(mx, _mm256_permute_ps(mx, 0xb1));
-      const float m = _mm256_cvtss_f32(mx);
-      if (m > best[s]) {  // (then m is finite or +inf, and a lane of sector s holds it)
-        best[s] = m;
-        idx[s] = i + __builtin_ctz(unsigned(_mm256_movemask_ps(_mm256_cmp_ps(rs, mx, _CMP_EQ_OQ))));
-      }
-    }
-  }
-  if (i < r.b) {
-    SeedRing tail = r;
-    tail.a = i;
-    sector_max_scalar(tail, best, idx);
-  }
-}
 #else
-void sector_max(const SeedRing& r, float* best, int* idx) { sector_max_scalar(r, best, idx); }
 bool available() { return false; }
 void set_enabled(bool) {}
 size_t band(const float*, const float*, const float*, size_t, size_t, const float*, float, const float*, float*, float*, float*,

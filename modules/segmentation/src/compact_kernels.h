@@ -57,23 +57,4 @@ float boxes_scalar(const float* x, const float* y, const float* z, size_t n, flo
 // dst[j] = src[j * stride] for j < m (the three arrays).
 void strided(const float* x, const float* y, const float* z, size_t m, size_t stride, float* ox, float* oy, float* oz);
 
-// One seed ring of the plane fit (RingPlaneFit::pick_seeds): the candidates [a, b), their column pixel - row0 and
-// its azimuth sector sector[column] (any order of columns and sectors; sectors < the best/idx arrays' size).
-// A point's seed range is range[i], or -inf when below the seed height: ux x + (uy y + uz z) < hmin in float
-// (the order of Eigen's Vector3f::dot; the sum is not fused).
-struct SeedRing {
-  const float *x, *y, *z, *range;
-  const int32_t* pixel;
-  int32_t a, b, row0;
-  const int* sector;
-  float ux, uy, uz, hmin;
-};
-// Per sector s, the first index of the largest seed range that is > best[s] (strict: the first of equal
-// ranges) goes to idx[s], that range to best[s]; a point whose seed range is not > best[s] (-inf, NaN) is never
-// taken. The same as taking the points one by one in index order. sector_max runs eight points at a time where
-// available() and kern::wide() (one vector maximum per sector among the eight), else sector_max_scalar: the same
-// best and idx, bit for bit.
-void sector_max(const SeedRing& r, float* best, int* idx);
-void sector_max_scalar(const SeedRing& r, float* best, int* idx);
-
 }  // namespace fploc::seg::ck

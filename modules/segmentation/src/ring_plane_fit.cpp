@@ -34,12 +34,39 @@ void RingPlaneFit::pick_seeds(const Candidates& c, const Eigen::Vector3f& upf) {
     sector_best_.assign(S, -1.f);
     sector_idx_.assign(S, -1);
     // A ring is one scan row: its column is the pixel index minus the row's first pixel (no division per point).
-    // A point below the seed height counts as range -inf (never above the -1 start).
     const int row0 = c.ring_start[r] < c.ring_start[r + 1] ? c.pixel[c.ring_start[r]] / c.width * c.width : 0;
-    const ck::SeedRing ring{c.x.data(), c.y.data(), c.z.data(), c.range.data(), c.pixel.data(), c.ring_start[r],
-                            c.ring_start[r + 1], row0, sector_of_col_.data(), upf.x(), upf.y(), upf.z(), k::kMinSeedHeightM};
-    if (ck::available() && kern::wide()) ck::sector_max(ring, sector_best_.data(), sector_idx_.data());
-    else ck::sector_max_scalar(ring, sector_best_.data(), sector_idx_.data());
+    // The ring is in column order, so a sector's points are one run: its maximum is kept in registers
+    // (the first of equal ranges, as a strict > over the points in order) and stored when the sector changes.
+    // A point below the seed height counts as range -inf (never above the -1 start).
+    const float* px = c.x.data();
+    const float* py = c.y.data();
+    const float* pz = c.z.data();
+    const float* prange = c.range.data();
+    const int32_t* ppix = c.pixel.data();
+    const int* sec = sector_of_col_.data();
+    int cur_s = -1, cur_i = -1;
+    float cur_best = -1.f;
+    for (int i = c.ring_start[r]; i < c.ring_start[r + 1]; ++i) {
+      const bool low = upf.dot(Eigen::Vector3f(px[i], py[i], pz[i])) < k::kMinSeedHeightM;
+      const int s = sec[ppix[i] - row0];
+      if (s != cur_s) {
+        if (cur_s >= 0) {
+          sector_best_[size_t(cur_s)] = cur_best;
+          sector_idx_[size_t(cur_s)] = cur_i;
+        }
+        cur_s = s;
+        cur_best = sector_best_[size_t(s)];
+        cur_i = sector_idx_[size_t(s)];
+      }
+      const float rv = low ? -std::numeric_limits<float>::infinity() : prange[i];
+      const bool better = rv > cur_best;
+      cur_i = better ? i : cur_i;
+      cur_best = better ? rv : cur_best;
+    }
+    if (cur_s >= 0) {
+      sector_best_[size_t(cur_s)] = cur_best;
+      sector_idx_[size_t(cur_s)] = cur_i;
+    }
     std::vector<int> cand;
     for (int s = 0; s < S; ++s)
       if (sector_idx_[s] >= 0) cand.push_back(sector_idx_[s]);

@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <random>
 #include <vector>
@@ -225,78 +224,4 @@ TEST(PlaneKernels, BoxSkipsChangeNothing) {
       }
     }
   }
-}
-
-// The seed scan of one ring (ck::sector_max, eight points at a time) against the scalar loop and a plain loop that
-// takes the points one by one with Eigen's dot (pick_seeds before the kernels): the same best ranges (bit for
-// bit) and indices per sector. Ranges quantised to 1/4 m (ties between lanes and groups), NaN ranges, heights a
-// few float steps around the seed height, columns with dropouts, in order and wrapped around (two runs per
-// sector), sectors of 256, 16 and 2 columns, and sectors starting from earlier bests.
-TEST(PlaneKernels, SeedSectorMaxMatchesScalar) {
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<float> u(-1.f, 1.f);
-  const int W = 1024;
-  const float hmin = 0.2f;
-  const Eigen::Vector3f up = Eigen::Vector3f(0.02f, -0.03f, 1.f).normalized();
-  int checked = 0;
-  for (int n_want : {0, 1, 7, 8, 9, 15, 16, 17, 100, 1000, 1024}) {
-    for (int S : {4, 64, 512}) {
-      for (bool wrap : {false, true}) {
-        std::vector<int> sector(W);
-        for (int col = 0; col < W; ++col) sector[size_t(col)] = col * S / W;
-        std::vector<float> x, y, z, range;
-        std::vector<int32_t> pixel;
-        const int32_t row0 = 5 * W;
-        const int first = wrap ? 700 : 0;
-        for (int k = 0; k < W && int(pixel.size()) < n_want; ++k) {
-          if (n_want < W && u(rng) > 0.8f) continue;  // dropouts
-          const int col = (first + k) % W;
-          const float px = 5.f * u(rng), py = 5.f * u(rng);
-          // the height: far above or below, or within a few float steps of hmin
-          const float target = u(rng) > 0.f ? hmin + 1e-6f * u(rng) : hmin + 2.f * u(rng);
-          x.push_back(px);
-          y.push_back(py);
-          z.push_back((target - up.x() * px - up.y() * py) / up.z());
-          const float q = u(rng);
-          range.push_back(q > 0.95f ? std::numeric_limits<float>::quiet_NaN() : std::round(8.f * (q + 1.f)) * 0.25f + 1.f);
-          pixel.push_back(row0 + col);
-        }
-        const int n = int(pixel.size());
-        ck::SeedRing ring{x.data(), y.data(), z.data(), range.data(), pixel.data(), 0, n, row0, sector.data(),
-                          up.x(), up.y(), up.z(), hmin};
-        for (bool preset : {false, true}) {
-          std::vector<float> best0(size_t(S), -1.f);
-          std::vector<int> idx0(size_t(S), -1);
-          if (preset)
-            for (int s = 0; s < S; s += 3) {
-              best0[size_t(s)] = 3.f;
-              idx0[size_t(s)] = -7;
-            }
-          // one by one, as pick_seeds did
-          std::vector<float> best_ref = best0;
-          std::vector<int> idx_ref = idx0;
-          for (int i = 0; i < n; ++i) {
-            const bool low = up.dot(Eigen::Vector3f(x[size_t(i)], y[size_t(i)], z[size_t(i)])) < hmin;
-            const float rv = low ? -std::numeric_limits<float>::infinity() : range[size_t(i)];
-            const int s = sector[size_t(pixel[size_t(i)] - row0)];
-            if (rv > best_ref[size_t(s)]) {
-              best_ref[size_t(s)] = rv;
-              idx_ref[size_t(s)] = i;
-            }
-          }
-          std::vector<float> best1 = best0, best2 = best0;
-          std::vector<int> idx1 = idx0, idx2 = idx0;
-          ck::sector_max_scalar(ring, best1.data(), idx1.data());
-          EXPECT_EQ(0, std::memcmp(best1.data(), best_ref.data(), best1.size() * sizeof(float)));
-          EXPECT_EQ(idx1, idx_ref);
-          if (!(ck::available() && kern::wide())) continue;
-          ck::sector_max(ring, best2.data(), idx2.data());
-          EXPECT_EQ(0, std::memcmp(best2.data(), best_ref.data(), best2.size() * sizeof(float))) << "n " << n << " S " << S;
-          EXPECT_EQ(idx2, idx_ref) << "n " << n << " S " << S << " wrap " << wrap;
-          ++checked;
-        }
-      }
-    }
-  }
-  if (ck::available() && kern::wide()) EXPECT_EQ(checked, 11 * 3 * 2 * 2);
 }
