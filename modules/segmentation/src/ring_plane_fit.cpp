@@ -38,16 +38,33 @@ void RingPlaneFit::pick_seeds(const Candidates& c, const Eigen::Vector3f& upf) {
     // The ring is in column order, so a sector's points are one run: its maximum is kept in registers
     // (the first of equal ranges, as a strict > over the points in order) and stored when the sector changes.
     // A point below the seed height counts as range -inf (never above the -1 start).
-    const float* px = c.x.data();
-    const float* py = c.y.data();
-    const float* pz = c.z.data();
-    const float* prange = c.range.data();
+    // The seed ranges first, four points at a time (the height summed as Eigen's dot, x + (y + z)).
+    const int rs = c.ring_start[r], re = c.ring_start[r + 1];
+    seed_rv_.resize(size_t(std::max(0, re - rs)));
+    {
+      using namespace simd;
+      const float* px = c.x.data();
+      const float* py = c.y.data();
+      const float* pz = c.z.data();
+      const float* prange = c.range.data();
+      const v4f ux = splat(upf.x()), uy = splat(upf.y()), uz = splat(upf.z()), hmin = splat(k::kMinSeedHeightM);
+      const v4f ninf = splat(-std::numeric_limits<float>::infinity());
+      float* rv = seed_rv_.data() - rs;
+      int i = rs;
+      for (; i + 4 <= re; i += 4) {
+        const v4f h = ux * load(px + i) + (uy * load(py + i) + uz * load(pz + i));
+        store(rv + i, h < hmin ? ninf : load(prange + i));
+      }
+      for (; i < re; ++i)
+        rv[i] = upf.dot(Eigen::Vector3f(px[i], py[i], pz[i])) < k::kMinSeedHeightM ? -std::numeric_limits<float>::infinity()
+                                                                                  : prange[i];
+    }
+    const float* prv = seed_rv_.data() - rs;
     const int32_t* ppix = c.pixel.data();
     const int* sec = sector_of_col_.data();
     int cur_s = -1, cur_i = -1;
     float cur_best = -1.f;
-    for (int i = c.ring_start[r]; i < c.ring_start[r + 1]; ++i) {
-      const bool low = upf.dot(Eigen::Vector3f(px[i], py[i], pz[i])) < k::kMinSeedHeightM;
+    for (int i = rs; i < re; ++i) {
       const int s = sec[ppix[i] - row0];
       if (s != cur_s) {
         if (cur_s >= 0) {
@@ -58,7 +75,7 @@ void RingPlaneFit::pick_seeds(const Candidates& c, const Eigen::Vector3f& upf) {
         cur_best = sector_best_[size_t(s)];
         cur_i = sector_idx_[size_t(s)];
       }
-      const float rv = low ? -std::numeric_limits<float>::infinity() : prange[i];
+      const float rv = prv[i];
       const bool better = rv > cur_best;
       cur_i = better ? i : cur_i;
       cur_best = better ? rv : cur_best;

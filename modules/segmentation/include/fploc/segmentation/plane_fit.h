@@ -60,6 +60,7 @@ class RingPlaneFit : public PlaneFit {
   std::vector<int> seeds_, all_seeds_;
   std::vector<float> sector_best_;
   std::vector<int> sector_idx_;
+  std::vector<float> seed_rv_;  // a seed ring's ranges, -inf below the seed height (pick_seeds)
   std::vector<int> sector_of_col_;  // azimuth sector of each staggered column (pick_seeds)
   int sector_cols_s_ = 0;
   // The current fit's candidates (Candidates' float arrays, NaN-padded to np_, a multiple of 4).
