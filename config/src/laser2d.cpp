@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "fploc/config/check.h"
+
 namespace fploc::config {
 
 laser2d::GridLocalizerConfig config_of(const Grid2dOptions& o) {
@@ -27,8 +29,8 @@ laser2d::GridLocalizerConfig config_of(const Grid2dOptions& o) {
   if (!o.fit_loss().empty()) {
     const auto loss = laser2d::fit_loss_from_name(o.fit_loss());
     if (!loss)
-      throw std::runtime_error("grid2d.fit_loss: unknown loss '" + o.fit_loss() +
-                               "' (use \"huber\", \"cauchy\" or \"tukey\")");
+      throw OptionError("grid2d", "fit_loss", "unknown loss '" + o.fit_loss() +
+                                                       "' (use \"huber\", \"cauchy\" or \"tukey\")");
     c.fit_loss = *loss;
   }
   if (o.huber_m() > 0) c.huber_m = o.huber_m();

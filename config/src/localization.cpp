@@ -5,15 +5,16 @@
 #include <stdexcept>
 #include <string>
 
+#include "fploc/config/check.h"
+
 namespace fploc::config {
 
 namespace {
 
 // The robust losses plan_terms knows; anything else is one clear error naming the option.
-const std::string& checked_loss(const std::string& loss, const char* field) {
+const std::string& checked_loss(const std::string& loss, const char* block) {
   if (loss == "cauchy" || loss == "geman-mcclure" || loss == "huber" || loss == "none") return loss;
-  throw std::runtime_error(std::string(field) + ": unknown loss '" + loss +
-                           "' (use \"cauchy\", \"geman-mcclure\", \"huber\" or \"none\")");
+  throw OptionError(block, "loss", "unknown loss '" + loss + "' (use \"cauchy\", \"geman-mcclure\", \"huber\" or \"none\")");
 }
 
 // The as-built model's options (the same fields in MatcherOptions and OptimizerOptions).
@@ -37,7 +38,7 @@ matcher::MatcherConfig config_of(const MatcherOptions& o) {
   if (o.max_correspondence_m() > 0) c.max_correspondence_m = o.max_correspondence_m();
   if (o.min_correspondence_m() > 0) c.min_correspondence_m = o.min_correspondence_m();
   if (o.loss_scale_m() > 0) c.loss_scale_m = o.loss_scale_m();
-  if (!o.loss().empty()) c.loss = checked_loss(o.loss(), "matcher.loss");
+  if (!o.loss().empty()) c.loss = checked_loss(o.loss(), "matcher");
   if (o.max_iterations() > 0) c.max_iterations = o.max_iterations();
   if (o.max_rounds() > 0) c.max_rounds = o.max_rounds();
   if (o.inlier_m() > 0) c.inlier_m = o.inlier_m();
@@ -68,7 +69,7 @@ optimizer::OptimizerConfig config_of(const OptimizerOptions& o) {
   if (o.keyframe_angle_deg() > 0) c.keyframe_angle_rad = o.keyframe_angle_deg() * kRadPerDeg;
   if (o.gate_m() > 0) c.gate_m = o.gate_m();
   if (o.loss_scale_m() > 0) c.loss_scale_m = o.loss_scale_m();
-  if (!o.loss().empty()) c.loss = checked_loss(o.loss(), "optimizer.loss");
+  if (!o.loss().empty()) c.loss = checked_loss(o.loss(), "optimizer");
   if (o.max_iterations() > 0) c.max_iterations = o.max_iterations();
   if (o.rounds() > 0) c.rounds = o.rounds();
   if (o.stride() > 0) c.stride = o.stride();
