@@ -30,6 +30,7 @@ void check_options(const google::protobuf::Message& m) {
       }) ||
       run<AmclOptions>(m, [](const auto& o) { config_of(o); }) ||
       run<Grid2dOptions>(m, [](const auto& o) { config_of(o); }) ||
+      run<Laser2dOptions>(m, [](const auto& o) { config_of(o); }) ||
       run<CloudToScanOptions>(m, [](const auto& o) { config_of(o); });
 }
 

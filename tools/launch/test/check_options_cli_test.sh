@@ -28,4 +28,11 @@ check_file 's#window: 10 alpha#window: 10\n              loss: "bogus" alpha#'
 line="$(grep -n 'loss: "bogus"' "$T/g.pbtxt" | cut -d: -f1)"
 echo "$out" | grep -qF "$T/g.pbtxt:$line: node 'optimizer': optimizer.loss: unknown loss 'bogus'" ||
   fail "optimizer loss bogus: no error at line $line"
+
+# A negative value where only > 0 means something (0 = the default) is an error, not the default.
+check_file 's#window: 10 alpha#window: -3 alpha#'
+[ "$rc" = 1 ] || fail "optimizer window -3: exit $rc, expected 1"
+line="$(grep -n 'window: -3' "$T/g.pbtxt" | cut -d: -f1)"
+echo "$out" | grep -qxF "$T/g.pbtxt:$line: node 'optimizer': optimizer.window: must be > 0 (0 = the default), got -3" ||
+  fail "optimizer window -3: no error at line $line"
 echo OK
