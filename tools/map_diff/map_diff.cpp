@@ -112,7 +112,9 @@ int main(int argc, char** argv) {
     if (!plan_file.empty() && plan_file[0] != '/')
       plan_file = (std::filesystem::path(graph_path).parent_path() / plan_file).lexically_normal().string();
     std::vector<std::string> layers(src->layers().begin(), src->layers().end());
-    const fploc::FloorPlan plan = fploc::load_floor_plan(plan_file, layers, src->units());
+    // The floor the graph names (plan.floor; a building or IFC model's first / lowest by default), as the node loads it.
+    const fploc::FloorPlan plan = fploc::load_floor_plan(plan_file, layers, src->units(), src->floor());
+    if (!src->floor().empty()) plan_file += " (floor " + src->floor() + ")";
     fploc::plandiff::PlanDiff diff(plan, po);
 
     lcm::LogFile log(log_path, "r");
