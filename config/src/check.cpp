@@ -4,6 +4,7 @@
 #include "fploc/config/laser2d.h"
 #include "fploc/config/localization.h"
 #include "fploc/config/perception.h"
+#include "fploc/config/plandiff.h"
 #include "fploc/config/recording.h"
 #include "fploc/config/relocalization.h"
 
@@ -31,7 +32,8 @@ void check_options(const google::protobuf::Message& m) {
       run<AmclOptions>(m, [](const auto& o) { config_of(o); }) ||
       run<Grid2dOptions>(m, [](const auto& o) { config_of(o); }) ||
       run<Laser2dOptions>(m, [](const auto& o) { config_of(o); }) ||
-      run<CloudToScanOptions>(m, [](const auto& o) { config_of(o); });
+      run<CloudToScanOptions>(m, [](const auto& o) { config_of(o); }) ||
+      run<PlanDiffOptions>(m, [](const auto& o) { config_of(o); });
 }
 
 }  // namespace fploc::config

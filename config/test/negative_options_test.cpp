@@ -11,6 +11,7 @@
 #include "options/laser2d.pb.h"
 #include "options/localization.pb.h"
 #include "options/perception.pb.h"
+#include "options/plandiff.pb.h"
 #include "options/recording.pb.h"
 #include "options/relocalization.pb.h"
 
@@ -80,6 +81,8 @@ TEST(NegativeOptions, RelocalizerAnd2dOptionsAreErrors) {
   check_all(fploc::Laser2dOptions(), "laser2d");
   check_all(fploc::CloudToScanOptions(), "cloud_to_scan");
 }
+
+TEST(NegativeOptions, PlanDiffOptionsAreErrors) { check_all(fploc::PlanDiffOptions(), "plan_diff"); }
 
 TEST(NegativeOptions, ZeroStillMeansTheDefault) {
   fploc::OptimizerOptions o;

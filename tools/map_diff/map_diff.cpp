@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "fploc/config/plandiff.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/plandiff/plan_diff.h"
 #include "fploc/runtime/graph.h"
@@ -91,10 +92,7 @@ int main(int argc, char** argv) {
       if (n.has_plan_diff() && !node) {
         node = &n;
         src = &n.plan_diff().plan();
-        const auto& o = n.plan_diff();
-        if (o.min_frames() > 0) po.min_frames = o.min_frames();
-        if (o.moved_min_m() > 0) po.moved_min_m = o.moved_min_m();
-        if (o.max_range_m() > 0) po.max_range_m = o.max_range_m();
+        po = fploc::config::config_of(n.plan_diff()).diff;  // as the node maps them (a negative one: an error)
         for (const auto& in : n.input()) {
           if (in.port() == "features" && feat_ch.empty()) feat_ch = in.channel();
           if (in.port() == "pose" && pose_ch.empty()) pose_ch = in.channel();
