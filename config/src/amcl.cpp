@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "fploc/config/check.h"
+
 namespace fploc::config {
 
 amcl::Settings config_of(const AmclOptions& o) {
@@ -30,15 +32,15 @@ amcl::Settings config_of(const AmclOptions& o) {
   if (o.has_recovery_alpha_fast()) c.recovery_alpha_fast = o.recovery_alpha_fast();
   if (o.resampler() == "low-variance") c.resampler = amcl::Resampler::kLowVariance;
   else if (!o.resampler().empty() && o.resampler() != "multinomial")
-    throw std::runtime_error("amcl.resampler: '" + o.resampler() + "' (use \"multinomial\" or \"low-variance\")");
+    throw OptionError("amcl", "resampler", "'" + o.resampler() + "' (use \"multinomial\" or \"low-variance\")");
   if (o.estimate() == "weighted-mean") c.estimate = amcl::EstimateMode::kWeightedMean;
   else if (!o.estimate().empty() && o.estimate() != "best-cluster")
-    throw std::runtime_error("amcl.estimate: '" + o.estimate() + "' (use \"best-cluster\" or \"weighted-mean\")");
+    throw OptionError("amcl", "estimate", "'" + o.estimate() + "' (use \"best-cluster\" or \"weighted-mean\")");
   if (o.has_map_resolution()) c.map_resolution = o.map_resolution();
   if (o.has_free_clearance_m()) c.free_clearance = o.free_clearance_m();
   if (o.has_seed()) c.seed = o.seed();
   if (o.has_scan_bins()) s.scan.bins = o.scan_bins();
-  if (s.scan.bins < 2) throw std::runtime_error("amcl.scan_bins must be >= 2");
+  if (s.scan.bins < 2) throw OptionError("amcl", "scan_bins", "must be >= 2");
   if (o.has_scan_range_min()) s.scan.range_min_m = o.scan_range_min();
   if (o.has_scan_range_max()) s.scan.range_max_m = o.scan_range_max();
   if (o.has_initial_std_xy_m()) s.initial.std_xy_m = o.initial_std_xy_m();
@@ -56,7 +58,7 @@ amcl::Settings config_of(const AmclOptions& o) {
     if (w.has_yaw_noise_deg_per_sqrt_m()) s.wheel.yaw_noise_deg_per_sqrt_m = w.yaw_noise_deg_per_sqrt_m();
     if (w.has_seed()) s.wheel.seed = w.seed();
   } else {
-    throw std::runtime_error("amcl.odometry: '" + o.odometry() + "' (use \"pose\" or \"simulated-wheel\")");
+    throw OptionError("amcl", "odometry", "'" + o.odometry() + "' (use \"pose\" or \"simulated-wheel\")");
   }
   return s;
 }

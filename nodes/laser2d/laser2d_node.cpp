@@ -11,30 +11,13 @@
 
 #include "fploc/laser2d/laser2d.h"
 #include "fploc/adapters/features_t.h"
+#include "fploc/config/laser2d.h"
 #include "fploc/runtime/node.h"
 #include "options/laser2d.pb.h"
 
 namespace {
 
 namespace l2 = fploc::laser2d;
-
-l2::Laser2dConfig config_of(const fploc::Laser2dOptions& o) {
-  l2::Laser2dConfig c;
-  if (o.min_range_m() > 0) c.min_range_m = o.min_range_m();
-  if (o.max_range_m() > 0) c.max_range_m = o.max_range_m();
-  c.mount_x_m = o.mount_x_m();
-  c.mount_y_m = o.mount_y_m();
-  c.mount_yaw_rad = o.mount_yaw_deg() * M_PI / 180;
-  c.upside_down = o.upside_down();
-  c.z_m = o.z_m();
-  if (o.max_corners_per_sector() > 0) c.features.max_corners_per_sector = o.max_corners_per_sector();
-  if (o.max_surfaces_per_sector() > 0) c.features.max_surfaces_per_sector = o.max_surfaces_per_sector();
-  if (o.corner_threshold() > 0) c.features.corner_threshold = o.corner_threshold();
-  if (o.surface_threshold() > 0) c.features.surface_threshold = o.surface_threshold();
-  c.features.min_range_m = c.min_range_m;
-  c.features.max_range_m = c.max_range_m;
-  return c;
-}
 
 class Laser2dNode : public fploc::rt::Node {
  public:
@@ -47,7 +30,7 @@ class Laser2dNode : public fploc::rt::Node {
 
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
-    l2_ = std::make_unique<l2::Laser2dFeatures>(config_of(ctx.options<fploc::Laser2dOptions>()));
+    l2_ = std::make_unique<l2::Laser2dFeatures>(fploc::config::config_of(ctx.options<fploc::Laser2dOptions>()));
     out_ = ctx.advertise<fploc::features_t>("features");
     ctx.subscribe<fploc::laser_scan_t>("scan", [this](const fploc::laser_scan_t& m) { on_scan(m); });
     ctx.subscribe<fploc::imu_t>("imu", [this](const fploc::imu_t& m) { on_imu(m); });

@@ -17,6 +17,7 @@
 #include "fploc/adapters/features_t.h"
 #include "fploc/adapters/plan_diff_t.h"
 #include "fploc/adapters/pose_t.h"
+#include "fploc/config/plandiff.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/plandiff/plan_diff.h"
 #include "fploc/runtime/node.h"
@@ -41,13 +42,10 @@ class PlanDiffNode : public fploc::rt::Node {
     if (o.plan().file().empty()) throw std::runtime_error("plan_diff: plan.file is required");
     std::vector<std::string> layers(o.plan().layers().begin(), o.plan().layers().end());
     plan_ = fploc::load_floor_plan(ctx.resolve_path(o.plan().file()), layers, o.plan().units(), o.plan().floor());
-    fploc::plandiff::Options po;
-    if (o.min_frames() > 0) po.min_frames = o.min_frames();
-    if (o.moved_min_m() > 0) po.moved_min_m = o.moved_min_m();
-    if (o.max_range_m() > 0) po.max_range_m = o.max_range_m();
-    diff_ = std::make_unique<fploc::plandiff::PlanDiff>(plan_, po);
-    publish_us_ = int64_t(1e6 / (o.publish_hz() > 0 ? o.publish_hz() : 1.0));
-    frame_us_ = o.frame_hz() > 0 ? int64_t(1e6 / o.frame_hz()) : 0;
+    const fploc::config::PlanDiffSettings ps = fploc::config::config_of(o);
+    diff_ = std::make_unique<fploc::plandiff::PlanDiff>(plan_, ps.diff);
+    publish_us_ = int64_t(1e6 / ps.publish_hz);
+    frame_us_ = ps.frame_hz > 0 ? int64_t(1e6 / ps.frame_hz) : 0;
     out_json_ = o.out_json();
     out_dxf_ = o.out_dxf();
     std::cerr << "[" << ctx.name() << "] " << plan_.elements.size() << " plan elements from " << plan_.source << "\n";

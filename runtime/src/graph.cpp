@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -81,6 +82,62 @@ void non_finite(const Message& m, const std::string& prefix, const TextFormat::P
   }
 }
 
+// String option values (nested and repeated ones too) with ${NAME} or ${NAME:-default}: the environment's value
+// (the default when NAME is unset or empty), so a graph can leave e.g. its output folder to the user
+// (graphs/demo.pbtxt: ${FPLOC_DEMO_DIR:-/tmp}). A NAME unset with no default: "path: ..." in `out`.
+void expand_env(Message& m, const std::string& prefix, const TextFormat::ParseInfoTree* tree, int line,
+                std::vector<std::pair<std::string, int>>& out) {
+  const auto* r = m.GetReflection();
+  std::vector<const FieldDescriptor*> fields;
+  r->ListFields(m, &fields);
+  for (const auto* f : fields) {
+    const int n = f->is_repeated() ? r->FieldSize(m, f) : 1;
+    for (int k = 0; k < n; ++k) {
+      const int index = f->is_repeated() ? k : -1;
+      const std::string path = prefix + f->name() + (f->is_repeated() ? "[" + std::to_string(k) + "]" : "");
+      int at = line;
+      if (tree) {
+        const auto loc = tree->GetLocation(f, index);
+        if (loc.line >= 0) at = loc.line + 1;
+      }
+      if (f->cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE) {
+        expand_env(f->is_repeated() ? *r->MutableRepeatedMessage(&m, f, k) : *r->MutableMessage(&m, f), path + ".",
+                   tree ? tree->GetTreeForNested(f, index) : nullptr, at, out);
+        continue;
+      }
+      if (f->cpp_type() != FieldDescriptor::CPPTYPE_STRING || f->type() == FieldDescriptor::TYPE_BYTES) continue;
+      const std::string v = f->is_repeated() ? r->GetRepeatedString(m, f, k) : r->GetString(m, f);
+      if (v.find("${") == std::string::npos) continue;
+      std::string res;
+      size_t i = 0;
+      bool ok = true;
+      while (i < v.size()) {
+        const size_t b = v.find("${", i);
+        const size_t e = b == std::string::npos ? b : v.find('}', b);
+        if (b == std::string::npos || e == std::string::npos) {
+          res += v.substr(i);
+          break;
+        }
+        res += v.substr(i, b - i);
+        const std::string expr = v.substr(b + 2, e - b - 2);
+        const size_t dflt = expr.find(":-");
+        const std::string name = expr.substr(0, dflt);
+        const char* env = std::getenv(name.c_str());
+        if (env && *env) res += env;
+        else if (dflt != std::string::npos) res += expr.substr(dflt + 2);
+        else {
+          out.push_back({path + ": environment variable " + name + " is not set (write ${" + name + ":-DEFAULT} for a default)", at});
+          ok = false;
+        }
+        i = e + 1;
+      }
+      if (!ok) continue;
+      if (f->is_repeated()) r->SetRepeatedString(&m, f, k, res);
+      else r->SetString(&m, f, res);
+    }
+  }
+}
+
 }  // namespace
 
 bool parse_graph_text(const std::string& text, const std::string& name, LoadedGraph& out,
@@ -104,6 +161,10 @@ bool parse_graph_text(const std::string& text, const std::string& name, LoadedGr
     bad.clear();
     non_finite(n, "", out.tree->GetTreeForNested(node_field, i), out.tree->GetLocation(node_field, i).line + 1, bad);
     for (const auto& [what, line] : bad) errors.push_back({name, line, "node '" + n.name() + "': " + what + " (not a finite number)"});
+    bad.clear();
+    expand_env(*out.graph.mutable_node(i), "", out.tree->GetTreeForNested(node_field, i),
+               out.tree->GetLocation(node_field, i).line + 1, bad);
+    for (const auto& [what, line] : bad) errors.push_back({name, line, "node '" + n.name() + "': " + what});
   }
   fploc::Graph rest = out.graph;  // the graph's own fields
   rest.clear_node();

@@ -111,3 +111,31 @@ TEST(Overrides, NonFiniteValueIsRejected) {
   EXPECT_NE(err.find("max_correspondence_m is inf"), std::string::npos) << err;
   EXPECT_TRUE(apply_overrides(*o, {"initial_pose.x=1e300"}, err)) << err;
 }
+
+// ${NAME:-default} in a string option is the environment's value (graphs/demo.pbtxt: ${FPLOC_DEMO_DIR:-/tmp}, so
+// two users' demos do not write the same files); an unset NAME without a default is one error with its line.
+TEST(Graph, EnvironmentInStringOptions) {
+  const std::string text = R"pb(name: "t"
+node {
+  name: "log"
+  executable: "fploc-pose-logger"
+  pose_logger { file: "${FPLOC_GRAPH_TEST_DIR:-/tmp}/poses.tum" }
+}
+)pb";
+  ::unsetenv("FPLOC_GRAPH_TEST_DIR");
+  LoadedGraph g;
+  std::vector<GraphError> errors;
+  ASSERT_TRUE(parse_graph_text(text, "t.pbtxt", g, errors)) << (errors.empty() ? "" : errors[0].str());
+  EXPECT_EQ(g.graph.node(0).pose_logger().file(), "/tmp/poses.tum");
+  ::setenv("FPLOC_GRAPH_TEST_DIR", "/home/u/run1", 1);
+  LoadedGraph g2;
+  ASSERT_TRUE(parse_graph_text(text, "t.pbtxt", g2, errors));
+  EXPECT_EQ(g2.graph.node(0).pose_logger().file(), "/home/u/run1/poses.tum");
+  ::unsetenv("FPLOC_GRAPH_TEST_DIR");
+  LoadedGraph g3;
+  EXPECT_FALSE(parse_graph_text("node {\n  name: \"log\"\n  pose_logger { file: \"${FPLOC_GRAPH_TEST_DIR}/p.tum\" }\n}\n",
+                                "u.pbtxt", g3, errors));
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_EQ(errors[0].str(), "u.pbtxt:3: node 'log': pose_logger.file: environment variable FPLOC_GRAPH_TEST_DIR is not set "
+                             "(write ${FPLOC_GRAPH_TEST_DIR:-DEFAULT} for a default)");
+}

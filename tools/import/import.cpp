@@ -84,6 +84,9 @@ int main(int argc, char** argv) {
   double start = -1, end = -1;
   CloudOptions cloud_opt;
   app.add_option("recording", path, "ROS 1 bag (.bag) or MCAP (.mcap) file")->required();
+  app.footer("Exit status: 0 everything imported; 1 the file is damaged or cut short, or Ouster lidar packets could not be\n"
+             "written (the log holds everything before the damage); 2 bad arguments; 3 single messages did not decode\n"
+             "and were skipped (the log holds all the others; stderr names each topic, the count and where the first is).");
   app.add_flag("--list", list, "print topics, types, message counts and the duration; write nothing");
   app.add_flag("--json", json, "machine-readable summary on stdout");
   app.add_option("--out", out, "LCM log to write");
@@ -248,7 +251,7 @@ int main(int argc, char** argv) {
   }
   std::string ouster_scan_channel = "OS1_SCAN", ouster_imu_channel = "OS1_IMU";
   std::map<std::string, uint64_t> written, skipped_types, decode_errors;
-  std::map<std::string, std::string> first_decode_error;
+  std::map<std::string, std::string> first_decode_error;  // topic -> "WHERE: why" of its first undecodable message
   std::vector<Scan> frames;
   size_t frames_total = 0;
   struct FrameInfo { int32_t frame_id, height, width, missing; };
@@ -277,8 +280,9 @@ int main(int argc, char** argv) {
     frames.clear();
     ouster.frame_times_ns.clear();
   };
+  RawMessage m;
   auto bad = [&](const Connection& c, const std::string& e) {
-    if (!decode_errors[c.topic]++) first_decode_error[c.topic] = e;
+    if (!decode_errors[c.topic]++) first_decode_error[c.topic] = where(m) + ": " + e;
   };
 
   bool odom_chosen = !odom_topic.empty();
@@ -286,7 +290,6 @@ int main(int argc, char** argv) {
   std::vector<uint8_t> cloud_header;  // point_cloud2_t up to its data; the points follow from the recording
   std::map<std::string, std::string> cloud_check_error;  // topic -> why its first cloud does not convert
   LaserScanView laser;
-  RawMessage m;
   while (rec->next(m)) {
     ++read_msgs;
     if (first_ns == INT64_MIN) first_ns = m.time_ns;
@@ -435,7 +438,10 @@ int main(int argc, char** argv) {
   std::vector<std::string> problems;
   if (!log_ok) problems.push_back(out + ": writing failed (disk full?); the log is cut short");
   if (!rec->error().empty()) problems.push_back(rec->error() + " (the output holds everything before it)");
-  for (const auto& [t, n] : decode_errors) problems.push_back(t + ": " + std::to_string(n) + " messages not decoded; first: " + first_decode_error[t]);
+  // Messages that did not decode are skipped, the others written: exit 3 (the log is complete but for them).
+  for (const auto& [t, n] : decode_errors)
+    problems.push_back(t + ": " + std::to_string(n) + " message" + (n > 1 ? "s" : "") + " not decoded, skipped (the first at " +
+                       first_decode_error[t] + ")");
   // Lidar packets that could not be written (no metadata to decode them, or too many before it): the log lacks
   // the lidar, so the import failed (exit 1), as for a damaged file.
   const bool lidar_lost = (ouster.lidar_packets > 0 && !ouster.has_metadata()) ||
@@ -470,7 +476,8 @@ int main(int argc, char** argv) {
   for (const auto& [t, e] : cloud_check_error)
     problems.push_back(t + ": its first cloud does not convert to a range image (" + e +
                        "); the clouds are written as they are, the cloud-to-scan node will report the same on replay");
-  if (ouster.bad_packets) problems.push_back(std::to_string(ouster.bad_packets) + " bad Ouster packets; last: " + ouster.last_error);
+  if (ouster.bad_packets) problems.push_back(std::to_string(ouster.bad_packets) + " bad Ouster packets skipped; last: " + ouster.last_error);
+  const bool skipped = !decode_errors.empty() || ouster.bad_packets > 0;
 
   if (json) {
     nlohmann::json j;
@@ -500,6 +507,7 @@ int main(int argc, char** argv) {
       j["clouds"][t] = {{"mode", decode_ouster ? "scans" : "clouds"}, {"ring_source", s.ring_source}, {"time_source", s.time_source}, {"points", s.points}, {"kept", s.kept},
                         {"collisions", s.collisions}, {"max_azimuth_error_deg", s.max_azimuth_error_deg}};
     j["errors"] = problems;
+    for (const auto& [t, n] : decode_errors) j["not_decoded"][t] = {{"count", n}, {"first", first_decode_error[t]}};
     std::cout << j.dump(2) << "\n";
   } else {
     std::printf("%s (%s): %llu messages read in %.2f s\n", path.c_str(), rec->format().c_str(), (unsigned long long)read_msgs, wall);
@@ -531,5 +539,10 @@ int main(int argc, char** argv) {
     if (!tum_out.empty()) std::printf("  %s: %llu poses\n", tum_out.c_str(), (unsigned long long)tum.poses());
   }
   for (const auto& p : problems) std::cerr << "fploc import: " << p << "\n";
-  return rec->error().empty() && log_ok && !lidar_lost ? 0 : 1;
+  if (!(rec->error().empty() && log_ok && !lidar_lost)) return 1;
+  if (skipped) {
+    std::cerr << "fploc import: exit 3: messages were skipped (above); the log holds everything else\n";
+    return 3;
+  }
+  return 0;
 }

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <set>
 
+#include "fploc/config/check.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/os1/metadata.h"
 
@@ -150,6 +151,50 @@ void check_option_files(const fploc::rt::LoadedGraph& g, std::vector<fploc::rt::
     c.node = i;
     c.field = fploc::rt::node_options_field(n);
     walk(c, c.field, *opts);
+  }
+}
+
+namespace {
+// 1-based line of `path` ("wheel.seed") inside node `i`'s options block, else of the block, else of the node.
+int option_line(const fploc::rt::LoadedGraph& g, int i, const std::string& path) {
+  const std::string block = fploc::rt::node_options_field(g.graph.node(i));
+  int line = g.node_line(i, block);
+  const auto* node_field = fploc::Graph::descriptor()->FindFieldByName("node");
+  const auto* tree = g.tree ? g.tree->GetTreeForNested(node_field, i) : nullptr;
+  const FieldDescriptor* f = fploc::Node::descriptor()->FindFieldByName(block);
+  if (tree && f) tree = tree->GetTreeForNested(f, -1);
+  const google::protobuf::Descriptor* d = f ? f->message_type() : nullptr;
+  size_t start = 0;
+  while (tree && d && start <= path.size()) {
+    const size_t dot = path.find('.', start);
+    const std::string part = path.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+    const FieldDescriptor* sub = d->FindFieldByName(part);
+    if (!sub || sub->is_repeated()) break;
+    const auto loc = tree->GetLocation(sub, -1);
+    if (loc.line < 0) break;
+    line = loc.line + 1;
+    if (dot == std::string::npos) break;
+    tree = tree->GetTreeForNested(sub, -1);
+    d = sub->message_type();
+    start = dot + 1;
+  }
+  return line;
+}
+}  // namespace
+
+void check_option_values(const fploc::rt::LoadedGraph& g, std::vector<fploc::rt::GraphError>& errors) {
+  for (int i = 0; i < g.graph.node_size(); ++i) {
+    const auto& n = g.graph.node(i);
+    if (n.disabled()) continue;
+    auto opts = fploc::rt::node_options(n);
+    if (!opts) continue;
+    try {
+      fploc::config::check_options(*opts);
+    } catch (const fploc::config::OptionError& e) {
+      errors.push_back({g.path, option_line(g, i, e.field), "node '" + n.name() + "': " + e.what()});
+    } catch (const std::exception& e) {
+      errors.push_back({g.path, option_line(g, i, ""), "node '" + n.name() + "': " + e.what()});
+    }
   }
 }
 

@@ -13,4 +13,9 @@ namespace fploc::launch {
 // Appends one error per bad file (file:line of the option, the resolved path and the reader's message).
 void check_option_files(const fploc::rt::LoadedGraph& g, std::vector<fploc::rt::GraphError>& errors);
 
+// Runs the option checks each enabled node does at start (fploc::config::check_options: the options mapped
+// to the node's Configs) and appends one error per node that would refuse its options: file:line of the
+// option (of the options block when the value came from --set), "node 'NAME': BLOCK.FIELD: why".
+void check_option_values(const fploc::rt::LoadedGraph& g, std::vector<fploc::rt::GraphError>& errors);
+
 }  // namespace fploc::launch

@@ -371,8 +371,9 @@ class Launcher : public Effects {
 
 void usage() {
   std::cerr << "usage: fploc launch GRAPH.pbtxt [--check [--skip-hosts]] [--duration SECONDS] [--lcm-url URL] [--set NODE.field=value ...]\n"
-               "  --check      validate the graph (fields, executables, ports, channel types, the files options name) and its\n"
-               "               hosts (reachable with ssh, fploc there at this commit, multicast route), then exit\n"
+               "  --check      validate the graph (fields, executables, ports, channel types, option values, the files options\n"
+               "               name) and its hosts (reachable with ssh, fploc there at this commit, multicast route),\n"
+               "               then exit\n"
                "  --skip-hosts with --check: do not contact the graph's hosts\n"
                "  --duration   stop every node cleanly after SECONDS\n"
                "  --set        override one option of one node for this run (e.g. --set pose_logger.file=run1.tum)\n";
@@ -421,6 +422,7 @@ int main(int argc, char** argv) {
   if (g.tree) validate_graph(g, hooks, errors, &resolved);
   url = graph_lcm_url(g.graph, url);
   if (check && g.tree) check_option_files(g, errors);
+  if (check && g.tree) check_option_values(g, errors);
   if (check && !skip_hosts && g.tree && errors.empty() && g.graph.host_size() > 0) {
     std::vector<HostPlan> plans;
     for (const auto& [name, p] : host_plans(g.graph, self_bin_dir())) plans.push_back(*p);

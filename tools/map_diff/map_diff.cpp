@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "fploc/config/plandiff.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/plandiff/plan_diff.h"
 #include "fploc/runtime/graph.h"
@@ -91,10 +92,7 @@ int main(int argc, char** argv) {
       if (n.has_plan_diff() && !node) {
         node = &n;
         src = &n.plan_diff().plan();
-        const auto& o = n.plan_diff();
-        if (o.min_frames() > 0) po.min_frames = o.min_frames();
-        if (o.moved_min_m() > 0) po.moved_min_m = o.moved_min_m();
-        if (o.max_range_m() > 0) po.max_range_m = o.max_range_m();
+        po = fploc::config::config_of(n.plan_diff()).diff;  // as the node maps them (a negative one: an error)
         for (const auto& in : n.input()) {
           if (in.port() == "features" && feat_ch.empty()) feat_ch = in.channel();
           if (in.port() == "pose" && pose_ch.empty()) pose_ch = in.channel();
@@ -112,15 +110,19 @@ int main(int argc, char** argv) {
     if (!plan_file.empty() && plan_file[0] != '/')
       plan_file = (std::filesystem::path(graph_path).parent_path() / plan_file).lexically_normal().string();
     std::vector<std::string> layers(src->layers().begin(), src->layers().end());
-    const fploc::FloorPlan plan = fploc::load_floor_plan(plan_file, layers, src->units());
+    // The floor the graph names (plan.floor; a building or IFC model's first / lowest by default), as the node loads it.
+    const fploc::FloorPlan plan = fploc::load_floor_plan(plan_file, layers, src->units(), src->floor());
+    if (!src->floor().empty()) plan_file += " (floor " + src->floor() + ")";
     fploc::plandiff::PlanDiff diff(plan, po);
 
     lcm::LogFile log(log_path, "r");
     if (!log.good()) throw std::runtime_error(log_path + ": cannot read the LCM log");
     std::map<int64_t, fploc::features_t> feats;
     int64_t events = 0, n_feat = 0, n_pose = 0, used = 0, bad = 0;
+    uint64_t event_bytes = 0;
     while (const lcm::LogEvent* ev = log.readNextEvent()) {
       ++events;
+      event_bytes += 28 + ev->channel.size() + uint64_t(ev->datalen);  // sync, number, time, two lengths, channel, data
       if (ev->channel == feat_ch) {
         fploc::features_t f;
         if (f.decode(ev->data, 0, ev->datalen) < 0) {
@@ -173,6 +175,15 @@ int main(int argc, char** argv) {
               << " missing, " << r.count(fploc::plandiff::Status::kMoved) << " moved, "
               << r.count(fploc::plandiff::Status::kUnobserved) << " unobserved, " << r.added.size() << " new\n";
     if (json) fploc::plandiff::write_json(r, plan, std::cout, all);
+    // A log cut short (or damaged part way): lcm's reader stops at the first bad event without a word, and the diff
+    // above is of the events before it; said, exit 1, as fploc replay does.
+    std::error_code ec;
+    const uint64_t size = std::filesystem::file_size(log_path, ec);
+    if (!ec && event_bytes != size) {
+      std::cerr << "fploc map diff: " << log_path << ": " << events << " events are " << event_bytes << " of its " << size
+                << " B; the rest is not an LCM event (truncated or damaged?); the diff is of the events read\n";
+      return 1;
+    }
   } catch (const std::exception& e) {
     std::cerr << "fploc map diff: " << e.what() << "\n";
     return 1;

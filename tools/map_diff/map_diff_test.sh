@@ -41,7 +41,25 @@ test "$(wc -l < "$T/err")" -eq 1 || { cat "$T/err"; exit 1; }
 "$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/run.lcm" --out "$T/c.json" \
   --set plan_diff.plan.file="$R/data/plans/corridor.json" 2> "$T/err"
 grep -q "against $R/data/plans/corridor.json:" "$T/err" || { cat "$T/err"; exit 1; }
+# A building's floor (plan.floor) is the plan diffed against (it was ignored: the first floor's plan was used):
+# data/buildings/two-floors.pbtxt floor "first" is corridor.json, so the same diff as above; an unknown floor is one
+# error naming it.
+"$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/run.lcm" --out "$T/f.json" \
+  --set plan_diff.plan.file="$R/data/buildings/two-floors.pbtxt" --set plan_diff.plan.floor=first 2> "$T/ferr"
+grep -q "against $R/data/buildings/two-floors.pbtxt (floor first):" "$T/ferr" || { cat "$T/ferr"; exit 1; }
+[ "$(sed 's/.*: //' "$T/ferr")" = "$(sed 's/.*: //' "$T/err")" ] || { echo "floor first != corridor.json:"; cat "$T/ferr" "$T/err"; exit 1; }
+rc=0
+"$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/run.lcm" --out "$T/f.json" \
+  --set plan_diff.plan.file="$R/data/buildings/two-floors.pbtxt" --set plan_diff.plan.floor=attic 2> "$T/ferr" || rc=$?
+[ "$rc" = 1 ] && grep -q "attic" "$T/ferr" && [ "$(grep -c . "$T/ferr")" = 1 ] || { echo "unknown floor: exit $rc"; cat "$T/ferr"; exit 1; }
 rc=0
 "$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/run.lcm" --out "$T/c.json" --set nonode.plan.file=x 2> "$T/err" || rc=$?
 [ "$rc" = 2 ] && grep -q "nonode.plan.file=x" "$T/err" || { echo "exit $rc"; cat "$T/err"; exit 1; }
+# A recorded run cut short: the diff of the events before the cut, and one error saying so, exit 1 (it was exit 0:
+# lcm's reader stops at a cut event without a word).
+head -c "$(( $(stat -c %s "$T/run.lcm") - 1000 ))" "$T/run.lcm" > "$T/cut.lcm"
+rc=0
+"$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/cut.lcm" --out "$T/cut.json" 2> "$T/err" || rc=$?
+[ "$rc" = 1 ] && grep -q "cut.lcm: .* the rest is not an LCM event (truncated or damaged?)" "$T/err" && test -s "$T/cut.json" ||
+  { echo "cut log: exit $rc"; cat "$T/err"; exit 1; }
 echo "map diff: ok"

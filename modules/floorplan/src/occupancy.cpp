@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -131,9 +132,36 @@ Eigen::Vector2d OccupancyGrid::cell_centre(int i, int j) const {
   return {origin_x + c * lx - s * ly, origin_y + s * lx + c * ly};
 }
 
+// Edit distance (a misspelt key's nearest known one).
+size_t distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diag = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
 MapYaml parse_map_yaml(const std::string& text, const std::string& source) {
   const auto m = parse_flat_mapping(text, source);
   MapYaml y;
+  // map_server's keys; anything else is ignored as ROS does, with a warning (a misspelt key is a silent default).
+  static const char* kKnown[] = {"image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh", "mode"};
+  for (const auto& [k, v] : m) {
+    if (std::find(std::begin(kKnown), std::end(kKnown), k) != std::end(kKnown)) continue;
+    std::string near;
+    size_t best = 3;  // at most 2 edits away
+    for (const char* known : kKnown)
+      if (distance(lower(k), known) < best) best = distance(lower(k), known), near = known;
+    y.warnings.push_back(source + ": line " + std::to_string(v.line) + ": unknown key '" + k + "' (ignored, as map_server does" +
+                         (near.empty() ? std::string("") : "; did you mean '" + near + "'?") + ")");
+  }
   auto scalar = [&](const std::string& k, bool required) -> const YamlValue* {
     auto it = m.find(k);
     if (it == m.end()) {
@@ -180,6 +208,7 @@ MapYaml parse_map_yaml(const std::string& text, const std::string& source) {
 
 MapYaml read_map_yaml(const std::string& path) {
   MapYaml y = parse_map_yaml(slurp(path), path);
+  for (const auto& w : y.warnings) std::cerr << "warning: " << w << "\n";
   std::filesystem::path img(y.image);
   if (img.is_relative()) img = std::filesystem::path(path).parent_path() / img;
   y.image_path = img.string();

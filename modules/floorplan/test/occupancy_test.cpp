@@ -84,6 +84,15 @@ TEST(Occupancy, YamlFieldsAndErrors) {
             std::string::npos);
 }
 
+TEST(Occupancy, UnknownYamlKeyIsAWarningNamingLineAndKey) {
+  const MapYaml y = parse_map_yaml("image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nocupied_thresh: 0.9\nfoo: 1\n", "t.yaml");
+  EXPECT_DOUBLE_EQ(y.occupied_thresh, 0.65);  // ignored, as map_server does
+  ASSERT_EQ(y.warnings.size(), 2u);
+  EXPECT_EQ(y.warnings[0], "t.yaml: line 5: unknown key 'foo' (ignored, as map_server does)");
+  EXPECT_EQ(y.warnings[1], "t.yaml: line 4: unknown key 'ocupied_thresh' (ignored, as map_server does; did you mean 'occupied_thresh'?)");
+  EXPECT_TRUE(parse_map_yaml("image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nmode: raw\n", "t.yaml").warnings.empty());
+}
+
 TEST(Occupancy, PgmErrors) {
   EXPECT_NE(err_of([] { read_pgm("P6\n1 1\n255\n\0\0\0", "a.pgm"); }).find("a.pgm: byte 0: magic"), std::string::npos);
   EXPECT_NE(err_of([] { read_pgm("P5\n10 10\n255\nabc", "a.pgm"); }).find("a.pgm: byte 13: pixels: truncated pixel data (expected 100 bytes, got 3)"),

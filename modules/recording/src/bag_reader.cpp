@@ -158,6 +158,9 @@ bool BagReader::next(RawMessage& m) {
         m.time_ns = int64_t(rd<uint32_t>(t->v)) * 1000000000 + rd<uint32_t>(t->v + 4);
         m.data = r.data;
         m.size = r.data_len;
+        m.in_chunk = !top_level_;
+        m.chunk_at = chunk_at_;
+        m.offset = top_level_ ? chunk_at_ : at;
         return true;
       }
       continue;
@@ -201,12 +204,15 @@ bool BagReader::next(RawMessage& m) {
       }
       cpos_ = 0;
       chunk_at_ = at;
+      top_level_ = false;
     } else if (r.op == 0x07 || r.op == 0x02) {
       // Outside chunks (allowed, rare): handle through the chunk path with a one-record "chunk".
       chunk_what_ = "top level";
       cd_ = rp;
       cn_ = pos_ - at;
       cpos_ = 0;
+      chunk_at_ = at;
+      top_level_ = true;
     } else if (r.op == 0x03) {
       header_seen_ = true;
       const Field* ip = find(r.fields, "index_pos");

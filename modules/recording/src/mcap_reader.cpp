@@ -178,7 +178,12 @@ bool McapReader::next(RawMessage& m) {
       if (len > cn_ - cpos_ - 9) return stop(chunk_what_ + ": record (op 0x" + std::to_string(op) + ") at chunk offset " + std::to_string(at) + " runs past the chunk");
       cpos_ += 9 + len;
       if (!on_record(op, cd_ + at + 9, len, &m, &is_msg, &why)) return stop(chunk_what_ + ": record at chunk offset " + std::to_string(at) + ": " + why);
-      if (is_msg) return true;
+      if (is_msg) {
+        m.in_chunk = true;
+        m.chunk_at = chunk_at_;
+        m.offset = at;
+        return true;
+      }
       continue;
     }
     const size_t at = pos_;
@@ -258,7 +263,11 @@ bool McapReader::next(RawMessage& m) {
       continue;
     }
     if (!on_record(op, body, len, &m, &is_msg, &why)) return stop("record at byte " + std::to_string(at) + ": " + why);
-    if (is_msg) return true;
+    if (is_msg) {
+      m.in_chunk = false;
+      m.offset = at;
+      return true;
+    }
   }
   return false;
 }

@@ -51,6 +51,7 @@ class FileReader : public Recording {
   // The chunk being read.
   const uint8_t* cd_ = nullptr;
   size_t cn_ = 0, cpos_ = 0, chunk_at_ = 0;
+  bool top_level_ = false;  // the "chunk" is one record outside chunks, at byte chunk_at_
   std::string chunk_what_;
   std::vector<uint8_t> buf_;
 };

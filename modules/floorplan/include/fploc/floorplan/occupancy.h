@@ -44,6 +44,9 @@ struct MapYaml {
   bool negate = false;
   double occupied_thresh = 0.65, free_thresh = 0.196;
   OccupancyMode mode = OccupancyMode::kTrinary;
+  // Keys map_server does not know (ROS ignores them, so do we): "SOURCE: line N: unknown key 'K' (ignored; ...)".
+  // read_map_yaml prints them to stderr as warnings.
+  std::vector<std::string> warnings;
 };
 
 // A grayscale (or colour-averaged) image with optional alpha, row 0 at the top (as stored).

@@ -26,7 +26,18 @@ struct RawMessage {
   int64_t time_ns = 0;            // record time (bag: receipt time; MCAP: log_time)
   const uint8_t* data = nullptr;  // valid until the next call to next()
   size_t size = 0;
+  // Where it is in the file (for messages about it): the byte offset of its record, or, for a record in a
+  // chunk, the chunk's byte offset and the record's offset among the chunk's (uncompressed) records.
+  bool in_chunk = false;
+  uint64_t chunk_at = 0;
+  uint64_t offset = 0;
 };
+
+// "byte N" or "chunk at byte N, record at chunk offset K".
+inline std::string where(const RawMessage& m) {
+  return m.in_chunk ? "chunk at byte " + std::to_string(m.chunk_at) + ", record at chunk offset " + std::to_string(m.offset)
+                    : "byte " + std::to_string(m.offset);
+}
 
 struct TopicSummary {
   std::string type;

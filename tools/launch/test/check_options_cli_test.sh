@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# fploc launch --check runs the option checks each node does at start (fploc::config::check_options): an
+# option value the node would refuse is one error naming file:line, node and option, exit 1 (it passed
+# --check and was first found when the node died at start). Inside scripts/netns-run.
+set -uo pipefail
+L="${FPLOC_BUILD_DIR:?}/bin/fploc-launch"; R="${FPLOC_ROOT:?}"
+T="$(mktemp -d)"; trap 'rm -rf "$T"' EXIT
+fail() { echo "FAIL: $1"; echo "$out" | tail -5; exit 1; }
+
+out="$(timeout 60 "$L" --check --skip-hosts "$R/graphs/demo.pbtxt" 2>&1)"; rc=$?
+[ "$rc" = 0 ] || fail "demo graph: exit $rc, expected 0"
+
+# A --set value: the line of the node's options block.
+out="$(timeout 60 "$L" --check --skip-hosts "$R/graphs/demo.pbtxt" --set matcher.loss=bogus 2>&1)"; rc=$?
+[ "$rc" = 1 ] || fail "--set matcher.loss=bogus: exit $rc, expected 1"
+line="$(grep -n '^  matcher {' "$R/graphs/demo.pbtxt" | cut -d: -f1)"
+echo "$out" | grep -qxF "$R/graphs/demo.pbtxt:$line: node 'matcher': matcher.loss: unknown loss 'bogus' (use \"cauchy\", \"geman-mcclure\", \"huber\" or \"none\")" ||
+  fail "--set matcher.loss=bogus: no error naming file:$line, node and option"
+[ "$(echo "$out" | grep -c "node '")" = 1 ] || fail "--set matcher.loss=bogus: not exactly one error"
+
+# A value in the file: the option's own line.
+check_file() {  # $1: sed expression applied to a copy of the demo graph (plans made absolute)
+  sed -e "s#\"\\.\\./data/#\"$R/data/#g" -e "$1" "$R/graphs/demo.pbtxt" > "$T/g.pbtxt"
+  out="$(timeout 60 "$L" --check --skip-hosts "$T/g.pbtxt" 2>&1)"; rc=$?
+}
+check_file 's#window: 10 alpha#window: 10\n              loss: "bogus" alpha#'
+[ "$rc" = 1 ] || fail "optimizer loss bogus: exit $rc, expected 1"
+line="$(grep -n 'loss: "bogus"' "$T/g.pbtxt" | cut -d: -f1)"
+echo "$out" | grep -qF "$T/g.pbtxt:$line: node 'optimizer': optimizer.loss: unknown loss 'bogus'" ||
+  fail "optimizer loss bogus: no error at line $line"
+
+# A negative value where only > 0 means something (0 = the default) is an error, not the default.
+check_file 's#window: 10 alpha#window: -3 alpha#'
+[ "$rc" = 1 ] || fail "optimizer window -3: exit $rc, expected 1"
+line="$(grep -n 'window: -3' "$T/g.pbtxt" | cut -d: -f1)"
+echo "$out" | grep -qxF "$T/g.pbtxt:$line: node 'optimizer': optimizer.window: must be > 0 (0 = the default), got -3" ||
+  fail "optimizer window -3: no error at line $line"
+echo OK
