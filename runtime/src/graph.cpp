@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <type_traits>
 
 namespace fploc::rt {
 
@@ -52,10 +53,11 @@ class Collector : public google::protobuf::io::ErrorCollector {
   std::vector<GraphError>& errors_;
 };
 
-// Float and double fields (nested and repeated ones too) that are NaN or infinite: "path is nan", with the
-// field's line when the parse tree has it (else `line`).
-void non_finite(const Message& m, const std::string& prefix, const TextFormat::ParseInfoTree* tree, int line,
-                std::vector<std::pair<std::string, int>>& out) {
+// Every field value of m that is not a message (nested and repeated ones too): fn(owner, field, k, path, line) with
+// k the index in a repeated field (0 otherwise), path "a.b[2].c" and the field's line when the parse tree has it
+// (else `line`). M: Message or const Message (nested messages are then reached for writing or for reading).
+template <class M, class Fn>
+void for_each_value(M& m, const std::string& prefix, const TextFormat::ParseInfoTree* tree, int line, Fn&& fn) {
   const auto* r = m.GetReflection();
   std::vector<const FieldDescriptor*> fields;
   r->ListFields(m, &fields);
@@ -69,17 +71,32 @@ void non_finite(const Message& m, const std::string& prefix, const TextFormat::P
         const auto loc = tree->GetLocation(f, index);
         if (loc.line >= 0) at = loc.line + 1;
       }
-      if (f->cpp_type() == FieldDescriptor::CPPTYPE_DOUBLE || f->cpp_type() == FieldDescriptor::CPPTYPE_FLOAT) {
-        const double v = f->cpp_type() == FieldDescriptor::CPPTYPE_DOUBLE
-                             ? (f->is_repeated() ? r->GetRepeatedDouble(m, f, k) : r->GetDouble(m, f))
-                             : (f->is_repeated() ? r->GetRepeatedFloat(m, f, k) : r->GetFloat(m, f));
-        if (!std::isfinite(v)) out.push_back({path + " is " + (std::isnan(v) ? "nan" : v > 0 ? "inf" : "-inf"), at});
-      } else if (f->cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE) {
-        non_finite(f->is_repeated() ? r->GetRepeatedMessage(m, f, k) : r->GetMessage(m, f), path + ".",
-                   tree ? tree->GetTreeForNested(f, index) : nullptr, at, out);
+      if (f->cpp_type() != FieldDescriptor::CPPTYPE_MESSAGE) {
+        fn(m, f, k, path, at);
+        continue;
       }
+      const TextFormat::ParseInfoTree* nested = tree ? tree->GetTreeForNested(f, index) : nullptr;
+      if constexpr (std::is_const_v<M>)
+        for_each_value(f->is_repeated() ? r->GetRepeatedMessage(m, f, k) : r->GetMessage(m, f), path + ".", nested, at, fn);
+      else
+        for_each_value(f->is_repeated() ? *r->MutableRepeatedMessage(&m, f, k) : *r->MutableMessage(&m, f), path + ".",
+                       nested, at, fn);
     }
   }
+}
+
+// Float and double fields (nested and repeated ones too) that are NaN or infinite: "path is nan", with the
+// field's line when the parse tree has it (else `line`).
+void non_finite(const Message& m, const std::string& prefix, const TextFormat::ParseInfoTree* tree, int line,
+                std::vector<std::pair<std::string, int>>& out) {
+  for_each_value(m, prefix, tree, line, [&](const Message& o, const FieldDescriptor* f, int k, const std::string& path, int at) {
+    if (f->cpp_type() != FieldDescriptor::CPPTYPE_DOUBLE && f->cpp_type() != FieldDescriptor::CPPTYPE_FLOAT) return;
+    const auto* r = o.GetReflection();
+    const double v = f->cpp_type() == FieldDescriptor::CPPTYPE_DOUBLE
+                         ? (f->is_repeated() ? r->GetRepeatedDouble(o, f, k) : r->GetDouble(o, f))
+                         : (f->is_repeated() ? r->GetRepeatedFloat(o, f, k) : r->GetFloat(o, f));
+    if (!std::isfinite(v)) out.push_back({path + " is " + (std::isnan(v) ? "nan" : v > 0 ? "inf" : "-inf"), at});
+  });
 }
 
 // String option values (nested and repeated ones too) with ${NAME} or ${NAME:-default}: the environment's value
@@ -87,55 +104,38 @@ void non_finite(const Message& m, const std::string& prefix, const TextFormat::P
 // (graphs/demo.pbtxt: ${FPLOC_DEMO_DIR:-/tmp}). A NAME unset with no default: "path: ..." in `out`.
 void expand_env(Message& m, const std::string& prefix, const TextFormat::ParseInfoTree* tree, int line,
                 std::vector<std::pair<std::string, int>>& out) {
-  const auto* r = m.GetReflection();
-  std::vector<const FieldDescriptor*> fields;
-  r->ListFields(m, &fields);
-  for (const auto* f : fields) {
-    const int n = f->is_repeated() ? r->FieldSize(m, f) : 1;
-    for (int k = 0; k < n; ++k) {
-      const int index = f->is_repeated() ? k : -1;
-      const std::string path = prefix + f->name() + (f->is_repeated() ? "[" + std::to_string(k) + "]" : "");
-      int at = line;
-      if (tree) {
-        const auto loc = tree->GetLocation(f, index);
-        if (loc.line >= 0) at = loc.line + 1;
+  for_each_value(m, prefix, tree, line, [&](Message& o, const FieldDescriptor* f, int k, const std::string& path, int at) {
+    if (f->cpp_type() != FieldDescriptor::CPPTYPE_STRING || f->type() == FieldDescriptor::TYPE_BYTES) return;
+    const auto* r = o.GetReflection();
+    const std::string v = f->is_repeated() ? r->GetRepeatedString(o, f, k) : r->GetString(o, f);
+    if (v.find("${") == std::string::npos) return;
+    std::string res;
+    size_t i = 0;
+    bool ok = true;
+    while (i < v.size()) {
+      const size_t b = v.find("${", i);
+      const size_t e = b == std::string::npos ? b : v.find('}', b);
+      if (b == std::string::npos || e == std::string::npos) {
+        res += v.substr(i);
+        break;
       }
-      if (f->cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE) {
-        expand_env(f->is_repeated() ? *r->MutableRepeatedMessage(&m, f, k) : *r->MutableMessage(&m, f), path + ".",
-                   tree ? tree->GetTreeForNested(f, index) : nullptr, at, out);
-        continue;
+      res += v.substr(i, b - i);
+      const std::string expr = v.substr(b + 2, e - b - 2);
+      const size_t dflt = expr.find(":-");
+      const std::string name = expr.substr(0, dflt);
+      const char* env = std::getenv(name.c_str());
+      if (env && *env) res += env;
+      else if (dflt != std::string::npos) res += expr.substr(dflt + 2);
+      else {
+        out.push_back({path + ": environment variable " + name + " is not set (write ${" + name + ":-DEFAULT} for a default)", at});
+        ok = false;
       }
-      if (f->cpp_type() != FieldDescriptor::CPPTYPE_STRING || f->type() == FieldDescriptor::TYPE_BYTES) continue;
-      const std::string v = f->is_repeated() ? r->GetRepeatedString(m, f, k) : r->GetString(m, f);
-      if (v.find("${") == std::string::npos) continue;
-      std::string res;
-      size_t i = 0;
-      bool ok = true;
-      while (i < v.size()) {
-        const size_t b = v.find("${", i);
-        const size_t e = b == std::string::npos ? b : v.find('}', b);
-        if (b == std::string::npos || e == std::string::npos) {
-          res += v.substr(i);
-          break;
-        }
-        res += v.substr(i, b - i);
-        const std::string expr = v.substr(b + 2, e - b - 2);
-        const size_t dflt = expr.find(":-");
-        const std::string name = expr.substr(0, dflt);
-        const char* env = std::getenv(name.c_str());
-        if (env && *env) res += env;
-        else if (dflt != std::string::npos) res += expr.substr(dflt + 2);
-        else {
-          out.push_back({path + ": environment variable " + name + " is not set (write ${" + name + ":-DEFAULT} for a default)", at});
-          ok = false;
-        }
-        i = e + 1;
-      }
-      if (!ok) continue;
-      if (f->is_repeated()) r->SetRepeatedString(&m, f, k, res);
-      else r->SetString(&m, f, res);
+      i = e + 1;
     }
-  }
+    if (!ok) return;
+    if (f->is_repeated()) r->SetRepeatedString(&o, f, k, res);
+    else r->SetString(&o, f, res);
+  });
 }
 
 }  // namespace
