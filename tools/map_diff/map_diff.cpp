@@ -22,6 +22,7 @@
 #include "fploc/floorplan/io.h"
 #include "fploc/plandiff/plan_diff.h"
 #include "fploc/runtime/graph.h"
+#include "fploc/runtime/log_coverage.h"
 
 namespace {
 
@@ -119,10 +120,10 @@ int main(int argc, char** argv) {
     if (!log.good()) throw std::runtime_error(log_path + ": cannot read the LCM log");
     std::map<int64_t, fploc::features_t> feats;
     int64_t events = 0, n_feat = 0, n_pose = 0, used = 0, bad = 0;
-    uint64_t event_bytes = 0;
+    fploc::rt::LogCoverage coverage;  // a log cut short is said at the end
     while (const lcm::LogEvent* ev = log.readNextEvent()) {
       ++events;
-      event_bytes += 28 + ev->channel.size() + uint64_t(ev->datalen);  // sync, number, time, two lengths, channel, data
+      coverage.add(*ev);
       if (ev->channel == feat_ch) {
         fploc::features_t f;
         if (f.decode(ev->data, 0, ev->datalen) < 0) {
@@ -175,13 +176,10 @@ int main(int argc, char** argv) {
               << " missing, " << r.count(fploc::plandiff::Status::kMoved) << " moved, "
               << r.count(fploc::plandiff::Status::kUnobserved) << " unobserved, " << r.added.size() << " new\n";
     if (json) fploc::plandiff::write_json(r, plan, std::cout, all);
-    // A log cut short (or damaged part way): lcm's reader stops at the first bad event without a word, and the diff
-    // above is of the events before it; said, exit 1, as fploc replay does.
-    std::error_code ec;
-    const uint64_t size = std::filesystem::file_size(log_path, ec);
-    if (!ec && event_bytes != size) {
-      std::cerr << "fploc map diff: " << log_path << ": " << events << " events are " << event_bytes << " of its " << size
-                << " B; the rest is not an LCM event (truncated or damaged?); the diff is of the events read\n";
+    // A log cut short (or damaged part way): the diff above is of the events before it; said, exit 1, as fploc
+    // replay does.
+    if (const std::string problem = coverage.problem(log_path); !problem.empty()) {
+      std::cerr << "fploc map diff: " << problem << "; the diff is of the events read\n";
       return 1;
     }
   } catch (const std::exception& e) {

@@ -25,6 +25,7 @@
 #include "fploc/runtime/bus.h"
 #include "fploc/runtime/compose.h"
 #include "fploc/runtime/graph.h"
+#include "fploc/runtime/log_coverage.h"
 #include "fploc/runtime/node.h"
 #include "options/tools.pb.h"
 
@@ -142,7 +143,7 @@ int main(int argc, char** argv) {
       std::cerr << "fploc replay: cannot read log '" << log_path << "'\n";
       return 1;
     }
-    int64_t events = 0, published = 0, t_first = -1, t_last = -1;
+    int64_t published = 0, t_first = -1, t_last = -1;
     std::unique_ptr<lcm::LogFile> rec;
     if (!record.empty()) {
       rec = std::make_unique<lcm::LogFile>(record, "w");
@@ -163,12 +164,9 @@ int main(int argc, char** argv) {
     }
     std::map<std::string, int64_t> per_channel;
     const double w0 = now_s();
-    // The bytes the events account for: the LCM reader skips what is not an event (a ROS bag given as the log, a
-    // damaged stretch) and stops at a cut event without a word; the file's size says whether it did.
-    uint64_t event_bytes = 0;
+    fploc::rt::LogCoverage coverage;  // a log cut short, or not a log at all (a ROS bag), is said at the end
     while (const lcm::LogEvent* ev = log.readNextEvent()) {
-      ++events;
-      event_bytes += 28 + ev->channel.size() + uint64_t(ev->datalen);  // sync, number, time, two lengths, channel, data
+      coverage.add(*ev);
       if (!ext.count(ev->channel)) continue;
       if (t_first < 0) t_first = ev->timestamp;
       t_last = ev->timestamp;
@@ -206,6 +204,7 @@ int main(int argc, char** argv) {
                        {"last_error", st.last_error},
                        {"detail", st.detail}});
     }
+    const int64_t events = coverage.events();
     std::cerr << "fploc replay: " << published << " of " << events << " log events fed in " << wall << " s (log span "
               << span << " s, real-time factor " << (wall > 0 ? span / wall : 0.0) << ")"
               << (node_errors ? ", " + std::to_string(node_errors) + " node errors" : std::string()) << "\n";
@@ -222,16 +221,8 @@ int main(int argc, char** argv) {
       if (!out.empty()) j["out"] = out;
       std::cout << j.dump() << std::endl;
     }
-    std::error_code ec;
-    const uint64_t size = std::filesystem::file_size(log_path, ec);
-    if (!ec && events == 0 && size > 0) {
-      std::cerr << "fploc replay: " << log_path << ": no LCM event in its " << size
-                << " B (not an LCM event log; a ROS bag or MCAP goes through `fploc import` first)\n";
-      return 1;
-    }
-    if (!ec && event_bytes != size) {
-      std::cerr << "fploc replay: " << log_path << ": " << events << " events are " << event_bytes << " of its " << size
-                << " B; the rest is not an LCM event (truncated or damaged?); the events read were replayed\n";
+    if (const std::string problem = coverage.problem(log_path); !problem.empty()) {
+      std::cerr << "fploc replay: " << problem << (events > 0 ? "; the events read were replayed" : "") << "\n";
       return 1;
     }
     return 0;
