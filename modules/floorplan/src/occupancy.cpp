@@ -124,16 +124,8 @@ double number(const std::map<std::string, YamlValue>& m, const std::string& sour
   return v;
 }
 
-}  // namespace
-
-Eigen::Vector2d OccupancyGrid::cell_centre(int i, int j) const {
-  const double lx = (i + 0.5) * resolution, ly = (j + 0.5) * resolution;
-  const double c = std::cos(origin_yaw), s = std::sin(origin_yaw);
-  return {origin_x + c * lx - s * ly, origin_y + s * lx + c * ly};
-}
-
 // Edit distance (a misspelt key's nearest known one).
-size_t distance(const std::string& a, const std::string& b) {
+size_t edit_distance(const std::string& a, const std::string& b) {
   std::vector<size_t> row(b.size() + 1);
   for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
   for (size_t i = 1; i <= a.size(); ++i) {
@@ -148,6 +140,14 @@ size_t distance(const std::string& a, const std::string& b) {
   return row[b.size()];
 }
 
+}  // namespace
+
+Eigen::Vector2d OccupancyGrid::cell_centre(int i, int j) const {
+  const double lx = (i + 0.5) * resolution, ly = (j + 0.5) * resolution;
+  const double c = std::cos(origin_yaw), s = std::sin(origin_yaw);
+  return {origin_x + c * lx - s * ly, origin_y + s * lx + c * ly};
+}
+
 MapYaml parse_map_yaml(const std::string& text, const std::string& source) {
   const auto m = parse_flat_mapping(text, source);
   MapYaml y;
@@ -158,7 +158,7 @@ MapYaml parse_map_yaml(const std::string& text, const std::string& source) {
     std::string near;
     size_t best = 3;  // at most 2 edits away
     for (const char* known : kKnown)
-      if (distance(lower(k), known) < best) best = distance(lower(k), known), near = known;
+      if (const size_t d = edit_distance(lower(k), known); d < best) best = d, near = known;
     y.warnings.push_back(source + ": line " + std::to_string(v.line) + ": unknown key '" + k + "' (ignored, as map_server does" +
                          (near.empty() ? std::string("") : "; did you mean '" + near + "'?") + ")");
   }
