@@ -28,7 +28,9 @@ recall. --jobs N simulates and replays N families at once (CPU times are per thr
 Prints one JSON document on stdout (progress on stderr):
   {"rows": [{"family", "method", "ate_m", "ate_aligned_m" (after the best rigid alignment of the whole trajectory, as
              TUM / evo ATE), "ate_floor_m" (the family's floor: the rigid part of the walls' as-built offsets along the
-             truth path, see gauge_floor; same for every method), "max_m", "lost", "false_ok", "false_ok_poses", "poor", "nees_median", "nees_poses",
+             truth path, see gauge_floor; same for every method), "ate_bound_m" (as-built worlds: the rms expected
+             error of the best per-scan estimate against the plan, `fploc eval --asbuilt-bound`, from the fploc run's
+             features at the true poses; same for every method), "max_m", "lost", "false_ok", "false_ok_poses", "poor", "nees_median", "nees_poses",
              "ms_per_scan", "ms_per_scan_localizer", "scans" (what the CPU is divided by), "poses"}],
    "detection": [{"family", "removed", "removed_found", "moved", "moved_found", "added", "added_found",
                   "doors_moved", "doors_moved_found" (both pieces), "door_opened_found" (the wall piece the new
@@ -238,6 +240,19 @@ def gauge_floor(plan_path, truth, gt_rows):
         dx, dy = x[0] - x[2] * ry, x[1] + x[2] * rx
         e2 += dx * dx + dy * dy
     return math.sqrt(e2 / max(1, len(gt_rows)))
+
+
+def asbuilt_bound(plan_path, truth, gt_path, rec):
+    """As-built worlds (truth's asbuilt_sigma_m > 0): the rms, over the run's scans, of the expected horizontal error of
+    the best estimate of each scan's pose from its features against the plan when every plan vertex stands N(0, sigma^2)
+    off (`fploc eval --asbuilt-bound`, modules/eval/asbuilt_bound.h). Scan by scan no localizer that knows only the plan
+    does better on average. None for other worlds."""
+    sigma = (truth or {}).get("asbuilt_sigma_m", 0.0)
+    if not sigma or not os.path.exists(rec):
+        return None
+    out = run([os.path.join(BIN, "fploc-eval"), "--gt", gt_path, "--est", gt_path, "--plan", plan_path,
+               "--asbuilt-bound", repr(sigma), "--features", rec, "--json"])[0]
+    return json.loads(out.strip().splitlines()[-1])["asbuilt_bound"]["rms_m"]
 
 
 # ---- change detection against the truth ------------------------------------------------------------------
@@ -460,6 +475,7 @@ class Bench:
         self.have_ndt = os.path.exists(os.path.join(BIN, "fploc-ndt")) and os.path.exists(self.ndt_graph)
         self.methods = [m for m in a.methods.split(",") if m]
         self.floors = {}  # family -> gauge_floor (families run in threads: one key each)
+        self.bounds = {}  # family -> as-built bound (ditto)
 
     def family(self, fam):
         d = os.path.join(self.work, fam)
@@ -501,6 +517,7 @@ class Bench:
         rep = json.loads(run(cmd)[0].strip().splitlines()[-1])
         rows = []
         self.floors[fam] = gauge_floor(plan, truth, g) if truth is not None else None
+        self.bounds[fam] = asbuilt_bound(plan, truth, gt, rec)
         for m in ("fploc", "amcl"):
             if m not in self.methods:
                 continue
@@ -589,14 +606,19 @@ class Bench:
     def floor_of(self, fam):
         return self.floors.get(fam)
 
+    def bound_of(self, fam):
+        return self.bounds.get(fam)
+
     def row(self, fam, method, poses, g, rep, nodes):
         s = score_poses(poses, g) or {"poses": 0}
         scans = scans_of(rep, len(g))  # this replay's own
         cpu = sum(n.get("cpu_ms", n["total_ms"]) for n in rep["nodes"] if n["name"] in nodes)
         own = sum(n.get("cpu_ms", n["total_ms"]) for n in rep["nodes"] if n["name"] in nodes and n["name"] not in SHARED_NODES)
         r = {"family": fam, "method": method, **s, "scans": scans, "ms_per_scan": round(cpu / max(scans, 1), 3),
-             "ms_per_scan_localizer": round(own / max(scans, 1), 3), "ate_floor_m": self.floor_of(fam)}
-        log(f"[{fam}] {method}: ATE {fmt(r.get('ate_m'))} (aligned {fmt(r.get('ate_aligned_m'))}, floor {fmt(r.get('ate_floor_m'))}) max {fmt(r.get('max_m'))} LOST {pct(r.get('lost'))} "
+             "ms_per_scan_localizer": round(own / max(scans, 1), 3), "ate_floor_m": self.floor_of(fam),
+             "ate_bound_m": self.bound_of(fam)}
+        log(f"[{fam}] {method}: ATE {fmt(r.get('ate_m'))} (aligned {fmt(r.get('ate_aligned_m'))}, floor {fmt(r.get('ate_floor_m'))}, "
+            f"as-built bound {fmt(r.get('ate_bound_m'))}) max {fmt(r.get('max_m'))} LOST {pct(r.get('lost'))} "
             f"false-OK {pct(r.get('false_ok'))} POOR {pct(r.get('poor'))} NEES {fmt(r.get('nees_median'), 2)} {r['ms_per_scan']} ms/scan "
             f"({r['ms_per_scan_localizer']} without the segmenter)")
         return r
@@ -667,13 +689,16 @@ def markdown(res, cmdline):
          "(what is left once a constant offset of the whole run is removed); floor = the rms, along the truth path, of the "
          "rigid motion of the whole building that best explains the walls' as-built offsets (sim.world.json): against "
          "the plan alone a localizer cannot tell it from its own error, so the unaligned ATE of any method is about "
-         "this far from 0 at best (0 where the walls stand where drawn):", "",
-         "| world | method | ATE [cm] | ATE aligned [cm] | floor [cm] | max [cm] | LOST | POOR | false OK | NEES | ms/scan | ms/scan w/o segmenter |",
-         "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+         "this far from 0 at best (0 where the walls stand where drawn); as-built bound = the rms over the scans of "
+         "the expected error of the best per-scan estimate when every plan vertex stands N(0, sigma^2) off, from the "
+         "scan's features at its true pose (`fploc eval --asbuilt-bound`): scan by scan no localizer that knows only "
+         "the plan does better on average (as-built worlds only):", "",
+         "| world | method | ATE [cm] | ATE aligned [cm] | floor [cm] | as-built bound [cm] | max [cm] | LOST | POOR | false OK | NEES | ms/scan | ms/scan w/o segmenter |",
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in res["rows"]:
         cm = lambda v, nd=2: fmt(100 * v if v is not None else None, nd)  # noqa: E731
         L.append(f"| {r['family']} | {r['method']} | {fmt(100 * r['ate_m'] if r.get('ate_m') is not None else None, 2)} | "
-                 f"{cm(r.get('ate_aligned_m'))} | {cm(r.get('ate_floor_m'))} | "
+                 f"{cm(r.get('ate_aligned_m'))} | {cm(r.get('ate_floor_m'))} | {cm(r.get('ate_bound_m'))} | "
                  f"{fmt(100 * r['max_m'] if r.get('max_m') is not None else None, 1)} | {pct(r.get('lost'))} | "
                  f"{pct(r.get('poor'))} | {pct(r.get('false_ok'))} | {fmt(r.get('nees_median'), 1)} | {r['ms_per_scan']} | "
                  f"{r.get('ms_per_scan_localizer', '-')} |")

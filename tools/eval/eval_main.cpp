@@ -6,11 +6,20 @@
 // NEES of x, y, yaw and the false-OK count (modules/eval/uncertainty.h). JSON on stdout with --json, a
 // summary on stderr. With --hat: the three-cornered hat of GT, EST and a third trajectory (e.g. wheel odometry):
 // each one's increment noise, i.e. how noisy the reference itself is (modules/eval/reference_noise.h).
+// With --asbuilt-bound SIGMA --features LOG --plan P: the as-built bound of the run (modules/eval/asbuilt_bound.h):
+// each scan's features (features_t on --features-channel) at the ground-truth pose, the expected error of the best
+// per-scan estimate when every vertex of the plan stands N(0, SIGMA^2) off; its rms beside the ATE.
+#include <fploc/features_t.hpp>
+#include <lcm/lcm-cpp.hpp>
+
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "fploc/adapters/features_t.h"
+#include "fploc/eval/asbuilt_bound.h"
 #include "fploc/eval/eval.h"
 #include "fploc/eval/reference_noise.h"
 #include "fploc/eval/uncertainty.h"
@@ -29,12 +38,73 @@ static void usage() {
                "       [--uncertainty FILE] (status + x/y/yaw covariance per pose: NEES and false OK)\n"
                "       [--false-ok-m M] (horizontal error of a false OK, default 0.3)\n"
                "       [--hat THIRD.tum [--hat-lag N]] (three-cornered hat of gt, est and THIRD: the noise of each,\n"
-               "       the reference's own included, from their increments N poses of gt apart, default 1)\n";
+               "       the reference's own included, from their increments N poses of gt apart, default 1)\n"
+               "       [--asbuilt-bound SIGMA --features LOG --plan FILE [--features-channel CH]] (the expected error of\n"
+               "       the best per-scan estimate when each plan vertex stands N(0, SIGMA^2) off, from LOG's features at\n"
+               "       the gt poses; JSON asbuilt_bound)\n";
 }
+
+namespace {
+// The as-built bound over a recorded run (see the file comment).
+nlohmann::json asbuilt_bound_of(const FloorPlan& plan, const Trajectory& gt, const std::string& log_path,
+                                const std::string& channel, double sigma, double max_dt) {
+  lcm::LogFile log(log_path, "r");
+  if (!log.good()) throw std::runtime_error(log_path + ": cannot read the LCM log");
+  eval::AsBuiltBoundOptions o;
+  o.vertex_sigma_m = sigma;
+  std::vector<double> err;
+  int64_t events = 0, frames = 0, undecoded = 0, open = 0, unmatched = 0;
+  std::vector<Eigen::Vector2d> pts;
+  while (const lcm::LogEvent* ev = log.readNextEvent()) {
+    ++events;
+    if (ev->channel != channel) continue;
+    features_t m;
+    if (m.decode(ev->data, 0, ev->datalen) < 0) {
+      if (undecoded++ == 0)
+        std::cerr << "fploc eval: " << log_path << ": event " << events << " on " << channel
+                  << " does not decode as features_t (skipped)\n";
+      continue;
+    }
+    ++frames;
+    const FeatureFrame f = adapters::from_msg(m);
+    const double t = double(f.utime) * 1e-6;
+    const auto it = std::lower_bound(gt.begin(), gt.end(), t, [](const StampedPose& p, double v) { return p.t < v; });
+    const StampedPose* best = nullptr;
+    for (auto j : {it, it == gt.begin() ? it : std::prev(it)})
+      if (j != gt.end() && std::abs(j->t - t) <= max_dt && (!best || std::abs(j->t - t) < std::abs(best->t - t))) best = &*j;
+    if (!best) {
+      ++unmatched;
+      continue;
+    }
+    pts.clear();
+    for (const auto& q : f.points) pts.push_back(q.p);
+    const auto b = eval::asbuilt_scan_bound(plan, Eigen::Vector3d(best->p.x(), best->p.y(), best->rpy().z()), pts, o);
+    if (b.ok()) err.push_back(b.xy_rms_m());
+    else ++open;
+  }
+  if (frames == 0)
+    throw std::runtime_error("--features " + log_path + ": no " + channel + " (features_t) events among " +
+                             std::to_string(events));
+  if (err.empty())
+    throw std::runtime_error("--features " + log_path + ": none of its " + std::to_string(frames) +
+                             " scans lies within --max-dt of a ground-truth pose and constrains the pose");
+  double e2 = 0;
+  for (double e : err) e2 += e * e;
+  std::vector<double> sorted = err;
+  std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
+  const double rms = std::sqrt(e2 / double(err.size())), median = sorted[sorted.size() / 2];
+  std::cerr << "fploc eval: as-built bound (each plan vertex off by N(0, " << sigma << " m)): expected horizontal error of "
+            << "the best per-scan estimate rms " << rms << " m, median " << median << " m over " << err.size()
+            << " scans (" << open << " leave a direction open, " << unmatched << " without a gt pose)\n";
+  return {{"vertex_sigma_m", sigma}, {"rms_m", rms}, {"median_m", median}, {"scans", err.size()},
+          {"scans_open", open}, {"scans_without_gt", unmatched}, {"features", log_path}, {"channel", channel}};
+}
+}  // namespace
 
 int main(int argc, char** argv) {
   std::string gt_path, est_path, plot, align_s = "none", unit = "s", plan_path, layers, units, unc_path, hat_path;
-  std::string plot_frame = "all";
+  std::string plot_frame = "all", features_path, features_channel = "FPLOC_FEATURES";
+  double bound_sigma = 0;
   int hat_lag = 1;
   bool json = false;
   double max_dt = 0.02, offset = 0, delta = 1.0, false_ok_m = 0.3;
@@ -72,6 +142,9 @@ int main(int argc, char** argv) {
       else if (a == "--uncertainty") unc_path = next();
       else if (a == "--false-ok-m") false_ok_m = number();
       else if (a == "--hat") hat_path = next();
+      else if (a == "--asbuilt-bound") bound_sigma = number();
+      else if (a == "--features") features_path = next();
+      else if (a == "--features-channel") features_channel = next();
       else if (a == "--hat-lag") {
         const std::string v = next();
         size_t used = 0;
@@ -91,6 +164,14 @@ int main(int argc, char** argv) {
   if (gt_path.empty() || est_path.empty() || (unit != "s" && unit != "f") || !(delta > 0) || !(max_dt >= 0) ||
       !(false_ok_m > 0)) {
     usage();
+    return 2;
+  }
+  if (bound_sigma != 0 && (!(bound_sigma > 0) || features_path.empty() || plan_path.empty())) {
+    std::cerr << "fploc eval: --asbuilt-bound needs a SIGMA > 0 [m], --features LOG and --plan FILE\n";
+    return 2;
+  }
+  if (bound_sigma == 0 && !features_path.empty()) {
+    std::cerr << "fploc eval: --features is read for --asbuilt-bound SIGMA only\n";
     return 2;
   }
   if (hat_lag != 1 && hat_path.empty()) {
@@ -173,6 +254,9 @@ int main(int argc, char** argv) {
                 << c.nees_x.median << ", y " << c.nees_y.median << ", yaw " << c.nees_yaw.median << "; " << c.ok
                 << " OK, " << c.false_ok << " false OK (horizontal error > " << c.false_ok_m << " m)\n";
     }
+    if (bound_sigma > 0)
+      j["asbuilt_bound"] = asbuilt_bound_of(load_floor_plan(plan_path, {layers}, units), gt, features_path,
+                                            features_channel, bound_sigma, max_dt);
     if (!hat_path.empty()) {
       const Trajectory third = read_tum(hat_path);
       eval::HatResult h;

@@ -247,6 +247,7 @@ WorldEdit perturb_world(const FloorPlan& plan, const std::vector<V2>& path, cons
   w.source = o.name;
   w.seed = seed;
   w.scale = o.scale;
+  w.asbuilt_sigma_m = o.asbuilt_sigma_m;
   w.wall_clutter = o.shelves;
   const size_t n = plan.elements.size();
   w.elements.assign(n, {});
@@ -468,6 +469,7 @@ std::string WorldEdit::truth_json(const FloorPlan& plan) const {
   j["source"] = source;
   j["seed"] = seed;
   j["scale"] = scale;
+  j["asbuilt_sigma_m"] = asbuilt_sigma_m;
   j["plan"] = plan.source;
   j["plan_elements"] = plan.elements.size();
   double wall_len = 0;

@@ -21,6 +21,7 @@ assert 0 < f["ms_per_scan_localizer"] < f["ms_per_scan"], f
 # Aligned ATE: the best rigid alignment can only lower the rms; the floor of a world without as-built offsets is 0.
 assert f["ate_aligned_m"] is not None and f["ate_aligned_m"] <= f["ate_m"] + 1e-12, f
 assert f["ate_floor_m"] == 0.0, f
+assert f["ate_bound_m"] is None, f  # no as-built offsets in the renovated world
 dw = rows["fploc+downweight"]
 assert dw["poses"] == f["poses"] and dw["lost"] == 0 and dw["ate_m"] < 0.5, dw
 assert f["poses"] >= 90, f

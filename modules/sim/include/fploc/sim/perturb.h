@@ -94,9 +94,10 @@ struct WorldEdit {
   std::vector<AddedTruth> added;
   std::vector<DoorMovedTruth> doors_moved;
   double scale = 0;
+  double asbuilt_sigma_m = 0;            // the as-built displacement's sigma (0: none, or a world file)
   std::string source;                    // family / spec / world file
   uint64_t seed = 0;
-  // The truth as JSON text: {"source", "seed", "scale", "plan_elements", "elements": [{"id", "change",
+  // The truth as JSON text: {"source", "seed", "scale", "asbuilt_sigma_m", "plan_elements", "elements": [{"id", "change",
   // "offset_m", "max_shift_m", "rotation_deg", "length_m"}], "added": [{"kind", "a", "b", "length_m"}],
   // "shelves_fraction", "people", "doors_moved": [{"from", "to", "closed", "opened" (each [[x, y], [x, y]]),
   // "shift_m", "elements"}]}.
