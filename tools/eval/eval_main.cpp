@@ -1,6 +1,7 @@
 // fploc eval --gt GT.tum --est EST.tum [--plot FILE.svg [--plan P [--layers A,B] [--units U]]] [--json]
 //            [--align none|se2|se3] [--max-dt S] [--offset S] [--delta D] [--delta-unit s|f]
 //            [--uncertainty EST.unc [--false-ok-m M]] [--hat THIRD.tum [--hat-lag N]]
+//            [--asbuilt-bound SIGMA --features LOG --plan P [--features-channel CH] [--bound-window S]]
 // ATE and RPE as in Sturm et al. 2012 (see modules/eval). No alignment by default: fploc poses are in
 // the floor-plan frame, like the ground truth. With --uncertainty (fploc-pose-logger's uncertainty_file):
 // NEES of x, y, yaw and the false-OK count (modules/eval/uncertainty.h). JSON on stdout with --json, a
@@ -8,7 +9,8 @@
 // each one's increment noise, i.e. how noisy the reference itself is (modules/eval/reference_noise.h).
 // With --asbuilt-bound SIGMA --features LOG --plan P: the as-built bound of the run (modules/eval/asbuilt_bound.h):
 // each scan's features (features_t on --features-channel) at the ground-truth pose, the expected error of the best
-// per-scan estimate when every vertex of the plan stands N(0, SIGMA^2) off; its rms beside the ATE.
+// per-scan estimate when every vertex of the plan stands N(0, SIGMA^2) off; its rms beside the ATE. --bound-window S:
+// the same with the scans within S/2 s of each sharing its pose error (exact odometry over the window).
 #include <fploc/features_t.hpp>
 #include <lcm/lcm-cpp.hpp>
 
@@ -41,19 +43,33 @@ static void usage() {
                "       the reference's own included, from their increments N poses of gt apart, default 1)\n"
                "       [--asbuilt-bound SIGMA --features LOG --plan FILE [--features-channel CH]] (the expected error of\n"
                "       the best per-scan estimate when each plan vertex stands N(0, SIGMA^2) off, from LOG's features at\n"
-               "       the gt poses; JSON asbuilt_bound)\n";
+               "       the gt poses; JSON asbuilt_bound) [--bound-window S] (also each scan's bound with the scans within\n"
+               "       S/2 seconds sharing its pose error, as with exact odometry: what smoothing over S could reach)\n";
 }
 
 namespace {
-// The as-built bound over a recorded run (see the file comment).
+// The as-built bound over a recorded run (see the file comment); with window_s > 0 also each scan's bound when
+// the scans within window_s / 2 of it share its pose error (exact odometry over the window).
+double rms_of(const std::vector<double>& v) {
+  double e2 = 0;
+  for (double e : v) e2 += e * e;
+  return std::sqrt(e2 / double(v.size()));
+}
+
+double median_of(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
 nlohmann::json asbuilt_bound_of(const FloorPlan& plan, const Trajectory& gt, const std::string& log_path,
-                                const std::string& channel, double sigma, double max_dt) {
+                                const std::string& channel, double sigma, double window_s, double max_dt) {
   lcm::LogFile log(log_path, "r");
   if (!log.good()) throw std::runtime_error(log_path + ": cannot read the LCM log");
   eval::AsBuiltBoundOptions o;
   o.vertex_sigma_m = sigma;
-  std::vector<double> err;
-  int64_t events = 0, frames = 0, undecoded = 0, open = 0, unmatched = 0;
+  eval::AsBuiltBound bound(plan, o);
+  std::vector<double> times;
+  int64_t events = 0, frames = 0, undecoded = 0, unmatched = 0;
   std::vector<Eigen::Vector2d> pts;
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     ++events;
@@ -72,39 +88,56 @@ nlohmann::json asbuilt_bound_of(const FloorPlan& plan, const Trajectory& gt, con
     const StampedPose* best = nullptr;
     for (auto j : {it, it == gt.begin() ? it : std::prev(it)})
       if (j != gt.end() && std::abs(j->t - t) <= max_dt && (!best || std::abs(j->t - t) < std::abs(best->t - t))) best = &*j;
-    if (!best) {
+    if (!best || (!times.empty() && best->t <= times.back())) {  // no gt pose, or not after the last scan's
       ++unmatched;
       continue;
     }
     pts.clear();
     for (const auto& q : f.points) pts.push_back(q.p);
-    const auto b = eval::asbuilt_scan_bound(plan, Eigen::Vector3d(best->p.x(), best->p.y(), best->rpy().z()), pts, o);
-    if (b.ok()) err.push_back(b.xy_rms_m());
-    else ++open;
+    bound.add_scan(Eigen::Vector3d(best->p.x(), best->p.y(), best->rpy().z()), pts);
+    times.push_back(best->t);
   }
   if (frames == 0)
     throw std::runtime_error("--features " + log_path + ": no " + channel + " (features_t) events among " +
                              std::to_string(events));
+  std::vector<double> err, werr;
+  int64_t open = 0;
+  for (int k = 0; k < bound.scans(); ++k) {
+    const auto b = bound.bound(k);
+    if (b.ok()) err.push_back(b.xy_rms_m());
+    else ++open;
+    if (window_s > 0) {
+      const int a = int(std::lower_bound(times.begin(), times.end(), times[size_t(k)] - window_s / 2) - times.begin());
+      const int z = int(std::upper_bound(times.begin(), times.end(), times[size_t(k)] + window_s / 2) - times.begin()) - 1;
+      const auto w = bound.bound(a, z, k);
+      if (w.ok()) werr.push_back(w.xy_rms_m());
+    }
+  }
   if (err.empty())
     throw std::runtime_error("--features " + log_path + ": none of its " + std::to_string(frames) +
                              " scans lies within --max-dt of a ground-truth pose and constrains the pose");
-  double e2 = 0;
-  for (double e : err) e2 += e * e;
-  std::vector<double> sorted = err;
-  std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
-  const double rms = std::sqrt(e2 / double(err.size())), median = sorted[sorted.size() / 2];
+  const double rms = rms_of(err), median = median_of(err);
   std::cerr << "fploc eval: as-built bound (each plan vertex off by N(0, " << sigma << " m)): expected horizontal error of "
             << "the best per-scan estimate rms " << rms << " m, median " << median << " m over " << err.size()
-            << " scans (" << open << " leave a direction open, " << unmatched << " without a gt pose)\n";
-  return {{"vertex_sigma_m", sigma}, {"rms_m", rms}, {"median_m", median}, {"scans", err.size()},
-          {"scans_open", open}, {"scans_without_gt", unmatched}, {"features", log_path}, {"channel", channel}};
+            << " scans (" << open << " leave a direction open, " << unmatched << " without a gt pose)";
+  nlohmann::json j{{"vertex_sigma_m", sigma}, {"rms_m", rms}, {"median_m", median}, {"scans", err.size()},
+                   {"scans_open", open}, {"scans_without_gt", unmatched}, {"features", log_path}, {"channel", channel}};
+  if (window_s > 0 && !werr.empty()) {
+    j["window_s"] = window_s;
+    j["window_rms_m"] = rms_of(werr);
+    j["window_median_m"] = median_of(werr);
+    std::cerr << "; with the scans within " << window_s / 2 << " s sharing the pose error (exact odometry): rms "
+              << rms_of(werr) << " m";
+  }
+  std::cerr << "\n";
+  return j;
 }
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string gt_path, est_path, plot, align_s = "none", unit = "s", plan_path, layers, units, unc_path, hat_path;
   std::string plot_frame = "all", features_path, features_channel = "FPLOC_FEATURES";
-  double bound_sigma = 0;
+  double bound_sigma = 0, bound_window = 0;
   int hat_lag = 1;
   bool json = false;
   double max_dt = 0.02, offset = 0, delta = 1.0, false_ok_m = 0.3;
@@ -143,6 +176,7 @@ int main(int argc, char** argv) {
       else if (a == "--false-ok-m") false_ok_m = number();
       else if (a == "--hat") hat_path = next();
       else if (a == "--asbuilt-bound") bound_sigma = number();
+      else if (a == "--bound-window") bound_window = number();
       else if (a == "--features") features_path = next();
       else if (a == "--features-channel") features_channel = next();
       else if (a == "--hat-lag") {
@@ -170,8 +204,12 @@ int main(int argc, char** argv) {
     std::cerr << "fploc eval: --asbuilt-bound needs a SIGMA > 0 [m], --features LOG and --plan FILE\n";
     return 2;
   }
-  if (bound_sigma == 0 && !features_path.empty()) {
-    std::cerr << "fploc eval: --features is read for --asbuilt-bound SIGMA only\n";
+  if (bound_sigma == 0 && (!features_path.empty() || bound_window != 0)) {
+    std::cerr << "fploc eval: --features and --bound-window are read for --asbuilt-bound SIGMA only\n";
+    return 2;
+  }
+  if (!(bound_window >= 0)) {
+    std::cerr << "fploc eval: --bound-window " << bound_window << ": a window in seconds >= 0\n";
     return 2;
   }
   if (hat_lag != 1 && hat_path.empty()) {
@@ -256,7 +294,7 @@ int main(int argc, char** argv) {
     }
     if (bound_sigma > 0)
       j["asbuilt_bound"] = asbuilt_bound_of(load_floor_plan(plan_path, {layers}, units), gt, features_path,
-                                            features_channel, bound_sigma, max_dt);
+                                            features_channel, bound_sigma, bound_window, max_dt);
     if (!hat_path.empty()) {
       const Trajectory third = read_tum(hat_path);
       eval::HatResult h;

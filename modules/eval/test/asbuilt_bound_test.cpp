@@ -190,3 +190,39 @@ TEST(AsBuiltBound, ScalesWithSigmaAndIgnoresClutter) {
   o.vertex_sigma_m = 0;
   EXPECT_THROW(asbuilt_scan_bound(plan, pose, pts, o), std::invalid_argument);
 }
+
+// A window of scans whose relative poses are exact shares one pose error and the walls' displacements: the same scan
+// twice tells nothing new about the walls (the bound barely moves, where two independent looks would divide the
+// variance by two); a second place can only add (in this room it sees the same walls: little); the error at another
+// scan of the window is the same rigid error carried over there.
+TEST(AsBuiltBound, AWindowSharesThePoseErrorAndTheWalls) {
+  const FloorPlan plan = room();
+  std::map<std::pair<long, long>, V2> zero;
+  for (const Element& e : plan.elements)
+    if (e.kind == ElementKind::kSegment)
+      for (const V2& v : {e.a, e.b}) zero[{std::lround(v.x() * 1000), std::lround(v.y() * 1000)}] = V2::Zero();
+  AsBuiltBoundOptions o;
+  o.point_sigma_m = 1e-3;
+  const Eigen::Vector3d pa(2.2, 1.7, 0.4), pb(4.0, 2.9, -1.0);
+  AsBuiltBound b(plan, o);
+  const int a0 = b.add_scan(pa, scan_of(plan, zero, {V2::Zero()}, pa));
+  const int a1 = b.add_scan(pa, scan_of(plan, zero, {V2::Zero()}, pa));
+  const int b0 = b.add_scan(pb, scan_of(plan, zero, {V2::Zero()}, pb));
+  const ScanBound one = b.bound(a0), twice = b.bound(a0, a1, a0);
+  EXPECT_NEAR(one.xy_rms_m(), asbuilt_scan_bound(plan, pa, scan_of(plan, zero, {V2::Zero()}, pa), o).xy_rms_m(), 1e-12);
+  EXPECT_LT(twice.xy_rms_m(), one.xy_rms_m());
+  EXPECT_GT(twice.xy_rms_m(), 0.99 * one.xy_rms_m());
+  const ScanBound both = b.bound(a0, b0, a0);
+  EXPECT_LE(both.cov(0, 0), one.cov(0, 0) * (1 + 1e-9));
+  EXPECT_LE(both.cov(1, 1), one.cov(1, 1) * (1 + 1e-9));
+  EXPECT_EQ(both.points, 2 * one.points + b.bound(b0).points);
+  // At b0's position: the same rigid error, moved by its rotation about a0.
+  const ScanBound at_b = b.bound(a0, b0, b0);
+  const V2 d = pb.head<2>() - pa.head<2>();
+  Eigen::Matrix3d T = Eigen::Matrix3d::Identity();
+  T(0, 2) = -d.y();
+  T(1, 2) = d.x();
+  const Eigen::Matrix3d moved = T * both.cov * T.transpose();
+  EXPECT_LT((moved - at_b.cov).norm(), 1e-9 * moved.norm());
+  EXPECT_THROW(b.bound(0, 3, 0), std::out_of_range);
+}

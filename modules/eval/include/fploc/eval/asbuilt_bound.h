@@ -9,11 +9,17 @@
 //   ( J'J/s_p^2  -  J'A/s_p^2 (A'A/s_p^2 + I/sigma^2)^-1 A'J/s_p^2 )^-1
 // with J the points' normal residuals' derivatives by the pose (x, y, yaw about the sensor), A by the vertex
 // displacements and s_p the points' own noise. Its rms over a run is the ATE a localizer cannot beat scan by scan
-// on that world's plan (a long window with exact odometry could, see docs/notes/realism.md).
+// on that world's plan.
+//
+// A window of scans whose poses are known exactly relative to each other (perfect odometry) shares one pose
+// error and sees the same walls from several places: its bound is lower, and is what a localizer that smooths
+// over that window could reach at best.
 #pragma once
 #include <Eigen/Core>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <tuple>
 #include <vector>
 
 #include "fploc/floorplan/plan.h"
@@ -34,10 +40,37 @@ struct ScanBound {
   double xy_rms_m() const { return std::sqrt(cov(0, 0) + cov(1, 1)); }  // expected horizontal error
 };
 
-// The bound for one scan: `pose` the scan's true pose in the plan frame (x, y, yaw), `points` its 2D points in
-// the sensor frame (e.g. the features). Points farther than the gate from every element are left out (clutter).
-// Not ok() when the points leave a direction of the pose unconstrained. Throws std::invalid_argument when
-// vertex_sigma_m or point_sigma_m is not > 0.
+class AsBuiltBound {
+ public:
+  // Throws std::invalid_argument when vertex_sigma_m or point_sigma_m is not > 0.
+  AsBuiltBound(const FloorPlan& plan, const AsBuiltBoundOptions& o = {});
+  // One scan: `pose` its true pose in the plan frame (x, y, yaw), `points` its 2D points in the sensor frame (e.g.
+  // the features). Points farther than the gate from every element are left out (clutter). Returns its index.
+  int add_scan(const Eigen::Vector3d& pose, const std::vector<Eigen::Vector2d>& points);
+  int scans() const { return int(scans_.size()); }
+  // The bound of the scans first..last (inclusive) sharing one pose error, expressed at scan `at`'s position.
+  // Not ok() when their points leave a direction of the pose unconstrained.
+  ScanBound bound(int first, int last, int at) const;
+  ScanBound bound(int scan) const { return bound(scan, scan, scan); }
+
+ private:
+  struct Scan {
+    Eigen::Vector2d sensor;
+    std::vector<int> disp;   // global displacement ids of the local blocks
+    Eigen::Matrix3d hpp;     // information, pose about the sensor
+    Eigen::MatrixXd hpv;     // 3 x 2 disp.size()
+    Eigen::MatrixXd hvv;     // 2 disp.size() square
+    int points = 0;
+    std::vector<int> elements;
+  };
+  const FloorPlan& plan_;
+  AsBuiltBoundOptions o_;
+  double gate_;
+  std::map<std::tuple<int, long, long>, int> index_;  // a displacement's id (joint or pillar)
+  std::vector<Scan> scans_;
+};
+
+// One scan on its own (AsBuiltBound with that scan alone).
 ScanBound asbuilt_scan_bound(const FloorPlan& plan, const Eigen::Vector3d& pose,
                              const std::vector<Eigen::Vector2d>& points, const AsBuiltBoundOptions& o = {});
 
