@@ -26,6 +26,7 @@
 #include "fploc/eval/reference_noise.h"
 #include "fploc/eval/uncertainty.h"
 #include "fploc/floorplan/io.h"
+#include "fploc/runtime/log_coverage.h"
 
 using namespace fploc;
 
@@ -48,8 +49,6 @@ static void usage() {
 }
 
 namespace {
-// The as-built bound over a recorded run (see the file comment); with window_s > 0 also each scan's bound when
-// the scans within window_s / 2 of it share its pose error (exact odometry over the window).
 double rms_of(const std::vector<double>& v) {
   double e2 = 0;
   for (double e : v) e2 += e * e;
@@ -61,6 +60,9 @@ double median_of(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// The as-built bound over a recorded run (see the file comment); with window_s > 0 also each scan's bound when
+// the scans within window_s / 2 of it share its pose error (exact odometry over the window). A log cut short (or
+// damaged part way): the bound of the events read, and "features_problem" says why (main exits 1).
 nlohmann::json asbuilt_bound_of(const FloorPlan& plan, const Trajectory& gt, const std::string& log_path,
                                 const std::string& channel, double sigma, double window_s, double max_dt) {
   lcm::LogFile log(log_path, "r");
@@ -71,8 +73,10 @@ nlohmann::json asbuilt_bound_of(const FloorPlan& plan, const Trajectory& gt, con
   std::vector<double> times;
   int64_t events = 0, frames = 0, undecoded = 0, unmatched = 0;
   std::vector<Eigen::Vector2d> pts;
+  rt::LogCoverage coverage;
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     ++events;
+    coverage.add(*ev);
     if (ev->channel != channel) continue;
     features_t m;
     if (m.decode(ev->data, 0, ev->datalen) < 0) {
@@ -97,9 +101,10 @@ nlohmann::json asbuilt_bound_of(const FloorPlan& plan, const Trajectory& gt, con
     bound.add_scan(Eigen::Vector3d(best->p.x(), best->p.y(), best->rpy().z()), pts);
     times.push_back(best->t);
   }
+  const std::string problem = coverage.problem(log_path);
   if (frames == 0)
-    throw std::runtime_error("--features " + log_path + ": no " + channel + " (features_t) events among " +
-                             std::to_string(events));
+    throw std::runtime_error("--features " + (problem.empty() ? log_path : problem) + ": no " + channel +
+                             " (features_t) events among " + std::to_string(events));
   std::vector<double> err, werr;
   int64_t open = 0;
   for (int k = 0; k < bound.scans(); ++k) {
@@ -130,6 +135,10 @@ nlohmann::json asbuilt_bound_of(const FloorPlan& plan, const Trajectory& gt, con
               << rms_of(werr) << " m";
   }
   std::cerr << "\n";
+  if (!problem.empty()) {
+    j["features_problem"] = problem;
+    std::cerr << "fploc eval: --features " << problem << "; the bound is of the events read\n";
+  }
   return j;
 }
 }  // namespace
@@ -323,7 +332,7 @@ int main(int argc, char** argv) {
               << r.trans.n << " pairs)\n";
     if (r.trans.n == 0) std::cerr << "fploc eval: warning: no pose pair " << delta << unit << " apart: RPE is 0\n";
     if (json) std::cout << j.dump() << std::endl;
-    return 0;
+    return j.contains("asbuilt_bound") && j["asbuilt_bound"].contains("features_problem") ? 1 : 0;
   } catch (const std::exception& e) {
     std::cerr << "fploc eval: " << e.what() << "\n";
     return 1;

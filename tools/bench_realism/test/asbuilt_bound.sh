@@ -23,8 +23,8 @@ assert a["scans"] >= 25 and a["scans_open"] == 0 and a["scans_without_gt"] == 0,
 assert 0.002 < a["rms_m"] < 0.015, a
 assert 1.9 < b["rms_m"] / a["rms_m"] < 2.05, (a, b)
 PY
-# Bad input: no --features; a log without features (the simulator's own); a sigma that is not > 0; a window without
-# a bound.
+# Bad input: no --features; a log without features (the simulator's own); a sigma that is not > 0; a features log
+# cut short; a window without a bound.
 rc=0; "$B/fploc-eval" --gt "$T/gt.tum" --est "$T/gt.tum" --plan "$R/data/plans/room.json" --asbuilt-bound 0.02 2> "$T/err" || rc=$?
 [ "$rc" = 2 ] && grep -q "needs a SIGMA > 0 \[m\], --features LOG and --plan FILE" "$T/err" || { cat "$T/err"; echo "rc $rc"; exit 1; }
 rc=0; "$B/fploc-eval" --gt "$T/gt.tum" --est "$T/gt.tum" --plan "$R/data/plans/room.json" --features "$T/sim.lcm" --asbuilt-bound 0.02 2> "$T/err" || rc=$?
@@ -32,6 +32,11 @@ rc=0; "$B/fploc-eval" --gt "$T/gt.tum" --est "$T/gt.tum" --plan "$R/data/plans/r
 test "$(grep -c . "$T/err")" -eq 1 || { cat "$T/err"; exit 1; }
 rc=0; "$B/fploc-eval" --gt "$T/gt.tum" --est "$T/gt.tum" --plan "$R/data/plans/room.json" --features "$T/rec.lcm" --asbuilt-bound -0.02 2> "$T/err" || rc=$?
 [ "$rc" = 2 ] || { cat "$T/err"; echo "rc $rc"; exit 1; }
+# A features log cut short: the bound of the events read in the JSON, the cut said in one line, exit 1.
+head -c $(( $(stat -c %s "$T/rec.lcm") * 6 / 10 )) "$T/rec.lcm" > "$T/cut.lcm"
+rc=0; "$B/fploc-eval" --gt "$T/gt.tum" --est "$T/gt.tum" --plan "$R/data/plans/room.json" --features "$T/cut.lcm" --asbuilt-bound 0.02 --json > "$T/out" 2> "$T/err" || rc=$?
+[ "$rc" = 1 ] && grep -q "cut.lcm: .* events are .*the rest is not an LCM event (truncated or damaged?); the bound is of the events read" "$T/err" || { cat "$T/err"; echo "rc $rc"; exit 1; }
+python3 -c "import json,sys; b=json.load(open(sys.argv[1]))['asbuilt_bound']; assert b['scans'] >= 10 and 'truncated' in b['features_problem'], b" "$T/out"
 rc=0; "$B/fploc-eval" --gt "$T/gt.tum" --est "$T/gt.tum" --bound-window 10 2> "$T/err" || rc=$?
 [ "$rc" = 2 ] && grep -q "read for --asbuilt-bound SIGMA only" "$T/err" || { cat "$T/err"; echo "rc $rc"; exit 1; }
 echo "asbuilt bound: ok"
