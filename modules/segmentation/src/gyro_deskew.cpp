@@ -123,20 +123,30 @@ bool GyroDeskew::prepare(const Scan& scan) {
   int cm = c0;
   while (cm < c1 && col_t_[cm] < tm) ++cm;
   // Columns are evenly spaced and the gyro's rate holds over a sample's interval: most consecutive steps rotate
-  // by the same angle vector, whose matrix (a sine and a cosine) is kept from the last step.
-  Eigen::Vector3d last_th = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d last_inc = Eigen::Matrix3d::Identity();
-  bool last_turns = false;  // (a zero angle vector: no rotation)
+  // by the same angle vector, whose matrix (a sine and a cosine) is kept. Two are kept: column times in whole
+  // microseconds step by two alternating lengths (e.g. 97 and 98 us at 1024 columns x 10 Hz), so the angle
+  // vectors alternate too within a gyro sample's interval.
+  struct Inc {
+    Eigen::Vector3d th = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d m = Eigen::Matrix3d::Identity();
+    bool turns = false;  // (a zero angle vector: no rotation)
+  };
+  Inc inc[2];
+  int older = 0;  // the entry replaced next
   size_t at = 0;  // the gyro sample of the last step
   auto step = [&](const Eigen::Matrix3d& R, int64_t ta, int64_t tb) {
     const Eigen::Vector3d th = rate_walk(ta + (tb - ta) / 2, at) * (1e-6 * double(tb - ta));
-    if (th != last_th) {
+    const Inc* e = th == inc[0].th ? &inc[0] : th == inc[1].th ? &inc[1] : nullptr;
+    if (!e) {
+      Inc& n = inc[older];
+      older ^= 1;
       const double a = th.norm();
-      last_th = th;
-      last_turns = a > 0;
-      if (last_turns) last_inc = Eigen::AngleAxisd(a, th / a).toRotationMatrix();
+      n.th = th;
+      n.turns = a > 0;
+      if (n.turns) n.m = Eigen::AngleAxisd(a, th / a).toRotationMatrix();
+      e = &n;
     }
-    return last_turns ? Eigen::Matrix3d(R * last_inc) : R;
+    return e->turns ? Eigen::Matrix3d(R * e->m) : R;
   };
   const Eigen::Matrix3d Rm = step(Eigen::Matrix3d::Identity(), tm, col_t_[cm]);
   Eigen::Matrix3d R = Rm;

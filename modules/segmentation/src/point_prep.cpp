@@ -31,9 +31,10 @@ constexpr lane8::CompressTable<false> kCompress;
 // the lidar's: the same floats as the table's); okm null: every column valid.
 template <bool kZRow, bool kAllOk>
 __attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const int32_t* okm, const float* const lut[6],
-                                                    const float* zr, const float* const rot[9], int W, int32_t lo,
-                                                    int32_t hi, int32_t pix_row, float* cx, float* cy, float* cz,
-                                                    float* cr, int32_t* cp, size_t m) {
+                                                    const float* zr, const float* const rot[9], float* const raw[3],
+                                                    const uint32_t* next_rng, int W, int32_t lo, int32_t hi,
+                                                    int32_t pix_row, float* cx, float* cy, float* cz, float* cr,
+                                                    int32_t* cp, size_t m) {
   typedef float v8f __attribute__((vector_size(32)));
   typedef int32_t v8i __attribute__((vector_size(32)));
 #define FPLOC_LD(p) ({ v8f v_; std::memcpy(&v_, (p), sizeof v_); v_; })
@@ -47,6 +48,8 @@ __attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const i
   const v8i lov = {lo, lo, lo, lo, lo, lo, lo, lo}, hiv = {hi, hi, hi, hi, hi, hi, hi, hi};
   const v8f mm = {1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f};
   for (int c = 0; c < W; c += 8) {
+    // The next row's ranges (a row is a page: the hardware's prefetch stops at its end).
+    if (next_rng) __builtin_prefetch(next_rng + c);
     v8i ri;
     std::memcpy(&ri, rng + c, sizeof ri);
     v8i inm = (ri >= lov) & (ri <= hiv);
@@ -62,6 +65,8 @@ __attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const i
         z = kZRow ? v8f{zr[0], zr[0], zr[0], zr[0], zr[0], zr[0], zr[0], zr[0]} * fr +
                         v8f{zr[1], zr[1], zr[1], zr[1], zr[1], zr[1], zr[1], zr[1]}
                   : FPLOC_LD(l2 + c) * fr + FPLOC_LD(l5 + c);
+    // (de-skewed: the return as measured, before the rotation, for the wall points; stored with the candidate)
+    v8f mx = x, my = y, mz = z;
     if (rot) {
       const v8f X = FPLOC_LD(rot[0] + c) * x + FPLOC_LD(rot[1] + c) * y + FPLOC_LD(rot[2] + c) * z;
       const v8f Y = FPLOC_LD(rot[3] + c) * x + FPLOC_LD(rot[4] + c) * y + FPLOC_LD(rot[5] + c) * z;
@@ -79,6 +84,11 @@ __attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const i
       std::memcpy(cz + m, &z, sizeof z);
       std::memcpy(cr + m, &rm, sizeof rm);
       std::memcpy(cp + m, &pv, sizeof pv);
+      if (rot) {
+        std::memcpy(raw[0] + m, &mx, sizeof mx);
+        std::memcpy(raw[1] + m, &my, sizeof my);
+        std::memcpy(raw[2] + m, &mz, sizeof mz);
+      }
       m += 8;
       continue;
     }
@@ -87,6 +97,14 @@ __attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const i
     const __m256i idx = lane8::to_front(kCompress, in);
 #define FPLOC_PERM(v) reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(v), idx))
     const v8f qx = FPLOC_PERM(x), qy = FPLOC_PERM(y), qz = FPLOC_PERM(z), qr = FPLOC_PERM(rm);
+    if (rot) {
+      mx = FPLOC_PERM(mx);
+      my = FPLOC_PERM(my);
+      mz = FPLOC_PERM(mz);
+      std::memcpy(raw[0] + m, &mx, sizeof mx);
+      std::memcpy(raw[1] + m, &my, sizeof my);
+      std::memcpy(raw[2] + m, &mz, sizeof mz);
+    }
 #undef FPLOC_PERM
     const v8i qp = reinterpret_cast<v8i>(_mm256_permutevar8x32_epi32(reinterpret_cast<__m256i>(pv), idx));
     std::memcpy(cx + m, &qx, sizeof qx);
@@ -100,13 +118,13 @@ __attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const i
   return m;
 }
 size_t ring_pass8(const uint32_t* rng, const int32_t* okm, const float* const lut[6], const float* zr,
-                  const float* const rot[9], int W, int32_t lo, int32_t hi, int32_t pix_row, float* cx, float* cy,
-                  float* cz, float* cr, int32_t* cp, size_t m) {
+                  const float* const rot[9], float* const raw[3], const uint32_t* next_rng, int W, int32_t lo,
+                  int32_t hi, int32_t pix_row, float* cx, float* cy, float* cz, float* cr, int32_t* cp, size_t m) {
   if (zr)
-    return okm ? ring_pass8_t<true, false>(rng, okm, lut, zr, rot, W, lo, hi, pix_row, cx, cy, cz, cr, cp, m)
-               : ring_pass8_t<true, true>(rng, okm, lut, zr, rot, W, lo, hi, pix_row, cx, cy, cz, cr, cp, m);
-  return okm ? ring_pass8_t<false, false>(rng, okm, lut, zr, rot, W, lo, hi, pix_row, cx, cy, cz, cr, cp, m)
-             : ring_pass8_t<false, true>(rng, okm, lut, zr, rot, W, lo, hi, pix_row, cx, cy, cz, cr, cp, m);
+    return okm ? ring_pass8_t<true, false>(rng, okm, lut, zr, rot, raw, next_rng, W, lo, hi, pix_row, cx, cy, cz, cr, cp, m)
+               : ring_pass8_t<true, true>(rng, okm, lut, zr, rot, raw, next_rng, W, lo, hi, pix_row, cx, cy, cz, cr, cp, m);
+  return okm ? ring_pass8_t<false, false>(rng, okm, lut, zr, rot, raw, next_rng, W, lo, hi, pix_row, cx, cy, cz, cr, cp, m)
+             : ring_pass8_t<false, true>(rng, okm, lut, zr, rot, raw, next_rng, W, lo, hi, pix_row, cx, cy, cz, cr, cp, m);
 }
 #else
 #define FPLOC_PREP_WIDE 0
@@ -299,29 +317,38 @@ bool Segmenter::prepare(const Scan& scan) {
 #if FPLOC_PREP_WIDE
   const bool wide8 = identity && W % 8 == 0 && kern::wide();
   const bool all_ok = std::all_of(col_ok_.begin(), col_ok_.end(), [](uint8_t o) { return o != 0; });
-  auto ring_pass8w = [&](int u, Candidates& cs) {
+  auto ring_pass8w = [&](int u, int next_u, Candidates& cs) {
     const size_t row = size_t(u) * W;
     const float* lut[6];
     for (int e = 0; e < 6; ++e) lut[e] = lut_soa_[e].data() + row;
     const float* rot[9];
     for (int e = 0; e < 9; ++e) rot[e] = deskew ? rot_soa_[e].data() : nullptr;
-    const bool zrow = !deskew && !std::isnan(row_z_[size_t(u)][0]);
+    // (the row's z is taken before the rotation: the same floats as the table's)
+    const bool zrow = !std::isnan(row_z_[size_t(u)][0]);
+    float* const raw[3] = {cs.raw_x.data(), cs.raw_y.data(), cs.raw_z.data()};
     cs.n = ring_pass8(rng + row, all_ok ? nullptr : col_okm_.data(), lut, zrow ? row_z_[size_t(u)].data() : nullptr,
-                      deskew ? rot : nullptr, W, int32_t(std::min<uint32_t>(r_lo, 0x7fffffffu)),
+                      deskew ? rot : nullptr, deskew ? raw : nullptr,
+                      next_u >= 0 ? rng + size_t(next_u) * W : nullptr, W, int32_t(std::min<uint32_t>(r_lo, 0x7fffffffu)),
                       int32_t(std::min<uint32_t>(r_hi, 0x7fffffffu)), int32_t(row), cs.x.data(), cs.y.data(), cs.z.data(),
                       cs.range.data(), cs.pixel.data(), cs.n);
     cs.ring_start.push_back(int32_t(cs.n));
   };
 #else
   const bool wide8 = false;
-  auto ring_pass8w = [&](int, Candidates&) {};
+  auto ring_pass8w = [&](int, int, Candidates&) {};
 #endif
-  auto ring_pass = [&](int u, Candidates& cs) { wide8 ? ring_pass8w(u, cs) : identity ? ring_pass4(u, cs) : ring_pass1(u, cs); };
+  auto ring_pass = [&](int u, int next_u, Candidates& cs) {
+    wide8 ? ring_pass8w(u, next_u, cs) : identity ? ring_pass4(u, cs) : ring_pass1(u, cs);
+  };
   const int half = H / 2;
   for (auto [cs, rings] : {std::pair{&upper_, half}, std::pair{&lower_, half}, std::pair{&middle_, H % 2}}) {
     // (+ 8: wall selection's eight-lane loops read up to 7 entries past a ring's end)
     const size_t cap = size_t(rings) * W + 2 * Candidates::kLanes;
     for (auto* v : {&cs->x, &cs->y, &cs->z, &cs->range}) v->resize(cap);
+    // The returns as measured beside the de-skewed ones (the wall points), written by the eight-lane pass.
+    cs->has_raw = deskew && wide8;
+    if (cs->has_raw)
+      for (auto* v : {&cs->raw_x, &cs->raw_y, &cs->raw_z}) v->resize(cap);
     cs->pixel.resize(cap);
     cs->p.clear();
     cs->n = 0;
@@ -331,9 +358,11 @@ bool Segmenter::prepare(const Scan& scan) {
     cs->start_stride = scale_.start_stride;
     cs->final_stride = scale_.final_stride;
   }
-  for (int k = 0; k < half; ++k) ring_pass(ring_order_[k], upper_);
-  for (int k = 0; k < half; ++k) ring_pass(ring_order_[H - 1 - k], lower_);
-  if (H % 2 == 1) ring_pass(ring_order_[half], middle_);
+  // (each with the row after it, whose ranges the eight-lane pass prefetches)
+  for (int k = 0; k < half; ++k) ring_pass(ring_order_[k], k + 1 < half ? ring_order_[k + 1] : ring_order_[H - 1], upper_);
+  for (int k = 0; k < half; ++k)
+    ring_pass(ring_order_[H - 1 - k], k + 1 < half ? ring_order_[H - 2 - k] : H % 2 == 1 ? ring_order_[half] : -1, lower_);
+  if (H % 2 == 1) ring_pass(ring_order_[half], -1, middle_);
   for (Candidates* cs : {&upper_, &lower_, &middle_})
     for (auto* v : {&cs->x, &cs->y, &cs->z}) std::fill(v->begin() + cs->n, v->begin() + cs->n + Candidates::kLanes, std::numeric_limits<float>::quiet_NaN());
   // The plane fits' candidates' bounding boxes per block (the band and the plane quality skip blocks by them).

@@ -93,8 +93,11 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
     w.ring.resize(m + 8);
     w.column.resize(m + 8);
     const wallk::Out out{w.x.data(), w.y.data(), w.z.data(), w.range.data(), w.t.data(), w.ring.data(), w.column.data()};
+    // De-skewed: the returns as measured, stored beside the candidates by the preparation (has_raw), else
+    // computed again from the range and the table.
+    const bool raw = deskewed && upper_.has_raw && lower_.has_raw && (middle_.n == 0 || middle_.has_raw);
     wallk::Measured meas{};
-    if (deskewed) {
+    if (deskewed && !raw) {
       for (int e = 0; e < 6; ++e) meas.lut[e] = lut_soa_[e].data();
       meas.range_mm = scan.range_mm.data();
     }
@@ -102,9 +105,10 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
     g = 0;
     for (const Piece& pc : pieces_) {
       const Candidates& cs = *pc.cs;
-      const wallk::Source src{cs.x.data(), cs.y.data(), cs.z.data(), cs.range.data(), cs.pixel.data()};
+      const wallk::Source src = raw ? wallk::Source{cs.raw_x.data(), cs.raw_y.data(), cs.raw_z.data(), cs.range.data(), cs.pixel.data()}
+                                    : wallk::Source{cs.x.data(), cs.y.data(), cs.z.data(), cs.range.data(), cs.pixel.data()};
       o = wallk::copy8(src, pc.a, pc.b, int32_t(pc.u) * W, pc.off, pc.u, masks_.data() + g, col_dt_.data(),
-                       deskewed ? &meas : nullptr, out, o);
+                       deskewed && !raw ? &meas : nullptr, out, o);
       g += size_t((pc.b - pc.a + 7) / 8);
     }
     for (auto* v : {&w.x, &w.y, &w.z, &w.range, &w.t}) v->resize(m);

@@ -45,6 +45,10 @@ struct Candidates {
   std::vector<float> range;
   std::vector<int32_t> pixel;      // row-major pixel index in the scan
   std::vector<int32_t> ring_start; // ring_start[k]..ring_start[k+1] = k-th ring from the outermost
+  // De-skewed scans (x/y/z rotated to mid-sweep): the same returns as measured, when has_raw (the preparation's
+  // eight-lane pass writes them; the wall points are published as measured).
+  bool has_raw = false;
+  std::vector<float> raw_x, raw_y, raw_z;
   int width = 0;                   // columns of the scan (pixel % width = staggered column)
   // How a fit samples these points, from the beam pattern (beam_scaling.h); 0 = the fit's reference values.
   int seed_rings = 0;
@@ -73,6 +77,7 @@ struct Candidates {
   // Appends one point (tests and tools building candidates by hand; keeps the padding).
   void push(const Eigen::Vector3f& q, float r, int32_t pix) {
     box_n = size_t(-1);
+    has_raw = false;
     for (auto* v : {&x, &y, &z}) v->resize(n + kLanes, std::numeric_limits<float>::quiet_NaN());
     x[n] = q.x();
     y[n] = q.y();
@@ -85,6 +90,7 @@ struct Candidates {
   }
   void clear(int w) {
     n = 0;
+    has_raw = false;
     box_n = size_t(-1);
     p.clear();
     x.assign(kLanes, std::numeric_limits<float>::quiet_NaN());
