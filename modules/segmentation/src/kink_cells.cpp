@@ -130,10 +130,19 @@ __attribute__((target("avx2"))) size_t cells8(const float* xs, const float* ys, 
       std::memcpy(&y, ys + i, 4 * sizeof(float));
       std::memcpy(&z, zs + i, 4 * sizeof(float));
     }
+    const int past = n - i < 8 ? (1 << (n - i)) - 1 : 255;  // (the lanes past n: off)
+    {
+      // Most groups have no return near the plane (walls, the far floor beyond the band): the band test
+      // alone first (lanes()'s, the same floats), the sector and band only where a lane is in.
+      v8f ar = nx * x + ny * y + nz * z + d;
+      v8i b;
+      std::memcpy(&b, &ar, sizeof b);
+      b &= 0x7fffffff;
+      std::memcpy(&ar, &b, sizeof b);
+      if ((_mm256_movemask_ps(reinterpret_cast<__m256>(ar <= zero + kSectorBandM)) & past) == 0) continue;
+    }
     v8i sec = lanes<v8f, v8i>(x, y, z, nx, ny, nz, d, e);
-    int in = _mm256_movemask_ps(reinterpret_cast<__m256>(sec >= 0));
-    if (n - i < 8) in &= (1 << (n - i)) - 1;  // (the lanes past n)
-    if (in == 0) continue;
+    const int in = _mm256_movemask_ps(reinterpret_cast<__m256>(sec >= 0)) & past;
     v8i idx = iota + int32_t(i);
     if (in != 255) {  // the kept lanes to the front
       const __m256i perm = lane8::to_front(kCompress, in);
