@@ -293,8 +293,8 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
       const int64_t tc = scan.column_utime[size_t(lower_.pixel[i] % W)];
       const Eigen::Vector3f p = lower_.point(i);
       if (tc == 0 || !p.allFinite() || std::abs(n.dot(p) + float(pl[3])) >= kSectorTightM) continue;
-      m0.add((p - reff).cast<double>(), 1.0);
-      m1.add((p + float(1e-6 * double(tc - t)) * shift - reff).cast<double>(), 1.0);
+      m0.add1((p - reff).cast<double>());
+      m1.add1((p + float(1e-6 * double(tc - t)) * shift - reff).cast<double>());
     }
     Eigen::Vector4d p0, p1;
     if (m0.w < 4 * kMinSectorPoints || !m0.plane(ref, -up, p0) || !m1.plane(ref, -up, p1)) return 0.0;

@@ -44,6 +44,23 @@ struct Moments {
     s += wi * p;
     ss.noalias() += wi * p * p.transpose();
   }
+  // add(p, 1.0) (the same sums bit for bit: a product with 1 is exact and p_i p_j = p_j p_i), the six distinct
+  // products once.
+  void add1(const Eigen::Vector3d& p) {
+    w += 1.0;
+    s += p;
+    const double xx = p.x() * p.x(), xy = p.y() * p.x(), xz = p.z() * p.x(), yy = p.y() * p.y(), yz = p.z() * p.y(),
+                 zz = p.z() * p.z();
+    ss(0, 0) += xx;
+    ss(1, 0) += xy;
+    ss(2, 0) += xz;
+    ss(0, 1) += xy;
+    ss(1, 1) += yy;
+    ss(2, 1) += yz;
+    ss(0, 2) += xz;
+    ss(1, 2) += yz;
+    ss(2, 2) += zz;
+  }
   bool plane(const Eigen::Vector3d& ref, const Eigen::Vector3d& up, Eigen::Vector4d& out,
              Eigen::Vector3d* eigenvalues = nullptr) const {
     if (w <= 0) return false;
