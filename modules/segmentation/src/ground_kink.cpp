@@ -283,6 +283,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   const double rate_sigma = std::sqrt(follow_rate_var_ * follow_rate_gain_ / (2 - follow_rate_gain_));
   const bool can_deskew = follow_rate_ok_ && std::abs(follow_rate_) > 2 * rate_sigma && W > 0 &&
                           int(scan.column_utime.size()) == W && lower_.width == W;
+  const bool pow2 = W > 0 && (W & (W - 1)) == 0;  // (the column of a pixel by a mask, not a division)
   const auto sweep_corrected = [&](const Eigen::Vector4d& pl, auto&& use, Eigen::Vector4d* out) {
     const Eigen::Vector3f n = pl.head<3>().cast<float>();
     const Eigen::Vector3f shift = float(follow_rate_) * n;
@@ -290,7 +291,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     for (size_t k = 0; k < near; ++k) {  // (a return within kSectorTightM of pl is one near the ring fit)
       if (!use(sector[k])) continue;
       const size_t i = size_t(index[k]);
-      const int64_t tc = scan.column_utime[size_t(lower_.pixel[i] % W)];
+      const int64_t tc = scan.column_utime[size_t(pow2 ? lower_.pixel[i] & (W - 1) : lower_.pixel[i] % W)];
       const Eigen::Vector3f p = lower_.point(i);
       if (tc == 0 || !p.allFinite() || std::abs(n.dot(p) + float(pl[3])) >= kSectorTightM) continue;
       m0.add1((p - reff).cast<double>());
