@@ -111,36 +111,6 @@ void BM_SegmenterPlusFeaturesImu(benchmark::State& st) {
 }
 BENCHMARK(BM_SegmenterPlusFeaturesImu)->Unit(benchmark::kMicrosecond);
 
-
-void BM_TmpImuFramesNoImu(benchmark::State& st) {
-  const auto& f = frames();
-  auto sg = std::make_unique<seg::RingSegmenter>(seg::SegmenterConfig{});
-  feat::FeatureExtractor fx;
-  size_t k = 0;
-  for (auto _ : st) {
-    if (k == f.consecutive.size()) k = 0;
-    const auto& fr = f.consecutive[k++];
-    benchmark::DoNotOptimize(fx.process(sg->process(fr.scan)).size());
-  }
-}
-BENCHMARK(BM_TmpImuFramesNoImu)->Unit(benchmark::kMicrosecond);
-void BM_TmpImuSegOnly(benchmark::State& st) {
-  const auto& f = frames();
-  auto sg = std::make_unique<seg::RingSegmenter>(seg::SegmenterConfig{});
-  size_t k = 0;
-  for (auto _ : st) {
-    if (k == f.consecutive.size()) {
-      st.PauseTiming();
-      sg = std::make_unique<seg::RingSegmenter>(seg::SegmenterConfig{});
-      k = 0;
-      st.ResumeTiming();
-    }
-    const auto& fr = f.consecutive[k++];
-    bench::feed_imu(*sg, fr);
-    benchmark::DoNotOptimize(sg->process(fr.scan).wall.x.size());
-  }
-}
-BENCHMARK(BM_TmpImuSegOnly)->Unit(benchmark::kMicrosecond);
 // The two stages alone (breakdown; not part of the ratio): the segmenter, and the features of segmentations
 // computed once before the timing.
 void BM_SegmenterOnly(benchmark::State& st) {
