@@ -31,6 +31,8 @@ matcher::AsBuiltModel as_built_of(const O& o, const char* block) {
   if (given(o.as_built_point_sigma_m(), block, "as_built_point_sigma_m")) m.point_sigma_m = o.as_built_point_sigma_m();
   if (o.as_built_loss_scale_m() != 0) m.loss_scale_m = std::max(0.0, o.as_built_loss_scale_m());
   m.keep_information = !o.as_built_free_information();
+  if (given(o.as_built_max_spread_sigmas(), block, "as_built_max_spread_sigmas"))
+    m.max_spread_sigmas = o.as_built_max_spread_sigmas();
   return m;
 }
 

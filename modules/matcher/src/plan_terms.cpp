@@ -524,11 +524,23 @@ class FrameCost : public ceres::CostFunction {
           }
           o = A.ldlt().solve(bb);
         }
+        double sw = 0, swe = 0;
         for (size_t k = b; k < e; ++k) {
           const double ee = sorted[k].r - sorted[k].U.dot(o);
-          point_w_[size_t(sorted[k].i)] = float(robust_weight(loss_, a_, ee * ee));
+          const double rw = robust_weight(loss_, a_, ee * ee);
+          point_w_[size_t(sorted[k].i)] = float(rw);
+          sw += sorted[k].w2 * rw;
+          swe += sorted[k].w2 * rw * ee * ee;
         }
-        offset_w_.emplace_back(el, Eigen::Vector2d(rho1_e(o[0] * o[0]), rho1_e(o[1] * o[1])));
+        // Points that do not lie on one line with their wall (AsBuiltModel::max_spread_sigmas): the element's
+        // share, its points' weights and its offsets' prior alike, scaled down by (limit / spread)^2.
+        double share = 1;
+        const double lim = ab_.max_spread_sigmas * ab_.point_sigma_m;
+        if (lim > 0 && sw > 0 && swe > lim * lim * sw) {
+          share = lim * lim * sw / swe;
+          for (size_t k = b; k < e; ++k) point_w_[size_t(sorted[k].i)] *= float(share);
+        }
+        offset_w_.emplace_back(el, share * Eigen::Vector2d(rho1_e(o[0] * o[0]), rho1_e(o[1] * o[1])));
         lw = lam * offset_w_.back().second;
       } else {
         while (wi < offset_w_.size() && offset_w_[wi].first < el) ++wi;
