@@ -31,6 +31,8 @@ matcher::AsBuiltModel as_built_of(const O& o, const char* block) {
   if (given(o.as_built_point_sigma_m(), block, "as_built_point_sigma_m")) m.point_sigma_m = o.as_built_point_sigma_m();
   if (o.as_built_loss_scale_m() != 0) m.loss_scale_m = std::max(0.0, o.as_built_loss_scale_m());
   m.keep_information = !o.as_built_free_information();
+  if (given(o.as_built_max_spread_sigmas(), block, "as_built_max_spread_sigmas"))
+    m.max_spread_sigmas = o.as_built_max_spread_sigmas();
   return m;
 }
 
@@ -57,6 +59,7 @@ matcher::MatcherConfig config_of(const MatcherOptions& o) {
   c.motion_model = !o.disable_motion_model();
   if (given(o.stride(), "matcher", "stride")) c.stride = o.stride();
   if (o.max_points() != 0) c.max_points = o.max_points() < 0 ? 0 : o.max_points();
+  if (given(o.element_quota(), "matcher", "element_quota")) c.element_quota = o.element_quota();
   c.deskew = !o.disable_deskew();
   if (o.prediction_sigma_m() != 0) c.prediction_sigma_m = std::max(0.0, o.prediction_sigma_m());
   if (o.prediction_sigma_deg() != 0) c.prediction_sigma_rad = std::max(0.0, o.prediction_sigma_deg()) * kRadPerDeg;
@@ -80,6 +83,7 @@ optimizer::OptimizerConfig config_of(const OptimizerOptions& o) {
   if (given(o.rounds(), "optimizer", "rounds")) c.rounds = o.rounds();
   if (given(o.stride(), "optimizer", "stride")) c.stride = o.stride();
   if (o.max_points() != 0) c.max_points = o.max_points() < 0 ? 0 : o.max_points();
+  if (given(o.element_quota(), "optimizer", "element_quota")) c.element_quota = o.element_quota();
   if (given(o.max_keyframe_gap_s(), "optimizer", "max_keyframe_gap_s")) c.max_keyframe_gap_s = o.max_keyframe_gap_s();
   if (o.keyframe_interval_s() != 0) c.keyframe_interval_s = std::max(0.0, o.keyframe_interval_s());
   if (o.max_final_delay_s() != 0) c.max_final_delay_s = std::max(0.0, o.max_final_delay_s());

@@ -105,7 +105,8 @@ TEST(ConfigDefaults, Matcher) {
          {"prediction_sigma_m", c.prediction_sigma_m}, {"prediction_sigma_deg", c.prediction_sigma_rad * kDeg},
          {"odom_gate_sigmas", c.odom_gate_sigmas}, {"as_built_sigma_m", c.as_built.sigma_m},
          {"as_built_point_sigma_m", c.as_built.point_sigma_m},
-         {"as_built_loss_scale_m", c.as_built.loss_scale_m}});
+         {"as_built_loss_scale_m", c.as_built.loss_scale_m}, {"element_quota", c.element_quota},
+         {"as_built_max_spread_sigmas", c.as_built.max_spread_sigmas}});
 }
 
 TEST(ConfigDefaults, Optimizer) {
@@ -118,7 +119,8 @@ TEST(ConfigDefaults, Optimizer) {
          {"max_final_delay_s", c.max_final_delay_s},
          {"max_points", c.max_points}, {"relook_m", c.relook_m},
          {"as_built_sigma_m", c.as_built.sigma_m}, {"as_built_point_sigma_m", c.as_built.point_sigma_m},
-         {"as_built_loss_scale_m", c.as_built.loss_scale_m}});
+         {"as_built_loss_scale_m", c.as_built.loss_scale_m}, {"element_quota", c.element_quota},
+         {"as_built_max_spread_sigmas", c.as_built.max_spread_sigmas}});
 }
 
 TEST(ConfigDefaults, Odometry) {

@@ -49,6 +49,17 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
   ao.stride = std::max(1, cfg.stride);
   if (cfg.max_points > 0 && int(f.points.size()) > cfg.max_points * ao.stride)
     ao.stride = int((f.points.size() + size_t(cfg.max_points) - 1) / size_t(cfg.max_points));
+  ao.element_quota = cfg.element_quota;
+  // The per-element budget's points, chosen once for the frame at the guess under the final gate (the rounds'
+  // poses differ from it by centimetres while tracking; a guess farther off keeps fewer points for sure,
+  // every stride-th point as without the budget).
+  std::vector<SampledPoint> sel;
+  if (cfg.element_quota > 0 && ao.stride > 1 && lookup.element_targets()) {
+    AssignOptions so = ao;
+    so.gate_m = cfg.min_correspondence_m;
+    select_points(lookup, f, guess, so, &sel);
+    ao.points = &sel;
+  }
   std::vector<Assignment> as, last_as;
   ceres::Problem::Options po;
   po.disable_all_safety_checks = true;

@@ -190,10 +190,11 @@ class FrameCost : public ceres::CostFunction {
 
  private:
   // A point of the as-built model: on element `el`, signed offset r (along the segment's left normal, or
-  // radially), r = U . (the element's offsets) + noise, d r / d x = j; w2 its squared weight.
+  // radially), r = U . (the element's offsets) + noise, d r / d x = j; w2 its squared weight, pw2 that without
+  // its sampling weight (Assignment::sw), which sets its element's offset prior.
   struct Obs {
     int el, i;          // element, assignment
-    double r, w2;
+    double r, w2, pw2;
     Eigen::Vector2d U;  // d r / d (o_a, o_b) (segments) or d r / d (centre offset) (circles), up to sign
     Eigen::Vector3d j;
   };
@@ -207,7 +208,8 @@ class FrameCost : public ceres::CostFunction {
     Eigen::Vector2d q;
     Eigen::Matrix2d J;
     const double d2 = closest_of2(*targets_, as_[i].cand, as_[i].n, pw, &q, jrow || ob ? &J : nullptr, &which);
-    const double we = w_ * (which >= 0 ? double(as_[i].w[which]) : 1.0);
+    const double we_el = w_ * (which >= 0 ? double(as_[i].w[which]) : 1.0);
+    const double we = we_el * double(as_[i].sw);
     if (ob && which >= 0) {
       // Segments: the signed offset from its line (also a little past an end: the wall as built may go on),
       // U = (1 - t, t) with t clamped to the segment. Circles and arcs (points within the arc): the signed
@@ -220,6 +222,7 @@ class FrameCost : public ceres::CostFunction {
         const double t = std::clamp((pw - e.a).dot(e.u) / e.len, 0.0, 1.0);
         ob->U = Eigen::Vector2d(1 - t, t);
         ob->w2 = we * we;
+        ob->pw2 = we_el * we_el;
         ob->j = Eigen::Vector3d(n.x(), n.y(), n.x() * -ry + n.y() * rx);
         return false;
       }
@@ -231,6 +234,7 @@ class FrameCost : public ceres::CostFunction {
         ob->r = nd - e.r;
         ob->U = u;
         ob->w2 = we * we;
+        ob->pw2 = we_el * we_el;
         ob->j = Eigen::Vector3d(u.x(), u.y(), u.x() * -ry + u.y() * rx);
         return false;
       }
@@ -323,14 +327,14 @@ class FrameCost : public ceres::CostFunction {
         w.el = el;
         w.n = Eigen::Vector2d(-e->u.y(), e->u.x());
         w.na = w.n.dot(e->a);
-        const double we = w_ * double(as_[i].w[k_on]);
+        const double we = w_ * double(as_[i].w[k_on]);  // the offset prior: without the sampling weight
         w.w2 = we * we;
         walls_.push_back(w);
       }
       WallAgg& w = walls_[size_t(slot[size_t(el)])];
       const double t = std::clamp((pw - e->a).dot(e->u) / e->len, 0.0, 1.0);
       const Eigen::Vector2d U(1 - t, t);
-      const double we = w_ * double(as_[i].w[k_on]);
+      const double we = w_ * double(as_[i].w[k_on]) * double(as_[i].sw);
       const double W = we * we * double(point_w_[i]);
       const double al = w.n.dot(p), be = w.n.x() * -p.y() + w.n.y() * p.x();
       w.S += W;
@@ -404,7 +408,7 @@ class FrameCost : public ceres::CostFunction {
         ElemAcc& a = acc[size_t(ob.el)];
         if (!a.used) {
           a.used = true;
-          a.w2 = ob.w2;
+          a.w2 = ob.pw2;
           used.push_back(ob.el);
         }
         const double w = ob.w2 * point_w_[i];
@@ -501,7 +505,7 @@ class FrameCost : public ceres::CostFunction {
       size_t e = b;
       const int el = sorted[b].el;
       double w2max = 0;
-      for (; e < sorted.size() && sorted[e].el == el; ++e) w2max = std::max(w2max, sorted[e].w2);
+      for (; e < sorted.size() && sorted[e].el == el; ++e) w2max = std::max(w2max, sorted[e].pw2);
       const double lam = lam0 * w2max;
       Eigen::Vector2d lw(lam, lam);  // the offsets' prior weights
       if (!prepared_) {
@@ -520,11 +524,23 @@ class FrameCost : public ceres::CostFunction {
           }
           o = A.ldlt().solve(bb);
         }
+        double sw = 0, swe = 0;
         for (size_t k = b; k < e; ++k) {
           const double ee = sorted[k].r - sorted[k].U.dot(o);
-          point_w_[size_t(sorted[k].i)] = float(robust_weight(loss_, a_, ee * ee));
+          const double rw = robust_weight(loss_, a_, ee * ee);
+          point_w_[size_t(sorted[k].i)] = float(rw);
+          sw += sorted[k].w2 * rw;
+          swe += sorted[k].w2 * rw * ee * ee;
         }
-        offset_w_.emplace_back(el, Eigen::Vector2d(rho1_e(o[0] * o[0]), rho1_e(o[1] * o[1])));
+        // Points that do not lie on one line with their wall (AsBuiltModel::max_spread_sigmas): the element's
+        // share, its points' weights and its offsets' prior alike, scaled down by (limit / spread)^2.
+        double share = 1;
+        const double lim = ab_.max_spread_sigmas * ab_.point_sigma_m;
+        if (lim > 0 && sw > 0 && swe > lim * lim * sw) {
+          share = lim * lim * sw / swe;
+          for (size_t k = b; k < e; ++k) point_w_[size_t(sorted[k].i)] *= float(share);
+        }
+        offset_w_.emplace_back(el, share * Eigen::Vector2d(rho1_e(o[0] * o[0]), rho1_e(o[1] * o[1])));
         lw = lam * offset_w_.back().second;
       } else {
         while (wi < offset_w_.size() && offset_w_[wi].first < el) ++wi;
@@ -618,6 +634,72 @@ double closest_of(const std::vector<TargetGeom>& targets, const int* cand, int n
   return std::sqrt(closest_of2(targets, cand, n, p, q, dr_dp));
 }
 
+namespace {
+// The candidates of weight <= 0 (AssignOptions::element_weight) taken out, the others' weights set.
+void weigh(const std::vector<float>* ew, Assignment* a) {
+  if (!ew) return;
+  int k = 0;
+  for (int i = 0; i < a->n; ++i) {
+    const size_t id = size_t(a->cand[i]);
+    const float w = id < ew->size() ? (*ew)[id] : 1.0f;
+    if (!(w > 0)) continue;
+    a->cand[k] = a->cand[i];
+    a->w[k] = w;
+    ++k;
+  }
+  a->n = k;
+}
+
+inline Eigen::Vector2d to_world(const Pose2& x, double c, double s, const Eigen::Vector2d& p) {
+  return Eigen::Vector2d(c * p.x() - s * p.y() + x.x, s * p.x() + c * p.y() + x.y);
+}
+}  // namespace
+
+void select_points(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, const AssignOptions& o,
+                   std::vector<SampledPoint>* out) {
+  out->clear();
+  const size_t n = f.points.size();
+  const size_t stride = size_t(std::max(1, o.stride));
+  if (!(o.element_quota > 0 && stride > 1 && lookup.element_targets())) {
+    out->reserve(n / stride + 1);
+    for (size_t i = 0; i < n; i += stride) out->push_back({int(i), 1.0f});
+    return;
+  }
+  // Per-element budget: every point looked up, its closest candidate within the gate counted per element; an
+  // element with at most element_quota points keeps them all (sampling weight 1/sqrt(stride): each stands for
+  // itself, a stride-th point for stride points), the others every stride-th point.
+  const auto& g = lookup.geometry();
+  const std::vector<float>* ew = o.element_weight;
+  const int maxc = std::clamp(o.max_candidates, 1, kMaxCandidates);
+  const double g2 = o.gate_m * o.gate_m;
+  const double c = std::cos(x.yaw), s = std::sin(x.yaw);
+  thread_local std::vector<int> on, count;
+  on.assign(n, -1);
+  if (count.size() < g.size()) count.resize(g.size(), 0);
+  Assignment a;
+  Eigen::Vector2d q;
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d pw = to_world(x, c, s, f.points[i].p);
+    a.n = lookup.candidates(pw, a.cand, maxc);
+    weigh(ew, &a);
+    if (a.n <= 0) continue;
+    int which = -1;
+    if (closest_of2(g, a.cand, a.n, pw, &q, nullptr, &which) <= g2 && which >= 0) {
+      on[i] = a.cand[which];
+      ++count[size_t(on[i])];
+    }
+  }
+  const float rare_w = float(1.0 / std::sqrt(double(stride)));
+  out->reserve(n / stride + 1);
+  for (size_t i = 0; i < n; ++i) {
+    const bool rare = on[i] >= 0 && count[size_t(on[i])] <= o.element_quota;
+    if (rare) out->push_back({int(i), rare_w});
+    else if (i % stride == 0) out->push_back({int(i), 1.0f});
+  }
+  for (size_t i = 0; i < n; ++i)
+    if (on[i] >= 0) count[size_t(on[i])] = 0;
+}
+
 void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, const AssignOptions& o,
             std::vector<Assignment>* out) {
   out->clear();
@@ -635,35 +717,35 @@ void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, 
   std::vector<GroupPoint> gps;
   Eigen::Vector2d q;
   const std::vector<float>* ew = lookup.element_targets() ? o.element_weight : nullptr;
-  // Weights of the candidates; those of weight <= 0 are taken out.
-  auto weigh = [ew](Assignment* a) {
-    if (!ew) return;
-    int k = 0;
-    for (int i = 0; i < a->n; ++i) {
-      const size_t id = size_t(a->cand[i]);
-      const float w = id < ew->size() ? (*ew)[id] : 1.0f;
-      if (!(w > 0)) continue;
-      a->cand[k] = a->cand[i];
-      a->w[k] = w;
-      ++k;
-    }
-    a->n = k;
-  };
   const double c = std::cos(x.yaw), s = std::sin(x.yaw);
-  out->reserve(f.points.size() / stride + 1);
-  for (size_t i = 0; i < f.points.size(); i += stride) {
-    const auto& fp = f.points[i];
-    const Eigen::Vector2d pw(c * fp.p.x() - s * fp.p.y() + x.x, s * fp.p.x() + c * fp.p.y() + x.y);
+  auto one = [&](size_t i, float sw) {
+    const Eigen::Vector2d pw = to_world(x, c, s, f.points[i].p);
     Assignment a;
     a.point = int(i);
+    a.sw = sw;
     a.n = lookup.candidates(pw, a.cand, maxc);
-    weigh(&a);
-    if (a.n <= 0) continue;
-    if (groups && fp.group >= 0) {
-      gps.push_back({fp.group, int(i), pw, a});
-      continue;
+    weigh(ew, &a);
+    if (a.n <= 0) return;
+    // The grouped points wait for their group's element.
+    if (groups && f.points[i].group >= 0) {
+      gps.push_back({f.points[i].group, int(i), pw, a});
+      return;
     }
     if (closest_of2(g, a.cand, a.n, pw, &q, nullptr) <= g2) out->push_back(a);
+  };
+  const std::vector<SampledPoint>* sel = o.points;
+  thread_local std::vector<SampledPoint> own;
+  if (!sel && o.element_quota > 0 && stride > 1 && lookup.element_targets()) {
+    select_points(lookup, f, x, o, &own);
+    sel = &own;
+  }
+  if (sel) {
+    out->reserve(sel->size());
+    for (const SampledPoint& sp : *sel)
+      if (sp.point >= 0 && size_t(sp.point) < f.points.size()) one(size_t(sp.point), sp.sw);
+  } else {
+    out->reserve(f.points.size() / stride + 1);
+    for (size_t i = 0; i < f.points.size(); i += stride) one(i, 1.0f);
   }
   if (gps.empty()) return;
   // One element per group: the candidate (from the union of its points' candidates) with the smallest
@@ -695,6 +777,7 @@ void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, 
         a.n = 1;
         a.cand[0] = best;
         if (ew && size_t(best) < ew->size()) a.w[0] = (*ew)[size_t(best)];
+        a.sw = gps[i].a.sw;
         out->push_back(a);
       }
     b = e;
@@ -746,7 +829,7 @@ Eigen::Matrix3d frame_information(const NearestLookup& lookup, const FeatureFram
     const Eigen::Vector2d pw(rx + x.x, ry + x.y);
     int which = -1;
     closest_of2(g, a.cand, a.n, pw, &q, &J, &which);
-    const double we = which >= 0 ? double(a.w[which]) : 1.0;
+    const double we = (which >= 0 ? double(a.w[which]) : 1.0) * double(a.sw);
     Eigen::Matrix<double, 2, 3> Jr;
     Jr.leftCols<2>() = J;
     Jr.col(2) = J * Eigen::Vector2d(-ry, rx);

@@ -76,6 +76,40 @@ TEST(AsBuilt, WorldAsDrawnUnchanged) {
   }
 }
 
+// A corridor whose east end wall is glass (no returns) with a cabinet behind it: the cabinet's face (0.9 m of
+// the 2 m wall, 22 deg askew, 1-35 cm behind the drawn line) and the west end wall 10-20 m away are all that
+// holds the position along the corridor. The face's points do not lie on one line with the wall (their spread
+// about the wall's fitted offsets is ~10 cm against the 4 cm point sigma), so they pull with a share scaled down
+// (AsBuiltModel::max_spread_sigmas), not as a whole wall standing off its place.
+TEST(AsBuilt, AFaceSeenThroughGlassDoesNotPullAsAWall) {
+  FloorPlan plan;
+  plan.elements.push_back(Element::segment({0, 0}, {30, 0}));
+  plan.elements.push_back(Element::segment({0, 2}, {30, 2}));
+  plan.elements.push_back(Element::segment({0, 0}, {0, 2}));
+  plan.elements.push_back(Element::segment({30, 0}, {30, 2}));
+  FloorPlan world = plan;
+  world.elements.pop_back();  // the east end: glass
+  const Eigen::Vector2d c(30.18, 1.0), u(std::sin(22 * M_PI / 180), std::cos(22 * M_PI / 180));
+  world.elements.push_back(Element::segment(c - 0.45 * u, c + 0.45 * u));
+  auto map = make_localization_map(plan, "annf-exact");
+  fploc::testing::SynthOptions so;
+  so.beams = 1440;
+  so.max_range = 30;
+  so.noise_sigma = 0.005;
+  for (const Pose2 truth : {Pose2{20.0, 1.0, 0.0}, Pose2{22.0, 0.7, 0.5}, Pose2{18.0, 1.3, 2.8}}) {
+    const FeatureFrame f = fploc::testing::synth_frame(world, truth, so);
+    MatcherConfig whole = config(true), bounded = config(true);
+    bounded.as_built.max_spread_sigmas = 1.0;
+    const MatchResult a = register_frame(*map.lookup, f, truth, whole);
+    const MatchResult b = register_frame(*map.lookup, f, truth, bounded);
+    ASSERT_EQ(a.status, FitStatus::kOk);
+    ASSERT_EQ(b.status, FitStatus::kOk);
+    const double e_whole = std::abs(a.pose.x - truth.x), e_bounded = std::abs(b.pose.x - truth.x);
+    EXPECT_GT(e_whole, 0.005) << "as a whole wall the face should pull the fit along the corridor";
+    EXPECT_LT(e_bounded, 0.7 * e_whole) << "whole share " << e_whole << " bounded " << e_bounded;
+  }
+}
+
 // The as-built term evaluated through the walls' moments (AsBuiltModel::per_wall) gives the cost, gradient
 // and Gauss-Newton matrix of the per-point evaluation: exactly at the pose it was prepared at, and within
 // what the points' frozen position along their wall allows 2 cm / 0.5 deg away from it.

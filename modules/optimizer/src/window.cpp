@@ -265,6 +265,7 @@ void WindowOptimizer::solve() {
   ao.group_rule = cfg_.group_rule;
   ao.element_weight = cfg_.element_weight;
   ao.stride = cfg_.stride;
+  ao.element_quota = cfg_.element_quota;
   // Anchors: the last final key poses, held fixed (optional).
   double anchors[2][3];
   std::vector<std::pair<double*, int64_t>> chain;  // pose block, utime
@@ -292,6 +293,13 @@ void WindowOptimizer::solve() {
       aok.stride = std::max(1, cfg_.stride);
       if (cfg_.max_points > 0 && np > size_t(cfg_.max_points) * size_t(aok.stride))
         aok.stride = int((np + size_t(cfg_.max_points) - 1) / size_t(cfg_.max_points));
+      if (aok.element_quota > 0 && aok.stride > 1 && lookup_.element_targets()) {
+        if (!k.sel_valid) {
+          matcher::select_points(lookup_, k.deskewed, xk, aok, &k.sel);
+          k.sel_valid = true;
+        }
+        aok.points = &k.sel;
+      }
       std::vector<matcher::Assignment> as;
       assign(lookup_, k.deskewed, xk, aok, &as);
       changed |= !k.as_valid || as != k.as;
@@ -309,7 +317,8 @@ void WindowOptimizer::solve() {
       problem.AddParameterBlock(k.x, 3);
       // The paper's sigma_sfr sums over all of the frame's features: a point budget (every stride-th
       // point) estimates that sum with weight stride, so the balance against the velocity terms does not
-      // depend on the budget.
+      // depend on the budget. With element_quota the points kept for sure (their element has few) carry their
+      // own sampling weight 1/sqrt(stride) (Assignment::sw), so they count once each.
       const double w = cfg_.budget_weight ? std::sqrt(double(k.as_stride)) : 1.0;
       if (!k.term) {
         const double xa[3] = {k.as_pose.x, k.as_pose.y, k.as_pose.yaw};

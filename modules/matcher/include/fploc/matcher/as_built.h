@@ -22,6 +22,13 @@ struct AsBuiltModel {
   double point_sigma_m = 0.04;  // (point_sigma_m / sigma_m)^2 = 4 points per wall end at sigma_m 2 cm
   double loss_scale_m = 0.03;   // <= 0: no loss on the offsets (Gaussian prior)
   bool keep_information = true;
+  // A wall's points that do not lie on one line with it are no wall standing off its drawn place (a cabinet's
+  // face seen through a glass wall, behind it and askew): when their rms spread about the wall's fitted offsets
+  // (weighted by the points' robust weights) exceeds max_spread_sigmas * point_sigma_m, the element's share (its
+  // points' and its offsets' prior weights alike) is scaled by (max_spread_sigmas * point_sigma_m / spread)^2,
+  // so it no longer pulls as a whole wall does. <= 0: off (the default: at 1 it takes the corridor glass world's
+  // seed 2 from 5.25 to 1.96 cm but costs the as-built worlds at sigma 5 cm 1-8 %, docs/notes/realism.md).
+  double max_spread_sigmas = 0;
   // Evaluate the points of a wall through the wall's moments (plan_terms.cpp aggregate_walls: one pass over
   // the walls per evaluation instead of a closest-point query per point; the same cost, gradient and
   // Gauss-Newton matrix at the pose the term is prepared at, the points' position along their wall held

@@ -14,12 +14,25 @@ struct Assignment {
   // Per candidate: the element's weight (AssignOptions::element_weight; 1 without). The residual of the
   // point is scaled by the weight of the candidate that is closest when it is evaluated.
   float w[kMaxCandidates] = {1, 1, 1, 1, 1, 1, 1, 1};
+  // The point's sampling weight (AssignOptions::element_quota): 1 for a point taken as every stride-th
+  // point (it stands for stride points), 1/sqrt(stride) for a point kept for sure because its element has
+  // few points in the frame (it stands for itself), so that the kept points' squared residuals, summed
+  // with these weights and times stride, estimate the sum over all points (Horvitz-Thompson). It scales
+  // the point's residual only, not the as-built model's offset prior of its element.
+  float sw = 1;
   bool operator==(const Assignment& o) const {
-    if (point != o.point || n != o.n) return false;
+    if (point != o.point || n != o.n || sw != o.sw) return false;
     for (int i = 0; i < n; ++i)
       if (cand[i] != o.cand[i] || w[i] != o.w[i]) return false;
     return true;
   }
+};
+
+// A point of the frame that the assignments use, with its sampling weight (Assignment::sw).
+struct SampledPoint {
+  int point = -1;
+  float sw = 1;
+  bool operator==(const SampledPoint& o) const { return point == o.point && sw == o.sw; }
 };
 
 struct AssignOptions {
@@ -27,6 +40,15 @@ struct AssignOptions {
   bool group_rule = true;  // one PCA group <-> one element (element look-ups only)
   int max_candidates = kMaxCandidates;
   int stride = 1;          // use every stride-th point (1 = all)
+  // Per-element point budget (element look-ups, stride > 1): the points whose closest candidate within the
+  // gate is an element that holds at most element_quota of the frame's points are all kept (the stride
+  // applies to the other elements' points), with sampling weight Assignment::sw = 1/sqrt(stride). A wall
+  // seen with a handful of points (the only one across a corridor, far away) keeps them all, where every
+  // stride-th would keep 0-2 of them. 0 = off (every stride-th point of the frame).
+  int element_quota = 0;
+  // The points to use, as select_points (plan_terms.h) chose them: when given, stride and element_quota are
+  // not looked at (a caller that assigns one frame many times at nearby poses selects once). Not owned.
+  const std::vector<SampledPoint>* points = nullptr;
   // Per plan element (target id of an element look-up): its weight in the floor-plan terms, e.g. from
   // the plan-change detector (element_weights.h). Elements with weight <= 0 are no candidates at all;
   // null (or a look-up of point targets): every element 1. Not owned.

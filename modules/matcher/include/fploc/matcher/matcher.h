@@ -35,6 +35,10 @@ struct MatcherConfig {
   bool deskew = true;             // motion compensation with the motion model's twist (IMU yaw rate if given)
   int stride = 1;                 // use every stride-th point
   int max_points = 800;           // more features than this: the stride grows to keep about this many (0 = all)
+  // With a stride > 1: the points of a plan element holding at most this many of the frame's points are all
+  // kept, weighted as a point budget's estimate of the sum over all points (AssignOptions::element_quota);
+  // 0 = off.
+  int element_quota = 0;
   // While tracking, the prediction enters the registration as one more measurement: its uncertainty over
   // one frame (a platform's deviation from constant velocity in 0.1 s plus the velocity estimate's error;
   // grows with the time since the last frame), weighed against the floor-plan residuals by the last fit's

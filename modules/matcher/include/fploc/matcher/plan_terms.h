@@ -20,7 +20,14 @@
 
 namespace fploc::matcher {
 
-// Correspondences of the frame's points at pose x (in point order).
+// The points assign() uses at pose x: every o.stride-th, and with o.element_quota (element look-ups, stride > 1)
+// also every point whose closest candidate within o.gate_m is an element holding at most element_quota of the
+// frame's points, at sampling weight 1/sqrt(stride) (AssignOptions::element_quota). In point order.
+void select_points(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, const AssignOptions& o,
+                   std::vector<SampledPoint>* out);
+
+// Correspondences of the frame's points at pose x (in point order): of o.points when given, else of the
+// points select_points chooses at x.
 void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, const AssignOptions& o,
             std::vector<Assignment>* out);
 

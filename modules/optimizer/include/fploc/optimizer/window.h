@@ -51,6 +51,7 @@ struct OptimizerConfig {
   int stride = 1;                      // use every stride-th feature point of a keyframe
   int max_points = 800;                // per keyframe: the stride grows to keep about this many (0 = all)
   bool budget_weight = true;           // weight the sampled points by the stride (estimate of the sum over all)
+  int element_quota = 0;               // as MatcherConfig::element_quota (0 = off)
   double relook_m = 0.01;              // a key's correspondences are looked up again when it moved this far
   double relook_rad = 0.2 * M_PI / 180;  // ... or turned this much since the last look-up
   bool anchor_final = false;           // also regularise against the last two final key poses (held fixed)
@@ -149,6 +150,9 @@ class WindowOptimizer {
     Pose2 as_pose;
     bool as_valid = false;
     int as_stride = 1;
+    // The points its look-ups use (matcher::select_points at its first look-up: the per-element budget).
+    std::vector<matcher::SampledPoint> sel;
+    bool sel_valid = false;
     // The floor-plan term of `as`, prepared at as_pose (matcher::make_frame_term): kept across rounds and
     // solves while the correspondences hold, re-built with them.
     std::shared_ptr<ceres::CostFunction> term;
