@@ -248,6 +248,14 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
   Eigen::Vector3d sg = Eigen::Vector3d::Zero();
   double so2 = 0;
   int scount = 0;
+  // The same sums per element (its share of the scan's scale information), for the variance by wall.
+  struct ScaleSums {
+    int element;
+    Eigen::Matrix3d A;
+    Eigen::Vector3d g;
+  };
+  std::vector<ScaleSums> esums;
+  std::vector<int> eslot(plan_.elements.size(), -1);
   for (const auto& pf : points) {
     const V2 ps(pf.x(), pf.y());
     const double r = ps.norm();
@@ -282,6 +290,13 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
         sg += row * off;
         so2 += off * off;
         ++scount;
+        int& slot = eslot[size_t(e)];
+        if (slot < 0) {
+          slot = int(esums.size());
+          esums.push_back({e, Eigen::Matrix3d::Zero(), Eigen::Vector3d::Zero()});
+        }
+        esums[size_t(slot)].A += row * row.transpose();
+        esums[size_t(slot)].g += row * off;
       }
     } else {
       const int ix = int(std::floor(p.x() / o_.new_cell_m)), iy = int(std::floor(p.y() / o_.new_cell_m));
@@ -383,6 +398,16 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
       scale_g_ += sg(0) - Asb.dot(inv * sg.tail<2>());
       scale_o2_ += so2 - sg.tail<2>().dot(inv * sg.tail<2>());
       scale_n_ += scount - 2;
+      // Each element's part of the eliminated score, G_e - s H_e at any s: with w = (1, -Abb^-1 Asb) and the
+      // scan's bias at s = 0, beta = Abb^-1 g_b, G_e = w.(g_e - A_e[:, b] beta), H_e = w.A_e w. Summed over
+      // the elements they are the scan's scale_g_ / scale_h_ terms above.
+      const Eigen::Vector2d k = inv * Asb, beta = inv * sg.tail<2>();
+      const Eigen::Vector3d w(1.0, -k.x(), -k.y());
+      if (scale_eg_.size() != plan_.elements.size()) scale_eg_.assign(plan_.elements.size(), 0.0), scale_eh_.assign(plan_.elements.size(), 0.0);
+      for (const ScaleSums& es : esums) {
+        scale_eg_[size_t(es.element)] += w.dot(es.g - es.A.rightCols<2>() * beta);
+        scale_eh_[size_t(es.element)] += w.dot(es.A * w);
+      }
     }
   }
   // Every unexplained cell seen so far: was it in view in this scan (in range, nothing measured in front)?
@@ -478,6 +503,20 @@ Diff PlanDiff::result() const {
     // scan as one observation of its walls, i.e. it is inflated by sqrt(points per scan).
     const double per_scan = double(scale_n_) / std::max(1, frames_);
     d.scale_sigma = std::sqrt(var / scale_h_ * std::max(1.0, per_scan));
+    // The walls themselves stand off their drawn lines (as built: a few cm each, for the whole run), and a
+    // wall's offsets look like a scale to the scans that see it across a narrow room: every scan of that wall
+    // repeats the same error. So the sigma is also taken with the walls as the independent units (the
+    // sandwich variance clustered by element, with the small-sample factor C / (C - 1)); the larger is kept.
+    double u2 = 0;
+    int clusters = 0;
+    for (size_t e = 0; e < scale_eg_.size(); ++e) {
+      if (!(scale_eh_[e] > 0)) continue;
+      const double u = scale_eg_[e] - d.scale_error * scale_eh_[e];
+      u2 += u * u;
+      ++clusters;
+    }
+    if (clusters >= 2)
+      d.scale_sigma = std::max(d.scale_sigma, std::sqrt(u2 * clusters / (clusters - 1)) / scale_h_);
     d.scale_points = scale_n_;
   }
   // As-built refinement: (H / sigma_obs^2 + I / sigma_prior^2) o = g / sigma_obs^2.

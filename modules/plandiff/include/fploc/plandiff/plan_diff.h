@@ -200,6 +200,7 @@ class PlanDiff {
   int frames_ = 0;
   double scale_h_ = 0, scale_g_ = 0, scale_o2_ = 0;
   int64_t scale_n_ = 0;
+  std::vector<double> scale_eg_, scale_eh_;  // per element: its part of scale_g_ / scale_h_ (the bias eliminated per scan)
   Eigen::MatrixXd ref_H_;   // as-built refinement: normal equations in (o_a, o_b) per segment, scans eliminated
   Eigen::VectorXd ref_g_;
   std::vector<int> ref_frames_;
