@@ -183,7 +183,9 @@ std::optional<DeadReckoned> Localizer::dead_reckoned(const FeatureFrame& f, cons
   const UncertaintyConfig& u = cfg_.uncertainty;
   if (!dr_odometry_) {
     // The stretch starts: the last OK frame at its fix is the odometry's map.
-    dr_odometry_.emplace();
+    odometry::OdometryConfig oc;
+    oc.max_points = u.dr_max_points;
+    dr_odometry_.emplace(oc);
     dr_odometry_->set_pose(anchor_.pose, anchor_velocity_);
     dr_odometry_->process(anchor_frame_);
     dr_valid_ = true;

@@ -101,8 +101,11 @@ struct UncertaintyConfig {
   // A frame the odometry cannot register, or over which its velocity changes by more than dr_jump_mps (the ICP caught
   // another minimum; a platform changes its velocity by a few cm/s per frame, the odometry's noise adds ~0.1 m/s),
   // ends the dead reckoning until the next OK: the fixes are then checked as before.
+  // The odometry registers every k-th point so that about dr_max_points are used (its own default is 800: a third of
+  // the CPU, the same verdicts on the corridor worlds).
   double dead_reckoning_gate_sigma = 3.0;
   double dr_jump_mps = 0.5;
+  int dr_max_points = 250;
   double dr_sigma_m = 0.02, dr_sigma_per_m = 0.02;
   double dr_sigma_rad = 0.5 * M_PI / 180, dr_sigma_per_rad = 0.02, dr_sigma_rad_per_m = 0.5 * M_PI / 180;
   // A second fit of a re-acquisition (the Localizer's, while the tracker confirms one: `confirming`): the frame
