@@ -83,12 +83,14 @@ void UncertaintyTracker::reset(double sigma_m, double sigma_rad) {
   have_mean_ = false;
   confirming_ = false;
   agreeing_ = 0;
+  dr_agreeing_ = 0;
+  not_ok_since_ok_ = true;  // a re-seeded track: its first fixes are checked against the dead reckoning
 }
 
 UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d& frame_cov_in, bool frame_valid,
                                             matcher::FitStatus matcher_status, const std::string& matcher_text,
                                             const Pose2* fix, const matcher::Twist2* twist, double inlier_ratio,
-                                            const Pose2* motion, double contradicted) {
+                                            const Pose2* motion, double contradicted, const DeadReckoned* dead_reckoned) {
   const double vmax = cfg_.frame.max_variance;
   const double v2 = cfg_.max_velocity_error_mps * cfg_.max_velocity_error_mps;
   const double w2 = cfg_.yaw_rate_sigma_rps * cfg_.yaw_rate_sigma_rps;
@@ -222,6 +224,38 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
       s.status = matcher::FitStatus::kPoor;
       s.text = b;
     }
+  }
+  // A fix after a stretch not published OK: against the dead-reckoned pose (dead_reckoning_gate_sigma).
+  if (s.status == matcher::FitStatus::kOk && not_ok_since_ok_ && fix && dead_reckoned && cfg_.dead_reckoning_gate_sigma > 0) {
+    const Eigen::Vector3d d(fix->x - dead_reckoned->pose.x, fix->y - dead_reckoned->pose.y,
+                            wrap_angle(fix->yaw - dead_reckoned->pose.yaw));
+    const Eigen::Matrix3d S = sym(frame_cov + clamp_spd(dead_reckoned->covariance, 1e-14, vmax));
+    const double d2 = d.dot(Eigen::LDLT<Eigen::Matrix3d>(S).solve(d));
+    s.dead_reckoned_sigma = std::sqrt(std::max(0.0, d2));
+    ++dr_agreeing_;
+    if (d2 > chi2_3dof_of_sigmas(cfg_.dead_reckoning_gate_sigma)) {
+      char b[200];
+      std::snprintf(b, sizeof b, "%.2f m / %.1f deg from the dead-reckoned pose (1 sigma %.2f m; Mahalanobis %.1f > %.1f)",
+                    std::hypot(d[0], d[1]), std::abs(d[2]) * 180 / M_PI, weakest_horizontal(dead_reckoned->covariance, nullptr),
+                    s.dead_reckoned_sigma, std::sqrt(chi2_3dof_of_sigmas(cfg_.dead_reckoning_gate_sigma)));
+      s.status = matcher::FitStatus::kPoor;
+      s.text = b;
+      s.off_dead_reckoning = true;
+      dr_agreeing_ = 0;
+      // Two places the pose may be: the fix's and the dead-reckoned one; the error's second moment.
+      s.covariance += d * d.transpose();
+      s.sigma_max_m = weakest_horizontal(s.covariance, &s.weak_direction_rad);
+      s.sigma_yaw_rad = std::sqrt(std::max(0.0, s.covariance(2, 2)));
+    }
+  }
+  s.confirming = confirming_;
+  // The stretch ends with confirm_fixes fixes in a row within the dead reckoning's gate (one slid a little at a time
+  // would otherwise re-anchor it on each brief OK), at once without a dead-reckoned pose to check against.
+  if (s.status == matcher::FitStatus::kOk) {
+    if (!dead_reckoned || dr_agreeing_ >= std::max(1, cfg_.confirm_fixes)) not_ok_since_ok_ = false, dr_agreeing_ = 0;
+  } else if (matcher_status != matcher::FitStatus::kNotInitialised) {
+    not_ok_since_ok_ = true;
+    dr_agreeing_ = 0;
   }
   return s;
 }

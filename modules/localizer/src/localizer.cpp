@@ -1,13 +1,22 @@
 #include "fploc/localizer/localizer.h"
 
 #include "fploc/matcher/free_space_check.h"
+#include "fploc/matcher/plan_terms.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace fploc::localizer {
 
 namespace {
+Eigen::Matrix3d embed(const Eigen::Matrix2d& A) {  // x/y block, a tiny yaw variance (add_sigmas' basis)
+  Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+  M.topLeftCorner<2, 2>() = A;
+  M(2, 2) = 1e-12;
+  return M;
+}
+
 Config with_uncertainty_defaults(Config c) {
   // The frame covariance is of the matcher's estimate: its loss and final gate.
   c.uncertainty.frame.loss = c.matcher.loss;
@@ -139,15 +148,139 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
     matcher::deskew(f, sfr.match.twist, t_ref, &deskewed_);
     const Pose2 at_ref = compose(sfr.match.pose, matcher::exp_twist(sfr.match.twist, t_ref));
     const auto fu = optimizer::frame_uncertainty(lookup_, deskewed_, at_ref, cfg_.uncertainty.frame);
+    const std::optional<DeadReckoned> dr = dead_reckoned(f, fu.valid ? fu.covariance : Eigen::Matrix3d::Identity() * 1e6);
     uncertainty_ = tracker_.update(f.utime, fu.covariance, fu.valid, sfr.match.status, sfr.match.text, &sfr.match.pose,
                                    &sfr.match.twist, sfr.match.fit.inlier_ratio, motion ? &*motion : nullptr,
-                                   contradicted(deskewed_, at_ref, sfr.match.fit.inlier_ratio));
+                                   contradicted(deskewed_, at_ref, sfr.match.fit.inlier_ratio), dr ? &*dr : nullptr);
+    if (cfg_.uncertainty.rival_ratio > 0 && sfr.match.status == matcher::FitStatus::kOk &&
+        (uncertainty_.confirming || have_rival_))
+      check_rival(deskewed_, at_ref, dr ? &*dr : nullptr, sfr.match.pose);
+    if (uncertainty_.status == matcher::FitStatus::kOk || sfr.match.status == matcher::FitStatus::kLost)
+      have_rival_ = false;  // confirmed, or lost again: a new re-acquisition searches again
+    if (cfg_.uncertainty.dead_reckoning_gate_sigma > 0 && uncertainty_.status == matcher::FitStatus::kOk &&
+        !tracker_.wants_dead_reckoning()) {
+      // The anchor of the next stretch not published OK.
+      anchor_frame_ = f;
+      anchor_.pose = sfr.match.pose;
+      anchor_.covariance = uncertainty_.covariance;
+      const double c = std::cos(sfr.match.pose.yaw), sn = std::sin(sfr.match.pose.yaw);
+      anchor_velocity_ = Eigen::Vector3d(c * sfr.match.twist.vx - sn * sfr.match.twist.vy,
+                                         sn * sfr.match.twist.vx + c * sfr.match.twist.vy, sfr.match.twist.w);
+      anchor_utime_ = f.utime;
+      have_anchor_ = true;
+      dr_odometry_.reset();
+    }
     in.covariance = uncertainty_.covariance;
     in.published_status = uncertainty_.status;
     in.status_text = uncertainty_.text;
   }
   add_map_error(f, &in.covariance);
   return window_.add(std::move(in), finals);
+}
+
+std::optional<DeadReckoned> Localizer::dead_reckoned(const FeatureFrame& f, const Eigen::Matrix3d& frame_cov) {
+  if (!tracker_.wants_dead_reckoning() || !have_anchor_) return std::nullopt;
+  const UncertaintyConfig& u = cfg_.uncertainty;
+  if (!dr_odometry_) {
+    // The stretch starts: the last OK frame at its fix is the odometry's map.
+    odometry::OdometryConfig oc;
+    oc.max_points = u.dr_max_points;
+    dr_odometry_.emplace(oc);
+    dr_odometry_->set_pose(anchor_.pose, anchor_velocity_);
+    dr_odometry_->process(anchor_frame_);
+    dr_valid_ = true;
+    dr_last_ = anchor_.pose;
+    dr_path_m_ = dr_turn_rad_ = 0;
+    dr_open_ = Eigen::Matrix2d::Zero();
+    dr_last_utime_ = anchor_utime_;
+    dr_velocity_ = anchor_velocity_.head<2>();
+  }
+  const odometry::OdometryResult r = dr_odometry_->process(f);
+  // A frame the odometry could not register breaks the chain: no dead-reckoned pose until the next OK.
+  if (!r.ok) dr_valid_ = false;
+  // ... and so does a jump: the velocity changing from one frame to the next by more than a platform does (the ICP
+  // caught another minimum: a moved wall, a local map of few frames).
+  const double dt = (f.utime - dr_last_utime_) * 1e-6;
+  if (dr_valid_ && dt > 0) {
+    const Eigen::Vector2d v((r.pose.x - dr_last_.x) / dt, (r.pose.y - dr_last_.y) / dt);
+    if ((v - dr_velocity_).norm() > u.dr_jump_mps) dr_valid_ = false;
+    dr_velocity_ = v;
+  }
+  if (!dr_valid_) return std::nullopt;
+  dr_path_m_ += std::hypot(r.pose.x - dr_last_.x, r.pose.y - dr_last_.y);
+  dr_turn_rad_ += std::abs(wrap_angle(r.pose.yaw - dr_last_.yaw));
+  dr_last_ = r.pose;
+  // Where the frame leaves a direction open (a corridor's axis: its own 1-sigma against the plan above poor_sigma_m) the
+  // odometry, on the same features, sees no more along it than the plan fit: it carries its velocity, whose error
+  // (velocity_sigma_mps) times the frame's interval adds to the 1-sigma along that direction.
+  double open_dir = 0;
+  if (weakest_horizontal(frame_cov, &open_dir) > u.poor_sigma_m) {
+    const double a = u.velocity_sigma_mps * std::max(0.0, (f.utime - dr_last_utime_) * 1e-6);
+    const Eigen::Vector2d e(std::cos(open_dir), std::sin(open_dir));
+    dr_open_ = add_sigmas(dr_open_.isZero() ? Eigen::Matrix3d::Identity() * 1e-12 : embed(dr_open_), embed(a * a * e * e.transpose()))
+                   .topLeftCorner<2, 2>();
+  }
+  dr_last_utime_ = f.utime;
+  const double sxy = u.dr_sigma_m + u.dr_sigma_per_m * dr_path_m_;
+  const double syaw = u.dr_sigma_rad + u.dr_sigma_per_rad * dr_turn_rad_ + u.dr_sigma_rad_per_m * dr_path_m_;
+  DeadReckoned d;
+  d.pose = r.pose;
+  d.covariance = anchor_.covariance + Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal().toDenseMatrix();
+  d.covariance.topLeftCorner<2, 2>() += dr_open_;
+  return d;
+}
+
+void Localizer::check_rival(const FeatureFrame& f, const Pose2& fix, const DeadReckoned* dr, const Pose2& fix_at_utime) {
+  const UncertaintyConfig& u = cfg_.uncertainty;
+  matcher::MatcherConfig mc = cfg_.matcher;
+  auto distinct = [&](const Pose2& p) {
+    return std::hypot(p.x - fix.x, p.y - fix.y) > u.rival_distance_m || std::abs(wrap_angle(p.yaw - fix.yaw)) > u.rival_distance_rad;
+  };
+  const int stride = std::max(1, mc.max_points > 0 ? int((f.points.size() + size_t(mc.max_points) - 1) / size_t(mc.max_points)) : 1);
+  std::optional<Pose2> rival;
+  int rival_inliers = 0;
+  if (have_rival_) {
+    // Carried with the track, registered again (the tracking gate).
+    matcher::MatcherConfig mt = mc;
+    mt.max_correspondence_m = std::min(mc.max_correspondence_m, mc.gate_tracking_m);
+    const matcher::MatchResult m = matcher::register_frame(lookup_, f, compose(fix, rival_offset_), mt);
+    if (m.status == matcher::FitStatus::kOk && distinct(m.solved)) rival = m.solved, rival_inliers = m.fit.num_inliers;
+  }
+  if (!rival) {
+    // None (yet, or it was lost): registrations from two rings of starts around the fix; the best distinct fit.
+    for (double r : {0.5 * u.rival_search_m, u.rival_search_m}) {
+      mc.max_correspondence_m = std::max(mc.min_correspondence_m, 0.7 * r);
+      for (int k = 0; k < 8; ++k) {
+        const double a = fix.yaw + k * M_PI / 4;
+        const matcher::MatchResult m =
+            matcher::register_frame(lookup_, f, Pose2{fix.x + r * std::cos(a), fix.y + r * std::sin(a), fix.yaw}, mc);
+        if (m.status != matcher::FitStatus::kOk || !distinct(m.solved)) continue;
+        if (!rival || m.fit.num_inliers > rival_inliers) rival = m.solved, rival_inliers = m.fit.num_inliers;
+      }
+    }
+  }
+  have_rival_ = rival.has_value();
+  if (!rival) return;
+  rival_offset_ = between(fix, *rival);
+  const int own = matcher::evaluate_fit(lookup_, f, fix, mc.inlier_m, stride).num_inliers;
+  const double share = double(rival_inliers) / double(std::max(1, own));
+  if (share < u.rival_ratio) return;
+  if (dr && u.dead_reckoning_gate_sigma > 0 && !uncertainty_.off_dead_reckoning) {
+    // The dead reckoning tells them apart: the fix within its gate (else the tracker said so), the rival beyond.
+    const Pose2 r_at_utime = compose(fix_at_utime, between(fix, *rival));
+    const Eigen::Vector3d e(r_at_utime.x - dr->pose.x, r_at_utime.y - dr->pose.y, wrap_angle(r_at_utime.yaw - dr->pose.yaw));
+    const Eigen::Matrix3d S = dr->covariance + uncertainty_.covariance;
+    if (e.dot(S.ldlt().solve(e)) > chi2_3dof_of_sigmas(u.dead_reckoning_gate_sigma)) return;
+  }
+  const Eigen::Vector3d d(rival->x - fix.x, rival->y - fix.y, wrap_angle(rival->yaw - fix.yaw));
+  char b[200];
+  std::snprintf(b, sizeof b, "re-acquired: a second fit %.2f m / %.1f deg away explains %.0f %% as many points", std::hypot(d[0], d[1]),
+                std::abs(d[2]) * 180 / M_PI, 100 * share);
+  if (uncertainty_.status == matcher::FitStatus::kOk || uncertainty_.confirming) uncertainty_.text = b;
+  if (uncertainty_.status == matcher::FitStatus::kOk) uncertainty_.status = matcher::FitStatus::kPoor;
+  uncertainty_.covariance += d * d.transpose();
+  uncertainty_.sigma_max_m = weakest_horizontal(uncertainty_.covariance, &uncertainty_.weak_direction_rad);
+  tracker_.restart_confirmation();
 }
 
 void Localizer::add_map_error(const FeatureFrame& f, Eigen::Matrix3d* covariance) {

@@ -67,6 +67,12 @@ void Odometry2D::set_pose(const Pose2& p) {
   map_->tree.reset();
 }
 
+void Odometry2D::set_pose(const Pose2& p, const Eigen::Vector3d& velocity) {
+  set_pose(p);
+  velocity_ = velocity;
+  have_velocity_ = true;
+}
+
 void Odometry2D::add_keyframe(const FeatureFrame& f, const Pose2& p) {
   std::vector<Eigen::Vector2d> w;
   w.reserve(f.points.size());

@@ -24,7 +24,10 @@
 // it here"). The matcher's POOR/LOST stay as they are (LOST means lost, not merely uncertain). A fix is also
 // published POOR when the innovation gate refuses it, while a re-acquired track is being confirmed
 // (confirm_fixes), when under half of its points lie on the plan (weak_fit_ratio) and when the map says empty
-// where many of them lie (max_contradicted; occupancy-map plans only).
+// where many of them lie (max_contradicted; occupancy-map plans only), and, after any frame published other than
+// OK, while a fix lies beyond the gate of the dead-reckoned pose (the pose last published OK carried on by the
+// LiDAR odometry since: dead_reckoning_gate_sigma; the Localizer runs that odometry), and while a re-acquisition has
+// a second fit that explains nearly as many points (rival_ratio; the Localizer searches it).
 #pragma once
 #include <Eigen/Core>
 #include <cmath>
@@ -82,6 +85,47 @@ struct UncertaintyConfig {
   // (x/y, yaw as MatcherConfig::odom_sigma_*: the Localizer copies the matcher's).
   double odom_sigma_m = 0.05, odom_sigma_per_m = 0.3;
   double odom_sigma_rad = 2.0 * M_PI / 180, odom_sigma_per_rad = 0.3, odom_sigma_rad_per_m = 3.0 * M_PI / 180;
+  // Dead reckoning through a stretch not published OK (POOR, LOST, a re-acquisition): the track may come back on a
+  // wrong place that explains the scan as well as the right one (shelf faces on the walls behind them, a corridor
+  // whose outer wall is glass), and the innovation gate cannot refuse it, its prediction having grown to metres.
+  // The Localizer carries the pose last published OK with a LiDAR odometry of the frames since (frame-to-local-map
+  // ICP on the same features, odometry/odometry.h, run only during such a stretch) and passes it to update()
+  // (`dead_reckoned`); a fix beyond dead_reckoning_gate_sigma (as gate_sigma: the 3-DoF chi-square quantile) of it
+  // is published POOR ("N m from the dead-reckoned pose") with the offset's second moment added to its covariance,
+  // and the stretch (the dead reckoning from the same pose) lasts until confirm_fixes fixes in a row lie within the
+  // gate. Where a frame leaves a direction open (its own 1-sigma above poor_sigma_m) the odometry only carries its
+  // velocity along it: velocity_sigma_mps times the frame interval is added to the 1-sigma along that direction. The
+  // odometry's error otherwise (independent of the OK pose's covariance, added to it) has the 1-sigma dr_sigma_m +
+  // dr_sigma_per_m * path length in x/y and dr_sigma_rad + dr_sigma_per_rad * turn + dr_sigma_rad_per_m * path in
+  // yaw. 0: off.
+  // A frame the odometry cannot register, or over which its velocity changes by more than dr_jump_mps (the ICP caught
+  // another minimum; a platform changes its velocity by a few cm/s per frame, the odometry's noise adds ~0.1 m/s),
+  // ends the dead reckoning until the next OK: the fixes are then checked as before.
+  // The odometry registers every k-th point so that about dr_max_points are used (its own default is 800: a third of
+  // the CPU, the same verdicts on the corridor worlds).
+  double dead_reckoning_gate_sigma = 3.0;
+  double dr_jump_mps = 0.5;
+  int dr_max_points = 250;
+  double dr_sigma_m = 0.02, dr_sigma_per_m = 0.02;
+  double dr_sigma_rad = 0.5 * M_PI / 180, dr_sigma_per_rad = 0.02, dr_sigma_rad_per_m = 0.5 * M_PI / 180;
+  // A second fit of a re-acquisition (the Localizer's, while the tracker confirms one: `confirming`): the frame
+  // registered from starts around the fix (rings of rival_search_m and half of it); the best fit more than
+  // rival_distance_m / rival_distance_rad from the fix is carried with the track (its offset in the fix's frame)
+  // and registered again on every frame until the fix is confirmed. While it explains at least rival_ratio as many
+  // points as the fix (within the matcher's inlier distance), the place is ambiguous (a cabinet's face on a drawn
+  // wall 0.4 m along a corridor): published POOR ("a second fit ... explains N % as many points"), the offset's
+  // second moment added to the covariance, and the confirmation starts again, unless the dead-reckoned pose tells
+  // them apart (the fix within its gate, the rival beyond). The registrations use the Localizer's MatcherConfig.
+  // 0: off.
+  double rival_ratio = 0.8;
+  double rival_search_m = 1.0;
+  double rival_distance_m = 0.25, rival_distance_rad = 5.0 * M_PI / 180;
+};
+
+// A frame's pose dead-reckoned from the pose last published OK, with its covariance (x, y, yaw).
+struct DeadReckoned {
+  Pose2 pose;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
 };
 
 struct UncertaintyState {
@@ -95,6 +139,9 @@ struct UncertaintyState {
   bool frame_degenerate = false;       // the frame alone leaves a direction open (frame sigma > poor_sigma_m)
   double innovation_sigma = 0;         // Mahalanobis distance of the fix from the prediction (0: not tested)
   bool refused = false;                // the fix failed the innovation gate
+  double dead_reckoned_sigma = 0;      // Mahalanobis distance of the fix from the dead-reckoned pose (0: not tested)
+  bool off_dead_reckoning = false;     // the fix failed that gate (published POOR)
+  bool confirming = false;             // a re-acquisition being confirmed (confirm_fixes)
 };
 
 class UncertaintyTracker {
@@ -110,7 +157,16 @@ class UncertaintyTracker {
   UncertaintyState update(int64_t utime, const Eigen::Matrix3d& frame_cov, bool frame_valid, matcher::FitStatus matcher_status,
                           const std::string& matcher_text = {}, const Pose2* fix = nullptr,
                           const matcher::Twist2* twist = nullptr, double inlier_ratio = 1.0,
-                          const Pose2* motion = nullptr, double contradicted = 0.0);
+                          const Pose2* motion = nullptr, double contradicted = 0.0,
+                          const DeadReckoned* dead_reckoned = nullptr);
+  // A frame since the last one published OK was not (POOR, LOST, re-acquired): the next fixes are checked against
+  // the dead-reckoned pose (dead_reckoning_gate_sigma), if the caller has one.
+  bool wants_dead_reckoning() const { return cfg_.dead_reckoning_gate_sigma > 0 && not_ok_since_ok_; }
+  // The re-acquisition is not confirmed yet (an ambiguity the caller found): confirm_fixes more fixes needed.
+  void restart_confirmation() {
+    if (cfg_.confirm_fixes > 0) confirming_ = true, agreeing_ = 0;
+    not_ok_since_ok_ = true;
+  }
   // A new initial pose with its uncertainty (1-sigma x/y and yaw); the velocity is unknown.
   void reset(double sigma_m, double sigma_rad);
   void reset() { have_ = false; }
@@ -128,6 +184,8 @@ class UncertaintyTracker {
   matcher::Twist2 twist_;
   bool confirming_ = false;                            // re-acquired: fixes in a row still to agree (confirm_fixes)
   int agreeing_ = 0;                                   // accepted fixes in a row since the re-acquisition
+  int dr_agreeing_ = 0;                                // fixes in a row within the dead reckoning's gate
+  bool not_ok_since_ok_ = true;                        // a frame published other than OK since the last OK one (or none yet)
 };
 
 // The 3-DoF chi-square quantile with the probability of a 1-D Gaussian within k sigma (k = 3: 14.16).

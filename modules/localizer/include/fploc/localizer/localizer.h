@@ -17,6 +17,7 @@
 #include "fploc/matcher/imu_yaw.h"
 #include "fploc/matcher/map.h"
 #include "fploc/matcher/matcher.h"
+#include "fploc/odometry/odometry.h"
 #include "fploc/optimizer/window.h"
 
 namespace fploc::localizer {
@@ -138,6 +139,28 @@ class Localizer {
   std::vector<double> ranges_;       // scratch: the frame's point ranges (add_map_error)
   UncertaintyTracker tracker_;
   UncertaintyState uncertainty_;
+  // Dead reckoning through a stretch not published OK (UncertaintyConfig::dead_reckoning_gate_sigma): the last
+  // frame published OK (its features, fix and covariance) is the odometry's first map; from the first frame not
+  // published OK on, every frame is registered to the odometry's local map until a fix is published OK again.
+  std::optional<DeadReckoned> dead_reckoned(const FeatureFrame& f, const Eigen::Matrix3d& frame_cov);
+  bool have_anchor_ = false;
+  FeatureFrame anchor_frame_;
+  DeadReckoned anchor_;
+  Eigen::Vector3d anchor_velocity_ = Eigen::Vector3d::Zero();  // plan frame, from the matcher's twist
+  int64_t anchor_utime_ = 0;
+  std::optional<odometry::Odometry2D> dr_odometry_;  // running (a stretch not OK)
+  bool dr_valid_ = false;            // the odometry registered every frame of the stretch
+  Pose2 dr_last_;
+  double dr_path_m_ = 0, dr_turn_rad_ = 0;
+  Eigen::Matrix2d dr_open_ = Eigen::Matrix2d::Zero();  // x/y covariance carried along the frames' open directions
+  int64_t dr_last_utime_ = 0;
+  Eigen::Vector2d dr_velocity_ = Eigen::Vector2d::Zero();  // the odometry's over its last frame (plan frame)
+  // The second fit of a re-acquisition (UncertaintyConfig::rival_ratio): searched while none is known during a
+  // confirmation, then carried with the fix; applied to uncertainty_.
+  // (dr: the frame's dead-reckoned pose, if any: a rival beyond its gate is no ambiguity.)
+  void check_rival(const FeatureFrame& deskewed, const Pose2& fix_at_ref, const DeadReckoned* dr, const Pose2& fix_at_utime);
+  bool have_rival_ = false;
+  Pose2 rival_offset_;               // the rival in the fix's frame
 };
 
 }  // namespace fploc::localizer

@@ -39,6 +39,10 @@ class Odometry2D {
   explicit Odometry2D(OdometryConfig cfg = {});
   ~Odometry2D();
   void set_pose(const Pose2& p);  // restarts (the map is cleared)
+  // ... moving with this velocity (plan frame: vx, vy [m/s], yaw rate [rad/s]) when the first frame after the one
+  // that starts the map is predicted (a track taken over in motion: along a corridor the ICP leaves the axis where
+  // the prediction put it, and a restart at rest would stall there).
+  void set_pose(const Pose2& p, const Eigen::Vector3d& velocity);
   OdometryResult process(const FeatureFrame& f);
   size_t map_points() const;
 
