@@ -236,7 +236,7 @@ void Localizer::check_rival(const FeatureFrame& f, const Pose2& fix, const DeadR
   auto distinct = [&](const Pose2& p) {
     return std::hypot(p.x - fix.x, p.y - fix.y) > u.rival_distance_m || std::abs(wrap_angle(p.yaw - fix.yaw)) > u.rival_distance_rad;
   };
-  const int stride = std::max(1, mc.max_points > 0 ? int((f.points.size() + size_t(mc.max_points) - 1) / size_t(mc.max_points)) : 1);
+  const int stride = matcher::budget_stride(f.points.size(), mc.stride, mc.max_points);  // as register_frame's fit
   std::optional<Pose2> rival;
   int rival_inliers = 0;
   if (have_rival_) {

@@ -46,9 +46,7 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
   ao.gate_m = std::max(cfg.max_correspondence_m, cfg.min_correspondence_m);
   ao.group_rule = cfg.group_rule;
   ao.element_weight = cfg.element_weight;
-  ao.stride = std::max(1, cfg.stride);
-  if (cfg.max_points > 0 && int(f.points.size()) > cfg.max_points * ao.stride)
-    ao.stride = int((f.points.size() + size_t(cfg.max_points) - 1) / size_t(cfg.max_points));
+  ao.stride = budget_stride(f.points.size(), cfg.stride, cfg.max_points);
   ao.element_quota = cfg.element_quota;
   // The per-element budget's points, chosen once for the frame at the guess under the final gate (the rounds'
   // poses differ from it by centimetres while tracking; a guess farther off keeps fewer points for sure,

@@ -40,9 +40,7 @@ FrameUncertainty frame_uncertainty(const matcher::NearestLookup& lookup, const F
   matcher::AssignOptions ao;
   ao.gate_m = cfg.gate_m;
   ao.group_rule = cfg.group_rule;
-  ao.stride = 1;
-  if (cfg.max_points > 0 && f.points.size() > size_t(cfg.max_points))
-    ao.stride = int((f.points.size() + size_t(cfg.max_points) - 1) / size_t(cfg.max_points));
+  ao.stride = matcher::budget_stride(f.points.size(), 1, cfg.max_points);
   std::vector<matcher::Assignment> as;
   matcher::assign(lookup, f, x, ao, &as);
   const auto& g = lookup.geometry();

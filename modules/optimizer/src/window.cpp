@@ -290,9 +290,7 @@ void WindowOptimizer::solve() {
         continue;
       matcher::AssignOptions aok = ao;
       const size_t np = k.deskewed.points.size();
-      aok.stride = std::max(1, cfg_.stride);
-      if (cfg_.max_points > 0 && np > size_t(cfg_.max_points) * size_t(aok.stride))
-        aok.stride = int((np + size_t(cfg_.max_points) - 1) / size_t(cfg_.max_points));
+      aok.stride = matcher::budget_stride(np, cfg_.stride, cfg_.max_points);
       if (aok.element_quota > 0 && aok.stride > 1 && lookup_.element_targets()) {
         if (!k.sel_valid) {
           matcher::select_points(lookup_, k.deskewed, xk, aok, &k.sel);

@@ -1,6 +1,7 @@
 // A feature point's correspondence candidates (target ids of a NearestLookup). No Ceres here: the
 // optimizer keeps these in its header.
 #pragma once
+#include <cstddef>
 #include <vector>
 
 namespace fploc::matcher {
@@ -27,6 +28,15 @@ struct Assignment {
     return true;
   }
 };
+
+// The point budget's stride: every `stride`-th point, or more sparsely so that at most about max_points of the
+// frame's `points` are used (max_points <= 0: no budget). The matcher, the window optimizer and the Localizer's
+// fit comparisons all take their points this way.
+inline int budget_stride(size_t points, int stride, int max_points) {
+  int s = stride > 1 ? stride : 1;
+  if (max_points > 0 && points > size_t(max_points) * size_t(s)) s = int((points + size_t(max_points) - 1) / size_t(max_points));
+  return s;
+}
 
 // A point of the frame that the assignments use, with its sampling weight (Assignment::sw).
 struct SampledPoint {
