@@ -253,6 +253,9 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
     int element;
     Eigen::Matrix3d A;
     Eigen::Vector3d g;
+    Eigen::Vector3d a;  // sum of its rows: what a shift of the element by 1 m adds to g
+    double o;           // sum of its offsets
+    int n;              // its points
   };
   std::vector<ScaleSums> esums;
   std::vector<int> eslot(plan_.elements.size(), -1);
@@ -293,10 +296,13 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
         int& slot = eslot[size_t(e)];
         if (slot < 0) {
           slot = int(esums.size());
-          esums.push_back({e, Eigen::Matrix3d::Zero(), Eigen::Vector3d::Zero()});
+          esums.push_back({e, Eigen::Matrix3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0, 0});
         }
         esums[size_t(slot)].A += row * row.transpose();
         esums[size_t(slot)].g += row * off;
+        esums[size_t(slot)].a += row;
+        esums[size_t(slot)].o += off;
+        ++esums[size_t(slot)].n;
       }
     } else {
       const int ix = int(std::floor(p.x() / o_.new_cell_m)), iy = int(std::floor(p.y() / o_.new_cell_m));
@@ -403,10 +409,24 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
       // the elements they are the scan's scale_g_ / scale_h_ terms above.
       const Eigen::Vector2d k = inv * Asb, beta = inv * sg.tail<2>();
       const Eigen::Vector3d w(1.0, -k.x(), -k.y());
-      if (scale_eg_.size() != plan_.elements.size()) scale_eg_.assign(plan_.elements.size(), 0.0), scale_eh_.assign(plan_.elements.size(), 0.0);
+      // An element's points' residuals at scale s with the scan's bias at s, beta - s k, summed: o_e - a_e.b beta
+      // - s w.a_e. And an element standing delta off its line adds delta to each of its points' offsets, so
+      // delta a_e to the scan's sums and delta w.a_e to its score (G = w.g).
+      if (scale_eg_.size() != plan_.elements.size()) {
+        const size_t ne = plan_.elements.size();
+        scale_eg_.assign(ne, 0.0), scale_eh_.assign(ne, 0.0), scale_ep_.assign(ne, 0.0), scale_ec_.assign(ne, 0.0);
+        scale_el_.assign(ne, 0.0);
+        scale_en_.assign(ne, 0), scale_ef_.assign(ne, 0);
+      }
       for (const ScaleSums& es : esums) {
-        scale_eg_[size_t(es.element)] += w.dot(es.g - es.A.rightCols<2>() * beta);
-        scale_eh_[size_t(es.element)] += w.dot(es.A * w);
+        const size_t e = size_t(es.element);
+        scale_eg_[e] += w.dot(es.g - es.A.rightCols<2>() * beta);
+        scale_eh_[e] += w.dot(es.A * w);
+        scale_ep_[e] += es.o - es.a.tail<2>().dot(beta);
+        scale_ec_[e] += w.dot(es.a);
+        scale_en_[e] += es.n;
+        scale_el_[e] += es.a.tail<2>().dot(inv * es.a.tail<2>());
+        ++scale_ef_[e];
       }
     }
   }
@@ -496,6 +516,26 @@ bool PlanDiff::halves_moved(const ElementDiff& e) const {
 Diff PlanDiff::result() const {
   Diff d;
   d.frames = frames_;
+  // As-built refinement: (H / sigma_obs^2 + I / sigma_prior^2) o = g / sigma_obs^2.
+  {
+    const double lam = std::pow(o_.refine_obs_sigma_m / o_.refine_prior_m, 2);
+    Eigen::MatrixXd H = ref_H_;
+    H.diagonal().array() += lam;
+    const Eigen::VectorXd o = H.ldlt().solve(ref_g_);
+    const double kmin = o_.refine_min_info;
+    for (size_t i = 0; i < plan_.elements.size(); ++i) {
+      const long a = 2 * long(i), b = a + 1;
+      if (ref_frames_[i] < o_.min_frames || !std::isfinite(o[a]) || !std::isfinite(o[b])) continue;
+      // Both ends observed well enough (the data's own information on each, scans' errors eliminated), else
+      // the mean offset (a wall seen near one end only), else nothing.
+      if (o_.refine_ends && ref_H_(a, a) >= kmin && ref_H_(b, b) >= kmin) {
+        d.refined.push_back({int(i), o[a], o[b], ref_frames_[i]});
+      } else if (ref_H_(a, a) + ref_H_(b, b) + 2 * ref_H_(a, b) >= 4 * kmin) {
+        const double m = 0.5 * (o[a] + o[b]);
+        d.refined.push_back({int(i), m, m, ref_frames_[i]});
+      }
+    }
+  }
   if (scale_h_ > 0 && scale_n_ > 10) {
     d.scale_error = scale_g_ / scale_h_;
     const double var = std::max(0.0, (scale_o2_ - d.scale_error * scale_g_) / (scale_n_ - 1));
@@ -517,27 +557,28 @@ Diff PlanDiff::result() const {
     }
     if (clusters >= 2)
       d.scale_sigma = std::max(d.scale_sigma, std::sqrt(u2 * clusters / (clusters - 1)) / scale_h_);
-    d.scale_points = scale_n_;
-  }
-  // As-built refinement: (H / sigma_obs^2 + I / sigma_prior^2) o = g / sigma_obs^2.
-  {
-    const double lam = std::pow(o_.refine_obs_sigma_m / o_.refine_prior_m, 2);
-    Eigen::MatrixXd H = ref_H_;
-    H.diagonal().array() += lam;
-    const Eigen::VectorXd o = H.ldlt().solve(ref_g_);
-    const double kmin = o_.refine_min_info;
-    for (size_t i = 0; i < plan_.elements.size(); ++i) {
-      const long a = 2 * long(i), b = a + 1;
-      if (ref_frames_[i] < o_.min_frames || !std::isfinite(o[a]) || !std::isfinite(o[b])) continue;
-      // Both ends observed well enough (the data's own information on each, scans' errors eliminated), else
-      // the mean offset (a wall seen near one end only), else nothing.
-      if (o_.refine_ends && ref_H_(a, a) >= kmin && ref_H_(b, b) >= kmin) {
-        d.refined.push_back({int(i), o[a], o[b], ref_frames_[i]});
-      } else if (ref_H_(a, a) + ref_H_(b, b) + 2 * ref_H_(a, b) >= 4 * kmin) {
-        const double m = 0.5 * (o[a] + o[b]);
-        d.refined.push_back({int(i), m, m, ref_frames_[i]});
-      }
+    // The walls stand off their drawn lines as built (a few cm each, for the whole run), and an offset reads as a
+    // scale to every scan that sees its wall across a narrow corridor, the same error scan after scan: the walls
+    // seen so far may happen to look like a consistent scale, which the scatter above cannot tell. So the sigma
+    // also holds what offsets of the size the walls show can fake: an element delta_e off its line moves the
+    // estimate by delta_e c_e / H (c_e: scale_ec_), so independent offsets of sigma_w give
+    // sigma_w sqrt(sum_e c_e^2) / H. sigma_w^2 is the sum over the elements seen in >= min_frames scans of their
+    // mean offset left by the scale and the scans' biases, squared -- all walls, also those that carry no scale, so
+    // a few walls that fake one do not hide the spread -- over the degrees of freedom those residuals keep: each
+    // element 1 less its mean leverage on the scans' biases (across a corridor the bias takes about half of the
+    // two walls' offsets; without this the sigma came out ~1.3x too small there).
+    double m2 = 0, c2 = 0, dof = 0;
+    int walls = 0;
+    for (size_t e = 0; e < scale_ec_.size(); ++e) {
+      c2 += scale_ec_[e] * scale_ec_[e];
+      if (scale_ef_[e] < o_.min_frames || scale_en_[e] <= 0) continue;
+      const double m = (scale_ep_[e] - d.scale_error * scale_ec_[e]) / double(scale_en_[e]);
+      m2 += m * m;
+      dof += std::max(0.0, 1.0 - scale_el_[e] / double(scale_en_[e]));
+      ++walls;
     }
+    if (walls >= 3 && dof > 0) d.scale_sigma = std::hypot(d.scale_sigma, std::sqrt(m2 / dof * c2) / scale_h_);
+    d.scale_points = scale_n_;
   }
   d.elements.resize(plan_.elements.size());
   for (size_t i = 0; i < plan_.elements.size(); ++i) {

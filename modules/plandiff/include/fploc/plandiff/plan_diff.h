@@ -201,6 +201,12 @@ class PlanDiff {
   double scale_h_ = 0, scale_g_ = 0, scale_o2_ = 0;
   int64_t scale_n_ = 0;
   std::vector<double> scale_eg_, scale_eh_;  // per element: its part of scale_g_ / scale_h_ (the bias eliminated per scan)
+  // Per element, summed over its points and scans with each scan's bias eliminated: its offsets' residual from the
+  // scale model is (scale_ep_ - s scale_ec_) / scale_en_ at scale s; scale_ec_ is also d scale_g_ / d (its offset).
+  std::vector<double> scale_ep_, scale_ec_;
+  std::vector<double> scale_el_;  // per element: its leverage on the scans' biases, times its points (sum over scans)
+  std::vector<int64_t> scale_en_;
+  std::vector<int> scale_ef_;  // scans
   Eigen::MatrixXd ref_H_;   // as-built refinement: normal equations in (o_a, o_b) per segment, scans eliminated
   Eigen::VectorXd ref_g_;
   std::vector<int> ref_frames_;
