@@ -390,6 +390,15 @@ WorldEdit perturb_world(const FloorPlan& plan, const std::vector<V2>& path, cons
       // Inside the building: something of the plan in all four directions.
       for (const V2& dd : {V2(1, 0), V2(-1, 0), V2(0, 1), V2(0, -1)})
         if (ok && line_of_sight(plan, c, c + 100 * dd, -1)) ok = false;
+      // ... and where the robot can see it: lines of sight from 10 points of the path within 12 m (as
+      // visible_from_path; several, so a ray slipping through a joint of two walls does not count). A partition
+      // inside a corridor loop's walled-in core is no renovation anyone could find.
+      if (ok) {
+        int seen = 0;
+        for (size_t k = 0; k < path.size() && seen < 10; k += 5)
+          if ((path[k] - c).norm() < 12 && line_of_sight(wp, path[k], c, -1)) ++seen;
+        ok = seen >= 10;
+      }
       if (!ok) continue;
       wp.elements.push_back(Element::segment(a, b, layer));
       w.added.push_back({"partition", a, b});

@@ -9,6 +9,7 @@
 #include "fploc/sim/perturb.h"
 #include "fploc/sim/scenarios.h"
 #include "fploc/sim/simulator.h"
+#include "fploc/sim/world.h"
 
 using namespace fploc;
 using namespace fploc::sim;
@@ -100,6 +101,35 @@ TEST(Perturb, RenovationTruthMatchesTheWorld) {
     for (const auto& p : path) EXPECT_GT((p - 0.5 * (a.a + a.b)).norm(), 0.79);
   }
   EXPECT_EQ(w.world.elements.size(), size_t(plan.elements.size() - removed + 2));
+}
+
+// An added partition is a renovation the robot can find: seen from the path (a ray from the sensor's height at
+// 10 or more points of the path within 12 m reaches it). On the corridor loop, partitions used to land in the
+// loop's walled-in core (seed 1: both), where nothing could see them.
+TEST(Perturb, AddedPartitionsAreSeenFromThePath) {
+  SimulatorOptions o;
+  o.scenario = "corridor-loop-medium";
+  o.clutter = false;
+  o.shared_dir = "";
+  Simulator sim(FloorPlan{}, o);
+  const auto path = sim.motion().sample_path(0.1);
+  for (uint64_t seed = 1; seed <= 4; ++seed) {
+    const WorldEdit w = perturb_world(demo_corridor_plan(), path, perturb_family("renovated"), seed);
+    const World world(w.world);
+    for (const auto& a : w.added) {
+      if (a.kind != "partition") continue;
+      const V2 c = 0.5 * (a.a + a.b);
+      int seen = 0;
+      for (const auto& p : path) {
+        const double d = (c - p).norm();
+        if (d >= 12) continue;
+        const V2 u = (c - p) / d;
+        const Hit h = world.cast(Eigen::Vector3d(p.x(), p.y(), 1.0), Eigen::Vector3d(u.x(), u.y(), 0), 30.0);
+        if (std::isfinite(h.t) && h.t > d - 0.05) ++seen;
+      }
+      EXPECT_GE(seen, 10) << "seed " << seed << ": partition at (" << c.x() << ", " << c.y() << ")";
+    }
+  }
 }
 
 TEST(Perturb, DoorwaysOfTheDemoRoom) {
