@@ -51,6 +51,13 @@ constexpr double kKinkDeg = 3.0;          // another surface: this far from the 
 constexpr double kSideShare = 0.9;        // of a group's returns on one side of the kink line
 constexpr double kFollowDeg = 1.5;        // a sector this near a surface is on it
 constexpr std::array<float, 3> kRefineCutM{0.05f, 0.03f, 0.02f};  // the followed surface's own fit (Tukey cut-offs)
+// One surface followed steadily (SegmenterConfig::kink_recheck_scans): the split is skipped while the ring fit
+// stays within kQuietOffDeg of the surface the last split followed (carried by the gyro; half the kKinkFitOffDeg
+// at which the split replaces the ring fit) and within kQuietStepM of its distance (a step to another surface).
+constexpr double kQuietOffDeg = 0.5 * k::kKinkFitOffDeg;
+constexpr double kQuietStepM = 0.01;
+constexpr int64_t kFollowRateMaxDtUs = 300'000;  // consecutive distances at most this far apart for the rate
+constexpr double kQuietRefRateMs = 0.1;          // the rate at which the sweep's tilt per unit rate is measured
 
 constexpr int32_t kPad = 8;              // the kernels' lanes
 
@@ -79,15 +86,85 @@ struct Group {
 };
 }  // namespace
 
+void Segmenter::FollowRate::update(int64_t t, double d_now, bool same_surface) {
+  if (same_surface && d_t != 0 && t > d_t && t - d_t < kFollowRateMaxDtUs) {
+    const double dt = 1e-6 * double(t - d_t);
+    const double raw = (d_now - d) / dt;
+    if (std::abs(raw) > k::kFollowRateMaxMs) {
+      ok = false;
+    } else if (ok) {
+      // Exponentially weighted mean and variance of the raw rates (each scan's distance is a few millimetres off:
+      // more where the surface is seen only far away).
+      gain = 1 - std::exp(-dt / k::kFollowRateTauS);
+      const double e = raw - rate;
+      rate += gain * e;
+      var = (1 - gain) * (var + gain * e * e);
+    } else {
+      rate = raw;
+      var = raw * raw;  // nothing known of its spread yet
+      gain = 1;
+      ok = true;
+    }
+  } else {
+    ok = false;
+  }
+  d = d_now;
+  d_t = t;
+}
+
+bool Segmenter::FollowRate::stands_out() const {
+  // Only a rate that stands out of its own noise (2 sigmas of the weighted mean): a wrong one would skew the fit.
+  const double sigma = std::sqrt(var * gain / (2 - gain));
+  return ok && std::abs(rate) > 2 * sigma;
+}
+
 void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   Plane& g = out_.ground;
   g.under_m = 0;
   // The followed surface is carried from scan to scan by the gyro: without one, the ring fit as it is.
   if (!cfg_.imu_attitude || !fusion_.has_gyro()) return;
-  if (!g.found || lower_.n < 100) return;  // (the followed surface is kept for up to 1 s)
+  if (!g.found || lower_.n < 100) {  // (the followed surface is kept for up to 1 s)
+    kink_quiet_left_ = 0;
+    return;
+  }
+  const Eigen::Vector3d up = g.coeffs.head<3>();  // the ground's normal points up (into the room)
+  const auto angle = [](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+    return std::acos(std::clamp(u.dot(v), -1.0, 1.0));
+  };
+  // The ground to follow: the last scan's, carried by the gyro.
+  Eigen::Vector3d prev = up;
+  Eigen::Matrix3d R;
+  const bool carried =
+      follow_t_ != 0 && t - follow_t_ < 1'000'000 && fusion_.rotation(follow_t_, t, deskew_.bias(), &R);
+  if (carried) prev = (R.transpose() * follow_up_).normalized();
+  const bool ground_attitude =
+      !out_.ceiling.found ||
+      angle(-out_.ceiling.coeffs.head<3>(), up) > cfg_.attitude_consistency_deg * k::kDeg;
+  // One surface followed steadily: the last split found it alone with the ring fit on it and the ceiling giving
+  // the attitude (its result: the ring fit as it is), and this scan's ring fit is still on it, at its distance,
+  // the ceiling still giving the attitude and no sweep's translation to correct. The split would give the ring
+  // fit again; it is skipped (at most kink_recheck_scans - 1 scans in a row), the surface carried by the gyro
+  // and its distance, the ring fit's plus the difference of the two at the last split (they differ by a few
+  // millimetres: the surface's own fit has fewer returns and a tighter cut-off), kept for the rate.
+  const double d_followed = g.coeffs[3] + kink_d_offset_;
+  if (kink_quiet_left_ > 0 && carried && t - follow_t_ < kFollowRateMaxDtUs && !ground_attitude &&
+      angle(up, prev) < kQuietOffDeg * k::kDeg && std::abs(d_followed - follow_.d) < kQuietStepM) {
+    FollowRate next = follow_;
+    next.update(t, d_followed, true);
+    // The sweep's translation: its rate too low to be corrected, or the tilt it would correct (the last split's
+    // measured tilt per unit rate, the same returns seen) within half of kSweepSkewDeg.
+    if (!next.stands_out() || kink_skew_per_rate_ * std::abs(next.rate) < 0.5 * k::kSweepSkewDeg * k::kDeg) {
+      follow_ = next;
+      follow_up_ = prev;
+      follow_t_ = t;
+      --kink_quiet_left_;
+      ++kink_skipped_;
+      return;
+    }
+  }
+  kink_quiet_left_ = 0;
   const Eigen::Vector3f n0 = g.coeffs.head<3>().cast<float>();
   const float d0 = float(g.coeffs[3]);
-  const Eigen::Vector3d up = g.coeffs.head<3>();  // the ground's normal points up (into the room)
   const Eigen::Vector3d ref = -g.coeffs[3] * up;  // numerics: moments relative to the point under the sensor
   const Eigen::Vector3f reff = ref.cast<float>();
   // Per sector: three least-squares passes (a wide band around the ring fit, then tight around its own plane).
@@ -164,17 +241,9 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
       if (!ok[s]) spl[s] = g.coeffs;
     }
   }
-  // The ground to follow: the last scan's, carried by the gyro.
-  Eigen::Vector3d prev = up;
-  Eigen::Matrix3d R;
-  if (follow_t_ != 0 && t - follow_t_ < 1'000'000 && fusion_.rotation(follow_t_, t, deskew_.bias(), &R))
-    prev = (R.transpose() * follow_up_).normalized();
   // Until a surface is found below: the ring fit's.
   follow_up_ = up;
   follow_t_ = t;
-  const auto angle = [](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
-    return std::acos(std::clamp(u.dot(v), -1.0, 1.0));
-  };
   // F: the sectors on that surface; O: those on another one (kinked against F's plane by more than kKinkDeg).
   Group F, O;
   // The sectors within kFollowDeg of a surface's normal, pooled.
@@ -205,7 +274,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     }
   }
   if (F.sectors < 2 || F.m.w < 4 * kMinSectorPoints || !F.m.plane(ref, -up, F.pl)) {
-    follow_rate_ok_ = false;
+    follow_.ok = false;
     return;  // the ring fit as it is
   }
   // F's plane from its returns, each weighed by its distance to that plane (Tukey, the cut-off shrinking). A
@@ -251,42 +320,18 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   // followed surface's distance from scan to scan (low-passed); the returns moved back by rate x tau along
   // the surface's normal and the surface fitted again. Used only where it tilts the fit by more than a plane
   // fit's own noise (kSweepSkewDeg): a robot driving on the surface it sees is left as it is.
-  const double d_now = F.pl[3];
-  if (same_surface && follow_d_t_ != 0 && t > follow_d_t_ && t - follow_d_t_ < 300'000) {
-    const double dt = 1e-6 * double(t - follow_d_t_);
-    const double rate = (d_now - follow_d_) / dt;
-    if (std::abs(rate) > k::kFollowRateMaxMs) {
-      follow_rate_ok_ = false;
-    } else if (follow_rate_ok_) {
-      // Exponentially weighted mean and variance of the raw rates (each scan's distance is a few millimetres off:
-      // more where the surface is seen only far away).
-      follow_rate_gain_ = 1 - std::exp(-dt / k::kFollowRateTauS);
-      const double e = rate - follow_rate_;
-      follow_rate_ += follow_rate_gain_ * e;
-      follow_rate_var_ = (1 - follow_rate_gain_) * (follow_rate_var_ + follow_rate_gain_ * e * e);
-    } else {
-      follow_rate_ = rate;
-      follow_rate_var_ = rate * rate;  // nothing known of its spread yet
-      follow_rate_gain_ = 1;
-      follow_rate_ok_ = true;
-    }
-  } else {
-    follow_rate_ok_ = false;
-  }
-  follow_d_ = d_now;
-  follow_d_t_ = t;
+  follow_.update(t, F.pl[3], same_surface);
   // A plane corrected for the sweep's translation: its returns (those `use` takes, within kSectorTightM of it)
   // fitted as measured and moved back by rate x tau, the difference of the two fits added to it (the plane
-  // keeps its own fit's weighting; only the skew is removed). Returns the tilt removed [rad] (0: not possible).
+  // keeps its own fit's weighting; only the skew is removed). rate: the sensor's speed off the surface [m/s].
+  // Returns the tilt removed [rad] (0: not possible).
   const int W = scan.width;
-  // Only a rate that stands out of its own noise (2 sigmas of the weighted mean): a wrong one would skew the fit.
-  const double rate_sigma = std::sqrt(follow_rate_var_ * follow_rate_gain_ / (2 - follow_rate_gain_));
-  const bool can_deskew = follow_rate_ok_ && std::abs(follow_rate_) > 2 * rate_sigma && W > 0 &&
-                          int(scan.column_utime.size()) == W && lower_.width == W;
+  const bool has_times = W > 0 && int(scan.column_utime.size()) == W && lower_.width == W;
+  const bool can_deskew = follow_.stands_out() && has_times;
   const bool pow2 = W > 0 && (W & (W - 1)) == 0;  // (the column of a pixel by a mask, not a division)
-  const auto sweep_corrected = [&](const Eigen::Vector4d& pl, auto&& use, Eigen::Vector4d* out) {
+  const auto sweep_corrected = [&](const Eigen::Vector4d& pl, auto&& use, double rate, Eigen::Vector4d* out) {
     const Eigen::Vector3f n = pl.head<3>().cast<float>();
-    const Eigen::Vector3f shift = float(follow_rate_) * n;
+    const Eigen::Vector3f shift = float(rate) * n;
     detail::Moments m0, m1;
     for (size_t k = 0; k < near; ++k) {  // (a return within kSectorTightM of pl is one near the ring fit)
       if (!use(sector[k])) continue;
@@ -309,7 +354,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     Eigen::Vector4d Fc;
     sweep_skew = sweep_corrected(F.pl, [&](int16_t s) {
       return in_f[size_t(s)];
-    }, &Fc);
+    }, follow_.rate, &Fc);
     if (sweep_skew > k::kSweepSkewDeg * k::kDeg) {
       F.pl = Fc;
       sweep_deskewed = true;
@@ -325,20 +370,29 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     if (O.m.w < 4 * kMinSectorPoints || !O.m.plane(ref, -up, O.pl)) O.sectors = 0;
   }
   const double off_fit = angle(F.pl.head<3>(), up);
-  const bool ground_attitude =
-      !out_.ceiling.found ||
-      angle(-out_.ceiling.coeffs.head<3>(), up) > cfg_.attitude_consistency_deg * k::kDeg;
   if (O.sectors == 0 && off_fit < k::kKinkFitOffDeg * k::kDeg && !ground_attitude) {
     // One surface, the ring fit on it, and the ceiling gives the attitude: the ring fit corrected for the sweep's
     // translation as the followed surface was. (Where the ground gives the attitude, F's own fit replaces the ring
     // fit below: on the demo building's first floor the ring fit was 0.1-0.3 deg off where F was within 0.03.)
     Eigen::Vector4d gc;
-    const double skew = sweep_deskewed ? sweep_corrected(g.coeffs, [](int16_t) { return true; }, &gc) : 0.0;
+    const double skew = sweep_deskewed ? sweep_corrected(g.coeffs, [](int16_t) { return true; }, follow_.rate, &gc) : 0.0;
+    // The ring fit as it is, well within the kink's threshold of the followed surface: the next scans may skip
+    // the split while that holds (see the top).
+    if (!sweep_deskewed && off_fit < kQuietOffDeg * k::kDeg) {
+      kink_quiet_left_ = std::max(cfg_.kink_recheck_scans, 1) - 1;
+      // The tilt the sweep's translation gives the followed surface's fit per unit of rate (as measured, or at
+      // kQuietRefRateMs: linear for the millimetres to centimetres involved), for the skipped scans' rates.
+      Eigen::Vector4d unused;
+      kink_skew_per_rate_ = can_deskew && follow_.rate != 0 ? sweep_skew / std::abs(follow_.rate)
+                            : has_times ? sweep_corrected(F.pl, [&](int16_t s) { return in_f[size_t(s)]; }, kQuietRefRateMs, &unused) / kQuietRefRateMs
+                                        : 0.0;
+      kink_d_offset_ = F.pl[3] - g.coeffs[3];
+    }
     if (skew > k::kSweepSkewDeg * k::kDeg) {
       g.coeffs = gc;
       char buf[200];
       std::snprintf(buf, sizeof buf, "ground: the sensor moving %.3f m/s off it, de-skewed for the sweep's translation (%.2f deg)",
-                    follow_rate_, skew / k::kDeg);
+                    follow_.rate, skew / k::kDeg);
       out_.note(buf);
     }
     return;
@@ -397,7 +451,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   out_.note(buf);
   if (sweep_deskewed) {
     std::snprintf(buf, sizeof buf, " (the sensor moving %.3f m/s off it: de-skewed for the sweep's translation, %.2f deg)",
-                  follow_rate_, sweep_skew / k::kDeg);
+                  follow_.rate, sweep_skew / k::kDeg);
     out_.status_text += buf;
   }
 }

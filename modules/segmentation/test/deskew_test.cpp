@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 #include "fploc/segmentation/segmenter.h"
@@ -90,4 +91,61 @@ TEST(GyroDeskew, BiasEstimateFollowsAnAddedBias) {
   EXPECT_NEAR(moved.y(), added.y(), 0.0015);
   EXPECT_LT(percentile(b.tilt_err_deg, 0.95), 0.2);
   EXPECT_LT(percentile(b.tilt_err_deg, 0.5), 0.05);
+}
+
+// The column rotations, integrated block by block with the columns inside a block interpolated (gyro_deskew.cpp),
+// against the rotations integrated column by column (each step's midpoint rate): a rate turning about a changing
+// axis (1 kHz samples, 1.5 rad/s about z with a 0.5 rad/s wobble), 1024 columns over 0.1 s in whole microseconds.
+// Every column within 1e-5 rad and 1e-5 per matrix entry (measured: 4.3e-6 inside the blocks, 3e-8 at their
+// ends; 43 um at 10 m in a 95 deg/s turn, against the OS-1's centimetre of range noise).
+TEST(GyroDeskew, ColumnRotationsMatchTheExactIntegration) {
+  const auto rate = [](double t) {  // rad/s at t [s]
+    return Eigen::Vector3d(0.5 * std::sin(20 * t), 0.5 * std::cos(15 * t), 1.5);
+  };
+  seg::GyroDeskew dk(true);
+  const int64_t t0 = 1'000'000;
+  // Each sample: the mean rate over the millisecond before it (as the segmenter expects).
+  for (int64_t u = t0 - 50'000; u <= t0 + 150'000; u += 1000) {
+    Eigen::Vector3d m = Eigen::Vector3d::Zero();
+    for (int j = 0; j < 10; ++j) m += rate(1e-6 * double(u - 1000 + 100 * j + 50)) / 10;
+    dk.add(m, u);
+  }
+  Scan scan;
+  scan.width = 1024;
+  scan.height = 1;
+  scan.utime = t0;
+  scan.column_utime.resize(1024);
+  for (int c = 0; c < 1024; ++c) scan.column_utime[size_t(c)] = t0 + (100'000 * c) / 1024;
+  ASSERT_TRUE(dk.prepare(scan));
+  const int64_t tm = dk.sweep_mid_utime();
+  // Column by column: R_c = R_(c-1) exp([w dt]x), w the sample holding the step's midpoint (its interval's mean
+  // rate), from the mid-sweep column's rotation on.
+  const auto sample_rate = [&](int64_t u) {  // the first sample at or after u
+    const int64_t s = t0 - 50'000 + ((u - (t0 - 50'000) + 999) / 1000) * 1000;
+    Eigen::Vector3d m = Eigen::Vector3d::Zero();
+    for (int j = 0; j < 10; ++j) m += rate(1e-6 * double(s - 1000 + 100 * j + 50)) / 10;
+    return m;
+  };
+  const auto exp_map = [](const Eigen::Vector3d& th) {
+    return th.norm() > 0 ? Eigen::Matrix3d(Eigen::AngleAxisd(th.norm(), th.normalized())) : Eigen::Matrix3d::Identity();
+  };
+  const auto& ct = scan.column_utime;
+  int cm = 0;
+  while (ct[size_t(cm)] < tm) ++cm;
+  std::vector<Eigen::Matrix3d> exact(1024);
+  exact[size_t(cm)] = exp_map(sample_rate(tm + (ct[size_t(cm)] - tm) / 2) * (1e-6 * double(ct[size_t(cm)] - tm)));
+  for (int c = cm + 1; c < 1024; ++c)
+    exact[size_t(c)] = exact[size_t(c - 1)] * exp_map(sample_rate(ct[size_t(c - 1)] + (ct[size_t(c)] - ct[size_t(c - 1)]) / 2) *
+                                                      (1e-6 * double(ct[size_t(c)] - ct[size_t(c - 1)])));
+  for (int c = cm - 1; c >= 0; --c)
+    exact[size_t(c)] = exact[size_t(c + 1)] * exp_map(sample_rate(ct[size_t(c + 1)] + (ct[size_t(c)] - ct[size_t(c + 1)]) / 2) *
+                                                      (1e-6 * double(ct[size_t(c)] - ct[size_t(c + 1)])));
+  double worst = 0;
+  for (int c = 0; c < 1024; ++c) {
+    const Eigen::Matrix3d R = dk.rotations()[size_t(c)].cast<double>();
+    worst = std::max(worst, Eigen::AngleAxisd(R * exact[size_t(c)].transpose()).angle());
+    worst = std::max(worst, (R - exact[size_t(c)]).cwiseAbs().maxCoeff());
+  }
+  std::printf("worst column rotation error %.3g rad\n", worst);
+  EXPECT_LT(worst, 1e-5);
 }

@@ -17,6 +17,7 @@
 #include <functional>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "fploc/segmentation/segmenter.h"
 #include "fploc/segmentation/synthetic.h"
@@ -45,6 +46,8 @@ struct Result {
   double max_kink_z_err = 0;
   int kink_ground_scans = 0;
   bool said_two_surfaces = false;
+  std::vector<Eigen::Vector4d> zrp;  // per scan: z, roll, pitch, the ground's distance above the surface under it
+  int64_t kink_skipped = 0;          // scans whose ground-at-a-kink split was skipped
 };
 
 // Drives the trajectory pose(t) (t in s) for n scans of 0.1 s. The IMU (100 Hz, or 1 kHz with column times)
@@ -53,8 +56,8 @@ struct Result {
 // carries column times (a moving sensor; the segmenter de-skews with the gyro).
 Result drive(const synth::Room& room, const std::function<SensorPose(double)>& pose_at,
              const std::function<double(double)>& acc, int n, bool imu, int blocks, uint32_t seed,
-             const std::function<bool(double)>& on_ramp, const Eigen::Vector3d& acc_bias = Eigen::Vector3d::Zero()) {
-  SegmenterConfig cfg;
+             const std::function<bool(double)>& on_ramp, const Eigen::Vector3d& acc_bias = Eigen::Vector3d::Zero(),
+             const SegmenterConfig& cfg = SegmenterConfig{}) {
   RingSegmenter seg(cfg);
   const auto beams = synth::os1_like_beams();
   std::mt19937 rng(seed);
@@ -103,6 +106,7 @@ Result drive(const synth::Room& room, const std::function<SensorPose(double)>& p
     const SensorPose truth = pose_at(t0);  // the pose's time: utime
     const double err = std::max(std::abs(out.roll - truth.roll), std::abs(out.pitch - truth.pitch));
     const bool ramp = on_ramp(t0);
+    r.zrp.emplace_back(out.z, out.roll, out.pitch, out.ground.under_m != 0 ? out.ground.under_m : out.ground.coeffs[3]);
     if (k >= 3) {
       r.max_rp_err = std::max(r.max_rp_err, err);
       if (ramp) r.max_rp_err_ramp = std::max(r.max_rp_err_ramp, err);
@@ -131,6 +135,7 @@ Result drive(const synth::Room& room, const std::function<SensorPose(double)>& p
                   out.pitch / kDeg, truth.roll / kDeg, truth.pitch / kDeg, to_string(out.attitude_source), out.attitude_t,
                   out.status_text.c_str());
   }
+  r.kink_skipped = seg.kink_splits_skipped();
   return r;
 }
 
@@ -192,6 +197,38 @@ TEST(GravityFusion, GroundAtTheRampsFootAndHeadIsTheSurfaceUnderTheRobot) {
   EXPECT_GT(r.kink_ground_scans, 10);
   EXPECT_TRUE(r.said_two_surfaces);
   EXPECT_LT(r.max_kink_z_err, 0.02);
+}
+
+// While one surface is followed steadily (the level floor, then the ramp, then the landing, each under the ceiling
+// that gives the attitude), the ground-at-a-kink split is skipped on up to kink_recheck_scans - 1 scans in a row;
+// approaching, crossing and leaving the ramp's foot and head it runs on every scan. The outputs are those of the
+// split run on every scan (kink_recheck_scans = 1): z within 1 mm, roll/pitch within 0.01 deg, the ground's
+// distance to the surface under the robot within 1 mm.
+TEST(GravityFusion, KinkSplitIsSkippedOnlyWhileOneSurfaceIsFollowed) {
+  const auto room = ramp_hall();
+  SegmenterConfig every;
+  every.kink_recheck_scans = 1;
+  const auto run = [&](const SegmenterConfig& cfg) {
+    return drive(room, [&](double t) { return ramp_pose(room, t); }, wobbly_acc, 310, true, 1, 11,
+                 [&](double t) { return on_ramp(room, t); }, Eigen::Vector3d::Zero(), cfg);
+  };
+  const Result a = run(every), b = run(SegmenterConfig{});
+  EXPECT_EQ(a.kink_skipped, 0);
+  EXPECT_GT(b.kink_skipped, 40);  // of 310 scans (on most the ground gives the attitude: the split runs)
+  ASSERT_EQ(a.zrp.size(), b.zrp.size());
+  double dz = 0, drp = 0, dd = 0;
+  for (size_t k = 0; k < a.zrp.size(); ++k) {
+    dz = std::max(dz, std::abs(a.zrp[k][0] - b.zrp[k][0]));
+    drp = std::max({drp, std::abs(a.zrp[k][1] - b.zrp[k][1]), std::abs(a.zrp[k][2] - b.zrp[k][2])});
+    dd = std::max(dd, std::abs(a.zrp[k][3] - b.zrp[k][3]));
+  }
+  std::printf("skipped %lld of %zu scans; largest differences: z %.5f m, roll/pitch %.4f deg, ground distance %.5f m\n",
+              (long long)b.kink_skipped, b.zrp.size(), dz, drp / kDeg, dd);
+  EXPECT_LT(dz, 0.001);
+  EXPECT_LT(drp, 0.01 * kDeg);
+  EXPECT_LT(dd, 0.001);
+  EXPECT_TRUE(b.said_two_surfaces);
+  EXPECT_LT(b.max_kink_z_err, 0.02);
 }
 
 // Off the ramp's head onto a landing under a sloped roof (8.5 deg, the demo building's lobby): the ground

@@ -58,6 +58,8 @@ class Segmenter {
   // The sensor-dependent numbers in use (from the last scan's beam pattern, beam_scaling.h).
   const BeamScaling& beam_scaling() const { return scale_; }
   const Eigen::Vector3d& gyro_bias() const { return deskew_.bias(); }  // rad/s, perpendicular-to-gravity part
+  // Scans whose ground-at-a-kink split was skipped, one surface followed steadily (SegmenterConfig::kink_recheck_scans).
+  int64_t kink_splits_skipped() const { return kink_skipped_; }
   // Last scan's points per pixel (row-major like the scan, de-skewed when last().deskewed; NaN where there
   // is no return inside [min_range_m, max_range_m]). Diagnostics: built on each call.
   const std::vector<Eigen::Vector3f>& points() const;
@@ -120,9 +122,22 @@ class Segmenter {
   int64_t follow_t_ = 0;
   // ... its distance from the sensor then, and the rate of that distance (the sensor's speed off the surface,
   // low-passed; valid while the same surface is followed scan after scan).
-  double follow_d_ = 0, follow_rate_ = 0, follow_rate_var_ = 0, follow_rate_gain_ = 1;  // (var: of the raw rates)
-  int64_t follow_d_t_ = 0;
-  bool follow_rate_ok_ = false;
+  struct FollowRate {
+    double d = 0, rate = 0, var = 0, gain = 1;  // (var: of the raw rates)
+    int64_t d_t = 0;
+    bool ok = false;
+    // The surface's distance d_now at t (same_surface: the one of the last update).
+    void update(int64_t t, double d_now, bool same_surface);
+    // The rate stands out of its own noise (2 sigmas of the weighted mean): the sweep's translation is corrected.
+    bool stands_out() const;
+  };
+  FollowRate follow_;
+  // Scans the ground-at-a-kink split may still be skipped for while one surface is followed steadily
+  // (ground_kink.cpp, SegmenterConfig::kink_recheck_scans); and how many it was skipped for (diagnostics).
+  int kink_quiet_left_ = 0;
+  double kink_skew_per_rate_ = 0;   // the last split's sweep tilt of the followed surface per m/s of the rate [rad s/m]
+  double kink_d_offset_ = 0;         // the last split's followed surface's distance - the ring fit's [m]
+  int64_t kink_skipped_ = 0;
   // ground_kink.cpp's scratch, kept from scan to scan: the lower candidates near the ring fit's plane (their
   // indices and sectors), and the sectors' points grouped (sector by sector, relative to the plane's reference
   // point), the followed surface's.

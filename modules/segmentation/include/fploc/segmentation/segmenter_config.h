@@ -17,6 +17,13 @@ struct SegmenterConfig {
   // planes' disagreement with the gyro/accelerometer, gyro prediction without planes, and roll/pitch moved
   // from mid-sweep to the scan's time (jolts). Level floors: the planes' attitude unchanged.
   bool imu_attitude = true;         // rotate returns to mid-sweep with the gyro rate (when gyro samples arrive)
+  // With the IMU, the ground at a kink (ground_kink.cpp: the returns near the ground split into sectors, each
+  // fitted, the surface under the robot found) runs on every scan while a second surface or a ring fit off the
+  // followed surface is in view. While one surface is followed steadily (the last split found it alone, the ring
+  // fit on it and the ceiling giving the attitude, and this scan's ring fit still on it as the gyro carries it,
+  // with no sweep to correct) the split, whose result would be the ring fit as it is, is skipped on up to this
+  // many scans minus one before it runs again (1: it runs on every scan).
+  int kink_recheck_scans = 4;
   double min_range_m = 0.4;        // ignore returns closer than this (platform, tripod)
   double max_range_m = 120.0;
   int min_plane_inliers = 200;     // fewer inliers -> plane not found
