@@ -225,11 +225,11 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
       s.text = b;
     }
   }
-  // A fix after a stretch not published OK: against the dead-reckoned pose (dead_reckoning_gate_sigma).
-  if (s.status == matcher::FitStatus::kOk && not_ok_since_ok_ && fix && dead_reckoned && cfg_.dead_reckoning_gate_sigma > 0) {
+  // A fix against the dead-reckoned pose (dead_reckoning_gate_sigma), the covariance it would be published with.
+  if (s.status == matcher::FitStatus::kOk && fix && dead_reckoned && cfg_.dead_reckoning_gate_sigma > 0) {
     const Eigen::Vector3d d(fix->x - dead_reckoned->pose.x, fix->y - dead_reckoned->pose.y,
                             wrap_angle(fix->yaw - dead_reckoned->pose.yaw));
-    const Eigen::Matrix3d S = sym(frame_cov + clamp_spd(dead_reckoned->covariance, 1e-14, vmax));
+    const Eigen::Matrix3d S = sym(s.covariance + clamp_spd(dead_reckoned->covariance, 1e-14, vmax));
     const double d2 = d.dot(Eigen::LDLT<Eigen::Matrix3d>(S).solve(d));
     s.dead_reckoned_sigma = std::sqrt(std::max(0.0, d2));
     ++dr_agreeing_;

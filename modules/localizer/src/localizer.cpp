@@ -148,7 +148,7 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
     matcher::deskew(f, sfr.match.twist, t_ref, &deskewed_);
     const Pose2 at_ref = compose(sfr.match.pose, matcher::exp_twist(sfr.match.twist, t_ref));
     const auto fu = optimizer::frame_uncertainty(lookup_, deskewed_, at_ref, cfg_.uncertainty.frame);
-    const std::optional<DeadReckoned> dr = dead_reckoned(f, fu.valid ? fu.covariance : Eigen::Matrix3d::Identity() * 1e6);
+    const std::optional<DeadReckoned> dr = dead_reckoned(f, sfr);
     uncertainty_ = tracker_.update(f.utime, fu.covariance, fu.valid, sfr.match.status, sfr.match.text, &sfr.match.pose,
                                    &sfr.match.twist, sfr.match.fit.inlier_ratio, motion ? &*motion : nullptr,
                                    contradicted(deskewed_, at_ref, sfr.match.fit.inlier_ratio), dr ? &*dr : nullptr);
@@ -157,18 +157,24 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
       check_rival(deskewed_, at_ref, dr ? &*dr : nullptr, sfr.match.pose);
     if (uncertainty_.status == matcher::FitStatus::kOk || sfr.match.status == matcher::FitStatus::kLost)
       have_rival_ = false;  // confirmed, or lost again: a new re-acquisition searches again
-    if (cfg_.uncertainty.dead_reckoning_gate_sigma > 0 && uncertainty_.status == matcher::FitStatus::kOk &&
-        !tracker_.wants_dead_reckoning()) {
-      // The anchor of the next stretch not published OK.
-      anchor_frame_ = f;
-      anchor_.pose = sfr.match.pose;
-      anchor_.covariance = uncertainty_.covariance;
+    last_off_dead_reckoning_ = uncertainty_.off_dead_reckoning;
+    if (!tracker_.wants_dead_reckoning()) have_frozen_ = false;  // the stretch (if any) is over
+    if (cfg_.uncertainty.dead_reckoning_gate_sigma > 0 && dr_odometry_ && dr_last_utime_ == f.utime &&
+        uncertainty_.status == matcher::FitStatus::kOk && !tracker_.wants_dead_reckoning()) {
+      // An anchor: the fix, its published covariance, its velocity and where the odometry was.
+      Anchor a;
+      a.utime = f.utime;
+      a.fix = sfr.match.pose;
+      a.covariance = uncertainty_.covariance;
       const double c = std::cos(sfr.match.pose.yaw), sn = std::sin(sfr.match.pose.yaw);
-      anchor_velocity_ = Eigen::Vector3d(c * sfr.match.twist.vx - sn * sfr.match.twist.vy,
-                                         sn * sfr.match.twist.vx + c * sfr.match.twist.vy, sfr.match.twist.w);
-      anchor_utime_ = f.utime;
-      have_anchor_ = true;
-      dr_odometry_.reset();
+      a.velocity = Eigen::Vector3d(c * sfr.match.twist.vx - sn * sfr.match.twist.vy, sn * sfr.match.twist.vx + c * sfr.match.twist.vy,
+                                   sfr.match.twist.w);
+      a.odometry = dr_last_;
+      a.path_m = dr_path_m_;
+      a.turn_rad = dr_turn_rad_;
+      ok_frames_.push_back(a);
+      while (ok_frames_.size() > 1 && double(f.utime - ok_frames_.front().utime) * 1e-6 > cfg_.uncertainty.dr_history_s)
+        ok_frames_.pop_front();
     }
     in.covariance = uncertainty_.covariance;
     in.published_status = uncertainty_.status;
@@ -178,55 +184,89 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
   return window_.add(std::move(in), finals);
 }
 
-std::optional<DeadReckoned> Localizer::dead_reckoned(const FeatureFrame& f, const Eigen::Matrix3d& frame_cov) {
-  if (!tracker_.wants_dead_reckoning() || !have_anchor_) return std::nullopt;
+std::optional<DeadReckoned> Localizer::dead_reckoned(const FeatureFrame& f, const FramePose& sfr) {
   const UncertaintyConfig& u = cfg_.uncertainty;
-  if (!dr_odometry_) {
-    // The stretch starts: the last OK frame at its fix is the odometry's map.
+  if (!(u.dead_reckoning_gate_sigma > 0)) return std::nullopt;
+  const double c = std::cos(sfr.match.pose.yaw), sn = std::sin(sfr.match.pose.yaw);
+  const Eigen::Vector3d velocity(c * sfr.match.twist.vx - sn * sfr.match.twist.vy, sn * sfr.match.twist.vx + c * sfr.match.twist.vy,
+                                 sfr.match.twist.w);
+  // (Re)starts the odometry at this frame (its fix, the matcher's velocity): the anchors before cannot be related to it.
+  auto restart = [&]() {
     odometry::OdometryConfig oc;
     oc.max_points = u.dr_max_points;
+    oc.static_support_m = u.dr_static_support_m;
+    oc.prediction_sigma_m = u.dr_prediction_sigma_m;
+    oc.prediction_sigma_rad = u.dr_prediction_sigma_rad;
     dr_odometry_.emplace(oc);
-    dr_odometry_->set_pose(anchor_.pose, anchor_velocity_);
-    dr_odometry_->process(anchor_frame_);
-    dr_valid_ = true;
-    dr_last_ = anchor_.pose;
-    dr_path_m_ = dr_turn_rad_ = 0;
-    dr_open_ = Eigen::Matrix2d::Zero();
-    dr_last_utime_ = anchor_utime_;
-    dr_velocity_ = anchor_velocity_.head<2>();
-  }
+    dr_odometry_->set_pose(sfr.match.pose, velocity);
+    dr_last_ = dr_odometry_->process(f).pose;
+    dr_last_utime_ = f.utime;
+    dr_velocity_ = velocity.head<2>();
+    ok_frames_.clear();
+    have_frozen_ = false;
+    return std::optional<DeadReckoned>();
+  };
+  if (!dr_odometry_) return restart();
   const odometry::OdometryResult r = dr_odometry_->process(f);
-  // A frame the odometry could not register breaks the chain: no dead-reckoned pose until the next OK.
-  if (!r.ok) dr_valid_ = false;
-  // ... and so does a jump: the velocity changing from one frame to the next by more than a platform does (the ICP
-  // caught another minimum: a moved wall, a local map of few frames).
+  // A frame the odometry could not register breaks the chain, and so does a jump: the velocity changing from one frame
+  // to the next by more than a platform does (the ICP caught another minimum: a moved wall, a local map of few frames).
   const double dt = (f.utime - dr_last_utime_) * 1e-6;
-  if (dr_valid_ && dt > 0) {
-    const Eigen::Vector2d v((r.pose.x - dr_last_.x) / dt, (r.pose.y - dr_last_.y) / dt);
-    if ((v - dr_velocity_).norm() > u.dr_jump_mps) dr_valid_ = false;
-    dr_velocity_ = v;
-  }
-  if (!dr_valid_) return std::nullopt;
+  if (!r.ok || !(dt > 0)) return restart();
+  const Eigen::Vector2d v((r.pose.x - dr_last_.x) / dt, (r.pose.y - dr_last_.y) / dt);
+  if ((v - dr_velocity_).norm() > u.dr_jump_mps) return restart();
+  dr_velocity_ = v;
   dr_path_m_ += std::hypot(r.pose.x - dr_last_.x, r.pose.y - dr_last_.y);
   dr_turn_rad_ += std::abs(wrap_angle(r.pose.yaw - dr_last_.yaw));
   dr_last_ = r.pose;
-  // Where the frame leaves a direction open (a corridor's axis: its own 1-sigma against the plan above poor_sigma_m) the
-  // odometry, on the same features, sees no more along it than the plan fit: it carries its velocity, whose error
-  // (velocity_sigma_mps) times the frame's interval adds to the 1-sigma along that direction.
-  double open_dir = 0;
-  if (weakest_horizontal(frame_cov, &open_dir) > u.poor_sigma_m) {
-    const double a = u.velocity_sigma_mps * std::max(0.0, (f.utime - dr_last_utime_) * 1e-6);
-    const Eigen::Vector2d e(std::cos(open_dir), std::sin(open_dir));
-    dr_open_ = add_sigmas(dr_open_.isZero() ? Eigen::Matrix3d::Identity() * 1e-12 : embed(dr_open_), embed(a * a * e * e.transpose()))
-                   .topLeftCorner<2, 2>();
-  }
   dr_last_utime_ = f.utime;
-  const double sxy = u.dr_sigma_m + u.dr_sigma_per_m * dr_path_m_;
-  const double syaw = u.dr_sigma_rad + u.dr_sigma_per_rad * dr_turn_rad_ + u.dr_sigma_rad_per_m * dr_path_m_;
+  // Where the odometry's own registration leaves a direction open (its 1-sigma there above poor_sigma_m: a corridor's
+  // axis with nothing else in view) it carries its velocity, whose error (velocity_sigma_mps) times the frame's
+  // interval adds to the 1-sigma along that direction, for every anchor.
+  double open_dir = 0;
+  if (weakest_horizontal((r.information + 1e-9 * Eigen::Matrix3d::Identity()).inverse(), &open_dir) > u.poor_sigma_m) {
+    const double a = u.velocity_sigma_mps * dt;
+    const Eigen::Matrix3d step = embed(a * a * Eigen::Vector2d(std::cos(open_dir), std::sin(open_dir)) *
+                                       Eigen::Vector2d(std::cos(open_dir), std::sin(open_dir)).transpose());
+    auto grow = [&](Anchor& an) {
+      an.open = add_sigmas(an.open.isZero() ? Eigen::Matrix3d::Identity() * 1e-12 : embed(an.open), step).topLeftCorner<2, 2>();
+    };
+    for (Anchor& an : ok_frames_) grow(an);
+    if (have_frozen_) grow(frozen_);
+  }
+  // The anchor: in a stretch the one frozen at its start (after a fix that failed this gate, the oldest it failed
+  // against; else the one whose covariance grown by the odometry's error since is the smallest: the last OK frame is
+  // often one the tracker carried along an open direction, a frame the plan fixed a second before is better known);
+  // outside one the oldest.
+  auto drift = [&](const Anchor& an) { return u.dr_sigma_m + u.dr_sigma_per_m * (dr_path_m_ - an.path_m); };
+  const Anchor* a = nullptr;
+  if (tracker_.wants_dead_reckoning()) {
+    if (!have_frozen_ && !ok_frames_.empty()) {
+      size_t k = 0;
+      if (!last_off_dead_reckoning_) {
+        double best = 0;
+        for (size_t j = ok_frames_.size(); j-- > 0;) {
+          const double v2 = std::pow(weakest_horizontal(ok_frames_[j].covariance, nullptr), 2) + std::pow(drift(ok_frames_[j]), 2);
+          if (j + 1 == ok_frames_.size() || v2 < best) best = v2, k = j;
+        }
+      }
+      frozen_ = ok_frames_[k];
+      have_frozen_ = true;
+      // The odometry goes on with the anchor's velocity (the plan fixed it; along a direction the odometry's points
+      // leave open its own velocity is what it slid).
+      dr_odometry_->set_velocity(frozen_.velocity);
+      dr_velocity_ = frozen_.velocity.head<2>();
+    }
+    if (have_frozen_) a = &frozen_;
+  } else if (!ok_frames_.empty()) {
+    a = &ok_frames_.front();
+  }
+  if (!a) return std::nullopt;
+  const double sxy = drift(*a);
+  const double syaw = u.dr_sigma_rad + u.dr_sigma_per_rad * (dr_turn_rad_ - a->turn_rad) + u.dr_sigma_rad_per_m * (dr_path_m_ - a->path_m);
   DeadReckoned d;
-  d.pose = r.pose;
-  d.covariance = anchor_.covariance + Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal().toDenseMatrix();
-  d.covariance.topLeftCorner<2, 2>() += dr_open_;
+  d.pose = compose(a->fix, between(a->odometry, r.pose));
+  d.covariance = a->covariance + Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal().toDenseMatrix();
+  d.covariance.topLeftCorner<2, 2>() += a->open;
   return d;
 }
 

@@ -25,17 +25,22 @@ struct Odometry2D::Map {
   Cloud cloud{&pts};
   std::unique_ptr<Tree> tree;
 
-  void rebuild(const std::deque<std::vector<Eigen::Vector2d>>& kfs, int k) {
+  void rebuild(const std::deque<std::vector<Eigen::Vector2d>>& kfs, double static_support_m) {
     pts.clear();
-    for (const auto& kf : kfs) pts.insert(pts.end(), kf.begin(), kf.end());
+    std::vector<int> key;  // each point's keyframe
+    for (size_t k = 0; k < kfs.size(); ++k) {
+      pts.insert(pts.end(), kfs[k].begin(), kfs[k].end());
+      key.insert(key.end(), kfs[k].size(), int(k));
+    }
     tree = std::make_unique<Tree>(2, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
     tree->buildIndex();
     normals.assign(pts.size(), Eigen::Vector2d::Zero());
     valid.assign(pts.size(), 0);
+    const bool static_only = static_support_m > 0 && kfs.size() >= 2;
     // Normals from a fixed radius (a k-nearest neighbourhood collapses onto a noisy clump once several
     // keyframes overlap).
-    (void)k;
     std::vector<std::pair<uint32_t, double>> found;
+    size_t kept = 0;
     for (size_t i = 0; i < pts.size(); ++i) {
       found.clear();
       const size_t n = tree->radiusSearch(pts[i].data(), 0.25 * 0.25, found, nanoflann::SearchParams(32, 0.0f, false));
@@ -48,8 +53,27 @@ struct Odometry2D::Map {
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(C);
       if (es.eigenvalues()[0] > 0.05 * es.eigenvalues()[1]) continue;  // not a line locally
       normals[i] = es.eigenvectors().col(0);
+      if (static_only) {
+        // Seen again: a point of another keyframe on this point's line.
+        bool seen = false;
+        for (size_t j = 0; j < n && !seen; ++j)
+          seen = key[found[j].first] != key[i] && std::abs(normals[i].dot(pts[found[j].first] - pts[i])) <= static_support_m;
+        if (!seen) continue;
+      }
       valid[i] = 1;
+      ++kept;
     }
+    if (!static_only) return;
+    // Only the static points are searched (a point's nearest neighbour must not be a person's trail that hides the
+    // wall behind it).
+    size_t w = 0;
+    for (size_t i = 0; i < pts.size(); ++i)
+      if (valid[i]) pts[w] = pts[i], normals[w] = normals[i], ++w;
+    pts.resize(kept);
+    normals.resize(kept);
+    valid.assign(kept, 1);
+    tree = std::make_unique<Tree>(2, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+    tree->buildIndex();
   }
 };
 
@@ -73,26 +97,27 @@ void Odometry2D::set_pose(const Pose2& p, const Eigen::Vector3d& velocity) {
   have_velocity_ = true;
 }
 
+const FeatureFrame& Odometry2D::subsampled(const FeatureFrame& f_in) {
+  if (!(cfg_.max_points > 0 && f_in.points.size() > size_t(cfg_.max_points))) return f_in;
+  const size_t stride = (f_in.points.size() + size_t(cfg_.max_points) - 1) / size_t(cfg_.max_points);
+  sub_.utime = f_in.utime;
+  sub_.points.clear();
+  for (size_t i = 0; i < f_in.points.size(); i += stride) sub_.points.push_back(f_in.points[i]);
+  return sub_;
+}
+
 void Odometry2D::add_keyframe(const FeatureFrame& f, const Pose2& p) {
   std::vector<Eigen::Vector2d> w;
   w.reserve(f.points.size());
   for (const auto& fp : f.points) w.push_back(matcher::transform(p, fp.p));
   keyframes_.push_back(std::move(w));
   while (int(keyframes_.size()) > std::max(1, cfg_.map_keyframes)) keyframes_.pop_front();
-  map_->rebuild(keyframes_, cfg_.normal_neighbours);
+  map_->rebuild(keyframes_, cfg_.static_support_m);
   last_key_ = p;
 }
 
 OdometryResult Odometry2D::process(const FeatureFrame& f_in) {
-  FeatureFrame sub;
-  const FeatureFrame* fp_ = &f_in;
-  if (cfg_.max_points > 0 && f_in.points.size() > size_t(cfg_.max_points)) {
-    const size_t stride = (f_in.points.size() + size_t(cfg_.max_points) - 1) / size_t(cfg_.max_points);
-    sub.utime = f_in.utime;
-    for (size_t i = 0; i < f_in.points.size(); i += stride) sub.points.push_back(f_in.points[i]);
-    fp_ = &sub;
-  }
-  const FeatureFrame& f = *fp_;
+  const FeatureFrame& f = subsampled(f_in);
   OdometryResult r;
   r.num_points = int(f.points.size());
   if (!have_pose_) return r;
@@ -114,11 +139,17 @@ OdometryResult Odometry2D::process(const FeatureFrame& f_in) {
     x.yaw += velocity_[2] * dt;
   }
   const Pose2 pred = x;
+  // The prediction as a prior (OdometryConfig::prediction_sigma_m), in the points' units.
+  Eigen::Vector3d prior = Eigen::Vector3d::Zero();
+  if (have_velocity_ && cfg_.prediction_sigma_m > 0 && cfg_.prediction_sigma_rad > 0) {
+    const double wxy = std::pow(cfg_.point_sigma_m / cfg_.prediction_sigma_m, 2);
+    prior = Eigen::Vector3d(wxy, wxy, std::pow(cfg_.point_sigma_m / cfg_.prediction_sigma_rad, 2));
+  }
   const double gate2 = cfg_.max_correspondence_m * cfg_.max_correspondence_m;
   int inliers = 0;
   double sum2 = 0;
   for (int it = 0; it < cfg_.max_iterations; ++it) {
-    Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+    Eigen::Matrix3d H = Eigen::Matrix3d::Zero(), Hin = Eigen::Matrix3d::Zero();
     Eigen::Vector3d g = Eigen::Vector3d::Zero();
     const double c = std::cos(x.yaw), s = std::sin(x.yaw);
     inliers = 0;
@@ -127,20 +158,25 @@ OdometryResult Odometry2D::process(const FeatureFrame& f_in) {
       const Eigen::Vector2d pw = matcher::transform(x, fp.p);
       uint32_t idx;
       double d2;
-      if (map_->tree->knnSearch(pw.data(), 1, &idx, &d2) < 1 || d2 > gate2 || !map_->valid[idx]) continue;
+      if (map_->pts.empty() || map_->tree->knnSearch(pw.data(), 1, &idx, &d2) < 1 || d2 > gate2 || !map_->valid[idx]) continue;
       const Eigen::Vector2d& n = map_->normals[idx];
       const double e = n.dot(pw - map_->pts[idx]);
       const Eigen::Vector3d J(n.x(), n.y(), n.dot(Eigen::Vector2d(-s * fp.p.x() - c * fp.p.y(), c * fp.p.x() - s * fp.p.y())));
       const double w = std::abs(e) <= cfg_.huber_m ? 1.0 : cfg_.huber_m / std::abs(e);
       H += w * J * J.transpose();
       g += w * J * e;
+      if (std::abs(e) <= cfg_.huber_m) Hin += J * J.transpose();
       if (std::abs(e) <= 2 * cfg_.huber_m) {
         ++inliers;
         sum2 += e * e;
       }
     }
     r.iterations = it + 1;
+    r.information = Hin / (cfg_.point_sigma_m * cfg_.point_sigma_m);
     if (inliers < 10) break;
+    const Eigen::Vector3d off(x.x - pred.x, x.y - pred.y, wrap_angle(x.yaw - pred.yaw));
+    H += prior.asDiagonal();
+    g += prior.cwiseProduct(off);
     const Eigen::Vector3d dx = -(H + 1e-6 * Eigen::Matrix3d::Identity()).ldlt().solve(g);
     x.x += dx[0];
     x.y += dx[1];
@@ -152,6 +188,7 @@ OdometryResult Odometry2D::process(const FeatureFrame& f_in) {
   r.rms_m = inliers > 0 ? std::sqrt(sum2 / inliers) : 0;
   r.ok = inliers >= 10 && double(inliers) >= cfg_.min_inlier_ratio * double(std::max(1, r.num_points));
   if (!r.ok) {
+    r.information.setZero();
     x = pred;
     have_velocity_ = false;  // hold the pose instead of extrapolating into nowhere
   }

@@ -25,8 +25,8 @@
 // published POOR when the innovation gate refuses it, while a re-acquired track is being confirmed
 // (confirm_fixes), when under half of its points lie on the plan (weak_fit_ratio) and when the map says empty
 // where many of them lie (max_contradicted; occupancy-map plans only), and, after any frame published other than
-// OK, while a fix lies beyond the gate of the dead-reckoned pose (the pose last published OK carried on by the
-// LiDAR odometry since: dead_reckoning_gate_sigma; the Localizer runs that odometry), and while a re-acquisition has
+// OK, while a fix lies beyond the gate of the dead-reckoned pose (a pose published OK carried on by the LiDAR odometry
+// since: dead_reckoning_gate_sigma; the Localizer runs that odometry), and while a re-acquisition has
 // a second fit that explains nearly as many points (rival_ratio; the Localizer searches it).
 #pragma once
 #include <Eigen/Core>
@@ -85,27 +85,39 @@ struct UncertaintyConfig {
   // (x/y, yaw as MatcherConfig::odom_sigma_*: the Localizer copies the matcher's).
   double odom_sigma_m = 0.05, odom_sigma_per_m = 0.3;
   double odom_sigma_rad = 2.0 * M_PI / 180, odom_sigma_per_rad = 0.3, odom_sigma_rad_per_m = 3.0 * M_PI / 180;
-  // Dead reckoning through a stretch not published OK (POOR, LOST, a re-acquisition): the track may come back on a
-  // wrong place that explains the scan as well as the right one (shelf faces on the walls behind them, a corridor
-  // whose outer wall is glass), and the innovation gate cannot refuse it, its prediction having grown to metres.
-  // The Localizer carries the pose last published OK with a LiDAR odometry of the frames since (frame-to-local-map
-  // ICP on the same features, odometry/odometry.h, run only during such a stretch) and passes it to update()
-  // (`dead_reckoned`); a fix beyond dead_reckoning_gate_sigma (as gate_sigma: the 3-DoF chi-square quantile) of it
-  // is published POOR ("N m from the dead-reckoned pose") with the offset's second moment added to its covariance,
-  // and the stretch (the dead reckoning from the same pose) lasts until confirm_fixes fixes in a row lie within the
-  // gate. Where a frame leaves a direction open (its own 1-sigma above poor_sigma_m) the odometry only carries its
-  // velocity along it: velocity_sigma_mps times the frame interval is added to the 1-sigma along that direction. The
-  // odometry's error otherwise (independent of the OK pose's covariance, added to it) has the 1-sigma dr_sigma_m +
-  // dr_sigma_per_m * path length in x/y and dr_sigma_rad + dr_sigma_per_rad * turn + dr_sigma_rad_per_m * path in
-  // yaw. 0: off.
+  // Dead reckoning (the Localizer's; update()'s `dead_reckoned`): after a stretch not published OK (POOR, LOST, a
+  // re-acquisition) the track may come back on a wrong place that explains the scan as well as the right one (shelf
+  // faces on the walls behind them, a corridor whose outer wall is glass), and the innovation gate cannot refuse it,
+  // its prediction having grown to metres; and a track published OK may slide along a corridor a little per frame,
+  // each step within the innovation gate. The Localizer runs a LiDAR odometry over every frame (frame-to-local-map
+  // ICP on the same features, odometry/odometry.h, every k-th point so that about dr_max_points are used) and keeps
+  // the frames published OK outside a stretch of the last dr_history_s as anchors: an anchor's fix carried on by the
+  // odometry's motion since is a dead-reckoned pose. A fix (published OK so far) beyond dead_reckoning_gate_sigma (as
+  // gate_sigma: the 3-DoF chi-square quantile; the covariance the fix would be published with plus the dead-reckoned
+  // one) of it is published POOR ("N m from the dead-reckoned pose") with the offset's second moment added to its
+  // covariance. Outside a stretch the fixes are checked against the oldest anchor (a slide drifts away from it); a
+  // stretch freezes its anchor at its start (after a fix refused so, the anchor it was refused against; else the one
+  // whose covariance grown by the odometry's error since is the smallest: the last OK frame is often one the tracker
+  // carried along an open direction, its 1-sigma near poor_sigma_m, while one the plan fixed a second before is
+  // better known; the odometry then goes on with that anchor's velocity) and lasts until confirm_fixes fixes in a row
+  // lie within the gate. The dead-reckoned covariance: the anchor's published one plus the odometry's error, the
+  // 1-sigma dr_sigma_m + dr_sigma_per_m * path length in x/y and dr_sigma_rad + dr_sigma_per_rad * turn +
+  // dr_sigma_rad_per_m * path in yaw, plus, along each direction the odometry's own registration leaves open (its
+  // 1-sigma from its points above poor_sigma_m), velocity_sigma_mps times the frame interval. 0: off.
   // A frame the odometry cannot register, or over which its velocity changes by more than dr_jump_mps (the ICP caught
   // another minimum; a platform changes its velocity by a few cm/s per frame, the odometry's noise adds ~0.1 m/s),
-  // ends the dead reckoning until the next OK: the fixes are then checked as before.
-  // The odometry registers every k-th point so that about dr_max_points are used (its own default is 800: a third of
-  // the CPU, the same verdicts on the corridor worlds).
+  // starts it again at that frame: the anchors before are dropped (no check until the next OK frame).
+  // The odometry keeps only static points (OdometryConfig::static_support_m = dr_static_support_m: a map point another
+  // keyframe saw on the same line; the walking people a crowd leaves in its map are not registered against) and holds
+  // the constant-velocity prediction as a prior (OdometryConfig::prediction_sigma_m / _rad = dr_prediction_sigma_m /
+  // _rad per frame): along a direction its points leave open it carries the velocity, as the covariance assumes,
+  // instead of sliding where a passing person pulls it.
   double dead_reckoning_gate_sigma = 3.0;
   double dr_jump_mps = 0.5;
   int dr_max_points = 250;
+  double dr_history_s = 2.0;
+  double dr_static_support_m = 0.05;
+  double dr_prediction_sigma_m = 0.01, dr_prediction_sigma_rad = 0.005;
   double dr_sigma_m = 0.02, dr_sigma_per_m = 0.02;
   double dr_sigma_rad = 0.5 * M_PI / 180, dr_sigma_per_rad = 0.02, dr_sigma_rad_per_m = 0.5 * M_PI / 180;
   // A second fit of a re-acquisition (the Localizer's, while the tracker confirms one: `confirming`): the frame
@@ -159,8 +171,9 @@ class UncertaintyTracker {
                           const matcher::Twist2* twist = nullptr, double inlier_ratio = 1.0,
                           const Pose2* motion = nullptr, double contradicted = 0.0,
                           const DeadReckoned* dead_reckoned = nullptr);
-  // A frame since the last one published OK was not (POOR, LOST, re-acquired): the next fixes are checked against
-  // the dead-reckoned pose (dead_reckoning_gate_sigma), if the caller has one.
+  // A frame since the last one published OK was not (POOR, LOST, re-acquired): a stretch whose fixes the caller checks
+  // against the dead-reckoned pose of one anchor (dead_reckoning_gate_sigma) until confirm_fixes agree. A fix given a
+  // dead-reckoned pose is checked against it in or out of a stretch.
   bool wants_dead_reckoning() const { return cfg_.dead_reckoning_gate_sigma > 0 && not_ok_since_ok_; }
   // The re-acquisition is not confirmed yet (an ambiguity the caller found): confirm_fixes more fixes needed.
   void restart_confirmation() {

@@ -7,6 +7,7 @@
 // as graphs/paper.pbtxt wires FPLOC_POSE_LATEST into the matcher's `refined` input.
 #pragma once
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <optional>
 #include <string>
@@ -139,22 +140,29 @@ class Localizer {
   std::vector<double> ranges_;       // scratch: the frame's point ranges (add_map_error)
   UncertaintyTracker tracker_;
   UncertaintyState uncertainty_;
-  // Dead reckoning through a stretch not published OK (UncertaintyConfig::dead_reckoning_gate_sigma): the last
-  // frame published OK (its features, fix and covariance) is the odometry's first map; from the first frame not
-  // published OK on, every frame is registered to the odometry's local map until a fix is published OK again.
-  std::optional<DeadReckoned> dead_reckoned(const FeatureFrame& f, const Eigen::Matrix3d& frame_cov);
-  bool have_anchor_ = false;
-  FeatureFrame anchor_frame_;
-  DeadReckoned anchor_;
-  Eigen::Vector3d anchor_velocity_ = Eigen::Vector3d::Zero();  // plan frame, from the matcher's twist
-  int64_t anchor_utime_ = 0;
-  std::optional<odometry::Odometry2D> dr_odometry_;  // running (a stretch not OK)
-  bool dr_valid_ = false;            // the odometry registered every frame of the stretch
-  Pose2 dr_last_;
-  double dr_path_m_ = 0, dr_turn_rad_ = 0;
-  Eigen::Matrix2d dr_open_ = Eigen::Matrix2d::Zero();  // x/y covariance carried along the frames' open directions
+  // Dead reckoning (UncertaintyConfig::dead_reckoning_gate_sigma): the LiDAR odometry registers every frame; the
+  // frames published OK outside a stretch are its anchors (their fixes carried on by the odometry's motion since).
+  // Outside a stretch a fix is checked against the oldest anchor of the last dr_history_s (a track sliding a little
+  // per frame drifts away from it), in a stretch against the anchor frozen at its start.
+  std::optional<DeadReckoned> dead_reckoned(const FeatureFrame& f, const FramePose& sfr);
+  struct Anchor {
+    int64_t utime = 0;
+    Pose2 fix;
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+    Pose2 odometry;                                       // the odometry's pose at it
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();   // the fix's (the matcher's twist, plan frame)
+    double path_m = 0, turn_rad = 0;                      // the odometry's path / turn at it (running totals)
+    Eigen::Matrix2d open = Eigen::Matrix2d::Zero();       // x/y covariance carried along open directions since it
+  };
+  std::deque<Anchor> ok_frames_;     // oldest first
+  bool have_frozen_ = false;         // the anchor of the current stretch
+  Anchor frozen_;
+  bool last_off_dead_reckoning_ = false;  // the previous frame failed the dead reckoning's gate (against the oldest anchor)
+  std::optional<odometry::Odometry2D> dr_odometry_;
+  Pose2 dr_last_;                    // the odometry's last pose
+  double dr_path_m_ = 0, dr_turn_rad_ = 0;  // running totals
   int64_t dr_last_utime_ = 0;
-  Eigen::Vector2d dr_velocity_ = Eigen::Vector2d::Zero();  // the odometry's over its last frame (plan frame)
+  Eigen::Vector2d dr_velocity_ = Eigen::Vector2d::Zero();  // the odometry's over its last frame
   // The second fit of a re-acquisition (UncertaintyConfig::rival_ratio): searched while none is known during a
   // confirmation, then carried with the fix; applied to uncertainty_.
   // (dr: the frame's dead-reckoned pose, if any: a rival beyond its gate is no ambiguity.)

@@ -23,6 +23,19 @@ struct OdometryConfig {
   int normal_neighbours = 6;
   double min_inlier_ratio = 0.3;
   int max_points = 800;  // per frame: every k-th feature so that about this many are used (0 = all)
+  // Static points only (0: off, every map point with a line-like neighbourhood is registered against). A map point
+  // is kept only where another keyframe of the map saw the same line: a point of another keyframe within the
+  // normal neighbourhood (0.25 m) and within static_support_m of the point's local line. Walls, shelves and parked
+  // things are seen again from the next keyframe (0.3 m of travel on); a walking person has moved by then (a
+  // 0.45 m blob, seen again a body width or more away), so the trail of people a crowd leaves in the map does not
+  // pull the registration along with them. Needs two keyframes: with one (the start) every point is kept.
+  double static_support_m = 0;
+  // The constant-velocity prediction as a prior of the registration (0: off), once the velocity is known: its 1-sigma
+  // per frame, against point_sigma_m of a point's distance to its line. Where the points fix the pose (hundreds of
+  // them on two walls) it moves the answer by nothing; along a direction they leave open (a corridor's axis) the
+  // pose keeps the velocity instead of sliding wherever the few points off the walls (a passing person) pull it.
+  double prediction_sigma_m = 0, prediction_sigma_rad = 0;
+  double point_sigma_m = 0.03;
 };
 
 struct OdometryResult {
@@ -32,6 +45,10 @@ struct OdometryResult {
   int num_points = 0, num_inliers = 0;
   double rms_m = 0;
   int iterations = 0;
+  // What the points fix of the pose (x, y, yaw): sum of J J^T / point_sigma_m^2 over the points within huber_m of
+  // their lines at the last iteration (the prior left out); its inverse is the registration's covariance, large along
+  // a direction the points leave open. Zero when not registered.
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
 };
 
 class Odometry2D {
@@ -44,11 +61,19 @@ class Odometry2D {
   // the prediction put it, and a restart at rest would stall there).
   void set_pose(const Pose2& p, const Eigen::Vector3d& velocity);
   OdometryResult process(const FeatureFrame& f);
+  // The velocity (plan frame, as set_pose's) the next frame is predicted with, e.g. a better-known one from a
+  // localizer's fix; the pose and the map stay.
+  const Eigen::Vector3d& velocity() const { return velocity_; }
+  void set_velocity(const Eigen::Vector3d& velocity) {
+    velocity_ = velocity;
+    have_velocity_ = true;
+  }
   size_t map_points() const;
 
  private:
   struct Map;
   void add_keyframe(const FeatureFrame& f, const Pose2& p);
+  const FeatureFrame& subsampled(const FeatureFrame& f);
   OdometryConfig cfg_;
   std::unique_ptr<Map> map_;
   std::deque<std::vector<Eigen::Vector2d>> keyframes_;  // world points per keyframe
@@ -56,6 +81,7 @@ class Odometry2D {
   Pose2 pose_, last_key_;
   int64_t utime_ = 0;
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();
+  FeatureFrame sub_;  // scratch: the subsampled frame
 };
 
 }  // namespace fploc::odometry
