@@ -212,9 +212,14 @@ TEST(GravityFusion, KinkSplitIsSkippedOnlyWhileOneSurfaceIsFollowed) {
     return drive(room, [&](double t) { return ramp_pose(room, t); }, wobbly_acc, 310, true, 1, 11,
                  [&](double t) { return on_ramp(room, t); }, Eigen::Vector3d::Zero(), cfg);
   };
-  const Result a = run(every), b = run(SegmenterConfig{});
+  SegmenterConfig four;
+  four.kink_recheck_scans = 4;
+  const Result a = run(every), b = run(SegmenterConfig{}), c = run(four);
   EXPECT_EQ(a.kink_skipped, 0);
-  EXPECT_GT(b.kink_skipped, 40);  // of 310 scans (on most the ground gives the attitude: the split runs)
+  EXPECT_GT(c.kink_skipped, 40);  // of 310 scans (on most the ground gives the attitude: the split runs)
+  // The default (8) skips up to seven scans in a row where 4 skips three: more in all.
+  EXPECT_GT(b.kink_skipped, c.kink_skipped);
+  std::printf("kink_recheck_scans 4: skipped %lld, max kink z error %.4f m\n", (long long)c.kink_skipped, c.max_kink_z_err);
   ASSERT_EQ(a.zrp.size(), b.zrp.size());
   double dz = 0, drp = 0, dd = 0;
   for (size_t k = 0; k < a.zrp.size(); ++k) {

@@ -23,7 +23,9 @@ struct SegmenterConfig {
   // fit on it and the ceiling giving the attitude, and this scan's ring fit still on it as the gyro carries it,
   // with no sweep to correct) the split, whose result would be the ring fit as it is, is skipped on up to this
   // many scans minus one before it runs again (1: it runs on every scan).
-  int kink_recheck_scans = 4;
+  // 8: a second surface that comes into view without moving the ring fit is split off at most 0.7 s (10 Hz) later;
+  // the ring fit itself leaving the followed surface (a kink under the robot) ends the skipping on that scan.
+  int kink_recheck_scans = 8;
   double min_range_m = 0.4;        // ignore returns closer than this (platform, tripod)
   double max_range_m = 120.0;
   int min_plane_inliers = 200;     // fewer inliers -> plane not found
