@@ -10,6 +10,12 @@
 namespace fploc::localizer {
 
 namespace {
+
+// The matcher's body twist at a fix as the plan-frame velocity (vx, vy, yaw rate) the odometry is set with.
+Eigen::Vector3d plan_velocity(const matcher::MatchResult& m) {
+  const double c = std::cos(m.pose.yaw), sn = std::sin(m.pose.yaw);
+  return {c * m.twist.vx - sn * m.twist.vy, sn * m.twist.vx + c * m.twist.vy, m.twist.w};
+}
 Eigen::Matrix3d embed(const Eigen::Matrix2d& A) {  // x/y block, a tiny yaw variance (add_sigmas' basis)
   Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
   M.topLeftCorner<2, 2>() = A;
@@ -166,9 +172,7 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
       a.utime = f.utime;
       a.fix = sfr.match.pose;
       a.covariance = uncertainty_.covariance;
-      const double c = std::cos(sfr.match.pose.yaw), sn = std::sin(sfr.match.pose.yaw);
-      a.velocity = Eigen::Vector3d(c * sfr.match.twist.vx - sn * sfr.match.twist.vy, sn * sfr.match.twist.vx + c * sfr.match.twist.vy,
-                                   sfr.match.twist.w);
+      a.velocity = plan_velocity(sfr.match);
       a.odometry = dr_last_;
       a.path_m = dr_path_m_;
       a.turn_rad = dr_turn_rad_;
@@ -187,9 +191,7 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
 std::optional<DeadReckoned> Localizer::dead_reckoned(const FeatureFrame& f, const FramePose& sfr) {
   const UncertaintyConfig& u = cfg_.uncertainty;
   if (!(u.dead_reckoning_gate_sigma > 0)) return std::nullopt;
-  const double c = std::cos(sfr.match.pose.yaw), sn = std::sin(sfr.match.pose.yaw);
-  const Eigen::Vector3d velocity(c * sfr.match.twist.vx - sn * sfr.match.twist.vy, sn * sfr.match.twist.vx + c * sfr.match.twist.vy,
-                                 sfr.match.twist.w);
+  const Eigen::Vector3d velocity = plan_velocity(sfr.match);
   // (Re)starts the odometry at this frame (its fix, the matcher's velocity): the anchors before cannot be related to it.
   auto restart = [&]() {
     odometry::OdometryConfig oc;
