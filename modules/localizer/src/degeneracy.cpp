@@ -84,6 +84,7 @@ void UncertaintyTracker::reset(double sigma_m, double sigma_rad) {
   confirming_ = false;
   agreeing_ = 0;
   dr_agreeing_ = 0;
+  dr_refused_ = false;
   not_ok_since_ok_ = true;  // a re-seeded track: its first fixes are checked against the dead reckoning
 }
 
@@ -226,6 +227,7 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
     }
   }
   // A fix against the dead-reckoned pose (dead_reckoning_gate_sigma), the covariance it would be published with.
+  bool held = false;  // published POOR while a stretch with a refused fix counts the fixes that end it
   if (s.status == matcher::FitStatus::kOk && fix && dead_reckoned && cfg_.dead_reckoning_gate_sigma > 0) {
     const Eigen::Vector3d d(fix->x - dead_reckoned->pose.x, fix->y - dead_reckoned->pose.y,
                             wrap_angle(fix->yaw - dead_reckoned->pose.yaw));
@@ -242,17 +244,35 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
       s.text = b;
       s.off_dead_reckoning = true;
       dr_agreeing_ = 0;
+      dr_refused_ = true;
       // Two places the pose may be: the fix's and the dead-reckoned one; the error's second moment.
       s.covariance += d * d.transpose();
       s.sigma_max_m = weakest_horizontal(s.covariance, &s.weak_direction_rad);
       s.sigma_yaw_rad = std::sqrt(std::max(0.0, s.covariance(2, 2)));
+    } else if (dr_refused_ && not_ok_since_ok_) {
+      // A stretch a fix was refused in (the track slid, or came back on a twin): it ends only with confirm_fixes fixes
+      // in a row within the tighter dr_confirm_gate_sigma, each published POOR until then (a fix drifting back at the
+      // gate's edge would otherwise end it and be published OK where it was refused a frame before).
+      if (d2 > chi2_3dof_of_sigmas(cfg_.dr_confirm_gate_sigma)) dr_agreeing_ = 0;
+      if (dr_agreeing_ < std::max(1, cfg_.confirm_fixes)) {
+        char b[200];
+        std::snprintf(b, sizeof b, "%d of %d fixes within %.0f sigma of the dead-reckoned pose (this one %.2f m, Mahalanobis %.1f)",
+                      dr_agreeing_, std::max(1, cfg_.confirm_fixes), cfg_.dr_confirm_gate_sigma, std::hypot(d[0], d[1]),
+                      s.dead_reckoned_sigma);
+        s.status = matcher::FitStatus::kPoor;
+        s.text = b;
+        held = true;
+      }
     }
   }
   s.confirming = confirming_;
   // The stretch ends with confirm_fixes fixes in a row within the dead reckoning's gate (one slid a little at a time
   // would otherwise re-anchor it on each brief OK), at once without a dead-reckoned pose to check against.
   if (s.status == matcher::FitStatus::kOk) {
-    if (!dead_reckoned || dr_agreeing_ >= std::max(1, cfg_.confirm_fixes)) not_ok_since_ok_ = false, dr_agreeing_ = 0;
+    if (!dead_reckoned || dr_agreeing_ >= std::max(1, cfg_.confirm_fixes))
+      not_ok_since_ok_ = false, dr_agreeing_ = 0, dr_refused_ = false;
+  } else if (held) {
+    not_ok_since_ok_ = true;  // still counting
   } else if (matcher_status != matcher::FitStatus::kNotInitialised) {
     not_ok_since_ok_ = true;
     dr_agreeing_ = 0;

@@ -112,7 +112,11 @@ struct UncertaintyConfig {
   // the constant-velocity prediction as a prior (OdometryConfig::prediction_sigma_m / _rad = dr_prediction_sigma_m /
   // _rad per frame): along a direction its points leave open it carries the velocity, as the covariance assumes,
   // instead of sliding where a passing person pulls it.
+  // A stretch in which a fix was refused so ends only with confirm_fixes fixes in a row within dr_confirm_gate_sigma
+  // (the same chi-square quantile) of the dead-reckoned pose, each published POOR until then: a track that slid comes
+  // back to the gate's edge a little at a time, and the fix at the edge is no better than the one refused before it.
   double dead_reckoning_gate_sigma = 3.0;
+  double dr_confirm_gate_sigma = 2.0;
   double dr_jump_mps = 0.5;
   int dr_max_points = 250;
   double dr_history_s = 2.0;
@@ -198,6 +202,7 @@ class UncertaintyTracker {
   bool confirming_ = false;                            // re-acquired: fixes in a row still to agree (confirm_fixes)
   int agreeing_ = 0;                                   // accepted fixes in a row since the re-acquisition
   int dr_agreeing_ = 0;                                // fixes in a row within the dead reckoning's gate
+  bool dr_refused_ = false;                            // the current stretch refused a fix against the dead reckoning
   bool not_ok_since_ok_ = true;                        // a frame published other than OK since the last OK one (or none yet)
 };
 
