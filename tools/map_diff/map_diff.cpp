@@ -185,7 +185,7 @@ int main(int argc, char** argv) {
         const int ix[3] = {0, 1, 5};
         for (int r = 0; r < 3; ++r)
           for (int c = 0; c < 3; ++c) cov(r, c) = p.covariance[ix[r] * 6 + ix[c]];
-        diff.add_frame(p.position[0], p.position[1], yaw, pts, &cov);
+        diff.add_frame(p.position[0], p.position[1], yaw, pts, &cov, p.status == 0);  // POOR: no change evidence
         ++used;
       }
     }
