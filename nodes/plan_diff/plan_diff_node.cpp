@@ -87,7 +87,7 @@ class PlanDiffNode : public fploc::rt::Node {
     pts.reserve(f->points.size());
     for (const auto& p : f->points) pts.emplace_back(float(p.p.x()), float(p.p.y()));
     const Eigen::Matrix3d cov = fploc::adapters::xy_yaw_covariance(m);
-    diff_->add_frame(x.x, x.y, x.yaw, pts, &cov);
+    diff_->add_frame(x.x, x.y, x.yaw, pts, &cov, m.status == 0);  // POOR: scale only, no change evidence
     if (last_publish_ == 0 || m.utime - last_publish_ >= publish_us_) {
       last_publish_ = m.utime;
       publish(m.utime);

@@ -37,7 +37,8 @@ Prints one JSON document on stdout (progress on stderr):
                   "doors_moved", "doors_moved_found" (both pieces), "door_opened_found" (the wall piece the new
                   opening took: a missing part), "door_closed_found" (the old opening's piece that is wall now:
                   new structure), "missing_parts", "flags", "false_flags", "false_flags_per_100m", "new_on_clutter", "precision", "recall",
-                  "scale_true", "scale_estimate", "scale_sigma"}],
+                  "scale_true", "scale_estimate", "scale_sigma",
+                  "truth_poses" (with --diff-truth-poses: the same scores with the scans placed at the ground truth)}],
    "config": {...}}
 Rates (lost, false_ok, precision, recall) are fractions 0..1.
 """
@@ -601,6 +602,18 @@ class Bench:
             log(f"[{fam}] detection: removed {det['removed_found']}/{det['removed']}, moved {det['moved_found']}/{det['moved']}, "
                 f"added {det['added_found']}/{det['added']}, false flags {det['false_flags']} "
                 f"({det['false_flags_per_100m']:.2f} per 100 m), new on clutter {det['new_on_clutter']}")
+            if self.a.diff_truth_poses:
+                # Diagnostic: the same scans placed with the ground truth instead of fploc's poses (what the detector
+                # finds with good poses; the difference to the row above is the localizer's part).
+                djt = os.path.join(d, "diff-truth-poses.json")
+                run([os.path.join(BIN, "fploc-map-diff"), "--graph", os.path.join(ROOT, "graphs", "realism.pbtxt"), "--log", rec,
+                     "--out", djt, "--all", "--set", f"plan_diff.plan.file={plan}", "--poses", gt])
+                with open(djt) as f:
+                    t = score_detection(json.load(f), truth)
+                det["truth_poses"] = t
+                log(f"[{fam}] detection with the truth's poses: removed {t['removed_found']}/{t['removed']}, moved "
+                    f"{t['moved_found']}/{t['moved']}, added {t['added_found']}/{t['added']}, false flags {t['false_flags']} "
+                    f"({t['false_flags_per_100m']:.2f} per 100 m), new on clutter {t['new_on_clutter']}")
         if not self.a.keep:
             for f in (logf, rec, os.path.join(d, "ndt.lcm")):
                 if os.path.exists(f) and not (fam == "renovated" and f == rec):
@@ -743,6 +756,8 @@ def main():
                     help="fploc and fploc+downweight without the online drawing-scale correction (plan_diff_scale)")
     ap.add_argument("--scale-frame-hz", type=float, default=2.0,
                     help="scans per second the live plan diff of the fploc row uses for its scale estimate (2)")
+    ap.add_argument("--diff-truth-poses", action="store_true",
+                    help="also run the change detector with the ground-truth poses (detection[].truth_poses)")
     a = ap.parse_args()
     fams = [f for f in a.families.split(",") if f]
     for f in fams:

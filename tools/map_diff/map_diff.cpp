@@ -6,10 +6,13 @@
 // the graph's plan_diff node (or, without one, the plan of its matcher). Writes JSON and/or DXF (layers
 // FPLOC-MISSING, FPLOC-MOVED, FPLOC-NEW, FPLOC-PLAN) by the --out extension; --json prints the JSON diff on stdout; --all lists
 // every element (also those seen where expected); --set NODE.field=value as for fploc replay (the run's plan).
+// --poses FILE.tum (diagnostic): each scan placed with the pose of FILE nearest its time (within 5 ms; e.g. the
+// simulator's ground truth) instead of the localizer's, no covariance: what the detector finds with good poses.
 #include <fploc/features_t.hpp>
 #include <fploc/pose_t.hpp>
 #include <lcm/lcm-cpp.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -19,6 +22,7 @@
 #include <sstream>
 
 #include "fploc/config/plandiff.h"
+#include "fploc/core/pose.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/plandiff/plan_diff.h"
 #include "fploc/runtime/graph.h"
@@ -29,7 +33,8 @@ namespace {
 void usage() {
   std::cerr << "usage: fploc map diff --graph GRAPH --log LOG.lcm --out DIFF.json|DIFF.dxf [--out ...] [--json]\n"
                "       [--features-channel C] [--pose-channel C] [--all (every element in the JSON, also those seen)]\n"
-               "       [--set NODE.field=value ...] (as given to fploc replay: e.g. matcher.plan.file=PLAN)\n";
+               "       [--set NODE.field=value ...] (as given to fploc replay: e.g. matcher.plan.file=PLAN)\n"
+               "       [--poses FILE.tum] (place each scan with these poses, e.g. the ground truth, not the localizer's)\n";
 }
 
 std::string lower_ext(const std::string& p) {
@@ -41,7 +46,7 @@ std::string lower_ext(const std::string& p) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string graph_path, log_path, feat_ch, pose_ch;
+  std::string graph_path, log_path, feat_ch, pose_ch, poses_path;
   std::vector<std::string> outs, sets;
   bool json = false, all = false;
   for (int i = 1; i < argc; ++i) {
@@ -59,6 +64,7 @@ int main(int argc, char** argv) {
     else if (a == "--features-channel") feat_ch = next();
     else if (a == "--pose-channel") pose_ch = next();
     else if (a == "--set") sets.push_back(next());
+    else if (a == "--poses") poses_path = next();
     else if (a == "--json") json = true;
     else if (a == "--all") all = true;
     else if (a == "-h" || a == "--help") { usage(); return 0; }
@@ -116,6 +122,21 @@ int main(int argc, char** argv) {
     if (!src->floor().empty()) plan_file += " (floor " + src->floor() + ")";
     fploc::plandiff::PlanDiff diff(plan, po);
 
+    // --poses: the scans placed with a given trajectory (sorted by time), looked up at each scan's time.
+    fploc::Trajectory given;
+    if (!poses_path.empty()) {
+      given = fploc::read_tum(poses_path);
+      if (given.empty()) throw std::runtime_error(poses_path + ": no poses");
+      std::stable_sort(given.begin(), given.end(), [](const auto& a, const auto& b) { return a.t < b.t; });
+    }
+    int64_t unmatched = 0;
+    auto given_at = [&](double t) -> const fploc::StampedPose* {
+      auto it = std::lower_bound(given.begin(), given.end(), t, [](const auto& p, double v) { return p.t < v; });
+      const fploc::StampedPose* best = nullptr;
+      if (it != given.end()) best = &*it;
+      if (it != given.begin() && (!best || std::abs(std::prev(it)->t - t) < std::abs(best->t - t))) best = &*std::prev(it);
+      return best && std::abs(best->t - t) <= 0.005 ? best : nullptr;
+    };
     lcm::LogFile log(log_path, "r");
     if (!log.good()) throw std::runtime_error(log_path + ": cannot read the LCM log");
     std::map<int64_t, fploc::features_t> feats;
@@ -131,9 +152,23 @@ int main(int argc, char** argv) {
           continue;
         }
         ++n_feat;
+        if (!given.empty()) {
+          // The given trajectory places the scan (no localizer, no covariance).
+          if (f.status != 0) continue;
+          const fploc::StampedPose* g = given_at(double(f.utime) * 1e-6);
+          if (!g) {
+            ++unmatched;
+            continue;
+          }
+          std::vector<Eigen::Vector2f> pts;
+          for (int i = 0; i < f.num_points; ++i) pts.emplace_back(f.x[size_t(i)], f.y[size_t(i)]);
+          diff.add_frame(g->p.x(), g->p.y(), g->rpy().z(), pts);
+          ++used;
+          continue;
+        }
         feats[f.utime] = std::move(f);
         while (feats.size() > 50) feats.erase(feats.begin());
-      } else if (ev->channel == pose_ch) {
+      } else if (ev->channel == pose_ch && given.empty()) {
         fploc::pose_t p;
         if (p.decode(ev->data, 0, ev->datalen) < 0) {
           if (bad++ == 0) std::cerr << "fploc map diff: " << log_path << ": event " << events << " on " << pose_ch << " does not decode as pose_t (skipped)\n";
@@ -150,7 +185,7 @@ int main(int argc, char** argv) {
         const int ix[3] = {0, 1, 5};
         for (int r = 0; r < 3; ++r)
           for (int c = 0; c < 3; ++c) cov(r, c) = p.covariance[ix[r] * 6 + ix[c]];
-        diff.add_frame(p.position[0], p.position[1], yaw, pts, &cov);
+        diff.add_frame(p.position[0], p.position[1], yaw, pts, &cov, p.status == 0);  // POOR: no change evidence
         ++used;
       }
     }
@@ -158,7 +193,10 @@ int main(int argc, char** argv) {
       throw std::runtime_error(log_path + ": no " + feat_ch + " (features_t) events in " + std::to_string(events) +
                                " log events; record a run with them (lcm-logger during `fploc launch`, or `fploc replay --graph " +
                                graph_path + " --log SIM.lcm --record LOG.lcm`)");
-    if (n_pose == 0)
+    if (!given.empty() && used == 0)
+      throw std::runtime_error(poses_path + ": no pose within 5 ms of any of the " + std::to_string(n_feat) + " " +
+                               feat_ch + " scans");
+    if (given.empty() && n_pose == 0)
       throw std::runtime_error(log_path + ": no " + pose_ch + " (pose_t) events in " + std::to_string(events) + " log events");
     if (used == 0)
       throw std::runtime_error(log_path + ": no " + pose_ch + " pose has the utime of a " + feat_ch + " scan (" +
@@ -171,6 +209,9 @@ int main(int argc, char** argv) {
       else fploc::plandiff::write_dxf(r, plan, f);
       if (!f) throw std::runtime_error(o + ": write failed");
     }
+    if (!given.empty())
+      std::cerr << "fploc map diff: scans placed with the poses of " << poses_path << " (" << unmatched
+                << " scans without one within 5 ms, left out)\n";
     std::cerr << "fploc map diff: " << used << " scans of " << log_path << " against " << plan_file << ": "
               << r.count(fploc::plandiff::Status::kSeen) << " seen, " << r.count(fploc::plandiff::Status::kMissing)
               << " missing, " << r.count(fploc::plandiff::Status::kMoved) << " moved, "

@@ -62,4 +62,14 @@ rc=0
 "$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/cut.lcm" --out "$T/cut.json" 2> "$T/err" || rc=$?
 [ "$rc" = 1 ] && grep -q "cut.lcm: .* the rest is not an LCM event (truncated or damaged?)" "$T/err" && test -s "$T/cut.json" ||
   { echo "cut log: exit $rc"; cat "$T/err"; exit 1; }
+# --poses (diagnostic): the scans placed with the simulator's truth instead of the localizer's poses; every scan finds
+# its pose; a trajectory whose times match no scan is one error, exit 1.
+"$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/run.lcm" --out "$T/t.json" --poses "$T/gt.tum" 2> "$T/err"
+grep -q "scans placed with the poses of $T/gt.tum (0 scans without one within 5 ms" "$T/err" || { cat "$T/err"; exit 1; }
+grep -q '"summary"' "$T/t.json"
+awk '{ printf "%.6f", $1 + 1000; for (i = 2; i <= NF; ++i) printf " %s", $i; print "" }' "$T/gt.tum" > "$T/late.tum"
+rc=0
+"$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/run.lcm" --out "$T/l.json" --poses "$T/late.tum" 2> "$T/err" || rc=$?
+[ "$rc" = 1 ] && grep -q "late.tum: no pose within 5 ms of any of the" "$T/err" && [ "$(grep -c . "$T/err")" = 1 ] ||
+  { echo "--poses late: exit $rc"; cat "$T/err"; exit 1; }
 echo "map diff: ok"

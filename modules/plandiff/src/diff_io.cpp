@@ -11,6 +11,7 @@ namespace fploc::plandiff {
 void write_json(const Diff& d, const FloorPlan& plan, std::ostream& out, bool all_elements) {
   nlohmann::json j;
   j["frames"] = d.frames;
+  j["evidence_frames"] = d.evidence_frames;
   j["plan"] = plan.source;
   j["summary"] = {{"seen", d.count(Status::kSeen)},
                   {"missing", d.count(Status::kMissing)},

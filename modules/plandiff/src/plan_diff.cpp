@@ -42,6 +42,24 @@ double median_of(std::vector<T> v) {
   return double(v[m]);
 }
 
+// The median of the cluster of offsets farthest from the sensor that holds at least min_share of them (and >= 3):
+// side = +1 when the sensor is on the side the offsets grow towards (-1 the other). Clusters split at gaps > gap.
+// What stands in front of a wall (shelves, furniture along it) is nearer the sensor, never behind the wall.
+double far_median(std::vector<float> v, double side, double gap, double min_share) {
+  if (v.empty()) return 0;
+  if (gap <= 0) return median_of(std::move(v));
+  for (float& x : v) x = float(side * x);  // ascending = farthest first
+  std::sort(v.begin(), v.end());
+  const size_t need = std::max<size_t>(3, size_t(std::ceil(min_share * double(v.size()))));
+  for (size_t i = 0; i < v.size();) {
+    size_t j = i + 1;
+    while (j < v.size() && v[j] - v[j - 1] <= gap) ++j;
+    if (j - i >= need) return side * double(v[i + (j - i) / 2]);
+    i = j;
+  }
+  return side * median_of(std::move(v));
+}
+
 V2 left_normal(const Element& e) {
   const V2 d = (e.b - e.a).normalized();
   return V2(-d.y(), d.x());
@@ -117,7 +135,21 @@ void PlanDiff::cells_of(const V2& lo, const V2& hi, std::vector<int>& out) const
     for (int y = y0; y <= y1; ++y) out.push_back(x * gy_ + y);
 }
 
-int PlanDiff::nearest(const V2& p, double* signed_offset, bool* inside, const V2* sensor) const {
+bool PlanDiff::along(const Element& e, const V2& p, const V2& dir) const {
+  const double smax = std::sin(o_.assoc_max_angle_deg * M_PI / 180);
+  if (e.kind == ElementKind::kSegment) {
+    const V2 d = e.b - e.a;
+    const double len = d.norm();
+    // A piece shorter than the neighbourhood the direction is taken over (a jamb, a wall's stub) is not judged:
+    // its points' neighbours are mostly the walls it joins.
+    return len < 2 * o_.dir_radius_m || std::abs(cross2(d / len, dir)) <= smax;
+  }
+  const V2 r = p - e.c;  // a circle's tangent at p is perpendicular to the radius
+  const double rn = r.norm();
+  return rn < 1e-9 || std::abs(r.dot(dir)) / rn <= smax;
+}
+
+int PlanDiff::nearest(const V2& p, double* signed_offset, bool* inside, const V2* sensor, const V2* dir) const {
   const int cx = int(std::floor((p.x() - gmin_.x()) / gcell_)), cy = int(std::floor((p.y() - gmin_.y()) / gcell_));
   if (cx < 0 || cy < 0 || cx >= gx_ || cy >= gy_) return -1;
   // Candidates within assoc_m, nearest first; the first whose nearest point the sensor can see (a wall
@@ -126,7 +158,7 @@ int PlanDiff::nearest(const V2& p, double* signed_offset, bool* inside, const V2
   cand.clear();
   for (int i : grid_[size_t(cx * gy_ + cy)]) {
     const double d = distance(plan_.elements[size_t(i)], p);
-    if (d < o_.assoc_m) cand.push_back({d, i});
+    if (d < o_.assoc_m && (!dir || along(plan_.elements[size_t(i)], p, *dir))) cand.push_back({d, i});
   }
   if (cand.empty()) return -1;
   std::sort(cand.begin(), cand.end());
@@ -222,10 +254,22 @@ bool PlanDiff::plan_blocks(const V2& o, const V2& q, int skip) const {
 }
 
 void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen::Vector2f>& points,
-                         const Eigen::Matrix3d* pose_cov) {
+                         const Eigen::Matrix3d* pose_cov, bool pose_ok) {
   // A pose that is not finite is no registered scan (its points all fell into one "new" cell at INT_MIN).
   if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(yaw)) return;
   const int frame = frames_++;
+  // Change evidence only from a pose the localizer calls good (status OK, small covariance); the scale takes all.
+  bool evidence = pose_ok;
+  if (evidence && pose_cov) {
+    const Eigen::Matrix2d pc = pose_cov->topLeftCorner<2, 2>();
+    const double tr = pc.trace(), det = pc.determinant();
+    const double lmax = 0.5 * tr + std::sqrt(std::max(0.0, 0.25 * tr * tr - det));
+    if (!pose_cov->allFinite() ||
+        (o_.max_pose_sigma_m > 0 && lmax > o_.max_pose_sigma_m * o_.max_pose_sigma_m) ||
+        (o_.max_pose_yaw_sigma_deg > 0 && (*pose_cov)(2, 2) > std::pow(o_.max_pose_yaw_sigma_deg * M_PI / 180, 2)))
+      evidence = false;
+  }
+  if (evidence) ++evidence_frames_;
   const V2 s(x, y);
   const double c = std::cos(yaw), sn = std::sin(yaw);
   const int nb = int(std::lround(360.0 / o_.bin_deg));
@@ -241,6 +285,11 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
   std::vector<std::vector<Obs>> bins(static_cast<size_t>(nb));
   std::vector<float> min_range(size_t(nb), std::numeric_limits<float>::infinity());
   std::vector<std::vector<float>> offs(plan_.elements.size());
+  // The offsets of the points that lie on straight structure along their element (a known direction): the far cluster
+  // is taken among these (a window's reveal or a jamb seen past a wall's face is no straight run along it).
+  std::vector<std::vector<float>> flat_offs(plan_.elements.size());
+  std::vector<std::vector<float>> flat_half_offs[2] = {std::vector<std::vector<float>>(plan_.elements.size()),
+                                                       std::vector<std::vector<float>>(plan_.elements.size())};
   std::vector<std::vector<float>> half_offs[2] = {std::vector<std::vector<float>>(plan_.elements.size()),
                                                   std::vector<std::vector<float>>(plan_.elements.size())};
   std::vector<V2> along_sum(plan_.elements.size(), V2::Zero());  // sum of (point - sensor) of the inside points
@@ -259,52 +308,108 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
   };
   std::vector<ScaleSums> esums;
   std::vector<int> eslot(plan_.elements.size(), -1);
+  // The scan's points in range, on the plan, and the direction of the straight structure each lies on (its
+  // neighbours' principal axis, where they are straight enough to tell).
+  std::vector<V2> wp;
+  std::vector<double> wr;
+  wp.reserve(points.size());
+  wr.reserve(points.size());
   for (const auto& pf : points) {
     const V2 ps(pf.x(), pf.y());
     const double r = ps.norm();
     if (!(r >= o_.min_range_m && r <= o_.max_range_m)) continue;
-    const V2 p = s + V2(c * ps.x() - sn * ps.y(), sn * ps.x() + c * ps.y());
+    wp.push_back(s + V2(c * ps.x() - sn * ps.y(), sn * ps.x() + c * ps.y()));
+    wr.push_back(r);
+  }
+  std::vector<V2> pdir(wp.size(), V2::Zero());
+  if (o_.assoc_max_angle_deg > 0 && o_.dir_radius_m > 0) {
+    const double cs = o_.dir_radius_m, r2 = cs * cs;
+    std::unordered_map<int64_t, std::vector<int>> pg;
+    auto key = [&](const V2& q) { return cell_key(int(std::floor(q.x() / cs)), int(std::floor(q.y() / cs))); };
+    for (size_t i = 0; i < wp.size(); ++i) pg[key(wp[i])].push_back(int(i));
+    std::vector<int> nb_idx;
+    for (size_t i = 0; i < wp.size(); ++i) {
+      const int ix = int(std::floor(wp[i].x() / cs)), iy = int(std::floor(wp[i].y() / cs));
+      nb_idx.clear();
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy) {
+          const auto it = pg.find(cell_key(ix + dx, iy + dy));
+          if (it == pg.end()) continue;
+          for (int j : it->second)
+            if ((wp[size_t(j)] - wp[i]).squaredNorm() <= r2) nb_idx.push_back(j);
+        }
+      if (int(nb_idx.size()) < o_.dir_min_points) continue;
+      V2 m = V2::Zero();
+      for (int j : nb_idx) m += wp[size_t(j)];
+      m /= double(nb_idx.size());
+      Eigen::Matrix2d C = Eigen::Matrix2d::Zero();
+      for (int j : nb_idx) {
+        const V2 q = wp[size_t(j)] - m;
+        C += q * q.transpose();
+      }
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(C);
+      const double l0 = es.eigenvalues()(0), l1 = es.eigenvalues()(1);
+      if (!(l1 > 0) || l0 > o_.dir_max_flatness * l1) continue;
+      pdir[i] = es.eigenvectors().col(1).normalized();
+    }
+  }
+  for (size_t pi = 0; pi < wp.size(); ++pi) {
+    const V2& p = wp[pi];
+    const double r = wr[pi];
     double off = 0;
     bool inside = false;
-    const int e = nearest(p, &off, &inside, &s);
+    // The plain nearest element (for the drawing scale, as before), and the nearest the point's structure runs along.
+    const int e0 = nearest(p, &off, &inside, &s);
+    const double off0 = off;
+    const bool inside0 = inside;
+    int e = e0;
+    if (e0 >= 0 && pdir[pi].squaredNorm() > 0 && !along(plan_.elements[size_t(e0)], p, pdir[pi]))
+      e = nearest(p, &off, &inside, &s, &pdir[pi]);
     bool e_as_new = false;  // continues a wall beyond its drawn end: unexplained (see extends_beyond_end)
     const int b = bin_of(p - s);
     bins[size_t(b)].push_back({float(r), e});
     min_range[size_t(b)] = std::min(min_range[size_t(b)], float(r));
     if (e >= 0 && !inside && extends_beyond_end(p)) e_as_new = true;
+    const bool e0_as_new = e0 == e ? e_as_new : e0 >= 0 && !inside0 && extends_beyond_end(p);
+    if (e0 >= 0 && !e0_as_new) {
+      const Element& el = plan_.elements[size_t(e0)];
+      if (inside0 && el.kind == ElementKind::kSegment && std::abs(off0) < o_.scale_max_offset_m) {
+        // Scale model: off = scale * n.(q - sensor) + n.b (b: this scan's registration bias).
+        const V2 n = left_normal(el);
+        const double dd = n.dot(p - s) - off0;
+        const Eigen::Vector3d row(dd, n.x(), n.y());
+        sA += row * row.transpose();
+        sg += row * off0;
+        so2 += off0 * off0;
+        ++scount;
+        int& slot = eslot[size_t(e0)];
+        if (slot < 0) {
+          slot = int(esums.size());
+          esums.push_back({e0, Eigen::Matrix3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0, 0});
+        }
+        esums[size_t(slot)].A += row * row.transpose();
+        esums[size_t(slot)].g += row * off0;
+        esums[size_t(slot)].a += row;
+        esums[size_t(slot)].o += off0;
+        ++esums[size_t(slot)].n;
+      }
+    }
+    if (!pose_ok) continue;
     if (e >= 0 && !e_as_new) {
       if (inside) {
         offs[size_t(e)].push_back(float(off));
+        const bool flat = pdir[pi].squaredNorm() > 0;
+        if (flat) flat_offs[size_t(e)].push_back(float(off));
         along_sum[size_t(e)] += p - s;
         const Element& es = plan_.elements[size_t(e)];
         if (es.kind == ElementKind::kSegment) {
           const V2 d = es.b - es.a;
           const double t = d.squaredNorm() > 0 ? (p - es.a).dot(d) / d.squaredNorm() : 0.0;
           half_offs[t < 0.5 ? 0 : 1][size_t(e)].push_back(float(off));
+          if (flat) flat_half_offs[t < 0.5 ? 0 : 1][size_t(e)].push_back(float(off));
         }
       }
-      const Element& el = plan_.elements[size_t(e)];
-      if (inside && el.kind == ElementKind::kSegment && std::abs(off) < o_.scale_max_offset_m) {
-        // Scale model: off = scale * n.(q - sensor) + n.b (b: this scan's registration bias).
-        const V2 n = left_normal(el);
-        const double dd = n.dot(p - s) - off;
-        const Eigen::Vector3d row(dd, n.x(), n.y());
-        sA += row * row.transpose();
-        sg += row * off;
-        so2 += off * off;
-        ++scount;
-        int& slot = eslot[size_t(e)];
-        if (slot < 0) {
-          slot = int(esums.size());
-          esums.push_back({e, Eigen::Matrix3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0, 0});
-        }
-        esums[size_t(slot)].A += row * row.transpose();
-        esums[size_t(slot)].g += row * off;
-        esums[size_t(slot)].a += row;
-        esums[size_t(slot)].o += off;
-        ++esums[size_t(slot)].n;
-      }
-    } else {
+    } else if (evidence) {
       const int ix = int(std::floor(p.x() / o_.new_cell_m)), iy = int(std::floor(p.y() / o_.new_cell_m));
       Cell& cell = cells_[cell_key(ix, iy)];
       if (cell.last_frame != frame) {
@@ -319,29 +424,49 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
       }
     }
   }
-  const bool cov_ok = pose_cov && o_.moved_pose_covariance && pose_cov->allFinite() && (*pose_cov)(0, 0) >= 0 &&
-                      (*pose_cov)(1, 1) >= 0 && (*pose_cov)(2, 2) >= 0;
+  const bool cov_given = pose_cov && pose_cov->allFinite() && (*pose_cov)(0, 0) >= 0 && (*pose_cov)(1, 1) >= 0 &&
+                         (*pose_cov)(2, 2) >= 0;
   for (size_t e = 0; e < offs.size(); ++e) {
     if (offs[e].size() < 5) continue;
-    acc_[e].frame_offsets.push_back(float(median_of(offs[e])));
-    for (int h = 0; h < 2; ++h)
-      if (half_offs[h][e].size() >= 3) acc_[e].half_offsets[h].push_back(float(median_of(half_offs[h][e])));
-    if (!cov_ok) continue;
-    // The pose error (dx, dy, dyaw) moves the element's points along its normal n by
-    // n . (dx, dy) + dyaw n . perp(rc) (rc: the mean point relative to the sensor, perp: +90 deg).
-    const Element& el = plan_.elements[e];
-    const V2 rc = along_sum[e] / double(offs[e].size());
-    V2 n;
-    if (el.kind == ElementKind::kSegment) {
-      n = left_normal(el);
-    } else {
-      const V2 d = s + rc - el.c;
-      if (d.norm() < 1e-9) continue;
-      n = d.normalized();
+    // The pose's variance along the element's normal at its points: the pose error (dx, dy, dyaw) moves them along
+    // n by n . (dx, dy) + dyaw n . perp(rc) (rc: the mean point relative to the sensor, perp: +90 deg).
+    double v = -1;
+    if (cov_given) {
+      const Element& el = plan_.elements[e];
+      const V2 rc = along_sum[e] / double(offs[e].size());
+      V2 n = V2::Zero();
+      if (el.kind == ElementKind::kSegment) {
+        n = left_normal(el);
+      } else if ((s + rc - el.c).norm() > 1e-9) {
+        n = (s + rc - el.c).normalized();
+      }
+      if (n.squaredNorm() > 0) {
+        const Eigen::Vector3d cv(n.x(), n.y(), n.y() * rc.x() - n.x() * rc.y());
+        v = cv.dot(*pose_cov * cv);
+      }
     }
-    const Eigen::Vector3d cv(n.x(), n.y(), n.y() * rc.x() - n.x() * rc.y());
-    const double v = cv.dot(*pose_cov * cv);
-    if (!(v >= 0)) continue;
+    // A scan whose pose is loose (along a corridor, say) still measures the offsets of the elements its
+    // uncertainty runs along: those are kept when the variance along their normal is within the limit.
+    if (!evidence && !(v >= 0 && (o_.max_pose_sigma_m <= 0 || v <= o_.max_pose_sigma_m * o_.max_pose_sigma_m)))
+      continue;
+    // The sensor's side of the element: its points' offsets grow towards it (+1) or away (-1).
+    double side = 1;
+    {
+      const Element& el = plan_.elements[e];
+      if (el.kind == ElementKind::kSegment) side = left_normal(el).dot(s - el.a) >= 0 ? 1 : -1;
+      else side = (s - el.c).norm() >= el.r ? 1 : -1;
+    }
+    // The far cluster among the points on straight structure along the element when there are enough of them,
+    // else the plain median of all.
+    auto frame_offset = [&](const std::vector<float>& all, const std::vector<float>& flat, size_t min_n) {
+      if (flat.size() >= min_n) return far_median(flat, side, o_.offset_cluster_gap_m, o_.offset_cluster_share);
+      return median_of(all);
+    };
+    acc_[e].frame_offsets.push_back(float(frame_offset(offs[e], flat_offs[e], 5)));
+    for (int h = 0; h < 2; ++h)
+      if (half_offs[h][e].size() >= 3)
+        acc_[e].half_offsets[h].push_back(float(frame_offset(half_offs[h][e], flat_half_offs[h][e], 3)));
+    if (!o_.moved_pose_covariance || !(v >= 0)) continue;
     acc_[e].pose_var += v;
     ++acc_[e].pose_frames;
   }
@@ -355,7 +480,7 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
       Eigen::Vector3d c;
     };
     std::vector<RObs> obs;
-    for (size_t e = 0; e < offs.size(); ++e) {
+    for (size_t e = 0; e < offs.size() && evidence; ++e) {
       const Element& el = plan_.elements[e];
       if (el.kind != ElementKind::kSegment || int(offs[e].size()) < o_.refine_min_points) continue;
       const V2 d = el.b - el.a;
@@ -430,6 +555,7 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
       }
     }
   }
+  if (!evidence) return;  // the rest is change evidence
   // Every unexplained cell seen so far: was it in view in this scan (in range, nothing measured in front)?
   // Static structure is hit in a good share of the scans that see its place; a person's track is not.
   for (auto& [k, cell] : view_) {
@@ -516,6 +642,7 @@ bool PlanDiff::halves_moved(const ElementDiff& e) const {
 Diff PlanDiff::result() const {
   Diff d;
   d.frames = frames_;
+  d.evidence_frames = evidence_frames_;
   // As-built refinement: (H / sigma_obs^2 + I / sigma_prior^2) o = g / sigma_obs^2.
   {
     const double lam = std::pow(o_.refine_obs_sigma_m / o_.refine_prior_m, 2);
@@ -656,6 +783,19 @@ Diff PlanDiff::result() const {
       }
     }
     k = end;
+  }
+  // Elements whose missing parts cover most of their length are missing (what was seen there stands elsewhere).
+  if (o_.missing_part_share > 0) {
+    std::vector<double> gone(plan_.elements.size(), 0.0);
+    for (const auto& mp : d.missing_parts) gone[size_t(mp.element)] += mp.length();
+    for (size_t i = 0; i < plan_.elements.size(); ++i) {
+      const Element& pe = plan_.elements[i];
+      if (pe.kind != ElementKind::kSegment || gone[i] <= 0) continue;
+      if (gone[i] >= o_.missing_part_share * (pe.b - pe.a).norm()) d.elements[i].status = Status::kMissing;
+    }
+    d.missing_parts.erase(std::remove_if(d.missing_parts.begin(), d.missing_parts.end(), [&](const MissingPart& mp) {
+                            return d.elements[size_t(mp.element)].status == Status::kMissing;
+                          }), d.missing_parts.end());
   }
 
   // New structure: cells hit in enough frames, then straight runs by greedy RANSAC.

@@ -387,3 +387,189 @@ TEST(PlanDiff, AsBuiltWallsAreNoSignificantDrawingScale) {
     EXPECT_GT(std::abs(s.diff.scale_error), 4 * s.diff.scale_sigma) << scenario;
   }
 }
+
+namespace {
+// A 2D scan of a world of segments from (o, yaw): every 0.5 deg, the nearest hit within 12 m, in the sensor frame.
+std::vector<Eigen::Vector2f> cast2d(const std::vector<std::pair<V2, V2>>& world, const V2& o, double yaw) {
+  std::vector<Eigen::Vector2f> pts;
+  for (int i = 0; i < 720; ++i) {
+    const double a = i * M_PI / 360;
+    const V2 d(std::cos(a), std::sin(a));
+    double best = 12.0;
+    for (const auto& [p, q] : world) {
+      const V2 e = q - p;
+      const double den = d.x() * e.y() - d.y() * e.x();
+      if (std::abs(den) < 1e-12) continue;
+      const V2 w = p - o;
+      const double t = (w.x() * e.y() - w.y() * e.x()) / den, u = (w.x() * d.y() - w.y() * d.x()) / den;
+      if (t > 0.05 && u >= 0 && u <= 1) best = std::min(best, t);
+    }
+    if (best >= 12.0) continue;
+    const double rel = a - yaw;
+    pts.emplace_back(float(best * std::cos(rel)), float(best * std::sin(rel)));
+  }
+  return pts;
+}
+
+// Scans from poses along y = 0 (x in [-3, 3]) of a world, diffed against a plan.
+plandiff::Diff diff_of(const FloorPlan& plan, const std::vector<std::pair<V2, V2>>& world, plandiff::Options o = {}) {
+  plandiff::PlanDiff d(plan, o);
+  for (int f = 0; f <= 60; ++f) {
+    const V2 s(-3 + 0.1 * f, 0.0);
+    const double yaw = 0.2 + 0.05 * f;
+    d.add_frame(s.x(), s.y(), yaw, cast2d(world, s, yaw));
+  }
+  return d.result();
+}
+
+// The plan of these tests: a wall W at y = 2 (x in [-4, 4]) in front of the robot, a wall behind it at y = 5 and one
+// behind the robot at y = -2.
+FloorPlan front_wall_plan() {
+  FloorPlan plan;
+  plan.elements.push_back(Element::segment({-4, 2}, {4, 2}));    // W (left normal +y: away from the robot)
+  plan.elements.push_back(Element::segment({-8, 5}, {8, 5}));
+  plan.elements.push_back(Element::segment({-8, -2}, {8, -2}));
+  return plan;
+}
+}  // namespace
+
+// A partition built across where a removed wall was drawn (17 deg to it, within assoc_m of its line over most of its
+// length) is not that wall seen: the wall is missing and the partition new. Without the direction test the
+// partition's points observed the wall (seen, not missing) and no new structure was reported.
+TEST(PlanDiff, StructureAcrossAWallIsNotThatWall) {
+  const FloorPlan plan = front_wall_plan();
+  const V2 pa(-1.5, 1.78), pb(1.5, 2.7);  // 17 deg to W, crossing its line
+  const std::vector<std::pair<V2, V2>> world = {{pa, pb}, {{-8, 5}, {8, 5}}, {{-8, -2}, {8, -2}}};
+  const plandiff::Diff d = diff_of(plan, world);
+  EXPECT_EQ(d.elements[0].status, plandiff::Status::kMissing) << "seen ratio " << d.elements[0].seen_ratio();
+  EXPECT_EQ(d.elements[1].status, plandiff::Status::kSeen);
+  EXPECT_EQ(d.elements[2].status, plandiff::Status::kSeen);
+  bool found = false;
+  for (const auto& n : d.added)
+    if (covered(n.a, n.b, pa, pb) > 0.7 * (pb - pa).norm()) found = true;
+  EXPECT_TRUE(found) << d.added.size() << " new";
+  plandiff::Options off;
+  off.assoc_max_angle_deg = 0;  // the rule off: the partition observes W
+  const plandiff::Diff d0 = diff_of(plan, world, off);
+  EXPECT_LT(d.elements[0].seen_ratio(), off.missing_seen_ratio);  // missing on its own seen ratio
+  EXPECT_GT(d0.elements[0].seen_ratio(), off.missing_seen_ratio) << "the partition observed W";
+  bool found0 = false;
+  for (const auto& n : d0.added)
+    if (covered(n.a, n.b, pa, pb) > 0.7 * (pb - pa).norm()) found0 = true;
+  EXPECT_FALSE(found0);
+}
+
+// A wall that is gone except where something else stands on its line, parallel to it (a cabinet's face, 1 m of its
+// 8 m): the piece still "seen" keeps its seen ratio above missing_seen_ratio, but the missing parts cover most of it:
+// missing as a whole, no parts. Without the rule: seen, with missing parts.
+TEST(PlanDiff, WallMostlyGoneIsMissing) {
+  const FloorPlan plan = front_wall_plan();
+  const std::vector<std::pair<V2, V2>> world = {{{0.5, 1.95}, {1.5, 1.95}}, {{0.5, 1.95}, {0.5, 2.3}}, {{1.5, 1.95}, {1.5, 2.3}},
+                                                {{-8, 5}, {8, 5}}, {{-8, -2}, {8, -2}}};
+  const plandiff::Diff d = diff_of(plan, world);
+  EXPECT_EQ(d.elements[0].status, plandiff::Status::kMissing) << "seen ratio " << d.elements[0].seen_ratio();
+  EXPECT_TRUE(d.missing_parts.empty());
+  plandiff::Options off;
+  off.missing_part_share = 0;
+  const plandiff::Diff d0 = diff_of(plan, world, off);
+  EXPECT_EQ(d0.elements[0].status, plandiff::Status::kSeen);
+  EXPECT_GT(d0.elements[0].seen_ratio(), off.missing_seen_ratio);
+  double gone = 0;
+  for (const auto& mp : d0.missing_parts)
+    if (mp.element == 0) gone += mp.length();
+  EXPECT_GT(gone, 2.0 / 3.0 * 8.0);
+}
+
+// Shelves along a moved wall: their faces stand 0.4 m in front of it, within assoc_m of the drawn line on the robot's
+// side, over 70 % of its length. The scan's offset of the wall is the farthest cluster of its points (shelves
+// stand in front of walls, not behind): moved by +0.2 m as built. With the plain median the shelf faces win and the
+// wall reads about -0.2 m (towards the robot), the wrong way.
+TEST(PlanDiff, ShelvesInFrontOfAMovedWallDoNotHideIt) {
+  const FloorPlan plan = front_wall_plan();
+  std::vector<std::pair<V2, V2>> world = {{{-4, 2.2}, {4, 2.2}}, {{-8, 5}, {8, 5}}, {{-8, -2}, {8, -2}}};
+  for (double x0 : {-3.5, 0.7}) world.push_back({{x0, 1.8}, {x0 + 2.8, 1.8}});  // shelf faces
+  const plandiff::Diff d = diff_of(plan, world);
+  EXPECT_EQ(d.elements[0].status, plandiff::Status::kMoved);
+  EXPECT_NEAR(d.elements[0].offset_m, 0.2, 0.03);
+  plandiff::Options off;
+  off.offset_cluster_gap_m = 0;
+  const plandiff::Diff d0 = diff_of(plan, world, off);
+  EXPECT_LT(d0.elements[0].offset_m, 0.0);
+}
+
+// Scans whose pose the localizer calls POOR, or whose covariance is wide, give no change evidence: here 60 scans
+// placed 0.4 m off (y) and 30 right. Given as good, the wrong ones paint the walls moved; as POOR, or with a 0.3 m
+// sigma, nothing is flagged. A pose loose only along x (sigma 0.2 m) still measures the walls along x.
+TEST(PlanDiff, PoorPosesGiveNoChangeEvidence) {
+  FloorPlan plan;
+  plan.elements.push_back(Element::segment({-6, 2}, {6, 2}));
+  plan.elements.push_back(Element::segment({-6, -2}, {6, -2}));
+  plan.elements.push_back(Element::segment({6, -2}, {6, 2}));
+  plan.elements.push_back(Element::segment({-6, 2}, {-6, -2}));
+  std::vector<std::pair<V2, V2>> world;
+  for (const auto& e : plan.elements) world.push_back({e.a, e.b});
+  auto run = [&](bool bad_ok, const Eigen::Matrix3d* bad_cov) {
+    plandiff::PlanDiff d(plan);
+    const Eigen::Matrix3d good = Eigen::Vector3d(1e-4, 1e-4, 1e-6).asDiagonal();
+    for (int f = 0; f < 90; ++f) {
+      const V2 s(-3 + 0.06 * f, 0.3);
+      const auto pts = cast2d(world, s, 0.1);
+      if (f % 3 == 0) d.add_frame(s.x(), s.y(), 0.1, pts, &good);
+      else d.add_frame(s.x(), s.y() + 0.4, 0.1, pts, bad_cov, bad_ok);  // 0.4 m off
+    }
+    return std::make_pair(d.result(), d.evidence_frames());
+  };
+  auto flags = [](const plandiff::Diff& r) {
+    return r.count(plandiff::Status::kMissing) + r.count(plandiff::Status::kMoved) + int(r.added.size()) +
+           int(r.missing_parts.size());
+  };
+  const auto [given_good, n_all] = run(true, nullptr);
+  EXPECT_GT(flags(given_good), 0);  // the wrong poses do paint changes
+  EXPECT_EQ(n_all, 90);
+  const auto [poor, n_poor] = run(false, nullptr);
+  EXPECT_EQ(flags(poor), 0);
+  EXPECT_EQ(n_poor, 30);
+  EXPECT_EQ(poor.frames, 90);
+  const Eigen::Matrix3d wide = Eigen::Vector3d(0.09, 0.09, 1e-4).asDiagonal();
+  const auto [loose, n_loose] = run(true, &wide);
+  EXPECT_EQ(flags(loose), 0);
+  EXPECT_EQ(n_loose, 30);
+  // Loose along x only (and placed right): the walls along x (normal y) get every scan's offset, the others not.
+  plandiff::PlanDiff d(plan);
+  const Eigen::Matrix3d along_x = Eigen::Vector3d(0.04, 1e-4, 1e-6).asDiagonal();
+  for (int f = 0; f < 30; ++f) {
+    const V2 s(-3 + 0.2 * f, 0.3);
+    d.add_frame(s.x(), s.y(), 0.1, cast2d(world, s, 0.1), &along_x);
+  }
+  const plandiff::Diff r = d.result();
+  EXPECT_EQ(d.evidence_frames(), 0);
+  EXPECT_EQ(r.elements[0].frames_with_points, 30);
+  EXPECT_EQ(r.elements[1].frames_with_points, 30);
+  EXPECT_EQ(r.elements[2].frames_with_points, 0);
+}
+
+// The far cluster is taken among points on straight structure along the wall only: a wall moved 0.15 m towards the
+// robot, with four 1 m openings in which two posts each (square, 0.2 m, set diagonally: a railing, a column's
+// casing) stand behind its face, within assoc_m of the drawn line. The posts' points have no straight neighbourhood
+// (two faces at right angles); taken among all points they form the farthest cluster (about a third of the points)
+// and the wall reads about +0.08 m (not moved). Among the straight points the wall reads -0.15 m.
+TEST(PlanDiff, FarClusterIgnoresPointsWithoutALine) {
+  const FloorPlan plan = front_wall_plan();
+  std::vector<std::pair<V2, V2>> world = {{{-8, 5}, {8, 5}}, {{-8, -2}, {8, -2}}};
+  double x = -4;
+  for (double w0 : {-3.5, -1.5, 0.5, 2.5}) {  // openings [w0, w0 + 1]
+    world.push_back({{x, 1.85}, {w0, 1.85}});
+    for (double c : {w0 + 0.25, w0 + 0.75}) {  // diamonds, half-diagonal 0.14, centred at y = 2.15
+      const V2 o(c, 2.15);
+      const V2 v[4] = {o + V2(0, -0.14), o + V2(0.14, 0), o + V2(0, 0.14), o + V2(-0.14, 0)};
+      for (int k = 0; k < 4; ++k) world.push_back({v[k], v[(k + 1) % 4]});
+    }
+    x = w0 + 1;
+  }
+  world.push_back({{x, 1.85}, {4, 1.85}});
+  const plandiff::Diff d = diff_of(plan, world);
+  const auto& e = d.elements[0];
+  EXPECT_EQ(e.status, plandiff::Status::kMoved) << "offset " << e.offset_m << " halves " << e.half_offset_m[0] << " "
+                                                << e.half_offset_m[1] << " spread " << e.offset_spread_m;
+  EXPECT_NEAR(e.offset_m, -0.15, 0.03);
+}

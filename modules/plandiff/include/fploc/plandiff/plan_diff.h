@@ -34,6 +34,16 @@ namespace fploc::plandiff {
 struct Options {
   double min_range_m = 0.5, max_range_m = 12.0;
   double assoc_m = 0.35;            // a point within this of an element observes it
+  // ... if the straight structure it lies on runs along the element: a point whose neighbours in its scan (within
+  // dir_radius_m, >= dir_min_points, straight: smallest / largest PCA eigenvalue <= dir_max_flatness) form a line
+  // more than assoc_max_angle_deg off the element's direction there observes another element or nothing (new
+  // structure): a partition built across where a removed wall was drawn, furniture left where it stood, is not
+  // that wall seen. 0: no direction test. Segments shorter than 2 dir_radius_m (jambs) are not judged. (The
+  // drawing-scale estimate keeps the plain nearest element.)
+  double assoc_max_angle_deg = 10;
+  double dir_radius_m = 0.3;
+  int dir_min_points = 5;
+  double dir_max_flatness = 0.05;
   double probe_step_m = 0.25;       // visibility probes along each element
   double bin_deg = 0.75;            // bearing bins of a scan (visibility / occlusion test)
   double min_incidence_deg = 25;    // probes seen at a more grazing angle are not expected
@@ -42,6 +52,12 @@ struct Options {
   double missing_seen_ratio = 0.08; // seen / expected probe observations below this: missing
   int missing_min_expected = 30;    // ... over at least this many expected probe observations
   double moved_min_m = 0.07;        // |median offset| at least this: moved
+  // A scan's offset of an element: the median of the cluster of its points' offsets (split at gaps larger than
+  // offset_cluster_gap_m) farthest from the sensor that holds >= offset_cluster_share of them: shelves and furniture
+  // stand in front of a wall, not behind it (their faces within assoc_m of the drawn line pulled a scan's median
+  // towards the sensor). 0: the plain median.
+  double offset_cluster_gap_m = 0.06;
+  double offset_cluster_share = 0.2;
   double moved_max_spread_m = 0.05; // ... and the per-frame offsets agree (MAD) within this
   double moved_min_length_m = 0.5;  // ... for segments at least this long (a door jamb's end is not a wall)
   // ... and |offset| - moved_z sigma >= moved_min_m (sigma: PlanDiff::offset_sigma): a wall a few cm off as
@@ -57,6 +73,16 @@ struct Options {
   // standing askew (one end a few cm off, the other 10) or seen near one end only is not a wall moved as a whole.
   bool moved_both_halves = true;
   double moved_max_looks = 30;        // the scans count as at most this many independent looks
+  // Change evidence (seen, missing, moved, new, missing parts) only from scans whose pose the localizer calls good:
+  // add_frame's pose_ok (status OK: not POOR / LOST) and, with a covariance, a horizontal sigma (the larger axis)
+  // <= max_pose_sigma_m and a yaw sigma <= max_pose_yaw_sigma_deg. A scan placed 0.4 m off paints the walls it sees
+  // as moved and new structure beside them. The other scans still count for the drawing scale (as before).
+  // 0: no limit.
+  double max_pose_sigma_m = 0.05;
+  double max_pose_yaw_sigma_deg = 1.0;
+  // An element otherwise seen whose missing parts cover at least this share of its length is missing as a whole
+  // (what was still seen there is something else standing where it was drawn: furniture, a partition's end).
+  double missing_part_share = 2.0 / 3.0;
   double new_cell_m = 0.05;         // grid of unexplained points
   int new_min_frames = 5;           // a cell hit in at least this many frames ...
   double new_min_hit_ratio = 0.3;   // ... and whose view cell was hit in this share of the scans that had it
@@ -143,6 +169,7 @@ struct Diff {
   std::vector<NewStructure> added;
   std::vector<MissingPart> missing_parts;
   int frames = 0;
+  int evidence_frames = 0;  // of them, those whose pose was good enough for change evidence (Options::max_pose_sigma_m)
   // Drawing scale: the building is (1 + scale_error) times the plan (0.005: the drawing is 0.5 % too small),
   // from every point's offset against its distance to the sensor along the wall's normal, each scan's
   // registration bias eliminated. 0 with scale_points 0 when there was too little to tell.
@@ -156,10 +183,12 @@ class PlanDiff {
  public:
   explicit PlanDiff(FloorPlan plan, Options o = {});
   // One registered scan: pose of the sensor on the plan, wall points in the sensor frame (metres); pose_cov:
-  // the pose's x, y, yaw covariance (the localizer's, optional: see Options::moved_pose_covariance). A pose that is
-  // not finite is ignored (no frame).
+  // the pose's x, y, yaw covariance (the localizer's, optional: see Options::moved_pose_covariance); pose_ok: the
+  // localizer's status is OK (false: POOR; see Options::max_pose_sigma_m). A pose that is not finite is ignored
+  // (no frame).
   void add_frame(double x, double y, double yaw, const std::vector<Eigen::Vector2f>& points,
-                 const Eigen::Matrix3d* pose_cov = nullptr);
+                 const Eigen::Matrix3d* pose_cov = nullptr, bool pose_ok = true);
+  int evidence_frames() const { return evidence_frames_; }
   Diff result() const;
   int frames() const { return frames_; }
   const FloorPlan& plan() const { return plan_; }
@@ -184,7 +213,11 @@ class PlanDiff {
   };
   double offset_sigma(const ElementDiff& e) const;
   bool halves_moved(const ElementDiff& e) const;
-  int nearest(const Eigen::Vector2d& p, double* signed_offset, bool* inside, const Eigen::Vector2d* sensor) const;
+  // dir: the local direction of the structure p lies on (unit; nullptr: none known); candidates not along it are
+  // skipped (Options::assoc_max_angle_deg).
+  int nearest(const Eigen::Vector2d& p, double* signed_offset, bool* inside, const Eigen::Vector2d* sensor,
+              const Eigen::Vector2d* dir = nullptr) const;
+  bool along(const Element& e, const Eigen::Vector2d& p, const Eigen::Vector2d& dir) const;
   bool extends_beyond_end(const Eigen::Vector2d& p) const;
   int extended_element(const Eigen::Vector2d& a, const Eigen::Vector2d& b) const;
   bool plan_blocks(const Eigen::Vector2d& o, const Eigen::Vector2d& q, int skip) const;
@@ -198,6 +231,7 @@ class PlanDiff {
   std::unordered_map<int64_t, Cell> cells_;  // new_cell_m: where
   std::unordered_map<int64_t, Cell> view_;   // new_view_cell_m: hit in how many of the scans that saw it
   int frames_ = 0;
+  int evidence_frames_ = 0;  // of them, those that gave change evidence
   double scale_h_ = 0, scale_g_ = 0, scale_o2_ = 0;
   int64_t scale_n_ = 0;
   std::vector<double> scale_eg_, scale_eh_;  // per element: its part of scale_g_ / scale_h_ (the bias eliminated per scan)
@@ -217,7 +251,7 @@ class PlanDiff {
   std::vector<std::vector<int>> grid_;
 };
 
-// {"frames", "summary": {"seen", "missing", "moved", "unobserved", "new"}, "scale": {"error", "sigma", "points"},
+// {"frames", "evidence_frames", "summary": {"seen", "missing", "moved", "unobserved", "new"}, "scale": {"error", "sigma", "points"},
 //  "elements": [{"id", "status",
 //  "offset_m", "offset_spread_m", "offset_sigma_m", "seen_ratio", "frames_expected", "frames_with_points", "a", "b" | "c", "r"}],
 //  "new": [{"a", "b", "length_m", "cells", "min_frames", "rms_m", "extends"}],
