@@ -16,6 +16,16 @@ using namespace fploc::localizer;
 
 namespace {
 Eigen::Matrix3d diag(double sx, double sy, double syaw) { return Eigen::Vector3d(sx * sx, sy * sy, syaw * syaw).asDiagonal(); }
+// A tracker's scene for the dead reckoning's rules: fixes with a 1 cm covariance, the matcher's twist 0.5 m/s along x,
+// the truth from (1, 2) and the dead-reckoned pose on it with a 5 cm / 0.57 deg covariance.
+struct DeadReckoningScene {
+  Eigen::Matrix3d fixed = diag(0.01, 0.01, 0.002);
+  matcher::Twist2 v{0.5, 0, 0};
+  int64_t t = 0;
+  Pose2 truth{1.0, 2.0, 0.0};
+  DeadReckoned dr;
+  DeadReckoningScene() { dr.covariance = diag(0.05, 0.05, 0.01); }
+};
 }  // namespace
 
 TEST(Degeneracy, TighterOfTakesEachDirectionFromTheBetterSource) {
@@ -335,13 +345,8 @@ TEST(Degeneracy, FixFarFromTheDeadReckonedPoseIsPoorUntilOneAgrees) {
   cfg.confirm_fixes = off.confirm_fixes = 0;  // (the re-acquisition's own confirmation: ReacquiredTrackIsPoorUntilFixesAgree)
   off.dead_reckoning_gate_sigma = 0;
   UncertaintyTracker tr(cfg), gate_off(off), no_dr(cfg);
-  const Eigen::Matrix3d fixed = diag(0.01, 0.01, 0.002);
-  matcher::Twist2 v;
-  v.vx = 0.5;
-  int64_t t = 0;
-  Pose2 truth{1.0, 2.0, 0.0};
-  DeadReckoned dr;
-  dr.covariance = diag(0.05, 0.05, 0.01);
+  DeadReckoningScene sc;
+  auto& [fixed, v, t, truth, dr] = sc;
   auto step = [&](UncertaintyTracker& u, FitStatus st, const Pose2& fix, bool with_dr) {
     dr.pose = truth;
     return u.update(t, fixed, true, st, {}, &fix, &v, 1.0, nullptr, 0.0, with_dr ? &dr : nullptr);
@@ -392,13 +397,8 @@ TEST(Degeneracy, AStretchWithARefusedFixEndsOnlyWithinTheTighterGate) {
     cfg.confirm_fixes = 0;  // (the re-acquisition's own confirmation is another rule)
     cfg.dr_confirm_gate_sigma = confirm_gate;
     UncertaintyTracker tr(cfg);
-    const Eigen::Matrix3d fixed = diag(0.01, 0.01, 0.002);
-    matcher::Twist2 v;
-    v.vx = 0.5;
-    int64_t t = 0;
-    Pose2 truth{1.0, 2.0, 0.0};
-    DeadReckoned dr;
-    dr.covariance = diag(0.05, 0.05, 0.01);
+    DeadReckoningScene sc;
+    auto& [fixed, v, t, truth, dr] = sc;
     auto step = [&](double off_y) {
       dr.pose = truth;
       const Pose2 fix{truth.x, truth.y + off_y, truth.yaw};
