@@ -34,13 +34,20 @@ Eigen::Vector3d GyroDeskew::rate_at(int64_t t) const {
   return it->second - gyro_bias_;
 }
 
-Eigen::Vector3d GyroDeskew::rate_walk(int64_t t, size_t& at) const {
+const Eigen::Vector3d& GyroDeskew::sweep_rate_walk(int64_t t, size_t& at) const {
   // The first sample at or after t (the last one when none is), as rate_at's search finds it.
-  const size_t n = gyro_.size();
+  const size_t n = sweep_rate_.size();
   at = std::min(at, n - 1);
-  while (at + 1 < n && gyro_[at].first < t) ++at;
-  while (at > 0 && gyro_[at - 1].first >= t) --at;
-  return gyro_[at].second - gyro_bias_;
+  while (at + 1 < n && sweep_rate_[at].first < t) ++at;
+  while (at > 0 && sweep_rate_[at - 1].first >= t) --at;
+  return sweep_rate_[at].second;
+}
+
+Eigen::Matrix3f GyroDeskew::rotation_at(int c) const {
+  Eigen::Matrix3f R;
+  const float* g = rot_il_.data() + size_t(c / 8) * 72 + c % 8;
+  for (int e = 0; e < 9; ++e) R(e / 3, e % 3) = g[e * 8];
+  return R;
 }
 
 bool GyroDeskew::covers(int64_t ta, int64_t tb) const {
@@ -123,7 +130,27 @@ bool GyroDeskew::prepare(const Scan& scan) {
   for (const auto& g : gyro_)
     if (g.first >= t0 - k::kGyroEdgeUs && g.first <= t1 + k::kGyroEdgeUs) peak = std::max(peak, g.second.norm());
   if (peak * 0.5e-6 * double(t1 - t0) < k::kMinDeskewRad) return false;
-  col_rot_.resize(W);
+  rot_il_.resize(size_t((W + 7) / 8) * 72);
+  float* const il = rot_il_.data();
+  // Column c's entries (stride 8 in interleaved()).
+  const auto at_col = [il](int c) { return il + (size_t(c) >> 3) * 72 + (size_t(c) & 7); };  // (c >= 0)
+  const auto put = [&](int c, const Eigen::Matrix3f& m) {
+    float* g = at_col(c);
+    for (int e = 0; e < 9; ++e) g[e * 8] = m(e / 3, e % 3);
+  };
+  // The samples the walks below can reach (for a time t in the sweep: the first sample at or after t, else the
+  // last one), the bias subtracted once (the same difference rate_at forms per call).
+  sweep_rate_.clear();
+  {
+    const int64_t lo_t = col_t_[0] < tm ? col_t_[0] : tm, hi_t = col_t_[size_t(W - 1)] > tm ? col_t_[size_t(W - 1)] : tm;
+    auto it = std::lower_bound(gyro_.begin(), gyro_.end(), lo_t,
+                               [](const std::pair<int64_t, Eigen::Vector3d>& g, int64_t v) { return g.first < v; });
+    for (; it != gyro_.end(); ++it) {
+      sweep_rate_.emplace_back(it->first, it->second - gyro_bias_);
+      if (it->first >= hi_t) break;
+    }
+    if (sweep_rate_.empty()) sweep_rate_.emplace_back(gyro_.back().first, gyro_.back().second - gyro_bias_);
+  }
   int cm = c0;
   while (cm < c1 && col_t_[cm] < tm) ++cm;
   // Integrated block by block (kDeskewBlockCols columns): a block's rotation is the product of its columns'
@@ -143,22 +170,32 @@ bool GyroDeskew::prepare(const Scan& scan) {
     Eigen::Vector3d th = Eigen::Vector3d::Zero();
     for (int c = cm + dir; dir > 0 ? c <= end : c >= end; c += dir) {
       const int64_t ta = col_t_[c - dir], tb = col_t_[c];
-      th += rate_walk(ta + (tb - ta) / 2, at) * (1e-6 * double(tb - ta));
+      th += sweep_rate_walk(ta + (tb - ta) / 2, at) * (1e-6 * double(tb - ta));
       if ((c - cm) * dir % kDeskewBlockCols != 0 && c != end) continue;
       const Eigen::Matrix3d Rb = Ra * exp_map(th);
       const Eigen::Matrix3f fa = Ra.cast<float>(), fb = Rb.cast<float>();
-      col_rot_[c] = fb;
+      put(c, fb);
       const Eigen::Matrix3f diff = fb - fa;
       const int64_t span = col_t_[c] - col_t_[a];
       const double per_us = span != 0 ? 1.0 / double(span) : 0.0;
-      for (int i = a + dir; i != c; i += dir) col_rot_[i] = fa + float(double(col_t_[i] - col_t_[a]) * per_us) * diff;
+      float fa9[9], d9[9];  // (entry e = (e / 3, e % 3))
+      for (int e = 0; e < 9; ++e) {
+        fa9[e] = fa(e / 3, e % 3);
+        d9[e] = diff(e / 3, e % 3);
+      }
+      for (int i = a + dir; i != c; i += dir) {  // fa + s diff, entry by entry
+        const float s = float(double(col_t_[i] - col_t_[a]) * per_us);
+        float* g = at_col(i);
+#pragma GCC unroll 9
+        for (int e = 0; e < 9; ++e) g[e * 8] = fa9[e] + s * d9[e];
+      }
       Ra = Rb;
       a = c;
       th.setZero();
     }
   };
-  const Eigen::Matrix3d Rm = exp_map(rate_walk(tm + (col_t_[cm] - tm) / 2, at) * (1e-6 * double(col_t_[cm] - tm)));
-  col_rot_[cm] = Rm.cast<float>();
+  const Eigen::Matrix3d Rm = exp_map(sweep_rate_walk(tm + (col_t_[cm] - tm) / 2, at) * (1e-6 * double(col_t_[cm] - tm)));
+  put(cm, Rm.cast<float>());
   const size_t at_m = at;
   walk(Rm, W - 1, +1);
   at = at_m;

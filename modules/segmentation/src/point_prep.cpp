@@ -26,12 +26,12 @@ namespace {
 constexpr lane8::CompressTable<false> kCompress;
 // One scan row of the four-column pass below, eight columns at a time (AVX2, chosen at run time with the plane
 // fit's kernels: kern::wide()): the same arithmetic per point (no fused multiply-add), so the same
-// candidates. rng/okm/lut/rot point at the row's first column; returns the new candidate count.
+// candidates. rng/okm/lut point at the row's first column, rot at column 0 (GyroDeskew::interleaved()); returns the new candidate count.
 // zrow: the row's z direction and offset are one value each (zr[0], zr[1]; the OS-1's, whose sensor z axis is
 // the lidar's: the same floats as the table's); okm null: every column valid.
 template <bool kZRow, bool kAllOk>
 __attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const int32_t* okm, const float* const lut[6],
-                                                    const float* zr, const float* const rot[9], float* const raw[3],
+                                                    const float* zr, const float* rot, float* const raw[3],
                                                     const uint32_t* next_rng, int W, int32_t lo, int32_t hi,
                                                     int32_t pix_row, float* cx, float* cy, float* cz, float* cr,
                                                     int32_t* cp, size_t m) {
@@ -45,6 +45,16 @@ __attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const i
   const float* __restrict l3 = lut[3];
   const float* __restrict l4 = lut[4];
   const float* __restrict l5 = lut[5];
+  // (and the rotations, the measured copies and the candidates: every pointer the loop uses stays in a register)
+  const float* __restrict rt = rot;
+  float* __restrict rx = raw ? raw[0] : nullptr;
+  float* __restrict ry = raw ? raw[1] : nullptr;
+  float* __restrict rz = raw ? raw[2] : nullptr;
+  float* __restrict ox = cx;
+  float* __restrict oy = cy;
+  float* __restrict oz = cz;
+  float* __restrict orr = cr;
+  int32_t* __restrict op = cp;
   const v8i lov = {lo, lo, lo, lo, lo, lo, lo, lo}, hiv = {hi, hi, hi, hi, hi, hi, hi, hi};
   const v8f mm = {1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f, 1e-3f};
   for (int c = 0; c < W; c += 8) {
@@ -67,10 +77,11 @@ __attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const i
                   : FPLOC_LD(l2 + c) * fr + FPLOC_LD(l5 + c);
     // (de-skewed: the return as measured, before the rotation, for the wall points; stored with the candidate)
     v8f mx = x, my = y, mz = z;
-    if (rot) {
-      const v8f X = FPLOC_LD(rot[0] + c) * x + FPLOC_LD(rot[1] + c) * y + FPLOC_LD(rot[2] + c) * z;
-      const v8f Y = FPLOC_LD(rot[3] + c) * x + FPLOC_LD(rot[4] + c) * y + FPLOC_LD(rot[5] + c) * z;
-      const v8f Z = FPLOC_LD(rot[6] + c) * x + FPLOC_LD(rot[7] + c) * y + FPLOC_LD(rot[8] + c) * z;
+    if (rt) {
+      const float* g = rt + size_t(c) * 9;  // this group's 72 entries (c is a multiple of 8)
+      const v8f X = FPLOC_LD(g) * x + FPLOC_LD(g + 8) * y + FPLOC_LD(g + 16) * z;
+      const v8f Y = FPLOC_LD(g + 24) * x + FPLOC_LD(g + 32) * y + FPLOC_LD(g + 40) * z;
+      const v8f Z = FPLOC_LD(g + 48) * x + FPLOC_LD(g + 56) * y + FPLOC_LD(g + 64) * z;
       x = X;
       y = Y;
       z = Z;
@@ -79,15 +90,15 @@ __attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const i
     const int32_t p0 = pix_row + c;
     const v8i pv = v8i{p0, p0, p0, p0, p0, p0, p0, p0} + v8i{0, 1, 2, 3, 4, 5, 6, 7};
     if (in == 255) {
-      std::memcpy(cx + m, &x, sizeof x);
-      std::memcpy(cy + m, &y, sizeof y);
-      std::memcpy(cz + m, &z, sizeof z);
-      std::memcpy(cr + m, &rm, sizeof rm);
-      std::memcpy(cp + m, &pv, sizeof pv);
-      if (rot) {
-        std::memcpy(raw[0] + m, &mx, sizeof mx);
-        std::memcpy(raw[1] + m, &my, sizeof my);
-        std::memcpy(raw[2] + m, &mz, sizeof mz);
+      std::memcpy(ox + m, &x, sizeof x);
+      std::memcpy(oy + m, &y, sizeof y);
+      std::memcpy(oz + m, &z, sizeof z);
+      std::memcpy(orr + m, &rm, sizeof rm);
+      std::memcpy(op + m, &pv, sizeof pv);
+      if (rt) {
+        std::memcpy(rx + m, &mx, sizeof mx);
+        std::memcpy(ry + m, &my, sizeof my);
+        std::memcpy(rz + m, &mz, sizeof mz);
       }
       m += 8;
       continue;
@@ -97,28 +108,28 @@ __attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const i
     const __m256i idx = lane8::to_front(kCompress, in);
 #define FPLOC_PERM(v) reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(v), idx))
     const v8f qx = FPLOC_PERM(x), qy = FPLOC_PERM(y), qz = FPLOC_PERM(z), qr = FPLOC_PERM(rm);
-    if (rot) {
+    if (rt) {
       mx = FPLOC_PERM(mx);
       my = FPLOC_PERM(my);
       mz = FPLOC_PERM(mz);
-      std::memcpy(raw[0] + m, &mx, sizeof mx);
-      std::memcpy(raw[1] + m, &my, sizeof my);
-      std::memcpy(raw[2] + m, &mz, sizeof mz);
+      std::memcpy(rx + m, &mx, sizeof mx);
+      std::memcpy(ry + m, &my, sizeof my);
+      std::memcpy(rz + m, &mz, sizeof mz);
     }
 #undef FPLOC_PERM
     const v8i qp = reinterpret_cast<v8i>(_mm256_permutevar8x32_epi32(reinterpret_cast<__m256i>(pv), idx));
-    std::memcpy(cx + m, &qx, sizeof qx);
-    std::memcpy(cy + m, &qy, sizeof qy);
-    std::memcpy(cz + m, &qz, sizeof qz);
-    std::memcpy(cr + m, &qr, sizeof qr);
-    std::memcpy(cp + m, &qp, sizeof qp);
+    std::memcpy(ox + m, &qx, sizeof qx);
+    std::memcpy(oy + m, &qy, sizeof qy);
+    std::memcpy(oz + m, &qz, sizeof qz);
+    std::memcpy(orr + m, &qr, sizeof qr);
+    std::memcpy(op + m, &qp, sizeof qp);
     m += size_t(__builtin_popcount(unsigned(in)));
   }
 #undef FPLOC_LD
   return m;
 }
 size_t ring_pass8(const uint32_t* rng, const int32_t* okm, const float* const lut[6], const float* zr,
-                  const float* const rot[9], float* const raw[3], const uint32_t* next_rng, int W, int32_t lo,
+                  const float* rot, float* const raw[3], const uint32_t* next_rng, int W, int32_t lo,
                   int32_t hi, int32_t pix_row, float* cx, float* cy, float* cz, float* cr, int32_t* cp, size_t m) {
   if (zr)
     return okm ? ring_pass8_t<true, false>(rng, okm, lut, zr, rot, raw, next_rng, W, lo, hi, pix_row, cx, cy, cz, cr, cp, m)
@@ -199,7 +210,8 @@ bool Segmenter::prepare(const Scan& scan) {
   // v_z * 0.05 s (mm). Wall points are published as measured (with their times): downstream compensates.
   const bool deskew = deskew_.prepare(scan);
   out_.deskewed = deskew;
-  const std::vector<Eigen::Matrix3f>& rots = deskew_.rotations();
+  // (the column rotations as floats interleaved by groups of eight columns: GyroDeskew::interleaved())
+  const float* const rot_il = deskew ? deskew_.interleaved() : nullptr;
   // Range gate in integers: float(r) < rmin || float(r) > rmax for the 20-bit ranges (exact in float).
   const float rmin = float(cfg_.min_range_m * 1000.0), rmax = float(cfg_.max_range_m * 1000.0);
   const uint32_t r_lo = uint32_t(std::clamp(std::ceil(double(rmin)), 1.0, 4294967295.0));
@@ -234,11 +246,6 @@ bool Segmenter::prepare(const Scan& scan) {
   if (identity) {
     col_okm_.resize(W);
     for (int c = 0; c < W; ++c) col_okm_[c] = col_ok_[c] ? -1 : 0;
-    if (deskew) {
-      for (auto& v : rot_soa_) v.resize(W);
-      for (int c = 0; c < W; ++c)
-        for (int e = 0; e < 9; ++e) rot_soa_[e][c] = rots[c](e / 3, e % 3);
-    }
   }
   auto ring_pass4 = [&](int u, Candidates& cs) {
     using namespace simd;
@@ -262,7 +269,7 @@ bool Segmenter::prepare(const Scan& scan) {
       const v4f fr = __builtin_convertvector(ri, v4f);
       v4f x = load(dx + c) * fr + load(ox + c), y = load(dy + c) * fr + load(oy + c), z = load(dz + c) * fr + load(oz + c);
       if (deskew) {
-        const auto R = [&](int e) { return load(rot_soa_[e].data() + c); };
+        const auto R = [&](int e) { return load(rot_il + size_t(c / 8) * 72 + e * 8 + c % 8); };
         const v4f X = R(0) * x + R(1) * y + R(2) * z, Y = R(3) * x + R(4) * y + R(5) * z, Z = R(6) * x + R(7) * y + R(8) * z;
         x = X;
         y = Y;
@@ -303,7 +310,7 @@ bool Segmenter::prepare(const Scan& scan) {
       const size_t k = 3 * (row + col_mid_[c]);
       const float fr = float(r);
       Eigen::Vector3f p(dir[k] * fr + off[k], dir[k + 1] * fr + off[k + 1], dir[k + 2] * fr + off[k + 2]);
-      if (deskew) p = rots[c] * p;
+      if (deskew) p = deskew_.rotation_at(c) * p;
       cx[m] = p.x();
       cy[m] = p.y();
       cz[m] = p.z();
@@ -321,13 +328,11 @@ bool Segmenter::prepare(const Scan& scan) {
     const size_t row = size_t(u) * W;
     const float* lut[6];
     for (int e = 0; e < 6; ++e) lut[e] = lut_soa_[e].data() + row;
-    const float* rot[9];
-    for (int e = 0; e < 9; ++e) rot[e] = deskew ? rot_soa_[e].data() : nullptr;
     // (the row's z is taken before the rotation: the same floats as the table's)
     const bool zrow = !std::isnan(row_z_[size_t(u)][0]);
     float* const raw[3] = {cs.raw_x.data(), cs.raw_y.data(), cs.raw_z.data()};
     cs.n = ring_pass8(rng + row, all_ok ? nullptr : col_okm_.data(), lut, zrow ? row_z_[size_t(u)].data() : nullptr,
-                      deskew ? rot : nullptr, deskew ? raw : nullptr,
+                      rot_il, deskew ? raw : nullptr,
                       next_u >= 0 ? rng + size_t(next_u) * W : nullptr, W, int32_t(std::min<uint32_t>(r_lo, 0x7fffffffu)),
                       int32_t(std::min<uint32_t>(r_hi, 0x7fffffffu)), int32_t(row), cs.x.data(), cs.y.data(), cs.z.data(),
                       cs.range.data(), cs.pixel.data(), cs.n);

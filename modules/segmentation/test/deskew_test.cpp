@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "fploc/core/xyz.h"
 #include "fploc/segmentation/segmenter.h"
 #include "fploc/sim/simulator.h"
 
@@ -142,10 +143,59 @@ TEST(GyroDeskew, ColumnRotationsMatchTheExactIntegration) {
                                                       (1e-6 * double(ct[size_t(c)] - ct[size_t(c + 1)])));
   double worst = 0;
   for (int c = 0; c < 1024; ++c) {
-    const Eigen::Matrix3d R = dk.rotations()[size_t(c)].cast<double>();
+    const Eigen::Matrix3d R = dk.rotation_at(c).cast<double>();
     worst = std::max(worst, Eigen::AngleAxisd(R * exact[size_t(c)].transpose()).angle());
     worst = std::max(worst, (R - exact[size_t(c)]).cwiseAbs().maxCoeff());
   }
   std::printf("worst column rotation error %.3g rad\n", worst);
   EXPECT_LT(worst, 1e-5);
+}
+
+// The point preparation's de-skewed candidates (the eight-lane pass on AVX2 CPUs, the four-lane one
+// elsewhere; both read the rotations in GyroDeskew::interleaved()'s layout) are the returns as measured
+// rotated by their column's rotation, each entry ((R_i0 x + R_i1 y) + R_i2 z) in float: bit for bit.
+TEST(GyroDeskew, PreparedCandidatesAreTheColumnRotationsApplied) {
+  sim::SimulatorOptions o;
+  o.scenario = "corridor-loop-fast";
+  o.seed = 1;
+  o.shared_dir = FPLOC_SHARED_DIR;
+  sim::Simulator sim(FloorPlan{}, o);
+  seg::RingSegmenter sg(seg::SegmenterConfig{});
+  seg::GyroDeskew dk(true);
+  sim::SimScan f;
+  const int k = 160;
+  const double tb = sim.frame_time(k) - o.t0_s + 1.0 / o.rate_hz;
+  for (const auto& s : sim.imu())
+    if (s.t < tb) {
+      const int64_t u = int64_t(std::llround((o.t0_s + s.t) * 1e6));
+      sg.add_gyro(s.gyro, u);
+      dk.add(s.gyro, u);
+    }
+  sim.frame(k, f);
+  const Scan& scan = f.scan;
+  ASSERT_TRUE(sg.process(scan).deskewed);
+  ASSERT_TRUE(dk.prepare(scan));
+  const auto& pts = sg.points();
+  const XyzLut lut = make_xyz_lut(scan.beams, scan.width);
+  const int W = scan.width;
+  size_t checked = 0, differ = 0;
+  double largest_rotation = 0;
+  for (int u = 0; u < scan.height; ++u)
+    for (int c = 0; c < W; ++c) {
+      const size_t i = size_t(u) * W + c;
+      if (!pts[i].allFinite()) continue;
+      const float fr = float(scan.range_mm[i]);
+      const float x = lut.direction(i, 0) * fr + lut.offset(i, 0), y = lut.direction(i, 1) * fr + lut.offset(i, 1),
+                  z = lut.direction(i, 2) * fr + lut.offset(i, 2);
+      const Eigen::Matrix3f R = dk.rotation_at(c);
+      largest_rotation = std::max(largest_rotation, double((R - Eigen::Matrix3f::Identity()).cwiseAbs().maxCoeff()));
+      for (int r = 0; r < 3; ++r) {
+        const float want = (R(r, 0) * x + R(r, 1) * y) + R(r, 2) * z;
+        differ += size_t(!(pts[i][r] == want));
+      }
+      ++checked;
+    }
+  EXPECT_GT(checked, 30000u);
+  EXPECT_GT(largest_rotation, 1e-3);  // (a sweep that turns: the rotations are not the identity)
+  EXPECT_EQ(differ, 0u);
 }

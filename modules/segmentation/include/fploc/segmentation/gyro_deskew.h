@@ -18,10 +18,14 @@ class GyroDeskew {
 
   // Gyro sample (rad/s, sensor frame) at utime [us, the scan's clock]; bad or out-of-order samples ignored.
   void add(const Eigen::Vector3d& rate, int64_t utime);
-  // Column rotations R_mid<-c for this sweep (rotations()). False when the scan is used as measured
+  // Column rotations R_mid<-c for this sweep (rotation_at(), interleaved()). False when the scan is used as measured
   // (disabled, gyro not covering the sweep, no column times, or a rotation below 0.001 deg).
   bool prepare(const Scan& scan);
-  const std::vector<Eigen::Matrix3f>& rotations() const { return col_rot_; }
+  // After a true prepare(): column c's rotation, and all of them as floats interleaved by groups of eight
+  // columns, entry (e / 3, e % 3) of column c at interleaved()[(c / 8) * 72 + e * 8 + c % 8] (the layout the
+  // segmenter's eight-lane point preparation loads; room for the width rounded up to eight).
+  Eigen::Matrix3f rotation_at(int c) const;
+  const float* interleaved() const { return rot_il_.data(); }
   // After prepare(): this sweep's mid-sweep time when the gyro covers it, else 0.
   int64_t sweep_mid_utime() const { return sweep_tm_; }
   // Up vector (sensor frame) of the ceiling found at mid-sweep: refines the bias. forget_up() when none.
@@ -31,9 +35,10 @@ class GyroDeskew {
 
  private:
   Eigen::Vector3d rate_at(int64_t utime) const;
-  // rate_at(utime), searched from sample `at` on (a sweep's columns are walked in time order: a step or two
-  // instead of a search); `at` is left at the sample taken. Both need at least one sample (prepare() checks).
-  Eigen::Vector3d rate_walk(int64_t utime, size_t& at) const;
+  // rate_at(utime) for a time in this sweep, from sweep_rate_ (the samples prepare() copied, the bias
+  // subtracted once: the same values), searched from sample `at` on (a sweep's columns are walked in time
+  // order: a step or two instead of a search); `at` is left at the sample taken.
+  const Eigen::Vector3d& sweep_rate_walk(int64_t utime, size_t& at) const;
   bool covers(int64_t ta, int64_t tb) const;
   Eigen::Matrix3d rotation(int64_t ta, int64_t tb) const;
 
@@ -45,7 +50,8 @@ class GyroDeskew {
   int64_t bias_ref_t_ = 0;
   Eigen::Vector3d bias_ref_up_ = Eigen::Vector3d::UnitZ();
   std::vector<int64_t> col_t_;
-  std::vector<Eigen::Matrix3f> col_rot_;
+  std::vector<float> rot_il_;                                  // the column rotations (interleaved())
+  std::vector<std::pair<int64_t, Eigen::Vector3d>> sweep_rate_;  // prepare(): this sweep's samples minus the bias
 };
 
 }  // namespace fploc::seg

@@ -101,7 +101,6 @@ class Segmenter {
   std::vector<float> lut_soa_[6];           // lut_ as float arrays: direction x/y/z, offset x/y/z
   std::vector<std::array<float, 2>> row_z_;  // per row: z direction and offset when one value each, else NaN
   bool col_identity_ = false;               // this scan's look-up columns are its own (lut_soa_ per pixel)
-  std::vector<float> rot_soa_[9];           // de-skew rotation per column, entry (e / 3, e % 3)
   std::vector<int8_t> row_set_;   // per scan row: 0 upper_, 1 lower_, 2 middle_ (with row_ring_: its ring there)
   std::vector<int> row_ring_;
   struct WallPiece {  // wall selection: a contiguous run of one row's candidates (wall_select.cpp)
