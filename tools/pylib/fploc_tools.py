@@ -14,7 +14,12 @@ def log(msg):
 
 def run(cmd, who):
     """Runs cmd; on failure prints the end of its stderr and exits naming `who` and the program."""
-    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    except FileNotFoundError:
+        # A driver started from the source tree looks for the programs beside itself.
+        how = f"run it as `bin/{who}`" if who.startswith("fploc bench ") else "run the built copy (build/bin)"
+        raise SystemExit(f"{who}: {cmd[0]} not found: {how}, or set FPLOC_BIN to the directory of the built programs")
     if r.returncode != 0:
         log(r.stderr[-4000:])
         raise SystemExit(f"{who}: {os.path.basename(cmd[0])} failed (exit {r.returncode}): {' '.join(cmd)}")
