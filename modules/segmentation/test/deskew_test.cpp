@@ -28,12 +28,18 @@ double percentile(std::vector<double> v, double q) {
   return v.empty() ? NAN : v[std::min(v.size() - 1, size_t(q * double(v.size())))];
 }
 
-// Frames [first, first + n) of corridor-loop-fast; gyro fed (plus `added_bias`) when with_gyro.
-SeqResult run(bool with_gyro, const Eigen::Vector3d& added_bias, int first = 150, int n = 200) {
+// The simulator's corridor-loop-fast sequence, seed 1 (its IMU turns fast: the de-skew matters).
+sim::SimulatorOptions corridor_fast() {
   sim::SimulatorOptions o;
   o.scenario = "corridor-loop-fast";
   o.seed = 1;
   o.shared_dir = FPLOC_SHARED_DIR;
+  return o;
+}
+
+// Frames [first, first + n) of corridor-loop-fast; gyro fed (plus `added_bias`) when with_gyro.
+SeqResult run(bool with_gyro, const Eigen::Vector3d& added_bias, int first = 150, int n = 200) {
+  const sim::SimulatorOptions o = corridor_fast();
   sim::Simulator sim(FloorPlan{}, o);
   seg::RingSegmenter sg(seg::SegmenterConfig{});
   sim::SimScan f;
@@ -155,10 +161,7 @@ TEST(GyroDeskew, ColumnRotationsMatchTheExactIntegration) {
 // elsewhere; both read the rotations in GyroDeskew::interleaved()'s layout) are the returns as measured
 // rotated by their column's rotation, each entry ((R_i0 x + R_i1 y) + R_i2 z) in float: bit for bit.
 TEST(GyroDeskew, PreparedCandidatesAreTheColumnRotationsApplied) {
-  sim::SimulatorOptions o;
-  o.scenario = "corridor-loop-fast";
-  o.seed = 1;
-  o.shared_dir = FPLOC_SHARED_DIR;
+  const sim::SimulatorOptions o = corridor_fast();
   sim::Simulator sim(FloorPlan{}, o);
   seg::RingSegmenter sg(seg::SegmenterConfig{});
   seg::GyroDeskew dk(true);
