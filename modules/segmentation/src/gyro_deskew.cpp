@@ -45,7 +45,7 @@ const Eigen::Vector3d& GyroDeskew::sweep_rate_walk(int64_t t, size_t& at) const 
 
 Eigen::Matrix3f GyroDeskew::rotation_at(int c) const {
   Eigen::Matrix3f R;
-  const float* g = rot_il_.data() + size_t(c / 8) * 72 + c % 8;
+  const float* g = rot_il_.data() + interleaved_offset(c);
   for (int e = 0; e < 9; ++e) R(e / 3, e % 3) = g[e * 8];
   return R;
 }
@@ -133,7 +133,7 @@ bool GyroDeskew::prepare(const Scan& scan) {
   rot_il_.resize(size_t((W + 7) / 8) * 72);
   float* const il = rot_il_.data();
   // Column c's entries (stride 8 in interleaved()).
-  const auto at_col = [il](int c) { return il + (size_t(c) >> 3) * 72 + (size_t(c) & 7); };  // (c >= 0)
+  const auto at_col = [il](int c) { return il + interleaved_offset(c); };
   const auto put = [&](int c, const Eigen::Matrix3f& m) {
     float* g = at_col(c);
     for (int e = 0; e < 9; ++e) g[e * 8] = m(e / 3, e % 3);

@@ -3,6 +3,7 @@
 // perpendicular to gravity) estimated from consecutive ceilings. Transport-free.
 #pragma once
 #include <Eigen/Core>
+#include <cstddef>
 #include <cstdint>
 #include <deque>
 #include <utility>
@@ -26,6 +27,8 @@ class GyroDeskew {
   // segmenter's eight-lane point preparation loads; room for the width rounded up to eight).
   Eigen::Matrix3f rotation_at(int c) const;
   const float* interleaved() const { return rot_il_.data(); }
+  // Where column c's entry (0, 0) lies in interleaved() (entry e at + e * 8).
+  static size_t interleaved_offset(int c) { return size_t(c / 8) * 72 + size_t(c % 8); }
   // After prepare(): this sweep's mid-sweep time when the gyro covers it, else 0.
   int64_t sweep_mid_utime() const { return sweep_tm_; }
   // Up vector (sensor frame) of the ceiling found at mid-sweep: refines the bias. forget_up() when none.
