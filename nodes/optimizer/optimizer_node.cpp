@@ -136,10 +136,11 @@ class OptimizerNode : public fploc::rt::Node {
       loc_ = plan_.make_localizer(cfg_);
       std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << ": window on floor '" << m.floor << "'\n";
     }
-    const auto latest = loc_->optimize(fz, fploc::adapters::from_msg(m), &finals);
+    auto latest = loc_->optimize(fz, fploc::adapters::from_msg(m), &finals);
     // The floor of each frame is the matcher's (frame_pose_t); kept until the frame's pose is final.
     floor_of_[m.utime] = {m.floor_index, m.floor};
     if (latest) {
+      plan_.add_scale_error(&*latest);
       latest_out_.publish(fploc::adapters::to_msg(*latest, latest_seq_++, m.floor_index, m.floor));
       // Status changes with their reason (pose_t has no text): e.g. POOR where the plan leaves a direction open.
       if (latest->status != last_status_ && ++status_changes_ <= 200)
@@ -154,6 +155,7 @@ class OptimizerNode : public fploc::rt::Node {
   // window's poses become final on the old plan and a new window starts on the corrected plan.
   void on_plan_diff(const fploc::plan_diff_t& m) {
     std::string error, said;
+    const double scale_before = plan_.unexplained_scale_squared();  // what the window's poses were estimated with
     if (!plan_.apply_flags(fploc::adapters::flagged_elements(m), &error)) {
       ctx_->error("plan_diff seq " + std::to_string(m.seq) + ": optimizer.plan: " + error);
       return;
@@ -164,13 +166,15 @@ class OptimizerNode : public fploc::rt::Node {
     }
     std::vector<fploc::localizer::Pose> finals;
     loc_->flush(&finals);
-    publish_finals(finals);
+    publish_finals(finals, scale_before);
     loc_ = plan_.make_localizer(cfg_);
     std::cerr << "[" << ctx_->name() << "] " << said << "\n";
   }
 
-  void publish_finals(const std::vector<fploc::localizer::Pose>& finals) {
-    for (const auto& p : finals) {
+  // Each with the drawing scale's share of its uncertainty (ActivePlan::add_scale_error; s2 < 0: the current).
+  void publish_finals(std::vector<fploc::localizer::Pose>& finals, double scale_s2 = -1) {
+    for (auto& p : finals) {
+      plan_.add_scale_error(&p, scale_s2 < 0 ? plan_.unexplained_scale_squared() : scale_s2);
       auto it = floor_of_.find(p.utime);
       const auto fl = it != floor_of_.end() ? it->second : std::pair<int, std::string>{-1, ""};
       pose_out_.publish(fploc::adapters::to_msg(p, pose_seq_++, fl.first, fl.second));

@@ -1,5 +1,7 @@
 #include "fploc/localizer/active_plan.h"
 
+#include <algorithm>
+#include <cmath>
 #include <utility>
 
 namespace fploc::localizer {
@@ -38,6 +40,10 @@ bool ActivePlan::apply_flags(const std::vector<matcher::FlaggedElement>& flagged
 
 bool ActivePlan::correct(double scale_error, double scale_sigma, const std::vector<matcher::SegmentOffset>& offsets,
                          int64_t utime, std::string* said, std::string* error) {
+  if (std::isfinite(scale_error) && std::isfinite(scale_sigma) && scale_sigma > 0) {
+    scale_estimate_ = scale_error;
+    scale_sigma_ = scale_sigma;
+  }
   if (!correction_.enabled()) return false;
   if (multi_floor()) {
     if (!warned_) *error = "plan_diff_scale / plan_diff_refine: not for a building of several floors (ignored)";
@@ -49,6 +55,18 @@ bool ActivePlan::correct(double scale_error, double scale_sigma, const std::vect
   previous_corrected_ = std::move(corrected_);
   corrected_ = std::move(map);
   return true;
+}
+
+double ActivePlan::unexplained_scale_squared() const {
+  if (!(scale_sigma_ > 0) || multi_floor()) return 0;
+  const double left = scale_estimate_ - correction_.scale();
+  return std::max(0.0, left * left - scale_sigma_ * scale_sigma_);
+}
+
+void ActivePlan::add_scale_error(Pose* pose, double s2) const {
+  if (!(s2 > 0)) return;
+  const Eigen::Vector2d d = Eigen::Vector2d(pose->pose.x, pose->pose.y) - matcher::scale_centre(plan());
+  pose->covariance.topLeftCorner<2, 2>() += s2 * d * d.transpose();
 }
 
 }  // namespace fploc::localizer

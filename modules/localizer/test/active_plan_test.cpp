@@ -52,5 +52,52 @@ TEST(ActivePlan, NoCorrectionWhenOffAndANewMapWhenTheScaleIsSignificant) {
   EXPECT_GT(on.scale(), 0.0);
 }
 
+// A pose d metres from the plan's scale centre, with a unit covariance in the fit's own terms.
+Pose pose_at(const ActivePlan& p, const Eigen::Vector2d& d) {
+  Pose q;
+  const Eigen::Vector2d at = matcher::scale_centre(p.plan()) + d;
+  q.pose = {at.x(), at.y(), 0.3};
+  q.covariance = Eigen::Matrix3d::Identity() * 1e-6;
+  return q;
+}
+
+TEST(ActivePlan, ADrawingScaleErrorWidensThePublishedCovarianceAlongTheRadius) {
+  std::string said, error;
+  ActivePlan p = room(false);  // the correction off: the whole estimated scale error stays in the poses
+  Pose before = pose_at(p, {3, 4});
+  p.add_scale_error(&before);
+  EXPECT_EQ(before.covariance, Eigen::Matrix3d::Identity() * 1e-6) << "no estimate yet: nothing added";
+
+  p.correct(0.005, 0.0005, {}, 1'000'000, &said, &error);  // 0.5 % +- 0.05 %
+  const double s2 = 0.005 * 0.005 - 0.0005 * 0.0005;
+  EXPECT_NEAR(p.unexplained_scale_squared(), s2, 1e-12);
+  Pose q = pose_at(p, {3, 4});  // 5 m out along (0.6, 0.8): 0.5 % of it is 2.5 cm
+  p.add_scale_error(&q);
+  const Eigen::Vector2d radial(0.6, 0.8), across(-0.8, 0.6);
+  EXPECT_NEAR(radial.dot(q.covariance.topLeftCorner<2, 2>() * radial), 1e-6 + s2 * 25, 1e-9);
+  EXPECT_NEAR(across.dot(q.covariance.topLeftCorner<2, 2>() * across), 1e-6, 1e-9);
+  EXPECT_EQ(q.covariance(2, 2), 1e-6) << "a scale moves no heading";
+  Pose centre = pose_at(p, {0, 0});
+  p.add_scale_error(&centre);
+  EXPECT_EQ(centre.covariance, Eigen::Matrix3d::Identity() * 1e-6) << "the scale centre does not move";
+
+  // An estimate within its sigma (a plan drawn to scale) adds nothing; a bad estimate leaves the last one.
+  p.correct(0.0004, 0.0005, {}, 2'000'000, &said, &error);
+  EXPECT_EQ(p.unexplained_scale_squared(), 0.0);
+  p.correct(std::nan(""), 0.0005, {}, 3'000'000, &said, &error);
+  EXPECT_EQ(p.unexplained_scale_squared(), 0.0);
+}
+
+TEST(ActivePlan, TheCorrectedScaleIsNoLongerInThePublishedCovariance) {
+  std::string said, error;
+  ActivePlan on = room(true);
+  for (int i = 0; i < 30 && on.scale() == 0; ++i) on.correct(0.02, 0.001, {}, int64_t(i + 1) * 1'000'000, &said, &error);
+  ASSERT_GT(on.scale(), 0.0);
+  EXPECT_EQ(on.unexplained_scale_squared(), 0.0) << "estimate 2 % +- 0.1 %, 2 % applied";
+  on.correct(0.0203, 0.0001, {}, 40'000'000, &said, &error);  // 0.03 % more than applied (below min_change)
+  EXPECT_NEAR(on.unexplained_scale_squared(), (0.0203 - on.scale()) * (0.0203 - on.scale()) - 1e-8, 1e-12);
+  EXPECT_GT(on.unexplained_scale_squared(), 0.0);
+}
+
 }  // namespace
 }  // namespace fploc::localizer

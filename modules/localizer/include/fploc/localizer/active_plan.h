@@ -43,6 +43,18 @@ class ActivePlan {
                std::string* said, std::string* error);
   bool correcting() const { return correction_.enabled(); }
   double scale() const { return correction_.scale(); }  // the scale error corrected for now (0: none)
+  // The drawing scale's share of a published pose's uncertainty. A scale error s left in the plan moves a
+  // pose by s (p - c) (c = matcher::scale_centre, the point the correction and the simulator scale about), the
+  // same on every frame, so the window's fit cannot see it. From the diff's latest estimate (correct() keeps
+  // it, whether or not the correction is on): s^2 is estimated by (estimate - applied)^2 - sigma^2, floored at
+  // 0 (an unbiased estimate of a square: E[estimate^2] = s^2 + sigma^2), so a plan drawn to scale adds ~0 and
+  // one off by 0.5 % the spread its error has. Added to x/y as s^2 (p - c)(p - c)^T; published only (like
+  // Config::map_sigma_m, the gates keep the fit's own covariance). Nothing before the first estimate, nor
+  // for a building of several floors (no scale estimate is used there).
+  void add_scale_error(Pose* pose) const { add_scale_error(pose, unexplained_scale_squared()); }
+  double unexplained_scale_squared() const;
+  // The same with a given s^2 (the poses a correction makes final were estimated before it).
+  void add_scale_error(Pose* pose, double s2) const;
 
  private:
   FloorMaps floors_;
@@ -51,6 +63,7 @@ class ActivePlan {
   matcher::PlanCorrection correction_{false, false};
   std::string lookup_;
   bool warned_ = false;
+  double scale_estimate_ = 0, scale_sigma_ = 0;  // the diff's latest (sigma 0: none yet)
   // The current and the previous weights and corrected map: a Localizer made before the last change may
   // still point at them until the node replaces it.
   std::unique_ptr<matcher::ElementWeights> weights_, previous_weights_;
