@@ -83,7 +83,8 @@ int Diff::count(Status s) const {
   return int(std::count_if(elements.begin(), elements.end(), [s](const ElementDiff& e) { return e.status == s; }));
 }
 
-PlanDiff::PlanDiff(FloorPlan plan, Options o) : plan_(std::move(plan)), o_(o) {
+PlanDiff::PlanDiff(FloorPlan plan, Options o)
+    : plan_(std::move(plan)), o_(o), scale_(plan_.elements.size()), refine_(plan_.elements.size()) {
   if (plan_.elements.empty()) throw std::runtime_error("plan diff: the plan has no elements");
   acc_.resize(plan_.elements.size());
   for (size_t i = 0; i < plan_.elements.size(); ++i) {
@@ -106,9 +107,6 @@ PlanDiff::PlanDiff(FloorPlan plan, Options o) : plan_(std::move(plan)), o_(o) {
       }
     }
   }
-  ref_H_ = Eigen::MatrixXd::Zero(2 * long(plan_.elements.size()), 2 * long(plan_.elements.size()));
-  ref_g_ = Eigen::VectorXd::Zero(2 * long(plan_.elements.size()));
-  ref_frames_.assign(plan_.elements.size(), 0);
   probe_expected_.assign(probes_.size(), 0);
   probe_seen_.assign(probes_.size(), 0);
   probe_through_.assign(probes_.size(), 0);
@@ -293,21 +291,6 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
   std::vector<std::vector<float>> half_offs[2] = {std::vector<std::vector<float>>(plan_.elements.size()),
                                                   std::vector<std::vector<float>>(plan_.elements.size())};
   std::vector<V2> along_sum(plan_.elements.size(), V2::Zero());  // sum of (point - sensor) of the inside points
-  Eigen::Matrix3d sA = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d sg = Eigen::Vector3d::Zero();
-  double so2 = 0;
-  int scount = 0;
-  // The same sums per element (its share of the scan's scale information), for the variance by wall.
-  struct ScaleSums {
-    int element;
-    Eigen::Matrix3d A;
-    Eigen::Vector3d g;
-    Eigen::Vector3d a;  // sum of its rows: what a shift of the element by 1 m adds to g
-    double o;           // sum of its offsets
-    int n;              // its points
-  };
-  std::vector<ScaleSums> esums;
-  std::vector<int> eslot(plan_.elements.size(), -1);
   // The scan's points in range, on the plan, and the direction of the straight structure each lies on (its
   // neighbours' principal axis, where they are straight enough to tell).
   std::vector<V2> wp;
@@ -377,21 +360,7 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
         // Scale model: off = scale * n.(q - sensor) + n.b (b: this scan's registration bias).
         const V2 n = left_normal(el);
         const double dd = n.dot(p - s) - off0;
-        const Eigen::Vector3d row(dd, n.x(), n.y());
-        sA += row * row.transpose();
-        sg += row * off0;
-        so2 += off0 * off0;
-        ++scount;
-        int& slot = eslot[size_t(e0)];
-        if (slot < 0) {
-          slot = int(esums.size());
-          esums.push_back({e0, Eigen::Matrix3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0, 0});
-        }
-        esums[size_t(slot)].A += row * row.transpose();
-        esums[size_t(slot)].g += row * off0;
-        esums[size_t(slot)].a += row;
-        esums[size_t(slot)].o += off0;
-        ++esums[size_t(slot)].n;
+        scale_.add_point(e0, Eigen::Vector3d(dd, n.x(), n.y()), off0);
       }
     }
     if (!pose_ok) continue;
@@ -470,91 +439,20 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
     acc_[e].pose_var += v;
     ++acc_[e].pose_frames;
   }
-  // As-built refinement: median offset of each wall = (1 - t) o_a + t o_b + c . (bx, by, byaw) (c: how the
-  // scan's registration error moves the wall's points along its normal); the scan's error is eliminated
-  // (Schur complement) and the rest accumulated over the run.
-  {
-    struct RObs {
-      int e;
-      double t, m;
-      Eigen::Vector3d c;
-    };
-    std::vector<RObs> obs;
-    for (size_t e = 0; e < offs.size() && evidence; ++e) {
-      const Element& el = plan_.elements[e];
-      if (el.kind != ElementKind::kSegment || int(offs[e].size()) < o_.refine_min_points) continue;
-      const V2 d = el.b - el.a;
-      const V2 rc = along_sum[e] / double(offs[e].size());  // mean point, relative to the sensor
-      const double t = std::clamp((s + rc - el.a).dot(d) / d.squaredNorm(), 0.0, 1.0);
-      const V2 n = left_normal(el);
-      obs.push_back({int(e), t, median_of(offs[e]), Eigen::Vector3d(-n.x(), -n.y(), -(n.y() * rc.x() - n.x() * rc.y()))});
-    }
-    Eigen::Matrix3d Hbb = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d gb = Eigen::Vector3d::Zero();
-    for (const auto& o : obs) Hbb += o.c * o.c.transpose(), gb += o.c * o.m;
-    Eigen::LDLT<Eigen::Matrix3d> ldlt(Hbb);
-    const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Hbb).eigenvalues();
-    if (obs.size() >= 4 && ev.minCoeff() > 1e-6 * std::max(1.0, ev.maxCoeff())) {
-      std::vector<Eigen::Vector3d> Ki(obs.size());  // Hbb^-1 c_k
-      for (size_t k = 0; k < obs.size(); ++k) Ki[k] = ldlt.solve(obs[k].c);
-      const Eigen::Vector3d bg = ldlt.solve(gb);
-      for (size_t k = 0; k < obs.size(); ++k) {
-        const long ia = 2 * obs[k].e, ib = ia + 1;
-        const double wa = 1 - obs[k].t, wb = obs[k].t;
-        ref_g_[ia] += wa * (obs[k].m - obs[k].c.dot(bg));
-        ref_g_[ib] += wb * (obs[k].m - obs[k].c.dot(bg));
-        for (size_t l = 0; l < obs.size(); ++l) {
-          const long ja = 2 * obs[l].e, jb = ja + 1;
-          const double v = (k == l ? 1.0 : 0.0) - obs[k].c.dot(Ki[l]);
-          const double xa = 1 - obs[l].t, xb = obs[l].t;
-          ref_H_(ia, ja) += wa * v * xa;
-          ref_H_(ia, jb) += wa * v * xb;
-          ref_H_(ib, ja) += wb * v * xa;
-          ref_H_(ib, jb) += wb * v * xb;
-        }
-        ++ref_frames_[size_t(obs[k].e)];
-      }
-    }
+  // As-built refinement (wall_refinement.h): each well-seen wall's median offset in this scan, where along it,
+  // and how the scan's registration error moves its points along its normal.
+  std::vector<WallRefinement::Observation> obs;
+  for (size_t e = 0; e < offs.size() && evidence; ++e) {
+    const Element& el = plan_.elements[e];
+    if (el.kind != ElementKind::kSegment || int(offs[e].size()) < o_.refine_min_points) continue;
+    const V2 d = el.b - el.a;
+    const V2 rc = along_sum[e] / double(offs[e].size());  // mean point, relative to the sensor
+    const double t = std::clamp((s + rc - el.a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+    const V2 n = left_normal(el);
+    obs.push_back({int(e), t, median_of(offs[e]), Eigen::Vector3d(-n.x(), -n.y(), -(n.y() * rc.x() - n.x() * rc.y()))});
   }
-  // The scan's bias (b) eliminated (Schur complement): what this scan tells about the scale.
-  if (scount >= 20) {
-    const Eigen::Matrix2d Abb = sA.bottomRightCorner<2, 2>();
-    const double det = Abb(0, 0) * Abb(1, 1) - Abb(0, 1) * Abb(1, 0);
-    if (det > 1e-9 * std::max(1.0, Abb.trace() * Abb.trace())) {
-      Eigen::Matrix2d inv;
-      inv << Abb(1, 1), -Abb(0, 1), -Abb(1, 0), Abb(0, 0);
-      inv /= det;
-      const Eigen::Vector2d Asb = sA.block<2, 1>(1, 0);
-      scale_h_ += sA(0, 0) - Asb.dot(inv * Asb);
-      scale_g_ += sg(0) - Asb.dot(inv * sg.tail<2>());
-      scale_o2_ += so2 - sg.tail<2>().dot(inv * sg.tail<2>());
-      scale_n_ += scount - 2;
-      // Each element's part of the eliminated score, G_e - s H_e at any s: with w = (1, -Abb^-1 Asb) and the
-      // scan's bias at s = 0, beta = Abb^-1 g_b, G_e = w.(g_e - A_e[:, b] beta), H_e = w.A_e w. Summed over
-      // the elements they are the scan's scale_g_ / scale_h_ terms above.
-      const Eigen::Vector2d k = inv * Asb, beta = inv * sg.tail<2>();
-      const Eigen::Vector3d w(1.0, -k.x(), -k.y());
-      // An element's points' residuals at scale s with the scan's bias at s, beta - s k, summed: o_e - a_e.b beta
-      // - s w.a_e. And an element standing delta off its line adds delta to each of its points' offsets, so
-      // delta a_e to the scan's sums and delta w.a_e to its score (G = w.g).
-      if (scale_eg_.size() != plan_.elements.size()) {
-        const size_t ne = plan_.elements.size();
-        scale_eg_.assign(ne, 0.0), scale_eh_.assign(ne, 0.0), scale_ep_.assign(ne, 0.0), scale_ec_.assign(ne, 0.0);
-        scale_el_.assign(ne, 0.0);
-        scale_en_.assign(ne, 0), scale_ef_.assign(ne, 0);
-      }
-      for (const ScaleSums& es : esums) {
-        const size_t e = size_t(es.element);
-        scale_eg_[e] += w.dot(es.g - es.A.rightCols<2>() * beta);
-        scale_eh_[e] += w.dot(es.A * w);
-        scale_ep_[e] += es.o - es.a.tail<2>().dot(beta);
-        scale_ec_[e] += w.dot(es.a);
-        scale_en_[e] += es.n;
-        scale_el_[e] += es.a.tail<2>().dot(inv * es.a.tail<2>());
-        ++scale_ef_[e];
-      }
-    }
-  }
+  refine_.add_scan(obs);
+  scale_.end_scan();
   if (!evidence) return;  // the rest is change evidence
   // Every unexplained cell seen so far: was it in view in this scan (in range, nothing measured in front)?
   // Static structure is hit in a good share of the scans that see its place; a person's track is not.
@@ -643,70 +541,11 @@ Diff PlanDiff::result() const {
   Diff d;
   d.frames = frames_;
   d.evidence_frames = evidence_frames_;
-  // As-built refinement: (H / sigma_obs^2 + I / sigma_prior^2) o = g / sigma_obs^2.
-  {
-    const double lam = std::pow(o_.refine_obs_sigma_m / o_.refine_prior_m, 2);
-    Eigen::MatrixXd H = ref_H_;
-    H.diagonal().array() += lam;
-    const Eigen::VectorXd o = H.ldlt().solve(ref_g_);
-    const double kmin = o_.refine_min_info;
-    for (size_t i = 0; i < plan_.elements.size(); ++i) {
-      const long a = 2 * long(i), b = a + 1;
-      if (ref_frames_[i] < o_.min_frames || !std::isfinite(o[a]) || !std::isfinite(o[b])) continue;
-      // Both ends observed well enough (the data's own information on each, scans' errors eliminated), else
-      // the mean offset (a wall seen near one end only), else nothing.
-      if (o_.refine_ends && ref_H_(a, a) >= kmin && ref_H_(b, b) >= kmin) {
-        d.refined.push_back({int(i), o[a], o[b], ref_frames_[i]});
-      } else if (ref_H_(a, a) + ref_H_(b, b) + 2 * ref_H_(a, b) >= 4 * kmin) {
-        const double m = 0.5 * (o[a] + o[b]);
-        d.refined.push_back({int(i), m, m, ref_frames_[i]});
-      }
-    }
-  }
-  if (scale_h_ > 0 && scale_n_ > 10) {
-    d.scale_error = scale_g_ / scale_h_;
-    const double var = std::max(0.0, (scale_o2_ - d.scale_error * scale_g_) / (scale_n_ - 1));
-    // Points of one scan are not independent (the same walls, frame after frame): the sigma counts every
-    // scan as one observation of its walls, i.e. it is inflated by sqrt(points per scan).
-    const double per_scan = double(scale_n_) / std::max(1, frames_);
-    d.scale_sigma = std::sqrt(var / scale_h_ * std::max(1.0, per_scan));
-    // The walls themselves stand off their drawn lines (as built: a few cm each, for the whole run), and a
-    // wall's offsets look like a scale to the scans that see it across a narrow room: every scan of that wall
-    // repeats the same error. So the sigma is also taken with the walls as the independent units (the
-    // sandwich variance clustered by element, with the small-sample factor C / (C - 1)); the larger is kept.
-    double u2 = 0;
-    int clusters = 0;
-    for (size_t e = 0; e < scale_eg_.size(); ++e) {
-      if (!(scale_eh_[e] > 0)) continue;
-      const double u = scale_eg_[e] - d.scale_error * scale_eh_[e];
-      u2 += u * u;
-      ++clusters;
-    }
-    if (clusters >= 2)
-      d.scale_sigma = std::max(d.scale_sigma, std::sqrt(u2 * clusters / (clusters - 1)) / scale_h_);
-    // The walls stand off their drawn lines as built (a few cm each, for the whole run), and an offset reads as a
-    // scale to every scan that sees its wall across a narrow corridor, the same error scan after scan: the walls
-    // seen so far may happen to look like a consistent scale, which the scatter above cannot tell. So the sigma
-    // also holds what offsets of the size the walls show can fake: an element delta_e off its line moves the
-    // estimate by delta_e c_e / H (c_e: scale_ec_), so independent offsets of sigma_w give
-    // sigma_w sqrt(sum_e c_e^2) / H. sigma_w^2 is the sum over the elements seen in >= min_frames scans of their
-    // mean offset left by the scale and the scans' biases, squared -- all walls, also those that carry no scale, so
-    // a few walls that fake one do not hide the spread -- over the degrees of freedom those residuals keep: each
-    // element 1 less its mean leverage on the scans' biases (across a corridor the bias takes about half of the
-    // two walls' offsets; without this the sigma came out ~1.3x too small there).
-    double m2 = 0, c2 = 0, dof = 0;
-    int walls = 0;
-    for (size_t e = 0; e < scale_ec_.size(); ++e) {
-      c2 += scale_ec_[e] * scale_ec_[e];
-      if (scale_ef_[e] < o_.min_frames || scale_en_[e] <= 0) continue;
-      const double m = (scale_ep_[e] - d.scale_error * scale_ec_[e]) / double(scale_en_[e]);
-      m2 += m * m;
-      dof += std::max(0.0, 1.0 - scale_el_[e] / double(scale_en_[e]));
-      ++walls;
-    }
-    if (walls >= 3 && dof > 0) d.scale_sigma = std::hypot(d.scale_sigma, std::sqrt(m2 / dof * c2) / scale_h_);
-    d.scale_points = scale_n_;
-  }
+  d.refined = refine_.result({o_.refine_obs_sigma_m, o_.refine_prior_m, o_.refine_min_info, o_.refine_ends, o_.min_frames});
+  const DrawingScale::Estimate scale = scale_.estimate(frames_, o_.min_frames);
+  d.scale_error = scale.error;
+  d.scale_sigma = scale.sigma;
+  d.scale_points = scale.points;
   d.elements.resize(plan_.elements.size());
   for (size_t i = 0; i < plan_.elements.size(); ++i) {
     const Acc& a = acc_[i];

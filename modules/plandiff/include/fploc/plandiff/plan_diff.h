@@ -28,6 +28,8 @@
 #include <vector>
 
 #include "fploc/floorplan/plan.h"
+#include "fploc/plandiff/drawing_scale.h"
+#include "fploc/plandiff/wall_refinement.h"
 
 namespace fploc::plandiff {
 
@@ -155,14 +157,6 @@ struct MissingPart {
   double length() const { return (b - a).norm(); }
 };
 
-// The plan refined to the building (as built): segment `element` offset along its left normal by
-// offset_a at its end a and offset_b at b. The frame is that of the whole plan (the per-scan registration
-// error is eliminated, the prior holds the gauge: the offsets are as small as the data allow).
-struct RefinedSegment {
-  int element = -1;
-  double offset_a = 0, offset_b = 0;
-  int frames = 0;  // scans that observed it
-};
 
 struct Diff {
   std::vector<ElementDiff> elements;  // one per plan element
@@ -232,18 +226,8 @@ class PlanDiff {
   std::unordered_map<int64_t, Cell> view_;   // new_view_cell_m: hit in how many of the scans that saw it
   int frames_ = 0;
   int evidence_frames_ = 0;  // of them, those that gave change evidence
-  double scale_h_ = 0, scale_g_ = 0, scale_o2_ = 0;
-  int64_t scale_n_ = 0;
-  std::vector<double> scale_eg_, scale_eh_;  // per element: its part of scale_g_ / scale_h_ (the bias eliminated per scan)
-  // Per element, summed over its points and scans with each scan's bias eliminated: its offsets' residual from the
-  // scale model is (scale_ep_ - s scale_ec_) / scale_en_ at scale s; scale_ec_ is also d scale_g_ / d (its offset).
-  std::vector<double> scale_ep_, scale_ec_;
-  std::vector<double> scale_el_;  // per element: its leverage on the scans' biases, times its points (sum over scans)
-  std::vector<int64_t> scale_en_;
-  std::vector<int> scale_ef_;  // scans
-  Eigen::MatrixXd ref_H_;   // as-built refinement: normal equations in (o_a, o_b) per segment, scans eliminated
-  Eigen::VectorXd ref_g_;
-  std::vector<int> ref_frames_;
+  DrawingScale scale_;
+  WallRefinement refine_;
   // Uniform grid of elements (1 m cells, bounding boxes grown by assoc_m) for the point association.
   Eigen::Vector2d gmin_;
   int gx_ = 0, gy_ = 0;
