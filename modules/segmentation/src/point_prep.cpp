@@ -10,6 +10,7 @@
 #include "fploc/segmentation/segmenter.h"
 #include "compact_kernels.h"
 #include "plane_kernels.h"
+#include "wall_kernels.h"
 #include "simd4.h"
 #if defined(__x86_64__) && defined(__GNUC__)
 #include "lane8.h"
@@ -49,7 +50,7 @@ __attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const i
   const float* __restrict rt = rot;
   float* __restrict rx = raw ? raw[0] : nullptr;
   float* __restrict ry = raw ? raw[1] : nullptr;
-  float* __restrict rz = raw ? raw[2] : nullptr;
+  float* __restrict rz = raw ? raw[2] : nullptr;  // (null: a row whose z wall selection takes from the range)
   float* __restrict ox = cx;
   float* __restrict oy = cy;
   float* __restrict oz = cz;
@@ -95,10 +96,10 @@ __attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const i
       std::memcpy(oz + m, &z, sizeof z);
       std::memcpy(orr + m, &rm, sizeof rm);
       std::memcpy(op + m, &pv, sizeof pv);
-      if (rt) {
+      if (rx) {
         std::memcpy(rx + m, &mx, sizeof mx);
         std::memcpy(ry + m, &my, sizeof my);
-        std::memcpy(rz + m, &mz, sizeof mz);
+        if (rz) std::memcpy(rz + m, &mz, sizeof mz);
       }
       m += 8;
       continue;
@@ -108,13 +109,15 @@ __attribute__((target("avx2"))) size_t ring_pass8_t(const uint32_t* rng, const i
     const __m256i idx = lane8::to_front(kCompress, in);
 #define FPLOC_PERM(v) reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(v), idx))
     const v8f qx = FPLOC_PERM(x), qy = FPLOC_PERM(y), qz = FPLOC_PERM(z), qr = FPLOC_PERM(rm);
-    if (rt) {
+    if (rx) {
       mx = FPLOC_PERM(mx);
       my = FPLOC_PERM(my);
-      mz = FPLOC_PERM(mz);
       std::memcpy(rx + m, &mx, sizeof mx);
       std::memcpy(ry + m, &my, sizeof my);
-      std::memcpy(rz + m, &mz, sizeof mz);
+      if (rz) {
+        mz = FPLOC_PERM(mz);
+        std::memcpy(rz + m, &mz, sizeof mz);
+      }
     }
 #undef FPLOC_PERM
     const v8i qp = reinterpret_cast<v8i>(_mm256_permutevar8x32_epi32(reinterpret_cast<__m256i>(pv), idx));
@@ -216,6 +219,9 @@ bool Segmenter::prepare(const Scan& scan) {
   const float rmin = float(cfg_.min_range_m * 1000.0), rmax = float(cfg_.max_range_m * 1000.0);
   const uint32_t r_lo = uint32_t(std::clamp(std::ceil(double(rmin)), 1.0, 4294967295.0));
   const uint32_t r_hi = uint32_t(std::clamp(std::floor(double(rmax)), 0.0, 4294967295.0));
+  // Every candidate's range [m] gives its range in mm back exactly (wallk::Source::zrow): on a row whose z is one
+  // value, a de-skewed return's measured z is computed again from it by wall selection, not stored here.
+  raw_z_from_range_ = r_hi < wallk::kExactRangeMm;
   // Per column (once, not per pixel): look-up column (measurement id) and validity.
   const int W = scan.width, H = scan.height;
   const bool mids = int(scan.measurement_id.size()) == W;
@@ -330,7 +336,9 @@ bool Segmenter::prepare(const Scan& scan) {
     for (int e = 0; e < 6; ++e) lut[e] = lut_soa_[e].data() + row;
     // (the row's z is taken before the rotation: the same floats as the table's)
     const bool zrow = !std::isnan(row_z_[size_t(u)][0]);
-    float* const raw[3] = {cs.raw_x.data(), cs.raw_y.data(), cs.raw_z.data()};
+    // (the measured z not stored where wall selection computes it again from the candidate's range: the row's z
+    // one value and the range giving the mm back exactly)
+    float* const raw[3] = {cs.raw_x.data(), cs.raw_y.data(), zrow && raw_z_from_range_ ? nullptr : cs.raw_z.data()};
     cs.n = ring_pass8(rng + row, all_ok ? nullptr : col_okm_.data(), lut, zrow ? row_z_[size_t(u)].data() : nullptr,
                       rot_il, deskew ? raw : nullptr,
                       next_u >= 0 ? rng + size_t(next_u) * W : nullptr, W, int32_t(std::min<uint32_t>(r_lo, 0x7fffffffu)),

@@ -72,6 +72,12 @@ __attribute__((target("avx2"))) size_t copy8(const Source& s, int32_t a, int32_t
   const __m128i rings = _mm_set1_epi16(u);
   const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   const __m128i iota16 = _mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7);
+  // z from the range (s.zrow): fr = round(range * 1000) in float (Source)
+  const bool zr = s.zrow != nullptr;
+  const float zd = zr ? s.zrow[0] : 0.f, zo = zr ? s.zrow[1] : 0.f;
+  const v8f zdv = {zd, zd, zd, zd, zd, zd, zd, zd}, zov = {zo, zo, zo, zo, zo, zo, zo, zo};
+  const v8f k1000 = {1000.f, 1000.f, 1000.f, 1000.f, 1000.f, 1000.f, 1000.f, 1000.f};
+#define z_of(rm) (zdv * reinterpret_cast<v8f>(_mm256_cvtepi32_ps(_mm256_cvtps_epi32(reinterpret_cast<__m256>((rm) * k1000)))) + zov)
   size_t g = 0;
   for (int32_t j = a; j < b; j += 8) {
     const int mk = masks[g++];
@@ -87,11 +93,13 @@ __attribute__((target("avx2"))) size_t copy8(const Source& s, int32_t a, int32_t
         st(oy + o, ld(meas->lut[1] + pix0) * fr + ld(meas->lut[4] + pix0));
         st(oz + o, ld(meas->lut[2] + pix0) * fr + ld(meas->lut[5] + pix0));
       } else {
+        const v8f rm = ld(srange + j);
         st(ox + o, ld(sx + j));
         st(oy + o, ld(sy + j));
-        st(oz + o, ld(sz + j));
+        st(oz + o, zr ? z_of(rm) : ld(sz + j));
+        st(orng + o, rm);
       }
-      st(orng + o, ld(srange + j));
+      if (meas) st(orng + o, ld(srange + j));
       st(ot + o, ld(col_dt + (pix0 - row)));
       _mm_storeu_si128(reinterpret_cast<__m128i*>(ocol + o), _mm_add_epi16(_mm_set1_epi16(int16_t(pix0 + off)), iota16));
       o += 8;
@@ -114,9 +122,11 @@ __attribute__((target("avx2"))) size_t copy8(const Source& s, int32_t a, int32_t
     } else {
       st(ox + o, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(ld(sx + j)), idx)));
       st(oy + o, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(ld(sy + j)), idx)));
-      st(oz + o, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(ld(sz + j)), idx)));
     }
-    st(orng + o, reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(ld(srange + j)), idx)));
+    const v8f qr = reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(ld(srange + j)), idx));
+    if (!meas)
+      st(oz + o, zr ? z_of(qr) : reinterpret_cast<v8f>(_mm256_permutevar8x32_ps(reinterpret_cast<__m256>(ld(sz + j)), idx)));
+    st(orng + o, qr);
     st(ot + o, reinterpret_cast<v8f>(_mm256_i32gather_ps(col_dt, colv, 4)));
     const __m256i cd = _mm256_add_epi32(pix, _mm256_set1_epi32(off));
     const __m256i packed = _mm256_packs_epi32(cd, cd);  // per 128-bit half: c0..c3 c0..c3 | c4..c7 c4..c7
@@ -125,6 +135,7 @@ __attribute__((target("avx2"))) size_t copy8(const Source& s, int32_t a, int32_t
     o += size_t(__builtin_popcount(unsigned(mk)));
     (void)iota;
   }
+#undef z_of
   return o;
 }
 #else

@@ -24,10 +24,16 @@ struct Bounds {
 size_t masks8(const float* x, const float* y, const float* z, int32_t a, int32_t b, const Bounds& bd, uint8_t* masks);
 
 // The candidates' arrays (read up to 7 entries past a piece's end).
+// zrow: null, or the row's z direction and offset (one value each, the same floats as the table's) when z is not
+// stored: z = zrow[0] fr + zrow[1] with fr taken back from the candidate's range [m] (fr * 1e-3f in float) as the
+// nearest integer to range * 1000 in float, which is fr exactly for fr < kExactRangeMm (the relative error of the
+// two products is below 2^-22).
 struct Source {
   const float *x, *y, *z, *range;
   const int32_t* pixel;
+  const float* zrow = nullptr;
 };
+constexpr uint32_t kExactRangeMm = 1u << 21;
 // Per return as measured (de-skewed scans): x = dir_x[pix] fr + off_x[pix] etc. with fr = range_mm[pix]
 // (the table per pixel when the look-up column is the scan's own).
 struct Measured {

@@ -105,7 +105,9 @@ void Segmenter::select_walls(const Scan& scan, const Eigen::Vector3d& up) {
     g = 0;
     for (const Piece& pc : pieces_) {
       const Candidates& cs = *pc.cs;
-      const wallk::Source src = raw ? wallk::Source{cs.raw_x.data(), cs.raw_y.data(), cs.raw_z.data(), cs.range.data(), cs.pixel.data()}
+      // (a row whose measured z the preparation did not store: taken from the range, Source::zrow)
+      const float* zr = raw && raw_z_from_range_ && !std::isnan(row_z_[size_t(pc.u)][0]) ? row_z_[size_t(pc.u)].data() : nullptr;
+      const wallk::Source src = raw ? wallk::Source{cs.raw_x.data(), cs.raw_y.data(), cs.raw_z.data(), cs.range.data(), cs.pixel.data(), zr}
                                     : wallk::Source{cs.x.data(), cs.y.data(), cs.z.data(), cs.range.data(), cs.pixel.data()};
       o = wallk::copy8(src, pc.a, pc.b, int32_t(pc.u) * W, pc.off, pc.u, masks_.data() + g, col_dt_.data(),
                        deskewed && !raw ? &meas : nullptr, out, o);

@@ -3,6 +3,7 @@
 // and without them (synthetic scans with dropouts and noise, as measured and gyro de-skewed).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <vector>
 
@@ -75,4 +76,45 @@ TEST(Lane8Kernels, SegmenterOutputIsTheSameWithAndWithoutThem) {
     ASSERT_EQ(four.size(), eight.size()) << "gyro " << gyro;
     EXPECT_TRUE(std::memcmp(four.data(), eight.data(), four.size()) == 0) << "gyro " << gyro;
   }
+}
+
+// A de-skewed scan's wall points on a row whose z is one value: copy8 computes the measured z again from the
+// candidate's range [m] (fr * 1e-3f) as zrow[0] fr + zrow[1], fr taken back as round(range * 1000): the same
+// floats as the preparation's zrow[0] fr + zrow[1], for every range in mm below kExactRangeMm.
+TEST(Lane8Kernels, WallZFromTheCandidateRangeIsTheMeasuredZ) {
+  if (!wallk::available() || !kern::wide()) GTEST_SKIP() << "no eight-lane loops here (not x86-64 with AVX2, or FPLOC_SIMD=sse2)";
+  const float zrow[2] = {-0.0571263f, 0.0363f};  // (an OS-1 beam's z direction per mm and offset [m])
+  constexpr int32_t kChunk = 1 << 16;
+  std::vector<float> x(kChunk + 8, 1.f), y(kChunk + 8, 2.f), z(kChunk + 8, 3.f), range(kChunk + 8), col_dt(kChunk, 0.f);
+  std::vector<int32_t> pixel(kChunk + 8);
+  std::vector<uint8_t> masks(kChunk / 8);
+  std::vector<float> ox(kChunk + 8), oy(kChunk + 8), oz(kChunk + 8), orng(kChunk + 8), ot(kChunk + 8);
+  std::vector<int16_t> oring(kChunk + 8), ocol(kChunk + 8);
+  const wallk::Out out{ox.data(), oy.data(), oz.data(), orng.data(), ot.data(), oring.data(), ocol.data()};
+  size_t differ = 0, checked = 0;
+  for (uint32_t first = 1; first < wallk::kExactRangeMm; first += kChunk) {
+    for (int32_t j = 0; j < kChunk + 8; ++j) {
+      range[size_t(j)] = float(first + uint32_t(j)) * 1e-3f;  // (as the preparation stores it)
+      pixel[size_t(j)] = j;
+    }
+    // Full groups, and every eighth group with lanes left out (the compressing path).
+    for (int32_t g = 0; g < kChunk / 8; ++g) masks[size_t(g)] = g % 8 == 3 ? uint8_t(0xb5) : uint8_t(0xff);
+    const wallk::Source src{x.data(), y.data(), z.data(), range.data(), pixel.data(), zrow};
+    const size_t n = wallk::copy8(src, 0, kChunk, 0, 0, 0, masks.data(), col_dt.data(), nullptr, out, 0);
+    size_t o = 0;
+    for (int32_t g = 0; g < kChunk / 8; ++g)
+      for (int l = 0; l < 8; ++l) {
+        if (!((masks[size_t(g)] >> l) & 1)) continue;
+        const uint32_t mm = first + uint32_t(g * 8 + l);
+        const float want = zrow[0] * float(mm) + zrow[1];
+        if (mm < wallk::kExactRangeMm) {
+          differ += std::memcmp(&want, &oz[o], sizeof want) != 0;
+          ++checked;
+        }
+        ++o;
+      }
+    EXPECT_EQ(o, n);
+  }
+  EXPECT_GT(checked, size_t(1800000));
+  EXPECT_EQ(differ, 0u);
 }

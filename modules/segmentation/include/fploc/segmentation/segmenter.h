@@ -101,6 +101,7 @@ class Segmenter {
   std::vector<float> lut_soa_[6];           // lut_ as float arrays: direction x/y/z, offset x/y/z
   std::vector<std::array<float, 2>> row_z_;  // per row: z direction and offset when one value each, else NaN
   bool col_identity_ = false;               // this scan's look-up columns are its own (lut_soa_ per pixel)
+  bool raw_z_from_range_ = false;           // candidate ranges give the mm back exactly (wallk::kExactRangeMm)
   std::vector<int8_t> row_set_;   // per scan row: 0 upper_, 1 lower_, 2 middle_ (with row_ring_: its ring there)
   std::vector<int> row_ring_;
   struct WallPiece {  // wall selection: a contiguous run of one row's candidates (wall_select.cpp)
