@@ -94,6 +94,9 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--refine-prior-sigma", rcfg.prior_sigma_xy_m, "map refinement: the reference pose's prior sigma [m] (0.05)")
       ->check(CLI::PositiveNumber);
+  app.add_option("--refine-highpass", rcfg.highpass_scans,
+                 "map refinement: remove the corrections' moving mean over +-N scans after each pass (0: off)")
+      ->check(CLI::NonNegativeNumber);
   std::string refine_method = "lines";
   app.add_option("--refine-method", refine_method,
                  "map refinement: lines (each point to the others' mean line, default) or field (the grid localizer's fit on "
@@ -228,7 +231,7 @@ int main(int argc, char** argv) {
           refined.back().pose = {out_poses[k].x, out_poses[k].y, out_poses[k].yaw};
         }
         for (size_t k = 0; k < sel.size(); ++k) sel[k] = &refined[k];
-        refine_j = {{"passes", rcfg.passes}, {"method", refine_method}, {"prior_sigma_xy_m", rcfg.prior_sigma_xy_m}, {"per_pass", nlohmann::json::array()}};
+        refine_j = {{"passes", rcfg.passes}, {"method", refine_method}, {"highpass_scans", rcfg.highpass_scans}, {"prior_sigma_xy_m", rcfg.prior_sigma_xy_m}, {"per_pass", nlohmann::json::array()}};
         for (const auto& p : rs.passes)
           refine_j["per_pass"].push_back({{"refined", p.refined}, {"kept", p.kept}, {"rms_shift_m", p.rms_shift_m},
                                           {"rms_from_reference_m", p.rms_from_start_m},

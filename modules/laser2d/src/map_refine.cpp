@@ -316,6 +316,22 @@ std::vector<Pose2> refine_map_poses(const std::vector<std::vector<Eigen::Vector2
         }
       }
     }
+    // High-pass: the corrections' moving mean over +-highpass_scans scans (in the scans' order) is taken out, so only
+    // their part that changes from scan to scan (the reference's white per-pose noise) is applied and the map
+    // keeps the reference's slow shape.
+    if (cfg.highpass_scans > 0) {
+      std::vector<Eigen::Vector3d> c(n);
+      for (size_t k = 0; k < n; ++k)
+        c[k] = {poses[k].x - start[k].x, poses[k].y - start[k].y, wrap_angle(poses[k].yaw - start[k].yaw)};
+      std::vector<Eigen::Vector3d> prefix(n + 1, Eigen::Vector3d::Zero());
+      for (size_t k = 0; k < n; ++k) prefix[k + 1] = prefix[k] + c[k];
+      const size_t hw = size_t(cfg.highpass_scans);
+      for (size_t k = 0; k < n; ++k) {
+        const size_t lo = k > hw ? k - hw : 0, hi = std::min(n, k + hw + 1);
+        const Eigen::Vector3d m = (prefix[hi] - prefix[lo]) / double(hi - lo);
+        poses[k] = {start[k].x + c[k].x() - m.x(), start[k].y + c[k].y() - m.y(), wrap_angle(start[k].yaw + c[k].z() - m.z())};
+      }
+    }
     double from2 = 0, yaw2 = 0;
     for (size_t k = 0; k < n; ++k) {
       from2 += std::pow(poses[k].x - start[k].x, 2) + std::pow(poses[k].y - start[k].y, 2);

@@ -124,6 +124,23 @@ TEST(MapRefine, NoisyReferencePosesComeNearerTheTruthAndTheMapSharper) {
   EXPECT_LT(after_field, before);
 }
 
+// With the high-pass (the corrections' moving mean over +-5 scans removed after each pass) the white noise is still
+// mostly removed: the part of the correction it takes out is the slow one, which white noise hardly has.
+TEST(MapRefine, HighPassStillRemovesWhiteNoise) {
+  std::vector<std::vector<Eigen::Vector2d>> scans;
+  std::vector<Pose2> truth;
+  simulate(&scans, &truth);
+  const std::vector<Pose2> ref = noisy(truth, 0.04, 0.5 * M_PI / 180, 11);
+  MapRefineConfig hp;
+  hp.highpass_scans = 5;
+  const std::vector<Pose2> plain = refine_map_poses(scans, ref), filtered = refine_map_poses(scans, ref, hp);
+  const double before = rms_error(ref, truth), after = rms_error(filtered, truth);
+  std::printf("high-pass: pose error rms %.1f -> %.1f mm (without it %.1f)\n", before * 1e3, after * 1e3,
+              rms_error(plain, truth) * 1e3);
+  EXPECT_LT(after, 0.6 * before);
+  EXPECT_GT(rms_error(filtered, plain), 0.001);  // the filter changed the poses
+}
+
 TEST(MapRefine, ExactPosesStayAndNothingIsRefinedWithoutPasses) {
   std::vector<std::vector<Eigen::Vector2d>> scans;
   std::vector<Pose2> truth;

@@ -49,6 +49,9 @@ struct MapRefineConfig {
   int icp_rounds = 5;
   int max_iterations = 10;          // Ceres iterations per round
   int max_points = 400;             // per scan (every k-th)
+  // After each pass the corrections' moving mean over +-highpass_scans scans is removed (0: off): the reference's
+  // error is white per pose (sixteenth pass), so only the corrections' scan-to-scan part is applied.
+  int highpass_scans = 0;
 };
 
 struct MapRefineStats {
