@@ -15,7 +15,9 @@
 //    reference holds it, and the map stays in the reference's frame;
 //  - a refinement is taken only when at least min_inlier_ratio of the scan's points lie within inlier_m of an
 //    accepted line and it stays within max_shift_m / max_turn_rad of the reference; otherwise the pose is kept.
-// Transport-free.
+// Used by `fploc import-carmen --refine-map-poses` / `fploc bench real --refine-map-poses` (off by default: on the five
+// Radish logs it moved the floors by -0.4..+0.5 cm and the tracker's ATE both ways; docs/notes/real2d.md, twenty-first
+// pass). Transport-free.
 #pragma once
 #include <Eigen/Core>
 #include <cmath>
