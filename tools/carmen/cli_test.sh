@@ -15,4 +15,10 @@ for bad in "--resolution nan" "--begin nan" "--coverage-radius nan"; do
   grep -qx "fploc import-carmen: $1 $2: not a finite number" "$T/err" || { cat "$T/err"; fail "$bad: error text"; }
   [ ! -e "$T/n.lcm" ] && [ ! -e "$T/m" ] || fail "$bad: wrote output"
 done
+# --refine-map-poses: the map's scans refined before rasterising, reported under map.refine (passes run, poses kept when
+# the scans do not constrain them, as these four-beam ones do not).
+"$IMP" "$T/a.log" --out "$T/r.lcm" --map "$T/rm" --map-end 1 --refine-map-poses 2 --map-poses-out "$T/poses.txt" --json > "$T/r.json" 2>/dev/null \
+  || fail "--refine-map-poses"
+grep -q '"refine"' "$T/r.json" || fail "--refine-map-poses: no map.refine in the JSON"
+[ "$(grep -vc '^#' "$T/poses.txt")" = 8 ] || fail "--map-poses-out: not 8 poses"
 echo OK

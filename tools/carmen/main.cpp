@@ -9,6 +9,9 @@
 // of --map-begin..--map-end (e.g. the first half): the non-circular protocol of `fploc bench real`.
 // --odom-tum writes the WHEEL_ODOM poses as TUM too (the odometry's own frame; e.g. the third trajectory of
 // `fploc eval --hat`, which estimates the reference's own noise).
+// --refine-map-poses N: before the map is rasterised, its scans' poses are refined by N passes of each scan aligned
+// to the others' scans with a prior on its reference pose (modules/laser2d/map_refine.h): the reference's per-pose
+// noise no longer blurs the map's walls. 0 (default): the reference poses as they are.
 #include <fploc/laser_scan_t.hpp>
 #include <fploc/pose_t.hpp>
 #include <lcm/lcm-cpp.hpp>
@@ -24,6 +27,8 @@
 #include "fploc/runtime/cli_numbers.h"
 #include "fploc/carmen/carmen.h"
 #include "fploc/carmen/coverage.h"
+#include "fploc/laser2d/grid_localizer.h"
+#include "fploc/laser2d/map_refine.h"
 #include "fploc/runtime/log_writer.h"
 
 namespace {
@@ -81,6 +86,26 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--coverage-ratio", ccfg.covered_ratio, "a scan is covered when this share of its returns is (0.5)")
       ->check(CLI::Range(0.0, 1.0));
+  fploc::laser2d::MapRefineConfig rcfg;
+  rcfg.passes = 0;
+  app.add_option("--refine-map-poses", rcfg.passes,
+                 "map: refine the mapping scans' poses by this many passes of scan-to-others alignment with a prior on "
+                 "the reference pose before rasterising (modules/laser2d/map_refine.h; 0: the reference poses, default)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--refine-prior-sigma", rcfg.prior_sigma_xy_m, "map refinement: the reference pose's prior sigma [m] (0.05)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--refine-highpass", rcfg.highpass_scans,
+                 "map refinement: remove the corrections' moving mean over +-N scans after each pass (0: off)")
+      ->check(CLI::NonNegativeNumber);
+  std::string refine_method = "lines";
+  app.add_option("--refine-method", refine_method,
+                 "map refinement: lines (each point to the others' mean line, default) or field (the grid localizer's fit on "
+                 "the distance field of the others' hits)")
+      ->check(CLI::IsMember({"lines", "field"}));
+  std::string map_poses_out;
+  app.add_option("--map-poses-out", map_poses_out,
+                 "map: write the mapping scans' poses (\"scan x y theta ref_x ref_y ref_theta\": as rasterised, and the "
+                 "reference) to this file");
   CLI11_PARSE(app, argc, argv);
   if (!fploc::rt::check_finite_options(app, "fploc import-carmen", std::cerr)) return 1;  // nan, inf: one error naming the option
   namespace cm = fploc::carmen;
@@ -185,6 +210,44 @@ int main(int argc, char** argv) {
       if (me <= mb) throw std::runtime_error("--map-begin/--map-end select no scans");
       std::vector<const cm::LaserRecord*> sel;
       for (size_t k = mb; k < me; ++k) sel.push_back(&log.scans[k]);
+      // Refined poses: copies of the mapping scans with their poses replaced (the scored part keeps the reference).
+      std::vector<cm::LaserRecord> refined;
+      nlohmann::json refine_j;
+      if (rcfg.passes > 0) {
+        namespace l2 = fploc::laser2d;
+        const double rmax = std::isfinite(no_return) ? std::min<double>(40.0, no_return) : 40.0;
+        std::vector<std::vector<Eigen::Vector2d>> pts;
+        std::vector<fploc::Pose2> poses;
+        for (const auto* s : sel) {
+          pts.push_back(l2::scan_points(s->ranges, -M_PI / 2, cm::beam_increment(s->ranges.size()), 0.1, rmax));
+          poses.push_back({s->pose.x, s->pose.y, s->pose.theta});
+        }
+        l2::MapRefineStats rs;
+        rcfg.method = refine_method == "field" ? l2::MapRefineMethod::kField : l2::MapRefineMethod::kLines;
+        const auto out_poses = l2::refine_map_poses(pts, poses, rcfg, &rs);
+        refined.reserve(sel.size());
+        for (size_t k = 0; k < sel.size(); ++k) {
+          refined.push_back(*sel[k]);
+          refined.back().pose = {out_poses[k].x, out_poses[k].y, out_poses[k].yaw};
+        }
+        for (size_t k = 0; k < sel.size(); ++k) sel[k] = &refined[k];
+        refine_j = {{"passes", rcfg.passes}, {"method", refine_method}, {"highpass_scans", rcfg.highpass_scans}, {"prior_sigma_xy_m", rcfg.prior_sigma_xy_m}, {"per_pass", nlohmann::json::array()}};
+        for (const auto& p : rs.passes)
+          refine_j["per_pass"].push_back({{"refined", p.refined}, {"kept", p.kept}, {"rms_shift_m", p.rms_shift_m},
+                                          {"rms_from_reference_m", p.rms_from_start_m},
+                                          {"rms_from_reference_yaw_rad", p.rms_from_start_yaw_rad},
+                                          {"rms_residual_m", p.rms_residual_m}});
+      }
+      if (!map_poses_out.empty()) {
+        std::ofstream f(map_poses_out);
+        f << "# scan x y theta ref_x ref_y ref_theta\n" << std::setprecision(9);
+        for (size_t k = 0; k < sel.size(); ++k) {
+          const auto& r = log.scans[mb + k].pose;
+          f << mb + k << " " << sel[k]->pose.x << " " << sel[k]->pose.y << " " << sel[k]->pose.theta << " " << r.x << " "
+            << r.y << " " << r.theta << "\n";
+        }
+        if (!f) throw std::runtime_error(map_poses_out + ": write failed");
+      }
       cm::GridConfig gc = gcfg;
       gc.resolution = resolution;
       gc.no_return = no_return;
@@ -194,6 +257,7 @@ int main(int argc, char** argv) {
       for (auto c : g.cells) occ += c == 100;
       j["map"] = {{"dir", map_dir}, {"first_scan", mb}, {"end_scan", me}, {"width", g.width}, {"height", g.height},
                   {"resolution_m", resolution}, {"occupied_cells", occ}};
+      if (rcfg.passes > 0) j["map"]["refine"] = refine_j;
       // Per scan of [b, e): the share of its returns within coverage_radius of an occupied cell of this map
       // at the reference pose (the bench scores the scans with >= coverage_ratio separately).
       j["coverage"] = cm::grid_coverage(g, log.scans, b, e, ccfg);
