@@ -31,19 +31,6 @@ struct PointCost {
   double inv_sigma_;
 };
 
-struct PriorCost {
-  PriorCost(const Pose2& p, double sxy, double syaw) : p_(p), ixy_(1 / sxy), iyaw_(1 / syaw) {}
-  template <class T>
-  bool operator()(const T* pose, T* r) const {
-    r[0] = (pose[0] - p_.x) * ixy_;
-    r[1] = (pose[1] - p_.y) * ixy_;
-    const T d = pose[2] - p_.yaw;
-    r[2] = atan2(sin(d), cos(d)) * iyaw_;
-    return true;
-  }
-  Pose2 p_;
-  double ixy_, iyaw_;
-};
 
 std::unique_ptr<ceres::Problem> solve(const InterpolatedField& f, const FieldFitOptions& o, FitLoss kind,
                                       const std::vector<Eigen::Vector2d>& pts, const Pose2& pred, double sxy,

@@ -27,6 +27,23 @@ struct InterpolatedField {
   FieldInterp interp;
 };
 
+// The prior on a planar pose x = (x, y, yaw): its offsets from p over sxy, sxy and the wrapped yaw over syaw
+// (a Ceres auto-diff functor; the field fit and the map refinement add it).
+struct PriorCost {
+  PriorCost(const Pose2& p, double sxy, double syaw) : p_(p), ixy_(1 / sxy), iyaw_(1 / syaw) {}
+  template <class T>
+  bool operator()(const T* pose, T* r) const {
+    using std::atan2, std::cos, std::sin;
+    r[0] = (pose[0] - p_.x) * ixy_;
+    r[1] = (pose[1] - p_.y) * ixy_;
+    const T d = pose[2] - p_.yaw;
+    r[2] = atan2(sin(d), cos(d)) * iyaw_;
+    return true;
+  }
+  Pose2 p_;
+  double ixy_, iyaw_;
+};
+
 struct FieldFitOptions {
   double point_sigma_m = 0.05, huber_m = 0.05;
   FitLoss loss = FitLoss::kHuber;

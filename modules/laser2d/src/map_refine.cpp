@@ -116,19 +116,6 @@ struct PointToLine {
   double inv_sigma_;
 };
 
-struct PosePrior {
-  PosePrior(const Pose2& p, double sxy, double syaw) : p_(p), ixy_(1 / sxy), iyaw_(1 / syaw) {}
-  template <class T>
-  bool operator()(const T* x, T* r) const {
-    r[0] = (x[0] - p_.x) * ixy_;
-    r[1] = (x[1] - p_.y) * ixy_;
-    const T d = x[2] - p_.yaw;
-    r[2] = atan2(sin(d), cos(d)) * iyaw_;
-    return true;
-  }
-  Pose2 p_;
-  double ixy_, iyaw_;
-};
 
 Eigen::Vector2d transform(const double* x, const Eigen::Vector2d& p) {
   const double c = std::cos(x[2]), s = std::sin(x[2]);
@@ -229,6 +216,22 @@ std::vector<Pose2> refine_map_poses(const std::vector<std::vector<Eigen::Vector2
         }
         dfield = std::make_unique<detail::InterpolatedField>(std::make_shared<DistanceField>(og, 0.5));
       }
+      // A refined pose is taken when enough of its scan fits (inl points, at least min_ratio of them and
+      // cfg.min_inliers; ss their squared distances) and it stays near its start; else the pose is kept.
+      auto take = [&](size_t k, const double* x, int inl, double ss, double min_ratio) {
+        const bool near = std::hypot(x[0] - start[k].x, x[1] - start[k].y) <= cfg.max_shift_m &&
+                          std::abs(wrap_angle(x[2] - start[k].yaw)) <= cfg.max_turn_rad;
+        if (double(inl) >= min_ratio * double(scans[k].size()) && inl >= cfg.min_inliers && near &&
+            std::isfinite(x[0] + x[1] + x[2])) {
+          shift2 += std::pow(x[0] - poses[k].x, 2) + std::pow(x[1] - poses[k].y, 2);
+          poses[k] = {x[0], x[1], wrap_angle(x[2])};
+          ++ps.refined;
+          res2 += ss;
+          res_n += inl;
+        } else {
+          ++ps.kept;
+        }
+      };
       for (size_t k = size_t(g); k < n; k += size_t(groups)) {
         const auto& pts = scans[k];
         if (pts.empty()) continue;
@@ -241,17 +244,7 @@ std::vector<Pose2> refine_map_poses(const std::vector<std::vector<Eigen::Vector2
           detail::refine_on_field(*dfield, fo, pts, start[k], cfg.prior_sigma_xy_m, cfg.prior_sigma_yaw_rad, x, &cost, &its);
           double ss = 0;
           const int inl = detail::count_inliers(*dfield->df, pts, x, cfg.inlier_m, &ss);
-          const bool near = std::hypot(x[0] - start[k].x, x[1] - start[k].y) <= cfg.max_shift_m &&
-                            std::abs(wrap_angle(x[2] - start[k].yaw)) <= cfg.max_turn_rad;
-          if (inl >= cfg.min_inliers && double(inl) >= 0.5 * double(pts.size()) && near && std::isfinite(x[0] + x[1] + x[2])) {
-            shift2 += std::pow(x[0] - poses[k].x, 2) + std::pow(x[1] - poses[k].y, 2);
-            poses[k] = {x[0], x[1], wrap_angle(x[2])};
-            ++ps.refined;
-            res2 += ss;
-            res_n += inl;
-          } else {
-            ++ps.kept;
-          }
+          take(k, x, inl, ss, 0.5);
           continue;
         }
         for (int round = 0; round < cfg.icp_rounds; ++round) {
@@ -274,8 +267,8 @@ std::vector<Pose2> refine_map_poses(const std::vector<std::vector<Eigen::Vector2
             ++used;
           }
           if (used < 3) break;
-          problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PosePrior, 3, 3>(
-                                       new PosePrior(start[k], cfg.prior_sigma_xy_m, cfg.prior_sigma_yaw_rad)),
+          problem.AddResidualBlock(new ceres::AutoDiffCostFunction<detail::PriorCost, 3, 3>(
+                                       new detail::PriorCost(start[k], cfg.prior_sigma_xy_m, cfg.prior_sigma_yaw_rad)),
                                    nullptr, x);
           const double before[3] = {x[0], x[1], x[2]};
           ceres::Solver::Options so;
@@ -303,17 +296,7 @@ std::vector<Pose2> refine_map_poses(const std::vector<std::vector<Eigen::Vector2
           const double d = nrm.dot(wp - m);
           if (std::abs(d) < cfg.inlier_m) ++inl, ss += d * d;
         }
-        const bool near = std::hypot(x[0] - start[k].x, x[1] - start[k].y) <= cfg.max_shift_m &&
-                          std::abs(wrap_angle(x[2] - start[k].yaw)) <= cfg.max_turn_rad;
-        if (double(inl) >= cfg.min_inlier_ratio * double(pts.size()) && inl >= cfg.min_inliers && near && std::isfinite(x[0] + x[1] + x[2])) {
-          shift2 += std::pow(x[0] - poses[k].x, 2) + std::pow(x[1] - poses[k].y, 2);
-          poses[k] = {x[0], x[1], wrap_angle(x[2])};
-          ++ps.refined;
-          res2 += ss;
-          res_n += inl;
-        } else {
-          ++ps.kept;
-        }
+        take(k, x, inl, ss, cfg.min_inlier_ratio);
       }
     }
     // High-pass: the corrections' moving mean over +-highpass_scans scans (in the scans' order) is taken out, so only
