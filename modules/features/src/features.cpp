@@ -124,6 +124,10 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   surface_.assign(size_t(n) / 64 + 2, 0);
   picked_.assign(size_t(n), 0);
   occ_.clear();
+  // The times are read only for the picks, after this ring's pass: fetched now (every line of the ring's
+  // times, which nothing else reads).
+  if (w.t.size() == w.x.size())
+    for (size_t k = begin; k < end; k += 16) __builtin_prefetch(w.t.data() + k);
   const detail::RingIn in{w.x.data() + begin, w.y.data() + begin, w.z.data() + begin, w.range.data() + begin,
                           w.column.data() + begin, n};
   const detail::RingRules rules{hw, cfg_.max_column_gap, float(cfg_.min_range_m), float(cfg_.max_range_m),
