@@ -17,6 +17,9 @@ namespace fploc::feat {
 
 namespace {
 constexpr float kInf = std::numeric_limits<float>::infinity();
+// The values a suppressed entry gets (picked, corner c), eight of each.
+constexpr uint8_t kOnes8[8] = {1, 1, 1, 1, 1, 1, 1, 1};
+constexpr float kNegInf8[8] = {-kInf, -kInf, -kInf, -kInf, -kInf, -kInf, -kInf, -kInf};
 
 // The end of the run of equal values that starts at b (one ring of the ring-major wall points).
 size_t run_end(const int16_t* v, size_t b, size_t n) {
@@ -142,12 +145,29 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   for (int k = n - hw; k < nb * 8; ++k) corner_c[k] = -kInf;
   uint8_t* picked = picked_.data();
   // Taking points a..b out: no later corner or surface pick there (a pick's neighbours, occlusions).
+  // (stored in blocks of 8 or 4, the last block ending at b: overlapping blocks write the same values, so the
+  // same entries a..b are set, with fewer stores than one per entry)
   auto suppress = [&](int a, int b) {
     a = std::max(0, a);
     b = std::min(n - 1, b);
-    for (int k = a; k <= b; ++k) {
-      picked[k] = 1;
-      corner_c[k] = -kInf;
+    const int len = b - a + 1;
+    if (len >= 8) {
+      for (int k = a; k < b - 7; k += 8) {
+        std::memcpy(picked + k, kOnes8, 8);
+        std::memcpy(corner_c + k, kNegInf8, 32);
+      }
+      std::memcpy(picked + b - 7, kOnes8, 8);
+      std::memcpy(corner_c + b - 7, kNegInf8, 32);
+    } else if (len >= 4) {
+      std::memcpy(picked + a, kOnes8, 4);
+      std::memcpy(corner_c + a, kNegInf8, 16);
+      std::memcpy(picked + b - 3, kOnes8, 4);
+      std::memcpy(corner_c + b - 3, kNegInf8, 16);
+    } else {
+      for (int k = a; k <= b; ++k) {
+        picked[k] = 1;
+        corner_c[k] = -kInf;
+      }
     }
   };
   for (const int e : occ_) {  // +(j+1): the near side is j (j+1 .. j+hw out); -(j+1): j-hw+1 .. j out
