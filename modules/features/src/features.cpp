@@ -70,19 +70,28 @@ const FeatureFrame& FeatureExtractor::process(const seg::Segmentation& seg) {
   frame_.attitude_t = seg.attitude_t;
   frame_.num_groups = out_.num_groups;
   const size_t n = out_.x.size();
-  frame_.points.reserve(n);
-  source_.clear();
-  source_.reserve(n);
+  // (sized for every point, written through plain pointers, then cut to the finite ones: no per-point
+  // capacity check and end-pointer update in memory)
+  frame_.points.resize(n);
+  source_.resize(n);
+  Feature2* fp = frame_.points.data();
+  int32_t* sp = source_.data();
+  const float *ox = out_.x.data(), *oy = out_.y.data(), *ot = out_.t.data();
+  const int8_t* ok = out_.kind.data();
+  const int32_t *og = out_.group.data(), *os = out_.source.data();
+  size_t m = 0;
   for (size_t i = 0; i < n; ++i) {
-    if (!std::isfinite(out_.x[i]) || !std::isfinite(out_.y[i])) continue;
-    Feature2 p;
-    p.p = {double(out_.x[i]), double(out_.y[i])};
-    p.kind = FeatureKind(out_.kind[i]);
-    p.group = out_.group[i];
-    p.t = out_.t[i];
-    frame_.points.push_back(p);
-    source_.push_back(out_.source[i]);
+    if (!std::isfinite(ox[i]) || !std::isfinite(oy[i])) continue;
+    Feature2& p = fp[m];
+    p.p = {double(ox[i]), double(oy[i])};
+    p.kind = FeatureKind(ok[i]);
+    p.group = og[i];
+    p.t = ot[i];
+    sp[m] = os[i];
+    ++m;
   }
+  frame_.points.resize(m);
+  source_.resize(m);
   return frame_;
 }
 
