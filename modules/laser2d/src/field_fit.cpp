@@ -53,13 +53,7 @@ std::unique_ptr<ceres::Problem> solve(const InterpolatedField& f, const FieldFit
   }
   problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, 3>(new PriorCost(pred, sxy, syaw)), nullptr, x);
   if (fix_yaw) problem->SetManifold(x, new ceres::SubsetManifold(3, {2}));
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
-  so.max_num_iterations = o.max_iterations;
-  so.num_threads = 1;
-  so.logging_type = ceres::SILENT;
-  ceres::Solver::Summary sum;
-  ceres::Solve(so, problem.get(), &sum);
+  const ceres::Solver::Summary sum = solve_small(problem.get(), o.max_iterations);
   if (iterations) *iterations += int(sum.iterations.size());
   *cost = sum.final_cost;
   return problem;
@@ -74,6 +68,17 @@ std::unique_ptr<ceres::Problem> refine_on_field(const InterpolatedField& f, cons
   if (o.huber_first && o.loss != FitLoss::kHuber)
     solve(f, o, FitLoss::kHuber, pts, pred, sxy, syaw, x, cost, iterations, fix_yaw);
   return solve(f, o, o.loss, pts, pred, sxy, syaw, x, cost, iterations, fix_yaw);
+}
+
+ceres::Solver::Summary solve_small(ceres::Problem* problem, int max_iterations) {
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = max_iterations;
+  so.num_threads = 1;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary sum;
+  ceres::Solve(so, problem, &sum);
+  return sum;
 }
 
 Eigen::Matrix3d covariance_of(ceres::Problem& problem, const Eigen::Matrix3d& fallback) {

@@ -60,6 +60,9 @@ std::unique_ptr<ceres::Problem> refine_on_field(const InterpolatedField& f, cons
                                                 double sxy, double syaw, double* x, double* cost, int* iterations,
                                                 bool fix_yaw = false);
 
+// Solves a small pose problem as every laser2d fit does (dense QR, one thread, silent, at most max_iterations).
+ceres::Solver::Summary solve_small(ceres::Problem* problem, int max_iterations);
+
 // The inverse of J^T J at the problem's current parameters (loss applied); `fallback` when singular.
 Eigen::Matrix3d covariance_of(ceres::Problem& problem, const Eigen::Matrix3d& fallback);
 

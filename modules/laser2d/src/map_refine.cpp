@@ -271,13 +271,7 @@ std::vector<Pose2> refine_map_poses(const std::vector<std::vector<Eigen::Vector2
                                        new detail::PriorCost(start[k], cfg.prior_sigma_xy_m, cfg.prior_sigma_yaw_rad)),
                                    nullptr, x);
           const double before[3] = {x[0], x[1], x[2]};
-          ceres::Solver::Options so;
-          so.linear_solver_type = ceres::DENSE_QR;
-          so.max_num_iterations = cfg.max_iterations;
-          so.num_threads = 1;
-          so.logging_type = ceres::SILENT;
-          ceres::Solver::Summary sum;
-          ceres::Solve(so, &problem, &sum);
+          detail::solve_small(&problem, cfg.max_iterations);
           if (std::hypot(x[0] - before[0], x[1] - before[1]) < 1e-4 && std::abs(wrap_angle(x[2] - before[2])) < 1e-5) break;
         }
         // Taken when enough of the scan lies on the others' lines and the pose stays near its start.

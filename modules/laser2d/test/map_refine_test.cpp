@@ -94,11 +94,19 @@ size_t occupied_cells(const std::vector<std::vector<Eigen::Vector2d>>& scans, co
   return cells.size();
 }
 
-TEST(MapRefine, NoisyReferencePosesComeNearerTheTruthAndTheMapSharper) {
+// The simulated scans, their true poses and reference poses with 4 cm / 0.5 deg of white noise.
+struct NoisyScene {
+  NoisyScene() {
+    simulate(&scans, &truth);
+    ref = noisy(truth, 0.04, 0.5 * M_PI / 180, 11);
+  }
   std::vector<std::vector<Eigen::Vector2d>> scans;
-  std::vector<Pose2> truth;
-  simulate(&scans, &truth);
-  const std::vector<Pose2> ref = noisy(truth, 0.04, 0.5 * M_PI / 180, 11);
+  std::vector<Pose2> truth, ref;
+};
+
+TEST(MapRefine, NoisyReferencePosesComeNearerTheTruthAndTheMapSharper) {
+  const NoisyScene sc;
+  const auto& [scans, truth, ref] = sc;
   MapRefineStats st;
   const std::vector<Pose2> out = refine_map_poses(scans, ref, {}, &st);
   const double before = rms_error(ref, truth), after = rms_error(out, truth);
@@ -127,10 +135,8 @@ TEST(MapRefine, NoisyReferencePosesComeNearerTheTruthAndTheMapSharper) {
 // With the high-pass (the corrections' moving mean over +-5 scans removed after each pass) the white noise is still
 // mostly removed: the part of the correction it takes out is the slow one, which white noise hardly has.
 TEST(MapRefine, HighPassStillRemovesWhiteNoise) {
-  std::vector<std::vector<Eigen::Vector2d>> scans;
-  std::vector<Pose2> truth;
-  simulate(&scans, &truth);
-  const std::vector<Pose2> ref = noisy(truth, 0.04, 0.5 * M_PI / 180, 11);
+  const NoisyScene sc;
+  const auto& [scans, truth, ref] = sc;
   MapRefineConfig hp;
   hp.highpass_scans = 5;
   const std::vector<Pose2> plain = refine_map_poses(scans, ref), filtered = refine_map_poses(scans, ref, hp);

@@ -22,6 +22,7 @@ std::unique_ptr<Localizer> ActivePlan::make_localizer(Config cfg) const {
 
 void ActivePlan::set_floor(int floor) {
   floor_ = floor;
+  scale_centre_ = matcher::scale_centre(plan());
   previous_weights_ = std::move(weights_);
   weights_ = std::make_unique<matcher::ElementWeights>(plan(), matcher::DiffWeightOptions{diff_weight_, diff_weight_});
 }
@@ -65,7 +66,7 @@ double ActivePlan::unexplained_scale_squared() const {
 
 void ActivePlan::add_scale_error(Pose* pose, double s2) const {
   if (!(s2 > 0)) return;
-  const Eigen::Vector2d d = Eigen::Vector2d(pose->pose.x, pose->pose.y) - matcher::scale_centre(plan());
+  const Eigen::Vector2d d = Eigen::Vector2d(pose->pose.x, pose->pose.y) - scale_centre_;
   pose->covariance.topLeftCorner<2, 2>() += s2 * d * d.transpose();
 }
 

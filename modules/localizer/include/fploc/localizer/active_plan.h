@@ -64,6 +64,7 @@ class ActivePlan {
   std::string lookup_;
   bool warned_ = false;
   double scale_estimate_ = 0, scale_sigma_ = 0;  // the diff's latest (sigma 0: none yet)
+  Eigen::Vector2d scale_centre_ = Eigen::Vector2d::Zero();  // matcher::scale_centre of the floor's plan
   // The current and the previous weights and corrected map: a Localizer made before the last change may
   // still point at them until the node replaces it.
   std::unique_ptr<matcher::ElementWeights> weights_, previous_weights_;
