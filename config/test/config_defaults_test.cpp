@@ -106,7 +106,8 @@ TEST(ConfigDefaults, Matcher) {
          {"odom_gate_sigmas", c.odom_gate_sigmas}, {"as_built_sigma_m", c.as_built.sigma_m},
          {"as_built_point_sigma_m", c.as_built.point_sigma_m},
          {"as_built_loss_scale_m", c.as_built.loss_scale_m}, {"element_quota", c.element_quota},
-         {"as_built_max_spread_sigmas", c.as_built.max_spread_sigmas}});
+         {"as_built_max_spread_sigmas", c.as_built.max_spread_sigmas},
+         {"as_built_plausible_offset_m", c.as_built.plausible_offset_m}});
 }
 
 TEST(ConfigDefaults, Optimizer) {
@@ -120,7 +121,8 @@ TEST(ConfigDefaults, Optimizer) {
          {"max_points", c.max_points}, {"relook_m", c.relook_m},
          {"as_built_sigma_m", c.as_built.sigma_m}, {"as_built_point_sigma_m", c.as_built.point_sigma_m},
          {"as_built_loss_scale_m", c.as_built.loss_scale_m}, {"element_quota", c.element_quota},
-         {"as_built_max_spread_sigmas", c.as_built.max_spread_sigmas}});
+         {"as_built_max_spread_sigmas", c.as_built.max_spread_sigmas},
+         {"as_built_plausible_offset_m", c.as_built.plausible_offset_m}});
 }
 
 TEST(ConfigDefaults, Odometry) {

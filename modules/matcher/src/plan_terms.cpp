@@ -458,6 +458,29 @@ class FrameCost : public ceres::CostFunction {
       a = ElemAcc();
     }
   }
+  // Whether the points of one element (first..last, their robust weights in point_w_) lie on a line that puts
+  // the wall's ends within about plausible_offset_m of their drawn place (AsBuiltModel::plausible_offset_m):
+  // their end offsets by weighted least squares without the prior, o_f, against S = P^2 I + C, C their own
+  // covariance (point_sigma_m^2 A^-1). A metre's prior keeps a line seen over a short piece of its wall finite;
+  // its ends are then uncertain by about a metre, and so plausible.
+  bool own_line_plausible(const Obs* first, const Obs* last, double w2max) const {
+    const double P = ab_.plausible_offset_m;
+    if (!(P > 0)) return false;
+    constexpr double kChi2Dof2P99 = 9.21;  // the 99 % point of chi-square with 2 degrees of freedom
+    constexpr double kRidgeM = 1.0;        // the prior that keeps an ill-determined end finite
+    const double ps2 = ab_.point_sigma_m * ab_.point_sigma_m;
+    Eigen::Matrix2d A = (ps2 / (kRidgeM * kRidgeM)) * w2max * Eigen::Matrix2d::Identity();
+    Eigen::Vector2d bb = Eigen::Vector2d::Zero();
+    for (const Obs* o = first; o != last; ++o) {
+      const double w = o->w2 * point_w_[size_t(o->i)];
+      A.noalias() += w * o->U * o->U.transpose();
+      bb += w * o->r * o->U;
+    }
+    const Eigen::Matrix2d Ai = A.inverse();
+    const Eigen::Vector2d of = Ai * bb;
+    const Eigen::Matrix2d S = P * P * Eigen::Matrix2d::Identity() + ps2 * Ai;
+    return of.dot(S.ldlt().solve(of)) <= kChi2Dof2P99;
+  }
   // Gauss-Newton matrix H, gradient g and cost (sum of squared residuals) of the frame at x: the per-point
   // form, or (as_built) the as-built model's with the segments' end offsets eliminated.
   void accumulate(const double* x, bool as_built, Eigen::Matrix3d* H, Eigen::Vector3d* g, double* cost2) const {
@@ -536,7 +559,8 @@ class FrameCost : public ceres::CostFunction {
         // share, its points' weights and its offsets' prior alike, scaled down by (limit / spread)^2.
         double share = 1;
         const double lim = ab_.max_spread_sigmas * ab_.point_sigma_m;
-        if (lim > 0 && sw > 0 && swe > lim * lim * sw) {
+        if (lim > 0 && sw > 0 && swe > lim * lim * sw &&
+            !own_line_plausible(sorted.data() + b, sorted.data() + e, w2max)) {
           share = lim * lim * sw / swe;
           for (size_t k = b; k < e; ++k) point_w_[size_t(sorted[k].i)] *= float(share);
         }

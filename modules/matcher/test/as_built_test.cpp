@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <random>
 
 #include "fploc/matcher/map.h"
 #include "fploc/matcher/matcher.h"
@@ -98,16 +100,64 @@ TEST(AsBuilt, AFaceSeenThroughGlassDoesNotPullAsAWall) {
   so.noise_sigma = 0.005;
   for (const Pose2 truth : {Pose2{20.0, 1.0, 0.0}, Pose2{22.0, 0.7, 0.5}, Pose2{18.0, 1.3, 2.8}}) {
     const FeatureFrame f = fploc::testing::synth_frame(world, truth, so);
-    MatcherConfig whole = config(true), bounded = config(true);
+    MatcherConfig whole = config(true), bounded = config(true), gated = config(true);
     bounded.as_built.max_spread_sigmas = 1.0;
+    gated.as_built.max_spread_sigmas = 1.0;
+    gated.as_built.plausible_offset_m = 0.1;  // the face's own line meets the wall's ends metres off
     const MatchResult a = register_frame(*map.lookup, f, truth, whole);
     const MatchResult b = register_frame(*map.lookup, f, truth, bounded);
+    const MatchResult g = register_frame(*map.lookup, f, truth, gated);
     ASSERT_EQ(a.status, FitStatus::kOk);
     ASSERT_EQ(b.status, FitStatus::kOk);
+    ASSERT_EQ(g.status, FitStatus::kOk);
     const double e_whole = std::abs(a.pose.x - truth.x), e_bounded = std::abs(b.pose.x - truth.x);
     EXPECT_GT(e_whole, 0.005) << "as a whole wall the face should pull the fit along the corridor";
     EXPECT_LT(e_bounded, 0.7 * e_whole) << "whole share " << e_whole << " bounded " << e_bounded;
+    EXPECT_LT(std::abs(g.pose.x - truth.x), 0.7 * e_whole) << "the gate should still bound the face's share";
   }
+}
+
+// An as-built world at sigma 5 cm against the model's 2 cm prior: every wall end displaced by its own
+// N(0, 5 cm) along the wall's normal (seeded). Near the room's corners and doors, a displaced wall's points
+// spread about the offsets the prior holds small, so the spread rule alone takes some real walls' shares down
+// as if they were faces seen through glass. Their own lines put their ends within plausible_offset_m of the
+// drawing, so with the gate every wall keeps its whole share: the fit is the one without the spread rule.
+TEST(AsBuilt, WallsAFewCentimetresOffKeepTheirShareWithTheGate) {
+  const FloorPlan plan = fploc::testing::room_with_pillars();
+  auto map = make_localization_map(plan, "annf-exact");
+  fploc::testing::SynthOptions so;
+  so.beams = 720;
+  so.noise_sigma = 0.005;
+  int differs = 0, frames = 0;
+  for (uint32_t seed = 1; seed <= 6; ++seed) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> n5(0.0, 0.05);
+    FloorPlan world = plan;
+    for (Element& e : world.elements) {
+      if (e.kind != ElementKind::kSegment) continue;
+      const Eigen::Vector2d u = (e.b - e.a).normalized(), nrm(-u.y(), u.x());
+      e.a += n5(rng) * nrm;
+      e.b += n5(rng) * nrm;
+    }
+    for (const Pose2 truth : {Pose2{10.0, 4.0, 0.4}, Pose2{3.0, 2.0, -1.0}, Pose2{17.0, 8.0, 2.0}}) {
+      const FeatureFrame f = fploc::testing::synth_frame(world, truth, so);
+      MatcherConfig plain = config(true), spread = config(true), gated = config(true);
+      spread.as_built.max_spread_sigmas = gated.as_built.max_spread_sigmas = 1.0;
+      gated.as_built.plausible_offset_m = 0.1;
+      const MatchResult p = register_frame(*map.lookup, f, truth, plain);
+      const MatchResult s = register_frame(*map.lookup, f, truth, spread);
+      const MatchResult g = register_frame(*map.lookup, f, truth, gated);
+      ASSERT_EQ(p.status, FitStatus::kOk);
+      ASSERT_EQ(g.status, FitStatus::kOk);
+      ++frames;
+      const double ds = std::hypot(s.pose.x - p.pose.x, s.pose.y - p.pose.y);
+      const double dg = std::hypot(g.pose.x - p.pose.x, g.pose.y - p.pose.y);
+      std::printf("seed %u: spread moves the fit %.2f mm, gated %.2f mm\n", seed, 1e3 * ds, 1e3 * dg);
+      if (ds > 1e-4) ++differs;
+      EXPECT_LT(dg, 1e-4) << "seed " << seed;
+    }
+  }
+  EXPECT_GT(differs, 0) << "the spread rule alone should take a displaced wall's share in " << frames << " frames";
 }
 
 // The as-built term evaluated through the walls' moments (AsBuiltModel::per_wall) gives the cost, gradient
