@@ -33,8 +33,8 @@ matcher::AsBuiltModel as_built_of(const O& o, const char* block) {
   m.keep_information = !o.as_built_free_information();
   if (given(o.as_built_max_spread_sigmas(), block, "as_built_max_spread_sigmas"))
     m.max_spread_sigmas = o.as_built_max_spread_sigmas();
-  if (given(o.as_built_plausible_offset_m(), block, "as_built_plausible_offset_m"))
-    m.plausible_offset_m = o.as_built_plausible_offset_m();
+  if (given(o.as_built_max_askew_m(), block, "as_built_max_askew_m"))
+    m.max_askew_m = o.as_built_max_askew_m();
   return m;
 }
 

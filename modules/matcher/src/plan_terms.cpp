@@ -458,15 +458,16 @@ class FrameCost : public ceres::CostFunction {
       a = ElemAcc();
     }
   }
-  // Whether the points of one element (first..last, their robust weights in point_w_) lie on a line that puts
-  // the wall's ends within about plausible_offset_m of their drawn place (AsBuiltModel::plausible_offset_m):
-  // their end offsets by weighted least squares without the prior, o_f, against S = P^2 I + C, C their own
-  // covariance (point_sigma_m^2 A^-1). A metre's prior keeps a line seen over a short piece of its wall finite;
-  // its ends are then uncertain by about a metre, and so plausible.
-  bool own_line_plausible(const Obs* first, const Obs* last, double w2max) const {
-    const double P = ab_.plausible_offset_m;
-    if (!(P > 0)) return false;
-    constexpr double kChi2Dof2P99 = 9.21;  // the 99 % point of chi-square with 2 degrees of freedom
+  // Whether the points of one element (first..last, their robust weights in point_w_) lie on a line askew to
+  // it beyond what a wall standing off its drawn place can be (AsBuiltModel::max_askew_m): their end offsets by
+  // weighted least squares without the prior, o_f, and the difference d = o_b - o_a (the line's turn against
+  // the wall, over the wall's length), against 2 max_askew_m^2 + its own variance (point_sigma_m^2 v^T A^-1 v).
+  // A metre's prior keeps a line seen over a short piece of its wall finite; its turn is then uncertain by about
+  // a metre, and so plausible. Askew lines are faces, partitions and clutter, not a displaced wall.
+  bool askew_to_its_wall(const Obs* first, const Obs* last, double w2max) const {
+    const double P = ab_.max_askew_m;
+    if (!(P > 0)) return true;
+    constexpr double kChi2Dof1P99 = 6.63;  // the 99 % point of chi-square with 1 degree of freedom
     constexpr double kRidgeM = 1.0;        // the prior that keeps an ill-determined end finite
     const double ps2 = ab_.point_sigma_m * ab_.point_sigma_m;
     Eigen::Matrix2d A = (ps2 / (kRidgeM * kRidgeM)) * w2max * Eigen::Matrix2d::Identity();
@@ -477,9 +478,9 @@ class FrameCost : public ceres::CostFunction {
       bb += w * o->r * o->U;
     }
     const Eigen::Matrix2d Ai = A.inverse();
-    const Eigen::Vector2d of = Ai * bb;
-    const Eigen::Matrix2d S = P * P * Eigen::Matrix2d::Identity() + ps2 * Ai;
-    return of.dot(S.ldlt().solve(of)) <= kChi2Dof2P99;
+    const Eigen::Vector2d v(-1, 1);
+    const double d = v.dot(Ai * bb);
+    return d * d > kChi2Dof1P99 * (2 * P * P + ps2 * v.dot(Ai * v));
   }
   // Gauss-Newton matrix H, gradient g and cost (sum of squared residuals) of the frame at x: the per-point
   // form, or (as_built) the as-built model's with the segments' end offsets eliminated.
@@ -560,7 +561,7 @@ class FrameCost : public ceres::CostFunction {
         double share = 1;
         const double lim = ab_.max_spread_sigmas * ab_.point_sigma_m;
         if (lim > 0 && sw > 0 && swe > lim * lim * sw &&
-            !own_line_plausible(sorted.data() + b, sorted.data() + e, w2max)) {
+            askew_to_its_wall(sorted.data() + b, sorted.data() + e, w2max)) {
           share = lim * lim * sw / swe;
           for (size_t k = b; k < e; ++k) point_w_[size_t(sorted[k].i)] *= float(share);
         }

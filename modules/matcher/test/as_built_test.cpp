@@ -103,7 +103,7 @@ TEST(AsBuilt, AFaceSeenThroughGlassDoesNotPullAsAWall) {
     MatcherConfig whole = config(true), bounded = config(true), gated = config(true);
     bounded.as_built.max_spread_sigmas = 1.0;
     gated.as_built.max_spread_sigmas = 1.0;
-    gated.as_built.plausible_offset_m = 0.1;  // the face's own line meets the wall's ends metres off
+    gated.as_built.max_askew_m = 0.1;  // the face's own line meets the wall's ends metres apart
     const MatchResult a = register_frame(*map.lookup, f, truth, whole);
     const MatchResult b = register_frame(*map.lookup, f, truth, bounded);
     const MatchResult g = register_frame(*map.lookup, f, truth, gated);
@@ -120,8 +120,9 @@ TEST(AsBuilt, AFaceSeenThroughGlassDoesNotPullAsAWall) {
 // An as-built world at sigma 5 cm against the model's 2 cm prior: every wall end displaced by its own
 // N(0, 5 cm) along the wall's normal (seeded). Near the room's corners and doors, a displaced wall's points
 // spread about the offsets the prior holds small, so the spread rule alone takes some real walls' shares down
-// as if they were faces seen through glass. Their own lines put their ends within plausible_offset_m of the
-// drawing, so with the gate every wall keeps its whole share: the fit is the one without the spread rule.
+// as if they were faces seen through glass. Their own lines turn against their walls by no more than the
+// displacements do, so with the gate (max_askew_m) every wall keeps its whole share: the fit is the one without
+// the spread rule.
 TEST(AsBuilt, WallsAFewCentimetresOffKeepTheirShareWithTheGate) {
   const FloorPlan plan = fploc::testing::room_with_pillars();
   auto map = make_localization_map(plan, "annf-exact");
@@ -143,7 +144,7 @@ TEST(AsBuilt, WallsAFewCentimetresOffKeepTheirShareWithTheGate) {
       const FeatureFrame f = fploc::testing::synth_frame(world, truth, so);
       MatcherConfig plain = config(true), spread = config(true), gated = config(true);
       spread.as_built.max_spread_sigmas = gated.as_built.max_spread_sigmas = 1.0;
-      gated.as_built.plausible_offset_m = 0.1;
+      gated.as_built.max_askew_m = 0.1;
       const MatchResult p = register_frame(*map.lookup, f, truth, plain);
       const MatchResult s = register_frame(*map.lookup, f, truth, spread);
       const MatchResult g = register_frame(*map.lookup, f, truth, gated);

@@ -29,14 +29,15 @@ struct AsBuiltModel {
   // so it no longer pulls as a whole wall does. <= 0: off (the default: at 1 it takes the corridor glass world's
   // seed 2 from 5.25 to 1.96 cm but costs the as-built worlds at sigma 5 cm 1-8 %, docs/notes/realism.md).
   double max_spread_sigmas = 0;
-  // The spread alone cannot tell a face askew to its wall from a wall standing a few cm off its drawn place
-  // (a displaced wall's points spread about the offsets the prior holds small, too). With plausible_offset_m
-  // > 0 the spread rule applies only to an element whose points' own line (their end offsets by least
-  // squares, no prior) puts the wall's ends implausibly far from their drawn place: beyond about
-  // plausible_offset_m, counting that line's own uncertainty (the 99 % point of chi-square with 2 degrees of
-  // freedom). A wall displaced by a few cm keeps its whole share; a face 22 deg askew, whose line meets the
-  // wall's ends metres off, does not. 0: the spread rule applies to every element.
-  double plausible_offset_m = 0;
+  // The spread alone cannot tell a face or partition askew to its wall from a wall standing a few cm off its
+  // drawn place (its points spread about the offsets the prior holds small too), and cutting real walls' shares
+  // loses what holds a corridor. With max_askew_m > 0 the spread rule
+  // applies only to an element whose points' own line (their end offsets by least squares, no prior) turns
+  // against the wall: its offsets at the wall's two ends differ by more than about max_askew_m * sqrt(2),
+  // counting that line's own uncertainty (the 99 % point of chi-square with 1 degree of freedom). A displaced
+  // wall keeps its share; a cabinet's face 22 deg askew, whose line meets the wall's
+  // ends metres apart, does not. 0: the spread rule applies to every element.
+  double max_askew_m = 0;
   // Evaluate the points of a wall through the wall's moments (plan_terms.cpp aggregate_walls: one pass over
   // the walls per evaluation instead of a closest-point query per point; the same cost, gradient and
   // Gauss-Newton matrix at the pose the term is prepared at, the points' position along their wall held
