@@ -34,8 +34,14 @@ XyzLut make_xyz_lut(const BeamIntrinsics& beams, int width) {
     const double cos_phi = std::cos(phi), sin_phi = std::sin(phi);  // (per beam)
     for (int v = 0; v < width; ++v) {
       const double theta = theta_e[size_t(v)] + theta_a;
+      double ct = std::cos(theta), st = std::sin(theta);
+#if defined(__GNUC__) && defined(__x86_64__)
+      // (each taken into a register as it is: the compiler otherwise reads the two results sincos stores as one
+      // 16-byte load, which cannot be forwarded from the two 8-byte stores and waited for them on every pixel)
+      asm("" : "+x"(ct), "+x"(st));
+#endif
       // p(r) = (r - n) * d + n * e  =  r * d + (n * e - n * d)
-      const Eigen::Vector3d d(std::cos(theta) * cos_phi, std::sin(theta) * cos_phi, sin_phi);
+      const Eigen::Vector3d d(ct * cos_phi, st * cos_phi, sin_phi);
       const Eigen::Vector3d& ev = e[size_t(v)];
       const Eigen::Vector3d dir = R * d;                          // per mm of range
       const Eigen::Vector3d off = R * (n_mm * ev - n_mm * d) + t;  // mm
