@@ -34,7 +34,7 @@ Eigen::Vector3d GyroDeskew::rate_at(int64_t t) const {
   return it->second - gyro_bias_;
 }
 
-const Eigen::Vector3d& GyroDeskew::sweep_rate_walk(int64_t t, size_t& at) const {
+inline const Eigen::Vector3d& GyroDeskew::sweep_rate_walk(int64_t t, size_t& at) const {
   // The first sample at or after t (the last one when none is), as rate_at's search finds it.
   const size_t n = sweep_rate_.size();
   at = std::min(at, n - 1);
@@ -167,12 +167,20 @@ bool GyroDeskew::prepare(const Scan& scan) {
   const auto walk = [&](const Eigen::Matrix3d& Rm, int end, int dir) {
     Eigen::Matrix3d Ra = Rm;
     int a = cm;  // the block's first column (its rotation known)
-    Eigen::Vector3d th = Eigen::Vector3d::Zero();
+    // The block's angle vector, entry by entry (th += rate * dt as Eigen sums it), in registers; and the columns
+    // stepped in this block (the block ends at kDeskewBlockCols).
+    double th0 = 0, th1 = 0, th2 = 0;
+    int in_block = 0;
     for (int c = cm + dir; dir > 0 ? c <= end : c >= end; c += dir) {
       const int64_t ta = col_t_[c - dir], tb = col_t_[c];
-      th += sweep_rate_walk(ta + (tb - ta) / 2, at) * (1e-6 * double(tb - ta));
-      if ((c - cm) * dir % kDeskewBlockCols != 0 && c != end) continue;
-      const Eigen::Matrix3d Rb = Ra * exp_map(th);
+      const Eigen::Vector3d& w = sweep_rate_walk(ta + (tb - ta) / 2, at);
+      const double dt = 1e-6 * double(tb - ta);
+      th0 += w[0] * dt;
+      th1 += w[1] * dt;
+      th2 += w[2] * dt;
+      if (++in_block != kDeskewBlockCols && c != end) continue;
+      in_block = 0;
+      const Eigen::Matrix3d Rb = Ra * exp_map(Eigen::Vector3d(th0, th1, th2));
       const Eigen::Matrix3f fa = Ra.cast<float>(), fb = Rb.cast<float>();
       put(c, fb);
       const Eigen::Matrix3f diff = fb - fa;
@@ -191,7 +199,7 @@ bool GyroDeskew::prepare(const Scan& scan) {
       }
       Ra = Rb;
       a = c;
-      th.setZero();
+      th0 = th1 = th2 = 0;
     }
   };
   const Eigen::Matrix3d Rm = exp_map(sweep_rate_walk(tm + (col_t_[cm] - tm) / 2, at) * (1e-6 * double(col_t_[cm] - tm)));
