@@ -271,7 +271,9 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     const float inv_binf = float(k::kScaleBins / cut);
     float cutf = float(cut);
     if (double(cutf) < cut) cutf = std::nextafter(cutf, std::numeric_limits<float>::infinity());
-    scratch_.resize(src->padded());
+    // (grown, never shrunk: the iterations alternate between the subsample and the band, and residual_scale
+    // writes every entry it reads; a resize up would zero-fill the difference each time)
+    if (scratch_.size() < src->padded()) scratch_.resize(src->padded());
     int inside = 0;
     // The last iteration's scale as the guess of the bin (the result does not depend on it).
     const int hint = last_sigma > 0 ? int(std::min(double(k::kScaleBins), last_sigma / k::kMadToSigma * inv_binf)) : -1;
