@@ -55,8 +55,9 @@ const FeatureFrame& FeatureExtractor::process(const seg::Segmentation& seg) {
   out_.source.clear();
   out_.num_groups = 0;
   const FeatureStatus status = extract(seg);
+  // (the last frame's points keep their entries: sized to this frame's below, only the entries past the last
+  // frame's count are constructed; every entry kept is written)
   std::vector<Feature2> points = std::move(frame_.points);
-  points.clear();
   frame_ = FeatureFrame{};
   frame_.points = std::move(points);
   frame_.utime = seg.utime;
