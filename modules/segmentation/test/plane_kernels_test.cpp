@@ -3,6 +3,7 @@
 // versions, with point counts that leave a partial group of four at the end of the eight-lane loop.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -12,6 +13,7 @@
 
 #include "../src/compact_kernels.h"
 #include "../src/plane_kernels.h"
+#include "../src/seed_order.h"
 #include "fploc/segmentation/candidates.h"
 
 using namespace fploc::seg;
@@ -224,4 +226,33 @@ TEST(PlaneKernels, BoxSkipsChangeNothing) {
       }
     }
   }
+}
+
+// The seed rings' sector maxima sorted with their ranges beside them (src/seed_order.h) come in the order of their
+// indices sorted by a look-up of the ranges: the same order, ties included. Ranges in whole millimetres (as the
+// candidates'), few distinct values, so that most lists have ties; lists of 1 to 64 (the sectors of a ring).
+
+TEST(SeedOrder, SortedWithTheirRangesAsTheIndicesByRange) {
+  struct Key {
+    float range;
+    int index;
+  };
+  std::mt19937 rng(17);
+  int with_ties = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const int n = 1 + trial % 64;
+    std::vector<float> range(size_t(3 * n));
+    std::uniform_int_distribution<int> mm(3000, 3000 + (trial % 3 == 0 ? 5 : 2000));
+    for (auto& r : range) r = float(mm(rng)) * 1e-3f;
+    std::vector<int> idx;
+    for (int i = 0; i < n; ++i) idx.push_back(3 * i + int(rng() % 3));  // increasing, as the sectors' maxima
+    std::vector<Key> keys;
+    for (int i : idx) keys.push_back({range[size_t(i)], i});
+    std::sort(idx.begin(), idx.end(), [&](int a, int b) { return range[size_t(a)] > range[size_t(b)]; });
+    fploc::seg::seeds::sort_by_range(keys);
+    ASSERT_EQ(keys.size(), idx.size());
+    for (size_t j = 0; j < idx.size(); ++j) ASSERT_EQ(keys[j].index, idx[j]) << "trial " << trial << " position " << j;
+    for (size_t j = 1; j < idx.size(); ++j) with_ties += range[size_t(idx[j])] == range[size_t(idx[j - 1])];
+  }
+  EXPECT_GT(with_ties, 1000);
 }
