@@ -13,6 +13,7 @@
 
 #include "../src/compact_kernels.h"
 #include "../src/plane_kernels.h"
+#include "../src/plane_math.h"
 #include "../src/seed_order.h"
 #include "fploc/segmentation/candidates.h"
 
@@ -255,4 +256,28 @@ TEST(SeedOrder, SortedWithTheirRangesAsTheIndicesByRange) {
     for (size_t j = 1; j < idx.size(); ++j) with_ties += range[size_t(idx[j])] == range[size_t(idx[j - 1])];
   }
   EXPECT_GT(with_ties, 1000);
+}
+
+// Moments::of_points (the ground-at-a-kink's sweep correction) gives the moments of adding the points one at a
+// time with add1, bit for bit: points around a floor 1.2 m below, relative to a reference point, as that
+// correction forms them.
+TEST(PlaneMath, MomentsOfPointsAreThoseAddedOneAtATime) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<float> u(-8.f, 8.f), h(-0.05f, 0.05f);
+  for (size_t m : {size_t(0), size_t(1), size_t(7), size_t(1000), size_t(25000)}) {
+    std::vector<float> x(m), y(m), z(m);
+    for (size_t j = 0; j < m; ++j) {
+      x[j] = u(rng);
+      y[j] = u(rng);
+      z[j] = 0.02f * x[j] - 0.01f * y[j] + h(rng);
+    }
+    fploc::seg::detail::Moments one;
+    for (size_t j = 0; j < m; ++j) one.add1(Eigen::Vector3f(x[j], y[j], z[j]).cast<double>());
+    const auto all = fploc::seg::detail::Moments::of_points(x.data(), y.data(), z.data(), m);
+    EXPECT_EQ(all.w, one.w) << m;
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_EQ(all.s[a], one.s[a]) << m << " s" << a;
+      for (int b = 0; b < 3; ++b) EXPECT_EQ(all.ss(a, b), one.ss(a, b)) << m << " ss" << a << b;
+    }
+  }
 }
