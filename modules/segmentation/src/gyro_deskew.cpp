@@ -117,11 +117,16 @@ bool GyroDeskew::prepare(const Scan& scan) {
   if (t1 - t0 > k::kMaxSweepUs) return false;
   if (gyro_.front().first > t0 + k::kGyroEdgeUs || gyro_.back().first < t1 - k::kGyroEdgeUs) return false;
   // Column times (invalid columns take the previous column's time: they carry no returns anyway).
+  // (through plain pointers, the test without branches: the same times)
   col_t_.resize(W);
   int64_t last = t0;
+  const int64_t* ut = scan.column_utime.data();
+  const uint8_t* cv = cvalid ? scan.column_valid.data() : nullptr;
+  int64_t* ct = col_t_.data();
   for (int c = 0; c < W; ++c) {
-    if (c >= c0 && c <= c1 && scan.column_utime[c] != 0 && !(cvalid && !scan.column_valid[c])) last = scan.column_utime[c];
-    col_t_[c] = last;
+    const bool take = (c >= c0) & (c <= c1) & (ut[c] != 0) & (!cv || cv[c] != 0);
+    last = take ? ut[c] : last;
+    ct[c] = last;
   }
   const int64_t tm = t0 + (t1 - t0) / 2;
   sweep_tm_ = tm;  // the gyro covers this sweep (planes refer to mid-sweep)
