@@ -154,8 +154,9 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   uint8_t* picked = picked_.data();
   // Taking points a..b out: no later corner or surface pick there (a pick's neighbours, occlusions).
   // (stored in blocks of 8 or 4, the last block ending at b: overlapping blocks write the same values, so the
-  // same entries a..b are set, with fewer stores than one per entry)
-  auto suppress = [&](int a, int b) {
+  // same entries a..b are set, with fewer stores than one per entry; inlined at its five calls: a call per pick
+  // cost more than its stores)
+  auto suppress = [&](int a, int b) __attribute__((always_inline)) {
     a = std::max(0, a);
     b = std::min(n - 1, b);
     const int len = b - a + 1;
