@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstring>
+
 #include "fploc/core/xyz.h"
 
 using namespace fploc;
@@ -28,6 +32,65 @@ TEST(Xyz, MatchesManualFormula) {
     }
   }
   EXPECT_TRUE(lut_point(lut, 0, 0, 0).hasNaN());
+}
+
+// The table computed pixel by pixel, every sine and cosine taken at the pixel (make_xyz_lut computes those of
+// the encoder angle once per column and those of the altitude once per beam: the same values).
+static XyzLut per_pixel_lut(const BeamIntrinsics& beams, int width) {
+  XyzLut lut;
+  lut.height = beams.beams();
+  lut.width = width;
+  const size_t n = size_t(lut.height) * width;
+  lut.direction.resize(n, 3);
+  lut.offset.resize(n, 3);
+  const auto& T = beams.lidar_to_sensor;
+  Eigen::Matrix3d R;
+  R << T[0], T[1], T[2], T[4], T[5], T[6], T[8], T[9], T[10];
+  const Eigen::Vector3d t(T[3], T[7], T[11]);
+  const double n_mm = beams.beam_offset_mm;
+  for (int u = 0; u < lut.height; ++u) {
+    const double phi = beams.altitude_deg[u] * M_PI / 180.0;
+    const double theta_a = -beams.azimuth_deg[u] * M_PI / 180.0;
+    for (int v = 0; v < width; ++v) {
+      const double theta_e = 2.0 * M_PI - v * 2.0 * M_PI / width;
+      const Eigen::Vector3d d(std::cos(theta_e + theta_a) * std::cos(phi), std::sin(theta_e + theta_a) * std::cos(phi),
+                              std::sin(phi));
+      const Eigen::Vector3d e(std::cos(theta_e), std::sin(theta_e), 0.0);
+      const Eigen::Vector3d dir = R * d;
+      const Eigen::Vector3d off = R * (n_mm * e - n_mm * d) + t;
+      const size_t i = size_t(u) * width + v;
+      lut.direction.row(i) = (dir * 1e-3).cast<float>().transpose();
+      lut.offset.row(i) = (off * 1e-3).cast<float>().transpose();
+    }
+  }
+  return lut;
+}
+
+// Bit for bit the per-pixel table: 64 beams with their own altitudes and azimuth offsets (as a calibrated OS-1's),
+// a tilted and shifted lidar frame, the usual widths and an odd one.
+TEST(Xyz, TableIsThePerPixelFormulaBitForBit) {
+  BeamIntrinsics b;
+  for (int u = 0; u < 64; ++u) {
+    b.altitude_deg.push_back(16.6 - u * 0.5234 + 0.013 * std::sin(u));
+    b.azimuth_deg.push_back((u % 4 == 0 ? 3.073 : u % 4 == 1 ? 0.904 : u % 4 == 2 ? -1.261 : -3.384) + 0.0071 * u);
+  }
+  b.beam_offset_mm = 15.806;
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.031, Eigen::Vector3d(0.3, -0.2, 1.0).normalized()).toRotationMatrix();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) b.lidar_to_sensor[size_t(4 * r + c)] = R(r, c);
+  b.lidar_to_sensor[3] = 1.5;
+  b.lidar_to_sensor[7] = -2.25;
+  b.lidar_to_sensor[11] = 36.18;
+  for (int W : {512, 1024, 2048, 1000}) {
+    const XyzLut a = make_xyz_lut(b, W), ref = per_pixel_lut(b, W);
+    ASSERT_EQ(a.direction.rows(), ref.direction.rows());
+    size_t differ = 0;
+    for (Eigen::Index i = 0; i < ref.direction.rows(); ++i)
+      for (int e = 0; e < 3; ++e)
+        differ += std::memcmp(&a.direction(i, e), &ref.direction(i, e), sizeof(float)) != 0 ||
+                  std::memcmp(&a.offset(i, e), &ref.offset(i, e), sizeof(float)) != 0;
+    EXPECT_EQ(differ, 0u) << "width " << W;
+  }
 }
 
 TEST(Xyz, Destagger) {

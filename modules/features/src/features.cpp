@@ -49,14 +49,13 @@ FeatureExtractor::FeatureExtractor(FeatureConfig cfg) : cfg_(cfg) {}
 
 const FeatureFrame& FeatureExtractor::process(const seg::Segmentation& seg) {
   // Cleared, not re-created: the arrays keep their capacity from scan to scan.
-  for (auto* v : {&out_.x, &out_.y, &out_.t}) v->clear();
-  out_.kind.clear();
-  out_.group.clear();
-  out_.source.clear();
+  // Emptied, not cleared: the arrays keep their size and capacity from scan to scan (Picked).
+  out_.n = 0;
   out_.num_groups = 0;
   const FeatureStatus status = extract(seg);
+  // (the last frame's points keep their entries: sized to this frame's below, only the entries past the last
+  // frame's count are constructed; every entry kept is written)
   std::vector<Feature2> points = std::move(frame_.points);
-  points.clear();
   frame_ = FeatureFrame{};
   frame_.points = std::move(points);
   frame_.utime = seg.utime;
@@ -69,7 +68,7 @@ const FeatureFrame& FeatureExtractor::process(const seg::Segmentation& seg) {
   frame_.z_sigma = seg.z_sigma;
   frame_.attitude_t = seg.attitude_t;
   frame_.num_groups = out_.num_groups;
-  const size_t n = out_.x.size();
+  const size_t n = out_.n;
   // (sized for every point, written through plain pointers, then cut to the finite ones: no per-point
   // capacity check and end-pointer update in memory)
   frame_.points.resize(n);
@@ -119,7 +118,7 @@ FeatureStatus FeatureExtractor::extract(const seg::Segmentation& seg) {
     if (w.ring[b] % ring_step_ == 0) ring(seg, b, e);
     b = e;
   }
-  return out_.x.size() < 30 ? FeatureStatus::kFewFeatures : FeatureStatus::kOk;
+  return out_.n < 30 ? FeatureStatus::kFewFeatures : FeatureStatus::kOk;
 }
 
 
@@ -155,8 +154,9 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   uint8_t* picked = picked_.data();
   // Taking points a..b out: no later corner or surface pick there (a pick's neighbours, occlusions).
   // (stored in blocks of 8 or 4, the last block ending at b: overlapping blocks write the same values, so the
-  // same entries a..b are set, with fewer stores than one per entry)
-  auto suppress = [&](int a, int b) {
+  // same entries a..b are set, with fewer stores than one per entry; inlined at its five calls: a call per pick
+  // cost more than its stores)
+  auto suppress = [&](int a, int b) __attribute__((always_inline)) {
     a = std::max(0, a);
     b = std::min(n - 1, b);
     const int len = b - a + 1;
@@ -305,13 +305,16 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   const bool has_t = w.t.size() == w.x.size();
   const float max_gap2 = float(cfg_.group_max_gap_m * cfg_.group_max_gap_m);
   // The picks' output first (independent iterations, written in place), then the runs.
-  const size_t o0 = out_.x.size(), m = sel_.size();
-  out_.x.resize(o0 + m);
-  out_.y.resize(o0 + m);
-  out_.kind.resize(o0 + m);
-  out_.group.resize(o0 + m, -1);
-  out_.t.resize(o0 + m);
-  out_.source.resize(o0 + m);
+  const size_t o0 = out_.n, m = sel_.size();
+  if (out_.x.size() < o0 + m) {  // (grown only: every entry below o0 + m is written here)
+    out_.x.resize(o0 + m);
+    out_.y.resize(o0 + m);
+    out_.kind.resize(o0 + m);
+    out_.group.resize(o0 + m);
+    out_.t.resize(o0 + m);
+    out_.source.resize(o0 + m);
+  }
+  out_.n = o0 + m;
   for (size_t k = 0; k < m; ++k) {
     const int code = sel_[k];
     const size_t src = begin + size_t(code >> 1), o = o0 + k;
@@ -319,6 +322,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     out_.x[o] = q.x();
     out_.y[o] = q.y();
     out_.kind[o] = code & 1 ? kCorner : kSurface;
+    out_.group[o] = -1;  // (unclassified until a line group takes it, below)
     out_.t[o] = has_t ? w.t[src] : 0.f;
     out_.source[o] = int32_t(src);
   }

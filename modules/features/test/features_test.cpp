@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -185,6 +187,34 @@ TEST(Features, ReferenceEqualOnSyntheticScans) {
         ASSERT_GT(s.wall.size(), 1000u);
         expect_same(s, FeatureConfig{}, "seed " + std::to_string(seed));
       }
+}
+
+// One extractor for a sequence of scans (process() keeps its arrays and the last frame's points from scan to scan:
+// only their count changes): every frame equals the reference's, with more and fewer features than the last.
+TEST(Features, ReferenceEqualWhenOneExtractorRunsManyScans) {
+  const synth::Room rooms[] = {synth::furnished_room(), synth::Room{}};
+  const synth::SensorPose poses[] = {{0.0, 0.0, 1.5, 0, 0, 0}, {2.5, -1.0, 1.2, 3 * kDeg, -2 * kDeg, 0.7},
+                                     {-6.5, 4.0, 2.0, -1 * kDeg, 4 * kDeg, 2.0}};
+  FeatureExtractor fx;
+  std::set<size_t> sizes;
+  uint32_t seed = 700;
+  for (int k = 0; k < 8; ++k) {
+    const auto s = segment(rooms[k % 2], poses[(k * 2) % 3], k % 3 == 0 ? 0.0 : 0.01, ++seed);
+    const auto& f = fx.process(s);
+    const auto ref = reference::extract(s, FeatureConfig{});
+    const std::string what = "scan " + std::to_string(k);
+    ASSERT_EQ(f.size(), ref.points.size()) << what;
+    ASSERT_EQ(fx.source(), ref.source) << what;
+    for (size_t i = 0; i < f.size(); ++i) {
+      ASSERT_EQ(f.points[i].p.x(), ref.points[i].p.x()) << what << " feature " << i;
+      ASSERT_EQ(f.points[i].p.y(), ref.points[i].p.y()) << what << " feature " << i;
+      ASSERT_EQ(int(f.points[i].kind), int(ref.points[i].kind)) << what << " feature " << i;
+      ASSERT_EQ(f.points[i].group, ref.points[i].group) << what << " feature " << i;
+      ASSERT_EQ(f.points[i].t, ref.points[i].t) << what << " feature " << i;
+    }
+    sizes.insert(f.size());
+  }
+  EXPECT_GE(sizes.size(), 4u);  // (the counts differ from scan to scan)
 }
 
 // The pass's c (both instruction-set copies: features_test_base runs this with the baseline one) equals the

@@ -332,16 +332,28 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   const auto sweep_corrected = [&](const Eigen::Vector4d& pl, auto&& use, double rate, Eigen::Vector4d* out) {
     const Eigen::Vector3f n = pl.head<3>().cast<float>();
     const Eigen::Vector3f shift = float(rate) * n;
-    detail::Moments m0, m1;
+    // The returns taken, relative to ref as measured (a) and moved back (b), in float, in order; then their
+    // moments (Moments::of_points: the sums of adding them one at a time, kept in registers).
+    sweep_q_.resize(6 * near);
+    float *ax = sweep_q_.data(), *ay = ax + near, *az = ay + near, *bx = az + near, *by = bx + near, *bz = by + near;
+    size_t m = 0;
     for (size_t k = 0; k < near; ++k) {  // (a return within kSectorTightM of pl is one near the ring fit)
       if (!use(sector[k])) continue;
       const size_t i = size_t(index[k]);
       const int64_t tc = scan.column_utime[size_t(pow2 ? lower_.pixel[i] & (W - 1) : lower_.pixel[i] % W)];
       const Eigen::Vector3f p = lower_.point(i);
       if (tc == 0 || !p.allFinite() || std::abs(n.dot(p) + float(pl[3])) >= kSectorTightM) continue;
-      m0.add1((p - reff).cast<double>());
-      m1.add1((p + float(1e-6 * double(tc - t)) * shift - reff).cast<double>());
+      const Eigen::Vector3f a = p - reff;
+      const Eigen::Vector3f b = p + float(1e-6 * double(tc - t)) * shift - reff;
+      ax[m] = a.x();
+      ay[m] = a.y();
+      az[m] = a.z();
+      bx[m] = b.x();
+      by[m] = b.y();
+      bz[m] = b.z();
+      ++m;
     }
+    const detail::Moments m0 = detail::Moments::of_points(ax, ay, az, m), m1 = detail::Moments::of_points(bx, by, bz, m);
     Eigen::Vector4d p0, p1;
     if (m0.w < 4 * kMinSectorPoints || !m0.plane(ref, -up, p0) || !m1.plane(ref, -up, p1)) return 0.0;
     const Eigen::Vector3d nc = (pl.head<3>() + p1.head<3>() - p0.head<3>()).normalized();

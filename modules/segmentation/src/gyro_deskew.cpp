@@ -34,7 +34,7 @@ Eigen::Vector3d GyroDeskew::rate_at(int64_t t) const {
   return it->second - gyro_bias_;
 }
 
-const Eigen::Vector3d& GyroDeskew::sweep_rate_walk(int64_t t, size_t& at) const {
+inline const Eigen::Vector3d& GyroDeskew::sweep_rate_walk(int64_t t, size_t& at) const {
   // The first sample at or after t (the last one when none is), as rate_at's search finds it.
   const size_t n = sweep_rate_.size();
   at = std::min(at, n - 1);
@@ -117,11 +117,16 @@ bool GyroDeskew::prepare(const Scan& scan) {
   if (t1 - t0 > k::kMaxSweepUs) return false;
   if (gyro_.front().first > t0 + k::kGyroEdgeUs || gyro_.back().first < t1 - k::kGyroEdgeUs) return false;
   // Column times (invalid columns take the previous column's time: they carry no returns anyway).
+  // (through plain pointers, the test without branches: the same times)
   col_t_.resize(W);
   int64_t last = t0;
+  const int64_t* ut = scan.column_utime.data();
+  const uint8_t* cv = cvalid ? scan.column_valid.data() : nullptr;
+  int64_t* ct = col_t_.data();
   for (int c = 0; c < W; ++c) {
-    if (c >= c0 && c <= c1 && scan.column_utime[c] != 0 && !(cvalid && !scan.column_valid[c])) last = scan.column_utime[c];
-    col_t_[c] = last;
+    const bool take = (c >= c0) & (c <= c1) & (ut[c] != 0) & (!cv || cv[c] != 0);
+    last = take ? ut[c] : last;
+    ct[c] = last;
   }
   const int64_t tm = t0 + (t1 - t0) / 2;
   sweep_tm_ = tm;  // the gyro covers this sweep (planes refer to mid-sweep)
@@ -167,12 +172,20 @@ bool GyroDeskew::prepare(const Scan& scan) {
   const auto walk = [&](const Eigen::Matrix3d& Rm, int end, int dir) {
     Eigen::Matrix3d Ra = Rm;
     int a = cm;  // the block's first column (its rotation known)
-    Eigen::Vector3d th = Eigen::Vector3d::Zero();
+    // The block's angle vector, entry by entry (th += rate * dt as Eigen sums it), in registers; and the columns
+    // stepped in this block (the block ends at kDeskewBlockCols).
+    double th0 = 0, th1 = 0, th2 = 0;
+    int in_block = 0;
     for (int c = cm + dir; dir > 0 ? c <= end : c >= end; c += dir) {
       const int64_t ta = col_t_[c - dir], tb = col_t_[c];
-      th += sweep_rate_walk(ta + (tb - ta) / 2, at) * (1e-6 * double(tb - ta));
-      if ((c - cm) * dir % kDeskewBlockCols != 0 && c != end) continue;
-      const Eigen::Matrix3d Rb = Ra * exp_map(th);
+      const Eigen::Vector3d& w = sweep_rate_walk(ta + (tb - ta) / 2, at);
+      const double dt = 1e-6 * double(tb - ta);
+      th0 += w[0] * dt;
+      th1 += w[1] * dt;
+      th2 += w[2] * dt;
+      if (++in_block != kDeskewBlockCols && c != end) continue;
+      in_block = 0;
+      const Eigen::Matrix3d Rb = Ra * exp_map(Eigen::Vector3d(th0, th1, th2));
       const Eigen::Matrix3f fa = Ra.cast<float>(), fb = Rb.cast<float>();
       put(c, fb);
       const Eigen::Matrix3f diff = fb - fa;
@@ -191,7 +204,7 @@ bool GyroDeskew::prepare(const Scan& scan) {
       }
       Ra = Rb;
       a = c;
-      th.setZero();
+      th0 = th1 = th2 = 0;
     }
   };
   const Eigen::Matrix3d Rm = exp_map(sweep_rate_walk(tm + (col_t_[cm] - tm) / 2, at) * (1e-6 * double(col_t_[cm] - tm)));

@@ -61,6 +61,25 @@ struct Moments {
     ss(1, 2) += yz;
     ss(2, 2) += zz;
   }
+  // add1 of the points (x[j], y[j], z[j]) in float, j < m, in order, on empty moments (the same sums bit for bit:
+  // each sum takes the same terms in the same order; w counts them, exactly; the three mirrored products of ss
+  // are summed once). The sums stay in registers, not in the moments' members.
+  static Moments of_points(const float* x, const float* y, const float* z, size_t m) {
+    double S[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    for (size_t j = 0; j < m; ++j) {
+      const double px = x[j], py = y[j], pz = z[j];
+      S[0] += px;
+      S[1] += py;
+      S[2] += pz;
+      S[3] += px * px;
+      S[4] += py * px;
+      S[5] += pz * px;
+      S[6] += py * py;
+      S[7] += pz * py;
+      S[8] += pz * pz;
+    }
+    return from_inliers(S, int(m));
+  }
   bool plane(const Eigen::Vector3d& ref, const Eigen::Vector3d& up, Eigen::Vector4d& out,
              Eigen::Vector3d* eigenvalues = nullptr) const {
     if (w <= 0) return false;

@@ -181,10 +181,21 @@ bool Segmenter::prepare(const Scan& scan) {
     std::stable_sort(ring_order_.begin(), ring_order_.end(),
                      [&](int a, int b) { return scan.beams.altitude_deg[a] > scan.beams.altitude_deg[b]; });
     scale_ = seg::beam_scaling(scan.beams, scan.width, cfg_);
-    for (int e = 0; e < 6; ++e) {  // the table as float arrays: direction x/y/z, offset x/y/z per pixel
-      const auto& src = e < 3 ? lut_.direction : lut_.offset;
-      lut_soa_[e].resize(size_t(src.rows()));
-      for (Eigen::Index i = 0; i < src.rows(); ++i) lut_soa_[e][size_t(i)] = src(i, e % 3);
+    {  // the table as float arrays: direction x/y/z, offset x/y/z per pixel (one pass over both matrices)
+      const size_t np = size_t(lut_.direction.rows());
+      for (auto& a : lut_soa_) a.resize(np);
+      const float* d = lut_.direction.data();  // (row-major: pixel i's x, y, z at 3 i)
+      const float* o = lut_.offset.data();
+      float *dx = lut_soa_[0].data(), *dy = lut_soa_[1].data(), *dz = lut_soa_[2].data();
+      float *ox = lut_soa_[3].data(), *oy = lut_soa_[4].data(), *oz = lut_soa_[5].data();
+      for (size_t i = 0; i < np; ++i) {
+        dx[i] = d[3 * i];
+        dy[i] = d[3 * i + 1];
+        dz[i] = d[3 * i + 2];
+        ox[i] = o[3 * i];
+        oy[i] = o[3 * i + 1];
+        oz[i] = o[3 * i + 2];
+      }
     }
     // Rows whose z direction and offset are one value each (the same floats in every column): their pair.
     row_z_.assign(size_t(scan.height), {std::numeric_limits<float>::quiet_NaN(), 0.f});

@@ -8,6 +8,7 @@
 #include "compact_kernels.h"
 #include "plane_kernels.h"
 #include "plane_math.h"
+#include "seed_order.h"
 #include "segmenter_constants.h"
 #include "simd4.h"
 
@@ -84,13 +85,16 @@ void RingPlaneFit::pick_seeds(const Candidates& c, const Eigen::Vector3f& upf) {
       sector_best_[size_t(cur_s)] = cur_best;
       sector_idx_[size_t(cur_s)] = cur_i;
     }
-    std::vector<int> cand;
+    // The sector maxima by range, largest first (seed_order.h: the order of the indices sorted by c.range).
+    seed_keys_.clear();
     for (int s = 0; s < S; ++s)
-      if (sector_idx_[s] >= 0) cand.push_back(sector_idx_[s]);
-    std::sort(cand.begin(), cand.end(), [&](int a, int b) { return c.range[a] > c.range[b]; });
-    const size_t keep = std::min(cand.size(), std::max<size_t>(k::kMinSeedsKept, size_t(std::ceil(cfg_.seed_fraction * S))));
-    seeds_.insert(seeds_.end(), cand.begin(), cand.begin() + keep);
-    all_seeds_.insert(all_seeds_.end(), cand.begin(), cand.end());
+      if (sector_idx_[s] >= 0) seed_keys_.push_back({c.range[size_t(sector_idx_[s])], sector_idx_[s]});
+    seeds::sort_by_range(seed_keys_);
+    const size_t keep = std::min(seed_keys_.size(), std::max<size_t>(k::kMinSeedsKept, size_t(std::ceil(cfg_.seed_fraction * S))));
+    for (size_t j = 0; j < seed_keys_.size(); ++j) {
+      if (j < keep) seeds_.push_back(seed_keys_[j].index);
+      all_seeds_.push_back(seed_keys_[j].index);
+    }
   }
 }
 
@@ -271,7 +275,9 @@ std::optional<RingPlaneFit::Fit> RingPlaneFit::refine(const Eigen::Vector3d& up,
     const float inv_binf = float(k::kScaleBins / cut);
     float cutf = float(cut);
     if (double(cutf) < cut) cutf = std::nextafter(cutf, std::numeric_limits<float>::infinity());
-    scratch_.resize(src->padded());
+    // (grown, never shrunk: the iterations alternate between the subsample and the band, and residual_scale
+    // writes every entry it reads; a resize up would zero-fill the difference each time)
+    if (scratch_.size() < src->padded()) scratch_.resize(src->padded());
     int inside = 0;
     // The last iteration's scale as the guess of the bin (the result does not depend on it).
     const int hint = last_sigma > 0 ? int(std::min(double(k::kScaleBins), last_sigma / k::kMadToSigma * inv_binf)) : -1;

@@ -3,6 +3,7 @@
 // versions, with point counts that leave a partial group of four at the end of the eight-lane loop.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -12,6 +13,8 @@
 
 #include "../src/compact_kernels.h"
 #include "../src/plane_kernels.h"
+#include "../src/plane_math.h"
+#include "../src/seed_order.h"
 #include "fploc/segmentation/candidates.h"
 
 using namespace fploc::seg;
@@ -222,6 +225,59 @@ TEST(PlaneKernels, BoxSkipsChangeNothing) {
         EXPECT_EQ(by1[j], by2[j]);
         EXPECT_EQ(bz1[j], bz2[j]);
       }
+    }
+  }
+}
+
+// The seed rings' sector maxima sorted with their ranges beside them (src/seed_order.h) come in the order of their
+// indices sorted by a look-up of the ranges: the same order, ties included. Ranges in whole millimetres (as the
+// candidates'), few distinct values, so that most lists have ties; lists of 1 to 64 (the sectors of a ring).
+
+TEST(SeedOrder, SortedWithTheirRangesAsTheIndicesByRange) {
+  struct Key {
+    float range;
+    int index;
+  };
+  std::mt19937 rng(17);
+  int with_ties = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const int n = 1 + trial % 64;
+    std::vector<float> range(size_t(3 * n));
+    std::uniform_int_distribution<int> mm(3000, 3000 + (trial % 3 == 0 ? 5 : 2000));
+    for (auto& r : range) r = float(mm(rng)) * 1e-3f;
+    std::vector<int> idx;
+    for (int i = 0; i < n; ++i) idx.push_back(3 * i + int(rng() % 3));  // increasing, as the sectors' maxima
+    std::vector<Key> keys;
+    for (int i : idx) keys.push_back({range[size_t(i)], i});
+    std::sort(idx.begin(), idx.end(), [&](int a, int b) { return range[size_t(a)] > range[size_t(b)]; });
+    fploc::seg::seeds::sort_by_range(keys);
+    ASSERT_EQ(keys.size(), idx.size());
+    for (size_t j = 0; j < idx.size(); ++j) ASSERT_EQ(keys[j].index, idx[j]) << "trial " << trial << " position " << j;
+    for (size_t j = 1; j < idx.size(); ++j) with_ties += range[size_t(idx[j])] == range[size_t(idx[j - 1])];
+  }
+  EXPECT_GT(with_ties, 1000);
+}
+
+// Moments::of_points (the ground-at-a-kink's sweep correction) gives the moments of adding the points one at a
+// time with add1, bit for bit: points around a floor 1.2 m below, relative to a reference point, as that
+// correction forms them.
+TEST(PlaneMath, MomentsOfPointsAreThoseAddedOneAtATime) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<float> u(-8.f, 8.f), h(-0.05f, 0.05f);
+  for (size_t m : {size_t(0), size_t(1), size_t(7), size_t(1000), size_t(25000)}) {
+    std::vector<float> x(m), y(m), z(m);
+    for (size_t j = 0; j < m; ++j) {
+      x[j] = u(rng);
+      y[j] = u(rng);
+      z[j] = 0.02f * x[j] - 0.01f * y[j] + h(rng);
+    }
+    fploc::seg::detail::Moments one;
+    for (size_t j = 0; j < m; ++j) one.add1(Eigen::Vector3f(x[j], y[j], z[j]).cast<double>());
+    const auto all = fploc::seg::detail::Moments::of_points(x.data(), y.data(), z.data(), m);
+    EXPECT_EQ(all.w, one.w) << m;
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_EQ(all.s[a], one.s[a]) << m << " s" << a;
+      for (int b = 0; b < 3; ++b) EXPECT_EQ(all.ss(a, b), one.ss(a, b)) << m << " ss" << a << b;
     }
   }
 }

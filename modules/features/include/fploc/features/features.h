@@ -47,8 +47,10 @@ class FeatureExtractor {
 
  private:
   enum Kind : int8_t { kCorner = int8_t(FeatureKind::kCorner), kSurface = int8_t(FeatureKind::kSurface) };
-  // The features as they are picked, ring by ring (structure of arrays).
+  // The features as they are picked, ring by ring (structure of arrays): the first n entries of the arrays (they
+  // keep their size from scan to scan: entries written as picked, not constructed first).
   struct Picked {
+    size_t n = 0;
     std::vector<float> x, y;          // gravity-aligned, sensor-centred [m]
     std::vector<int8_t> kind;
     std::vector<int32_t> group;       // -1 = unclassified

@@ -58,6 +58,11 @@ class RingPlaneFit : public PlaneFit {
 
   SegmenterConfig cfg_;
   std::vector<int> seeds_, all_seeds_;
+  struct SeedKey {  // pick_seeds: a sector maximum's range and index (src/seed_order.h)
+    float range;
+    int index;
+  };
+  std::vector<SeedKey> seed_keys_;
   std::vector<float> sector_best_;
   std::vector<int> sector_idx_;
   std::vector<float> seed_rv_;  // a seed ring's ranges, -inf below the seed height (pick_seeds)

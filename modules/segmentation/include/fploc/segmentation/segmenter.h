@@ -144,6 +144,7 @@ class Segmenter {
   std::vector<int32_t> kink_index_;
   std::vector<int16_t> kink_sector_;
   std::vector<float> kink_x_, kink_y_, kink_z_, near_x_, near_y_, near_z_;
+  std::vector<float> sweep_q_;  // the sweep correction's returns as measured and moved back (ground_kink.cpp)
   Eigen::Vector3d accel_sum_ = Eigen::Vector3d::Zero();
   double accel_sq_ = 0;  // sum of |a|^2 (the spread: is the IMU measuring gravity alone?)
   int accel_n_ = 0;
