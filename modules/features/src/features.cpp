@@ -48,7 +48,6 @@ inline uint32_t order_bits(float f) {
 FeatureExtractor::FeatureExtractor(FeatureConfig cfg) : cfg_(cfg) {}
 
 const FeatureFrame& FeatureExtractor::process(const seg::Segmentation& seg) {
-  // Cleared, not re-created: the arrays keep their capacity from scan to scan.
   // Emptied, not cleared: the arrays keep their size and capacity from scan to scan (Picked).
   out_.n = 0;
   out_.num_groups = 0;

@@ -466,7 +466,6 @@ class FrameCost : public ceres::CostFunction {
   // a metre, and so plausible. Askew lines are faces, partitions and clutter, not a displaced wall.
   bool askew_to_its_wall(const Obs* first, const Obs* last, double w2max) const {
     const double P = ab_.max_askew_m;
-    if (!(P > 0)) return true;
     constexpr double kChi2Dof1P99 = 6.63;  // the 99 % point of chi-square with 1 degree of freedom
     constexpr double kRidgeM = 1.0;        // the prior that keeps an ill-determined end finite
     const double ps2 = ab_.point_sigma_m * ab_.point_sigma_m;
@@ -557,11 +556,12 @@ class FrameCost : public ceres::CostFunction {
           swe += sorted[k].w2 * rw * ee * ee;
         }
         // Points that do not lie on one line with their wall (AsBuiltModel::max_spread_sigmas): the element's
-        // share, its points' weights and its offsets' prior alike, scaled down by (limit / spread)^2.
+        // share, its points' weights and its offsets' prior alike, scaled down by (limit / spread)^2; with the gate
+        // on (max_askew_m > 0), only when their own line is askew to the wall.
         double share = 1;
         const double lim = ab_.max_spread_sigmas * ab_.point_sigma_m;
         if (lim > 0 && sw > 0 && swe > lim * lim * sw &&
-            askew_to_its_wall(sorted.data() + b, sorted.data() + e, w2max)) {
+            (!(ab_.max_askew_m > 0) || askew_to_its_wall(sorted.data() + b, sorted.data() + e, w2max))) {
           share = lim * lim * sw / swe;
           for (size_t k = b; k < e; ++k) point_w_[size_t(sorted[k].i)] *= float(share);
         }
