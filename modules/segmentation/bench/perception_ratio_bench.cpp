@@ -6,10 +6,22 @@
 // The pipeline's segmenter also takes the IMU (graphs/paper.pbtxt: gyro de-skew, gravity fusion, the ground at a
 // kink): BM_SegmenterPlusFeaturesImu runs it so, on 144 consecutive frames of the same sequence with each sweep's
 // IMU samples fed before its scan, and its ratio is printed beside the one without the IMU.
-//   build/bin/perception_ratio_bench [--benchmark_repetitions=N]
+// Each iteration's input arrives as in the pipeline: copied, outside the timing, into one receive buffer that is
+// reused (a socket's receive leaves the packets, LCM's decode the scan, in the caches). Before the thirty-first
+// round the lines read their inputs straight from the pools (24 frames' packets, 19 MB; 144 scans, 66 MB), so the
+// decode streamed its packets from the shared L3 or memory and took 1.6x its time with received packets, more or
+// less as the machine's other processes left the caches; the segmenter and features, bound by their own
+// arithmetic, take the same time either way (docs/notes/perception.md, thirty-first round).
+// Last, the ratio again with the two lines alternated in blocks (alternated_ratio), the figure least moved by the
+// machine's load changing during the run, with received inputs and, for comparison, read from the pools.
+//   build/bin/perception_ratio_bench [--benchmark_repetitions=N] [--alternate=BLOCKS (40; 0: none)]
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -25,11 +37,13 @@
 namespace {
 using namespace fploc;
 
+using FramePackets = std::vector<std::vector<uint8_t>>;  // one frame's packets
+
 struct Frames {
   std::vector<Scan> scans;
   std::vector<bench::ImuFrame> consecutive;  // with their IMU samples (sim_sequence.h)
   os1::SensorInfo info;
-  std::vector<std::vector<std::vector<uint8_t>>> packets;  // per frame
+  std::vector<FramePackets> packets;  // per frame
 };
 
 const Frames& frames() {
@@ -56,27 +70,100 @@ const Frames& frames() {
   return f;
 }
 
+// A pool's items in turn, each copied into one reused buffer (its capacity kept) before it is worked on: the
+// input as the pipeline receives it. With `received` false, the pool's own item (read from wherever it lies).
+template <class T>
+class Inputs {
+ public:
+  Inputs(const std::vector<T>& pool, bool received) : pool_(pool), received_(received) {}
+  T& next() {
+    const T& src = pool_[k_++ % pool_.size()];
+    if (!received_) return const_cast<T&>(src);
+    rx_ = src;
+    return rx_;
+  }
+  size_t count() const { return k_; }
+  void restart() { k_ = 0; }
+
+ private:
+  const std::vector<T>& pool_;
+  bool received_;
+  T rx_;
+  size_t k_ = 0;
+};
+
+// The driver's work on one frame: its packets assembled into a scan, then XYZ. A new frame id every call (written
+// into the packets), so that every call assembles a whole frame.
+class DecodeLine {
+ public:
+  explicit DecodeLine(const Frames& f) : fa_(f.info), lut_(make_xyz_lut(f.info.beams, f.info.columns_per_frame)) {}
+  void frame(FramePackets& pk) {
+    ++fid_;
+    out_.clear();
+    for (auto& p : pk) {
+      for (int c = 0; c < 16; ++c) std::memcpy(p.data() + c * 788 + 10, &fid_, 2);
+      fa_.add_packet(p.data(), p.size(), out_);
+    }
+    if (out_.empty()) return;
+    scan_to_xyz(out_.back(), lut_, xyz_);
+    benchmark::DoNotOptimize(xyz_.data());
+    fa_.recycle(std::move(out_.back()));
+  }
+
+ private:
+  os1::FrameAssembler fa_;
+  XyzLut lut_;
+  std::vector<Scan> out_;
+  std::vector<Eigen::Vector3f> xyz_;
+  uint16_t fid_ = 0;
+};
+
+// The pipeline's perception on one frame of the consecutive sequence: the sweep's IMU samples into the segmenter
+// (as the segmenter node gives them, before the scan), the scan segmented, its features extracted. At the
+// sequence's wrap a new segmenter, built by `wrap()` (outside any timing).
+class ImuLine {
+ public:
+  ImuLine(const Frames& f, bool received) : f_(f), scans_(pool(f), received) { wrap(); }
+  bool at_wrap() const { return scans_.count() == f_.consecutive.size(); }
+  void wrap() {
+    sg_ = std::make_unique<seg::RingSegmenter>(seg::SegmenterConfig{});
+    scans_.restart();
+  }
+  const Scan& receive() {
+    imu_ = &f_.consecutive[scans_.count()];
+    return *(scan_ = &scans_.next());
+  }
+  void frame() {
+    bench::feed_imu(*sg_, *imu_);
+    benchmark::DoNotOptimize(fx_.process(sg_->process(*scan_)).size());
+  }
+
+ private:
+  static const std::vector<Scan>& pool(const Frames& f) {
+    static const std::vector<Scan> scans = [&] {
+      std::vector<Scan> out;
+      for (const auto& fr : f.consecutive) out.push_back(fr.scan);
+      return out;
+    }();
+    return scans;
+  }
+  const Frames& f_;
+  Inputs<Scan> scans_;
+  const bench::ImuFrame* imu_ = nullptr;
+  const Scan* scan_ = nullptr;
+  std::unique_ptr<seg::RingSegmenter> sg_;
+  feat::FeatureExtractor fx_;
+};
+
 void BM_DecodeAndXyz(benchmark::State& st) {
   const auto& f = frames();
-  os1::FrameAssembler fa(f.info);
-  const XyzLut lut = make_xyz_lut(f.info.beams, f.info.columns_per_frame);
-  auto packets = f.packets;
-  std::vector<Scan> out;
-  std::vector<Eigen::Vector3f> xyz;
-  uint16_t fid = 0;
-  size_t k = 0;
+  DecodeLine line(f);
+  Inputs<FramePackets> in(f.packets, true);
   for (auto _ : st) {
-    auto& pk = packets[k++ % packets.size()];
-    ++fid;
-    out.clear();
-    for (auto& p : pk) {  // a new frame id every iteration: every iteration assembles a whole frame
-      for (int c = 0; c < 16; ++c) std::memcpy(p.data() + c * 788 + 10, &fid, 2);
-      fa.add_packet(p.data(), p.size(), out);
-    }
-    if (out.empty()) continue;
-    scan_to_xyz(out.back(), lut, xyz);
-    benchmark::DoNotOptimize(xyz.data());
-    fa.recycle(std::move(out.back()));
+    st.PauseTiming();
+    auto& pk = in.next();
+    st.ResumeTiming();
+    line.frame(pk);
   }
 }
 BENCHMARK(BM_DecodeAndXyz)->Unit(benchmark::kMicrosecond);
@@ -85,28 +172,25 @@ void BM_SegmenterPlusFeatures(benchmark::State& st) {
   const auto& f = frames();
   seg::RingSegmenter sg(seg::SegmenterConfig{});
   feat::FeatureExtractor fx;
-  size_t k = 0;
-  for (auto _ : st) benchmark::DoNotOptimize(fx.process(sg.process(f.scans[k++ % f.scans.size()])).size());
+  Inputs<Scan> in(f.scans, true);
+  for (auto _ : st) {
+    st.PauseTiming();
+    const Scan& scan = in.next();
+    st.ResumeTiming();
+    benchmark::DoNotOptimize(fx.process(sg.process(scan)).size());
+  }
 }
 BENCHMARK(BM_SegmenterPlusFeatures)->Unit(benchmark::kMicrosecond);
 
-// As in the pipeline: the segmenter with the IMU (each sweep's samples fed before its scan, as the segmenter
-// node does), then the features. The 144 frames are consecutive; at the wrap a new segmenter (outside the timing).
+// As in the pipeline: the segmenter with the IMU, then the features (ImuLine).
 void BM_SegmenterPlusFeaturesImu(benchmark::State& st) {
-  const auto& f = frames();
-  auto sg = std::make_unique<seg::RingSegmenter>(seg::SegmenterConfig{});
-  feat::FeatureExtractor fx;
-  size_t k = 0;
+  ImuLine line(frames(), true);
   for (auto _ : st) {
-    if (k == f.consecutive.size()) {
-      st.PauseTiming();
-      sg = std::make_unique<seg::RingSegmenter>(seg::SegmenterConfig{});
-      k = 0;
-      st.ResumeTiming();
-    }
-    const auto& fr = f.consecutive[k++];
-    bench::feed_imu(*sg, fr);
-    benchmark::DoNotOptimize(fx.process(sg->process(fr.scan)).size());
+    st.PauseTiming();
+    if (line.at_wrap()) line.wrap();
+    line.receive();
+    st.ResumeTiming();
+    line.frame();
   }
 }
 BENCHMARK(BM_SegmenterPlusFeaturesImu)->Unit(benchmark::kMicrosecond);
@@ -116,8 +200,13 @@ BENCHMARK(BM_SegmenterPlusFeaturesImu)->Unit(benchmark::kMicrosecond);
 void BM_SegmenterOnly(benchmark::State& st) {
   const auto& f = frames();
   seg::RingSegmenter sg(seg::SegmenterConfig{});
-  size_t k = 0;
-  for (auto _ : st) benchmark::DoNotOptimize(sg.process(f.scans[k++ % f.scans.size()]).wall.x.size());
+  Inputs<Scan> in(f.scans, true);
+  for (auto _ : st) {
+    st.PauseTiming();
+    const Scan& scan = in.next();
+    st.ResumeTiming();
+    benchmark::DoNotOptimize(sg.process(scan).wall.x.size());
+  }
 }
 BENCHMARK(BM_SegmenterOnly)->Unit(benchmark::kMicrosecond);
 
@@ -127,10 +216,64 @@ void BM_FeaturesOnly(benchmark::State& st) {
   std::vector<seg::Segmentation> segs;
   for (const auto& s : f.scans) segs.push_back(sg.process(s));
   feat::FeatureExtractor fx;
-  size_t k = 0;
-  for (auto _ : st) benchmark::DoNotOptimize(fx.process(segs[k++ % segs.size()]).size());
+  Inputs<seg::Segmentation> in(segs, true);
+  for (auto _ : st) {
+    st.PauseTiming();
+    const seg::Segmentation& sgm = in.next();
+    st.ResumeTiming();
+    benchmark::DoNotOptimize(fx.process(sgm).size());
+  }
 }
 BENCHMARK(BM_FeaturesOnly)->Unit(benchmark::kMicrosecond);
+
+// The ratio with the two lines alternated: blocks of 48 frames of each in turn, each frame timed in this thread's
+// CPU time (its input's copy not timed), so that what changes in the machine over the run (other processes, what
+// the shared caches hold) falls on both lines alike; the median and quartiles of the blocks' ratios.
+double thread_cpu_us() {
+  timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec * 1e6 + t.tv_nsec * 1e-3;
+}
+
+void alternated_ratio(int blocks, bool received) {
+  const auto& f = frames();
+  DecodeLine decode(f);
+  Inputs<FramePackets> packets(f.packets, received);
+  ImuLine imu(f, received);
+  constexpr int kFrames = 48;
+  for (int i = 0; i < 2 * kFrames; ++i) decode.frame(packets.next());  // warm both lines: a new segmenter's first
+  for (int i = 0; i < kFrames; ++i) imu.receive(), imu.frame();         // scans are slower than the steady ones
+  std::vector<double> d, s, r;
+  for (int b = 0; b < blocks; ++b) {
+    double busy = 0;
+    for (int i = 0; i < kFrames; ++i) {
+      auto& pk = packets.next();
+      const double t0 = thread_cpu_us();
+      decode.frame(pk);
+      busy += thread_cpu_us() - t0;
+    }
+    d.push_back(busy / kFrames);
+    busy = 0;
+    for (int i = 0; i < kFrames; ++i) {
+      if (imu.at_wrap()) imu.wrap();
+      imu.receive();
+      const double t0 = thread_cpu_us();
+      imu.frame();
+      busy += thread_cpu_us() - t0;
+    }
+    s.push_back(busy / kFrames);
+    r.push_back(s.back() / d.back());
+  }
+  auto q = [](std::vector<double> v, double p) {
+    std::sort(v.begin(), v.end());
+    return v[size_t(p * double(v.size() - 1) + 0.5)];
+  };
+  std::printf(
+      "alternated, %s, %d blocks of %d frames: decode + XYZ %.0f us, segmenter + features with the IMU %.0f us "
+      "(medians); ratio per block: median %.2fx, quartiles %.2fx - %.2fx%s\n",
+      received ? "inputs received (as in the pipeline)" : "inputs read from the pools (before the 31st round)",
+      blocks, kFrames, q(d, 0.5), q(s, 0.5), q(r, 0.5), q(r, 0.25), q(r, 0.75), received ? " (target <= 2x)" : "");
+}
 
 class RatioReporter : public benchmark::ConsoleReporter {
  public:
@@ -145,6 +288,14 @@ class RatioReporter : public benchmark::ConsoleReporter {
 }  // namespace
 
 int main(int argc, char** argv) {
+  int alternate_blocks = 40;  // --alternate=N: blocks of the alternated ratio (0: none)
+  for (int i = 1; i < argc; ++i)
+    if (std::strncmp(argv[i], "--alternate=", 12) == 0) {
+      alternate_blocks = std::atoi(argv[i] + 12);
+      for (int j = i; j + 1 < argc; ++j) argv[j] = argv[j + 1];
+      --argc;
+      --i;
+    }
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   RatioReporter rep;
@@ -158,5 +309,9 @@ int main(int argc, char** argv) {
   if (d > 0 && si > 0)
     std::cout << "with the IMU, as in the pipeline (consecutive frames of the same sequence): " << si << " us / " << d
               << " us = " << si / d << "x (target <= 2x)\n";
+  if (alternate_blocks > 0) {
+    alternated_ratio(alternate_blocks, true);
+    alternated_ratio(alternate_blocks, false);
+  }
   return 0;
 }
