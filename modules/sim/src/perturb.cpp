@@ -443,10 +443,14 @@ WorldEdit perturb_world(const FloorPlan& plan, const std::vector<V2>& path, cons
     }
   }
   measure(plan, world_of_plan, wp, w);
-  // A crowd: people walking 2-6 m straight lines (back and forth) near the path, never on it.
+  // A crowd: people walking 2-6 m straight lines (back and forth) near the path, never on it, and where the robot
+  // can see them: both ends and the middle of a person's line seen from 5 or more points of the path within 10 m
+  // (lines of sight through the world's walls). Without it, on the corridor loop every person landed in the loop's
+  // walled-in core or outside its outer walls (inside the plan's bounding box, 0.6 m off the path, 0.35 m off the
+  // walls: the corridor's own strip beside the path is narrow), and crowd-15 was the clean world.
   if (o.crowd > 0) {
     int people = 0;
-    for (int attempt = 0; attempt < 4000 && people < o.crowd; ++attempt) {
+    for (int attempt = 0; attempt < 20000 && people < o.crowd; ++attempt) {
       const V2 base = path[size_t(rng.uniform() * double(path.size())) % path.size()];
       const double ang = rng.uniform(0, 2 * M_PI), r = rng.uniform(0.8, 5.0);
       const V2 p0 = base + r * V2(std::cos(ang), std::sin(ang));
@@ -460,6 +464,12 @@ WorldEdit perturb_world(const FloorPlan& plan, const std::vector<V2>& path, cons
         if (d < 0.35 || dist_to_points(path, q) < 0.6 || q.x() < bb.min.x() || q.y() < bb.min.y() || q.x() > bb.max.x() ||
             q.y() > bb.max.y())
           ok = false;
+      }
+      for (const V2& q : {p0, V2(0.5 * (p0 + p1)), p1}) {
+        int seen = 0;
+        for (size_t k = 0; ok && k < path.size() && seen < 5; k += 5)
+          if ((path[k] - q).norm() < 10 && line_of_sight(wp, path[k], q, -1)) ++seen;
+        ok = ok && seen >= 5;
       }
       if (!ok) continue;
       Person p;

@@ -132,6 +132,35 @@ TEST(Perturb, AddedPartitionsAreSeenFromThePath) {
   }
 }
 
+// A crowd walks where the robot sees it: every person of crowd-15 on the corridor loop (seeds 1-4) has the middle
+// of its walking line in sight (a ray from the sensor's height reaches it) from 5 or more points of the path within
+// 10 m, and all 15 are placed. They used to land in the loop's walled-in core or outside its outer walls.
+TEST(Perturb, CrowdWalksWhereTheRobotSeesIt) {
+  SimulatorOptions o;
+  o.scenario = "corridor-loop-medium";
+  o.clutter = false;
+  o.shared_dir = "";
+  Simulator sim(FloorPlan{}, o);
+  const auto path = sim.motion().sample_path(0.1);
+  for (uint64_t seed = 1; seed <= 4; ++seed) {
+    const WorldEdit w = perturb_world(demo_corridor_plan(), path, perturb_family("crowd-15"), seed);
+    EXPECT_EQ(w.people.size(), 15u) << "seed " << seed;
+    const World world(w.world);
+    for (const auto& person : w.people) {
+      const V2 c = 0.5 * (person.path.front() + person.path.back());
+      int seen = 0;
+      for (const auto& p : path) {
+        const double d = (c - p).norm();
+        if (d >= 10) continue;
+        const V2 u = (c - p) / d;
+        const Hit h = world.cast(Eigen::Vector3d(p.x(), p.y(), 1.0), Eigen::Vector3d(u.x(), u.y(), 0), 30.0);
+        if (std::isfinite(h.t) && h.t > d - 0.05) ++seen;
+      }
+      EXPECT_GE(seen, 5) << "seed " << seed << ": person walking about (" << c.x() << ", " << c.y() << ")";
+    }
+  }
+}
+
 TEST(Perturb, DoorwaysOfTheDemoRoom) {
   const auto d = find_doorways(demo_room_plan());
   ASSERT_EQ(d.size(), 2u);  // the two doors of the room (inner faces; the outer faces are duplicates)
