@@ -384,6 +384,7 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
       if (cell.last_frame != frame) {
         cell.last_frame = frame;
         ++cell.frames;
+        if (cell.hit_frames.size() < kMaxHitFrames) cell.hit_frames.push_back(frame);
       }
       ++cell.points;
       Cell& vc = view_[cell_key(int(std::floor(p.x() / o_.new_view_cell_m)), int(std::floor(p.y() / o_.new_view_cell_m)))];
@@ -640,6 +641,7 @@ Diff PlanDiff::result() const {
   // New structure: cells hit in enough frames, then straight runs by greedy RANSAC.
   std::vector<V2> pts;
   std::vector<int> pf;
+  std::vector<const std::vector<int>*> ph;
   for (const auto& [k, c] : cells_) {
     if (c.frames < o_.new_min_frames) continue;
     const int ix = int(k >> 32), iy = int(int32_t(uint32_t(k & 0xffffffff)));
@@ -650,6 +652,7 @@ Diff PlanDiff::result() const {
     }
     pts.emplace_back((ix + 0.5) * o_.new_cell_m, (iy + 0.5) * o_.new_cell_m);
     pf.push_back(c.frames);
+    ph.push_back(&c.hit_frames);
   }
   // Deterministic order (the hash map's is not).
   std::vector<size_t> order(pts.size());
@@ -659,7 +662,32 @@ Diff PlanDiff::result() const {
   });
   std::vector<V2> P;
   std::vector<int> F;
-  for (size_t i : order) P.push_back(pts[i]), F.push_back(pf[i]);
+  std::vector<const std::vector<int>*> H;
+  for (size_t i : order) P.push_back(pts[i]), F.push_back(pf[i]), H.push_back(ph[i]);
+  // Was a run seen at once? Frames whose cells of the run cover, without a gap wider than new_max_gap_m, a stretch
+  // >= `span` along v (new_min_span_m): >= new_min_frames of them and >= new_min_span_share of the frames that hit
+  // the run. Two people pacing along one line are a gap apart, but for the moments they pass each other.
+  std::unordered_map<int, std::vector<double>> hits;  // frame -> positions along v of the cells it hit
+  auto seen_at_once = [&](const std::vector<std::pair<double, size_t>>& on, size_t s0, size_t k, const V2& v,
+                          const V2& m, double span) -> bool {
+    hits.clear();
+    for (size_t j = s0; j < k; ++j) {
+      const double t = v.dot(P[on[j].second] - m);
+      for (int f : *H[on[j].second]) hits[f].push_back(t);
+    }
+    int n = 0;
+    for (auto& [f, ts] : hits) {
+      std::sort(ts.begin(), ts.end());
+      double from = ts[0], longest = 0;
+      for (size_t i = 1; i <= ts.size(); ++i) {
+        if (i < ts.size() && ts[i] - ts[i - 1] <= o_.new_max_gap_m) continue;
+        longest = std::max(longest, ts[i - 1] - from + o_.new_cell_m);
+        if (i < ts.size()) from = ts[i];
+      }
+      if (longest >= span) ++n;
+    }
+    return n >= std::max(double(o_.new_min_frames), o_.new_min_span_share * double(hits.size()));
+  };
   std::vector<char> used(P.size(), 0);
   uint64_t rs = 0x9E3779B97F4A7C15ull;
   auto rnd = [&](size_t n) {
@@ -724,6 +752,13 @@ Diff PlanDiff::result() const {
         ns.extends = extended_element(ns.a, ns.b);
         // Shorter than new_min_length_m: only as a wall's continuation.
         if (!(len >= o_.new_min_length_m && n >= min_cells) && ns.extends < 0) {
+          s0 = k;
+          continue;
+        }
+        // Seen at once, as a wall is, not a trail swept over scan after scan. (A wall's continuation lies on the
+        // wall's own line, within ext_lateral_m: no one walks there.)
+        if (o_.new_min_span_m > 0 && ns.extends < 0 &&
+            !seen_at_once(on, s0, k, v, m, std::min(o_.new_min_span_m, 0.8 * (hi - lo + o_.new_cell_m)))) {
           s0 = k;
           continue;
         }

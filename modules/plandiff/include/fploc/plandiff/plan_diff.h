@@ -90,6 +90,13 @@ struct Options {
   double new_min_hit_ratio = 0.3;   // ... and whose view cell was hit in this share of the scans that had it
   double new_view_cell_m = 0.25;    // in view (nothing measured in front) is static structure
   double new_min_length_m = 0.8;    // shortest new wall reported
+  // A new wall is seen at once: its cells hit in one scan cover >= new_min_span_m of it without a gap wider than
+  // new_max_gap_m (or 0.8 of its length, if shorter), in >= new_min_frames scans and in >= new_min_span_share of the
+  // scans that hit it. A person pacing back and forth along a line leaves a straight trail
+  // of cells hit in many scans, but covers no more than its own width (~0.45 m) at a time. Not asked of a wall's
+  // continuation (extends >= 0). 0: off.
+  double new_min_span_m = 0.6;
+  double new_min_span_share = 0.2;
   double new_line_tol_m = 0.05;
   double new_max_gap_m = 0.3;
   double scale_max_offset_m = 0.1;  // points this close to their wall enter the drawing-scale estimate
@@ -204,7 +211,9 @@ class PlanDiff {
   };
   struct Cell {
     int frames = 0, last_frame = -1, points = 0, in_view = 0;
+    std::vector<int> hit_frames;  // new-structure cells: the frames that hit it (the first kMaxHitFrames)
   };
+  static constexpr size_t kMaxHitFrames = 256;
   double offset_sigma(const ElementDiff& e) const;
   bool halves_moved(const ElementDiff& e) const;
   // dir: the local direction of the structure p lies on (unit; nullptr: none known); candidates not along it are
