@@ -10,6 +10,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -199,6 +200,9 @@ Result Localizer::process(const Scan& s, std::optional<double> dyaw) {
     vx_ = (c * dx + sn * dy) / dt;
     vy_ = (-sn * dx + c * dy) / dt;
     w_ = wrap(r.yaw - yaw_) / dt;
+    const double speed = std::hypot(vx_, vy_);
+    if (cfg_.max_speed_mps > 0 && speed > cfg_.max_speed_mps) vx_ *= cfg_.max_speed_mps / speed, vy_ *= cfg_.max_speed_mps / speed;
+    if (cfg_.max_yaw_rate_rps > 0) w_ = std::clamp(w_, -cfg_.max_yaw_rate_rps, cfg_.max_yaw_rate_rps);
   }
   x_ = r.x, y_ = r.y, yaw_ = r.yaw, t_ = s.t;
   return r;

@@ -139,6 +139,27 @@ TEST(NdtLocalizer, UnusableScanKeepsThePredictionAndEndsLost) {
   EXPECT_GE(r.covariance(0, 0), 1.0);
 }
 
+// A match 0.09 m from the last pose 0.02 s later is 4.7 m/s; the prediction flies on at the platform's top speed
+// (max_speed_mps, 2 m/s) at most while the next scans are unusable.
+TEST(NdtLocalizer, PredictionSpeedIsThePlatformsAtMost) {
+  const FloorPlan plan = sim::demo_room_plan();
+  Localizer loc(plan);
+  const double x = 5.8, y = 3.2, yaw = -1.44;
+  loc.set_pose(x, y, yaw);
+  Result r = loc.process(cast_scan(plan, x, y, yaw, 1.0, 0.1));
+  ASSERT_TRUE(r.matched) << r.text;
+  const double x0 = r.x, y0 = r.y;
+  r = loc.process(cast_scan(plan, x + 0.05, y - 0.08, yaw, 1.0, 0.12));
+  ASSERT_TRUE(r.matched) << r.text;
+  ASSERT_GT(std::hypot(r.x - x0, r.y - y0), 0.06);  // > 3 m/s
+  const double x1 = r.x, y1 = r.y;
+  Scan empty;
+  empty.t = 0.14;
+  r = loc.process(empty);
+  EXPECT_FALSE(r.matched);
+  EXPECT_NEAR(std::hypot(r.x - x1, r.y - y1), 0.04, 0.002);  // 2 m/s for 0.02 s
+}
+
 TEST(NdtLocalizer, BadConfigIsRejected) {
   Config c;
   c.resolution_m = 0;

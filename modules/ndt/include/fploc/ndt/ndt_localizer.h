@@ -42,6 +42,11 @@ struct Config {
   double poor_sigma_m = 0.3;       // ... and the largest x/y 1-sigma within this
   double min_inlier_ratio = 0.2;   // below: the match is not used (the prediction is kept)
   int lost_after = 10;             // consecutive unusable scans -> LOST
+  // The constant-velocity prediction's speed is the platform's at most (hdl_localization predicts with a UKF
+  // whose velocity a single jumping match moves only in part): one match 1.3 m off the last pose is not 13 m/s
+  // to fly on, scan after scan, while the matches are unusable. <= 0: no limit.
+  double max_speed_mps = 2.0;
+  double max_yaw_rate_rps = 2.0;
 };
 
 enum class Status : int { kOk = 0, kPoor = 1, kLost = 2, kNotInitialised = 3 };
