@@ -30,6 +30,8 @@ Config with_uncertainty_defaults(Config c) {
   c.uncertainty.frame.loss_scale_m = c.matcher.loss_scale_m;
   c.uncertainty.frame.gate_m = c.matcher.min_correspondence_m;
   c.uncertainty.frame.group_rule = c.matcher.group_rule;
+  // A second fit's structure counts from as many points as the matcher takes for a fit.
+  if (c.uncertainty.rival_min_gained < 0) c.uncertainty.rival_min_gained = c.matcher.min_inliers;
   // The odometry's error model is the matcher's (its window and the tracker's prediction agree).
   c.uncertainty.odom_sigma_m = c.matcher.odom_sigma_m;
   c.uncertainty.odom_sigma_per_m = c.matcher.odom_sigma_per_m;

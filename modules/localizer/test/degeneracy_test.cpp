@@ -576,8 +576,8 @@ TEST(Degeneracy, ShelvesAcrossACorridorEndAreNoEndWall) {
   };
   for (const Case& c : {Case{"corridor, shelves across its end", &corridor, &shelved, {1.2, 1.0, 0}, UncertaintyConfig{}.rival_min_gained, false, 0},
                         Case{"... rival_ratio alone", &corridor, &shelved, {1.2, 1.0, 0}, 0, true, 0},
-                        Case{"corridor, no shelves", &corridor, &corridor, {1.2, 1.0, 0}, 15, false, 30},
-                        Case{"room with pillars", &room, &room, {5, 5, 0.3}, 15, false, 30}}) {
+                        Case{"corridor, no shelves", &corridor, &corridor, {1.2, 1.0, 0}, -1, false, 30},
+                        Case{"room with pillars", &room, &room, {5, 5, 0.3}, -1, false, 30}}) {
     auto map = make_localization_map(*c.plan, "brute-force");
     localizer::Config cfg;
     cfg.uncertainty.rival_min_gained = c.min_gained;
