@@ -2,6 +2,7 @@
 
 #include "fploc/matcher/free_space_check.h"
 #include "fploc/matcher/plan_terms.h"
+#include "fploc/localizer/rival.h"
 
 #include <algorithm>
 #include <cmath>
@@ -29,6 +30,8 @@ Config with_uncertainty_defaults(Config c) {
   c.uncertainty.frame.loss_scale_m = c.matcher.loss_scale_m;
   c.uncertainty.frame.gate_m = c.matcher.min_correspondence_m;
   c.uncertainty.frame.group_rule = c.matcher.group_rule;
+  // A second fit's structure counts from as many points as the matcher takes for a fit.
+  if (c.uncertainty.rival_min_gained < 0) c.uncertainty.rival_min_gained = c.matcher.min_inliers;
   // The odometry's error model is the matcher's (its window and the tracker's prediction agree).
   c.uncertainty.odom_sigma_m = c.matcher.odom_sigma_m;
   c.uncertainty.odom_sigma_per_m = c.matcher.odom_sigma_per_m;
@@ -279,17 +282,39 @@ void Localizer::check_rival(const FeatureFrame& f, const Pose2& fix, const DeadR
     return std::hypot(p.x - fix.x, p.y - fix.y) > u.rival_distance_m || std::abs(wrap_angle(p.yaw - fix.yaw)) > u.rival_distance_rad;
   };
   const int stride = matcher::budget_stride(f.points.size(), mc.stride, mc.max_points);  // as register_frame's fit
+  // Another explanation of the scan (rival.h): it explains structure the fix leaves off the plan, and what it leaves
+  // off could stand in front of the plan's walls.
+  auto explains_otherwise = [&](const Pose2& p, FitComparison* out) {
+    // Within the searched region only: a fit that converged farther is another place along the plan (a corridor's
+    // twin stretch), not a second reading of this one.
+    if (!(u.rival_min_gained > 0) || std::hypot(p.x - fix.x, p.y - fix.y) > u.rival_search_m) return false;
+    const FitComparison c = compare_fits(lookup_, f, fix, p, mc.inlier_m, stride);
+    if (out) *out = c;
+    return c.gained_structure >= u.rival_min_gained && c.lost_behind <= u.rival_max_behind_share * c.lost;
+  };
+  const int own = matcher::evaluate_fit(lookup_, f, fix, mc.inlier_m, stride).num_inliers;
   std::optional<Pose2> rival;
   int rival_inliers = 0;
+  bool otherwise = false;
+  FitComparison cmp;
   if (have_rival_) {
     // Carried with the track, registered again (the tracking gate).
     matcher::MatcherConfig mt = mc;
     mt.max_correspondence_m = std::min(mc.max_correspondence_m, mc.gate_tracking_m);
     const matcher::MatchResult m = matcher::register_frame(lookup_, f, compose(fix, rival_offset_), mt);
-    if (m.status == matcher::FitStatus::kOk && distinct(m.solved)) rival = m.solved, rival_inliers = m.fit.num_inliers;
+    if (m.status == matcher::FitStatus::kOk && distinct(m.solved)) {
+      otherwise = explains_otherwise(m.solved, &cmp);
+      // Kept while it is still an ambiguity; else searched again (another place may be one now).
+      if (otherwise || m.fit.num_inliers >= u.rival_ratio * own || !(u.rival_min_gained > 0))
+        rival = m.solved, rival_inliers = m.fit.num_inliers;
+    }
   }
   if (!rival) {
-    // None (yet, or it was lost): registrations from two rings of starts around the fix; the best distinct fit.
+    // None (yet, or it was lost): registrations from two rings of starts around the fix; the best distinct fit that
+    // explains the scan otherwise, else the best distinct fit.
+    std::vector<std::pair<int, Pose2>> fits;
+    std::optional<Pose2> best;
+    int best_inliers = 0;
     for (double r : {0.5 * u.rival_search_m, u.rival_search_m}) {
       mc.max_correspondence_m = std::max(mc.min_correspondence_m, 0.7 * r);
       for (int k = 0; k < 8; ++k) {
@@ -297,16 +322,29 @@ void Localizer::check_rival(const FeatureFrame& f, const Pose2& fix, const DeadR
         const matcher::MatchResult m =
             matcher::register_frame(lookup_, f, Pose2{fix.x + r * std::cos(a), fix.y + r * std::sin(a), fix.yaw}, mc);
         if (m.status != matcher::FitStatus::kOk || !distinct(m.solved)) continue;
-        if (!rival || m.fit.num_inliers > rival_inliers) rival = m.solved, rival_inliers = m.fit.num_inliers;
+        if (!best || m.fit.num_inliers > best_inliers) best = m.solved, best_inliers = m.fit.num_inliers;
+        bool seen = false;  // several starts end in one fit
+        for (const auto& q : fits)
+          seen |= std::hypot(q.second.x - m.solved.x, q.second.y - m.solved.y) < 0.05 &&
+                  std::abs(wrap_angle(q.second.yaw - m.solved.yaw)) < 0.01;
+        if (!seen) fits.emplace_back(m.fit.num_inliers, m.solved);
       }
     }
+    std::stable_sort(fits.begin(), fits.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+    for (const auto& q : fits) {
+      FitComparison c;
+      if (explains_otherwise(q.second, &c)) {
+        rival = q.second, rival_inliers = q.first, otherwise = true, cmp = c;
+        break;
+      }
+    }
+    if (!rival) rival = best, rival_inliers = best_inliers;
   }
   have_rival_ = rival.has_value();
   if (!rival) return;
   rival_offset_ = between(fix, *rival);
-  const int own = matcher::evaluate_fit(lookup_, f, fix, mc.inlier_m, stride).num_inliers;
   const double share = double(rival_inliers) / double(std::max(1, own));
-  if (share < u.rival_ratio) return;
+  if (share < u.rival_ratio && !otherwise) return;
   if (dr && u.dead_reckoning_gate_sigma > 0 && !uncertainty_.off_dead_reckoning) {
     // The dead reckoning tells them apart: the fix within its gate (else the tracker said so), the rival beyond.
     const Pose2 r_at_utime = compose(fix_at_utime, between(fix, *rival));
@@ -316,8 +354,12 @@ void Localizer::check_rival(const FeatureFrame& f, const Pose2& fix, const DeadR
   }
   const Eigen::Vector3d d(rival->x - fix.x, rival->y - fix.y, wrap_angle(rival->yaw - fix.yaw));
   char b[200];
-  std::snprintf(b, sizeof b, "re-acquired: a second fit %.2f m / %.1f deg away explains %.0f %% as many points", std::hypot(d[0], d[1]),
-                std::abs(d[2]) * 180 / M_PI, 100 * share);
+  if (share >= u.rival_ratio)
+    std::snprintf(b, sizeof b, "re-acquired: a second fit %.2f m / %.1f deg away explains %.0f %% as many points", std::hypot(d[0], d[1]),
+                  std::abs(d[2]) * 180 / M_PI, 100 * share);
+  else
+    std::snprintf(b, sizeof b, "re-acquired: a second fit %.2f m / %.1f deg away explains %d points the fix leaves off the plan "
+                  "(%d of its own off it, in front of the walls)", std::hypot(d[0], d[1]), std::abs(d[2]) * 180 / M_PI, cmp.gained, cmp.lost);
   if (uncertainty_.status == matcher::FitStatus::kOk || uncertainty_.confirming) uncertainty_.text = b;
   if (uncertainty_.status == matcher::FitStatus::kOk) uncertainty_.status = matcher::FitStatus::kPoor;
   uncertainty_.covariance += d * d.transpose();

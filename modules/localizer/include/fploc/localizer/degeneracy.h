@@ -27,7 +27,9 @@
 // where many of them lie (max_contradicted; occupancy-map plans only), and, after any frame published other than
 // OK, while a fix lies beyond the gate of the dead-reckoned pose (a pose published OK carried on by the LiDAR odometry
 // since: dead_reckoning_gate_sigma; the Localizer runs that odometry), and while a re-acquisition has
-// a second fit that explains nearly as many points (rival_ratio; the Localizer searches it).
+// a second fit that explains nearly as many points (rival_ratio; the Localizer searches it) or that explains the scan
+// otherwise (structure the fix leaves off the plan, while what it leaves off could stand in front of the walls:
+// rival_min_gained, rival.h).
 #pragma once
 #include <Eigen/Core>
 #include <cmath>
@@ -134,6 +136,14 @@ struct UncertaintyConfig {
   // them apart (the fix within its gate, the rival beyond). The registrations use the Localizer's MatcherConfig.
   // 0: off.
   double rival_ratio = 0.8;
+  // ... or while a second fit within rival_search_m explains the scan otherwise (rival.h): it puts at least
+  // rival_min_gained points on one plan element that the fix leaves off the plan (structure, not chance hits), and of
+  // the points it leaves off that the fix puts on, at most rival_max_behind_share lie beyond a drawn wall seen from it
+  // (clutter stands in front of walls). Among the search's fits the one with most inliers that does so is the rival; a
+  // carried rival that is neither is searched again. -1: the matcher's min_inliers (the fewest points it takes as a
+  // fit; the Localizer copies it); 0: off (rival_ratio alone).
+  int rival_min_gained = -1;
+  double rival_max_behind_share = 0.1;
   double rival_search_m = 1.0;
   double rival_distance_m = 0.25, rival_distance_rad = 5.0 * M_PI / 180;
 };

@@ -163,8 +163,9 @@ class Localizer {
   double dr_path_m_ = 0, dr_turn_rad_ = 0;  // running totals
   int64_t dr_last_utime_ = 0;
   Eigen::Vector2d dr_velocity_ = Eigen::Vector2d::Zero();  // the odometry's over its last frame
-  // The second fit of a re-acquisition (UncertaintyConfig::rival_ratio): searched while none is known during a
-  // confirmation, then carried with the fix; applied to uncertainty_.
+  // The second fit of a re-acquisition (UncertaintyConfig::rival_ratio, rival_min_gained; rival.h): searched while
+  // none is known during a confirmation (or the one carried is no ambiguity any more), then carried with the fix;
+  // applied to uncertainty_.
   // (dr: the frame's dead-reckoned pose, if any: a rival beyond its gate is no ambiguity.)
   void check_rival(const FeatureFrame& deskewed, const Pose2& fix_at_ref, const DeadReckoned* dr, const Pose2& fix_at_utime);
   bool have_rival_ = false;

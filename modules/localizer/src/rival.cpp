@@ -1,0 +1,79 @@
+#include "fploc/localizer/rival.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+#include "fploc/matcher/assignment.h"
+#include "fploc/matcher/plan_terms.h"
+#include "fploc/matcher/types.h"
+
+namespace fploc::localizer {
+
+namespace {
+double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// Squared distance from p to the nearest of the lookup's candidate targets (as evaluate_fit measures it), and which.
+double nearest2(const matcher::NearestLookup& lookup, const std::vector<matcher::TargetGeom>& g, const Eigen::Vector2d& p,
+                int* which) {
+  int cand[matcher::kMaxCandidates];
+  const int n = lookup.candidates(p, cand, matcher::kMaxCandidates);
+  double best = std::numeric_limits<double>::infinity();
+  *which = -1;
+  Eigen::Vector2d q;
+  for (int i = 0; i < n; ++i) {
+    const double d = matcher::closest_of(g, cand + i, 1, p, &q, nullptr);
+    if (d * d < best) best = d * d, *which = cand[i];
+  }
+  return best;
+}
+}  // namespace
+
+bool seen_through_plan(const std::vector<matcher::TargetGeom>& geometry, const Eigen::Vector2d& from, const Eigen::Vector2d& to,
+                       double margin_m) {
+  const Eigen::Vector2d r = to - from;
+  const double len = r.norm();
+  if (!(len > margin_m)) return false;
+  const double t_max = (len - margin_m) / len;  // crossings before this fraction of the ray hide the point
+  for (const matcher::TargetGeom& t : geometry) {
+    if (t.kind != ElementKind::kSegment || !(t.len > 0)) continue;
+    const Eigen::Vector2d s = t.b - t.a;
+    const double den = cross2(r, s);
+    if (std::abs(den) < 1e-12) continue;  // parallel: grazes, hides nothing
+    const Eigen::Vector2d q = t.a - from;
+    const double tr = cross2(q, s) / den;  // along the ray
+    const double ts = cross2(q, r) / den;  // along the segment
+    if (tr > 0 && tr < t_max && ts >= 0 && ts <= 1) return true;
+  }
+  return false;
+}
+
+FitComparison compare_fits(const matcher::NearestLookup& lookup, const FeatureFrame& f, const Pose2& fix, const Pose2& rival,
+                           double inlier_m, int stride) {
+  FitComparison c;
+  const auto& g = lookup.geometry();
+  const double in2 = inlier_m * inlier_m;
+  const Eigen::Vector2d sensor(rival.x, rival.y);
+  const size_t st = size_t(std::max(1, stride));
+  std::unordered_map<int, int> gained_on;  // gained points per plan element
+  for (size_t i = 0; i < f.points.size(); i += st) {
+    ++c.points;
+    const Eigen::Vector2d pf = matcher::transform(fix, f.points[i].p), pr = matcher::transform(rival, f.points[i].p);
+    int ef = -1, er = -1;
+    const bool at_fix = nearest2(lookup, g, pf, &ef) <= in2, at_rival = nearest2(lookup, g, pr, &er) <= in2;
+    c.fix_inliers += at_fix;
+    c.rival_inliers += at_rival;
+    if (at_rival && !at_fix) {
+      ++c.gained;
+      if (er >= 0) c.gained_structure = std::max(c.gained_structure, ++gained_on[er]);
+    }
+    if (at_fix && !at_rival) {
+      ++c.lost;
+      if (seen_through_plan(g, sensor, pr, inlier_m)) ++c.lost_behind;
+    }
+  }
+  return c;
+}
+
+}  // namespace fploc::localizer
