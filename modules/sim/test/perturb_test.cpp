@@ -103,60 +103,63 @@ TEST(Perturb, RenovationTruthMatchesTheWorld) {
   EXPECT_EQ(w.world.elements.size(), size_t(plan.elements.size() - removed + 2));
 }
 
-// An added partition is a renovation the robot can find: seen from the path (a ray from the sensor's height at
-// 10 or more points of the path within 12 m reaches it). On the corridor loop, partitions used to land in the
-// loop's walled-in core (seed 1: both), where nothing could see them.
-TEST(Perturb, AddedPartitionsAreSeenFromThePath) {
+namespace {
+
+std::vector<V2> corridor_path() {
   SimulatorOptions o;
   o.scenario = "corridor-loop-medium";
   o.clutter = false;
   o.shared_dir = "";
   Simulator sim(FloorPlan{}, o);
-  const auto path = sim.motion().sample_path(0.1);
+  return sim.motion().sample_path(0.1);
+}
+
+// How many points of the path within max_range_m see c: a level ray from the sensor's height (1 m) in the world
+// reaches it.
+int seen_from_path(const World& world, const std::vector<V2>& path, const V2& c, double max_range_m) {
+  int seen = 0;
+  for (const auto& p : path) {
+    const double d = (c - p).norm();
+    if (d >= max_range_m) continue;
+    const V2 u = (c - p) / d;
+    const Hit h = world.cast(Eigen::Vector3d(p.x(), p.y(), 1.0), Eigen::Vector3d(u.x(), u.y(), 0), 30.0);
+    if (std::isfinite(h.t) && h.t > d - 0.05) ++seen;
+  }
+  return seen;
+}
+
+}  // namespace
+
+// An added partition is a renovation the robot can find: seen from the path (a ray from the sensor's height at
+// 10 or more points of the path within 12 m reaches it). On the corridor loop, partitions used to land in the
+// loop's walled-in core (seed 1: both), where nothing could see them.
+TEST(Perturb, AddedPartitionsAreSeenFromThePath) {
+  const auto path = corridor_path();
   for (uint64_t seed = 1; seed <= 4; ++seed) {
     const WorldEdit w = perturb_world(demo_corridor_plan(), path, perturb_family("renovated"), seed);
     const World world(w.world);
     for (const auto& a : w.added) {
       if (a.kind != "partition") continue;
       const V2 c = 0.5 * (a.a + a.b);
-      int seen = 0;
-      for (const auto& p : path) {
-        const double d = (c - p).norm();
-        if (d >= 12) continue;
-        const V2 u = (c - p) / d;
-        const Hit h = world.cast(Eigen::Vector3d(p.x(), p.y(), 1.0), Eigen::Vector3d(u.x(), u.y(), 0), 30.0);
-        if (std::isfinite(h.t) && h.t > d - 0.05) ++seen;
-      }
-      EXPECT_GE(seen, 10) << "seed " << seed << ": partition at (" << c.x() << ", " << c.y() << ")";
+      EXPECT_GE(seen_from_path(world, path, c, 12), 10) << "seed " << seed << ": partition at (" << c.x() << ", "
+                                                        << c.y() << ")";
     }
   }
 }
 
 // A crowd walks where the robot sees it: every person of crowd-15 on the corridor loop (seeds 1-4) has the middle
-// of its walking line in sight (a ray from the sensor's height reaches it) from 5 or more points of the path within
-// 10 m, and all 15 are placed. They used to land in the loop's walled-in core or outside its outer walls.
+// of its walking line in sight from 5 or more points of the path within 10 m, and all 15 are placed. They used to
+// land in the loop's walled-in core or outside its outer walls.
 TEST(Perturb, CrowdWalksWhereTheRobotSeesIt) {
-  SimulatorOptions o;
-  o.scenario = "corridor-loop-medium";
-  o.clutter = false;
-  o.shared_dir = "";
-  Simulator sim(FloorPlan{}, o);
-  const auto path = sim.motion().sample_path(0.1);
+  const auto path = corridor_path();
   for (uint64_t seed = 1; seed <= 4; ++seed) {
     const WorldEdit w = perturb_world(demo_corridor_plan(), path, perturb_family("crowd-15"), seed);
     EXPECT_EQ(w.people.size(), 15u) << "seed " << seed;
     const World world(w.world);
     for (const auto& person : w.people) {
       const V2 c = 0.5 * (person.path.front() + person.path.back());
-      int seen = 0;
-      for (const auto& p : path) {
-        const double d = (c - p).norm();
-        if (d >= 10) continue;
-        const V2 u = (c - p) / d;
-        const Hit h = world.cast(Eigen::Vector3d(p.x(), p.y(), 1.0), Eigen::Vector3d(u.x(), u.y(), 0), 30.0);
-        if (std::isfinite(h.t) && h.t > d - 0.05) ++seen;
-      }
-      EXPECT_GE(seen, 5) << "seed " << seed << ": person walking about (" << c.x() << ", " << c.y() << ")";
+      EXPECT_GE(seen_from_path(world, path, c, 10), 5) << "seed " << seed << ": person walking about (" << c.x()
+                                                       << ", " << c.y() << ")";
     }
   }
 }
