@@ -5,6 +5,7 @@
 #include <limits>
 #include <unordered_map>
 
+#include "fploc/core/segment2d.h"
 #include "fploc/matcher/assignment.h"
 #include "fploc/matcher/plan_terms.h"
 #include "fploc/matcher/types.h"
@@ -12,8 +13,6 @@
 namespace fploc::localizer {
 
 namespace {
-double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
-
 // Squared distance from p to the nearest of the lookup's candidate targets (as evaluate_fit measures it), and which.
 double nearest2(const matcher::NearestLookup& lookup, const std::vector<matcher::TargetGeom>& g, const Eigen::Vector2d& p,
                 int* which) {
@@ -35,17 +34,10 @@ bool seen_through_plan(const std::vector<matcher::TargetGeom>& geometry, const E
   const Eigen::Vector2d r = to - from;
   const double len = r.norm();
   if (!(len > margin_m)) return false;
-  const double t_max = (len - margin_m) / len;  // crossings before this fraction of the ray hide the point
-  for (const matcher::TargetGeom& t : geometry) {
-    if (t.kind != ElementKind::kSegment || !(t.len > 0)) continue;
-    const Eigen::Vector2d s = t.b - t.a;
-    const double den = cross2(r, s);
-    if (std::abs(den) < 1e-12) continue;  // parallel: grazes, hides nothing
-    const Eigen::Vector2d q = t.a - from;
-    const double tr = cross2(q, s) / den;  // along the ray
-    const double ts = cross2(q, r) / den;  // along the segment
-    if (tr > 0 && tr < t_max && ts >= 0 && ts <= 1) return true;
-  }
+  // Crossings on the ray short of margin_m before `to` hide the point.
+  const Eigen::Vector2d short_of = from + r * ((len - margin_m) / len);
+  for (const matcher::TargetGeom& t : geometry)
+    if (t.kind == ElementKind::kSegment && t.len > 0 && segments_cross(from, short_of, t.a, t.b)) return true;
   return false;
 }
 

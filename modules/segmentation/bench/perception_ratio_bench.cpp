@@ -25,6 +25,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <utility>
 
 #include "fploc/core/xyz.h"
 #include "fploc/features/features.h"
@@ -71,14 +72,15 @@ const Frames& frames() {
 }
 
 // A pool's items in turn, each copied into one reused buffer (its capacity kept) before it is worked on: the
-// input as the pipeline receives it. With `received` false, the pool's own item (read from wherever it lies).
+// input as the pipeline receives it. With `received` false, the pool's own item (read from wherever it lies). The
+// pool is its own copy (the decode writes its frame ids into the packets).
 template <class T>
 class Inputs {
  public:
-  Inputs(const std::vector<T>& pool, bool received) : pool_(pool), received_(received) {}
+  Inputs(std::vector<T> pool, bool received) : pool_(std::move(pool)), received_(received) {}
   T& next() {
-    const T& src = pool_[k_++ % pool_.size()];
-    if (!received_) return const_cast<T&>(src);
+    T& src = pool_[k_++ % pool_.size()];
+    if (!received_) return src;
     rx_ = src;
     return rx_;
   }
@@ -86,7 +88,7 @@ class Inputs {
   void restart() { k_ = 0; }
 
  private:
-  const std::vector<T>& pool_;
+  std::vector<T> pool_;
   bool received_;
   T rx_;
   size_t k_ = 0;
@@ -139,13 +141,10 @@ class ImuLine {
   }
 
  private:
-  static const std::vector<Scan>& pool(const Frames& f) {
-    static const std::vector<Scan> scans = [&] {
-      std::vector<Scan> out;
-      for (const auto& fr : f.consecutive) out.push_back(fr.scan);
-      return out;
-    }();
-    return scans;
+  static std::vector<Scan> pool(const Frames& f) {
+    std::vector<Scan> out;
+    for (const auto& fr : f.consecutive) out.push_back(fr.scan);
+    return out;
   }
   const Frames& f_;
   Inputs<Scan> scans_;
