@@ -338,7 +338,12 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
   np_ = (n + 3) & ~size_t(3);  // NaN-padded (Candidates)
   n_ = n;
   cand_ = &c;
+  // A plane followed steadily: last frame's plane is this role's last result and the search is not due.
+  Steady& st = steady_[role == PlaneRole::kCeiling ? 0 : 1];
+  const bool steady = previous && st.left > 0 && *previous == st.plane;
+  if (!steady) st.left = 0;
   for (auto [sub, stride] : {std::pair{&sub_start_, start_stride_}, std::pair{&sub_final_, final_stride_}}) {
+    if (steady && sub == &sub_start_) continue;  // (the start's subsample: only the search scores on it)
     sub->resize((n + stride - 1) / stride);
     if (ck::available() && kern::wide()) {
       ck::strided(xs_, ys_, zs_, sub->n, stride, sub->x.data(), sub->y.data(), sub->z.data());
@@ -352,6 +357,66 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
     }
     sub->pad();
   }
+  const float thr = float(cfg_.inlier_threshold_m);
+  auto score = [&](const Eigen::Vector4d& pl) { return score_band(sub_final_, final_stride_, pl, thr); };
+  std::optional<Fit> res1;
+  if (steady) {
+    // Last frame's plane refined alone. It must keep its support (else the walls captured it) and end within a
+    // step the search would not be needed for; otherwise the search runs on this scan.
+    --st.left;
+    const auto r = refine(up, *previous, cfg_.irls_initial_scale_m, k::kMinCutM, false, nullptr);
+    const double support = r ? score(r->pl) : 0.0;
+    if (r && support >= score(*previous) && support >= k::kSteadyMinSupport * st.support &&
+        std::acos(std::clamp(r->pl.head<3>().dot(previous->head<3>()), -1.0, 1.0)) < k::kSteadyStepDeg * k::kDeg &&
+        std::abs(r->pl[3] - (*previous)[3]) < k::kSteadyStepM) {
+      res1 = r;
+      ++steady_fits_;
+    } else {
+      st.left = 0;
+      if (start_stride_ > 0) {  // the start's subsample, skipped above
+        sub_start_.resize((n + start_stride_ - 1) / start_stride_);
+        if (ck::available() && kern::wide()) {
+          ck::strided(xs_, ys_, zs_, sub_start_.n, start_stride_, sub_start_.x.data(), sub_start_.y.data(), sub_start_.z.data());
+        } else {
+          for (size_t i = 0, j = 0; i < n; i += start_stride_, ++j) {
+            sub_start_.x[j] = xs_[i];
+            sub_start_.y[j] = ys_[i];
+            sub_start_.z[j] = zs_[i];
+          }
+        }
+        sub_start_.pad();
+      }
+    }
+  }
+  if (!res1 && !search(c, up, previous, role, res1)) return false;
+  // Ceiling only: a refit at a fixed cut-off of tight_refit_sigmas robust sigmas (>= 1 cm) of the result.
+  // Where two surfaces meet (a sloped ceiling patch next to the flat ceiling) the Tukey fit at 4.7 sigma
+  // settles on a compromise tilted a few tenths of a degree between them; at ~2.5 sigma only the dominant
+  // surface keeps its support. The tighter of the two wins on the narrow-band support.
+  auto select_band = [&](double s1, double s2) {
+    return float(std::clamp(k::kSelectBandSigmas * std::min(s1, s2), k::kSelectBandMinM, cfg_.inlier_threshold_m));
+  };
+  if (res1 && role == PlaneRole::kCeiling && cfg_.tight_refit_sigmas > 0) {
+    const double ct = std::max(cfg_.tight_refit_sigmas * res1->sigma, k::kTightMinCutM);
+    // (joined: its first step showed it stays at res1's plane, within 0.01 deg / 1 mm: nothing to choose)
+    if (const auto tight = refine(up, res1->pl, ct, ct, true, &*res1); tight && !tight->joined) {
+      const float t_sel = select_band(res1->sigma, tight->sigma);
+      if (score_band(sub_final_, final_stride_, tight->pl, t_sel) > score_band(sub_final_, final_stride_, res1->pl, t_sel)) res1 = tight;
+    }
+  }
+  if (!res1) return false;
+  plane = res1->pl;
+  st.plane = plane;
+  st.support = score(plane);
+  return true;
+}
+
+// The search for the start (seeds, regression, triplets, last frame's plane), its refinement and last frame's
+// plane's; `res1` the better (Fit), st.left set when the plane is followed steadily from here.
+bool RingPlaneFit::search(const Candidates& c, const Eigen::Vector3d& up, const Eigen::Vector4d* previous,
+                          PlaneRole role, std::optional<Fit>& res1) {
+  Steady& st = steady_[role == PlaneRole::kCeiling ? 0 : 1];
+  st.left = 0;
   pick_seeds(c, up.cast<float>());
   Eigen::Vector4d cur;
   if (!choose_start(c, up, previous, cur)) return false;
@@ -372,7 +437,9 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
     if (r && (r->joined || score(r->pl) >= score(start))) return r;
     return Fit{start, cfg_.inlier_threshold_m / 3};
   };
-  std::optional<Fit> res1 = refine_guarded(cur, nullptr);
+  res1 = refine_guarded(cur, nullptr);
+  // Followed steadily from here: the start was last frame's plane, or its refinement joined the start's.
+  bool followed = previous && (cur - *previous).norm() <= 1e-9 && res1 && res1->pl != cur;
   if (previous && (cur - *previous).norm() > 1e-9) {
     // When the first refinement moved its start (it passed the guard), the second stops once it reaches that
     // plane: the usual case, both starts lie in the same plane's basin.
@@ -380,6 +447,7 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
     const std::optional<Fit> res2 = refine_guarded(*previous, res1_refined ? &*res1 : nullptr);
     if (res2 && res2->joined) {
       // the same plane: nothing to choose
+      followed = true;
     } else if (res2 && res1) {
       const float t_sel = select_band(res1->sigma, res2->sigma);
       if (score_band(sub_final_, final_stride_, res2->pl, t_sel) > score_band(sub_final_, final_stride_, res1->pl, t_sel)) res1 = res2;
@@ -387,21 +455,8 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
       res1 = res2;
     }
   }
-  // Ceiling only: a refit at a fixed cut-off of tight_refit_sigmas robust sigmas (>= 1 cm) of the result.
-  // Where two surfaces meet (a sloped ceiling patch next to the flat ceiling) the Tukey fit at 4.7 sigma
-  // settles on a compromise tilted a few tenths of a degree between them; at ~2.5 sigma only the dominant
-  // surface keeps its support. The tighter of the two wins on the narrow-band support.
-  if (res1 && role == PlaneRole::kCeiling && cfg_.tight_refit_sigmas > 0) {
-    const double ct = std::max(cfg_.tight_refit_sigmas * res1->sigma, k::kTightMinCutM);
-    // (joined: its first step showed it stays at res1's plane, within 0.01 deg / 1 mm: nothing to choose)
-    if (const auto tight = refine(up, res1->pl, ct, ct, true, &*res1); tight && !tight->joined) {
-      const float t_sel = select_band(res1->sigma, tight->sigma);
-      if (score_band(sub_final_, final_stride_, tight->pl, t_sel) > score_band(sub_final_, final_stride_, res1->pl, t_sel)) res1 = tight;
-    }
-  }
-  if (!res1) return false;
-  plane = res1->pl;
-  return true;
+  if (followed && res1) st.left = std::max(cfg_.start_recheck_scans, 1) - 1;
+  return bool(res1);
 }
 
 }  // namespace fploc::seg

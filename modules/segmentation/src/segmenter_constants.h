@@ -50,6 +50,13 @@ constexpr double kJoinCutRatio = 1.25;      // with a cut-off at most this times
 constexpr double kStillStepFraction = 1.0 / 3;  // a refit's first step below this x kJoin*: it stays (see refine)
 constexpr double kSelectBandSigmas = 3.0;   // choosing between refinements: soft band at 3 robust sigmas
 constexpr double kSelectBandMinM = 0.01;    // of at least 1 cm
+// A plane followed steadily (SegmenterConfig::start_recheck_scans): last frame's plane refined alone ends the
+// following when it moves more than this (a step to another surface, a start the search would have to find).
+constexpr double kSteadyStepDeg = 1.0;
+constexpr double kSteadyStepM = 0.05;
+// ... or when its support falls below this share of the last fit's (a ceiling step: a slice of the walls at the old
+// height fits as a plane, with a fraction of the ceiling's returns).
+constexpr double kSteadyMinSupport = 0.8;
 constexpr double kTightMinCutM = 0.01;      // tight ceiling refit cut-off at least 1 cm
 constexpr double kMinBeyondRatio = 1e-3;    // guards 1 / max_beyond_ratio
 

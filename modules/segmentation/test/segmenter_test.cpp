@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "fploc/segmentation/segmenter.h"
 #include "fploc/segmentation/synthetic.h"
@@ -197,4 +199,60 @@ TEST(RingSegmenter, BadInput) {
 
   // Still works after bad input.
   EXPECT_EQ(seg.process(s).status, SegStatus::kOk);
+}
+
+// A plane followed steadily (SegmenterConfig::start_recheck_scans): last frame's plane refined without the start
+// search on most scans, with the attitude and height of the search on every scan (start_recheck_scans = 1).
+TEST(RingSegmenter, FollowedPlanesSkipTheStartSearch) {
+  const auto room = synth::furnished_room();
+  const auto beams = synth::os1_like_beams();
+  SegmenterConfig every;
+  every.start_recheck_scans = 1;
+  RingSegmenter steady(SegmenterConfig{}), searched(every);
+  double worst_rp = 0, worst_z = 0;
+  for (int n = 0; n < 16; ++n) {
+    const SensorPose pose{0.15 * n - 1.0, 0.05 * n, 1.4 + 0.002 * n, (0.5 + 0.05 * n) * kDeg, (-0.3 + 0.03 * n) * kDeg,
+                          0.02 * n};
+    const auto s = synth::render(room, pose, beams, 1024, 0.01, 0.02, 300 + n);
+    const Segmentation a = steady.process(s.scan);
+    const Segmentation& b = searched.process(s.scan);
+    ASSERT_EQ(a.status, SegStatus::kOk) << a.status_text;
+    ASSERT_EQ(b.status, SegStatus::kOk) << b.status_text;
+    EXPECT_NEAR(a.roll, pose.roll, 0.1 * kDeg);
+    EXPECT_NEAR(a.pitch, pose.pitch, 0.1 * kDeg);
+    EXPECT_NEAR(a.z, pose.z, 0.02);
+    worst_rp = std::max({worst_rp, std::abs(a.roll - b.roll), std::abs(a.pitch - b.pitch)});
+    worst_z = std::max(worst_z, std::abs(a.z - b.z));
+  }
+  std::printf("steady fits %lld of 32, worst roll/pitch difference %.5f deg, z %.3f mm\n",
+              (long long)steady.steady_plane_fits(), worst_rp / kDeg, 1e3 * worst_z);
+  EXPECT_EQ(searched.steady_plane_fits(), 0);
+  EXPECT_GE(steady.steady_plane_fits(), 16);  // 2 fits per scan, the search on every eighth of each
+  EXPECT_LT(worst_rp, 0.005 * kDeg);
+  EXPECT_LT(worst_z, 0.001);
+}
+
+// A ceiling step (into a higher room) while the ceiling is followed: a slice of the walls at the old height fits as
+// a plane, with a fraction of the ceiling's support; the search runs on that scan and finds the new ceiling.
+TEST(RingSegmenter, CeilingStepEndsTheFollowing) {
+  const auto beams = synth::os1_like_beams();
+  SegmenterConfig every;
+  every.start_recheck_scans = 1;
+  for (const double step : {0.25, 0.3, 0.4, 0.6, -0.3}) {
+    auto room = synth::furnished_room();
+    RingSegmenter steady(SegmenterConfig{}), searched(every);
+    for (int n = 0; n < 6; ++n) {
+      if (n == 4) room.height += step;
+      const SensorPose pose{0.1 * n, 0.0, 1.4, 0.3 * kDeg, -0.2 * kDeg, 0.01 * n};
+      const auto s = synth::render(room, pose, beams, 1024, 0.01, 0.02, 400 + n);
+      const Segmentation a = steady.process(s.scan);
+      const Segmentation& b = searched.process(s.scan);
+      ASSERT_EQ(b.status, SegStatus::kOk) << b.status_text;
+      ASSERT_TRUE(b.ceiling.found);
+      EXPECT_NEAR(b.ceiling.coeffs[3], room.height - pose.z, 0.02) << "scan " << n;
+      EXPECT_EQ(a.ceiling.found, b.ceiling.found) << "step " << step << " scan " << n << ": " << a.status_text;
+      EXPECT_NEAR(a.ceiling.coeffs[3], b.ceiling.coeffs[3], 0.002) << "step " << step << " scan " << n;
+    }
+    EXPECT_GT(steady.steady_plane_fits(), 0);
+  }
 }

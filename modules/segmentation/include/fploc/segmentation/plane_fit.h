@@ -3,6 +3,7 @@
 // PCL's RANSAC variant is RansacPlaneFit (ransac_plane_fit.h, PCL stays in its .cpp).
 #pragma once
 #include <Eigen/Core>
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -24,6 +25,8 @@ class PlaneFit {
   // plane in the same convention. Returns the plane with n pointing against `up` (into the room), or false.
   virtual bool fit(const Candidates& c, const Eigen::Vector3d& up, const Eigen::Vector4d* previous, PlaneRole role,
                    Eigen::Vector4d& plane) = 0;
+  // Fits that refined last frame's plane without searching for a start (diagnostics, tests).
+  virtual int64_t steady_fits() const { return 0; }
 };
 
 // The paper's fit: max-range seeds on the top K_r rings, linear regression, IRLS (Tukey), see
@@ -44,6 +47,8 @@ class RingPlaneFit : public PlaneFit {
     double cut = 0;       // the IRLS cut-off it ended with (0: not a refinement)
   };
   void pick_seeds(const Candidates& c, const Eigen::Vector3f& up);
+  bool search(const Candidates& c, const Eigen::Vector3d& up, const Eigen::Vector4d* previous, PlaneRole role,
+              std::optional<Fit>& res1);
   bool choose_start(const Candidates& c, const Eigen::Vector3d& up, const Eigen::Vector4d* previous,
                     Eigen::Vector4d& start);
   // Support of `pl` on `sub`, a subsample of the candidates (every stride-th), scaled by the stride.
@@ -75,6 +80,19 @@ class RingPlaneFit : public PlaneFit {
   PointsSoa band_, band_sub_, sub_start_, sub_final_;  // band_: relative to the refinement's reference point
   std::vector<float> scratch_;  // refine: the band's residuals in histogram bins
   size_t start_stride_ = 1, final_stride_ = 1;  // of the current fit (Candidates, else the reference strides)
+  // Per role: fits left that refine last frame's plane alone (SegmenterConfig::start_recheck_scans), and the
+  // plane the last fit of that role returned (a steady fit needs `previous` to be it: consecutive accepted fits).
+  struct Steady {
+    int left = 0;
+    Eigen::Vector4d plane = Eigen::Vector4d::Zero();
+    double support = 0;  // its support (score_band at the inlier threshold)
+  };
+  Steady steady_[2];
+  int64_t steady_fits_ = 0;
+
+ public:
+  // Fits that refined last frame's plane alone (diagnostics, tests).
+  int64_t steady_fits() const override { return steady_fits_; }
 };
 
 }  // namespace fploc::seg

@@ -60,6 +60,8 @@ class Segmenter {
   const Eigen::Vector3d& gyro_bias() const { return deskew_.bias(); }  // rad/s, perpendicular-to-gravity part
   // Scans whose ground-at-a-kink split was skipped, one surface followed steadily (SegmenterConfig::kink_recheck_scans).
   int64_t kink_splits_skipped() const { return kink_skipped_; }
+  // Plane fits that refined last frame's plane without the start search (SegmenterConfig::start_recheck_scans).
+  int64_t steady_plane_fits() const { return fit_->steady_fits(); }
   // Last scan's points per pixel (row-major like the scan, de-skewed when last().deskewed; NaN where there
   // is no return inside [min_range_m, max_range_m]). Diagnostics: built on each call.
   const std::vector<Eigen::Vector3f>& points() const;

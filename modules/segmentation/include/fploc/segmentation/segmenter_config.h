@@ -26,6 +26,13 @@ struct SegmenterConfig {
   // 8: a second surface that comes into view without moving the ring fit is split off at most 0.7 s (10 Hz) later;
   // the ring fit itself leaving the followed surface (a kink under the robot) ends the skipping on that scan.
   int kink_recheck_scans = 8;
+  // The plane fits' start (ring_plane_fit.cpp): the seeds, the seed regression, the seed triplets and last frame's
+  // plane scored on a subsample, the best refined, then last frame's plane refined too. While a plane is followed
+  // steadily (the last search's start was last frame's plane, or the refinement from it joined the best start's)
+  // the next fits of that plane refine last frame's plane alone, on up to this many scans minus one in a row
+  // before the search runs again; a refinement that loses support, or moves the plane more than a step a
+  // search would be needed for, ends it on that scan (1: the search on every scan).
+  int start_recheck_scans = 8;
   double min_range_m = 0.4;        // ignore returns closer than this (platform, tripod)
   double max_range_m = 120.0;
   int min_plane_inliers = 200;     // fewer inliers -> plane not found
