@@ -342,21 +342,22 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
   Steady& st = steady_[role == PlaneRole::kCeiling ? 0 : 1];
   const bool steady = previous && st.left > 0 && *previous == st.plane;
   if (!steady) st.left = 0;
-  for (auto [sub, stride] : {std::pair{&sub_start_, start_stride_}, std::pair{&sub_final_, final_stride_}}) {
-    if (steady && sub == &sub_start_) continue;  // (the start's subsample: only the search scores on it)
+  // Every stride-th candidate into a subsample.
+  auto fill = [&](auto* sub, size_t stride) {
     sub->resize((n + stride - 1) / stride);
     if (ck::available() && kern::wide()) {
       ck::strided(xs_, ys_, zs_, sub->n, stride, sub->x.data(), sub->y.data(), sub->z.data());
-      sub->pad();
-      continue;
-    }
-    for (size_t i = 0, j = 0; i < n; i += stride, ++j) {
-      sub->x[j] = xs_[i];
-      sub->y[j] = ys_[i];
-      sub->z[j] = zs_[i];
+    } else {
+      for (size_t i = 0, j = 0; i < n; i += stride, ++j) {
+        sub->x[j] = xs_[i];
+        sub->y[j] = ys_[i];
+        sub->z[j] = zs_[i];
+      }
     }
     sub->pad();
-  }
+  };
+  if (!steady) fill(&sub_start_, start_stride_);  // (the start's subsample: only the search scores on it)
+  fill(&sub_final_, final_stride_);
   const float thr = float(cfg_.inlier_threshold_m);
   auto score = [&](const Eigen::Vector4d& pl) { return score_band(sub_final_, final_stride_, pl, thr); };
   std::optional<Fit> res1;
@@ -373,19 +374,7 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
       ++steady_fits_;
     } else {
       st.left = 0;
-      if (start_stride_ > 0) {  // the start's subsample, skipped above
-        sub_start_.resize((n + start_stride_ - 1) / start_stride_);
-        if (ck::available() && kern::wide()) {
-          ck::strided(xs_, ys_, zs_, sub_start_.n, start_stride_, sub_start_.x.data(), sub_start_.y.data(), sub_start_.z.data());
-        } else {
-          for (size_t i = 0, j = 0; i < n; i += start_stride_, ++j) {
-            sub_start_.x[j] = xs_[i];
-            sub_start_.y[j] = ys_[i];
-            sub_start_.z[j] = zs_[i];
-          }
-        }
-        sub_start_.pad();
-      }
+      if (start_stride_ > 0) fill(&sub_start_, start_stride_);  // the start's subsample, skipped above
     }
   }
   if (!res1 && !search(c, up, previous, role, res1)) return false;
