@@ -212,6 +212,9 @@ std::optional<DeadReckoned> Localizer::dead_reckoned(const FeatureFrame& f, cons
     return std::optional<DeadReckoned>();
   };
   if (!dr_odometry_) return restart();
+  // The gyro's yaw change since the odometry's last frame holds its yaw (dr_gyro_sigma_rad).
+  if (u.dr_gyro_sigma_rad > 0 && cfg_.use_imu)
+    if (const auto dyaw = imu_.integral(dr_last_utime_, f.utime)) dr_odometry_->set_yaw_change(*dyaw, u.dr_gyro_sigma_rad);
   const odometry::OdometryResult r = dr_odometry_->process(f);
   // A frame the odometry could not register breaks the chain, and so does a jump: the velocity changing from one frame
   // to the next by more than a platform does (the ICP caught another minimum: a moved wall, a local map of few frames).
