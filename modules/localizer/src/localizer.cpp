@@ -196,47 +196,20 @@ std::optional<DeadReckoned> Localizer::dead_reckoned(const FeatureFrame& f, cons
   if (!(u.dead_reckoning_gate_sigma > 0)) return std::nullopt;
   const Eigen::Vector3d velocity = plan_velocity(sfr.match);
   // (Re)starts the odometry at this frame (its fix, the matcher's velocity): the anchors before cannot be related to it.
-  // In a stretch whose anchor is frozen the refused fixes are what is in doubt: the odometry starts again where the
-  // stretch's dead reckoning was (its last pose carried on by the anchor's velocity), and that pose is the stretch's
-  // anchor from now on, with the covariance it had grown to (a restart there would otherwise start from the doubted
-  // fix and end the stretch at once, a dead reckoning that agrees with the fix it started from).
   auto restart = [&]() {
-    const bool keep = tracker_.wants_dead_reckoning() && have_frozen_ && last_dr_ && f.utime > last_dr_utime_;
-    Pose2 start = sfr.match.pose;
-    Eigen::Vector3d v0 = velocity;
-    if (keep) {
-      const double dt = (f.utime - last_dr_utime_) * 1e-6;
-      v0 = frozen_.velocity;
-      start = {last_dr_->pose.x + v0[0] * dt, last_dr_->pose.y + v0[1] * dt, wrap_angle(last_dr_->pose.yaw + v0[2] * dt)};
-    }
     odometry::OdometryConfig oc;
     oc.max_points = u.dr_max_points;
     oc.static_support_m = u.dr_static_support_m;
     oc.prediction_sigma_m = u.dr_prediction_sigma_m;
     oc.prediction_sigma_rad = u.dr_prediction_sigma_rad;
     dr_odometry_.emplace(oc);
-    dr_odometry_->set_pose(start, v0);
+    dr_odometry_->set_pose(sfr.match.pose, velocity);
     dr_last_ = dr_odometry_->process(f).pose;
     dr_last_utime_ = f.utime;
-    dr_velocity_ = v0.head<2>();
+    dr_velocity_ = velocity.head<2>();
     ok_frames_.clear();
-    if (!keep) {
-      have_frozen_ = false;
-      last_dr_.reset();
-      return std::optional<DeadReckoned>();
-    }
-    Anchor a;
-    a.utime = f.utime;
-    a.fix = start;
-    a.covariance = last_dr_->covariance;
-    a.velocity = v0;
-    a.odometry = dr_last_;
-    a.path_m = dr_path_m_;
-    a.turn_rad = dr_turn_rad_;
-    frozen_ = a;
-    last_dr_->pose = start;
-    last_dr_utime_ = f.utime;
-    return last_dr_;
+    have_frozen_ = false;
+    return std::optional<DeadReckoned>();
   };
   if (!dr_odometry_) return restart();
   // The gyro's yaw change since the odometry's last frame holds its yaw (dr_gyro_sigma_rad).
@@ -302,8 +275,6 @@ std::optional<DeadReckoned> Localizer::dead_reckoned(const FeatureFrame& f, cons
   d.pose = compose(a->fix, between(a->odometry, r.pose));
   d.covariance = a->covariance + Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal().toDenseMatrix();
   d.covariance.topLeftCorner<2, 2>() += a->open;
-  last_dr_ = d;
-  last_dr_utime_ = f.utime;
   return d;
 }
 

@@ -157,8 +157,6 @@ class Localizer {
   std::deque<Anchor> ok_frames_;     // oldest first
   bool have_frozen_ = false;         // the anchor of the current stretch
   Anchor frozen_;
-  std::optional<DeadReckoned> last_dr_;  // the last frame's dead-reckoned pose (a restart in a stretch goes on from it)
-  int64_t last_dr_utime_ = 0;
   bool last_off_dead_reckoning_ = false;  // the previous frame failed the dead reckoning's gate (against the oldest anchor)
   std::optional<odometry::Odometry2D> dr_odometry_;
   Pose2 dr_last_;                    // the odometry's last pose
