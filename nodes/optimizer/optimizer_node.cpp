@@ -6,6 +6,7 @@
 // final on the old floor) and starts one on the new floor's plan.
 #include <fploc/features_t.hpp>
 #include <fploc/frame_pose_t.hpp>
+#include <fploc/imu_t.hpp>
 #include <fploc/plan_diff_t.hpp>
 #include <fploc/pose_t.hpp>
 
@@ -42,6 +43,9 @@ class OptimizerNode : public fploc::rt::Node {
              // Optional wheel odometry, as the matcher's `odom`: its increments predict the published
              // uncertainty's track (the innovation gate) between frames.
              fploc::rt::input<fploc::pose_t>("odom", ""),
+             // Optional IMU (OS1_IMU): the gyro holds the yaw of the published status's dead reckoning
+             // (localizer::UncertaintyConfig::dr_gyro_sigma_rad).
+             fploc::rt::input<fploc::imu_t>("imu", ""),
              fploc::rt::output<fploc::pose_t>("pose", "FPLOC_POSE"),
              fploc::rt::output<fploc::pose_t>("latest", "FPLOC_POSE_LATEST")}};
   }
@@ -73,6 +77,7 @@ class OptimizerNode : public fploc::rt::Node {
       if (const auto p = fploc::adapters::finite_pose2_of(m)) loc_->add_odometry(m.utime, *p);
       else ctx_->error("odom seq " + std::to_string(m.seq) + ": non-finite pose (ignored)");
     });
+    ctx.subscribe<fploc::imu_t>("imu", [this](const fploc::imu_t& m) { loc_->add_imu(m.utime, m.gyro[2]); });
     ctx.subscribe<fploc::frame_pose_t>("frame_pose", [this](const fploc::frame_pose_t& m) {
       frame_poses_[m.scan_seq] = m;
       trim(frame_poses_);

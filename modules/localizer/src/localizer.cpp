@@ -212,6 +212,9 @@ std::optional<DeadReckoned> Localizer::dead_reckoned(const FeatureFrame& f, cons
     return std::optional<DeadReckoned>();
   };
   if (!dr_odometry_) return restart();
+  // The gyro's yaw change since the odometry's last frame holds its yaw (dr_gyro_sigma_rad).
+  if (u.dr_gyro_sigma_rad > 0 && cfg_.use_imu)
+    if (const auto dyaw = imu_.integral(dr_last_utime_, f.utime)) dr_odometry_->set_yaw_change(*dyaw, u.dr_gyro_sigma_rad);
   const odometry::OdometryResult r = dr_odometry_->process(f);
   // A frame the odometry could not register breaks the chain, and so does a jump: the velocity changing from one frame
   // to the next by more than a platform does (the ICP caught another minimum: a moved wall, a local map of few frames).
@@ -257,9 +260,14 @@ std::optional<DeadReckoned> Localizer::dead_reckoned(const FeatureFrame& f, cons
       frozen_ = ok_frames_[k];
       have_frozen_ = true;
       // The odometry goes on with the anchor's velocity (the plan fixed it; along a direction the odometry's points
-      // leave open its own velocity is what it slid).
-      dr_odometry_->set_velocity(frozen_.velocity);
-      dr_velocity_ = frozen_.velocity.head<2>();
+      // leave open its own velocity is what it slid), unless the two differ by more than a platform's change
+      // (dr_jump_mps): then the fixes before the stretch were sliding (a fix slid 0.5 m in 0.4 s, 1 m/s off), and the
+      // odometry's points, taking it back to its own velocity, would count as a jump and start it again at the fix
+      // in doubt.
+      if ((frozen_.velocity.head<2>() - dr_velocity_).norm() <= u.dr_jump_mps) {
+        dr_odometry_->set_velocity(frozen_.velocity);
+        dr_velocity_ = frozen_.velocity.head<2>();
+      }
     }
     if (have_frozen_) a = &frozen_;
   } else if (!ok_frames_.empty()) {

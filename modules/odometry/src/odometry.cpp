@@ -138,6 +138,9 @@ OdometryResult Odometry2D::process(const FeatureFrame& f_in) {
     x.y += velocity_[1] * dt;
     x.yaw += velocity_[2] * dt;
   }
+  const bool yaw_measured = have_yaw_change_ && dt > 0 && dt < 1.0;
+  if (yaw_measured) x.yaw = pose_.yaw + yaw_change_;
+  have_yaw_change_ = false;
   const Pose2 pred = x;
   // The prediction as a prior (OdometryConfig::prediction_sigma_m), in the points' units.
   Eigen::Vector3d prior = Eigen::Vector3d::Zero();
@@ -145,6 +148,8 @@ OdometryResult Odometry2D::process(const FeatureFrame& f_in) {
     const double wxy = std::pow(cfg_.point_sigma_m / cfg_.prediction_sigma_m, 2);
     prior = Eigen::Vector3d(wxy, wxy, std::pow(cfg_.point_sigma_m / cfg_.prediction_sigma_rad, 2));
   }
+  // A measured yaw change (set_yaw_change) holds the yaw with its own sigma.
+  if (yaw_measured) prior[2] = std::pow(cfg_.point_sigma_m / yaw_change_sigma_, 2);
   const double gate2 = cfg_.max_correspondence_m * cfg_.max_correspondence_m;
   int inliers = 0;
   double sum2 = 0;

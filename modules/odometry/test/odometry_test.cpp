@@ -118,3 +118,34 @@ TEST(Odometry2D, StaticPointsAndThePredictionKeepACorridorFromFollowingACrowd) {
   EXPECT_GT(e_every, 0.3);
   EXPECT_LT(e_held, 0.1);
 }
+
+// In a round room seen from its centre every frame's points are the same whatever the heading: the registration
+// cannot see the robot turn (as it cannot tell people turning with it from the robot turning). A measured yaw
+// change (a gyro's integral, set_yaw_change) carries the heading; without it the odometry keeps its (unknown) yaw.
+TEST(Odometry2D, AMeasuredYawChangeTurnsWhatThePointsCannot) {
+  FloorPlan room;
+  room.elements.push_back(Element::circle({5, 5}, 4.0));
+  const double w = 0.2;  // rad/s
+  auto truth = [&](double t) { return Pose2{5, 5, w * t}; };
+  auto run = [&](bool gyro) {
+    Odometry2D odo;
+    odo.set_pose(truth(0));
+    double err = 0;
+    for (int k = 0; k < 50; ++k) {
+      const double t = 0.1 * k;
+      SynthOptions so;
+      so.noise_sigma = 0.005;
+      so.seed = uint32_t(k + 11);
+      if (gyro && k > 0) odo.set_yaw_change(w * 0.1, 0.002);
+      const OdometryResult r = odo.process(synth_frame(room, truth(t), so, int64_t(std::llround(t * 1e6))));
+      EXPECT_TRUE(r.ok) << k;
+      err = std::max(err, std::abs(wrap_angle(r.pose.yaw - truth(t).yaw)));
+      EXPECT_LT(std::hypot(r.pose.x - 5, r.pose.y - 5), 0.02) << k;
+    }
+    return err;
+  };
+  const double without = run(false), with = run(true);
+  std::printf("heading error after 4.9 s: points alone %.3f rad, with the gyro %.4f rad\n", without, with);
+  EXPECT_GT(without, 0.5);
+  EXPECT_LT(with, 0.01);
+}

@@ -117,6 +117,11 @@ struct UncertaintyConfig {
   // A stretch in which a fix was refused so ends only with confirm_fixes fixes in a row within dr_confirm_gate_sigma
   // (the same chi-square quantile) of the dead-reckoned pose, each published POOR until then: a track that slid comes
   // back to the gate's edge a little at a time, and the fix at the edge is no better than the one refused before it.
+  // The IMU's gyro (the Localizer's add_imu samples, when it has them): the odometry's yaw change from one frame to
+  // the next is the gyro's integral, held with this 1-sigma per frame (Odometry2D::set_yaw_change). People walking
+  // beside the robot turn the ICP with them, by degrees over a stretch (0.1 m per 1 deg and 6 m travelled); a gyro
+  // they cannot turn. 0: off (the ICP's own yaw, with the prediction's prior).
+  double dr_gyro_sigma_rad = 0.002;
   double dead_reckoning_gate_sigma = 3.0;
   double dr_confirm_gate_sigma = 2.0;
   double dr_jump_mps = 0.5;

@@ -5,6 +5,7 @@
 // matcher so its trajectory is in the plan frame.
 #pragma once
 #include <Eigen/Core>
+#include <cmath>
 #include <deque>
 #include <memory>
 #include <vector>
@@ -64,6 +65,15 @@ class Odometry2D {
   // The velocity (plan frame, as set_pose's) the next frame is predicted with, e.g. a better-known one from a
   // localizer's fix; the pose and the map stay.
   const Eigen::Vector3d& velocity() const { return velocity_; }
+  // The next frame's yaw change since the last one, measured (a gyro's integral), with its 1-sigma: the next
+  // process() predicts the yaw with it (instead of the velocity's yaw rate) and holds the registration to it as a
+  // prior of that sigma, whether or not a velocity is known. Used once. What the points cannot do alone: among
+  // people walking beside the robot the ICP turns with them, a gyro does not.
+  void set_yaw_change(double dyaw, double sigma_rad) {
+    yaw_change_ = dyaw;
+    yaw_change_sigma_ = sigma_rad;
+    have_yaw_change_ = std::isfinite(dyaw) && sigma_rad > 0;
+  }
   void set_velocity(const Eigen::Vector3d& velocity) {
     velocity_ = velocity;
     have_velocity_ = true;
@@ -81,6 +91,8 @@ class Odometry2D {
   Pose2 pose_, last_key_;
   int64_t utime_ = 0;
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();
+  double yaw_change_ = 0, yaw_change_sigma_ = 0;
+  bool have_yaw_change_ = false;
   FeatureFrame sub_;  // scratch: the subsampled frame
 };
 
