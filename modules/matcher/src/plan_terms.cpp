@@ -680,25 +680,118 @@ inline Eigen::Vector2d to_world(const Pose2& x, double c, double s, const Eigen:
 }
 }  // namespace
 
+namespace {
+// The elements whose points (on: each point's closest element within the gate, -1 none) lie on a line askew to
+// them (AssignOptions::askew_max_m): per segment, the points' end offsets by least squares (U = (1 - t, t) at
+// fraction t along it, a 1 m ridge keeping an ill-determined end finite) and their difference d = o_b - o_a, the
+// line's turn over the segment's length. The guess's own yaw error turns every element's points alike (d = yaw
+// error x length): the point-weighted median of d / length over the elements seen with >= kMinYawPoints points
+// is taken out first. An element is askew when what is left exceeds about askew_max_m * sqrt(2), counting the
+// line's own uncertainty (chi-square, 1 dof, 99 %): askew[el] = 1.
+void askew_elements(const std::vector<TargetGeom>& g, const FeatureFrame& f, const Pose2& x, const std::vector<int>& on,
+                    const AssignOptions& o, std::vector<char>* askew) {
+  constexpr double kChi2Dof1P99 = 6.63;
+  constexpr double kRidgeM = 1.0;
+  constexpr int kMinPoints = 4;       // fewer: never judged askew
+  constexpr int kMinYawPoints = 10;   // elements that vote on the guess's yaw error
+  struct Acc {
+    double a00 = 0, a01 = 0, a11 = 0, b0 = 0, b1 = 0;
+    int n = 0;
+  };
+  thread_local std::vector<Acc> acc;
+  thread_local std::vector<int> used;
+  if (acc.size() < g.size()) acc.resize(g.size());
+  used.clear();
+  const double c = std::cos(x.yaw), s = std::sin(x.yaw);
+  for (size_t i = 0; i < on.size(); ++i) {
+    if (on[i] < 0) continue;
+    const TargetGeom& e = g[size_t(on[i])];
+    if (e.kind != ElementKind::kSegment || !(e.len > 0)) continue;
+    const Eigen::Vector2d pw = to_world(x, c, s, f.points[i].p);
+    const Eigen::Vector2d nrm(-e.u.y(), e.u.x());
+    const double t = std::clamp((pw - e.a).dot(e.u) / e.len, 0.0, 1.0), r = (pw - e.a).dot(nrm);
+    Acc& a = acc[size_t(on[i])];
+    if (a.n++ == 0) used.push_back(on[i]);
+    a.a00 += (1 - t) * (1 - t);
+    a.a01 += (1 - t) * t;
+    a.a11 += t * t;
+    a.b0 += r * (1 - t);
+    a.b1 += r * t;
+  }
+  const double ps2 = o.askew_point_sigma_m * o.askew_point_sigma_m, ridge = ps2 / (kRidgeM * kRidgeM);
+  struct Turn {
+    int el;
+    double d, var, per_m;
+    int n;
+  };
+  thread_local std::vector<Turn> turns;
+  turns.clear();
+  for (int el : used) {
+    Acc& a = acc[size_t(el)];
+    if (a.n >= kMinPoints) {
+      // The points' own offsets, o = A^-1 b with A = sum U U^T / ps^2 + ridge (in units of 1 / ps^2).
+      Eigen::Matrix2d A;
+      A << a.a00 + ridge, a.a01, a.a01, a.a11 + ridge;
+      const Eigen::Matrix2d Ai = A.inverse();
+      const Eigen::Vector2d oo = Ai * Eigen::Vector2d(a.b0, a.b1), v(-1, 1);
+      const double d = v.dot(oo);
+      turns.push_back({el, d, ps2 * v.dot(Ai * v), d / g[size_t(el)].len, a.n});
+    }
+    a = Acc();
+  }
+  // The guess's yaw error: the point-weighted median turn per metre of the well-seen elements.
+  thread_local std::vector<std::pair<double, int>> votes;
+  votes.clear();
+  int total = 0;
+  for (const Turn& t : turns)
+    if (t.n >= kMinYawPoints) {
+      votes.push_back({t.per_m, t.n});
+      total += t.n;
+    }
+  double yaw_err = 0;
+  if (!votes.empty()) {
+    std::sort(votes.begin(), votes.end());
+    int acc_n = 0;
+    for (const auto& v : votes) {
+      acc_n += v.second;
+      if (2 * acc_n >= total) {
+        yaw_err = v.first;
+        break;
+      }
+    }
+  }
+  askew->assign(g.size(), 0);
+  const double P = o.askew_max_m;
+  for (const Turn& t : turns) {
+    const double d = t.d - yaw_err * g[size_t(t.el)].len;
+    if (d * d > kChi2Dof1P99 * (2 * P * P + t.var)) (*askew)[size_t(t.el)] = 1;
+  }
+}
+}  // namespace
+
 void select_points(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, const AssignOptions& o,
                    std::vector<SampledPoint>* out) {
   out->clear();
   const size_t n = f.points.size();
   const size_t stride = size_t(std::max(1, o.stride));
-  if (!(o.element_quota > 0 && stride > 1 && lookup.element_targets())) {
+  const bool budget = o.element_quota > 0 && stride > 1 && lookup.element_targets();
+  const bool askew_rule = o.askew_max_m > 0 && lookup.element_targets();
+  if (!budget && !askew_rule) {
     out->reserve(n / stride + 1);
     for (size_t i = 0; i < n; i += stride) out->push_back({int(i), 1.0f});
     return;
   }
   // Per-element budget: every point looked up, its closest candidate within the gate counted per element; an
   // element with at most element_quota points keeps them all (sampling weight 1/sqrt(stride): each stands for
-  // itself, a stride-th point for stride points), the others every stride-th point.
+  // itself, a stride-th point for stride points), the others every stride-th point. Askew faces
+  // (askew_max_m): the points of an element whose points lie on a line askew to it are left out.
   const auto& g = lookup.geometry();
   const std::vector<float>* ew = o.element_weight;
   const int maxc = std::clamp(o.max_candidates, 1, kMaxCandidates);
   const double g2 = o.gate_m * o.gate_m;
   const double c = std::cos(x.yaw), s = std::sin(x.yaw);
   thread_local std::vector<int> on, count;
+  thread_local std::vector<char> askew;
   on.assign(n, -1);
   if (count.size() < g.size()) count.resize(g.size(), 0);
   Assignment a;
@@ -714,10 +807,12 @@ void select_points(const NearestLookup& lookup, const FeatureFrame& f, const Pos
       ++count[size_t(on[i])];
     }
   }
+  if (askew_rule) askew_elements(g, f, x, on, o, &askew);
   const float rare_w = float(1.0 / std::sqrt(double(stride)));
   out->reserve(n / stride + 1);
   for (size_t i = 0; i < n; ++i) {
-    const bool rare = on[i] >= 0 && count[size_t(on[i])] <= o.element_quota;
+    if (askew_rule && on[i] >= 0 && askew[size_t(on[i])]) continue;
+    const bool rare = budget && on[i] >= 0 && count[size_t(on[i])] <= o.element_quota;
     if (rare) out->push_back({int(i), rare_w});
     else if (i % stride == 0) out->push_back({int(i), 1.0f});
   }
@@ -760,7 +855,7 @@ void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, 
   };
   const std::vector<SampledPoint>* sel = o.points;
   thread_local std::vector<SampledPoint> own;
-  if (!sel && o.element_quota > 0 && stride > 1 && lookup.element_targets()) {
+  if (!sel && ((o.element_quota > 0 && stride > 1) || o.askew_max_m > 0) && lookup.element_targets()) {
     select_points(lookup, f, x, o, &own);
     sel = &own;
   }
