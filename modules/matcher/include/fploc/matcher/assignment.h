@@ -57,13 +57,14 @@ struct AssignOptions {
   // stride-th would keep 0-2 of them. 0 = off (every stride-th point of the frame).
   int element_quota = 0;
   // Faces askew to their element (element look-ups): the points whose closest candidate within the gate is a
-  // segment whose points, taken together, lie on a line turning against it by more than about askew_max_m *
-  // sqrt(2) between its two ends (beyond that line's own uncertainty at askew_point_sigma_m per point, and after
-  // the turn every element shows alike, the guess's own yaw error) are left out: a cabinet's face seen where a
-  // glass wall is drawn, askew to it, is not that wall, and as a wall (the as-built model gives every wall a
-  // share) it holds the pose against the walls that are there. A wall standing a few centimetres off its drawn
-  // place, or moved along its normal, turns by no more than its ends' offsets. Judged at the pose the points are
-  // selected at (select_points): a tracking guess. 0 = off.
+  // segment, in a run along it (a gap of more than 0.5 m ends a run) that lies on a line turning against the
+  // segment by more than about askew_max_m * sqrt(2) between its two ends (beyond that line's own uncertainty at
+  // askew_point_sigma_m per point, and after the turn every run shows alike, the guess's own yaw error), are left
+  // out: a cabinet's face seen where a glass wall is drawn, askew to it, is not that wall, and as a wall (the
+  // as-built model gives every wall a share) it holds the pose against the walls that are there. A wall standing a
+  // few centimetres off its drawn place, or moved along its normal, turns by no more than its ends' offsets; a
+  // person in front of a wall is a run of its own, too short to turn significantly. Judged at the pose the points
+  // are selected at (select_points): a tracking guess. 0 = off.
   double askew_max_m = 0;
   double askew_point_sigma_m = 0.04;
   // The points to use, as select_points (plan_terms.h) chose them: when given, stride, element_quota and
