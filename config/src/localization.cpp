@@ -62,6 +62,7 @@ matcher::MatcherConfig config_of(const MatcherOptions& o) {
   if (given(o.stride(), "matcher", "stride")) c.stride = o.stride();
   if (o.max_points() != 0) c.max_points = o.max_points() < 0 ? 0 : o.max_points();
   if (given(o.element_quota(), "matcher", "element_quota")) c.element_quota = o.element_quota();
+  if (given(o.askew_max_m(), "matcher", "askew_max_m")) c.askew_max_m = o.askew_max_m();
   c.deskew = !o.disable_deskew();
   if (o.prediction_sigma_m() != 0) c.prediction_sigma_m = std::max(0.0, o.prediction_sigma_m());
   if (o.prediction_sigma_deg() != 0) c.prediction_sigma_rad = std::max(0.0, o.prediction_sigma_deg()) * kRadPerDeg;
@@ -86,6 +87,7 @@ optimizer::OptimizerConfig config_of(const OptimizerOptions& o) {
   if (given(o.stride(), "optimizer", "stride")) c.stride = o.stride();
   if (o.max_points() != 0) c.max_points = o.max_points() < 0 ? 0 : o.max_points();
   if (given(o.element_quota(), "optimizer", "element_quota")) c.element_quota = o.element_quota();
+  if (given(o.askew_max_m(), "optimizer", "askew_max_m")) c.askew_max_m = o.askew_max_m();
   if (given(o.max_keyframe_gap_s(), "optimizer", "max_keyframe_gap_s")) c.max_keyframe_gap_s = o.max_keyframe_gap_s();
   if (o.keyframe_interval_s() != 0) c.keyframe_interval_s = std::max(0.0, o.keyframe_interval_s());
   if (o.max_final_delay_s() != 0) c.max_final_delay_s = std::max(0.0, o.max_final_delay_s());

@@ -107,7 +107,7 @@ TEST(ConfigDefaults, Matcher) {
          {"as_built_point_sigma_m", c.as_built.point_sigma_m},
          {"as_built_loss_scale_m", c.as_built.loss_scale_m}, {"element_quota", c.element_quota},
          {"as_built_max_spread_sigmas", c.as_built.max_spread_sigmas},
-         {"as_built_max_askew_m", c.as_built.max_askew_m}});
+         {"as_built_max_askew_m", c.as_built.max_askew_m}, {"askew_max_m", c.askew_max_m}});
 }
 
 TEST(ConfigDefaults, Optimizer) {
@@ -122,7 +122,7 @@ TEST(ConfigDefaults, Optimizer) {
          {"as_built_sigma_m", c.as_built.sigma_m}, {"as_built_point_sigma_m", c.as_built.point_sigma_m},
          {"as_built_loss_scale_m", c.as_built.loss_scale_m}, {"element_quota", c.element_quota},
          {"as_built_max_spread_sigmas", c.as_built.max_spread_sigmas},
-         {"as_built_max_askew_m", c.as_built.max_askew_m}});
+         {"as_built_max_askew_m", c.as_built.max_askew_m}, {"askew_max_m", c.askew_max_m}});
 }
 
 TEST(ConfigDefaults, Odometry) {

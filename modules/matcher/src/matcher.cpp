@@ -51,8 +51,13 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
   // The per-element budget's points, chosen once for the frame at the guess under the final gate (the rounds'
   // poses differ from it by centimetres while tracking; a guess farther off keeps fewer points for sure,
   // every stride-th point as without the budget).
+  // Askew faces (askew_max_m) are judged at the guess only while tracking: a prediction good to centimetres.
+  if (prior && cfg.askew_max_m > 0) {
+    ao.askew_max_m = cfg.askew_max_m;
+    ao.askew_point_sigma_m = cfg.as_built.point_sigma_m;
+  }
   std::vector<SampledPoint> sel;
-  if (cfg.element_quota > 0 && ao.stride > 1 && lookup.element_targets()) {
+  if (((cfg.element_quota > 0 && ao.stride > 1) || ao.askew_max_m > 0) && lookup.element_targets()) {
     AssignOptions so = ao;
     so.gate_m = cfg.min_correspondence_m;
     select_points(lookup, f, guess, so, &sel);

@@ -680,25 +680,148 @@ inline Eigen::Vector2d to_world(const Pose2& x, double c, double s, const Eigen:
 }
 }  // namespace
 
+namespace {
+// The points (on: each point's closest element within the gate, -1 none) of the runs that lie on a line askew to
+// their element (AssignOptions::askew_max_m): per segment, its points in runs along it (a gap of more than
+// kRunGapM ends a run: a cabinet's face, a stretch of the wall itself, a person in front of it are runs of their
+// own); per run, the line most of its points lie on (Theil-Sen: the median of the pairwise slopes over up to
+// kSample of them, spread evenly) and the least-squares slope of that line's inliers with its variance; its turn
+// over the segment's whole length, d = slope x length, is what the run's line makes of the wall's end offsets.
+// The guess's own yaw error turns every run alike: the point-weighted median slope of the runs of >=
+// kMinYawPoints points is taken out first. A run is askew when what is left exceeds about askew_max_m * sqrt(2),
+// counting the slope's own uncertainty (chi-square, 1 dof, 99 %): its points get drop[i] = 1.
+void askew_points(const std::vector<TargetGeom>& g, const FeatureFrame& f, const Pose2& x, const std::vector<int>& on,
+                  const AssignOptions& o, std::vector<char>* drop) {
+  constexpr double kChi2Dof1P99 = 6.63;
+  constexpr int kMinPoints = 4;         // fewer: never judged askew
+  constexpr int kMinYawPoints = 10;     // runs that vote on the guess's yaw error
+  constexpr size_t kSample = 40;        // points per run for the pairwise slopes
+  constexpr double kMinBaseM = 0.05;    // pairs closer along the element give no slope
+  constexpr double kInlierSigmas = 3;
+  constexpr double kRunGapM = 0.5;
+  struct Obs {
+    int el, i;
+    double s, r;  // along the element from its start, along its left normal [m]
+  };
+  thread_local std::vector<Obs> obs;
+  obs.clear();
+  const double c = std::cos(x.yaw), sn = std::sin(x.yaw);
+  for (size_t i = 0; i < on.size(); ++i) {
+    if (on[i] < 0) continue;
+    const TargetGeom& e = g[size_t(on[i])];
+    if (e.kind != ElementKind::kSegment || !(e.len > 0)) continue;
+    const Eigen::Vector2d pw = to_world(x, c, sn, f.points[i].p);
+    const Eigen::Vector2d nrm(-e.u.y(), e.u.x());
+    obs.push_back({on[i], int(i), (pw - e.a).dot(e.u), (pw - e.a).dot(nrm)});
+  }
+  std::sort(obs.begin(), obs.end(), [](const Obs& a, const Obs& b) { return a.el != b.el ? a.el < b.el : a.s < b.s; });
+  const double ps2 = o.askew_point_sigma_m * o.askew_point_sigma_m;
+  struct Run {
+    size_t b, e;
+    double slope, var, len;
+    int n;
+  };
+  thread_local std::vector<Run> runs;
+  thread_local std::vector<double> slopes;
+  runs.clear();
+  for (size_t b = 0; b < obs.size();) {
+    size_t e = b + 1;
+    while (e < obs.size() && obs[e].el == obs[b].el && obs[e].s - obs[e - 1].s <= kRunGapM) ++e;
+    const size_t n = e - b;
+    if (n >= size_t(kMinPoints)) {
+      const size_t step = std::max<size_t>(1, n / kSample);
+      slopes.clear();
+      for (size_t k = b; k < e; k += step)
+        for (size_t l = k + step; l < e; l += step) {
+          const double ds = obs[l].s - obs[k].s;
+          if (ds > kMinBaseM) slopes.push_back((obs[l].r - obs[k].r) / ds);
+        }
+      if (!slopes.empty()) {
+        std::nth_element(slopes.begin(), slopes.begin() + long(slopes.size() / 2), slopes.end());
+        const double m = slopes[slopes.size() / 2];
+        slopes.clear();
+        for (size_t k = b; k < e; ++k) slopes.push_back(obs[k].r - m * obs[k].s);
+        std::nth_element(slopes.begin(), slopes.begin() + long(slopes.size() / 2), slopes.end());
+        const double c0 = slopes[slopes.size() / 2], lim2 = kInlierSigmas * kInlierSigmas * ps2;
+        // Least squares over the inliers: slope = S_sr / S_ss about their means, variance ps^2 / S_ss.
+        double n_in = 0, ms = 0, mr = 0;
+        for (size_t k = b; k < e; ++k) {
+          const double ee = obs[k].r - (c0 + m * obs[k].s);
+          if (ee * ee > lim2) continue;
+          n_in += 1;
+          ms += obs[k].s;
+          mr += obs[k].r;
+        }
+        if (n_in >= kMinPoints) {
+          ms /= n_in;
+          mr /= n_in;
+          double sss = 0, ssr = 0;
+          for (size_t k = b; k < e; ++k) {
+            const double ee = obs[k].r - (c0 + m * obs[k].s);
+            if (ee * ee > lim2) continue;
+            sss += (obs[k].s - ms) * (obs[k].s - ms);
+            ssr += (obs[k].s - ms) * (obs[k].r - mr);
+          }
+          if (sss > 0) runs.push_back({b, e, ssr / sss, ps2 / sss, g[size_t(obs[b].el)].len, int(n_in)});
+        }
+      }
+    }
+    b = e;
+  }
+  // The guess's yaw error: the point-weighted median slope of the well-seen runs.
+  thread_local std::vector<std::pair<double, int>> votes;
+  votes.clear();
+  int total = 0;
+  for (const Run& r : runs)
+    if (r.n >= kMinYawPoints) {
+      votes.push_back({r.slope, r.n});
+      total += r.n;
+    }
+  double yaw_err = 0;
+  if (!votes.empty()) {
+    std::sort(votes.begin(), votes.end());
+    int acc_n = 0;
+    for (const auto& v : votes) {
+      acc_n += v.second;
+      if (2 * acc_n >= total) {
+        yaw_err = v.first;
+        break;
+      }
+    }
+  }
+  drop->assign(on.size(), 0);
+  const double P = o.askew_max_m;
+  for (const Run& r : runs) {
+    const double d = (r.slope - yaw_err) * r.len, var = r.var * r.len * r.len;
+    if (d * d > kChi2Dof1P99 * (2 * P * P + var))
+      for (size_t k = r.b; k < r.e; ++k) (*drop)[size_t(obs[k].i)] = 1;
+  }
+}
+}  // namespace
+
 void select_points(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, const AssignOptions& o,
                    std::vector<SampledPoint>* out) {
   out->clear();
   const size_t n = f.points.size();
   const size_t stride = size_t(std::max(1, o.stride));
-  if (!(o.element_quota > 0 && stride > 1 && lookup.element_targets())) {
+  const bool budget = o.element_quota > 0 && stride > 1 && lookup.element_targets();
+  const bool askew_rule = o.askew_max_m > 0 && lookup.element_targets();
+  if (!budget && !askew_rule) {
     out->reserve(n / stride + 1);
     for (size_t i = 0; i < n; i += stride) out->push_back({int(i), 1.0f});
     return;
   }
   // Per-element budget: every point looked up, its closest candidate within the gate counted per element; an
   // element with at most element_quota points keeps them all (sampling weight 1/sqrt(stride): each stands for
-  // itself, a stride-th point for stride points), the others every stride-th point.
+  // itself, a stride-th point for stride points), the others every stride-th point. Askew faces
+  // (askew_max_m): the points of a run along an element that lies on a line askew to it are left out.
   const auto& g = lookup.geometry();
   const std::vector<float>* ew = o.element_weight;
   const int maxc = std::clamp(o.max_candidates, 1, kMaxCandidates);
   const double g2 = o.gate_m * o.gate_m;
   const double c = std::cos(x.yaw), s = std::sin(x.yaw);
   thread_local std::vector<int> on, count;
+  thread_local std::vector<char> drop;
   on.assign(n, -1);
   if (count.size() < g.size()) count.resize(g.size(), 0);
   Assignment a;
@@ -714,10 +837,12 @@ void select_points(const NearestLookup& lookup, const FeatureFrame& f, const Pos
       ++count[size_t(on[i])];
     }
   }
+  if (askew_rule) askew_points(g, f, x, on, o, &drop);
   const float rare_w = float(1.0 / std::sqrt(double(stride)));
   out->reserve(n / stride + 1);
   for (size_t i = 0; i < n; ++i) {
-    const bool rare = on[i] >= 0 && count[size_t(on[i])] <= o.element_quota;
+    if (askew_rule && drop[i]) continue;
+    const bool rare = budget && on[i] >= 0 && count[size_t(on[i])] <= o.element_quota;
     if (rare) out->push_back({int(i), rare_w});
     else if (i % stride == 0) out->push_back({int(i), 1.0f});
   }
@@ -760,7 +885,7 @@ void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, 
   };
   const std::vector<SampledPoint>* sel = o.points;
   thread_local std::vector<SampledPoint> own;
-  if (!sel && o.element_quota > 0 && stride > 1 && lookup.element_targets()) {
+  if (!sel && ((o.element_quota > 0 && stride > 1) || o.askew_max_m > 0) && lookup.element_targets()) {
     select_points(lookup, f, x, o, &own);
     sel = &own;
   }

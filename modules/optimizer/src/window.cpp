@@ -266,6 +266,8 @@ void WindowOptimizer::solve() {
   ao.element_weight = cfg_.element_weight;
   ao.stride = cfg_.stride;
   ao.element_quota = cfg_.element_quota;
+  ao.askew_max_m = cfg_.askew_max_m;
+  ao.askew_point_sigma_m = cfg_.as_built.point_sigma_m;
   // Anchors: the last final key poses, held fixed (optional).
   double anchors[2][3];
   std::vector<std::pair<double*, int64_t>> chain;  // pose block, utime
@@ -291,7 +293,7 @@ void WindowOptimizer::solve() {
       matcher::AssignOptions aok = ao;
       const size_t np = k.deskewed.points.size();
       aok.stride = matcher::budget_stride(np, cfg_.stride, cfg_.max_points);
-      if (aok.element_quota > 0 && aok.stride > 1 && lookup_.element_targets()) {
+      if (((aok.element_quota > 0 && aok.stride > 1) || aok.askew_max_m > 0) && lookup_.element_targets()) {
         if (!k.sel_valid) {
           matcher::select_points(lookup_, k.deskewed, xk, aok, &k.sel);
           k.sel_valid = true;

@@ -56,8 +56,19 @@ struct AssignOptions {
   // seen with a handful of points (the only one across a corridor, far away) keeps them all, where every
   // stride-th would keep 0-2 of them. 0 = off (every stride-th point of the frame).
   int element_quota = 0;
-  // The points to use, as select_points (plan_terms.h) chose them: when given, stride and element_quota are
-  // not looked at (a caller that assigns one frame many times at nearby poses selects once). Not owned.
+  // Faces askew to their element (element look-ups): the points whose closest candidate within the gate is a
+  // segment, in a run along it (a gap of more than 0.5 m ends a run) that lies on a line turning against the
+  // segment by more than about askew_max_m * sqrt(2) between its two ends (beyond that line's own uncertainty at
+  // askew_point_sigma_m per point, and after the turn every run shows alike, the guess's own yaw error), are left
+  // out: a cabinet's face seen where a glass wall is drawn, askew to it, is not that wall, and as a wall (the
+  // as-built model gives every wall a share) it holds the pose against the walls that are there. A wall standing a
+  // few centimetres off its drawn place, or moved along its normal, turns by no more than its ends' offsets; a
+  // person in front of a wall is a run of its own, too short to turn significantly. Judged at the pose the points
+  // are selected at (select_points): a tracking guess. 0 = off.
+  double askew_max_m = 0;
+  double askew_point_sigma_m = 0.04;
+  // The points to use, as select_points (plan_terms.h) chose them: when given, stride, element_quota and
+  // askew_max_m are not looked at (a caller that assigns one frame many times at nearby poses selects once). Not owned.
   const std::vector<SampledPoint>* points = nullptr;
   // Per plan element (target id of an element look-up): its weight in the floor-plan terms, e.g. from
   // the plan-change detector (element_weights.h). Elements with weight <= 0 are no candidates at all;

@@ -39,6 +39,10 @@ struct MatcherConfig {
   // kept, weighted as a point budget's estimate of the sum over all points (AssignOptions::element_quota);
   // 0 = off.
   int element_quota = 0;
+  // While tracking (the prediction a prior of the registration): the points of a run along a plan segment that
+  // lies on a line askew to it are left out of the frame (AssignOptions::askew_max_m; judged once at the
+  // prediction); 0 = off.
+  double askew_max_m = 0;
   // While tracking, the prediction enters the registration as one more measurement: its uncertainty over
   // one frame (a platform's deviation from constant velocity in 0.1 s plus the velocity estimate's error;
   // grows with the time since the last frame), weighed against the floor-plan residuals by the last fit's

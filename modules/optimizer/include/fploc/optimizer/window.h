@@ -52,6 +52,7 @@ struct OptimizerConfig {
   int max_points = 800;                // per keyframe: the stride grows to keep about this many (0 = all)
   bool budget_weight = true;           // weight the sampled points by the stride (estimate of the sum over all)
   int element_quota = 0;               // as MatcherConfig::element_quota (0 = off)
+  double askew_max_m = 0;              // as MatcherConfig::askew_max_m, judged at a key's first look-up (0 = off)
   double relook_m = 0.01;              // a key's correspondences are looked up again when it moved this far
   double relook_rad = 0.2 * M_PI / 180;  // ... or turned this much since the last look-up
   bool anchor_final = false;           // also regularise against the last two final key poses (held fixed)
