@@ -107,7 +107,7 @@ TEST(ConfigDefaults, Matcher) {
          {"as_built_point_sigma_m", c.as_built.point_sigma_m},
          {"as_built_loss_scale_m", c.as_built.loss_scale_m}, {"element_quota", c.element_quota},
          {"as_built_max_spread_sigmas", c.as_built.max_spread_sigmas},
-         {"as_built_max_askew_m", c.as_built.max_askew_m}});
+         {"as_built_max_askew_m", c.as_built.max_askew_m}, {"max_speed_mps", c.max_speed_mps}});
 }
 
 TEST(ConfigDefaults, Optimizer) {
