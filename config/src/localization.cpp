@@ -67,6 +67,7 @@ matcher::MatcherConfig config_of(const MatcherOptions& o) {
   if (o.prediction_sigma_m() != 0) c.prediction_sigma_m = std::max(0.0, o.prediction_sigma_m());
   if (o.prediction_sigma_deg() != 0) c.prediction_sigma_rad = std::max(0.0, o.prediction_sigma_deg()) * kRadPerDeg;
   if (o.odom_gate_sigmas() != 0) c.odom_gate_sigmas = std::max(0.0, o.odom_gate_sigmas());
+  if (o.max_speed_mps() != 0) c.max_speed_mps = std::max(0.0, o.max_speed_mps());
   c.as_built = as_built_of(o, "matcher");
   return c;
 }

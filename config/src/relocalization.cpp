@@ -1,5 +1,7 @@
 #include "fploc/config/relocalization.h"
 
+#include <algorithm>
+
 #include "fploc/config/check.h"
 
 namespace fploc::config {
@@ -18,6 +20,8 @@ reloc::Schedule schedule_of(const RelocalizerOptions& o) {
   if (given(o.region_radius_m(), "relocalizer", "region_radius_m")) s.region_radius_m = o.region_radius_m();
   if (given(o.global_after_s(), "relocalizer", "global_after_s")) s.global_after_s = o.global_after_s();
   if (given(o.min_interval_s(), "relocalizer", "min_interval_s")) s.min_interval_s = o.min_interval_s();
+  if (o.max_speed_mps() != 0) s.max_speed_mps = std::max(0.0, o.max_speed_mps());
+  if (given(o.speed_margin_m(), "relocalizer", "speed_margin_m")) s.speed_margin_m = o.speed_margin_m();
   return s;
 }
 

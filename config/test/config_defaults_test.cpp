@@ -107,7 +107,8 @@ TEST(ConfigDefaults, Matcher) {
          {"as_built_point_sigma_m", c.as_built.point_sigma_m},
          {"as_built_loss_scale_m", c.as_built.loss_scale_m}, {"element_quota", c.element_quota},
          {"as_built_max_spread_sigmas", c.as_built.max_spread_sigmas},
-         {"as_built_max_askew_m", c.as_built.max_askew_m}, {"askew_max_m", c.askew_max_m}});
+         {"as_built_max_askew_m", c.as_built.max_askew_m}, {"askew_max_m", c.askew_max_m},
+         {"max_speed_mps", c.max_speed_mps}});
 }
 
 TEST(ConfigDefaults, Optimizer) {
@@ -156,10 +157,11 @@ TEST(ConfigDefaults, Relocalizer) {
   check("relocalization.proto", "RelocalizerOptions",
         {{"grid_m", c.grid_m}, {"yaw_step_deg", c.yaw_step_deg}, {"min_inlier_ratio", c.min_inlier_ratio},
          {"min_evidence", c.min_evidence}},
-        {"region_radius_m", "global_after_s", "min_interval_s"});
+        {"region_radius_m", "global_after_s", "min_interval_s", "max_speed_mps", "speed_margin_m"});
   const fploc::reloc::Schedule w = fploc::config::schedule_of(fploc::RelocalizerOptions{});
   check("relocalization.proto", "RelocalizerOptions",
-        {{"region_radius_m", w.region_radius_m}, {"global_after_s", w.global_after_s}, {"min_interval_s", w.min_interval_s}},
+        {{"region_radius_m", w.region_radius_m}, {"global_after_s", w.global_after_s}, {"min_interval_s", w.min_interval_s},
+         {"max_speed_mps", w.max_speed_mps}, {"speed_margin_m", w.speed_margin_m}},
         {"grid_m", "yaw_step_deg", "min_inlier_ratio", "min_evidence"});
 }
 

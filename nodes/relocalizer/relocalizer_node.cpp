@@ -52,10 +52,9 @@ class RelocalizerNode : public fploc::rt::Node {
     floor_ = floors_.initial;
     for (const auto& m : floors_.maps)
       relocs_.push_back(std::make_unique<fploc::reloc::Relocalizer>(*m.plan, *m.lookup, fploc::config::config_of(o)));
-    const fploc::reloc::Schedule when = fploc::config::schedule_of(o);
-    radius_ = when.region_radius_m;
-    global_after_us_ = int64_t(when.global_after_s * 1e6);
-    interval_us_ = int64_t(when.min_interval_s * 1e6);
+    when_ = fploc::config::schedule_of(o);
+    global_after_us_ = int64_t(when_.global_after_s * 1e6);
+    interval_us_ = int64_t(when_.min_interval_s * 1e6);
     for (size_t i = 0; i < relocs_.size(); ++i)
       std::cerr << "[" << ctx.name() << "] floor '" << floors_.building->floors[i].name << "': "
                 << floors_.maps[i].plan->elements.size() << " elements, " << relocs_[i]->free_cells() << " free search cells\n";
@@ -121,7 +120,10 @@ class RelocalizerNode : public fploc::rt::Node {
     std::optional<fploc::reloc::SearchRegion> region;
     const bool local = m.utime - lost_since_ < global_after_us_ &&
                        (st == fploc::matcher::FitStatus::kLost || (have_ok_ && m.utime - last_ok_utime_ < global_after_us_));
-    if (local) region = fploc::reloc::SearchRegion{have_ok_ ? last_ok_ : fploc::Pose2{m.x, m.y, m.yaw}, radius_, M_PI};
+    // (No farther from the last good pose than the platform can have driven since: on corridor s2 mixed the answer
+    // lay 2.8 m from the last good fix, 0.5 s after it.)
+    const double radius = have_ok_ ? fploc::reloc::local_radius_m(when_, (m.utime - last_ok_utime_) * 1e-6) : when_.region_radius_m;
+    if (local) region = fploc::reloc::SearchRegion{have_ok_ ? last_ok_ : fploc::Pose2{m.x, m.y, m.yaw}, radius, M_PI};
     std::string where = local ? "near the last pose" : "over the whole plan";
     // Just after a floor change: the connection area between the two floors.
     if (floor_changed_ != 0 && m.utime - floor_changed_ < global_after_us_)
@@ -158,7 +160,7 @@ class RelocalizerNode : public fploc::rt::Node {
   fploc::Pose2 last_ok_;
   bool have_ok_ = false;
   int64_t lost_since_ = 0, last_search_ = 0, last_ok_utime_ = 0, seq_ = 0;
-  double radius_ = 3.0;
+  fploc::reloc::Schedule when_;
   int64_t global_after_us_ = 2000000, interval_us_ = 500000;
   std::string last_text_;
 };

@@ -320,6 +320,14 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
     // building). Until two frames in a row register, the motion model predicts no motion.
     if (tracking && dt > 0 && dt < 1.0) {
       twist_ = log_twist(pose_, solved_ref, dt);
+      // The platform's speed at most: two fixes farther apart than it can drive (a fit that slid along a corridor,
+      // or caught a twin of the place) are no motion, and carried as the prediction's velocity through the frames
+      // after them they would run the track away along every direction the plan leaves open.
+      const double v = std::hypot(twist_.vx, twist_.vy);
+      if (cfg_.max_speed_mps > 0 && v > cfg_.max_speed_mps) {
+        twist_.vx *= cfg_.max_speed_mps / v;
+        twist_.vy *= cfg_.max_speed_mps / v;
+      }
       have_velocity_ = true;
     }
     pose_ = solved_ref;

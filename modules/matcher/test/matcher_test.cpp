@@ -178,6 +178,36 @@ TEST(Matcher, ReacquiredAfterLostTheCorrectionIsNotReadAsVelocity) {
   EXPECT_LT(pos_err(third.predicted, truth(0.1 * k)), 0.01) << "two registered frames give the velocity again";
 }
 
+TEST(Matcher, AFixThatJumpedIsNoFasterThanThePlatform) {
+  // Tracking at 0.5 m/s, then one fix 0.6 m ahead (a fit that caught another place: within max_jump_m, and the
+  // tracking gate opened so that it registers), then the sensor's next frame. The 6.5 m/s between the two fixes is
+  // no motion a platform makes: the next prediction runs on at max_speed_mps at most (the corridor's mixed and
+  // shelved worlds: carried through the POOR frames after it, such a velocity ran the track away along the
+  // corridor at 3-9 m/s). Without the limit it predicts the next frame 0.65 m on.
+  auto map = make_localization_map(room_with_pillars(), "brute-force");
+  for (double vmax : {2.0, 0.0}) {
+    MatcherConfig cfg;
+    cfg.max_speed_mps = vmax;
+    cfg.gate_tracking_m = 1.5;
+    Matcher m(*map.lookup, cfg);
+    auto truth = [](int k) { return Pose2{4.0 + 0.05 * k, 3.0, 0.2}; };
+    m.set_pose(truth(0), 0.3);
+    SynthOptions so;
+    int k = 0;
+    for (; k < 5; ++k) ASSERT_EQ(m.process(synth_frame(*map.plan, truth(k), so, int64_t(k) * 100'000)).status, FitStatus::kOk);
+    const Pose2 jumped{truth(k).x + 0.6, truth(k).y, truth(k).yaw};
+    const MatchResult j = m.process(synth_frame(*map.plan, jumped, so, int64_t(k) * 100'000));
+    ASSERT_EQ(j.status, FitStatus::kOk) << j.text;
+    ASSERT_LT(pos_err(j.pose, jumped), 0.01);
+    ++k;
+    const MatchResult next = m.process(synth_frame(*map.plan, truth(k), so, int64_t(k) * 100'000));
+    const double step = pos_err(next.predicted, j.pose);
+    std::printf("max_speed_mps %.1f: predicted %.2f m on from the jumped fix in 0.1 s\n", vmax, step);
+    if (vmax > 0) EXPECT_LT(step, vmax * 0.1 + 0.01);
+    else EXPECT_GT(step, 0.5);
+  }
+}
+
 TEST(Matcher, NotInitialisedWithoutAPose) {
   auto map = make_localization_map(room_with_pillars(), "brute-force");
   Matcher m(*map.lookup, {});

@@ -187,6 +187,10 @@ RelocResult Relocalizer::locate(const FeatureFrame& f, const std::optional<Searc
   for (const auto& s : seeds) {
     const matcher::MatchResult m = register_frame(lookup_, f, s.pose, cfg_.registration);
     RelocHypothesis h{m.solved, s.score, m.fit, 0.0};
+    // A local search answers within its region (a grid step's leeway): a seed whose refinement slid out of it
+    // (along a corridor) is another place, and the region is where the robot can be.
+    if (region && std::hypot(h.pose.x - region->center.x, h.pose.y - region->center.y) > region->radius_m + cfg_.grid_m)
+      continue;
     std::vector<uint8_t> e = explained_points(f, h.pose, tstride);
     auto same = std::find_if(out.candidates.begin(), out.candidates.end(),
                              [&](const RelocHypothesis& o) { return same_place(o.pose, h.pose, cfg_); });

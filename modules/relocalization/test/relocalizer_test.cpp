@@ -1,4 +1,5 @@
 #include "fploc/relocalization/relocalizer.h"
+#include "fploc/relocalization/schedule.h"
 
 #include <gtest/gtest.h>
 
@@ -98,6 +99,34 @@ TEST(Relocalizer, RegionSearchAroundALostPose) {
   // A smaller search than the whole plan.
   const RelocResult all = reloc.locate(synth::synth_frame(*map.plan, truth, noisy(11)));
   EXPECT_LT(r.hypotheses, all.hypotheses / 3);
+}
+
+// A local search answers within its region: a seed whose refinement slides out of the disc (here onto the truth,
+// 1.2 m from a disc of 0.6 m: the robot cannot have driven there since its last good pose) is another place. The
+// same scan searched in a disc around the truth is found.
+TEST(Relocalizer, ALocalSearchAnswersWithinItsRegion) {
+  auto map = matcher::make_localization_map(synth::room_with_pillars(), "annf-exact");
+  Relocalizer reloc(*map.plan, *map.lookup);
+  const Pose2 truth{12, 8, -0.7};
+  const FeatureFrame f = synth::synth_frame(*map.plan, truth, noisy(11));
+  const RelocResult near = reloc.locate(f, SearchRegion{{truth.x + 1.2, truth.y, truth.yaw}, 0.6, M_PI});
+  std::cerr << "  disc 1.2 m away: " << to_string(near.status) << " " << near.text << "\n";
+  for (const auto& c : near.candidates)
+    EXPECT_LE(std::hypot(c.pose.x - truth.x - 1.2, c.pose.y - truth.y), 0.6 + RelocalizerConfig{}.grid_m) << "outside the region";
+  if (near.status == RelocStatus::kFound) EXPECT_GT(std::hypot(near.pose.x - truth.x, near.pose.y - truth.y), 0.5);
+  const RelocResult at = reloc.locate(f, SearchRegion{{truth.x + 0.2, truth.y, truth.yaw}, 0.6, M_PI});
+  ASSERT_EQ(at.status, RelocStatus::kFound) << at.text;
+  EXPECT_LT(std::hypot(at.pose.x - truth.x, at.pose.y - truth.y), 0.05);
+}
+
+// The fploc-relocalizer's local radius: what the platform can drive since the last good pose, at most region_radius_m.
+TEST(Schedule, LocalRadiusIsWhatThePlatformCanHaveDriven) {
+  Schedule s;
+  EXPECT_DOUBLE_EQ(local_radius_m(s, 0.0), 0.5);
+  EXPECT_DOUBLE_EQ(local_radius_m(s, 0.5), 1.5);
+  EXPECT_DOUBLE_EQ(local_radius_m(s, 5.0), 3.0);
+  s.max_speed_mps = 0;
+  EXPECT_DOUBLE_EQ(local_radius_m(s, 0.5), 3.0);
 }
 
 TEST(Relocalizer, RejectsBadConfiguration) {

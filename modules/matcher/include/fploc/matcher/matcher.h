@@ -32,6 +32,9 @@ struct MatcherConfig {
   double max_jump_rad = 30 * M_PI / 180;
   bool group_rule = true;
   bool motion_model = true;       // constant velocity (else: previous pose)
+  // The motion model's speed is the platform's at most (as fploc-ndt's prediction): a velocity measured between two
+  // fixes above it is scaled down to it (0 = no limit).
+  double max_speed_mps = 2.0;
   bool deskew = true;             // motion compensation with the motion model's twist (IMU yaw rate if given)
   int stride = 1;                 // use every stride-th point
   int max_points = 800;           // more features than this: the stride grows to keep about this many (0 = all)
