@@ -78,26 +78,45 @@ TEST(AsBuilt, WorldAsDrawnUnchanged) {
   }
 }
 
+// A 30 m corridor, 2 m wide, its east end wall glass (no returns), a cabinet's 0.9 m face 22 deg askew to that end
+// centred at (face_x, 1) (behind the drawn line beyond 30 m, in front of it short of 30 m); and the scans of it.
+namespace {
+struct GlassEnd {
+  FloorPlan plan, world;
+  Eigen::Vector2d face;  // the face's centre
+};
+GlassEnd glass_end_corridor(double face_x) {
+  GlassEnd g;
+  g.plan.elements.push_back(Element::segment({0, 0}, {30, 0}));
+  g.plan.elements.push_back(Element::segment({0, 2}, {30, 2}));
+  g.plan.elements.push_back(Element::segment({0, 0}, {0, 2}));
+  g.plan.elements.push_back(Element::segment({30, 0}, {30, 2}));
+  g.world = g.plan;
+  g.world.elements.pop_back();  // the east end: glass
+  const Eigen::Vector2d c(face_x, 1.0), u(std::sin(22 * M_PI / 180), std::cos(22 * M_PI / 180));
+  g.world.elements.push_back(Element::segment(c - 0.45 * u, c + 0.45 * u));
+  g.face = c;
+  return g;
+}
+fploc::testing::SynthOptions glass_end_scan() {
+  fploc::testing::SynthOptions so;
+  so.beams = 1440;
+  so.max_range = 30;
+  so.noise_sigma = 0.005;
+  return so;
+}
+}  // namespace
+
 // A corridor whose east end wall is glass (no returns) with a cabinet behind it: the cabinet's face (0.9 m of
 // the 2 m wall, 22 deg askew, 1-35 cm behind the drawn line) and the west end wall 10-20 m away are all that
 // holds the position along the corridor. The face's points do not lie on one line with the wall (their spread
 // about the wall's fitted offsets is ~10 cm against the 4 cm point sigma), so they pull with a share scaled down
 // (AsBuiltModel::max_spread_sigmas), not as a whole wall standing off its place.
 TEST(AsBuilt, AFaceSeenThroughGlassDoesNotPullAsAWall) {
-  FloorPlan plan;
-  plan.elements.push_back(Element::segment({0, 0}, {30, 0}));
-  plan.elements.push_back(Element::segment({0, 2}, {30, 2}));
-  plan.elements.push_back(Element::segment({0, 0}, {0, 2}));
-  plan.elements.push_back(Element::segment({30, 0}, {30, 2}));
-  FloorPlan world = plan;
-  world.elements.pop_back();  // the east end: glass
-  const Eigen::Vector2d c(30.18, 1.0), u(std::sin(22 * M_PI / 180), std::cos(22 * M_PI / 180));
-  world.elements.push_back(Element::segment(c - 0.45 * u, c + 0.45 * u));
-  auto map = make_localization_map(plan, "annf-exact");
-  fploc::testing::SynthOptions so;
-  so.beams = 1440;
-  so.max_range = 30;
-  so.noise_sigma = 0.005;
+  const GlassEnd g = glass_end_corridor(30.18);
+  const FloorPlan& world = g.world;
+  auto map = make_localization_map(g.plan, "annf-exact");
+  const fploc::testing::SynthOptions so = glass_end_scan();
   for (const Pose2 truth : {Pose2{20.0, 1.0, 0.0}, Pose2{22.0, 0.7, 0.5}, Pose2{18.0, 1.3, 2.8}}) {
     const FeatureFrame f = fploc::testing::synth_frame(world, truth, so);
     MatcherConfig whole = config(true), bounded = config(true), gated = config(true);
@@ -216,20 +235,11 @@ TEST(AsBuilt, PerWallEvaluationMatchesPerPoint) {
 // wall's ends, so with the rule they are left out of the frame: the fit is held by the walls that are there.
 // The rule is judged at the tracking guess only (a prior given); its yaw error is taken out first.
 TEST(AskewFaces, AFaceWhereAGlassWallIsDrawnIsLeftOut) {
-  FloorPlan plan;
-  plan.elements.push_back(Element::segment({0, 0}, {30, 0}));
-  plan.elements.push_back(Element::segment({0, 2}, {30, 2}));
-  plan.elements.push_back(Element::segment({0, 0}, {0, 2}));
-  plan.elements.push_back(Element::segment({30, 0}, {30, 2}));
-  FloorPlan world = plan;
-  world.elements.pop_back();  // the east end: glass
-  const Eigen::Vector2d c(29.8, 1.0), u(std::sin(22 * M_PI / 180), std::cos(22 * M_PI / 180));
-  world.elements.push_back(Element::segment(c - 0.45 * u, c + 0.45 * u));
-  auto map = make_localization_map(plan, "annf-exact");
-  fploc::testing::SynthOptions so;
-  so.beams = 1440;
-  so.max_range = 30;
-  so.noise_sigma = 0.005;
+  const GlassEnd g = glass_end_corridor(29.8);
+  const FloorPlan& world = g.world;
+  const Eigen::Vector2d c = g.face;
+  auto map = make_localization_map(g.plan, "annf-exact");
+  const fploc::testing::SynthOptions so = glass_end_scan();
   for (const Pose2 truth : {Pose2{20.0, 1.0, 0.0}, Pose2{22.0, 0.7, 0.5}, Pose2{18.0, 1.3, 2.8}}) {
     const FeatureFrame f = fploc::testing::synth_frame(world, truth, so);
     PosePrior prior;  // a tracking frame: the prediction as a (here weak) prior
@@ -273,7 +283,9 @@ TEST(AskewFaces, AFaceWhereAGlassWallIsDrawnIsLeftOut) {
         walls += on_wall(f.points[size_t(s.point)]);
       }
       ASSERT_GT(face_all, 10);
-      if (dyaw < 1 * M_PI / 180) EXPECT_EQ(face, 0) << "yaw off by " << dyaw;
+      if (dyaw < 1 * M_PI / 180) {
+        EXPECT_EQ(face, 0) << "yaw off by " << dyaw;
+      }
       EXPECT_EQ(walls, walls_all) << "yaw off by " << dyaw;
     }
   }
