@@ -120,11 +120,10 @@ struct UncertaintyConfig {
   // The IMU's gyro (the Localizer's add_imu samples, when it has them): the odometry's yaw change from one frame to
   // the next is the gyro's integral, held with this 1-sigma per frame (Odometry2D::set_yaw_change). People walking
   // beside the robot turn the ICP with them, by degrees over a stretch (0.1 m per 1 deg and 6 m travelled); a gyro
-  // they cannot turn. 0: off (the ICP's own yaw, with the prediction's prior). Off by default: with it (0.002) the
-  // corridor crowd's right poses published POOR fell from 9-23 % to 0.5-4.8 %, but on corridor s1 mixed the odometry,
-  // its heading held, slid 1 m in 2 s and started again inside a stretch, which ends a stretch at once: one pose
-  // published OK 2.3 m off (docs/notes/realism.md, thirty-second round).
-  double dr_gyro_sigma_rad = 0;
+  // they cannot turn. 0: off (the ICP's own yaw, with the prediction's prior). On the corridor crowd's worlds the
+  // right poses published POOR fall from 9-23 % to 0.5-4.8 %; on the mixed corridors one pose (s1) is published OK
+  // 2.3 m off with it, 24 (s2) without it (docs/notes/realism.md, thirty-second round).
+  double dr_gyro_sigma_rad = 0.002;
   double dead_reckoning_gate_sigma = 3.0;
   double dr_confirm_gate_sigma = 2.0;
   double dr_jump_mps = 0.5;
