@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <utility>
 
 #include "fploc/matcher/map.h"
 #include "fploc/matcher/matcher.h"
@@ -104,6 +105,17 @@ fploc::testing::SynthOptions glass_end_scan() {
   so.max_range = 30;
   so.noise_sigma = 0.005;
   return so;
+}
+// A tracking frame (the prediction at the truth as a weak prior) registered with the as-built model, without and with
+// the askew rule (askew_max_m 0.1).
+std::pair<MatchResult, MatchResult> tracked_without_and_with_askew(const NearestLookup& lookup, const FeatureFrame& f,
+                                                                    const Pose2& truth) {
+  PosePrior prior;
+  prior.pose = truth;
+  prior.sqrt_info = Eigen::Vector3d(1e-3, 1e-3, 1e-3);
+  MatcherConfig plain = config(true), askew = config(true);
+  askew.askew_max_m = 0.1;
+  return {register_frame(lookup, f, truth, plain, &prior), register_frame(lookup, f, truth, askew, &prior)};
 }
 }  // namespace
 
@@ -242,13 +254,7 @@ TEST(AskewFaces, AFaceWhereAGlassWallIsDrawnIsLeftOut) {
   const fploc::testing::SynthOptions so = glass_end_scan();
   for (const Pose2 truth : {Pose2{20.0, 1.0, 0.0}, Pose2{22.0, 0.7, 0.5}, Pose2{18.0, 1.3, 2.8}}) {
     const FeatureFrame f = fploc::testing::synth_frame(world, truth, so);
-    PosePrior prior;  // a tracking frame: the prediction as a (here weak) prior
-    prior.pose = truth;
-    prior.sqrt_info = Eigen::Vector3d(1e-3, 1e-3, 1e-3);
-    MatcherConfig whole = config(true), askew = config(true);
-    askew.askew_max_m = 0.1;
-    const MatchResult a = register_frame(*map.lookup, f, truth, whole, &prior);
-    const MatchResult b = register_frame(*map.lookup, f, truth, askew, &prior);
+    const auto [a, b] = tracked_without_and_with_askew(*map.lookup, f, truth);
     ASSERT_EQ(a.status, FitStatus::kOk);
     ASSERT_EQ(b.status, FitStatus::kOk);
     const double e_whole = std::abs(a.pose.x - truth.x), e_askew = std::abs(b.pose.x - truth.x);
@@ -321,13 +327,7 @@ TEST(AskewFaces, DisplacedWallsAreKept) {
         select_points(*map.lookup, f, Pose2{truth.x, truth.y, truth.yaw + dyaw}, ao, &sel);
         EXPECT_EQ(sel.size(), f.points.size()) << "seed " << seed << " yaw off by " << dyaw;
       }
-      PosePrior prior;
-      prior.pose = truth;
-      prior.sqrt_info = Eigen::Vector3d(1e-3, 1e-3, 1e-3);
-      MatcherConfig plain = config(true), askew = config(true);
-      askew.askew_max_m = 0.1;
-      const MatchResult p = register_frame(*map.lookup, f, truth, plain, &prior);
-      const MatchResult g = register_frame(*map.lookup, f, truth, askew, &prior);
+      const auto [p, g] = tracked_without_and_with_askew(*map.lookup, f, truth);
       ASSERT_EQ(p.status, FitStatus::kOk);
       ASSERT_EQ(g.status, FitStatus::kOk);
       EXPECT_LT(std::hypot(g.pose.x - p.pose.x, g.pose.y - p.pose.y), 1e-6) << "seed " << seed;
