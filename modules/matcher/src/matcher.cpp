@@ -57,7 +57,7 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
     ao.askew_point_sigma_m = cfg.as_built.point_sigma_m;
   }
   std::vector<SampledPoint> sel;
-  if (((cfg.element_quota > 0 && ao.stride > 1) || ao.askew_max_m > 0) && lookup.element_targets()) {
+  if (selects_per_element(lookup, ao)) {
     AssignOptions so = ao;
     so.gate_m = cfg.min_correspondence_m;
     select_points(lookup, f, guess, so, &sel);

@@ -769,7 +769,7 @@ void assign(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, 
   };
   const std::vector<SampledPoint>* sel = o.points;
   thread_local std::vector<SampledPoint> own;
-  if (!sel && ((o.element_quota > 0 && stride > 1) || o.askew_max_m > 0) && lookup.element_targets()) {
+  if (!sel && selects_per_element(lookup, o)) {
     select_points(lookup, f, x, o, &own);
     sel = &own;
   }

@@ -580,7 +580,9 @@ TEST(Matcher, OdometryWindowReacquiresAfterABadOdometryStep) {
     const Pose2 said = k == 1 ? Pose2{0.3, 0, 0.05 - 0.35} : motion;
     const MatchResult r = m.process(synth_frame(*map.plan, truth, so, 1'000'000 + k * 1'000'000), std::nullopt, said);
     if (r.status == FitStatus::kOk && first_ok_after < 0) first_ok_after = k;
-    if (r.status == FitStatus::kOk) EXPECT_LT(pos_err(r.pose, truth), 0.01) << "frame " << k << ": " << r.text;
+    if (r.status == FitStatus::kOk) {
+      EXPECT_LT(pos_err(r.pose, truth), 0.01) << "frame " << k << ": " << r.text;
+    }
   }
   EXPECT_EQ(first_ok_after, 2);
 }

@@ -293,7 +293,7 @@ void WindowOptimizer::solve() {
       matcher::AssignOptions aok = ao;
       const size_t np = k.deskewed.points.size();
       aok.stride = matcher::budget_stride(np, cfg_.stride, cfg_.max_points);
-      if (((aok.element_quota > 0 && aok.stride > 1) || aok.askew_max_m > 0) && lookup_.element_targets()) {
+      if (matcher::selects_per_element(lookup_, aok)) {
         if (!k.sel_valid) {
           matcher::select_points(lookup_, k.deskewed, xk, aok, &k.sel);
           k.sel_valid = true;

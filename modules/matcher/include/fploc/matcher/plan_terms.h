@@ -25,6 +25,11 @@ namespace fploc::matcher {
 // frame's points, at sampling weight 1/sqrt(stride) (AssignOptions::element_quota). In point order.
 void select_points(const NearestLookup& lookup, const FeatureFrame& f, const Pose2& x, const AssignOptions& o,
                    std::vector<SampledPoint>* out);
+// Whether select_points does more than take every o.stride-th point (the per-element budget or the askew rule,
+// both needing element look-ups): callers that keep a selection compute one only then.
+inline bool selects_per_element(const NearestLookup& lookup, const AssignOptions& o) {
+  return ((o.element_quota > 0 && o.stride > 1) || o.askew_max_m > 0) && lookup.element_targets();
+}
 
 // Correspondences of the frame's points at pose x (in point order): of o.points when given, else of the
 // points select_points chooses at x.
