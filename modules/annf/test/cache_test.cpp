@@ -10,6 +10,7 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <vector>
 
 #include "fploc/floorplan/io.h"
 
@@ -19,10 +20,21 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// The test's folders, removed when the test program ends (the forked children leave with _exit, so only the parent
+// removes them).
+struct Folders {
+  std::vector<std::string> made;
+  ~Folders() {
+    std::error_code ec;
+    for (const auto& d : made) fs::remove_all(d, ec);
+  }
+} folders;
+
 std::string fresh_dir(const std::string& name) {
   const std::string d = testing::TempDir() + "/annf_cache_" + name + "_" + std::to_string(::getpid());
   fs::remove_all(d);
   fs::create_directories(d);
+  folders.made.push_back(d);
   return d;
 }
 
