@@ -161,9 +161,14 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
     uncertainty_ = tracker_.update(f.utime, fu.covariance, fu.valid, sfr.match.status, sfr.match.text, &sfr.match.pose,
                                    &sfr.match.twist, sfr.match.fit.inlier_ratio, motion ? &*motion : nullptr,
                                    contradicted(deskewed_, at_ref, sfr.match.fit.inlier_ratio), dr ? &*dr : nullptr);
+    bool ambiguous = false;
     if (cfg_.uncertainty.rival_ratio > 0 && sfr.match.status == matcher::FitStatus::kOk &&
-        (uncertainty_.confirming || have_rival_))
-      check_rival(deskewed_, at_ref, dr ? &*dr : nullptr, sfr.match.pose);
+        (uncertainty_.confirming || have_rival_ || reacquiring_without_dr_))
+      ambiguous = check_rival(deskewed_, at_ref, dr ? &*dr : nullptr, sfr.match.pose);
+    if (reacquiring_without_dr_ && !ambiguous && !uncertainty_.confirming && sfr.match.status == matcher::FitStatus::kOk) {
+      reacquiring_without_dr_ = false;  // no fit nearby explains more points than the fix: the stretch ends on it
+      have_rival_ = false;
+    }
     if (uncertainty_.status == matcher::FitStatus::kOk || sfr.match.status == matcher::FitStatus::kLost)
       have_rival_ = false;  // confirmed, or lost again: a new re-acquisition searches again
     last_off_dead_reckoning_ = uncertainty_.off_dead_reckoning;
@@ -196,7 +201,12 @@ std::optional<DeadReckoned> Localizer::dead_reckoned(const FeatureFrame& f, cons
   if (!(u.dead_reckoning_gate_sigma > 0)) return std::nullopt;
   const Eigen::Vector3d velocity = plan_velocity(sfr.match);
   // (Re)starts the odometry at this frame (its fix, the matcher's velocity): the anchors before cannot be related to it.
+  // Inside a stretch that refused a fix against the dead reckoning the odometry then starts at a fix in doubt, and no
+  // dead-reckoned pose is left to end the stretch against: it ends at the next OK fix unless a second fit near it
+  // explains more points than it does (check_rival; corridor s1 mixed: a fix 2.3 m off, published OK, where a fit ~2 m
+  // away explained 1.3x as many points), which makes the stretch's end a re-acquisition.
   auto restart = [&]() {
+    if (dr_odometry_ && tracker_.refused_in_stretch()) reacquiring_without_dr_ = true;
     odometry::OdometryConfig oc;
     oc.max_points = u.dr_max_points;
     oc.static_support_m = u.dr_static_support_m;
@@ -283,7 +293,7 @@ std::optional<DeadReckoned> Localizer::dead_reckoned(const FeatureFrame& f, cons
   return d;
 }
 
-void Localizer::check_rival(const FeatureFrame& f, const Pose2& fix, const DeadReckoned* dr, const Pose2& fix_at_utime) {
+bool Localizer::check_rival(const FeatureFrame& f, const Pose2& fix, const DeadReckoned* dr, const Pose2& fix_at_utime) {
   const UncertaintyConfig& u = cfg_.uncertainty;
   matcher::MatcherConfig mc = cfg_.matcher;
   auto distinct = [&](const Pose2& p) {
@@ -301,6 +311,10 @@ void Localizer::check_rival(const FeatureFrame& f, const Pose2& fix, const DeadR
     return c.gained_structure >= u.rival_min_gained && c.lost_behind <= u.rival_max_behind_share * c.lost;
   };
   const int own = matcher::evaluate_fit(lookup_, f, fix, mc.inlier_m, stride).num_inliers;
+  // After the dead reckoning was lost in a stretch (dead_reckoned()) the fix continues a track: a look-alike explaining 80 %
+  // as many points (the corridor's twin stretch among people) is no evidence against it; one that explains more points
+  // than the fix says the track holds a worse minimum.
+  const double rival_ratio = reacquiring_without_dr_ ? std::max(1.0, u.rival_ratio) : u.rival_ratio;
   std::optional<Pose2> rival;
   int rival_inliers = 0;
   bool otherwise = false;
@@ -313,7 +327,7 @@ void Localizer::check_rival(const FeatureFrame& f, const Pose2& fix, const DeadR
     if (m.status == matcher::FitStatus::kOk && distinct(m.solved)) {
       otherwise = explains_otherwise(m.solved, &cmp);
       // Kept while it is still an ambiguity; else searched again (another place may be one now).
-      if (otherwise || m.fit.num_inliers >= u.rival_ratio * own || !(u.rival_min_gained > 0))
+      if (otherwise || m.fit.num_inliers >= rival_ratio * own || !(u.rival_min_gained > 0))
         rival = m.solved, rival_inliers = m.fit.num_inliers;
     }
   }
@@ -349,20 +363,20 @@ void Localizer::check_rival(const FeatureFrame& f, const Pose2& fix, const DeadR
     if (!rival) rival = best, rival_inliers = best_inliers;
   }
   have_rival_ = rival.has_value();
-  if (!rival) return;
+  if (!rival) return false;
   rival_offset_ = between(fix, *rival);
   const double share = double(rival_inliers) / double(std::max(1, own));
-  if (share < u.rival_ratio && !otherwise) return;
+  if (share < rival_ratio && !otherwise) return false;
   if (dr && u.dead_reckoning_gate_sigma > 0 && !uncertainty_.off_dead_reckoning) {
     // The dead reckoning tells them apart: the fix within its gate (else the tracker said so), the rival beyond.
     const Pose2 r_at_utime = compose(fix_at_utime, between(fix, *rival));
     const Eigen::Vector3d e(r_at_utime.x - dr->pose.x, r_at_utime.y - dr->pose.y, wrap_angle(r_at_utime.yaw - dr->pose.yaw));
     const Eigen::Matrix3d S = dr->covariance + uncertainty_.covariance;
-    if (e.dot(S.ldlt().solve(e)) > chi2_3dof_of_sigmas(u.dead_reckoning_gate_sigma)) return;
+    if (e.dot(S.ldlt().solve(e)) > chi2_3dof_of_sigmas(u.dead_reckoning_gate_sigma)) return false;
   }
   const Eigen::Vector3d d(rival->x - fix.x, rival->y - fix.y, wrap_angle(rival->yaw - fix.yaw));
   char b[200];
-  if (share >= u.rival_ratio)
+  if (share >= rival_ratio)
     std::snprintf(b, sizeof b, "re-acquired: a second fit %.2f m / %.1f deg away explains %.0f %% as many points", std::hypot(d[0], d[1]),
                   std::abs(d[2]) * 180 / M_PI, 100 * share);
   else
@@ -373,6 +387,7 @@ void Localizer::check_rival(const FeatureFrame& f, const Pose2& fix, const DeadR
   uncertainty_.covariance += d * d.transpose();
   uncertainty_.sigma_max_m = weakest_horizontal(uncertainty_.covariance, &uncertainty_.weak_direction_rad);
   tracker_.restart_confirmation();
+  return true;
 }
 
 void Localizer::add_map_error(const FeatureFrame& f, Eigen::Matrix3d* covariance) {

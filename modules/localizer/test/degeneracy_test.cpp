@@ -495,6 +495,51 @@ TEST(Degeneracy, LocalizerReseededOnePeriodOffIsPoorAgainstTheDeadReckoning) {
   }
 }
 
+// A track re-seeded one period off along the fins' corridor (as above, without the cabinets), whose fins lack one
+// (x = 13) in the plan and the world: from the twin, the fin before the gap lands on it, so the truth 1.5 m back explains
+// more points than the twin's fixes. The twin's fixes are refused against the dead reckoning; then one frame the
+// odometry cannot register (nothing within range) starts it again at a fix in doubt, inside that stretch, and no
+// dead-reckoned pose is left to check the stretch's end against. It must not end at the next OK fix (before: the
+// twin's fixes published OK 1.5 m off from there on): a second-fit search finds the truth explaining more points than
+// the fix, which makes it a re-acquisition: POOR, saying so. Without the lost frame the dead reckoning says so itself.
+TEST(Degeneracy, DeadReckoningLostInAStretchMakesItsEndAReacquisition) {
+  FloorPlan plan;
+  plan.elements.push_back(Element::segment({-20, 0}, {200, 0}));
+  plan.elements.push_back(Element::segment({-20, 2}, {200, 2}));
+  for (double x = -20; x < 200; x += 1.5)
+    if (std::abs(x - 13) > 0.1) plan.elements.push_back(Element::segment({x, 2}, {x, 1.6}));
+  auto map = make_localization_map(plan, "brute-force");
+  for (bool lose_it : {true, false}) {
+    localizer::Config cfg;
+    cfg.uncertainty.rival_search_m = 1.5;  // (the truth one period back)
+    localizer::Localizer loc(*map.lookup, cfg);
+    loc.set_pose({0.2, 0.8, 0}, 0.15);
+    fploc::testing::SynthOptions so;
+    so.noise_sigma = 0.005;
+    so.max_range = 6;
+    std::vector<localizer::Pose> finals;
+    int on_twin = 0, ok_on_twin = 0, said = 0;
+    for (int k = 0; k < 110; ++k) {
+      const Pose2 truth{0.2 + 0.1 * k, 0.8, 0};
+      fploc::testing::SynthOptions sk = so;
+      sk.seed = uint32_t(k + 1);
+      if (k == 60) loc.set_pose({truth.x + 1.5, truth.y, truth.yaw}, 0.1);  // the relocalizer's answer, one period on
+      if (k == 70 && lose_it) sk.max_range = 0.5;                           // nothing in range
+      const auto s = loc.process(fploc::testing::synth_frame(plan, truth, sk, k * 100'000), &finals);
+      ASSERT_TRUE(s.latest);
+      if (k <= 70 || s.sfr.match.status != FitStatus::kOk || std::abs(s.sfr.match.pose.x - truth.x - 1.5) > 0.1) continue;
+      ++on_twin;
+      ok_on_twin += loc.uncertainty().status == FitStatus::kOk;
+      said += loc.uncertainty().text.find(lose_it ? "a second fit" : "dead-reckoned pose") != std::string::npos;
+    }
+    std::printf("%s: %d fixes on the twin after it, %d published OK, %d said why\n",
+                lose_it ? "odometry lost in the stretch" : "odometry kept", on_twin, ok_on_twin, said);
+    EXPECT_GT(on_twin, 30);  // the scenario: the matcher stays on the twin
+    EXPECT_EQ(ok_on_twin, 0);
+    EXPECT_GT(said, on_twin / 2);
+  }
+}
+
 // A start (or any re-acquisition) where a second fit explains about as many points as the fix: along a corridor whose
 // wall has a fin every 1.5 m (beyond the sensor's 6 m range the view repeats) the place one period on is as good, so
 // the track is published POOR ("a second fit ... away"), the offset in its covariance, however many fixes agree; in

@@ -108,7 +108,13 @@ struct UncertaintyConfig {
   // 1-sigma from its points above poor_sigma_m), velocity_sigma_mps times the frame interval. 0: off.
   // A frame the odometry cannot register, or over which its velocity changes by more than dr_jump_mps (the ICP caught
   // another minimum; a platform changes its velocity by a few cm/s per frame, the odometry's noise adds ~0.1 m/s),
-  // starts it again at that frame: the anchors before are dropped (no check until the next OK frame).
+  // starts it again at that frame: the anchors before are dropped (no check until the next OK frame). Inside a stretch
+  // that refused a fix against the dead-reckoned pose, that restart leaves the stretch nothing to end against: the
+  // Localizer then searches a second fit near the next OK fix (as a re-acquisition's), and one explaining at least as
+  // many points as the fix makes the stretch's end a re-acquisition (restart_confirmation()); else the stretch ends on
+  // the fix, as before (corridor s1 mixed published a pose OK 2.3 m off where a fit 1.9 m away explained 1.3x as many
+  // points; a stretch's end delayed always, by confirm_fixes, made corridor s3 crowd-15's dead reckoning drift among
+  // people through a later stretch: right poses POOR 2 -> 24 %).
   // The odometry keeps only static points (OdometryConfig::static_support_m = dr_static_support_m: a map point another
   // keyframe saw on the same line; the walking people a crowd leaves in its map are not registered against) and holds
   // the constant-velocity prediction as a prior (OdometryConfig::prediction_sigma_m / _rad = dr_prediction_sigma_m /
@@ -196,6 +202,8 @@ class UncertaintyTracker {
   // against the dead-reckoned pose of one anchor (dead_reckoning_gate_sigma) until confirm_fixes agree. A fix given a
   // dead-reckoned pose is checked against it in or out of a stretch.
   bool wants_dead_reckoning() const { return cfg_.dead_reckoning_gate_sigma > 0 && not_ok_since_ok_; }
+  // The current stretch refused a fix against the dead-reckoned pose (the two disagree).
+  bool refused_in_stretch() const { return wants_dead_reckoning() && dr_refused_; }
   // The re-acquisition is not confirmed yet (an ambiguity the caller found): confirm_fixes more fixes needed.
   void restart_confirmation() {
     if (cfg_.confirm_fixes > 0) confirming_ = true, agreeing_ = 0;

@@ -155,6 +155,7 @@ class Localizer {
     Eigen::Matrix2d open = Eigen::Matrix2d::Zero();       // x/y covariance carried along open directions since it
   };
   std::deque<Anchor> ok_frames_;     // oldest first
+  bool reacquiring_without_dr_ = false;  // the dead reckoning was lost in a stretch that refused a fix: check_rival next
   bool have_frozen_ = false;         // the anchor of the current stretch
   Anchor frozen_;
   bool last_off_dead_reckoning_ = false;  // the previous frame failed the dead reckoning's gate (against the oldest anchor)
@@ -165,9 +166,11 @@ class Localizer {
   Eigen::Vector2d dr_velocity_ = Eigen::Vector2d::Zero();  // the odometry's over its last frame
   // The second fit of a re-acquisition (UncertaintyConfig::rival_ratio, rival_min_gained; rival.h): searched while
   // none is known during a confirmation (or the one carried is no ambiguity any more), then carried with the fix;
-  // applied to uncertainty_.
+  // applied to uncertainty_. Also on the OK fixes after the dead reckoning was lost in a stretch that refused a fix
+  // (reacquiring_without_dr_), there with a rival_ratio of at least 1. True: an ambiguity (published POOR, the
+  // re-acquisition's confirmation started again).
   // (dr: the frame's dead-reckoned pose, if any: a rival beyond its gate is no ambiguity.)
-  void check_rival(const FeatureFrame& deskewed, const Pose2& fix_at_ref, const DeadReckoned* dr, const Pose2& fix_at_utime);
+  bool check_rival(const FeatureFrame& deskewed, const Pose2& fix_at_ref, const DeadReckoned* dr, const Pose2& fix_at_utime);
   bool have_rival_ = false;
   Pose2 rival_offset_;               // the rival in the fix's frame
 };
