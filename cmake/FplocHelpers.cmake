@@ -14,12 +14,13 @@ function(fploc_add_test NAME)
   target_compile_definitions(${NAME} PRIVATE FPLOC_SHARED_DIR="${FPLOC_SHARED_DIR}"
                                                FPLOC_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   add_test(NAME ${NAME} COMMAND ${NAME})
-  set_tests_properties(${NAME} PROPERTIES TIMEOUT 300)
+  # The test's scratch files (GoogleTest's TempDir(), which reads TEST_TMPDIR) in a folder of its own in the build tree:
+  # fixed names directly in /tmp were shared by every checkout's test runs, and left behind.
+  set(tmp "${CMAKE_BINARY_DIR}/test-tmp/${NAME}")
+  file(MAKE_DIRECTORY "${tmp}")
+  set_tests_properties(${NAME} PROPERTIES TIMEOUT 300 ENVIRONMENT "TEST_TMPDIR=${tmp}")
   if(A_LABELS)
     set_tests_properties(${NAME} PROPERTIES LABELS "${A_LABELS}")
-  endif()
-  if(A_SERIAL)  # parsed but never applied before: demo_live_swap shared the 2 cores with demo_building_live
-    set_tests_properties(${NAME} PROPERTIES RUN_SERIAL TRUE)
   endif()
 endfunction()
 
