@@ -34,6 +34,7 @@ feat::FeatureConfig config_of(const FeatureOptions& o) {
   if (given(o.half_window(), "features", "half_window")) c.half_window = o.half_window();
   if (given(o.min_group_points(), "features", "min_group_points")) c.min_group_points = o.min_group_points();
   if (given(o.line_max_rms_m(), "features", "line_max_rms_m")) c.line_max_rms_m = o.line_max_rms_m();
+  if (given(o.column_front_m(), "features", "column_front_m")) c.column_front_m = o.column_front_m();
   return c;
 }
 

@@ -112,6 +112,24 @@ FeatureStatus FeatureExtractor::extract(const seg::Segmentation& seg) {
   const int H = std::max(1, seg.height);
   ring_step_ = std::max(1, int(std::lround(double(H) / kRefRings)));
   limit_scale_ = std::max(1.0, double(kRefRings) / H);
+  // Per column, the farthest vertical structure (column_front_m): the second-farthest levelled horizontal range.
+  far1_.clear();
+  far2_.clear();
+  if (cfg_.column_front_m > 0) {
+    int width = std::max<int>(0, seg.width);
+    for (size_t i = 0; i < n; ++i) width = std::max(width, int(w.column[i]) + 1);
+    far1_.assign(size_t(width), 0.f);
+    far2_.assign(size_t(width), 0.f);
+    for (size_t i = 0; i < n; ++i) {
+      if (w.column[i] < 0) continue;
+      const Eigen::Vector3f q = R_ * Eigen::Vector3f(w.x[i], w.y[i], w.z[i]);
+      const float r = std::sqrt(q.x() * q.x() + q.y() * q.y());
+      if (!std::isfinite(r)) continue;
+      float &a = far1_[size_t(w.column[i])], &b = far2_[size_t(w.column[i])];
+      if (r > a) b = a, a = r;
+      else if (r > b) b = r;
+    }
+  }
   for (size_t b = 0; b < n;) {
     const size_t e = run_end(w.ring.data(), b, n);
     if (w.ring[b] % ring_step_ == 0) ring(seg, b, e);
@@ -183,6 +201,20 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       suppress(-e - 1 - hw + 1, -e - 1);
     else
       suppress(e, e - 1 + hw);
+  }
+  // Points in front of a farther vertical structure of their column (column_front_m): no features.
+  if (!far2_.empty()) {
+    const float m = float(cfg_.column_front_m), ratio = float(cfg_.column_front_ratio);
+    for (int k = 0; k < n; ++k) {
+      const size_t i = begin + size_t(k);
+      const int c = w.column[i];
+      if (c < 0 || size_t(c) >= far2_.size()) continue;
+      const float f = far2_[size_t(c)];
+      if (!(f > 0)) continue;
+      const Eigen::Vector3f q = R_ * Eigen::Vector3f(w.x[i], w.y[i], w.z[i]);
+      const float r = std::sqrt(q.x() * q.x() + q.y() * q.y());
+      if (r < f - m - ratio * f) suppress(k, k);
+    }
   }
 
   // Per-sector selection (sectors split the ring's points evenly, as LOAM does): the sharpest corner

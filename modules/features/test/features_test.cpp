@@ -304,6 +304,8 @@ TEST(Features, ReferenceEqualWithOtherOptionsAndBeamCounts) {
   expect_same(s, cfg([](FeatureConfig& c) { c.surface_threshold = 0.003; c.max_surfaces_per_sector = 3; }), "few surfaces");
   expect_same(s, cfg([](FeatureConfig& c) { c.surface_spacing = -1; }), "no spacing");
   expect_same(s, cfg([](FeatureConfig& c) { c.line_max_rms_m = 0.002; c.line_min_ratio = 500; }), "tight lines");
+  expect_same(s, cfg([](FeatureConfig& c) { c.column_front_m = 0.2; }), "column rule");
+  expect_same(s, cfg([](FeatureConfig& c) { c.column_front_m = 0.05; c.column_front_ratio = 0; }), "column rule, tight");
   expect_same(s, cfg([](FeatureConfig& c) { c.min_group_points = 2; c.line_min_ratio = 1.0; c.line_max_rms_m = 1.0; }), "loose lines");
 }
 
@@ -382,4 +384,39 @@ TEST(Features, CornerPicksOnNoisyWallsAreNotBiasedTowardTheSensor) {
   }
   ASSERT_GT(n, 200);
   EXPECT_LT(std::abs(sum / n), 0.0025) << n << " corner features on the long walls, mean offset " << 1000 * sum / n << " mm";
+}
+
+// A cabinet 2 m tall and 0.45 m deep along a wall, 5.5 m away: its face is a wall-like surface parallel to the plan's
+// wall, and the wall shows above it in the same columns. Without the column rule the face gives features as if it were
+// a wall 0.45 m in front of the drawn one; with it (column_front_m) no feature lies on the face, and the wall above it
+// still gives features.
+TEST(Features, APointInFrontOfTheWallAboveItIsNoFeature) {
+  synth::Room room;
+  room.boxes.push_back({{7.55, -2.0, 0.0}, {8.0, 2.0, 2.0}, synth::kClutter});
+  const synth::SensorPose pose{2.0, 0.0, 1.2, 0.5 * kDeg, -0.5 * kDeg, 0.1};
+  const auto s = synth::render(room, pose, synth::os1_like_beams(), 1024, 0.005, 0.01, 31);
+  seg::RingSegmenter sg(seg::SegmenterConfig{});
+  const auto seg = sg.process(s.scan);
+  ASSERT_EQ(seg.status, seg::SegStatus::kOk);
+  auto count = [&](const FeatureConfig& cfg, int* on_face, int* on_wall) {
+    FeatureExtractor fx(cfg);
+    const FeatureFrame& f = fx.process(seg);
+    const double c = std::cos(pose.yaw), sn = std::sin(pose.yaw);
+    *on_face = *on_wall = 0;
+    for (const auto& p : f.points) {
+      const double wx = c * p.p.x() - sn * p.p.y() + pose.x, wy = sn * p.p.x() + c * p.p.y() + pose.y;
+      if (std::abs(wy) > 1.9) continue;
+      *on_face += std::abs(wx - 7.55) < 0.1;
+      *on_wall += std::abs(wx - 8.0) < 0.1;
+    }
+  };
+  FeatureConfig on;
+  on.column_front_m = 0.2;
+  int face_off = 0, wall_off = 0, face_on = 0, wall_on = 0;
+  count(FeatureConfig{}, &face_off, &wall_off);
+  count(on, &face_on, &wall_on);
+  EXPECT_GT(face_off, 40);  // the face is taken for a wall without the rule
+  EXPECT_EQ(face_on, 0);
+  EXPECT_GT(wall_on, 20);   // the wall above the cabinet is still seen
+  EXPECT_GE(wall_on, wall_off);
 }

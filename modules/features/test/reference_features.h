@@ -59,6 +59,27 @@ inline Result extract(const seg::Segmentation& seg, const FeatureConfig& cfg = {
   std::vector<int8_t> okind;
   std::vector<int32_t> ogroup, osrc;
   int32_t groups = 0;
+  // The farthest vertical structure of each column (column_front_m): its second-farthest levelled horizontal range.
+  auto level_range = [&](size_t i) {
+    const Eigen::Vector3f q = Rot * Eigen::Vector3f(w.x[i], w.y[i], w.z[i]);
+    return std::sqrt(q.x() * q.x() + q.y() * q.y());
+  };
+  std::vector<std::vector<float>> column_ranges;
+  if (cfg.column_front_m > 0)
+    for (size_t i = 0; i < N; ++i) {
+      if (w.column[i] < 0) continue;
+      if (size_t(w.column[i]) >= column_ranges.size()) column_ranges.resize(size_t(w.column[i]) + 1);
+      const float r = level_range(i);
+      if (std::isfinite(r)) column_ranges[size_t(w.column[i])].push_back(r);
+    }
+  auto in_front = [&](size_t i) {
+    if (!(cfg.column_front_m > 0) || w.column[i] < 0) return false;
+    std::vector<float> v = column_ranges[size_t(w.column[i])];
+    if (v.size() < 2) return false;
+    std::sort(v.begin(), v.end());
+    const float f = v[v.size() - 2];
+    return f > 0 && level_range(i) < f - float(cfg.column_front_m) - float(cfg.column_front_ratio) * f;
+  };
   auto ring = [&](size_t begin, size_t end) {
     const int n = int(end - begin), hw = std::max(1, cfg.half_window);
     if (n < 2 * hw + 1) return;
@@ -74,7 +95,7 @@ inline Result extract(const seg::Segmentation& seg, const FeatureConfig& cfg = {
       const float par = float(cfg.parallel_ratio);
       const bool parallel = std::abs(R[i - 1] - r) > par * r && std::abs(R[i + 1] - r) > par * r;
       c[i] = smoothness(X, Y, Z, i, hw);
-      ok[i] = connected && in_range && !parallel;
+      ok[i] = connected && in_range && !parallel && !in_front(begin + size_t(i));
     }
     for (int j = 0; j + 1 < n; ++j) {  // occlusion boundaries: clear hw points on the far side
       const float a = R[j], b = R[j + 1];

@@ -27,6 +27,14 @@ struct FeatureConfig {
   double occlusion_ratio = 0.1;     // |r_i - r_j| > ratio * r_i between neighbours = occlusion boundary
   double parallel_ratio = 0.02;     // both-side range jumps > ratio * r_i = surface parallel to the beam
   int surface_spacing = 2;          // picked surface points suppress +-this many neighbours
+  // A plan's wall stands from floor to ceiling, so at one azimuth nothing is seen beyond it: a wall point more than
+  // column_front_m + column_front_ratio * range nearer (horizontally) than the farthest vertical structure seen in
+  // its column (the column's second-farthest wall point, so two points at least) stands in front of a surface that
+  // shows above or below it -- a cabinet, a table, a person -- and is never a feature. 0 = off (the default: 0.2 m
+  // took corridor shelves s1 / s2 / s3 from 51.3 / 24.8 / 36.7 cm to 21.9 / 16.7 / 9.1 cm, but corridor s3 renovated
+  // from 7.8 cm to 7.3 m; docs/notes/realism.md, thirty-third round).
+  double column_front_m = 0;
+  double column_front_ratio = 0.02;
   // PCA line groups.
   int min_group_points = 4;
   double line_max_rms_m = 0.03;     // sqrt(smallest eigenvalue) of the group's 2D covariance
@@ -77,6 +85,7 @@ class FeatureExtractor {
   std::vector<uint64_t> pick_bits_;              // the ring's picks (features, corners) as bits
   std::vector<int> occ_, surf_, sel_, run_;
   std::vector<float> ring_w_;
+  std::vector<float> far1_, far2_;            // per column: the farthest and second-farthest levelled range
   std::vector<uint64_t> ring_brk_;
 };
 
