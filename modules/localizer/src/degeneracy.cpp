@@ -192,16 +192,6 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
     confirming_ = true;
     agreeing_ = 0;
   }
-  // A stretch that refused a fix against the dead reckoning, whose odometry started again (no dead-reckoned pose: it
-  // could not register a frame, or jumped): the fixes it would check are the ones it doubted, and the odometry now
-  // starts from one of them. The stretch does not end on that: the fix is a re-acquisition to confirm (confirm_fixes,
-  // and the caller's second-fit check) like one after a LOST.
-  if (frame_ok && !dead_reckoned && dr_refused_ && not_ok_since_ok_ && cfg_.dead_reckoning_gate_sigma > 0 &&
-      cfg_.confirm_fixes > 0) {
-    confirming_ = true;
-    agreeing_ = 0;
-    dr_refused_ = false;
-  }
   if (confirming_) {
     agreeing_ = frame_ok ? agreeing_ + 1 : 0;
     if (agreeing_ >= cfg_.confirm_fixes) confirming_ = false;

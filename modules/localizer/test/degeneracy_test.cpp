@@ -438,41 +438,6 @@ TEST(Degeneracy, AStretchWithARefusedFixEndsOnlyWithinTheTighterGate) {
   }
 }
 
-// A stretch that refused fixes against the dead reckoning, whose odometry then starts again (the Localizer gives no
-// dead-reckoned pose for that frame: it could not register it, or its velocity jumped): the fix is the one the stretch
-// doubted, and the odometry now starts from it. Corridor s1 mixed published 28 poses OK 0.44 m off that way (the frame
-// after the restart ended the stretch at once). The stretch goes on as a re-acquisition: published POOR until
-// confirm_fixes fixes agree (time for the Localizer's second-fit check), OK after that.
-TEST(Degeneracy, AnOdometryRestartDoesNotEndAStretchThatRefusedAFix) {
-  UncertaintyConfig cfg;
-  UncertaintyTracker tr(cfg);
-  DeadReckoningScene sc;
-  auto& [fixed, v, t, truth, dr] = sc;
-  auto step = [&](double off_y, bool with_dr) {
-    dr.pose = truth;
-    const Pose2 fix{truth.x, truth.y + off_y, truth.yaw};
-    const auto s = tr.update(t, fixed, true, FitStatus::kOk, {}, &fix, &v, 1.0, nullptr, 0.0, with_dr ? &dr : nullptr);
-    t += 100000;
-    truth.x += 0.05;
-    return s;
-  };
-  for (int k = 0; k < 9; ++k) step(0, true);  // (the start's own confirmation)
-  ASSERT_EQ(step(0, true).status, FitStatus::kOk);
-  int refused = 0;  // slides sideways 2 cm per frame to 0.44 m
-  for (int k = 1; k <= 22; ++k) refused += step(0.02 * k, true).off_dead_reckoning;
-  ASSERT_GT(refused, 5);
-  ASSERT_TRUE(tr.wants_dead_reckoning());
-  // The odometry starts again: no dead-reckoned pose, the fix still 0.44 m off.
-  const auto restarted = step(0.44, false);
-  EXPECT_EQ(restarted.status, FitStatus::kPoor) << restarted.text;
-  EXPECT_TRUE(restarted.confirming);
-  EXPECT_NE(restarted.text.find("re-acquired"), std::string::npos) << restarted.text;
-  int poor = 1;
-  for (int k = 0; k < cfg.confirm_fixes + 2; ++k) poor += step(0.44, false).status != FitStatus::kOk;
-  EXPECT_EQ(poor, cfg.confirm_fixes - 1);  // the confirm_fixes-th agreeing fix (the restart's counts) is OK
-  EXPECT_FALSE(tr.wants_dead_reckoning());
-}
-
 // The Localizer end to end: the track goes POOR where cabinets stand 0.35 m in front of both walls (the world, not the
 // plan), and a relocalizer then re-seeds it one period off along a corridor whose wall has a fin every 1.5 m (beyond
 // the sensor's 6 m range the view repeats), where every fix registers as well as the truth, fixed in every direction.
