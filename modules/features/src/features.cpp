@@ -316,16 +316,27 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     out_.source.resize(o0 + m);
   }
   out_.n = o0 + m;
-  for (size_t k = 0; k < m; ++k) {
-    const int code = sel_[k];
-    const size_t src = begin + size_t(code >> 1), o = o0 + k;
-    const Eigen::Vector3f q = R_ * Eigen::Vector3f(w.x[src], w.y[src], w.z[src]);
-    out_.x[o] = q.x();
-    out_.y[o] = q.y();
-    out_.kind[o] = code & 1 ? kCorner : kSurface;
-    out_.group[o] = -1;  // (unclassified until a line group takes it, below)
-    out_.t[o] = has_t ? w.t[src] : 0.f;
-    out_.source[o] = int32_t(src);
+  {
+    // (through plain pointers and a local rotation: a store of a kind, an int8_t, may alias anything, so the arrays'
+    // and the rotation's members were loaded again after each pick's)
+    const Eigen::Matrix3f R = R_;
+    const int* const sel = sel_.data();
+    const float *const wx = w.x.data(), *const wy = w.y.data(), *const wz = w.z.data();
+    const float* const wt = has_t ? w.t.data() : nullptr;
+    float *const ox = out_.x.data(), *const oy = out_.y.data(), *const ot = out_.t.data();
+    int8_t* const okind = out_.kind.data();
+    int32_t *const ogroup = out_.group.data(), *const osource = out_.source.data();
+    for (size_t k = 0; k < m; ++k) {
+      const int code = sel[k];
+      const size_t src = begin + size_t(code >> 1), o = o0 + k;
+      const Eigen::Vector3f q = R * Eigen::Vector3f(wx[src], wy[src], wz[src]);
+      ox[o] = q.x();
+      oy[o] = q.y();
+      okind[o] = code & 1 ? kCorner : kSurface;
+      ogroup[o] = -1;  // (unclassified until a line group takes it, below)
+      ot[o] = wt ? wt[src] : 0.f;
+      osource[o] = int32_t(src);
+    }
   }
   for (size_t k = 0; k < m; ++k) {
     const bool corner = sel_[k] & 1;
