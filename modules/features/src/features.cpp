@@ -160,7 +160,10 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     b = std::min(n - 1, b);
     const int len = b - a + 1;
     if (len >= 8) {
-      for (int k = a; k < b - 7; k += 8) {
+      // (a corner's 2 hw + 1 = 11 entries: the blocks at a and at b - 7, no loop)
+      std::memcpy(picked + a, kOnes8, 8);
+      std::memcpy(corner_c + a, kNegInf8, 32);
+      for (int k = a + 8; k < b - 7; k += 8) {
         std::memcpy(picked + k, kOnes8, 8);
         std::memcpy(corner_c + k, kNegInf8, 32);
       }
