@@ -178,7 +178,10 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     b = std::min(n - 1, b);
     const int len = b - a + 1;
     if (len >= 8) {
-      for (int k = a; k < b - 7; k += 8) {
+      // (a corner's 2 hw + 1 = 11 entries: the blocks at a and at b - 7, no loop)
+      std::memcpy(picked + a, kOnes8, 8);
+      std::memcpy(corner_c + a, kNegInf8, 32);
+      for (int k = a + 8; k < b - 7; k += 8) {
         std::memcpy(picked + k, kOnes8, 8);
         std::memcpy(corner_c + k, kNegInf8, 32);
       }
@@ -231,7 +234,11 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   const int S = std::max(1, cfg_.sectors);
   const int max_corners = int(std::lround(cfg_.max_corners_per_sector * limit_scale_));
   const int max_surfaces = int(std::lround(cfg_.max_surfaces_per_sector * limit_scale_));
-  auto& cand = surf_;
+  // A sector's surface candidates and their sort keys, written through plain pointers (at most n of each).
+  if (surf_.size() < size_t(n)) surf_.resize(size_t(n));
+  if (surf_keys_.size() < size_t(n)) surf_keys_.resize(size_t(n));
+  int* const cand = surf_.data();
+  uint64_t* const keys = surf_keys_.data();
   for (int s = 0; s < S; ++s) {
     const int sb = hw + (n - 2 * hw) * s / S, se = hw + (n - 2 * hw) * (s + 1) / S;
     if (se <= sb) continue;
@@ -244,7 +251,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       suppress(best - hw, best + hw);
     }
     if (max_surfaces <= 0) continue;
-    cand.clear();
+    size_t nc = 0;
     for (int wb = sb >> 6; wb <= (se - 1) >> 6; ++wb) {  // the bits of [sb, se)
       uint64_t bits = sk[wb];
       if (wb == sb >> 6) bits &= ~uint64_t(0) << (sb & 63);
@@ -252,15 +259,15 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       while (bits) {
         const int i = (wb << 6) + __builtin_ctzll(bits);
         bits &= bits - 1;
-        if (!picked[i]) cand.push_back(i);
+        cand[nc] = i;
+        nc += !picked[i];
       }
     }
     // When the sector's candidates are no more than its limit, every one that no other candidate's pick
     // can suppress (none within the spacing) is picked whatever the order: no sort for those.
     const int sp = cfg_.surface_spacing;
-    if (int(cand.size()) <= max_surfaces) {
+    if (int(nc) <= max_surfaces) {
       size_t m = 0;
-      const size_t nc = cand.size();
       for (size_t k = 0; k < nc; ++k) {
         const int i = cand[k];
         const bool near = (k > 0 && i - cand[k - 1] <= sp) || (k + 1 < nc && cand[k + 1] - i <= sp);
@@ -271,16 +278,14 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
           cand[m++] = i;
         }
       }
-      cand.resize(m);
+      nc = m;
     }
     // The others in the order (c, index), sorted as 64-bit keys: order_bits(c) above the index.
-    auto& keys = surf_keys_;
-    keys.clear();
-    for (const int i : cand) keys.push_back(uint64_t(order_bits(sc[i])) << 32 | uint32_t(i));
-    std::sort(keys.begin(), keys.end());
+    for (size_t k = 0; k < nc; ++k) keys[k] = uint64_t(order_bits(sc[cand[k]])) << 32 | uint32_t(cand[k]);
+    std::sort(keys, keys + nc);
     int surfaces = 0;  // (the direct picks above only happen when the limit cannot be reached)
-    for (const uint64_t key : keys) {
-      const int i = int(uint32_t(key));
+    for (size_t k = 0; k < nc; ++k) {
+      const int i = int(uint32_t(keys[k]));
       if (picked[i]) continue;
       pick(i, false);
       suppress(i - cfg_.surface_spacing, i + cfg_.surface_spacing);
@@ -346,16 +351,27 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     out_.source.resize(o0 + m);
   }
   out_.n = o0 + m;
-  for (size_t k = 0; k < m; ++k) {
-    const int code = sel_[k];
-    const size_t src = begin + size_t(code >> 1), o = o0 + k;
-    const Eigen::Vector3f q = R_ * Eigen::Vector3f(w.x[src], w.y[src], w.z[src]);
-    out_.x[o] = q.x();
-    out_.y[o] = q.y();
-    out_.kind[o] = code & 1 ? kCorner : kSurface;
-    out_.group[o] = -1;  // (unclassified until a line group takes it, below)
-    out_.t[o] = has_t ? w.t[src] : 0.f;
-    out_.source[o] = int32_t(src);
+  {
+    // (through plain pointers and a local rotation: a store of a kind, an int8_t, may alias anything, so the arrays'
+    // and the rotation's members were loaded again after each pick's)
+    const Eigen::Matrix3f R = R_;
+    const int* const sel = sel_.data();
+    const float *const wx = w.x.data(), *const wy = w.y.data(), *const wz = w.z.data();
+    const float* const wt = has_t ? w.t.data() : nullptr;
+    float *const ox = out_.x.data(), *const oy = out_.y.data(), *const ot = out_.t.data();
+    int8_t* const okind = out_.kind.data();
+    int32_t *const ogroup = out_.group.data(), *const osource = out_.source.data();
+    for (size_t k = 0; k < m; ++k) {
+      const int code = sel[k];
+      const size_t src = begin + size_t(code >> 1), o = o0 + k;
+      const Eigen::Vector3f q = R * Eigen::Vector3f(wx[src], wy[src], wz[src]);
+      ox[o] = q.x();
+      oy[o] = q.y();
+      okind[o] = code & 1 ? kCorner : kSurface;
+      ogroup[o] = -1;  // (unclassified until a line group takes it, below)
+      ot[o] = wt ? wt[src] : 0.f;
+      osource[o] = int32_t(src);
+    }
   }
   for (size_t k = 0; k < m; ++k) {
     const bool corner = sel_[k] & 1;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "fploc/segmentation/plane_fit.h"
 #include "compact_kernels.h"
@@ -361,6 +362,8 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
   const float thr = float(cfg_.inlier_threshold_m);
   auto score = [&](const Eigen::Vector4d& pl) { return score_band(sub_final_, final_stride_, pl, thr); };
   std::optional<Fit> res1;
+  // The steady refinement's support, kept for its plane's (the same score of the same points): st.support below.
+  std::optional<std::pair<Eigen::Vector4d, double>> scored;
   if (steady) {
     // Last frame's plane refined alone. It must keep its support (else the walls captured it) and end within a
     // step the search would not be needed for; otherwise the search runs on this scan.
@@ -371,6 +374,7 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
         std::acos(std::clamp(r->pl.head<3>().dot(previous->head<3>()), -1.0, 1.0)) < k::kSteadyStepDeg * k::kDeg &&
         std::abs(r->pl[3] - (*previous)[3]) < k::kSteadyStepM) {
       res1 = r;
+      scored.emplace(r->pl, support);
       ++steady_fits_;
     } else {
       st.left = 0;
@@ -396,7 +400,7 @@ bool RingPlaneFit::fit(const Candidates& c, const Eigen::Vector3d& up_in, const 
   if (!res1) return false;
   plane = res1->pl;
   st.plane = plane;
-  st.support = score(plane);
+  st.support = scored && scored->first == plane ? scored->second : score(plane);
   return true;
 }
 
