@@ -19,6 +19,23 @@ namespace {
 Eigen::Matrix3d diag(double sx, double sy, double syaw) { return Eigen::Vector3d(sx * sx, sy * sy, syaw * syaw).asDiagonal(); }
 // A tracker's scene for the dead reckoning's rules: fixes with a 1 cm covariance, the matcher's twist 0.5 m/s along x,
 // the truth from (1, 2) and the dead-reckoned pose on it with a 5 cm / 0.57 deg covariance.
+// A corridor along x between walls at y = 0 and 2, with a fin every 1.5 m on the upper wall (beyond the sensor's 6 m
+// range the view repeats), without the fin at `missing_x` when given.
+FloorPlan fins_corridor(double missing_x = NAN) {
+  FloorPlan plan;
+  plan.elements.push_back(Element::segment({-20, 0}, {200, 0}));
+  plan.elements.push_back(Element::segment({-20, 2}, {200, 2}));
+  for (double x = -20; x < 200; x += 1.5)
+    if (!(std::abs(x - missing_x) < 0.1)) plan.elements.push_back(Element::segment({x, 2}, {x, 1.6}));
+  return plan;
+}
+// The sensor of the corridor tests: 6 m range, 5 mm range noise.
+fploc::testing::SynthOptions six_metre_sensor() {
+  fploc::testing::SynthOptions so;
+  so.noise_sigma = 0.005;
+  so.max_range = 6;
+  return so;
+}
 struct DeadReckoningScene {
   Eigen::Matrix3d fixed = diag(0.01, 0.01, 0.002);
   matcher::Twist2 v{0.5, 0, 0};
@@ -246,7 +263,7 @@ TEST(Degeneracy, ReacquiredTrackIsPoorUntilFixesAgree) {
     }
     const auto s = step(tr, FitStatus::kOk);
     seen.push_back(s.status);
-    if (s.status == FitStatus::kPoor) EXPECT_NE(s.text.find("re-acquired"), std::string::npos) << s.text;
+    if (s.status == FitStatus::kPoor) { EXPECT_NE(s.text.find("re-acquired"), std::string::npos) << s.text; }
     const auto s1 = step(single, FitStatus::kOk);
     EXPECT_EQ(s1.status, FitStatus::kOk) << k << " " << s1.text;  // off: every fix OK
   }
@@ -271,7 +288,7 @@ TEST(Degeneracy, WeakFitIsPublishedPoor) {
   for (double ratio : {0.9, 0.46, 0.5, 0.9}) {
     const auto s = tr.update(t, fixed, true, FitStatus::kOk, {}, &p, &v, ratio);
     EXPECT_EQ(s.status, ratio < 0.5 ? FitStatus::kPoor : FitStatus::kOk) << ratio;
-    if (ratio < 0.5) EXPECT_NE(s.text.find("weak fit: 46 %"), std::string::npos) << s.text;
+    if (ratio < 0.5) { EXPECT_NE(s.text.find("weak fit: 46 %"), std::string::npos) << s.text; }
     EXPECT_NEAR(s.sigma_max_m, 0.01, 1e-6);
     EXPECT_EQ(keep.update(t, fixed, true, FitStatus::kOk, {}, &p, &v, ratio).status, FitStatus::kOk);
     t += 100000;
@@ -293,7 +310,7 @@ TEST(Degeneracy, FixContradictingTheMapsFreeSpaceIsPublishedPoor) {
   for (double c : {0.0, 0.3, 0.25, 0.1, 0.6}) {
     const auto s = tr.update(t, fixed, true, FitStatus::kOk, {}, &p, &v, 0.9, nullptr, c);
     EXPECT_EQ(s.status, c > 0.25 ? FitStatus::kPoor : FitStatus::kOk) << c;
-    if (c == 0.3) EXPECT_NE(s.text.find("the map says empty where 30 %"), std::string::npos) << s.text;
+    if (c == 0.3) { EXPECT_NE(s.text.find("the map says empty where 30 %"), std::string::npos) << s.text; }
     EXPECT_EQ(keep.update(t, fixed, true, FitStatus::kOk, {}, &p, &v, 0.9, nullptr, c).status, FitStatus::kOk);
     t += 100000;
   }
@@ -446,10 +463,7 @@ TEST(Degeneracy, AStretchWithARefusedFixEndsOnlyWithinTheTighterGate) {
 // its correction over the re-seed. After a LOST longer than the window's max_keyframe_gap_s it restarts from the fix,
 // and the corridor worlds' re-acquisitions were published OK metres off: FixFarFromTheDeadReckonedPose... above.)
 TEST(Degeneracy, LocalizerReseededOnePeriodOffIsPoorAgainstTheDeadReckoning) {
-  FloorPlan plan;
-  plan.elements.push_back(Element::segment({-20, 0}, {200, 0}));
-  plan.elements.push_back(Element::segment({-20, 2}, {200, 2}));
-  for (double x = -20; x < 200; x += 1.5) plan.elements.push_back(Element::segment({x, 2}, {x, 1.6}));
+  const FloorPlan plan = fins_corridor();
   FloorPlan world = plan;
   world.elements.push_back(Element::segment({3, 0.35}, {6.5, 0.35}));
   world.elements.push_back(Element::segment({3, 1.65}, {6.5, 1.65}));
@@ -460,9 +474,7 @@ TEST(Degeneracy, LocalizerReseededOnePeriodOffIsPoorAgainstTheDeadReckoning) {
     if (!gate_on) cfg.uncertainty.dead_reckoning_gate_sigma = 0;
     localizer::Localizer loc(*map.lookup, cfg);
     loc.set_pose({0.2, 0.8, 0}, 0.15);
-    fploc::testing::SynthOptions so;
-    so.noise_sigma = 0.005;
-    so.max_range = 6;
+    fploc::testing::SynthOptions so = six_metre_sensor();
     std::vector<localizer::Pose> finals;
     int ok_before = 0, false_ok = 0, on_twin = 0, said = 0;
     bool reseeded = false;
@@ -503,20 +515,14 @@ TEST(Degeneracy, LocalizerReseededOnePeriodOffIsPoorAgainstTheDeadReckoning) {
 // twin's fixes published OK 1.5 m off from there on): a second-fit search finds the truth explaining more points than
 // the fix, which makes it a re-acquisition: POOR, saying so. Without the lost frame the dead reckoning says so itself.
 TEST(Degeneracy, DeadReckoningLostInAStretchMakesItsEndAReacquisition) {
-  FloorPlan plan;
-  plan.elements.push_back(Element::segment({-20, 0}, {200, 0}));
-  plan.elements.push_back(Element::segment({-20, 2}, {200, 2}));
-  for (double x = -20; x < 200; x += 1.5)
-    if (std::abs(x - 13) > 0.1) plan.elements.push_back(Element::segment({x, 2}, {x, 1.6}));
+  const FloorPlan plan = fins_corridor(13.0);
   auto map = make_localization_map(plan, "brute-force");
   for (bool lose_it : {true, false}) {
     localizer::Config cfg;
     cfg.uncertainty.rival_search_m = 1.5;  // (the truth one period back)
     localizer::Localizer loc(*map.lookup, cfg);
     loc.set_pose({0.2, 0.8, 0}, 0.15);
-    fploc::testing::SynthOptions so;
-    so.noise_sigma = 0.005;
-    so.max_range = 6;
+    fploc::testing::SynthOptions so = six_metre_sensor();
     std::vector<localizer::Pose> finals;
     int on_twin = 0, ok_on_twin = 0, said = 0;
     for (int k = 0; k < 110; ++k) {
@@ -545,10 +551,7 @@ TEST(Degeneracy, DeadReckoningLostInAStretchMakesItsEndAReacquisition) {
 // the track is published POOR ("a second fit ... away"), the offset in its covariance, however many fixes agree; in
 // a room whose pillars fix the pose the start is confirmed as before. rival_ratio 0: the periodic start is OK.
 TEST(Degeneracy, ReacquisitionWithASecondFitAsGoodStaysPoor) {
-  FloorPlan fins;
-  fins.elements.push_back(Element::segment({-20, 0}, {200, 0}));
-  fins.elements.push_back(Element::segment({-20, 2}, {200, 2}));
-  for (double x = -20; x < 200; x += 1.5) fins.elements.push_back(Element::segment({x, 2}, {x, 1.6}));
+  const FloorPlan fins = fins_corridor();
   const FloorPlan room = fploc::testing::room_with_pillars();
   struct Case {
     const FloorPlan* plan;
@@ -563,9 +566,7 @@ TEST(Degeneracy, ReacquisitionWithASecondFitAsGoodStaysPoor) {
     cfg.uncertainty.rival_ratio = c.ratio;
     localizer::Localizer loc(*map.lookup, cfg);
     loc.set_pose(c.start, 1.0);
-    fploc::testing::SynthOptions so;
-    so.noise_sigma = 0.005;
-    so.max_range = 6;
+    fploc::testing::SynthOptions so = six_metre_sensor();
     std::vector<localizer::Pose> finals;
     int ok = 0, said = 0;
     double sigma_when_said = 0;
