@@ -115,16 +115,17 @@ FeatureStatus FeatureExtractor::extract(const seg::Segmentation& seg) {
   // Per column, the farthest vertical structure (column_front_m): the second-farthest levelled horizontal range.
   far1_.clear();
   far2_.clear();
+  level_range_.clear();
   if (cfg_.column_front_m > 0) {
     int width = std::max<int>(0, seg.width);
     for (size_t i = 0; i < n; ++i) width = std::max(width, int(w.column[i]) + 1);
     far1_.assign(size_t(width), 0.f);
     far2_.assign(size_t(width), 0.f);
+    level_range_.resize(n);
     for (size_t i = 0; i < n; ++i) {
-      if (w.column[i] < 0) continue;
       const Eigen::Vector3f q = R_ * Eigen::Vector3f(w.x[i], w.y[i], w.z[i]);
-      const float r = std::sqrt(q.x() * q.x() + q.y() * q.y());
-      if (!std::isfinite(r)) continue;
+      const float r = level_range_[i] = std::sqrt(q.x() * q.x() + q.y() * q.y());
+      if (w.column[i] < 0 || !std::isfinite(r)) continue;
       float &a = far1_[size_t(w.column[i])], &b = far2_[size_t(w.column[i])];
       if (r > a) b = a, a = r;
       else if (r > b) b = r;
@@ -213,10 +214,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       const int c = w.column[i];
       if (c < 0 || size_t(c) >= far2_.size()) continue;
       const float f = far2_[size_t(c)];
-      if (!(f > 0)) continue;
-      const Eigen::Vector3f q = R_ * Eigen::Vector3f(w.x[i], w.y[i], w.z[i]);
-      const float r = std::sqrt(q.x() * q.x() + q.y() * q.y());
-      if (r < f - m - ratio * f) suppress(k, k);
+      if (f > 0 && level_range_[i] < f - m - ratio * f) suppress(k, k);
     }
   }
 

@@ -117,7 +117,7 @@ void run(seg::Segmenter& sg, bool with_imu) {
   }
   ASSERT_GE(checked, 6);
   EXPECT_GT(max_t, 0.09);  // times cover the sweep
-  if (with_imu) EXPECT_EQ(deskewed, checked) << "gyro de-skew should be active";
+  if (with_imu) { EXPECT_EQ(deskewed, checked) << "gyro de-skew should be active"; }
   // Right times: on the walls to the range quantisation (1 mm steps: |error| <= 0.5 mm along the ray,
   // rms 0.29 mm) plus float rounding.
   EXPECT_LT(worst_rms, 0.0005);

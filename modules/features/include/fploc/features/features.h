@@ -86,6 +86,7 @@ class FeatureExtractor {
   std::vector<int> occ_, surf_, sel_, run_;
   std::vector<float> ring_w_;
   std::vector<float> far1_, far2_;            // per column: the farthest and second-farthest levelled range
+  std::vector<float> level_range_;            // per wall point: its levelled horizontal range (column_front_m only)
   std::vector<uint64_t> ring_brk_;
 };
 
