@@ -156,20 +156,33 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
     const double t_ref = matcher::mean_time(f);
     matcher::deskew(f, sfr.match.twist, t_ref, &deskewed_);
     const Pose2 at_ref = compose(sfr.match.pose, matcher::exp_twist(sfr.match.twist, t_ref));
-    const auto fu = optimizer::frame_uncertainty(lookup_, deskewed_, at_ref, cfg_.uncertainty.frame);
     const std::optional<DeadReckoned> dr = dead_reckoned(f, sfr);
-    uncertainty_ = tracker_.update(f.utime, fu.covariance, fu.valid, sfr.match.status, sfr.match.text, &sfr.match.pose,
-                                   &sfr.match.twist, sfr.match.fit.inlier_ratio, motion ? &*motion : nullptr,
-                                   contradicted(deskewed_, at_ref, sfr.match.fit.inlier_ratio), dr ? &*dr : nullptr);
+    auto fu = optimizer::frame_uncertainty(lookup_, deskewed_, at_ref, cfg_.uncertainty.frame);
+    const matcher::MatchResult* m = &sfr.match;
+    Pose2 m_at_ref = at_ref;
+    std::optional<Refit> refit;
+    if (dr && cfg_.uncertainty.dr_refit_ratio > 0 && sfr.match.status != matcher::FitStatus::kLost &&
+        (refit = refit_from_dead_reckoning(deskewed_, sfr, at_ref, fu.covariance, *dr, t_ref))) {
+      m = &refit->match;
+      m_at_ref = refit->at_ref;
+      fu = optimizer::frame_uncertainty(lookup_, deskewed_, m_at_ref, cfg_.uncertainty.frame);
+      in.sfr = m->pose;
+      in.status = m->status;
+      in.covariance = m->covariance;
+      in.published_status = m->status;
+    }
+    uncertainty_ = tracker_.update(f.utime, fu.covariance, fu.valid, m->status, m->text, &m->pose, &m->twist,
+                                   m->fit.inlier_ratio, motion ? &*motion : nullptr,
+                                   contradicted(deskewed_, m_at_ref, m->fit.inlier_ratio), dr ? &*dr : nullptr);
     bool ambiguous = false;
-    if (cfg_.uncertainty.rival_ratio > 0 && sfr.match.status == matcher::FitStatus::kOk &&
+    if (cfg_.uncertainty.rival_ratio > 0 && m->status == matcher::FitStatus::kOk &&
         (uncertainty_.confirming || have_rival_ || reacquiring_without_dr_))
-      ambiguous = check_rival(deskewed_, at_ref, dr ? &*dr : nullptr, sfr.match.pose);
-    if (reacquiring_without_dr_ && !ambiguous && !uncertainty_.confirming && sfr.match.status == matcher::FitStatus::kOk) {
+      ambiguous = check_rival(deskewed_, m_at_ref, dr ? &*dr : nullptr, m->pose);
+    if (reacquiring_without_dr_ && !ambiguous && !uncertainty_.confirming && m->status == matcher::FitStatus::kOk) {
       reacquiring_without_dr_ = false;  // no fit nearby explains more points than the fix: the stretch ends on it
       have_rival_ = false;
     }
-    if (uncertainty_.status == matcher::FitStatus::kOk || sfr.match.status == matcher::FitStatus::kLost)
+    if (uncertainty_.status == matcher::FitStatus::kOk || m->status == matcher::FitStatus::kLost)
       have_rival_ = false;  // confirmed, or lost again: a new re-acquisition searches again
     last_off_dead_reckoning_ = uncertainty_.off_dead_reckoning;
     if (!tracker_.wants_dead_reckoning()) have_frozen_ = false;  // the stretch (if any) is over
@@ -178,9 +191,9 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
       // An anchor: the fix, its published covariance, its velocity and where the odometry was.
       Anchor a;
       a.utime = f.utime;
-      a.fix = sfr.match.pose;
+      a.fix = m->pose;
       a.covariance = uncertainty_.covariance;
-      a.velocity = plan_velocity(sfr.match);
+      a.velocity = plan_velocity(*m);
       a.odometry = dr_last_;
       a.path_m = dr_path_m_;
       a.turn_rad = dr_turn_rad_;
@@ -291,6 +304,41 @@ std::optional<DeadReckoned> Localizer::dead_reckoned(const FeatureFrame& f, cons
   d.covariance = a->covariance + Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal().toDenseMatrix();
   d.covariance.topLeftCorner<2, 2>() += a->open;
   return d;
+}
+
+std::optional<Localizer::Refit> Localizer::refit_from_dead_reckoning(const FeatureFrame& f, const FramePose& sfr, const Pose2& fix_at_ref,
+                                                                     const Eigen::Matrix3d& fix_covariance, const DeadReckoned& dr,
+                                                                     double t_ref) {
+  const UncertaintyConfig& u = cfg_.uncertainty;
+  const double gate = chi2_3dof_of_sigmas(u.dead_reckoning_gate_sigma);
+  auto off_dr = [&](const Pose2& p, const Eigen::Matrix3d& cov) {
+    const Eigen::Vector3d d(p.x - dr.pose.x, p.y - dr.pose.y, wrap_angle(p.yaw - dr.pose.yaw));
+    const Eigen::Matrix3d S = dr.covariance + cov;
+    return d.dot(S.ldlt().solve(d));
+  };
+  if (!(off_dr(sfr.match.pose, fix_covariance) > gate)) return std::nullopt;  // the fix agrees with the dead reckoning
+  // The dead-reckoned pose at the de-skew reference (the fix's twist carries it there), registered from with the
+  // matcher's tracking gate: the minimum nearest the odometry's track.
+  const Pose2 ref_of_utime = matcher::exp_twist(sfr.match.twist, t_ref);
+  matcher::MatcherConfig mc = cfg_.matcher;
+  mc.max_correspondence_m = std::min(mc.max_correspondence_m, mc.gate_tracking_m);
+  const matcher::MatchResult r = matcher::register_frame(lookup_, f, compose(dr.pose, ref_of_utime), mc);
+  if (r.status != matcher::FitStatus::kOk) return std::nullopt;
+  const int stride = matcher::budget_stride(f.points.size(), mc.stride, mc.max_points);
+  const int own = matcher::evaluate_fit(lookup_, f, fix_at_ref, mc.inlier_m, stride).num_inliers;
+  const int theirs = matcher::evaluate_fit(lookup_, f, r.solved, mc.inlier_m, stride).num_inliers;
+  if (double(theirs) < u.dr_refit_ratio * double(std::max(1, own))) return std::nullopt;
+  Refit out;
+  out.at_ref = r.solved;
+  out.match = sfr.match;
+  out.match.pose = compose(r.solved, inverse(ref_of_utime));
+  out.match.pose.yaw = wrap_angle(out.match.pose.yaw);
+  out.match.solved = out.match.pose;
+  out.match.sweep_pose = r.solved;
+  out.match.fit = r.fit;
+  out.match.covariance = r.covariance;
+  if (!(off_dr(out.match.pose, r.covariance) <= gate)) return std::nullopt;  // converged beyond the gate too
+  return out;
 }
 
 bool Localizer::check_rival(const FeatureFrame& f, const Pose2& fix, const DeadReckoned* dr, const Pose2& fix_at_utime) {

@@ -159,6 +159,13 @@ struct UncertaintyConfig {
   double rival_max_behind_share = 0.1;
   double rival_search_m = 1.0;
   double rival_distance_m = 0.25, rival_distance_rad = 5.0 * M_PI / 180;
+  // A fix beyond the dead reckoning's gate (dead_reckoning_gate_sigma) is registered again from the dead-reckoned
+  // pose (the Localizer's, with the matcher's tracking gate): where that fit lies within the gate and explains at
+  // least dr_refit_ratio as many points as the fix, it replaces the fix for the frame (the tracker, the window, and so
+  // the pose fed back to the matcher). The matcher tracks inside its gate from its own last pose, so a fix that slid
+  // onto a look-alike (cabinet faces meeting a bent wall 1.6 m along a corridor) stays there while the odometry holds
+  // the truth and a fit from it explains more of the scan. 0: off.
+  double dr_refit_ratio = 1.15;
 };
 
 // A frame's pose dead-reckoned from the pose last published OK, with its covariance (x, y, yaw).

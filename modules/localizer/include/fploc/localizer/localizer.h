@@ -164,6 +164,14 @@ class Localizer {
   double dr_path_m_ = 0, dr_turn_rad_ = 0;  // running totals
   int64_t dr_last_utime_ = 0;
   Eigen::Vector2d dr_velocity_ = Eigen::Vector2d::Zero();  // the odometry's over its last frame
+  // UncertaintyConfig::dr_refit_ratio: the frame registered again from the dead-reckoned pose, when the fix lies beyond
+  // the dead reckoning's gate; the fit (its pose at the frame's utime and at the de-skew reference) if it replaces the fix.
+  struct Refit {
+    matcher::MatchResult match;  // pose at utime, fit, covariance (the twist the fix's)
+    Pose2 at_ref;
+  };
+  std::optional<Refit> refit_from_dead_reckoning(const FeatureFrame& deskewed, const FramePose& sfr, const Pose2& fix_at_ref,
+                                                 const Eigen::Matrix3d& fix_covariance, const DeadReckoned& dr, double t_ref);
   // The second fit of a re-acquisition (UncertaintyConfig::rival_ratio, rival_min_gained; rival.h): searched while
   // none is known during a confirmation (or the one carried is no ambiguity any more), then carried with the fix;
   // applied to uncertainty_. Also on the OK fixes after the dead reckoning was lost in a stretch that refused a fix
