@@ -117,7 +117,7 @@ MatchResult register_frame(const NearestLookup& lookup, const FeatureFrame& f, c
 Matcher::Matcher(const NearestLookup& lookup, MatcherConfig cfg) : lookup_(lookup), cfg_(std::move(cfg)) {}
 
 MatchResult Matcher::search_grid(const FeatureFrame& in, const Pose2& centre, double s_in, double a_in,
-                                 const MatcherConfig& cfg, const Eigen::Vector2d* window) const {
+                                 const MatcherConfig& cfg, const Eigen::Vector2d* window, double nearest_band) const {
   // One registration converges from about half a metre / a few degrees: starts 2/3 of the half-width apart.
   const double s = s_in * 2 / 3, a = a_in * 2 / 3;
   MatcherConfig c = cfg;
@@ -165,6 +165,19 @@ MatchResult Matcher::search_grid(const FeatureFrame& in, const Pose2& centre, do
   size_t best = 0;
   for (size_t i = 1; i < fits.size(); ++i)
     if (better(fits[i], fits[best])) best = i;
+  if (!window && nearest_band > 0 && fits[best].status == FitStatus::kOk) {
+    // About as good: the nearest to the centre (MatcherConfig::initial_search_band).
+    auto offset2 = [&](const MatchResult& m) {
+      const double dx = (m.solved.x - centre.x) / sm, dy = (m.solved.y - centre.y) / sm;
+      const double da = wrap_angle(m.solved.yaw - centre.yaw) / sa;
+      return dx * dx + dy * dy + da * da;
+    };
+    const double enough = nearest_band * fits[best].fit.num_inliers;
+    const size_t top = best;
+    for (size_t i = 0; i < fits.size(); ++i)
+      if (i != top && fits[i].status == FitStatus::kOk && fits[i].fit.num_inliers >= enough && offset2(fits[i]) < offset2(fits[best]))
+        best = i;
+  }
   r = std::move(fits[best]);
   r.iterations = iterations;
   return r;
@@ -263,7 +276,7 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
   if (!have_last_ && search_m_ > 2 * cfg_.gate_tracking_m) {
     // First frame from a pose known only to within search_m / search_yaw: one registration converges
     // from about half a metre / a few degrees, so start from a grid over the uncertainty.
-    r = search_grid(in, pred, search_m_, search_yaw_, cfg);
+    r = search_grid(in, pred, search_m_, search_yaw_, cfg, nullptr, cfg_.initial_search_band);
   } else if (odom_window && !tracking && win_m > 2 * cfg_.gate_tracking_m) {
     // Dead reckoning with the odometry for a while: the prediction is known only to within the window.
     r = search_grid(in, pred, win_m, win_rad, cfg, &window);

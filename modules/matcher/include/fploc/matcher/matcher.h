@@ -79,6 +79,13 @@ struct MatcherConfig {
   // ... and the window search's fits are ranked by their inliers times exp(-m^2 / 2 kappa^2) of their
   // Mahalanobis offset m from the prediction (the grid localizer's prior, SearchWindow::prior_kappa).
   double search_prior_kappa = 1.5;
+  // The first frame's search from a pose known only to within search_m (set_pose: the user's initial pose, a
+  // relocalizer's answer): of its OK fits that explain at least initial_search_band as many points as the best one,
+  // the one nearest the given pose (Mahalanobis, the half-widths as 3 sigma) is taken. Of two places the scan fits
+  // about as well the given pose is the evidence left; the most points alone took a pose 0.3-0.5 m along the corridor
+  // (cabinet faces on a drawn wall) over the truth the corridor's mixed and renovated worlds started at. A weight on
+  // the offset, as the window search's, pulled a start 1 m off onto a wrong fit near it. 0: off (the most points).
+  double initial_search_band = 0.9;
   AsBuiltModel as_built;          // per-wall end offsets eliminated (as_built.h); off by default
 };
 
@@ -161,9 +168,10 @@ class Matcher {
   FeatureFrame deskewed_;       // scratch
   // Registration from a grid of starts over +-s / +-a around `centre` (spacing 2/3 of it, the centre first):
   // the fit with the most inliers (then the lower rms), OK ones first; with `window` only fits within it,
-  // their inliers weighted by the prior on the offset (search_prior_kappa).
+  // their inliers weighted by the prior on the offset (search_prior_kappa); with `nearest_band` (and no window) the
+  // nearest of the OK fits with at least that share of the best one's points.
   MatchResult search_grid(const FeatureFrame& in, const Pose2& centre, double s, double a, const MatcherConfig& cfg,
-                          const Eigen::Vector2d* window = nullptr) const;
+                          const Eigen::Vector2d* window = nullptr, double nearest_band = 0) const;
 };
 
 }  // namespace fploc::matcher
