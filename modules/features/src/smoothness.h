@@ -10,7 +10,8 @@
 // the seventh speed round c was LOAM's value with the window sum in double and picks ordered by that exact
 // value; the float value differs from it by ~1e-6 relative (the rounding of 12 float sums), which changes
 // the order of two candidates only where their c agree to that precision (test/reference_features.h holds
-// the plain rules with this c).
+// the plain rules with this c). Since the thirty-fourth round the pass computes q = c^2 (no root) and the picks
+// follow q's order, the thresholds still applied to c (float_smoothness_sq below).
 #pragma once
 #include <cmath>
 #include <cstdint>
