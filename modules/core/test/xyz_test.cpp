@@ -35,7 +35,9 @@ TEST(Xyz, MatchesManualFormula) {
 }
 
 // The table computed pixel by pixel, every sine and cosine taken at the pixel (make_xyz_lut computes those of
-// the encoder angle once per column and those of the altitude once per beam: the same values).
+// the encoder angle once per column and those of the altitude and azimuth once per beam, the pixel's by the
+// angle sums: in double within a few 1e-16 of these, the same floats but where a value lies at a float's
+// rounding edge, which none of the tables below has).
 static XyzLut per_pixel_lut(const BeamIntrinsics& beams, int width) {
   XyzLut lut;
   lut.height = beams.beams();

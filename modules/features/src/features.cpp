@@ -163,7 +163,7 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
                                 float(cfg_.occlusion_ratio), float(cfg_.parallel_ratio),
                                 float(cfg_.corner_threshold), float(cfg_.surface_threshold)};
   detail::RingScratch scratch{ring_w_, ring_brk_};
-  float* corner_c = corner_c_.data();  // c of corner candidates, -inf elsewhere
+  float* corner_c = corner_c_.data();  // q = c^2 of corner candidates, -inf elsewhere
   const float* sc = surface_c_.data();
   const uint64_t* sk = surface_.data();
   detail::smoothness(in, rules, scratch, corner_c, surface_.data(), surface_c_.data(), occ_);
@@ -219,8 +219,8 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   }
 
   // Per-sector selection (sectors split the ring's points evenly, as LOAM does): the sharpest corner
-  // candidates that no earlier pick suppressed (the first index among equal c), then the smoothest surface
-  // candidates, walked in the order (c, index): the plain rules' picks.
+  // candidates that no earlier pick suppressed (the first index among equal q = c^2), then the smoothest surface
+  // candidates, walked in the order (q, index): the plain rules' picks.
   // The picks as bits (points in column order without a sort): bit i of feat, and of corner for a corner.
   const size_t words = size_t(n) / 64 + 1;
   pick_bits_.assign(2 * words, 0);
@@ -241,8 +241,8 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     const int sb = hw + (n - 2 * hw) * s / S, se = hw + (n - 2 * hw) * (s + 1) / S;
     if (se <= sb) continue;
     for (int corners = 0; corners < max_corners; ++corners) {
-      // The sharpest candidate: the first index with the largest c (one vector scan of the sector: a sector
-      // is ~n/6 points, cheaper than keeping block maxima up to date).
+      // The sharpest candidate: the first index with the largest q = c^2 (smoothness.h; one vector scan of the
+      // sector: a sector is ~n/6 points, cheaper than keeping block maxima up to date).
       const int best = detail::first_argmax(corner_c, sb, se);
       if (best < 0) break;
       pick(best, true);
@@ -278,7 +278,8 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       }
       nc = m;
     }
-    // The others in the order (c, index), sorted as 64-bit keys: order_bits(c) above the index.
+    // The others in the order (q, index), sorted as 64-bit keys: order_bits(q) above the index (q = c^2 before
+    // the root, smoothness.h).
     for (size_t k = 0; k < nc; ++k) keys[k] = uint64_t(order_bits(sc[cand[k]])) << 32 | uint32_t(cand[k]);
     std::sort(keys, keys + nc);
     int surfaces = 0;  // (the direct picks above only happen when the limit cannot be reached)

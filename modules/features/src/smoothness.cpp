@@ -62,9 +62,36 @@ const Choice& choice() {
 }
 }  // namespace
 
+float squared_above(float t) {
+  if (std::isnan(t)) return t;
+  if (t < 0) return -std::numeric_limits<float>::infinity();  // every root (>= 0) is above
+  if (std::isinf(t)) return t;
+  const float inf = std::numeric_limits<float>::infinity();
+  float q = t * t;
+  if (std::isinf(q)) q = std::numeric_limits<float>::max();
+  while (std::sqrt(q) > t) q = std::nextafter(q, -inf);
+  for (float u = std::nextafter(q, inf); std::sqrt(u) <= t; u = std::nextafter(q, inf)) q = u;
+  return q;
+}
+
+float squared_below(float s) {
+  if (std::isnan(s)) return s;
+  const float inf = std::numeric_limits<float>::infinity();
+  if (s <= 0) return -inf;  // no root (>= 0) is below
+  if (std::isinf(s)) return s;
+  float q = s * s;
+  if (std::isinf(q)) q = std::numeric_limits<float>::max();
+  while (std::sqrt(q) < s) q = std::nextafter(q, inf);
+  for (float d = std::nextafter(q, -inf); d >= 0 && std::sqrt(d) >= s; d = std::nextafter(q, -inf)) q = d;
+  return q;
+}
+
 void smoothness(const RingIn& in, const RingRules& rules, RingScratch& scratch, float* corner, uint64_t* surface,
                 float* surface_c, std::vector<int>& occlusions) {
-  choice().pass(in, rules, scratch, corner, surface, surface_c, occlusions);
+  RingRules ru = rules;
+  ru.corner_sq = squared_above(rules.corner);
+  ru.surface_sq = squared_below(rules.surface);
+  choice().pass(in, ru, scratch, corner, surface, surface_c, occlusions);
 }
 
 int first_argmax(const float* v, int b, int e) { return choice().argmax(v, b, e); }

@@ -64,6 +64,29 @@ Run run(const synth::Room& room, const synth::SensorPose& pose, double noise, ui
 }
 }  // namespace
 
+// The pass tests c = sqrt(q) against the thresholds as q against squared_above / squared_below: the same answer
+// for every q, checked at the two floats around each boundary and over a sweep of q, for the default thresholds,
+// zero, negative, tiny, huge and infinite ones.
+TEST(Features, SquaredThresholdsAreTheRootsTests) {
+  const float inf = std::numeric_limits<float>::infinity();
+  std::vector<float> ts = {0.002f, 0.0005f, 0.f, -1.f, 1e-20f, 1e-3f, 0.3f, 1.f, 7.25f, 3e19f, inf};
+  for (int k = 0; k < 200; ++k) ts.push_back(std::ldexp(1.f + 0.37f * float(k % 7), k / 7 - 20) * (1.f + 1e-7f * float(k)));
+  size_t checked = 0;
+  for (const float t : ts) {
+    const float a = detail::squared_above(t), b = detail::squared_below(t);
+    std::vector<float> qs = {0.f, a, std::nextafter(a, inf), std::nextafter(a, -inf), b, std::nextafter(b, inf),
+                             std::nextafter(b, -inf), t * t, inf, std::numeric_limits<float>::max()};
+    for (float q = 1e-30f; q < 1e30f; q *= 1.37f) qs.push_back(q);
+    for (const float q : qs) {
+      if (!(q >= 0)) continue;
+      EXPECT_EQ(std::sqrt(q) > t, q > a) << "t " << t << " q " << q;
+      EXPECT_EQ(std::sqrt(q) < t, q < b) << "t " << t << " q " << q;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 10000u);
+}
+
 TEST(Features, EmptyRoomSurfacesOnWallsGroupsOnOneWall) {
   synth::Room room;
   synth::SensorPose pose{1.0, -0.5, 1.5, 2 * kDeg, -1.5 * kDeg, 0.4};
@@ -244,8 +267,10 @@ TEST(Features, ReferenceEqualSmoothnessPass) {
         for (int i = hw; i < n - hw; ++i) {
           const float c = reference::smoothness(in.x, in.y, in.z, i, hw);
           if (!(bits[size_t(i) >> 6] >> (i & 63) & 1)) continue;  // a broken window (column gap)
-          ASSERT_EQ(std::memcmp(&c, &sc[size_t(i)], 4), 0) << "ring " << w.ring[b] << " point " << i << " hw " << hw;
-          ASSERT_EQ(std::memcmp(&c, &corner[size_t(i)], 4), 0) << "ring " << w.ring[b] << " point " << i;
+          // (the pass stores c^2 before the root: its correctly rounded root is c)
+          const float csc = std::sqrt(sc[size_t(i)]), ccorner = std::sqrt(corner[size_t(i)]);
+          ASSERT_EQ(std::memcmp(&c, &csc, 4), 0) << "ring " << w.ring[b] << " point " << i << " hw " << hw;
+          ASSERT_EQ(std::memcmp(&c, &ccorner, 4), 0) << "ring " << w.ring[b] << " point " << i;
           ++checked;
         }
       }

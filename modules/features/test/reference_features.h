@@ -18,7 +18,9 @@ namespace fploc::feat::reference {
 // (LOAM's with the neighbours' range for the point's own, see src/smoothness.h), defined by its float
 // computation (float_smoothness, written out here): the hw points before i and the hw points after i each
 // added up in index order, S = A + B, d = S - 2hw X_i, one division, one root.
-inline float smoothness(const float* X, const float* Y, const float* Z, int i, int hw) {
+// smoothness_sq: c^2 before the root, q; the picks follow q's order (c's, but where two q round to the same c:
+// src/smoothness.h), the thresholds apply to c.
+inline float smoothness_sq(const float* X, const float* Y, const float* Z, int i, int hw) {
   float ax = 0, ay = 0, az = 0, bx = 0, by = 0, bz = 0;
   for (int q = 0; q < hw; ++q) {
     ax = q == 0 ? X[i - hw] : ax + X[i - hw + q];
@@ -31,7 +33,10 @@ inline float smoothness(const float* X, const float* Y, const float* Z, int i, i
   const float den = float(2 * hw);
   const float sx = ax + bx, sy = ay + by, sz = az + bz;
   const float dx = sx - den * X[i], dy = sy - den * Y[i], dz = sz - den * Z[i];
-  return std::sqrt(((dx * dx + dy * dy) + dz * dz) / ((sx * sx + sy * sy) + sz * sz));
+  return ((dx * dx + dy * dy) + dz * dz) / ((sx * sx + sy * sy) + sz * sz);
+}
+inline float smoothness(const float* X, const float* Y, const float* Z, int i, int hw) {
+  return std::sqrt(smoothness_sq(X, Y, Z, i, hw));
 }
 
 struct Result {
@@ -85,7 +90,7 @@ inline Result extract(const seg::Segmentation& seg, const FeatureConfig& cfg = {
     if (n < 2 * hw + 1) return;
     const float *X = &w.x[begin], *Y = &w.y[begin], *Z = &w.z[begin], *R = &w.range[begin];
     const int16_t* C = &w.column[begin];
-    std::vector<float> c(n, 0.f);
+    std::vector<float> c(n, 0.f), q(n, 0.f);  // c and q = c^2 before the root
     std::vector<bool> ok(n, false), picked(n, false);
     for (int i = hw; i < n - hw; ++i) {
       bool connected = true;
@@ -94,7 +99,8 @@ inline Result extract(const seg::Segmentation& seg, const FeatureConfig& cfg = {
       const bool in_range = !(r < float(cfg.min_range_m)) && !(r > float(cfg.max_range_m));
       const float par = float(cfg.parallel_ratio);
       const bool parallel = std::abs(R[i - 1] - r) > par * r && std::abs(R[i + 1] - r) > par * r;
-      c[i] = smoothness(X, Y, Z, i, hw);
+      q[i] = smoothness_sq(X, Y, Z, i, hw);
+      c[i] = std::sqrt(q[i]);
       ok[i] = connected && in_range && !parallel && !in_front(begin + size_t(i));
     }
     for (int j = 0; j + 1 < n; ++j) {  // occlusion boundaries: clear hw points on the far side
@@ -117,7 +123,7 @@ inline Result extract(const seg::Segmentation& seg, const FeatureConfig& cfg = {
         if (ok[i] && c[i] > float(cfg.corner_threshold)) corners.push_back(i);
         if (ok[i] && c[i] < float(cfg.surface_threshold)) surfaces.push_back(i);
       }
-      std::stable_sort(corners.begin(), corners.end(), [&](int a, int b) { return c[a] > c[b]; });
+      std::stable_sort(corners.begin(), corners.end(), [&](int a, int b) { return q[a] > q[b]; });
       int picks = 0;
       for (int i : corners) {
         if (picks >= max_c) break;
@@ -127,7 +133,7 @@ inline Result extract(const seg::Segmentation& seg, const FeatureConfig& cfg = {
         ++picks;
         for (int k = std::max(0, i - hw); k <= std::min(n - 1, i + hw); ++k) picked[k] = true;
       }
-      std::stable_sort(surfaces.begin(), surfaces.end(), [&](int a, int b) { return c[a] < c[b]; });
+      std::stable_sort(surfaces.begin(), surfaces.end(), [&](int a, int b) { return q[a] < q[b]; });
       picks = 0;
       for (int i : surfaces) {
         if (picks >= max_s) break;
