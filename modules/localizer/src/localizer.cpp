@@ -161,7 +161,11 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
     const matcher::MatchResult* m = &sfr.match;
     Pose2 m_at_ref = at_ref;
     std::optional<Refit> refit;
-    if (dr && cfg_.uncertainty.dr_refit_ratio > 0 && sfr.match.status != matcher::FitStatus::kLost &&
+    // (Not with the robot's own odometry: it predicts the frame, and the LiDAR odometry under the dead reckoning is the
+    // weaker witness there. On the Radish logs' 2D scans, 1-2 s apart, it stood still for 10 m of corridor while the
+    // wheels and the fixes moved on, and the refit from it, explaining more of the corridor's map, took the plan path
+    // 9.5 m back.)
+    if (dr && !motion && cfg_.uncertainty.dr_refit_ratio > 0 && sfr.match.status != matcher::FitStatus::kLost &&
         (refit = refit_from_dead_reckoning(deskewed_, sfr, at_ref, fu.covariance, *dr, t_ref))) {
       m = &refit->match;
       m_at_ref = refit->at_ref;

@@ -164,7 +164,8 @@ struct UncertaintyConfig {
   // least dr_refit_ratio as many points as the fix, it replaces the fix for the frame (the tracker, the window, and so
   // the pose fed back to the matcher). The matcher tracks inside its gate from its own last pose, so a fix that slid
   // onto a look-alike (cabinet faces meeting a bent wall 1.6 m along a corridor) stays there while the odometry holds
-  // the truth and a fit from it explains more of the scan. 0: off.
+  // the truth and a fit from it explains more of the scan. Not where the robot's odometry predicts the frame
+  // (Localizer::add_odometry). 0: off.
   double dr_refit_ratio = 1.15;
 };
 
