@@ -334,7 +334,7 @@ std::optional<Localizer::Refit> Localizer::refit_from_dead_reckoning(const Featu
   if (double(theirs) < u.dr_refit_ratio * double(std::max(1, own))) return std::nullopt;
   Refit out;
   out.at_ref = r.solved;
-  out.match = sfr.match;
+  out.match = sfr.match;  // the matcher's status, text and twist stay (a POOR fix's refit is published POOR still)
   out.match.pose = compose(r.solved, inverse(ref_of_utime));
   out.match.pose.yaw = wrap_angle(out.match.pose.yaw);
   out.match.solved = out.match.pose;
