@@ -62,6 +62,10 @@ double strongest_horizontal(const Eigen::Matrix3d& P) {
   return std::sqrt(std::max(0.0, es.eigenvalues()[0]));
 }
 
+Eigen::Vector3d pose_difference(const Pose2& a, const Pose2& b) { return {a.x - b.x, a.y - b.y, wrap_angle(a.yaw - b.yaw)}; }
+
+double mahalanobis2(const Eigen::Vector3d& d, const Eigen::Matrix3d& S) { return d.dot(S.ldlt().solve(d)); }
+
 double chi2_3dof_of_sigmas(double k) {
   // P(chi2_3 <= x) = erf(sqrt(x/2)) - sqrt(2x/pi) exp(-x/2): bisection for the probability erf(k/sqrt2).
   const double p = std::erf(k / std::sqrt(2.0));
@@ -140,9 +144,8 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
   bool refused = false;
   Eigen::Vector3d nu = Eigen::Vector3d::Zero();
   if (fix && continuing && frame_ok && cfg_.gate_sigma > 0) {
-    nu = Eigen::Vector3d(fix->x - mean_pred.x, fix->y - mean_pred.y, wrap_angle(fix->yaw - mean_pred.yaw));
-    Eigen::LDLT<Eigen::Matrix3d> ldlt(sym(P_pred + frame_cov));
-    const double d2 = nu.dot(ldlt.solve(nu));
+    nu = pose_difference(*fix, mean_pred);
+    const double d2 = mahalanobis2(nu, sym(P_pred + frame_cov));
     innovation_sigma = std::sqrt(std::max(0.0, d2));
     if (d2 > chi2_3dof_of_sigmas(cfg_.gate_sigma)) {
       refused = true;
@@ -229,10 +232,8 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
   // A fix against the dead-reckoned pose (dead_reckoning_gate_sigma), the covariance it would be published with.
   bool held = false;  // published POOR while a stretch with a refused fix counts the fixes that end it
   if (s.status == matcher::FitStatus::kOk && fix && dead_reckoned && cfg_.dead_reckoning_gate_sigma > 0) {
-    const Eigen::Vector3d d(fix->x - dead_reckoned->pose.x, fix->y - dead_reckoned->pose.y,
-                            wrap_angle(fix->yaw - dead_reckoned->pose.yaw));
-    const Eigen::Matrix3d S = sym(s.covariance + clamp_spd(dead_reckoned->covariance, 1e-14, vmax));
-    const double d2 = d.dot(Eigen::LDLT<Eigen::Matrix3d>(S).solve(d));
+    const Eigen::Vector3d d = pose_difference(*fix, dead_reckoned->pose);
+    const double d2 = mahalanobis2(d, sym(s.covariance + clamp_spd(dead_reckoned->covariance, 1e-14, vmax)));
     s.dead_reckoned_sigma = std::sqrt(std::max(0.0, d2));
     ++dr_agreeing_;
     if (d2 > chi2_3dof_of_sigmas(cfg_.dead_reckoning_gate_sigma)) {

@@ -170,10 +170,7 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
       m = &refit->match;
       m_at_ref = refit->at_ref;
       fu = optimizer::frame_uncertainty(lookup_, deskewed_, m_at_ref, cfg_.uncertainty.frame);
-      in.sfr = m->pose;
-      in.status = m->status;
-      in.covariance = m->covariance;
-      in.published_status = m->status;
+      in.sfr = m->pose;  // (its status is the fix's; covariance and published status are the tracker's, below)
     }
     uncertainty_ = tracker_.update(f.utime, fu.covariance, fu.valid, m->status, m->text, &m->pose, &m->twist,
                                    m->fit.inlier_ratio, motion ? &*motion : nullptr,
@@ -315,11 +312,7 @@ std::optional<Localizer::Refit> Localizer::refit_from_dead_reckoning(const Featu
                                                                      double t_ref) {
   const UncertaintyConfig& u = cfg_.uncertainty;
   const double gate = chi2_3dof_of_sigmas(u.dead_reckoning_gate_sigma);
-  auto off_dr = [&](const Pose2& p, const Eigen::Matrix3d& cov) {
-    const Eigen::Vector3d d(p.x - dr.pose.x, p.y - dr.pose.y, wrap_angle(p.yaw - dr.pose.yaw));
-    const Eigen::Matrix3d S = dr.covariance + cov;
-    return d.dot(S.ldlt().solve(d));
-  };
+  auto off_dr = [&](const Pose2& p, const Eigen::Matrix3d& cov) { return mahalanobis2(pose_difference(p, dr.pose), dr.covariance + cov); };
   if (!(off_dr(sfr.match.pose, fix_covariance) > gate)) return std::nullopt;  // the fix agrees with the dead reckoning
   // The dead-reckoned pose at the de-skew reference (the fix's twist carries it there), registered from with the
   // matcher's tracking gate: the minimum nearest the odometry's track.
@@ -422,11 +415,11 @@ bool Localizer::check_rival(const FeatureFrame& f, const Pose2& fix, const DeadR
   if (dr && u.dead_reckoning_gate_sigma > 0 && !uncertainty_.off_dead_reckoning) {
     // The dead reckoning tells them apart: the fix within its gate (else the tracker said so), the rival beyond.
     const Pose2 r_at_utime = compose(fix_at_utime, between(fix, *rival));
-    const Eigen::Vector3d e(r_at_utime.x - dr->pose.x, r_at_utime.y - dr->pose.y, wrap_angle(r_at_utime.yaw - dr->pose.yaw));
-    const Eigen::Matrix3d S = dr->covariance + uncertainty_.covariance;
-    if (e.dot(S.ldlt().solve(e)) > chi2_3dof_of_sigmas(u.dead_reckoning_gate_sigma)) return false;
+    if (mahalanobis2(pose_difference(r_at_utime, dr->pose), dr->covariance + uncertainty_.covariance) >
+        chi2_3dof_of_sigmas(u.dead_reckoning_gate_sigma))
+      return false;
   }
-  const Eigen::Vector3d d(rival->x - fix.x, rival->y - fix.y, wrap_angle(rival->yaw - fix.yaw));
+  const Eigen::Vector3d d = pose_difference(*rival, fix);
   char b[200];
   if (share >= rival_ratio)
     std::snprintf(b, sizeof b, "re-acquired: a second fit %.2f m / %.1f deg away explains %.0f %% as many points", std::hypot(d[0], d[1]),

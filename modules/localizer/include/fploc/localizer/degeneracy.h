@@ -242,6 +242,10 @@ class UncertaintyTracker {
 // The 3-DoF chi-square quantile with the probability of a 1-D Gaussian within k sigma (k = 3: 14.16).
 double chi2_3dof_of_sigmas(double k);
 
+// a - b as (x, y, yaw), the yaw wrapped; and d^T S^-1 d (S symmetric, by LDLT): the gates' Mahalanobis distances.
+Eigen::Vector3d pose_difference(const Pose2& a, const Pose2& b);
+double mahalanobis2(const Eigen::Vector3d& d, const Eigen::Matrix3d& S);
+
 // The tighter of two covariances per direction of their common eigenbasis (generalised eigenvectors).
 Eigen::Matrix3d tighter_of(const Eigen::Matrix3d& A, const Eigen::Matrix3d& B);
 // (sqrt(P) + sqrt(Q))^2 per direction of the basis that diagonalises both: standard deviations add.
