@@ -10,6 +10,7 @@
 #include <fploc/pose_t.hpp>
 
 #include <algorithm>
+#include <climits>
 #include <chrono>
 #include <cstdio>
 #include <deque>
@@ -43,6 +44,10 @@ class MatcherNode : public fploc::rt::Node {
             {fploc::rt::input<fploc::features_t>("features", "FPLOC_FEATURES"),
              fploc::rt::input<fploc::imu_t>("imu", "OS1_IMU"),
              fploc::rt::input<fploc::pose_t>("initial_pose", "FPLOC_INITIAL_POSE"),
+             // Optional: the optimizer's re-seeds while LOST (its `reseed` output, FPLOC_RESEED in the shipped graphs:
+             // the frame registered from the dead-reckoned pose). Taken as an initial pose; a relocalizer's answer for
+             // the same or an older frame is then stale (the robot's track, not a search around the last good pose).
+             fploc::rt::input<fploc::pose_t>("reseed", ""),
              // The optimizer's window estimate of each frame (FPLOC_POSE_LATEST in the shipped graphs):
              // the next frame is predicted from it. Not connected by default: the matcher then predicts
              // from its own single-frame poses only, as the paper's SFR, and runs without an optimizer.
@@ -80,26 +85,16 @@ class MatcherNode : public fploc::rt::Node {
     ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) { on_features(m); });
     ctx.subscribe<fploc::imu_t>("imu", [this](const fploc::imu_t& m) { on_imu(m); });
     ctx.subscribe<fploc::pose_t>("initial_pose", [this](const fploc::pose_t& m) {
-      const fploc::Pose2 p = fploc::adapters::pose2_of(m);
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.yaw)) {
-        ctx_->error("initial_pose seq " + std::to_string(m.seq) + ": non-finite pose (ignored)");
+      // (A relocalizer's answer for a frame up to 2 s before the optimizer's last re-seed: stale. An operator's pose
+      // stamped otherwise, e.g. 0, is taken.)
+      if (m.utime <= reseed_utime_ && m.utime >= reseed_utime_ - 2'000'000) {
+        std::cerr << "[" << ctx_->name() << "] initial_pose seq " << m.seq << " for a frame the optimizer re-seeded (ignored)\n";
         return;
       }
-      // A pose on another floor (an operator's, a relocalization's): that floor's plan from now on.
-      const int floors = int(plan_.floors().maps.size());
-      if (m.floor_index >= 0 && m.floor_index < floors && m.floor_index != plan_.floor()) {
-        const std::string from = plan_.floor_name();
-        plan_.set_floor(m.floor_index);
-        new_localizer();
-        if (tracker_) tracker_->set_floor(plan_.floor(), "initial pose on floor '" + m.floor + "' (was '" + from + "')");
-        std::cerr << "[" << ctx_->name() << "] initial pose on floor '" << m.floor << "' (was '" << from << "')\n";
-      } else if (m.floor_index >= floors) {
-        ctx_->error("initial_pose seq " + std::to_string(m.seq) + ": floor_index " + std::to_string(m.floor_index) +
-                    " but the plan has " + std::to_string(floors) + " floor(s) (floor kept)");
-      }
-      // Search within 3 sigma of the message's position covariance when it has one.
-      const double var = std::max(m.covariance[0], m.covariance[7]);
-      loc_->set_pose(p, std::isfinite(var) && var > 0 ? std::optional<double>(3 * std::sqrt(var)) : std::nullopt);
+      on_initial_pose(m, "initial_pose");
+    });
+    ctx.subscribe<fploc::pose_t>("reseed", [this](const fploc::pose_t& m) {
+      if (on_initial_pose(m, "reseed")) reseed_utime_ = std::max(reseed_utime_, m.utime);
     });
     ctx.subscribe<fploc::pose_t>("odom", [this](const fploc::pose_t& m) {
       if (const auto p = fploc::adapters::finite_pose2_of(m)) loc_->add_odometry(m.utime, *p);
@@ -119,6 +114,31 @@ class MatcherNode : public fploc::rt::Node {
   }
 
  private:
+  // An initial pose (an operator's, the relocalizer's, the optimizer's re-seed) from `port`: false if not finite.
+  bool on_initial_pose(const fploc::pose_t& m, const char* port) {
+    const fploc::Pose2 p = fploc::adapters::pose2_of(m);
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.yaw)) {
+      ctx_->error(std::string(port) + " seq " + std::to_string(m.seq) + ": non-finite pose (ignored)");
+      return false;
+    }
+    // A pose on another floor (an operator's, a relocalization's): that floor's plan from now on.
+    const int floors = int(plan_.floors().maps.size());
+    if (m.floor_index >= 0 && m.floor_index < floors && m.floor_index != plan_.floor()) {
+      const std::string from = plan_.floor_name();
+      plan_.set_floor(m.floor_index);
+      new_localizer();
+      if (tracker_) tracker_->set_floor(plan_.floor(), "initial pose on floor '" + m.floor + "' (was '" + from + "')");
+      std::cerr << "[" << ctx_->name() << "] initial pose on floor '" << m.floor << "' (was '" << from << "')\n";
+    } else if (m.floor_index >= floors) {
+      ctx_->error(std::string(port) + " seq " + std::to_string(m.seq) + ": floor_index " + std::to_string(m.floor_index) +
+                  " but the plan has " + std::to_string(floors) + " floor(s) (floor kept)");
+    }
+    // Search within 3 sigma of the message's position covariance when it has one.
+    const double var = std::max(m.covariance[0], m.covariance[7]);
+    loc_->set_pose(p, std::isfinite(var) && var > 0 ? std::optional<double>(3 * std::sqrt(var)) : std::nullopt);
+    return true;
+  }
+
   void on_imu(const fploc::imu_t& m) {
     loc_->add_imu(m.utime, m.gyro[2]);
     if (tracker_) tracker_->add_imu(m.utime, {m.accel[0], m.accel[1], m.accel[2]});
@@ -273,6 +293,7 @@ class MatcherNode : public fploc::rt::Node {
   fploc::rt::Publisher<fploc::frame_pose_t> out_;
   int64_t seq_ = 0;
   int64_t refined_ignored_ = 0;
+  int64_t reseed_utime_ = INT64_MIN / 2;  // the newest frame the optimizer re-seeded (`reseed`)
   fploc::matcher::FitStatus last_status_ = fploc::matcher::FitStatus::kOk;
 };
 

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -47,7 +48,11 @@ class OptimizerNode : public fploc::rt::Node {
              // (localizer::UncertaintyConfig::dr_gyro_sigma_rad).
              fploc::rt::input<fploc::imu_t>("imu", ""),
              fploc::rt::output<fploc::pose_t>("pose", "FPLOC_POSE"),
-             fploc::rt::output<fploc::pose_t>("latest", "FPLOC_POSE_LATEST")}};
+             fploc::rt::output<fploc::pose_t>("latest", "FPLOC_POSE_LATEST"),
+             // Optional: where the matcher should start again while it is LOST and the dead-reckoned pose's fit
+             // explains the frame (localizer::UncertaintyConfig::dr_reseed_when_lost; FPLOC_INITIAL_POSE in the
+             // shipped graphs, the matcher's initial_pose input, beside the relocalizer's answers).
+             fploc::rt::output<fploc::pose_t>("reseed", "")}};
   }
 
   void setup(fploc::rt::Context& ctx) override {
@@ -62,6 +67,7 @@ class OptimizerNode : public fploc::rt::Node {
     loc_ = plan_.make_localizer(cfg_);
     pose_out_ = ctx.advertise<fploc::pose_t>("pose");
     latest_out_ = ctx.advertise<fploc::pose_t>("latest");
+    reseed_out_ = ctx.advertise<fploc::pose_t>("reseed");
     ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) {
       try {
         features_[m.scan_seq] = fploc::adapters::from_msg(m);
@@ -153,6 +159,18 @@ class OptimizerNode : public fploc::rt::Node {
                   << (latest->status_text.empty() ? "" : ": " + latest->status_text) << "\n";
       last_status_ = latest->status;
     }
+    if (const auto r = loc_->take_reseed()) {
+      // The search radius as the 3 sigma the matcher reads from an initial pose's covariance.
+      const double s = r->search_m / 3;
+      char b[160];
+      std::snprintf(b, sizeof b, "scan %lld (LOST): re-seeded at (%.2f, %.2f, %.1f deg) from the dead reckoning",
+                    (long long)m.scan_seq, r->pose.x, r->pose.y, r->pose.yaw * 180 / M_PI);
+      std::cerr << "[" << ctx_->name() << "] " << b << "\n";
+      reseed_out_.publish(fploc::adapters::make_pose_msg(r->utime, reseed_seq_++, r->pose, fz.roll, fz.pitch, fz.z,
+                                                         Eigen::Vector3d(s * s, s * s, 0.0).asDiagonal(), fz.z_sigma,
+                                                         fz.roll_pitch_sigma, int8_t(FitStatus::kPoor), false, false,
+                                                         m.floor_index, m.floor));
+    }
     publish_finals(finals);
   }
 
@@ -191,13 +209,13 @@ class OptimizerNode : public fploc::rt::Node {
   fploc::localizer::ActivePlan plan_;  // before loc_: the Localizer reads its weights and map
   fploc::localizer::Config cfg_;
   std::unique_ptr<fploc::localizer::Localizer> loc_;
-  fploc::rt::Publisher<fploc::pose_t> pose_out_, latest_out_;
+  fploc::rt::Publisher<fploc::pose_t> pose_out_, latest_out_, reseed_out_;
   std::map<int64_t, fploc::FeatureFrame> features_;
   std::map<int64_t, fploc::frame_pose_t> frame_poses_;
   std::map<int64_t, std::pair<int, std::string>> floor_of_;  // utime -> floor (index, name)
   int64_t last_seq_ = 0;
   bool have_last_ = false;
-  int64_t pose_seq_ = 0, latest_seq_ = 0;
+  int64_t pose_seq_ = 0, latest_seq_ = 0, reseed_seq_ = 0;
   FitStatus last_status_ = FitStatus::kOk;
   int status_changes_ = 0;
 };

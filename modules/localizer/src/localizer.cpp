@@ -165,12 +165,22 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
     // weaker witness there. On the Radish logs' 2D scans, 1-2 s apart, it stood still for 10 m of corridor while the
     // wheels and the fixes moved on, and the refit from it, explaining more of the corridor's map, took the plan path
     // 9.5 m back.)
-    if (dr && !motion && cfg_.uncertainty.dr_refit_ratio > 0 && sfr.match.status != matcher::FitStatus::kLost &&
-        (refit = refit_from_dead_reckoning(deskewed_, sfr, at_ref, fu.covariance, *dr, t_ref))) {
+    const bool lost = sfr.match.status == matcher::FitStatus::kLost;
+    if (dr && !motion && cfg_.uncertainty.dr_refit_ratio > 0 && (!lost || cfg_.uncertainty.dr_reseed_when_lost) &&
+        (refit = refit_from_dead_reckoning(deskewed_, sfr, at_ref, fu.covariance, *dr, t_ref, lost))) {
+      if (lost) {
+        // A lost matcher's frame re-seeded: still LOST for the published status (the re-acquisition's confirmation
+        // follows on the matcher's next fixes, as after a relocalizer's answer), in the window as a POOR frame at the
+        // fit, and the matcher started again there with its tracking gate twice (the robot moves on a frame or two
+        // before the pose reaches it).
+        refit->match.text = "re-seeded from the dead reckoning";
+        reseed_ = Reseed{f.utime, refit->match.pose, 2 * cfg_.matcher.gate_tracking_m};
+      }
       m = &refit->match;
       m_at_ref = refit->at_ref;
       fu = optimizer::frame_uncertainty(lookup_, deskewed_, m_at_ref, cfg_.uncertainty.frame);
       in.sfr = m->pose;  // (its status is the fix's; covariance and published status are the tracker's, below)
+      if (lost) in.status = matcher::FitStatus::kPoor;  // (a re-seed: in the window as the other POOR frames)
     }
     uncertainty_ = tracker_.update(f.utime, fu.covariance, fu.valid, m->status, m->text, &m->pose, &m->twist,
                                    m->fit.inlier_ratio, motion ? &*motion : nullptr,
@@ -207,6 +217,8 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
     in.status_text = uncertainty_.text;
   }
   add_map_error(f, &in.covariance);
+  // A re-seed starts a new track: the window's old one (lost, and corrected by the fixes before) does not carry over.
+  if (reseed_ && reseed_->utime == f.utime) window_.restart(finals);
   return window_.add(std::move(in), finals);
 }
 
@@ -309,11 +321,11 @@ std::optional<DeadReckoned> Localizer::dead_reckoned(const FeatureFrame& f, cons
 
 std::optional<Localizer::Refit> Localizer::refit_from_dead_reckoning(const FeatureFrame& f, const FramePose& sfr, const Pose2& fix_at_ref,
                                                                      const Eigen::Matrix3d& fix_covariance, const DeadReckoned& dr,
-                                                                     double t_ref) {
+                                                                     double t_ref, bool lost) {
   const UncertaintyConfig& u = cfg_.uncertainty;
   const double gate = chi2_3dof_of_sigmas(u.dead_reckoning_gate_sigma);
   auto off_dr = [&](const Pose2& p, const Eigen::Matrix3d& cov) { return mahalanobis2(pose_difference(p, dr.pose), dr.covariance + cov); };
-  if (!(off_dr(sfr.match.pose, fix_covariance) > gate)) return std::nullopt;  // the fix agrees with the dead reckoning
+  if (!lost && !(off_dr(sfr.match.pose, fix_covariance) > gate)) return std::nullopt;  // the fix agrees with the dead reckoning
   // The dead-reckoned pose at the de-skew reference (the fix's twist carries it there), registered from with the
   // matcher's tracking gate: the minimum nearest the odometry's track.
   const Pose2 ref_of_utime = matcher::exp_twist(sfr.match.twist, t_ref);
@@ -449,7 +461,9 @@ Localizer::Step Localizer::process(const FeatureFrame& f, std::vector<Pose>* fin
   Step s;
   s.sfr = register_frame(f);
   s.latest = optimize(f, s.sfr, finals);
-  if (s.latest && cfg_.refine_from_window) refine(s.latest->utime, s.latest->pose);
+  // (The matcher only: the published uncertainty's track goes on, as in the two-process graph.)
+  if (const auto r = take_reseed()) matcher_.set_pose(r->pose, r->search_m);
+  else if (s.latest && cfg_.refine_from_window) refine(s.latest->utime, s.latest->pose);
   return s;
 }
 

@@ -739,3 +739,52 @@ TEST(Degeneracy, FixOnALookAlikeIsRefitFromTheDeadReckonedPose) {
     else EXPECT_EQ(ok, 0);  // no refit: off, or the robot's odometry predicts the frames
   }
 }
+
+// A matcher started again at a wrong pose (a relocalizer's answer 8 m off) goes LOST and, lost, neither moves
+// with the robot nor takes the window's pose; the dead reckoning (the LiDAR odometry carried from the last OK
+// frames) goes on with the robot. With dr_reseed_when_lost the frame is registered from the dead-reckoned pose,
+// published POOR, and the matcher started again there (Localizer::process; the optimizer node's `reseed` output
+// in the graphs): the frames are published OK on the truth again after the re-acquisition's confirmation. Without
+// it the matcher stays LOST for the rest of the run (nothing else re-seeds it here: no relocalizer).
+TEST(Degeneracy, ALostMatcherIsReseededFromTheDeadReckoning) {
+  FloorPlan plan;
+  plan.elements.push_back(Element::segment({-20, 0}, {200, 0}));
+  plan.elements.push_back(Element::segment({-20, 2}, {200, 2}));
+  for (int i = 0; i < 140; ++i)
+    if (i % 3 != 0) plan.elements.push_back(Element::segment({-20 + 1.5 * i, 2}, {-20 + 1.5 * i, 1.3}));
+  auto map = make_localization_map(plan, "brute-force");
+  for (const bool reseed : {true, false}) {
+    localizer::Config cfg;
+    cfg.uncertainty.dr_reseed_when_lost = reseed;
+    localizer::Localizer loc(*map.lookup, cfg);
+    loc.set_pose({0.2, 0.8, 0}, 0.15);
+    fploc::testing::SynthOptions so = six_metre_sensor();
+    std::vector<localizer::Pose> finals;
+    int after = 0, near_ok = 0, lost = 0, false_ok = 0, reseeds = 0;
+    for (int k = 0; k < 110; ++k) {
+      const Pose2 truth{0.2 + 0.1 * k, 0.8, 0};
+      so.seed = uint32_t(k + 1);
+      if (k == 40) loc.set_pose({truth.x, truth.y + 8, 0}, 0.1);  // a wrong answer: 8 m off, beyond every wall's reach
+      const auto s = loc.process(fploc::testing::synth_frame(plan, truth, so, k * 100'000), &finals);
+      ASSERT_TRUE(s.latest);
+      const double err = std::hypot(s.latest->pose.x - truth.x, s.latest->pose.y - truth.y);
+      if (s.latest->status == FitStatus::kOk && err > 0.3) ++false_ok;
+      reseeds += s.latest->status_text == "re-seeded from the dead reckoning";
+      if (k < 60) continue;
+      ++after;
+      near_ok += s.latest->status == FitStatus::kOk && err < 0.05;
+      lost += s.sfr.match.status == FitStatus::kLost;
+    }
+    std::printf("dr_reseed_when_lost %d: %d re-seeds; of %d frames from 2 s after the wrong pose, %d OK within 5 cm of the "
+                "truth, %d LOST fixes; %d false OK\n", int(reseed), reseeds, after, near_ok, lost, false_ok);
+    EXPECT_EQ(false_ok, 0);
+    if (reseed) {
+      EXPECT_GE(reseeds, 1);
+      EXPECT_GT(near_ok, after * 9 / 10);
+      EXPECT_EQ(lost, 0);
+    } else {
+      EXPECT_EQ(reseeds, 0);
+      EXPECT_GT(lost, after * 9 / 10);  // the scenario: nothing else brings the matcher back
+    }
+  }
+}

@@ -214,10 +214,7 @@ PoseOut WindowOptimizer::add(FrameInput in, std::vector<PoseOut>* finals) {
     const double since_key_s = (t - last_key_utime_) * 1e-6;
     key = d >= cfg_.keyframe_distance_m || a >= cfg_.keyframe_angle_rad ||
           (cfg_.keyframe_interval_s > 0 && since_key_s >= cfg_.keyframe_interval_s - 1e-6);
-    if (key && since_key_s > cfg_.max_keyframe_gap_s) {
-      flush(finals);  // a long gap: the velocities across it mean nothing
-      finals_.clear();
-    }
+    if (key && since_key_s > cfg_.max_keyframe_gap_s) restart(finals);  // a long gap: the velocities across it mean nothing
   }
   PoseOut o;
   if (!key) {
@@ -412,6 +409,11 @@ void WindowOptimizer::flush(std::vector<PoseOut>* finals) {
   while (!window_.empty()) finalize_front(finals);
   const Eigen::Vector3d c = finals_.empty() ? Eigen::Vector3d::Zero() : finals_.back().correction;
   emit_pending_until(std::numeric_limits<int64_t>::max(), c, finals);
+}
+
+void WindowOptimizer::restart(std::vector<PoseOut>* finals) {
+  flush(finals);
+  finals_.clear();
 }
 
 }  // namespace fploc::optimizer

@@ -95,6 +95,19 @@ class Localizer {
   // (kNotInitialised) are skipped (nullopt). Otherwise appends the poses that became final to `finals`
   // and returns the current window estimate of this frame.
   std::optional<Pose> optimize(const FeatureFrame& f, const FramePose& sfr, std::vector<Pose>* finals);
+  // A pose the matcher should be started again at (UncertaintyConfig::dr_reseed_when_lost), once, after the
+  // optimize() that found it: the frame's utime, the pose there and the search radius for set_pose. process()
+  // applies it itself; the two-process graph sends it on FPLOC_INITIAL_POSE.
+  struct Reseed {
+    int64_t utime = 0;
+    Pose2 pose;
+    double search_m = 0;
+  };
+  std::optional<Reseed> take_reseed() {
+    auto r = reseed_;
+    reseed_.reset();
+    return r;
+  }
   // Makes every pose still in the window final (end of a sequence).
   void flush(std::vector<Pose>* finals) { window_.flush(finals); }
   // A frame's z ends a dead-reckoned stretch before a flush (optimizer::WindowOptimizer::end_z_stretch).
@@ -170,8 +183,11 @@ class Localizer {
     matcher::MatchResult match;  // pose at utime, fit, covariance (the twist the fix's)
     Pose2 at_ref;
   };
+  // (lost: the matcher is LOST, its pose is a stale prediction: the fix's gate test is skipped.)
   std::optional<Refit> refit_from_dead_reckoning(const FeatureFrame& deskewed, const FramePose& sfr, const Pose2& fix_at_ref,
-                                                 const Eigen::Matrix3d& fix_covariance, const DeadReckoned& dr, double t_ref);
+                                                 const Eigen::Matrix3d& fix_covariance, const DeadReckoned& dr, double t_ref,
+                                                 bool lost = false);
+  std::optional<Reseed> reseed_;
   // The second fit of a re-acquisition (UncertaintyConfig::rival_ratio, rival_min_gained; rival.h): searched while
   // none is known during a confirmation (or the one carried is no ambiguity any more), then carried with the fix;
   // applied to uncertainty_. Also on the OK fixes after the dead reckoning was lost in a stretch that refused a fix

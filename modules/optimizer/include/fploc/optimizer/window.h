@@ -124,6 +124,9 @@ class WindowOptimizer {
   PoseOut add(FrameInput in, std::vector<PoseOut>* finals);
   // Makes everything still in the window final (end of a sequence).
   void flush(std::vector<PoseOut>* finals);
+  // flush(), and the next frame starts a new track: nothing of the old one (its correction, its final poses as
+  // anchors) carries over (a long keyframe gap does the same; the Localizer after re-seeding a lost matcher).
+  void restart(std::vector<PoseOut>* finals);
   // The z of a frame about to come ends a dead-reckoned stretch of z (OptimizerConfig::z_stretch_ratio): the
   // optimizer node calls it when a lift ride ends on another floor, before the window is made final there.
   // (Not in add(): a held prediction's sigma grows too, but its error is no integrated bias.)
