@@ -50,8 +50,8 @@ class OptimizerNode : public fploc::rt::Node {
              fploc::rt::output<fploc::pose_t>("pose", "FPLOC_POSE"),
              fploc::rt::output<fploc::pose_t>("latest", "FPLOC_POSE_LATEST"),
              // Optional: where the matcher should start again while it is LOST and the dead-reckoned pose's fit
-             // explains the frame (localizer::UncertaintyConfig::dr_reseed_when_lost; FPLOC_INITIAL_POSE in the
-             // shipped graphs, the matcher's initial_pose input, beside the relocalizer's answers).
+             // explains the frame (localizer::UncertaintyConfig::dr_reseed_when_lost; FPLOC_RESEED in the shipped
+             // graphs, the matcher's `reseed` input).
              fploc::rt::output<fploc::pose_t>("reseed", "")}};
   }
 

@@ -168,11 +168,11 @@ struct UncertaintyConfig {
   // (Localizer::add_odometry). 0: off.
   double dr_refit_ratio = 1.15;
   // While the matcher is LOST the frame is registered from the dead-reckoned pose too (the same tracking gate and
-  // ratio, against the matcher's stale pose): an OK fit within the dead reckoning's gate is published POOR
-  // ("re-seeded from the dead reckoning") and the matcher is started again there (Localizer::take_reseed; the
-  // optimizer node's `reseed` output, FPLOC_INITIAL_POSE in the graphs). A lost matcher does not move with the
-  // robot and takes no refined pose; the relocalizer searches around the last good pose, which the robot left
-  // behind long ago after seconds of LOST frames. Off with dr_refit_ratio 0.
+  // ratio, against the matcher's stale pose): an OK fit within the dead reckoning's gate goes to the window as a POOR
+  // frame (the window restarts there; published LOST, "re-seeded from the dead reckoning") and the matcher is started
+  // again there (Localizer::take_reseed; the optimizer node's `reseed` output, FPLOC_RESEED in the graphs). A lost
+  // matcher does not move with the robot and takes no refined pose; the relocalizer searches around the last good
+  // pose, which the robot left behind long ago after seconds of LOST frames. Off with dr_refit_ratio 0.
   bool dr_reseed_when_lost = true;
 };
 

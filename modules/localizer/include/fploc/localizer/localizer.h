@@ -97,7 +97,7 @@ class Localizer {
   std::optional<Pose> optimize(const FeatureFrame& f, const FramePose& sfr, std::vector<Pose>* finals);
   // A pose the matcher should be started again at (UncertaintyConfig::dr_reseed_when_lost), once, after the
   // optimize() that found it: the frame's utime, the pose there and the search radius for set_pose. process()
-  // applies it itself; the two-process graph sends it on FPLOC_INITIAL_POSE.
+  // applies it itself; in the two-process graph the optimizer node sends it to the matcher node (FPLOC_RESEED).
   struct Reseed {
     int64_t utime = 0;
     Pose2 pose;
