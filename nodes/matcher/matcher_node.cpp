@@ -85,16 +85,23 @@ class MatcherNode : public fploc::rt::Node {
     ctx.subscribe<fploc::features_t>("features", [this](const fploc::features_t& m) { on_features(m); });
     ctx.subscribe<fploc::imu_t>("imu", [this](const fploc::imu_t& m) { on_imu(m); });
     ctx.subscribe<fploc::pose_t>("initial_pose", [this](const fploc::pose_t& m) {
-      // (A relocalizer's answer for a frame up to 2 s before the optimizer's last re-seed: stale. An operator's pose
-      // stamped otherwise, e.g. 0, is taken.)
-      if (m.utime <= reseed_utime_ && m.utime >= reseed_utime_ - 2'000'000) {
+      // (A relocalizer's answer for a frame of the LOST stretch a re-seed ended: from 2 s before the re-seeded frame to
+      // the newest frame registered when the re-seed was taken. An operator's pose stamped otherwise, e.g. 0, is taken.)
+      if (m.utime >= reseed_utime_ - 2'000'000 && m.utime <= reseed_newest_) {
         std::cerr << "[" << ctx_->name() << "] initial_pose seq " << m.seq << " for a frame the optimizer re-seeded (ignored)\n";
         return;
       }
       on_initial_pose(m, "initial_pose");
     });
     ctx.subscribe<fploc::pose_t>("reseed", [this](const fploc::pose_t& m) {
-      if (on_initial_pose(m, "reseed")) reseed_utime_ = std::max(reseed_utime_, m.utime);
+      // Only while still LOST (the optimizer runs a frame or more behind: its re-seeds of the next LOST frames, or one
+      // for a matcher a relocalizer's answer already brought back, would restart a track that holds), for a newer frame
+      // than the last re-seed, and on this floor (a lift ride may have changed it since).
+      if (last_status_ != FitStatus::kLost || m.utime <= reseed_utime_ || m.floor_index != plan_.floor()) return;
+      if (on_initial_pose(m, "reseed")) {
+        reseed_utime_ = m.utime;
+        reseed_newest_ = std::max(m.utime, last_frame_utime_);
+      }
     });
     ctx.subscribe<fploc::pose_t>("odom", [this](const fploc::pose_t& m) {
       if (const auto p = fploc::adapters::finite_pose2_of(m)) loc_->add_odometry(m.utime, *p);
@@ -259,6 +266,7 @@ class MatcherNode : public fploc::rt::Node {
     }
     if (dropped) ctx_->error("features seq " + std::to_string(m.seq) + ": " + std::to_string(dropped) + " non-finite points dropped");
     fploc::localizer::FramePose fp = loc_->register_frame(f);
+    last_frame_utime_ = f.utime;
     if (tracker_) track_floor(f, &fp);
     if (fp.match.status != FitStatus::kNotInitialised) last_pose_ = fp.match.pose, have_pose_ = true;
     fp.floor_index = plan_.floor();
@@ -294,6 +302,8 @@ class MatcherNode : public fploc::rt::Node {
   int64_t seq_ = 0;
   int64_t refined_ignored_ = 0;
   int64_t reseed_utime_ = INT64_MIN / 2;  // the newest frame the optimizer re-seeded (`reseed`)
+  int64_t reseed_newest_ = INT64_MIN / 2;  // the newest frame registered when that re-seed was taken
+  int64_t last_frame_utime_ = INT64_MIN / 2;  // the newest frame registered
   fploc::matcher::FitStatus last_status_ = fploc::matcher::FitStatus::kOk;
 };
 

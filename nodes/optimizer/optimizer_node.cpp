@@ -3,7 +3,8 @@
 // frame, in time order) and FPLOC_POSE_LATEST (the current window estimate of each frame, low latency):
 // the WO step of fploc::localizer::Localizer. A building (.pbtxt/.ifc) loads every floor; the window follows the floor
 // of the matcher's frames (frame_pose_t.floor_index): a new floor flushes the window (those poses are
-// final on the old floor) and starts one on the new floor's plan.
+// final on the old floor) and starts one on the new floor's plan. While the matcher is LOST, the frame's fit from the
+// dead-reckoned pose goes out on `reseed` (FPLOC_RESEED: the matcher starts again there).
 #include <fploc/features_t.hpp>
 #include <fploc/frame_pose_t.hpp>
 #include <fploc/imu_t.hpp>
@@ -64,6 +65,8 @@ class OptimizerNode : public fploc::rt::Node {
         float(std::max(0.0, o.plan_diff_weight())), fploc::matcher::PlanCorrection(o.plan_diff_scale(), o.plan_diff_refine()),
         o.lookup());
     cfg_ = fploc::config::localizer_config(o);
+    // Nobody to take a re-seed: none made (the window would restart on frames the matcher stays lost on).
+    if (ctx.channel("reseed").empty()) cfg_.uncertainty.dr_reseed_when_lost = false;
     loc_ = plan_.make_localizer(cfg_);
     pose_out_ = ctx.advertise<fploc::pose_t>("pose");
     latest_out_ = ctx.advertise<fploc::pose_t>("latest");

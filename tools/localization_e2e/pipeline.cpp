@@ -130,8 +130,9 @@ Result run(const FloorPlan& plan_in, const Options& o) {
     }
     r.lost_frames += m.status == matcher::FitStatus::kLost;
     t0 = clk::now();
-    // The window step, and its estimate of this frame predicts the next one (the graphs' `refined` input).
-    if (const auto latest = loc.optimize(frame, sfr, &finals)) loc.refine(latest->utime, latest->pose);
+    // The window step, and its estimate of this frame predicts the next one (the graphs' `refined` input; or the
+    // matcher is re-seeded, their `reseed`).
+    loc.feed_back(loc.optimize(frame, sfr, &finals));
     r.us_optimizer += us_since(t0);
     t0 = clk::now();
     const odometry::OdometryResult od = odo.process(frame);

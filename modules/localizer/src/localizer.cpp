@@ -461,10 +461,14 @@ Localizer::Step Localizer::process(const FeatureFrame& f, std::vector<Pose>* fin
   Step s;
   s.sfr = register_frame(f);
   s.latest = optimize(f, s.sfr, finals);
+  feed_back(s.latest);
+  return s;
+}
+
+void Localizer::feed_back(const std::optional<Pose>& latest) {
   // (The matcher only: the published uncertainty's track goes on, as in the two-process graph.)
   if (const auto r = take_reseed()) matcher_.set_pose(r->pose, r->search_m);
-  else if (s.latest && cfg_.refine_from_window) refine(s.latest->utime, s.latest->pose);
-  return s;
+  else if (latest && cfg_.refine_from_window) refine(latest->utime, latest->pose);
 }
 
 }  // namespace fploc::localizer

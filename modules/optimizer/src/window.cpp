@@ -414,6 +414,9 @@ void WindowOptimizer::flush(std::vector<PoseOut>* finals) {
 void WindowOptimizer::restart(std::vector<PoseOut>* finals) {
   flush(finals);
   finals_.clear();
+  // (The next frame's output is not interpolated from the old track's last one, and it starts the keyframes.)
+  last_final_.valid = last_latest_.valid = false;
+  have_last_key_ = false;
 }
 
 }  // namespace fploc::optimizer

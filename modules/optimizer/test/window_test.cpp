@@ -369,3 +369,44 @@ TEST(WindowOptimizer, ARideEndingOnAFloorMovesTheRidesFramesNotYetFinal) {
     }
   }
 }
+
+TEST(WindowOptimizer, ARestartedTrackIsNotInterpolatedFromTheOldOne) {
+  // After restart() (the Localizer re-seeding a lost matcher) the next frame is a new track 1 m away, 0.1 s after the
+  // last frame: its pose at utime is its own, not a blend with the old track's last output (a sweeping sensor's
+  // frames are published at utime, interpolated between the outputs at their mid-sweep times).
+  auto map = matcher::make_localization_map(room_with_pillars(), "brute-force");
+  SynthOptions so;
+  so.noise_sigma = 0.005;
+  so.sweep_s = 0.1;
+  const SeqRun run = make_run(*map.lookup, *map.plan, 21, so);
+  WindowOptimizer opt(*map.lookup, OptimizerConfig{});
+  std::vector<PoseOut> finals;
+  auto input = [&](const FeatureFrame& f, const matcher::MatchResult& r, matcher::FitStatus st) {
+    FrameInput in;
+    in.features = f;
+    in.sfr = r.pose;
+    in.twist = r.twist;
+    in.status = st;
+    return in;
+  };
+  for (int k = 0; k < 20; ++k) opt.add(input(run.frames[size_t(k)], run.sfr[size_t(k)], run.sfr[size_t(k)].status), &finals);
+  opt.restart(&finals);
+  const size_t before = finals.size();
+  EXPECT_EQ(before, 20u);  // the old track made final, once
+  matcher::MatchResult moved = run.sfr[20];
+  moved.pose.x += 1.0;  // the frame as if the robot stood 1 m on (its features too)
+  SynthOptions s20 = so;
+  s20.seed = so.seed + 20;
+  const Pose2 t20{run.truth[20].x + 1.0, run.truth[20].y, run.truth[20].yaw};
+  s20.sweep_twist = run.sfr[20].twist;
+  const FeatureFrame f20 = synth_frame(*map.plan, t20, s20, run.frames[20].utime);
+  const PoseOut latest = opt.add(input(f20, moved, matcher::FitStatus::kPoor), &finals);
+  opt.flush(&finals);
+  ASSERT_EQ(finals.size(), before + 1);
+  const double e_latest = std::hypot(latest.pose.x - moved.pose.x, latest.pose.y - moved.pose.y);
+  const double e_final = std::hypot(finals.back().pose.x - moved.pose.x, finals.back().pose.y - moved.pose.y);
+  std::printf("the first frame after a restart, 1 m from the old track: latest %.3f m, final %.3f m from its fix\n", e_latest,
+              e_final);
+  EXPECT_LT(e_latest, 0.02);
+  EXPECT_LT(e_final, 0.02);
+}

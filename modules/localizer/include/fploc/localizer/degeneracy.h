@@ -172,7 +172,9 @@ struct UncertaintyConfig {
   // frame (the window restarts there; published LOST, "re-seeded from the dead reckoning") and the matcher is started
   // again there (Localizer::take_reseed; the optimizer node's `reseed` output, FPLOC_RESEED in the graphs). A lost
   // matcher does not move with the robot and takes no refined pose; the relocalizer searches around the last good
-  // pose, which the robot left behind long ago after seconds of LOST frames. Off with dr_refit_ratio 0.
+  // pose, which the robot left behind long ago after seconds of LOST frames. Off with dr_refit_ratio 0, and where the
+  // robot's odometry predicts the frame (as the refit); the optimizer node turns it off when its `reseed` output is
+  // not connected.
   bool dr_reseed_when_lost = true;
 };
 

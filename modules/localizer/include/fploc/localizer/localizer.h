@@ -113,6 +113,9 @@ class Localizer {
   // A frame's z ends a dead-reckoned stretch before a flush (optimizer::WindowOptimizer::end_z_stretch).
   void end_z_stretch(const FeatureFrame& f) { window_.end_z_stretch(f); }
 
+  // What follows the WO step in one process (process(), tools that time the steps apart): the matcher started again at
+  // a re-seed (take_reseed) if there is one, else refined with the window's estimate of the frame (cfg.refine_from_window).
+  void feed_back(const std::optional<Pose>& latest);
   // Both steps in one process.
   struct Step {
     FramePose sfr;
