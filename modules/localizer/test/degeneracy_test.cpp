@@ -696,6 +696,25 @@ FloorPlan fins_corridor_thirds() {
   return plan;
 }
 
+// The walk of the tests on it: 110 frames at 1 m/s along y = 0.8 from x = 0.2 (6 m sensor), the Localizer started at
+// the first and, at frame 40, set at the truth plus `answer_offset` (a relocalizer's answer), with the robot's odometry
+// if `odometry`; `frame(k, truth, step, horizontal error of the window's pose)` sees each frame.
+template <class F>
+void walk_fins_corridor(localizer::Localizer& loc, const FloorPlan& plan, const Pose2& answer_offset, bool odometry, F frame) {
+  loc.set_pose({0.2, 0.8, 0}, 0.15);
+  fploc::testing::SynthOptions so = six_metre_sensor();
+  std::vector<localizer::Pose> finals;
+  for (int k = 0; k < 110; ++k) {
+    const Pose2 truth{0.2 + 0.1 * k, 0.8, 0};
+    so.seed = uint32_t(k + 1);
+    if (k == 40) loc.set_pose({truth.x + answer_offset.x, truth.y + answer_offset.y, truth.yaw + answer_offset.yaw}, 0.1);
+    if (odometry) loc.add_odometry(k * 100'000, truth);
+    const auto s = loc.process(fploc::testing::synth_frame(plan, truth, so, k * 100'000), &finals);
+    ASSERT_TRUE(s.latest);
+    frame(k, truth, s, std::hypot(s.latest->pose.x - truth.x, s.latest->pose.y - truth.y));
+  }
+}
+
 // A fix on a look-alike while the odometry holds the truth (corridor s1 shelves, thirty-fourth round): a corridor whose
 // upper wall has a 0.7 m fin every 1.5 m except every third one (plan and world alike), the matcher re-seeded one period
 // (1.5 m) on. From there it tracks inside its gate: the walls agree, and where the plan lacks a fin the twin's view puts
@@ -717,25 +736,16 @@ TEST(Degeneracy, FixOnALookAlikeIsRefitFromTheDeadReckonedPose) {
     localizer::Config cfg;
     cfg.uncertainty.dr_refit_ratio = ratio;
     localizer::Localizer loc(*map.lookup, cfg);
-    loc.set_pose({0.2, 0.8, 0}, 0.15);
-    fploc::testing::SynthOptions so = six_metre_sensor();
-    std::vector<localizer::Pose> finals;
     int after = 0, near = 0, ok = 0, on_twin = 0, false_ok = 0;
-    for (int k = 0; k < 110; ++k) {
-      const Pose2 truth{0.2 + 0.1 * k, 0.8, 0};
-      so.seed = uint32_t(k + 1);
-      if (k == 40) loc.set_pose({truth.x + 1.5, truth.y, truth.yaw}, 0.1);  // the relocalizer's answer, one period on
-      if (c.odometry) loc.add_odometry(k * 100'000, truth);
-      const auto s = loc.process(fploc::testing::synth_frame(plan, truth, so, k * 100'000), &finals);
-      ASSERT_TRUE(s.latest);
-      const double err = std::hypot(s.latest->pose.x - truth.x, s.latest->pose.y - truth.y);
+    // (the relocalizer's answer one period on)
+    walk_fins_corridor(loc, plan, {1.5, 0, 0}, c.odometry, [&](int k, const Pose2& truth, const auto& s, double err) {
       if (s.latest->status == FitStatus::kOk && err > 0.3) ++false_ok;
-      if (k < 60) continue;
+      if (k < 60) return;
       ++after;
       near += err < 0.05;
       ok += s.latest->status == FitStatus::kOk;
       on_twin += std::abs(s.sfr.match.pose.x - truth.x - 1.5) < 0.1;
-    }
+    });
     std::printf("dr_refit_ratio %.2f%s: of %d frames from 2 s after the re-seed, %d fixes on the twin, %d published within "
                 "5 cm of the truth, %d OK; %d false OK\n", ratio, c.odometry ? " with the robot's odometry" : "", after, on_twin,
                 near, ok, false_ok);
@@ -760,24 +770,16 @@ TEST(Degeneracy, ALostMatcherIsReseededFromTheDeadReckoning) {
     localizer::Config cfg;
     cfg.uncertainty.dr_reseed_when_lost = reseed;
     localizer::Localizer loc(*map.lookup, cfg);
-    loc.set_pose({0.2, 0.8, 0}, 0.15);
-    fploc::testing::SynthOptions so = six_metre_sensor();
-    std::vector<localizer::Pose> finals;
     int after = 0, near_ok = 0, lost = 0, false_ok = 0, reseeds = 0;
-    for (int k = 0; k < 110; ++k) {
-      const Pose2 truth{0.2 + 0.1 * k, 0.8, 0};
-      so.seed = uint32_t(k + 1);
-      if (k == 40) loc.set_pose({truth.x, truth.y + 8, 0}, 0.1);  // a wrong answer: 8 m off, beyond every wall's reach
-      const auto s = loc.process(fploc::testing::synth_frame(plan, truth, so, k * 100'000), &finals);
-      ASSERT_TRUE(s.latest);
-      const double err = std::hypot(s.latest->pose.x - truth.x, s.latest->pose.y - truth.y);
+    // (a wrong answer: 8 m off, beyond every wall's reach)
+    walk_fins_corridor(loc, plan, {0, 8, 0}, false, [&](int k, const Pose2&, const auto& s, double err) {
       if (s.latest->status == FitStatus::kOk && err > 0.3) ++false_ok;
       reseeds += s.latest->status_text == "re-seeded from the dead reckoning";
-      if (k < 60) continue;
+      if (k < 60) return;
       ++after;
       near_ok += s.latest->status == FitStatus::kOk && err < 0.05;
       lost += s.sfr.match.status == FitStatus::kLost;
-    }
+    });
     std::printf("dr_reseed_when_lost %d: %d re-seeds; of %d frames from 2 s after the wrong pose, %d OK within 5 cm of the "
                 "truth, %d LOST fixes; %d false OK\n", int(reseed), reseeds, after, near_ok, lost, false_ok);
     EXPECT_EQ(false_ok, 0);
