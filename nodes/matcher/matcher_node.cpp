@@ -10,8 +10,8 @@
 #include <fploc/pose_t.hpp>
 
 #include <algorithm>
-#include <climits>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <deque>
 #include <cmath>

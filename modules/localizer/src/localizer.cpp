@@ -142,6 +142,7 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
   const std::optional<Pose2> motion = have_prev_optimized_ ? odometry_between(prev_optimized_utime_, f.utime) : std::nullopt;
   prev_optimized_utime_ = f.utime;
   have_prev_optimized_ = true;
+  bool reseeded = false;  // this frame re-seeds a lost matcher (reseed_)
   optimizer::FrameInput in;
   in.features = f;
   in.sfr = sfr.match.pose;
@@ -175,6 +176,7 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
         // before the pose reaches it).
         refit->match.text = "re-seeded from the dead reckoning";
         reseed_ = Reseed{f.utime, refit->match.pose, 2 * cfg_.matcher.gate_tracking_m};
+        reseeded = true;
       }
       m = &refit->match;
       m_at_ref = refit->at_ref;
@@ -218,7 +220,7 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
   }
   add_map_error(f, &in.covariance);
   // A re-seed starts a new track: the window's old one (lost, and corrected by the fixes before) does not carry over.
-  if (reseed_ && reseed_->utime == f.utime) window_.restart(finals);
+  if (reseeded) window_.restart(finals);
   return window_.add(std::move(in), finals);
 }
 
