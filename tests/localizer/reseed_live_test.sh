@@ -10,11 +10,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/../support/netns_test.sh"
 ROOT="${FPLOC_ROOT:?}"
 require_exes fploc-sim fploc-launch fploc-node fploc-segmenter fploc-features fploc-matcher fploc-optimizer fploc-pose-logger
 "$B/fploc-sim" --scenario room-small-loop-fast --seed 5 --duration 10 --out "$T/log.lcm" --gt "$T/gt.tum" 2> "$T/sim.txt"
-read -r X Y YAW_DEG < <(python3 -c "
-import math
-r=list(map(float,open('$T/gt.tum').readline().split()))
-qx,qy,qz,qw=r[4:8]
-print(r[1],r[2],math.degrees(math.atan2(2*(qw*qz+qx*qy),1-2*(qy*qy+qz*qz))))")
+read -r X Y YAW_DEG < <(gt_start_pose "$T/gt.tum")
 PLAN="$ROOT/data/plans/room.json"
 
 run() {  # run NAME WIRED(0|1): the graph, the log played at half speed, the wrong pose sent 8 s (4 s of log) in

@@ -6,6 +6,7 @@
 #   pids  background processes to stop at exit: `cmd & pids+=($!)`
 #   require_exes NAME...   one line naming the first missing binary, then exit 1
 #   require_shared FILE    skip (exit 77, ctest's SKIP_RETURN_CODE) when ../shared/data/FILE is absent
+#   gt_start_pose GT.tum   prints "x y yaw_deg" of the TUM file's first pose (e.g. a matcher's initial pose)
 set -euo pipefail
 B="${FPLOC_BUILD_DIR:?run through ctest (fploc_add_netns_test sets FPLOC_BUILD_DIR)}/bin"
 T="$(mktemp -d)"
@@ -24,4 +25,11 @@ require_exes() {
 }
 require_shared() {
   [ -f "${FPLOC_SHARED_DIR:?}/data/$1" ] || { echo "no ../shared/data/$1: skipped"; exit 77; }
+}
+gt_start_pose() {
+  python3 -c "
+import math, sys
+r = list(map(float, open(sys.argv[1]).readline().split()))
+qx, qy, qz, qw = r[4:8]
+print(r[1], r[2], math.degrees(math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))))" "$1"
 }
