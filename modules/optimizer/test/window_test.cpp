@@ -49,16 +49,21 @@ double rms_err(const std::vector<Pose2>& est, const std::vector<Pose2>& truth) {
   return std::sqrt(s / double(est.size()));
 }
 
+// A frame and its single-frame fix as the window's input (pose, twist, status).
+FrameInput input_of(const FeatureFrame& f, const matcher::MatchResult& r) {
+  FrameInput in;
+  in.features = f;
+  in.sfr = r.pose;
+  in.twist = r.twist;
+  in.status = r.status;
+  return in;
+}
+
 std::vector<PoseOut> optimise(const matcher::NearestLookup& lookup, const SeqRun& run, OptimizerConfig cfg) {
   WindowOptimizer opt(lookup, cfg);
   std::vector<PoseOut> finals;
   for (size_t k = 0; k < run.frames.size(); ++k) {
-    FrameInput in;
-    in.features = run.frames[k];
-    in.sfr = run.sfr[k].pose;
-    in.twist = run.sfr[k].twist;
-    in.status = run.sfr[k].status;
-    const PoseOut latest = opt.add(in, &finals);
+    const PoseOut latest = opt.add(input_of(run.frames[k], run.sfr[k]), &finals);
     EXPECT_FALSE(latest.final_estimate);
     EXPECT_EQ(latest.utime, run.frames[k].utime);
   }
@@ -308,11 +313,7 @@ TEST(WindowOptimizer, PoseFarFromItsFixIsPublishedPoor) {
   WindowOptimizer opt(*map.lookup, cfg);
   std::vector<PoseOut> finals;
   for (size_t k = 0; k < run.frames.size(); ++k) {
-    FrameInput in;
-    in.features = run.frames[k];
-    in.sfr = run.sfr[k].pose;
-    in.twist = run.sfr[k].twist;
-    in.status = run.sfr[k].status;
+    FrameInput in = input_of(run.frames[k], run.sfr[k]);
     in.covariance = Eigen::Matrix3d::Identity() * 1e-6;
     if (k == 4) in.sfr.x += 0.4;  // a fix 0.4 m off its frame's points: the window stays where they fit
     const PoseOut o = opt.add(in, &finals);
@@ -381,15 +382,7 @@ TEST(WindowOptimizer, ARestartedTrackIsNotInterpolatedFromTheOldOne) {
   const SeqRun run = make_run(*map.lookup, *map.plan, 21, so);
   WindowOptimizer opt(*map.lookup, OptimizerConfig{});
   std::vector<PoseOut> finals;
-  auto input = [&](const FeatureFrame& f, const matcher::MatchResult& r, matcher::FitStatus st) {
-    FrameInput in;
-    in.features = f;
-    in.sfr = r.pose;
-    in.twist = r.twist;
-    in.status = st;
-    return in;
-  };
-  for (int k = 0; k < 20; ++k) opt.add(input(run.frames[size_t(k)], run.sfr[size_t(k)], run.sfr[size_t(k)].status), &finals);
+  for (size_t k = 0; k < 20; ++k) opt.add(input_of(run.frames[k], run.sfr[k]), &finals);
   opt.restart(&finals);
   const size_t before = finals.size();
   EXPECT_EQ(before, 20u);  // the old track made final, once
@@ -400,7 +393,8 @@ TEST(WindowOptimizer, ARestartedTrackIsNotInterpolatedFromTheOldOne) {
   const Pose2 t20{run.truth[20].x + 1.0, run.truth[20].y, run.truth[20].yaw};
   s20.sweep_twist = run.sfr[20].twist;
   const FeatureFrame f20 = synth_frame(*map.plan, t20, s20, run.frames[20].utime);
-  const PoseOut latest = opt.add(input(f20, moved, matcher::FitStatus::kPoor), &finals);
+  moved.status = matcher::FitStatus::kPoor;  // (a re-seed goes in as a POOR frame)
+  const PoseOut latest = opt.add(input_of(f20, moved), &finals);
   opt.flush(&finals);
   ASSERT_EQ(finals.size(), before + 1);
   const double e_latest = std::hypot(latest.pose.x - moved.pose.x, latest.pose.y - moved.pose.y);
