@@ -17,4 +17,15 @@ for bad in "--delta 1x" "--offset nan" "--max-dt inf" "--false-ok-m -nan" "--off
   grep -qx "fploc eval: $1 $2: not a number" "$T/err" || { cat "$T/err"; fail "$bad: error text"; }
   [ "$(grep -c . "$T/err")" = 1 ] || { cat "$T/err"; fail "$bad: more than one line"; }
 done
+# Numbers out of range, a wrong unit, a missing file option: the problem named first (then the usage), exit 2.
+check() {  # check "ARGS" "EXPECTED FIRST LINE"
+  rc=0
+  "$EVAL" $1 > "$T/out" 2> "$T/err" || rc=$?
+  [ "$rc" = 2 ] || fail "$1: exit $rc, expected 2"
+  [ "$(head -1 "$T/err")" = "$2" ] || { cat "$T/err"; fail "$1: first line"; }
+}
+check "--gt $T/gt.tum --est $T/est.tum --max-dt -1" "fploc eval: --max-dt -1: the association window must be >= 0 [s]"
+check "--gt $T/gt.tum --est $T/est.tum --delta 0" "fploc eval: --delta 0: the RPE delta must be > 0"
+check "--gt $T/gt.tum --est $T/est.tum --delta-unit x" "fploc eval: --delta-unit x: s (seconds) or f (frames)"
+check "--gt $T/gt.tum" "fploc eval: --est EST.tum is missing"
 echo OK

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "fploc/adapters/features_t.h"
@@ -26,7 +27,7 @@
 #include "fploc/eval/reference_noise.h"
 #include "fploc/eval/uncertainty.h"
 #include "fploc/floorplan/io.h"
-#include "fploc/runtime/log_coverage.h"
+#include "fploc/runtime/log_reader.h"
 
 using namespace fploc;
 
@@ -65,7 +66,7 @@ double median_of(std::vector<double> v) {
 // damaged part way): the bound of the events read, and "features_problem" says why (main exits 1).
 nlohmann::json asbuilt_bound_of(const FloorPlan& plan, const Trajectory& gt, const std::string& log_path,
                                 const std::string& channel, double sigma, double window_s, double max_dt) {
-  lcm::LogFile log(log_path, "r");
+  rt::LogReader log(log_path);
   if (!log.good()) throw std::runtime_error(log_path + ": cannot read the LCM log");
   eval::AsBuiltBoundOptions o;
   o.vertex_sigma_m = sigma;
@@ -73,10 +74,8 @@ nlohmann::json asbuilt_bound_of(const FloorPlan& plan, const Trajectory& gt, con
   std::vector<double> times;
   int64_t events = 0, frames = 0, undecoded = 0, unmatched = 0;
   std::vector<Eigen::Vector2d> pts;
-  rt::LogCoverage coverage;
-  while (const lcm::LogEvent* ev = log.readNextEvent()) {
+  while (const lcm::LogEvent* ev = log.next()) {
     ++events;
-    coverage.add(*ev);
     if (ev->channel != channel) continue;
     features_t m;
     if (m.decode(ev->data, 0, ev->datalen) < 0) {
@@ -101,7 +100,7 @@ nlohmann::json asbuilt_bound_of(const FloorPlan& plan, const Trajectory& gt, con
     bound.add_scan(Eigen::Vector3d(best->p.x(), best->p.y(), best->rpy().z()), pts);
     times.push_back(best->t);
   }
-  const std::string problem = coverage.problem(log_path);
+  const std::string problem = log.problem();
   if (frames == 0)
     throw std::runtime_error("--features " + (problem.empty() ? log_path : problem) + ": no " + channel +
                              " (features_t) events among " + std::to_string(events));
@@ -204,8 +203,17 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (gt_path.empty() || est_path.empty() || (unit != "s" && unit != "f") || !(delta > 0) || !(max_dt >= 0) ||
-      !(false_ok_m > 0)) {
+  // Each problem named on its own line, then the usage.
+  std::string wrong;
+  if (gt_path.empty()) wrong += "fploc eval: --gt GT.tum is missing\n";
+  if (est_path.empty()) wrong += "fploc eval: --est EST.tum is missing\n";
+  if (unit != "s" && unit != "f") wrong += "fploc eval: --delta-unit " + unit + ": s (seconds) or f (frames)\n";
+  auto num = [](double v) { std::ostringstream o; o << v; return o.str(); };
+  if (!(delta > 0)) wrong += "fploc eval: --delta " + num(delta) + ": the RPE delta must be > 0\n";
+  if (!(max_dt >= 0)) wrong += "fploc eval: --max-dt " + num(max_dt) + ": the association window must be >= 0 [s]\n";
+  if (!(false_ok_m > 0)) wrong += "fploc eval: --false-ok-m " + num(false_ok_m) + ": must be > 0 [m]\n";
+  if (!wrong.empty()) {
+    std::cerr << wrong;
     usage();
     return 2;
   }

@@ -26,7 +26,7 @@
 #include "fploc/floorplan/io.h"
 #include "fploc/plandiff/plan_diff.h"
 #include "fploc/runtime/graph.h"
-#include "fploc/runtime/log_coverage.h"
+#include "fploc/runtime/log_reader.h"
 
 namespace {
 
@@ -137,14 +137,12 @@ int main(int argc, char** argv) {
       if (it != given.begin() && (!best || std::abs(std::prev(it)->t - t) < std::abs(best->t - t))) best = &*std::prev(it);
       return best && std::abs(best->t - t) <= 0.005 ? best : nullptr;
     };
-    lcm::LogFile log(log_path, "r");
+    fploc::rt::LogReader log(log_path);
     if (!log.good()) throw std::runtime_error(log_path + ": cannot read the LCM log");
     std::map<int64_t, fploc::features_t> feats;
     int64_t events = 0, n_feat = 0, n_pose = 0, used = 0, bad = 0;
-    fploc::rt::LogCoverage coverage;  // a log cut short is said at the end
-    while (const lcm::LogEvent* ev = log.readNextEvent()) {
+    while (const lcm::LogEvent* ev = log.next()) {
       ++events;
-      coverage.add(*ev);
       if (ev->channel == feat_ch) {
         fploc::features_t f;
         if (f.decode(ev->data, 0, ev->datalen) < 0) {
@@ -219,7 +217,7 @@ int main(int argc, char** argv) {
     if (json) fploc::plandiff::write_json(r, plan, std::cout, all);
     // A log cut short (or damaged part way): the diff above is of the events before it; said, exit 1, as fploc
     // replay does.
-    if (const std::string problem = coverage.problem(log_path); !problem.empty()) {
+    if (const std::string problem = log.problem(); !problem.empty()) {
       std::cerr << "fploc map diff: " << problem << "; the diff is of the events read\n";
       return 1;
     }

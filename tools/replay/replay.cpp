@@ -25,7 +25,7 @@
 #include "fploc/runtime/bus.h"
 #include "fploc/runtime/compose.h"
 #include "fploc/runtime/graph.h"
-#include "fploc/runtime/log_coverage.h"
+#include "fploc/runtime/log_reader.h"
 #include "fploc/runtime/node.h"
 #include "options/tools.pb.h"
 
@@ -138,7 +138,7 @@ int main(int argc, char** argv) {
       std::cerr << "fploc replay: no node of " << graph_path << " is linked into fploc-replay\n";
       return 1;
     }
-    lcm::LogFile log(log_path, "r");
+    fploc::rt::LogReader log(log_path);
     if (!log.good()) {
       std::cerr << "fploc replay: cannot read log '" << log_path << "'\n";
       return 1;
@@ -164,9 +164,7 @@ int main(int argc, char** argv) {
     }
     std::map<std::string, int64_t> per_channel;
     const double w0 = now_s();
-    fploc::rt::LogCoverage coverage;  // a log cut short, or not a log at all (a ROS bag), is said at the end
-    while (const lcm::LogEvent* ev = log.readNextEvent()) {
-      coverage.add(*ev);
+    while (const lcm::LogEvent* ev = log.next()) {
       if (!ext.count(ev->channel)) continue;
       if (t_first < 0) t_first = ev->timestamp;
       t_last = ev->timestamp;
@@ -204,7 +202,7 @@ int main(int argc, char** argv) {
                        {"last_error", st.last_error},
                        {"detail", st.detail}});
     }
-    const int64_t events = coverage.events();
+    const int64_t events = log.events();
     std::cerr << "fploc replay: " << published << " of " << events << " log events fed in " << wall << " s (log span "
               << span << " s, real-time factor " << (wall > 0 ? span / wall : 0.0) << ")"
               << (node_errors ? ", " + std::to_string(node_errors) + " node errors" : std::string()) << "\n";
@@ -221,7 +219,7 @@ int main(int argc, char** argv) {
       if (!out.empty()) j["out"] = out;
       std::cout << j.dump() << std::endl;
     }
-    if (const std::string problem = coverage.problem(log_path); !problem.empty()) {
+    if (const std::string problem = log.problem(); !problem.empty()) {
       std::cerr << "fploc replay: " << problem << (events > 0 ? "; the events read were replayed" : "") << "\n";
       return 1;
     }
