@@ -21,4 +21,19 @@ done
   || fail "--refine-map-poses"
 grep -q '"refine"' "$T/r.json" || fail "--refine-map-poses: no map.refine in the JSON"
 [ "$(grep -vc '^#' "$T/poses.txt")" = 8 ] || fail "--map-poses-out: not 8 poses"
+# A log damaged part way (a bad record, a .gz cut short): the scans before the damage are written (log and --tum), then
+# one error naming the place, exit 1.
+{ cat "$T/a.log"; echo "FLASER 4 1.0"; cat "$T/a.log"; } > "$T/bad.log"
+if "$IMP" "$T/bad.log" --out "$T/b.lcm" --tum "$T/b.tum" 2> "$T/err"; then fail "bad record accepted"; fi
+grep -q "bad.log:17: FLASER: 3 fields, expected at least 13 for 4 readings (the 8 scans before it were written)" "$T/err" \
+  || { cat "$T/err"; fail "bad record: error text"; }
+[ "$(grep -vc '^#' "$T/b.tum")" = 8 ] && [ -s "$T/b.lcm" ] || fail "bad record: the 8 scans before it not written"
+for k in $(seq 1 40); do cat "$T/a.log"; done > "$T/long.log"
+gzip -c "$T/long.log" > "$T/long.log.gz"
+head -c $(( $(wc -c < "$T/long.log.gz") / 2 )) "$T/long.log.gz" > "$T/cut.log.gz"
+if "$IMP" "$T/cut.log.gz" --out "$T/c.lcm" --tum "$T/c.tum" 2> "$T/err"; then fail "cut .gz accepted"; fi
+grep -q "cut.log.gz: compressed data end early after .* B decompressed (file truncated?) (the .* scans before it were written)" "$T/err" \
+  || { cat "$T/err"; fail "cut .gz: error text"; }
+n=$(grep -vc '^#' "$T/c.tum")
+[ "$n" -gt 0 ] && [ "$n" -lt 320 ] && [ -s "$T/c.lcm" ] || fail "cut .gz: $n scans written"
 echo OK

@@ -110,7 +110,20 @@ int main(int argc, char** argv) {
   if (!fploc::rt::check_finite_options(app, "fploc import-carmen", std::cerr)) return 1;  // nan, inf: one error naming the option
   namespace cm = fploc::carmen;
   try {
-    const cm::Log log = cm::parse_log(cm::read_maybe_gz(in), in);
+    // A log cut short or damaged part way: what came before the damage is written as usual, then the error (exit 1).
+    std::string damage;
+    std::string text = cm::read_maybe_gz(in, &damage);
+    if (!damage.empty()) text.erase(text.rfind('\n') == std::string::npos ? 0 : text.rfind('\n') + 1);  // a cut last line
+    std::string bad_record;
+    const cm::Log log = [&] {
+      try {
+        return cm::parse_log(text, in, &bad_record);
+      } catch (const std::runtime_error&) {
+        if (!damage.empty()) throw std::runtime_error(damage);  // nothing whole before it: the damage is the error
+        throw;
+      }
+    }();
+    if (damage.empty()) damage = bad_record;
     std::string note;
     const std::vector<double> t = cm::scan_times(log, &note);
     const float no_return = cm::no_return_range(log);
@@ -269,6 +282,10 @@ int main(int argc, char** argv) {
               << "; wrote scans " << b << ".." << e
               << (note.empty() ? "" : "; " + note) << "\n";
     if (json) std::cout << j.dump(1) << "\n";
+    if (!damage.empty()) {
+      std::cerr << "fploc import-carmen: " << damage << " (the " << n << " scans before it were written)\n";
+      return 1;
+    }
   } catch (const std::exception& ex) {
     std::cerr << "fploc import-carmen: " << ex.what() << "\n";
     return 1;

@@ -46,7 +46,7 @@ struct Fields {
 
 }  // namespace
 
-std::string read_maybe_gz(const std::string& path) {
+std::string read_maybe_gz(const std::string& path, std::string* damage) {
   if (!std::filesystem::exists(path)) fail(path + ": no such file");
   gzFile f = gzopen(path.c_str(), "rb");  // reads plain files too
   if (!f) fail(path + ": cannot open");
@@ -58,7 +58,10 @@ std::string read_maybe_gz(const std::string& path) {
       int err = 0;
       const std::string msg = gzerror(f, &err);
       gzclose(f);
-      fail(path + ": byte " + std::to_string(out.size()) + " (decompressed): " + msg);
+      const std::string what = path + ": byte " + std::to_string(out.size()) + " (decompressed): " + msg;
+      if (!damage) fail(what);
+      *damage = what;
+      return out;
     }
     if (n == 0) break;
     out.append(buf, size_t(n));
@@ -69,12 +72,15 @@ std::string read_maybe_gz(const std::string& path) {
   }
   // zlib reports a stream cut short ("unexpected end of file") only here: without this a cut .log.gz read as a
   // shorter log.
-  if (const int z = gzclose(f); z != Z_OK)
-    fail(path + ": compressed data end early after " + std::to_string(out.size()) + " B decompressed (file truncated?)");
+  if (const int z = gzclose(f); z != Z_OK) {
+    const std::string what = path + ": compressed data end early after " + std::to_string(out.size()) + " B decompressed (file truncated?)";
+    if (!damage) fail(what);
+    *damage = what;
+  }
   return out;
 }
 
-Log parse_log(const std::string& text, const std::string& source) {
+Log parse_log(const std::string& text, const std::string& source, std::string* damage) {
   Log log;
   size_t line_no = 0, pos = 0;
   long last_odom = -1;  // index into log.odom
@@ -90,74 +96,80 @@ Log parse_log(const std::string& text, const std::string& source) {
     const double c = std::cos(a.theta), s = std::sin(a.theta);
     return Pose2d{a.x + c * d.x - s * d.y, a.y + s * d.x + c * d.y, std::remainder(a.theta + d.theta, 2 * M_PI)};
   };
-  while (pos < text.size()) {
-    size_t e = text.find('\n', pos);
-    if (e == std::string::npos) e = text.size();
-    const std::string_view line(text.data() + pos, e - pos);
-    pos = e + 1;
-    ++line_no;
-    const auto t = split(line);
-    if (t.empty() || t[0][0] == '#') continue;
-    const std::string type(t[0]);
-    const std::string where = source + ":" + std::to_string(line_no) + ": " + type;
-    Fields f{t, where};
-    if (type == "FLASER") {
-      const double nd = f.num(1, "num_readings");
-      if (nd < 1 || nd > 100000 || nd != std::floor(nd))
-        fail(where + ": field 1 (num_readings): expected a count in [1, 100000], got '" + std::string(t[1]) + "'");
-      const size_t n = size_t(nd);
-      if (t.size() < n + 2 + 6 + 1)
-        fail(where + ": " + std::to_string(t.size()) + " fields, expected at least " + std::to_string(n + 9) + " for " +
-             std::to_string(n) + " readings");
-      LaserRecord r;
-      r.line = line_no;
-      r.ranges.resize(n);
-      for (size_t k = 0; k < n; ++k) {
-        const double v = f.num(2 + k, "range");
-        if (v < 0) fail(where + ": field " + std::to_string(2 + k) + " (range): negative");
-        r.ranges[k] = float(v);
-      }
-      const size_t b = 2 + n;
-      r.pose = {f.num(b, "x"), f.num(b + 1, "y"), f.num(b + 2, "theta")};
-      r.odom = {f.num(b + 3, "odom_x"), f.num(b + 4, "odom_y"), f.num(b + 5, "odom_theta")};
-      r.ipc_timestamp = f.num(b + 6, "ipc_timestamp");
-      if (t.size() > b + 8) r.logger_timestamp = f.num(b + 8, "logger_timestamp");
-      if (last_odom >= 0) {
-        const Pose2d& o = log.odom[size_t(last_odom)].pose;
-        chain = have_chain && have_from ? compose(chain, between(chain_from, o)) : o;
-        have_chain = true;
-        chain_from = o;
-        have_from = true;
-        r.wheel_odom = chain;
-        r.have_wheel_odom = true;
-      }
-      log.scans.push_back(std::move(r));
-      after_flaser = true;
-      continue;
-    } else if (type == "ODOM") {
-      OdomRecord o;
-      o.line = line_no;
-      o.pose = {f.num(1, "x"), f.num(2, "y"), f.num(3, "theta")};
-      o.tv = f.num(4, "tv");
-      o.rv = f.num(5, "rv");
-      o.accel = f.num(6, "accel");
-      o.ipc_timestamp = f.num(7, "ipc_timestamp");
-      const Pose2d& fp = log.scans.empty() ? o.pose : log.scans.back().pose;
-      if (after_flaser && std::abs(o.pose.x - fp.x) < 1e-6 && std::abs(o.pose.y - fp.y) < 1e-6 &&
-          std::abs(o.pose.theta - fp.theta) < 1e-6) {
-        // Re-anchoring: the chain continues from here (the next increment is measured from this record).
-        ++log.odom_reanchors;
-        chain_from = o.pose;
-        have_from = have_chain;
-        after_flaser = false;
+  try {
+    while (pos < text.size()) {
+      size_t e = text.find('\n', pos);
+      if (e == std::string::npos) e = text.size();
+      const std::string_view line(text.data() + pos, e - pos);
+      pos = e + 1;
+      ++line_no;
+      const auto t = split(line);
+      if (t.empty() || t[0][0] == '#') continue;
+      const std::string type(t[0]);
+      const std::string where = source + ":" + std::to_string(line_no) + ": " + type;
+      Fields f{t, where};
+      if (type == "FLASER") {
+        const double nd = f.num(1, "num_readings");
+        if (nd < 1 || nd > 100000 || nd != std::floor(nd))
+          fail(where + ": field 1 (num_readings): expected a count in [1, 100000], got '" + std::string(t[1]) + "'");
+        const size_t n = size_t(nd);
+        if (t.size() < n + 2 + 6 + 1)
+          fail(where + ": " + std::to_string(t.size()) + " fields, expected at least " + std::to_string(n + 9) + " for " +
+               std::to_string(n) + " readings");
+        LaserRecord r;
+        r.line = line_no;
+        r.ranges.resize(n);
+        for (size_t k = 0; k < n; ++k) {
+          const double v = f.num(2 + k, "range");
+          if (v < 0) fail(where + ": field " + std::to_string(2 + k) + " (range): negative");
+          r.ranges[k] = float(v);
+        }
+        const size_t b = 2 + n;
+        r.pose = {f.num(b, "x"), f.num(b + 1, "y"), f.num(b + 2, "theta")};
+        r.odom = {f.num(b + 3, "odom_x"), f.num(b + 4, "odom_y"), f.num(b + 5, "odom_theta")};
+        r.ipc_timestamp = f.num(b + 6, "ipc_timestamp");
+        if (t.size() > b + 8) r.logger_timestamp = f.num(b + 8, "logger_timestamp");
+        if (last_odom >= 0) {
+          const Pose2d& o = log.odom[size_t(last_odom)].pose;
+          chain = have_chain && have_from ? compose(chain, between(chain_from, o)) : o;
+          have_chain = true;
+          chain_from = o;
+          have_from = true;
+          r.wheel_odom = chain;
+          r.have_wheel_odom = true;
+        }
+        log.scans.push_back(std::move(r));
+        after_flaser = true;
         continue;
+      } else if (type == "ODOM") {
+        OdomRecord o;
+        o.line = line_no;
+        o.pose = {f.num(1, "x"), f.num(2, "y"), f.num(3, "theta")};
+        o.tv = f.num(4, "tv");
+        o.rv = f.num(5, "rv");
+        o.accel = f.num(6, "accel");
+        o.ipc_timestamp = f.num(7, "ipc_timestamp");
+        const Pose2d& fp = log.scans.empty() ? o.pose : log.scans.back().pose;
+        if (after_flaser && std::abs(o.pose.x - fp.x) < 1e-6 && std::abs(o.pose.y - fp.y) < 1e-6 &&
+            std::abs(o.pose.theta - fp.theta) < 1e-6) {
+          // Re-anchoring: the chain continues from here (the next increment is measured from this record).
+          ++log.odom_reanchors;
+          chain_from = o.pose;
+          have_from = have_chain;
+          after_flaser = false;
+          continue;
+        }
+        log.odom.push_back(o);
+        last_odom = long(log.odom.size()) - 1;
+      } else {
+        ++log.skipped[type];
       }
-      log.odom.push_back(o);
-      last_odom = long(log.odom.size()) - 1;
-    } else {
-      ++log.skipped[type];
+      after_flaser = false;
     }
-    after_flaser = false;
+  } catch (const std::runtime_error& ex) {
+    // A bad record: without `damage` the error; with it, the records before it are the log.
+    if (!damage || log.scans.empty()) throw;
+    *damage = ex.what();
   }
   if (log.scans.empty()) fail(source + ": no FLASER records (is this a CARMEN log?)");
   return log;

@@ -54,10 +54,12 @@ struct Log {
   size_t odom_reanchors = 0;
 };
 
-// Parses a whole log (text, already decompressed).
-Log parse_log(const std::string& text, const std::string& source);
-// Reads a file; .gz is decompressed with zlib.
-std::string read_maybe_gz(const std::string& path);
+// Parses a whole log (text, already decompressed). With `damage`, a bad record ends the log there instead of
+// throwing (when records came before it): *damage says which and why, and the records before it are returned.
+Log parse_log(const std::string& text, const std::string& source, std::string* damage = nullptr);
+// Reads a file; .gz is decompressed with zlib. With `damage`, compressed data that are cut or corrupt end the text
+// there instead of throwing: *damage says where, and the text decompressed before it is returned.
+std::string read_maybe_gz(const std::string& path, std::string* damage = nullptr);
 
 // Beam geometry of a FLASER with n beams over 180 degrees: angle_i = -pi/2 + i * increment, increment
 // pi/n for even n (180: 1 degree, 360: 0.5 degree) and pi/(n-1) for odd n (181, 361: both ends included).
