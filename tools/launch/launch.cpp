@@ -101,6 +101,19 @@ class Launcher : public Effects {
   }
 
   int run(double duration) {
+    // Nodes of this graph already on the bus (a second launch of the graph in the same network, or nodes a killed
+    // launcher left running): their messages would mix with ours and `fploc node` commands would reach both. The
+    // nodes beat once a second; listen that long before starting anything.
+    for (const double t0 = now_s(); now_s() - t0 < 1.2 && foreign_.empty();) {
+      pollfd p{bus_.lcm().getFileno(), POLLIN, 0};
+      if (::poll(&p, 1, 50) > 0) bus_.lcm().handleTimeout(0);
+    }
+    if (!foreign_.empty()) {
+      log("refusing to start: " + foreign_ + " already runs on " + bus_.url() +
+          " (another launch of this graph, or its nodes left running?); stop it, or give this one another --lcm-url");
+      return 1;
+    }
+    listening_only_ = false;
     const double t_start = now_s();
     for (size_t i = 0; i < table_.size(); ++i)
       if (table_.remote(i)) masters_[table_[i].host->spec.name()];
@@ -224,6 +237,8 @@ class Launcher : public Effects {
   void log(const std::string& line) override { log_line(line); }
 
  private:
+  bool listening_only_ = true;  // run() has not started the nodes yet
+  std::string foreign_;          // a node of this graph seen running elsewhere before that
   // One `ssh -M -N` per host in use, restarted a second after it ends (link cut, host reboot).
   void tend_masters(bool stopping) {
     if (stopping) return;
@@ -314,6 +329,11 @@ class Launcher : public Effects {
   }
 
   void on_telemetry(const lcm::ReceiveBuffer*, const std::string&, const fploc::node_status_t* m) {
+    if (listening_only_) {  // before our own nodes start: any report of one of them comes from elsewhere
+      if (foreign_.empty() && sup_.find(m->node) && m->state != "stopped" && m->state != "dead")
+        foreign_ = "node '" + m->node + "' (pid " + std::to_string(m->pid) + (m->host.empty() ? "" : " on " + m->host) + ")";
+      return;
+    }
     sup_.on_transport_ok();  // our own "starting" reports come back too when the LCM URL works here
     if (m->reporter == "launcher") return;
     // A remote node reports its pid on its host; the supervisor knows the local ssh process.
@@ -373,7 +393,7 @@ void usage() {
   std::cerr << "usage: fploc launch GRAPH.pbtxt [--check [--skip-hosts]] [--duration SECONDS] [--lcm-url URL] [--set NODE.field=value ...]\n"
                "  --check      validate the graph (fields, executables, ports, channel types, option values, the files options\n"
                "               name) and its hosts (reachable with ssh, fploc there at this commit, multicast route),\n"
-               "               then exit\n"
+               "               then exit (a launch checks the same, except the hosts, and refuses to start on an error)\n"
                "  --skip-hosts with --check: do not contact the graph's hosts\n"
                "  --duration   stop every node cleanly after SECONDS\n"
                "  --set        override one option of one node for this run (e.g. --set pose_logger.file=run1.tum)\n";
@@ -421,8 +441,10 @@ int main(int argc, char** argv) {
   std::vector<ResolvedNode> resolved;
   if (g.tree) validate_graph(g, hooks, errors, &resolved);
   url = graph_lcm_url(g.graph, url);
-  if (check && g.tree) check_option_files(g, errors);
-  if (check && g.tree) check_option_values(g, errors);
+  // The files the options name and the values the nodes would refuse: checked before anything starts, by `--check`
+  // and by a launch alike (a launch with a missing plan ran every other node while the matcher died five times).
+  if (g.tree) check_option_files(g, errors);
+  if (g.tree) check_option_values(g, errors);
   if (check && !skip_hosts && g.tree && errors.empty() && g.graph.host_size() > 0) {
     std::vector<HostPlan> plans;
     for (const auto& [name, p] : host_plans(g.graph, self_bin_dir())) plans.push_back(*p);
@@ -434,6 +456,13 @@ int main(int argc, char** argv) {
     }
     for (const auto& p : check_hosts(g.graph, plans, host_exe, url))
       errors.push_back({graph_path, 0, "host '" + p.host + "': " + p.message});
+  }
+  if (g.tree && errors.empty()) {
+    int enabled = 0;
+    for (const auto& n : g.graph.node()) enabled += !n.disabled();
+    if (enabled == 0)
+      errors.push_back({graph_path, 0, g.graph.node_size() == 0 ? "no node: the graph declares none (an empty or wrong file?)"
+                                                              : "no node to run: every node is disabled"});
   }
   if (!check && url.rfind("memq://", 0) == 0)
     errors.push_back({graph_path, 0, "lcm_url memq:// only works inside one process (use fploc replay)"});

@@ -139,7 +139,10 @@ void Supervisor::advance_shutdown(double t) {
 
 void Supervisor::kill_all() {
   for (size_t i = 0; i < nodes_.size(); ++i)
-    if (nodes_[i].pid > 0) fx_.signal(i, nodes_[i].pid, SIGKILL);
+    if (nodes_[i].pid > 0) {
+      fx_.signal(i, nodes_[i].pid, SIGKILL);
+      killed_.push_back(nodes_[i].policy.name);
+    }
 }
 
 void Supervisor::begin_stop(size_t i, bool restart_after, double t) {
@@ -167,6 +170,7 @@ void Supervisor::escalate(size_t i, double t) {
   } else if (n.stop_stage == 1) {
     fx_.log("node '" + n.policy.name + "' ignores SIGTERM: SIGKILL");
     fx_.signal(i, n.pid, SIGKILL);
+    killed_.push_back(n.policy.name);
     n.stop_stage = 2;
     n.stop_deadline = t + 1e9;
   }
@@ -243,6 +247,7 @@ bool Supervisor::on_exit(pid_t pid, const ExitStatus& st, double t) {
     if (!d.restart && !d.give_up) {
       fx_.log("node '" + n.policy.name + "' " + how + (failed ? " (restart policy: not restarted)" : ""));
       n.state = failed ? State::Dead : State::Stopped;
+      if (failed) died_.push_back(n.policy.name);
       publish(i, failed ? "dead" : "stopped", how);
     } else {
       apply_restart(i, d, (n.hung ? "hung, " : "") + how, t);
@@ -258,6 +263,7 @@ void Supervisor::apply_restart(size_t i, const fploc::rt::RestartDecision& d, co
     fx_.log("node '" + n.policy.name + "' " + why + ": " + std::to_string(d.max_restarts) + " restarts within " +
             fmt2(d.window_s) + " s already, giving up (dead)");
     n.state = State::Dead;
+    died_.push_back(n.policy.name);
     publish(i, "dead", why + "; too many restarts");
     return;
   }
@@ -312,9 +318,17 @@ std::optional<int> Supervisor::finished() {
     return dead ? 1 : 0;
   }
   if (shutting_down_ && std::all_of(nodes_.begin(), nodes_.end(), [](const Run& n) { return n.pid <= 0; })) {
-    fx_.log("all nodes stopped");
+    auto names = [](const std::vector<std::string>& v) {
+      std::string s;
+      for (const auto& n : v) s += (s.empty() ? "'" : ", '") + n + "'";
+      return s;
+    };
+    std::string how;
+    if (!died_.empty()) how += "; dead during the run: " + names(died_);
+    if (!killed_.empty()) how += "; killed: " + names(killed_);
+    fx_.log("all nodes stopped" + how + (how.empty() ? "" : " (exit code 1)"));
     for (size_t i = 0; i < nodes_.size(); ++i) publish(i, "stopped", "");
-    return 0;
+    return how.empty() ? 0 : 1;
   }
   return std::nullopt;
 }

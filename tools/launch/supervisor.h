@@ -91,7 +91,8 @@ class Supervisor {
   void tick(double t);
 
   // ---- outputs
-  // The launcher's exit code once it should exit (all finished, or shutdown complete), else nothing.
+  // The launcher's exit code once it should exit (all finished, or shutdown complete), else nothing: 1 when a node
+  // ended dead (given up on) during the run or had to be killed at the shutdown, else 0.
   std::optional<int> finished();
   bool shutting_down() const { return shutting_down_; }
   size_t size() const { return nodes_.size(); }
@@ -128,6 +129,9 @@ class Supervisor {
   void publish(size_t i, const std::string& state, const std::string& error);
 
   std::vector<Run> nodes_;
+  // What makes the launcher's exit code 1 after a shutdown: nodes given up on (dead) during the run, and nodes that
+  // had to be killed (SIGKILL: they ignored SIGINT and SIGTERM, or a second Ctrl-C) -- a script must notice both.
+  std::vector<std::string> died_, killed_;
   SupervisorConfig cfg_;
   Effects& fx_;
   bool transport_ok_ = false, transport_warned_ = false;

@@ -35,4 +35,13 @@ check_file 's#window: 10 alpha#window: -3 alpha#'
 line="$(grep -n 'window: -3' "$T/g.pbtxt" | cut -d: -f1)"
 echo "$out" | grep -qxF "$T/g.pbtxt:$line: node 'optimizer': optimizer.window: must be > 0 (0 = the default), got -3" ||
   fail "optimizer window -3: no error at line $line"
+# A graph without a node to run (an empty file, comments only, every node disabled): one error, exit 1.
+printf '# nothing here\n' > "$T/empty.pbtxt"
+out="$(timeout 60 "$L" --check --skip-hosts "$T/empty.pbtxt" 2>&1)"; rc=$?
+[ "$rc" = 1 ] || fail "empty graph: exit $rc, expected 1"
+echo "$out" | grep -qxF "$T/empty.pbtxt: no node: the graph declares none (an empty or wrong file?)" || fail "empty graph: error text"
+sed -e "s#\"\.\./data/#\"$R/data/#g" "$R/graphs/demo.pbtxt" | awk '/^node \{$/ {print; print "  disabled: true"; next} {print}' > "$T/off.pbtxt"
+out="$(timeout 60 "$L" --check --skip-hosts "$T/off.pbtxt" 2>&1)"; rc=$?
+[ "$rc" = 1 ] || fail "all nodes disabled: exit $rc, expected 1"
+echo "$out" | grep -qF "no node to run: every node is disabled" || fail "all nodes disabled: error text"
 echo OK

@@ -235,7 +235,9 @@ TEST(Supervisor, ShutdownStopsProducersBeforeConsumers) {
   s.tick(13.0);
   EXPECT_EQ(w.signals_to(1), (std::vector<int>{SIGINT, SIGTERM, SIGKILL}));
   s.on_exit(p_mid, killed(SIGKILL), 13.01);
-  EXPECT_EQ(s.finished(), std::optional<int>(0));
+  // A node had to be killed: the launcher exits 1 (it exited 0, and a script could not tell).
+  EXPECT_EQ(s.finished(), std::optional<int>(1));
+  EXPECT_EQ(w.logs.back(), "all nodes stopped; killed: 'matcher' (exit code 1)");
   // Nothing restarts during a shutdown.
   s.tick(20);
   EXPECT_EQ(w.starts.size(), 3u);
@@ -356,4 +358,36 @@ TEST(Supervisor, RemoteNodeGraceCountsFromTheNodesStartNotTheSessions) {
   EXPECT_EQ(s.state(1), State::Stopping);
   ASSERT_FALSE(w.logs.empty());
   EXPECT_NE(w.logs.back().find("ssh session did not start the node"), std::string::npos) << w.logs.back();
+}
+
+TEST(Supervisor, ANodeDeadDuringTheRunMakesTheShutdownsExitCodeOne) {
+  FakeWorld w;
+  auto a = node("a"), b = node("b");
+  a.restart.set_max_restarts(1);
+  a.restart.set_window_s(10);
+  a.restart.set_backoff_initial_s(0.1);
+  Supervisor s({a, b}, {}, w);
+  s.start_all(0);
+  s.on_exit(s.pid(0), code(1), 0.5);
+  s.tick(0.7);
+  ASSERT_EQ(s.state(0), State::Running);
+  s.on_exit(s.pid(0), code(1), 0.8);
+  ASSERT_EQ(s.state(0), State::Dead);
+  EXPECT_FALSE(s.finished());  // b still runs
+  s.begin_shutdown(5);
+  s.on_exit(s.pid(1), code(0), 5.1);
+  EXPECT_EQ(s.finished(), std::optional<int>(1));
+  EXPECT_EQ(w.logs.back(), "all nodes stopped; dead during the run: 'a' (exit code 1)");
+}
+
+TEST(Supervisor, ACleanShutdownExitsZero) {
+  FakeWorld w;
+  Supervisor s({node("a"), node("b")}, {}, w);
+  s.start_all(0);
+  s.begin_shutdown(5);
+  s.tick(5.3);
+  s.on_exit(s.pid(0), code(0), 5.4);
+  s.on_exit(s.pid(1), code(0), 5.4);
+  EXPECT_EQ(s.finished(), std::optional<int>(0));
+  EXPECT_EQ(w.logs.back(), "all nodes stopped");
 }
