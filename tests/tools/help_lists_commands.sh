@@ -34,4 +34,11 @@ for b in bad:
     print("FAIL:", b)
 sys.exit(1 if bad else 0)
 PY
+# A command of two words without its second (`fploc bench`, `fploc bench --help`) lists the second words; `fploc map
+# --help` names `diff` (its own program). Both said "unknown command" / left diff out.
+out="$(FPLOC_SKIP_SETUP=1 "$R/bin/fploc" bench --help 2>&1)" || { echo "FAIL: fploc bench --help: exit $?: $out"; exit 1; }
+echo "$out" | grep -q "^usage: fploc bench <.*paper.*realism.*>" || { echo "FAIL: fploc bench --help: $out"; exit 1; }
+out="$(FPLOC_SKIP_SETUP=1 "$R/bin/fploc" bench nosuch 2>&1)" && { echo "FAIL: fploc bench nosuch: exit 0"; exit 1; }
+echo "$out" | grep -q "unknown command 'bench nosuch' (fploc bench: one of .*paper" || { echo "FAIL: fploc bench nosuch: $out"; exit 1; }
+"$B/fploc-map" --help | grep -q "diff (plan changes seen in a recorded run" || { echo "FAIL: fploc map --help does not name diff"; exit 1; }
 echo OK
