@@ -44,6 +44,9 @@ localizer::FramePose from_msg(const frame_pose_t& m) {
     f.match.twist = {m.twist[0], m.twist[1], m.twist[2]};
   f.match.status = m.status >= 0 && m.status <= 3 ? matcher::FitStatus(m.status) : matcher::FitStatus::kLost;
   f.match.text = m.status_text;
+  // to_msg writes "STATUS: text": the text without its status (else the optimizer's log said "POOR: POOR: ...").
+  const std::string prefix = std::string(to_string(f.match.status)) + ": ";
+  if (f.match.text.compare(0, prefix.size(), prefix) == 0) f.match.text.erase(0, prefix.size());
   for (int i = 0; i < 9; ++i) f.match.covariance(i / 3, i % 3) = m.covariance[i];
   f.match.fit.num_points = m.num_points;
   f.match.fit.num_inliers = m.num_inliers;

@@ -25,6 +25,7 @@ TEST(FramePoseAdapter, RoundTripAndSanitising) {
   EXPECT_EQ(m.status_text, "POOR: few inliers");
   localizer::FramePose g = adapters::from_msg(m);
   EXPECT_EQ(g.match.status, matcher::FitStatus::kPoor);
+  EXPECT_EQ(g.match.text, "few inliers");  // the status prefix the wire text carries is not kept twice
   EXPECT_EQ(g.match.pose.yaw, 0.3);
   EXPECT_EQ(g.match.twist.vx, 0.5);
   EXPECT_EQ(g.z, 1.3);
