@@ -45,7 +45,7 @@ bool LogReader::next_fits() {
       fits = false;
     } else if (data_len < 0 || uint64_t(channel_len) + uint64_t(data_len) > left) {
       damaged_ = where + "its data length " + std::to_string(data_len) + " runs past the end of the file (" +
-                 std::to_string(size_) + " B)" + before;
+                 std::to_string(size_) + " B: truncated, or the length damaged)" + before;
       fits = false;
     }
   }

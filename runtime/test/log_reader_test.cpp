@@ -89,7 +89,7 @@ TEST(LogReader, ADamagedDataLengthEndsTheReadingWithItsOffset) {
   fploc::rt::LogReader r(p);
   EXPECT_EQ(read_all(r), (std::vector<int>{10}));
   EXPECT_EQ(r.problem(), p + ": event 2 at byte " + std::to_string(kEvent1) + ": its data length 2147483647 runs past the end of the file (" +
-                             std::to_string(b.size()) + " B); the 1 events before it were read");
+                             std::to_string(b.size()) + " B: truncated, or the length damaged); the 1 events before it were read");
   put_be32(b, kEvent1 + 24, 0x80000000u);  // negative
   const std::string q = write("datalen_neg.lcm", b);
   fploc::rt::LogReader s(q);

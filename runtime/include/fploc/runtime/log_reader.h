@@ -23,7 +23,7 @@ class LogReader {
   int64_t events() const { return events_; }
   // Empty when the events read are the whole file (or its size cannot be read); else why not, starting with the path:
   // "P: no LCM event in its N B (not an LCM event log; ...)", "P: event K at byte O: its data length L runs past the
-  // end of the file (N B); the K - 1 events before it were read", or "P: K events are B of its N B; the rest is not
+  // end of the file (N B: truncated, or the length damaged); the K - 1 events before it were read", or "P: K events are B of its N B; the rest is not
   // an LCM event (truncated or damaged?)".
   std::string problem() const;
 
