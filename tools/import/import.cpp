@@ -74,6 +74,11 @@ std::string sanitize(const std::string& topic) {
 
 double seconds(int64_t ns) { return double(ns) * 1e-9; }
 
+// The summary as text: topic names, types and error messages come from the recording and may hold bytes
+// that are not UTF-8 (a damaged file); nlohmann's dump() threw (type_error 316, an abort) on them. Each bad
+// byte becomes U+FFFD instead.
+std::string dump_json(const nlohmann::json& j) { return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace); }
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -162,7 +167,7 @@ int main(int argc, char** argv) {
                               if (c.topic == t) return std::string(kind_of(c) == Kind::kNone ? "" : "yes");
                             return std::string();
                           }()}};
-      std::cout << j.dump(2) << "\n";
+      std::cout << dump_json(j) << "\n";
     } else {
       std::printf("%s: %s, %llu messages, %.3f s", path.c_str(), rec->format().c_str(), (unsigned long long)total, dur);
       if (total) std::printf(" (from %.3f)", seconds(first));
@@ -508,7 +513,7 @@ int main(int argc, char** argv) {
                         {"collisions", s.collisions}, {"max_azimuth_error_deg", s.max_azimuth_error_deg}};
     j["errors"] = problems;
     for (const auto& [t, n] : decode_errors) j["not_decoded"][t] = {{"count", n}, {"first", first_decode_error[t]}};
-    std::cout << j.dump(2) << "\n";
+    std::cout << dump_json(j) << "\n";
   } else {
     std::printf("%s (%s): %llu messages read in %.2f s\n", path.c_str(), rec->format().c_str(), (unsigned long long)read_msgs, wall);
     for (const auto& [ch, n] : written) std::printf("  %-28s %8llu\n", ch.c_str(), (unsigned long long)n);
