@@ -41,9 +41,27 @@ jcheck comp_out "j['written'] == {'OS1_IMU': 2} and len(j['errors']) == 1"
 BAG="$SHARED/ouster/512x10_raw.bag"
 if [ -f "$BAG" ]; then
   # The metadata JSON with one byte flipped (0x84, not UTF-8).
-  flip "$BAG" "$T/o_md.bag" 13294 0x84
+  flip "$BAG" "$T/o_md.bag" 13293 0x84
   run o_md 1 "$T/o_md.bag" --out "$T/o_md.lcm" --json
   jcheck o_md "j['written']['OS1_IMU_PACKETS'] == 10"
+  # 4. It is one error saying the topic is there but does not parse (it also said "no metadata topic"), and the
+  # lidar packets are written as they are (they were all dropped).
+  jcheck o_md "j['written']['OS1_LIDAR_PACKETS'] == 32 and len(j['errors']) == 1"
+  grep -q "^fploc import: /os_node0/metadata: the metadata topic is there but its JSON (10432 B) does not parse at byte 1 (0x84), the message at chunk at byte 4109, record at chunk offset 9085; 32 Ouster lidar packets written as they are, without metadata: give --metadata FILE" "$T/o_md.err" ||
+    fail "o_md: no single line naming the topic, the byte and what to do"
+  [ "$(grep -c . "$T/o_md.err")" = 1 ] || { fail "o_md: not one error line"; cat "$T/o_md.err"; }
+  run o_md_decode 1 "$T/o_md.bag" --decode --out "$T/o_mdd.lcm" --quiet
+  grep -q "does not parse at byte 1 (0x84).*; 32 Ouster lidar packets could not be decoded: give --metadata FILE" "$T/o_md_decode.err" ||
+    fail "o_md --decode: $(cat "$T/o_md_decode.err")"
+  [ "$(grep -c . "$T/o_md_decode.err")" = 1 ] || { fail "o_md --decode: not one error line"; cat "$T/o_md_decode.err"; }
+  # 5. An IMU packet whose length field says 4 B: skipped and reported on its topic (exit 3), not written as a lidar packet.
+  flip "$BAG" "$T/o_imu.bag" 23771 0x04
+  run o_imu 3 "$T/o_imu.bag" --out "$T/o_imu.lcm" --json
+  jcheck o_imu "j['written']['OS1_LIDAR_PACKETS'] == 32 and j['written']['OS1_IMU_PACKETS'] == 9 and j['not_decoded']['/os_node0/imu_packets']['count'] == 1"
+  grep -q "^fploc import: /os_node0/imu_packets: 1 message not decoded, skipped (the first at .*: IMU packet of 4 B (an IMU packet has 48))" "$T/o_imu.err" ||
+    fail "o_imu: $(cat "$T/o_imu.err")"
+  run o_imu_decode 3 "$T/o_imu.bag" --decode --out "$T/o_imud.lcm" --json
+  jcheck o_imu_decode "j['written']['OS1_IMU'] == 9 and j['ouster']['lidar_packets'] == 32"
 else
   echo "no $BAG (../shared/data absent): the Ouster bag cases are skipped"
 fi

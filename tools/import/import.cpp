@@ -74,6 +74,23 @@ std::string sanitize(const std::string& topic) {
 
 double seconds(int64_t ns) { return double(ns) * 1e-9; }
 
+// Why a metadata topic's text is unusable: where its JSON stops parsing, or (valid JSON) what the OS-1 parser said.
+std::string metadata_problem(const std::string& text, const std::string& err) {
+  try {
+    (void)nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    char b[8] = "";
+    if (e.byte >= 1 && e.byte <= text.size()) std::snprintf(b, sizeof b, "0x%02x", unsigned(uint8_t(text[e.byte - 1])));
+    return "its JSON (" + std::to_string(text.size()) + " B) does not parse at byte " + std::to_string(e.byte) + (*b ? std::string(" (") + b + ")" : "");
+  } catch (const std::exception&) {
+  }
+  return "its JSON is not usable sensor metadata";
+}
+
+bool ends_with(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
 // The summary as text: topic names, types and error messages come from the recording and may hold bytes
 // that are not UTF-8 (a damaged file); nlohmann's dump() threw (type_error 316, an abort) on them. Each bad
 // byte becomes U+FFFD instead.
@@ -90,7 +107,7 @@ int main(int argc, char** argv) {
   CloudOptions cloud_opt;
   app.add_option("recording", path, "ROS 1 bag (.bag) or MCAP (.mcap) file")->required();
   app.footer("Exit status: 0 everything imported; 1 the file is damaged or cut short, or Ouster lidar packets could not be\n"
-             "written (the log holds everything before the damage); 2 bad arguments; 3 single messages did not decode\n"
+             "written or have no usable metadata (the log holds everything before the damage); 2 bad arguments; 3 single messages did not decode\n"
              "and were skipped (the log holds all the others; stderr names each topic, the count and where the first is).");
   app.add_flag("--list", list, "print topics, types, message counts and the duration; write nothing");
   app.add_flag("--json", json, "machine-readable summary on stdout");
@@ -290,6 +307,7 @@ int main(int argc, char** argv) {
     if (!decode_errors[c.topic]++) first_decode_error[c.topic] = where(m) + ": " + e;
   };
 
+  std::string metadata_failed, metadata_why;  // the first metadata topic whose JSON was unusable, and why
   bool odom_chosen = !odom_topic.empty();
   Scan cloud_scan;
   std::vector<uint8_t> cloud_header;  // point_cloud2_t up to its data; the points follow from the recording
@@ -317,7 +335,11 @@ int main(int argc, char** argv) {
       case Kind::kOusterMetadata: {
         std::string text;
         if (!decode_string(m.data, m.size, c.encoding, text, &err)) { bad(c, err); break; }
-        if (!(decode_ouster ? ouster.set_metadata(text, c.topic, &err) : raw.metadata(text, c.topic, m.time_ns, &err))) bad(c, err);
+        if (!(decode_ouster ? ouster.set_metadata(text, c.topic, &err) : raw.metadata(text, c.topic, m.time_ns, &err))) {
+          bad(c, err);
+          if (metadata_failed.empty()) metadata_failed = c.topic, metadata_why = metadata_problem(text, err) + ", the message at " + where(m);
+          if (!decode_ouster) raw.without_metadata();  // the lidar packets are kept, as they are
+        }
         ++written["(metadata " + c.topic + ")"];
         break;
       }
@@ -325,9 +347,22 @@ int main(int argc, char** argv) {
         const uint8_t* buf = nullptr;
         size_t n = 0;
         if (!decode_bytes(m.data, m.size, c.encoding, &buf, &n, &err)) { bad(c, err); break; }
+        // The topic says what a packet is (a damaged IMU packet is not a lidar packet because of its size); a
+        // topic named otherwise: its size.
+        const auto route = ends_with(c.topic, "imu_packets")     ? OusterRawWriter::Route::kImu
+                           : ends_with(c.topic, "lidar_packets") ? OusterRawWriter::Route::kLidar
+                                                                 : OusterRawWriter::Route::kBySize;
+        if (route == OusterRawWriter::Route::kImu && n != os1::kImuPacketSize) {
+          bad(c, "IMU packet of " + std::to_string(n) + " B (an IMU packet has " + std::to_string(os1::kImuPacketSize) + ")");
+          break;
+        }
         if (!decode_ouster) {
           if (!raw.has_metadata() && !metadata_text.empty()) raw.metadata(metadata_text, metadata_file, m.time_ns, &err);
-          raw.packet(buf, n, m.time_ns, rec->stable(buf, n));
+          raw.packet(buf, n, m.time_ns, rec->stable(buf, n), route);
+          break;
+        }
+        if (route == OusterRawWriter::Route::kLidar && n == os1::kImuPacketSize) {  // the decoder would take it for IMU
+          bad(c, "lidar packet of " + std::to_string(n) + " B (the size of an IMU packet)");
           break;
         }
         os1::ImuSample s;
@@ -444,16 +479,26 @@ int main(int argc, char** argv) {
   if (!log_ok) problems.push_back(out + ": writing failed (disk full?); the log is cut short");
   if (!rec->error().empty()) problems.push_back(rec->error() + " (the output holds everything before it)");
   // Messages that did not decode are skipped, the others written: exit 3 (the log is complete but for them).
+  // Lidar packets without metadata because the metadata topic's JSON is unusable: one line for both (below).
+  const uint64_t lidar_without = decode_ouster ? ouster.lidar_packets : raw.lidar_packets;
+  const bool metadata_broken = !metadata_failed.empty() && lidar_without > 0 && !(decode_ouster ? ouster.has_metadata() : raw.has_metadata());
   for (const auto& [t, n] : decode_errors)
-    problems.push_back(t + ": " + std::to_string(n) + " message" + (n > 1 ? "s" : "") + " not decoded, skipped (the first at " +
+    if (!(metadata_broken && t == metadata_failed))
+      problems.push_back(t + ": " + std::to_string(n) + " message" + (n > 1 ? "s" : "") + " not decoded, skipped (the first at " +
                        first_decode_error[t] + ")");
   // Lidar packets that could not be written (no metadata to decode them, or too many before it): the log lacks
   // the lidar, so the import failed (exit 1), as for a damaged file.
   const bool lidar_lost = (ouster.lidar_packets > 0 && !ouster.has_metadata()) ||
                           (raw.lidar_packets > 0 && !raw.has_metadata()) || raw.waiting_dropped > 0;
-  if (ouster.lidar_packets > 0 && !ouster.has_metadata())
+  if (metadata_broken)
+    problems.push_back(metadata_failed + ": the metadata topic is there but " + metadata_why + "; " + std::to_string(lidar_without) +
+                       " Ouster lidar packets " +
+                       (decode_ouster ? "could not be decoded: give --metadata FILE"
+                                      : "written as they are, without metadata: give --metadata FILE (to import again, or "
+                                        "--set os1_driver.metadata=FILE on replay)"));
+  else if (ouster.lidar_packets > 0 && !ouster.has_metadata())
     problems.push_back(std::to_string(ouster.lidar_packets) + " Ouster lidar packets without metadata (no metadata topic; give --metadata FILE)");
-  if (raw.lidar_packets > 0 && !raw.has_metadata())
+  else if (raw.lidar_packets > 0 && !raw.has_metadata())
     problems.push_back(std::to_string(raw.lidar_packets) + " Ouster lidar packets without metadata (no metadata topic; give --metadata FILE)");
   if (raw.waiting_dropped)
     problems.push_back(std::to_string(raw.waiting_dropped) + " Ouster lidar packets before the metadata dropped (more than 20000 waited)");
@@ -461,6 +506,7 @@ int main(int argc, char** argv) {
     problems.push_back(std::to_string(raw.other_size) + " Ouster lidar packets not of the metadata's size " + std::to_string(raw.lidar_size()) +
                        " B (written as they are; the driver will report them)");
   if (raw.imu_packets) written[raw.imu_channel] = raw.imu_packets;  // IMU packets need no metadata
+  if (raw.written_without_metadata) written[raw.lidar_channel] = raw.written_without_metadata;
   if (raw.lidar_packets && raw.has_metadata()) {
     written[raw.lidar_channel] = raw.lidar_packets - raw.waiting_dropped;
     written[raw.metadata_channel] = 1;
