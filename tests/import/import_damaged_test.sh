@@ -38,6 +38,33 @@ jcheck comp_list "j['topics']['/imu']['count'] == 2 and 'unsupported compression
 run comp_out 1 "$T/comp.mcap" --out "$T/comp.lcm" --json
 jcheck comp_out "j['written'] == {'OS1_IMU': 2} and len(j['errors']) == 1"
 
+# 3. Options that match nothing: an error naming what is missing and listing what is there, exit 2, nothing written
+# (they gave an empty or partial log, exit 0).
+L="$T/laser.bag"
+run no_topic 2 "$L" --topics /nonexistent --out "$T/nt.lcm"
+grep -q "^fploc import: no topic '/nonexistent' in the recording; its topics:" "$T/no_topic.err" && grep -q "^  /scan_front  sensor_msgs/LaserScan" "$T/no_topic.err" ||
+  fail "no_topic: $(cat "$T/no_topic.err")"
+[ ! -e "$T/nt.lcm" ] || fail "no_topic: a log was written"
+run late_start 2 "$L" --start 100 --out "$T/ls.lcm"
+grep -q "^fploc import: --start 100 s is past the recording's end: its messages span 0 to 4.000 s after the first" "$T/late_start.err" ||
+  fail "late_start: $(cat "$T/late_start.err")"
+[ ! -e "$T/ls.lcm" ] || fail "late_start: a log was written"
+run typo_channel 2 "$L" --channel /scan_bakc=LASER_SCAN --out "$T/tc.lcm"
+grep -q "^fploc import: no topic '/scan_bakc' in the recording" "$T/typo_channel.err" || fail "typo_channel: $(cat "$T/typo_channel.err")"
+run no_frame 2 "$L" --tum-out "$T/nf.tum" --tf-parent odm --tf-child laser
+grep -q "^fploc import: no tf frame 'odm' in the recording's tf messages; its frames: base_link, laser, odom$" "$T/no_frame.err" ||
+  fail "no_frame: $(cat "$T/no_frame.err")"
+[ ! -e "$T/nf.tum" ] || fail "no_frame: a TUM file was written"
+run no_odom 2 "$L" --tum-out "$T/no.tum" --odom-topic /odometry
+# The same options naming what is there still work.
+run good 0 "$L" --topics /scan_back,/tf --channel /scan_back=LASER_SCAN --start 1 --tum-out "$T/g.tum" --tf-parent /odom --tf-child laser --out "$T/g.lcm" --json
+jcheck good "j['written'] == {'LASER_SCAN': 4, '(tf /tf)': 4}"
+# 6. --list says /tf is imported only when it is (--tum-out with frames), as the import's "not imported" does.
+run list_tf 0 "$L" --list
+grep -q "^  /tf .*tf2_msgs/TFMessage  (to TUM with --tum-out F --tf-parent P --tf-child C)$" "$T/list_tf.out" || fail "list_tf: $(cat "$T/list_tf.out")"
+run list_tf_json 0 "$L" --list --json
+jcheck list_tf_json "j['topics']['/tf']['imported_as'] == '' and j['topics']['/scan_back']['imported_as'] == 'yes'"
+
 BAG="$SHARED/ouster/512x10_raw.bag"
 if [ -f "$BAG" ]; then
   # The metadata JSON with one byte flipped (0x84, not UTF-8).

@@ -158,6 +158,10 @@ int main(int argc, char** argv) {
     return 1;
   }
 
+  // tf goes to the TUM file only (--tum-out with --tf-parent/--tf-child); otherwise the import says "not imported".
+  const bool tf_imported = !tum_out.empty() && !tf_parent.empty();
+  auto imported = [&](Kind k) { return k == Kind::kTf ? tf_imported : k != Kind::kNone; };
+  static const char* kTfNote = "to TUM with --tum-out F --tf-parent P --tf-child C";
   if (list) {
     const auto t0 = std::chrono::steady_clock::now();
     const auto topics_seen = summarize(*rec);
@@ -178,12 +182,13 @@ int main(int argc, char** argv) {
       j["duration_s"] = dur;
       j["start_s"] = total ? seconds(first) : 0.0;
       j["error"] = rec->error();
-      for (const auto& [t, s] : topics_seen)
-        j["topics"][t] = {{"type", s.type}, {"count", s.count}, {"imported_as", [&] {
-                            for (const auto& [id, c] : rec->connections())
-                              if (c.topic == t) return std::string(kind_of(c) == Kind::kNone ? "" : "yes");
-                            return std::string();
-                          }()}};
+      for (const auto& [t, s] : topics_seen) {
+        Kind k = Kind::kNone;
+        for (const auto& [id, c] : rec->connections())
+          if (c.topic == t) k = kind_of(c);
+        j["topics"][t] = {{"type", s.type}, {"count", s.count}, {"imported_as", imported(k) ? "yes" : ""}};
+        if (k == Kind::kTf && !imported(k)) j["topics"][t]["note"] = kTfNote;
+      }
       std::cout << dump_json(j) << "\n";
     } else {
       std::printf("%s: %s, %llu messages, %.3f s", path.c_str(), rec->format().c_str(), (unsigned long long)total, dur);
@@ -195,8 +200,9 @@ int main(int argc, char** argv) {
         Connection c;
         for (const auto& [id, cc] : rec->connections())
           if (cc.topic == t) c = cc;
+        const Kind k = kind_of(c);
         std::printf("  %-*s %8llu  %s%s\n", int(w), t.c_str(), (unsigned long long)s.count, s.type.c_str(),
-                    kind_of(c) == Kind::kNone ? "" : "  (imported)");
+                    imported(k) ? "  (imported)" : k == Kind::kTf ? (std::string("  (") + kTfNote + ")").c_str() : "");
       }
     }
     (void)t0;
@@ -245,6 +251,74 @@ int main(int argc, char** argv) {
     topic_channel[c.topic] = ch;
     return channel_of[c.id] = ch;
   };
+
+  // Options that name something in the recording (topics, tf frames, a start time) are checked before anything is
+  // written: a name that matches nothing gave an empty or partial log and exit 0. A first pass reads until every
+  // name has been seen (usually the first chunk; to the end only when one is wrong, to list the real ones).
+  {
+    std::set<std::string> named(topics.begin(), topics.end());
+    for (const auto& [t, ch] : channel_override) named.insert(t);
+    if (!odom_topic.empty()) named.insert(odom_topic);
+    const bool frames_wanted = !tum_out.empty() && !tf_parent.empty();
+    const bool start_wanted = start_opt->count() > 0;
+    if (!named.empty() || frames_wanted || start_wanted) {
+      auto pre = open_recording(path, &err);
+      if (!pre) {
+        std::cerr << "fploc import: " << err << "\n";
+        return 1;
+      }
+      auto bare = [](const std::string& f) { return f.rfind('/', 0) == 0 ? f.substr(1) : f; };  // tf: leading '/' ignored
+      std::set<std::string> frames;
+      std::map<std::string, std::string> types;  // topic -> type
+      int64_t first = INT64_MIN, last = INT64_MIN;
+      bool start_seen = false;
+      std::vector<Transform> ts;
+      auto done = [&] {
+        for (const auto& t : named)
+          if (!types.count(t)) return false;
+        if (frames_wanted && !(frames.count(bare(tf_parent)) && frames.count(bare(tf_child)))) return false;
+        return !start_wanted || start_seen;
+      };
+      RawMessage pm;
+      while (!done() && pre->next(pm)) {
+        if (first == INT64_MIN) first = pm.time_ns;
+        last = std::max(last, pm.time_ns);
+        if (start_wanted && seconds(pm.time_ns) - seconds(first) >= start) start_seen = true;
+        for (const auto& [id, c] : pre->connections()) types.emplace(c.topic, c.type);
+        const Connection& c = pre->connections().at(pm.conn);
+        if (frames_wanted && kind_of(c) == Kind::kTf && decode_tf(pm.data, pm.size, c.encoding, ts, &err))
+          for (const auto& t : ts) frames.insert(bare(t.header.frame_id)), frames.insert(bare(t.child_frame_id));
+      }
+      for (const auto& [id, c] : pre->connections()) types.emplace(c.topic, c.type);
+      std::vector<std::string> problems;
+      for (const auto& t : named)
+        if (!types.count(t)) problems.push_back("no topic '" + t + "' in the recording");
+      if (!problems.empty()) {
+        std::string list;
+        for (const auto& [t, ty] : types) list += "\n  " + t + "  " + ty;
+        problems.back() += "; its topics:" + (list.empty() ? std::string(" none") : list);
+      }
+      if (frames_wanted)
+        for (const auto& f : {tf_parent, tf_child})
+          if (!frames.count(bare(f))) {
+            std::string list;
+            for (const auto& x : frames) list += (list.empty() ? "" : ", ") + x;
+            problems.push_back("no tf frame '" + f + "' in the recording's tf messages; its frames: " + (list.empty() ? "none" : list));
+          }
+      if (start_wanted && !start_seen) {
+        char b[160];
+        std::snprintf(b, sizeof b, "--start %g s is past the recording's end: its messages span 0 to %.3f s after the first", start,
+                      first == INT64_MIN ? 0.0 : seconds(last) - seconds(first));
+        problems.push_back(b);
+      }
+      if (!problems.empty()) {
+        for (const auto& p : problems) std::cerr << "fploc import: " << p << "\n";
+        if (!pre->error().empty()) std::cerr << "fploc import: (read up to the damage: " << pre->error() << ")\n";
+        std::cerr << "fploc import: nothing written\n";
+        return 2;
+      }
+    }
+  }
 
   LcmLog lcm_log;
   if (!out.empty() && !lcm_log.open(out, direct_io)) {
