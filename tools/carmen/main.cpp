@@ -281,7 +281,7 @@ int main(int argc, char** argv) {
               << (log.odom_reanchors ? " (+" + std::to_string(log.odom_reanchors) + " re-anchorings at scans: increments measured from them)" : "")
               << "; wrote scans " << b << ".." << e
               << (note.empty() ? "" : "; " + note) << "\n";
-    if (json) std::cout << j.dump(1) << "\n";
+    if (json) std::cout << j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";  // file names: any bytes
     if (!damage.empty()) {
       std::cerr << "fploc import-carmen: " << damage << " (the " << n << " scans before it were written)\n";
       return 1;

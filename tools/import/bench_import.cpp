@@ -398,6 +398,6 @@ int main(int argc, char** argv) {
     if (keep.empty()) fs::remove(bag), fs::remove(chunks);
   }
   if (keep.empty()) fs::remove_all(dir);
-  if (json) std::cout << out.dump(2) << "\n";
+  if (json) std::cout << out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";  // paths: any bytes
   return 0;
 }

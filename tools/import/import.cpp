@@ -74,6 +74,28 @@ std::string sanitize(const std::string& topic) {
 
 double seconds(int64_t ns) { return double(ns) * 1e-9; }
 
+// Why a metadata topic's text is unusable: where its JSON stops parsing, or (valid JSON) what the OS-1 parser said.
+std::string metadata_problem(const std::string& text, const std::string& err) {
+  try {
+    (void)nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    char b[8] = "";
+    if (e.byte >= 1 && e.byte <= text.size()) std::snprintf(b, sizeof b, "0x%02x", unsigned(uint8_t(text[e.byte - 1])));
+    return "its JSON (" + std::to_string(text.size()) + " B) does not parse at byte " + std::to_string(e.byte) + (*b ? std::string(" (") + b + ")" : "");
+  } catch (const std::exception&) {
+  }
+  return "its JSON is not usable sensor metadata";
+}
+
+bool ends_with(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+// The summary as text: topic names, types and error messages come from the recording and may hold bytes
+// that are not UTF-8 (a damaged file); nlohmann's dump() threw (type_error 316, an abort) on them. Each bad
+// byte becomes U+FFFD instead.
+std::string dump_json(const nlohmann::json& j) { return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace); }
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -85,7 +107,7 @@ int main(int argc, char** argv) {
   CloudOptions cloud_opt;
   app.add_option("recording", path, "ROS 1 bag (.bag) or MCAP (.mcap) file")->required();
   app.footer("Exit status: 0 everything imported; 1 the file is damaged or cut short, or Ouster lidar packets could not be\n"
-             "written (the log holds everything before the damage); 2 bad arguments; 3 single messages did not decode\n"
+             "written or have no usable metadata (the log holds everything before the damage); 2 bad arguments; 3 single messages did not decode\n"
              "and were skipped (the log holds all the others; stderr names each topic, the count and where the first is).");
   app.add_flag("--list", list, "print topics, types, message counts and the duration; write nothing");
   app.add_flag("--json", json, "machine-readable summary on stdout");
@@ -136,6 +158,10 @@ int main(int argc, char** argv) {
     return 1;
   }
 
+  // tf goes to the TUM file only (--tum-out with --tf-parent/--tf-child); otherwise the import says "not imported".
+  const bool tf_imported = !tum_out.empty() && !tf_parent.empty();
+  auto imported = [&](Kind k) { return k == Kind::kTf ? tf_imported : k != Kind::kNone; };
+  static const char* kTfNote = "to TUM with --tum-out F --tf-parent P --tf-child C";
   if (list) {
     const auto t0 = std::chrono::steady_clock::now();
     const auto topics_seen = summarize(*rec);
@@ -156,13 +182,14 @@ int main(int argc, char** argv) {
       j["duration_s"] = dur;
       j["start_s"] = total ? seconds(first) : 0.0;
       j["error"] = rec->error();
-      for (const auto& [t, s] : topics_seen)
-        j["topics"][t] = {{"type", s.type}, {"count", s.count}, {"imported_as", [&] {
-                            for (const auto& [id, c] : rec->connections())
-                              if (c.topic == t) return std::string(kind_of(c) == Kind::kNone ? "" : "yes");
-                            return std::string();
-                          }()}};
-      std::cout << j.dump(2) << "\n";
+      for (const auto& [t, s] : topics_seen) {
+        Kind k = Kind::kNone;
+        for (const auto& [id, c] : rec->connections())
+          if (c.topic == t) k = kind_of(c);
+        j["topics"][t] = {{"type", s.type}, {"count", s.count}, {"imported_as", imported(k) ? "yes" : ""}};
+        if (k == Kind::kTf && !imported(k)) j["topics"][t]["note"] = kTfNote;
+      }
+      std::cout << dump_json(j) << "\n";
     } else {
       std::printf("%s: %s, %llu messages, %.3f s", path.c_str(), rec->format().c_str(), (unsigned long long)total, dur);
       if (total) std::printf(" (from %.3f)", seconds(first));
@@ -173,8 +200,9 @@ int main(int argc, char** argv) {
         Connection c;
         for (const auto& [id, cc] : rec->connections())
           if (cc.topic == t) c = cc;
+        const Kind k = kind_of(c);
         std::printf("  %-*s %8llu  %s%s\n", int(w), t.c_str(), (unsigned long long)s.count, s.type.c_str(),
-                    kind_of(c) == Kind::kNone ? "" : "  (imported)");
+                    imported(k) ? "  (imported)" : k == Kind::kTf ? (std::string("  (") + kTfNote + ")").c_str() : "");
       }
     }
     (void)t0;
@@ -223,6 +251,74 @@ int main(int argc, char** argv) {
     topic_channel[c.topic] = ch;
     return channel_of[c.id] = ch;
   };
+
+  // Options that name something in the recording (topics, tf frames, a start time) are checked before anything is
+  // written: a name that matches nothing gave an empty or partial log and exit 0. A first pass reads until every
+  // name has been seen (usually the first chunk; to the end only when one is wrong, to list the real ones).
+  {
+    std::set<std::string> named(topics.begin(), topics.end());
+    for (const auto& [t, ch] : channel_override) named.insert(t);
+    if (!odom_topic.empty()) named.insert(odom_topic);
+    const bool frames_wanted = !tum_out.empty() && !tf_parent.empty();
+    const bool start_wanted = start_opt->count() > 0;
+    if (!named.empty() || frames_wanted || start_wanted) {
+      auto pre = open_recording(path, &err);
+      if (!pre) {
+        std::cerr << "fploc import: " << err << "\n";
+        return 1;
+      }
+      auto bare = [](const std::string& f) { return f.rfind('/', 0) == 0 ? f.substr(1) : f; };  // tf: leading '/' ignored
+      std::set<std::string> frames;
+      std::map<std::string, std::string> types;  // topic -> type
+      int64_t first = INT64_MIN, last = INT64_MIN;
+      bool start_seen = false;
+      std::vector<Transform> ts;
+      auto done = [&] {
+        for (const auto& t : named)
+          if (!types.count(t)) return false;
+        if (frames_wanted && !(frames.count(bare(tf_parent)) && frames.count(bare(tf_child)))) return false;
+        return !start_wanted || start_seen;
+      };
+      RawMessage pm;
+      while (!done() && pre->next(pm)) {
+        if (first == INT64_MIN) first = pm.time_ns;
+        last = std::max(last, pm.time_ns);
+        if (start_wanted && seconds(pm.time_ns) - seconds(first) >= start) start_seen = true;
+        for (const auto& [id, c] : pre->connections()) types.emplace(c.topic, c.type);
+        const Connection& c = pre->connections().at(pm.conn);
+        if (frames_wanted && kind_of(c) == Kind::kTf && decode_tf(pm.data, pm.size, c.encoding, ts, &err))
+          for (const auto& t : ts) frames.insert(bare(t.header.frame_id)), frames.insert(bare(t.child_frame_id));
+      }
+      for (const auto& [id, c] : pre->connections()) types.emplace(c.topic, c.type);
+      std::vector<std::string> problems;
+      for (const auto& t : named)
+        if (!types.count(t)) problems.push_back("no topic '" + t + "' in the recording");
+      if (!problems.empty()) {
+        std::string list;
+        for (const auto& [t, ty] : types) list += "\n  " + t + "  " + ty;
+        problems.back() += "; its topics:" + (list.empty() ? std::string(" none") : list);
+      }
+      if (frames_wanted)
+        for (const auto& f : {tf_parent, tf_child})
+          if (!frames.count(bare(f))) {
+            std::string list;
+            for (const auto& x : frames) list += (list.empty() ? "" : ", ") + x;
+            problems.push_back("no tf frame '" + f + "' in the recording's tf messages; its frames: " + (list.empty() ? "none" : list));
+          }
+      if (start_wanted && !start_seen) {
+        char b[160];
+        std::snprintf(b, sizeof b, "--start %g s is past the recording's end: its messages span 0 to %.3f s after the first", start,
+                      first == INT64_MIN ? 0.0 : seconds(last) - seconds(first));
+        problems.push_back(b);
+      }
+      if (!problems.empty()) {
+        for (const auto& p : problems) std::cerr << "fploc import: " << p << "\n";
+        if (!pre->error().empty()) std::cerr << "fploc import: (read up to the damage: " << pre->error() << ")\n";
+        std::cerr << "fploc import: nothing written\n";
+        return 2;
+      }
+    }
+  }
 
   LcmLog lcm_log;
   if (!out.empty() && !lcm_log.open(out, direct_io)) {
@@ -285,6 +381,7 @@ int main(int argc, char** argv) {
     if (!decode_errors[c.topic]++) first_decode_error[c.topic] = where(m) + ": " + e;
   };
 
+  std::string metadata_failed, metadata_why;  // the first metadata topic whose JSON was unusable, and why
   bool odom_chosen = !odom_topic.empty();
   Scan cloud_scan;
   std::vector<uint8_t> cloud_header;  // point_cloud2_t up to its data; the points follow from the recording
@@ -312,7 +409,11 @@ int main(int argc, char** argv) {
       case Kind::kOusterMetadata: {
         std::string text;
         if (!decode_string(m.data, m.size, c.encoding, text, &err)) { bad(c, err); break; }
-        if (!(decode_ouster ? ouster.set_metadata(text, c.topic, &err) : raw.metadata(text, c.topic, m.time_ns, &err))) bad(c, err);
+        if (!(decode_ouster ? ouster.set_metadata(text, c.topic, &err) : raw.metadata(text, c.topic, m.time_ns, &err))) {
+          bad(c, err);
+          if (metadata_failed.empty()) metadata_failed = c.topic, metadata_why = metadata_problem(text, err) + ", the message at " + where(m);
+          if (!decode_ouster) raw.without_metadata();  // the lidar packets are kept, as they are
+        }
         ++written["(metadata " + c.topic + ")"];
         break;
       }
@@ -320,9 +421,22 @@ int main(int argc, char** argv) {
         const uint8_t* buf = nullptr;
         size_t n = 0;
         if (!decode_bytes(m.data, m.size, c.encoding, &buf, &n, &err)) { bad(c, err); break; }
+        // The topic says what a packet is (a damaged IMU packet is not a lidar packet because of its size); a
+        // topic named otherwise: its size.
+        const auto route = ends_with(c.topic, "imu_packets")     ? OusterRawWriter::Route::kImu
+                           : ends_with(c.topic, "lidar_packets") ? OusterRawWriter::Route::kLidar
+                                                                 : OusterRawWriter::Route::kBySize;
+        if (route == OusterRawWriter::Route::kImu && n != os1::kImuPacketSize) {
+          bad(c, "IMU packet of " + std::to_string(n) + " B (an IMU packet has " + std::to_string(os1::kImuPacketSize) + ")");
+          break;
+        }
         if (!decode_ouster) {
           if (!raw.has_metadata() && !metadata_text.empty()) raw.metadata(metadata_text, metadata_file, m.time_ns, &err);
-          raw.packet(buf, n, m.time_ns, rec->stable(buf, n));
+          raw.packet(buf, n, m.time_ns, rec->stable(buf, n), route);
+          break;
+        }
+        if (route == OusterRawWriter::Route::kLidar && n == os1::kImuPacketSize) {  // the decoder would take it for IMU
+          bad(c, "lidar packet of " + std::to_string(n) + " B (the size of an IMU packet)");
           break;
         }
         os1::ImuSample s;
@@ -439,16 +553,26 @@ int main(int argc, char** argv) {
   if (!log_ok) problems.push_back(out + ": writing failed (disk full?); the log is cut short");
   if (!rec->error().empty()) problems.push_back(rec->error() + " (the output holds everything before it)");
   // Messages that did not decode are skipped, the others written: exit 3 (the log is complete but for them).
+  // Lidar packets without metadata because the metadata topic's JSON is unusable: one line for both (below).
+  const uint64_t lidar_without = decode_ouster ? ouster.lidar_packets : raw.lidar_packets;
+  const bool metadata_broken = !metadata_failed.empty() && lidar_without > 0 && !(decode_ouster ? ouster.has_metadata() : raw.has_metadata());
   for (const auto& [t, n] : decode_errors)
-    problems.push_back(t + ": " + std::to_string(n) + " message" + (n > 1 ? "s" : "") + " not decoded, skipped (the first at " +
+    if (!(metadata_broken && t == metadata_failed))
+      problems.push_back(t + ": " + std::to_string(n) + " message" + (n > 1 ? "s" : "") + " not decoded, skipped (the first at " +
                        first_decode_error[t] + ")");
   // Lidar packets that could not be written (no metadata to decode them, or too many before it): the log lacks
   // the lidar, so the import failed (exit 1), as for a damaged file.
   const bool lidar_lost = (ouster.lidar_packets > 0 && !ouster.has_metadata()) ||
                           (raw.lidar_packets > 0 && !raw.has_metadata()) || raw.waiting_dropped > 0;
-  if (ouster.lidar_packets > 0 && !ouster.has_metadata())
+  if (metadata_broken)
+    problems.push_back(metadata_failed + ": the metadata topic is there but " + metadata_why + "; " + std::to_string(lidar_without) +
+                       " Ouster lidar packets " +
+                       (decode_ouster ? "could not be decoded: give --metadata FILE"
+                                      : "written as they are, without metadata: give --metadata FILE (to import again, or "
+                                        "--set os1_driver.metadata=FILE on replay)"));
+  else if (ouster.lidar_packets > 0 && !ouster.has_metadata())
     problems.push_back(std::to_string(ouster.lidar_packets) + " Ouster lidar packets without metadata (no metadata topic; give --metadata FILE)");
-  if (raw.lidar_packets > 0 && !raw.has_metadata())
+  else if (raw.lidar_packets > 0 && !raw.has_metadata())
     problems.push_back(std::to_string(raw.lidar_packets) + " Ouster lidar packets without metadata (no metadata topic; give --metadata FILE)");
   if (raw.waiting_dropped)
     problems.push_back(std::to_string(raw.waiting_dropped) + " Ouster lidar packets before the metadata dropped (more than 20000 waited)");
@@ -456,6 +580,7 @@ int main(int argc, char** argv) {
     problems.push_back(std::to_string(raw.other_size) + " Ouster lidar packets not of the metadata's size " + std::to_string(raw.lidar_size()) +
                        " B (written as they are; the driver will report them)");
   if (raw.imu_packets) written[raw.imu_channel] = raw.imu_packets;  // IMU packets need no metadata
+  if (raw.written_without_metadata) written[raw.lidar_channel] = raw.written_without_metadata;
   if (raw.lidar_packets && raw.has_metadata()) {
     written[raw.lidar_channel] = raw.lidar_packets - raw.waiting_dropped;
     written[raw.metadata_channel] = 1;
@@ -508,7 +633,7 @@ int main(int argc, char** argv) {
                         {"collisions", s.collisions}, {"max_azimuth_error_deg", s.max_azimuth_error_deg}};
     j["errors"] = problems;
     for (const auto& [t, n] : decode_errors) j["not_decoded"][t] = {{"count", n}, {"first", first_decode_error[t]}};
-    std::cout << j.dump(2) << "\n";
+    std::cout << dump_json(j) << "\n";
   } else {
     std::printf("%s (%s): %llu messages read in %.2f s\n", path.c_str(), rec->format().c_str(), (unsigned long long)read_msgs, wall);
     for (const auto& [ch, n] : written) std::printf("  %-28s %8llu\n", ch.c_str(), (unsigned long long)n);

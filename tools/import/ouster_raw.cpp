@@ -43,13 +43,18 @@ bool OusterRawWriter::metadata(const std::string& json, const std::string& sourc
   return true;
 }
 
-void OusterRawWriter::packet(const uint8_t* d, size_t n, int64_t time_ns, bool stable) {
-  if (n == os1::kImuPacketSize) {
+void OusterRawWriter::packet(const uint8_t* d, size_t n, int64_t time_ns, bool stable, Route route) {
+  if (route == Route::kImu || (route == Route::kBySize && n == os1::kImuPacketSize)) {
     ++imu_packets;
     write(imu_channel, time_ns, d, n, stable);
     return;
   }
   ++lidar_packets;
+  if (!lidar_size_ && without_metadata_) {
+    ++written_without_metadata;
+    write(lidar_channel, time_ns, d, n, stable);
+    return;
+  }
   if (!lidar_size_) {
     if (waiting_.size() < kMaxWaiting) waiting_.push_back({time_ns, std::vector<uint8_t>(d, d + n)});
     else ++waiting_dropped;
@@ -58,6 +63,14 @@ void OusterRawWriter::packet(const uint8_t* d, size_t n, int64_t time_ns, bool s
   if (n == lidar_size_ + 1) n = lidar_size_;  // ouster_ros 0.x: buf is one byte longer than the packet
   if (n != lidar_size_) ++other_size;         // written as it is: the driver reports it, as it would live
   write(lidar_channel, time_ns, d, n, stable);
+}
+
+void OusterRawWriter::without_metadata() {
+  if (lidar_size_ || without_metadata_) return;
+  without_metadata_ = true;
+  auto waiting = std::move(waiting_);
+  waiting_.clear();
+  for (auto& [t, p] : waiting) packet(p.data(), p.size(), t), --lidar_packets;  // counted when they came
 }
 
 void OusterRawWriter::write(const std::string& ch, int64_t time_ns, const uint8_t* d, size_t n, bool stable) {

@@ -42,16 +42,22 @@ const Field* find(const std::vector<Field>& fs, std::string_view name) {
   return nullptr;
 }
 
-// One record at base[pos]; advances pos.
-bool read_record(const uint8_t* base, size_t n, size_t& pos, Record& r, std::string* why) {
-  if (n - pos < 4) return *why = "header length cut off (file truncated?)", false;
+// One record at base[pos]; advances pos. `end`: what base[n] is the end of ("the chunk", "the file"); *cut: set
+// when the record fails only because it runs past that end (a length past it, or cut off by it).
+bool read_record(const uint8_t* base, size_t n, size_t& pos, Record& r, std::string* why, const char* end = "the chunk",
+                 bool* cut = nullptr) {
+  if (cut) *cut = true;
+  if (n - pos < 4) return *why = std::string("header length cut off by the end of ") + end, false;
   const uint32_t hl = rd<uint32_t>(base + pos);
-  if (hl > n - pos - 4) return *why = "header of " + std::to_string(hl) + " B runs past the end (file truncated?)", false;
+  if (hl > n - pos - 4) return *why = "header of " + std::to_string(hl) + " B runs past the end of " + end, false;
+  if (cut) *cut = false;
   if (!parse_fields(base + pos + 4, hl, r.fields, why)) return false;
+  if (cut) *cut = true;
   const size_t dpos = pos + 4 + hl;
-  if (n - dpos < 4) return *why = "data length cut off (file truncated?)", false;
+  if (n - dpos < 4) return *why = std::string("data length cut off by the end of ") + end, false;
   const uint32_t dl = rd<uint32_t>(base + dpos);
-  if (dl > n - dpos - 4) return *why = "data of " + std::to_string(dl) + " B runs past the end (file truncated?)", false;
+  if (dl > n - dpos - 4) return *why = "data of " + std::to_string(dl) + " B runs past the end of " + end, false;
+  if (cut) *cut = false;
   const Field* op = find(r.fields, "op");
   if (!op || op->n != 1) return *why = "record without a one-byte 'op' field", false;
   r.op = op->v[0];
@@ -65,7 +71,7 @@ bool read_record(const uint8_t* base, size_t n, size_t& pos, Record& r, std::str
 // (f.seq()): each part is read once the length before it has been checked against the end of the file,
 // so a bad length fails the same check, with the same message, without reading further. *p: the
 // record's first byte (valid until the next seq()).
-bool read_file_record(FileBytes& f, size_t at, size_t& pos, Record& r, const uint8_t** p, std::string* why) {
+bool read_file_record(FileBytes& f, size_t at, size_t& pos, Record& r, const uint8_t** p, std::string* why, bool* cut) {
   const size_t rem = f.size() - at;
   size_t need = std::min<size_t>(rem, 4);
   if (!(*p = f.seq(at, need))) return *why = f.read_error(), false;
@@ -80,7 +86,7 @@ bool read_file_record(FileBytes& f, size_t at, size_t& pos, Record& r, const uin
   }
   if (!(*p = f.seq(at, need))) return *why = f.read_error(), false;
   size_t end = 0;
-  if (!read_record(*p, rem, end, r, why)) return false;
+  if (!read_record(*p, rem, end, r, why, "the file", cut)) return false;
   pos = at + end;
   return true;
 }
@@ -98,7 +104,7 @@ std::string text(const Field* f) { return f ? std::string(reinterpret_cast<const
 // message or connection record outside chunks, a bad record or the end: none).
 bool next_compressed_chunk(const uint8_t* base, size_t n, size_t pos, size_t& at, Record& r) {
   std::string why;
-  for (int k = 0; k < 256 && pos < n; ++k) {
+  for (int k = 0; k < 256 && pos < n; ++k) {  // (a record cut by the end of the file: none)
     at = pos;
     if (!read_record(base, n, pos, r, &why)) return false;
     if (r.op == 0x05) {
@@ -123,6 +129,46 @@ void BagReader::prefetch_after(size_t pos) {
   ahead_.start({at, text(find(r.fields, "compression")), r.data, r.data_len, usize, false});
 }
 
+std::string BagReader::cut_cause(size_t at) const {
+  if (index_pos_ > size_)
+    return "file truncated: the bag header puts its index at byte " + std::to_string(index_pos_);
+  if (index_pos_ > at)  // the index is in the file, after this record: the file is not short, the length is wrong
+    return "the file is not short (its index at byte " + std::to_string(index_pos_) + " is in it): the length is damaged";
+  return "file truncated?";
+}
+
+// The record at `at` runs past the end of the file (why): the error, with the file's size and what that
+// means; or, for an uncompressed chunk, "" after setting it up as the chunk being read: its records up to the
+// cut are whole and are read first (then cut_error_).
+std::string BagReader::cut_record(size_t at, const std::string& why) {
+  const size_t rem = size_ - at;
+  const std::string size = "(file size " + std::to_string(size_) + " B; " + cut_cause(at) + ")";
+  const std::string plain = "record at byte " + std::to_string(at) + ": " + why + " " + size;
+  const uint8_t* p = rem >= 8 ? f_->seq(at, rem) : nullptr;
+  if (!p) return plain;
+  const uint32_t hl = rd<uint32_t>(p);
+  Record& r = rec_;
+  std::string w;
+  if (hl > rem - 8 || !parse_fields(p + 4, hl, r.fields, &w)) return plain;
+  const Field* op = find(r.fields, "op");
+  const Field* c = find(r.fields, "compression");
+  if (!op || op->n != 1 || op->v[0] != 0x05 || !c) return plain;
+  const std::string method = text(c);
+  const uint32_t dl = rd<uint32_t>(p + 4 + hl);
+  const std::string what = "record at byte " + std::to_string(at) + ": chunk (" + escaped(method) + ") of " + std::to_string(dl) +
+                           " B runs past the end of the file " + size;
+  if (method != "none") return what + ": a cut compressed chunk cannot be decompressed, its messages are lost";
+  cut_error_ = what;
+  cd_ = p + 8 + hl;
+  cn_ = rem - 8 - hl;
+  cpos_ = 0;
+  chunk_at_ = at;
+  top_level_ = false;
+  chunk_what_ = "chunk at byte " + std::to_string(at) + " (none)";
+  pos_ = size_;
+  return "";
+}
+
 BagReader::BagReader(std::unique_ptr<FileBytes> f, std::string name) : FileReader(std::move(f), std::move(name), "bag 2.0") {
   if (size_ < kMagicLen || std::memcmp(f_->data(), kMagic, kMagicLen) != 0) {
     stop("not a ROS bag 2.0 (no '#ROSBAG V2.0' magic)");
@@ -137,8 +183,11 @@ bool BagReader::next(RawMessage& m) {
   while (!done_) {
     if (in_chunk()) {
       const size_t at = cpos_;
-      if (!read_record(cd_, cn_, cpos_, r, &why))
+      bool cut = false;
+      if (!read_record(cd_, cn_, cpos_, r, &why, "the chunk", &cut)) {
+        if (cut && !cut_error_.empty()) return stop(cut_error_);  // the record the end of the file cut in two
         return stop(chunk_what_ + ": record at chunk offset " + std::to_string(at) + ": " + why);
+      }
       uint32_t conn = 0;
       if (r.op == 0x07 || r.op == 0x02) {
         if (!field_u32(r, "conn", conn, &why)) return stop(chunk_what_ + ": record at chunk offset " + std::to_string(at) + ": " + why);
@@ -161,11 +210,13 @@ bool BagReader::next(RawMessage& m) {
         m.in_chunk = !top_level_;
         m.chunk_at = chunk_at_;
         m.offset = top_level_ ? chunk_at_ : at;
+        if (!cut_error_.empty()) ++cut_messages_;
         return true;
       }
       continue;
     }
     if (pos_ >= size_) {
+      if (!cut_error_.empty()) return stop(cut_error_);  // every whole record of the cut chunk read
       // Cut between two records: nothing is cut in two, but a bag without its header record, or whose header
       // puts the index past the end, lost what came after the cut.
       if (!header_seen_) return stop("no bag header record after the '#ROSBAG V2.0' line (file truncated?)");
@@ -178,16 +229,20 @@ bool BagReader::next(RawMessage& m) {
     const size_t at = pos_;
     f_->read_ahead(at);
     const uint8_t* rp = nullptr;  // the record's bytes
-    if (!read_file_record(*f_, at, pos_, r, &rp, &why)) {
+    bool cut = false;
+    if (!read_file_record(*f_, at, pos_, r, &rp, &why, &cut)) {
       pos_ = at;
-      return stop("record at byte " + std::to_string(at) + ": " + why);
+      if (!cut) return stop("record at byte " + std::to_string(at) + ": " + why);
+      const std::string e = cut_record(at, why);  // "": an uncompressed chunk whose whole records are read first
+      if (!e.empty()) return stop(e);
+      continue;
     }
     if (r.op == 0x05) {
       const Field* c = find(r.fields, "compression");
       uint32_t usize = 0;
       if (!c || !field_u32(r, "size", usize, &why)) return stop("chunk at byte " + std::to_string(at) + ": no 'compression'/'size'");
       const std::string method = text(c);
-      chunk_what_ = "chunk at byte " + std::to_string(at) + " (" + method + ")";
+      chunk_what_ = "chunk at byte " + std::to_string(at) + " (" + escaped(method) + ")";
       if (method == "none") {
         if (usize != r.data_len) return stop(chunk_what_ + ": size field " + std::to_string(usize) + " != data length " + std::to_string(r.data_len));
         cd_ = r.data;

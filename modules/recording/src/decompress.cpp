@@ -15,7 +15,15 @@ std::string decompress(const std::string& method, const uint8_t* in, size_t n, s
     unsigned int len = unsigned(expected);
     const int rc = BZ2_bzBuffToBuffDecompress(reinterpret_cast<char*>(out.data()), &len,
                                               const_cast<char*>(reinterpret_cast<const char*>(in)), unsigned(n), 0, 0);
-    if (rc != BZ_OK) return "bz2 error " + std::to_string(rc) + (rc == BZ_OUTBUFF_FULL ? " (larger than the size field)" : "");
+    if (rc != BZ_OK) {
+      const char* what = rc == BZ_DATA_ERROR         ? "BZ_DATA_ERROR: the compressed data is corrupt"
+                         : rc == BZ_DATA_ERROR_MAGIC ? "BZ_DATA_ERROR_MAGIC: not bz2 data (no 'BZh' header)"
+                         : rc == BZ_UNEXPECTED_EOF   ? "BZ_UNEXPECTED_EOF: the compressed data ends too early"
+                         : rc == BZ_OUTBUFF_FULL     ? "BZ_OUTBUFF_FULL: larger than the size field"
+                         : rc == BZ_MEM_ERROR        ? "BZ_MEM_ERROR: out of memory"
+                                                     : "see bzlib.h";
+      return "bz2 error " + std::to_string(rc) + " (" + what + ")";
+    }
     if (len != expected) return "bz2 gave " + std::to_string(len) + " B, size field says " + std::to_string(expected);
     return "";
   }
@@ -50,7 +58,14 @@ std::string decompress(const std::string& method, const uint8_t* in, size_t n, s
     if (r != expected) return "zstd gave " + std::to_string(r) + " B, size field says " + std::to_string(expected);
     return "";
   }
-  return "unsupported compression '" + method + "'";
+  std::string name;  // the name from the file, printable (a damaged one holds any bytes)
+  for (const char ch : method) {
+    const auto u = uint8_t(ch);
+    static const char* hex = "0123456789abcdef";
+    if (u >= 0x20 && u < 0x7F && ch != '\\') name += ch;
+    else name += std::string("\\x") + hex[u >> 4] + hex[u & 15];
+  }
+  return "unsupported compression '" + name + "'";
 }
 
 std::vector<uint8_t> compress(const std::string& method, const uint8_t* in, size_t n) {

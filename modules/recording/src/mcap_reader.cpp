@@ -172,20 +172,28 @@ bool McapReader::next(RawMessage& m) {
   while (!done_) {
     if (in_chunk()) {
       const size_t at = cpos_;
-      if (cn_ - cpos_ < 9) return stop(chunk_what_ + ": record header cut at chunk offset " + std::to_string(at));
+      if (cn_ - cpos_ < 9) {
+        if (!cut_error_.empty()) return stop(cut_error_);  // the record the end of the file cut in two
+        return stop(chunk_what_ + ": record header cut at chunk offset " + std::to_string(at));
+      }
       const uint8_t op = cd_[cpos_];
       const uint64_t len = rd<uint64_t>(cd_ + cpos_ + 1);
-      if (len > cn_ - cpos_ - 9) return stop(chunk_what_ + ": record (op 0x" + std::to_string(op) + ") at chunk offset " + std::to_string(at) + " runs past the chunk");
+      if (len > cn_ - cpos_ - 9) {
+        if (!cut_error_.empty()) return stop(cut_error_);
+        return stop(chunk_what_ + ": record (op 0x" + std::to_string(op) + ") at chunk offset " + std::to_string(at) + " runs past the chunk");
+      }
       cpos_ += 9 + len;
       if (!on_record(op, cd_ + at + 9, len, &m, &is_msg, &why)) return stop(chunk_what_ + ": record at chunk offset " + std::to_string(at) + ": " + why);
       if (is_msg) {
         m.in_chunk = true;
         m.chunk_at = chunk_at_;
         m.offset = at;
+        if (!cut_error_.empty()) ++cut_messages_;
         return true;
       }
       continue;
     }
+    if (!cut_error_.empty()) return stop(cut_error_);  // every whole record of the cut chunk read
     const size_t at = pos_;
     f_->read_ahead(at);
     if (size_ - pos_ < 9) return stop("record at byte " + std::to_string(at) + ": cut off (file truncated? no footer)");
@@ -193,7 +201,34 @@ bool McapReader::next(RawMessage& m) {
     if (!d) return stop("record at byte " + std::to_string(at) + ": " + f_->read_error());
     const uint8_t op = d[0];
     const uint64_t len = rd<uint64_t>(d + 1);
-    if (len > size_ - pos_ - 9) return stop("record (opcode " + std::to_string(op) + ") at byte " + std::to_string(at) + ": length " + std::to_string(len) + " runs past the end (file truncated?)");
+    if (len > size_ - pos_ - 9) {
+      const std::string past = ": length " + std::to_string(len) + " runs past the end of the file (file size " + std::to_string(size_) +
+                               " B; file truncated, or the length damaged)";
+      if (op != 0x06) return stop("record (opcode " + std::to_string(op) + ") at byte " + std::to_string(at) + past);
+      // A chunk cut by the end of the file: an uncompressed one's whole records are read first (its CRC cannot be
+      // checked); a compressed one cannot be decompressed.
+      const size_t avail = size_ - pos_ - 9;
+      const uint8_t* cp = f_->seq(at, 9 + avail);
+      if (!cp) return stop("record at byte " + std::to_string(at) + ": " + f_->read_error());
+      Body b{cp + 9, avail};
+      b.get<uint64_t>();
+      b.get<uint64_t>();
+      b.get<uint64_t>();
+      b.get<uint32_t>();
+      const std::string method = b.str();
+      b.get<uint64_t>();
+      const std::string chunk = "chunk at byte " + std::to_string(at) + " (" + (method.empty() ? "none" : escaped(method)) + ")";
+      if (!b.ok) return stop(chunk + past + ": its header is cut");
+      if (!method.empty()) return stop(chunk + past + ": a cut compressed chunk cannot be decompressed, its messages are lost");
+      cut_error_ = chunk + past;
+      chunk_what_ = chunk;
+      cd_ = cp + 9 + b.i;
+      cn_ = avail - b.i;
+      cpos_ = 0;
+      chunk_at_ = at;
+      pos_ = size_;
+      continue;
+    }
     if (!(d = f_->seq(at, 9 + size_t(len)))) return stop("record at byte " + std::to_string(at) + ": " + f_->read_error());
     pos_ += 9 + len;
     const uint8_t* body = d + 9;
@@ -222,7 +257,7 @@ bool McapReader::next(RawMessage& m) {
     if (op == 0x06) {
       ChunkHeader h;
       if (!parse_chunk(body, len, h)) return stop("chunk at byte " + std::to_string(at) + ": header cut short");
-      chunk_what_ = "chunk at byte " + std::to_string(at) + " (" + (h.method.empty() ? "none" : h.method) + ")";
+      chunk_what_ = "chunk at byte " + std::to_string(at) + " (" + (h.method.empty() ? "none" : escaped(h.method)) + ")";
       bool crc_known = false;
       uint32_t got = 0;
       if (h.method.empty()) {

@@ -19,6 +19,23 @@ T rd(const uint8_t* p) {
   return v;
 }
 
+// A name from the file (a compression method) for a message: bytes outside printable ASCII as \xHH.
+inline std::string escaped(const std::string& s) {
+  std::string out;
+  for (const char ch : s) {
+    const auto u = uint8_t(ch);
+    if (u >= 0x20 && u < 0x7F && ch != '\\') {
+      out += ch;
+    } else {
+      static const char* hex = "0123456789abcdef";
+      out += "\\x";
+      out += hex[u >> 4];
+      out += hex[u & 15];
+    }
+  }
+  return out;
+}
+
 // What both readers share: the file (read in order with FileBytes::seq(); its mapping for the look-ahead),
 // the position, the first error (which stops the stream, prefixed with the file name), and the chunk
 // being read (in seq()'s buffer, or decompressed into buf_).
@@ -42,8 +59,12 @@ class FileReader : public Recording {
   }
   bool stop(const std::string& what) {
     done_ = true;
-    return fail(name_ + ": " + what);
+    return fail(name_ + ": " + what + (cut_error_.empty() ? "" : "; the chunk's " + std::to_string(cut_messages_) +
+                                                                   " whole message" + (cut_messages_ == 1 ? " before the cut was read" : "s before the cut were read")));
   }
+  // The file ends inside the uncompressed chunk being read: its whole records are read, then this error.
+  std::string cut_error_;
+  uint64_t cut_messages_ = 0;
   std::unique_ptr<FileBytes> f_;
   std::string name_;
   size_t pos_ = 0;
@@ -84,6 +105,8 @@ class BagReader : public FileReader {
 
  private:
   void prefetch_after(size_t pos);  // starts decompressing the compressed chunk that follows pos, if any
+  std::string cut_record(size_t at, const std::string& why);
+  std::string cut_cause(size_t at) const;  // why a record at `at` can run past the end: truncated, or a bad length
   ChunkAhead ahead_;
   bag::Record rec_;  // the record being read (its field list reused)
   bool header_seen_ = false;  // the bag header record (op 0x03) was read

@@ -278,6 +278,66 @@ TEST(Bag, WrittenBagsAllCompressionsAndDamage) {
   }
 }
 
+// The file ends inside an uncompressed chunk (or the chunk's length is damaged): the chunk's whole records are read
+// (they were all lost: "0 messages read"), then one error naming the chunk, the file's size and how many of its
+// messages were read. A compressed chunk cut short cannot be decompressed: the error says so. A corrupt bz2 chunk
+// says what bz2's error code means.
+TEST(Bag, CutInsideAChunkKeepsItsWholeRecords) {
+  const std::string dir = ::testing::TempDir();
+  for (const std::string comp : {"none", "bz2"}) {
+    const auto bytes = write_mixed<BagWriter>(dir + "/c_" + comp + ".bag", comp, 1, [](BagWriter& w) {
+      return std::pair{w.add_connection("/a", "std_msgs/String"), w.add_connection("/b", "ouster_ros/PacketMsg")};
+    });
+    std::vector<size_t> chunk_at, chunk_end;
+    for (size_t pos = 13; pos + 8 <= bytes.size();) {
+      uint32_t hl, dl;
+      std::memcpy(&hl, &bytes[pos], 4);
+      std::memcpy(&dl, &bytes[pos + 4 + hl], 4);
+      if (memmem(&bytes[pos + 4], hl, "op=\x05", 4)) chunk_at.push_back(pos), chunk_end.push_back(pos + 8 + hl + dl);
+      pos += 8 + size_t(hl) + dl;
+    }
+    ASSERT_GE(chunk_at.size(), 4u);
+    std::string err;
+    const auto all = read_all(bytes.data(), bytes.size(), &err);
+    const auto upto2 = read_all(bytes.data(), chunk_at[2], &err);
+    const auto upto3 = read_all(bytes.data(), chunk_end[2], &err);
+    ASSERT_LT(upto2.size(), upto3.size());
+    const size_t cut = (chunk_at[2] + chunk_end[2]) / 2;  // inside the third chunk's data
+    const auto part = read_all(bytes.data(), cut, &err, "cut.bag");
+    const std::string what = "cut.bag: record at byte " + std::to_string(chunk_at[2]) + ": chunk (" + comp + ") of ";
+    EXPECT_EQ(err.find(what), 0u) << err;
+    EXPECT_NE(err.find("runs past the end of the file (file size " + std::to_string(cut) + " B; file truncated"), std::string::npos) << err;
+    if (comp == "none") {
+      EXPECT_GT(part.size(), upto2.size());  // some of the cut chunk's messages
+      EXPECT_LT(part.size(), upto3.size());
+      EXPECT_NE(err.find("; the chunk's " + std::to_string(part.size() - upto2.size()) + " whole messages before the cut were read"),
+                std::string::npos) << err;
+      // Its length damaged in a whole file: not truncated; every message still read.
+      auto bad = bytes;
+      uint32_t hl;
+      std::memcpy(&hl, &bad[chunk_at[2]], 4);
+      const uint32_t huge = 0xFFFFFFF0u;
+      std::memcpy(&bad[chunk_at[2] + 4 + hl], &huge, 4);
+      const auto got = read_all(bad.data(), bad.size(), &err, "len.bag");
+      EXPECT_NE(err.find("len.bag: record at byte " + std::to_string(chunk_at[2]) + ": chunk (none) of 4294967280 B runs past the end of the file (file size " +
+                         std::to_string(bad.size()) + " B; the file is not short"), std::string::npos) << err;
+      EXPECT_NE(err.find("the length is damaged"), std::string::npos) << err;
+      EXPECT_GE(got.size(), upto3.size());
+      for (size_t i = 0; i < got.size() && i < all.size(); ++i) EXPECT_EQ(got[i].data, all[i].data) << i;
+    } else {
+      EXPECT_EQ(part.size(), upto2.size());
+      EXPECT_NE(err.find("a cut compressed chunk cannot be decompressed, its messages are lost"), std::string::npos) << err;
+      // Its stream CRC (the last bytes of the bz2 data) damaged: bz2's code and what it means.
+      auto bad = bytes;
+      bad[chunk_end[2] - 2] ^= 0x01;
+      read_all(bad.data(), bad.size(), &err, "bad.bag");
+      EXPECT_NE(err.find("bad.bag: chunk at byte " + std::to_string(chunk_at[2]) + " (bz2): bz2 error -4 (BZ_DATA_ERROR: the compressed data is corrupt)"),
+                std::string::npos) << err;
+    }
+    for (size_t i = 0; i < part.size(); ++i) ASSERT_EQ(part[i].data, all[i].data) << i;
+  }
+}
+
 TEST(Bag, NotABag) {
   const std::string s = "#ROSBAG V1.2\nxxxxxxxx";
   std::string err;

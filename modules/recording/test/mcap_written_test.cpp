@@ -71,5 +71,44 @@ TEST(McapWritten, ManyChunksReadAheadAndDamage) {
   }
 }
 
+// The file ends inside an uncompressed chunk: its whole records are read (they were lost), then one error naming the
+// chunk and the file's size; a compressed chunk cut short cannot be decompressed (said so); a damaged compression
+// name is printed escaped (it was printed as raw bytes).
+TEST(McapWritten, CutInsideAChunkKeepsItsWholeRecords) {
+  const std::string dir = ::testing::TempDir();
+  for (const std::string comp : {"none", "zstd"}) {
+    const auto bytes = write_mixed<McapWriter>(dir + "/c_" + comp + ".mcap", comp, 7, [](McapWriter& w) {
+      return std::pair{w.add_channel("/a", "std_msgs/msg/String"), w.add_channel("/b", "ouster_ros/msg/PacketMsg")};
+    });
+    const auto chunks = chunks_of(bytes);
+    ASSERT_GE(chunks.size(), 4u);
+    std::string err;
+    const auto all = read_all(bytes.data(), bytes.size(), &err);
+    const auto upto2 = read_all(bytes.data(), chunks[2].first, &err);
+    const auto upto3 = read_all(bytes.data(), chunks[3].first, &err);
+    const size_t cut = chunks[2].second;  // the middle of the third chunk's records
+    const auto part = read_all(bytes.data(), cut, &err, "cut.mcap");
+    const std::string what = "cut.mcap: chunk at byte " + std::to_string(chunks[2].first) + " (" + comp + "): length ";
+    EXPECT_EQ(err.find(what), 0u) << err;
+    EXPECT_NE(err.find("runs past the end of the file (file size " + std::to_string(cut) + " B; file truncated"), std::string::npos) << err;
+    if (comp == "none") {
+      EXPECT_GT(part.size(), upto2.size());
+      EXPECT_LT(part.size(), upto3.size());
+      EXPECT_NE(err.find("; the chunk's " + std::to_string(part.size() - upto2.size()) + " whole messages before the cut were read"),
+                std::string::npos) << err;
+    } else {
+      EXPECT_EQ(part.size(), upto2.size());
+      EXPECT_NE(err.find("a cut compressed chunk cannot be decompressed"), std::string::npos) << err;
+      // The compression name's first byte damaged: printed escaped.
+      auto bad = bytes;
+      bad[chunks[2].first + 9 + 28 + 4] = 0xE9;  // after start, end, size, crc and the name's length
+      read_all(bad.data(), bad.size(), &err, "comp.mcap");
+      EXPECT_NE(err.find("comp.mcap: chunk at byte " + std::to_string(chunks[2].first) + " (\\xe9std): unsupported compression '\\xe9std'"),
+                std::string::npos) << err;
+    }
+    for (size_t i = 0; i < part.size(); ++i) ASSERT_EQ(part[i].data, all[i].data) << i;
+  }
+}
+
 }  // namespace
 }  // namespace fploc::rec::test
