@@ -267,7 +267,15 @@ std::vector<std::string> Composition::external_inputs() const {
 }
 
 // ---- process main -------------------------------------------------------------------------------
-static void on_signal(int) { loop().stop = true; }
+// A stop signal from a process other than the one that started this node (a user's `kill`, not the launcher, whose
+// stops come from the parent: the launcher, or fploc-remote relaying it) -- under a launcher such a stop is a
+// failure (the node exits with 128 + the signal, and the graph's restart policy applies): it exited 0 and was never
+// restarted. si_pid 0: the kernel (a terminal's Ctrl-C).
+static volatile sig_atomic_t g_outside_signal = 0, g_outside_pid = 0;
+static void on_signal(int sig, siginfo_t* si, void*) {
+  loop().stop = true;
+  if (si && si->si_pid > 0 && si->si_pid != getppid()) g_outside_signal = sig, g_outside_pid = si->si_pid;
+}
 
 static fploc::node_status_t make_status(Context& ctx, const std::string& executable, const std::string& state,
                                         double cpu, double uptime, int restarts) {
@@ -391,13 +399,15 @@ int node_main(int argc, char** argv) {
   }
 
   struct sigaction sa {};
-  sa.sa_handler = on_signal;
+  sa.sa_sigaction = on_signal;
+  sa.sa_flags = SA_SIGINFO;
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
   signal(SIGPIPE, SIG_IGN);
 
-  const int restarts = getenv("FPLOC_RESTARTS") ? atoi(getenv("FPLOC_RESTARTS")) : 0;
+  const bool launched = getenv("FPLOC_RESTARTS") != nullptr;  // set by fploc launch (and fploc-remote) only
+  const int restarts = launched ? atoi(getenv("FPLOC_RESTARTS")) : 0;
   std::string executable = std::string("fploc-") + reg.spec.type;
   std::replace(executable.begin(), executable.end(), '_', '-');
   try {
@@ -514,6 +524,12 @@ int node_main(int argc, char** argv) {
   } catch (const std::exception& e) {
     std::cerr << "[" << instance << "] fatal: " << e.what() << std::endl;
     return 1;
+  }
+  if (launched && g_outside_signal) {
+    std::cerr << "[" << instance << "] stopped by " << strsignal(g_outside_signal) << " from pid " << int(g_outside_pid)
+              << ", not the launcher: exit code " << 128 + g_outside_signal << " (the graph's restart policy applies)"
+              << std::endl;
+    return 128 + g_outside_signal;
   }
   return 0;
 }
