@@ -1,5 +1,6 @@
 #include "fploc/runtime/log_reader.h"
 
+#include <cstdint>
 #include <filesystem>
 #include <system_error>
 
@@ -46,6 +47,9 @@ bool LogReader::next_fits() {
     } else if (data_len < 0 || uint64_t(channel_len) + uint64_t(data_len) > left) {
       damaged_ = where + "its data length " + std::to_string(data_len) + " runs past the end of the file (" +
                  std::to_string(size_) + " B: truncated, or the length damaged)" + before;
+      fits = false;
+    } else if (data_len == INT32_MAX) {  // liblcm's buffer of data length + 1 overflows, whatever the file's size
+      damaged_ = where + "its data length " + std::to_string(data_len) + " is damaged (liblcm cannot read it)" + before;
       fits = false;
     }
   }

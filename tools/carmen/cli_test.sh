@@ -25,14 +25,16 @@ grep -q '"refine"' "$T/r.json" || fail "--refine-map-poses: no map.refine in the
 # one error naming the place, exit 1.
 { cat "$T/a.log"; echo "FLASER 4 1.0"; cat "$T/a.log"; } > "$T/bad.log"
 if "$IMP" "$T/bad.log" --out "$T/b.lcm" --tum "$T/b.tum" 2> "$T/err"; then fail "bad record accepted"; fi
-grep -q "bad.log:17: FLASER: 3 fields, expected at least 13 for 4 readings (the 8 scans before it were written)" "$T/err" \
+grep -q "bad.log:17: FLASER: 3 fields, expected at least 13 for 4 readings (the log ends there: 8 scans read before it, scans 0..8 of them written)" "$T/err" \
   || { cat "$T/err"; fail "bad record: error text"; }
 [ "$(grep -vc '^#' "$T/b.tum")" = 8 ] && [ -s "$T/b.lcm" ] || fail "bad record: the 8 scans before it not written"
+"$IMP" "$T/bad.log" --out "$T/b2.lcm" --json > "$T/b.json" 2>/dev/null && fail "bad record accepted (--json)"
+grep -q '"damage": "[^"]*bad.log:17: FLASER' "$T/b.json" || { cat "$T/b.json"; fail "bad record: no \"damage\" in the JSON"; }
 for k in $(seq 1 40); do cat "$T/a.log"; done > "$T/long.log"
 gzip -c "$T/long.log" > "$T/long.log.gz"
 head -c $(( $(wc -c < "$T/long.log.gz") / 2 )) "$T/long.log.gz" > "$T/cut.log.gz"
 if "$IMP" "$T/cut.log.gz" --out "$T/c.lcm" --tum "$T/c.tum" 2> "$T/err"; then fail "cut .gz accepted"; fi
-grep -q "cut.log.gz: compressed data end early after .* B decompressed (file truncated?) (the .* scans before it were written)" "$T/err" \
+grep -q "cut.log.gz: compressed data end early after .* B decompressed (file truncated?) (the log ends there: .* scans read before it" "$T/err" \
   || { cat "$T/err"; fail "cut .gz: error text"; }
 n=$(grep -vc '^#' "$T/c.tum")
 [ "$n" -gt 0 ] && [ "$n" -lt 320 ] && [ -s "$T/c.lcm" ] || fail "cut .gz: $n scans written"

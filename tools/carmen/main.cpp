@@ -109,9 +109,9 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   if (!fploc::rt::check_finite_options(app, "fploc import-carmen", std::cerr)) return 1;  // nan, inf: one error naming the option
   namespace cm = fploc::carmen;
+  // A log cut short or damaged part way: what came before the damage is written as usual, then the error (exit 1).
+  std::string damage;
   try {
-    // A log cut short or damaged part way: what came before the damage is written as usual, then the error (exit 1).
-    std::string damage;
     std::string text = cm::read_maybe_gz(in, &damage);
     if (!damage.empty()) text.erase(text.rfind('\n') == std::string::npos ? 0 : text.rfind('\n') + 1);  // a cut last line
     std::string bad_record;
@@ -123,7 +123,7 @@ int main(int argc, char** argv) {
         throw;
       }
     }();
-    if (damage.empty()) damage = bad_record;
+    if (!bad_record.empty()) damage = bad_record;  // a bad record lies before a cut (the text ends at the cut)
     std::string note;
     const std::vector<double> t = cm::scan_times(log, &note);
     const float no_return = cm::no_return_range(log);
@@ -281,13 +281,16 @@ int main(int argc, char** argv) {
               << (log.odom_reanchors ? " (+" + std::to_string(log.odom_reanchors) + " re-anchorings at scans: increments measured from them)" : "")
               << "; wrote scans " << b << ".." << e
               << (note.empty() ? "" : "; " + note) << "\n";
+    if (!damage.empty()) j["damage"] = damage;  // the log ends there: what was read before it is all there is
     if (json) std::cout << j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";  // file names: any bytes
     if (!damage.empty()) {
-      std::cerr << "fploc import-carmen: " << damage << " (the " << n << " scans before it were written)\n";
+      std::cerr << "fploc import-carmen: " << damage << " (the log ends there: " << n
+                << " scans read before it, scans " << b << ".." << e << " of them written)\n";
       return 1;
     }
   } catch (const std::exception& ex) {
     std::cerr << "fploc import-carmen: " << ex.what() << "\n";
+    if (!damage.empty() && damage != ex.what()) std::cerr << "fploc import-carmen: (the log was damaged: " << damage << ")\n";
     return 1;
   }
   return 0;

@@ -137,7 +137,7 @@ void collect_written(const Message& m, const fploc::rt::LoadedGraph& g, std::set
 
 }  // namespace
 
-void check_option_files(const fploc::rt::LoadedGraph& g, std::vector<fploc::rt::GraphError>& errors) {
+void check_option_files(const fploc::rt::LoadedGraph& g, std::vector<fploc::rt::GraphError>& errors, bool skip_remote) {
   Ctx c{g, errors, {}, 0, ""};
   for (int i = 0; i < g.graph.node_size(); ++i) {
     auto opts = fploc::rt::node_options(g.graph.node(i));
@@ -145,7 +145,7 @@ void check_option_files(const fploc::rt::LoadedGraph& g, std::vector<fploc::rt::
   }
   for (int i = 0; i < g.graph.node_size(); ++i) {
     const auto& n = g.graph.node(i);
-    if (n.disabled()) continue;
+    if (n.disabled() || (skip_remote && !n.host().empty())) continue;
     auto opts = fploc::rt::node_options(n);
     if (!opts) continue;
     c.node = i;

@@ -11,7 +11,9 @@
 namespace fploc::launch {
 
 // Appends one error per bad file (file:line of the option, the resolved path and the reader's message).
-void check_option_files(const fploc::rt::LoadedGraph& g, std::vector<fploc::rt::GraphError>& errors);
+// skip_remote: leave out the nodes that run on another host (a launch: their files are on that host).
+void check_option_files(const fploc::rt::LoadedGraph& g, std::vector<fploc::rt::GraphError>& errors,
+                        bool skip_remote = false);
 
 // Runs the option checks each enabled node does at start (fploc::config::check_options: the options mapped
 // to the node's Configs) and appends one error per node that would refuse its options: file:line of the

@@ -105,11 +105,21 @@ class Launcher : public Effects {
     // launcher left running): their messages would mix with ours and `fploc node` commands would reach both. The
     // nodes beat once a second; listen that long before starting anything.
     for (const double t0 = now_s(); now_s() - t0 < 1.2 && foreign_.empty();) {
-      pollfd p{bus_.lcm().getFileno(), POLLIN, 0};
-      if (::poll(&p, 1, 50) > 0) bus_.lcm().handleTimeout(0);
+      pollfd p[2] = {{bus_.lcm().getFileno(), POLLIN, 0}, {g_sig_pipe[0], POLLIN, 0}};
+      ::poll(p, 2, 50);
+      if (p[0].revents & POLLIN) bus_.lcm().handleTimeout(0);
+      if (p[1].revents & POLLIN) {  // Ctrl-C before anything started: nothing to stop
+        char buf[16];
+        const ssize_t n = ::read(g_sig_pipe[0], buf, sizeof buf);
+        for (ssize_t k = 0; k < n; ++k)
+          if (buf[k] != SIGCHLD) {
+            log(std::string("received ") + strsignal(buf[k]) + " before any node started: exiting");
+            return 0;
+          }
+      }
     }
     if (!foreign_.empty()) {
-      log("refusing to start: " + foreign_ + " already runs on " + bus_.url() +
+      log("refusing to start: a node named " + foreign_ + " already runs on " + bus_.url() +
           " (another launch of this graph, or its nodes left running?); stop it, or give this one another --lcm-url");
       return 1;
     }
@@ -331,7 +341,7 @@ class Launcher : public Effects {
   void on_telemetry(const lcm::ReceiveBuffer*, const std::string&, const fploc::node_status_t* m) {
     if (listening_only_) {  // before our own nodes start: any report of one of them comes from elsewhere
       if (foreign_.empty() && sup_.find(m->node) && m->state != "stopped" && m->state != "dead")
-        foreign_ = "node '" + m->node + "' (pid " + std::to_string(m->pid) + (m->host.empty() ? "" : " on " + m->host) + ")";
+        foreign_ = "'" + m->node + "' (pid " + std::to_string(m->pid) + (m->host.empty() ? "" : " on " + m->host) + ")";
       return;
     }
     sup_.on_transport_ok();  // our own "starting" reports come back too when the LCM URL works here
@@ -359,6 +369,7 @@ class Launcher : public Effects {
   }
 
   void on_control(const lcm::ReceiveBuffer*, const std::string&, const fploc::node_command_t* m) {
+    if (listening_only_) return;  // for a launch already running (this one refuses, or starts after its listen)
     const auto i = sup_.find(m->node);
     auto d = decide_control(*m, i ? &table_[*i] : nullptr, g_.graph, hooks_);
     if (d.kind == ControlDecision::Reject) return reject(m->node, d.error);
@@ -443,7 +454,7 @@ int main(int argc, char** argv) {
   url = graph_lcm_url(g.graph, url);
   // The files the options name and the values the nodes would refuse: checked before anything starts, by `--check`
   // and by a launch alike (a launch with a missing plan ran every other node while the matcher died five times).
-  if (g.tree) check_option_files(g, errors);
+  if (g.tree) check_option_files(g, errors, /*skip_remote=*/!check);  // a launch: remote nodes' files are on their host
   if (g.tree) check_option_values(g, errors);
   if (check && !skip_hosts && g.tree && errors.empty() && g.graph.host_size() > 0) {
     std::vector<HostPlan> plans;

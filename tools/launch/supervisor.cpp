@@ -141,7 +141,8 @@ void Supervisor::kill_all() {
   for (size_t i = 0; i < nodes_.size(); ++i)
     if (nodes_[i].pid > 0) {
       fx_.signal(i, nodes_[i].pid, SIGKILL);
-      killed_.push_back(nodes_[i].policy.name);
+      if (std::find(killed_.begin(), killed_.end(), nodes_[i].policy.name) == killed_.end())
+        killed_.push_back(nodes_[i].policy.name);
     }
 }
 
@@ -284,6 +285,7 @@ void Supervisor::request_stop(size_t i, double t) {
 void Supervisor::request_restart(size_t i, double t) {
   auto& n = nodes_[i];
   n.tracker.reset();
+  died_.erase(std::remove(died_.begin(), died_.end(), n.policy.name), died_.end());  // revived: no longer ended dead
   if (n.pid > 0) {
     begin_stop(i, true, t);
   } else {

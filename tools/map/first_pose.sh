@@ -1,6 +1,7 @@
 #!/bin/bash
-# Time to first pose of a live graph: `fploc launch GRAPH` and `lcm-logplayer LOG` start at the same
-# instant t0; lcm-logger records the pose channels with their receive times; prints, per channel, the
+# Time to first pose of a live graph: `lcm-logplayer LOG` starts at the instant t0 `fploc launch GRAPH` starts the
+# graph's nodes (its "running" line; before it the launcher checks the graph and listens 1.2 s for nodes of the graph
+# already running); lcm-logger records the pose channels with their receive times; prints, per channel, the
 # first pose's arrival after t0 and the log time of the scan it belongs to. Runs itself in a private
 # network namespace (scripts/netns-run), so no LCM traffic leaves the machine.
 #   tools/map/first_pose.sh GRAPH LOG [DURATION_S]
@@ -15,9 +16,10 @@ URL=$(sed -n 's/^lcm_url: *"\(.*\)".*/\1/p' "$GRAPH")
 lcm-logger --lcm-url="$URL" -c '^FPLOC_(FRAME_POSE|POSE|POSE_LATEST)$' "$T/pose.lcm" > /dev/null 2>&1 &
 G=$!
 sleep 0.5
-t0=$(date +%s%N)
 FPLOC_SKIP_SETUP=1 "$ROOT/bin/fploc" launch "$GRAPH" --duration "$DUR" > "$T/launch.log" 2>&1 &
 L=$!
+for _ in $(seq 300); do grep -q "' running: " "$T/launch.log" && break; sleep 0.01; done
+t0=$(date +%s%N)
 lcm-logplayer --lcm-url="$URL" "$LOG" > /dev/null 2>&1 &
 P=$!
 wait $P

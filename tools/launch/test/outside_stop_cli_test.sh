@@ -24,4 +24,6 @@ grep -q "node 'features' started: .*restart 1" "$T/launch.log" || fail "no resta
 wait $pid; rc=$?; pid=""
 [ "$rc" = 0 ] || fail "launcher exit $rc after its duration, expected 0"
 grep -q "all nodes stopped$" "$T/launch.log" || fail "no clean stop"
+# The launcher's own stop (here its --duration) is no outside stop: the restarted node stops with code 0.
+grep -q "node 'features' stopped (exited with code 0)" "$T/launch.log" || fail "the launcher's stop did not end features with code 0"
 echo OK

@@ -23,7 +23,7 @@ sleep 2.5  # the nodes' first heartbeats
 t0=$(date +%s.%N)
 out="$(timeout 30 "$L" "$R/graphs/import.pbtxt" --duration 5 2>&1)"; rc=$?
 [ "$rc" = 1 ] || fail "second launch: exit $rc, expected 1"
-echo "$out" | grep -Eq "refusing to start: node '(segmenter|features)' \(pid [0-9]+.*\) already runs on udpm://" ||
+echo "$out" | grep -Eq "refusing to start: a node named '(segmenter|features)' \(pid [0-9]+.*\) already runs on udpm://" ||
   fail "second launch: no error naming the running node"
 echo "$out" | grep -q "started" && fail "second launch: a node was started"
 # The first run goes on undisturbed and exits 0 at its duration.

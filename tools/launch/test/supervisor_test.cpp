@@ -391,3 +391,19 @@ TEST(Supervisor, ACleanShutdownExitsZero) {
   EXPECT_EQ(s.finished(), std::optional<int>(0));
   EXPECT_EQ(w.logs.back(), "all nodes stopped");
 }
+
+TEST(Supervisor, ANodeRevivedByAControlRestartNoLongerCountsAsDead) {
+  FakeWorld w;
+  auto a = node("a", fploc::RestartPolicy::NEVER);
+  Supervisor s({a, node("b")}, {}, w);
+  s.start_all(0);
+  s.on_exit(s.pid(0), code(1), 0.5);
+  ASSERT_EQ(s.state(0), State::Dead);
+  s.request_restart(0, 1.0);
+  ASSERT_EQ(s.state(0), State::Running);
+  s.begin_shutdown(5);
+  s.tick(5.3);
+  s.on_exit(s.pid(0), code(0), 5.4);
+  s.on_exit(s.pid(1), code(0), 5.4);
+  EXPECT_EQ(s.finished(), std::optional<int>(0));
+}
