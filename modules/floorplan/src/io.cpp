@@ -1,6 +1,7 @@
 #include "fploc/floorplan/io.h"
 
 #include <fnmatch.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <charconv>
@@ -77,15 +78,24 @@ bool finite_element(const Element& e) {
          std::isfinite(e.a1);
 }
 
-std::string read_all(const std::string& path) {
+}  // namespace
+
+void check_input_file(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) fail(path + ": cannot open (" + std::strerror(errno) + ")");
+  if (S_ISDIR(st.st_mode)) fail(path + ": is a directory");
+  if (S_ISREG(st.st_mode) && st.st_size == 0) fail(path + ": empty file");
+}
+
+std::string read_input_file(const std::string& path) {
+  check_input_file(path);
   std::ifstream f(path, std::ios::binary);
   if (!f) fail(path + ": cannot open (" + std::strerror(errno) + ")");
   std::ostringstream ss;
   ss << f.rdbuf();
+  if (f.bad()) fail(path + ": read error");
   return ss.str();
 }
-
-}  // namespace
 
 double metres_per_unit(const std::string& units0) {
   const std::string u = lower(trim(units0));
@@ -410,6 +420,7 @@ FloorPlan load_floor_plan(const std::string& path, const PlanLoadOptions& option
   PlanLoadOptions options = options_in;
   options.layer_globs = split_layer_globs(options_in.layer_globs);
   const std::string ext = extension(path);
+  check_input_file(path);
   if (is_building_file(path)) {
     BuildingLoadOptions bo;
     bo.ifc_cut_height = options.ifc_cut_height;
@@ -429,7 +440,7 @@ FloorPlan load_floor_plan(const std::string& path, const PlanLoadOptions& option
     if (!f) fail(path + ": cannot open (" + std::strerror(errno) + ")");
     plan = read_plan_json(f, path, options);
   } else if (ext == ".dxf") {
-    plan = read_plan_dxf(read_all(path), path, options);
+    plan = read_plan_dxf(read_input_file(path), path, options);
   } else if (ext == ".fpmap") {
     plan = read_plan_from_fpmap(path);
     if (!options.units_override.empty() && metres_per_unit(options.units_override) != 1.0)

@@ -1,5 +1,7 @@
 #include "fploc/floorplan/occupancy.h"
 
+#include "fploc/floorplan/io.h"
+
 #include <png.h>
 #include <yaml.h>
 
@@ -20,13 +22,7 @@ namespace {
 
 [[noreturn]] void fail(const std::string& m) { throw std::runtime_error(m); }
 
-std::string slurp(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) fail(path + ": cannot open (" + std::strerror(errno) + ")");
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+std::string slurp(const std::string& path) { return read_input_file(path); }
 
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -275,6 +271,7 @@ GrayImage read_image(const std::string& path) {
   std::string ext = lower(std::filesystem::path(path).extension().string());
   if (ext == ".pgm") return read_pgm(slurp(path), path);
   if (ext != ".png") fail(path + ": image: unsupported format '" + ext + "' (use .pgm or .png)");
+  check_input_file(path);
   png_image im;
   std::memset(&im, 0, sizeof im);
   im.version = PNG_IMAGE_VERSION;
@@ -344,6 +341,11 @@ OccupancyGrid occupancy_from_image(const GrayImage& img, const MapYaml& y, const
 OccupancyGrid read_occupancy_map(const std::string& yaml_path) {
   const MapYaml y = read_map_yaml(yaml_path);
   if (!std::filesystem::exists(y.image_path)) fail(yaml_path + ": image: file '" + y.image_path + "' not found");
+  try {
+    check_input_file(y.image_path);
+  } catch (const std::exception& e) {
+    fail(yaml_path + ": image: " + e.what());
+  }
   return occupancy_from_image(read_image(y.image_path), y, yaml_path);
 }
 

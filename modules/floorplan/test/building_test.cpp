@@ -92,7 +92,8 @@ TEST(Building, BadFilesNameFileLineAndField) {
   const std::vector<Case> cases = {
       {"floor { name: \"a\" \n plan { file: \"x.json\" } ceiling_height_m: 3 \n", "bad.pbtxt:3:"},  // unterminated
       {floor_ok + "floor { name: \"b\" plan { file: \"" + plan + "\" } ceilng_height_m: 3 }\n", "bad.pbtxt:2:"},
-      {"", "at least one floor"},
+      {"", "bad.pbtxt: empty file"},
+      {"\n", "at least one floor"},
       {floor_ok + "floor {\n name: \"a\"\n plan { file: \"" + plan + "\" } ceiling_height_m: 3 }\n",
        "bad.pbtxt:3: floor[1] (a): name 'a' used by another floor"},
       {"floor { name: \"a\" ceiling_height_m: 3 }\n", "floor[0] (a).plan.file: no plan file"},

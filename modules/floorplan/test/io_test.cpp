@@ -148,3 +148,20 @@ TEST(PlanIo, SaveWithUnsupportedExtensionLeavesTheFileAlone) {
   EXPECT_NE(error_of([&] { save_floor_plan(plan, fresh); }), "");
   EXPECT_FALSE(std::filesystem::exists(fresh)) << "an empty file left behind";
 }
+
+// A directory or an empty file where a plan is expected: one error about the path, from every reader
+// (it used to be "note: no EOF marker" then "no supported entities" for a DXF, a JSON parse error, ...).
+TEST(PlanIo, DirectoryOrEmptyFileIsNamedAsSuch) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "plan_io_dir_test";
+  std::filesystem::remove_all(dir);
+  for (const std::string ext : {".dxf", ".json", ".csv", ".fpmap", ".yaml", ".ifc", ".pbtxt"}) {
+    const std::string d = (dir / ("plan" + ext)).string();
+    std::filesystem::create_directories(d);
+    EXPECT_EQ(error_of([&] { load_floor_plan(d); }), d + ": is a directory");
+    const std::string e = (dir / ("empty" + ext)).string();
+    { std::ofstream(e, std::ios::binary); }
+    EXPECT_EQ(error_of([&] { load_floor_plan(e); }), e + ": empty file");
+  }
+  EXPECT_EQ(error_of([&] { read_input_file(dir.string()); }), dir.string() + ": is a directory");
+  std::filesystem::remove_all(dir);
+}

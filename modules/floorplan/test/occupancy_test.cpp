@@ -105,6 +105,23 @@ TEST(Occupancy, PgmErrors) {
   EXPECT_EQ(g.value[1], 255);
 }
 
+// `fploc occupancy DIR` said "image: missing", a YAML whose image is a directory "magic ... got ''".
+TEST(Occupancy, DirectoryOrEmptyFileIsNamedAsSuch) {
+  const auto d = tmpdir() / "dirs";
+  std::filesystem::create_directories(d / "img.pgm");
+  EXPECT_EQ(err_of([&] { read_occupancy_map(d.string()); }), d.string() + ": is a directory");
+  write(d / "m.yaml", "image: img.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n");
+  EXPECT_EQ(err_of([&] { read_occupancy_map((d / "m.yaml").string()); }),
+            (d / "m.yaml").string() + ": image: " + (d / "img.pgm").string() + ": is a directory");
+  write(d / "e.pgm", "");
+  write(d / "e.yaml", "image: e.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n");
+  EXPECT_EQ(err_of([&] { read_occupancy_map((d / "e.yaml").string()); }),
+            (d / "e.yaml").string() + ": image: " + (d / "e.pgm").string() + ": empty file");
+  write(d / "z.yaml", "");
+  EXPECT_EQ(err_of([&] { read_occupancy_map((d / "z.yaml").string()); }), (d / "z.yaml").string() + ": empty file");
+  std::filesystem::remove_all(d);
+}
+
 TEST(Occupancy, ModesAndOrientation) {
   // 3 x 2 image: top row black/mid-grey/white, bottom row white/white/black.
   GrayImage img;

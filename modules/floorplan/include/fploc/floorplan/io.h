@@ -31,6 +31,12 @@
 
 namespace fploc {
 
+// Every plan reader opens its input files through these, so a wrong path gets one clear error about
+// the path instead of a reader's confusing one about the content: "PATH: cannot open (No such file or
+// directory)", "PATH: is a directory", "PATH: empty file". Other non-regular files (pipes) are allowed.
+void check_input_file(const std::string& path);
+std::string read_input_file(const std::string& path);  // check_input_file, then the whole file
+
 // Units accepted by `--units`: m, cm, mm, in (inch), ft. Returns metres per unit; throws on others.
 double metres_per_unit(const std::string& units);
 
