@@ -261,9 +261,32 @@ GrayImage read_pgm(const std::string& bytes, const std::string& source) {
       if (v > maxval) fail(source + ": byte " + std::to_string(pos + k * bpp) + ": pixel value " + std::to_string(v) + " > maxval");
       img.value[k] = scale(v);
     }
+    pos += n * bpp;
   } else {
-    for (size_t k = 0; k < n; ++k) img.value[k] = scale(integer("pixel", 0, maxval));
+    for (size_t k = 0; k < n; ++k) {
+      size_t p = pos;
+      while (p < bytes.size() && (std::isspace((unsigned char)bytes[p]) || bytes[p] == '#')) {
+        if (bytes[p] == '#')
+          while (p < bytes.size() && bytes[p] != '\n') ++p;
+        else
+          ++p;
+      }
+      if (p >= bytes.size())
+        fail(source + ": byte " + std::to_string(p) + ": pixel data truncated: got " + std::to_string(k) + " of " +
+             std::to_string(img.width) + "x" + std::to_string(img.height) + " = " + std::to_string(n) + " values");
+      img.value[k] = scale(integer("pixel", 0, maxval));
+    }
   }
+  // More data than the header's width x height: a wrong header (the map would be silently cut). Trailing
+  // whitespace is fine.
+  size_t extra = pos;
+  while (extra < bytes.size() && std::isspace((unsigned char)bytes[extra])) ++extra;
+  if (extra < bytes.size())
+    fail(source + ": byte " + std::to_string(pos) + ": the pixel data is longer than the header's " + std::to_string(img.width) +
+         "x" + std::to_string(img.height) + " says: " + std::to_string(bytes.size() - pos) + " bytes after the image" +
+         (magic == "P5" ? " (" + std::to_string((bytes.size() - pos) / (maxval > 255 ? 2 * size_t(img.width) : size_t(img.width))) +
+                              " more rows of " + std::to_string(img.width) + ")"
+                        : std::string("")));
   return img;
 }
 
