@@ -216,6 +216,20 @@ FloorPlan read_plan_json(std::istream& in, const std::string& source, const Plan
   FloorPlan plan;
   plan.source = source;
   if (!j.is_object()) fail(source + ": expected a JSON object with \"elements\"");
+  // Every key must be known: a misspelt one ("unit") would otherwise be a silent default.
+  auto known_keys = [](std::initializer_list<const char*> keys) {
+    std::string l;
+    for (const char* k : keys) l += (l.empty() ? "" : ", ") + std::string(k);
+    return l;
+  };
+  auto check_keys = [&](const json& o, std::initializer_list<const char*> keys, const std::string& what) {
+    for (const auto& [k, v] : o.items()) {
+      bool ok = false;
+      for (const char* known : keys) ok = ok || k == known;
+      if (!ok) fail(what + "unknown key \"" + k + "\" (known keys: " + known_keys(keys) + ")");
+    }
+  };
+  check_keys(j, {"units", "elements"}, source + ": ");
   std::string units = "m";
   if (j.contains("units")) {
     if (!j["units"].is_string()) fail(source + ": \"units\" must be a string");
@@ -248,6 +262,9 @@ FloorPlan read_plan_json(std::istream& in, const std::string& source, const Plan
         return o[key].get<double>();
       };
       const int layer = plan.layer_index(o.contains("layer") && o["layer"].is_string() ? o["layer"].get<std::string>() : "0");
+      if (type == "segment" || type == "line") check_keys(o, {"type", "a", "b", "layer"}, type + ": ");
+      else if (type == "circle") check_keys(o, {"type", "c", "r", "layer"}, "circle: ");
+      else if (type == "arc") check_keys(o, {"type", "c", "r", "start_deg", "end_deg", "layer"}, "arc: ");
       Element e;
       if (type == "segment" || type == "line") {
         e = Element::segment(vec("a"), vec("b"), layer);

@@ -14,6 +14,7 @@
 //  - .json {"units":"m","elements":[{"type":"segment","a":[x,y],"b":[x,y],"layer":"walls"},
 //          {"type":"circle","c":[x,y],"r":0.3},
 //          {"type":"arc","c":[x,y],"r":1,"start_deg":0,"end_deg":90}]}   (arcs counter-clockwise)
+//          Only these keys: any other (a misspelt "unit", an element's "colour") is an error naming it.
 //  - .dxf  ASCII DXF (see dxf.h for what is read). Binary DXF is a clear error.
 //  - .fpmap the plan stored inside a map built by `fploc map build` (fploc/annf/annf.h).
 //  - .yaml/.yml a ROS map_server occupancy map (YAML + PGM/PNG), vectorised (fploc/floorplan/occupancy.h).
