@@ -689,10 +689,14 @@ class DxfLoader {
         ++dropped_;
         if (notes.size() < 8) {
           const Eigen::Vector2d c = (b.min + b.max) / 2 * unit_;
-          char buf[256];
-          std::snprintf(buf, sizeof buf, "%s at line %d on layer '%s' near (%.1f, %.1f) m", prov_[i].type.c_str(),
-                        prov_[i].line, plan_.layers[plan_.elements[i].layer].c_str(), c.x(), c.y());
-          notes.push_back(buf);
+          // %.1f of a coordinate such as 5e300 prints 300 digits: large ones with %g's 6 significant digits.
+          auto coord = [](double v) {
+            char b[64];
+            std::snprintf(b, sizeof b, std::abs(v) < 1e7 ? "%.1f" : "%.6g", v);
+            return std::string(b);
+          };
+          notes.push_back(prov_[i].type + " at line " + std::to_string(prov_[i].line) + " on layer '" +
+                          plan_.layers[plan_.elements[i].layer] + "' near (" + coord(c.x()) + ", " + coord(c.y()) + ") m");
         }
       }
     }

@@ -259,3 +259,20 @@ TEST(Dxf, RealShanghaiTechColumnsInsideBlocks) {
   EXPECT_LT(b.x(), 400);
   EXPECT_LT(b.y(), 400);
 }
+
+// The note about a dropped far-away entity printed its coordinates with %.1f: ~300 digits for 5e300.
+TEST(Dxf, DroppedEntityNoteKeepsLargeCoordinatesShort) {
+  Dxf d;
+  d.g(0, "SECTION").g(2, "ENTITIES");
+  for (int i = 0; i < 40; ++i) d.line(i * 0.5, 0, i * 0.5, 10);
+  d.line(5e300, 5e300, 5e300, 6e300);
+  d.line(12345.25, 0, 12345.25, 1);
+  d.g(0, "ENDSEC").g(0, "EOF");
+  PlanLoadOptions o;
+  testing::internal::CaptureStderr();
+  read_plan_dxf(d.str(), "t.dxf", o);
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("near (5e+300, 5.5e+300) m"), std::string::npos) << err;
+  EXPECT_NE(err.find("near (12345.2, 0.5) m"), std::string::npos) << err;  // ordinary ones as before
+  EXPECT_LT(err.size(), 600u) << err;
+}
