@@ -17,7 +17,8 @@
 //
 // Output: {"schema", "source", "storeys":[{"name","id","elevation","ceiling_height",
 //          "elements":[{"layer","id","a":[x,y],"b":[x,y]}],"spaces":[{"name","id","ceiling_height","polygon":[[x,y],..]}]}]}
-// Errors: one line on stderr "FILE:LINE: ..." or "FILE: #ID=IFCTYPE: ..." and exit status 2.
+// Errors: one line on stderr "FILE:LINE: ..." or "FILE: #ID=IFCTYPE: ..." and exit status 2: a broken
+// STEP structure (checkStep), a used entity that is malformed or refers to a missing one (checkUsed).
 import fs from 'node:fs';
 
 const DEFAULT_CLASSES = ['IfcWall', 'IfcWallStandardCase', 'IfcWallElementedCase', 'IfcCurtainWall', 'IfcPlate',
@@ -50,7 +51,9 @@ try {
 
 // ---- STEP syntax check (web-ifc skips what it cannot parse silently; a truncated or garbled file
 // must be one clear error naming the line). Checks the header, that every DATA record is
-// "#id=TYPE(...);" with balanced parentheses outside strings, and the trailer.
+// "#id=TYPE(...);" with balanced parentheses outside strings, and the trailer. Indexes the records
+// in `entities` (id -> {type, line, args: offset after '(', end: offset of ';'}) for checkUsed.
+const entities = new Map();
 function checkStep(text) {
   if (!text.startsWith('ISO-10303-21;')) die(`${file}:1: not an IFC (STEP) file: it does not start with ISO-10303-21;`);
   const schema = /FILE_SCHEMA\s*\(\s*\(\s*'([^']*)'/i.exec(text);
@@ -89,7 +92,12 @@ function checkStep(text) {
       if (--depth < 0) die(`${file}:${line}: ${head(text, recStart)}: unbalanced ')'`);
     } else if (c === ';' && depth === 0) {
       recText = text.slice(recStart, i);
-      if (!/^#\d+\s*=\s*[A-Za-z0-9_]+\s*\(/.test(recText)) die(`${file}:${recLine}: malformed entity '${recText.slice(0, 60)}'`);
+      const m = /^#(\d+)\s*=\s*([A-Za-z0-9_]+)\s*\(/.exec(recText);
+      if (!m) die(`${file}:${recLine}: malformed entity '${recText.slice(0, 60)}'`);
+      const id = Number(m[1]);
+      const prev = entities.get(id);
+      if (prev) die(`${file}:${recLine}: #${id} is defined twice (first at line ${prev.line})`);
+      entities.set(id, { type: m[2].toUpperCase(), line: recLine, args: recStart + m[0].length, end: i });
       lastId = head(text, recStart);
       recStart = -1;
     }
@@ -104,10 +112,167 @@ function head(text, at) {
   const m = /^#(\d+)\s*=\s*([A-Za-z0-9_]+)/.exec(text.slice(at, at + 80));
   return m ? `#${m[1]}=${m[2].toUpperCase()}` : text.slice(at, at + 20);
 }
-const schemaName = checkStep(bytes.toString('latin1'));
+const stepText = bytes.toString('latin1');
+const schemaName = checkStep(stepText);
 
 // ---- open with web-ifc (imported only now: loading it takes most of a second)
 const WebIFC = await import('web-ifc');
+
+// ---- the entities this script uses must be well-formed. web-ifc reads a bad number ('abc', '1.#INF')
+// as 0, a missing argument as unset and a reference to a missing entity as nothing, so a corrupt file
+// would give a distorted plan or lose a wall without a word. From every entity of the classes read
+// (and the storeys, spaces, ceilings, units), every entity reachable by references is parsed here:
+// each value must be valid STEP (number, 'string', #ref, .ENUM., $, *, TYPED(value) or a list), each
+// reference must name an entity of the file, and an entity of a type the schema knows must have as
+// many arguments as the schema's constructor (web-ifc's IFC2X3/IFC4/IFC4X3 classes) takes. Entities of
+// types the schema does not know are not read by web-ifc and are left alone here, as are entities no
+// used entity refers to (relations, property sets).
+function checkUsed(text, schema, roots) {
+  const ns = schema.startsWith('IFC2X3') ? WebIFC.IFC2X3 : schema.startsWith('IFC4X') ? WebIFC.IFC4X3 ?? WebIFC.IFC4 : WebIFC.IFC4;
+  const arity = new Map();
+  for (const [k, v] of Object.entries(ns ?? {})) if (typeof v === 'function' && k.startsWith('Ifc')) arity.set(k.toUpperCase(), v.length);
+  const num = /[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?/y;
+  const word = /[A-Za-z_][A-Za-z0-9_]*/y;
+  const seen = new Set();
+  let rec, recId, i, arg, refs, derived;
+  const bad = (what) => {
+    throw new Error(`${file}:${rec.line}: #${recId}=${rec.type}: argument ${arg}: ${what}`);
+  };
+  const token = () => text.slice(i, Math.min(rec.end, i + 40)).split(/[,()\s]/)[0] || text.slice(i, i + 1);
+  const ws = () => {
+    while (i < rec.end && text.charCodeAt(i) <= 32) ++i;
+  };
+  function value() {
+    ws();
+    const c = text[i];
+    if (c === '$') {
+      ++i;
+    } else if (c === '*') {  // an attribute derived in this subtype: not a constructor argument
+      ++i;
+      ++derived;
+    } else if (c === "'") {
+      for (++i; ; ++i) {
+        if (i >= rec.end) bad('unterminated string');
+        if (text[i] === "'") {
+          if (text[i + 1] !== "'") break;
+          ++i;
+        }
+      }
+      ++i;
+    } else if (c === '#') {
+      const s = ++i;
+      while (i < rec.end && text.charCodeAt(i) >= 48 && text.charCodeAt(i) <= 57) ++i;
+      if (i === s) bad(`'#' without an entity number`);
+      refs.push([Number(text.slice(s, i)), arg]);
+    } else if (c === '(') {
+      ++i;
+      ws();
+      if (text[i] === ')') {
+        ++i;
+        return;
+      }
+      for (;;) {
+        value();
+        ws();
+        if (text[i] === ')') break;
+        if (text[i] !== ',') bad(`expected ',' or ')' in a list, got '${token()}'`);
+        ++i;
+      }
+      ++i;
+    } else if (c === '"') {
+      const e = text.indexOf('"', i + 1);
+      if (e < 0 || e > rec.end || !/^[0-9A-Fa-f]*$/.test(text.slice(i + 1, e))) bad(`bad binary value '${token()}'`);
+      i = e + 1;
+    } else if (c === '.') {
+      word.lastIndex = i + 1;
+      if (!word.test(text) || text[word.lastIndex] !== '.') bad(`'${token()}' is not a number or an .ENUMERATION.`);
+      i = word.lastIndex + 1;
+    } else {
+      word.lastIndex = i;
+      if (word.test(text)) {  // a typed value IFCLABEL('x'), or garbage such as abc
+        const s = i;
+        i = word.lastIndex;
+        ws();
+        if (text[i] !== '(') {
+          i = s;
+          bad(`'${token()}' is not a number (nor a 'string', #reference, .ENUM., $ or typed value)`);
+        }
+        ++i;
+        value();
+        ws();
+        if (text[i] !== ')') bad(`expected ')' after the typed value ${text.slice(s, s + 40).split('(')[0]}(...)`);
+        ++i;
+        return;
+      }
+      num.lastIndex = i;
+      const s = i;
+      if (!num.test(text)) bad(`'${token()}' is not a number`);
+      i = num.lastIndex;
+      const d = text[i];
+      if (i < rec.end && d !== ',' && d !== ')' && !/\s/.test(d)) {
+        i = s;
+        bad(`'${token()}' is not a number`);
+      }
+      if (!Number.isFinite(Number(text.slice(s, i)))) bad(`'${text.slice(s, i)}' is not a finite number`);
+    }
+  }
+  const via = new Map();  // id -> the used entity it was reached from (for the message)
+  try {
+    for (const root of roots) {
+      const stack = [root];
+      while (stack.length) {
+        recId = stack.pop();
+        if (seen.has(recId)) continue;
+        seen.add(recId);
+        rec = entities.get(recId);
+        const want = arity.get(rec.type);
+        if (want === undefined) continue;  // a type web-ifc does not know: it ignores it, so do we
+        i = rec.args;
+        refs = [];
+        arg = 0;
+        derived = 0;
+        ws();
+        if (text[i] !== ')') {
+          for (;;) {
+            ++arg;
+            value();
+            ws();
+            if (text[i] === ')') break;
+            if (text[i] !== ',') bad(`expected ',' or ')' after the argument, got '${token()}'`);
+            ++i;
+          }
+        }
+        if (arg - derived !== want && arg !== want) {
+          const got = derived ? `${arg} (${derived} of them derived '*')` : `${arg}`;
+          throw new Error(`${file}:${rec.line}: #${recId}=${rec.type}: expects ${want} argument${want === 1 ? '' : 's'}, got ${got}`);
+        }
+        for (const [ref, a] of refs) {
+          if (!entities.has(ref)) {
+            arg = a;
+            bad(`refers to #${ref}, which does not exist`);
+          }
+          if (ref === recId) {
+            arg = a;
+            bad('refers to the entity itself');
+          }
+          if (!seen.has(ref)) {
+            if (!via.has(ref)) via.set(ref, via.get(recId) ?? recId);
+            stack.push(ref);
+          }
+        }
+      }
+    }
+  } catch (e) {
+    const from = via.get(recId);
+    die(e.message + (from !== undefined && from !== recId ? ` (used by #${from}=${entities.get(from).type})` : ''));
+  }
+}
+{
+  const used = new Set([...classes, ...CEILING_CLASSES, 'IfcSpace', 'IfcBuildingStorey', 'IfcBuilding', 'IfcUnitAssignment'].map((c) => c.toUpperCase()));
+  const roots = [];
+  for (const [id, e] of entities) if (used.has(e.type)) roots.push(id);
+  checkUsed(stepText, schemaName, roots);
+}
 const api = new WebIFC.IfcAPI();
 await api.Init();
 api.SetLogLevel(WebIFC.LogLevel.LOG_LEVEL_OFF);

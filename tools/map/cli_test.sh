@@ -52,4 +52,10 @@ for bad in "export-pgm --resolution inf" "export-pgm --margin nan --resolution 0
   grep -q "^fploc map: error: $2 .*: not a finite number" "$T/err" || fail "$bad: $(cat "$T/err")"
   [ ! -e "$T/n" ] && [ ! -e "$T/n.svg" ] || fail "$bad: wrote output"
 done
+# A size that is not > 0: one error, nothing written (--width -5 wrote a 16 x 16 PNG).
+for w in -5 0; do
+  if "$MAP" render --plan "$T/p.json" --width $w --out "$T/w.png" 2> "$T/err"; then fail "--width $w accepted"; fi
+  grep -q "^fploc map: error: --width must be > 0 (pixels / SVG user units), got $w" "$T/err" || fail "--width $w: $(cat "$T/err")"
+  [ ! -e "$T/w.png" ] || fail "--width $w: wrote output"
+done
 echo "fploc-map CLI checks passed"

@@ -210,6 +210,11 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   // nan, inf: one error naming the option (--resolution inf wrote a 0 x 0 map).
   if (!fploc::rt::check_finite_options(app, "fploc map: error", std::cerr)) return 1;
+  // --width -5 wrote a 16 x 16 PNG.
+  if (*render && r.width <= 0) {
+    std::cerr << "fploc map: error: --width must be > 0 (pixels / SVG user units), got " << r.width << "\n";
+    return 1;
+  }
   try {
     if (*build) return cmd_build(b_plan, b_annf, b_out, as_json);
     if (*validate) return cmd_validate(v_plan.load(), v, as_json);

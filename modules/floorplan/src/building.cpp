@@ -13,6 +13,7 @@
 
 #include "building.pb.h"
 #include "fploc/floorplan/ifc.h"
+#include "fploc/floorplan/io.h"
 
 namespace fploc {
 namespace {
@@ -230,6 +231,7 @@ Building parse_building(const std::string& text, const std::string& source) {
 
 Building load_building(const std::string& path, const BuildingLoadOptions& options) {
   const std::string ext = lower_ext(path);
+  check_input_file(path);
   if (ext == ".ifc") {
     IfcReadOptions io;
     io.cut_height = options.ifc_cut_height;

@@ -1,7 +1,11 @@
 // A focused ASCII DXF reader for floor plans (see dxf.h for what it reads and why it exists).
 #include "fploc/floorplan/dxf.h"
 
+#include <iconv.h>
+
 #include <Eigen/Dense>
+#include <cerrno>
+#include <cstdio>
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -154,6 +158,122 @@ struct Provenance {
   int line;
 };
 
+// iconv's name for a $DWGCODEPAGE value: ANSI_1252 -> CP1252, DOS850 -> CP850, ISO8859-1 -> ISO-8859-1, ...
+std::string iconv_codepage(const std::string& dxf) {
+  const std::string u = upper(dxf);
+  if (u.rfind("ANSI_", 0) == 0) return "CP" + u.substr(5);
+  if (u.rfind("DOS", 0) == 0 && u.size() > 3 && std::isdigit((unsigned char)u[3])) return "CP" + u.substr(3);
+  if (u.rfind("ISO8859", 0) == 0 && u.size() > 8) return "ISO-8859-" + u.substr(8);
+  if (u == "UTF8" || u == "UTF-8") return "UTF-8";
+  if (u == "MAC-ROMAN") return "MACINTOSH";
+  if (u == "KSC5601") return "EUC-KR";
+  return u;  // BIG5, GB2312, JOHAB, ... as iconv knows them
+}
+
+// Text of a DXF (layer and block names) to UTF-8. Before R2007 ($ACADVER < AC1021) text is in $DWGCODEPAGE;
+// from R2007 on it is UTF-8, but writers that declare AC1027 and still write the code page exist (a layer
+// 'W\xe4nde' in an ANSI_1252 file): text that is not valid UTF-8 is then read in $DWGCODEPAGE. Without a code
+// page: UTF-8. Bytes that convert in neither are escaped as \xNN. ASCII strings (nearly all) take no
+// conversion; others are converted once.
+class TextDecoder {
+ public:
+  TextDecoder() = default;
+  TextDecoder(const TextDecoder&) = delete;
+  TextDecoder& operator=(const TextDecoder&) = delete;
+  ~TextDecoder() {
+    for (iconv_t cd : {utf8_, cp_})
+      if (cd != iconv_t(-1)) iconv_close(cd);
+  }
+  void setup(const std::string& codepage, const std::string& acadver) {
+    codepage_ = codepage;
+    unicode_ = codepage.empty() || acadver >= "AC1021";
+    utf8_ = iconv_open("UTF-8", "UTF-8");
+    if (codepage.empty()) return;
+    const std::string from = iconv_codepage(codepage);
+    if (from == "UTF-8") {
+      unicode_ = true;
+      return;
+    }
+    cp_ = iconv_open("UTF-8", from.c_str());
+    if (cp_ == iconv_t(-1)) unknown_ = true;
+  }
+  std::string operator()(const std::string& raw) {
+    bool ascii = true;
+    for (unsigned char c : raw)
+      if (c >= 0x80) {
+        ascii = false;
+        break;
+      }
+    if (ascii) return decode_unicode(raw);
+    auto it = cache_.find(raw);
+    if (it != cache_.end()) return it->second;
+    std::string out;
+    bool ok;
+    if (unicode_) {
+      ok = convert(utf8_, raw, &out);
+      if (!ok && cp_ != iconv_t(-1) && (ok = convert(cp_, raw, &out))) read_in_codepage_ = true;
+    } else {
+      ok = cp_ != iconv_t(-1) && convert(cp_, raw, &out);  // an unknown code page: escaped
+    }
+    if (!ok) {
+      convert(iconv_t(-1), raw, &out);
+      escaped_ = true;
+    }
+    out = decode_unicode(out);
+    cache_.emplace(raw, out);
+    return out;
+  }
+  // What to warn about after the read ("" = nothing).
+  std::string warning(const std::string& acadver) const {
+    if (escaped_ && unknown_)
+      return "unknown code page $DWGCODEPAGE '" + codepage_ + "': non-ASCII bytes in layer and block names are shown as \\xNN";
+    if (escaped_)
+      return std::string("layer or block names that are not text in ") +
+             (codepage_.empty() ? "UTF-8" : "UTF-8 nor $DWGCODEPAGE " + codepage_) + ": the bytes are shown as \\xNN";
+    if (read_in_codepage_)
+      return "layer or block names are not UTF-8 as $ACADVER " + acadver + " says; read them as $DWGCODEPAGE " + codepage_;
+    return "";
+  }
+
+ private:
+  // raw -> *out with `cd`; false at the first byte that does not convert. cd = -1: escape every non-ASCII byte.
+  bool convert(iconv_t cd, const std::string& in, std::string* out) {
+    out->clear();
+    if (cd == iconv_t(-1)) {
+      for (unsigned char c : in) {
+        if (c < 0x80) {
+          *out += char(c);
+          continue;
+        }
+        char e[8];
+        std::snprintf(e, sizeof e, "\\x%02X", c);
+        *out += e;
+      }
+      return true;
+    }
+    iconv(cd, nullptr, nullptr, nullptr, nullptr);
+    char* ip = const_cast<char*>(in.data());
+    size_t il = in.size();
+    char buf[512];
+    while (il > 0) {
+      char* op = buf;
+      size_t ol = sizeof buf;
+      const size_t r = iconv(cd, &ip, &il, &op, &ol);
+      out->append(buf, size_t(op - buf));
+      if (r == size_t(-1) && errno != E2BIG) return false;  // EILSEQ / EINVAL: not text in this encoding
+    }
+    char* op = buf;
+    size_t ol = sizeof buf;
+    iconv(cd, nullptr, nullptr, &op, &ol);
+    out->append(buf, size_t(op - buf));
+    return true;
+  }
+  iconv_t utf8_ = iconv_t(-1), cp_ = iconv_t(-1);
+  std::string codepage_;
+  bool unicode_ = true, unknown_ = false, escaped_ = false, read_in_codepage_ = false;
+  std::unordered_map<std::string, std::string> cache_;
+};
+
 class DxfLoader {
  public:
   DxfLoader(const std::string& source, const PlanLoadOptions& o) : source_(source), o_(o) {}
@@ -162,6 +282,7 @@ class DxfLoader {
     if (text.rfind("AutoCAD Binary DXF", 0) == 0)
       fail(source_ + ": binary DXF is not supported; save the drawing as ASCII DXF");
     parse(text);
+    text_.setup(codepage_, acadver_);
     // Units.
     double unit = 1.0;
     std::string unit_name = "m (default)";
@@ -204,6 +325,8 @@ class DxfLoader {
     }
     drop_outliers();
     scale_plan(plan_, unit);
+    if (!o_.quiet)
+      if (const std::string w = text_.warning(acadver_); !w.empty()) std::cerr << source_ << ": warning: " << w << "\n";
     if (!o_.quiet) {
       const Box2 b = plan_.bounds();
       std::cerr << source_ << ": " << plan_.elements.size() << " elements from " << entities_.size()
@@ -279,6 +402,8 @@ class DxfLoader {
       if (g.code == 0 && g.value == "ENDSEC") return;
       if (g.code == 9) var = g.value;
       if (var == "$INSUNITS" && g.code == 70) insunits_ = parse_int(g, "HEADER $INSUNITS");
+      if (var == "$DWGCODEPAGE" && g.code == 3) codepage_ = g.value;
+      if (var == "$ACADVER" && g.code == 1) acadver_ = g.value;
     }
     truncated("section HEADER", line);
   }
@@ -488,7 +613,7 @@ class DxfLoader {
   void emit_entity(const Entity& e, const Xf& xf, const std::string& inherited, int depth, const Entity& top) {
     if (++visits_ > kMaxVisits) fail(where(top) + ": more than " + std::to_string(kMaxVisits) + " block entity expansions (runaway INSERT arrays?)");
     if (num(e, 67, 0) != 0) return;  // paper space
-    std::string lname = decode_unicode(str(e, 8, "0"));
+    std::string lname = text_(str(e, 8, "0"));
     if (lname == "0" && !inherited.empty()) lname = inherited;
     const std::string& t = e.type;
     if (t == "INSERT") {
@@ -624,7 +749,7 @@ class DxfLoader {
     auto it = blocks_.find(name);
     if (it == blocks_.end()) {
       if (!o_.quiet && missing_blocks_.insert(name).second)
-        std::cerr << where(e) << ": block '" << name << "' is not defined (ignored)\n";
+        std::cerr << where(e) << ": block '" << text_(name) << "' is not defined (ignored)\n";
       return;
     }
     if (depth >= 16) fail(where(top) + ": INSERT nesting deeper than 16 (recursive block '" + name + "'?)");
@@ -689,10 +814,14 @@ class DxfLoader {
         ++dropped_;
         if (notes.size() < 8) {
           const Eigen::Vector2d c = (b.min + b.max) / 2 * unit_;
-          char buf[256];
-          std::snprintf(buf, sizeof buf, "%s at line %d on layer '%s' near (%.1f, %.1f) m", prov_[i].type.c_str(),
-                        prov_[i].line, plan_.layers[plan_.elements[i].layer].c_str(), c.x(), c.y());
-          notes.push_back(buf);
+          // %.1f of a coordinate such as 5e300 prints 300 digits: large ones with %g's 6 significant digits.
+          auto coord = [](double v) {
+            char b[64];
+            std::snprintf(b, sizeof b, std::abs(v) < 1e7 ? "%.1f" : "%.6g", v);
+            return std::string(b);
+          };
+          notes.push_back(prov_[i].type + " at line " + std::to_string(prov_[i].line) + " on layer '" +
+                          plan_.layers[plan_.elements[i].layer] + "' near (" + coord(c.x()) + ", " + coord(c.y()) + ") m");
         }
       }
     }
@@ -714,6 +843,8 @@ class DxfLoader {
   std::string source_;
   const PlanLoadOptions& o_;
   int insunits_ = -1;
+  std::string codepage_, acadver_;  // $DWGCODEPAGE, $ACADVER
+  TextDecoder text_;
   double unit_ = 1, tol_ = 0.01;
   std::vector<Entity> entities_;
   std::unordered_map<std::string, Block> blocks_;

@@ -1,5 +1,7 @@
 #include "fploc/floorplan/ifc.h"
 
+#include "fploc/floorplan/io.h"
+
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -126,7 +128,7 @@ Building building_from_ifc_json(const std::string& text, const std::string& sour
 }
 
 Building read_ifc_building(const std::string& path, const IfcReadOptions& options) {
-  if (!std::filesystem::exists(path)) fail(path + ": cannot open (" + std::strerror(ENOENT) + ")");
+  check_input_file(path);
   if (!(options.cut_height > 0) || !std::isfinite(options.cut_height)) fail(path + ": IFC cut height must be > 0");
   const std::string script = ifc2plan_script();
   if (!std::filesystem::exists(script)) fail(path + ": the IFC reader " + script + " is missing");

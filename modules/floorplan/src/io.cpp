@@ -1,6 +1,7 @@
 #include "fploc/floorplan/io.h"
 
 #include <fnmatch.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <charconv>
@@ -77,15 +78,24 @@ bool finite_element(const Element& e) {
          std::isfinite(e.a1);
 }
 
-std::string read_all(const std::string& path) {
+}  // namespace
+
+void check_input_file(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) fail(path + ": cannot open (" + std::strerror(errno) + ")");
+  if (S_ISDIR(st.st_mode)) fail(path + ": is a directory");
+  if (S_ISREG(st.st_mode) && st.st_size == 0) fail(path + ": empty file");
+}
+
+std::string read_input_file(const std::string& path) {
+  check_input_file(path);
   std::ifstream f(path, std::ios::binary);
   if (!f) fail(path + ": cannot open (" + std::strerror(errno) + ")");
   std::ostringstream ss;
   ss << f.rdbuf();
+  if (f.bad()) fail(path + ": read error");
   return ss.str();
 }
-
-}  // namespace
 
 double metres_per_unit(const std::string& units0) {
   const std::string u = lower(trim(units0));
@@ -206,6 +216,20 @@ FloorPlan read_plan_json(std::istream& in, const std::string& source, const Plan
   FloorPlan plan;
   plan.source = source;
   if (!j.is_object()) fail(source + ": expected a JSON object with \"elements\"");
+  // Every key must be known: a misspelt one ("unit") would otherwise be a silent default.
+  auto known_keys = [](std::initializer_list<const char*> keys) {
+    std::string l;
+    for (const char* k : keys) l += (l.empty() ? "" : ", ") + std::string(k);
+    return l;
+  };
+  auto check_keys = [&](const json& o, std::initializer_list<const char*> keys, const std::string& what) {
+    for (const auto& [k, v] : o.items()) {
+      bool ok = false;
+      for (const char* known : keys) ok = ok || k == known;
+      if (!ok) fail(what + "unknown key \"" + k + "\" (known keys: " + known_keys(keys) + ")");
+    }
+  };
+  check_keys(j, {"units", "elements"}, source + ": ");
   std::string units = "m";
   if (j.contains("units")) {
     if (!j["units"].is_string()) fail(source + ": \"units\" must be a string");
@@ -238,6 +262,9 @@ FloorPlan read_plan_json(std::istream& in, const std::string& source, const Plan
         return o[key].get<double>();
       };
       const int layer = plan.layer_index(o.contains("layer") && o["layer"].is_string() ? o["layer"].get<std::string>() : "0");
+      if (type == "segment" || type == "line") check_keys(o, {"type", "a", "b", "layer"}, type + ": ");
+      else if (type == "circle") check_keys(o, {"type", "c", "r", "layer"}, "circle: ");
+      else if (type == "arc") check_keys(o, {"type", "c", "r", "start_deg", "end_deg", "layer"}, "arc: ");
       Element e;
       if (type == "segment" || type == "line") {
         e = Element::segment(vec("a"), vec("b"), layer);
@@ -410,6 +437,7 @@ FloorPlan load_floor_plan(const std::string& path, const PlanLoadOptions& option
   PlanLoadOptions options = options_in;
   options.layer_globs = split_layer_globs(options_in.layer_globs);
   const std::string ext = extension(path);
+  check_input_file(path);
   if (is_building_file(path)) {
     BuildingLoadOptions bo;
     bo.ifc_cut_height = options.ifc_cut_height;
@@ -429,7 +457,7 @@ FloorPlan load_floor_plan(const std::string& path, const PlanLoadOptions& option
     if (!f) fail(path + ": cannot open (" + std::strerror(errno) + ")");
     plan = read_plan_json(f, path, options);
   } else if (ext == ".dxf") {
-    plan = read_plan_dxf(read_all(path), path, options);
+    plan = read_plan_dxf(read_input_file(path), path, options);
   } else if (ext == ".fpmap") {
     plan = read_plan_from_fpmap(path);
     if (!options.units_override.empty() && metres_per_unit(options.units_override) != 1.0)

@@ -1,5 +1,7 @@
 #include "fploc/floorplan/occupancy.h"
 
+#include "fploc/floorplan/io.h"
+
 #include <png.h>
 #include <yaml.h>
 
@@ -20,13 +22,7 @@ namespace {
 
 [[noreturn]] void fail(const std::string& m) { throw std::runtime_error(m); }
 
-std::string slurp(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) fail(path + ": cannot open (" + std::strerror(errno) + ")");
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+std::string slurp(const std::string& path) { return read_input_file(path); }
 
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -265,9 +261,32 @@ GrayImage read_pgm(const std::string& bytes, const std::string& source) {
       if (v > maxval) fail(source + ": byte " + std::to_string(pos + k * bpp) + ": pixel value " + std::to_string(v) + " > maxval");
       img.value[k] = scale(v);
     }
+    pos += n * bpp;
   } else {
-    for (size_t k = 0; k < n; ++k) img.value[k] = scale(integer("pixel", 0, maxval));
+    for (size_t k = 0; k < n; ++k) {
+      size_t p = pos;
+      while (p < bytes.size() && (std::isspace((unsigned char)bytes[p]) || bytes[p] == '#')) {
+        if (bytes[p] == '#')
+          while (p < bytes.size() && bytes[p] != '\n') ++p;
+        else
+          ++p;
+      }
+      if (p >= bytes.size())
+        fail(source + ": byte " + std::to_string(p) + ": pixel data truncated: got " + std::to_string(k) + " of " +
+             std::to_string(img.width) + "x" + std::to_string(img.height) + " = " + std::to_string(n) + " values");
+      img.value[k] = scale(integer("pixel", 0, maxval));
+    }
   }
+  // More data than the header's width x height: a wrong header (the map would be silently cut). Trailing
+  // whitespace is fine.
+  size_t extra = pos;
+  while (extra < bytes.size() && std::isspace((unsigned char)bytes[extra])) ++extra;
+  if (extra < bytes.size())
+    fail(source + ": byte " + std::to_string(pos) + ": the pixel data is longer than the header's " + std::to_string(img.width) +
+         "x" + std::to_string(img.height) + " says: " + std::to_string(bytes.size() - pos) + " bytes after the image" +
+         (magic == "P5" ? " (" + std::to_string((bytes.size() - pos) / (maxval > 255 ? 2 * size_t(img.width) : size_t(img.width))) +
+                              " more rows of " + std::to_string(img.width) + ")"
+                        : std::string("")));
   return img;
 }
 
@@ -275,6 +294,7 @@ GrayImage read_image(const std::string& path) {
   std::string ext = lower(std::filesystem::path(path).extension().string());
   if (ext == ".pgm") return read_pgm(slurp(path), path);
   if (ext != ".png") fail(path + ": image: unsupported format '" + ext + "' (use .pgm or .png)");
+  check_input_file(path);
   png_image im;
   std::memset(&im, 0, sizeof im);
   im.version = PNG_IMAGE_VERSION;
@@ -344,6 +364,11 @@ OccupancyGrid occupancy_from_image(const GrayImage& img, const MapYaml& y, const
 OccupancyGrid read_occupancy_map(const std::string& yaml_path) {
   const MapYaml y = read_map_yaml(yaml_path);
   if (!std::filesystem::exists(y.image_path)) fail(yaml_path + ": image: file '" + y.image_path + "' not found");
+  try {
+    check_input_file(y.image_path);
+  } catch (const std::exception& e) {
+    fail(yaml_path + ": image: " + e.what());
+  }
   return occupancy_from_image(read_image(y.image_path), y, yaml_path);
 }
 

@@ -259,3 +259,54 @@ TEST(Dxf, RealShanghaiTechColumnsInsideBlocks) {
   EXPECT_LT(b.x(), 400);
   EXPECT_LT(b.y(), 400);
 }
+
+namespace {
+// A plan with one line on `layer`, the header giving $ACADVER / $DWGCODEPAGE when not empty.
+std::string with_codepage(const std::string& acadver, const std::string& codepage, const std::string& layer) {
+  Dxf d;
+  d.g(0, "SECTION").g(2, "HEADER");
+  if (!acadver.empty()) d.g(9, "$ACADVER").g(1, acadver);
+  if (!codepage.empty()) d.g(9, "$DWGCODEPAGE").g(3, codepage);
+  d.g(0, "ENDSEC").g(0, "SECTION").g(2, "ENTITIES").line(0, 0, 1, 0, layer).line(0, 1, 1, 1, "other");
+  return d.g(0, "ENDSEC").g(0, "EOF").str();
+}
+std::string first_layer(const std::string& text) {
+  const FloorPlan p = read_plan_dxf(text, "t.dxf", quiet());
+  return p.layers[p.elements[0].layer];
+}
+}  // namespace
+
+// Layer names in the file's code page were kept as raw bytes ('W\xe4nde'), so --layers 'Wände' matched nothing.
+TEST(Dxf, NamesInTheFilesCodePageAreUtf8) {
+  const std::string latin1 = "W\xe4nde";  // "Wände" in Windows-1252
+  EXPECT_EQ(first_layer(with_codepage("AC1015", "ANSI_1252", latin1)), "W\u00e4nde");
+  EXPECT_EQ(first_layer(with_codepage("AC1015", "DOS850", "W\x84nde")), "W\u00e4nde");           // CP850 0x84
+  EXPECT_EQ(first_layer(with_codepage("AC1015", "ANSI_1251", "\xd1\xf2\xe5\xed\xe0")), "\u0421\u0442\u0435\u043d\u0430");
+  // R2007 and later are UTF-8 whatever $DWGCODEPAGE says; a name that is not UTF-8 there (a writer that declares
+  // AC1027 and writes the code page, as in the user's file) is read in the code page.
+  EXPECT_EQ(first_layer(with_codepage("AC1021", "ANSI_1252", "W\u00e4nde")), "W\u00e4nde");
+  EXPECT_EQ(first_layer(with_codepage("AC1027", "ANSI_1252", latin1)), "W\u00e4nde");
+  // Invalid UTF-8 without a code page, and an unknown code page: the bytes escaped, not raw.
+  EXPECT_EQ(first_layer(with_codepage("AC1027", "", latin1)), "W\\xE4nde");
+  EXPECT_EQ(first_layer(with_codepage("AC1015", "ANSI_99999", latin1)), "W\\xE4nde");
+  PlanLoadOptions o = quiet();
+  o.layer_globs = {"W\u00e4nde"};
+  EXPECT_EQ(read_plan_dxf(with_codepage("AC1015", "ANSI_1252", latin1), "t.dxf", o).elements.size(), 1u);
+}
+
+// The note about a dropped far-away entity printed its coordinates with %.1f: ~300 digits for 5e300.
+TEST(Dxf, DroppedEntityNoteKeepsLargeCoordinatesShort) {
+  Dxf d;
+  d.g(0, "SECTION").g(2, "ENTITIES");
+  for (int i = 0; i < 40; ++i) d.line(i * 0.5, 0, i * 0.5, 10);
+  d.line(5e300, 5e300, 5e300, 6e300);
+  d.line(12345.25, 0, 12345.25, 1);
+  d.g(0, "ENDSEC").g(0, "EOF");
+  PlanLoadOptions o;
+  testing::internal::CaptureStderr();
+  read_plan_dxf(d.str(), "t.dxf", o);
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("near (5e+300, 5.5e+300) m"), std::string::npos) << err;
+  EXPECT_NE(err.find("near (12345.2, 0.5) m"), std::string::npos) << err;  // ordinary ones as before
+  EXPECT_LT(err.size(), 600u) << err;
+}

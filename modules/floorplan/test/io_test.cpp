@@ -103,6 +103,21 @@ TEST(PlanIo, JsonBadElementNamesIndex) {
   EXPECT_NE(err.find("b.json: elements[1]"), std::string::npos) << err;
 }
 
+// "unit": "cm" (for "units") loaded the plan in metres without a word; a typo in an element was ignored too.
+TEST(PlanIo, JsonUnknownKeyIsAnError) {
+  std::istringstream top(R"({"unit":"cm","elements":[{"type":"segment","a":[0,0],"b":[1,0]}]})");
+  EXPECT_EQ(error_of([&] { read_plan_json(top, "u.json", {}); }),
+            "u.json: unknown key \"unit\" (known keys: units, elements)");
+  std::istringstream el(R"({"elements":[{"type":"segment","a":[0,0],"b":[1,0]},{"a":[0,0],"b":[1,0],"colour":"red"}]})");
+  EXPECT_EQ(error_of([&] { read_plan_json(el, "e.json", {}); }),
+            "e.json: elements[1]: segment: unknown key \"colour\" (known keys: type, a, b, layer)");
+  std::istringstream arc(R"({"elements":[{"type":"arc","c":[0,0],"r":1,"start_deg":0,"end":90}]})");
+  EXPECT_EQ(error_of([&] { read_plan_json(arc, "a.json", {}); }),
+            "a.json: elements[0]: arc: unknown key \"end\" (known keys: type, c, r, start_deg, end_deg, layer)");
+  std::istringstream ok(R"({"units":"cm","elements":[{"type":"circle","c":[0,0],"r":30,"layer":"cols"}]})");
+  EXPECT_NEAR(read_plan_json(ok, "ok.json", {}).elements[0].r, 0.3, 1e-12);
+}
+
 TEST(PlanIo, GlobMatchesRealLayerNames) {
   EXPECT_TRUE(glob_match("*$A-WALL", "E1-RI-1F$0$A-WALL"));
   EXPECT_TRUE(glob_match("e-cols-f4*", "E-COLS-F4$0$0S-COLS-I"));
@@ -147,4 +162,21 @@ TEST(PlanIo, SaveWithUnsupportedExtensionLeavesTheFileAlone) {
   std::filesystem::remove(fresh);
   EXPECT_NE(error_of([&] { save_floor_plan(plan, fresh); }), "");
   EXPECT_FALSE(std::filesystem::exists(fresh)) << "an empty file left behind";
+}
+
+// A directory or an empty file where a plan is expected: one error about the path, from every reader
+// (it used to be "note: no EOF marker" then "no supported entities" for a DXF, a JSON parse error, ...).
+TEST(PlanIo, DirectoryOrEmptyFileIsNamedAsSuch) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "plan_io_dir_test";
+  std::filesystem::remove_all(dir);
+  for (const std::string ext : {".dxf", ".json", ".csv", ".fpmap", ".yaml", ".ifc", ".pbtxt"}) {
+    const std::string d = (dir / ("plan" + ext)).string();
+    std::filesystem::create_directories(d);
+    EXPECT_EQ(error_of([&] { load_floor_plan(d); }), d + ": is a directory");
+    const std::string e = (dir / ("empty" + ext)).string();
+    { std::ofstream(e, std::ios::binary); }
+    EXPECT_EQ(error_of([&] { load_floor_plan(e); }), e + ": empty file");
+  }
+  EXPECT_EQ(error_of([&] { read_input_file(dir.string()); }), dir.string() + ": is a directory");
+  std::filesystem::remove_all(dir);
 }

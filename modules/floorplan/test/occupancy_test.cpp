@@ -105,6 +105,37 @@ TEST(Occupancy, PgmErrors) {
   EXPECT_EQ(g.value[1], 255);
 }
 
+// `fploc occupancy DIR` said "image: missing", a YAML whose image is a directory "magic ... got ''".
+TEST(Occupancy, DirectoryOrEmptyFileIsNamedAsSuch) {
+  const auto d = tmpdir() / "dirs";
+  std::filesystem::create_directories(d / "img.pgm");
+  EXPECT_EQ(err_of([&] { read_occupancy_map(d.string()); }), d.string() + ": is a directory");
+  write(d / "m.yaml", "image: img.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n");
+  EXPECT_EQ(err_of([&] { read_occupancy_map((d / "m.yaml").string()); }),
+            (d / "m.yaml").string() + ": image: " + (d / "img.pgm").string() + ": is a directory");
+  write(d / "e.pgm", "");
+  write(d / "e.yaml", "image: e.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n");
+  EXPECT_EQ(err_of([&] { read_occupancy_map((d / "e.yaml").string()); }),
+            (d / "e.yaml").string() + ": image: " + (d / "e.pgm").string() + ": empty file");
+  write(d / "z.yaml", "");
+  EXPECT_EQ(err_of([&] { read_occupancy_map((d / "z.yaml").string()); }), (d / "z.yaml").string() + ": empty file");
+  std::filesystem::remove_all(d);
+}
+
+// A header smaller than the data (height 51 for 515 rows) silently gave a cut map; an ASCII PGM cut in the
+// pixels said "truncated PGM header".
+TEST(Occupancy, PixelDataLongerOrShorterThanTheHeader) {
+  EXPECT_EQ(err_of([] { read_pgm("P5\n4 1\n255\nabcdefghijkl", "a.pgm"); }),
+            "a.pgm: byte 15: the pixel data is longer than the header's 4x1 says: 8 bytes after the image (2 more rows of 4)");
+  EXPECT_EQ(err_of([] { read_pgm("P2\n2 2\n255\n0 1\n2 3\n4 5\n", "b.pgm"); }),
+            "b.pgm: byte 18: the pixel data is longer than the header's 2x2 says: 5 bytes after the image");
+  EXPECT_EQ(err_of([] { read_pgm("P2\n3 2\n255\n0 1 2\n3 # c\n", "c.pgm"); }),
+            "c.pgm: byte 23: pixel data truncated: got 4 of 3x2 = 6 values");
+  // Trailing whitespace after the pixels is fine.
+  EXPECT_EQ(read_pgm("P5\n2 1\n255\nab\n", "d.pgm").value.size(), 2u);
+  EXPECT_EQ(read_pgm("P2\n2 1\n255\n0 1\n\n", "e.pgm").value.size(), 2u);
+}
+
 TEST(Occupancy, ModesAndOrientation) {
   // 3 x 2 image: top row black/mid-grey/white, bottom row white/white/black.
   GrayImage img;

@@ -8,6 +8,11 @@
 // WCS by the arbitrary-axis algorithm, so (0,0,-1) mirrors x). Units from $INSUNITS (1 in, 2 ft,
 // 4 mm, 5 cm, 6 m; 0/absent = metres) unless PlanLoadOptions::units_override is set. Robust
 // extents: entities far away from the bulk are dropped and listed on stderr.
+// Text: layer and block names are converted to UTF-8 (glibc iconv) from the file's $DWGCODEPAGE
+// (ANSI_1252 -> CP1252, DOS850 -> CP850, ISO8859-n, ...) when $ACADVER is before AC1021 (R2007); R2007 and
+// later, and files without a code page, are UTF-8 (a name that is not valid UTF-8 in an R2007+ file with a
+// code page is read in the code page: such writers exist). Bytes that do not convert (an unknown code page,
+// invalid UTF-8 without a code page) become "\xNN" with a warning on stderr. \U+XXXX escapes are decoded.
 // Binary DXF ("AutoCAD Binary DXF" sentinel) is rejected with a clear error.
 // Errors name "FILE:LINE: ..." (group-code level) or "FILE:LINE: ENTITY: ..." (entity level).
 #pragma once

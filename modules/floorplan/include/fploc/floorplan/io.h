@@ -14,6 +14,7 @@
 //  - .json {"units":"m","elements":[{"type":"segment","a":[x,y],"b":[x,y],"layer":"walls"},
 //          {"type":"circle","c":[x,y],"r":0.3},
 //          {"type":"arc","c":[x,y],"r":1,"start_deg":0,"end_deg":90}]}   (arcs counter-clockwise)
+//          Only these keys: any other (a misspelt "unit", an element's "colour") is an error naming it.
 //  - .dxf  ASCII DXF (see dxf.h for what is read). Binary DXF is a clear error.
 //  - .fpmap the plan stored inside a map built by `fploc map build` (fploc/annf/annf.h).
 //  - .yaml/.yml a ROS map_server occupancy map (YAML + PGM/PNG), vectorised (fploc/floorplan/occupancy.h).
@@ -30,6 +31,12 @@
 #include "fploc/floorplan/plan.h"
 
 namespace fploc {
+
+// Every plan reader opens its input files through these, so a wrong path gets one clear error about
+// the path instead of a reader's confusing one about the content: "PATH: cannot open (No such file or
+// directory)", "PATH: is a directory", "PATH: empty file". Other non-regular files (pipes) are allowed.
+void check_input_file(const std::string& path);
+std::string read_input_file(const std::string& path);  // check_input_file, then the whole file
 
 // Units accepted by `--units`: m, cm, mm, in (inch), ft. Returns metres per unit; throws on others.
 double metres_per_unit(const std::string& units);

@@ -24,7 +24,9 @@
 // Every boundary cell centre is then within tolerance of its chain's segments (the stats measure it).
 //
 // Errors: std::runtime_error "FILE: FIELD: what", e.g. "map.yaml: resolution: must be > 0, got -1",
-// "map.pgm: byte 15: truncated pixel data (expected 92700 bytes, got 120)".
+// "map.pgm: byte 15: truncated pixel data (expected 92700 bytes, got 120)", "map.pgm: byte 9233: the pixel data is
+// longer than the header's 180x51 says: 83520 bytes after the image (464 more rows of 180)" (trailing whitespace
+// is fine), "map.pgm: byte 184587: pixel data truncated: got 46396 of 180x515 = 92700 values" (ASCII P2).
 #pragma once
 #include <cstdint>
 #include <string>
