@@ -108,15 +108,11 @@ class Launcher : public Effects {
       pollfd p[2] = {{bus_.lcm().getFileno(), POLLIN, 0}, {g_sig_pipe[0], POLLIN, 0}};
       ::poll(p, 2, 50);
       if (p[0].revents & POLLIN) bus_.lcm().handleTimeout(0);
-      if (p[1].revents & POLLIN) {  // Ctrl-C before anything started: nothing to stop
-        char buf[16];
-        const ssize_t n = ::read(g_sig_pipe[0], buf, sizeof buf);
-        for (ssize_t k = 0; k < n; ++k)
-          if (buf[k] != SIGCHLD) {
-            log(std::string("received ") + strsignal(buf[k]) + " before any node started: exiting");
-            return 0;
-          }
-      }
+      if (p[1].revents & POLLIN)
+        if (const auto sigs = read_signals(); !sigs.empty()) {  // Ctrl-C before anything started: nothing to stop
+          log(std::string("received ") + strsignal(sigs[0]) + " before any node started: exiting");
+          return 0;
+        }
     }
     if (!foreign_.empty()) {
       log("refusing to start: a node named " + foreign_ + " already runs on " + bus_.url() +
@@ -159,12 +155,9 @@ class Launcher : public Effects {
           if (table_.remote(i)) table_.send(i, '.');
       }
       if (p[1].revents & POLLIN) {
-        char buf[16];
-        const ssize_t n = ::read(g_sig_pipe[0], buf, sizeof buf);
-        for (ssize_t k = 0; k < n; ++k) {
-          if (buf[k] == SIGCHLD) continue;
+        for (const int sig : read_signals()) {
           if (!sup_.shutting_down()) {
-            log(std::string("received ") + strsignal(buf[k]) + ": stopping every node");
+            log(std::string("received ") + strsignal(sig) + ": stopping every node");
             sup_.begin_shutdown(now_s());
           } else {
             log("second signal: killing every node now");
@@ -247,6 +240,15 @@ class Launcher : public Effects {
   void log(const std::string& line) override { log_line(line); }
 
  private:
+  // The signals the handler wrote to the pipe since the last call, SIGCHLD left out (children are reaped anyway).
+  static std::vector<int> read_signals() {
+    char buf[16];
+    const ssize_t n = ::read(g_sig_pipe[0], buf, sizeof buf);
+    std::vector<int> out;
+    for (ssize_t k = 0; k < n; ++k)
+      if (buf[k] != SIGCHLD) out.push_back(buf[k]);
+    return out;
+  }
   bool listening_only_ = true;  // run() has not started the nodes yet
   std::string foreign_;          // a node of this graph seen running elsewhere before that
   // One `ssh -M -N` per host in use, restarted a second after it ends (link cut, host reboot).
@@ -468,13 +470,11 @@ int main(int argc, char** argv) {
     for (const auto& p : check_hosts(g.graph, plans, host_exe, url))
       errors.push_back({graph_path, 0, "host '" + p.host + "': " + p.message});
   }
-  if (g.tree && errors.empty()) {
-    int enabled = 0;
-    for (const auto& n : g.graph.node()) enabled += !n.disabled();
-    if (enabled == 0)
-      errors.push_back({graph_path, 0, g.graph.node_size() == 0 ? "no node: the graph declares none (an empty or wrong file?)"
-                                                              : "no node to run: every node is disabled"});
-  }
+  int enabled = 0;
+  for (const auto& n : g.graph.node()) enabled += !n.disabled();
+  if (g.tree && errors.empty() && enabled == 0)
+    errors.push_back({graph_path, 0, g.graph.node_size() == 0 ? "no node: the graph declares none (an empty or wrong file?)"
+                                                            : "no node to run: every node is disabled"});
   if (!check && url.rfind("memq://", 0) == 0)
     errors.push_back({graph_path, 0, "lcm_url memq:// only works inside one process (use fploc replay)"});
   std::stable_sort(errors.begin(), errors.end(), [](const GraphError& a, const GraphError& b) {
@@ -486,8 +486,6 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (check) {
-    int enabled = 0;
-    for (const auto& n : g.graph.node()) enabled += !n.disabled();
     std::cerr << graph_path << ": OK (" << enabled << " nodes)\n";
     return 0;
   }
