@@ -65,6 +65,21 @@ std::vector<std::string> HostPlan::master_argv() const {
   return a;
 }
 
+std::vector<std::string> HostPlan::probe_argv(const std::string& command) const {
+  HostPlan own = *this;
+  own.control_path.clear();
+  auto a = own.ssh_argv(command);
+  a.insert(a.end() - 3, {"-o", "ControlPath=none"});  // before the address, "--" and the command
+  return a;
+}
+
+std::string HostPlan::unreachable(int rc, const std::string& out) const {
+  const std::string who = spec.address() + (spec.user().empty() ? "" : " as " + spec.user());
+  const std::string first = out.substr(0, out.find('\n'));
+  return "not reachable with ssh (" + who + "): " +
+         (rc < 0 ? std::string("timed out") : first.empty() ? "exit code " + std::to_string(rc) : first);
+}
+
 std::string remote_node_command(const HostPlan& h, const std::vector<std::string>& argv, int restarts, double watchdog_s) {
   std::ostringstream c;
   c << "exec " << shell_quote(h.bin() + "/fploc-remote") << " --timeout " << watchdog_s << " --restarts " << restarts
@@ -119,12 +134,9 @@ std::vector<HostProblem> check_hosts(const fploc::Graph& g, const std::vector<Ho
          "MISSING \"$e\";; esac; done; echo ROUTE $(ip route get "
       << group << " 2>&1 | head -1)";
     std::string out;
-    const int rc = run_merged(h.ssh_argv(c.str()), 10, out);
-    const std::string who = h.spec.address() + (h.spec.user().empty() ? "" : " as " + h.spec.user());
+    const int rc = run_merged(h.probe_argv(c.str()), 10, out);
     if (rc != 0) {
-      std::string first = out.substr(0, out.find('\n'));
-      problems.push_back({h.spec.name(), "not reachable with ssh (" + who + "): " +
-                                             (rc < 0 ? std::string("timed out") : first.empty() ? "exit code " + std::to_string(rc) : first)});
+      problems.push_back({h.spec.name(), h.unreachable(rc, out), true});
       continue;
     }
     if (out.find("ROOT_OK") == std::string::npos) {

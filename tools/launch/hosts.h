@@ -25,6 +25,11 @@ struct HostPlan {
   // connection while the master is down. "" = no multiplexing.
   std::string control_path;
   std::vector<std::string> master_argv() const;
+  // The host probe (`--check`, the launch's check, and the launcher's probes of a host its nodes wait for): ssh
+  // running `command` over a connection of its own (never a multiplexed one, which may outlive a cut link).
+  std::vector<std::string> probe_argv(const std::string& command) const;
+  // "not reachable with ssh (ADDRESS as USER): <ssh's first line>" for a probe that ended with `rc` (-1: timed out).
+  std::string unreachable(int rc, const std::string& output) const;
 };
 
 std::string shell_quote(const std::string& s);
@@ -40,6 +45,7 @@ std::string local_commit(const std::string& root);
 // naming the host.
 struct HostProblem {
   std::string host, message;
+  bool unreachable = false;  // ssh did not get there (nothing else about the host could be checked)
 };
 std::vector<HostProblem> check_hosts(const fploc::Graph& g, const std::vector<HostPlan>& hosts,
                                      const std::vector<std::pair<std::string, std::string>>& host_exe,  // host, exe path
