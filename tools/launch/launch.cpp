@@ -1,5 +1,6 @@
 // fploc launch: validates a graph (every error as file:line), then runs and supervises its nodes.
-//   fploc launch GRAPH [--check] [--duration S] [--lcm-url URL] [--set NODE.field=value ...]
+//   fploc launch GRAPH [--check] [--skip-hosts] [--wait-for-hosts] [--duration S] [--lcm-url URL]
+//                [--set NODE.field=value ...]
 // Three parts: the process table (process_table.h: each node its own process group with
 // PR_SET_PDEATHSIG=SIGKILL, started as EXE --graph GRAPH --node NAME [--set k=v ...] [args...] with
 // FPLOC_RESTARTS=<restarts so far>), the supervisor (supervisor.h: restart policy with backoff, heartbeat
@@ -90,12 +91,13 @@ std::map<std::string, std::shared_ptr<const HostPlan>> host_plans(const fploc::G
 class Launcher : public Effects {
  public:
   // `sets`: the command line's NODE.field=value overrides (already checked against the graph).
+  // `hosts_down`: hosts the launch's check did not reach (with --wait-for-hosts), and what it said.
   Launcher(LoadedGraph g, const std::vector<ResolvedNode>& resolved, std::string url, std::string bin_dir,
-           const std::vector<std::string>& sets)
+           const std::vector<std::string>& sets, std::vector<std::pair<std::string, std::string>> hosts_down)
       : g_(std::move(g)), robot_(robot_of(&g_.graph)), telemetry_(robot_channel(robot_, kTelemetryChannel)),
         hooks_(default_hooks(bin_dir)), bus_(url), hosts_(host_plans(g_.graph, bin_dir, true)),
         table_(entries(g_, resolved, sets, hosts_), std::filesystem::absolute(g_.path).string()),
-        sup_(policies(g_, resolved), config(g_), *this) {
+        sup_(policies(g_, resolved), config(g_), *this), hosts_down_(std::move(hosts_down)) {
     bus_.lcm().subscribe(telemetry_, &Launcher::on_telemetry, this);
     bus_.lcm().subscribe(robot_channel(robot_, control_channel(g_.graph)), &Launcher::on_control, this);
   }
@@ -123,11 +125,16 @@ class Launcher : public Effects {
     const double t_start = now_s();
     for (size_t i = 0; i < table_.size(); ++i)
       if (table_.remote(i)) masters_[table_[i].host->spec.name()];
+    for (const auto& [h, why] : hosts_down_) {
+      sup_.host_down_at_start(h, why, now_s());
+      masters_[h].quiet = true;  // its master fails until the host is back: said once, by the supervisor
+    }
     tend_masters(false);
     // Give the master connections a moment, so that the nodes' sessions share them from the start.
     for (double t0 = now_s(); now_s() - t0 < 3.0;) {
       bool all = true;
-      for (const auto& [h, m] : masters_) all = all && std::filesystem::exists(hosts_.at(h)->control_path);
+      for (const auto& [h, m] : masters_)
+        all = all && (m.quiet || std::filesystem::exists(hosts_.at(h)->control_path));
       if (all) break;
       ::usleep(20000);
     }
@@ -171,13 +178,16 @@ class Launcher : public Effects {
       }
       ExitStatus st;
       while (const pid_t pid = ProcessTable::reap_one(st)) {
+        if (probe_ended(pid, st)) continue;
         for (auto& [h, m] : masters_)
           if (m.pid == pid) {
             m.pid = -1;
             m.next_try = now_s() + 1.0;
-            if (!sup_.shutting_down())
+            // Said once per outage: while the host is away every attempt fails.
+            if (!sup_.shutting_down() && !m.quiet)
               log("ssh master connection to host '" + h + "' (" + hosts_.at(h)->spec.address() + ") ended (" + st.str() +
                   "); reconnecting every second");
+            m.quiet = true;
           }
         for (size_t i = 0; i < table_.size(); ++i)
           if (sup_.pid(i) == pid && table_.remote(i)) {
@@ -189,12 +199,16 @@ class Launcher : public Effects {
           }
         sup_.on_exit(pid, st, now_s());
       }
+      time_out_probes();
+      deliver_probes();
       sup_.tick(now_s());
+      deliver_probes();
       tend_masters(sup_.shutting_down());
       if (auto rc = sup_.finished()) {
         for (auto& [h, m] : masters_)
           if (m.pid > 0) ProcessTable::signal_group(m.pid, SIGTERM);
         for (auto& [h, m] : masters_) std::filesystem::remove(hosts_.at(h)->control_path);
+        for (auto& [pid, p] : probes_) ProcessTable::signal_group(pid, SIGKILL);
         return *rc;
       }
     }
@@ -238,8 +252,79 @@ class Launcher : public Effects {
     bus_.lcm().publish(telemetry_, &s);
   }
   void log(const std::string& line) override { log_line(line); }
+  // A fresh ssh connection running `true` there, in the background; its end is reaped by the event loop
+  // (probe_ended) and its answer handed to the supervisor outside the supervisor's own calls.
+  void probe_host(const std::string& host) override {
+    const auto& plan = *hosts_.at(host);
+    int out[2];
+    if (::pipe2(out, O_CLOEXEC) != 0) {
+      answers_.push_back({host, false, std::string("cannot probe: pipe failed: ") + strerror(errno)});
+      return;
+    }
+    fploc::rt::SpawnOptions o;
+    o.search_path = true;
+    o.stdin_fd = fploc::rt::SpawnOptions::kDevNull;
+    o.stdout_fd = o.stderr_fd = out[1];
+    o.close_other_fds = true;
+    o.who = "fploc launch";
+    std::string error;
+    const pid_t pid = fploc::rt::spawn_supervised(plan.probe_argv("true"), o, error);
+    ::close(out[1]);
+    if (pid < 0) {
+      ::close(out[0]);
+      answers_.push_back({host, false, "cannot probe: " + error});
+      return;
+    }
+    ::fcntl(out[0], F_SETFL, O_NONBLOCK);
+    probes_[pid] = Probe{host, out[0], now_s(), ""};
+  }
 
  private:
+  // Host probes under way (pid -> host, its output) and answers not yet given to the supervisor.
+  struct Probe {
+    std::string host;
+    int fd = -1;
+    double started = 0;
+    std::string output;
+  };
+  struct Answer {
+    std::string host;
+    bool reachable = false;
+    std::string why;
+  };
+  std::map<pid_t, Probe> probes_;
+  std::vector<Answer> answers_;
+  static constexpr double kProbeTimeout = 10.0;  // ssh's ConnectTimeout (3 s) ends it first, normally
+  static void read_all(int fd, std::string& into) {
+    char buf[4096];
+    for (ssize_t n; (n = ::read(fd, buf, sizeof buf)) > 0;) into.append(buf, size_t(n));
+  }
+  bool probe_ended(pid_t pid, const ExitStatus& st) {
+    const auto it = probes_.find(pid);
+    if (it == probes_.end()) return false;
+    auto& p = it->second;
+    read_all(p.fd, p.output);
+    ::close(p.fd);
+    const bool ok = st.exited && st.code == 0;
+    const bool timed_out = !st.exited && now_s() - p.started >= kProbeTimeout;
+    answers_.push_back({p.host, ok, ok ? "" : hosts_.at(p.host)->unreachable(timed_out ? -1 : st.exited ? st.code : 255, p.output)});
+    probes_.erase(it);
+    return true;
+  }
+  void time_out_probes() {
+    for (auto& [pid, p] : probes_) {
+      read_all(p.fd, p.output);
+      if (now_s() - p.started >= kProbeTimeout) ProcessTable::signal_group(pid, SIGKILL);
+    }
+  }
+  void deliver_probes() {
+    auto answers = std::move(answers_);
+    answers_.clear();
+    for (const auto& a : answers) {
+      sup_.on_host_probe(a.host, a.reachable, a.why, now_s());
+    }
+  }
+
   // The signals the handler wrote to the pipe since the last call, SIGCHLD left out (children are reaped anyway).
   static std::vector<int> read_signals() {
     char buf[16];
@@ -255,13 +340,18 @@ class Launcher : public Effects {
   void tend_masters(bool stopping) {
     if (stopping) return;
     for (auto& [h, m] : masters_) {
+      if (m.quiet && m.pid > 0 && std::filesystem::exists(hosts_.at(h)->control_path)) m.quiet = false;  // up again
       if (m.pid > 0 || now_s() < m.next_try) continue;
       fploc::rt::SpawnOptions o;
       o.search_path = true;
       o.stdin_fd = fploc::rt::SpawnOptions::kDevNull;
       o.who = "fploc launch";
+      // While its host is away, the attempts' "Connection timed out" every few seconds says nothing new.
+      const int devnull = m.quiet ? ::open("/dev/null", O_WRONLY | O_CLOEXEC) : -1;
+      o.stderr_fd = devnull;
       std::string error;
       const pid_t pid = fploc::rt::spawn_supervised(hosts_.at(h)->master_argv(), o, error);
+      if (devnull >= 0) ::close(devnull);
       if (pid < 0) log_line("ssh master for host " + h + ": " + error);
       m.pid = pid;
       m.next_try = now_s() + 1.0;
@@ -322,6 +412,7 @@ class Launcher : public Effects {
       p.heartbeat_timeout_s = policy_or(n.heartbeat_timeout_s(), 3.0);
       p.supervised = rn.desc.describable;
       p.remote = !n.host().empty();
+      p.host = n.host();
       for (const auto& s : rn.desc.spec.ports) (s.output ? p.outputs : p.inputs).push_back(channel_of(n, s));
       add_udp_links(n, rn.desc.spec.type, p);
       out.push_back(std::move(p));
@@ -396,18 +487,23 @@ class Launcher : public Effects {
   struct Master {
     pid_t pid = -1;
     double next_try = 0;
+    bool quiet = false;  // its end was reported (or its host is away): not again until it has been up
   };
   std::map<std::string, Master> masters_;  // hosts with at least one node
   ProcessTable table_;
   Supervisor sup_;
+  std::vector<std::pair<std::string, std::string>> hosts_down_;
 };
 
 void usage() {
-  std::cerr << "usage: fploc launch GRAPH.pbtxt [--check [--skip-hosts]] [--duration SECONDS] [--lcm-url URL] [--set NODE.field=value ...]\n"
+  std::cerr << "usage: fploc launch GRAPH.pbtxt [--check] [--skip-hosts] [--wait-for-hosts] [--duration SECONDS] [--lcm-url URL]\n"
+               "                                [--set NODE.field=value ...]\n"
                "  --check      validate the graph (fields, executables, ports, channel types, option values, the files options\n"
                "               name) and its hosts (reachable with ssh, fploc there at this commit, multicast route),\n"
-               "               then exit (a launch checks the same, except the hosts, and refuses to start on an error)\n"
-               "  --skip-hosts with --check: do not contact the graph's hosts\n"
+               "               then exit (a launch checks the same and refuses to start on an error)\n"
+               "  --skip-hosts do not contact the graph's hosts before starting (or in --check)\n"
+               "  --wait-for-hosts  a host that does not answer at the start does not stop the launch: the other nodes\n"
+               "               start, and that host's nodes start once it answers (the graph's wait_for_hosts: true)\n"
                "  --duration   stop every node cleanly after SECONDS\n"
                "  --set        override one option of one node for this run (e.g. --set pose_logger.file=run1.tum)\n";
 }
@@ -417,12 +513,13 @@ void usage() {
 int main(int argc, char** argv) {
   std::string graph_path, url;
   std::vector<std::string> sets;
-  bool check = false, skip_hosts = false;
+  bool check = false, skip_hosts = false, wait_for_hosts = false;
   double duration = 0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--check") check = true;
     else if (a == "--skip-hosts") skip_hosts = true;
+    else if (a == "--wait-for-hosts") wait_for_hosts = true;
     else if (a == "--duration" && i + 1 < argc) {
       // Strictly a number > 0: atof read "ten" or "nan" as 0, which ran the graph until Ctrl-C.
       const std::string v = argv[++i];
@@ -458,17 +555,42 @@ int main(int argc, char** argv) {
   // and by a launch alike (a launch with a missing plan ran every other node while the matcher died five times).
   if (g.tree) check_option_files(g, errors, /*skip_remote=*/!check);  // a launch: remote nodes' files are on their host
   if (g.tree) check_option_values(g, errors);
-  if (check && !skip_hosts && g.tree && errors.empty() && g.graph.host_size() > 0) {
+  // The hosts, by --check and by a launch alike (a launch used to start its remote nodes without asking, and they
+  // ended dead after five failed ssh sessions): one ssh round trip each. A host that does not answer is an error
+  // naming its nodes, unless the launch is to wait for it (--wait-for-hosts, Graph.wait_for_hosts).
+  wait_for_hosts = wait_for_hosts || (g.tree && g.graph.wait_for_hosts());
+  std::vector<std::pair<std::string, std::string>> hosts_down;  // host, why
+  std::vector<std::string> warnings;
+  if (!skip_hosts && g.tree && errors.empty() && g.graph.host_size() > 0) {
     std::vector<HostPlan> plans;
     for (const auto& [name, p] : host_plans(g.graph, self_bin_dir())) plans.push_back(*p);
     std::vector<std::pair<std::string, std::string>> host_exe;
+    std::map<std::string, std::vector<std::string>> nodes_on;
     for (const auto& rn : resolved) {
       const auto& n = g.graph.node(rn.index);
-      if (!n.disabled() && !n.host().empty())
-        host_exe.push_back({n.host(), rn.executable.empty() ? n.executable() : rn.executable});
+      if (n.disabled() || n.host().empty()) continue;
+      host_exe.push_back({n.host(), rn.executable.empty() ? n.executable() : rn.executable});
+      nodes_on[n.host()].push_back(n.name());
     }
-    for (const auto& p : check_hosts(g.graph, plans, host_exe, url))
-      errors.push_back({graph_path, 0, "host '" + p.host + "': " + p.message});
+    auto its_nodes = [&](const std::string& host) {  // "its nodes 'a', 'b'"
+      std::string s;
+      for (const auto& name : nodes_on[host]) s += (s.empty() ? "'" : ", '") + name + "'";
+      return (nodes_on[host].size() == 1 ? "its node " : "its nodes ") + s;
+    };
+    for (const auto& p : check_hosts(g.graph, plans, host_exe, url)) {
+      const std::string line = "host '" + p.host + "': " + p.message;
+      if (!p.unreachable) {
+        errors.push_back({graph_path, 0, line});
+      } else if (!check && wait_for_hosts) {
+        warnings.push_back(graph_path + ": warning: " + line + "; " + its_nodes(p.host) +
+                           " will start once it answers (waiting for hosts)");
+        hosts_down.push_back({p.host, p.message});
+      } else {
+        errors.push_back({graph_path, 0, line + "; " + its_nodes(p.host) + " cannot start" +
+                                             (check ? "" : " (--wait-for-hosts, or wait_for_hosts: true in the graph, "
+                                                           "starts the others and waits for it)")});
+      }
+    }
   }
   int enabled = 0;
   for (const auto& n : g.graph.node()) enabled += !n.disabled();
@@ -489,6 +611,7 @@ int main(int argc, char** argv) {
     std::cerr << graph_path << ": OK (" << enabled << " nodes)\n";
     return 0;
   }
+  for (const auto& w : warnings) std::cerr << w << "\n";
 
   if (::pipe2(g_sig_pipe, O_CLOEXEC | O_NONBLOCK) != 0) return 1;
   struct sigaction sa {};
@@ -501,7 +624,7 @@ int main(int argc, char** argv) {
   sigaction(SIGCHLD, &sa, nullptr);
   signal(SIGPIPE, SIG_IGN);
   try {
-    Launcher l(std::move(g), resolved, url, self_bin_dir(), sets);
+    Launcher l(std::move(g), resolved, url, self_bin_dir(), sets, hosts_down);
     return l.run(duration);
   } catch (const std::exception& e) {
     std::cerr << "fploc launch: " << e.what() << "\n";

@@ -17,6 +17,7 @@ const char* state_name(State s) {
     case State::Stopping: return "stopping";
     case State::Stopped: return "stopped";
     case State::Dead: return "dead";
+    case State::WaitingForHost: return "waiting";
   }
   return "?";
 }
@@ -52,12 +53,59 @@ void Supervisor::publish(size_t i, const std::string& state, const std::string& 
   fx_.publish(i, nodes_[i].pid, nodes_[i].restarts, state, error);
 }
 
+std::string Supervisor::nodes_waiting_on(const std::string& host) const {
+  std::string s;
+  int count = 0;
+  for (const auto& n : nodes_)
+    if (n.state == State::WaitingForHost && n.policy.host == host) {
+      s += (s.empty() ? "'" : ", '") + n.policy.name + "'";
+      ++count;
+    }
+  return (count == 1 ? "node " : "nodes ") + s;
+}
+
+std::string Supervisor::waiting_error(size_t i) const {
+  const auto& n = nodes_[i];
+  const auto h = hosts_.find(n.policy.host);
+  if (n.host_confirmed && h != hosts_.end())
+    return "waiting for host '" + n.policy.host + "': " + h->second.why;
+  return "checking host '" + n.policy.host + "' after: " + (n.hung ? "hung, " : "") + n.wait_why;
+}
+
+void Supervisor::host_down_at_start(const std::string& host, const std::string& why, double t) {
+  auto& h = hosts_[host];
+  h.down = true;
+  h.down_since = t;
+  h.why = why;
+  h.delay = cfg_.host_probe_initial_s;
+  h.next_probe = t + h.delay;
+}
+
 void Supervisor::start_all(double t) {
-  for (size_t i = 0; i < nodes_.size(); ++i) start(i, t);
+  for (size_t i = 0; i < nodes_.size(); ++i) {
+    auto& n = nodes_[i];
+    const auto h = hosts_.find(n.policy.host);
+    if (n.policy.host.empty() || h == hosts_.end() || !h->second.down) {
+      start(i, t);
+      continue;
+    }
+    n.state = State::WaitingForHost;
+    n.host_confirmed = true;
+    n.wait_since = t;
+    n.wait_ran = 0;
+    n.wait_why = "not started";
+    publish(i, "waiting", waiting_error(i));
+  }
+  for (const auto& [name, h] : hosts_)
+    if (h.down)
+      fx_.log("host '" + name + "' " + h.why + ": " + nodes_waiting_on(name) + " waiting for host '" + name +
+              "'; probing it in " + fmt2(h.delay) + " s, then with backoff (at most every " +
+              fmt2(cfg_.host_probe_max_s) + " s)");
 }
 
 void Supervisor::start(size_t i, double t) {
   auto& n = nodes_[i];
+  n.ever_started = true;
   const pid_t pid = fx_.start(i, n.restarts);
   n.started_at = t;
   if (pid <= 0) {
@@ -112,6 +160,8 @@ void Supervisor::rank_for_shutdown() {
 // at most shutdown_timeout_s + 1 s in all.
 void Supervisor::begin_shutdown(double t) {
   if (shutting_down_) return;
+  for (const auto& n : nodes_)
+    if (n.state == State::WaitingForHost) waiting_at_shutdown_.push_back(n.policy.name);
   shutting_down_ = true;
   shutdown_started_ = t;
   stop_rank_ = -1;
@@ -244,18 +294,108 @@ bool Supervisor::on_exit(pid_t pid, const ExitStatus& st, double t) {
       fx_.log("node '" + n.policy.name + "' " + how);
       return true;
     }
-    const auto d = n.tracker.on_exit(t, t - n.started_at, failed);
-    if (!d.restart && !d.give_up) {
-      fx_.log("node '" + n.policy.name + "' " + how + (failed ? " (restart policy: not restarted)" : ""));
-      n.state = failed ? State::Dead : State::Stopped;
-      if (failed) died_.push_back(n.policy.name);
-      publish(i, failed ? "dead" : "stopped", how);
-    } else {
-      apply_restart(i, d, (n.hung ? "hung, " : "") + how, t);
+    // A remote node's session ended with ssh's own failure code (connection refused, timed out or lost), or the
+    // node went silent: its host may be away. That is found out (a probe) before the restart budget is spent.
+    if (failed && n.policy.remote && !n.policy.host.empty() && (n.hung || (st.exited && st.code == 255))) {
+      wait_for_host(i, how, t - n.started_at, t);
+      return true;
     }
+    settle_exit(i, failed, how, t, t - n.started_at, t);
     return true;
   }
   return false;
+}
+
+void Supervisor::settle_exit(size_t i, bool failed, const std::string& how, double t_exit, double ran_s, double t) {
+  auto& n = nodes_[i];
+  const auto d = n.tracker.on_exit(t_exit, ran_s, failed);
+  if (!d.restart && !d.give_up) {
+    fx_.log("node '" + n.policy.name + "' " + how + (failed ? " (restart policy: not restarted)" : ""));
+    n.state = failed ? State::Dead : State::Stopped;
+    if (failed) died_.push_back(n.policy.name);
+    publish(i, failed ? "dead" : "stopped", how);
+  } else {
+    apply_restart(i, d, (n.hung ? "hung, " : "") + how, t);
+  }
+}
+
+void Supervisor::wait_for_host(size_t i, const std::string& how, double ran_s, double t) {
+  auto& n = nodes_[i];
+  auto& h = hosts_[n.policy.host];
+  n.state = State::WaitingForHost;
+  n.wait_since = t;
+  n.wait_ran = ran_s;
+  n.wait_why = how;
+  n.host_confirmed = h.down;
+  const std::string what = "node '" + n.policy.name + "' " + (n.hung ? "hung, " : "") + how;
+  if (h.down) {
+    fx_.log(what + ": host '" + n.policy.host + "' " + h.why + ": waiting for host '" + n.policy.host + "'");
+  } else {
+    fx_.log(what + ": checking whether host '" + n.policy.host + "' answers (if not, the node waits for it)");
+    if (!h.probing) h.next_probe = t;
+  }
+  publish(i, "waiting", waiting_error(i));
+  if (!h.probing && t >= h.next_probe) {
+    h.probing = true;
+    fx_.probe_host(n.policy.host);
+  }
+}
+
+void Supervisor::on_host_probe(const std::string& host, bool reachable, const std::string& why, double t) {
+  const auto it = hosts_.find(host);
+  if (it == hosts_.end()) return;
+  auto& h = it->second;
+  h.probing = false;
+  if (shutting_down_) return;
+  std::vector<size_t> waiting;
+  for (size_t i = 0; i < nodes_.size(); ++i)
+    if (nodes_[i].state == State::WaitingForHost && nodes_[i].policy.host == host) waiting.push_back(i);
+  if (reachable) {
+    const bool was_down = h.down;
+    const double away = t - h.down_since;
+    h = HostWatch{};
+    std::vector<size_t> back;
+    for (size_t i : waiting) {
+      auto& n = nodes_[i];
+      if (n.host_confirmed) {
+        back.push_back(i);
+        continue;
+      }
+      // The host answered at once: the session's failure was the node's own, charged as any other.
+      fx_.log("host '" + host + "' answers: node '" + n.policy.name + "' failed on its own");
+      settle_exit(i, true, n.wait_why, n.wait_since, n.wait_ran, t);
+    }
+    if (was_down && !back.empty()) {
+      std::string names;
+      for (size_t i : back) names += (names.empty() ? "'" : ", '") + nodes_[i].policy.name + "'";
+      fx_.log("host '" + host + "' answers again (away for " + fmt2(away) + " s): starting " + names);
+    }
+    for (size_t i : back) {
+      auto& n = nodes_[i];
+      if (n.ever_started) ++n.restarts;  // FPLOC_RESTARTS: a node that ran before is a restarted one
+      start(i, t);
+    }
+    return;
+  }
+  if (!h.down) {
+    h.down = true;
+    h.down_since = t;
+    for (size_t i : waiting) h.down_since = std::min(h.down_since, nodes_[i].wait_since);
+    h.delay = 0;
+  }
+  const bool news = why != h.why;
+  h.why = why;
+  h.delay = h.delay > 0 ? std::min(h.delay * 2, cfg_.host_probe_max_s) : cfg_.host_probe_initial_s;
+  h.next_probe = t + h.delay;
+  for (size_t i : waiting)
+    if (!nodes_[i].host_confirmed) {
+      nodes_[i].host_confirmed = true;
+      publish(i, "waiting", waiting_error(i));
+    }
+  if (news && !waiting.empty())
+    fx_.log("host '" + host + "' " + why + ": " + nodes_waiting_on(host) + " waiting for host '" + host +
+            "'; probing it again in " + fmt2(h.delay) + " s, then with backoff (at most every " +
+            fmt2(cfg_.host_probe_max_s) + " s)");
 }
 
 void Supervisor::apply_restart(size_t i, const fploc::rt::RestartDecision& d, const std::string& why, double t) {
@@ -296,6 +436,21 @@ void Supervisor::request_restart(size_t i, double t) {
 
 void Supervisor::tick(double t) {
   if (shutting_down_) advance_shutdown(t);
+  // Hosts that nodes wait for: probed with backoff (the answer comes through on_host_probe). A host nobody
+  // waits for any more (its nodes stopped on request) is forgotten: a later failure probes it afresh.
+  for (auto& [name, h] : hosts_) {
+    if (shutting_down_ || h.probing) continue;
+    const bool waited_for = std::any_of(nodes_.begin(), nodes_.end(), [&](const Run& n) {
+      return n.state == State::WaitingForHost && n.policy.host == name;
+    });
+    if (!waited_for) {
+      h = HostWatch{};
+      continue;
+    }
+    if (t < h.next_probe) continue;
+    h.probing = true;
+    fx_.probe_host(name);
+  }
   for (size_t i = 0; i < nodes_.size(); ++i) {
     auto& n = nodes_[i];
     if (n.state == State::Stopping) escalate(i, t);
@@ -308,6 +463,8 @@ void Supervisor::tick(double t) {
     for (size_t i = 0; i < nodes_.size(); ++i)
       if (nodes_[i].state == State::Dead || nodes_[i].state == State::Backoff)
         publish(i, state_name(nodes_[i].state), "");
+      else if (nodes_[i].state == State::WaitingForHost)
+        publish(i, "waiting", waiting_error(i));
   }
 }
 
@@ -327,6 +484,7 @@ std::optional<int> Supervisor::finished() {
     };
     std::string how;
     if (!died_.empty()) how += "; dead during the run: " + names(died_);
+    if (!waiting_at_shutdown_.empty()) how += "; still waiting for their host: " + names(waiting_at_shutdown_);
     if (!killed_.empty()) how += "; killed: " + names(killed_);
     fx_.log("all nodes stopped" + how + (how.empty() ? "" : " (exit code 1)"));
     for (size_t i = 0; i < nodes_.size(); ++i) publish(i, "stopped", "");

@@ -7,6 +7,7 @@
 #include <sys/types.h>
 
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,7 +17,10 @@
 
 namespace fploc::launch {
 
-enum class State { Starting, Running, Backoff, Stopping, Stopped, Dead };
+// WaitingForHost: a remote node whose ssh session failed in a way its host's absence explains (ssh's own exit
+// code 255: connection refused, timed out or lost; or silence) while the host does not answer a probe. It
+// spends no restart budget; the supervisor probes the host with backoff and starts the node when it answers.
+enum class State { Starting, Running, Backoff, Stopping, Stopped, Dead, WaitingForHost };
 const char* state_name(State s);
 
 // What the supervisor needs to know of one node of the graph.
@@ -32,6 +36,7 @@ struct NodePolicy {
   // seconds (slow rc files, a loaded host), so until then the session-start bound applies, not the
   // heartbeat grace.
   bool remote = false;
+  std::string host;  // Graph.host name of a remote node (what its waits and probes are about)
 };
 
 // How a process ended (from waitpid).
@@ -54,6 +59,9 @@ class Effects {
   // node_status_t with reporter "launcher".
   virtual void publish(size_t i, pid_t pid, int restarts, const std::string& state, const std::string& error) = 0;
   virtual void log(const std::string& line) = 0;
+  // Contacts `host` (a fresh ssh connection, not the multiplexed one) without blocking; the answer comes back
+  // through Supervisor::on_host_probe.
+  virtual void probe_host(const std::string& host) = 0;
 };
 
 struct SupervisorConfig {
@@ -61,7 +69,11 @@ struct SupervisorConfig {
   double stage_gap_s = 0.25;        // graph-wide stop: next rank after this even if the previous still runs
   double first_beat_grace_s = 10.0; // until its first heartbeat a node may be loading (maps)
   double remote_start_s = 60.0;     // a remote node's ssh session must start the node within this
-  double report_period_s = 1.0;     // dead/restarting nodes are re-published this often
+  double report_period_s = 1.0;     // dead/restarting/waiting nodes are re-published this often
+  // A host its nodes wait for is probed after host_probe_initial_s, then twice as long each time it does not
+  // answer, at most every host_probe_max_s.
+  double host_probe_initial_s = 0.5;
+  double host_probe_max_s = 2.0;  // + ssh's ConnectTimeout (3 s) while the host is silent
   std::vector<std::string> ignored_channels;  // telemetry/control: not part of the stop order
 };
 
@@ -70,7 +82,12 @@ class Supervisor {
   Supervisor(std::vector<NodePolicy> nodes, SupervisorConfig cfg, Effects& fx);
 
   // ---- inputs
+  // Before start_all: `host` did not answer the launch's check (the graph or the command line asked to wait for
+  // it): start_all leaves its nodes waiting for it. `why`: the check's message.
+  void host_down_at_start(const std::string& host, const std::string& why, double t);
   void start_all(double t);
+  // The answer to Effects::probe_host: the host answered (ssh ran a command there), or not (`why`).
+  void on_host_probe(const std::string& host, bool reachable, const std::string& why, double t);
   // A process ended (reaped). Returns false when the pid is not one of ours.
   bool on_exit(pid_t pid, const ExitStatus& st, double t);
   // The far end of remote node i started the node process (fploc-remote reported its pid): the
@@ -102,6 +119,10 @@ class Supervisor {
   int restarts(size_t i) const { return nodes_[i].restarts; }
   int stop_rank(size_t i) const { return nodes_[i].stop_rank; }
   std::optional<size_t> find(const std::string& name) const;
+  // The host node i waits for ("" when it does not wait).
+  std::string waiting_for(size_t i) const {
+    return nodes_[i].state == State::WaitingForHost ? nodes_[i].policy.host : std::string();
+  }
   // The node now runs another executable (control request): is it heartbeat-supervised?
   void set_supervised(size_t i, bool s) { nodes_[i].policy.supervised = s; }
 
@@ -117,6 +138,20 @@ class Supervisor {
     bool restart_after_stop = false, hung = false;
     bool remote_started = false;  // remote nodes: the far end has started the node process
     int stop_rank = 0;
+    bool ever_started = false;
+    // WaitingForHost: since when, and the failure that led there. Until a probe has found the host away
+    // (host_confirmed) the failure may still be the node's own: if the host answers at once, it is charged to
+    // the restart policy as any other.
+    bool host_confirmed = false;
+    double wait_since = 0, wait_ran = 0;
+    std::string wait_why;
+  };
+  // A host that nodes wait for.
+  struct HostWatch {
+    bool down = false;        // the last probe (or the launch's check) did not reach it
+    bool probing = false;     // a probe is under way
+    double next_probe = 0, delay = 0, down_since = 0;
+    std::string why;          // what the last failed probe said
   };
   void start(size_t i, double t);
   void begin_stop(size_t i, bool restart_after, double t);
@@ -127,11 +162,19 @@ class Supervisor {
   void advance_shutdown(double t);
   void rank_for_shutdown();
   void publish(size_t i, const std::string& state, const std::string& error);
+  // A failed exit of node i (ended at t_exit after running ran_s): restart with backoff, or dead, or stopped.
+  void settle_exit(size_t i, bool failed, const std::string& how, double t_exit, double ran_s, double t);
+  void wait_for_host(size_t i, const std::string& why, double ran_s, double t);
+  std::string waiting_error(size_t i) const;
+  std::string nodes_waiting_on(const std::string& host) const;
 
   std::vector<Run> nodes_;
   // What makes the launcher's exit code 1 after a shutdown: nodes given up on (dead) during the run, and nodes that
   // had to be killed (SIGKILL: they ignored SIGINT and SIGTERM, or a second Ctrl-C) -- a script must notice both.
   std::vector<std::string> died_, killed_;
+  // Nodes still waiting for their host when the shutdown began: they did not run, and the exit code says so.
+  std::vector<std::string> waiting_at_shutdown_;
+  std::map<std::string, HostWatch> hosts_;
   SupervisorConfig cfg_;
   Effects& fx_;
   bool transport_ok_ = false, transport_warned_ = false;

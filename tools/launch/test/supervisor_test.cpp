@@ -1,5 +1,5 @@
 // The launcher's supervision policy with a fake clock and fake processes: restart policy and backoff,
-// giving up, heartbeat timeout, ordered shutdown with escalation, control requests.
+// giving up, heartbeat timeout, ordered shutdown with escalation, control requests, remote nodes whose host is away.
 #include "supervisor.h"
 #include "udp_links.h"
 
@@ -19,6 +19,8 @@ struct FakeWorld : Effects {
   std::vector<std::pair<size_t, pid_t>> starts;           // node, pid
   std::vector<std::tuple<size_t, pid_t, int>> signals;    // node, pid, signal
   std::vector<std::pair<size_t, std::string>> published;  // node, state
+  std::vector<std::string> published_errors;              // the same reports' last_error
+  std::vector<std::string> probes;                        // hosts probed, in order
   std::vector<std::string> logs;
   std::map<size_t, int> start_restarts;
   double now = 0;
@@ -32,9 +34,11 @@ struct FakeWorld : Effects {
     return next_pid++;
   }
   void signal(size_t i, pid_t pid, int sig) override { signals.push_back({i, pid, sig}); }
-  void publish(size_t i, pid_t, int, const std::string& state, const std::string&) override {
+  void publish(size_t i, pid_t, int, const std::string& state, const std::string& error) override {
     published.push_back({i, state});
+    published_errors.push_back(error);
   }
+  void probe_host(const std::string& host) override { probes.push_back(host); }
   void log(const std::string& l) override { logs.push_back(l); }
   // The signals (other than the SIGKILL to the group after an exit) sent to node i, in order.
   std::vector<int> signals_to(size_t i) const {
@@ -50,6 +54,13 @@ NodePolicy node(const std::string& name, fploc::RestartPolicy::Mode mode = fploc
   p.name = name;
   p.restart.set_mode(mode);
   p.supervised = true;
+  return p;
+}
+
+NodePolicy remote(const std::string& name, const std::string& host) {
+  NodePolicy p = node(name);
+  p.remote = true;
+  p.host = host;
   return p;
 }
 
@@ -406,4 +417,196 @@ TEST(Supervisor, ANodeRevivedByAControlRestartNoLongerCountsAsDead) {
   s.on_exit(s.pid(0), code(0), 5.4);
   s.on_exit(s.pid(1), code(0), 5.4);
   EXPECT_EQ(s.finished(), std::optional<int>(0));
+}
+
+// ---- Remote nodes whose host is away (the user trial: a host that did not answer made its nodes fail five times
+// and end dead, and nothing started them again once it was back).
+
+const std::string kAway = "not reachable with ssh (10.0.0.2 as root): ssh: connect to host 10.0.0.2 port 22: No route to host";
+
+// A remote node's ssh session ends with ssh's own code (255) and the host does not answer: the node waits for the
+// host, spends no restart, is probed with backoff and starts again when the host answers -- outage after outage,
+// more of them than the restart policy allows restarts.
+TEST(Supervisor, ARemoteNodeWaitsForItsHostWithoutSpendingItsRestarts) {
+  FakeWorld w;
+  auto p = remote("matcher", "compute");
+  p.restart.set_max_restarts(2);
+  p.restart.set_window_s(600);
+  p.restart.set_backoff_initial_s(0.1);
+  SupervisorConfig cfg;
+  cfg.host_probe_initial_s = 0.5;
+  cfg.host_probe_max_s = 4;
+  Supervisor s({p}, cfg, w);
+  s.start_all(0);
+  double t = 10;
+  for (int outage = 0; outage < 4; ++outage) {
+    const size_t probes_before = w.probes.size();
+    ASSERT_TRUE(s.on_exit(s.pid(0), code(255), t));
+    EXPECT_EQ(s.state(0), State::WaitingForHost);
+    EXPECT_EQ(s.waiting_for(0), "compute");
+    ASSERT_EQ(w.probes.size(), probes_before + 1) << "the host is probed at once";
+    EXPECT_EQ(w.published.back().second, "waiting");
+    // The probe does not get there: the node waits for the host (said in the log and in its telemetry).
+    s.on_host_probe("compute", false, kAway, t + 3);
+    EXPECT_EQ(s.state(0), State::WaitingForHost);
+    EXPECT_NE(w.published_errors.back().find("waiting for host 'compute': " + kAway), std::string::npos)
+        << w.published_errors.back();
+    EXPECT_NE(w.logs.back().find("host 'compute' " + kAway + ": node 'matcher' waiting for host 'compute'"),
+              std::string::npos) << w.logs.back();
+    // Probes with backoff: 0.5, 1, 2, 4, 4, ... s after each failed answer (an answer takes 0.1 s here).
+    double at = t + 3;
+    for (double gap : {0.5, 1.0, 2.0, 4.0, 4.0, 4.0}) {
+      const size_t n = w.probes.size();
+      s.tick(at + gap - 0.01);
+      EXPECT_EQ(w.probes.size(), n) << "probed before its backoff of " << gap << " s";
+      s.tick(at + gap);
+      ASSERT_EQ(w.probes.size(), n + 1) << "not probed after " << gap << " s";
+      s.tick(at + gap + 0.05);
+      EXPECT_EQ(w.probes.size(), n + 1) << "a second probe while one is under way";
+      at += gap + 0.1;
+      s.on_host_probe("compute", false, kAway, at);
+    }
+    EXPECT_EQ(s.state(0), State::WaitingForHost);
+    EXPECT_EQ(s.restarts(0), outage) << "a restart spent while the host was away";
+    // The host answers: the node starts at once, as a restart (FPLOC_RESTARTS), its budget untouched.
+    const size_t starts = w.starts.size();
+    s.tick(at + 4);
+    s.on_host_probe("compute", true, "", at + 4.1);
+    ASSERT_EQ(w.starts.size(), starts + 1);
+    EXPECT_EQ(s.state(0), State::Running);
+    EXPECT_EQ(s.restarts(0), outage + 1);
+    EXPECT_EQ(w.start_restarts[0], outage + 1);
+    EXPECT_NE(w.logs.back().find("host 'compute' answers again"), std::string::npos) << w.logs.back();
+    t = at + 20;
+  }
+  // Its two restarts are still there for its own crashes.
+  for (int k = 0; k < 2; ++k) {
+    s.on_exit(s.pid(0), code(1), t);
+    ASSERT_EQ(s.state(0), State::Backoff);
+    s.tick(t + 1);
+    ASSERT_EQ(s.state(0), State::Running);
+    t += 2;
+  }
+  s.on_exit(s.pid(0), code(1), t);
+  EXPECT_EQ(s.state(0), State::Dead);
+}
+
+// ssh's code 255 is also what a node itself may exit with (exit(-1)). When the host answers the probe at once, the
+// failure is the node's own: charged to the restart policy, and a node that keeps failing ends dead as before.
+TEST(Supervisor, ARemoteNodeFailingOnAReachableHostStillEndsDead) {
+  FakeWorld w;
+  auto p = remote("crasher", "compute");
+  p.restart.set_max_restarts(3);
+  p.restart.set_window_s(60);
+  p.restart.set_backoff_initial_s(0.1);
+  p.restart.set_backoff_factor(1);
+  Supervisor s({p}, {}, w);
+  s.start_all(0);
+  double t = 1;
+  for (int k = 0; k < 3; ++k) {
+    s.on_exit(s.pid(0), code(255), t);
+    ASSERT_EQ(s.state(0), State::WaitingForHost);
+    s.on_host_probe("compute", true, "", t + 0.05);
+    ASSERT_EQ(s.state(0), State::Backoff) << "restart " << k;
+    EXPECT_NE(std::find_if(w.logs.begin(), w.logs.end(),
+                           [](const std::string& l) { return l.find("failed on its own") != std::string::npos; }),
+              w.logs.end());
+    s.tick(t + 0.2);
+    ASSERT_EQ(s.state(0), State::Running);
+    t += 0.5;
+  }
+  s.on_exit(s.pid(0), code(255), t);
+  s.on_host_probe("compute", true, "", t + 0.05);
+  EXPECT_EQ(s.state(0), State::Dead);
+  EXPECT_EQ(w.published.back().second, "dead");
+  EXPECT_EQ(s.finished(), std::optional<int>(1));
+  // A crash that is not ssh's (a signal, another code) is not a reason to ask the host.
+  FakeWorld w2;
+  Supervisor s2({remote("r", "compute")}, {}, w2);
+  s2.start_all(0);
+  s2.on_exit(s2.pid(0), killed(SIGSEGV), 1);
+  EXPECT_EQ(s2.state(0), State::Backoff);
+  EXPECT_TRUE(w2.probes.empty());
+}
+
+// The launch's check did not reach a host and the launch is to wait for it: the other nodes start, the host's nodes
+// wait; when the host answers they start as first starts (FPLOC_RESTARTS=0). Nodes of one host share its probes.
+TEST(Supervisor, AHostAwayAtTheStartLeavesItsNodesWaitingAndTheOthersRunning) {
+  FakeWorld w;
+  SupervisorConfig cfg;
+  cfg.host_probe_initial_s = 0.5;
+  Supervisor s({node("local"), remote("a", "compute"), remote("b", "compute"), remote("c", "dash")}, cfg, w);
+  s.host_down_at_start("compute", kAway, 0);
+  s.start_all(0);
+  ASSERT_EQ(w.starts.size(), 2u);
+  EXPECT_EQ(s.state(0), State::Running);
+  EXPECT_EQ(s.state(1), State::WaitingForHost);
+  EXPECT_EQ(s.state(2), State::WaitingForHost);
+  EXPECT_EQ(s.state(3), State::Running);
+  EXPECT_NE(std::find(w.logs.begin(), w.logs.end(),
+                      "host 'compute' " + kAway + ": nodes 'a', 'b' waiting for host 'compute'; probing it in 0.50 s, "
+                      "then with backoff (at most every 2.00 s)"),
+            w.logs.end()) << w.logs.back();
+  s.tick(0.49);
+  EXPECT_TRUE(w.probes.empty());
+  s.tick(0.5);
+  ASSERT_EQ(w.probes, std::vector<std::string>{"compute"});
+  s.tick(1.0);
+  EXPECT_EQ(w.probes.size(), 1u) << "one probe per host, not per node";
+  EXPECT_FALSE(s.finished());
+  s.on_host_probe("compute", true, "", 1.2);
+  ASSERT_EQ(w.starts.size(), 4u);
+  EXPECT_EQ(s.state(1), State::Running);
+  EXPECT_EQ(s.state(2), State::Running);
+  EXPECT_EQ(w.start_restarts[1], 0);
+  EXPECT_EQ(s.restarts(1), 0);
+}
+
+// The cut link is often noticed first as silence (no heartbeat): a remote node killed as hung asks its host too.
+TEST(Supervisor, ASilentRemoteNodeWhoseHostIsAwayWaitsForIt) {
+  FakeWorld w;
+  auto p = remote("r", "compute");
+  p.heartbeat_timeout_s = 3;
+  Supervisor s({p}, {}, w);
+  s.start_all(0);
+  s.on_transport_ok();
+  s.on_remote_started(0, 0.5);
+  const pid_t pid = s.pid(0);
+  s.on_heartbeat("r", pid, 1);
+  s.tick(4.1);
+  ASSERT_EQ(s.state(0), State::Stopping);  // hung: SIGKILL
+  s.on_exit(pid, killed(SIGKILL), 4.2);
+  EXPECT_EQ(s.state(0), State::WaitingForHost);
+  ASSERT_EQ(w.probes.size(), 1u);
+  EXPECT_NE(w.published_errors.back().find("checking host 'compute' after: hung, killed by signal 9"), std::string::npos)
+      << w.published_errors.back();
+  s.on_host_probe("compute", false, kAway, 7.2);
+  EXPECT_EQ(s.state(0), State::WaitingForHost);
+  s.on_host_probe("compute", true, "", 12);
+  EXPECT_EQ(s.state(0), State::Running);
+  EXPECT_EQ(s.restarts(0), 1);
+}
+
+// A node waiting for its host: re-reported every second, stopped by a control request (probes end), and at a
+// shutdown it counts, like a dead node, for the exit code 1 (it did not run).
+TEST(Supervisor, AWaitingNodeIsReportedStoppableAndMakesTheExitCodeOne) {
+  FakeWorld w;
+  Supervisor s({node("local"), remote("a", "compute"), remote("b", "compute")}, {}, w);
+  s.host_down_at_start("compute", kAway, 0);
+  s.start_all(0);
+  w.published.clear();
+  s.tick(1.1);
+  EXPECT_NE(std::find(w.published.begin(), w.published.end(), std::make_pair(size_t(1), std::string("waiting"))),
+            w.published.end());
+  s.request_stop(2, 1.5);
+  EXPECT_EQ(s.state(2), State::Stopped);
+  EXPECT_EQ(s.waiting_for(2), "");
+  s.on_host_probe("compute", false, kAway, 1.6);
+  s.begin_shutdown(5);
+  s.on_exit(s.pid(0), code(0), 5.1);
+  EXPECT_EQ(s.finished(), std::optional<int>(1));
+  EXPECT_EQ(w.logs.back(), "all nodes stopped; still waiting for their host: 'a' (exit code 1)");
+  const size_t probes = w.probes.size();
+  s.tick(30);
+  EXPECT_EQ(w.probes.size(), probes) << "probing during the shutdown";
 }
