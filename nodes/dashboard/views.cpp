@@ -144,6 +144,9 @@ std::string nodes_view(const std::map<std::string, NodeRow>& rows, double silent
       char b[64];
       std::snprintf(b, sizeof b, "silent for %.1f s", age);
       reason = b;
+    } else if (s.state == "waiting") {  // the launcher: a remote node waiting for its host ("waiting for host 'H': ...")
+      health = "bad";
+      reason = s.last_error.empty() ? "waiting for its host (launcher)" : s.last_error;
     } else if (s.state == "restarting" || s.state == "dead" || s.state == "hung" || s.state == "stopped") {
       health = "bad";
       reason = s.state + " (" + s.reporter + ")";

@@ -100,6 +100,23 @@ TEST(DashboardModel, NodeTurnsRedWhenSilentOrRestartingAndGreenAgain) {
   EXPECT_EQ(health(), "bad");
 }
 
+// The launcher reports a remote node whose host is away as "waiting" with the host in last_error: a red row
+// that names the host (it was "warn" with the bare word "waiting").
+TEST(DashboardModel, ANodeWaitingForItsHostIsRedAndNamesTheHost) {
+  Model m;
+  fploc::node_status_t s{};
+  s.node = "matcher";
+  s.state = "waiting";
+  s.reporter = "launcher";
+  s.last_error = "waiting for host 'compute': not reachable with ssh (10.0.0.2): ssh: connect to host 10.0.0.2 port 22: "
+                 "No route to host";
+  m.on_status(s, 1.0);
+  const auto n = json::parse(m.state_json())["nodes"]["nodes"][0];
+  EXPECT_EQ(n["health"], "bad");
+  EXPECT_EQ(n["state"], "waiting");
+  EXPECT_EQ(n["reason"], s.last_error);
+}
+
 static fploc::port_stats_t input(const std::string& port, double rate_hz, double p50, double p99) {
   fploc::port_stats_t p{};
   p.port = port;
