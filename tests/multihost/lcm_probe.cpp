@@ -1,9 +1,13 @@
 // Test-only LCM probe for the network test: records when scans and poses arrive on this host (wall clock,
 // which every network namespace of one machine shares) and the last telemetry of every node.
 //   fploc-test-lcm-probe --url URL --out FILE --duration S [--scan CH] [--pose CH] [--final CH] [--telemetry CH]...
+//                        [--states CH]...
 // --pose: the per-scan estimate (FPLOC_POSE_LATEST); --final: poses leaving the optimizer's window.
 // Lines: "scan UTIME RX_US", "pose UTIME RX_US", "final UTIME RX_US",
 //        "status CHANNEL NODE ROBOT HOST REPORTER in=N out=N undecodable=N port=CHANNEL:MESSAGES ..."
+//        (the last one of each node, at the end), and with --states every node_status_t as it arrives
+//        (written at once, for scripts reading the file during the run):
+//        "state RX_US NODE REPORTER STATE RESTARTS | LAST_ERROR"
 #include <fploc/node_status_t.hpp>
 #include <fploc/pose_t.hpp>
 #include <fploc/scan_t.hpp>
@@ -63,12 +67,17 @@ int main(int argc, char** argv) {
         if (!p.output) s += " port=" + p.channel + ":" + std::to_string(p.messages);
       if (m->reporter == "node") (*st)[ch + " " + m->node] = s;
     }
+    void state(const lcm::ReceiveBuffer*, const std::string&, const fploc::node_status_t* m) {
+      *f << "state " << wall_us() << " " << m->node << " " << m->reporter << " " << m->state << " " << m->restarts
+         << " | " << m->last_error << std::endl;
+    }
   } h{&f, &last_status};
   for (const auto& [kind, ch] : subs) {
     if (kind == "--scan") lc.subscribe(ch, &H::scan, &h);
     else if (kind == "--pose") lc.subscribe(ch, &H::pose, &h);
     else if (kind == "--final") lc.subscribe(ch, &H::final_pose, &h);
     else if (kind == "--telemetry") lc.subscribe(ch, &H::status, &h);
+    else if (kind == "--states") lc.subscribe(ch, &H::state, &h);
   }
   const auto t0 = std::chrono::steady_clock::now();
   while (!g_stop && std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() < duration)

@@ -5,7 +5,7 @@
 # a temp dir. Everything runs inside `unshare -n -m`: no address or route outside the test's namespaces.
 # Measures and checks: the three-host graph against the same graph on one host (poses, ATE), latency scan
 # (driver host) -> pose (dashboard host), no cross-talk between robots r1 and r2, kill -9 of a remote node,
-# a cut ssh link, Ctrl-C. Skips (exit 77) without root, unshare, ip or sshd.
+# a cut ssh link and its return (the compute nodes run again), Ctrl-C. Skips (exit 77) without root, unshare, ip or sshd.
 set -euo pipefail
 BIN="${FPLOC_BUILD_DIR:?}/bin"
 ROOT="${FPLOC_ROOT:?}"
@@ -168,8 +168,21 @@ echo "ssh link cut: launcher reported it after ${said:-never} s, compute nodes g
 [ -n "$said" ] || FAIL "the launcher did not report the lost ssh connection"
 [ -n "$gone" ] && within "$gone" 5 "cut link -> remote nodes gone" || FAIL "compute nodes not gone within 10 s"
 grep -m3 "ssh connection lost\|fploc-remote" "$T/mh.log" || true
+# The link is back: the compute nodes run again (they waited for their host, or were restarted), before the Ctrl-C
+# (a node still waiting for its host at the stop makes the launcher exit 1, as a dead one).
+t0=$(date +%s.%N)
 ip link set v-compute up
-sleep 3
+back=""
+for i in $(seq 400); do
+  if [ "$(pgrep -f -- "^$BIN/fploc-[a-z0-9-]+ --graph $T/mh.pbtxt --node ($cmp_nodes)" | wc -l)" = 5 ]; then
+    back=$(python3 -c "import time,sys; print(f'{time.time()-float(sys.argv[1]):.2f}')" "$t0"); break
+  fi
+  sleep 0.05
+done
+echo "link back: the five compute nodes running again after ${back:-never} s"
+[ -n "$back" ] || FAIL "the compute nodes did not run again within 20 s of the link coming back"
+grep "host 'compute'" "$T/mh.log" | grep -v "started: on host" | tail -n +2 | head -6 || true
+sleep 1
 
 # ---- Ctrl-C: nothing of the graph left on any host within 5 s
 t0=$(date +%s.%N)
