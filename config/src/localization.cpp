@@ -68,6 +68,8 @@ matcher::MatcherConfig config_of(const MatcherOptions& o) {
   if (o.prediction_sigma_deg() != 0) c.prediction_sigma_rad = std::max(0.0, o.prediction_sigma_deg()) * kRadPerDeg;
   if (o.odom_gate_sigmas() != 0) c.odom_gate_sigmas = std::max(0.0, o.odom_gate_sigmas());
   if (o.max_speed_mps() != 0) c.max_speed_mps = std::max(0.0, o.max_speed_mps());
+  if (o.gap_s() != 0) c.gap_s = std::max(0.0, o.gap_s());
+  if (given(o.gap_max_search_m(), "matcher", "gap_max_search_m")) c.gap_max_search_m = o.gap_max_search_m();
   c.as_built = as_built_of(o, "matcher");
   return c;
 }

@@ -108,7 +108,7 @@ TEST(ConfigDefaults, Matcher) {
          {"as_built_loss_scale_m", c.as_built.loss_scale_m}, {"element_quota", c.element_quota},
          {"as_built_max_spread_sigmas", c.as_built.max_spread_sigmas},
          {"as_built_max_askew_m", c.as_built.max_askew_m}, {"askew_max_m", c.askew_max_m},
-         {"max_speed_mps", c.max_speed_mps}});
+         {"max_speed_mps", c.max_speed_mps}, {"gap_s", c.gap_s}, {"gap_max_search_m", c.gap_max_search_m}});
 }
 
 TEST(ConfigDefaults, Optimizer) {

@@ -23,7 +23,7 @@ using google::protobuf::Message;
 // BLOCK.FIELD that take a negative value on purpose (documented in the proto) or are signed quantities.
 const std::set<std::string> kSigned = {
     "matcher.max_points", "matcher.prediction_sigma_m", "matcher.prediction_sigma_deg", "matcher.odom_gate_sigmas",
-    "matcher.max_speed_mps", "relocalizer.max_speed_mps",
+    "matcher.max_speed_mps", "matcher.gap_s", "relocalizer.max_speed_mps",
     "matcher.plan_diff_weight", "matcher.as_built_loss_scale_m", "optimizer.max_points",
     "optimizer.keyframe_interval_s", "optimizer.max_final_delay_s", "optimizer.plan_diff_weight",
     "optimizer.as_built_loss_scale_m", "grid2d.confirm_within_sigmas", "grid2d.far_confirm_travel_m",

@@ -9,6 +9,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -42,9 +43,9 @@ int main(int argc, char** argv) {
   CLI::App app{"fploc sim: simulate an OS-1-64 + IMU sequence into an LCM log and a TUM ground truth"};
   std::string plan_file, scenario, out, gt, units, metadata, beams, demo_dir, floor, world_file, perturb, truth, gt_floors,
       demo_building_dir, ceilings_building;
-  std::vector<std::string> layers;
+  std::vector<std::string> layers, gaps;
   uint64_t seed = 0;
-  bool no_clutter = false, no_patches = false, json = false, no_thresholds = false;
+  bool no_clutter = false, no_patches = false, json = false, no_thresholds = false, gap_imu = false;
   double noise = 0.02, dropout = 0.01, imu_rate = 100, duration = 0, ceiling = 0, wall_clutter = 0, drop_scans = 0;
   app.add_option("--plan", plan_file, "floor plan (.dxf/.csv/.json/.fpmap) or building (.pbtxt/.ifc); default: the scenario's demo plan");
   app.add_option("--layers", layers, "layer globs")->delimiter(',');
@@ -68,6 +69,9 @@ int main(int argc, char** argv) {
   app.add_flag("--no-clutter", no_clutter, "no furniture or people");
   app.add_option("--wall-clutter", wall_clutter, "fraction of the wall length hidden behind 2 m cabinets (robustness tests)");
   app.add_option("--drop-scans", drop_scans, "fraction of scans left out of the log (deterministic for a seed; robustness tests)");
+  app.add_option("--gap", gaps, "START:SECONDS: no scans from START for SECONDS (seconds from the sequence's start; "
+                 "repeatable; ground truth and IMU stay): a sensor or network dropout");
+  app.add_flag("--gap-imu", gap_imu, "--gap drops the IMU samples too (the OS-1's IMU comes over the same link)");
   app.add_flag("--no-ceiling-patches", no_patches, "flat ceiling everywhere");
   app.add_flag("--json", json, "print a JSON summary on stdout");
   app.add_option("--world", world_file, "the world the sensor sees, when it differs from the plan: a plan file or a world JSON (see modules/sim perturb.h)");
@@ -109,6 +113,18 @@ int main(int argc, char** argv) {
     o.clutter = !no_clutter;
     if (!(wall_clutter >= 0 && wall_clutter <= 1)) throw std::runtime_error("--wall-clutter: expected a fraction 0..1");
     if (!(drop_scans >= 0 && drop_scans < 1)) throw std::runtime_error("--drop-scans: expected a fraction 0..1 (less than 1)");
+    std::vector<std::pair<double, double>> gap_spans;  // [start, end) from the sequence's start
+    for (const auto& g : gaps) {
+      const auto c = g.find(':');
+      char* e1 = nullptr;
+      char* e2 = nullptr;
+      const double a = c == std::string::npos ? NAN : std::strtod(g.c_str(), &e1);
+      const double d = c == std::string::npos ? NAN : std::strtod(g.c_str() + c + 1, &e2);
+      if (c == std::string::npos || e1 != g.c_str() + c || *e2 != 0 || !(a >= 0) || !(d > 0) || !std::isfinite(a + d))
+        throw std::runtime_error("--gap " + g + ": expected START:SECONDS (both finite, START >= 0, SECONDS > 0)");
+      gap_spans.emplace_back(a, a + d);
+    }
+    if (gap_imu && gap_spans.empty()) throw std::runtime_error("--gap-imu: needs --gap");
     o.wall_clutter = wall_clutter;
     o.ceiling_patches = !no_patches;
     o.range_noise_m = noise;
@@ -176,8 +192,12 @@ int main(int argc, char** argv) {
     const auto& imu = sim.imu();
     int frames = 0, dropped = 0;
     uint64_t drop_state = seed * 2654435761u + 1;
+    auto in_gap = [&](double t) {  // t from the sequence's start
+      return std::any_of(gap_spans.begin(), gap_spans.end(), [&](const auto& g) { return t >= g.first && t < g.second; });
+    };
     auto flush_imu = [&](double until) {
       for (; imu_k < imu.size() && o.t0_s + imu[imu_k].t <= until; ++imu_k) {
+        if (gap_imu && in_gap(imu[imu_k].t)) continue;
         fploc::imu_t m;
         const int64_t ut = int64_t(std::llround((o.t0_s + imu[imu_k].t) * 1e6));
         m.utime = m.accel_utime = m.gyro_utime = ut;
@@ -211,7 +231,7 @@ int main(int argc, char** argv) {
       const double t_pub = ts + period;
       flush_imu(t_pub);
       drop_state = drop_state * 6364136223846793005ull + 1442695040888963407ull;
-      if (drop_scans > 0 && double(drop_state >> 11) / double(1ull << 53) < drop_scans) {
+      if (in_gap(ts - o.t0_s) || (drop_scans > 0 && double(drop_state >> 11) / double(1ull << 53) < drop_scans)) {
         ++dropped;  // lost on the way: ground truth and IMU stay
       } else {
         fploc::adapters::to_msg(f.scan, sm);
@@ -248,7 +268,7 @@ int main(int argc, char** argv) {
     }
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     const double simulated = frames * period;
-    if (dropped) std::cerr << "fploc sim: " << dropped << " of " << frames << " scans dropped (--drop-scans)\n";
+    if (dropped) std::cerr << "fploc sim: " << dropped << " of " << frames << " scans dropped (--drop-scans, --gap)\n";
     std::cerr << "fploc sim: wrote " << frames - dropped << " scans, " << imu_k << " IMU samples to " << out << " in " << wall
               << " s (" << simulated / std::max(wall, 1e-9) << "x real time)\n";
     if (json) {

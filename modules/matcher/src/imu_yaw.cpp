@@ -20,6 +20,7 @@ std::optional<double> ImuYaw::integral(int64_t t0, int64_t t1, int64_t slack_us)
   size_t i = size_t(std::max<std::ptrdiff_t>(1, it - s_.begin()));
   double sum = 0;
   for (; i < s_.size() && s_[i - 1].first < t1; ++i) {
+    if (s_[i].first - s_[i - 1].first > max_hole_us_) return std::nullopt;  // samples lost: the rate is unknown there
     const int64_t a = std::max(s_[i - 1].first, t0), b = std::min(s_[i].first, t1);
     if (b > a) sum += 0.5 * (s_[i - 1].second + s_[i].second) * double(b - a) * 1e-6;
   }

@@ -140,7 +140,7 @@ MatchResult Matcher::search_grid(const FeatureFrame& in, const Pose2& centre, do
   if (fits.empty()) {  // every start converged out of the window
     r = register_frame(lookup_, in, centre, cfg);
     r.status = FitStatus::kPoor;
-    r.text = "no fit within the odometry's window";
+    r.text = "no fit within the window";
     r.iterations = iterations;
     return r;
   }
@@ -193,6 +193,7 @@ void Matcher::set_pose(const Pose2& p, std::optional<double> search_m, std::opti
   twist_ = {};
   poor_count_ = 0;
   dead_reckoned_m_ = dead_reckoned_rad_ = 0;
+  gap_window_m_ = gap_window_rad_ = 0;
   refine_armed_ = false;
 }
 
@@ -222,6 +223,15 @@ Pose2 Matcher::predict(int64_t tau, std::optional<double> yaw_delta, const std::
     return p;
   }
   const double dt = (tau - tau_) * 1e-6;
+  if (have_last_ && gap(dt) && dt <= cfg_.gap_max_s) {
+    // Over a gap (MatcherConfig::gap_s): the last body velocity, turned by the IMU's yaw change when given.
+    Twist2 v;
+    if (cfg_.motion_model && have_velocity_) v = twist_;
+    if (yaw_delta) v.w = *yaw_delta / dt;
+    Pose2 p = compose(pose_, exp_twist(v, dt));
+    p.yaw = wrap_angle(yaw_delta ? pose_.yaw + *yaw_delta : p.yaw);
+    return p;
+  }
   const bool valid_dt = have_last_ && dt > 0 && dt < 1.0;
   Twist2 v;
   if (cfg_.motion_model && have_velocity_ && valid_dt) v = twist_;
@@ -272,8 +282,28 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
     dead_reckoned_m_ += sm;
     dead_reckoned_rad_ += sa;
   }
-  const Eigen::Vector2d window(win_m, win_rad);
-  if (!have_last_ && search_m_ > 2 * cfg_.gate_tracking_m) {
+  // A gap (MatcherConfig::gap_s): its search window, kept over the POOR frames after it until one registers.
+  if (!motion && have_last_ && !lost && gap((tau - tau_) * 1e-6)) {
+    const double dt = (tau - tau_) * 1e-6;
+    gap_dt_s_ = dt;
+    gap_window_m_ = std::max(gap_window_m_, std::min(3 * (cfg_.gap_sigma_mps * dt + 0.5 * cfg_.gap_sigma_mps2 * dt * dt), cfg_.gap_max_search_m));
+    gap_window_rad_ = std::max(gap_window_rad_, std::min(3 * (yaw_delta ? cfg_.gap_sigma_rad + cfg_.gap_sigma_rad_per_s * dt
+                                                                         : cfg_.gap_sigma_rad_per_s_no_imu * dt),
+                                                         cfg_.gap_max_search_rad));
+  }
+  if (lost || motion) gap_window_m_ = gap_window_rad_ = 0;
+  const bool gap_search = gap_window_m_ > 2 * cfg_.gate_tracking_m;
+  const Eigen::Vector2d window = gap_search ? Eigen::Vector2d(gap_window_m_, gap_window_rad_) : Eigen::Vector2d(win_m, win_rad);
+  if (gap_search) {
+    // Scans lost for a while: the prediction is known only to within the gap's window.
+    r = search_grid(in, pred, gap_window_m_, gap_window_rad_, cfg, &window);
+    if (r.status != FitStatus::kOk) {
+      char b[160];
+      std::snprintf(b, sizeof b, "after a %.1f s gap in the scans: no fit within %.2f m / %.1f deg of the prediction (%s)",
+                    gap_dt_s_, gap_window_m_, gap_window_rad_ * 180 / M_PI, r.text.c_str());
+      r.text = b;
+    }
+  } else if (!have_last_ && search_m_ > 2 * cfg_.gate_tracking_m) {
     // First frame from a pose known only to within search_m / search_yaw: one registration converges
     // from about half a metre / a few degrees, so start from a grid over the uncertainty.
     r = search_grid(in, pred, search_m_, search_yaw_, cfg, nullptr, cfg_.initial_search_band);
@@ -305,22 +335,24 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
   const Pose2 solved_ref = r.solved;
   const double jump = std::hypot(solved_ref.x - pred.x, solved_ref.y - pred.y);
   const double jump_yaw = std::abs(wrap_angle(solved_ref.yaw - pred.yaw));
-  if (odom_window) {
-    if (r.status == FitStatus::kOk && (jump > win_m || jump_yaw > win_rad)) {
+  if (odom_window || gap_search) {
+    // The fit must lie in the window, and one more than 2 sigma from the prediction must explain the scan well.
+    const char* whose = gap_search ? "the gap's" : "the odometry's";
+    if (r.status == FitStatus::kOk && (jump > window[0] || jump_yaw > window[1])) {
       char b[160];
-      std::snprintf(b, sizeof b, "outside the odometry's window: %.2f m / %.1f deg from the prediction (window %.2f m / %.1f deg)",
-                    jump, jump_yaw * 180 / M_PI, win_m, win_rad * 180 / M_PI);
+      std::snprintf(b, sizeof b, "outside %s window: %.2f m / %.1f deg from the prediction (window %.2f m / %.1f deg)", whose,
+                    jump, jump_yaw * 180 / M_PI, window[0], window[1] * 180 / M_PI);
       r.status = FitStatus::kPoor;
       r.text = b;
     } else if (r.status == FitStatus::kOk && r.fit.inlier_ratio < cfg_.odom_far_inlier_ratio &&
-               std::hypot(jump / std::max(win_m / 3, 1e-6), jump_yaw / std::max(win_rad / 3, 1e-9)) > 2) {
-      char b[160];
-      std::snprintf(b, sizeof b, "%.0f %% inliers %.2f m / %.1f deg from the prediction (beyond 2 sigma: %.0f %% needed)",
-                    100 * r.fit.inlier_ratio, jump, jump_yaw * 180 / M_PI, 100 * cfg_.odom_far_inlier_ratio);
+               std::hypot(jump / std::max(window[0] / 3, 1e-6), jump_yaw / std::max(window[1] / 3, 1e-9)) > 2) {
+      char b[200];
+      std::snprintf(b, sizeof b, "%.0f %% inliers %.2f m / %.1f deg from the prediction (beyond 2 sigma of %s window: %.0f %% needed)",
+                    100 * r.fit.inlier_ratio, jump, jump_yaw * 180 / M_PI, whose, 100 * cfg_.odom_far_inlier_ratio);
       r.status = FitStatus::kPoor;
       r.text = b;
     }
-  } else if (r.status == FitStatus::kOk && have_last_ && !lost && (jump > cfg_.max_jump_m || jump_yaw > cfg_.max_jump_rad)) {
+  } else if (r.status == FitStatus::kOk && have_last_ && !lost && !gap_search && (jump > cfg_.max_jump_m || jump_yaw > cfg_.max_jump_rad)) {
     r.status = FitStatus::kPoor;
     r.text = "refused jump of " + std::to_string(jump) + " m";
   }
@@ -346,6 +378,7 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
     pose_ = solved_ref;
     poor_count_ = 0;
     dead_reckoned_m_ = dead_reckoned_rad_ = 0;
+    gap_window_m_ = gap_window_rad_ = 0;
     last_rms_ = r.fit.rms_m;
   } else {
     ++poor_count_;
