@@ -166,6 +166,10 @@ class Launcher : public Effects {
           if (!sup_.shutting_down()) {
             log(std::string("received ") + strsignal(sig) + ": stopping every node");
             sup_.begin_shutdown(now_s());
+            first_signal_s_ = now_s();
+          } else if (first_signal_s_ >= 0 && now_s() - first_signal_s_ < kSameStopS) {
+            // The same stop delivered twice, to the launcher and to its process group (GNU timeout, systemd's
+            // control-group stop): no second signal. It killed every node at once, which lost their last output.
           } else {
             log("second signal: killing every node now");
             sup_.kill_all();
@@ -334,6 +338,9 @@ class Launcher : public Effects {
       if (buf[k] != SIGCHLD) out.push_back(buf[k]);
     return out;
   }
+  // A signal within this long of the one that began the shutdown is the same stop (see run()); a later one kills.
+  static constexpr double kSameStopS = 0.2;
+  double first_signal_s_ = -1;  // when a signal began the shutdown (-1: none did)
   bool listening_only_ = true;  // run() has not started the nodes yet
   std::string foreign_;          // a node of this graph seen running elsewhere before that
   // One `ssh -M -N` per host in use, restarted a second after it ends (link cut, host reboot).
