@@ -215,12 +215,15 @@ def main():
     ap.add_argument("--resolution", type=float, default=0.05)
     ap.add_argument("--rows", default="ref,off")
     # The map of the first part: a cell is occupied with >= min_hits hits and hits >= occupied_ratio of hits +
-    # pass-throughs, and a beam marks nothing within hit_clearance of its hit free. With 2 / 0.25 / 0 (the
-    # importer's defaults) beams grazing a wall erased it: only 33-60 % of a scan's returns lay within 10 cm
-    # of an occupied cell at its own reference pose (fhw); with 1 / 0.1 / 0.1 m, 97 %.
-    ap.add_argument("--min-hits", type=int, default=1)
-    ap.add_argument("--occupied-ratio", type=float, default=0.1)
-    ap.add_argument("--hit-clearance", type=float, default=0.1)
+    # pass-throughs, and a beam marks nothing within hit_clearance of its hit free. The bench uses fploc
+    # import-carmen's defaults (1 / 0.1 / 0.1 m, modules/carmen carmen.h GridConfig); these options override them.
+    # With 2 / 0.25 / 0 beams grazing a wall erased it: only 33-60 % of a scan's returns lay within 10 cm of an
+    # occupied cell at its own reference pose (fhw); with 1 / 0.1 / 0.1 m, 97 %.
+    ap.add_argument("--min-hits", type=int, help="map: occupied needs this many hits (default: import-carmen's, 1)")
+    ap.add_argument("--occupied-ratio", type=float,
+                    help="map: occupied when hits >= this share of hits + pass-throughs (default: import-carmen's, 0.1)")
+    ap.add_argument("--hit-clearance", type=float,
+                    help="map: a beam marks no cell within this [m] of its hit free (default: import-carmen's, 0.1)")
     # Refining the mapping scans' poses before rasterising (each scan aligned to the others' mean lines with a prior on
     # its reference pose, modules/laser2d/map_refine.h): 0 = off. Not the default: on the five logs it moved the
     # floor by -0.3..+0.5 cm and the tracker's ATE both ways (docs/notes/real2d.md, twenty-first pass).
@@ -250,6 +253,12 @@ def main():
         print(f"fploc bench real: {radish} absent (shared data); nothing to do", file=sys.stderr)
         return 0
     os.makedirs(a.out, exist_ok=True)
+    # The map options given here; the others are import-carmen's defaults (its --json reports what it used).
+    map_opts = []
+    for opt, v in (("--min-hits", a.min_hits), ("--occupied-ratio", a.occupied_ratio), ("--hit-clearance", a.hit_clearance)):
+        if v is not None:
+            map_opts += [opt, str(v)]
+    map_used = None
     rows = []
     for name in a.logs.split(","):
         src = os.path.join(radish, f"{name}-corrected.log.gz")
@@ -260,10 +269,10 @@ def main():
         split = ["--auto-split"] if a.split == "auto" else ["--begin", a.split, "--map-begin", "0", "--map-end", a.split]
         imp = json.loads(run([os.path.join(BIN, "fploc-import-carmen"), src, "--out", lcm, "--tum", ref, "--odom-tum", odom, "--end", str(a.end),
                               "--map", mapdir] + split + [
-                              "--resolution", str(a.resolution), "--min-hits", str(a.min_hits), "--occupied-ratio",
-                              str(a.occupied_ratio), "--hit-clearance", str(a.hit_clearance), "--json"] +
+                              "--resolution", str(a.resolution), "--json"] + map_opts +
                              (["--refine-map-poses", str(a.refine_map_poses)] if a.refine_map_poses > 0 else [])).stdout)
         plan = os.path.join(mapdir, "map.yaml")
+        map_used = {k: imp["map"][k] for k in ("min_hits", "occupied_ratio", "hit_clearance_m")}
         reft = read_tum(ref)
         t0 = min(reft.items())[1]
         # Scans the map covers (>= coverage_ratio of the returns within 10 cm of an occupied cell at the reference
@@ -328,8 +337,9 @@ def main():
                   f"LOST {f['all']['lost_pct']:.1f} %, AMCL {am['all']['ate_m']*100:.1f} cm | floor {floor['ate_m']*100:.1f} cm (Cauchy fit {floor['cauchy']['ate_m']*100:.1f} cm) | reference noise {rnoise['pose_sigma_xy_m']*100:.1f} cm "
                   f"(lag 2: {rnoise['lag2']['pose_sigma_xy_m']*100:.1f}), fploc less it {(f['ate_less_reference_noise_m'] if f['ate_less_reference_noise_m'] is not None else float('nan'))*100:.1f} cm", file=sys.stderr)
     doc = {"bench": "real", "protocol": {"split": a.split, "scored": "scans covered by the map", "end": a.end, "resolution_m": a.resolution,
-                                         "map": {"min_hits": a.min_hits, "occupied_ratio": a.occupied_ratio,
-                                                 "hit_clearance_m": a.hit_clearance, "refine_map_poses": a.refine_map_poses},
+                                         "map": {**(map_used or {"min_hits": a.min_hits, "occupied_ratio": a.occupied_ratio,
+                                                                  "hit_clearance_m": a.hit_clearance}),
+                                                 "refine_map_poses": a.refine_map_poses},
                                          "lost_m": a.lost_m, "graph": a.graph}, "rows": rows}
     if a.json:
         print(json.dumps(doc, indent=1))

@@ -15,6 +15,18 @@ for bad in "--resolution nan" "--begin nan" "--coverage-radius nan"; do
   grep -qx "fploc import-carmen: $1 $2: not a finite number" "$T/err" || { cat "$T/err"; fail "$bad: error text"; }
   [ ! -e "$T/n.lcm" ] && [ ! -e "$T/m" ] || fail "$bad: wrote output"
 done
+# The map's defaults are those of `fploc bench real` (1 hit, 10 %, 0.1 m clearance; 2 / 25 % / 0 erased walls grazed
+# by beams), reported in the JSON; --help shows the default of every option that has one.
+"$IMP" "$T/a.log" --out "$T/d.lcm" --map "$T/dm" --map-end 1 --json > "$T/d.json" 2>/dev/null || fail "default map"
+for kv in '"min_hits": 1' '"occupied_ratio": 0.1' '"hit_clearance_m": 0.1'; do
+  grep -Eq "$kv,?\$" "$T/d.json" || { cat "$T/d.json"; fail "default map: no $kv in the JSON"; }
+done
+"$IMP" --help > "$T/help" 2>&1 || fail "--help"
+for od in "--min-hits:1" "--occupied-ratio:0.1" "--hit-clearance:0.1" "--resolution:0.05" "--map-end:0.5" "--split-covered-share:0.75" \
+          "--odom-from:odom" "--refine-method:lines" "--coverage-radius:0.1"; do
+  o=${od%%:*} d=${od#*:}
+  grep -E -- "^ +$o [A-Z].*\[$d\]" "$T/help" > /dev/null || { cat "$T/help"; fail "--help: $o does not show its default $d"; }
+done
 # --refine-map-poses: the map's scans refined before rasterising, reported under map.refine (passes run, poses kept when
 # the scans do not constrain them, as these four-beam ones do not).
 "$IMP" "$T/a.log" --out "$T/r.lcm" --map "$T/rm" --map-end 1 --refine-map-poses 2 --map-poses-out "$T/poses.txt" --json > "$T/r.json" 2>/dev/null \
