@@ -22,6 +22,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "fploc/runtime/cli_numbers.h"
@@ -145,7 +146,18 @@ int main(int argc, char** argv) {
                            {"covered_ratio", ccfg.covered_ratio}}},
                  {"split", sp.split}, {"fraction", sp.fraction}, {"covered_share", sp.covered_share}, {"met", sp.met}};
     }
-    if (e <= b) throw std::runtime_error("--begin/--end select no scans");
+    if (e <= b) {
+      // Say where the range starts and ends: with --auto-split the start is the split, not --begin.
+      std::ostringstream m;
+      m << std::setprecision(3);
+      if (auto_split)
+        m << "--end " << end << " selects no scans: the automatic split (--auto-split) is at " << double(b) / double(n)
+          << " (scan " << b << " of " << n << "), and the scans to write run from the split to --end (scan " << e
+          << "); give an --end above " << double(b) / double(n) << ", or --begin/--map-end instead of --auto-split";
+      else
+        m << "--begin " << begin << " / --end " << end << " select no scans (scans " << b << ".." << e << " of " << n << ")";
+      throw std::runtime_error(m.str());
+    }
     nlohmann::json j = {{"log", in}, {"scans_total", n}, {"odom_records", log.odom.size()},
                         {"odom_reanchors", log.odom_reanchors}, {"first_scan", b},
                         {"end_scan", e}, {"no_return_m", std::isfinite(no_return) ? double(no_return) : -1.0},
