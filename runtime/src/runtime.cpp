@@ -199,14 +199,16 @@ void Context::watch_fd(int fd, std::function<void()> fn) {
   loop().fds.push_back({this, FdEntry{fd, std::move(fn)}});
 }
 
-void Context::error(const std::string& msg) {
+bool Context::error(const std::string& msg) {
   ++stats_.errors;
   stats_.last_error = msg;
   if (stats_.errors <= 5 || (stats_.errors % 1000) == 0) {
     std::cerr << "[" << name_ << "] error: " << msg;
     if (stats_.errors == 5) std::cerr << " (further errors are counted in telemetry)";
     std::cerr << std::endl;
+    return true;
   }
+  return false;
 }
 
 void Context::request_stop() { loop().stop = true; }
