@@ -163,8 +163,10 @@ int main(int argc, char** argv) {
       }, new std::pair<lcm::LogFile*, int64_t*>(rec.get(), &t_last));
     }
     std::map<std::string, int64_t> per_channel;
+    std::map<std::string, int64_t> log_channels;  // every channel of the log (an error names them when none is fed)
     const double w0 = now_s();
     while (const lcm::LogEvent* ev = log.next()) {
+      ++log_channels[ev->channel];
       if (!ext.count(ev->channel)) continue;
       if (t_first < 0) t_first = ev->timestamp;
       t_last = ev->timestamp;
@@ -218,6 +220,24 @@ int main(int argc, char** argv) {
                        {"nodes", nodes}};
       if (!out.empty()) j["out"] = out;
       std::cout << j.dump() << std::endl;
+    }
+    if (published == 0 && events > 0) {
+      // Nothing of the log reached the graph: its nodes ran on nothing (poses, if any, are no estimate of it).
+      std::string have, want;
+      for (const auto& [c, k] : log_channels) have += (have.empty() ? "" : ", ") + c + " (" + std::to_string(k) + ")";
+      for (const auto& c : external) want += (want.empty() ? "" : ", ") + c;
+      std::cerr << "fploc replay: no event of " << log_path << " is on an input channel of " << graph_path
+                << ": the log holds " << have << "; the graph reads " << (want.empty() ? "nothing from outside" : want);
+      bool packets = false;
+      for (const auto& [c, k] : log_channels) {
+        const std::string bare = c.substr(c.find('/') == std::string::npos ? 0 : c.rfind('/') + 1);  // robot R/...
+        packets |= bare == "OS1_LIDAR_PACKETS" || bare == "OS1_IMU_PACKETS";
+      }
+      if (packets)
+        std::cerr << ". The log holds Ouster packets: replay it with --graph graphs/replay-packets.pbtxt (its drivers "
+                     "decode them), or import the bag again with `fploc import --decode` for graphs/replay.pbtxt";
+      std::cerr << "\n";
+      return 1;
     }
     if (const std::string problem = log.problem(); !problem.empty()) {
       std::cerr << "fploc replay: " << problem << (events > 0 ? "; the events read were replayed" : "") << "\n";
