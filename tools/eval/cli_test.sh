@@ -28,4 +28,9 @@ check "--gt $T/gt.tum --est $T/est.tum --max-dt -1" "fploc eval: --max-dt -1: th
 check "--gt $T/gt.tum --est $T/est.tum --delta 0" "fploc eval: --delta 0: the RPE delta must be > 0"
 check "--gt $T/gt.tum --est $T/est.tum --delta-unit x" "fploc eval: --delta-unit x: s (seconds) or f (frames)"
 check "--gt $T/gt.tum" "fploc eval: --est EST.tum is missing"
+# --plot writes SVG: another extension (direct.png got SVG bytes) is refused, naming the option; nothing written.
+check "--gt $T/gt.tum --est $T/est.tum --plot $T/direct.png" "fploc eval: --plot $T/direct.png: the plot is written as SVG only; give a file name ending in .svg"
+[ ! -e "$T/direct.png" ] || fail "--plot direct.png: written"
+"$EVAL" --gt "$T/gt.tum" --est "$T/est.tum" --plot "$T/p.SVG" 2>/dev/null || fail "--plot p.SVG"
+grep -q "<svg" "$T/p.SVG" || fail "--plot p.SVG: no SVG"
 echo OK

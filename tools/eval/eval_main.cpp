@@ -15,6 +15,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -32,7 +33,7 @@
 using namespace fploc;
 
 static void usage() {
-  std::cerr << "usage: fploc eval --gt GT.tum --est EST.tum [--plot FILE.svg] [--json]\n"
+  std::cerr << "usage: fploc eval --gt GT.tum --est EST.tum [--plot FILE.svg] [--json]   (--plot: SVG only)\n"
                "       [--align none|se2|se3] (default none: both in the floor-plan frame)\n"
                "       [--max-dt S] (association, default 0.02) [--offset S] (added to est times)\n"
                "       [--delta D] [--delta-unit s|f] (RPE delta, default 1 s; f = frames)\n"
@@ -212,6 +213,14 @@ int main(int argc, char** argv) {
   if (!(delta > 0)) wrong += "fploc eval: --delta " + num(delta) + ": the RPE delta must be > 0\n";
   if (!(max_dt >= 0)) wrong += "fploc eval: --max-dt " + num(max_dt) + ": the association window must be >= 0 [s]\n";
   if (!(false_ok_m > 0)) wrong += "fploc eval: --false-ok-m " + num(false_ok_m) + ": must be > 0 [m]\n";
+  // The plot is SVG only: a .png name got SVG bytes (viewers refused it or showed nothing).
+  if (!plot.empty()) {
+    const auto dot = plot.find_last_of('.'), slash = plot.find_last_of('/');
+    std::string ext = dot == std::string::npos || (slash != std::string::npos && dot < slash) ? "" : plot.substr(dot);
+    for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    if (ext != ".svg")
+      wrong += "fploc eval: --plot " + plot + ": the plot is written as SVG only; give a file name ending in .svg\n";
+  }
   if (!wrong.empty()) {
     std::cerr << wrong;
     usage();
