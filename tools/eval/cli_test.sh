@@ -33,4 +33,18 @@ check "--gt $T/gt.tum --est $T/est.tum --plot $T/direct.png" "fploc eval: --plot
 [ ! -e "$T/direct.png" ] || fail "--plot direct.png: written"
 "$EVAL" --gt "$T/gt.tum" --est "$T/est.tum" --plot "$T/p.SVG" 2>/dev/null || fail "--plot p.SVG"
 grep -q "<svg" "$T/p.SVG" || fail "--plot p.SVG: no SVG"
+# --floor (a building's floor, as in map and sim): the legend names the floor drawn (the first by default); an
+# unknown floor is one error listing the building's floors; a different floor draws a different plan.
+ROOT="$2"
+B="$ROOT/data/buildings/demo-building.pbtxt"
+"$EVAL" --gt "$T/gt.tum" --est "$T/est.tum" --plot "$T/b0.svg" --plan "$B" 2>/dev/null || fail "--plan building"
+grep -q "floor plan: floor 'ground'" "$T/b0.svg" || fail "--plan building: the legend does not name floor ground"
+"$EVAL" --gt "$T/gt.tum" --est "$T/est.tum" --plot "$T/b1.svg" --plan "$B" --floor first 2>/dev/null || fail "--floor first"
+grep -q "floor plan: floor 'first'" "$T/b1.svg" || fail "--floor first: the legend does not name floor first"
+cmp -s "$T/b0.svg" "$T/b1.svg" && fail "--floor first drew the same as the default floor"
+rc=0
+"$EVAL" --gt "$T/gt.tum" --est "$T/est.tum" --plot "$T/b2.svg" --plan "$B" --floor attic > /dev/null 2> "$T/err" || rc=$?
+[ "$rc" = 1 ] || fail "--floor attic: exit $rc, expected 1"
+grep -q "no floor 'attic' (floors: ground, first)" "$T/err" || { cat "$T/err"; fail "--floor attic: error text"; }
+check "--gt $T/gt.tum --est $T/est.tum --floor first" "fploc eval: --floor needs --plan (a building .pbtxt or .ifc)"
 echo OK

@@ -207,7 +207,7 @@ std::string plot_svg(const Trajectory& gt, const Trajectory& est, const std::str
   }
   if (!o.plan.empty()) {
     std::snprintf(buf, sizeof buf, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#9a9a9a\" stroke-width=\"1.6\"/>", lx, ly, lx + 24, ly);
-    item(buf, "floor plan");
+    item(buf, esc(o.plan_label));
   }
   std::snprintf(buf, sizeof buf, "<text x=\"%.1f\" y=\"%.1f\" fill=\"#888\">grid %s m</text>\n", lx, ly + 4, num(step).c_str());
   s << buf << "</g>\n</svg>\n";
