@@ -139,3 +139,23 @@ node {
   EXPECT_EQ(errors[0].str(), "u.pbtxt:3: node 'log': pose_logger.file: environment variable FPLOC_GRAPH_TEST_DIR is not set "
                              "(write ${FPLOC_GRAPH_TEST_DIR:-DEFAULT} for a default)");
 }
+
+// The shipped demo graphs write their files under ${FPLOC_DEMO_DIR:-/tmp}: none hard-codes /tmp (graphs/
+// demo-building.pbtxt did, so two users' building demos wrote the same files).
+TEST(Graph, DemoGraphsWriteUnderFplocDemoDir) {
+  ::setenv("FPLOC_DEMO_DIR", "/home/u/demo", 1);
+  for (const char* name : {"demo.pbtxt", "demo-building.pbtxt"}) {
+    LoadedGraph g;
+    std::vector<GraphError> errors;
+    ASSERT_TRUE(load_graph(std::string(FPLOC_SOURCE_DIR) + "/graphs/" + name, g, errors))
+        << name << ": " << (errors.empty() ? "" : errors[0].str());
+    int files = 0;
+    for (const auto& n : g.graph.node()) {
+      const std::string text = n.DebugString();
+      EXPECT_EQ(text.find("\"/tmp/"), std::string::npos) << name << ": node '" << n.name() << "' writes to /tmp:\n" << text;
+      for (size_t at = text.find("\"/home/u/demo/"); at != std::string::npos; at = text.find("\"/home/u/demo/", at + 1)) ++files;
+    }
+    EXPECT_GE(files, 4) << name << ": metadata, poses and ground truth under $FPLOC_DEMO_DIR";
+  }
+  ::unsetenv("FPLOC_DEMO_DIR");
+}
