@@ -144,6 +144,7 @@ class Context {
 
  private:
   void subscribe_raw(const std::string& port, std::function<bool(const void*, int)> fn);
+  void warn_yaw_units(const google::protobuf::Message& m, const std::string& path) const;
   Bus& bus_;
   NodeSpec spec_;
   std::string name_;
