@@ -23,6 +23,7 @@
 #include <fstream>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -659,8 +660,25 @@ int main(int argc, char** argv) {
       for (const auto& [t, n] : skipped_types) std::printf(" %s (%llu)", t.c_str(), (unsigned long long)n);
       std::printf("\n");
     }
-    if (!out.empty() && !replay_graph.empty())
-      std::printf("  replay: bin/fploc replay --graph %s --log %s [--set ...]\n", replay_graph.c_str(), out.c_str());
+    if (!out.empty() && !replay_graph.empty()) {
+      // The whole command: where the poses go (--out; else ./poses.tum, silently) and the plan and start pose of each
+      // localizing node as placeholders (else the graph's own: the demo room's plan). PLAN and X Y YAW (radians) are
+      // the user's to fill in.
+      const bool lidar2d = replay_graph == "graphs/lidar2d.pbtxt";
+      const std::vector<std::string> plan_nodes = lidar2d ? std::vector<std::string>{"matcher", "optimizer", "grid2d", "amcl"}
+                                                          : std::vector<std::string>{"matcher", "optimizer", "relocalizer"};
+      const std::vector<std::string> pose_nodes = lidar2d ? std::vector<std::string>{"matcher", "grid2d", "amcl"}
+                                                          : std::vector<std::string>{"matcher"};
+      std::string est = std::filesystem::path(out).replace_extension("").string() + "-poses.tum";
+      std::printf("  replay (PLAN: your plan; X Y: the start in it [m], YAW [rad]):
+"
+                  "    bin/fploc replay --graph %s --log %s --out %s \\\n     ", replay_graph.c_str(), out.c_str(), est.c_str());
+      for (const auto& n : plan_nodes) std::printf(" --set %s.plan.file=PLAN", n.c_str());
+      std::printf(" \\\n     ");
+      for (const auto& n : pose_nodes)
+        std::printf(" --set %s.initial_pose.x=X --set %s.initial_pose.y=Y --set %s.initial_pose.yaw=YAW", n.c_str(), n.c_str(), n.c_str());
+      std::printf("\n");
+    }
     if (!tum_out.empty()) std::printf("  %s: %llu poses\n", tum_out.c_str(), (unsigned long long)tum.poses());
   }
   for (const auto& p : problems) std::cerr << "fploc import: " << p << "\n";

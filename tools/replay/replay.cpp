@@ -114,6 +114,40 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  // Localizing nodes left on the graph's own plan (no --set NODE.plan.file=): one line naming it, so a log is not
+  // localized against the demo room's plan unawares.
+  {
+    std::map<std::string, std::vector<std::string>> by_plan;  // plan file -> nodes
+    for (const auto& n : g.graph.node()) {
+      if (n.disabled() || !find_registration(type_from_executable(n.executable()))) continue;
+      const auto opts = node_options(n);
+      if (!opts) continue;
+      const auto* pf = opts->GetDescriptor()->FindFieldByName("plan");
+      if (!pf || pf->type() != google::protobuf::FieldDescriptor::TYPE_MESSAGE || pf->is_repeated()) continue;
+      const auto& plan = opts->GetReflection()->GetMessage(*opts, pf);
+      const auto* ff = plan.GetDescriptor()->FindFieldByName("file");
+      if (!ff || ff->type() != google::protobuf::FieldDescriptor::TYPE_STRING) continue;
+      const std::string file = plan.GetReflection()->GetString(plan, ff);
+      if (file.empty()) continue;
+      bool given = false;
+      for (const auto& kv : sets) given |= kv.rfind(n.name() + ".plan.file=", 0) == 0;
+      if (given) continue;
+      const std::filesystem::path fp(file);
+      by_plan[(fp.is_absolute() ? fp : (std::filesystem::path(g.dir) / fp)).lexically_normal().string()].push_back(n.name());
+    }
+    if (!by_plan.empty()) {
+      std::cerr << "fploc replay: the graph's own plan (no --set NODE.plan.file=PLAN):";
+      std::string sep = " ";
+      for (const auto& [file, names] : by_plan) {
+        std::string ns;
+        for (const auto& x : names) ns += (ns.empty() ? "" : ", ") + x;
+        std::cerr << sep << ns << " -> " << file;
+        sep = "; ";
+      }
+      std::cerr << "\n";
+    }
+  }
+
   try {
     Bus bus("memq://");
     std::vector<std::string> skipped;
