@@ -114,7 +114,14 @@ if [ -n "$SHIP" ]; then
   # loggers all wrote EST.tum (overwriting each other's bytes: a torn last line); now EST.tum is the pipeline's
   # pose (FPLOC_POSE) and the others write EST.NODE.tum beside it.
   MAP="$(ls "$D"/recordings/ship-interior/*.yaml | head -1)"
-  "$B/fploc-import" "$SHIP" --end 6 --out "$T/ship6.lcm" --quiet > /dev/null
+  "$B/fploc-import" "$SHIP" --end 6 --out "$T/ship6.lcm" > "$T/ship6.txt"
+  # The text summary's count column lines up whatever the channel names' length (LASER_SCAN_GUARDIAN_... broke it).
+  python3 - "$T/ship6.txt" <<'PY'
+import re, sys
+rows = [l.rstrip("\n") for l in open(sys.argv[1]) if re.match(r"^  [A-Z][A-Z0-9_/]* +[0-9]+$", l)]
+assert len(rows) >= 3 and len({len(r) for r in rows}) == 1, rows
+print("ship6.txt: count column ok,", len(rows), "channels")
+PY
   "$B/fploc-replay" --graph "$FPLOC_ROOT/graphs/lidar2d.pbtxt" --log "$T/ship6.lcm" --out "$T/est.tum" \
     --set matcher.plan.file="$MAP" --set optimizer.plan.file="$MAP" --set grid2d.plan.file="$MAP" \
     --set amcl.plan.file="$MAP" --set matcher.initial_pose.x=0.5 --set matcher.initial_pose.y=0.5 \

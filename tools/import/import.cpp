@@ -21,6 +21,7 @@
 
 #include <CLI/CLI.hpp>
 #include <fstream>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -637,7 +638,9 @@ int main(int argc, char** argv) {
     std::cout << dump_json(j) << "\n";
   } else {
     std::printf("%s (%s): %llu messages read in %.2f s\n", path.c_str(), rec->format().c_str(), (unsigned long long)read_msgs, wall);
-    for (const auto& [ch, n] : written) std::printf("  %-28s %8llu\n", ch.c_str(), (unsigned long long)n);
+    int width = 28;  // the channel column as wide as the longest name (long ones broke the column)
+    for (const auto& [ch, n] : written) width = std::max(width, int(ch.size()));
+    for (const auto& [ch, n] : written) std::printf("  %-*s %8llu\n", width, ch.c_str(), (unsigned long long)n);
     for (const auto& [t, ch] : topic_channel) std::printf("  topic %s -> %s\n", t.c_str(), ch.c_str());
     if (raw.has_metadata() && raw.lidar_packets + raw.imu_packets > 0)
       std::printf("  ouster: %s, %dx%d (%s), %llu lidar + %llu imu packets written as they are\n"
