@@ -673,8 +673,7 @@ int main(int argc, char** argv) {
       const std::vector<std::string> pose_nodes = lidar2d ? std::vector<std::string>{"matcher", "grid2d", "amcl"}
                                                           : std::vector<std::string>{"matcher"};
       std::string est = std::filesystem::path(out).replace_extension("").string() + "-poses.tum";
-      std::printf("  replay (PLAN: your plan; X Y: the start in it [m], YAW [rad]):
-"
+      std::printf("  replay (PLAN: your plan; X Y: the start in it [m], YAW [rad]):\n"
                   "    bin/fploc replay --graph %s --log %s --out %s \\\n     ", replay_graph.c_str(), out.c_str(), est.c_str());
       for (const auto& n : plan_nodes) std::printf(" --set %s.plan.file=PLAN", n.c_str());
       std::printf(" \\\n     ");
