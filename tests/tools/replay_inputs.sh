@@ -24,6 +24,6 @@ set -e
 [ "$rc" = 1 ] || { cat "$W/err"; fail "exit $rc, not 1"; }
 grep -q "no event of $W/packets.lcm is on an input channel of .*import.pbtxt: the log holds OS1_LIDAR_PACKETS (3), OS1_METADATA (1); the graph reads OS1_SCAN" "$W/err" \
   || { cat "$W/err"; fail "error text: channels"; }
-grep -q "Ouster packets: replay it with --graph graphs/replay-packets.pbtxt .* fploc import --decode" "$W/err" \
+grep -q "Ouster packets: replay it with --graph graphs/replay-packets.pbtxt .*fploc import --decode" "$W/err" \
   || { cat "$W/err"; fail "error text: the way out for packets"; }
 echo OK

@@ -3,6 +3,7 @@
 # the value, exit 2 ("--delta 1x" was read as 1; "--offset nan" associated nothing and blamed --max-dt).
 set -e
 EVAL="$1"
+ROOT="$2"  # the source tree (data/buildings)
 T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 printf '0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n2 2 0 0 0 0 0 1\n' > "$T/gt.tum"
@@ -35,7 +36,6 @@ check "--gt $T/gt.tum --est $T/est.tum --plot $T/direct.png" "fploc eval: --plot
 grep -q "<svg" "$T/p.SVG" || fail "--plot p.SVG: no SVG"
 # --floor (a building's floor, as in map and sim): the legend names the floor drawn (the first by default); an
 # unknown floor is one error listing the building's floors; a different floor draws a different plan.
-ROOT="$2"
 B="$ROOT/data/buildings/demo-building.pbtxt"
 "$EVAL" --gt "$T/gt.tum" --est "$T/est.tum" --plot "$T/b0.svg" --plan "$B" 2>/dev/null || fail "--plan building"
 grep -q "floor plan: floor 'ground'" "$T/b0.svg" || fail "--plan building: the legend does not name floor ground"
