@@ -8,6 +8,7 @@
 #include <fploc/pose_t.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #include <optional>
@@ -89,11 +90,43 @@ class Grid2dNode : public fploc::rt::Node {
       std::cerr << "[grid2d] " << seq_ << " " << r.pose.x << " " << r.pose.y << " " << r.pose.yaw * 180 / M_PI << " status "
                 << int(r.status) << " inl " << r.inlier_ratio << " n " << r.num_points << " win " << r.search_xy_m << " m "
                 << r.search_yaw_rad * 180 / M_PI << " deg score " << r.score << "\n";
+    say_status(r, c);
     out_.publish(fploc::adapters::make_pose_msg(m.utime, seq_++, r.pose, 0, 0, z_, r.covariance, 0.01, 0.01,
                                                 int8_t(r.status), true, true, floor_.index, floor_.name));
   }
 
+  // Each change of status (OK / POOR / LOST) with its reason: on stderr once per change (the first 200), in
+  // telemetry's detail (the current one), and LOST as an error (last_error, count) as the matcher says it.
+  void say_status(const l2::GridResult& r, const l2::GridLocalizerConfig& c) {
+    if (r.status == l2::GridStatus::kOk) bad_run_ = 0;
+    else ++bad_run_;
+    if (r.status == said_status_) return;
+    said_status_ = r.status;
+    const char* names[] = {"OK", "POOR", "LOST", "NOT_INITIALISED"};
+    char why[320];
+    const int pct = int(std::lround(100 * r.inlier_ratio)), need = int(std::lround(100 * c.min_inlier_ratio));
+    if (r.status == l2::GridStatus::kOk)
+      std::snprintf(why, sizeof why, "%smap fit, %d %% of %d returns within the inlier distance", r.reacquired ? "re-acquired: " : "",
+                    pct, r.num_points);
+    else if (r.num_points < 10)
+      std::snprintf(why, sizeof why, "%d returns in range, too few to fit; odometry prediction kept", r.num_points);
+    else
+      std::snprintf(why, sizeof why,
+                    "no map fit trusted for %d scan(s) (best: %d %% of %d returns inliers, %d %% needed; searched +-%.2f m, "
+                    "+-%.1f deg)%s", bad_run_, pct, r.num_points, need, r.search_xy_m, r.search_yaw_rad * 180 / M_PI,
+                    r.status == l2::GridStatus::kLost ? "; re-acquiring" : "; odometry prediction kept");
+    const std::string line = "scan " + std::to_string(seq_) + ": " + names[int(r.status)] + ": " + why;
+    ctx_->set_detail(line);
+    bool printed = false;
+    if (r.status == l2::GridStatus::kLost) printed = ctx_->error("LOST at scan " + std::to_string(seq_) + ": " + why);
+    if (!printed && ++status_changes_ <= 200)
+      std::cerr << "[" << ctx_->name() << "] " << line << (status_changes_ == 200 ? " (further changes: telemetry's detail)" : "")
+                << "\n";
+  }
+
   fploc::rt::Context* ctx_ = nullptr;
+  l2::GridStatus said_status_ = l2::GridStatus::kNotInitialised;  // the first scan's status is said too
+  int bad_run_ = 0, status_changes_ = 0;
   std::unique_ptr<l2::GridLocalizer> loc_;
   fploc::rt::Publisher<fploc::pose_t> out_;
   std::optional<Pose2> odom_;

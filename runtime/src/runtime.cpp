@@ -91,7 +91,32 @@ Context::Context(Bus& bus, const NodeSpec& spec, std::string instance_name,
       options_(std::move(options)),
       port_map_(std::move(port_map)),
       base_dir_(std::move(base_dir)),
-      composed_(composed) {}
+      composed_(composed) {
+  if (options_) warn_yaw_units(*options_, "");
+}
+
+// A start pose's yaw (Pose2D, radians) beyond +-2 pi is almost surely degrees (`fploc node initial-pose` takes
+// degrees): said once per field when the node's options are set up, for launch and replay alike.
+void Context::warn_yaw_units(const google::protobuf::Message& m, const std::string& path) const {
+  const auto* d = m.GetDescriptor();
+  const auto* r = m.GetReflection();
+  for (int i = 0; i < d->field_count(); ++i) {
+    const auto* f = d->field(i);
+    if (f->type() != google::protobuf::FieldDescriptor::TYPE_MESSAGE || f->is_repeated() || !r->HasField(m, f)) continue;
+    const auto& sub = r->GetMessage(m, f);
+    const std::string where = path + f->name();
+    if (f->message_type()->name() == "Pose2D") {
+      const auto* yf = f->message_type()->FindFieldByName("yaw");
+      const double yaw = yf ? sub.GetReflection()->GetDouble(sub, yf) : 0.0;
+      if (std::abs(yaw) > 2 * M_PI)
+        std::cerr << "[" << name_ << "] warning: " << spec_.options_field << "." << where << ".yaw " << yaw
+                  << " is outside [-2 pi, 2 pi]: yaw is in radians (" << yaw << " deg would be " << yaw * M_PI / 180
+                  << ")" << std::endl;
+    } else {
+      warn_yaw_units(sub, where + ".");
+    }
+  }
+}
 
 Context::~Context() = default;
 
@@ -199,14 +224,16 @@ void Context::watch_fd(int fd, std::function<void()> fn) {
   loop().fds.push_back({this, FdEntry{fd, std::move(fn)}});
 }
 
-void Context::error(const std::string& msg) {
+bool Context::error(const std::string& msg) {
   ++stats_.errors;
   stats_.last_error = msg;
   if (stats_.errors <= 5 || (stats_.errors % 1000) == 0) {
     std::cerr << "[" << name_ << "] error: " << msg;
     if (stats_.errors == 5) std::cerr << " (further errors are counted in telemetry)";
     std::cerr << std::endl;
+    return true;
   }
+  return false;
 }
 
 void Context::request_stop() { loop().stop = true; }

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include "fploc/runtime/graph.h"
+#include "fploc/runtime/bus.h"
+#include "fploc/runtime/node.h"
 
 using namespace fploc::rt;
 
@@ -138,4 +140,46 @@ node {
   ASSERT_EQ(errors.size(), 1u);
   EXPECT_EQ(errors[0].str(), "u.pbtxt:3: node 'log': pose_logger.file: environment variable FPLOC_GRAPH_TEST_DIR is not set "
                              "(write ${FPLOC_GRAPH_TEST_DIR:-DEFAULT} for a default)");
+}
+
+// The shipped demo graphs write their files under ${FPLOC_DEMO_DIR:-/tmp}: none hard-codes /tmp (graphs/
+// demo-building.pbtxt did, so two users' building demos wrote the same files).
+TEST(Graph, DemoGraphsWriteUnderFplocDemoDir) {
+  ::setenv("FPLOC_DEMO_DIR", "/home/u/demo", 1);
+  for (const char* name : {"demo.pbtxt", "demo-building.pbtxt"}) {
+    LoadedGraph g;
+    std::vector<GraphError> errors;
+    ASSERT_TRUE(load_graph(std::string(FPLOC_SOURCE_DIR) + "/graphs/" + name, g, errors))
+        << name << ": " << (errors.empty() ? "" : errors[0].str());
+    int files = 0;
+    for (const auto& n : g.graph.node()) {
+      const std::string text = n.DebugString();
+      EXPECT_EQ(text.find("\"/tmp/"), std::string::npos) << name << ": node '" << n.name() << "' writes to /tmp:\n" << text;
+      for (size_t at = text.find("\"/home/u/demo/"); at != std::string::npos; at = text.find("\"/home/u/demo/", at + 1)) ++files;
+    }
+    EXPECT_GE(files, 4) << name << ": metadata, poses and ground truth under $FPLOC_DEMO_DIR";
+  }
+  ::unsetenv("FPLOC_DEMO_DIR");
+}
+
+// A Pose2D yaw beyond +-2 pi in a node's options (degrees given where radians are read: `fploc node initial-pose`
+// takes degrees, the options radians) is said once when the node's context is made, naming the option.
+TEST(Context, WarnsOnceOfAYawInDegrees) {
+  Bus bus("memq://");
+  NodeSpec spec{"matcher", "matcher", "", {}};
+  auto o = default_options("matcher");
+  ASSERT_TRUE(o);
+  std::string err;
+  ASSERT_TRUE(apply_overrides(*o, {"initial_pose.yaw=90"}, err)) << err;
+  testing::internal::CaptureStderr();
+  { Context ctx(bus, spec, "m1", std::move(o), {}, "/", true); }
+  std::string said = testing::internal::GetCapturedStderr();
+  EXPECT_NE(said.find("[m1] warning: matcher.initial_pose.yaw 90 is outside [-2 pi, 2 pi]: yaw is in radians"), std::string::npos) << said;
+  EXPECT_EQ(said.find("warning", said.find("warning") + 1), std::string::npos) << "said twice: " << said;
+  auto ok = default_options("matcher");
+  ASSERT_TRUE(apply_overrides(*ok, {"initial_pose.yaw=-1.44"}, err)) << err;
+  testing::internal::CaptureStderr();
+  { Context ctx(bus, spec, "m2", std::move(ok), {}, "/", true); }
+  said = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(said.find("warning"), std::string::npos) << said;
 }

@@ -42,6 +42,18 @@ check "$T/importp.json" "j['replay_graph']=='graphs/replay-packets.pbtxt' and j[
   --record "$T/p_rec.lcm" --record-channels 'OS1_SCAN|OS1_IMU' > "$T/replayp.json" 2> "$T/replayp.err"
 check "$T/replayp.json" "j['channels_fed']=={'OS1_LIDAR_PACKETS':32,'OS1_IMU_PACKETS':10,'OS1_METADATA':1} and [n['messages_out'] for n in j['nodes'] if n['name'] in ('os1_driver','imu_driver','segmenter')]==[1,10,1] and all(n['errors']==0 for n in j['nodes'] if n['name'] in ('os1_driver','imu_driver'))"
 
+# The text summary's replay command is whole: --out (without it the poses went to ./poses.tum) and the plan and start
+# pose of each localizing node as placeholders; replay names the plan of each localizing node left on the graph's own
+# (the demo room's), and with --set matcher.plan.file no longer the matcher.
+"$B/fploc-import" "$BAG" --out "$T/p2.lcm" > "$T/importp.txt"
+grep -q -- "bin/fploc replay --graph graphs/replay-packets.pbtxt --log $T/p2.lcm --out $T/p2-poses.tum" "$T/importp.txt" \
+  || { cat "$T/importp.txt"; echo "import: the replay command has no --out"; exit 1; }
+grep -q -- "--set matcher.plan.file=PLAN --set optimizer.plan.file=PLAN --set relocalizer.plan.file=PLAN" "$T/importp.txt" \
+  && grep -q -- "--set matcher.initial_pose.x=X --set matcher.initial_pose.y=Y --set matcher.initial_pose.yaw=YAW" "$T/importp.txt" \
+  || { cat "$T/importp.txt"; echo "import: the replay command has no plan / start pose"; exit 1; }
+grep -q "^fploc replay: the graph's own plan (no --set NODE.plan.file=PLAN): matcher, relocalizer, optimizer -> $FPLOC_ROOT/data/plans/room.json$" "$T/replayp.err" \
+  || { cat "$T/replayp.err"; echo "replay: no line naming the graph's own plan"; exit 1; }
+
 # --start/--end that are no time span: one error naming the option, exit 2, nothing written (NaN and negative ones
 # were ignored; an END before START wrote an empty log, exit 0).
 for bad in "--start nan" "--end -1" "--start 5 --end 1"; do
@@ -102,12 +114,25 @@ if [ -n "$SHIP" ]; then
   # loggers all wrote EST.tum (overwriting each other's bytes: a torn last line); now EST.tum is the pipeline's
   # pose (FPLOC_POSE) and the others write EST.NODE.tum beside it.
   MAP="$(ls "$D"/recordings/ship-interior/*.yaml | head -1)"
-  "$B/fploc-import" "$SHIP" --end 6 --out "$T/ship6.lcm" --quiet > /dev/null
+  "$B/fploc-import" "$SHIP" --end 6 --out "$T/ship6.lcm" > "$T/ship6.txt"
+  # The text summary's count column lines up whatever the channel names' length (LASER_SCAN_GUARDIAN_... broke it).
+  python3 - "$T/ship6.txt" <<'PY'
+import re, sys
+rows = [l.rstrip("\n") for l in open(sys.argv[1]) if re.match(r"^  [A-Z][A-Z0-9_/]* +[0-9]+$", l)]
+assert len(rows) >= 3 and len({len(r) for r in rows}) == 1, rows
+print("ship6.txt: count column ok,", len(rows), "channels")
+PY
   "$B/fploc-replay" --graph "$FPLOC_ROOT/graphs/lidar2d.pbtxt" --log "$T/ship6.lcm" --out "$T/est.tum" \
     --set matcher.plan.file="$MAP" --set optimizer.plan.file="$MAP" --set grid2d.plan.file="$MAP" \
     --set amcl.plan.file="$MAP" --set matcher.initial_pose.x=0.5 --set matcher.initial_pose.y=0.5 \
-    > /dev/null 2> "$T/est.err"
+    --json > "$T/est.json" 2> "$T/est.err"
   grep -q "wo_logger -> $T/est.tum" "$T/est.err" || { cat "$T/est.err"; exit 1; }
+  # grid2d says each change of its status with the reason (it lost track silently: telemetry errors 0, nothing on
+  # stderr); its start (0, 0) is not where the bag starts, so it goes LOST: an error, and the detail of its status.
+  grep -q "^\[grid2d\] scan 0: " "$T/est.err" || { cat "$T/est.err"; echo "grid2d: its first status not said"; exit 1; }
+  grep -q "^\[grid2d\] error: LOST at scan [0-9]*: no map fit trusted for [0-9]* scan(s)" "$T/est.err" \
+    || { cat "$T/est.err"; echo "grid2d: LOST not said"; exit 1; }
+  check "$T/est.json" "[(n['errors'] >= 1 and n['last_error'].startswith('LOST at scan') and n['detail'].startswith('scan ')) for n in j['nodes'] if n['name']=='grid2d']==[True]"
   python3 - "$T" <<'PY'
 import sys
 d = sys.argv[1]

@@ -333,12 +333,24 @@ def bench(a, work, plan, layers, scenario):
     log(f"[{name}] ATE xy {100 * row.get('ate_xy_m', float('nan')):.2f} cm, z med/p99 "
         f"{100 * row.get('z_err_median_m', float('nan')):.2f}/{100 * row.get('z_err_p99_m', float('nan')):.2f} cm, "
         f"rp p99 {row.get('rp_err_p99_deg', float('nan')):.3f} deg, LOST {row['lost']}, "
-        f"NEES {row.get('nees_median')}, false OK {row.get('false_ok')}, ms/scan {ms}")
+        f"NEES {fmt_num(row.get('nees_median'))}, false OK {row.get('false_ok', '-')}, ms/scan {fmt_ms(ms)}")
     if floors is not None:
         log(f"[{name}] floors: " + (f"wrong-floor poses {floors['wrong_floor_poses']} ({floors['wrong_floor_after_3s']} later "
             f"than 3 s after a change), recognised after {[c['recognised_after_s'] for c in floors['floor_changes']]} s, "
             f"ATE after lift {floors['ate_after_lift_m']} m" if floors.get("floor_scored") else floors["floor_note"]))
     return row
+
+
+def fmt_num(v, digits=2):
+    """A number for the text summary: 1.55, not 1.5474540577388338 ("-" when absent)."""
+    return "-" if v is None else f"{v:.{digits}f}" if isinstance(v, (int, float)) and math.isfinite(v) else str(v)
+
+
+def fmt_ms(ms):
+    """ms per scan per node for the text summary: "segmenter 1.2, features 0.8", not a Python dict."""
+    if isinstance(ms, dict):
+        return ", ".join(f"{k} {fmt_num(v, 1)}" for k, v in ms.items()) or "-"
+    return fmt_num(ms, 1)
 
 
 def main():

@@ -205,33 +205,39 @@ def markdown(doc, cmdline):
 
 def main():
     ap = argparse.ArgumentParser(description="fploc vs AMCL on the Radish logs (non-circular: map from the first part)")
-    ap.add_argument("--json", action="store_true")
-    ap.add_argument("--logs", default=",".join(LOGS))
+    ap.add_argument("--json", action="store_true", help="the report as JSON on stdout")
+    ap.add_argument("--logs", default=",".join(LOGS),
+                    help="comma-separated Radish logs (NAME-corrected.log.gz under the shared data) (default: %(default)s)")
     ap.add_argument("--split", default="auto",
                     help="auto (default): the coverage rule of modules/carmen/coverage.h (the smallest split in 0.20, "
                          "0.25 .. 0.80 whose map covers >= 75 %% of the remaining scans, else the best of them), or a fraction: "
-                         "map from scans [0, split), localize [split, end)")
-    ap.add_argument("--end", type=float, default=1.0, help="localize up to this fraction (a short test run)")
-    ap.add_argument("--resolution", type=float, default=0.05)
-    ap.add_argument("--rows", default="ref,off")
+                         "map from scans [0, split), localize [split, end) (default: %(default)s)")
+    ap.add_argument("--end", type=float, default=1.0, help="localize up to this fraction of the log's scans (a short test run; above the split) (default: %(default)s)")
+    ap.add_argument("--resolution", type=float, default=0.05, help="map cell size [m] (default: %(default)s)")
+    ap.add_argument("--rows", default="ref,off",
+                    help="starts to run: ref (the reference pose of the first scan), off (1 m / 10 deg off it) (default: %(default)s)")
     # The map of the first part: a cell is occupied with >= min_hits hits and hits >= occupied_ratio of hits +
-    # pass-throughs, and a beam marks nothing within hit_clearance of its hit free. With 2 / 0.25 / 0 (the
-    # importer's defaults) beams grazing a wall erased it: only 33-60 % of a scan's returns lay within 10 cm
-    # of an occupied cell at its own reference pose (fhw); with 1 / 0.1 / 0.1 m, 97 %.
-    ap.add_argument("--min-hits", type=int, default=1)
-    ap.add_argument("--occupied-ratio", type=float, default=0.1)
-    ap.add_argument("--hit-clearance", type=float, default=0.1)
+    # pass-throughs, and a beam marks nothing within hit_clearance of its hit free. The bench uses fploc
+    # import-carmen's defaults (modules/carmen carmen.h GridConfig: 1 / 0.1 / 0.1 m); these options override them.
+    # With 2 / 0.25 / 0 beams grazing a wall erased it: only 33-60 % of a scan's returns lay within 10 cm of an
+    # occupied cell at its own reference pose (fhw); with 1 / 0.1 / 0.1 m, 97 %.
+    ap.add_argument("--min-hits", type=int, help="map: occupied needs this many hits (default: fploc import-carmen's, see its --help)")
+    ap.add_argument("--occupied-ratio", type=float,
+                    help="map: occupied when hits >= this share of hits + pass-throughs (default: fploc import-carmen's)")
+    ap.add_argument("--hit-clearance", type=float,
+                    help="map: a beam marks no cell within this [m] of its hit free (default: fploc import-carmen's)")
     # Refining the mapping scans' poses before rasterising (each scan aligned to the others' mean lines with a prior on
     # its reference pose, modules/laser2d/map_refine.h): 0 = off. Not the default: on the five logs it moved the
     # floor by -0.3..+0.5 cm and the tracker's ATE both ways (docs/notes/real2d.md, twenty-first pass).
     ap.add_argument("--refine-map-poses", type=int, default=0,
-                    help="refine the mapping scans' poses by this many passes before the map is rasterised (0: off)")
-    ap.add_argument("--lost-m", type=float, default=0.5)
-    ap.add_argument("--out", default="bench-real")
-    ap.add_argument("--graph", default=os.path.join(ROOT, "graphs", "lidar2d.pbtxt"))
+                    help="refine the mapping scans' poses by this many passes before the map is rasterised (0: off) (default: %(default)s)")
+    ap.add_argument("--lost-m", type=float, default=0.5, help="a scan whose position error exceeds this [m] counts as LOST (default: %(default)s)")
+    ap.add_argument("--out", default="bench-real", help="directory for the per-log maps, logs, tracks and plots (default: %(default)s)")
+    ap.add_argument("--graph", default=os.path.join(ROOT, "graphs", "lidar2d.pbtxt"),
+                    help="the graph replayed on each log (default: %(default)s)")
     ap.add_argument("--fploc", default="grid", choices=["grid", "wo"],
                     help="fploc's estimate: grid (fploc-grid2d on the map's raster) or wo (matcher + optimizer on its "
-                         "vectorised plan); the other is reported too (fploc_grid, fploc_plan)")
+                         "vectorised plan); the other is reported too (fploc_grid, fploc_plan) (default: %(default)s)")
     ap.add_argument("--markdown", help="write the tables (Markdown) here")
     ap.add_argument("--from-json", help="an earlier run's --json output: write its --markdown, run nothing")
     a = ap.parse_args()
@@ -250,6 +256,12 @@ def main():
         print(f"fploc bench real: {radish} absent (shared data); nothing to do", file=sys.stderr)
         return 0
     os.makedirs(a.out, exist_ok=True)
+    # The map options given here; the others are import-carmen's defaults (its --json reports what it used).
+    map_opts = []
+    for opt, v in (("--min-hits", a.min_hits), ("--occupied-ratio", a.occupied_ratio), ("--hit-clearance", a.hit_clearance)):
+        if v is not None:
+            map_opts += [opt, str(v)]
+    map_used = None
     rows = []
     for name in a.logs.split(","):
         src = os.path.join(radish, f"{name}-corrected.log.gz")
@@ -260,10 +272,10 @@ def main():
         split = ["--auto-split"] if a.split == "auto" else ["--begin", a.split, "--map-begin", "0", "--map-end", a.split]
         imp = json.loads(run([os.path.join(BIN, "fploc-import-carmen"), src, "--out", lcm, "--tum", ref, "--odom-tum", odom, "--end", str(a.end),
                               "--map", mapdir] + split + [
-                              "--resolution", str(a.resolution), "--min-hits", str(a.min_hits), "--occupied-ratio",
-                              str(a.occupied_ratio), "--hit-clearance", str(a.hit_clearance), "--json"] +
+                              "--resolution", str(a.resolution), "--json"] + map_opts +
                              (["--refine-map-poses", str(a.refine_map_poses)] if a.refine_map_poses > 0 else [])).stdout)
         plan = os.path.join(mapdir, "map.yaml")
+        map_used = {k: imp["map"][k] for k in ("min_hits", "occupied_ratio", "hit_clearance_m")}
         reft = read_tum(ref)
         t0 = min(reft.items())[1]
         # Scans the map covers (>= coverage_ratio of the returns within 10 cm of an occupied cell at the reference
@@ -328,8 +340,9 @@ def main():
                   f"LOST {f['all']['lost_pct']:.1f} %, AMCL {am['all']['ate_m']*100:.1f} cm | floor {floor['ate_m']*100:.1f} cm (Cauchy fit {floor['cauchy']['ate_m']*100:.1f} cm) | reference noise {rnoise['pose_sigma_xy_m']*100:.1f} cm "
                   f"(lag 2: {rnoise['lag2']['pose_sigma_xy_m']*100:.1f}), fploc less it {(f['ate_less_reference_noise_m'] if f['ate_less_reference_noise_m'] is not None else float('nan'))*100:.1f} cm", file=sys.stderr)
     doc = {"bench": "real", "protocol": {"split": a.split, "scored": "scans covered by the map", "end": a.end, "resolution_m": a.resolution,
-                                         "map": {"min_hits": a.min_hits, "occupied_ratio": a.occupied_ratio,
-                                                 "hit_clearance_m": a.hit_clearance, "refine_map_poses": a.refine_map_poses},
+                                         "map": {**(map_used or {"min_hits": a.min_hits, "occupied_ratio": a.occupied_ratio,
+                                                                  "hit_clearance_m": a.hit_clearance}),
+                                                 "refine_map_poses": a.refine_map_poses},
                                          "lost_m": a.lost_m, "graph": a.graph}, "rows": rows}
     if a.json:
         print(json.dumps(doc, indent=1))

@@ -15,6 +15,25 @@ for bad in "--resolution nan" "--begin nan" "--coverage-radius nan"; do
   grep -qx "fploc import-carmen: $1 $2: not a finite number" "$T/err" || { cat "$T/err"; fail "$bad: error text"; }
   [ ! -e "$T/n.lcm" ] && [ ! -e "$T/m" ] || fail "$bad: wrote output"
 done
+# The map's defaults are those of `fploc bench real` (1 hit, 10 %, 0.1 m clearance; 2 / 25 % / 0 erased walls grazed
+# by beams), reported in the JSON; --help shows the default of every option that has one.
+"$IMP" "$T/a.log" --out "$T/d.lcm" --map "$T/dm" --map-end 1 --json > "$T/d.json" 2>/dev/null || fail "default map"
+for kv in '"min_hits": 1' '"occupied_ratio": 0.1' '"hit_clearance_m": 0.1'; do
+  grep -Eq "$kv,?\$" "$T/d.json" || { cat "$T/d.json"; fail "default map: no $kv in the JSON"; }
+done
+"$IMP" --help > "$T/help" 2>&1 || fail "--help"
+for od in "--min-hits:1" "--occupied-ratio:0.1" "--hit-clearance:0.1" "--resolution:0.05" "--map-end:0.5" "--split-covered-share:0.75" \
+          "--odom-from:odom" "--refine-method:lines" "--coverage-radius:0.1"; do
+  o=${od%%:*} d=${od#*:}
+  grep -E -- "^ +$o [A-Z].*=$d( |$)" "$T/help" > /dev/null || { cat "$T/help"; fail "--help: $o does not show its default $d"; }
+done
+# --begin/--end selecting no scans say the range; with --auto-split, the split (bench real --end 0.6 on aces, whose
+# split is 0.65, said only "--begin/--end select no scans").
+if "$IMP" "$T/a.log" --auto-split --end 0.1 --out "$T/s.lcm" 2> "$T/err"; then fail "--end below the split accepted"; fi
+grep -q "^fploc import-carmen: --end 0.1 selects no scans: the automatic split (--auto-split) is at 0.625 (scan 5 of 8), .*(scan 1)" "$T/err" \
+  || { cat "$T/err"; fail "--end below the split: error text"; }
+if "$IMP" "$T/a.log" --begin 0.5 --end 0.5 --out "$T/s.lcm" 2> "$T/err"; then fail "--begin = --end accepted"; fi
+grep -qx "fploc import-carmen: --begin 0.5 / --end 0.5 select no scans (scans 4..4 of 8)" "$T/err" || { cat "$T/err"; fail "--begin = --end: error text"; }
 # --refine-map-poses: the map's scans refined before rasterising, reported under map.refine (passes run, poses kept when
 # the scans do not constrain them, as these four-beam ones do not).
 "$IMP" "$T/a.log" --out "$T/r.lcm" --map "$T/rm" --map-end 1 --refine-map-poses 2 --map-poses-out "$T/poses.txt" --json > "$T/r.json" 2>/dev/null \

@@ -22,6 +22,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "fploc/runtime/cli_numbers.h"
@@ -54,16 +55,17 @@ int main(int argc, char** argv) {
   bool auto_split = false;
   fploc::carmen::SplitRule rule;
   fploc::carmen::CoverageConfig ccfg;
+  app.option_defaults()->always_capture_default();  // --help shows every option's default
   app.add_option("log", in, "CARMEN log (.log or .log.gz)")->required();
   app.add_option("--out", out, "LCM log to write");
   app.add_option("--tum", tum, "reference (FLASER poses) as TUM");
   app.add_option("--odom-tum", odom_tum, "the odometry of the WHEEL_ODOM events (--odom-from) as TUM, at the scans' times");
-  app.add_option("--begin", begin, "first scan, as a fraction of the log's scans (0)")->check(CLI::Range(0.0, 1.0));
-  app.add_option("--end", end, "end (exclusive), fraction (1)")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--begin", begin, "first scan, as a fraction of the log's scans")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--end", end, "end (exclusive), fraction")->check(CLI::Range(0.0, 1.0));
   app.add_option("--map", map_dir, "write DIR/map.pgm + DIR/map.yaml from --map-begin..--map-end");
-  app.add_option("--map-begin", map_begin, "(0)")->check(CLI::Range(0.0, 1.0));
-  app.add_option("--map-end", map_end, "(0.5)")->check(CLI::Range(0.0, 1.0));
-  app.add_option("--resolution", resolution, "map cell size [m] (0.05)")->check(CLI::PositiveNumber);
+  app.add_option("--map-begin", map_begin, "first mapping scan, fraction")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--map-end", map_end, "end of the mapping scans (exclusive), fraction")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--resolution", resolution, "map cell size [m]")->check(CLI::PositiveNumber);
   app.add_flag("--json", json, "summary as JSON on stdout");
   app.add_option("--occupied-ratio", gcfg.occupied_ratio, "map: occupied when hits >= this share of hits + pass-throughs")
       ->check(CLI::Range(0.0, 1.0));
@@ -71,35 +73,35 @@ int main(int argc, char** argv) {
   app.add_option("--hit-clearance", gcfg.hit_clearance_m, "map: a beam marks no cell within this [m] of its hit free")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--odom-from", odom_from,
-                 "odom: the ODOM records (wheel odometry, default); flaser: the FLASER odom_* columns (in the corrected "
+                 "odom: the ODOM records (wheel odometry); flaser: the FLASER odom_* columns (in the corrected "
                  "Radish logs a copy of the reference: a diagnostic, circular)")
       ->check(CLI::IsMember({"odom", "flaser"}));
   app.add_flag("--auto-split", auto_split,
                "choose the split by the coverage rule (modules/carmen/coverage.h): map from scans [0, S), the LCM log "
                "and TUM from [S, --end); overrides --begin, --map-begin, --map-end");
-  app.add_option("--split-min", rule.min_fraction, "auto split: smallest candidate fraction (0.2)")->check(CLI::Range(0.0, 1.0));
-  app.add_option("--split-max", rule.max_fraction, "auto split: largest candidate fraction (0.8)")->check(CLI::Range(0.0, 1.0));
-  app.add_option("--split-step", rule.step, "auto split: candidate step (0.05)")->check(CLI::Range(0.001, 1.0));
+  app.add_option("--split-min", rule.min_fraction, "auto split: smallest candidate fraction")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--split-max", rule.max_fraction, "auto split: largest candidate fraction")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--split-step", rule.step, "auto split: candidate step")->check(CLI::Range(0.001, 1.0));
   app.add_option("--split-covered-share", rule.covered_share,
-                 "auto split: share of the remaining scans the prefix must cover (0.75)")->check(CLI::Range(0.0, 1.0));
-  app.add_option("--coverage-radius", ccfg.radius_m, "a return within this [m] of a mapped cell is covered (0.1)")
+                 "auto split: share of the remaining scans the prefix must cover")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--coverage-radius", ccfg.radius_m, "a return within this [m] of a mapped cell is covered")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--coverage-ratio", ccfg.covered_ratio, "a scan is covered when this share of its returns is (0.5)")
+  app.add_option("--coverage-ratio", ccfg.covered_ratio, "a scan is covered when this share of its returns is")
       ->check(CLI::Range(0.0, 1.0));
   fploc::laser2d::MapRefineConfig rcfg;
   rcfg.passes = 0;
   app.add_option("--refine-map-poses", rcfg.passes,
                  "map: refine the mapping scans' poses by this many passes of scan-to-others alignment with a prior on "
-                 "the reference pose before rasterising (modules/laser2d/map_refine.h; 0: the reference poses, default)")
+                 "the reference pose before rasterising (modules/laser2d/map_refine.h; 0: the reference poses)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--refine-prior-sigma", rcfg.prior_sigma_xy_m, "map refinement: the reference pose's prior sigma [m] (0.05)")
+  app.add_option("--refine-prior-sigma", rcfg.prior_sigma_xy_m, "map refinement: the reference pose's prior sigma [m]")
       ->check(CLI::PositiveNumber);
   app.add_option("--refine-highpass", rcfg.highpass_scans,
                  "map refinement: remove the corrections' moving mean over +-N scans after each pass (0: off)")
       ->check(CLI::NonNegativeNumber);
   std::string refine_method = "lines";
   app.add_option("--refine-method", refine_method,
-                 "map refinement: lines (each point to the others' mean line, default) or field (the grid localizer's fit on "
+                 "map refinement: lines (each point to the others' mean line) or field (the grid localizer's fit on "
                  "the distance field of the others' hits)")
       ->check(CLI::IsMember({"lines", "field"}));
   std::string map_poses_out;
@@ -144,7 +146,18 @@ int main(int argc, char** argv) {
                            {"covered_ratio", ccfg.covered_ratio}}},
                  {"split", sp.split}, {"fraction", sp.fraction}, {"covered_share", sp.covered_share}, {"met", sp.met}};
     }
-    if (e <= b) throw std::runtime_error("--begin/--end select no scans");
+    if (e <= b) {
+      // Say where the range starts and ends: with --auto-split the start is the split, not --begin.
+      std::ostringstream m;
+      m << std::setprecision(3);
+      if (auto_split)
+        m << "--end " << end << " selects no scans: the automatic split (--auto-split) is at " << double(b) / double(n)
+          << " (scan " << b << " of " << n << "), and the scans to write run from the split to --end (scan " << e
+          << "); give an --end above " << double(b) / double(n) << ", or --begin/--map-end instead of --auto-split";
+      else
+        m << "--begin " << begin << " / --end " << end << " select no scans (scans " << b << ".." << e << " of " << n << ")";
+      throw std::runtime_error(m.str());
+    }
     nlohmann::json j = {{"log", in}, {"scans_total", n}, {"odom_records", log.odom.size()},
                         {"odom_reanchors", log.odom_reanchors}, {"first_scan", b},
                         {"end_scan", e}, {"no_return_m", std::isfinite(no_return) ? double(no_return) : -1.0},
@@ -269,7 +282,8 @@ int main(int argc, char** argv) {
       size_t occ = 0;
       for (auto c : g.cells) occ += c == 100;
       j["map"] = {{"dir", map_dir}, {"first_scan", mb}, {"end_scan", me}, {"width", g.width}, {"height", g.height},
-                  {"resolution_m", resolution}, {"occupied_cells", occ}};
+                  {"resolution_m", resolution}, {"occupied_cells", occ}, {"min_hits", gc.min_hits},
+                  {"occupied_ratio", gc.occupied_ratio}, {"hit_clearance_m", gc.hit_clearance_m}};
       if (rcfg.passes > 0) j["map"]["refine"] = refine_j;
       // Per scan of [b, e): the share of its returns within coverage_radius of an occupied cell of this map
       // at the reference pose (the bench scores the scans with >= coverage_ratio separately).

@@ -3,6 +3,7 @@
 # the value, exit 2 ("--delta 1x" was read as 1; "--offset nan" associated nothing and blamed --max-dt).
 set -e
 EVAL="$1"
+ROOT="$2"  # the source tree (data/buildings)
 T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 printf '0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n2 2 0 0 0 0 0 1\n' > "$T/gt.tum"
@@ -28,4 +29,22 @@ check "--gt $T/gt.tum --est $T/est.tum --max-dt -1" "fploc eval: --max-dt -1: th
 check "--gt $T/gt.tum --est $T/est.tum --delta 0" "fploc eval: --delta 0: the RPE delta must be > 0"
 check "--gt $T/gt.tum --est $T/est.tum --delta-unit x" "fploc eval: --delta-unit x: s (seconds) or f (frames)"
 check "--gt $T/gt.tum" "fploc eval: --est EST.tum is missing"
+# --plot writes SVG: another extension (direct.png got SVG bytes) is refused, naming the option; nothing written.
+check "--gt $T/gt.tum --est $T/est.tum --plot $T/direct.png" "fploc eval: --plot $T/direct.png: the plot is written as SVG only; give a file name ending in .svg"
+[ ! -e "$T/direct.png" ] || fail "--plot direct.png: written"
+"$EVAL" --gt "$T/gt.tum" --est "$T/est.tum" --plot "$T/p.SVG" 2>/dev/null || fail "--plot p.SVG"
+grep -q "<svg" "$T/p.SVG" || fail "--plot p.SVG: no SVG"
+# --floor (a building's floor, as in map and sim): the legend names the floor drawn (the first by default); an
+# unknown floor is one error listing the building's floors; a different floor draws a different plan.
+B="$ROOT/data/buildings/demo-building.pbtxt"
+"$EVAL" --gt "$T/gt.tum" --est "$T/est.tum" --plot "$T/b0.svg" --plan "$B" 2>/dev/null || fail "--plan building"
+grep -q "floor plan: floor 'ground'" "$T/b0.svg" || fail "--plan building: the legend does not name floor ground"
+"$EVAL" --gt "$T/gt.tum" --est "$T/est.tum" --plot "$T/b1.svg" --plan "$B" --floor first 2>/dev/null || fail "--floor first"
+grep -q "floor plan: floor 'first'" "$T/b1.svg" || fail "--floor first: the legend does not name floor first"
+cmp -s "$T/b0.svg" "$T/b1.svg" && fail "--floor first drew the same as the default floor"
+rc=0
+"$EVAL" --gt "$T/gt.tum" --est "$T/est.tum" --plot "$T/b2.svg" --plan "$B" --floor attic > /dev/null 2> "$T/err" || rc=$?
+[ "$rc" = 1 ] || fail "--floor attic: exit $rc, expected 1"
+grep -q "no floor 'attic' (floors: ground, first)" "$T/err" || { cat "$T/err"; fail "--floor attic: error text"; }
+check "--gt $T/gt.tum --est $T/est.tum --floor first" "fploc eval: --floor needs --plan (a building .pbtxt or .ifc)"
 echo OK

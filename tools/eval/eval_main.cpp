@@ -1,4 +1,4 @@
-// fploc eval --gt GT.tum --est EST.tum [--plot FILE.svg [--plan P [--layers A,B] [--units U]]] [--json]
+// fploc eval --gt GT.tum --est EST.tum [--plot FILE.svg [--plan P [--floor NAME] [--layers A,B] [--units U]]] [--json]
 //            [--align none|se2|se3] [--max-dt S] [--offset S] [--delta D] [--delta-unit s|f]
 //            [--uncertainty EST.unc [--false-ok-m M]] [--hat THIRD.tum [--hat-lag N]]
 //            [--asbuilt-bound SIGMA --features LOG --plan P [--features-channel CH] [--bound-window S]]
@@ -15,6 +15,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -26,17 +27,19 @@
 #include "fploc/eval/eval.h"
 #include "fploc/eval/reference_noise.h"
 #include "fploc/eval/uncertainty.h"
+#include "fploc/floorplan/building.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/runtime/log_reader.h"
 
 using namespace fploc;
 
 static void usage() {
-  std::cerr << "usage: fploc eval --gt GT.tum --est EST.tum [--plot FILE.svg] [--json]\n"
+  std::cerr << "usage: fploc eval --gt GT.tum --est EST.tum [--plot FILE.svg] [--json]   (--plot: SVG only)\n"
                "       [--align none|se2|se3] (default none: both in the floor-plan frame)\n"
                "       [--max-dt S] (association, default 0.02) [--offset S] (added to est times)\n"
                "       [--delta D] [--delta-unit s|f] (RPE delta, default 1 s; f = frames)\n"
-               "       [--plan FILE [--layers A,B] [--units U]] (drawn under the trajectories of --plot)\n"
+               "       [--plan FILE [--floor NAME] [--layers A,B] [--units U]] (drawn under the trajectories of --plot;\n"
+               "       --floor: a building's (.pbtxt, .ifc) floor, default the first listed; the legend names it)\n"
                "       [--plot-frame all|trajectories] (the plot's axes frame the trajectories and the whole plan\n"
                "       (default), or the trajectories with a 3 m margin, the plan clipped: a map with stray specks)\n"
                "       [--uncertainty FILE] (status + x/y/yaw covariance per pose: NEES and false OK)\n"
@@ -143,7 +146,7 @@ nlohmann::json asbuilt_bound_of(const FloorPlan& plan, const Trajectory& gt, con
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string gt_path, est_path, plot, align_s = "none", unit = "s", plan_path, layers, units, unc_path, hat_path;
+  std::string gt_path, est_path, plot, align_s = "none", unit = "s", plan_path, layers, units, unc_path, hat_path, floor;
   std::string plot_frame = "all", features_path, features_channel = "FPLOC_FEATURES";
   double bound_sigma = 0, bound_window = 0;
   int hat_lag = 1;
@@ -177,6 +180,7 @@ int main(int argc, char** argv) {
       else if (a == "--delta") delta = number();
       else if (a == "--delta-unit") unit = next();
       else if (a == "--plan") plan_path = next();
+      else if (a == "--floor") floor = next();
       else if (a == "--plot-frame") plot_frame = next();
       else if (a == "--layers") layers = next();
       else if (a == "--units") units = next();
@@ -212,6 +216,14 @@ int main(int argc, char** argv) {
   if (!(delta > 0)) wrong += "fploc eval: --delta " + num(delta) + ": the RPE delta must be > 0\n";
   if (!(max_dt >= 0)) wrong += "fploc eval: --max-dt " + num(max_dt) + ": the association window must be >= 0 [s]\n";
   if (!(false_ok_m > 0)) wrong += "fploc eval: --false-ok-m " + num(false_ok_m) + ": must be > 0 [m]\n";
+  // The plot is SVG only: a .png name got SVG bytes (viewers refused it or showed nothing).
+  if (!plot.empty()) {
+    const auto dot = plot.find_last_of('.'), slash = plot.find_last_of('/');
+    std::string ext = dot == std::string::npos || (slash != std::string::npos && dot < slash) ? "" : plot.substr(dot);
+    for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    if (ext != ".svg")
+      wrong += "fploc eval: --plot " + plot + ": the plot is written as SVG only; give a file name ending in .svg\n";
+  }
   if (!wrong.empty()) {
     std::cerr << wrong;
     usage();
@@ -229,10 +241,27 @@ int main(int argc, char** argv) {
     std::cerr << "fploc eval: --bound-window " << bound_window << ": a window in seconds >= 0\n";
     return 2;
   }
+  if (!floor.empty() && plan_path.empty()) {
+    std::cerr << "fploc eval: --floor needs --plan (a building .pbtxt or .ifc)\n";
+    return 2;
+  }
   if (hat_lag != 1 && hat_path.empty()) {
     std::cerr << "fploc eval: --hat-lag needs --hat THIRD.tum\n";
     return 2;
   }
+  // The plan of --floor (a building's; a single plan has only floor "0"); an unknown floor is an error listing
+  // the building's floors. floor_drawn: the floor's name, for the plot's legend ("" for a single plan).
+  std::string floor_drawn;
+  auto load_plan = [&]() -> FloorPlan {
+    if (!is_building_file(plan_path)) return load_floor_plan(plan_path, {layers}, units, floor);
+    const Building b = load_building(plan_path);
+    const BuildingFloor& f = b.floor(floor);
+    floor_drawn = f.name;
+    PlanLoadOptions o;
+    if (!layers.empty()) o.layer_globs = {layers};
+    o.units_override = units;
+    return load_floor_plan(b, f.name, o);
+  };
   try {
     const auto align = eval::parse_align(align_s);
     const Trajectory gt = read_tum(gt_path), est = read_tum(est_path);
@@ -250,7 +279,8 @@ int main(int argc, char** argv) {
         throw std::runtime_error("--plot-frame: '" + plot_frame + "' is not one of all, trajectories");
       po.frame_trajectories = plot_frame == "trajectories";
       if (!plan_path.empty()) {
-        const FloorPlan plan = load_floor_plan(plan_path, {layers}, units);
+        const FloorPlan plan = load_plan();
+        if (!floor_drawn.empty()) po.plan_label = "floor plan: floor '" + floor_drawn + "'";
         for (const auto& e : plan.elements) {
           std::vector<Eigen::Vector2d> l;
           if (e.kind == ElementKind::kSegment) {
@@ -310,7 +340,7 @@ int main(int argc, char** argv) {
                 << " OK, " << c.false_ok << " false OK (horizontal error > " << c.false_ok_m << " m)\n";
     }
     if (bound_sigma > 0)
-      j["asbuilt_bound"] = asbuilt_bound_of(load_floor_plan(plan_path, {layers}, units), gt, features_path,
+      j["asbuilt_bound"] = asbuilt_bound_of(load_plan(), gt, features_path,
                                             features_channel, bound_sigma, bound_window, max_dt);
     if (!hat_path.empty()) {
       const Trajectory third = read_tum(hat_path);

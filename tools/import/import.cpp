@@ -21,8 +21,10 @@
 
 #include <CLI/CLI.hpp>
 #include <fstream>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -636,7 +638,9 @@ int main(int argc, char** argv) {
     std::cout << dump_json(j) << "\n";
   } else {
     std::printf("%s (%s): %llu messages read in %.2f s\n", path.c_str(), rec->format().c_str(), (unsigned long long)read_msgs, wall);
-    for (const auto& [ch, n] : written) std::printf("  %-28s %8llu\n", ch.c_str(), (unsigned long long)n);
+    int width = 28;  // the channel column as wide as the longest name (long ones broke the column)
+    for (const auto& [ch, n] : written) width = std::max(width, int(ch.size()));
+    for (const auto& [ch, n] : written) std::printf("  %-*s %8llu\n", width, ch.c_str(), (unsigned long long)n);
     for (const auto& [t, ch] : topic_channel) std::printf("  topic %s -> %s\n", t.c_str(), ch.c_str());
     if (raw.has_metadata() && raw.lidar_packets + raw.imu_packets > 0)
       std::printf("  ouster: %s, %dx%d (%s), %llu lidar + %llu imu packets written as they are\n"
@@ -659,8 +663,24 @@ int main(int argc, char** argv) {
       for (const auto& [t, n] : skipped_types) std::printf(" %s (%llu)", t.c_str(), (unsigned long long)n);
       std::printf("\n");
     }
-    if (!out.empty() && !replay_graph.empty())
-      std::printf("  replay: bin/fploc replay --graph %s --log %s [--set ...]\n", replay_graph.c_str(), out.c_str());
+    if (!out.empty() && !replay_graph.empty()) {
+      // The whole command: where the poses go (--out; else ./poses.tum, silently) and the plan and start pose of each
+      // localizing node as placeholders (else the graph's own: the demo room's plan). PLAN and X Y YAW (radians) are
+      // the user's to fill in.
+      const bool lidar2d = replay_graph == "graphs/lidar2d.pbtxt";
+      const std::vector<std::string> plan_nodes = lidar2d ? std::vector<std::string>{"matcher", "optimizer", "grid2d", "amcl"}
+                                                          : std::vector<std::string>{"matcher", "optimizer", "relocalizer"};
+      const std::vector<std::string> pose_nodes = lidar2d ? std::vector<std::string>{"matcher", "grid2d", "amcl"}
+                                                          : std::vector<std::string>{"matcher"};
+      std::string est = std::filesystem::path(out).replace_extension("").string() + "-poses.tum";
+      std::printf("  replay (PLAN: your plan; X Y: the start in it [m], YAW [rad]):\n"
+                  "    bin/fploc replay --graph %s --log %s --out %s \\\n     ", replay_graph.c_str(), out.c_str(), est.c_str());
+      for (const auto& n : plan_nodes) std::printf(" --set %s.plan.file=PLAN", n.c_str());
+      std::printf(" \\\n     ");
+      for (const auto& n : pose_nodes)
+        std::printf(" --set %s.initial_pose.x=X --set %s.initial_pose.y=Y --set %s.initial_pose.yaw=YAW", n.c_str(), n.c_str(), n.c_str());
+      std::printf("\n");
+    }
     if (!tum_out.empty()) std::printf("  %s: %llu poses\n", tum_out.c_str(), (unsigned long long)tum.poses());
   }
   for (const auto& p : problems) std::cerr << "fploc import: " << p << "\n";

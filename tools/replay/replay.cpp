@@ -114,6 +114,40 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  // Localizing nodes left on the graph's own plan (no --set NODE.plan.file=): one line naming it, so a log is not
+  // localized against the demo room's plan unawares.
+  {
+    std::map<std::string, std::vector<std::string>> by_plan;  // plan file -> nodes
+    for (const auto& n : g.graph.node()) {
+      if (n.disabled() || !find_registration(type_from_executable(n.executable()))) continue;
+      const auto opts = node_options(n);
+      if (!opts) continue;
+      const auto* pf = opts->GetDescriptor()->FindFieldByName("plan");
+      if (!pf || pf->type() != google::protobuf::FieldDescriptor::TYPE_MESSAGE || pf->is_repeated()) continue;
+      const auto& plan = opts->GetReflection()->GetMessage(*opts, pf);
+      const auto* ff = plan.GetDescriptor()->FindFieldByName("file");
+      if (!ff || ff->type() != google::protobuf::FieldDescriptor::TYPE_STRING) continue;
+      const std::string file = plan.GetReflection()->GetString(plan, ff);
+      if (file.empty()) continue;
+      bool given = false;
+      for (const auto& kv : sets) given |= kv.rfind(n.name() + ".plan.file=", 0) == 0;
+      if (given) continue;
+      const std::filesystem::path fp(file);
+      by_plan[(fp.is_absolute() ? fp : (std::filesystem::path(g.dir) / fp)).lexically_normal().string()].push_back(n.name());
+    }
+    if (!by_plan.empty()) {
+      std::cerr << "fploc replay: the graph's own plan (no --set NODE.plan.file=PLAN):";
+      std::string sep = " ";
+      for (const auto& [file, names] : by_plan) {
+        std::string ns;
+        for (const auto& x : names) ns += (ns.empty() ? "" : ", ") + x;
+        std::cerr << sep << ns << " -> " << file;
+        sep = "; ";
+      }
+      std::cerr << "\n";
+    }
+  }
+
   try {
     Bus bus("memq://");
     std::vector<std::string> skipped;
@@ -163,8 +197,10 @@ int main(int argc, char** argv) {
       }, new std::pair<lcm::LogFile*, int64_t*>(rec.get(), &t_last));
     }
     std::map<std::string, int64_t> per_channel;
+    std::map<std::string, int64_t> log_channels;  // every channel of the log (an error names them when none is fed)
     const double w0 = now_s();
     while (const lcm::LogEvent* ev = log.next()) {
+      ++log_channels[ev->channel];
       if (!ext.count(ev->channel)) continue;
       if (t_first < 0) t_first = ev->timestamp;
       t_last = ev->timestamp;
@@ -218,6 +254,24 @@ int main(int argc, char** argv) {
                        {"nodes", nodes}};
       if (!out.empty()) j["out"] = out;
       std::cout << j.dump() << std::endl;
+    }
+    if (published == 0 && events > 0) {
+      // Nothing of the log reached the graph: its nodes ran on nothing (poses, if any, are no estimate of it).
+      std::string have, want;
+      for (const auto& [c, k] : log_channels) have += (have.empty() ? "" : ", ") + c + " (" + std::to_string(k) + ")";
+      for (const auto& c : external) want += (want.empty() ? "" : ", ") + c;
+      std::cerr << "fploc replay: no event of " << log_path << " is on an input channel of " << graph_path
+                << ": the log holds " << have << "; the graph reads " << (want.empty() ? "nothing from outside" : want);
+      bool packets = false;
+      for (const auto& [c, k] : log_channels) {
+        const std::string bare = c.substr(c.find('/') == std::string::npos ? 0 : c.rfind('/') + 1);  // robot R/...
+        packets |= bare == "OS1_LIDAR_PACKETS" || bare == "OS1_IMU_PACKETS";
+      }
+      if (packets)
+        std::cerr << ". The log holds Ouster packets: replay it with --graph graphs/replay-packets.pbtxt (its drivers "
+                     "decode them), or import the bag again with `fploc import --decode` for graphs/replay.pbtxt";
+      std::cerr << "\n";
+      return 1;
     }
     if (const std::string problem = log.problem(); !problem.empty()) {
       std::cerr << "fploc replay: " << problem << (events > 0 ? "; the events read were replayed" : "") << "\n";

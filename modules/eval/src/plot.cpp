@@ -30,6 +30,16 @@ std::string jet(double v) {
 }
 
 // A "nice" tick step (1, 2, 5 x 10^k) giving about `n` ticks over `span`.
+// An error for the colour bar, in the unit that suits it: "1.25 m", "6.7 cm", "0.0665 mm" (not "6.65e-05 m").
+std::string length_text(double v) {
+  char b[48];
+  const double a = std::abs(v);
+  if (a >= 1 || a == 0) std::snprintf(b, sizeof b, "%.3g m", v);
+  else if (a >= 0.01) std::snprintf(b, sizeof b, "%.3g cm", v * 100);
+  else std::snprintf(b, sizeof b, "%.3g mm", v * 1000);
+  return b;
+}
+
 double nice_step(double span, int n) {
   const double raw = span / std::max(1, n);
   const double p = std::pow(10.0, std::floor(std::log10(raw)));
@@ -80,7 +90,14 @@ std::string plot_svg(const Trajectory& gt, const Trajectory& est, const std::str
   const double LW = colour ? 150 : 0;             // colour bar on the right
   const double sc = std::min(820 / span_x, 760 / span_y);
   const double PW = span_x * sc, PH = span_y * sc;
-  const double W = ML + PW + MR + LW, H = MT + PH + MB + 30;
+  // The legend below the plot (items as drawn further down: swatch, text, 40 px + 7.5 px a character each, then
+  // the grid's step): the picture is at least as wide (a narrow plan cut its text off).
+  const double step = nice_step(std::max(span_x, span_y), 12);
+  const std::string grid_text = "grid " + num(step) + " m";
+  double legend_w = 40 + 7.5 * 12 /* ground truth */ + 40 + 7.5 * double(colour ? 24 /* estimate (colour: error) */ : 8) +
+                    7.5 * double(grid_text.size());
+  if (!o.plan.empty()) legend_w += 40 + 7.5 * double(esc(o.plan_label).size());
+  const double W = std::max(ML + PW + MR + LW, ML + legend_w + MR), H = MT + PH + MB + 30;
   auto X = [&](double x) { return ML + (x - x0) * sc; };
   auto Y = [&](double y) { return MT + PH - (y - y0) * sc; };
   std::ostringstream s;
@@ -89,7 +106,6 @@ std::string plot_svg(const Trajectory& gt, const Trajectory& est, const std::str
     << "\" viewBox=\"0 0 " << num(std::round(W)) << " " << num(std::round(H))
     << "\" font-family=\"sans-serif\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   // Grid, ticks and tick labels in metres.
-  const double step = nice_step(std::max(span_x, span_y), 12);
   s << "<g stroke=\"#ececec\" stroke-width=\"1\">\n";
   std::ostringstream labels;
   for (double gx = std::ceil(x0 / step) * step; gx <= x1 + 1e-9; gx += step) {
@@ -169,10 +185,10 @@ std::string plot_svg(const Trajectory& gt, const Trajectory& est, const std::str
     }
     std::snprintf(buf, sizeof buf,
                   "<rect x=\"%.1f\" y=\"%.1f\" width=\"18\" height=\"%.1f\" fill=\"none\" stroke=\"#444\"/>\n"
-                  "<text x=\"%.1f\" y=\"%.1f\" font-size=\"12\">%.3g m</text>\n"
-                  "<text x=\"%.1f\" y=\"%.1f\" font-size=\"12\">%.3g m</text>\n"
+                  "<text x=\"%.1f\" y=\"%.1f\" font-size=\"12\">%s</text>\n"
+                  "<text x=\"%.1f\" y=\"%.1f\" font-size=\"12\">%s</text>\n"
                   "<text x=\"%.1f\" y=\"%.1f\" font-size=\"12\">error</text>\n",
-                  bx, by, bh, bx + 24, by + 10, emax, bx + 24, by + bh, emin, bx, by - 8);
+                  bx, by, bh, bx + 24, by + 10, length_text(emax).c_str(), bx + 24, by + bh, length_text(emin).c_str(), bx, by - 8);
     s << buf << "</g>\n";
   } else {
     path(b, "#d62728", "estimate", 1.8, "");
@@ -207,9 +223,9 @@ std::string plot_svg(const Trajectory& gt, const Trajectory& est, const std::str
   }
   if (!o.plan.empty()) {
     std::snprintf(buf, sizeof buf, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#9a9a9a\" stroke-width=\"1.6\"/>", lx, ly, lx + 24, ly);
-    item(buf, "floor plan");
+    item(buf, esc(o.plan_label));
   }
-  std::snprintf(buf, sizeof buf, "<text x=\"%.1f\" y=\"%.1f\" fill=\"#888\">grid %s m</text>\n", lx, ly + 4, num(step).c_str());
+  std::snprintf(buf, sizeof buf, "<text x=\"%.1f\" y=\"%.1f\" fill=\"#888\">%s</text>\n", lx, ly + 4, grid_text.c_str());
   s << buf << "</g>\n</svg>\n";
   return s.str();
 }

@@ -194,6 +194,37 @@ TEST(Plot, PlanAxesLegendAndErrorColours) {
   EXPECT_GT(std::stoi(last.substr(1, 2), nullptr, 16), 0x80) << last;
 }
 
+// A narrow plan (a corridor 0.2 m wide, 20 m long: the plot area is a few px wide) still shows its whole legend:
+// the picture is as wide as the legend's text; sub-centimetre errors on the colour bar are in mm, not "6.65e-05 m".
+TEST(Plot, NarrowPlanKeepsTheLegendAndSmallErrorsReadInMm) {
+  Trajectory gt, est;
+  for (int i = 0; i < 50; ++i) {
+    StampedPose p;
+    p.t = i;
+    p.p = Eigen::Vector3d(0.1, 0.4 * i, 0);
+    gt.push_back(p);
+    p.p.x() += 6.65e-5 * (1 + i % 2);
+    est.push_back(p);
+  }
+  PlotOptions o;
+  o.plan = {{Eigen::Vector2d(0, 0), Eigen::Vector2d(0, 20)}, {Eigen::Vector2d(0.2, 0), Eigen::Vector2d(0.2, 20)}};
+  o.plan_label = "floor plan: floor 'a long floor name'";
+  o.est_error = pose_errors(gt, est, associate(gt, est));
+  const auto svg = plot_svg(gt, est, "t", Eigen::Isometry3d::Identity(), o);
+  const double width = std::stod(svg.substr(svg.find("width=\"") + 7));
+  // The legend's last text (the grid step) starts at x and runs ~7.5 px a character.
+  const size_t g = svg.find(">grid ");
+  ASSERT_NE(g, std::string::npos);
+  const size_t xa = svg.rfind("x=\"", g) + 3;
+  const double x = std::stod(svg.substr(xa));
+  const size_t len = svg.find("</text>", g) - g - 1;
+  EXPECT_GE(width, x + 7.5 * double(len)) << "legend cut off: width " << width << ", grid text at " << x;
+  EXPECT_NE(svg.find("floor plan: floor 'a long floor name'"), std::string::npos);
+  EXPECT_NE(svg.find(">0.133 mm</text>"), std::string::npos) << svg.substr(svg.find("error</text>") - 200, 220);
+  EXPECT_NE(svg.find(">0.0665 mm</text>"), std::string::npos);
+  EXPECT_EQ(svg.find("e-05"), std::string::npos);
+}
+
 // A map with a stray speck far from the building: by default the axes take it in (the building shrinks to a
 // corner of the plot); framed on the trajectories they keep to the path and its margin, and the plan is clipped.
 TEST(Plot, FramedOnTheTrajectoriesAFarSpeckIsLeftOut) {

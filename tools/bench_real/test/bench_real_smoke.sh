@@ -3,6 +3,14 @@
 # contract, and fploc tracking that slice from the reference start (a real run; seconds); and the split rule's
 # JSON (import-carmen --auto-split on aces).
 set -e
+# --help describes each option with its default (--logs, --rows, --resolution, --lost-m, --out, --graph had none).
+"$FPLOC_BUILD_DIR/bin/fploc-bench-real" --help | python3 -c '
+import re, sys
+h = " ".join(sys.stdin.read().split())
+for o in ("--logs", "--rows", "--resolution", "--lost-m", "--out", "--graph", "--end", "--split"):
+    m = re.search(" " + o + r" [A-Z_]+ (.*?)(?= --[a-z]|$)", h)
+    assert m and "(default: " in m.group(1), (o, m and m.group(1))
+'
 if [ ! -d "$FPLOC_SHARED_DIR/data/recordings/radish" ]; then echo "SKIP: shared data absent"; exit 0; fi
 T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
 "$FPLOC_BUILD_DIR/bin/fploc-bench-real" --json --logs intel --split 0.5 --end 0.6 --rows ref --out "$T" --markdown "$T/r.md" > "$T/r.json"

@@ -125,8 +125,9 @@ class Context {
   void every(double period_s, std::function<void()> fn);
   // Calls fn whenever fd is readable (sockets).
   void watch_fd(int fd, std::function<void()> fn);
-  // Records an error for telemetry (last_error, count) and prints it to stderr the first few times.
-  void error(const std::string& msg);
+  // Records an error for telemetry (last_error, count) and prints it to stderr the first few times (then
+  // every 1000th); returns whether it printed this one.
+  bool error(const std::string& msg);
   // The condition behind the last error is over (e.g. the metadata file appeared): telemetry's last_error
   // is cleared, the error count stays.
   void error_resolved() { stats_.last_error.clear(); }
@@ -143,6 +144,7 @@ class Context {
 
  private:
   void subscribe_raw(const std::string& port, std::function<bool(const void*, int)> fn);
+  void warn_yaw_units(const google::protobuf::Message& m, const std::string& path) const;
   Bus& bus_;
   NodeSpec spec_;
   std::string name_;

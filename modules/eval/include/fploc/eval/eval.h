@@ -55,6 +55,7 @@ Rpe rpe(const Trajectory& gt, const Trajectory& est, const Pairs& pairs, double 
 struct PlotOptions {
   // The floor plan as polylines (plan frame, metres), drawn under the trajectories.
   std::vector<std::vector<Eigen::Vector2d>> plan;
+  std::string plan_label = "floor plan";  // its legend entry (e.g. which floor of a building is drawn)
   // Per estimate pose (same order as `est`), its error [m]; NaN = not associated. Non-empty: the
   // estimate is coloured by error (as evo's --plot_mode xy with colour mapping) with a colour bar.
   std::vector<double> est_error;
