@@ -30,6 +30,24 @@ done
 [ "$(grep -c '"hit_exact": 1.0,' "$T/x.json")" = 3 ] || fail "exact mode not exact: $(grep hit_exact "$T/x.json")"
 "$MAP" render --plan "$T/p.json" --map "$T/p.fpmap" --out "$T/r.svg" 2>/dev/null || fail "render"
 grep -q "<svg" "$T/r.svg" || fail "svg"
+# The lines only (--fields none: no look-up fields built, no field rectangles); a plan-change drawing's layers in
+# colour with a legend, and a scale bar (the trial found `map diff`'s DXF drawn all black over the fields).
+cat > "$T/d.json" <<'J'
+{"units":"m","elements":[{"type":"segment","a":[0,0],"b":[10,0],"layer":"FPLOC-PLAN"},{"type":"segment","a":[0,0],"b":[0,8],"layer":"FPLOC-MISSING"},
+ {"type":"segment","a":[3,3],"b":[6,3],"layer":"FPLOC-NEW"}]}
+J
+"$MAP" render --plan "$T/d.json" --fields none --out "$T/d.svg" 2> "$T/err" || fail "render --fields none: $(cat "$T/err")"
+grep -q "building the look-up" "$T/err" && fail "--fields none built the fields"
+grep -v 'fill="#ffffffd0"' "$T/d.svg" | grep -q "<rect" && fail "--fields none drew field rectangles"
+grep -q 'stroke="#d62728"' "$T/d.svg" || fail "FPLOC-MISSING not drawn red"
+grep -q 'stroke="#2ca02c"' "$T/d.svg" || fail "FPLOC-NEW not drawn green"
+grep -q 'FPLOC-MISSING (1)' "$T/d.svg" || fail "no legend line for FPLOC-MISSING"
+grep -q '>2 m</text>' "$T/d.svg" || fail "no 2 m scale bar (plan 10 m wide)"
+grep -q "FPLOC-MOVED" "$T/d.svg" && fail "a legend line for a layer the drawing does not have"
+"$MAP" render --plan "$T/d.json" --fields none --out "$T/d.png" 2> "$T/err" || fail "render png --fields none"
+grep -q "scale bar (bottom left) 2 m" "$T/err" || fail "png scale bar not reported: $(cat "$T/err")"
+if "$MAP" render --plan "$T/d.json" --fields some --out "$T/x.svg" 2> "$T/err"; then fail "--fields some accepted"; fi
+grep -q "fields" "$T/err" || fail "--fields error does not name the option: $(cat "$T/err")"
 "$MAP" export-pgm --plan "$T/p.json" --resolution 0.1 --out "$T/pgm" 2>/dev/null || fail "export-pgm"
 head -c 2 "$T/pgm/map.pgm" | grep -q P5 || fail "pgm header"
 grep -q "resolution: 0.1" "$T/pgm/map.yaml" || fail "yaml"

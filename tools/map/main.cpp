@@ -182,6 +182,10 @@ int main(int argc, char** argv) {
   render->add_option("--depth", r.depth, "depth when building (default 5, like the paper's Fig. 2)");
   render->add_option("--out", r.out, "output .svg or .png")->required();
   render->add_option("--width", r.width, "image width in pixels (PNG) / user units (SVG)");
+  render->add_option("--fields", r.fields, "nearest: the look-up's leaf fields coloured by their nearest element (as the "
+                     "paper's Fig. 2); none: the plan's lines only, without building the fields (fast on a large plan)")
+      ->check(CLI::IsMember({"nearest", "none"}))
+      ->capture_default_str();
 
   PlanArgs p_plan;
   PgmArgs p;

@@ -30,6 +30,7 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json);
 
 struct RenderArgs {
   std::string map, out;
+  std::string fields = "nearest";  // "nearest": the look-up's leaf fields coloured by nearest element; "none": lines only
   int depth = 5;
   int width = 1600;
 };

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 
 #include "fploc/annf/annf.h"
@@ -39,8 +40,33 @@ void colour(uint32_t id, uint8_t rgb[3]) {
   rgb[2] = uint8_t((b + m) * 255);
 }
 
-void write_svg(const annf::Annf& f, const std::string& out, int width) {
-  const FloorPlan& plan = f.plan();
+// A plan element's line colour: the plan-change layers of `fploc map diff` (FPLOC-MISSING red, FPLOC-MOVED orange,
+// FPLOC-NEW green), every other layer black.
+struct LayerStyle {
+  const char* prefix;
+  const char* svg;
+  uint8_t rgb[3];
+  const char* label;
+};
+const LayerStyle kDiffLayers[] = {{"FPLOC-MISSING", "#d62728", {214, 39, 40}, "in the plan, not seen"},
+                                  {"FPLOC-MOVED", "#ff7f0e", {255, 127, 14}, "seen offset"},
+                                  {"FPLOC-NEW", "#2ca02c", {44, 160, 44}, "seen, not in the plan"}};
+const LayerStyle* style_of(const FloorPlan& plan, const Element& e) {
+  if (e.layer < 0 || e.layer >= int(plan.layers.size())) return nullptr;
+  for (const auto& st : kDiffLayers)
+    if (plan.layers[size_t(e.layer)].rfind(st.prefix, 0) == 0) return &st;
+  return nullptr;
+}
+
+// A scale bar's length: 1, 2 or 5 times a power of ten, about a fifth of the width.
+double scale_bar_m(double width_m) {
+  const double target = width_m / 5, p = std::pow(10.0, std::floor(std::log10(target)));
+  for (double k : {5.0, 2.0, 1.0})
+    if (k * p <= target) return k * p;
+  return p;
+}
+
+void write_svg(const FloorPlan& plan, const annf::Annf* f, const std::string& out, int width) {
   const Box2 b = plan.bounds();
   const double pad = 0.02 * b.size().maxCoeff() + 0.1;
   const double W = b.size().x() + 2 * pad, H = b.size().y() + 2 * pad;
@@ -50,7 +76,7 @@ void write_svg(const annf::Annf& f, const std::string& out, int width) {
   s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << int(width * H / W)
     << "\" viewBox=\"" << b.min.x() - pad << " " << -(b.max.y() + pad) << " " << W << " " << H << "\">\n"
     << "<g transform=\"scale(1,-1)\">\n<g stroke=\"#00000030\" stroke-width=\"" << sw * 0.5 << "\">\n";
-  f.for_each_leaf([&](const Box2& box, int, const uint32_t* ids, int n) {
+  if (f) f->for_each_leaf([&](const Box2& box, int, const uint32_t* ids, int n) {
     if (box.max.x() < b.min.x() - pad || box.min.x() > b.max.x() + pad || box.max.y() < b.min.y() - pad ||
         box.min.y() > b.max.y() + pad)
       return;
@@ -62,7 +88,13 @@ void write_svg(const annf::Annf& f, const std::string& out, int width) {
       << box.size().y() << "\" fill=\"" << buf << "\"/>\n";
   });
   s << "</g>\n<g fill=\"none\" stroke=\"#000\" stroke-width=\"" << sw * 2 << "\">\n";
+  int diff_count[3] = {0, 0, 0};
   for (const auto& e : plan.elements) {
+    const LayerStyle* st = style_of(plan, e);
+    if (st) {
+      ++diff_count[st - kDiffLayers];
+      s << "<g stroke=\"" << st->svg << "\" stroke-width=\"" << sw * 4 << "\">";
+    }
     if (e.kind == ElementKind::kSegment) {
       s << "<line x1=\"" << e.a.x() << "\" y1=\"" << e.a.y() << "\" x2=\"" << e.b.x() << "\" y2=\"" << e.b.y() << "\"/>\n";
     } else if (e.kind == ElementKind::kCircle) {
@@ -74,71 +106,122 @@ void write_svg(const annf::Annf& f, const std::string& out, int width) {
       s << "<path d=\"M " << p0.x() << " " << p0.y() << " A " << e.r << " " << e.r << " 0 " << large << " 1 " << p1.x()
         << " " << p1.y() << "\"/>\n";
     }
+    if (st) s << "</g>\n";
   }
-  s << "</g>\n</g>\n</svg>\n";
+  s << "</g>\n</g>\n";
+  // Scale bar (bottom left) and, for a plan-change drawing, the legend of its layers (top left); upright text.
+  const double fs = std::min(W, H) / 60, bar = scale_bar_m(b.size().x());
+  const double x0 = b.min.x() - pad + fs, ybar = -(b.min.y() - pad) - fs;
+  s << "<g font-family=\"sans-serif\" font-size=\"" << fs << "\">\n<line x1=\"" << x0 << "\" y1=\"" << ybar << "\" x2=\""
+    << x0 + bar << "\" y2=\"" << ybar << "\" stroke=\"#000\" stroke-width=\"" << fs / 4 << "\"/>\n<text x=\"" << x0
+    << "\" y=\"" << ybar - fs / 2 << "\">" << bar << " m</text>\n";
+  double yl = -(b.max.y() + pad) + 1.5 * fs;
+  const int legend_lines = (diff_count[0] > 0) + (diff_count[1] > 0) + (diff_count[2] > 0);
+  if (legend_lines > 0)  // a white ground for the legend over the fields
+    s << "<rect x=\"" << x0 - fs / 2 << "\" y=\"" << yl - 1.2 * fs << "\" width=\"" << 22 * fs << "\" height=\""
+      << 1.4 * fs * legend_lines + 0.4 * fs << "\" fill=\"#ffffffd0\"/>\n";
+  for (int k = 0; k < 3; ++k)
+    if (diff_count[k] > 0) {
+      s << "<line x1=\"" << x0 << "\" y1=\"" << yl - fs / 3 << "\" x2=\"" << x0 + 1.5 * fs << "\" y2=\"" << yl - fs / 3
+        << "\" stroke=\"" << kDiffLayers[k].svg << "\" stroke-width=\"" << fs / 3 << "\"/><text x=\"" << x0 + 2 * fs << "\" y=\"" << yl
+        << "\">" << kDiffLayers[k].prefix << " (" << diff_count[k] << "): " << kDiffLayers[k].label << "</text>\n";
+      yl += 1.4 * fs;
+    }
+  s << "</g>\n</svg>\n";
   if (!s) throw std::runtime_error(out + ": write error");
 }
 
-void write_png(const annf::Annf& f, const std::string& out, int width) {
-  const FloorPlan& plan = f.plan();
+void write_png(const FloorPlan& plan, const annf::Annf* f, const std::string& out, int width) {
   const Box2 b = plan.bounds();
   const double pad = 0.02 * b.size().maxCoeff() + 0.1;
   const double W = b.size().x() + 2 * pad, H = b.size().y() + 2 * pad;
   const int w = std::max(16, width), h = std::max(16, int(std::ceil(w * H / W)));
   const double px = W / w;
-  annf::AnnfOptions xo;
-  xo.mode = annf::AnnfMode::kExact;
-  xo.max_depth = 9;
-  const annf::Annf exact = annf::Annf::build(plan, xo);
-  std::vector<uint8_t> img(size_t(w) * h * 3);
-  std::vector<int64_t> leaf_key(size_t(w) * h, -1);
-  for (int j = 0; j < h; ++j)
-    for (int i = 0; i < w; ++i) {
-      const Eigen::Vector2d p(b.min.x() - pad + (i + 0.5) * px, b.max.y() + pad - (j + 0.5) * px);
-      uint8_t* c = &img[(size_t(j) * w + i) * 3];
-      int n;
-      const uint32_t* ids = f.lookup(p, &n);
-      if (ids && n > 0) {
-        colour(ids[0], c);
-        Box2 lb;
-        if (f.leaf_box(p, &lb)) leaf_key[size_t(j) * w + i] = int64_t(std::llround(lb.min.x() * 1e4)) * 1000003 + std::llround(lb.min.y() * 1e4);
-      } else {
-        c[0] = c[1] = c[2] = 235;
+  std::vector<uint8_t> img(size_t(w) * h * 3, 255);
+  if (f) {
+    std::vector<int64_t> leaf_key(size_t(w) * h, -1);
+    for (int j = 0; j < h; ++j)
+      for (int i = 0; i < w; ++i) {
+        const Eigen::Vector2d p(b.min.x() - pad + (i + 0.5) * px, b.max.y() + pad - (j + 0.5) * px);
+        uint8_t* c = &img[(size_t(j) * w + i) * 3];
+        int n;
+        const uint32_t* ids = f->lookup(p, &n);
+        if (ids && n > 0) {
+          colour(ids[0], c);
+          Box2 lb;
+          if (f->leaf_box(p, &lb)) leaf_key[size_t(j) * w + i] = int64_t(std::llround(lb.min.x() * 1e4)) * 1000003 + std::llround(lb.min.y() * 1e4);
+        } else {
+          c[0] = c[1] = c[2] = 235;
+        }
       }
-      double d;
-      exact.nearest(p, &d);
-      if (d <= 0.75 * px) c[0] = c[1] = c[2] = 0;
+    for (int j = 1; j < h; ++j)
+      for (int i = 1; i < w; ++i) {
+        const size_t k = size_t(j) * w + i;
+        if (leaf_key[k] != leaf_key[k - 1] || leaf_key[k] != leaf_key[k - w])
+          for (int q = 0; q < 3; ++q) img[k * 3 + q] = uint8_t(img[k * 3 + q] * 0.8);
+      }
+  }
+  // The elements, sampled every quarter pixel along them (1.5 px wide; the plan-change layers 3 px, in colour).
+  auto dot = [&](const Eigen::Vector2d& p, const uint8_t rgb[3], double r_px) {
+    const double ci = (p.x() - (b.min.x() - pad)) / px - 0.5, cj = ((b.max.y() + pad) - p.y()) / px - 0.5;
+    const int r = int(std::ceil(r_px));
+    for (int j = int(std::floor(cj)) - r; j <= int(std::ceil(cj)) + r; ++j)
+      for (int i = int(std::floor(ci)) - r; i <= int(std::ceil(ci)) + r; ++i)
+        if (i >= 0 && j >= 0 && i < w && j < h && std::hypot(i - ci, j - cj) <= r_px)
+          for (int q = 0; q < 3; ++q) img[(size_t(j) * w + i) * 3 + q] = rgb[q];
+  };
+  const uint8_t black[3] = {0, 0, 0};
+  for (int pass = 0; pass < 2; ++pass)  // the plan-change layers over the others
+    for (const auto& e : plan.elements) {
+      const LayerStyle* st = style_of(plan, e);
+      if ((st != nullptr) != (pass == 1)) continue;
+      const uint8_t* rgb = st ? st->rgb : black;
+      const double r_px = st ? 1.5 : 0.75;
+      if (e.kind == ElementKind::kSegment) {
+        const int n = std::max(1, int(std::ceil((e.b - e.a).norm() / (px / 4))));
+        for (int k = 0; k <= n; ++k) dot(e.a + (e.b - e.a) * (double(k) / n), rgb, r_px);
+      } else {
+        const double a0 = e.kind == ElementKind::kCircle ? 0.0 : e.a0, a1 = e.kind == ElementKind::kCircle ? 2 * M_PI : e.a1;
+        const int n = std::max(8, int(std::ceil(e.r * std::abs(a1 - a0) / (px / 4))));
+        for (int k = 0; k <= n; ++k) {
+          const double a = a0 + (a1 - a0) * double(k) / n;
+          dot(e.c + e.r * Eigen::Vector2d(std::cos(a), std::sin(a)), rgb, r_px);
+        }
+      }
     }
-  for (int j = 1; j < h; ++j)
-    for (int i = 1; i < w; ++i) {
-      const size_t k = size_t(j) * w + i;
-      if (leaf_key[k] != leaf_key[k - 1] || leaf_key[k] != leaf_key[k - w])
-        for (int q = 0; q < 3; ++q) img[k * 3 + q] = uint8_t(img[k * 3 + q] * 0.8);
-    }
+  // Scale bar (bottom left), 1, 2 or 5 times a power of ten metres; its length is printed with the summary.
+  const double bar = scale_bar_m(b.size().x());
+  for (double x = 0; x <= bar; x += px / 4) dot(Eigen::Vector2d(b.min.x() - pad + 10 * px + x, b.min.y() - pad + 10 * px), black, 1.5);
   write_rgb_png(out, w, h, img);
+  std::cerr << "fploc map render: " << w << " x " << h << " px, " << px << " m per pixel; scale bar (bottom left) " << bar
+            << " m\n";
 }
 
 }  // namespace
 
 
 int cmd_render(const FloorPlan& plan, const RenderArgs& a) {
-  annf::Annf f;
+  const std::string ext = lower_ext(a.out);
+  if (ext != ".svg" && ext != ".png") throw std::runtime_error(a.out + ": output must be .svg or .png");
+  std::optional<annf::Annf> f;
   if (!a.map.empty()) {
     f = annf::Annf::load(a.map);
-  } else {
+  } else if (a.fields != "none") {
+    std::cerr << "fploc map render: building the look-up's leaf fields (depth " << a.depth << ") over "
+              << plan.elements.size() << " elements (--fields none draws the lines only)\n";
     annf::AnnfOptions o;
     o.max_depth = a.depth;
     f = annf::Annf::build(plan, o);
   }
-  const std::string ext = lower_ext(a.out);
+  const FloorPlan& drawn = f ? f->plan() : plan;
+  const annf::Annf* fp = f && a.fields != "none" ? &*f : nullptr;
   if (ext == ".svg")
-    write_svg(f, a.out, a.width);
-  else if (ext == ".png")
-    write_png(f, a.out, a.width);
+    write_svg(drawn, fp, a.out, a.width);
   else
-    throw std::runtime_error(a.out + ": output must be .svg or .png");
-  std::cerr << "fploc map render: " << f.stats().leaves << " leaf fields, " << f.plan().elements.size()
-            << " elements -> " << a.out << "\n";
+    write_png(drawn, fp, a.out, a.width);
+  std::cerr << "fploc map render: ";
+  if (fp) std::cerr << fp->stats().leaves << " leaf fields, ";
+  std::cerr << drawn.elements.size() << " elements -> " << a.out << "\n";
   return 0;
 }
 
