@@ -157,9 +157,11 @@ class OptimizerNode : public fploc::rt::Node {
       plan_.add_scale_error(&*latest);
       latest_out_.publish(fploc::adapters::to_msg(*latest, latest_seq_++, m.floor_index, m.floor));
       // Status changes with their reason (pose_t has no text): e.g. POOR where the plan leaves a direction open.
+      const std::string line = fploc::matcher::to_string(latest->status) + (latest->status_text.empty() ? "" : ": " + latest->status_text);
       if (latest->status != last_status_ && ++status_changes_ <= 200)
-        std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << ": " << fploc::matcher::to_string(latest->status)
-                  << (latest->status_text.empty() ? "" : ": " + latest->status_text) << "\n";
+        std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << ": " << line << "\n";
+      // ... and in telemetry while not OK (the dashboard shows it beside the pose's status).
+      ctx_->set_detail(latest->status == FitStatus::kOk ? "" : line);
       last_status_ = latest->status;
     }
     if (const auto r = loc_->take_reseed()) {

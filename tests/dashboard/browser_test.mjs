@@ -103,6 +103,11 @@ try {
   const onPlan = await page.evaluate(() => window.__fploc.featuresMatched);
   check(onPlan > 0.6 && onPlan < 0.995, `features on the plan vs off it (${(100 * onPlan).toFixed(1)} % on the plan)`);
 
+  // A POOR pose names its reason (the publishing node's telemetry detail; the fake is POOR 3 s of every 10).
+  const statusRow = () => page.evaluate(() => [...document.querySelectorAll('#posebox tr')].find((r) => r.cells[0]?.textContent === 'status')?.cells[1]?.textContent ?? '');
+  const tPoor = await waitFor(async () => (await statusRow()).startsWith('POOR · a second fit 1.20 m'), 12000);
+  check(tPoor >= 0, `a POOR status names its reason ("${await statusRow()}")`);
+
   // Every node in the table, all green.
   const everyNode = [...NODES, 'dashboard'];
   const allOk = await waitFor(async () => {

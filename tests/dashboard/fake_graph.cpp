@@ -104,6 +104,7 @@ int main(int argc, char** argv) {
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   int64_t seq = 0, out_period = 0, out_total = 0;
   double next_beat = 0, next_msg = 0, last_cpu = cpu_s(), last_beat_t = 0;
+  auto poor = [&](int64_t k) { return k % 100 >= 40 && k % 100 < 70; };
   auto beat = [&] {
     fploc::node_status_t s{};
     s.utime = wall_us();
@@ -128,6 +129,7 @@ int main(int argc, char** argv) {
       p.rate_hz = t > last_beat_t ? double(out_period) / (t - last_beat_t) : 0;
       s.ports.push_back(p);
     }
+    if (sim && poor(seq)) s.detail = "POOR: a second fit 1.20 m / 0.0 deg away explains 95 %";
     s.num_ports = int32_t(s.ports.size());
     last_beat_t = t;
     out_period = 0;
@@ -202,6 +204,7 @@ int main(int argc, char** argv) {
       p.utime = ut;
       p.seq = seq;
       p.keyframe = (seq % 5) == 0;
+      p.status = poor(seq) ? 1 : 0;  // POOR for 3 s of every 10 (the status row names the reason: telemetry detail)
       p.floor_index = 0;
       p.floor = "0";
       p.position[0] = ex, p.position[1] = ey, p.position[2] = z + 0.01;
