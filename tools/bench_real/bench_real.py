@@ -198,8 +198,10 @@ def markdown(doc, cmdline):
                    f"{f.get('false_ok_poses', '-')} | {cm(pl['ate_m'])} | {pl['max_m'] * 100:.0f} | "
                    f"{pl.get('poor_pct', float('nan')):.1f} % | {pl['lost_pct']:.1f} % | {pl.get('false_ok_poses', '-')} | "
                    f"{nees(pl)} | {nees(pl, 'nees_median_with_reference_noise')} | {pl['ms_per_scan']:.1f} | {nees(a)} |")
-    out += ["", "Plots (reference green, fploc blue, AMCL orange; `-fploc.png` without AMCL):", ""]
-    out += [f"- {r['log']} {r['start']}: `{r['plot']}`, `{r['plot_fploc']}`" for r in doc["rows"]]
+    # Paths under the run's --out directory (a reader of the table has no copy of the runner's /tmp).
+    rel = lambda f: os.path.join(os.path.basename(os.path.dirname(f)), os.path.basename(f))
+    out += ["", "Plots, under the run's `--out` directory (reference green, fploc blue, AMCL orange; `-fploc.png` without AMCL):", ""]
+    out += [f"- {r['log']} {r['start']}: `{rel(r['plot'])}`, `{rel(r['plot_fploc'])}`" for r in doc["rows"]]
     return "\n".join(out) + "\n"
 
 
