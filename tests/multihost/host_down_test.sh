@@ -23,12 +23,8 @@ if [ "${FPLOC_HD_INNER:-}" != "1" ]; then
   exec unshare -n -m -- env FPLOC_HD_INNER=1 "$0" "$@"
 fi
 OUTAGE_S="${OUTAGE_S:-25}"
-mount --make-rprivate /
-# A plain login shell on the host (see multihost_net_test.sh): an empty ~/.bashrc in this mount namespace only.
-ROOT_HOME="$(getent passwd root | cut -d: -f6)"
-[ -f "$ROOT_HOME/.bashrc" ] && mount --bind /dev/null "$ROOT_HOME/.bashrc"
-mkdir -p /run/netns && mount -t tmpfs fploc-hd-netns /run/netns   # named namespaces private to this test
-mkdir -p /run/sshd
+. "$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)/hosts_lib.sh"
+mh_private_view hd
 T="$(mktemp -d /tmp/fploc-hd-XXXXXX)"
 G="$T/g.pbtxt"
 HOSTS=(drv compute)
@@ -36,7 +32,7 @@ bg=()   # launchers and probes started here
 cleanup() {
   set +e
   for p in "${bg[@]}"; do kill -KILL "$p" 2>/dev/null; done
-  [ -f "$T/sshd.pid" ] && kill "$(cat "$T/sshd.pid")" 2>/dev/null
+  [ -f "$T/sshd-compute.pid" ] && kill "$(cat "$T/sshd-compute.pid")" 2>/dev/null
   for p in $(pgrep -f -- "--graph $T/"); do kill -KILL "$p" 2>/dev/null; done  # this test's graphs only (unique dir)
   for h in "${HOSTS[@]}"; do ip netns del "$h" 2>/dev/null; done
   umount /run/netns 2>/dev/null
@@ -63,37 +59,9 @@ remote_new() { local a b; a=$(node_pid logger); b=$(node_pid source2)
 state_after() { awk -v t="$2" -v re="$1" '$1 == "state" && $2 / 1e6 >= t && $0 ~ re { found = 1 } END { exit !found }' "$T/states.txt"; }
 
 # ---- the network: a bridge and a veth per host namespace, an sshd on compute
-ip link set lo up
-ip link add br0 type bridge mcast_snooping 0
-ip link set br0 up
-n=1
-for h in "${HOSTS[@]}"; do
-  ip netns add "$h"
-  ip link add "v-$h" type veth peer name eth0 netns "$h"
-  ip link set "v-$h" master br0 up
-  ip -n "$h" link set lo up
-  ip -n "$h" addr add "10.213.0.$n/24" dev eth0
-  ip -n "$h" link set eth0 up multicast on
-  ip -n "$h" route add 224.0.0.0/4 dev eth0
-  n=$((n + 1))
-done
-ssh-keygen -q -t ed25519 -N '' -f "$T/id" -C fploc-hd-test
-cp "$T/id.pub" "$T/authorized_keys"
-ssh-keygen -q -t ed25519 -N '' -f "$T/hostkey"
-cat > "$T/sshd.conf" <<CONF
-ListenAddress 10.213.0.2
-Port 22
-HostKey $T/hostkey
-PidFile $T/sshd.pid
-AuthorizedKeysFile $T/authorized_keys
-StrictModes no
-PermitRootLogin prohibit-password
-PasswordAuthentication no
-KbdInteractiveAuthentication no
-UsePAM no
-PrintMotd no
-CONF
-ip netns exec compute /usr/sbin/sshd -f "$T/sshd.conf" -E "$T/sshd.log"
+mh_bridge "${HOSTS[@]}"
+mh_client_key "$T" fploc-hd-test
+mh_sshd "$T" compute 10.213.0.2
 SSHO="-o BatchMode=yes -o StrictHostKeyChecking=no -o UserKnownHostsFile=/dev/null -o LogLevel=ERROR -i $T/id"
 wait_until 10 ip netns exec drv ssh $SSHO root@10.213.0.2 true 2>/dev/null || { echo "sshd on compute not reachable"; exit 1; }
 

@@ -19,16 +19,8 @@ if [ "${FPLOC_MH_INNER:-}" != "1" ]; then
   exec unshare -n -m -- env FPLOC_MH_INNER=1 "$0" "$@"
 fi
 [ -f "$ROOT/data/plans/room.json" ] || skip "$ROOT/data/plans/room.json missing"
-mount --make-rprivate /
-# A remote node starts through the user's shell on its host (ssh runs `$SHELL -c`), and bash started by sshd
-# reads ~/.bashrc. A developer machine's may be slow (version-manager init that also locks against parallel
-# shells: 10-50 s for eight sessions at once here). The launcher copes (a session has 60 s to start its node;
-# the heartbeat grace counts from the node's start), but the figures below are about the launcher, so the
-# test's hosts get a plain shell: an empty ~/.bashrc in this test's mount namespace only.
-ROOT_HOME="$(getent passwd root | cut -d: -f6)"
-[ -f "$ROOT_HOME/.bashrc" ] && mount --bind /dev/null "$ROOT_HOME/.bashrc"
-mkdir -p /run/netns && mount -t tmpfs fploc-mh-netns /run/netns   # named namespaces private to this test
-mkdir -p /run/sshd
+. "$HERE/hosts_lib.sh"
+mh_private_view mh
 T="$(mktemp -d /tmp/fploc-mh-XXXXXX)"
 HOSTS=(drv compute dash r2)
 cleanup() {
@@ -45,44 +37,12 @@ t_start=$(date +%s.%N)
 elapsed() { python3 -c "import time,sys; print(f'{time.time()-float(sys.argv[1]):.1f}')" "$t_start"; }
 
 # ---- the network: bridge + one veth per host namespace
-ip link set lo up
-ip link add br0 type bridge mcast_snooping 0
-ip link set br0 up
-n=1
-for h in "${HOSTS[@]}"; do
-  ip netns add "$h"
-  ip link add "v-$h" type veth peer name eth0 netns "$h"
-  ip link set "v-$h" master br0 up
-  ip -n "$h" link set lo up
-  ip -n "$h" addr add "10.213.0.$n/24" dev eth0
-  ip -n "$h" link set eth0 up multicast on
-  ip -n "$h" route add 224.0.0.0/4 dev eth0
-  ip netns exec "$h" sysctl -qw net.core.rmem_max=33554432 net.core.rmem_default=4194304 2>/dev/null || true
-  n=$((n + 1))
-done
+mh_bridge "${HOSTS[@]}"
 
 # ---- keys and one sshd per host (its own host key; root with our key only)
-ssh-keygen -q -t ed25519 -N '' -f "$T/id" -C fploc-mh-test
-cp "$T/id.pub" "$T/authorized_keys"
+mh_client_key "$T" fploc-mh-test
 n=1
-for h in "${HOSTS[@]}"; do
-  ssh-keygen -q -t ed25519 -N '' -f "$T/hostkey-$h"
-  cat > "$T/sshd-$h.conf" <<CONF
-ListenAddress 10.213.0.$n
-Port 22
-HostKey $T/hostkey-$h
-PidFile $T/sshd-$h.pid
-AuthorizedKeysFile $T/authorized_keys
-StrictModes no
-PermitRootLogin prohibit-password
-PasswordAuthentication no
-KbdInteractiveAuthentication no
-UsePAM no
-PrintMotd no
-CONF
-  ip netns exec "$h" /usr/sbin/sshd -f "$T/sshd-$h.conf" -E "$T/sshd-$h.log"
-  n=$((n + 1))
-done
+for h in "${HOSTS[@]}"; do mh_sshd "$T" "$h" "10.213.0.$n"; n=$((n + 1)); done
 python3 "$HERE/make_graphs.py" "$T" "$ROOT" "$T/id"
 for i in $(seq 50); do
   ip netns exec drv ssh -o BatchMode=yes -o StrictHostKeyChecking=no -o UserKnownHostsFile=/dev/null -o LogLevel=ERROR \
@@ -159,7 +119,7 @@ ip link set v-compute down
 gone="" said=""
 for i in $(seq 200); do
   dt=$(python3 -c "import time,sys; print(f'{time.time()-float(sys.argv[1]):.2f}')" "$t0")
-  [ -z "$said" ] && grep -qE "host 'compute'.*(ssh connection lost|ssh master connection.*ended)" "$T/mh.log" && said=$dt
+  [ -z "$said" ] && grep -qE "host 'compute'.*ssh connection lost|ssh master connection to host 'compute'.*ended" "$T/mh.log" && said=$dt
   [ -z "$gone" ] && [ -z "$(pgrep -f -- "^$BIN/fploc-[a-z0-9-]+ --graph $T/mh.pbtxt --node ($cmp_nodes)" || true)" ] && gone=$dt
   [ -n "$said" ] && [ -n "$gone" ] && break
   sleep 0.05
