@@ -38,6 +38,20 @@ jcheck comp_list "j['topics']['/imu']['count'] == 2 and 'unsupported compression
 run comp_out 1 "$T/comp.mcap" --out "$T/comp.lcm" --json
 jcheck comp_out "j['written'] == {'OS1_IMU': 2} and len(j['errors']) == 1"
 
+# 2. The same bytes in the text output (the summary, --list, the errors): names from the recording printed with \xHH
+# escapes (a terminal escape and a byte that is not UTF-8 were printed raw).
+ESC=$(printf '\033')
+run esc_list 0 "$T/topic_esc.bag" --list
+grep -qF '  /imu\x1b[2J\xe9        2  sensor_msgs/Imu  (imported)' "$T/esc_list.out" || fail "esc_list: $(cat -v "$T/esc_list.out")"
+run esc_out 0 "$T/topic_esc.bag" --out "$T/esc.lcm"
+grep -qxF '  topic /imu\x1b[2J\xe9 -> OS1_IMU' "$T/esc_out.out" || fail "esc_out: $(cat -v "$T/esc_out.out")"
+run esc_topics 2 "$T/topic_esc.bag" --topics "/imu${ESC}[2J" --out "$T/esc2.lcm"
+grep -qxF "fploc import: no topic '/imu\x1b[2J' in the recording; its topics:" "$T/esc_topics.err" &&
+  grep -qxF '  /imu\x1b[2J\xe9  sensor_msgs/Imu' "$T/esc_topics.err" || fail "esc_topics: $(cat -v "$T/esc_topics.err")"
+for k in esc_list esc_out esc_topics; do
+  LC_ALL=C grep -q "[$ESC$(printf '\351')]" "$T/$k.out" "$T/$k.err" && fail "$k: raw bytes in the output: $(cat -v "$T/$k.out" "$T/$k.err")"
+done
+
 # 3. Options that match nothing: an error naming what is missing and listing what is there, exit 2, nothing written
 # (they gave an empty or partial log, exit 0).
 L="$T/laser.bag"

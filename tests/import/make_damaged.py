@@ -2,6 +2,7 @@
 # Small recordings with one defect each, for import_damaged_test.sh (written here, independently of fploc's writers).
 #   make_damaged.py DIR   writes:
 #   topic_e9.bag   an Imu topic whose name holds the byte 0xE9 (not UTF-8), 3 messages, one uncompressed chunk
+#   topic_esc.bag  an Imu topic named b'/imu\x1b[2J\xe9' (a terminal escape, a byte that is not UTF-8), 2 messages
 #   comp.mcap      one uncompressed chunk of 2 Imu messages, then a chunk whose compression name is b'\xff\xfe'
 #   laser.bag      /scan_front, /scan_back (LaserScan), /odom (Odometry), /tf (odom -> base_link, base_link -> laser)
 #                  at 100..104 s, one uncompressed chunk
@@ -50,6 +51,7 @@ def mcap_comp(path):
 
 d = sys.argv[1]
 bag(os.path.join(d, 'topic_e9.bag'), [(b'/imu\xe9', 'sensor_msgs/Imu', imu)], 3)
+bag(os.path.join(d, 'topic_esc.bag'), [(b'/imu\x1b[2J\xe9', 'sensor_msgs/Imu', imu)], 2)
 mcap_comp(os.path.join(d, 'comp.mcap'))
 bag(os.path.join(d, 'laser.bag'), [(b'/scan_front', 'sensor_msgs/LaserScan', scan), (b'/scan_back', 'sensor_msgs/LaserScan', scan),
                                    (b'/odom', 'nav_msgs/Odometry', odom), (b'/tf', 'tf2_msgs/TFMessage', tf)], 5)
