@@ -79,6 +79,25 @@ grep -q "^  /tf .*tf2_msgs/TFMessage  (to TUM with --tum-out F --tf-parent P --t
 run list_tf_json 0 "$L" --list --json
 jcheck list_tf_json "j['topics']['/tf']['imported_as'] == '' and j['topics']['/scan_back']['imported_as'] == 'yes'"
 
+# 7. A damaged chunk length in a whole bag (its index after the chunk is in the file): "the length is damaged", not a
+# truncation, and the chunk's whole messages are read (the reader said "file truncated?" and read none of them).
+run len_bag 1 "$T/len.bag" --out "$T/len.lcm" --json
+jcheck len_bag "j['written'] == {'OS1_IMU': 3}"
+grep -qF "/len.bag: record at byte 106: chunk (none) of 4294967280 B runs past the end of the file (file size 1424 B; the file is not short (its index at byte 1331 is in it): the length is damaged); the chunk's 3 whole messages before the cut were read" "$T/len_bag.err" ||
+  fail "len_bag: $(cat "$T/len_bag.err")"
+# 8. A damaged compression name in the text errors: escaped (raw bytes before; the JSON's U+FFFD hid it), for a whole
+# chunk and for a chunk the end of the file cuts (MCAP and bag).
+grep -qF "/comp.mcap: chunk at byte 860 (\xff\xfe): unsupported compression '\xff\xfe'" "$T/comp_out.err" ||
+  fail "comp_out: $(cat -v "$T/comp_out.err")"
+run cutcomp_mcap 1 "$T/cutcomp.mcap" --out "$T/ccm.lcm" --json
+jcheck cutcomp_mcap "j['written'] == {'OS1_IMU': 2}"
+grep -qF "/cutcomp.mcap: chunk at byte 860 (\xff\xfe): length 388 runs past the end of the file (file size 951 B; file truncated, or the length damaged): a cut compressed chunk cannot be decompressed, its messages are lost" "$T/cutcomp_mcap.err" ||
+  fail "cutcomp_mcap: $(cat -v "$T/cutcomp_mcap.err")"
+run cutcomp_bag 1 "$T/cutcomp.bag" --out "$T/ccb.lcm" --json
+jcheck cutcomp_bag "j['written'] == {'OS1_IMU': 2}"
+grep -qF "/cutcomp.bag: record at byte 970: chunk (\xff\xfe) of 361 B runs past the end of the file (file size 1057 B; file truncated?): a cut compressed chunk cannot be decompressed, its messages are lost" "$T/cutcomp_bag.err" ||
+  fail "cutcomp_bag: $(cat -v "$T/cutcomp_bag.err")"
+
 BAG="$SHARED/ouster/512x10_raw.bag"
 if [ -f "$BAG" ]; then
   # The metadata JSON with one byte flipped (0x84, not UTF-8).
