@@ -20,6 +20,7 @@
 #include <thread>
 #include <mutex>
 
+#include "fploc/core/text_out.h"
 #include "fploc/runtime/bus.h"
 #include "fploc/runtime/graph.h"
 #include "fploc/runtime/node.h"
@@ -117,11 +118,11 @@ class DashboardNode : public fploc::rt::Node {
         ctx.error("dashboard.graph: " + (errors.empty() ? gpath : errors.front().str()));
       }
     }
-    model_->set_info("bind", json(bind_).dump());
+    model_->set_info("bind", fploc::json_text(json(bind_)));
     model_->set_info("port", std::to_string(port_));
-    model_->set_info("max_push_hz", json(max_hz_).dump());
+    model_->set_info("max_push_hz", fploc::json_text(json(max_hz_)));
     model_->set_info("control", token_.empty() ? "false" : "true");
-    model_->set_info("silent_after_s", json(mc.silent_after_s).dump());
+    model_->set_info("silent_after_s", fploc::json_text(json(mc.silent_after_s)));
 
     ctx.subscribe<fploc::pose_t>("pose", [this](const fploc::pose_t& m) { model_->on_pose(m, steady_s(), wall_us()); });
     ctx.subscribe<fploc::frame_pose_t>(

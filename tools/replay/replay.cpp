@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "fploc/core/text_out.h"
 #include "fploc/runtime/bus.h"
 #include "fploc/runtime/compose.h"
 #include "fploc/runtime/graph.h"
@@ -217,7 +218,7 @@ int main(int argc, char** argv) {
                        {"handler_cpu_ms", total_cpu_ms},
                        {"nodes", nodes}};
       if (!out.empty()) j["out"] = out;
-      std::cout << j.dump() << std::endl;
+      std::cout << fploc::json_text(j) << std::endl;
     }
     if (const std::string problem = log.problem(); !problem.empty()) {
       std::cerr << "fploc replay: " << problem << (events > 0 ? "; the events read were replayed" : "") << "\n";
