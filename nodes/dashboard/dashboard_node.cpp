@@ -289,11 +289,12 @@ class DashboardNode : public fploc::rt::Node {
     }
     std::string err;
     if (!server_->listen(err)) {
-      if (!bind_error_reported_) ctx_->error("dashboard: cannot listen on " + bind_ + ":" + std::to_string(port_) + " (" +
-                                             err + "); retrying every 0.5 s");
-      bind_error_reported_ = true;
+      // Its telemetry says so while it lasts (state "failing", last_error), not only one line on stderr.
+      ctx_->set_failing("dashboard: cannot listen on " + bind_ + ":" + std::to_string(port_) + " (" + err +
+                        "); not serving, retrying every 0.5 s");
       return;
     }
+    ctx_->set_failing("");
     listening_ = true;
     server_->start();
     std::cerr << "[" << ctx_->name() << "] dashboard on http://" << bind_ << ":" << port_ << "/ (web root "
@@ -326,7 +327,7 @@ class DashboardNode : public fploc::rt::Node {
   double max_hz_ = 20;
   FloorPlans floors_;  // set in setup, read by the HTTP thread
   fs::path web_root_;
-  bool listening_ = false, stopping_ = false, bind_error_reported_ = false;
+  bool listening_ = false, stopping_ = false;
   std::mutex cmd_mu_;
   std::vector<fploc::node_command_t> commands_;
 };

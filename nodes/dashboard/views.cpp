@@ -148,6 +148,9 @@ std::string nodes_view(const std::map<std::string, NodeRow>& rows, double silent
     } else if (s.state == "restarting" || s.state == "dead" || s.state == "hung" || s.state == "stopped") {
       health = "bad";
       reason = s.state + " (" + s.reporter + ")";
+    } else if (s.state == "failing") {  // running, but not doing its job: last_error says why
+      health = "bad";
+      reason = s.last_error.empty() ? s.state : s.last_error;
     } else if (s.state == "starting") {
       health = "warn";
       reason = "starting";
