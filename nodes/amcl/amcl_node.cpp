@@ -33,6 +33,7 @@
 #include "fploc/amcl/amcl.h"
 #include "fploc/amcl/odometry.h"
 #include "fploc/config/amcl.h"
+#include "fploc/core/text_out.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/adapters/features_t.h"
 #include "fploc/adapters/pose_t.h"
@@ -161,7 +162,7 @@ class AmclNode : public fploc::rt::Node {
                        {"messages_out_of_order", out_of_order_},
                        {"odometry", wheel_mode_ ? "simulated-wheel" : "pose"}};
       std::ofstream f(stats_file_);
-      if (f) f << j.dump(1) << "\n";
+      if (f) f << fploc::json_text(j, 1) << "\n";
       else ctx_->error("stats_file '" + stats_file_ + "': cannot write");
     }
   }

@@ -20,6 +20,7 @@
 #include <thread>
 #include <mutex>
 
+#include "fploc/core/text_out.h"
 #include "fploc/runtime/bus.h"
 #include "fploc/runtime/graph.h"
 #include "fploc/runtime/node.h"
@@ -117,11 +118,11 @@ class DashboardNode : public fploc::rt::Node {
         ctx.error("dashboard.graph: " + (errors.empty() ? gpath : errors.front().str()));
       }
     }
-    model_->set_info("bind", json(bind_).dump());
+    model_->set_info("bind", fploc::json_text(json(bind_)));
     model_->set_info("port", std::to_string(port_));
-    model_->set_info("max_push_hz", json(max_hz_).dump());
+    model_->set_info("max_push_hz", fploc::json_text(json(max_hz_)));
     model_->set_info("control", token_.empty() ? "false" : "true");
-    model_->set_info("silent_after_s", json(mc.silent_after_s).dump());
+    model_->set_info("silent_after_s", fploc::json_text(json(mc.silent_after_s)));
 
     ctx.subscribe<fploc::pose_t>("pose", [this](const fploc::pose_t& m) { model_->on_pose(m, steady_s(), wall_us()); });
     ctx.subscribe<fploc::frame_pose_t>(
@@ -288,11 +289,12 @@ class DashboardNode : public fploc::rt::Node {
     }
     std::string err;
     if (!server_->listen(err)) {
-      if (!bind_error_reported_) ctx_->error("dashboard: cannot listen on " + bind_ + ":" + std::to_string(port_) + " (" +
-                                             err + "); retrying every 0.5 s");
-      bind_error_reported_ = true;
+      // Its telemetry says so while it lasts (state "failing", last_error), not only one line on stderr.
+      ctx_->set_failing("dashboard: cannot listen on " + bind_ + ":" + std::to_string(port_) + " (" + err +
+                        "); not serving, retrying every 0.5 s");
       return;
     }
+    ctx_->set_failing("");
     listening_ = true;
     server_->start();
     std::cerr << "[" << ctx_->name() << "] dashboard on http://" << bind_ << ":" << port_ << "/ (web root "
@@ -325,7 +327,7 @@ class DashboardNode : public fploc::rt::Node {
   double max_hz_ = 20;
   FloorPlans floors_;  // set in setup, read by the HTTP thread
   fs::path web_root_;
-  bool listening_ = false, stopping_ = false, bind_error_reported_ = false;
+  bool listening_ = false, stopping_ = false;
   std::mutex cmd_mu_;
   std::vector<fploc::node_command_t> commands_;
 };

@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "fploc/core/text_out.h"
 #include "fploc/floorplan/building.h"
 #include "plan_json.h"
 
@@ -27,7 +28,7 @@ FloorPlans load_floor_plans(const std::string& path, const std::vector<std::stri
       list.push_back({{"index", i}, {"name", f.name}, {"elevation", f.elevation}});
     }
   }
-  out.floors_json = nlohmann::json({{"floors", list}, {"initial", out.initial}}).dump();
+  out.floors_json = fploc::json_text(nlohmann::json({{"floors", list}, {"initial", out.initial}}));
   return out;
 }
 

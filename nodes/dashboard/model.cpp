@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include "fploc/core/text_out.h"
 
 namespace fploc::dashboard {
 
@@ -157,7 +158,7 @@ void Model::tick(double now_s, int64_t wall_us) {
             {"ate_rmse", num(r6(ate_.rmse()))},
             {"ate_n", ate_.count()},
             {"wall_us", wall_us}};
-  hub_.set("stats", s.dump());
+  hub_.set("stats", fploc::json_text(s));
 }
 
 // ---- fleet -----------------------------------------------------------------------------------------
@@ -172,7 +173,7 @@ void Model::set_robots(const std::string& own, const std::vector<std::string>& o
     fleet_[r];
     list.push_back({{"name", r}, {"color", kColours[k++ % 7]}, {"own", false}});
   }
-  hub_.set("robots", list.dump());
+  hub_.set("robots", fploc::json_text(list));
 }
 
 bool Model::has_robot(const std::string& robot) const {
@@ -222,7 +223,7 @@ std::string Model::fleet_history_json(const std::string& robot, int64_t since) c
         est.push_back(est_row(p));
   json j = {{"robot", robot}, {"fields_est", kEstFields},
             {"est", est}, {"gt", json::array()}};
-  return j.dump();
+  return fploc::json_text(j);
 }
 
 void Model::rebuild_nodes(double now_s, int64_t wall_us) {
@@ -253,7 +254,7 @@ std::string Model::history_json(int64_t since) const {
             {"gt", gt},
             {"ate_rmse", num(ate_.rmse())},
             {"ate_n", ate_.count()}};
-  return j.dump();
+  return fploc::json_text(j);
 }
 
 std::string Model::info_json() const {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include "fploc/core/text_out.h"
 
 namespace fploc::dashboard {
 
@@ -20,12 +21,11 @@ std::string plan_diff_json(const fploc::plan_diff_t& m) {
                      {"y1", r4(m.y1[size_t(i)])},
                      {"offset_m", r4(m.offset_m[size_t(i)])}});
   }
-  return nlohmann::json{{"utime", m.utime},          {"frames", m.frames},
-                        {"seen", m.elements_seen},    {"missing", m.elements_missing},
-                        {"moved", m.elements_moved},  {"unobserved", m.elements_unobserved},
-                        {"scale_error", m.scale_error}, {"scale_sigma", m.scale_sigma},
-                        {"items", items}}
-      .dump();
+  return fploc::json_text(nlohmann::json{{"utime", m.utime},          {"frames", m.frames},
+                                         {"seen", m.elements_seen},    {"missing", m.elements_missing},
+                                         {"moved", m.elements_moved},  {"unobserved", m.elements_unobserved},
+                                         {"scale_error", m.scale_error}, {"scale_sigma", m.scale_sigma},
+                                         {"items", items}});
 }
 
 }  // namespace fploc::dashboard

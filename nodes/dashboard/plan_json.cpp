@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "fploc/core/text_out.h"
 #include "fploc/floorplan/io.h"
 
 namespace fploc::dashboard {
@@ -34,7 +35,7 @@ std::string plan_to_json(const FloorPlan& plan) {
   const Box2 b = plan.bounds();
   json j = {{"units", "m"}, {"source", plan.source}, {"elements", els}, {"layers", plan.layers}};
   j["bounds"] = b.empty() ? json(nullptr) : json({r(b.min.x()), r(b.min.y()), r(b.max.x()), r(b.max.y())});
-  return j.dump();
+  return fploc::json_text(j);
 }
 
 }  // namespace fploc::dashboard

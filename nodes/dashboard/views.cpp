@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fploc/core/pose.h"
+#include "fploc/core/text_out.h"
 
 namespace fploc::dashboard {
 
@@ -52,7 +53,7 @@ std::string pose_view(const fploc::pose_t& m, const Rpy& r, const AteFigure& ate
             {"floor_index", int(m.floor_index)},
             {"floor", m.floor},
             {"rx_us", wall_us}};
-  return j.dump();
+  return fploc::json_text(j);
 }
 
 std::string ground_truth_view(const fploc::ground_truth_t& m, const Rpy& r, const AteFigure& ate, int64_t wall_us) {
@@ -69,7 +70,7 @@ std::string ground_truth_view(const fploc::ground_truth_t& m, const Rpy& r, cons
             {"ate_rmse", num(r6(ate.rmse))},
             {"ate_n", ate.n},
             {"rx_us", wall_us}};
-  return j.dump();
+  return fploc::json_text(j);
 }
 
 std::string frame_pose_view(const fploc::frame_pose_t& m, double frame_rate_hz, int64_t wall_us) {
@@ -90,13 +91,13 @@ std::string frame_pose_view(const fploc::frame_pose_t& m, double frame_rate_hz, 
             {"floor_index", int(m.floor_index)},
             {"floor", m.floor},
             {"rx_us", wall_us}};
-  return j.dump();
+  return fploc::json_text(j);
 }
 
 std::string frame_pose_for_features(const fploc::frame_pose_t& fp, int64_t features_scan_seq) {
   json p = {{"x", num(fp.x)}, {"y", num(fp.y)}, {"yaw", num(fp.yaw)}, {"scan_seq", fp.scan_seq},
             {"exact", fp.scan_seq == features_scan_seq}};
-  return p.dump();
+  return fploc::json_text(p);
 }
 
 std::string features_view(const fploc::features_t& m, size_t max_points, const std::string& pose_json) {
@@ -150,6 +151,9 @@ std::string nodes_view(const std::map<std::string, NodeRow>& rows, double silent
     } else if (s.state == "restarting" || s.state == "dead" || s.state == "hung" || s.state == "stopped") {
       health = "bad";
       reason = s.state + " (" + s.reporter + ")";
+    } else if (s.state == "failing") {  // running, but not doing its job: last_error says why
+      health = "bad";
+      reason = s.last_error.empty() ? s.state : s.last_error;
     } else if (s.state == "starting") {
       health = "warn";
       reason = "starting";
@@ -203,7 +207,7 @@ std::string nodes_view(const std::map<std::string, NodeRow>& rows, double silent
                    {"ports", ports}});
   }
   json j = {{"silent_after_s", silent_after_s}, {"wall_us", wall_us}, {"nodes", arr}};
-  return j.dump();
+  return fploc::json_text(j);
 }
 
 }  // namespace fploc::dashboard

@@ -20,6 +20,7 @@
 #include <optional>
 
 #include "fploc/config/floor_ref.h"
+#include "fploc/core/text_out.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/matcher/imu_yaw.h"
 #include "fploc/ndt/ndt_localizer.h"
@@ -112,7 +113,7 @@ class NdtNode : public fploc::rt::Node {
                        {"iterations_per_scan", scans_ ? double(iterations_) / double(scans_) : 0.0},
                        {"points_per_scan", scans_ ? double(points_) / double(scans_) : 0.0}};
       std::ofstream f(stats_file_);
-      if (f) f << j.dump(1) << "\n";
+      if (f) f << fploc::json_text(j, 1) << "\n";
       else ctx_->error("stats_file '" + stats_file_ + "': cannot write");
     }
   }

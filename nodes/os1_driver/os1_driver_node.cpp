@@ -9,6 +9,7 @@
 #include <fploc/scan_t.hpp>
 
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -40,6 +41,7 @@ class Os1DriverNode : public fploc::rt::Node {
 
   void setup(fploc::rt::Context& ctx) override {
     ctx_ = &ctx;
+    started_ = std::chrono::steady_clock::now();
     const auto& opt = ctx.options<fploc::Os1DriverOptions>();
     out_ = ctx.advertise<fploc::scan_t>("scan");
     port_ = fploc::os1::port_or_default(opt.lidar_port(), fploc::os1::kDefaultLidarPort);
@@ -74,7 +76,9 @@ class Os1DriverNode : public fploc::rt::Node {
     }
     // A missing or broken metadata file is bad input, not a reason to die: it is reported (stderr and
     // telemetry, once per distinct error), packets are dropped and counted, and the file is read again
-    // every 0.5 s until it loads (e.g. the simulator writes it a moment after the driver starts).
+    // every 0.5 s until it loads. A file that does not exist yet is waited for quietly for the first
+    // kMetadataGraceS (the simulator writes it a moment after the driver starts: every start of the demo
+    // printed "cannot open metadata file ... retrying"); still missing after that, it is reported.
     if (!load()) ctx.every(0.5, [this] { if (!assembler_) load(); });
     if (pcap_mode_) {
       std::string err;
@@ -197,7 +201,15 @@ class Os1DriverNode : public fploc::rt::Node {
         return false;  // waiting for the next HTTP attempt
       }
     } catch (const MetadataError& e) {
-      report_metadata(e.what());
+      std::string what = e.what();
+      if (source == metadata_path_ && !metadata_path_.empty()) {
+        std::error_code ec;
+        if (!std::filesystem::exists(metadata_path_, ec)) {
+          if (std::chrono::steady_clock::now() - started_ < std::chrono::duration<double>(kMetadataGraceS)) return false;
+          what += " (no such file " + std::to_string(int(kMetadataGraceS)) + " s after the driver started)";
+        }
+      }
+      report_metadata(what);
       return false;
     }
     if (!metadata_error_.empty() || source != metadata_path_)
@@ -308,6 +320,8 @@ class Os1DriverNode : public fploc::rt::Node {
   int port_ = fploc::os1::kDefaultLidarPort;
   std::string metadata_path_;
   std::string metadata_error_;  // last load error (reported once)
+  static constexpr double kMetadataGraceS = 3.0;  // a metadata file that does not exist yet: quiet this long
+  std::chrono::steady_clock::time_point started_{};
   std::string sensor_host_;
   std::chrono::steady_clock::time_point next_http_{};
   std::unique_ptr<SensorSession> session_;

@@ -13,7 +13,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <cerrno>
 #include <fstream>
 #include <memory>
 #include <stdexcept>
@@ -93,10 +96,20 @@ class SimSensorNode : public fploc::rt::Node {
     info_ = fploc::sim::sensor_info_for(sim_->lidar().config().beams, so_.width, so_.rate_hz);
     fmt_ = fploc::os1::PacketFormat::from(info_);
     if (!opt.metadata_out().empty()) {
+      // Written beside it and renamed: a driver polling for the file never reads it half-written (or truncated, when
+      // an older one is overwritten).
       const std::string p = ctx.resolve_path(opt.metadata_out());
-      std::ofstream f(p);
-      f << fploc::sim::metadata_json(info_);
-      if (!f) throw std::runtime_error("sim: cannot write metadata_out " + p);
+      const std::string tmp = p + ".tmp" + std::to_string(::getpid());
+      {
+        std::ofstream f(tmp);
+        f << fploc::sim::metadata_json(info_);
+        if (!f) throw std::runtime_error("sim: cannot write metadata_out " + p + " (writing " + tmp + ")");
+      }
+      if (std::rename(tmp.c_str(), p.c_str()) != 0) {
+        const std::string why = std::strerror(errno);
+        std::remove(tmp.c_str());
+        throw std::runtime_error("sim: cannot write metadata_out " + p + " (" + why + ")");
+      }
     }
     gt_ = ctx.advertise<fploc::ground_truth_t>("ground_truth");
     // UDP socket.

@@ -236,6 +236,17 @@ bool Context::error(const std::string& msg) {
   return false;
 }
 
+void Context::set_failing(const std::string& what) {
+  if (what == stats_.failing) return;
+  if (what.empty()) {
+    if (stats_.last_error == stats_.failing) stats_.last_error.clear();
+    stats_.failing.clear();
+    return;
+  }
+  stats_.failing = what;
+  error(what);
+}
+
 void Context::request_stop() { loop().stop = true; }
 
 // ---- composition --------------------------------------------------------------------------------
@@ -323,6 +334,10 @@ static fploc::node_status_t make_status(Context& ctx, const std::string& executa
   s.dropped = st.dropped();
   s.undecodable = st.undecodable();
   s.last_error = st.last_error;
+  if (state == "running" && !st.failing.empty()) {  // running, but not doing its job (Context::set_failing)
+    s.state = "failing";
+    s.last_error = st.failing;
+  }
   s.detail = st.detail;
   s.uptime_s = uptime;
   const double now = now_s();

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -225,5 +226,78 @@ TEST(DashboardFlags, BindAndPortFlags) {
   }
   stop(d);
   EXPECT_TRUE(up);
+}
+}  // namespace
+
+namespace {
+// The dashboard cannot listen (its port is taken by another program): while that lasts its own telemetry says so —
+// state "failing", last_error naming host:port and the reason — and another dashboard shows its row as bad; once the
+// port is free it listens, and its row is ok again with last_error cleared. (Its row stayed "ok" while it logged the
+// error once and retried.)
+json row_of(httplib::Client& c, const std::string& node) {
+  auto r = c.Get("/api/state");
+  if (!r || r->status != 200) return nullptr;
+  const json s = json::parse(r->body, nullptr, false);
+  if (!s.is_object() || !s.contains("nodes")) return nullptr;
+  for (const auto& n : s["nodes"]["nodes"])
+    if (n.value("node", "") == node) return n;
+  return nullptr;
+}
+
+TEST(DashboardFlags, AFailedBindIsInItsTelemetryUntilItListens) {
+  const std::string bin = build_dir() + "/bin/";
+  // Port 18082 taken.
+  int taken = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);  // not inherited by the dashboards spawned below
+  ASSERT_GE(taken, 0);
+  const int one = 1;
+  setsockopt(taken, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(18082);
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(bind(taken, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+  ASSERT_EQ(listen(taken, 4), 0);
+  // The dashboard that cannot listen, as the node 'busy_dash' of a graph; another one on 18083 watches.
+  char dir[] = "/tmp/fploc-dash-bind-XXXXXX";
+  ASSERT_NE(mkdtemp(dir), nullptr);
+  const std::string graph = std::string(dir) + "/busy.pbtxt";
+  std::ofstream(graph) << "name: \"busy\"\nnode { name: \"busy_dash\" executable: \"fploc-dashboard\" dashboard { port: 18082 } }\n";
+  pid_t busy = spawn({bin + "fploc-dashboard", "--graph", graph, "--node", "busy_dash"});
+  pid_t watch = spawn({bin + "fploc-dashboard", "--port", "18083"});
+  httplib::Client c("127.0.0.1", 18083);
+  json row;
+  for (int i = 0; i < 100; ++i) {  // a heartbeat that says it is failing
+    row = row_of(c, "busy_dash");
+    if (row.is_object() && row.value("state", "") == "failing") break;
+    std::this_thread::sleep_for(100ms);
+  }
+  ASSERT_TRUE(row.is_object()) << "no row for busy_dash";
+  EXPECT_EQ(row.value("state", ""), "failing") << row.dump();
+  EXPECT_EQ(row.value("health", ""), "bad") << row.dump();
+  const std::string err = row.value("last_error", "");
+  EXPECT_NE(err.find("cannot listen on 127.0.0.1:18082"), std::string::npos) << err;
+  EXPECT_NE(err.find("Address already in use"), std::string::npos) << err;
+  EXPECT_NE(row.value("reason", "").find("127.0.0.1:18082"), std::string::npos) << row.dump();
+  // The port freed: it listens, and its next heartbeats say it is running, without the error.
+  close(taken);
+  httplib::Client b("127.0.0.1", 18082);
+  bool up = false;
+  for (int i = 0; i < 100 && !up; ++i) {
+    auto r = b.Get("/api/info");
+    up = r && r->status == 200;
+    if (!up) std::this_thread::sleep_for(100ms);
+  }
+  EXPECT_TRUE(up) << "busy_dash does not listen on 18082 once it is free";
+  for (int i = 0; i < 50; ++i) {
+    row = row_of(c, "busy_dash");
+    if (row.is_object() && row.value("state", "") == "running") break;
+    std::this_thread::sleep_for(100ms);
+  }
+  EXPECT_EQ(row.value("state", ""), "running") << row.dump();
+  EXPECT_EQ(row.value("health", ""), "ok") << row.dump();
+  EXPECT_EQ(row.value("last_error", "x"), "") << row.dump();
+  stop(busy);
+  stop(watch);
+  std::filesystem::remove_all(dir);
 }
 }  // namespace

@@ -38,6 +38,20 @@ jcheck comp_list "j['topics']['/imu']['count'] == 2 and 'unsupported compression
 run comp_out 1 "$T/comp.mcap" --out "$T/comp.lcm" --json
 jcheck comp_out "j['written'] == {'OS1_IMU': 2} and len(j['errors']) == 1"
 
+# 2. The same bytes in the text output (the summary, --list, the errors): names from the recording printed with \xHH
+# escapes (a terminal escape and a byte that is not UTF-8 were printed raw).
+ESC=$(printf '\033')
+run esc_list 0 "$T/topic_esc.bag" --list
+grep -qF '  /imu\x1b[2J\xe9        2  sensor_msgs/Imu  (imported)' "$T/esc_list.out" || fail "esc_list: $(cat -v "$T/esc_list.out")"
+run esc_out 0 "$T/topic_esc.bag" --out "$T/esc.lcm"
+grep -qxF '  topic /imu\x1b[2J\xe9 -> OS1_IMU' "$T/esc_out.out" || fail "esc_out: $(cat -v "$T/esc_out.out")"
+run esc_topics 2 "$T/topic_esc.bag" --topics "/imu${ESC}[2J" --out "$T/esc2.lcm"
+grep -qxF "fploc import: no topic '/imu\x1b[2J' in the recording; its topics:" "$T/esc_topics.err" &&
+  grep -qxF '  /imu\x1b[2J\xe9  sensor_msgs/Imu' "$T/esc_topics.err" || fail "esc_topics: $(cat -v "$T/esc_topics.err")"
+for k in esc_list esc_out esc_topics; do
+  LC_ALL=C grep -q "[$ESC$(printf '\351')]" "$T/$k.out" "$T/$k.err" && fail "$k: raw bytes in the output: $(cat -v "$T/$k.out" "$T/$k.err")"
+done
+
 # 3. Options that match nothing: an error naming what is missing and listing what is there, exit 2, nothing written
 # (they gave an empty or partial log, exit 0).
 L="$T/laser.bag"
@@ -64,6 +78,25 @@ run list_tf 0 "$L" --list
 grep -q "^  /tf .*tf2_msgs/TFMessage  (to TUM with --tum-out F --tf-parent P --tf-child C)$" "$T/list_tf.out" || fail "list_tf: $(cat "$T/list_tf.out")"
 run list_tf_json 0 "$L" --list --json
 jcheck list_tf_json "j['topics']['/tf']['imported_as'] == '' and j['topics']['/scan_back']['imported_as'] == 'yes'"
+
+# 7. A damaged chunk length in a whole bag (its index after the chunk is in the file): "the length is damaged", not a
+# truncation, and the chunk's whole messages are read (the reader said "file truncated?" and read none of them).
+run len_bag 1 "$T/len.bag" --out "$T/len.lcm" --json
+jcheck len_bag "j['written'] == {'OS1_IMU': 3}"
+grep -qF "/len.bag: record at byte 106: chunk (none) of 4294967280 B runs past the end of the file (file size 1424 B; the file is not short (its index at byte 1331 is in it): the length is damaged); the chunk's 3 whole messages before the cut were read" "$T/len_bag.err" ||
+  fail "len_bag: $(cat "$T/len_bag.err")"
+# 8. A damaged compression name in the text errors: escaped (raw bytes before; the JSON's U+FFFD hid it), for a whole
+# chunk and for a chunk the end of the file cuts (MCAP and bag).
+grep -qF "/comp.mcap: chunk at byte 860 (\xff\xfe): unsupported compression '\xff\xfe'" "$T/comp_out.err" ||
+  fail "comp_out: $(cat -v "$T/comp_out.err")"
+run cutcomp_mcap 1 "$T/cutcomp.mcap" --out "$T/ccm.lcm" --json
+jcheck cutcomp_mcap "j['written'] == {'OS1_IMU': 2}"
+grep -qF "/cutcomp.mcap: chunk at byte 860 (\xff\xfe): length 388 runs past the end of the file (file size 951 B; file truncated, or the length damaged): a cut compressed chunk cannot be decompressed, its messages are lost" "$T/cutcomp_mcap.err" ||
+  fail "cutcomp_mcap: $(cat -v "$T/cutcomp_mcap.err")"
+run cutcomp_bag 1 "$T/cutcomp.bag" --out "$T/ccb.lcm" --json
+jcheck cutcomp_bag "j['written'] == {'OS1_IMU': 2}"
+grep -qF "/cutcomp.bag: record at byte 970: chunk (\xff\xfe) of 361 B runs past the end of the file (file size 1057 B; file truncated?): a cut compressed chunk cannot be decompressed, its messages are lost" "$T/cutcomp_bag.err" ||
+  fail "cutcomp_bag: $(cat -v "$T/cutcomp_bag.err")"
 
 BAG="$SHARED/ouster/512x10_raw.bag"
 if [ -f "$BAG" ]; then

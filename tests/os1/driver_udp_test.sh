@@ -113,4 +113,25 @@ for run in http cache; do
 done
 grep -q "http://127.0.0.1:18080/api/v1/sensor/metadata" "$T/os1_http.txt" || { echo "FAIL: metadata not from HTTP"; exit 1; }
 grep -q "trying the cached" "$T/os1_cache.txt" || { echo "FAIL: unreachable sensor not reported"; exit 1; }
+# A metadata file that appears a moment after the driver starts (graphs/demo.pbtxt: the simulator writes it) is waited
+# for quietly, then the capture decodes (the driver printed "cannot open metadata file ... retrying" at every start of
+# the demo). One that never appears is reported, naming it, once the grace period is over.
+lcm-logger --lcm-url="$URL" "$T/log_late.lcm" > /dev/null 2>&1 & lg=$!
+"$B/fploc-os1-driver" --lcm-url "$URL" --set metadata="$T/late.json" --set lidar_port=17502 > "$T/late.txt" 2>&1 & drv=$!
+sleep 1
+cp "$META" "$T/late.json.part" && mv "$T/late.json.part" "$T/late.json"
+sleep 1.5
+"$B/fploc-os1-send" --pcap "$PCAP" --lidar-port 17502 --imu-port 17503 --rate 1
+sleep 1
+kill -INT "$drv"; wait "$drv" || { echo "FAIL: driver (late metadata) exit status"; cat "$T/late.txt"; exit 1; }
+kill -INT "$lg"; wait "$lg" 2>/dev/null || true
+cat "$T/late.txt"
+if grep -qE "error|cannot open|retrying" "$T/late.txt"; then echo "FAIL: a metadata file written 1 s after the start was reported"; exit 1; fi
+python3 "$(dirname "$0")/check_log.py" --lidar-only "$T/log_late.lcm" "$T/decode.json"
+"$B/fploc-os1-driver" --lcm-url "$URL" --set metadata="$T/never.json" --set lidar_port=17502 > "$T/never.txt" 2>&1 & drv=$!
+want="error: $T/never.json: cannot open metadata file (no such file 3 s after the driver started) (lidar packets are dropped; retrying)"
+for _ in $(seq 150); do grep -qF "$want" "$T/never.txt" && break; sleep 0.1; done
+kill -INT "$drv"; wait "$drv" || { echo "FAIL: driver (no metadata) exit status"; cat "$T/never.txt"; exit 1; }
+grep -qF "$want" "$T/never.txt" || { echo "FAIL: a metadata file that never appears is not reported: $(cat "$T/never.txt")"; exit 1; }
+[ "$(grep -c "never.json" "$T/never.txt")" = 1 ] || { echo "FAIL: not one report: $(cat "$T/never.txt")"; exit 1; }
 echo "os1 driver tests passed"

@@ -1,12 +1,19 @@
 #!/usr/bin/env bash
 # `fploc help` names every command that README.md says it lists ("`bin/fploc help` lists the commands (...)"),
 # subcommands included (map compare/diff, import-carmen and occupancy were missing), each with a built executable.
+# bin/fploc runs with FPLOC_SKIP_BUILD=1: the built programs as they are (`fploc bench` ran `cmake --build` on the
+# build directory from inside ctest). A `cmake` first in PATH records any call: there must be none.
 set -euo pipefail
 R="${FPLOC_ROOT:?run through ctest}"
 B="${FPLOC_BUILD_DIR:?run through ctest}/bin"
-H="$(mktemp)"
-trap 'rm -f "$H"' EXIT
-"$R/bin/fploc" help 2> "$H"  # the usage goes to stderr
+T="$(mktemp -d)"
+trap 'rm -rf "$T"' EXIT
+H="$T/help"
+mkdir "$T/fakebin"
+printf '#!/bin/sh\necho "cmake $*" >> "%s/cmake-called"\n' "$T" > "$T/fakebin/cmake"
+chmod +x "$T/fakebin/cmake"
+fploc() { PATH="$T/fakebin:$PATH" FPLOC_SKIP_SETUP=1 FPLOC_SKIP_BUILD=1 "$R/bin/fploc" "$@"; }
+fploc help 2> "$H"  # the usage goes to stderr
 python3 - "$R/README.md" "$H" "$B" <<'PY'
 import os, re, sys
 readme, help_text, bindir = open(sys.argv[1]).read(), open(sys.argv[2]).read(), sys.argv[3]
@@ -36,9 +43,11 @@ sys.exit(1 if bad else 0)
 PY
 # A command of two words without its second (`fploc bench`, `fploc bench --help`) lists the second words; `fploc map
 # --help` names `diff` (its own program). Both said "unknown command" / left diff out.
-out="$(FPLOC_SKIP_SETUP=1 "$R/bin/fploc" bench --help 2>&1)" || { echo "FAIL: fploc bench --help: exit $?: $out"; exit 1; }
+out="$(fploc bench --help 2>&1)" || { echo "FAIL: fploc bench --help: exit $?: $out"; exit 1; }
 echo "$out" | grep -q "^usage: fploc bench <.*paper.*realism.*>" || { echo "FAIL: fploc bench --help: $out"; exit 1; }
-out="$(FPLOC_SKIP_SETUP=1 "$R/bin/fploc" bench nosuch 2>&1)" && { echo "FAIL: fploc bench nosuch: exit 0"; exit 1; }
+out="$(fploc bench nosuch 2>&1)" && { echo "FAIL: fploc bench nosuch: exit 0"; exit 1; }
 echo "$out" | grep -q "unknown command 'bench nosuch' (fploc bench: one of .*paper" || { echo "FAIL: fploc bench nosuch: $out"; exit 1; }
-"$B/fploc-map" --help | grep -q "diff (plan changes seen in a recorded run" || { echo "FAIL: fploc map --help does not name diff"; exit 1; }
+fploc map --help | grep -q "diff (plan changes seen in a recorded run" || { echo "FAIL: fploc map --help does not name diff"; exit 1; }
+"$B/fploc-map" --help | grep -q "diff (plan changes seen in a recorded run" || { echo "FAIL: fploc-map --help does not name diff"; exit 1; }
+if [ -e "$T/cmake-called" ]; then echo "FAIL: bin/fploc ran a build inside the test: $(cat "$T/cmake-called")"; exit 1; fi
 echo OK

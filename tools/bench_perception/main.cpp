@@ -17,6 +17,7 @@
 #include <iostream>
 #include <map>
 
+#include "fploc/core/text_out.h"
 #include "fploc/features/features.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/segmentation/ransac_segmenter.h"
@@ -369,9 +370,9 @@ int main(int argc, char** argv) {
       out["gyro_bias_estimate_rad_s"] = {rings.gyro_bias().x(), rings.gyro_bias().y(), rings.gyro_bias().z()};
     out["seed"] = seed;
     if (json) {
-      std::cout << out.dump(2) << "\n";
+      std::cout << fploc::json_text(out, 2) << "\n";
     } else {
-      std::cerr << out.dump(2) << "\n";
+      std::cerr << fploc::json_text(out, 2) << "\n";
     }
     return 0;
   } catch (const std::exception& e) {

@@ -17,6 +17,7 @@
 #include "fploc/carmen/carmen.h"
 #include "fit_loss_option.h"
 #include "log_scans.h"
+#include "fploc/core/text_out.h"
 #include "fploc/floorplan/occupancy.h"
 #include "fploc/laser2d/grid_localizer.h"
 
@@ -63,7 +64,7 @@ int main(int argc, char** argv) {
                       {"dyaw_deg", fploc::wrap_angle(r.pose.yaw - ref.yaw) * 180 / M_PI},
                       {"inlier_ratio", r.inlier_ratio}, {"ok", r.status == l2::GridStatus::kOk}});
     }
-    std::cout << nlohmann::json{{"log", log_path}, {"map", map_path}, {"scans", rows}}.dump() << "\n";
+    std::cout << fploc::json_text(nlohmann::json{{"log", log_path}, {"map", map_path}, {"scans", rows}}) << "\n";
   } catch (const std::exception& ex) {
     std::cerr << "fploc real-floor: " << ex.what() << "\n";
     return 1;

@@ -12,6 +12,7 @@
 #include "fploc/carmen/carmen.h"
 #include "fploc/config/localization.h"
 #include "fploc/config/plan_source.h"
+#include "fploc/core/text_out.h"
 #include "fploc/floorplan/distance_field.h"
 #include "fploc/laser2d/grid_localizer.h"
 #include "fploc/laser2d/laser_odometry.h"
@@ -181,7 +182,7 @@ int main(int argc, char** argv) {
       rows.push_back(row);
     }
     if (laser_odom) std::cerr << "laser odometry: " << lo_kept << " of " << lo_n << " steps matched\n";
-    std::cout << nlohmann::json{{"log", log_path}, {"map", map_path}, {"start", start}, {"scans", rows}}.dump() << "\n";
+    std::cout << fploc::json_text(nlohmann::json{{"log", log_path}, {"map", map_path}, {"start", start}, {"scans", rows}}) << "\n";
   } catch (const std::exception& ex) {
     std::cerr << "fploc real-plan-track: " << ex.what() << "\n";
     return 1;

@@ -15,6 +15,7 @@
 #include "fploc/carmen/carmen.h"
 #include "fit_loss_option.h"
 #include "log_scans.h"
+#include "fploc/core/text_out.h"
 #include "fploc/floorplan/occupancy.h"
 #include "fploc/laser2d/grid_localizer.h"
 
@@ -125,9 +126,8 @@ int main(int argc, char** argv) {
       if (r.laser_step)
         rows.back()["laser_increment"] = {r.laser_increment.x, r.laser_increment.y, r.laser_increment.yaw};
     }
-    std::cout << nlohmann::json{{"log", log_path}, {"map", map_path}, {"start", start},
-                                {"ms_per_scan", total_ms / double(end - first)}, {"scans", rows}}
-                     .dump()
+    std::cout << fploc::json_text(nlohmann::json{{"log", log_path}, {"map", map_path}, {"start", start},
+                                                 {"ms_per_scan", total_ms / double(end - first)}, {"scans", rows}})
               << "\n";
   } catch (const std::exception& ex) {
     std::cerr << "fploc real-track: " << ex.what() << "\n";

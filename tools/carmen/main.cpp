@@ -25,6 +25,7 @@
 #include <sstream>
 #include <nlohmann/json.hpp>
 
+#include "fploc/core/text_out.h"
 #include "fploc/runtime/cli_numbers.h"
 #include "fploc/carmen/carmen.h"
 #include "fploc/carmen/coverage.h"
@@ -296,7 +297,7 @@ int main(int argc, char** argv) {
               << "; wrote scans " << b << ".." << e
               << (note.empty() ? "" : "; " + note) << "\n";
     if (!damage.empty()) j["damage"] = damage;  // the log ends there: what was read before it is all there is
-    if (json) std::cout << j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";  // file names: any bytes
+    if (json) std::cout << fploc::json_text(j, 1) << "\n";  // file names: any bytes
     if (!damage.empty()) {
       std::cerr << "fploc import-carmen: " << damage << " (the log ends there: " << n
                 << " scans read before it, scans " << b << ".." << e << " of them written)\n";

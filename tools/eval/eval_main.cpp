@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fploc/adapters/features_t.h"
+#include "fploc/core/text_out.h"
 #include "fploc/eval/asbuilt_bound.h"
 #include "fploc/eval/eval.h"
 #include "fploc/eval/reference_noise.h"
@@ -369,7 +370,7 @@ int main(int argc, char** argv) {
               << " m; RPE/" << delta << unit << " mean " << r.trans.mean << " m, " << r.rot_deg.mean << " deg ("
               << r.trans.n << " pairs)\n";
     if (r.trans.n == 0) std::cerr << "fploc eval: warning: no pose pair " << delta << unit << " apart: RPE is 0\n";
-    if (json) std::cout << j.dump() << std::endl;
+    if (json) std::cout << fploc::json_text(j) << std::endl;
     return j.contains("asbuilt_bound") && j["asbuilt_bound"].contains("features_problem") ? 1 : 0;
   } catch (const std::exception& e) {
     std::cerr << "fploc eval: " << e.what() << "\n";

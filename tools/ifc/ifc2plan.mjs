@@ -16,9 +16,13 @@
 // footprint (the cut outline) and its top as the area's ceiling height.
 //
 // Output: {"schema", "source", "storeys":[{"name","id","elevation","ceiling_height",
-//          "elements":[{"layer","id","a":[x,y],"b":[x,y]}],"spaces":[{"name","id","ceiling_height","polygon":[[x,y],..]}]}]}
+//          "elements":[{"layer","id","a":[x,y],"b":[x,y]}],"spaces":[{"name","id","ceiling_height","polygon":[[x,y],..]}]}],
+//          "unhandled_representation": N, "warnings": ["FILE:LINE: #ID=IFCTYPE: warning: ..."]}
+// Warnings (also on stderr): an element of a cut class with a representation item web-ifc gives no
+// geometry for (the element, or that part of it, is not in the plan); N counts those elements.
 // Errors: one line on stderr "FILE:LINE: ..." or "FILE: #ID=IFCTYPE: ..." and exit status 2: a broken
-// STEP structure (checkStep), a used entity that is malformed or refers to a missing one (checkUsed).
+// STEP structure (checkStep), a used entity that is malformed or refers to a missing one, or has an
+// empty point list or an extrusion depth that is not > 0 (checkUsed).
 import fs from 'node:fs';
 
 const DEFAULT_CLASSES = ['IfcWall', 'IfcWallStandardCase', 'IfcWallElementedCase', 'IfcCurtainWall', 'IfcPlate',
@@ -134,7 +138,7 @@ function checkUsed(text, schema, roots) {
   const num = /[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?/y;
   const word = /[A-Za-z_][A-Za-z0-9_]*/y;
   const seen = new Set();
-  let rec, recId, i, arg, refs, derived;
+  let rec, recId, i, arg, refs, derived, spans;
   const bad = (what) => {
     throw new Error(`${file}:${rec.line}: #${recId}=${rec.type}: argument ${arg}: ${what}`);
   };
@@ -216,6 +220,47 @@ function checkUsed(text, schema, roots) {
       if (!Number.isFinite(Number(text.slice(s, i)))) bad(`'${text.slice(s, i)}' is not a finite number`);
     }
   }
+  // Values web-ifc accepts although the schema does not, and that give no (or wrong) geometry without a
+  // word: a coordinate list without points, an extrusion depth that is not > 0.
+  const minItems = { IFCPOLYLINE: [1, 2, 'points'], IFCPOLYLOOP: [1, 3, 'points'], IFCCARTESIANPOINT: [1, 1, 'coordinates'],
+    IFCCARTESIANPOINTLIST2D: [1, 1, 'points'], IFCCARTESIANPOINTLIST3D: [1, 1, 'points'] };
+  const positive = { IFCEXTRUDEDAREASOLID: [4, 'depth'], IFCEXTRUDEDAREASOLIDTAPERED: [4, 'depth'] };
+  function listItems(s, e) {  // number of items of the list text[s, e) ("(a,(b,c),'x')" -> 3), -1 if no list
+    if (text[s] !== '(') return -1;
+    if (text.slice(s + 1, e - 1).trim() === '') return 0;
+    let depth = 0, n = 1, inStr = false;
+    for (let k = s; k < e; ++k) {
+      const c = text[k];
+      if (inStr) {
+        if (c === "'") inStr = false;  // '' (an escaped quote) reopens at the next character
+      } else if (c === "'") inStr = true;
+      else if (c === '(') ++depth;
+      else if (c === ')') --depth;
+      else if (c === ',' && depth === 1) ++n;
+    }
+    return n;
+  }
+  function checkValues(t, sp) {
+    const mi = minItems[t];
+    if (mi && sp.length >= mi[0]) {
+      const [a, min, what] = mi;
+      const n = listItems(sp[a - 1][0], sp[a - 1][1]);
+      if (n >= 0 && n < min) {
+        arg = a;
+        bad(`${n === 0 ? `an empty list of ${what}` : `a list of ${n} ${what.replace(/s$/, '')}`} (${className(t)} needs at least ${min})`);
+      }
+    }
+    const po = positive[t];
+    if (po && sp.length >= po[0]) {
+      const [a, what] = po;
+      const v = text.slice(sp[a - 1][0], sp[a - 1][1]);
+      if (!(Number(v) > 0)) {
+        arg = a;
+        bad(`${what} '${v}' is not > 0 (a positive length)`);
+      }
+    }
+  }
+  const className = (t) => Object.keys(ns ?? {}).find((k) => k.toUpperCase() === t) ?? t;
   const via = new Map();  // id -> the used entity it was reached from (for the message)
   try {
     for (const root of roots) {
@@ -229,13 +274,17 @@ function checkUsed(text, schema, roots) {
         if (want === undefined) continue;  // a type web-ifc does not know: it ignores it, so do we
         i = rec.args;
         refs = [];
+        spans = [];
         arg = 0;
         derived = 0;
         ws();
         if (text[i] !== ')') {
           for (;;) {
             ++arg;
+            ws();
+            const s = i;
             value();
+            spans.push([s, i]);
             ws();
             if (text[i] === ')') break;
             if (text[i] !== ',') bad(`expected ',' or ')' after the argument, got '${token()}'`);
@@ -246,6 +295,7 @@ function checkUsed(text, schema, roots) {
           const got = derived ? `${arg} (${derived} of them derived '*')` : `${arg}`;
           throw new Error(`${file}:${rec.line}: #${recId}=${rec.type}: expects ${want} argument${want === 1 ? '' : 's'}, got ${got}`);
         }
+        checkValues(rec.type, spans);
         for (const [ref, a] of refs) {
           if (!entities.has(ref)) {
             arg = a;
@@ -448,7 +498,60 @@ function outline(segs) {
   return best;
 }
 
-function streamClass(cls, fn) {
+// The representation items of an element (IfcMappedItem followed to the items of its mapped
+// representation), each [id, representation identifier].
+function representationItems(id) {
+  const items = [];
+  const walk = (repId, depth) => {
+    const r = api.GetLine(model, repId);
+    const ident = value(r.RepresentationIdentifier) ?? '';
+    for (const it of r.Items || []) {
+      const iid = value(it);
+      if (api.GetLineType(model, iid) === type('IFCMAPPEDITEM') && depth < 8) {
+        const map = api.GetLine(model, value(api.GetLine(model, iid).MappingSource));
+        walk(value(map.MappedRepresentation), depth + 1);
+      } else items.push([iid, ident]);
+    }
+  };
+  const e = api.GetLine(model, id);
+  if (e.Representation) for (const r of api.GetLine(model, value(e.Representation)).Representations || []) walk(value(r), 0);
+  return items;
+}
+
+// Elements of the cut classes whose body has representation items web-ifc gives no geometry for
+// (IfcBlock, IfcCsgSolid, IfcBoundingBox, an 'Axis' curve as the only representation, ...): without this they, or those
+// parts of them, were left out of the plan without a word. One warning per element.
+const warnings = [];
+let unhandledElements = 0;
+function checkRepresentation(id, mesh) {
+  const got = new Set();
+  for (let g = 0; mesh && g < mesh.geometries.size(); ++g) {  // items with at least one triangle
+    const gid = mesh.geometries.get(g).geometryExpressID;
+    const geo = api.GetGeometry(model, gid);
+    if (geo.GetIndexDataSize() > 0) got.add(gid);
+    geo.delete();
+  }
+  let items;
+  try {
+    items = representationItems(id);
+  } catch {
+    return;  // a representation web-ifc cannot even list: checkUsed has vetted the references
+  }
+  // With some geometry, only body items count (an 'Axis' polyline or a 'Box' gives none, rightly).
+  const missing = items.filter(([iid, ident]) => !got.has(iid) && (got.size === 0 || ident === '' || ident === 'Body'));
+  if (missing.length === 0) return;
+  ++unhandledElements;
+  const e = entities.get(id);
+  const where = (iid) => `${label(iid)} (line ${entities.get(iid)?.line ?? '?'})`;
+  const types = [...new Set(missing.map(([iid]) => typeName(api.GetLineType(model, iid))))];
+  const w = `${file}:${e?.line ?? '?'}: ${label(id)}: warning: representation item${missing.length > 1 ? 's' : ''} ` +
+    `${missing.map(([iid]) => where(iid)).join(', ')}: ${types.join(', ')} ${types.length > 1 ? 'are types' : 'is a type'} ` +
+    `the IFC reader does not handle (no geometry): ${got.size ? 'that part of the element is' : 'the element is'} left out of the plan`;
+  warnings.push(w);
+  process.stderr.write(w + '\n');
+}
+
+function streamClass(cls, fn, check = false) {
   const code = type(cls);
   if (!code) return;
   const ids = [...api.GetLineIDsWithType(model, code)];
@@ -459,6 +562,7 @@ function streamClass(cls, fn) {
     } catch (e) {
       die(`${file}: ${label(id)}: web-ifc cannot build its geometry (${e.message ?? e})`);
     }
+    if (check) checkRepresentation(id, mesh);
     if (!mesh || mesh.geometries.size() === 0) continue;  // no body (e.g. a container)
     let tris;
     try {
@@ -482,7 +586,7 @@ for (const cls of classes) {
     for (const s of out) {
       for (const [a, b] of mergeCollinear(cutAt(tris, s.elevation + cut))) s.elements.push({ layer, id, a, b });
     }
-  });
+  }, true);
 }
 
 // Ceilings: slab undersides above the cut plane of each storey, below the next storey's cut plane.
@@ -514,5 +618,8 @@ streamClass('IfcSpace', (id, tris) => {
 api.CloseModel(model);
 
 const total = out.reduce((n, s) => n + s.elements.length, 0);
-if (total === 0) die(`${file}: no ${classes.join('/')} element crosses the cut plane ${cut} m above any storey's floor`);
-process.stdout.write(JSON.stringify({ schema: schemaName, source: file, cut_height: cut, storeys: out }));
+if (total === 0)
+  die(`${file}: no ${classes.join('/')} element crosses the cut plane ${cut} m above any storey's floor` +
+      (unhandledElements ? ` (${unhandledElements} element${unhandledElements > 1 ? 's have' : ' has'} representation items the IFC reader does not handle: see the warnings above)` : ''));
+process.stdout.write(JSON.stringify({ schema: schemaName, source: file, cut_height: cut, storeys: out,
+  unhandled_representation: unhandledElements, warnings }));

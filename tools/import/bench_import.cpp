@@ -32,6 +32,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "fploc/core/text_out.h"
 #include "fploc/recording/bag_writer.h"
 #include "fploc/recording/mcap_writer.h"
 #include "fploc/recording/recording.h"
@@ -398,6 +399,6 @@ int main(int argc, char** argv) {
     if (keep.empty()) fs::remove(bag), fs::remove(chunks);
   }
   if (keep.empty()) fs::remove_all(dir);
-  if (json) std::cout << out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";  // paths: any bytes
+  if (json) std::cout << fploc::json_text(out, 2) << "\n";  // paths: any bytes
   return 0;
 }

@@ -33,6 +33,7 @@
 
 #include "fploc/adapters/point_cloud2_t.h"
 #include "fploc/adapters/scan_t.h"
+#include "fploc/core/text_out.h"
 #include "fploc/recording/cloud_to_scan.h"
 #include "fploc/recording/ouster_packets.h"
 #include "fploc/recording/recording.h"
@@ -93,10 +94,10 @@ bool ends_with(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
-// The summary as text: topic names, types and error messages come from the recording and may hold bytes
-// that are not UTF-8 (a damaged file); nlohmann's dump() threw (type_error 316, an abort) on them. Each bad
-// byte becomes U+FFFD instead.
-std::string dump_json(const nlohmann::json& j) { return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace); }
+// The summary: topic names, types and error messages come from the recording and may hold any bytes (a damaged
+// file, a control character). As JSON each byte that is not UTF-8 becomes U+FFFD (nlohmann's dump() threw on them,
+// an abort); as text (the summary, --list, the errors) names are printed with \xHH escapes (fploc/core/text_out.h).
+std::string dump_json(const nlohmann::json& j) { return json_text(j, 2); }
 
 }  // namespace
 
@@ -193,17 +194,17 @@ int main(int argc, char** argv) {
       }
       std::cout << dump_json(j) << "\n";
     } else {
-      std::printf("%s: %s, %llu messages, %.3f s", path.c_str(), rec->format().c_str(), (unsigned long long)total, dur);
+      std::printf("%s: %s, %llu messages, %.3f s", printable(path).c_str(), rec->format().c_str(), (unsigned long long)total, dur);
       if (total) std::printf(" (from %.3f)", seconds(first));
       std::printf("\n");
       size_t w = 5;
-      for (const auto& [t, s] : topics_seen) w = std::max(w, t.size());
+      for (const auto& [t, s] : topics_seen) w = std::max(w, printable(t).size());
       for (const auto& [t, s] : topics_seen) {
         Connection c;
         for (const auto& [id, cc] : rec->connections())
           if (cc.topic == t) c = cc;
         const Kind k = kind_of(c);
-        std::printf("  %-*s %8llu  %s%s\n", int(w), t.c_str(), (unsigned long long)s.count, s.type.c_str(),
+        std::printf("  %-*s %8llu  %s%s\n", int(w), printable(t).c_str(), (unsigned long long)s.count, printable(s.type).c_str(),
                     imported(k) ? "  (imported)" : k == Kind::kTf ? (std::string("  (") + kTfNote + ")").c_str() : "");
       }
     }
@@ -294,18 +295,18 @@ int main(int argc, char** argv) {
       for (const auto& [id, c] : pre->connections()) types.emplace(c.topic, c.type);
       std::vector<std::string> problems;
       for (const auto& t : named)
-        if (!types.count(t)) problems.push_back("no topic '" + t + "' in the recording");
+        if (!types.count(t)) problems.push_back("no topic '" + printable(t) + "' in the recording");
       if (!problems.empty()) {
         std::string list;
-        for (const auto& [t, ty] : types) list += "\n  " + t + "  " + ty;
+        for (const auto& [t, ty] : types) list += "\n  " + printable(t) + "  " + printable(ty);
         problems.back() += "; its topics:" + (list.empty() ? std::string(" none") : list);
       }
       if (frames_wanted)
         for (const auto& f : {tf_parent, tf_child})
           if (!frames.count(bare(f))) {
             std::string list;
-            for (const auto& x : frames) list += (list.empty() ? "" : ", ") + x;
-            problems.push_back("no tf frame '" + f + "' in the recording's tf messages; its frames: " + (list.empty() ? "none" : list));
+            for (const auto& x : frames) list += (list.empty() ? "" : ", ") + printable(x);
+            problems.push_back("no tf frame '" + printable(f) + "' in the recording's tf messages; its frames: " + (list.empty() ? "none" : list));
           }
       if (start_wanted && !start_seen) {
         char b[160];
@@ -324,12 +325,12 @@ int main(int argc, char** argv) {
 
   LcmLog lcm_log;
   if (!out.empty() && !lcm_log.open(out, direct_io)) {
-    std::cerr << "fploc import: cannot write " << out << "\n";
+    std::cerr << "fploc import: cannot write " << printable(out) << "\n";
     return 1;
   }
   TumTrack tum;
   if (!tum_out.empty() && !tum.open(tum_out, tf_parent, tf_child)) {
-    std::cerr << "fploc import: cannot write " << tum_out << "\n";
+    std::cerr << "fploc import: cannot write " << printable(tum_out) << "\n";
     return 1;
   }
 
@@ -552,7 +553,7 @@ int main(int argc, char** argv) {
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
 
   std::vector<std::string> problems;
-  if (!log_ok) problems.push_back(out + ": writing failed (disk full?); the log is cut short");
+  if (!log_ok) problems.push_back(printable(out) + ": writing failed (disk full?); the log is cut short");
   if (!rec->error().empty()) problems.push_back(rec->error() + " (the output holds everything before it)");
   // Messages that did not decode are skipped, the others written: exit 3 (the log is complete but for them).
   // Lidar packets without metadata because the metadata topic's JSON is unusable: one line for both (below).
@@ -560,14 +561,14 @@ int main(int argc, char** argv) {
   const bool metadata_broken = !metadata_failed.empty() && lidar_without > 0 && !(decode_ouster ? ouster.has_metadata() : raw.has_metadata());
   for (const auto& [t, n] : decode_errors)
     if (!(metadata_broken && t == metadata_failed))
-      problems.push_back(t + ": " + std::to_string(n) + " message" + (n > 1 ? "s" : "") + " not decoded, skipped (the first at " +
+      problems.push_back(printable(t) + ": " + std::to_string(n) + " message" + (n > 1 ? "s" : "") + " not decoded, skipped (the first at " +
                        first_decode_error[t] + ")");
   // Lidar packets that could not be written (no metadata to decode them, or too many before it): the log lacks
   // the lidar, so the import failed (exit 1), as for a damaged file.
   const bool lidar_lost = (ouster.lidar_packets > 0 && !ouster.has_metadata()) ||
                           (raw.lidar_packets > 0 && !raw.has_metadata()) || raw.waiting_dropped > 0;
   if (metadata_broken)
-    problems.push_back(metadata_failed + ": the metadata topic is there but " + metadata_why + "; " + std::to_string(lidar_without) +
+    problems.push_back(printable(metadata_failed) + ": the metadata topic is there but " + metadata_why + "; " + std::to_string(lidar_without) +
                        " Ouster lidar packets " +
                        (decode_ouster ? "could not be decoded: give --metadata FILE"
                                       : "written as they are, without metadata: give --metadata FILE (to import again, or "
@@ -601,7 +602,7 @@ int main(int argc, char** argv) {
     for (const auto& [ch, n] : written)
       if (n && ch.rfind("LASER_SCAN", 0) == 0) replay_graph = "graphs/lidar2d.pbtxt";
   for (const auto& [t, e] : cloud_check_error)
-    problems.push_back(t + ": its first cloud does not convert to a range image (" + e +
+    problems.push_back(printable(t) + ": its first cloud does not convert to a range image (" + e +
                        "); the clouds are written as they are, the cloud-to-scan node will report the same on replay");
   if (ouster.bad_packets) problems.push_back(std::to_string(ouster.bad_packets) + " bad Ouster packets skipped; last: " + ouster.last_error);
   const bool skipped = !decode_errors.empty() || ouster.bad_packets > 0;
@@ -637,22 +638,22 @@ int main(int argc, char** argv) {
     for (const auto& [t, n] : decode_errors) j["not_decoded"][t] = {{"count", n}, {"first", first_decode_error[t]}};
     std::cout << dump_json(j) << "\n";
   } else {
-    std::printf("%s (%s): %llu messages read in %.2f s\n", path.c_str(), rec->format().c_str(), (unsigned long long)read_msgs, wall);
+    std::printf("%s (%s): %llu messages read in %.2f s\n", printable(path).c_str(), rec->format().c_str(), (unsigned long long)read_msgs, wall);
     int width = 28;  // the channel column as wide as the longest name (long ones broke the column)
-    for (const auto& [ch, n] : written) width = std::max(width, int(ch.size()));
-    for (const auto& [ch, n] : written) std::printf("  %-*s %8llu\n", width, ch.c_str(), (unsigned long long)n);
-    for (const auto& [t, ch] : topic_channel) std::printf("  topic %s -> %s\n", t.c_str(), ch.c_str());
+    for (const auto& [ch, n] : written) width = std::max(width, int(printable(ch).size()));
+    for (const auto& [ch, n] : written) std::printf("  %-*s %8llu\n", width, printable(ch).c_str(), (unsigned long long)n);
+    for (const auto& [t, ch] : topic_channel) std::printf("  topic %s -> %s\n", printable(t).c_str(), printable(ch).c_str());
     if (raw.has_metadata() && raw.lidar_packets + raw.imu_packets > 0)
       std::printf("  ouster: %s, %dx%d (%s), %llu lidar + %llu imu packets written as they are\n"
                   "          (the OS-1 and IMU drivers decode them on replay; --decode writes scan_t and imu_t here)\n",
-                  raw.sensor.c_str(), raw.pixels_per_column, raw.columns_per_frame, raw.udp_profile.c_str(),
+                  printable(raw.sensor).c_str(), raw.pixels_per_column, raw.columns_per_frame, raw.udp_profile.c_str(),
                   (unsigned long long)raw.lidar_packets, (unsigned long long)raw.imu_packets);
     if (ouster.info())
-      std::printf("  ouster: %s, %dx%d (%s), %llu lidar + %llu imu packets -> %zu frames\n", ouster.info()->sensor_name().c_str(),
+      std::printf("  ouster: %s, %dx%d (%s), %llu lidar + %llu imu packets -> %zu frames\n", printable(ouster.info()->sensor_name()).c_str(),
                   ouster.info()->pixels_per_column, ouster.info()->columns_per_frame, os1::to_string(ouster.info()->profile),
                   (unsigned long long)ouster.lidar_packets, (unsigned long long)ouster.imu_packets, frames_total);
     for (const auto& [t, s] : cloud_info)
-      std::printf("  cloud %s: rings from %s, times from %s, %llu/%llu points kept, %llu collisions%s\n", t.c_str(), s.ring_source.c_str(),
+      std::printf("  cloud %s: rings from %s, times from %s, %llu/%llu points kept, %llu collisions%s\n", printable(t).c_str(), s.ring_source.c_str(),
                   s.time_source.c_str(), (unsigned long long)s.kept, (unsigned long long)s.points, (unsigned long long)s.collisions,
                   decode_ouster ? "" : " (first cloud)");
     if (!decode_ouster && !cloud_info.empty())
@@ -660,7 +661,7 @@ int main(int argc, char** argv) {
                   "          (--set cloud_to_scan.rings=N / cloud_to_scan.columns=W there; --decode converts here)\n");
     if (!skipped_types.empty()) {
       std::printf("  not imported:");
-      for (const auto& [t, n] : skipped_types) std::printf(" %s (%llu)", t.c_str(), (unsigned long long)n);
+      for (const auto& [t, n] : skipped_types) std::printf(" %s (%llu)", printable(t).c_str(), (unsigned long long)n);
       std::printf("\n");
     }
     if (!out.empty() && !replay_graph.empty()) {
@@ -674,14 +675,14 @@ int main(int argc, char** argv) {
                                                           : std::vector<std::string>{"matcher"};
       std::string est = std::filesystem::path(out).replace_extension("").string() + "-poses.tum";
       std::printf("  replay (PLAN: your plan; X Y: the start in it [m], YAW [rad]):\n"
-                  "    bin/fploc replay --graph %s --log %s --out %s \\\n     ", replay_graph.c_str(), out.c_str(), est.c_str());
+                  "    bin/fploc replay --graph %s --log %s --out %s \\\n     ", replay_graph.c_str(), printable(out).c_str(), printable(est).c_str());
       for (const auto& n : plan_nodes) std::printf(" --set %s.plan.file=PLAN", n.c_str());
       std::printf(" \\\n     ");
       for (const auto& n : pose_nodes)
         std::printf(" --set %s.initial_pose.x=X --set %s.initial_pose.y=Y --set %s.initial_pose.yaw=YAW", n.c_str(), n.c_str(), n.c_str());
       std::printf("\n");
     }
-    if (!tum_out.empty()) std::printf("  %s: %llu poses\n", tum_out.c_str(), (unsigned long long)tum.poses());
+    if (!tum_out.empty()) std::printf("  %s: %llu poses\n", printable(tum_out).c_str(), (unsigned long long)tum.poses());
   }
   for (const auto& p : problems) std::cerr << "fploc import: " << p << "\n";
   if (!(rec->error().empty() && log_ok && !lidar_lost)) return 1;

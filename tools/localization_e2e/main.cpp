@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "fploc/core/text_out.h"
 #include "fploc/eval/eval.h"
 #include "fploc/floorplan/io.h"
 #include "pipeline.h"
@@ -69,7 +70,7 @@ int main(int argc, char** argv) {
                         {"us_per_scan", {{"segmenter", r.us_segment}, {"features", r.us_features}, {"matcher", r.us_matcher},
                                          {"optimizer", r.us_optimizer}, {"odometry", r.us_odometry}}},
                         {"hz", 1e6 / std::max(1.0, r.us_segment + r.us_features + r.us_matcher + r.us_optimizer)}};
-    std::cout << j.dump(2) << "\n";
+    std::cout << fploc::json_text(j, 2) << "\n";
     if (!out_prefix.empty()) {
       fploc::write_tum(out_prefix + "-gt.tum", r.gt);
       fploc::write_tum(out_prefix + "-sfr.tum", r.sfr);

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "fploc/annf/annf.h"
+#include "fploc/core/text_out.h"
 #include "fploc/floorplan/png.h"
 #include "map_tool.h"
 
@@ -159,7 +160,7 @@ int cmd_compare(const FloorPlan& a, const FloorPlan& b, const CompareArgs& args,
                       {"yaw_deg", yaw},
                       {"share", best_share}};
   if (as_json)
-    std::cout << j.dump(1) << "\n";
+    std::cout << fploc::json_text(j, 1) << "\n";
   else
     std::cout << "A " << a.source << " (" << a.elements.size() << " elements, " << total << " m) against B " << b.source
               << " (" << b.elements.size() << " elements)\n"

@@ -11,6 +11,7 @@
 #include <random>
 #include <sstream>
 
+#include "fploc/core/text_out.h"
 #include "fploc/runtime/cli_numbers.h"
 #include "fploc/annf/ablation.h"
 #include "fploc/annf/annf.h"
@@ -122,7 +123,7 @@ int cmd_build(const PlanArgs& pa, const AnnfArgs& aa, const std::string& out, bo
   std::cerr << "fploc map build: " << plan.elements.size() << " elements, mode " << aa.mode << ", depth " << aa.depth
             << ", leaf " << a.leaf_length() << " m, " << j["leaves"] << " leaves, " << j["bytes"] << " bytes, "
             << ms << " ms -> " << out << "\n";
-  if (as_json) std::cout << j.dump(1) << "\n";
+  if (as_json) std::cout << fploc::json_text(j, 1) << "\n";
   return 0;
 }
 

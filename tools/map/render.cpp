@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "fploc/annf/annf.h"
+#include "fploc/core/text_out.h"
 #include "fploc/floorplan/png.h"
 #include "map_tool.h"
 
@@ -273,9 +274,9 @@ int cmd_export_pgm(const FloorPlan& plan, const PgmArgs& a, bool as_json) {
   std::cerr << "fploc map export-pgm: " << w << " x " << h << " pixels at " << a.resolution << " m, " << occupied
             << " occupied -> " << pgm << ", " << yaml << "\n";
   if (as_json)
-    std::cout << nlohmann::json({{"pgm", pgm}, {"yaml", yaml}, {"width", w}, {"height", h},
-                                 {"resolution_m", a.resolution}, {"origin", {ox, oy, 0.0}}, {"occupied", occupied}})
-                     .dump(1)
+    std::cout << fploc::json_text(nlohmann::json({{"pgm", pgm}, {"yaml", yaml}, {"width", w}, {"height", h},
+                                                  {"resolution_m", a.resolution}, {"origin", {ox, oy, 0.0}}, {"occupied", occupied}}),
+                                  1)
               << "\n";
   return 0;
 }

@@ -14,6 +14,7 @@
 #include "fploc/annf/ablation.h"
 #include "fploc/annf/annf.h"
 #include "fploc/annf/baselines.h"
+#include "fploc/core/text_out.h"
 #include "map_tool.h"
 
 using nlohmann::json;
@@ -256,7 +257,7 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json) {
     std::fprintf(stderr, "baselines: brute force %.1f ns/q\n", brute_ns);
   }
   out["baselines"] = base;
-  if (as_json) std::cout << out.dump(1) << "\n";
+  if (as_json) std::cout << fploc::json_text(out, 1) << "\n";
   return 0;
 }
 

@@ -115,10 +115,10 @@ struct Watch {
       return;
     }
     if (learning) {
-      if (m->state == "running") old_pid = m->pid;
+      if (m->state == "running" || m->state == "failing") old_pid = m->pid;
       return;
     }
-    if (m->pid != old_pid && m->state == "running") new_pid = m->pid;
+    if (m->pid != old_pid && (m->state == "running" || m->state == "failing")) new_pid = m->pid;
     if (m->state == "stopped") state = "stopped";
   }
 };

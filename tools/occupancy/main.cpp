@@ -14,6 +14,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "fploc/core/text_out.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/floorplan/occupancy.h"
 #include "fploc/floorplan/png.h"
@@ -178,7 +179,7 @@ int main(int argc, char** argv) {
               << st.boundary_cells << " boundary cells -> " << st.segments << " segments (max error "
               << st.max_error_m * 1000 << " mm, mean " << st.mean_error_m * 1000 << " mm)" << (out.empty() ? "" : " -> " + out)
               << "\n";
-    if (json) std::cout << j.dump(1) << "\n";
+    if (json) std::cout << fploc::json_text(j, 1) << "\n";
   } catch (const std::exception& e) {
     std::cerr << "fploc occupancy: " << e.what() << "\n";
     return 1;

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "fploc/core/text_out.h"
 #include "fploc/os1/sensor_config.h"
 
 int main(int argc, char** argv) {
@@ -54,12 +55,12 @@ int main(int argc, char** argv) {
     if (as_json) {
       json alerts = json::array();
       for (const auto& x : r.alerts.active) alerts.push_back(x.text());
-      std::cout << json{{"sensor", host}, {"firmware", r.firmware.str()}, {"status", r.status},
-                        {"reinitialised", r.reinitialised}, {"changes", r.changes}, {"udp_dest", r.udp_dest},
-                        {"lidar_mode", r.lidar_mode}, {"udp_profile_lidar", r.udp_profile_lidar},
-                        {"timestamp_mode", r.timestamp_mode}, {"operating_mode", r.operating_mode},
-                        {"waited_s", r.waited_s}, {"active_alerts", alerts}}
-                       .dump(2)
+      std::cout << fploc::json_text(json{{"sensor", host}, {"firmware", r.firmware.str()}, {"status", r.status},
+                                         {"reinitialised", r.reinitialised}, {"changes", r.changes}, {"udp_dest", r.udp_dest},
+                                         {"lidar_mode", r.lidar_mode}, {"udp_profile_lidar", r.udp_profile_lidar},
+                                         {"timestamp_mode", r.timestamp_mode}, {"operating_mode", r.operating_mode},
+                                         {"waited_s", r.waited_s}, {"active_alerts", alerts}},
+                                    2)
                 << "\n";
     } else {
       std::cout << host << ": " << r.summary() << "\n";

@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "fploc/core/text_out.h"
 #include "fploc/core/xyz.h"
 #include "fploc/os1/metadata.h"
 #include "fploc/os1/packet.h"
@@ -293,6 +294,6 @@ int main(int argc, char** argv) {
   for (const auto& e : errors) std::cerr << "fploc os1 decode: " << e << "\n";
   std::cerr << lidar_packets << " lidar packets, " << st.frames << " frames (" << st.complete_frames << " complete), "
             << imu_packets << " IMU packets\n";
-  if (as_json) std::cout << out.dump(2) << "\n";
+  if (as_json) std::cout << fploc::json_text(out, 2) << "\n";
   return errors.empty() ? 0 : 1;  // a capture cut short, a PCD or digest that failed: the summary above, then exit 1
 }

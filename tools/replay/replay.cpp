@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "fploc/core/text_out.h"
 #include "fploc/runtime/bus.h"
 #include "fploc/runtime/compose.h"
 #include "fploc/runtime/graph.h"
@@ -253,7 +254,7 @@ int main(int argc, char** argv) {
                        {"handler_cpu_ms", total_cpu_ms},
                        {"nodes", nodes}};
       if (!out.empty()) j["out"] = out;
-      std::cout << j.dump() << std::endl;
+      std::cout << fploc::json_text(j) << std::endl;
     }
     if (published == 0 && events > 0) {
       // Nothing of the log reached the graph: its nodes ran on nothing (poses, if any, are no estimate of it).

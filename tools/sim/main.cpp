@@ -19,6 +19,7 @@
 #include <memory>
 #include <cstdio>
 
+#include "fploc/core/text_out.h"
 #include "fploc/runtime/cli_numbers.h"
 #include "fploc/floorplan/building.h"
 #include "fploc/floorplan/io.h"
@@ -262,7 +263,7 @@ int main(int argc, char** argv) {
       for (const auto& f : sim.world().furniture())
         fj.push_back({{"c", {f.center.x(), f.center.y()}}, {"yaw", f.yaw}, {"half", {f.half.x(), f.half.y()}}, {"height", f.z1}});
       tj["people"] = sim.world().people().size();
-      tf << tj.dump(1) << "\n";
+      tf << fploc::json_text(tj, 1) << "\n";
       if (!tf) throw std::runtime_error(truth_path + ": cannot write the world truth");
       std::cerr << "fploc sim: world-vs-plan truth written to " << truth_path << "\n";
     }
@@ -296,7 +297,7 @@ int main(int argc, char** argv) {
         for (const auto& c : sim.floor_changes())
           ch.push_back({{"t", o.t0_s + c.t}, {"from", sim.floor_name(c.from)}, {"to", sim.floor_name(c.to)}, {"how", c.how}});
       }
-      std::cout << j.dump() << std::endl;
+      std::cout << fploc::json_text(j) << std::endl;
     }
   } catch (const std::exception& e) {
     std::cerr << "fploc sim: " << e.what() << "\n";

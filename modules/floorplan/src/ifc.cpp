@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -124,6 +125,8 @@ Building building_from_ifc_json(const std::string& text, const std::string& sour
     b.floors.push_back(std::move(f));
   }
   if (b.floors.empty()) fail(source + ": the model has no storey");
+  for (const auto& w : j.value("warnings", nlohmann::json::array()))
+    if (w.is_string()) b.warnings.push_back(w.get<std::string>());
   return b;
 }
 
@@ -150,11 +153,31 @@ Building read_ifc_building(const std::string& path, const IfcReadOptions& option
     std::string msg = slurp(err);
     while (!msg.empty() && (msg.back() == '\n' || msg.back() == '\r')) msg.pop_back();
     if (msg.empty()) msg = path + ": the IFC reader failed (exit status " + std::to_string(rc) + ")";
+    // Warnings it printed before failing (elements it left out) stay warnings, not part of the error.
+    if (rc == 2) {
+      std::istringstream lines(msg);
+      std::string line, rest;
+      while (std::getline(lines, line)) {
+        if (line.find(": warning: ") != std::string::npos) {
+          if (!options.quiet) std::cerr << line << "\n";
+        } else {
+          rest += (rest.empty() ? "" : "\n") + line;
+        }
+      }
+      if (!rest.empty()) msg = rest;
+    }
     // Node's own errors are long: keep the first line, it names the problem.
     if (rc != 2) msg = path + ": the IFC reader failed: " + msg.substr(0, msg.find('\n'));
     fail(msg);
   }
-  return building_from_ifc_json(slurp(out), path);
+  Building b = building_from_ifc_json(slurp(out), path);
+  if (!options.quiet) {
+    for (const auto& w : b.warnings) std::cerr << w << "\n";
+    if (b.warnings.size() > 1)
+      std::cerr << path << ": " << b.warnings.size() << " elements with representation items the IFC reader does not "
+                << "handle (left out of the plan, in whole or in part)\n";
+  }
+  return b;
 }
 
 }  // namespace fploc

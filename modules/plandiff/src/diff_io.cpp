@@ -4,6 +4,7 @@
 #include <ostream>
 #include <sstream>
 
+#include "fploc/core/text_out.h"
 #include "fploc/plandiff/plan_diff.h"
 
 namespace fploc::plandiff {
@@ -56,7 +57,7 @@ void write_json(const Diff& d, const FloorPlan& plan, std::ostream& out, bool al
     mp.push_back({{"id", m.element}, {"a", {m.a.x(), m.a.y()}}, {"b", {m.b.x(), m.b.y()}}, {"length_m", m.length()},
                   {"seen_ratio", m.expected ? double(m.seen) / double(m.expected) : 0.0},
                   {"through_ratio", m.expected ? double(m.through) / double(m.expected) : 0.0}});
-  out << j.dump(1) << "\n";
+  out << fploc::json_text(j, 1) << "\n";
 }
 
 namespace {

@@ -131,6 +131,10 @@ class Context {
   // The condition behind the last error is over (e.g. the metadata file appeared): telemetry's last_error
   // is cleared, the error count stays.
   void error_resolved() { stats_.last_error.clear(); }
+  // A condition that keeps the node from doing its job while it lasts (the dashboard cannot listen on its port):
+  // reported once as an error (stderr, count), and every heartbeat meanwhile has state "failing" with it as
+  // last_error. "" ends it: heartbeats say "running" again, without that last_error.
+  void set_failing(const std::string& what);
   // The node's own state line in telemetry (node_status_t.detail, shown on the dashboard), e.g. a
   // sensor's status and active alerts; unlike last_error it stays until replaced ("" clears it).
   void set_detail(const std::string& text) { stats_.detail = text; }

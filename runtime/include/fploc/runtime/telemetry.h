@@ -73,6 +73,7 @@ struct NodeStats {
   int64_t errors = 0;
   std::string last_error;
   std::string detail;              // Context::set_detail (node_status_t.detail)
+  std::string failing;             // Context::set_failing: while set, heartbeats say state "failing"
   double busy_s_period = 0;        // time spent in handlers this period
 
   PortCounters& port(const std::string& name, const std::string& channel, bool output);

@@ -71,6 +71,9 @@ struct Building {
   std::string source;  // the file it came from
   std::vector<BuildingFloor> floors;
   std::vector<FloorConnection> connections;
+  // What the reader left out without failing, one line each (IFC: an element whose representation
+  // item the reader does not handle, "m.ifc:29: #63=IFCWALL: warning: ..."); printed unless quiet.
+  std::vector<std::string> warnings;
   // Index of the floor named `name` ("" = 0); -1 when there is none.
   int floor_index(const std::string& name) const;
   // The floor named `name` ("" = the first); throws "SOURCE: no floor 'X' (floors: a, b)".

@@ -7,6 +7,9 @@
 //
 // Needs `node` (FPLOC_NODE overrides the binary) and web-ifc installed in tools/ifc/node_modules
 // (scripts/setup-web.sh). FPLOC_IFC2PLAN overrides the script's path.
+// Elements whose representation items web-ifc gives no geometry for (IfcBlock, IfcBoundingBox, ...)
+// are left out with one warning each in Building::warnings ("m.ifc:29: #63=IFCWALL: warning: ..."),
+// printed on stderr unless quiet.
 // Errors: one std::runtime_error, e.g. "model.ifc:812: truncated file: entity #4711=IFCWALL (line 812)
 // is not finished" or "model.ifc: #123=IFCWALL: geometry has non-finite coordinates".
 #pragma once
