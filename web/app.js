@@ -136,8 +136,9 @@ function addToTrail(trail, utime, x, y, floor = null) {
 // Why the pose is not OK: the state line (telemetry detail) of the node publishing FPLOC_POSE, e.g. the optimizer's
 // "POOR: a second fit 1.47 m / 0.0 deg away explains 98 %" (pose_t carries the status only).
 function poseReason() {
-  const n = (S.nodes || []).find((m) => m.detail && (m.ports || []).some((q) => q.output && q.channel === 'FPLOC_POSE'));
-  return n ? ` · ${n.detail.replace(/^(POOR|LOST): /, '')}` : '';
+  // (a robot's channels are "R/FPLOC_POSE"; a node's line may start "scan N: ")
+  const n = (S.nodes || []).find((m) => m.detail && (m.ports || []).some((q) => q.output && /(^|\/)FPLOC_POSE$/.test(q.channel)));
+  return n ? ` · ${n.detail.replace(/^scan \d+: /, '').replace(/^(POOR|LOST): /, '')}` : '';
 }
 const fmt = (v, d = 3) => (v === null || v === undefined || !Number.isFinite(v) ? '–' : v.toFixed(d));
 function renderPoseBox() {

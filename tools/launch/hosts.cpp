@@ -69,7 +69,9 @@ std::vector<std::string> HostPlan::probe_argv(const std::string& command) const 
   HostPlan own = *this;
   own.control_path.clear();
   auto a = own.ssh_argv(command);
-  a.insert(a.end() - 3, {"-o", "ControlPath=none"});  // before the address, "--" and the command
+  // First, as ssh keeps an option's first value: a graph's own ssh_option ControlPath/ControlMaster cannot put the
+  // probe on a shared connection (which can outlive a cut link and answer for a host that is away).
+  a.insert(a.begin() + 1, {"-o", "ControlPath=none", "-o", "ControlMaster=no"});
   return a;
 }
 

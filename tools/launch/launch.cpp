@@ -339,7 +339,7 @@ class Launcher : public Effects {
     return out;
   }
   // A signal within this long of the one that began the shutdown is the same stop (see run()); a later one kills.
-  static constexpr double kSameStopS = 0.2;
+  static constexpr double kSameStopS = 0.5;
   double first_signal_s_ = -1;  // when a signal began the shutdown (-1: none did)
   bool listening_only_ = true;  // run() has not started the nodes yet
   std::string foreign_;          // a node of this graph seen running elsewhere before that

@@ -259,7 +259,7 @@ int main(int argc, char** argv) {
     if (published == 0 && events > 0) {
       // Nothing of the log reached the graph: its nodes ran on nothing (poses, if any, are no estimate of it).
       std::string have, want;
-      for (const auto& [c, k] : log_channels) have += (have.empty() ? "" : ", ") + c + " (" + std::to_string(k) + ")";
+      for (const auto& [c, k] : log_channels) have += (have.empty() ? "" : ", ") + fploc::printable(c) + " (" + std::to_string(k) + ")";
       for (const auto& c : external) want += (want.empty() ? "" : ", ") + c;
       std::cerr << "fploc replay: no event of " << log_path << " is on an input channel of " << graph_path
                 << ": the log holds " << have << "; the graph reads " << (want.empty() ? "nothing from outside" : want);

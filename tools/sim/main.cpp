@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
       char* e2 = nullptr;
       const double a = c == std::string::npos ? NAN : std::strtod(g.c_str(), &e1);
       const double d = c == std::string::npos ? NAN : std::strtod(g.c_str() + c + 1, &e2);
-      if (c == std::string::npos || e1 != g.c_str() + c || *e2 != 0 || !(a >= 0) || !(d > 0) || !std::isfinite(a + d))
+      if (c == std::string::npos || c == 0 || e1 != g.c_str() + c || *e2 != 0 || !(a >= 0) || !(d > 0) || !std::isfinite(a + d))
         throw std::runtime_error("--gap " + g + ": expected START:SECONDS (both finite, START >= 0, SECONDS > 0)");
       gap_spans.emplace_back(a, a + d);
     }
@@ -188,7 +188,7 @@ int main(int argc, char** argv) {
     }
     fploc::sim::SimScan f;
     fploc::scan_t sm;
-    size_t imu_k = 0;
+    size_t imu_k = 0, imu_dropped = 0;
     int64_t imu_seq = 0;
     const auto& imu = sim.imu();
     int frames = 0, dropped = 0;
@@ -198,7 +198,10 @@ int main(int argc, char** argv) {
     };
     auto flush_imu = [&](double until) {
       for (; imu_k < imu.size() && o.t0_s + imu[imu_k].t <= until; ++imu_k) {
-        if (gap_imu && in_gap(imu[imu_k].t)) continue;
+        if (gap_imu && in_gap(imu[imu_k].t)) {
+          ++imu_dropped;
+          continue;
+        }
         fploc::imu_t m;
         const int64_t ut = int64_t(std::llround((o.t0_s + imu[imu_k].t) * 1e6));
         m.utime = m.accel_utime = m.gyro_utime = ut;
@@ -270,7 +273,7 @@ int main(int argc, char** argv) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     const double simulated = frames * period;
     if (dropped) std::cerr << "fploc sim: " << dropped << " of " << frames << " scans dropped (--drop-scans, --gap)\n";
-    std::cerr << "fploc sim: wrote " << frames - dropped << " scans, " << imu_k << " IMU samples to " << out << " in " << wall
+    std::cerr << "fploc sim: wrote " << frames - dropped << " scans, " << imu_k - imu_dropped << " IMU samples to " << out << " in " << wall
               << " s (" << simulated / std::max(wall, 1e-9) << "x real time)\n";
     if (json) {
       nlohmann::json j;
@@ -278,7 +281,7 @@ int main(int argc, char** argv) {
       j["seed"] = seed;
       j["frames"] = frames;
       j["scans_dropped"] = dropped;
-      j["imu_samples"] = imu_k;
+      j["imu_samples"] = imu_k - imu_dropped;
       j["length_m"] = sim.motion().length();
       j["avg_speed_mps"] = sim.motion().avg_speed();
       j["max_speed_mps"] = sim.motion().max_speed();

@@ -223,7 +223,9 @@ Pose2 Matcher::predict(int64_t tau, std::optional<double> yaw_delta, const std::
     return p;
   }
   const double dt = (tau - tau_) * 1e-6;
-  if (have_last_ && gap(dt) && dt <= cfg_.gap_max_s) {
+  if (have_last_ && gap(dt) && dt > cfg_.gap_max_s)  // a velocity that old says nothing; the IMU's yaw change still holds
+    return {pose_.x, pose_.y, wrap_angle(yaw_delta ? pose_.yaw + *yaw_delta : pose_.yaw)};
+  if (have_last_ && gap(dt)) {
     // Over a gap (MatcherConfig::gap_s): the last body velocity, turned by the IMU's yaw change when given.
     Twist2 v;
     if (cfg_.motion_model && have_velocity_) v = twist_;

@@ -2,7 +2,7 @@
 # One stop delivered twice at once (GNU `timeout` signals the launcher and then its process group; systemd's
 # control-group stop does the same) is one stop: every node is stopped in order and exits 0, the launcher exits 0.
 # It was taken as a second signal ("second signal: killing every node now"): every node SIGKILLed, exit 1, a pose
-# logger's last lines lost. A second Ctrl-C later than 0.2 s still kills at once. Inside scripts/netns-run.
+# logger's last lines lost. A second Ctrl-C later than 0.5 s still kills at once. Inside scripts/netns-run.
 set -uo pipefail
 L="${FPLOC_BUILD_DIR:?}/bin/fploc-launch"; R="${FPLOC_ROOT:?}"
 T="$(mktemp -d)"; trap 'kill -9 $pid 2>/dev/null; rm -rf "$T"' EXIT

@@ -93,7 +93,7 @@ struct MatcherConfig {
   // gap_sigma_rad_per_s * dt in yaw with the IMU (gap_sigma_rad_per_s_no_imu * dt without; capped at
   // gap_max_search_rad). A window wider than twice the tracking gate is searched from a grid of starts, as the odometry
   // window (search_prior_kappa), and so are the POOR frames after it until one registers. Beyond gap_max_s the
-  // prediction is the last pose (a velocity that old says nothing). Before, a frame a second or more after the last
+  // prediction is the last position (a velocity that old says nothing), turned by the IMU's yaw change. Before, a frame a second or more after the last
   // was predicted at the last pose (no velocity, no IMU yaw) and registered within the tracking gate: after a 3 s gap
   // of the room loop, 1.27 m off, then a wrong fit 24 cm off kept for 23 s. gap_s 0: off.
   double gap_s = 0.5;
