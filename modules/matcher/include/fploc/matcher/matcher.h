@@ -92,10 +92,11 @@ struct MatcherConfig {
   // gap_sigma_mps * dt + gap_sigma_mps2 * dt^2 / 2 in x/y (capped at gap_max_search_m) and gap_sigma_rad +
   // gap_sigma_rad_per_s * dt in yaw with the IMU (gap_sigma_rad_per_s_no_imu * dt without; capped at
   // gap_max_search_rad). A window wider than twice the tracking gate is searched from a grid of starts, as the odometry
-  // window (search_prior_kappa), and so are the POOR frames after it until one registers. Beyond gap_max_s the
-  // prediction is the last position (a velocity that old says nothing), turned by the IMU's yaw change. Before, a frame a second or more after the last
-  // was predicted at the last pose (no velocity, no IMU yaw) and registered within the tracking gate: after a 3 s gap
-  // of the room loop, 1.27 m off, then a wrong fit 24 cm off kept for 23 s. gap_s 0: off.
+  // window (search_prior_kappa), and so are the POOR frames after it until one registers; a fit beyond 2 sigma must
+  // explain odom_far_inlier_ratio of the scan. Beyond gap_max_s the prediction is the last position (a velocity that
+  // old says nothing), turned by the IMU's yaw change. Before, a frame a second or more after the last was predicted
+  // at the last pose (no velocity, no IMU yaw) and registered within the tracking gate: after a 3 s gap of the room
+  // loop, 1.27 m off, then a wrong fit 24 cm off kept for 23 s. gap_s 0: off.
   double gap_s = 0.5;
   double gap_max_s = 10.0;
   double gap_sigma_mps = 0.05, gap_sigma_mps2 = 0.25;
