@@ -150,7 +150,7 @@ function renderPoseBox() {
     ['status', p ? (['OK', 'POOR', 'LOST'][p.status] ?? p.status) + (p.status !== 0 && !fr ? poseReason() : '') : '–'],
     ['floor', p ? floors.describe(p.floor) : '–'],
     ['ATE so far', p && p.ate_n ? `${fmt(p.ate_rmse)} m (${p.ate_n} poses)` : (g ? 'waiting for matches' : 'no ground truth')],
-    ['frame pose', f ? `${f.status_text || f.status} · inliers ${fmt(100 * f.inlier_ratio, 0)} % · ${fmt(f.solve_ms, 1)} ms` : '–'],
+    ['frame pose', f ? `${f.status_text || (['OK', 'POOR', 'LOST', 'NOT INITIALISED'][f.status] ?? f.status)} · inliers ${fmt(100 * f.inlier_ratio, 0)} % · ${fmt(f.solve_ms, 1)} ms` : '–'],
     ['features', S.features ? `${S.features.n} (shown ${S.features.shown})` +
       (S.featuresMatched !== null && S.featuresMatched !== undefined ? ` · ${(100 * S.featuresMatched).toFixed(0)} % on the plan` : '') : '–'],
   ];
