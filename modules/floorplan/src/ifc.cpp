@@ -176,6 +176,25 @@ Building read_ifc_building(const std::string& path, const IfcReadOptions& option
     if (b.warnings.size() > 1)
       std::cerr << path << ": " << b.warnings.size() << " elements with representation items the IFC reader does not "
                 << "handle (left out of the plan, in whole or in part)\n";
+    // What was read, as the DXF reader says it: each storey's elements, extents and elevation (metres).
+    std::ostringstream sum;
+    sum.precision(4);
+    sum << path << ": " << b.floors.size() << (b.floors.size() == 1 ? " storey" : " storeys") << ", walls cut "
+        << options.cut_height << " m above each floor:";
+    for (size_t k = 0; k < b.floors.size(); ++k) {
+      if (k == 6) {
+        sum << " ... (" << b.floors.size() - k << " more)";
+        break;
+      }
+      const auto& f = b.floors[k];
+      sum << (k ? ";" : "") << " '" << f.name << "' " << f.plan->elements.size() << " elements";
+      if (!f.plan->elements.empty()) {
+        const Box2 e = f.plan->bounds();
+        sum << ", " << e.size().x() << " x " << e.size().y() << " m";
+      }
+      sum << " at " << f.elevation << " m";
+    }
+    std::cerr << sum.str() << "\n";
   }
   return b;
 }
