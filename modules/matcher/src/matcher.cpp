@@ -354,7 +354,7 @@ MatchResult Matcher::process(const FeatureFrame& f, std::optional<double> yaw_de
       r.status = FitStatus::kPoor;
       r.text = b;
     }
-  } else if (r.status == FitStatus::kOk && have_last_ && !lost && !gap_search && (jump > cfg_.max_jump_m || jump_yaw > cfg_.max_jump_rad)) {
+  } else if (r.status == FitStatus::kOk && have_last_ && !lost && (jump > cfg_.max_jump_m || jump_yaw > cfg_.max_jump_rad)) {
     r.status = FitStatus::kPoor;
     r.text = "refused jump of " + std::to_string(jump) + " m";
   }
