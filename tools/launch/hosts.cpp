@@ -10,6 +10,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <future>
 #include <map>
 #include <regex>
 #include <set>
@@ -113,56 +114,72 @@ std::string local_commit(const std::string& root) {
   return out;
 }
 
+namespace {
+
+// One host's check (one ssh round trip answers everything); `exes` are the executables its nodes run.
+std::vector<HostProblem> check_host(const fploc::Graph& g, const HostPlan& h, const std::set<std::string>& exes,
+                                    const std::string& group) {
+  std::vector<HostProblem> problems;
+  const std::string commit = local_commit(h.local_root);
+  std::ostringstream c;
+  c << "cd " << shell_quote(h.root()) << " 2>/dev/null && echo ROOT_OK; "
+    << "echo COMMIT $(git -C " << shell_quote(h.root()) << " rev-parse HEAD 2>/dev/null); "
+    << "for e in " << shell_quote(h.bin() + "/fploc-remote");
+  for (const auto& e : exes) c << ' ' << shell_quote(e.find('/') == std::string::npos ? e : h.map_path(e));
+  c << "; do case \"$e\" in */*) test -x \"$e\" || echo MISSING \"$e\";; *) command -v \"$e\" >/dev/null || echo "
+       "MISSING \"$e\";; esac; done; echo ROUTE $(ip route get "
+    << group << " 2>&1 | head -1)";
+  std::string out;
+  const int rc = run_merged(h.probe_argv(c.str()), 10, out);
+  if (rc != 0) {
+    problems.push_back({h.spec.name(), h.unreachable(rc, out), true});
+    return problems;
+  }
+  if (out.find("ROOT_OK") == std::string::npos) {
+    problems.push_back({h.spec.name(), "fploc is missing: no folder " + h.root() + " (Host.fploc_root)"});
+    return problems;
+  }
+  std::istringstream in(out);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("MISSING ", 0) == 0)
+      problems.push_back({h.spec.name(), "fploc is incomplete: " + line.substr(8) + " is not there (build it on that host)"});
+    if (line.rfind("COMMIT", 0) == 0) {
+      std::string theirs = line.size() > 7 ? line.substr(7) : "";
+      if (!commit.empty() && theirs != commit)
+        problems.push_back({h.spec.name(), "fploc at " + h.root() + " is at commit " +
+                                               (theirs.empty() ? "(not a git checkout)" : theirs.substr(0, 12)) +
+                                               ", this checkout at " + commit.substr(0, 12)});
+    }
+    const std::string iface = !h.spec.lcm_interface().empty() ? h.spec.lcm_interface() : g.lcm_interface();
+    if (line.rfind("ROUTE", 0) == 0 && !iface.empty() && line.find(" dev " + iface + " ") == std::string::npos &&
+        line.find(" dev " + iface) == std::string::npos)
+      problems.push_back({h.spec.name(), "multicast to " + group + " does not leave through " + iface + " (" +
+                                             line.substr(6) + "); e.g. `ip route add 224.0.0.0/4 dev " + iface + "`"});
+  }
+  return problems;
+}
+
+}  // namespace
+
 std::vector<HostProblem> check_hosts(const fploc::Graph& g, const std::vector<HostPlan>& hosts,
                                      const std::vector<std::pair<std::string, std::string>>& host_exe,
                                      const std::string& lcm_url) {
-  std::vector<HostProblem> problems;
   std::string group = "239.255.76.67";
   std::smatch m;
   if (std::regex_search(lcm_url, m, std::regex("udpm://([0-9.]+)"))) group = m[1];
+  // The hosts are checked at the same time (a host that is away costs its ssh connect timeout once, not once per
+  // host); their problems are reported in the graph's order of hosts.
+  std::vector<std::future<std::vector<HostProblem>>> checks;
   for (const auto& h : hosts) {
     std::set<std::string> exes;
     for (const auto& [host, exe] : host_exe)
       if (host == h.spec.name()) exes.insert(exe);
     if (exes.empty()) continue;  // no enabled node runs there
-    const std::string commit = local_commit(h.local_root);
-    // One ssh round trip answers everything.
-    std::ostringstream c;
-    c << "cd " << shell_quote(h.root()) << " 2>/dev/null && echo ROOT_OK; "
-      << "echo COMMIT $(git -C " << shell_quote(h.root()) << " rev-parse HEAD 2>/dev/null); "
-      << "for e in " << shell_quote(h.bin() + "/fploc-remote");
-    for (const auto& e : exes) c << ' ' << shell_quote(e.find('/') == std::string::npos ? e : h.map_path(e));
-    c << "; do case \"$e\" in */*) test -x \"$e\" || echo MISSING \"$e\";; *) command -v \"$e\" >/dev/null || echo "
-         "MISSING \"$e\";; esac; done; echo ROUTE $(ip route get "
-      << group << " 2>&1 | head -1)";
-    std::string out;
-    const int rc = run_merged(h.probe_argv(c.str()), 10, out);
-    if (rc != 0) {
-      problems.push_back({h.spec.name(), h.unreachable(rc, out), true});
-      continue;
-    }
-    if (out.find("ROOT_OK") == std::string::npos) {
-      problems.push_back({h.spec.name(), "fploc is missing: no folder " + h.root() + " (Host.fploc_root)"});
-      continue;
-    }
-    std::istringstream in(out);
-    for (std::string line; std::getline(in, line);) {
-      if (line.rfind("MISSING ", 0) == 0)
-        problems.push_back({h.spec.name(), "fploc is incomplete: " + line.substr(8) + " is not there (build it on that host)"});
-      if (line.rfind("COMMIT", 0) == 0) {
-        std::string theirs = line.size() > 7 ? line.substr(7) : "";
-        if (!commit.empty() && theirs != commit)
-          problems.push_back({h.spec.name(), "fploc at " + h.root() + " is at commit " +
-                                                 (theirs.empty() ? "(not a git checkout)" : theirs.substr(0, 12)) +
-                                                 ", this checkout at " + commit.substr(0, 12)});
-      }
-      const std::string iface = !h.spec.lcm_interface().empty() ? h.spec.lcm_interface() : g.lcm_interface();
-      if (line.rfind("ROUTE", 0) == 0 && !iface.empty() && line.find(" dev " + iface + " ") == std::string::npos &&
-          line.find(" dev " + iface) == std::string::npos)
-        problems.push_back({h.spec.name(), "multicast to " + group + " does not leave through " + iface + " (" +
-                                               line.substr(6) + "); e.g. `ip route add 224.0.0.0/4 dev " + iface + "`"});
-    }
+    checks.push_back(std::async(std::launch::async, check_host, std::cref(g), std::cref(h), exes, group));
   }
+  std::vector<HostProblem> problems;
+  for (auto& c : checks)
+    for (auto& p : c.get()) problems.push_back(std::move(p));
   return problems;
 }
 
