@@ -105,7 +105,11 @@ check "$T/replay2.json" "j['channels_fed']=={'OS1_SCAN':1,'OS1_IMU':10}"
 SHIP="$(ls "$D"/recordings/ship-interior/*.bag 2>/dev/null | head -1 || true)"
 if [ -n "$SHIP" ]; then
   "$B/fploc-import" "$SHIP" --out "$T/ship.lcm" --tum-out "$T/odom.tum" --json > "$T/ship.json"
-  check "$T/ship.json" "j['written']['LASER_SCAN']==421 and j['written']['LASER_SCAN_GUARDIAN_LASER_HORIZONTAL_BACK']==418 and j['written']['(tum /guardian/odom)']==839 and j['written']['WHEEL_ODOM']==839"
+  check "$T/ship.json" "j['written']['LASER_SCAN_GUARDIAN_LASER_TILT_FRONT']==421 and j['written']['LASER_SCAN']==418 and j['written']['(tum /guardian/odom)']==839 and j['written']['WHEEL_ODOM']==839"
+  # LASER_SCAN is the level laser: tf tilts the front one 0-57 deg (a tilting unit); the back one is level, turned
+  # round, 0.43 m behind the robot frame (the odometry's base_footprint).
+  check "$T/ship.json" "j['lasers']['/guardian/laser_tilt_front']['level']==False and j['lasers']['/guardian/laser_tilt_front']['tilt_max_deg']>50"
+  check "$T/ship.json" "(lambda b: b['level'] and b['channel']=='LASER_SCAN' and b['base_frame']=='base_footprint' and abs(b['x_m']+0.432)<0.01 and abs(abs(b['yaw_deg'])-180)<0.5)(j['lasers']['/guardian/laser_horizontal_back'])"
   # --channel picks which laser is LASER_SCAN; the other one moves to its suffixed name instead of sharing it.
   "$B/fploc-import" "$SHIP" --out "$T/ship2.lcm" --channel /guardian/laser_horizontal_back=LASER_SCAN --json --quiet > "$T/ship2.json"
   check "$T/ship2.json" "j['written']['LASER_SCAN']==418 and j['written']['LASER_SCAN_GUARDIAN_LASER_TILT_FRONT']==421"

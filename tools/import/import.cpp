@@ -42,6 +42,8 @@
 #include "lcm_log.h"
 #include "ouster_raw.h"
 #include "scan_encode.h"
+#include "laser_mounts.h"
+#include "tf_tree.h"
 #include "tum_track.h"
 
 using namespace fploc;
@@ -99,6 +101,53 @@ bool ends_with(const std::string& s, const std::string& tail) {
 // an abort); as text (the summary, --list, the errors) names are printed with \xHH escapes (fploc/core/text_out.h).
 std::string dump_json(const nlohmann::json& j) { return json_text(j, 2); }
 
+// Where the planar lasers sit (laser_mounts.h): tf kept at most every 20 ms per edge, each laser's frame from its
+// first scan, the odometry's robot frame.
+constexpr int64_t kMountTfGapNs = 20'000'000;
+struct LaserSurvey {
+  std::vector<std::string> topics;              // in the order of their first scan
+  std::map<std::string, std::string> frame;     // topic -> header.frame_id of its first scan
+  std::string odom_child;                       // the first odometry message's child_frame_id
+  fploc::import::TfTree tf{kMountTfGapNs};
+  void laser(const std::string& topic, const std::string& frame_id) {
+    if (frame.emplace(topic, frame_id).second) topics.push_back(topic);
+  }
+  std::vector<fploc::import::LaserMount> mounts(const std::string& base_frame) {
+    tf.sort();
+    const std::string base = fploc::import::robot_frame(tf, base_frame.empty() ? odom_child : base_frame);
+    std::vector<fploc::import::LaserMount> m;
+    for (const auto& t : topics) m.push_back(fploc::import::laser_mount(tf, base, t, frame[t]));
+    return m;
+  }
+};
+
+// A first pass over a recording with more than one laser, for the one LASER_SCAN gets: the whole file (a 2D
+// recording is small), given up at the first Ouster packet or point cloud (a 3D recording: no choice made).
+bool survey_lasers(const std::string& path, const std::set<std::string>& wanted, LaserSurvey& s) {
+  std::string err;
+  auto rec = open_recording(path, &err);
+  if (!rec) return false;
+  RawMessage m;
+  LaserScanView laser;
+  Odometry odom;
+  std::vector<Transform> ts;
+  while (rec->next(m)) {
+    const Connection& c = rec->connections().at(m.conn);
+    const Kind k = kind_of(c);
+    if (k == Kind::kOusterPackets || k == Kind::kCloud) return false;
+    if (k == Kind::kTf) {
+      if (decode_tf(m.data, m.size, c.encoding, ts, &err))
+        for (const auto& t : ts) s.tf.add(t);
+    } else if (!wanted.empty() && !wanted.count(c.topic)) {
+    } else if (k == Kind::kLaser && !s.frame.count(c.topic) && decode(m.data, m.size, c.encoding, laser, &err)) {
+      s.laser(c.topic, laser.header.frame_id);
+    } else if (k == Kind::kOdom && s.odom_child.empty() && decode(m.data, m.size, c.encoding, odom, &err)) {
+      s.odom_child = odom.pose.child_frame_id;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -129,6 +178,10 @@ int main(int argc, char** argv) {
   app.add_option("--tf-parent", tf_parent, "with --tum-out: the tf parent frame (e.g. map, odom)");
   app.add_option("--tf-child", tf_child, "with --tum-out: the tf child frame (e.g. base_link)");
   app.add_option("--odom-topic", odom_topic, "with --tum-out: the nav_msgs/Odometry topic (default: the first one)");
+  std::string base_frame;
+  app.add_option("--base-frame", base_frame,
+                 "the robot frame the lasers' mounts are given in (tf; default: the odometry's child frame, else "
+                 "base_link, else base_footprint)");
   app.add_flag("--quiet", quiet, "no progress on stderr");
   bool direct_io = false;
   app.add_flag("--direct-io", direct_io,
@@ -323,6 +376,28 @@ int main(int argc, char** argv) {
     }
   }
 
+  // More than one laser and no --channel for LASER_SCAN: the 2D mode's channel goes to the first laser whose scan
+  // plane tf shows level all through the recording (a laser on a tilting unit, or one mounted askew, is no planar
+  // scanner), the others to LASER_SCAN_<TOPIC>.
+  std::string laser_choice;  // what was chosen and why (printed with the summary)
+  LaserSurvey pre;            // the whole recording's lasers (else the mounts come from what the import read)
+  std::vector<fploc::import::LaserMount> pre_mounts;
+  if (!used_channels.count("LASER_SCAN")) {
+    if (survey_lasers(path, wanted, pre) && pre.topics.size() > 1) {
+      pre_mounts = pre.mounts(base_frame);
+      for (const auto& m : pre_mounts)
+        if (m.level()) {
+          if (m.topic != pre.topics.front()) {
+            topic_channel[m.topic] = "LASER_SCAN";
+            used_channels.insert("LASER_SCAN");
+            laser_choice = "LASER_SCAN is " + printable(m.topic) + ", the first laser tf shows level (" +
+                           printable(pre.topics.front()) + " is not)";
+          }
+          break;
+        }
+    }
+  }
+
   LcmLog lcm_log;
   if (!out.empty() && !lcm_log.open(out, direct_io)) {
     std::cerr << "fploc import: cannot write " << printable(out) << "\n";
@@ -390,6 +465,7 @@ int main(int argc, char** argv) {
   std::vector<uint8_t> cloud_header;  // point_cloud2_t up to its data; the points follow from the recording
   std::map<std::string, std::string> cloud_check_error;  // topic -> why its first cloud does not convert
   LaserScanView laser;
+  LaserSurvey survey;  // the lasers' frames and tf, for their mounts (laser_mounts.h)
   while (rec->next(m)) {
     ++read_msgs;
     if (first_ns == INT64_MIN) first_ns = m.time_ns;
@@ -507,6 +583,7 @@ int main(int argc, char** argv) {
         // Encoded straight from the recording's bytes into the log's buffer (laser_encode.h): the bytes of
         // laser_scan_t::encode, in one pass.
         if (!decode(m.data, m.size, c.encoding, laser, &err)) { bad(c, err); break; }
+        survey.laser(c.topic, laser.header.frame_id);
         const std::string& ch = channel_for(c, k);
         if (!out.empty()) {
           const size_t n = fploc::import::laser_scan_encoded_size(laser);
@@ -518,6 +595,7 @@ int main(int argc, char** argv) {
       case Kind::kOdom: {
         Odometry o;
         if (!decode(m.data, m.size, c.encoding, o, &err)) { bad(c, err); break; }
+        if (survey.odom_child.empty()) survey.odom_child = o.pose.child_frame_id;
         const std::string& ch = channel_for(c, k);
         pose_t p{};
         p.utime = o.pose.header.stamp_ns / 1000;
@@ -535,9 +613,14 @@ int main(int argc, char** argv) {
         break;
       }
       case Kind::kTf: {
-        if (tum_out.empty() || tf_parent.empty()) { ++skipped_types[c.type]; break; }
+        // Kept for the lasers' mounts either way (decimated); a tf message that does not decode is an error only
+        // where tf is imported.
         std::vector<Transform> ts;
-        if (!decode_tf(m.data, m.size, c.encoding, ts, &err)) { bad(c, err); break; }
+        const bool ok = decode_tf(m.data, m.size, c.encoding, ts, &err);
+        if (ok)
+          for (const auto& t : ts) survey.tf.add(t);
+        if (tum_out.empty() || tf_parent.empty()) { ++skipped_types[c.type]; break; }
+        if (!ok) { bad(c, err); break; }
         for (const auto& t : ts) tum.tf(t);
         ++written["(tf " + c.topic + ")"];
         break;
@@ -606,6 +689,16 @@ int main(int argc, char** argv) {
                        "); the clouds are written as they are, the cloud-to-scan node will report the same on replay");
   if (ouster.bad_packets) problems.push_back(std::to_string(ouster.bad_packets) + " bad Ouster packets skipped; last: " + ouster.last_error);
   const bool skipped = !decode_errors.empty() || ouster.bad_packets > 0;
+  // The lasers' mounts (tf), and the one on LASER_SCAN (what the 2D mode reads).
+  const auto mounts = !pre_mounts.empty()     ? pre_mounts
+                      : survey.topics.empty() ? std::vector<fploc::import::LaserMount>{}
+                                              : survey.mounts(base_frame);
+  const fploc::import::LaserMount* main_laser = nullptr;
+  for (const auto& lm : mounts)
+    if (topic_channel.count(lm.topic) && topic_channel[lm.topic] == "LASER_SCAN") main_laser = &lm;
+  if (main_laser && main_laser->found && !main_laser->level())
+    problems.push_back("warning: LASER_SCAN (" + printable(main_laser->topic) + ") " + main_laser->describe() +
+                       "; give a level laser with --channel TOPIC=LASER_SCAN");
 
   if (json) {
     nlohmann::json j;
@@ -634,6 +727,18 @@ int main(int argc, char** argv) {
     for (const auto& [t, s] : cloud_info)
       j["clouds"][t] = {{"mode", decode_ouster ? "scans" : "clouds"}, {"ring_source", s.ring_source}, {"time_source", s.time_source}, {"points", s.points}, {"kept", s.kept},
                         {"collisions", s.collisions}, {"max_azimuth_error_deg", s.max_azimuth_error_deg}};
+    for (const auto& lm : mounts) {
+      nlohmann::json l = {{"frame", lm.frame}, {"channel", topic_channel.count(lm.topic) ? topic_channel[lm.topic] : ""},
+                          {"mount_found", lm.found}};
+      if (lm.found)
+        l.update({{"base_frame", lm.base}, {"x_m", lm.x_m}, {"y_m", lm.y_m}, {"z_m", lm.z_m}, {"yaw_deg", lm.yaw_deg},
+                  {"upside_down", lm.upside_down}, {"tilt_min_deg", lm.tilt_min_deg}, {"tilt_max_deg", lm.tilt_max_deg},
+                  {"level", lm.level()}});
+      else
+        l["why"] = lm.why;
+      j["lasers"][lm.topic] = l;
+    }
+    if (!laser_choice.empty()) j["laser_choice"] = laser_choice;
     j["errors"] = problems;
     for (const auto& [t, n] : decode_errors) j["not_decoded"][t] = {{"count", n}, {"first", first_decode_error[t]}};
     std::cout << dump_json(j) << "\n";
@@ -643,6 +748,9 @@ int main(int argc, char** argv) {
     for (const auto& [ch, n] : written) width = std::max(width, int(printable(ch).size()));
     for (const auto& [ch, n] : written) std::printf("  %-*s %8llu\n", width, printable(ch).c_str(), (unsigned long long)n);
     for (const auto& [t, ch] : topic_channel) std::printf("  topic %s -> %s\n", printable(t).c_str(), printable(ch).c_str());
+    for (const auto& lm : mounts)
+      std::printf("  laser %s (frame %s): %s\n", printable(lm.topic).c_str(), printable(lm.frame).c_str(), lm.describe().c_str());
+    if (!laser_choice.empty()) std::printf("  %s\n", laser_choice.c_str());
     if (raw.has_metadata() && raw.lidar_packets + raw.imu_packets > 0)
       std::printf("  ouster: %s, %dx%d (%s), %llu lidar + %llu imu packets written as they are\n"
                   "          (the OS-1 and IMU drivers decode them on replay; --decode writes scan_t and imu_t here)\n",
@@ -680,6 +788,14 @@ int main(int argc, char** argv) {
       std::printf(" \\\n     ");
       for (const auto& n : pose_nodes)
         std::printf(" --set %s.initial_pose.x=X --set %s.initial_pose.y=Y --set %s.initial_pose.yaw=YAW", n.c_str(), n.c_str(), n.c_str());
+      if (lidar2d && main_laser && main_laser->found) {  // the laser's mount from tf, for both nodes that read the scans
+        std::printf(" \\\n     ");
+        for (const char* n : {"laser2d", "grid2d"}) {
+          std::printf(" --set %s.mount_x_m=%.3f --set %s.mount_y_m=%.3f --set %s.mount_yaw_deg=%.1f", n, main_laser->x_m, n,
+                      main_laser->y_m, n, main_laser->yaw_deg);
+          if (main_laser->upside_down && std::string(n) == "laser2d") std::printf(" --set laser2d.upside_down=true");
+        }
+      }
       std::printf("\n");
     }
     if (!tum_out.empty()) std::printf("  %s: %llu poses\n", printable(tum_out).c_str(), (unsigned long long)tum.poses());

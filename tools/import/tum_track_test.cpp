@@ -60,12 +60,12 @@ TEST(TumTrack, InterpolatesASparseEdge) {
 }
 
 TEST(TumTrack, EdgeAtHoldsOutsideItsSpan) {
-  TumTrack::Edge e;
+  fploc::import::TfTree::Edge e;
   e.parent = "a";
   e.samples.push_back({1000, Eigen::Vector3d(1, 0, 0), Eigen::Quaterniond::Identity()});
   e.samples.push_back({3000, Eigen::Vector3d(3, 0, 0), Eigen::Quaterniond::Identity()});
-  EXPECT_NEAR(TumTrack::at(e, 0).translation().x(), 1, 1e-12);
-  EXPECT_NEAR(TumTrack::at(e, 2000).translation().x(), 2, 1e-12);
-  EXPECT_NEAR(TumTrack::at(e, 2500).translation().x(), 2.5, 1e-12);
-  EXPECT_NEAR(TumTrack::at(e, 9000).translation().x(), 3, 1e-12);
+  EXPECT_NEAR(fploc::import::TfTree::at(e, 0).translation().x(), 1, 1e-12);
+  EXPECT_NEAR(fploc::import::TfTree::at(e, 2000).translation().x(), 2, 1e-12);
+  EXPECT_NEAR(fploc::import::TfTree::at(e, 2500).translation().x(), 2.5, 1e-12);
+  EXPECT_NEAR(fploc::import::TfTree::at(e, 9000).translation().x(), 3, 1e-12);
 }
