@@ -50,6 +50,7 @@ class Grid2dNode : public fploc::rt::Node {
     auto field = std::make_shared<fploc::DistanceField>(g, c.field_max_m);
     loc_ = std::make_unique<l2::GridLocalizer>(field, c);
     mount_ = {o.mount_x_m(), o.mount_y_m(), o.mount_yaw_deg() * M_PI / 180};
+    upside_down_ = o.upside_down();
     z_ = o.z_m();
     const Pose2 p0{o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()};
     loc_->set_initial_pose(p0);
@@ -82,7 +83,7 @@ class Grid2dNode : public fploc::rt::Node {
     const auto& c = loc_->config();
     const double rmin = std::max<double>(c.min_range_m, m.range_min);
     const double rmax = m.range_max > 0 ? std::min<double>(c.max_range_m, m.range_max) : c.max_range_m;
-    const auto pts = l2::scan_points(m.ranges, m.angle_min, m.angle_increment, rmin, rmax, mount_);
+    const auto pts = l2::scan_points(m.ranges, m.angle_min, m.angle_increment, rmin, rmax, mount_, upside_down_);
     std::optional<Pose2> odom;
     if (odom_ && odom_utime_ <= m.utime) odom = odom_;
     const l2::GridResult r = loc_->update(pts, odom);
@@ -132,6 +133,7 @@ class Grid2dNode : public fploc::rt::Node {
   std::optional<Pose2> odom_;
   int64_t odom_utime_ = 0;
   Pose2 mount_;
+  bool upside_down_ = false;
   double z_ = 0;
   int64_t seq_ = 0;
   fploc::config::FloorRef floor_;

@@ -793,7 +793,7 @@ int main(int argc, char** argv) {
         for (const char* n : {"laser2d", "grid2d"}) {
           std::printf(" --set %s.mount_x_m=%.3f --set %s.mount_y_m=%.3f --set %s.mount_yaw_deg=%.1f", n, main_laser->x_m, n,
                       main_laser->y_m, n, main_laser->yaw_deg);
-          if (main_laser->upside_down && std::string(n) == "laser2d") std::printf(" --set laser2d.upside_down=true");
+          if (main_laser->upside_down) std::printf(" --set %s.upside_down=true", n);
         }
       }
       std::printf("\n");

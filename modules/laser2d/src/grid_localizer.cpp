@@ -174,14 +174,14 @@ void GridLocalizer::set_initial_pose(const Pose2& pose) {
 }
 
 std::vector<Eigen::Vector2d> scan_points(const std::vector<float>& ranges, double angle_min, double increment,
-                                         double min_range, double max_range, const Pose2& mount) {
+                                         double min_range, double max_range, const Pose2& mount, bool upside_down) {
   std::vector<Eigen::Vector2d> out;
   out.reserve(ranges.size());
   const double c = std::cos(mount.yaw), s = std::sin(mount.yaw);
   for (size_t i = 0; i < ranges.size(); ++i) {
     const double r = ranges[i];
     if (!std::isfinite(r) || r < min_range || r >= max_range) continue;
-    const double a = angle_min + double(i) * increment;
+    const double a = (angle_min + double(i) * increment) * (upside_down ? -1 : 1);
     const double lx = r * std::cos(a), ly = r * std::sin(a);
     out.emplace_back(mount.x + c * lx - s * ly, mount.y + s * lx + c * ly);
   }

@@ -216,6 +216,12 @@ TEST(GridLocalizer, ScanPointsDropInvalidAndApplyMount) {
   EXPECT_NEAR(p[0].y(), -1, 1e-9);
   EXPECT_NEAR(p[1].x(), 0.5, 1e-9);  // beam 4 at +90 deg, 2 m
   EXPECT_NEAR(p[1].y(), 2, 1e-9);
+  // Upside down (rolled 180 deg, as a laser hung under a shelf): the beam at +90 deg looks to the right.
+  const auto q = l2::scan_points(r, -M_PI / 2, M_PI / 4, 0.1, 40, {0.5, 0, 0}, true);
+  ASSERT_EQ(q.size(), 2u);
+  EXPECT_NEAR(q[0].y(), 1, 1e-9);
+  EXPECT_NEAR(q[1].x(), 0.5, 1e-9);
+  EXPECT_NEAR(q[1].y(), -2, 1e-9);
 }
 
 }  // namespace

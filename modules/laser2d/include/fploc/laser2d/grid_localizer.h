@@ -271,8 +271,10 @@ class GridLocalizer {
 };
 
 // The returns of a planar scan (beam i at angle_min + i * increment, x forward) in the robot frame, for a
-// laser mounted at (mount_x, mount_y, mount_yaw): ranges outside [min, max] or non-finite are dropped.
+// laser mounted at (mount_x, mount_y, mount_yaw), upside down (its angles mirrored, as Laser2dConfig::upside_down):
+// ranges outside [min, max] or non-finite are dropped.
 std::vector<Eigen::Vector2d> scan_points(const std::vector<float>& ranges, double angle_min, double increment,
-                                         double min_range, double max_range, const Pose2& mount = {});
+                                         double min_range, double max_range, const Pose2& mount = {},
+                                         bool upside_down = false);
 
 }  // namespace fploc::laser2d
