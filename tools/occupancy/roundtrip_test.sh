@@ -39,30 +39,11 @@ printf '0 1.2 1.2 0 0 0 0 1\n1 3.8 1.8 0 0 0 0 1\n' > "$T/e.tum"
 "$OCC" "$T/m0.05/map.yaml" --png "$T/legend.png" --scale 2 --crop-margin 1 --crop-to tracks --tum "$T/t.tum" \
   --label reference --tum "$T/e.tum" --label fploc 2>/dev/null || fail "png --crop-to tracks --label"
 if "$OCC" "$T/m0.05/map.yaml" --png "$T/n.png" --tum "$T/t.tum" --label a --label b 2> "$T/err"; then fail "2 labels for 1 track"; fi
-python3 - "$T/legend.png" <<'PY' || fail "legend, scale bar or crop"
-import struct, sys, zlib
-def read_png(path):  # 8-bit RGB, not interlaced (what fploc writes)
-    d = open(path, "rb").read()
-    w, h, depth, ctype = struct.unpack(">IIBB", d[16:26])
-    assert (depth, ctype) == (8, 2), (depth, ctype)
-    at, idat = 8, b""
-    while at < len(d):
-        n, kind = struct.unpack(">I4s", d[at:at + 8])
-        if kind == b"IDAT":
-            idat += d[at + 8:at + 8 + n]
-        at += 12 + n
-    raw, rows, prev, st = zlib.decompress(idat), [], bytearray(w * 3), w * 3
-    for y in range(h):
-        f, line = raw[y * (st + 1)], bytearray(raw[y * (st + 1) + 1:(y + 1) * (st + 1)])
-        for i in range(st):
-            a = line[i - 3] if i >= 3 else 0
-            b, c = prev[i], prev[i - 3] if i >= 3 else 0
-            p = a + b - c
-            pr = a if abs(p - a) <= abs(p - b) and abs(p - a) <= abs(p - c) else b if abs(p - b) <= abs(p - c) else c
-            line[i] = (line[i] + (0, a, b, (a + b) // 2, pr)[f]) & 255
-        rows.append(line)
-        prev = line
-    return w, h, lambda x, y: tuple(rows[y][3 * x:3 * x + 3])
+PYLIB="$(cd "$(dirname "$0")/../pylib" && pwd)"
+python3 - "$T/legend.png" "$PYLIB" <<'PY' || fail "legend, scale bar or crop"
+import sys
+sys.path.insert(0, sys.argv[2])
+from png_read import read_png
 w, h, px = read_png(sys.argv[1])
 print(f"legend png {w}x{h}")
 assert abs(w - 200) <= 4 and abs(h - 120) <= 4, (w, h)
