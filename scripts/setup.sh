@@ -7,6 +7,7 @@ PKGS=(
   liblcm-dev liblcm-bin liblcm-java default-jre-headless default-jdk-headless libjchart2d-java libglib2.0-dev
   libprotobuf-dev protobuf-compiler
   libgtest-dev libgmock-dev libbenchmark-dev
+  libfreetype-dev fonts-dejavu-core   # text in PNG pictures (legends, scale bars: modules/floorplan/src/text.cpp)
   nlohmann-json3-dev libyaml-dev libpng-dev libcli11-dev libcpp-httplib-dev libssl-dev libpcap-dev libnanoflann-dev
   libbz2-dev liblz4-dev libzstd-dev zlib1g-dev libisal-dev lz4
   python3

@@ -96,8 +96,8 @@ class Grid2dNode : public fploc::rt::Node {
                                                 int8_t(r.status), true, true, floor_.index, floor_.name));
   }
 
-  // Each change of status (OK / POOR / LOST) with its reason: on stderr once per change (the first 200), in
-  // telemetry's detail (the current one), and LOST as an error (last_error, count) as the matcher says it.
+  // Each change of status (OK / POOR / LOST) with its reason (Context::status_changed: on stderr, the first 200, and
+  // telemetry's detail), and LOST as an error (last_error, count) as the matcher says it.
   void say_status(const l2::GridResult& r, const l2::GridLocalizerConfig& c) {
     if (r.status == l2::GridStatus::kOk) bad_run_ = 0;
     else ++bad_run_;
@@ -117,17 +117,14 @@ class Grid2dNode : public fploc::rt::Node {
                     "+-%.1f deg)%s", bad_run_, pct, r.num_points, need, r.search_xy_m, r.search_yaw_rad * 180 / M_PI,
                     r.status == l2::GridStatus::kLost ? "; re-acquiring" : "; odometry prediction kept");
     const std::string line = "scan " + std::to_string(seq_) + ": " + names[int(r.status)] + ": " + why;
-    ctx_->set_detail(line);
     bool printed = false;
     if (r.status == l2::GridStatus::kLost) printed = ctx_->error("LOST at scan " + std::to_string(seq_) + ": " + why);
-    if (!printed && ++status_changes_ <= 200)
-      std::cerr << "[" << ctx_->name() << "] " << line << (status_changes_ == 200 ? " (further changes: telemetry's detail)" : "")
-                << "\n";
+    ctx_->status_changed(line, true, !printed);
   }
 
   fploc::rt::Context* ctx_ = nullptr;
   l2::GridStatus said_status_ = l2::GridStatus::kNotInitialised;  // the first scan's status is said too
-  int bad_run_ = 0, status_changes_ = 0;
+  int bad_run_ = 0;
   std::unique_ptr<l2::GridLocalizer> loc_;
   fploc::rt::Publisher<fploc::pose_t> out_;
   std::optional<Pose2> odom_;

@@ -156,12 +156,14 @@ class OptimizerNode : public fploc::rt::Node {
     if (latest) {
       plan_.add_scale_error(&*latest);
       latest_out_.publish(fploc::adapters::to_msg(*latest, latest_seq_++, m.floor_index, m.floor));
-      // Status changes with their reason (pose_t has no text): e.g. POOR where the plan leaves a direction open.
+      // Status changes with their reason (pose_t has no text): e.g. POOR where the plan leaves a direction open,
+      // said by the runtime (Context::status_changed) ...
       const std::string line = fploc::matcher::to_string(latest->status) + (latest->status_text.empty() ? "" : ": " + latest->status_text);
-      if (latest->status != last_status_ && ++status_changes_ <= 200)
-        std::cerr << "[" << ctx_->name() << "] scan " << m.scan_seq << ": " << line << "\n";
-      // ... and in telemetry while not OK (the dashboard shows it beside the pose's status).
-      ctx_->set_detail(latest->status == FitStatus::kOk ? "" : line);
+      const bool ok = latest->status == FitStatus::kOk;
+      if (latest->status != last_status_) ctx_->status_changed("scan " + std::to_string(m.scan_seq) + ": " + line, !ok);
+      // ... and the current reason in telemetry while not OK (the dashboard shows it beside the pose's status; the
+      // reason may change while the status does not).
+      if (!ok) ctx_->set_detail(line);
       last_status_ = latest->status;
     }
     if (const auto r = loc_->take_reseed()) {
@@ -222,7 +224,6 @@ class OptimizerNode : public fploc::rt::Node {
   bool have_last_ = false;
   int64_t pose_seq_ = 0, latest_seq_ = 0, reseed_seq_ = 0;
   FitStatus last_status_ = FitStatus::kOk;
-  int status_changes_ = 0;
 };
 
 }  // namespace

@@ -247,6 +247,15 @@ void Context::set_failing(const std::string& what) {
   error(what);
 }
 
+bool Context::status_changed(const std::string& line, bool keep_detail, bool print) {
+  stats_.detail = keep_detail ? line : std::string();
+  if (!print || status_changes_ >= kStatusChangesPrinted) return false;
+  ++status_changes_;
+  std::cerr << "[" << name_ << "] " << line
+            << (status_changes_ == kStatusChangesPrinted ? " (further changes: telemetry's detail)" : "") << std::endl;
+  return true;
+}
+
 void Context::request_stop() { loop().stop = true; }
 
 // ---- composition --------------------------------------------------------------------------------

@@ -183,3 +183,33 @@ TEST(Context, WarnsOnceOfAYawInDegrees) {
   said = testing::internal::GetCapturedStderr();
   EXPECT_EQ(said.find("warning"), std::string::npos) << said;
 }
+
+// A node's status changes (Context::status_changed) are said on stderr for the first 200 only, the 200th saying that
+// further ones are only in telemetry; the line is telemetry's detail (cleared for a status that needs no
+// explanation); a change already said elsewhere on stderr is neither printed again nor counted.
+TEST(Context, StatusChangesArePrintedTwoHundredTimesAndKeptInTheDetail) {
+  Bus bus("memq://");
+  NodeSpec spec{"grid2d", "", "", {}};
+  Context ctx(bus, spec, "g1", nullptr, {}, "/", true);
+  testing::internal::CaptureStderr();
+  EXPECT_TRUE(ctx.status_changed("scan 0: POOR: too few returns"));
+  std::string said = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(said, "[g1] scan 0: POOR: too few returns\n");
+  EXPECT_EQ(ctx.stats().detail, "scan 0: POOR: too few returns");
+  testing::internal::CaptureStderr();
+  EXPECT_FALSE(ctx.status_changed("scan 1: LOST: said by error()", true, false));
+  said = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(said, "");
+  EXPECT_EQ(ctx.stats().detail, "scan 1: LOST: said by error()");
+  EXPECT_TRUE(ctx.status_changed("scan 2: OK", false));
+  EXPECT_EQ(ctx.stats().detail, "") << "an OK status clears the detail";
+  testing::internal::CaptureStderr();
+  for (int i = 3; i < 400; ++i) ctx.status_changed("scan " + std::to_string(i) + ": " + (i % 2 ? "POOR" : "OK"));
+  said = testing::internal::GetCapturedStderr();
+  // 2 printed before, so 198 more: scans 3..200, the last one marked.
+  EXPECT_EQ(std::count(said.begin(), said.end(), '\n'), Context::kStatusChangesPrinted - 2) << said;
+  EXPECT_NE(said.find("[g1] scan 200: OK (further changes: telemetry's detail)\n"), std::string::npos) << said;
+  EXPECT_EQ(said.find("scan 201"), std::string::npos);
+  EXPECT_EQ(said.find("further changes"), said.rfind("further changes")) << "marked once";
+  EXPECT_EQ(ctx.stats().detail, "scan 399: POOR") << "the detail follows every change";
+}

@@ -25,8 +25,8 @@ one's noise from the increments between consecutive scans (and 2 scans apart: wh
 per-pose noise sigma even a perfect localizer scores an ATE of ~sigma, so each method's "ate_less_reference_noise_m"
 (sqrt(ATE^2 - sigma^2), an estimate of its own error) and "nees_median_with_reference_noise" (the reference's
 variance added to the published covariance) are given beside ATE and NEES. Plots
-per row, framed on the map's walls and the tracks: ROW.png (reference green, fploc blue, AMCL orange) and
-ROW-fploc.png (without AMCL).
+per row, framed on the tracks with 3 m around them, a legend and a scale bar in metres: ROW.png (reference green,
+fploc blue, AMCL orange) and ROW-fploc.png (without AMCL).
 
   fploc bench real [--json] [--markdown FILE] [--logs intel,aces] [--split auto|F] [--end 0.6] [--out DIR] [--rows ref,off]
   fploc bench real --from-json RUN.json --markdown FILE     (the tables of an earlier run's JSON, nothing rerun)
@@ -324,10 +324,14 @@ def main():
             g, p, am = (score(ref, est[k], a.lost_m, keep, unc[k], rnoise) for k in ("grid", "wo", "amcl"))
             f, fploc_ms = (g, grid_ms) if a.fploc == "grid" else (p, plan_ms)
             png = os.path.join(d, f"{row}.png")
-            run([os.path.join(BIN, "fploc-occupancy"), plan, "--png", png, "--scale", "2", "--crop-margin", "1", "--tum", ref, "--tum", est[a.fploc], "--tum", est["amcl"]])
+            # Framed on the tracks (3 m around them), a legend and a scale bar in metres (fploc occupancy --label).
+            frame = ["--scale", "2", "--crop-margin", "3", "--crop-to", "tracks"]
+            run([os.path.join(BIN, "fploc-occupancy"), plan, "--png", png] + frame + ["--tum", ref, "--label", "reference",
+                 "--tum", est[a.fploc], "--label", f"fploc ({a.fploc})", "--tum", est["amcl"], "--label", "AMCL"])
             # AMCL's jumps hide fploc's track in the picture of all three: fploc alone (blue) on the reference (green).
             png_f = os.path.join(d, f"{row}-fploc.png")
-            run([os.path.join(BIN, "fploc-occupancy"), plan, "--png", png_f, "--scale", "2", "--crop-margin", "1", "--tum", ref, "--tum", est[a.fploc]])
+            run([os.path.join(BIN, "fploc-occupancy"), plan, "--png", png_f] + frame + ["--tum", ref, "--label", "reference",
+                 "--tum", est[a.fploc], "--label", f"fploc ({a.fploc})"])
             r = {"log": name, "start": row, "scans": scans, "map_scans": imp["map"]["end_scan"],
                  "split": imp["split"] if "split" in imp else {"fraction": float(a.split)}, "covered_scans": len(keep),
                  "floor": floor, "reference_noise": rnoise, "map_refine": imp["map"].get("refine"),

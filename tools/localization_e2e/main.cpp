@@ -51,6 +51,8 @@ int main(int argc, char** argv) {
   app.add_flag("--body-velocity", o.body_frame_velocity, "optimizer: body-frame velocity regularisation");
   app.add_flag("--gt-gravity", o.gt_gravity, "diagnostic: project the features with the true roll/pitch");
   app.add_flag("--no-clutter", no_clutter);
+  bool json_flag = false;  // the output is JSON anyway; --json as every other tool takes it (it was refused)
+  app.add_flag("--json", json_flag, "JSON on stdout (what it prints in any case)");
   CLI11_PARSE(app, argc, argv);
   o.imu = !no_imu;
   o.clutter = !no_clutter;

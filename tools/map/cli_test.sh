@@ -55,6 +55,55 @@ grep -q "resolution: 0.1" "$T/pgm/map.yaml" || fail "yaml"
 B="$(cd "$(dirname "$0")/../.." && pwd)/data/buildings/two-floors.pbtxt"
 "$MAP" render --plan "$B" --floor first --out "$T/first.svg" 2>/dev/null || fail "render a building floor"
 grep -q "<svg" "$T/first.svg" || fail "building floor svg"
+# A building floor's stairs, ramps and lifts (the connections from or to it) are drawn, each kind in its colour (a
+# translucent area, its outline) with a legend line naming it and the other floor; connections elsewhere are not.
+D="$(cd "$(dirname "$0")/../.." && pwd)/data/plans"
+cat > "$T/b3.pbtxt" <<EOF
+name: "three"
+floor { name: "ground" plan { file: "$D/room.json" } elevation_m: 0 ceiling_height_m: 3 }
+floor { name: "first" plan { file: "$D/corridor.json" } elevation_m: 3.3 ceiling_height_m: 2.8 }
+floor { name: "second" plan { file: "$D/corridor.json" } elevation_m: 6.6 ceiling_height_m: 2.8 }
+connection { name: "s1" kind: STAIRS from_floor: "ground" to_floor: "first"
+             polygon { x: 0 y: 0 } polygon { x: 4 y: 0 } polygon { x: 4 y: 2 } polygon { x: 0 y: 2 } }
+connection { name: "r1" kind: RAMP from_floor: "ground" to_floor: "first"
+             polygon { x: 6 y: 4 } polygon { x: 9 y: 4 } polygon { x: 9 y: 6 } polygon { x: 6 y: 6 } }
+connection { name: "l1" kind: LIFT from_floor: "first" to_floor: "second"
+             polygon { x: 8 y: 10 } polygon { x: 10 y: 10 } polygon { x: 10 y: 12 } polygon { x: 8 y: 12 } }
+EOF
+PYLIB="$(cd "$(dirname "$0")/../pylib" && pwd)"
+for fl in ground first second; do
+  "$MAP" render --plan "$T/b3.pbtxt" --floor $fl --fields none --out "$T/$fl.svg" 2> "$T/err" || fail "render $fl: $(cat "$T/err")"
+  "$MAP" render --plan "$T/b3.pbtxt" --floor $fl --fields none --width 800 --out "$T/$fl.png" 2>> "$T/err" || fail "render $fl png"
+  case $fl in
+    ground) want="STAIRS 's1' to first|RAMP 'r1' to first"; not="LIFT" ;;
+    first) want="STAIRS 's1' to ground|RAMP 'r1' to ground|LIFT 'l1' to second"; not="-" ;;
+    second) want="LIFT 'l1' to first"; not="STAIRS|RAMP" ;;
+  esac
+  python3 - "$T/$fl.svg" "$T/$fl.png" "$T/err" "$want" "$not" "$PYLIB" <<'PY' || fail "floor $fl: stairs, ramps, lifts"
+import sys
+sys.path.insert(0, sys.argv[6])
+from png_read import read_png
+svg, err = open(sys.argv[1]).read(), open(sys.argv[3]).read()
+colour = {"STAIRS": (148, 103, 189, "#9467bd"), "RAMP": (140, 86, 75, "#8c564b"), "LIFT": (23, 190, 207, "#17becf")}
+w, h, px = read_png(sys.argv[2])
+count = {}
+for y in range(h):
+    for x in range(w):
+        count[px(x, y)] = count.get(px(x, y), 0) + 1
+for line in sys.argv[4].split("|"):
+    kind = line.split()[0]
+    r, g, b, hexc = colour[kind]
+    assert f">{line}</text>" in svg, ("SVG legend", line)
+    assert f'fill="{hexc}" fill-opacity="0.3"' in svg, ("SVG area", kind)
+    assert err.count(line) == 2, ("summary line", line, err)
+    area = tuple(int(0.7 * 255 + 0.3 * c) for c in (r, g, b))  # blended over the white ground
+    assert count.get(area, 0) > 500, ("PNG area", kind, area, count.get(area, 0))
+    assert count.get((r, g, b), 0) > 100, ("PNG outline and legend swatch", kind, count.get((r, g, b), 0))
+for kind in sys.argv[5].split("|"):
+    if kind in colour:
+        assert kind not in svg and kind not in err and count.get(colour[kind][:3], 0) == 0, ("drawn on the wrong floor", kind)
+PY
+done
 "$MAP" build --plan "$B" --mode exact --out "$T/ground.fpmap" --json > "$T/b.json" 2>/dev/null || fail "build the first floor"
 grep -q '"elements": 44' "$T/b.json" || fail "the default floor is the first (the room, 44 elements)"
 if "$MAP" validate --plan "$B" --floor roof --no-baselines 2> "$T/err"; then fail "unknown floor accepted"; fi

@@ -5,9 +5,12 @@
 # first pose's arrival after t0 and the log time of the scan it belongs to. Runs itself in a private
 # network namespace (scripts/netns-run), so no LCM traffic leaves the machine.
 #   tools/map/first_pose.sh GRAPH LOG [DURATION_S]
-# docs/notes/building.md: SIST-F4 with a warm ANNF cache (FPLOC_ANNF_CACHE).
+# It runs what is built ($FPLOC_BUILD_DIR, default build/: its bin/fploc-launch), building nothing.
+# docs/notes/building.md: SIST-F4 with a warm ANNF cache (FPLOC_ANNF_CACHE). Test: map_first_pose.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+LAUNCH="${FPLOC_BUILD_DIR:-$ROOT/build}/bin/fploc-launch"
+[ -x "$LAUNCH" ] || { echo "first_pose.sh: no $LAUNCH (build first: bin/fploc setup, or cmake --build)" >&2; exit 1; }
 if [ "${FPLOC_IN_NETNS:-}" != "1" ]; then exec "$ROOT/scripts/netns-run" "$0" "$@"; fi
 GRAPH="$1" LOG="$2" DUR="${3:-12}"
 T="$(mktemp -d)"
@@ -16,7 +19,7 @@ URL=$(sed -n 's/^lcm_url: *"\(.*\)".*/\1/p' "$GRAPH")
 lcm-logger --lcm-url="$URL" -c '^FPLOC_(FRAME_POSE|POSE|POSE_LATEST)$' "$T/pose.lcm" > /dev/null 2>&1 &
 G=$!
 sleep 0.5
-FPLOC_SKIP_SETUP=1 "$ROOT/bin/fploc" launch "$GRAPH" --duration "$DUR" > "$T/launch.log" 2>&1 &
+"$LAUNCH" "$GRAPH" --duration "$DUR" > "$T/launch.log" 2>&1 &
 L=$!
 for _ in $(seq 300); do grep -q "' running: " "$T/launch.log" && break; sleep 0.01; done
 t0=$(date +%s%N)

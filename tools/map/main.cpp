@@ -223,7 +223,21 @@ int main(int argc, char** argv) {
   try {
     if (*build) return cmd_build(b_plan, b_annf, b_out, as_json);
     if (*validate) return cmd_validate(v_plan.load(), v, as_json);
-    if (*render) return cmd_render(r_plan.load(), r);
+    if (*render) {
+      FloorPlan plan = r_plan.load();
+      // A building description's stairs, ramps and lifts that reach the floor drawn (an IFC file has none).
+      std::string ext = std::filesystem::path(r_plan.plan).extension().string();
+      for (auto& ch : ext) ch = char(std::tolower((unsigned char)ch));
+      if (ext == ".pbtxt") {
+        BuildingLoadOptions bo;
+        bo.quiet = true;
+        const Building bld = load_building(r_plan.plan, bo);
+        r.floor = bld.floor(r_plan.floor).name;
+        for (const auto& c : bld.connections)
+          if (c.from_floor == r.floor || c.to_floor == r.floor) r.connections.push_back(c);
+      }
+      return cmd_render(plan, r);
+    }
     if (*pgm) return cmd_export_pgm(p_plan.load(), p, as_json);
     if (*compare) return cmd_compare(c_plan.load(), c_ref.load(), c, as_json);
   } catch (const std::exception& e) {

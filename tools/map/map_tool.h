@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "fploc/floorplan/building.h"
 #include "fploc/floorplan/plan.h"
 
 namespace fploc {
@@ -33,6 +34,10 @@ struct RenderArgs {
   std::string fields = "nearest";  // "nearest": the look-up's leaf fields coloured by nearest element; "none": lines only
   int depth = 5;
   int width = 1600;
+  // A building floor's stairs, ramps and lifts (the building's connections from or to the floor), drawn over the
+  // plan with a legend entry each; `floor` names the floor drawn.
+  std::vector<FloorConnection> connections;
+  std::string floor;
 };
 int cmd_render(const FloorPlan& plan, const RenderArgs& a);
 

@@ -1,4 +1,6 @@
 // fploc map render (SVG / PNG like the paper's Fig. 2) and export-pgm (ROS map_server PGM + YAML).
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -59,6 +61,38 @@ const LayerStyle* style_of(const FloorPlan& plan, const Element& e) {
   return nullptr;
 }
 
+// A building floor's stairs, ramps and lifts: a translucent area in the kind's colour with its outline (a lift also
+// with the crossed box of architectural drawings), and a legend line each.
+struct ConnectionStyle {
+  const char* svg;
+  uint8_t rgb[3];
+};
+const ConnectionStyle& style_of(ConnectionKind k) {
+  static const ConnectionStyle kStairs{"#9467bd", {148, 103, 189}}, kRamp{"#8c564b", {140, 86, 75}},
+      kLift{"#17becf", {23, 190, 207}};
+  return k == ConnectionKind::kRamp ? kRamp : k == ConnectionKind::kLift ? kLift : kStairs;
+}
+std::string legend_text(const FloorConnection& c, const std::string& floor) {
+  std::string kind = to_string(c.kind);
+  for (auto& ch : kind) ch = char(std::toupper((unsigned char)ch));
+  return kind + " '" + c.name + "' to " + (c.from_floor == floor ? c.to_floor : c.from_floor);
+}
+bool point_in_polygon(const std::vector<Eigen::Vector2d>& poly, const Eigen::Vector2d& p) {
+  bool in = false;
+  for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++)
+    if ((poly[i].y() > p.y()) != (poly[j].y() > p.y()) &&
+        p.x() < (poly[j].x() - poly[i].x()) * (p.y() - poly[i].y()) / (poly[j].y() - poly[i].y()) + poly[i].x())
+      in = !in;
+  return in;
+}
+// The drawing's extent: the plan and the connections' areas.
+Box2 drawn_bounds(const FloorPlan& plan, const std::vector<FloorConnection>& conns) {
+  Box2 b = plan.bounds();
+  for (const auto& c : conns)
+    for (const auto& p : c.polygon) b.extend(p);
+  return b;
+}
+
 // A scale bar's length: 1, 2 or 5 times a power of ten, about a fifth of the width.
 double scale_bar_m(double width_m) {
   const double target = width_m / 5, p = std::pow(10.0, std::floor(std::log10(target)));
@@ -67,8 +101,9 @@ double scale_bar_m(double width_m) {
   return p;
 }
 
-void write_svg(const FloorPlan& plan, const annf::Annf* f, const std::string& out, int width) {
-  const Box2 b = plan.bounds();
+void write_svg(const FloorPlan& plan, const annf::Annf* f, const std::string& out, int width,
+               const std::vector<FloorConnection>& conns, const std::string& floor) {
+  const Box2 b = drawn_bounds(plan, conns);
   const double pad = 0.02 * b.size().maxCoeff() + 0.1;
   const double W = b.size().x() + 2 * pad, H = b.size().y() + 2 * pad;
   std::ofstream s(out);
@@ -109,15 +144,29 @@ void write_svg(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
     }
     if (st) s << "</g>\n";
   }
-  s << "</g>\n</g>\n";
-  // Scale bar (bottom left) and, for a plan-change drawing, the legend of its layers (top left); upright text.
+  s << "</g>\n";
+  // Stairs, ramps and lifts over the plan.
+  for (const auto& c : conns) {
+    const ConnectionStyle& st = style_of(c.kind);
+    s << "<polygon points=\"";
+    for (const auto& p : c.polygon) s << p.x() << "," << p.y() << " ";
+    s << "\" fill=\"" << st.svg << "\" fill-opacity=\"0.3\" stroke=\"" << st.svg << "\" stroke-width=\"" << sw * 3
+      << "\"><title>" << legend_text(c, floor) << "</title></polygon>\n";
+    if (c.kind == ConnectionKind::kLift && c.polygon.size() == 4)
+      for (int k = 0; k < 2; ++k)
+        s << "<line x1=\"" << c.polygon[k].x() << "\" y1=\"" << c.polygon[k].y() << "\" x2=\"" << c.polygon[k + 2].x() << "\" y2=\""
+          << c.polygon[k + 2].y() << "\" stroke=\"" << st.svg << "\" stroke-width=\"" << sw * 1.5 << "\"/>\n";
+  }
+  s << "</g>\n";
+  // Scale bar (bottom left) and, for a plan-change drawing or a floor with stairs, ramps or lifts, the legend of its
+  // layers and connections (top left); upright text.
   const double fs = std::min(W, H) / 60, bar = scale_bar_m(b.size().x());
   const double x0 = b.min.x() - pad + fs, ybar = -(b.min.y() - pad) - fs;
   s << "<g font-family=\"sans-serif\" font-size=\"" << fs << "\">\n<line x1=\"" << x0 << "\" y1=\"" << ybar << "\" x2=\""
     << x0 + bar << "\" y2=\"" << ybar << "\" stroke=\"#000\" stroke-width=\"" << fs / 4 << "\"/>\n<text x=\"" << x0
     << "\" y=\"" << ybar - fs / 2 << "\">" << bar << " m</text>\n";
   double yl = -(b.max.y() + pad) + 1.5 * fs;
-  const int legend_lines = (diff_count[0] > 0) + (diff_count[1] > 0) + (diff_count[2] > 0);
+  const int legend_lines = (diff_count[0] > 0) + (diff_count[1] > 0) + (diff_count[2] > 0) + int(conns.size());
   if (legend_lines > 0)  // a white ground for the legend over the fields
     s << "<rect x=\"" << x0 - fs / 2 << "\" y=\"" << yl - 1.2 * fs << "\" width=\"" << 22 * fs << "\" height=\""
       << 1.4 * fs * legend_lines + 0.4 * fs << "\" fill=\"#ffffffd0\"/>\n";
@@ -128,12 +177,20 @@ void write_svg(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
         << "\">" << kDiffLayers[k].prefix << " (" << diff_count[k] << "): " << kDiffLayers[k].label << "</text>\n";
       yl += 1.4 * fs;
     }
+  for (const auto& c : conns) {
+    const ConnectionStyle& st = style_of(c.kind);
+    s << "<rect x=\"" << x0 << "\" y=\"" << yl - 0.8 * fs << "\" width=\"" << 1.5 * fs << "\" height=\"" << 0.8 * fs << "\" fill=\""
+      << st.svg << "\" fill-opacity=\"0.3\" stroke=\"" << st.svg << "\" stroke-width=\"" << fs / 8 << "\"/><text x=\"" << x0 + 2 * fs
+      << "\" y=\"" << yl << "\">" << legend_text(c, floor) << "</text>\n";
+    yl += 1.4 * fs;
+  }
   s << "</g>\n</svg>\n";
   if (!s) throw std::runtime_error(out + ": write error");
 }
 
-void write_png(const FloorPlan& plan, const annf::Annf* f, const std::string& out, int width) {
-  const Box2 b = plan.bounds();
+void write_png(const FloorPlan& plan, const annf::Annf* f, const std::string& out, int width,
+               const std::vector<FloorConnection>& conns, const std::string& floor) {
+  const Box2 b = drawn_bounds(plan, conns);
   const double pad = 0.02 * b.size().maxCoeff() + 0.1;
   const double W = b.size().x() + 2 * pad, H = b.size().y() + 2 * pad;
   const int w = std::max(16, width), h = std::max(16, int(std::ceil(w * H / W)));
@@ -190,10 +247,53 @@ void write_png(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
         }
       }
     }
-  // Scale bar (bottom left), 1, 2 or 5 times a power of ten metres; its length is printed with the summary.
+  // Stairs, ramps and lifts: their area blended in the kind's colour, the outline 2 px (a lift's diagonals too).
+  for (const auto& c : conns) {
+    const ConnectionStyle& st = style_of(c.kind);
+    for (int j = 0; j < h; ++j)
+      for (int i = 0; i < w; ++i)
+        if (point_in_polygon(c.polygon, Eigen::Vector2d(b.min.x() - pad + (i + 0.5) * px, b.max.y() + pad - (j + 0.5) * px)))
+          for (int q = 0; q < 3; ++q) img[(size_t(j) * w + i) * 3 + q] = uint8_t(0.7 * img[(size_t(j) * w + i) * 3 + q] + 0.3 * st.rgb[q]);
+    auto edge = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& e) {
+      const int n = std::max(1, int(std::ceil((e - a).norm() / (px / 4))));
+      for (int k = 0; k <= n; ++k) dot(a + (e - a) * (double(k) / n), st.rgb, 1.0);
+    };
+    for (size_t k = 0; k < c.polygon.size(); ++k) edge(c.polygon[k], c.polygon[(k + 1) % c.polygon.size()]);
+    if (c.kind == ConnectionKind::kLift && c.polygon.size() == 4)
+      for (int k = 0; k < 2; ++k) edge(c.polygon[size_t(k)], c.polygon[size_t(k) + 2]);
+  }
+  // Scale bar (bottom left), 1, 2 or 5 times a power of ten metres, its length written above it.
   const double bar = scale_bar_m(b.size().x());
   for (double x = 0; x <= bar; x += px / 4) dot(Eigen::Vector2d(b.min.x() - pad + 10 * px + x, b.min.y() - pad + 10 * px), black, 1.5);
-  write_rgb_png(out, w, h, img);
+  RgbImage pic(w, h);
+  pic.px = std::move(img);
+  const int fs = std::clamp(w / 60, 12, 24);
+  char bar_text[32];
+  std::snprintf(bar_text, sizeof bar_text, "%g m", bar);
+  draw_text(pic, 10, h - 10 - fs / 2 - 2, bar_text, fs, black);
+  // Legend (top left, on a light ground): the plan-change layers present and the floor's connections.
+  std::vector<std::pair<const uint8_t*, std::string>> legend;
+  int diff_count[3] = {0, 0, 0};
+  for (const auto& e : plan.elements)
+    if (const LayerStyle* st = style_of(plan, e)) ++diff_count[st - kDiffLayers];
+  for (int k = 0; k < 3; ++k)
+    if (diff_count[k] > 0)
+      legend.emplace_back(kDiffLayers[k].rgb, std::string(kDiffLayers[k].prefix) + " (" + std::to_string(diff_count[k]) +
+                                                  "): " + kDiffLayers[k].label);
+  for (const auto& c : conns) legend.emplace_back(style_of(c.kind).rgb, legend_text(c, floor));
+  if (!legend.empty()) {
+    const int lh = fs * 3 / 2, sw = 2 * fs, x0 = fs / 2;
+    int tw = 0;
+    for (const auto& l : legend) tw = std::max(tw, text_width(l.second, fs));
+    const uint8_t white[3] = {255, 255, 255};
+    pic.fill_rect(x0 / 2, x0 / 2, x0 + sw + x0 + tw + x0, x0 + int(legend.size()) * lh + x0 / 2, white, 0.85);
+    for (size_t k = 0; k < legend.size(); ++k) {
+      const int y = x0 + int(k) * lh + lh / 2;
+      pic.fill_rect(x0, y - fs / 3, x0 + sw, y + fs / 3, legend[k].first);
+      draw_text(pic, x0 + sw + x0, y + fs * 2 / 5, legend[k].second, fs, black);
+    }
+  }
+  pic.write_png(out);
   std::cerr << "fploc map render: " << w << " x " << h << " px, " << px << " m per pixel; scale bar (bottom left) " << bar
             << " m\n";
 }
@@ -217,12 +317,14 @@ int cmd_render(const FloorPlan& plan, const RenderArgs& a) {
   const FloorPlan& drawn = f ? f->plan() : plan;
   const annf::Annf* fp = f && a.fields != "none" ? &*f : nullptr;
   if (ext == ".svg")
-    write_svg(drawn, fp, a.out, a.width);
+    write_svg(drawn, fp, a.out, a.width, a.connections, a.floor);
   else
-    write_png(drawn, fp, a.out, a.width);
+    write_png(drawn, fp, a.out, a.width, a.connections, a.floor);
   std::cerr << "fploc map render: ";
   if (fp) std::cerr << fp->stats().leaves << " leaf fields, ";
-  std::cerr << drawn.elements.size() << " elements -> " << a.out << "\n";
+  std::cerr << drawn.elements.size() << " elements";
+  for (const auto& c : a.connections) std::cerr << ", " << legend_text(c, a.floor);
+  std::cerr << " -> " << a.out << "\n";
   return 0;
 }
 

@@ -1,5 +1,5 @@
 // fploc occupancy MAP.yaml [--tolerance CELLS] [--out PLAN.json|.csv] [--compare PLAN] [--json]
-//                 [--png OUT.png [--scale N] [--tum T.tum ...] [--crop-margin M]]
+//                 [--png OUT.png [--scale N] [--tum T.tum [--label NAME] ...] [--crop-margin M [--crop-to tracks]]]
 // A ROS map_server occupancy map (YAML + PGM/PNG) vectorised into a plan (fploc/floorplan/occupancy.h):
 // prints the grid, the vectorisation's error (boundary cell centres to their segments) and, with --compare,
 // the two-way distance between the vectorised plan and another plan (e.g. the one `fploc map export-pgm` was
@@ -53,19 +53,30 @@ std::vector<Eigen::Vector2d> read_tum_xy(const std::string& path) {
   return out;
 }
 
+// A scale bar's length: 1, 2 or 5 times a power of ten metres, at most `max_m`.
+double scale_bar_m(double max_m) {
+  const double p = std::pow(10.0, std::floor(std::log10(max_m)));
+  for (double k : {5.0, 2.0, 1.0})
+    if (k * p <= max_m) return k * p;
+  return p;
+}
+
 // PNG: the grid (occupied black, free white, unknown grey), the vectorised segments in red and any TUM
 // trajectories on top (colours in order: green, blue, orange, magenta), `scale` pixels per cell. crop_margin_m
-// >= 0: only the box around the occupied cells and the trajectories, that much wider on each side (a log's map
-// is mostly the free space its longest beams swept).
+// >= 0: only the box around the occupied cells and the trajectories (crop_to_tracks: the trajectories alone), that
+// much wider on each side (a log's map is mostly the free space its longest beams swept). A scale bar in metres
+// (bottom left) and, with `labels` (one per trajectory), a legend of the trajectories' colours (top left).
 void write_png(const std::string& out, const fploc::OccupancyGrid& g, const fploc::FloorPlan& plan,
-               const std::vector<std::vector<Eigen::Vector2d>>& tracks, int scale, double crop_margin_m) {
+               const std::vector<std::vector<Eigen::Vector2d>>& tracks, const std::vector<std::string>& labels, int scale,
+               double crop_margin_m, bool crop_to_tracks) {
   const int W = g.width * scale, H = g.height * scale;
-  std::vector<uint8_t> img(size_t(W) * H * 3);
+  fploc::RgbImage full(W, H);
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) {
       const int v = g.at(x / scale, g.height - 1 - y / scale);
       const uint8_t c = v < 0 ? 200 : v > 100 * g.occupied_thresh ? 90 : uint8_t(255 - 2 * v);
-      for (int k = 0; k < 3; ++k) img[(size_t(y) * W + x) * 3 + k] = c;
+      const uint8_t rgb[3] = {c, c, c};
+      full.set(x, y, rgb);
     }
   const double c = std::cos(g.origin_yaw), s = std::sin(g.origin_yaw);
   auto px = [&](const Eigen::Vector2d& p) {  // world -> pixel (float)
@@ -78,45 +89,63 @@ void write_png(const std::string& out, const fploc::OccupancyGrid& g, const fplo
     const int n = std::max(1, int(std::ceil((pb - pa).norm())));
     for (int k = 0; k <= n; ++k) {
       const Eigen::Vector2d q = pa + (pb - pa) * (double(k) / n);
-      for (int dy = -thick; dy <= thick; ++dy)
-        for (int dx = -thick; dx <= thick; ++dx) {
-          const int x = int(q.x()) + dx, y = int(q.y()) + dy;
-          if (x < 0 || y < 0 || x >= W || y >= H) continue;
-          for (int m = 0; m < 3; ++m) img[(size_t(y) * W + x) * 3 + m] = col[m];
-        }
+      full.fill_rect(int(q.x()) - thick, int(q.y()) - thick, int(q.x()) + thick + 1, int(q.y()) + thick + 1, col);
     }
   };
-  static const uint8_t red[3] = {220, 0, 0};
+  static const uint8_t red[3] = {220, 0, 0}, black[3] = {0, 0, 0}, white[3] = {255, 255, 255};
   static const uint8_t cols[4][3] = {{0, 170, 0}, {0, 60, 255}, {255, 140, 0}, {200, 0, 200}};
   for (const auto& e : plan.elements) line(e.a, e.b, red, 0);
   for (size_t t = 0; t < tracks.size(); ++t)
     for (size_t k = 1; k < tracks[t].size(); ++k) line(tracks[t][k - 1], tracks[t][k], cols[t % 4], 1);
-  if (crop_margin_m < 0) {
-    fploc::write_rgb_png(out, W, H, img);
-    return;
+  // The box in pixels: occupied cells (unless crop_to_tracks) and trajectory points, widened by the margin, clamped
+  // to the image; the whole grid without a margin or with nothing to frame.
+  int cx0 = 0, cy0 = 0, cx1 = W, cy1 = H;
+  if (crop_margin_m >= 0) {
+    double x0 = W, y0 = H, x1 = -1, y1 = -1;
+    auto grow = [&](double x, double y) {
+      x0 = std::min(x0, x), y0 = std::min(y0, y), x1 = std::max(x1, x), y1 = std::max(y1, y);
+    };
+    if (!crop_to_tracks || tracks.empty())
+      for (int j = 0; j < g.height; ++j)
+        for (int i = 0; i < g.width; ++i)
+          if (g.at(i, j) > 100 * g.occupied_thresh) grow(double(i) * scale, double(g.height - 1 - j) * scale);
+    for (const auto& t : tracks)
+      for (const auto& p : t) grow(px(p).x(), px(p).y());
+    if (x1 >= 0) {
+      const double m = crop_margin_m / g.resolution * scale;
+      cx0 = std::max(0, int(x0 - m)), cy0 = std::max(0, int(y0 - m));
+      cx1 = std::min(W, int(x1 + m) + scale), cy1 = std::min(H, int(y1 + m) + scale);
+    }
   }
-  // The box in pixels: occupied cells and trajectory points, widened by the margin, clamped to the image.
-  double x0 = W, y0 = H, x1 = -1, y1 = -1;
-  auto grow = [&](double x, double y) {
-    x0 = std::min(x0, x), y0 = std::min(y0, y), x1 = std::max(x1, x), y1 = std::max(y1, y);
-  };
-  for (int j = 0; j < g.height; ++j)
-    for (int i = 0; i < g.width; ++i)
-      if (g.at(i, j) > 100 * g.occupied_thresh) grow(double(i) * scale, double(g.height - 1 - j) * scale);
-  for (const auto& t : tracks)
-    for (const auto& p : t) grow(px(p).x(), px(p).y());
-  if (x1 < 0) {  // nothing to frame
-    fploc::write_rgb_png(out, W, H, img);
-    return;
+  fploc::RgbImage img(cx1 - cx0, cy1 - cy0);
+  for (int y = 0; y < img.h; ++y)
+    std::copy_n(full.px.begin() + (size_t(cy0 + y) * W + cx0) * 3, size_t(img.w) * 3, img.px.begin() + size_t(y) * img.w * 3);
+  // Scale bar (bottom left, on a white ground): 1, 2 or 5 x 10^k m, at most a third of the width.
+  const int fs = std::clamp(std::min(img.w, img.h) / 30, 12, 28), pad = fs / 2;
+  const double m_per_px = g.resolution / scale, bar_m = scale_bar_m(img.w / 3.0 * m_per_px);
+  const int bar_px = int(std::lround(bar_m / m_per_px));
+  char bar_text[32];
+  std::snprintf(bar_text, sizeof bar_text, "%g m", bar_m);
+  const int bx = pad, by = img.h - pad;
+  img.fill_rect(bx - pad / 2, by - 2 * fs - pad / 2, bx + std::max(bar_px, fploc::text_width(bar_text, fs)) + pad / 2,
+                by + pad / 2, white, 0.85);
+  img.fill_rect(bx, by - fs / 4, bx + bar_px, by, black);
+  for (int k : {0, bar_px - 2}) img.fill_rect(bx + k, by - fs / 2, bx + k + 2, by, black);  // end ticks
+  fploc::draw_text(img, bx, by - fs / 2 - 3, bar_text, fs, black);
+  // Legend (top left): a swatch and the name of each trajectory.
+  if (!labels.empty()) {
+    const size_t n = std::min(labels.size(), tracks.size());
+    int tw = 0;
+    for (size_t t = 0; t < n; ++t) tw = std::max(tw, fploc::text_width(labels[t], fs));
+    const int lh = fs * 3 / 2, sw = 2 * fs;
+    img.fill_rect(pad / 2, pad / 2, pad + sw + pad + tw + pad, pad + int(n) * lh + pad / 2, white, 0.85);
+    for (size_t t = 0; t < n; ++t) {
+      const int y = pad + int(t) * lh + lh / 2;
+      img.fill_rect(pad, y - 2, pad + sw, y + 2, cols[t % 4]);
+      fploc::draw_text(img, pad + sw + pad, y + fs * 2 / 5, labels[t], fs, black);
+    }
   }
-  const double m = crop_margin_m / g.resolution * scale;
-  const int cx0 = std::max(0, int(x0 - m)), cy0 = std::max(0, int(y0 - m));
-  const int cx1 = std::min(W, int(x1 + m) + scale), cy1 = std::min(H, int(y1 + m) + scale);
-  const int cw = cx1 - cx0, ch = cy1 - cy0;
-  std::vector<uint8_t> crop(size_t(cw) * ch * 3);
-  for (int y = 0; y < ch; ++y)
-    std::copy_n(img.begin() + (size_t(cy0 + y) * W + cx0) * 3, size_t(cw) * 3, crop.begin() + size_t(y) * cw * 3);
-  fploc::write_rgb_png(out, cw, ch, crop);
+  img.write_png(out);
 }
 }  // namespace
 
@@ -128,7 +157,8 @@ int main(int argc, char** argv) {
   std::string png_out;
   int scale = 1;
   double crop_margin = -1;
-  std::vector<std::string> tums;
+  std::vector<std::string> tums, labels;
+  std::string crop_to = "map";
   app.add_option("map", map, "map_server YAML")->required();
   app.add_option("--tolerance", tol, "Douglas-Peucker tolerance [cells] (0.5)");
   app.add_option("--out", out, "write the plan (.json or .csv)");
@@ -137,8 +167,11 @@ int main(int argc, char** argv) {
   app.add_option("--png", png_out, "picture: grid, segments (red), --tum trajectories (green, blue, orange, magenta)");
   app.add_option("--scale", scale, "PNG pixels per cell (1)")->check(CLI::Range(1, 16));
   app.add_option("--tum", tums, "trajectory (TUM) to draw on the PNG; repeatable");
+  app.add_option("--label", labels, "PNG legend: the name of each --tum trajectory, in their order; repeatable (default: no legend)");
   app.add_option("--crop-margin", crop_margin,
                  "PNG: only the occupied cells and trajectories, this much [m] around them (default: the whole grid)");
+  app.add_option("--crop-to", crop_to, "PNG with --crop-margin: frame the occupied cells and trajectories (map) or the "
+                 "trajectories alone (tracks) (map)")->check(CLI::IsMember({"map", "tracks"}));
   CLI11_PARSE(app, argc, argv);
   // CLI11 takes "nan" and "inf" as numbers: a NaN tolerance vectorised the map into a few long wrong segments.
   if (!(std::isfinite(tol) && tol >= 0)) {
@@ -147,6 +180,10 @@ int main(int argc, char** argv) {
   }
   if (!std::isfinite(crop_margin)) {
     std::cerr << "fploc occupancy: --crop-margin " << crop_margin << ": expected a finite number of metres\n";
+    return 1;
+  }
+  if (labels.size() > tums.size()) {
+    std::cerr << "fploc occupancy: " << labels.size() << " --label for " << tums.size() << " --tum\n";
     return 1;
   }
   try {
@@ -173,7 +210,7 @@ int main(int argc, char** argv) {
     if (!png_out.empty()) {
       std::vector<std::vector<Eigen::Vector2d>> tracks;
       for (const auto& t : tums) tracks.push_back(read_tum_xy(t));
-      write_png(png_out, g, plan, tracks, scale, crop_margin);
+      write_png(png_out, g, plan, tracks, labels, scale, crop_margin, crop_to == "tracks");
     }
     std::cerr << "fploc occupancy: " << g.width << " x " << g.height << " cells at " << g.resolution << " m, "
               << st.boundary_cells << " boundary cells -> " << st.segments << " segments (max error "

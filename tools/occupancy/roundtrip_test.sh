@@ -31,6 +31,33 @@ def size(p):
 print(f"png {fw}x{fh}, cropped {cw}x{ch}")
 assert 0 < cw <= fw and 0 < ch <= fh and (cw, ch) != (fw, fh), (fw, fh, cw, ch)
 PY
+# Framed on the trajectories alone (--crop-to tracks: the map's walls reach far beyond them), with a legend naming them
+# in their colours (top left) and a scale bar in metres (bottom left). Tracks over 3 x 1 m, 1 m around them, 2 px per
+# 5 cm cell: 200 x 120 px, the bar 1 m = 40 px (1, 2 or 5 x 10^k m, at most a third of the width).
+printf '0 1.0 1.0 0 0 0 0 1\n1 4.0 2.0 0 0 0 0 1\n' > "$T/t.tum"
+printf '0 1.2 1.2 0 0 0 0 1\n1 3.8 1.8 0 0 0 0 1\n' > "$T/e.tum"
+"$OCC" "$T/m0.05/map.yaml" --png "$T/legend.png" --scale 2 --crop-margin 1 --crop-to tracks --tum "$T/t.tum" \
+  --label reference --tum "$T/e.tum" --label fploc 2>/dev/null || fail "png --crop-to tracks --label"
+if "$OCC" "$T/m0.05/map.yaml" --png "$T/n.png" --tum "$T/t.tum" --label a --label b 2> "$T/err"; then fail "2 labels for 1 track"; fi
+PYLIB="$(cd "$(dirname "$0")/../pylib" && pwd)"
+python3 - "$T/legend.png" "$PYLIB" <<'PY' || fail "legend, scale bar or crop"
+import sys
+sys.path.insert(0, sys.argv[2])
+from png_read import read_png
+w, h, px = read_png(sys.argv[1])
+print(f"legend png {w}x{h}")
+assert abs(w - 200) <= 4 and abs(h - 120) <= 4, (w, h)
+# Legend: a swatch per track in its colour (reference green, fploc blue), each followed by dark text on a light ground.
+fs = max(12, min(28, min(w, h) // 30)); pad, lh, sw = fs // 2, fs * 3 // 2, 2 * fs
+for t, col in enumerate(((0, 170, 0), (0, 60, 255))):
+    y = pad + t * lh + lh // 2
+    assert all(px(x, y) == col for x in range(pad, pad + sw)), (t, [px(x, y) for x in range(pad, pad + sw)])
+    text = [(x, yy) for x in range(pad + sw + pad, w // 2) for yy in range(y - lh // 2, y + lh // 2) if max(px(x, yy)) < 80]
+    assert len(text) > 20, (t, len(text))
+# Scale bar: a black bar 1 m (40 px) long just above the bottom, its length printed above it.
+bar = [x for x in range(w) if px(x, h - pad - 2) == (0, 0, 0)]
+assert bar and bar[-1] - bar[0] + 1 == 40, bar
+PY
 # A corrupt YAML: one clear error naming file and field, exit 1.
 printf 'image: map.pgm\nresolution: -1\norigin: [0, 0, 0]\n' > "$T/bad.yaml"
 if "$OCC" "$T/bad.yaml" 2> "$T/err"; then fail "bad yaml accepted"; fi

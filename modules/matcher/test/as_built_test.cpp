@@ -30,6 +30,19 @@ FloorPlan moved(const FloorPlan& plan, size_t i, double d) {
   return w;
 }
 
+// An as-built world: every segment's ends displaced by their own N(0, sigma) along the segment's normal (seeded).
+FloorPlan as_built_world(FloorPlan w, uint32_t seed, double sigma = 0.05) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g(0.0, sigma);
+  for (Element& e : w.elements) {
+    if (e.kind != ElementKind::kSegment) continue;
+    const Eigen::Vector2d u = (e.b - e.a).normalized(), nrm(-u.y(), u.x());
+    e.a += g(rng) * nrm;
+    e.b += g(rng) * nrm;
+  }
+  return w;
+}
+
 MatcherConfig config(bool as_built) {
   MatcherConfig c;
   c.max_iterations = 30;
@@ -162,15 +175,7 @@ TEST(AsBuilt, WallsAFewCentimetresOffKeepTheirShareWithTheGate) {
   so.noise_sigma = 0.005;
   int differs = 0, frames = 0;
   for (uint32_t seed = 1; seed <= 6; ++seed) {
-    std::mt19937 rng(seed);
-    std::normal_distribution<double> n5(0.0, 0.05);
-    FloorPlan world = plan;
-    for (Element& e : world.elements) {
-      if (e.kind != ElementKind::kSegment) continue;
-      const Eigen::Vector2d u = (e.b - e.a).normalized(), nrm(-u.y(), u.x());
-      e.a += n5(rng) * nrm;
-      e.b += n5(rng) * nrm;
-    }
+    const FloorPlan world = as_built_world(plan, seed);
     for (const Pose2 truth : {Pose2{10.0, 4.0, 0.4}, Pose2{3.0, 2.0, -1.0}, Pose2{17.0, 8.0, 2.0}}) {
       const FeatureFrame f = fploc::testing::synth_frame(world, truth, so);
       MatcherConfig plain = config(true), spread = config(true), gated = config(true);
@@ -308,15 +313,7 @@ TEST(AskewFaces, DisplacedWallsAreKept) {
   so.beams = 720;
   so.noise_sigma = 0.005;
   for (uint32_t seed = 1; seed <= 6; ++seed) {
-    std::mt19937 rng(seed);
-    std::normal_distribution<double> n5(0.0, 0.05);
-    FloorPlan world = moved(plan, 1, 0.25);
-    for (Element& e : world.elements) {
-      if (e.kind != ElementKind::kSegment) continue;
-      const Eigen::Vector2d u = (e.b - e.a).normalized(), nrm(-u.y(), u.x());
-      e.a += n5(rng) * nrm;
-      e.b += n5(rng) * nrm;
-    }
+    const FloorPlan world = as_built_world(moved(plan, 1, 0.25), seed);
     for (const Pose2 truth : {Pose2{10.0, 4.0, 0.4}, Pose2{3.0, 2.0, -1.0}, Pose2{17.0, 8.0, 2.0}}) {
       const FeatureFrame f = fploc::testing::synth_frame(world, truth, so);
       for (const double dyaw : {0.0, 1.0 * M_PI / 180}) {

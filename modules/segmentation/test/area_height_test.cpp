@@ -13,6 +13,7 @@
 
 #include "fploc/segmentation/segmenter.h"
 #include "fploc/segmentation/synthetic.h"
+#include "seg_test_util.h"
 
 using namespace fploc;
 using namespace fploc::seg;
@@ -22,17 +23,7 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 constexpr double kG = 9.80665;
 
-// 16 x 12 m room, 3.2 m high; for x < x_split the ceiling is 0.6 m lower (a drop ceiling).
-synth::Room two_height_room(double x_split) {
-  synth::Room room;
-  room.height = 3.2;
-  synth::Box drop;
-  drop.lo = Eigen::Vector3d(-8.0, -6.0, 2.6);
-  drop.hi = Eigen::Vector3d(x_split, 6.0, 3.2);
-  drop.label = synth::kCeiling;
-  room.boxes.push_back(drop);
-  return room;
-}
+using test_util::two_height_room;
 
 AreaCeiling rect_area(const std::string& name, double x0, double y0, double x1, double y1, double h) {
   AreaCeiling a;
@@ -43,9 +34,8 @@ AreaCeiling rect_area(const std::string& name, double x0, double y0, double x1, 
   return a;
 }
 
-struct Walk {
-  double max_z_err = 0, max_rp_err = 0, max_step = 0;
-  int ground = 0, ceiling = 0, predicted = 0, n = 0;
+struct Walk : test_util::HeightTally {
+  int n = 0;
   std::string last_status;
   bool said_building = false, said_learned = false;
 };
@@ -72,7 +62,6 @@ Walk walk(const synth::Room& room, const std::vector<double>& xs, uint32_t seed,
   std::mt19937 rng(seed);
   std::normal_distribution<double> gauss(0.0, 1.0);
   Walk w;
-  double prev_z = NAN, prev_true = NAN;
   const int n = int(xs.size());
   for (int k = 0; k < n; ++k) {
     const double f = double(k) / std::max(1, n - 1);
@@ -100,16 +89,7 @@ Walk walk(const synth::Room& room, const std::vector<double>& xs, uint32_t seed,
     const auto& out = seg.process(scan);
     // The localizer's pose of this scan arrives before the next one.
     seg.set_plan_pose({utime, pose.x, pose.y, pose.yaw, true});
-    if (k >= 2) {  // the first scans learn
-      w.max_z_err = std::max(w.max_z_err, std::abs(out.z - pose.z));
-      w.max_rp_err = std::max({w.max_rp_err, std::abs(out.roll - pose.roll), std::abs(out.pitch - pose.pitch)});
-      if (k > 2) w.max_step = std::max(w.max_step, std::abs((out.z - prev_z) - (pose.z - prev_true)));
-    }
-    prev_z = out.z;
-    prev_true = pose.z;
-    w.ground += out.z_source == HeightSource::kGround;
-    w.ceiling += out.z_source == HeightSource::kCeiling;
-    w.predicted += out.z_source == HeightSource::kPredicted;
+    w.add(out, pose, k >= 2, k > 2);  // the first scans learn
     w.said_building = w.said_building || out.status_text.find("building height") != std::string::npos;
     w.said_learned = w.said_learned || out.status_text.find("learned height") != std::string::npos;
     w.last_status = out.status_text;

@@ -8,6 +8,7 @@
 #include "fploc/segmentation/attitude_height.h"
 #include "fploc/segmentation/segmenter.h"
 #include "fploc/segmentation/synthetic.h"
+#include "seg_test_util.h"
 
 using namespace fploc;
 using namespace fploc::seg;
@@ -16,42 +17,20 @@ using fploc::seg::synth::SensorPose;
 namespace {
 constexpr double kDeg = M_PI / 180.0;
 
-// 16 x 12 m room, 3.2 m high; for x < x_split the ceiling is 0.6 m lower (a solid box labelled ceiling).
-synth::Room two_height_room(double x_split) {
-  synth::Room room;
-  room.height = 3.2;
-  synth::Box drop;
-  drop.lo = Eigen::Vector3d(-8.0, -6.0, 2.6);
-  drop.hi = Eigen::Vector3d(x_split, 6.0, 3.2);
-  drop.label = synth::kCeiling;
-  room.boxes.push_back(drop);
-  return room;
-}
+using test_util::HeightTally;
+using test_util::two_height_room;
 
-struct Walk {
-  double max_z_err = 0, max_rp_err = 0, max_step = 0;
-  int ground = 0, ceiling = 0, predicted = 0;
-};
-
-Walk walk(const synth::Room& room, double x0, double x1, int n, uint32_t seed) {
+HeightTally walk(const synth::Room& room, double x0, double x1, int n, uint32_t seed) {
   SegmenterConfig cfg;  // floor-to-ceiling height learned online
   RingSegmenter seg(cfg);
   const auto beams = synth::os1_like_beams();
-  Walk w;
-  double prev_z = NAN, prev_true = NAN;
+  HeightTally w;
   for (int k = 0; k < n; ++k) {
     const double f = double(k) / (n - 1);
     SensorPose pose{x0 + (x1 - x0) * f, 0.5 * std::sin(3 * f), 1.4 + 0.04 * std::sin(7 * f),
                     0.6 * kDeg * std::sin(11 * f), 0.5 * kDeg * std::cos(13 * f), 0.2 * k};
     const auto& out = seg.process(synth::render(room, pose, beams, 1024, 0.01, 0.01, seed + k).scan);
-    w.max_z_err = std::max(w.max_z_err, std::abs(out.z - pose.z));
-    w.max_rp_err = std::max({w.max_rp_err, std::abs(out.roll - pose.roll), std::abs(out.pitch - pose.pitch)});
-    if (k > 0) w.max_step = std::max(w.max_step, std::abs((out.z - prev_z) - (pose.z - prev_true)));
-    prev_z = out.z;
-    prev_true = pose.z;
-    w.ground += out.z_source == HeightSource::kGround;
-    w.ceiling += out.z_source == HeightSource::kCeiling;
-    w.predicted += out.z_source == HeightSource::kPredicted;
+    w.add(out, pose, true, k > 0);
   }
   return w;
 }
@@ -62,7 +41,7 @@ Walk walk(const synth::Room& room, double x0, double x1, int n, uint32_t seed) {
 // not fit the learned height, and re-learns the height when the new ceiling persists.
 TEST(HeightEstimator, WalkUnderADropCeiling) {
   const auto room = two_height_room(3.0);
-  const Walk w = walk(room, 6.5, -6.5, 60, 100);
+  const HeightTally w = walk(room, 6.5, -6.5, 60, 100);
   EXPECT_LT(w.max_z_err, 0.02);
   EXPECT_LT(w.max_step, 0.02);  // never a jump
   EXPECT_LT(w.max_rp_err, 0.2 * kDeg);  // the p99 target, here for every scan
@@ -88,7 +67,7 @@ TEST(HeightEstimator, BeamsAndLampsOnTheCeiling) {
       l.label = synth::kClutter;
       room.boxes.push_back(l);
     }
-  const Walk w = walk(room, -5.0, 5.0, 40, 300);
+  const HeightTally w = walk(room, -5.0, 5.0, 40, 300);
   EXPECT_LT(w.max_z_err, 0.02);
   EXPECT_LT(w.max_step, 0.02);
   EXPECT_LT(w.max_rp_err, 0.1 * kDeg);
@@ -108,7 +87,7 @@ TEST(HeightEstimator, SlopedCeilingGivesWayToTheFloor) {
     room.boxes.push_back(s);
   }
   room.wall_top = 6.0;
-  const Walk w = walk(room, -4.0, 4.0, 30, 500);
+  const HeightTally w = walk(room, -4.0, 4.0, 30, 500);
   EXPECT_LT(w.max_z_err, 0.02);
   EXPECT_LT(w.max_step, 0.02);
 }

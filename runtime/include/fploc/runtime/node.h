@@ -138,6 +138,13 @@ class Context {
   // The node's own state line in telemetry (node_status_t.detail, shown on the dashboard), e.g. a
   // sensor's status and active alerts; unlike last_error it stays until replaced ("" clears it).
   void set_detail(const std::string& text) { stats_.detail = text; }
+  // A change of the node's own status (a fit going OK -> POOR -> LOST, ...) with its reason, said in one way by
+  // every node: on stderr as "[name] LINE" for the first kStatusChangesPrinted changes (the last of them adds that
+  // further changes are only in telemetry), and LINE becomes telemetry's detail (`keep_detail` false: the detail
+  // is cleared instead, the new status needs no explanation, e.g. OK). `print` false: the change was already said
+  // on stderr (an error() that printed); it is neither printed nor counted. Returns whether it printed.
+  static constexpr int kStatusChangesPrinted = 200;
+  bool status_changed(const std::string& line, bool keep_detail = true, bool print = true);
   // Asks the process to stop after the current message (e.g. a pcap source reached its end).
   void request_stop();
 
@@ -157,6 +164,7 @@ class Context {
   std::string base_dir_;
   bool composed_;
   int restarts_ = 0;
+  int status_changes_ = 0;  // status_changed() lines printed
   std::string robot_;
   NodeStats stats_;
 };
