@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <initializer_list>
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -64,8 +65,10 @@ bool visible_from_path(const FloorPlan& plan, int id, const std::vector<V2>& pat
   return false;
 }
 
+}  // namespace
+
 // The other face of a wall drawn with two lines: a parallel segment within 0.4 m overlapping it.
-int twin_of(const FloorPlan& plan, int id) {
+int other_face(const FloorPlan& plan, int id) {
   const Element& e = plan.elements[size_t(id)];
   if (e.kind != ElementKind::kSegment) return -1;
   const V2 u = (e.b - e.a).normalized();
@@ -89,6 +92,10 @@ int twin_of(const FloorPlan& plan, int id) {
   return best;
 }
 
+namespace {
+
+int twin_of(const FloorPlan& plan, int id) { return other_face(plan, id); }
+
 V2 left_normal(const V2& a, const V2& b) {
   const V2 d = (b - a).normalized();
   return V2(-d.y(), d.x());
@@ -104,6 +111,22 @@ double read_num(const nlohmann::json& o, const char* key, double def, const std:
   if (!o.contains(key)) return def;
   if (!o[key].is_number()) throw std::runtime_error(where + "." + key + ": expected a number");
   return o[key].get<double>();
+}
+
+double read_required_num(const nlohmann::json& o, const char* key, const std::string& where) {
+  if (!o.contains(key)) throw std::runtime_error(where + "." + key + ": missing (a number is required)");
+  return read_num(o, key, 0, where);
+}
+
+// An object's keys must be among `allowed`: the first other one is an error naming it and the allowed keys.
+void check_keys(const nlohmann::json& o, const std::string& where, std::initializer_list<const char*> allowed) {
+  if (!o.is_object()) return;
+  for (auto it = o.begin(); it != o.end(); ++it) {
+    if (std::any_of(allowed.begin(), allowed.end(), [&](const char* k) { return it.key() == k; })) continue;
+    std::string list;
+    for (const char* k : allowed) list += (list.empty() ? "" : ", ") + std::string(k);
+    throw std::runtime_error(where + "." + it.key() + ": unknown key (allowed: " + list + ")");
+  }
 }
 
 // Fills offsets / shifts / rotation of the elements still present by comparing world and plan geometry.
@@ -549,10 +572,7 @@ WorldEdit load_world_file(const std::string& path, const FloorPlan& plan, const 
   }
   const auto& o = j["world"];
   if (!o.is_object()) throw std::runtime_error(path + ": world: expected an object");
-  static const char* known[] = {"plan", "remove", "glass", "move", "add", "doors", "shelves", "people"};
-  for (auto it = o.begin(); it != o.end(); ++it)
-    if (std::find_if(std::begin(known), std::end(known), [&](const char* k) { return it.key() == k; }) == std::end(known))
-      throw std::runtime_error(path + ": world." + it.key() + ": unknown key (keys: plan, remove, glass, move, add, doors, shelves, people)");
+  check_keys(o, path + ": world", {"plan", "remove", "glass", "move", "add", "doors", "shelves", "people"});
   FloorPlan base = plan;
   if (o.contains("plan")) {
     if (!o["plan"].is_string()) throw std::runtime_error(path + ": world.plan: expected a file name");
@@ -563,6 +583,11 @@ WorldEdit load_world_file(const std::string& path, const FloorPlan& plan, const 
     if (base.elements.size() != plan.elements.size())
       w.elements.assign(base.elements.size(), {});
   }
+  // Plan elements named in remove / glass / move. A wall drawn with two lines (two faces) changes as a whole,
+  // as with --perturb: the other face (other_face()) takes the same change (and the same displacement) unless
+  // it is named itself.
+  std::vector<bool> named(base.elements.size(), false);
+  std::vector<V2> shift(base.elements.size(), V2::Zero());
   auto ids = [&](const char* key, ElementChange c) {
     if (!o.contains(key)) return;
     if (!o[key].is_array()) throw std::runtime_error(path + ": world." + key + ": expected a list of element ids");
@@ -572,6 +597,7 @@ WorldEdit load_world_file(const std::string& path, const FloorPlan& plan, const 
       if (!v.is_number_integer() || v.get<long>() < 0 || v.get<size_t>() >= base.elements.size())
         throw std::runtime_error(where + ": expected an element id 0.." + std::to_string(base.elements.size() - 1));
       w.elements[v.get<size_t>()].change = c;
+      named[v.get<size_t>()] = true;
     }
   };
   ids("remove", ElementChange::kRemoved);
@@ -582,16 +608,30 @@ WorldEdit load_world_file(const std::string& path, const FloorPlan& plan, const 
     for (size_t i = 0; i < o["move"].size(); ++i) {
       const auto& m = o["move"][i];
       const std::string where = path + ": world.move[" + std::to_string(i) + "]";
-      if (!m.is_object() || !m.contains("id") || !m["id"].is_number_integer() || m["id"].get<long>() < 0 ||
+      if (!m.is_object()) throw std::runtime_error(where + ": expected an object {\"id\": N, \"offset_m\": metres}");
+      check_keys(m, where, {"id", "offset_m"});
+      if (!m.contains("id") || !m["id"].is_number_integer() || m["id"].get<long>() < 0 ||
           m["id"].get<size_t>() >= base.elements.size() || base.elements[m["id"].get<size_t>()].kind != ElementKind::kSegment)
         throw std::runtime_error(where + ".id: expected the id of a segment");
       const size_t id = m["id"].get<size_t>();
-      const double off = read_num(m, "offset_m", 0, where);
-      const V2 dv = off * left_normal(cur[id].a, cur[id].b);
-      cur[id].a += dv;
-      cur[id].b += dv;
+      const double off = read_required_num(m, "offset_m", where);
+      shift[id] = off * left_normal(cur[id].a, cur[id].b);
       w.elements[id].change = ElementChange::kMoved;
+      named[id] = true;
     }
+  }
+  std::vector<ElementChange> explicit_change(base.elements.size());
+  for (size_t i = 0; i < base.elements.size(); ++i) explicit_change[i] = w.elements[i].change;
+  for (size_t i = 0; i < base.elements.size(); ++i) {
+    if (!named[i]) continue;
+    const int t = other_face(base, int(i));
+    if (t < 0 || named[size_t(t)] || w.elements[size_t(t)].change != ElementChange::kUnchanged) continue;
+    w.elements[size_t(t)].change = explicit_change[i];
+    shift[size_t(t)] = shift[i];
+  }
+  for (size_t i = 0; i < base.elements.size(); ++i) {
+    cur[i].a += shift[i];
+    cur[i].b += shift[i];
   }
   w.world.layers = base.layers;
   w.world.source = path;
@@ -601,31 +641,33 @@ WorldEdit load_world_file(const std::string& path, const FloorPlan& plan, const 
     world_of_plan[i] = int(w.world.elements.size());
     w.world.elements.push_back(cur[i]);
   }
-  auto segs = [&](const char* key, const std::function<void(const nlohmann::json&, const V2&, const V2&, const std::string&)>& f) {
+  auto segs = [&](const char* key, std::initializer_list<const char*> allowed,
+                  const std::function<void(const nlohmann::json&, const V2&, const V2&, const std::string&)>& f) {
     if (!o.contains(key)) return;
     if (!o[key].is_array()) throw std::runtime_error(path + ": world." + key + ": expected a list");
     for (size_t i = 0; i < o[key].size(); ++i) {
       const auto& v = o[key][i];
       const std::string where = path + ": world." + key + "[" + std::to_string(i) + "]";
       if (!v.is_object()) throw std::runtime_error(where + ": expected an object");
+      check_keys(v, where, allowed);
       if (!v.contains("a") || !v.contains("b")) throw std::runtime_error(where + ": needs \"a\" and \"b\"");
       const V2 a = read_xy(v["a"], where + ".a"), b = read_xy(v["b"], where + ".b");
       if ((b - a).norm() < 1e-3) throw std::runtime_error(where + ": a and b coincide");
       f(v, a, b, where);
     }
   };
-  segs("add", [&](const nlohmann::json&, const V2& a, const V2& b, const std::string&) {
+  segs("add", {"a", "b"}, [&](const nlohmann::json&, const V2& a, const V2& b, const std::string&) {
     w.world.elements.push_back(Element::segment(a, b, w.world.layer_index("partition")));
     w.added.push_back({"partition", a, b});
   });
-  segs("doors", [&](const nlohmann::json& v, const V2& a, const V2& b, const std::string& where) {
+  segs("doors", {"a", "b", "open"}, [&](const nlohmann::json& v, const V2& a, const V2& b, const std::string& where) {
     if (v.contains("open") && !v["open"].is_boolean()) throw std::runtime_error(where + ".open: expected true or false");
     const bool open = v.value("open", false);
     const V2 q = open ? V2(a + (b - a).norm() * left_normal(a, b)) : b;
     w.world.elements.push_back(Element::segment(a, q, w.world.layer_index("door")));
     w.added.push_back({open ? "door-open" : "door-closed", a, q});
   });
-  segs("shelves", [&](const nlohmann::json& v, const V2& a, const V2& b, const std::string& where) {
+  segs("shelves", {"a", "b", "depth", "height"}, [&](const nlohmann::json& v, const V2& a, const V2& b, const std::string& where) {
     Furniture f;
     const double depth = read_num(v, "depth", 0.4, where), height = read_num(v, "height", 2.0, where);
     if (!(depth > 0 && height > 0)) throw std::runtime_error(where + ": depth and height must be positive");
@@ -641,6 +683,7 @@ WorldEdit load_world_file(const std::string& path, const FloorPlan& plan, const 
     for (size_t i = 0; i < o["people"].size(); ++i) {
       const auto& v = o["people"][i];
       const std::string where = path + ": world.people[" + std::to_string(i) + "]";
+      check_keys(v, where, {"path", "speed"});
       if (!v.is_object() || !v.contains("path") || !v["path"].is_array() || v["path"].empty())
         throw std::runtime_error(where + ".path: expected a list of [x, y] points");
       Person p;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "fploc/sim/perturb.h"
 #include "fploc/sim/scenarios.h"
@@ -195,7 +196,8 @@ TEST(WorldFile, ReadsEveryKind) {
   EXPECT_EQ(w.elements[7].change, ElementChange::kGlass);
   EXPECT_EQ(w.elements[9].change, ElementChange::kMoved);
   EXPECT_NEAR(w.elements[9].offset_m, 0.15, 1e-12);
-  EXPECT_EQ(w.world.elements.size(), plan.elements.size() - 2 + 2);
+  // 2 and 7 are one face of a two-line wall each: their other faces go with them (WallWithTwoFaces... below).
+  EXPECT_EQ(w.world.elements.size(), plan.elements.size() - 4 + 2);
   ASSERT_EQ(w.added.size(), 2u);
   EXPECT_EQ(w.added[1].kind, "door-open");
   EXPECT_EQ(w.furniture.size(), 1u);
@@ -220,6 +222,81 @@ TEST(WorldFile, BadInputIsOneClearError) {
   EXPECT_NE(id.find("world.remove[0]: expected an element id 0..43"), std::string::npos) << id;
   const std::string key = error_of("world_key.json", R"({"world": {"windows": []}})");
   EXPECT_NE(key.find("world.windows: unknown key"), std::string::npos) << key;
+}
+
+// A misspelt key inside an entry was ignored (move's "offset" moved element 12 by 0, "closed" left the door at
+// its default), and a move without offset_m moved by 0: each is now one error naming the file, the entry and the
+// key, with the keys allowed there.
+TEST(WorldFile, UnknownOrMissingKeysInEntriesAreErrors) {
+  const FloorPlan plan = demo_room_plan();
+  auto error_of = [&](const std::string& name, const std::string& text) {
+    try {
+      load_world_file(tmp_file(name, text), plan);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string move = error_of("world_mv.json", R"({"world": {"move": [{"id": 12, "offset": 0.2}]}})");
+  EXPECT_NE(move.find("world_mv.json: world.move[0].offset: unknown key (allowed: id, offset_m)"), std::string::npos) << move;
+  const std::string door = error_of("world_door.json", R"({"world": {"doors": [{"a": [0, 5.75], "b": [0, 6.75], "closed": true}]}})");
+  EXPECT_NE(door.find("world_door.json: world.doors[0].closed: unknown key (allowed: a, b, open)"), std::string::npos) << door;
+  const std::string shelf = error_of("world_shelf.json", R"({"world": {"shelves": [{"a": [13, 0], "b": [16, 0], "deep": 0.4}]}})");
+  EXPECT_NE(shelf.find("world.shelves[0].deep: unknown key (allowed: a, b, depth, height)"), std::string::npos) << shelf;
+  const std::string add = error_of("world_add.json", R"({"world": {"add": [{"a": [5, 6], "b": [7, 6], "c": [1, 1]}]}})");
+  EXPECT_NE(add.find("world.add[0].c: unknown key (allowed: a, b)"), std::string::npos) << add;
+  const std::string person = error_of("world_person.json", R"({"world": {"people": [{"path": [[8, 8], [9, 9]], "sped": 3}]}})");
+  EXPECT_NE(person.find("world.people[0].sped: unknown key (allowed: path, speed)"), std::string::npos) << person;
+  const std::string missing = error_of("world_nooff.json", R"({"world": {"move": [{"id": 12}]}})");
+  EXPECT_NE(missing.find("world_nooff.json: world.move[0].offset_m: missing"), std::string::npos) << missing;
+  const std::string top = error_of("world_top.json", R"({"world": {"windows": []}})");
+  EXPECT_NE(top.find("world.windows: unknown key (allowed: plan, remove, glass, move, add, doors, shelves, people)"),
+            std::string::npos) << top;
+}
+
+// A wall drawn with two faces (the demo room's outer walls: 0.25 m apart) is one wall in a world file as with
+// --perturb: remove / glass / move of one face take the other face too (the same change, the same displacement)
+// unless it is named itself, and the truth lists both. It used to act on the named line alone, so the diff saw
+// the other face "moved" by the wall's thickness.
+TEST(WorldFile, WallWithTwoFacesChangesAsAWhole) {
+  const FloorPlan plan = demo_room_plan();
+  // 2: south wall x 6..10 (inner face, y 0), 16 its outer face (y -0.25); 7 / 21 the north wall's; 9 / 23 the
+  // north wall x 13..16; 12 / 26 the east wall's lower part. Pillar faces (28..35) have no other face.
+  ASSERT_EQ(other_face(plan, 2), 16);
+  ASSERT_EQ(other_face(plan, 16), 2);
+  ASSERT_EQ(other_face(plan, 7), 21);
+  ASSERT_EQ(other_face(plan, 9), 23);
+  ASSERT_EQ(other_face(plan, 12), 26);
+  const WorldEdit w = load_world_file(tmp_file("world_faces.json", R"({"world": {
+    "remove": [2], "glass": [7], "move": [{"id": 9, "offset_m": 0.15}, {"id": 12, "offset_m": -0.1},
+                                          {"id": 26, "offset_m": 0.05}]}})"), plan);
+  EXPECT_EQ(w.elements[16].change, ElementChange::kRemoved);
+  EXPECT_EQ(w.elements[21].change, ElementChange::kGlass);
+  EXPECT_EQ(w.elements[23].change, ElementChange::kMoved);
+  EXPECT_NEAR(w.elements[23].offset_m, 0.15, 1e-12);  // same direction a->b on both faces: the same offset
+  // Both faces named: each its own offset (no double move).
+  EXPECT_NEAR(w.elements[12].offset_m, -0.1, 1e-12);
+  EXPECT_NEAR(w.elements[26].offset_m, 0.05, 1e-12);
+  // The world: 2 + 16 and 7 + 21 gone, nothing else.
+  EXPECT_EQ(w.world.elements.size(), plan.elements.size() - 4);
+  // The truth lists both faces.
+  const auto t = nlohmann::json::parse(w.truth_json(plan));
+  EXPECT_EQ(t["elements"][16]["change"], "removed");
+  EXPECT_EQ(t["elements"][21]["change"], "glass");
+  EXPECT_EQ(t["elements"][23]["change"], "moved");
+  int changed = 0;
+  for (const auto& e : t["elements"]) changed += e["change"] != "unchanged";
+  EXPECT_EQ(changed, 8);
+  // --perturb's renovation uses the same notion of a wall's other face: every removed / moved wall has its other
+  // face changed the same way.
+  PerturbOptions p;
+  p.remove = 2;
+  p.move = 2;
+  const WorldEdit r = perturb_world(plan, room_path(), p, 5);
+  for (size_t i = 0; i < plan.elements.size(); ++i) {
+    const int f = other_face(plan, int(i));
+    if (f >= 0 && r.elements[i].change != ElementChange::kUnchanged) EXPECT_EQ(r.elements[size_t(f)].change, r.elements[i].change) << i;
+  }
 }
 
 // "doors moved": a doorway shifted along its wall. Deterministic per seed; the truth says what closed and

@@ -11,13 +11,18 @@
 // World file (`fploc sim --world FILE`): either any plan file (.dxf/.csv/.json: the world's walls), or a
 // JSON object with a "world" key:
 //   {"world": {"plan": "room.json",                 // path relative to this file (any plan format)
-//              "remove": [2, 7], "glass": [5],       // plan element ids
-//              "move": [{"id": 9, "offset_m": 0.15}],// along the segment's left normal (a->b turned +90 deg)
+//              "remove": [2, 7], "glass": [5],       // plan element ids (a wall with its other face, see below)
+//              "move": [{"id": 9, "offset_m": 0.15}],// along the segment's left normal (a->b turned +90 deg); required
 //              "add": [{"a": [x, y], "b": [x, y]}],  // partitions not in the plan
 //              "doors": [{"a": [x, y], "b": [x, y], "open": false}],   // a doorway a-b: closed leaf or open (hinged at a)
 //              "shelves": [{"a": [x, y], "b": [x, y], "depth": 0.4, "height": 2.0}],  // box along a-b, on its left
 //              "people": [{"path": [[x, y], ...], "speed": 1.0}]}}
-// Errors: std::runtime_error "FILE: byte N: ..." (syntax) or "FILE: world.doors[1].a: expected [x, y]".
+// A wall drawn with two lines is one wall, as with --perturb: an id in remove / glass / move takes its other face
+// (other_face()) with it (the same change, the same displacement), unless that face is named itself; the truth
+// lists both faces. Every key is checked: an unknown one (at the top or inside an entry) or a missing required one
+// (a, b; move's id and offset_m; people's path) is an error.
+// Errors: std::runtime_error "FILE: byte N: ..." (syntax) or "FILE: world.doors[1].a: expected [x, y]" or
+// "FILE: world.move[0].offset: unknown key (allowed: id, offset_m)".
 #pragma once
 #include <Eigen/Core>
 #include <cstdint>
@@ -112,6 +117,11 @@ WorldEdit perturb_world(const FloorPlan& plan, const std::vector<Eigen::Vector2d
 // Reads a world file (see above) against `plan` (ids refer to it).
 WorldEdit load_world_file(const std::string& path, const FloorPlan& plan, const std::vector<std::string>& layers = {},
                           const std::string& units = "");
+
+// The other face of a wall drawn with two lines: the nearest parallel segment 2-40 cm away overlapping at least
+// half of the shorter of the two; -1 when there is none (or the element is not a segment). Used by --perturb
+// (remove, move, glass) and by world files alike.
+int other_face(const FloorPlan& plan, int id);
 
 // Doorways of a plan: gaps of 0.7-1.3 m between collinear segment ends (one per wall: the inner face).
 std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> find_doorways(const FloorPlan& plan);
