@@ -3,9 +3,14 @@
 // localizer's estimate of each scan (pose_t with the same utime) on the channels the graph's plan_diff node
 // reads (default FPLOC_FEATURES and FPLOC_POSE_LATEST) — a live run recorded with lcm-logger, or
 // `fploc replay --graph G --log SIM.lcm --record LOG.lcm`. The plan and the detector's options come from
-// the graph's plan_diff node (or, without one, the plan of its matcher). Writes JSON and/or DXF (layers
-// FPLOC-MISSING, FPLOC-MOVED, FPLOC-NEW, FPLOC-PLAN) by the --out extension; --json prints the JSON diff on stdout; --all lists
-// every element (also those seen where expected); --set NODE.field=value as for fploc replay (the run's plan).
+// the graph's plan_diff node (or, without one, the plan of its matcher); --plan FILE [--floor NAME] names the plan
+// instead. The first line on stderr says which plan and where it came from; a matcher / optimizer of the graph with
+// another plan, and a run in which no plan element was seen, are warned about (the wrong plan, most likely).
+// Writes JSON and/or DXF (layers FPLOC-MISSING, FPLOC-MOVED, FPLOC-NEW, FPLOC-PLAN) by the --out extension; --json
+// prints the JSON diff on stdout; --all lists every element (also those seen where expected); --set
+// NODE.field=value as for fploc replay (the plan_diff node's options: plan_diff.plan.file=PLAN, ...). The summary
+// on stderr: counts (with missing parts), the drawing scale, then one line per missing / moved element, missing
+// part and new run (plandiff::write_text).
 // --poses FILE.tum (diagnostic): each scan placed with the pose of FILE nearest its time (within 5 ms; e.g. the
 // simulator's ground truth) instead of the localizer's, no covariance: what the detector finds with good poses.
 #include <fploc/features_t.hpp>
@@ -33,7 +38,9 @@ namespace {
 void usage() {
   std::cerr << "usage: fploc map diff --graph GRAPH --log LOG.lcm --out DIFF.json|DIFF.dxf [--out ...] [--json]\n"
                "       [--features-channel C] [--pose-channel C] [--all (every element in the JSON, also those seen)]\n"
-               "       [--set NODE.field=value ...] (as given to fploc replay: e.g. matcher.plan.file=PLAN)\n"
+               "       [--plan PLAN [--floor NAME]] (the plan to diff against; default: the graph's plan_diff node's plan)\n"
+               "       [--set NODE.field=value ...] (the graph's node options, as for fploc replay: e.g.\n"
+               "        plan_diff.plan.file=PLAN; a matcher's plan is not the diff's plan)\n"
                "       [--poses FILE.tum] (place each scan with these poses, e.g. the ground truth, not the localizer's)\n";
 }
 
@@ -46,7 +53,7 @@ std::string lower_ext(const std::string& p) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string graph_path, log_path, feat_ch, pose_ch, poses_path;
+  std::string graph_path, log_path, feat_ch, pose_ch, poses_path, plan_arg, floor_arg;
   std::vector<std::string> outs, sets;
   bool json = false, all = false;
   for (int i = 1; i < argc; ++i) {
@@ -65,6 +72,8 @@ int main(int argc, char** argv) {
     else if (a == "--pose-channel") pose_ch = next();
     else if (a == "--set") sets.push_back(next());
     else if (a == "--poses") poses_path = next();
+    else if (a == "--plan") plan_arg = next();
+    else if (a == "--floor") floor_arg = next();
     else if (a == "--json") json = true;
     else if (a == "--all") all = true;
     else if (a == "-h" || a == "--help") { usage(); return 0; }
@@ -72,6 +81,10 @@ int main(int argc, char** argv) {
   }
   if (graph_path.empty() || log_path.empty() || (outs.empty() && !json)) {
     usage();
+    return 2;
+  }
+  if (!floor_arg.empty() && plan_arg.empty()) {
+    std::cerr << "fploc map diff: --floor needs --plan (the graph's plan.floor: --set plan_diff.plan.floor=NAME)\n";
     return 2;
   }
   for (const auto& o : outs)
@@ -94,11 +107,13 @@ int main(int argc, char** argv) {
     }
     const fploc::Node* node = nullptr;
     const fploc::PlanSource* src = nullptr;
+    std::string src_what;  // where the plan comes from, said on the first line
     fploc::plandiff::Options po;
     for (const auto& n : g.graph.node()) {
       if (n.has_plan_diff() && !node) {
         node = &n;
         src = &n.plan_diff().plan();
+        src_what = "the graph's plan_diff node '" + n.name() + "' (plan.file)";
         po = fploc::config::config_of(n.plan_diff()).diff;  // as the node maps them (a negative one: an error)
         for (const auto& in : n.input()) {
           if (in.port() == "features" && feat_ch.empty()) feat_ch = in.channel();
@@ -108,18 +123,49 @@ int main(int argc, char** argv) {
     }
     if (!src)
       for (const auto& n : g.graph.node())
-        if (n.has_matcher() && !n.disabled()) src = &n.matcher().plan();
-    if (!src || src->file().empty())
-      throw std::runtime_error(graph_path + ": no plan_diff node (and no matcher) names a plan");
+        if (n.has_matcher() && !n.disabled() && !src) {
+          src = &n.matcher().plan();
+          src_what = "the graph's matcher '" + n.name() + "' (no plan_diff node)";
+        }
+    if (plan_arg.empty() && (!src || src->file().empty()))
+      throw std::runtime_error(graph_path + ": no plan_diff node (and no matcher) names a plan; name one with --plan");
     if (feat_ch.empty()) feat_ch = "FPLOC_FEATURES";
     if (pose_ch.empty()) pose_ch = "FPLOC_POSE_LATEST";
-    std::string plan_file = src->file();
-    if (!plan_file.empty() && plan_file[0] != '/')
-      plan_file = (std::filesystem::path(graph_path).parent_path() / plan_file).lexically_normal().string();
-    std::vector<std::string> layers(src->layers().begin(), src->layers().end());
-    // The floor the graph names (plan.floor; a building or IFC model's first / lowest by default), as the node loads it.
-    const fploc::FloorPlan plan = fploc::load_floor_plan(plan_file, layers, src->units(), src->floor());
-    if (!src->floor().empty()) plan_file += " (floor " + src->floor() + ")";
+    auto graph_relative = [&](std::string f) {
+      if (!f.empty() && f[0] != '/')
+        f = (std::filesystem::path(graph_path).parent_path() / f).lexically_normal().string();
+      return f;
+    };
+    std::string plan_file;
+    fploc::FloorPlan plan;
+    if (!plan_arg.empty()) {
+      plan_file = std::filesystem::path(plan_arg).lexically_normal().string();
+      src_what = "--plan";
+      plan = fploc::load_floor_plan(plan_file, {}, "", floor_arg);
+      if (!floor_arg.empty()) plan_file += " (floor " + floor_arg + ")";
+    } else {
+      plan_file = graph_relative(src->file());
+      std::vector<std::string> layers(src->layers().begin(), src->layers().end());
+      // The floor the graph names (plan.floor; a building or IFC model's first / lowest by default), as the node loads it.
+      plan = fploc::load_floor_plan(plan_file, layers, src->units(), src->floor());
+      if (!src->floor().empty()) plan_file += " (floor " + src->floor() + ")";
+    }
+    // Said first once the log has been read (an error reading it stays one line).
+    std::ostringstream preface;
+    preface << "fploc map diff: the plan: " << plan_file << ", from " << src_what << "\n";
+    // The poses were estimated against the matcher's / optimizer's plan: another plan there is most likely a run
+    // replayed with --set matcher.plan.file=X, whose diff must name X too.
+    if (plan_arg.empty())
+      for (const auto& n : g.graph.node()) {
+        if (n.disabled() || (!n.has_matcher() && !n.has_optimizer())) continue;
+        const auto& ps = n.has_matcher() ? n.matcher().plan() : n.optimizer().plan();
+        if (ps.file().empty() || (graph_relative(ps.file()) == graph_relative(src->file()) && ps.floor() == src->floor()))
+          continue;
+        preface << "fploc map diff: warning: the graph's " << (n.has_matcher() ? "matcher" : "optimizer") << " '"
+                  << n.name() << "' localizes against " << graph_relative(ps.file())
+                  << (ps.floor().empty() ? "" : " (floor " + ps.floor() + ")") << ", not the plan diffed against; if that is the run's plan: --plan "
+                  << graph_relative(ps.file()) << "\n";
+      }
     fploc::plandiff::PlanDiff diff(plan, po);
 
     // --poses: the scans placed with a given trajectory (sorted by time), looked up at each scan's time.
@@ -187,6 +233,8 @@ int main(int argc, char** argv) {
         ++used;
       }
     }
+    // Not an LCM log at all (a world file, a ROS bag): the reader's own words, not "no features".
+    if (events == 0 && !log.problem().empty()) throw std::runtime_error(log.problem());
     if (n_feat == 0)
       throw std::runtime_error(log_path + ": no " + feat_ch + " (features_t) events in " + std::to_string(events) +
                                " log events; record a run with them (lcm-logger during `fploc launch`, or `fploc replay --graph " +
@@ -199,6 +247,7 @@ int main(int argc, char** argv) {
     if (used == 0)
       throw std::runtime_error(log_path + ": no " + pose_ch + " pose has the utime of a " + feat_ch + " scan (" +
                                std::to_string(n_feat) + " scans, " + std::to_string(n_pose) + " poses)");
+    std::cerr << preface.str();
     const auto r = diff.result();
     for (const auto& o : outs) {
       std::ofstream f(o);
@@ -210,10 +259,13 @@ int main(int argc, char** argv) {
     if (!given.empty())
       std::cerr << "fploc map diff: scans placed with the poses of " << poses_path << " (" << unmatched
                 << " scans without one within 5 ms, left out)\n";
-    std::cerr << "fploc map diff: " << used << " scans of " << log_path << " against " << plan_file << ": "
-              << r.count(fploc::plandiff::Status::kSeen) << " seen, " << r.count(fploc::plandiff::Status::kMissing)
-              << " missing, " << r.count(fploc::plandiff::Status::kMoved) << " moved, "
-              << r.count(fploc::plandiff::Status::kUnobserved) << " unobserved, " << r.added.size() << " new\n";
+    std::cerr << "fploc map diff: " << used << " scans of " << log_path << " against " << plan_file << ": ";
+    fploc::plandiff::write_text(r, plan, std::cerr);
+    // Nothing of the plan where the scans were placed: most likely another building's plan (or poses in another
+    // frame), not a building torn down.
+    if (used >= 20 && r.count(fploc::plandiff::Status::kSeen) == 0 && r.count(fploc::plandiff::Status::kMoved) == 0)
+      std::cerr << "fploc map diff: warning: no plan element was seen in " << used << " scans: is " << plan_file
+                << " the plan of this log? (--plan PLAN names the run's plan)\n";
     if (json) fploc::plandiff::write_json(r, plan, std::cout, all);
     // A log cut short (or damaged part way): the diff above is of the events before it; said, exit 1, as fploc
     // replay does.

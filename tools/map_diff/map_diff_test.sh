@@ -10,8 +10,24 @@ trap 'rm -rf "$T"' EXIT
 test -s "$T/sim.world.json"
 "$B/fploc-replay" --graph "$R/graphs/realism.pbtxt" --log "$T/sim.lcm" --record "$T/run.lcm" \
   --set plan_diff.out_json="$T/node.json" --set amcl_lidar_logger.file="$T/a.tum" --set wo_logger.file="$T/w.tum" 2>/dev/null
-"$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/run.lcm" --out "$T/diff.json" --out "$T/diff.dxf"
+"$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/run.lcm" --out "$T/diff.json" --out "$T/diff.dxf" 2> "$T/main.err"
 grep -q '"summary"' "$T/diff.json"
+# Which plan is said first; the summary has the missing parts and the drawing scale; one line per flagged item
+# (missing / moved elements, missing parts, new runs) as many as the JSON has.
+head -1 "$T/main.err" | grep -q "^fploc map diff: the plan: $R/data/plans/room.json, from the graph's plan_diff node 'plan_diff' (plan.file)$" ||
+  { echo "first line:"; cat "$T/main.err"; exit 1; }
+grep -q " scans of $T/run.lcm against .* new, [0-9]* missing parts\?; drawing scale " "$T/main.err" || { cat "$T/main.err"; exit 1; }
+flagged=$(/usr/bin/python3 -c '
+import json, sys
+d = json.load(open(sys.argv[1]))
+print(sum(e["status"] in ("missing", "moved") for e in d["elements"]) + len(d["missing_parts"]) + len(d["new"]))' "$T/diff.json")
+[ "$flagged" -gt 0 ] && [ "$(grep -c '^  \(element [0-9]*\|new\)' "$T/main.err")" = "$flagged" ] ||
+  { echo "expected $flagged item lines:"; cat "$T/main.err"; exit 1; }
+grep -q '^  element [0-9]* ([a-z]*): \(missing\|moved\).*, length [0-9.]* m, ' "$T/main.err" || { cat "$T/main.err"; exit 1; }
+# The help names the option that sets the diff's plan (it named matcher.plan.file, which did nothing here).
+"$B/fploc-map-diff" --help 2> "$T/help" || true
+grep -q "plan_diff.plan.file=PLAN" "$T/help" && grep -q -- "--plan PLAN" "$T/help" && ! grep -q "e.g. matcher.plan.file" "$T/help" ||
+  { cat "$T/help"; exit 1; }
 test -s "$T/node.json"   # the node wrote its own diff at shutdown
 for l in FPLOC-MISSING FPLOC-MOVED FPLOC-NEW; do grep -qx "$l" "$T/diff.dxf"; done
 "$B/fploc-map" render --plan "$T/diff.dxf" --out "$T/diff.svg" 2>/dev/null
@@ -41,13 +57,38 @@ test "$(wc -l < "$T/err")" -eq 1 || { cat "$T/err"; exit 1; }
 "$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/run.lcm" --out "$T/c.json" \
   --set plan_diff.plan.file="$R/data/plans/corridor.json" 2> "$T/err"
 grep -q "against $R/data/plans/corridor.json:" "$T/err" || { cat "$T/err"; exit 1; }
+# ... the corridor's plan is not this room run's: the first line names it, and the localizer's plan (room.json) is
+# said to differ.
+head -1 "$T/err" | grep -q "the plan: $R/data/plans/corridor.json, from the graph's plan_diff node 'plan_diff' (plan.file)" &&
+  grep -q "warning: the graph's matcher 'matcher' localizes against $R/data/plans/room.json, not the plan diffed against" "$T/err" ||
+  { cat "$T/err"; exit 1; }
+# Scans placed where nothing of the plan is (the truth shifted 100 m): no element seen, and that is said.
+awk '{ printf "%s %.6f", $1, $2 + 100; for (i = 3; i <= NF; ++i) printf " %s", $i; print "" }' "$T/gt.tum" > "$T/far.tum"
+"$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/run.lcm" --out "$T/far.json" --poses "$T/far.tum" 2> "$T/farerr"
+grep -q "warning: no plan element was seen in [0-9]* scans: is $R/data/plans/room.json the plan of this log?" "$T/farerr" ||
+  { cat "$T/farerr"; exit 1; }
+# A run's matcher plan set (--set matcher.plan.file, as the help used to suggest) is not the diff's plan: the diff
+# says which plan it used and warns that the matcher's differs; --plan names the plan directly.
+"$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/run.lcm" --out "$T/m.json" \
+  --set matcher.plan.file="$R/data/plans/corridor.json" 2> "$T/merr"
+grep -q "the plan: $R/data/plans/room.json, from the graph's plan_diff node" "$T/merr" &&
+  grep -q "warning: the graph's matcher 'matcher' localizes against $R/data/plans/corridor.json, not the plan diffed against" "$T/merr" ||
+  { cat "$T/merr"; exit 1; }
+"$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/run.lcm" --out "$T/p.json" --plan "$R/data/plans/corridor.json" 2> "$T/perr"
+grep -q "the plan: $R/data/plans/corridor.json, from --plan" "$T/perr" && grep -q "against $R/data/plans/corridor.json:" "$T/perr" ||
+  { cat "$T/perr"; exit 1; }
+# Not an LCM log at all (the world truth file): said so, one line, exit 1 (it said "no FPLOC_FEATURES ... in 0 log events").
+rc=0
+"$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/sim.world.json" --out "$T/x.json" 2> "$T/werr" || rc=$?
+[ "$rc" = 1 ] && grep -q "sim.world.json: no LCM event in its [0-9]* B (not an LCM event log" "$T/werr" && [ "$(grep -c . "$T/werr")" = 1 ] ||
+  { echo "world file as log: exit $rc"; cat "$T/werr"; exit 1; }
 # A building's floor (plan.floor) is the plan diffed against (it was ignored: the first floor's plan was used):
 # data/buildings/two-floors.pbtxt floor "first" is corridor.json, so the same diff as above; an unknown floor is one
 # error naming it.
 "$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/run.lcm" --out "$T/f.json" \
   --set plan_diff.plan.file="$R/data/buildings/two-floors.pbtxt" --set plan_diff.plan.floor=first 2> "$T/ferr"
 grep -q "against $R/data/buildings/two-floors.pbtxt (floor first):" "$T/ferr" || { cat "$T/ferr"; exit 1; }
-[ "$(sed 's/.*: //' "$T/ferr")" = "$(sed 's/.*: //' "$T/err")" ] || { echo "floor first != corridor.json:"; cat "$T/ferr" "$T/err"; exit 1; }
+[ "$(grep ' scans of ' "$T/ferr" | sed 's/.*: //')" = "$(grep ' scans of ' "$T/err" | sed 's/.*: //')" ] || { echo "floor first != corridor.json:"; cat "$T/ferr" "$T/err"; exit 1; }
 rc=0
 "$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/run.lcm" --out "$T/f.json" \
   --set plan_diff.plan.file="$R/data/buildings/two-floors.pbtxt" --set plan_diff.plan.floor=attic 2> "$T/ferr" || rc=$?

@@ -1,4 +1,5 @@
 // JSON and DXF output of a plan diff.
+#include <cmath>
 #include <iomanip>
 #include <nlohmann/json.hpp>
 #include <ostream>
@@ -58,6 +59,59 @@ void write_json(const Diff& d, const FloorPlan& plan, std::ostream& out, bool al
                   {"seen_ratio", m.expected ? double(m.seen) / double(m.expected) : 0.0},
                   {"through_ratio", m.expected ? double(m.through) / double(m.expected) : 0.0}});
   out << fploc::json_text(j, 1) << "\n";
+}
+
+namespace {
+
+std::string xy(const Eigen::Vector2d& p) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(2) << "(" << p.x() << ", " << p.y() << ")";
+  return s.str();
+}
+
+}  // namespace
+
+void write_text(const Diff& d, const FloorPlan& plan, std::ostream& out) {
+  std::ostringstream o;
+  o << std::fixed;
+  const size_t parts = d.missing_parts.size();
+  o << d.count(Status::kSeen) << " seen, " << d.count(Status::kMissing) << " missing, " << d.count(Status::kMoved)
+    << " moved, " << d.count(Status::kUnobserved) << " unobserved, " << d.added.size() << " new, " << parts
+    << (parts == 1 ? " missing part" : " missing parts") << "; drawing scale ";
+  if (d.scale_points > 0)
+    o << std::showpos << std::setprecision(2) << 100 * d.scale_error << std::noshowpos << " % +- " << 100 * d.scale_sigma
+      << " % (" << d.scale_points << " points)\n";
+  else
+    o << "too little to tell\n";
+  auto layer = [&](const Element& e) {
+    return e.layer >= 0 && size_t(e.layer) < plan.layers.size() ? " (" + plan.layers[size_t(e.layer)] + ")" : std::string();
+  };
+  auto length = [](const Element& e) { return e.kind == ElementKind::kSegment ? (e.b - e.a).norm() : 2 * M_PI * e.r; };
+  for (const auto& e : d.elements) {
+    if (e.status != Status::kMissing && e.status != Status::kMoved) continue;
+    if (e.id < 0 || size_t(e.id) >= plan.elements.size()) continue;
+    const Element& p = plan.elements[size_t(e.id)];
+    o << "  element " << e.id << layer(p) << ": " << status_name(e.status);
+    if (e.status == Status::kMoved)
+      o << " " << std::showpos << std::setprecision(3) << e.offset_m << std::noshowpos << " m (+- " << e.offset_sigma_m << ")";
+    else
+      o << ", seen " << std::setprecision(0) << 100 * e.seen_ratio() << " % of " << e.probes_expected << " expected looks";
+    o << ", length " << std::setprecision(2) << length(p) << " m, "
+      << (p.kind == ElementKind::kSegment ? xy(p.a) + "-" + xy(p.b) : "centre " + xy(p.c)) << "\n";
+  }
+  for (const auto& m : d.missing_parts) {
+    o << "  element " << m.element;
+    if (m.element >= 0 && size_t(m.element) < plan.elements.size()) o << layer(plan.elements[size_t(m.element)]);
+    o << ": missing part " << std::setprecision(2) << m.length() << " m, " << xy(m.a) << "-" << xy(m.b)
+      << ", seen through " << std::setprecision(0) << (m.expected ? 100.0 * double(m.through) / double(m.expected) : 0.0)
+      << " % of " << m.expected << " expected looks\n";
+  }
+  for (const auto& n : d.added) {
+    o << "  new: " << std::setprecision(2) << n.length() << " m, " << xy(n.a) << "-" << xy(n.b);
+    if (n.extends >= 0) o << ", extends element " << n.extends;
+    o << "\n";
+  }
+  out << o.str();
 }
 
 namespace {

@@ -244,7 +244,7 @@ class PlanDiff {
   std::vector<std::vector<int>> grid_;
 };
 
-// {"frames", "evidence_frames", "summary": {"seen", "missing", "moved", "unobserved", "new"}, "scale": {"error", "sigma", "points"},
+// {"frames", "evidence_frames", "summary": {"seen", "missing", "moved", "unobserved", "new", "missing_parts"}, "scale": {"error", "sigma", "points"},
 //  "elements": [{"id", "status",
 //  "offset_m", "offset_spread_m", "offset_sigma_m", "seen_ratio", "frames_expected", "frames_with_points", "a", "b" | "c", "r"}],
 //  "new": [{"a", "b", "length_m", "cells", "min_frames", "rms_m", "extends"}],
@@ -252,6 +252,11 @@ class PlanDiff {
 //  "refined": [{"id", "offset_a", "offset_b", "frames"}]}   (elements: only those not
 //  "seen" unless all_elements)
 void write_json(const Diff& d, const FloorPlan& plan, std::ostream& out, bool all_elements = false);
+// For people: one summary line ("26 seen, 2 missing, 0 moved, 16 unobserved, 4 new, 1 missing part; drawing scale
+// +0.48 % +- 0.05 % (N points)" or "drawing scale: too little to tell"), then one line per flagged item: each
+// missing / moved element (id, layer, verdict, offset, length, where), each missing part, each new run. The
+// caller prefixes the first line (fploc map diff: "N scans of LOG against PLAN: ").
+void write_text(const Diff& d, const FloorPlan& plan, std::ostream& out);
 // ASCII DXF (AC1009, $INSUNITS 6 = metres) with a LAYER table: FPLOC-PLAN (the plan, grey),
 // FPLOC-MISSING (red: missing elements and missing parts where the plan has them), FPLOC-MOVED (yellow: moved elements
 // where they were seen), FPLOC-NEW (green: new structure). LINE and CIRCLE entities only.
