@@ -47,4 +47,16 @@ rc=0
 [ "$rc" = 1 ] || fail "--floor attic: exit $rc, expected 1"
 grep -q "no floor 'attic' (floors: ground, first)" "$T/err" || { cat "$T/err"; fail "--floor attic: error text"; }
 check "--gt $T/gt.tum --est $T/est.tum --floor first" "fploc eval: --floor needs --plan (a building .pbtxt or .ifc)"
+# --hat: a three-cornered hat can estimate a negative variance (here est and THIRD carry the same error with opposite
+# signs, gt none: gt's variance comes out negative). That is no noise level: the text says "not resolvable", the JSON
+# keeps the signed value and says gt.xy_resolvable false (it printed "gt -0.0027 m" as a noise level).
+awk 'BEGIN { srand(7); for (i = 0; i < 200; ++i) { nx = 0.02 * (rand() - 0.5); ny = 0.02 * (rand() - 0.5); t = 0.1 * i;
+  printf "%.3f %.6f 0 0 0 0 0 1\n", t, t > "'"$T/hgt.tum"'";
+  printf "%.3f %.6f %.6f 0 0 0 0 1\n", t, t + nx, ny > "'"$T/hest.tum"'";
+  printf "%.3f %.6f %.6f 0 0 0 0 1\n", t, t - nx, -ny > "'"$T/hthird.tum"'" } }'
+"$EVAL" --gt "$T/hgt.tum" --est "$T/hest.tum" --hat "$T/hthird.tum" --json > "$T/hat.json" 2> "$T/hat.err" || { cat "$T/hat.err"; fail "--hat"; }
+grep -q "per-pose noise (if white) gt xy not resolvable (negative variance estimate) / " "$T/hat.err" || { cat "$T/hat.err"; fail "--hat: negative gt variance not said"; }
+grep -q "gt -[0-9]" "$T/hat.err" && { cat "$T/hat.err"; fail "--hat: a negative noise level printed"; }
+grep -q '"gt":{[^}]*"pose_sigma_xy_m":-[0-9][^}]*"xy_resolvable":false' "$T/hat.json" || { cat "$T/hat.json"; fail "--hat: JSON gt.xy_resolvable"; }
+grep -q '"est":{[^}]*"xy_resolvable":true' "$T/hat.json" || { cat "$T/hat.json"; fail "--hat: JSON est.xy_resolvable"; }
 echo OK

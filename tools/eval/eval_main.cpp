@@ -351,19 +351,35 @@ int main(int argc, char** argv) {
       } catch (const std::invalid_argument& e) {
         throw std::runtime_error("--hat " + hat_path + " (" + std::to_string(third.size()) + " poses): " + e.what());
       }
+      // A negative variance estimate (the hat's assumptions fail: correlated errors, too few increments) is no
+      // noise level: the JSON keeps the signed value under its key and says so in xy_resolvable / yaw_resolvable;
+      // the text says "not resolvable".
       auto src = [&](const eval::HatSource& s) {
         return nlohmann::json{{"increment_sigma_xy_m", eval::signed_sqrt(s.increment_var_xy_m2)},
                               {"increment_sigma_yaw_rad", eval::signed_sqrt(s.increment_var_yaw_rad2)},
                               {"pose_sigma_xy_m", s.pose_sigma_xy_m},
-                              {"pose_sigma_yaw_rad", s.pose_sigma_yaw_rad}};
+                              {"pose_sigma_yaw_rad", s.pose_sigma_yaw_rad},
+                              {"xy_resolvable", s.increment_var_xy_m2 >= 0},
+                              {"yaw_resolvable", s.increment_var_yaw_rad2 >= 0}};
       };
       j["hat"] = {{"third_file", hat_path}, {"lag", hat_lag}, {"increments", h.increments},
                   {"gt", src(h.ref)}, {"est", src(h.est)}, {"third", src(h.third)}};
+      auto noise = [](const eval::HatSource& s) {
+        std::ostringstream o;
+        if (s.increment_var_xy_m2 >= 0) o << s.pose_sigma_xy_m << " m";
+        else o << "xy not resolvable (negative variance estimate)";
+        o << " / ";
+        if (s.increment_var_yaw_rad2 >= 0) o << s.pose_sigma_yaw_rad * 180 / M_PI << " deg";
+        else o << "yaw not resolvable (negative variance estimate)";
+        return o.str();
+      };
       std::cerr << "fploc eval: three-cornered hat over " << h.increments << " increments (lag " << hat_lag
-                << "): per-pose noise (if white) gt " << h.ref.pose_sigma_xy_m << " m / "
-                << h.ref.pose_sigma_yaw_rad * 180 / M_PI << " deg, est " << h.est.pose_sigma_xy_m << " m / "
-                << h.est.pose_sigma_yaw_rad * 180 / M_PI << " deg, " << hat_path << " " << h.third.pose_sigma_xy_m
-                << " m / " << h.third.pose_sigma_yaw_rad * 180 / M_PI << " deg\n";
+                << "): per-pose noise (if white) gt " << noise(h.ref) << ", est " << noise(h.est) << ", " << hat_path
+                << " " << noise(h.third) << "\n";
+      if (h.ref.increment_var_xy_m2 < 0 || h.est.increment_var_xy_m2 < 0 || h.third.increment_var_xy_m2 < 0 ||
+          h.ref.increment_var_yaw_rad2 < 0 || h.est.increment_var_yaw_rad2 < 0 || h.third.increment_var_yaw_rad2 < 0)
+        std::cerr << "fploc eval: a negative variance estimate: the hat's assumptions fail (errors correlated between "
+                     "two of the trajectories, or too few increments)\n";
     }
     std::cerr << "fploc eval: " << pairs.size() << " associated poses (gt " << gt.size() << ", est " << est.size()
               << "); ATE rmse " << a.trans.rmse << " m, mean " << a.trans.mean << " m, max " << a.trans.max
