@@ -46,6 +46,32 @@ grep -q '>2 m</text>' "$T/d.svg" || fail "no 2 m scale bar (plan 10 m wide)"
 grep -q "FPLOC-MOVED" "$T/d.svg" && fail "a legend line for a layer the drawing does not have"
 "$MAP" render --plan "$T/d.json" --fields none --out "$T/d.png" 2> "$T/err" || fail "render png --fields none"
 grep -q "scale bar (bottom left) 2 m" "$T/err" || fail "png scale bar not reported: $(cat "$T/err")"
+# The legend sits in a band above the plan, not over its top-left walls (the trial: the SVG's legend box covered
+# them). SVG: the white box ends above the plan's top (y 8, -8 in SVG's downward y) and the view starts above it;
+# PNG: the band's height is said, the legend's swatch is in it, and the FPLOC-MISSING wall x = 0, y 0..8 is drawn
+# pure red over its whole length (the translucent box paled its top).
+PYLIB="$(cd "$(dirname "$0")/../pylib" && pwd)"
+python3 - "$T/d.svg" "$T/d.png" "$T/err" "$PYLIB" <<'PY' || fail "the legend covers the plan"
+import re, sys
+sys.path.insert(0, sys.argv[4])
+from png_read import read_png
+svg, err = open(sys.argv[1]).read(), open(sys.argv[3]).read()
+box = re.search(r'<rect x="[^"]*" y="([^"]*)" width="[^"]*" height="([^"]*)" fill="#ffffffd0"', svg)
+assert box and float(box.group(1)) + float(box.group(2)) <= -8.0, ("SVG legend box", box and box.groups())
+view_top = float(re.search(r'viewBox="[^ ]* ([^ ]*) ', svg).group(1))
+assert view_top <= float(box.group(1)), ("SVG view top", view_top)
+band = int(re.search(r"legend above the plan \((\d+) px\)", err).group(1))
+w, h, px = read_png(sys.argv[2])
+red = (214, 39, 40)
+rows = [y for y in range(h) if any(px(x, y) == red for x in range(0, w // 8))]
+assert any(y < band for y in rows), ("no legend swatch in the band", band)
+line = [y for y in rows if y >= band]
+top, bottom = min(line), max(line)
+scale = (h - band) / 8.6  # px per metre: the plan is 8 m high plus 2 x 0.3 m of margin
+assert top - band < 0.4 * scale and bottom - top > 7.5 * scale, ("the wall's extent", band, top, bottom, scale)
+missing = [y for y in range(top, bottom + 1) if not any(px(x, y) == red for x in range(0, w // 8))]
+assert not missing, ("the wall is not red at rows", missing[:5])
+PY
 if "$MAP" render --plan "$T/d.json" --fields some --out "$T/x.svg" 2> "$T/err"; then fail "--fields some accepted"; fi
 grep -q "fields" "$T/err" || fail "--fields error does not name the option: $(cat "$T/err")"
 "$MAP" export-pgm --plan "$T/p.json" --resolution 0.1 --out "$T/pgm" 2>/dev/null || fail "export-pgm"

@@ -105,12 +105,21 @@ void write_svg(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
                const std::vector<FloorConnection>& conns, const std::string& floor) {
   const Box2 b = drawn_bounds(plan, conns);
   const double pad = 0.02 * b.size().maxCoeff() + 0.1;
-  const double W = b.size().x() + 2 * pad, H = b.size().y() + 2 * pad;
+  const double W = b.size().x() + 2 * pad, H0 = b.size().y() + 2 * pad;
   std::ofstream s(out);
   if (!s) throw std::runtime_error(out + ": cannot write");
   const double sw = b.size().maxCoeff() / 1500.0;
+  // The legend (plan-change layers, connections) goes in a band above the plan: drawn over it, it hid the plan's
+  // top-left walls.
+  int diff_count[3] = {0, 0, 0};
+  for (const auto& e : plan.elements)
+    if (const LayerStyle* st = style_of(plan, e)) ++diff_count[st - kDiffLayers];
+  const int legend_lines = (diff_count[0] > 0) + (diff_count[1] > 0) + (diff_count[2] > 0) + int(conns.size());
+  const double fs = std::min(W, H0) / 60;
+  const double band = legend_lines > 0 ? 1.4 * fs * legend_lines + fs : 0.0;
+  const double H = H0 + band, top = -(b.max.y() + pad) - band;  // the view's top edge (SVG y, downwards)
   s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << int(width * H / W)
-    << "\" viewBox=\"" << b.min.x() - pad << " " << -(b.max.y() + pad) << " " << W << " " << H << "\">\n"
+    << "\" viewBox=\"" << b.min.x() - pad << " " << top << " " << W << " " << H << "\">\n"
     << "<g transform=\"scale(1,-1)\">\n<g stroke=\"#00000030\" stroke-width=\"" << sw * 0.5 << "\">\n";
   if (f) f->for_each_leaf([&](const Box2& box, int, const uint32_t* ids, int n) {
     if (box.max.x() < b.min.x() - pad || box.min.x() > b.max.x() + pad || box.max.y() < b.min.y() - pad ||
@@ -124,11 +133,9 @@ void write_svg(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
       << box.size().y() << "\" fill=\"" << buf << "\"/>\n";
   });
   s << "</g>\n<g fill=\"none\" stroke=\"#000\" stroke-width=\"" << sw * 2 << "\">\n";
-  int diff_count[3] = {0, 0, 0};
   for (const auto& e : plan.elements) {
     const LayerStyle* st = style_of(plan, e);
     if (st) {
-      ++diff_count[st - kDiffLayers];
       s << "<g stroke=\"" << st->svg << "\" stroke-width=\"" << sw * 4 << "\">";
     }
     if (e.kind == ElementKind::kSegment) {
@@ -159,15 +166,14 @@ void write_svg(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
   }
   s << "</g>\n";
   // Scale bar (bottom left) and, for a plan-change drawing or a floor with stairs, ramps or lifts, the legend of its
-  // layers and connections (top left); upright text.
-  const double fs = std::min(W, H) / 60, bar = scale_bar_m(b.size().x());
+  // layers and connections (in the band above the plan); upright text.
+  const double bar = scale_bar_m(b.size().x());
   const double x0 = b.min.x() - pad + fs, ybar = -(b.min.y() - pad) - fs;
   s << "<g font-family=\"sans-serif\" font-size=\"" << fs << "\">\n<line x1=\"" << x0 << "\" y1=\"" << ybar << "\" x2=\""
     << x0 + bar << "\" y2=\"" << ybar << "\" stroke=\"#000\" stroke-width=\"" << fs / 4 << "\"/>\n<text x=\"" << x0
     << "\" y=\"" << ybar - fs / 2 << "\">" << bar << " m</text>\n";
-  double yl = -(b.max.y() + pad) + 1.5 * fs;
-  const int legend_lines = (diff_count[0] > 0) + (diff_count[1] > 0) + (diff_count[2] > 0) + int(conns.size());
-  if (legend_lines > 0)  // a white ground for the legend over the fields
+  double yl = top + 1.5 * fs;
+  if (legend_lines > 0)  // a white ground for the legend
     s << "<rect x=\"" << x0 - fs / 2 << "\" y=\"" << yl - 1.2 * fs << "\" width=\"" << 22 * fs << "\" height=\""
       << 1.4 * fs * legend_lines + 0.4 * fs << "\" fill=\"#ffffffd0\"/>\n";
   for (int k = 0; k < 3; ++k)
@@ -265,13 +271,9 @@ void write_png(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
   // Scale bar (bottom left), 1, 2 or 5 times a power of ten metres, its length written above it.
   const double bar = scale_bar_m(b.size().x());
   for (double x = 0; x <= bar; x += px / 4) dot(Eigen::Vector2d(b.min.x() - pad + 10 * px + x, b.min.y() - pad + 10 * px), black, 1.5);
-  RgbImage pic(w, h);
-  pic.px = std::move(img);
+  // Legend (in a band above the plan, as in the SVG: over the plan it hid the top-left walls): the plan-change
+  // layers present and the floor's connections.
   const int fs = std::clamp(w / 60, 12, 24);
-  char bar_text[32];
-  std::snprintf(bar_text, sizeof bar_text, "%g m", bar);
-  draw_text(pic, 10, h - 10 - fs / 2 - 2, bar_text, fs, black);
-  // Legend (top left, on a light ground): the plan-change layers present and the floor's connections.
   std::vector<std::pair<const uint8_t*, std::string>> legend;
   int diff_count[3] = {0, 0, 0};
   for (const auto& e : plan.elements)
@@ -281,6 +283,12 @@ void write_png(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
       legend.emplace_back(kDiffLayers[k].rgb, std::string(kDiffLayers[k].prefix) + " (" + std::to_string(diff_count[k]) +
                                                   "): " + kDiffLayers[k].label);
   for (const auto& c : conns) legend.emplace_back(style_of(c.kind).rgb, legend_text(c, floor));
+  const int band = legend.empty() ? 0 : fs / 2 + int(legend.size()) * (fs * 3 / 2) + fs / 2;
+  RgbImage pic(w, h + band);
+  std::copy(img.begin(), img.end(), pic.px.begin() + std::ptrdiff_t(size_t(band) * size_t(w) * 3));
+  char bar_text[32];
+  std::snprintf(bar_text, sizeof bar_text, "%g m", bar);
+  draw_text(pic, 10, pic.h - 10 - fs / 2 - 2, bar_text, fs, black);
   if (!legend.empty()) {
     const int lh = fs * 3 / 2, sw = 2 * fs, x0 = fs / 2;
     int tw = 0;
@@ -294,8 +302,8 @@ void write_png(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
     }
   }
   pic.write_png(out);
-  std::cerr << "fploc map render: " << w << " x " << h << " px, " << px << " m per pixel; scale bar (bottom left) " << bar
-            << " m\n";
+  std::cerr << "fploc map render: " << w << " x " << pic.h << " px, " << px << " m per pixel; scale bar (bottom left) " << bar
+            << " m" << (band ? "; legend above the plan (" + std::to_string(band) + " px)" : std::string()) << "\n";
 }
 
 }  // namespace
