@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
   app.add_option("--world", world_file, "the world the sensor sees, when it differs from the plan: a plan file or a world JSON (see modules/sim perturb.h)");
   app.add_option("--perturb", perturb, "seeded world perturbation of the plan: a family (" +
                  [] { std::string s; for (auto& n : fploc::sim::perturb_family_names()) s += (s.empty() ? "" : ", ") + n; return s; }() +
-                 ") or key=value,... (asbuilt, scale, remove, add, move, glass, doors, shelves, crowd)");
+                 ") or key=value,... with the keys " + fploc::sim::perturb_keys_help());
   app.add_option("--truth", truth, "where to write the world-vs-plan truth JSON (default: LOG without .lcm + .world.json)");
   app.add_option("--ceilings-building", ceilings_building,
                  "building-* scenarios: write the simulated ceilings as a one-floor building file (.pbtxt) for the segmenter");

@@ -191,6 +191,49 @@ PerturbOptions perturb_family(const std::string& name) {
   return o;
 }
 
+namespace {
+bool is_count(double x) { return x >= 0 && x == std::floor(x) && x < 1000; }
+}  // namespace
+
+const std::vector<PerturbKey>& perturb_keys() {
+  static const std::vector<PerturbKey> keys = {
+      {"asbuilt", "every wall end and pillar displaced N(0, sigma m) per axis", "a sigma in metres 0..1",
+       [](double x) { return x >= 0 && x < 1; }, [](PerturbOptions& o, double x) { o.asbuilt_sigma_m = x; }},
+      {"scale", "world = (1 + s) x plan (0.005: the drawing 0.5 % too small)", "a scale error -0.2..0.2",
+       [](double x) { return std::abs(x) < 0.2; }, [](PerturbOptions& o, double x) { o.scale = x; }},
+      {"remove", "walls (with their other face) / pillars taken out (count)", "a count", is_count,
+       [](PerturbOptions& o, double x) { o.remove = int(x); }},
+      {"add", "partitions added (count)", "a count", is_count, [](PerturbOptions& o, double x) { o.add = int(x); }},
+      {"move", "walls moved along their normal (count)", "a count", is_count,
+       [](PerturbOptions& o, double x) { o.move = int(x); }},
+      {"move_min", "least wall move, m (0.10)", "metres 0..2", [](double x) { return x > 0 && x < 2; },
+       [](PerturbOptions& o, double x) { o.move_min_m = x; }},
+      {"move_max", "largest wall move, m (0.25)", "metres 0..2", [](double x) { return x > 0 && x < 2; },
+       [](PerturbOptions& o, double x) { o.move_max_m = x; }},
+      {"glass", "fraction of the visible wall length turned to glass", "a fraction 0..1",
+       [](double x) { return x >= 0 && x <= 1; }, [](PerturbOptions& o, double x) { o.glass = x; }},
+      {"doors", "door leaves in the doorways, open or closed (0/1)", "0 or 1", [](double x) { return x == 0 || x == 1; },
+       [](PerturbOptions& o, double x) { o.doors = x == 1; }},
+      {"shelves", "fraction of the wall length behind 2 m shelving", "a fraction 0..1",
+       [](double x) { return x >= 0 && x <= 1; }, [](PerturbOptions& o, double x) { o.shelves = x; }},
+      {"crowd", "people walking near the path (count)", "a count", is_count,
+       [](PerturbOptions& o, double x) { o.crowd = int(x); }},
+      {"doors_moved", "doorways shifted along their wall (count)", "a count", is_count,
+       [](PerturbOptions& o, double x) { o.doors_moved = int(x); }},
+      {"door_shift_min", "least doorway shift, m (0.4)", "metres 0..5", [](double x) { return x > 0 && x < 5; },
+       [](PerturbOptions& o, double x) { o.door_shift_min_m = x; }},
+      {"door_shift_max", "largest doorway shift, m (0.9)", "metres 0..5", [](double x) { return x > 0 && x < 5; },
+       [](PerturbOptions& o, double x) { o.door_shift_max_m = x; }},
+  };
+  return keys;
+}
+
+std::string perturb_keys_help() {
+  std::string s;
+  for (const auto& k : perturb_keys()) s += (s.empty() ? "" : "; ") + std::string(k.name) + ": " + k.doc;
+  return s;
+}
+
 PerturbOptions parse_perturb(const std::string& spec) {
   if (spec.find('=') == std::string::npos) return perturb_family(spec);
   PerturbOptions o;
@@ -210,28 +253,15 @@ PerturbOptions parse_perturb(const std::string& spec) {
     } catch (const std::exception&) {
       throw std::runtime_error("--perturb: " + k + "='" + v + "': expected a number");
     }
-    const bool count_ok = x >= 0 && x == std::floor(x) && x < 1000;
-    auto need = [&](bool ok, const char* what) {
-      if (!ok) throw std::runtime_error("--perturb: " + k + "=" + v + ": expected " + what);
-    };
-    if (k == "asbuilt") need(x >= 0 && x < 1, "a sigma in metres 0..1"), o.asbuilt_sigma_m = x;
-    else if (k == "scale") need(std::abs(x) < 0.2, "a scale error -0.2..0.2"), o.scale = x;
-    else if (k == "remove") need(count_ok, "a count"), o.remove = int(x);
-    else if (k == "add") need(count_ok, "a count"), o.add = int(x);
-    else if (k == "move") need(count_ok, "a count"), o.move = int(x);
-    else if (k == "move_min") need(x > 0 && x < 2, "metres 0..2"), o.move_min_m = x;
-    else if (k == "move_max") need(x > 0 && x < 2, "metres 0..2"), o.move_max_m = x;
-    else if (k == "glass") need(x >= 0 && x <= 1, "a fraction 0..1"), o.glass = x;
-    else if (k == "doors") need(x == 0 || x == 1, "0 or 1"), o.doors = x == 1;
-    else if (k == "shelves") need(x >= 0 && x <= 1, "a fraction 0..1"), o.shelves = x;
-    else if (k == "crowd") need(count_ok, "a count"), o.crowd = int(x);
-    else if (k == "doors_moved") need(count_ok, "a count"), o.doors_moved = int(x);
-    else if (k == "door_shift_min") need(x > 0 && x < 5, "metres 0..5"), o.door_shift_min_m = x;
-    else if (k == "door_shift_max") need(x > 0 && x < 5, "metres 0..5"), o.door_shift_max_m = x;
-    else
-      throw std::runtime_error("--perturb: unknown key '" + k +
-                               "' (keys: asbuilt, scale, remove, add, move, move_min, move_max, glass, doors, shelves, crowd, "
-                               "doors_moved, door_shift_min, door_shift_max)");
+    const auto& keys = perturb_keys();
+    const auto it = std::find_if(keys.begin(), keys.end(), [&](const PerturbKey& pk) { return k == pk.name; });
+    if (it == keys.end()) {
+      std::string all;
+      for (const auto& pk : keys) all += (all.empty() ? "" : ", ") + std::string(pk.name);
+      throw std::runtime_error("--perturb: unknown key '" + k + "' (keys: " + all + ")");
+    }
+    if (!it->ok(x)) throw std::runtime_error("--perturb: " + k + "=" + v + ": expected " + it->expected);
+    it->set(o, x);
   }
   if (o.move_max_m < o.move_min_m) throw std::runtime_error("--perturb: move_max < move_min");
   if (o.door_shift_max_m < o.door_shift_min_m) throw std::runtime_error("--perturb: door_shift_max < door_shift_min");

@@ -54,10 +54,21 @@ struct PerturbOptions {
   }
 };
 
-// "key=value,..." with keys asbuilt (sigma m), scale, remove, add, move, move_min, move_max, glass,
-// doors (0/1), shelves, crowd, doors_moved (count), door_shift_min, door_shift_max; or a family name.
+// "key=value,..." with the keys of perturb_keys() (asbuilt, scale, remove, add, move, move_min, move_max, glass,
+// doors, shelves, crowd, doors_moved, door_shift_min, door_shift_max); or a family name.
 // Throws on an unknown key/family or a bad value.
 PerturbOptions parse_perturb(const std::string& spec);
+// The --perturb keys: the one list parse_perturb reads them by, and help texts are made from.
+struct PerturbKey {
+  const char* name;
+  const char* doc;       // what it does, for help texts
+  const char* expected;  // the values it takes, for errors
+  bool (*ok)(double);
+  void (*set)(PerturbOptions&, double);
+};
+const std::vector<PerturbKey>& perturb_keys();
+// "asbuilt: every wall end ...; scale: ...; ..." (every key of perturb_keys() with its doc).
+std::string perturb_keys_help();
 // The bench families: clean, asbuilt-2cm, asbuilt-5cm, scale-0.5pct, renovated, glass, shelves, doors,
 // crowd-15, mixed, doors-moved. Throws on an unknown name (listing the names).
 PerturbOptions perturb_family(const std::string& name);
