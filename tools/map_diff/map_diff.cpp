@@ -155,7 +155,11 @@ int main(int argc, char** argv) {
     preface << "fploc map diff: the plan: " << plan_file << ", from " << src_what << "\n";
     // The poses were estimated against the matcher's / optimizer's plan: another plan there is most likely a run
     // replayed with --set matcher.plan.file=X, whose diff must name X too.
-    if (plan_arg.empty())
+    // (Not when the diff's plan was named explicitly: --plan, or --set NODE.plan.file for the plan_diff node.)
+    bool plan_set = false;
+    for (const auto& st : sets)
+      if (node && st.rfind(node->name() + ".plan.file=", 0) == 0) plan_set = true;
+    if (plan_arg.empty() && !plan_set)
       for (const auto& n : g.graph.node()) {
         if (n.disabled() || (!n.has_matcher() && !n.has_optimizer())) continue;
         const auto& ps = n.has_matcher() ? n.matcher().plan() : n.optimizer().plan();
