@@ -346,7 +346,15 @@ function connect() {
     const t = S.pose ? tsec(S.pose.utime) : null;
     if (t !== null) plots.rate.push(t, [s.frame_rate_hz, s.pose_rate_hz]);
     const l = S.latencies.slice(-50).sort((a, b) => a - b);
-    $('latency').textContent = l.length ? `latency p50 ${l[l.length >> 1].toFixed(0)} ms · ${s.clients} viewer(s)` : `${s.clients} viewer(s)`;
+    // How far the pose lags the newest sensor time seen (ground truth or the matcher's frame, both stamped
+    // with the scan's time): a localizer that falls behind shows here even when the stamps are not this
+    // machine's clock (replay, simulated time) and the latency above is not shown.
+    const newest = Math.max(S.gt ? S.gt.utime : 0, S.frame ? S.frame.utime : 0);
+    const behind = S.pose && newest ? (newest - S.pose.utime) / 1e6 : null;
+    const stale = behind !== null && behind > 1;
+    $('latency').textContent = (l.length ? `latency p50 ${l[l.length >> 1].toFixed(0)} ms · ` : '') +
+      (stale ? `pose ${behind.toFixed(1)} s behind the sensor · ` : '') + `${s.clients} viewer(s)`;
+    $('latency').classList.toggle('stale', stale);
   });
   on('plan_changed', async () => { try { const plan = await (await fetch('/api/plan')).json(); map.setPlan(plan); planIndex = new PlanIndex(plan); } catch (e) { /* next reconnect */ } });
 }
