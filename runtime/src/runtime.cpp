@@ -19,6 +19,7 @@
 #include "fploc/runtime/compose.h"
 #include "fploc/runtime/graph.h"
 #include "fploc/runtime/node.h"
+#include "fploc/runtime/restart.h"
 #include "fploc/runtime/validate.h"
 
 namespace fploc::rt {
@@ -549,7 +550,7 @@ int node_main(int argc, char** argv) {
       auto s = make_status(ctx, executable, "dead", 0, 0, restarts);
       s.last_error = std::string("setup failed: ") + e.what();
       bus.lcm().publish(telemetry, &s);
-      return 1;
+      return kSetupFailedExitCode;  // not restarted by the launcher (restart.h)
     }
     CpuMeter cpu;
     const double t_start = now_s();
