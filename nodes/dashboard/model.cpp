@@ -123,7 +123,12 @@ void Model::publish_features() {
   hub_.set("features", features_view(*features_, cfg_.max_feature_points, pose));
 }
 
+// The launcher's answer to a refused control request (state "rejected", for `fploc node` to print) carries the
+// requested name, which may be no node at all: it is neither a node nor a node's state.
+static bool is_control_answer(const fploc::node_status_t& m) { return m.state == "rejected"; }
+
 void Model::on_status(const fploc::node_status_t& m, double now_s) {
+  if (is_control_answer(m)) return;
   std::lock_guard<std::mutex> lk(mu_);
   auto& e = nodes_[m.node];
   e.status = std::make_shared<fploc::node_status_t>(m);
@@ -195,6 +200,7 @@ void Model::on_fleet_pose(const std::string& robot, const fploc::pose_t& m, doub
 }
 
 void Model::on_fleet_status(const std::string& robot, const fploc::node_status_t& m, double now_s) {
+  if (is_control_answer(m)) return;
   std::lock_guard<std::mutex> lk(mu_);
   auto it = fleet_.find(robot);
   if (it == fleet_.end()) return;

@@ -171,6 +171,30 @@ TEST(DashboardModel, ExpectedNodeIsListedBeforeItsFirstHeartbeat) {
   EXPECT_EQ(node()["health"], "ok");
 }
 
+// The launcher answers a refused control request (`fploc node restart nosuch`) with a node_status_t of state
+// "rejected" under the requested name, for `fploc node` to print: that is no node, and no state of a node.
+TEST(DashboardModel, ARejectedControlRequestIsNoNodeRow) {
+  Model m;
+  m.expect_node("optimizer", "fploc-optimizer", 0.0);
+  fploc::node_status_t s{};
+  s.node = "optimizer";
+  s.state = "running";
+  m.on_status(s, 0.5);
+  fploc::node_status_t r{};
+  r.node = "nosuch";
+  r.state = "rejected";
+  r.reporter = "launcher";
+  r.last_error = "control: no running node named 'nosuch'";
+  m.on_status(r, 1.0);
+  r.node = "optimizer";  // a refused request about a node that runs leaves its row as it was
+  m.on_status(r, 1.0);
+  m.tick(1.2, 0);
+  const auto nodes = json::parse(m.state_json())["nodes"]["nodes"];
+  ASSERT_EQ(nodes.size(), 1u) << nodes.dump();
+  EXPECT_EQ(nodes[0]["node"], "optimizer");
+  EXPECT_EQ(nodes[0]["health"], "ok") << nodes.dump();
+}
+
 TEST(DashboardModel, FeaturesJsonIsValidAndDecimated) {
   fploc::features_t f{};
   f.scan_seq = 7;

@@ -1,5 +1,6 @@
 // The launcher's supervision policy with a fake clock and fake processes: restart policy and backoff,
 // giving up, heartbeat timeout, ordered shutdown with escalation, control requests, remote nodes whose host is away.
+#include "control.h"
 #include "supervisor.h"
 #include "udp_links.h"
 
@@ -632,4 +633,20 @@ TEST(Supervisor, ASetupFailureIsNotRestartedAndStopsTheLaunch) {
   s.on_exit(s.pid(1), code(0), 3.1);
   EXPECT_EQ(s.finished(), std::optional<int>(1));
   EXPECT_EQ(w.logs.back(), "all nodes stopped; dead during the run: 'matcher' (exit code 1)");
+}
+
+// A control request for a name that is not in the graph is refused naming the graph's nodes.
+TEST(Control, UnknownNodeIsRefusedListingTheNodes) {
+  fploc::Graph g;
+  g.add_node()->set_name("matcher");
+  g.add_node()->set_name("optimizer");
+  auto* off = g.add_node();
+  off->set_name("old");
+  off->set_disabled(true);
+  fploc::node_command_t m{};
+  m.node = "nosuch";
+  m.action = "restart";
+  const auto d = decide_control(m, nullptr, g, fploc::rt::ValidateHooks{});
+  EXPECT_EQ(d.kind, ControlDecision::Reject);
+  EXPECT_EQ(d.error, "no running node named 'nosuch' (nodes: matcher, optimizer)");
 }
