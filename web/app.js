@@ -30,6 +30,7 @@ const plots = {
   z: new Plot($('plot-z'), [{ label: 'z', color: COL.est }, { label: 'gt z', color: COL.gt, dash: [3, 3], at: 0 }], { digits: 3, minSpan: 0.05 }),
   rate: new Plot($('plot-rate'), [{ label: 'frames', color: COL.fp }, { label: 'poses', color: COL.est }], { digits: 1, zero: true, minSpan: 1 }),
 };
+S.plots = plots;  // (tests read the plotted series)
 
 // ---- map layers ------------------------------------------------------------------------------
 // Other robots on the same plan (fleet): trail and pose in their colour, named.
@@ -301,7 +302,13 @@ async function loadStatic() {
     plots.rp.push(t, [roll * DEG, pitch * DEG, null, null]);
     plots.z.push(t, [z, null]);
   }
-  for (const [utime, x, y, z] of hist.gt) { addToTrail(S.gtTrail, utime, x, y); plots.z.push(tsec(utime), [null, z]); }
+  for (const [utime, x, y, z, roll, pitch] of hist.gt) {
+    addToTrail(S.gtTrail, utime, x, y);
+    const t = tsec(utime);
+    plots.z.push(t, [null, z]);
+    if (roll !== undefined) plots.rp.push(t, [null, null, roll * DEG, pitch * DEG]);  // (older dashboards: x, y, z only)
+  }
+  for (const [utime, frameHz, poseHz] of hist.rates || []) plots.rate.push(tsec(utime), [frameHz, poseHz]);
   map.invalidate();
 }
 
