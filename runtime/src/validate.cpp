@@ -278,8 +278,10 @@ bool validate_graph(const LoadedGraph& g, const ValidateHooks& hooks, std::vecto
     for (const auto& c : cons) {
       if (pit == producers.end()) {
         if (unknown_ports) continue;  // reported once every executable is there (no cascades)
+        // How to say "not connected" (a display-only input such as the dashboard's, an optional one).
         err(c.line, "node '" + c.node + "' input '" + c.port + "' on channel '" + channel +
-                        "' has no producer (no node of the graph publishes it)");
+                        "' has no producer (no node of the graph publishes it); if it is to stay unconnected: input { port: \"" +
+                        c.port + "\" channel: \"\" }");
         continue;
       }
       for (const auto& p : pit->second) {

@@ -78,13 +78,13 @@ void check_pcap(Ctx& c, const std::string& what, const std::string& path) {
 }
 
 // Option fields that name a file a node writes: `*_out` (resolved against the graph's folder), the pose
-// logger's files and `stats_file` (opened as given: relative to the working directory).
+// logger's files, `stats_file` and `out_*` (opened as given: relative to the working directory).
 enum class Written { kNo, kGraphRelative, kCwdRelative };
 Written written_kind(const google::protobuf::Descriptor* d, const FieldDescriptor* f) {
   if (f->cpp_type() != FieldDescriptor::CPPTYPE_STRING || f->is_repeated()) return Written::kNo;
   const std::string& n = f->name();
   if (n.size() > 4 && n.compare(n.size() - 4, 4, "_out") == 0) return Written::kGraphRelative;
-  if (n == "stats_file") return Written::kCwdRelative;
+  if (n == "stats_file" || n.rfind("out_", 0) == 0) return Written::kCwdRelative;  // out_json, out_dxf (plan_diff)
   if (d->full_name() == "fploc.PoseLoggerOptions" && (n == "file" || n == "uncertainty_file" || n == "floor_file"))
     return Written::kCwdRelative;
   return Written::kNo;

@@ -70,8 +70,10 @@ TEST(CheckFiles, OutputFolderMustExist) {
   Dir d;
   auto e = check(d, "node { name: \"log\" executable: \"x\" pose_logger { file: \"/nonexistent-fploc/dir/p.tum\""
                     " uncertainty_file: \"" + (d.p / "p.unc").string() + "\" } }\n"
-                    "node { name: \"s\" executable: \"y\" sim { metadata_out: \"no-dir/m.json\" } }\n");
-  ASSERT_EQ(e.size(), 2u) << (e.empty() ? "" : e[0].str());
+                    "node { name: \"s\" executable: \"y\" sim { metadata_out: \"no-dir/m.json\" } }\n"
+                    "node { name: \"d\" executable: \"z\" plan_diff { out_json: \"/nonexistent-fploc/d.json\" } }\n");
+  ASSERT_EQ(e.size(), 3u) << (e.empty() ? "" : e[0].str());
+  EXPECT_NE(e[2].message.find("plan_diff.out_json"), std::string::npos) << e[2].str();
   EXPECT_NE(e[0].message.find("node 'log': pose_logger.file '/nonexistent-fploc/dir/p.tum' cannot be written: its "
                               "folder '/nonexistent-fploc/dir' does not exist"), std::string::npos) << e[0].str();
   EXPECT_NE(e[1].message.find("sim.metadata_out"), std::string::npos) << e[1].str();
