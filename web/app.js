@@ -30,6 +30,7 @@ const plots = {
   z: new Plot($('plot-z'), [{ label: 'z', color: COL.est }, { label: 'gt z', color: COL.gt, dash: [3, 3], at: 0 }], { digits: 3, minSpan: 0.05 }),
   rate: new Plot($('plot-rate'), [{ label: 'frames', color: COL.fp }, { label: 'poses', color: COL.est }], { digits: 1, zero: true, minSpan: 1 }),
 };
+S.plots = plots;  // (tests read the plotted series)
 
 // ---- map layers ------------------------------------------------------------------------------
 // Other robots on the same plan (fleet): trail and pose in their colour, named.
@@ -301,7 +302,13 @@ async function loadStatic() {
     plots.rp.push(t, [roll * DEG, pitch * DEG, null, null]);
     plots.z.push(t, [z, null]);
   }
-  for (const [utime, x, y, z] of hist.gt) { addToTrail(S.gtTrail, utime, x, y); plots.z.push(tsec(utime), [null, z]); }
+  for (const [utime, x, y, z, roll, pitch] of hist.gt) {
+    addToTrail(S.gtTrail, utime, x, y);
+    const t = tsec(utime);
+    plots.z.push(t, [null, z]);
+    if (roll !== undefined) plots.rp.push(t, [null, null, roll * DEG, pitch * DEG]);  // (older dashboards: x, y, z only)
+  }
+  for (const [utime, frameHz, poseHz] of hist.rates || []) plots.rate.push(tsec(utime), [frameHz, poseHz]);
   map.invalidate();
 }
 
@@ -346,7 +353,15 @@ function connect() {
     const t = S.pose ? tsec(S.pose.utime) : null;
     if (t !== null) plots.rate.push(t, [s.frame_rate_hz, s.pose_rate_hz]);
     const l = S.latencies.slice(-50).sort((a, b) => a - b);
-    $('latency').textContent = l.length ? `latency p50 ${l[l.length >> 1].toFixed(0)} ms · ${s.clients} viewer(s)` : `${s.clients} viewer(s)`;
+    // How far the pose lags the newest sensor time seen (ground truth or the matcher's frame, both stamped
+    // with the scan's time): a localizer that falls behind shows here even when the stamps are not this
+    // machine's clock (replay, simulated time) and the latency above is not shown.
+    const newest = Math.max(S.gt ? S.gt.utime : 0, S.frame ? S.frame.utime : 0);
+    const behind = S.pose && newest ? (newest - S.pose.utime) / 1e6 : null;
+    const stale = behind !== null && behind > 1;
+    $('latency').textContent = (l.length ? `latency p50 ${l[l.length >> 1].toFixed(0)} ms · ` : '') +
+      (stale ? `pose ${behind.toFixed(1)} s behind the sensor · ` : '') + `${s.clients} viewer(s)`;
+    $('latency').classList.toggle('stale', stale);
   });
   on('plan_changed', async () => { try { const plan = await (await fetch('/api/plan')).json(); map.setPlan(plan); planIndex = new PlanIndex(plan); } catch (e) { /* next reconnect */ } });
 }

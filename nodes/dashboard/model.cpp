@@ -123,7 +123,12 @@ void Model::publish_features() {
   hub_.set("features", features_view(*features_, cfg_.max_feature_points, pose));
 }
 
+// The launcher's answer to a refused control request (state "rejected", for `fploc node` to print) carries the
+// requested name, which may be no node at all: it is neither a node nor a node's state.
+static bool is_control_answer(const fploc::node_status_t& m) { return m.state == "rejected"; }
+
 void Model::on_status(const fploc::node_status_t& m, double now_s) {
+  if (is_control_answer(m)) return;
   std::lock_guard<std::mutex> lk(mu_);
   auto& e = nodes_[m.node];
   e.status = std::make_shared<fploc::node_status_t>(m);
@@ -150,8 +155,13 @@ void Model::tick(double now_s, int64_t wall_us) {
   std::lock_guard<std::mutex> lk(mu_);
   rebuild_nodes(now_s, wall_us);
   for (auto& [r, f] : fleet_) rebuild_fleet_nodes(r, now_s, wall_us);
-  json s = {{"frame_rate_hz", num(r6(frame_rate_.rate_hz(now_s)))},
-            {"pose_rate_hz", num(r6(pose_rate_.rate_hz(now_s)))},
+  const double frame_hz = frame_rate_.rate_hz(now_s), pose_hz = pose_rate_.rate_hz(now_s);
+  if (!est_.empty() && (rates_.empty() || rates_.back().utime < est_.back().utime)) {
+    rates_.push_back({est_.back().utime, frame_hz, pose_hz});
+    while (rates_.size() > cfg_.max_trail) rates_.pop_front();
+  }
+  json s = {{"frame_rate_hz", num(r6(frame_hz))},
+            {"pose_rate_hz", num(r6(pose_hz))},
             {"features_rate_hz", num(r6(feature_rate_.rate_hz(now_s)))},
             {"clients", clients_},
             {"pushes", hub_.pushes()},
@@ -195,6 +205,7 @@ void Model::on_fleet_pose(const std::string& robot, const fploc::pose_t& m, doub
 }
 
 void Model::on_fleet_status(const std::string& robot, const fploc::node_status_t& m, double now_s) {
+  if (is_control_answer(m)) return;
   std::lock_guard<std::mutex> lk(mu_);
   auto it = fleet_.find(robot);
   if (it == fleet_.end()) return;
@@ -247,11 +258,17 @@ std::string Model::history_json(int64_t since) const {
     if (p.utime > since)
       est.push_back(est_row(p));
   for (const auto& p : gt_)
-    if (p.utime > since) gt.push_back({p.utime, num(r6(p.x)), num(r6(p.y)), num(r6(p.z))});
+    if (p.utime > since)
+      gt.push_back({p.utime, num(r6(p.x)), num(r6(p.y)), num(r6(p.z)), num(r6(p.roll)), num(r6(p.pitch)), num(r6(p.yaw))});
+  json rates = json::array();
+  for (const auto& r : rates_)
+    if (r.utime > since) rates.push_back({r.utime, num(r6(r.frame_hz)), num(r6(r.pose_hz))});
   json j = {{"fields_est", kEstFields},
-            {"fields_gt", {"utime", "x", "y", "z"}},
+            {"fields_gt", {"utime", "x", "y", "z", "roll", "pitch", "yaw"}},
             {"est", est},
             {"gt", gt},
+            {"fields_rates", {"utime", "frame_rate_hz", "pose_rate_hz"}},
+            {"rates", rates},
             {"ate_rmse", num(ate_.rmse())},
             {"ate_n", ate_.count()}};
   return fploc::json_text(j);

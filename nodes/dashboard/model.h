@@ -92,6 +92,13 @@ class Model {
     std::string floor;  // the pose's floor (pose_t.floor; "" unknown, and for the ground truth)
   };
   std::deque<TrailPoint> est_, gt_;
+  // The frame and pose rates at each tick, stamped with the newest pose's time (the page's rate plot axis),
+  // for /api/history (`rates`): a page opened mid-run draws the rates from before it was opened.
+  struct RateRow {
+    int64_t utime;
+    double frame_hz, pose_hz;
+  };
+  std::deque<RateRow> rates_;
   fploc::eval::OnlineAte ate_;
 
   struct NodeEntry {

@@ -58,7 +58,9 @@ class NdtNode : public fploc::rt::Node {
  public:
   static fploc::rt::NodeSpec spec() {
     return {"ndt", "ndt", "NDT peer (hdl_localization approach, PCL NDT) against the extruded floor plan",
-            {fploc::rt::input<fploc::segments_t>("segments", "FPLOC_SEGMENTS"),
+            // Live, a scan that waited is stale: a node slower than the scans takes the newest (the
+            // prediction spans the gap with the IMU and dt); `fploc replay` still gets every scan.
+            {fploc::rt::input<fploc::segments_t>("segments", "FPLOC_SEGMENTS", fploc::rt::Queue::kLatest),
              fploc::rt::input<fploc::imu_t>("imu", "OS1_IMU"),
              fploc::rt::output<fploc::pose_t>("pose", "FPLOC_POSE")}};
   }

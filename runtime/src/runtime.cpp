@@ -19,6 +19,7 @@
 #include "fploc/runtime/compose.h"
 #include "fploc/runtime/graph.h"
 #include "fploc/runtime/node.h"
+#include "fploc/runtime/restart.h"
 #include "fploc/runtime/validate.h"
 
 namespace fploc::rt {
@@ -68,6 +69,9 @@ struct HandlerEntry {
   Context* ctx;
   PortCounters* counters;
   std::function<bool(const void*, int)> fn;
+  bool latest = false;               // live keep-latest input: LCM's handler only keeps the newest here
+  bool has_pending = false;
+  std::vector<uint8_t> pending;
 };
 
 // Per-process loop state that nodes register timers and fds into.
@@ -169,20 +173,20 @@ static double thread_cpu_s() {
   return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
-static void raw_handler(const lcm::ReceiveBuffer* rbuf, const std::string&, HandlerEntry* h) {
+static void deliver(HandlerEntry* h, const void* data, int size) {
   const double t0 = now_s();
   const double c0 = h->ctx->composed() ? thread_cpu_s() : 0.0;
   bool ok = false;
   try {
-    ok = h->fn(rbuf->data, int(rbuf->data_size));
+    ok = h->fn(data, size);
   } catch (const std::exception& e) {
     h->ctx->error(std::string("handler on ") + h->counters->channel + ": " + e.what());
     ok = true;  // decoded, but the node failed on it
   }
+  h->counters->superseded = 0;  // (message types without seq: observe_seq did not reset it)
   if (!ok) {
     ++h->counters->undecodable;
-    h->ctx->error("undecodable message on " + h->counters->channel + " (" + std::to_string(rbuf->data_size) +
-                  " bytes)");
+    h->ctx->error("undecodable message on " + h->counters->channel + " (" + std::to_string(size) + " bytes)");
     return;
   }
   ++h->counters->messages;
@@ -201,6 +205,18 @@ static void raw_handler(const lcm::ReceiveBuffer* rbuf, const std::string&, Hand
   h->ctx->stats().busy_s_period += dt;
 }
 
+static void raw_handler(const lcm::ReceiveBuffer* rbuf, const std::string&, HandlerEntry* h) {
+  if (!h->latest) return deliver(h, rbuf->data, int(rbuf->data_size));
+  // Keep-latest: the newest message waits here until run_latest(); the one it replaces is a drop.
+  if (h->has_pending) {
+    ++h->counters->dropped;
+    ++h->counters->superseded;
+  }
+  const auto* p = static_cast<const uint8_t*>(rbuf->data);
+  h->pending.assign(p, p + rbuf->data_size);
+  h->has_pending = true;
+}
+
 void Context::subscribe_raw(const std::string& port, std::function<bool(const void*, int)> fn) {
   const std::string& ch = channel(port);
   if (ch.empty()) return;  // not connected
@@ -208,10 +224,44 @@ void Context::subscribe_raw(const std::string& port, std::function<bool(const vo
   h->ctx = this;
   h->counters = &stats_.port(port, ch, false);
   h->fn = std::move(fn);
+  h->latest = !composed_ && queue(port) == Queue::kLatest;  // replay delivers every message
   auto* sub = bus_.lcm().subscribeFunction(ch, &raw_handler, h.get());
   // Composed replay drains after every event; live nodes get room for bursts.
   if (sub) sub->setQueueCapacity(composed_ ? 10000 : 100);
   loop().handlers.push_back(std::move(h));
+}
+
+Queue Context::queue(const std::string& port) const {
+  for (const auto& [p, q] : queue_overrides_)
+    if (p == port) return q;
+  for (const auto& ps : spec_.ports)
+    if (ps.name == port) return ps.queue;
+  return Queue::kAll;
+}
+
+int run_latest() {
+  int n = 0;
+  for (auto& h : loop().handlers) {
+    if (!h->has_pending) continue;
+    h->has_pending = false;
+    std::vector<uint8_t> msg;
+    msg.swap(h->pending);  // the handler may run the loop's LCM again (not today), keep the slot free
+    deliver(h.get(), msg.data(), int(msg.size()));
+    ++n;
+  }
+  return n;
+}
+
+int dispatch_live(Bus& bus, double max_s) {
+  // Everything LCM has queued first (keep-latest inputs only store theirs), so a keep-latest handler
+  // sees the newest message; bounded in time so a slow keep-all node still beats and runs its timers.
+  int n = 0;
+  const double t_end = now_s() + max_s;
+  while (bus.lcm().handleTimeout(0) > 0) {
+    ++n;
+    if (now_s() >= t_end) break;
+  }
+  return n + run_latest();
 }
 
 void Context::every(double period_s, std::function<void()> fn) {
@@ -264,6 +314,12 @@ static std::vector<std::pair<std::string, std::string>> port_map_of(const fploc:
   for (const auto& p : n.input()) m.emplace_back(p.port(), p.channel());
   for (const auto& p : n.output()) m.emplace_back(p.port(), p.channel());
   return m;
+}
+static std::vector<std::pair<std::string, Queue>> queue_overrides_of(const fploc::Node& n) {
+  std::vector<std::pair<std::string, Queue>> q;
+  for (const auto& p : n.input())
+    if (p.queue() != fploc::Port::SPEC) q.emplace_back(p.port(), p.queue() == fploc::Port::LATEST ? Queue::kLatest : Queue::kAll);
+  return q;
 }
 
 Composition::Composition(const LoadedGraph& graph, Bus& bus, const std::vector<std::string>& skip) : bus_(bus) {
@@ -413,6 +469,7 @@ int node_main(int argc, char** argv) {
   // Options and ports from the graph (or defaults when run standalone).
   std::unique_ptr<google::protobuf::Message> options = default_options(reg.spec.options_field);
   std::vector<std::pair<std::string, std::string>> port_map;
+  std::vector<std::pair<std::string, Queue>> queues;
   std::string base_dir = std::filesystem::current_path().string();
   std::string instance = reg.spec.type;
   std::string robot = robot_of(nullptr);
@@ -432,6 +489,7 @@ int node_main(int argc, char** argv) {
     }
     if (auto o = node_options(*found)) options = std::move(o);
     port_map = port_map_of(*found);
+    queues = queue_overrides_of(*found);
     base_dir = g.dir;
     instance = node_name;
     url = graph_lcm_url(g.graph, url);
@@ -466,6 +524,7 @@ int node_main(int argc, char** argv) {
     Context ctx(bus, reg.spec, instance, std::move(options), port_map, base_dir, false);
     ctx.set_restarts(restarts);
     ctx.set_robot(robot);
+    ctx.set_queue_overrides(std::move(queues));
     const std::string telemetry = ctx.ns(kTelemetryChannel);
     auto node = reg.make();
     // setup() may take long (a large plan's ANNF on a cold cache, fploc/annf/cache.h): after 2 s a
@@ -500,7 +559,7 @@ int node_main(int argc, char** argv) {
       auto s = make_status(ctx, executable, "dead", 0, 0, restarts);
       s.last_error = std::string("setup failed: ") + e.what();
       bus.lcm().publish(telemetry, &s);
-      return 1;
+      return kSetupFailedExitCode;  // not restarted by the launcher (restart.h)
     }
     CpuMeter cpu;
     const double t_start = now_s();
@@ -528,7 +587,7 @@ int node_main(int argc, char** argv) {
         break;
       }
       if (r > 0) {
-        if (pfds[0].revents & POLLIN) bus.lcm().handleTimeout(0);
+        if (pfds[0].revents & POLLIN) dispatch_live(bus);
         for (size_t i = 1; i < pfds.size(); ++i) {
           if (pfds[i].revents & (POLLIN | POLLERR | POLLHUP)) {
             auto& [c, fe] = L.fds[i - 1];
@@ -570,6 +629,7 @@ int node_main(int argc, char** argv) {
     // last poses so). Until 100 ms pass without a message, at most 1 s.
     for (const double drain_end = now_s() + 1.0; now_s() < drain_end && bus.lcm().handleTimeout(100) > 0;) {
     }
+    run_latest();
     node->shutdown();
     beat("stopped");
   } catch (const std::exception& e) {

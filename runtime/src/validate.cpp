@@ -29,11 +29,13 @@ std::string spec_json(const NodeSpec& spec) {
   j["description"] = spec.description;
   j["options_field"] = spec.options_field;
   auto& ports = j["ports"] = nlohmann::json::array();
-  for (const auto& p : spec.ports)
+  for (const auto& p : spec.ports) {
     ports.push_back({{"name", p.name},
                      {"direction", p.output ? "output" : "input"},
                      {"lcm_type", p.lcm_type},
                      {"default_channel", p.default_channel}});
+    if (!p.output && p.queue == Queue::kLatest) ports.back()["queue"] = "latest";  // new key, only where set
+  }
   auto d = default_options(spec.options_field);
   j["options"] = d ? nlohmann::json::parse(describe_message_json(d->GetDescriptor())) : nlohmann::json();
   return j.dump();
@@ -57,6 +59,7 @@ NodeSpec parse_spec_json(const std::string& text) {
       ps.output = p.at("direction").get<std::string>() == "output";
       ps.lcm_type = p.at("lcm_type").get<std::string>();
       ps.default_channel = p.value("default_channel", "");
+      ps.queue = p.value("queue", "") == "latest" ? Queue::kLatest : Queue::kAll;
       s.ports.push_back(ps);
     }
   } catch (const std::exception& e) {
@@ -236,6 +239,8 @@ bool validate_graph(const LoadedGraph& g, const ValidateHooks& hooks, std::vecto
           continue;
         }
         if (!seen.insert(p.port()).second) err(pl, who + ": port '" + p.port() + "' mapped twice");
+        if (output && p.queue() != fploc::Port::SPEC)
+          err(pl, who + ": output port '" + p.port() + "' has a queue policy (queue applies to inputs only)");
         std::string type;
         if (typed) {
           const PortSpec* ps = nullptr;
@@ -273,8 +278,10 @@ bool validate_graph(const LoadedGraph& g, const ValidateHooks& hooks, std::vecto
     for (const auto& c : cons) {
       if (pit == producers.end()) {
         if (unknown_ports) continue;  // reported once every executable is there (no cascades)
+        // How to say "not connected" (a display-only input such as the dashboard's, an optional one).
         err(c.line, "node '" + c.node + "' input '" + c.port + "' on channel '" + channel +
-                        "' has no producer (no node of the graph publishes it)");
+                        "' has no producer (no node of the graph publishes it); if it is to stay unconnected: input { port: \"" +
+                        c.port + "\" channel: \"\" }");
         continue;
       }
       for (const auto& p : pit->second) {

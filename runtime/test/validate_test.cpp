@@ -66,6 +66,9 @@ node { name: "l3" executable: "fploc-log" }
   EXPECT_NE(s.find("g.pbtxt:9: node 'l2': fploc-log has no input port 'poze'"), std::string::npos) << s;
   // l3 is not mapped: its default channel FPLOC_POSE has no producer, reported at the node's line.
   EXPECT_NE(s.find("g.pbtxt:11: node 'l3' input 'pose' on channel 'FPLOC_POSE' has no producer"), std::string::npos) << s;
+  // ... and says how to leave an input unconnected (a display-only input, e.g. the dashboard's).
+  EXPECT_NE(s.find("FPLOC_POSE' has no producer (no node of the graph publishes it); if it is to stay unconnected: "
+                   "input { port: \"pose\" channel: \"\" }"), std::string::npos) << s;
   for (size_t i = 1; i < e.size(); ++i) EXPECT_LE(e[i - 1].line, e[i].line);  // sorted by line
 }
 

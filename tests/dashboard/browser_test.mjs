@@ -118,6 +118,22 @@ try {
   check((await health(page, 'imu_driver')) === 'bad', 'a graph node that never sent a heartbeat is listed red');
   check((await health(page, 'spare')) === null, 'disabled graph nodes are not listed');
 
+  // A page opened mid-run draws the plots from /api/history: the ground truth's roll/pitch (it had only z)
+  // and the frame/pose rates (they had no history), not only what arrives after it opened.
+  {
+    const late = await (await browser.newContext({ viewport: { width: 1200, height: 800 } })).newPage();
+    late.on('pageerror', (e) => pageErrors.push(String(e)));
+    await late.goto(URL);
+    await waitFor(() => late.evaluate(() => window.__fploc?.connected && window.__fploc.gtTrail.length > 0), 5000, 10);
+    const h = await late.evaluate(() => {
+      const S = window.__fploc;
+      return { gt: S.gtTrail.length, gtRoll: S.plots.rp.data[2].length, rates: S.plots.rate.data[1].length };
+    });
+    check(h.gt > 20 && h.gtRoll >= h.gt - 5, `a page opened mid-run plots the ground truth's roll from the history (${h.gtRoll} points, ${h.gt} gt poses)`);
+    check(h.rates >= 4, `a page opened mid-run plots the rates from the history (${h.rates} points)`);
+    await late.context().close();
+  }
+
   // Measurement window: two browsers attached, 10 Hz poses.
   await Promise.all(pages.map((p) => p.evaluate(() => { window.__fploc.latencies = []; window.__fploc.rxLatencies = []; window.__fploc.mark = { ...window.__fploc.events, t: performance.now() }; })));
   const cpu0 = cpuTicks(dash.pid), w0 = Date.now();

@@ -77,6 +77,28 @@ void check_pcap(Ctx& c, const std::string& what, const std::string& path) {
   if (!in || !ok.count(magic)) add(c, what, path, "is not a pcap/pcapng capture (bad magic number)");
 }
 
+// Option fields that name a file a node writes: `*_out` (resolved against the graph's folder), the pose
+// logger's files, `stats_file` and `out_*` (opened as given: relative to the working directory).
+enum class Written { kNo, kGraphRelative, kCwdRelative };
+Written written_kind(const google::protobuf::Descriptor* d, const FieldDescriptor* f) {
+  if (f->cpp_type() != FieldDescriptor::CPPTYPE_STRING || f->is_repeated()) return Written::kNo;
+  const std::string& n = f->name();
+  if (n.size() > 4 && n.compare(n.size() - 4, 4, "_out") == 0) return Written::kGraphRelative;
+  if (n == "stats_file" || n.rfind("out_", 0) == 0) return Written::kCwdRelative;  // out_json, out_dxf (plan_diff)
+  if (d->full_name() == "fploc.PoseLoggerOptions" && (n == "file" || n == "uncertainty_file" || n == "floor_file"))
+    return Written::kCwdRelative;
+  return Written::kNo;
+}
+
+// A file a node will write: its folder must exist (the node cannot create the file otherwise and fails at set-up).
+void check_output_folder(Ctx& c, const std::string& what, const std::string& path) {
+  std::error_code ec;
+  const fs::path dir = fs::absolute(fs::path(path), ec).parent_path();
+  if (dir.empty() || fs::is_directory(dir, ec)) return;
+  add(c, what, path, "cannot be written: its folder '" + dir.string() + "' " +
+                         (fs::exists(dir, ec) ? "is not a folder" : "does not exist"));
+}
+
 void walk(Ctx& c, const std::string& prefix, const Message& m) {
   const auto* d = m.GetDescriptor();
   const auto* r = m.GetReflection();
@@ -97,6 +119,10 @@ void walk(Ctx& c, const std::string& prefix, const Message& m) {
     const std::string v = r->GetString(m, f);
     if (v.empty()) continue;
     const std::string path = resolve(c.g, v);
+    if (const Written w = written_kind(d, f); w != Written::kNo) {
+      check_output_folder(c, name, w == Written::kGraphRelative ? path : v);
+      continue;
+    }
     if (f->name() == "metadata") {
       if (c.written.count(path)) continue;  // written by another node when the graph runs
       const auto* host = d->FindFieldByName("sensor_hostname");
@@ -190,6 +216,7 @@ void check_option_values(const fploc::rt::LoadedGraph& g, std::vector<fploc::rt:
     if (!opts) continue;
     try {
       fploc::config::check_options(*opts);
+      fploc::config::check_plan_required(*opts);
     } catch (const fploc::config::OptionError& e) {
       errors.push_back({g.path, option_line(g, i, e.field), "node '" + n.name() + "': " + e.what()});
     } catch (const std::exception& e) {

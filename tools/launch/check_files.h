@@ -2,7 +2,8 @@
 // floor plans and maps (every PlanSource.file: .dxf/.csv/.json/.fpmap through the floorplan reader), OS-1
 // metadata (`metadata` fields, unless another node of the graph writes that file at run time via
 // `metadata_out`, or the driver fetches it from `sensor_hostname`), pcap captures (`pcap`: the magic
-// number) and the dashboard's `graph`. Output paths (TUM files, stats) are not checked.
+// number) and the dashboard's `graph`. Files nodes write (`*_out`, `out_*`, the pose logger's files, `stats_file`): their
+// folder must exist (docs/notes/launch-check.md).
 #pragma once
 #include <vector>
 

@@ -19,7 +19,12 @@ ControlDecision reject(const std::string& node, std::string why) {
 ControlDecision decide_control(const fploc::node_command_t& m, const ProcessEntry* c, const fploc::Graph& graph,
                                const fploc::rt::ValidateHooks& hooks) {
   if (!graph.control_token().empty() && m.token != graph.control_token()) return reject(m.node, "wrong control token");
-  if (!c) return reject(m.node, "no running node named '" + m.node + "'");
+  if (!c) {
+    std::string names;  // the graph's nodes, so a typo is easy to fix
+    for (const auto& n : graph.node())
+      if (!n.disabled()) names += (names.empty() ? "" : ", ") + n.name();
+    return reject(m.node, "no running node named '" + m.node + "' (nodes: " + (names.empty() ? "none" : names) + ")");
+  }
   ControlDecision d;
   d.node = m.node;
   if (m.action == "stop") {

@@ -300,6 +300,17 @@ bool Supervisor::on_exit(pid_t pid, const ExitStatus& st, double t) {
       wait_for_host(i, how, t - n.started_at, t);
       return true;
     }
+    // A set-up that failed (a configuration error) fails again on every restart: said once, no restart, and
+    // the launch stops (it would run on without the node, the graph not being the one that was asked for).
+    if (st.exited && st.code == fploc::rt::kSetupFailedExitCode && !n.hung) {
+      fx_.log("node '" + n.policy.name + "' failed at set-up (" + how +
+              ": a configuration error, see its 'setup failed' line): not restarted; stopping the launch");
+      n.state = State::Dead;
+      died_.push_back(n.policy.name);
+      publish(i, "dead", "setup failed (" + how + ")");
+      begin_shutdown(t);
+      return true;
+    }
     settle_exit(i, failed, how, t, t - n.started_at, t);
     return true;
   }

@@ -22,7 +22,11 @@
 #include <string>
 #include <vector>
 
+#include <fploc/pose_t.hpp>
+
 #include "fploc/core/text_out.h"
+#include "fploc/floorplan/io.h"
+#include "fploc/runtime/robot.h"
 #include "fploc/runtime/bus.h"
 #include "fploc/runtime/compose.h"
 #include "fploc/runtime/graph.h"
@@ -102,7 +106,15 @@ int main(int argc, char** argv) {
     for (auto* n : loggers) {
       const std::string file =
           n == main_logger ? out : (o.parent_path() / (o.stem().string() + "." + n->name() + ".tum")).string();
-      n->mutable_pose_logger()->set_file(file);
+      auto* pl = n->mutable_pose_logger();
+      pl->set_file(file);
+      // Its other files, when relative (graphs/ndt.pbtxt: "ndt.unc"), go beside --out's file, not into the
+      // working directory: a replay writes where --out says.
+      const auto beside = [&](const std::string& f) {
+        return std::filesystem::path(f).is_relative() ? (std::filesystem::path(file).parent_path() / f).string() : f;
+      };
+      if (!pl->uncertainty_file().empty()) pl->set_uncertainty_file(beside(pl->uncertainty_file()));
+      if (!pl->floor_file().empty()) pl->set_floor_file(beside(pl->floor_file()));
       if (loggers.size() > 1) std::cerr << "fploc replay: " << n->name() << " -> " << file << "\n";
     }
   }
@@ -146,6 +158,50 @@ int main(int argc, char** argv) {
         sep = "; ";
       }
       std::cerr << "\n";
+    }
+  }
+
+  // A start pose outside the plan it is to be found in (a typo, the wrong plan, another frame): the run would
+  // go on LOST from the first scan. One warning per node, the replay still runs.
+  for (const auto& n : g.graph.node()) {
+    if (n.disabled() || !find_registration(type_from_executable(n.executable()))) continue;
+    const auto opts = node_options(n);
+    if (!opts) continue;
+    const auto* d = opts->GetDescriptor();
+    const auto* r = opts->GetReflection();
+    const auto* pf = d->FindFieldByName("plan");
+    const auto* ipf = d->FindFieldByName("initial_pose");
+    if (!pf || !ipf || pf->type() != google::protobuf::FieldDescriptor::TYPE_MESSAGE ||
+        ipf->type() != google::protobuf::FieldDescriptor::TYPE_MESSAGE || !r->HasField(*opts, ipf))
+      continue;
+    const auto& plan = r->GetMessage(*opts, pf);
+    const auto& ip = r->GetMessage(*opts, ipf);
+    const auto* ipd = ip.GetDescriptor();
+    const auto* fx = ipd->FindFieldByName("x");
+    const auto* fy = ipd->FindFieldByName("y");
+    const auto* ff = plan.GetDescriptor()->FindFieldByName("file");
+    if (!fx || !fy || !ff) continue;
+    const std::string file = plan.GetReflection()->GetString(plan, ff);
+    if (file.empty()) continue;
+    const std::string path = std::filesystem::path(file).is_absolute() || g.dir.empty()
+                                 ? file
+                                 : (std::filesystem::path(g.dir) / file).lexically_normal().string();
+    const double x = ip.GetReflection()->GetDouble(ip, fx), y = ip.GetReflection()->GetDouble(ip, fy);
+    try {
+      const auto* pd = plan.GetDescriptor();
+      const auto* pr = plan.GetReflection();
+      std::vector<std::string> layers;
+      for (int k = 0; k < pr->FieldSize(plan, pd->FindFieldByName("layers")); ++k)
+        layers.push_back(pr->GetRepeatedString(plan, pd->FindFieldByName("layers"), k));
+      const auto box = fploc::load_floor_plan(path, layers, pr->GetString(plan, pd->FindFieldByName("units")),
+                                              pr->GetString(plan, pd->FindFieldByName("floor")))
+                           .bounds();
+      if (!box.empty() && (x < box.min.x() || x > box.max.x() || y < box.min.y() || y > box.max.y()))
+        std::cerr << "fploc replay: warning: " << n.name() << "'s initial pose (" << x << ", " << y
+                  << ") lies outside its plan's extent (x " << box.min.x() << " .. " << box.max.x() << ", y "
+                  << box.min.y() << " .. " << box.max.y() << " m, " << path << ")\n";
+    } catch (const std::exception&) {
+      // the node says what is wrong with its plan when it loads it
     }
   }
 
@@ -197,6 +253,20 @@ int main(int argc, char** argv) {
         ctx->first->writeEvent(&ev);
       }, new std::pair<lcm::LogFile*, int64_t*>(rec.get(), &t_last));
     }
+    // The estimate's status (pose_t.status 0 OK, 1 POOR, 2 LOST) on the pose channel of the main pose logger
+    // (FPLOC_POSE when there is none), for the summary line: a run that was LOST throughout said only "done".
+    std::string pose_channel = "FPLOC_POSE";
+    for (const auto& n : g.graph.node())
+      if (!n.disabled() && type_from_executable(n.executable()) == "pose_logger")
+        for (const auto& in : n.input())
+          if (in.port() == "pose" && (pose_channel == "FPLOC_POSE" || in.channel() == "FPLOC_POSE")) pose_channel = in.channel();
+    pose_channel = fploc::rt::robot_channel(fploc::rt::robot_of(&g.graph), pose_channel);
+    int64_t status_count[4] = {0, 0, 0, 0};  // OK, POOR, LOST, other
+    bus.lcm().subscribeFunction(pose_channel, +[](const lcm::ReceiveBuffer* rb, const std::string&, int64_t* count) {
+      fploc::pose_t p;
+      if (p.decode(rb->data, 0, int(rb->data_size)) < 0) return;
+      ++count[p.status >= 0 && p.status <= 2 ? p.status : 3];
+    }, status_count);
     std::map<std::string, int64_t> per_channel;
     std::map<std::string, int64_t> log_channels;  // every channel of the log (an error names them when none is fed)
     const double w0 = now_s();
@@ -243,6 +313,11 @@ int main(int argc, char** argv) {
     std::cerr << "fploc replay: " << published << " of " << events << " log events fed in " << wall << " s (log span "
               << span << " s, real-time factor " << (wall > 0 ? span / wall : 0.0) << ")"
               << (node_errors ? ", " + std::to_string(node_errors) + " node errors" : std::string()) << "\n";
+    const int64_t poses = status_count[0] + status_count[1] + status_count[2] + status_count[3];
+    std::cerr << "fploc replay: " << poses << " poses on " << pose_channel << ": " << status_count[0] << " OK, "
+              << status_count[1] << " POOR, " << status_count[2] << " LOST"
+              << (status_count[3] ? ", " + std::to_string(status_count[3]) + " other status" : std::string())
+              << (poses > 0 && status_count[2] == poses ? " (every pose LOST: no estimate of the run)" : "") << "\n";
     if (json) {
       nlohmann::json j{{"log_events", events},
                        {"events_fed", published},
@@ -252,7 +327,9 @@ int main(int argc, char** argv) {
                        {"real_time_factor", wall > 0 ? span / wall : 0.0},
                        {"handler_ms", total_ms},
                        {"handler_cpu_ms", total_cpu_ms},
-                       {"nodes", nodes}};
+                       {"nodes", nodes},
+                       {"poses", {{"channel", pose_channel}, {"ok", status_count[0]}, {"poor", status_count[1]},
+                                  {"lost", status_count[2]}}}};
       if (!out.empty()) j["out"] = out;
       std::cout << fploc::json_text(j) << std::endl;
     }

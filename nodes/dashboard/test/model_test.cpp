@@ -56,6 +56,33 @@ TEST(DashboardModel, AteMatchesByUtimeInEitherOrder) {
   EXPECT_EQ(h["gt"].size(), 2u);
 }
 
+// A page opened mid-run draws the roll/pitch and rate plots from /api/history: the ground truth's rows carry
+// roll, pitch and yaw (they had utime, x, y, z only), and the frame/pose rates of each tick are kept with the
+// newest pose's time (they had no history).
+TEST(DashboardModel, HistoryHasGroundTruthAttitudeAndRates) {
+  Model m;
+  auto g = gt(1000000, 1, 2);
+  g.orientation[0] = std::sin(0.05);  // roll 0.1 rad
+  g.orientation[3] = std::cos(0.05);
+  m.on_ground_truth(g, 0.0, 0);
+  m.on_pose(pose(1000000, 1, 2), 0.0, 0);
+  m.on_pose(pose(1100000, 1, 2), 0.1, 0);
+  m.tick(0.5, 0);
+  m.on_pose(pose(1200000, 1, 2), 0.6, 0);
+  m.tick(1.0, 0);
+  auto h = json::parse(m.history_json());
+  ASSERT_EQ(h["fields_gt"], json({"utime", "x", "y", "z", "roll", "pitch", "yaw"}));
+  ASSERT_EQ(h["gt"].size(), 1u);
+  EXPECT_NEAR(h["gt"][0][4].get<double>(), 0.1, 1e-6);
+  EXPECT_NEAR(h["gt"][0][5].get<double>(), 0.0, 1e-6);
+  ASSERT_EQ(h["fields_rates"], json({"utime", "frame_rate_hz", "pose_rate_hz"}));
+  ASSERT_EQ(h["rates"].size(), 2u);
+  EXPECT_EQ(h["rates"][0][0], 1100000);
+  EXPECT_EQ(h["rates"][1][0], 1200000);
+  EXPECT_GT(h["rates"][1][2].get<double>(), 0.0);
+  EXPECT_EQ(json::parse(m.history_json(1150000))["rates"].size(), 1u);  // `since` applies
+}
+
 // The history keeps each pose's floor (the page draws only the trail on the floor it shows): the floor's name as
 // the row's last field, null when the pose did not say.
 TEST(DashboardModel, HistoryKeepsEachPosesFloor) {
@@ -169,6 +196,30 @@ TEST(DashboardModel, ExpectedNodeIsListedBeforeItsFirstHeartbeat) {
   s.state = "running";
   m.on_status(s, 3.0);
   EXPECT_EQ(node()["health"], "ok");
+}
+
+// The launcher answers a refused control request (`fploc node restart nosuch`) with a node_status_t of state
+// "rejected" under the requested name, for `fploc node` to print: that is no node, and no state of a node.
+TEST(DashboardModel, ARejectedControlRequestIsNoNodeRow) {
+  Model m;
+  m.expect_node("optimizer", "fploc-optimizer", 0.0);
+  fploc::node_status_t s{};
+  s.node = "optimizer";
+  s.state = "running";
+  m.on_status(s, 0.5);
+  fploc::node_status_t r{};
+  r.node = "nosuch";
+  r.state = "rejected";
+  r.reporter = "launcher";
+  r.last_error = "control: no running node named 'nosuch'";
+  m.on_status(r, 1.0);
+  r.node = "optimizer";  // a refused request about a node that runs leaves its row as it was
+  m.on_status(r, 1.0);
+  m.tick(1.2, 0);
+  const auto nodes = json::parse(m.state_json())["nodes"]["nodes"];
+  ASSERT_EQ(nodes.size(), 1u) << nodes.dump();
+  EXPECT_EQ(nodes[0]["node"], "optimizer");
+  EXPECT_EQ(nodes[0]["health"], "ok") << nodes.dump();
 }
 
 TEST(DashboardModel, FeaturesJsonIsValidAndDecimated) {

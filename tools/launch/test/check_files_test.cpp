@@ -64,3 +64,38 @@ TEST(CheckFiles, RealPlanAndRuntimeWrittenMetadataPass) {
                         "node { name: \"off\" executable: \"z\" disabled: true matcher { plan { file: \"gone.json\" } } }\n");
   EXPECT_TRUE(e.empty()) << e[0].str();
 }
+
+// A file a node writes in a folder that does not exist: the node fails at set-up, so --check says it.
+TEST(CheckFiles, OutputFolderMustExist) {
+  Dir d;
+  auto e = check(d, "node { name: \"log\" executable: \"x\" pose_logger { file: \"/nonexistent-fploc/dir/p.tum\""
+                    " uncertainty_file: \"" + (d.p / "p.unc").string() + "\" } }\n"
+                    "node { name: \"s\" executable: \"y\" sim { metadata_out: \"no-dir/m.json\" } }\n"
+                    "node { name: \"d\" executable: \"z\" plan_diff { out_json: \"/nonexistent-fploc/d.json\" } }\n");
+  ASSERT_EQ(e.size(), 3u) << (e.empty() ? "" : e[0].str());
+  EXPECT_NE(e[2].message.find("plan_diff.out_json"), std::string::npos) << e[2].str();
+  EXPECT_NE(e[0].message.find("node 'log': pose_logger.file '/nonexistent-fploc/dir/p.tum' cannot be written: its "
+                              "folder '/nonexistent-fploc/dir' does not exist"), std::string::npos) << e[0].str();
+  EXPECT_NE(e[1].message.find("sim.metadata_out"), std::string::npos) << e[1].str();
+  EXPECT_NE(e[1].message.find((d.p / "no-dir").string()), std::string::npos) << e[1].str();
+}
+
+// Names the node checks at start (matcher::lookup_names, the map builder's own list) and a plan it needs.
+TEST(CheckFiles, UnknownLookupAndMissingPlanAreOptionErrors) {
+  Dir d;
+  LoadedGraph g;
+  std::vector<GraphError> errors;
+  ASSERT_TRUE(load_graph(d.write("g.pbtxt", "node { name: \"m\" executable: \"x\"\n"
+                                              "  matcher { plan { file: \"p.json\" }\n    lookup: \"anf-exact\" } }\n"
+                                              "node { name: \"o\" executable: \"y\" optimizer { lookup: \"kdtree\" } }\n"
+                                              "node { name: \"r\" executable: \"z\" relocalizer { plan { file: \"p.json\" } lookup: \"brute-force\" } }\n"),
+                         g, errors));
+  fploc::launch::check_option_values(g, errors);
+  ASSERT_EQ(errors.size(), 2u) << (errors.empty() ? "" : errors[0].str());
+  EXPECT_EQ(errors[0].line, 3);
+  EXPECT_NE(errors[0].message.find("node 'm': matcher.lookup: unknown look-up 'anf-exact' (use \"annf-exact\", "),
+            std::string::npos) << errors[0].str();
+  EXPECT_NE(errors[0].message.find("\"kdtree\""), std::string::npos) << errors[0].str();
+  EXPECT_NE(errors[1].message.find("node 'o': optimizer.plan.file: no floor plan given"), std::string::npos)
+      << errors[1].str();
+}

@@ -18,6 +18,18 @@ echo "$out" | grep -qxF "$R/graphs/demo.pbtxt:$line: node 'matcher': matcher.los
   fail "--set matcher.loss=bogus: no error naming file:$line, node and option"
 [ "$(echo "$out" | grep -c "node '")" = 1 ] || fail "--set matcher.loss=bogus: not exactly one error"
 
+# A look-up name the matcher would refuse at start (the map builder's own list, matcher::lookup_names).
+out="$(timeout 60 "$L" --check --skip-hosts "$R/graphs/demo.pbtxt" --set matcher.lookup=kd 2>&1)"; rc=$?
+[ "$rc" = 1 ] || fail "--set matcher.lookup=kd: exit $rc, expected 1"
+echo "$out" | grep -qF "node 'matcher': matcher.lookup: unknown look-up 'kd' (use \"annf-exact\"" ||
+  fail "--set matcher.lookup=kd: no error naming the option and the valid names"
+
+# Output files in a folder that does not exist (the pose loggers could not open them at start).
+out="$(FPLOC_DEMO_DIR=/nonexistent-fploc/dir timeout 60 "$L" --check --skip-hosts "$R/graphs/demo.pbtxt" 2>&1)"; rc=$?
+[ "$rc" = 1 ] || fail "FPLOC_DEMO_DIR=/nonexistent-fploc/dir: exit $rc, expected 1"
+echo "$out" | grep -qF "pose_logger.file '/nonexistent-fploc/dir/fploc-demo-poses.tum' cannot be written: its folder '/nonexistent-fploc/dir' does not exist" ||
+  fail "FPLOC_DEMO_DIR=/nonexistent-fploc/dir: no error naming the output file"
+
 # A value in the file: the option's own line.
 check_file() {  # $1: sed expression applied to a copy of the demo graph (plans made absolute)
   sed -e "s#\"\\.\\./data/#\"$R/data/#g" -e "$1" "$R/graphs/demo.pbtxt" > "$T/g.pbtxt"
@@ -35,6 +47,10 @@ check_file 's#window: 10 alpha#window: -3 alpha#'
 line="$(grep -n 'window: -3' "$T/g.pbtxt" | cut -d: -f1)"
 echo "$out" | grep -qxF "$T/g.pbtxt:$line: node 'optimizer': optimizer.window: must be > 0 (0 = the default), got -3" ||
   fail "optimizer window -3: no error at line $line"
+# A matcher without a plan.
+check_file '/^  matcher {/ s#plan { file: "[^"]*" } ##'
+[ "$rc" = 1 ] || fail "matcher without plan: exit $rc, expected 1"
+echo "$out" | grep -qF "node 'matcher': matcher.plan.file: no floor plan given" || fail "matcher without plan: no error"
 # A graph without a node to run (an empty file, comments only, every node disabled): one error, exit 1.
 printf '# nothing here\n' > "$T/empty.pbtxt"
 out="$(timeout 60 "$L" --check --skip-hosts "$T/empty.pbtxt" 2>&1)"; rc=$?

@@ -1,5 +1,6 @@
 // The launcher's supervision policy with a fake clock and fake processes: restart policy and backoff,
 // giving up, heartbeat timeout, ordered shutdown with escalation, control requests, remote nodes whose host is away.
+#include "control.h"
 #include "supervisor.h"
 #include "udp_links.h"
 
@@ -609,4 +610,43 @@ TEST(Supervisor, AWaitingNodeIsReportedStoppableAndMakesTheExitCodeOne) {
   const size_t probes = w.probes.size();
   s.tick(30);
   EXPECT_EQ(w.probes.size(), probes) << "probing during the shutdown";
+}
+
+// A node whose set-up failed (exit code kSetupFailedExitCode: its options or files) would fail the same way
+// on every restart: it is not restarted, that is said once, and the launch stops with exit code 1.
+TEST(Supervisor, ASetupFailureIsNotRestartedAndStopsTheLaunch) {
+  FakeWorld w;
+  Supervisor s({node("matcher"), node("b")}, {}, w);
+  s.start_all(0);
+  ASSERT_EQ(w.starts.size(), 2u);
+  s.on_exit(s.pid(0), code(fploc::rt::kSetupFailedExitCode), 0.3);
+  EXPECT_NE(std::find(w.published.begin(), w.published.end(), std::pair<size_t, std::string>(0, "dead")),
+            w.published.end());
+  EXPECT_TRUE(s.shutting_down());
+  for (double t = 0.4; t < 3; t += 0.1) s.tick(t);
+  EXPECT_EQ(w.starts.size(), 2u) << "restarted after a set-up failure";
+  EXPECT_EQ(std::count_if(w.logs.begin(), w.logs.end(),
+                          [](const std::string& l) { return l.find("failed at set-up") != std::string::npos; }),
+            1);
+  ASSERT_FALSE(w.signals_to(1).empty()) << "the other node was not stopped";
+  EXPECT_EQ(w.signals_to(1).front(), SIGINT);
+  s.on_exit(s.pid(1), code(0), 3.1);
+  EXPECT_EQ(s.finished(), std::optional<int>(1));
+  EXPECT_EQ(w.logs.back(), "all nodes stopped; dead during the run: 'matcher' (exit code 1)");
+}
+
+// A control request for a name that is not in the graph is refused naming the graph's nodes.
+TEST(Control, UnknownNodeIsRefusedListingTheNodes) {
+  fploc::Graph g;
+  g.add_node()->set_name("matcher");
+  g.add_node()->set_name("optimizer");
+  auto* off = g.add_node();
+  off->set_name("old");
+  off->set_disabled(true);
+  fploc::node_command_t m{};
+  m.node = "nosuch";
+  m.action = "restart";
+  const auto d = decide_control(m, nullptr, g, fploc::rt::ValidateHooks{});
+  EXPECT_EQ(d.kind, ControlDecision::Reject);
+  EXPECT_EQ(d.error, "no running node named 'nosuch' (nodes: matcher, optimizer)");
 }

@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <options/common.pb.h>
+
 namespace fploc::config {
 
 // An option value a node refuses (out of range, an unknown name): what() is "BLOCK.FIELD: why" (e.g.
@@ -32,9 +34,19 @@ bool given(T value, const char* block, const char* field) {
   return value > 0;
 }
 
+// `lookup` of matcher/optimizer/relocalizer: "" (the default) or one of matcher::lookup_names() (the list
+// the map builder itself checks against); else an OptionError naming the valid ones.
+void check_lookup(const std::string& lookup, const char* block);
+// A node that cannot run without a plan (matcher, optimizer, relocalizer, amcl, ndt, plan_diff, grid2d):
+// an empty plan.file is an OptionError "BLOCK.plan.file: no floor plan given".
+void check_plan_given(const PlanSource& plan, const char* block);
+
 // Maps `options` (one of Node.options' messages) to every Config the node builds from it, i.e. runs the
 // same checks (the config_of functions of this library). Throws OptionError (or std::runtime_error) as the
 // node's setup would; options with no mapping here pass. Files are not read (launch's check_files does).
 void check_options(const google::protobuf::Message& options);
+// The options' plan, for the nodes that cannot run without one (check_plan_given): `fploc launch --check`
+// runs it beside check_options (which also maps option blocks that are not complete graphs, e.g. in tests).
+void check_plan_required(const google::protobuf::Message& options);
 
 }  // namespace fploc::config

@@ -34,11 +34,18 @@
 
 namespace fploc::rt {
 
+// What a live node that falls behind does with the messages queued on an input (graph: Port.queue).
+// kLatest: the runtime reads everything queued first, then calls the handler once with the newest
+// message of the port; the older ones are dropped and counted in telemetry as the port's drops. Composed
+// replay (`fploc replay`) ignores it and delivers every message.
+enum class Queue { kAll, kLatest };
+
 struct PortSpec {
   std::string name;
   std::string lcm_type;          // e.g. "fploc.scan_t"
   std::string default_channel;   // used when the graph does not map the port ("" = not connected)
   bool output = false;
+  Queue queue = Queue::kAll;     // inputs: the node's default (the graph's Port.queue overrides it)
 };
 
 struct NodeSpec {
@@ -49,8 +56,8 @@ struct NodeSpec {
 };
 
 template <class Msg>
-PortSpec input(std::string name, std::string default_channel) {
-  return {std::move(name), std::string("fploc.") + Msg::getTypeName(), std::move(default_channel), false};
+PortSpec input(std::string name, std::string default_channel, Queue queue = Queue::kAll) {
+  return {std::move(name), std::string("fploc.") + Msg::getTypeName(), std::move(default_channel), false, queue};
 }
 template <class Msg>
 PortSpec output(std::string name, std::string default_channel) {
@@ -115,6 +122,9 @@ class Context {
   void set_robot(const std::string& r);
   std::string ns(const std::string& channel) const;
   const std::string& channel(const std::string& port) const;
+  // The queue policy of an input: the graph's Port.queue (set_queue_overrides), else the spec's.
+  Queue queue(const std::string& port) const;
+  void set_queue_overrides(std::vector<std::pair<std::string, Queue>> q) { queue_overrides_ = std::move(q); }
 
   template <class Msg>
   Publisher<Msg> advertise(const std::string& port);
@@ -166,6 +176,7 @@ class Context {
   int restarts_ = 0;
   int status_changes_ = 0;  // status_changed() lines printed
   std::string robot_;
+  std::vector<std::pair<std::string, Queue>> queue_overrides_;
   NodeStats stats_;
 };
 
@@ -191,6 +202,12 @@ struct Registrar {
 
 // Entry point of every node executable (runtime/src/node_main.cpp calls it).
 int node_main(int argc, char** argv);
+// The live loop's LCM step (used by node_main; public for tests): handles what LCM has queued (for at
+// most ~max_s, at least one message), then calls each keep-latest input's handler with its newest
+// message. Returns the number of handler calls.
+int dispatch_live(Bus& bus, double max_s = 0.1);
+// Calls the keep-latest handlers that hold a message (dispatch_live's second half; also at shutdown).
+int run_latest();
 
 // ---- template implementation ----------------------------------------------------------------
 template <class Msg>

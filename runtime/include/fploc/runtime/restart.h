@@ -7,6 +7,11 @@
 
 namespace fploc::rt {
 
+// A node whose setup() failed (its options, plan, files: "[NAME] setup failed: ..." on stderr and a "dead"
+// heartbeat) exits with this code (sysexits' EX_CONFIG). `fploc launch` does not restart it: the same
+// set-up would fail again. It says so once and stops the launch (docs/notes/launch-check.md).
+constexpr int kSetupFailedExitCode = 78;
+
 struct RestartDecision {
   bool restart = false;   // start again after `delay`
   bool give_up = false;   // restart wanted but the window is full: the node is dead

@@ -1,5 +1,6 @@
 // Telemetry statistics kept by the runtime for each node (no LCM here; unit-tested on its own).
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <deque>
 #include <string>
@@ -48,9 +49,13 @@ struct PortCounters {
   int64_t undecodable = 0;
   int64_t last_seq = -1;
   LatencyWindow latency;       // inputs: this port's handler latency this period
+  // Messages a keep-latest input skipped since its last delivery (already in `dropped`): the gap they
+  // leave in the sequence is not counted again.
+  int64_t superseded = 0;
   // Sequence gaps on an input are counted as drops; a restart of the publisher (seq going back) is not.
   void observe_seq(int64_t seq) {
-    if (last_seq >= 0 && seq > last_seq + 1) dropped += seq - last_seq - 1;
+    if (last_seq >= 0 && seq > last_seq + 1) dropped += std::max<int64_t>(0, seq - last_seq - 1 - superseded);
+    superseded = 0;
     last_seq = seq;
   }
 };

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# `fploc replay` ends with one line counting the poses OK / POOR / LOST on the pose channel (JSON "poses"), and
+# warns when a node's initial pose lies outside its plan's extent (a run started there was LOST throughout and
+# said only "N node errors"). fploc replay runs over memq:// (no network).
+set -uo pipefail
+BIN="${FPLOC_BUILD_DIR:?}/bin"; R="${FPLOC_ROOT:?}"
+T="$(mktemp -d)"; trap 'rm -rf "$T"' EXIT
+fail() { echo "FAIL: $1"; tail -5 "$T/err"; exit 1; }
+"$BIN/fploc-sim" --scenario room-small-loop-fast --seed 3 --duration 4 --out "$T/log.lcm" --gt "$T/gt.tum" 2> "$T/sim.log" ||
+  { cat "$T/sim.log"; exit 1; }
+read -r X Y YAW < <(python3 -c "
+import math
+t,x,y,z,qx,qy,qz,qw=map(float,open('$T/gt.tum').readline().split())
+print(x,y,math.atan2(2*(qw*qz+qx*qy),1-2*(qy*qy+qz*qz)))")
+
+# From the true start: a summary line, mostly OK, no warning.
+"$BIN/fploc-replay" --graph "$R/graphs/replay.pbtxt" --log "$T/log.lcm" --out "$T/a.tum" --json \
+  --set matcher.initial_pose.x="$X" --set matcher.initial_pose.y="$Y" --set matcher.initial_pose.yaw="$YAW" > "$T/a.json" 2> "$T/err" ||
+  fail "replay from the true start: exit $?"
+line="$(grep -E '^fploc replay: [0-9]+ poses on FPLOC_POSE: [0-9]+ OK, [0-9]+ POOR, [0-9]+ LOST' "$T/err")" || fail "no pose summary line"
+echo "$line"
+rows="$(grep -vc '^#' "$T/a.tum")"
+python3 - "$T/a.json" "$rows" <<'PY' || exit 1
+import json, sys
+j = json.load(open(sys.argv[1])); p = j["poses"]; rows = int(sys.argv[2])
+n = p["ok"] + p["poor"] + p["lost"]
+assert n == rows, f"summary counts {n} poses, the TUM file has {rows} rows"
+assert p["ok"] > 0.8 * n, f"from the true start most poses should be OK: {p}"
+PY
+grep -q "outside its plan's extent" "$T/err" && fail "warning for a start inside the plan"
+
+# From (40, 40), far outside the 16 x 12.5 m room: a warning naming the node, and the summary says LOST.
+"$BIN/fploc-replay" --graph "$R/graphs/replay.pbtxt" --log "$T/log.lcm" --out "$T/b.tum" \
+  --set matcher.initial_pose.x=40 --set matcher.initial_pose.y=40 > /dev/null 2> "$T/err" || true
+grep -qE "^fploc replay: warning: matcher's initial pose \(40, 40\) lies outside its plan's extent \(x " "$T/err" ||
+  fail "no warning for an initial pose outside the plan"
+
+grep -E '^fploc replay: [0-9]+ poses on FPLOC_POSE' "$T/err"
+# graphs/ndt.pbtxt's uncertainty file ("ndt.unc", relative) is written beside --out, not into the working directory.
+mkdir -p "$T/out" "$T/cwd"
+(cd "$T/cwd" && "$BIN/fploc-replay" --graph "$R/graphs/ndt.pbtxt" --log "$T/log.lcm" --out "$T/out/n.tum" \
+  --set ndt.initial_pose.x="$X" --set ndt.initial_pose.y="$Y" --set ndt.initial_pose.yaw="$YAW" > /dev/null 2> "$T/err") ||
+  fail "ndt replay: exit $?"
+[ -s "$T/out/ndt.unc" ] || fail "ndt.unc not written beside --out ($(ls "$T/out" "$T/cwd" | tr '\n' ' '))"
+[ -e "$T/cwd/ndt.unc" ] && fail "ndt.unc written into the working directory"
+echo OK
