@@ -223,6 +223,7 @@ UncertaintyState UncertaintyTracker::update(int64_t utime, const Eigen::Matrix3d
       std::snprintf(b, sizeof b, "weak fit: %.0f %% of the points on the plan", 100 * inlier_ratio);
       s.status = matcher::FitStatus::kPoor;
       s.text = b;
+      s.weak_fit = true;
     } else if (cfg_.max_contradicted > 0 && contradicted > cfg_.max_contradicted) {
       std::snprintf(b, sizeof b, "the map says empty where %.0f %% of the points it knows lie", 100 * contradicted);
       s.status = matcher::FitStatus::kPoor;

@@ -197,6 +197,23 @@ std::optional<Pose> Localizer::optimize(const FeatureFrame& f, const FramePose& 
     }
     if (uncertainty_.status == matcher::FitStatus::kOk || m->status == matcher::FitStatus::kLost)
       have_rival_ = false;  // confirmed, or lost again: a new re-acquisition searches again
+    // A weak fit that agrees with the dead reckoning in a stretch bounds the dead reckoning's claimed uncertainty
+    // (UncertaintyConfig::dr_weak_fit_sigma): the frozen anchor moves to the dead-reckoned pose itself, with the tighter
+    // of its covariance and the fix's plus their offset's second moment.
+    if (cfg_.uncertainty.dr_weak_fit_sigma > 0 && uncertainty_.weak_fit && tracker_.wants_dead_reckoning() && dr &&
+        have_frozen_ && dr_odometry_ && dr_last_utime_ == f.utime) {
+      const Eigen::Vector3d d = pose_difference(m->pose, dr->pose);
+      const Eigen::Matrix3d& fix_cov = uncertainty_.covariance;
+      if (mahalanobis2(d, fix_cov + dr->covariance) <= chi2_3dof_of_sigmas(cfg_.uncertainty.dr_weak_fit_sigma)) {
+        frozen_.utime = f.utime;
+        frozen_.fix = dr->pose;
+        frozen_.covariance = tighter_of(dr->covariance, fix_cov + d * d.transpose());
+        frozen_.odometry = dr_last_;
+        frozen_.path_m = dr_path_m_;
+        frozen_.turn_rad = dr_turn_rad_;
+        frozen_.open.setZero();
+      }
+    }
     last_off_dead_reckoning_ = uncertainty_.off_dead_reckoning;
     if (!tracker_.wants_dead_reckoning()) have_frozen_ = false;  // the stretch (if any) is over
     if (cfg_.uncertainty.dead_reckoning_gate_sigma > 0 && dr_odometry_ && dr_last_utime_ == f.utime &&

@@ -176,6 +176,17 @@ struct UncertaintyConfig {
   // robot's odometry predicts the frame (as the refit); the optimizer node turns it off when its `reseed` output is
   // not connected.
   bool dr_reseed_when_lost = true;
+  // A stretch's frozen anchor grows the dead-reckoned covariance with the path (dr_sigma_per_m), whatever the fixes in
+  // it say: a stretch of right fixes published POOR only for their weak fit (a wall moved 0.2 m leaves 31-41 % of the
+  // points on the plan) made the claimed 1-sigma 0.25 m after 14 s while the dead reckoning was 0.01-0.07 m off, and a
+  // re-acquired fix 0.4 m off then passed its gate (corridor s3 mixed with the column rule). A weak fit (the tracker's
+  // `weak_fit`: POOR for that alone) within dr_weak_fit_sigma (as gate_sigma: the 3-DoF chi-square quantile) of the
+  // dead-reckoned pose bounds it: the anchor moves to the dead-reckoned pose itself, its covariance the tighter of the
+  // dead-reckoned one and the fix's plus their offset's second moment. The pose is the odometry's, not the fix's (a weak
+  // fit may be held off by cabinet faces; a dead reckoning moved to such fits published corridor s2 shelves OK 0.44 m
+  // off); only its claimed uncertainty is bounded by what the two agree on (a fix off by d leaves it at least d).
+  // 0: off.
+  double dr_weak_fit_sigma = 1.0;
 };
 
 // A frame's pose dead-reckoned from the pose last published OK, with its covariance (x, y, yaw).
@@ -198,6 +209,7 @@ struct UncertaintyState {
   double dead_reckoned_sigma = 0;      // Mahalanobis distance of the fix from the dead-reckoned pose (0: not tested)
   bool off_dead_reckoning = false;     // the fix failed that gate (published POOR)
   bool confirming = false;             // a re-acquisition being confirmed (confirm_fixes)
+  bool weak_fit = false;               // published POOR for its weak fit alone (weak_fit_ratio): otherwise an OK fix
 };
 
 class UncertaintyTracker {
