@@ -113,6 +113,12 @@ if [ -n "$SHIP" ]; then
   # --channel picks which laser is LASER_SCAN; the other one moves to its suffixed name instead of sharing it.
   "$B/fploc-import" "$SHIP" --out "$T/ship2.lcm" --channel /guardian/laser_horizontal_back=LASER_SCAN --json --quiet > "$T/ship2.json"
   check "$T/ship2.json" "j['written']['LASER_SCAN']==418 and j['written']['LASER_SCAN_GUARDIAN_LASER_TILT_FRONT']==421"
+  # The level laser renamed: LASER_SCAN is the other (tilting) one, with a warning (not an error).
+  "$B/fploc-import" "$SHIP" --out "$T/ship3.lcm" --channel /guardian/laser_horizontal_back=BACK --json --quiet > "$T/ship3.json"
+  check "$T/ship3.json" "j['written']['BACK']==418 and j['written']['LASER_SCAN']==421 and j['errors']==[] and any('LASER_SCAN (/guardian/laser_tilt_front)' in w for w in j['warnings']) and 'laser_choice' not in j"
+  # --topics leaves tf out of the log, not out of the mounts.
+  "$B/fploc-import" "$SHIP" --out "$T/ship4.lcm" --topics /guardian/laser_horizontal_back,/guardian/odom --start 2 --json --quiet > "$T/ship4.json"
+  check "$T/ship4.json" "(lambda b: b['mount_found'] and b['level'] and b['channel']=='LASER_SCAN' and abs(b['x_m']+0.432)<0.01)(j['lasers']['/guardian/laser_horizontal_back'])"
   [ "$(wc -l < "$T/odom.tum")" -ge 800 ] || { echo "odom.tum too short"; exit 1; }
   # README's recipe for a 2D laser: graphs/lidar2d.pbtxt on the map_server map, --out EST.tum. Its four pose
   # loggers all wrote EST.tum (overwriting each other's bytes: a torn last line); now EST.tum is the pipeline's

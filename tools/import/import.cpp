@@ -101,9 +101,10 @@ bool ends_with(const std::string& s, const std::string& tail) {
 // an abort); as text (the summary, --list, the errors) names are printed with \xHH escapes (fploc/core/text_out.h).
 std::string dump_json(const nlohmann::json& j) { return json_text(j, 2); }
 
-// Where the planar lasers sit (laser_mounts.h): tf kept at most every 20 ms per edge, each laser's frame from its
-// first scan, the odometry's robot frame.
-constexpr int64_t kMountTfGapNs = 20'000'000;
+// Where the planar lasers sit (laser_mounts.h): tf kept at most every 100 ms per edge (a sample equal to the edge's
+// last one is not kept: a static edge published again and again is one sample), each laser's frame from its first
+// scan, the odometry's robot frame.
+constexpr int64_t kMountTfGapNs = 100'000'000;
 struct LaserSurvey {
   std::vector<std::string> topics;              // in the order of their first scan
   std::map<std::string, std::string> frame;     // topic -> header.frame_id of its first scan
@@ -121,8 +122,11 @@ struct LaserSurvey {
   }
 };
 
-// A first pass over a recording with more than one laser, for the one LASER_SCAN gets: the whole file (a 2D
-// recording is small), given up at the first Ouster packet or point cloud (a 3D recording: no choice made).
+// A first pass for the laser LASER_SCAN gets, when the recording has more than one: the whole file (a laser on a
+// tilting unit may hold still for seconds first), given up at the first Ouster packet or point cloud (a 3D
+// recording) and after kSurveyProbeS seconds of recording with fewer than two lasers seen (lasers scan at 5 Hz or
+// more: one laser or none, no choice to make). False: no choice to make.
+constexpr double kSurveyProbeS = 5;
 bool survey_lasers(const std::string& path, const std::set<std::string>& wanted, LaserSurvey& s) {
   std::string err;
   auto rec = open_recording(path, &err);
@@ -131,7 +135,10 @@ bool survey_lasers(const std::string& path, const std::set<std::string>& wanted,
   LaserScanView laser;
   Odometry odom;
   std::vector<Transform> ts;
+  int64_t first_ns = INT64_MIN;
   while (rec->next(m)) {
+    if (first_ns == INT64_MIN) first_ns = m.time_ns;
+    if (s.topics.size() < 2 && seconds(m.time_ns) - seconds(first_ns) > kSurveyProbeS) return false;
     const Connection& c = rec->connections().at(m.conn);
     const Kind k = kind_of(c);
     if (k == Kind::kOusterPackets || k == Kind::kCloud) return false;
@@ -145,7 +152,7 @@ bool survey_lasers(const std::string& path, const std::set<std::string>& wanted,
       s.odom_child = odom.pose.child_frame_id;
     }
   }
-  return true;
+  return s.topics.size() > 1;
 }
 
 }  // namespace
@@ -382,19 +389,20 @@ int main(int argc, char** argv) {
   std::string laser_choice;  // what was chosen and why (printed with the summary)
   LaserSurvey pre;            // the whole recording's lasers (else the mounts come from what the import read)
   std::vector<fploc::import::LaserMount> pre_mounts;
-  if (!used_channels.count("LASER_SCAN")) {
-    if (survey_lasers(path, wanted, pre) && pre.topics.size() > 1) {
-      pre_mounts = pre.mounts(base_frame);
-      for (const auto& m : pre_mounts)
-        if (m.level()) {
-          if (m.topic != pre.topics.front()) {
-            topic_channel[m.topic] = "LASER_SCAN";
-            used_channels.insert("LASER_SCAN");
-            laser_choice = "LASER_SCAN is " + printable(m.topic) + ", the first laser tf shows level (" +
-                           printable(pre.topics.front()) + " is not)";
-          }
-          break;
-        }
+  if (!used_channels.count("LASER_SCAN") && survey_lasers(path, wanted, pre)) {
+    pre_mounts = pre.mounts(base_frame);
+    std::string not_level;
+    for (const auto& m : pre_mounts) {
+      if (channel_override.count(m.topic)) continue;  // the user named its channel
+      if (!m.level()) {
+        not_level += (not_level.empty() ? "" : ", ") + printable(m.topic);
+        continue;
+      }
+      topic_channel[m.topic] = "LASER_SCAN";  // explicitly: with --start the main pass may meet another laser first
+      used_channels.insert("LASER_SCAN");
+      laser_choice = "LASER_SCAN is " + printable(m.topic) + ", the first laser tf shows level" +
+                     (not_level.empty() ? std::string() : " (not level: " + not_level + ")");
+      break;
     }
   }
 
@@ -465,16 +473,22 @@ int main(int argc, char** argv) {
   std::vector<uint8_t> cloud_header;  // point_cloud2_t up to its data; the points follow from the recording
   std::map<std::string, std::string> cloud_check_error;  // topic -> why its first cloud does not convert
   LaserScanView laser;
-  LaserSurvey survey;  // the lasers' frames and tf, for their mounts (laser_mounts.h)
+  LaserSurvey survey;     // the lasers' frames and tf, for their mounts (laser_mounts.h)
+  bool mount_tf = true;   // tf kept for them: until a 3D recording shows (an Ouster packet or a cloud before any scan)
+  std::vector<Transform> mount_ts;
   while (rec->next(m)) {
     ++read_msgs;
     if (first_ns == INT64_MIN) first_ns = m.time_ns;
     const double rel = seconds(m.time_ns) - seconds(first_ns);
-    if (start >= 0 && rel < start) continue;
     if (end >= 0 && rel > end) break;
     const Connection& c = rec->connections().at(m.conn);
-    if (!wanted.empty() && !wanted.count(c.topic)) continue;
     const Kind k = kind_of(c);
+    // tf for the mounts whatever --start and --topics keep (a latched /tf_static is recorded at the start).
+    if (mount_tf && (k == Kind::kOusterPackets || k == Kind::kCloud) && survey.topics.empty()) mount_tf = false;
+    if (mount_tf && k == Kind::kTf && decode_tf(m.data, m.size, c.encoding, mount_ts, &err))
+      for (const auto& t : mount_ts) survey.tf.add(t);
+    if (start >= 0 && rel < start) continue;
+    if (!wanted.empty() && !wanted.count(c.topic)) continue;
     if (!quiet && (read_msgs & 15) == 0) {
       const auto now = std::chrono::steady_clock::now();
       if (now - last_progress > std::chrono::seconds(1)) {
@@ -613,14 +627,9 @@ int main(int argc, char** argv) {
         break;
       }
       case Kind::kTf: {
-        // Kept for the lasers' mounts either way (decimated); a tf message that does not decode is an error only
-        // where tf is imported.
-        std::vector<Transform> ts;
-        const bool ok = decode_tf(m.data, m.size, c.encoding, ts, &err);
-        if (ok)
-          for (const auto& t : ts) survey.tf.add(t);
         if (tum_out.empty() || tf_parent.empty()) { ++skipped_types[c.type]; break; }
-        if (!ok) { bad(c, err); break; }
+        std::vector<Transform> ts;
+        if (!decode_tf(m.data, m.size, c.encoding, ts, &err)) { bad(c, err); break; }
         for (const auto& t : ts) tum.tf(t);
         ++written["(tf " + c.topic + ")"];
         break;
@@ -696,8 +705,9 @@ int main(int argc, char** argv) {
   const fploc::import::LaserMount* main_laser = nullptr;
   for (const auto& lm : mounts)
     if (topic_channel.count(lm.topic) && topic_channel[lm.topic] == "LASER_SCAN") main_laser = &lm;
+  std::vector<std::string> warnings;
   if (main_laser && main_laser->found && !main_laser->level())
-    problems.push_back("warning: LASER_SCAN (" + printable(main_laser->topic) + ") " + main_laser->describe() +
+    warnings.push_back("LASER_SCAN (" + printable(main_laser->topic) + ") " + main_laser->describe() +
                        "; give a level laser with --channel TOPIC=LASER_SCAN");
 
   if (json) {
@@ -739,6 +749,7 @@ int main(int argc, char** argv) {
       j["lasers"][lm.topic] = l;
     }
     if (!laser_choice.empty()) j["laser_choice"] = laser_choice;
+    j["warnings"] = warnings;
     j["errors"] = problems;
     for (const auto& [t, n] : decode_errors) j["not_decoded"][t] = {{"count", n}, {"first", first_decode_error[t]}};
     std::cout << dump_json(j) << "\n";
@@ -800,6 +811,7 @@ int main(int argc, char** argv) {
     }
     if (!tum_out.empty()) std::printf("  %s: %llu poses\n", printable(tum_out).c_str(), (unsigned long long)tum.poses());
   }
+  for (const auto& w : warnings) std::cerr << "fploc import: warning: " << w << "\n";
   for (const auto& p : problems) std::cerr << "fploc import: " << p << "\n";
   if (!(rec->error().empty() && log_ok && !lidar_lost)) return 1;
   if (skipped) {

@@ -17,10 +17,15 @@ std::string TfTree::bare(const std::string& f) { return !f.empty() && f[0] == '/
 
 void TfTree::add(const rec::Transform& t) {
   auto& e = edges_[bare(t.child_frame_id)];
-  if (gap_ns_ > 0 && !e.samples.empty() && std::abs(t.header.stamp_ns - e.samples.back().t_ns) < gap_ns_) return;
+  const Sample smp{t.header.stamp_ns, Eigen::Vector3d(t.t[0], t.t[1], t.t[2]),
+                   Eigen::Quaterniond(t.q[3], t.q[0], t.q[1], t.q[2]).normalized()};
+  if (gap_ns_ > 0 && !e.samples.empty()) {
+    const Sample& last = e.samples.back();
+    if (std::abs(smp.t_ns - last.t_ns) < gap_ns_) return;
+    if (smp.p == last.p && smp.q.coeffs() == last.q.coeffs()) return;  // unchanged
+  }
   e.parent = bare(t.header.frame_id);
-  e.samples.push_back({t.header.stamp_ns, Eigen::Vector3d(t.t[0], t.t[1], t.t[2]),
-                       Eigen::Quaterniond(t.q[3], t.q[0], t.q[1], t.q[2]).normalized()});
+  e.samples.push_back(smp);
 }
 
 void TfTree::sort() {

@@ -32,8 +32,8 @@ class TfTree {
     std::set<int64_t> times_ns;  // every sample time of the path's edges
   };
 
-  // min_sample_gap_ns > 0: an edge keeps a sample only that long after its last one (bounded memory over long
-  // recordings, for uses that do not need every stamp).
+  // min_sample_gap_ns > 0: an edge keeps a sample only that long after its last one, and only when it differs from
+  // it (bounded memory over long recordings, for uses that do not need every stamp).
   explicit TfTree(int64_t min_sample_gap_ns = 0) : gap_ns_(min_sample_gap_ns) {}
   void add(const rec::Transform& t);
   // Sorts each edge's samples by time (call after the last add, before path/at).

@@ -570,7 +570,9 @@ int main(int argc, char** argv) {
   std::vector<std::string> warnings;
   if (!skip_hosts && g.tree && errors.empty() && g.graph.host_size() > 0) {
     std::vector<HostPlan> plans;
-    for (const auto& [name, p] : host_plans(g.graph, self_bin_dir())) plans.push_back(*p);
+    const auto by_name = host_plans(g.graph, self_bin_dir());
+    for (const auto& h : g.graph.host())  // in the graph's order: check_hosts reports in the order it is given
+      if (const auto it = by_name.find(h.name()); it != by_name.end()) plans.push_back(*it->second);
     std::vector<std::pair<std::string, std::string>> host_exe;
     std::map<std::string, std::vector<std::string>> nodes_on;
     for (const auto& rn : resolved) {

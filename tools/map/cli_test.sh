@@ -130,6 +130,11 @@ for kind in sys.argv[5].split("|"):
         assert kind not in svg and kind not in err and count.get(colour[kind][:3], 0) == 0, ("drawn on the wrong floor", kind)
 PY
 done
+# Names from the building file are XML text in the SVG (a name with & or < made a file no SVG reader opens).
+sed 's/name: "s1"/name: "A\&B <stairs>"/' "$T/b3.pbtxt" > "$T/b3x.pbtxt"
+"$MAP" render --plan "$T/b3x.pbtxt" --floor ground --fields none --out "$T/gx.svg" 2> "$T/err" || fail "render a name with & and <"
+python3 -c "import sys, xml.etree.ElementTree as E; t = E.parse(sys.argv[1]); assert any(\"'A&B <stairs>'\" in (x.text or '') for x in t.iter()), 'name'" "$T/gx.svg" \
+  || fail "the SVG with a name holding & and < does not parse or lost the name"
 "$MAP" build --plan "$B" --mode exact --out "$T/ground.fpmap" --json > "$T/b.json" 2>/dev/null || fail "build the first floor"
 grep -q '"elements": 44' "$T/b.json" || fail "the default floor is the first (the room, 44 elements)"
 if "$MAP" validate --plan "$B" --floor roof --no-baselines 2> "$T/err"; then fail "unknown floor accepted"; fi

@@ -158,7 +158,7 @@ void write_svg(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
     s << "<polygon points=\"";
     for (const auto& p : c.polygon) s << p.x() << "," << p.y() << " ";
     s << "\" fill=\"" << st.svg << "\" fill-opacity=\"0.3\" stroke=\"" << st.svg << "\" stroke-width=\"" << sw * 3
-      << "\"><title>" << legend_text(c, floor) << "</title></polygon>\n";
+      << "\"><title>" << fploc::xml_text(legend_text(c, floor)) << "</title></polygon>\n";
     if (c.kind == ConnectionKind::kLift && c.polygon.size() == 4)
       for (int k = 0; k < 2; ++k)
         s << "<line x1=\"" << c.polygon[k].x() << "\" y1=\"" << c.polygon[k].y() << "\" x2=\"" << c.polygon[k + 2].x() << "\" y2=\""
@@ -187,7 +187,7 @@ void write_svg(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
     const ConnectionStyle& st = style_of(c.kind);
     s << "<rect x=\"" << x0 << "\" y=\"" << yl - 0.8 * fs << "\" width=\"" << 1.5 * fs << "\" height=\"" << 0.8 * fs << "\" fill=\""
       << st.svg << "\" fill-opacity=\"0.3\" stroke=\"" << st.svg << "\" stroke-width=\"" << fs / 8 << "\"/><text x=\"" << x0 + 2 * fs
-      << "\" y=\"" << yl << "\">" << legend_text(c, floor) << "</text>\n";
+      << "\" y=\"" << yl << "\">" << fploc::xml_text(legend_text(c, floor)) << "</text>\n";
     yl += 1.4 * fs;
   }
   s << "</g>\n</svg>\n";

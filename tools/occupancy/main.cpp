@@ -109,8 +109,17 @@ void write_png(const std::string& out, const fploc::OccupancyGrid& g, const fplo
       for (int j = 0; j < g.height; ++j)
         for (int i = 0; i < g.width; ++i)
           if (g.at(i, j) > 100 * g.occupied_thresh) grow(double(i) * scale, double(g.height - 1 - j) * scale);
+    // Trajectory points off the grid frame nothing (they are not in the picture).
+    size_t on_grid = 0, points = 0;
     for (const auto& t : tracks)
-      for (const auto& p : t) grow(px(p).x(), px(p).y());
+      for (const auto& p : t) {
+        ++points;
+        const double x = px(p).x(), y = px(p).y();
+        if (x >= 0 && y >= 0 && x < W && y < H) grow(x, y), ++on_grid;
+      }
+    if (crop_to_tracks && points > 0 && on_grid == 0)
+      throw std::runtime_error("--crop-to tracks: none of the " + std::to_string(points) +
+                               " trajectory points lies on the map (another frame, or another map?)");
     if (x1 >= 0) {
       const double m = crop_margin_m / g.resolution * scale;
       cx0 = std::max(0, int(x0 - m)), cy0 = std::max(0, int(y0 - m));
@@ -180,6 +189,14 @@ int main(int argc, char** argv) {
   }
   if (!std::isfinite(crop_margin)) {
     std::cerr << "fploc occupancy: --crop-margin " << crop_margin << ": expected a finite number of metres\n";
+    return 1;
+  }
+  if (crop_to != "map" && crop_margin < 0) {
+    std::cerr << "fploc occupancy: --crop-to needs --crop-margin M\n";
+    return 1;
+  }
+  if (png_out.empty() && (!labels.empty() || !tums.empty() || crop_margin >= 0)) {
+    std::cerr << "fploc occupancy: --tum, --label and --crop-margin draw on the picture: give --png OUT.png\n";
     return 1;
   }
   if (labels.size() > tums.size()) {

@@ -39,6 +39,14 @@ printf '0 1.2 1.2 0 0 0 0 1\n1 3.8 1.8 0 0 0 0 1\n' > "$T/e.tum"
 "$OCC" "$T/m0.05/map.yaml" --png "$T/legend.png" --scale 2 --crop-margin 1 --crop-to tracks --tum "$T/t.tum" \
   --label reference --tum "$T/e.tum" --label fploc 2>/dev/null || fail "png --crop-to tracks --label"
 if "$OCC" "$T/m0.05/map.yaml" --png "$T/n.png" --tum "$T/t.tum" --label a --label b 2> "$T/err"; then fail "2 labels for 1 track"; fi
+# Trajectories wholly off the map frame nothing: an error, not a 20-px strip at the edge (or the whole grid).
+printf '0 1000.0 1000.0 0 0 0 0 1\n1 1001.0 1000.0 0 0 0 0 1\n' > "$T/far.tum"
+if "$OCC" "$T/m0.05/map.yaml" --png "$T/far.png" --crop-margin 1 --crop-to tracks --tum "$T/far.tum" 2> "$T/err"; then
+  fail "tracks off the map framed"; fi
+grep -q "none of the 2 trajectory points lies on the map" "$T/err" || fail "off-map tracks: $(cat "$T/err")"
+if "$OCC" "$T/m0.05/map.yaml" --crop-to tracks --png "$T/n.png" 2> "$T/err"; then fail "--crop-to without --crop-margin"; fi
+if "$OCC" "$T/m0.05/map.yaml" --tum "$T/t.tum" --label a 2> "$T/err"; then fail "--tum/--label without --png"; fi
+grep -q "give --png" "$T/err" || fail "--label without --png: $(cat "$T/err")"
 PYLIB="$(cd "$(dirname "$0")/../pylib" && pwd)"
 python3 - "$T/legend.png" "$PYLIB" <<'PY' || fail "legend, scale bar or crop"
 import sys

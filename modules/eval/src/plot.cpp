@@ -4,21 +4,13 @@
 #include <limits>
 #include <sstream>
 
+#include "fploc/core/text_out.h"
 #include "fploc/eval/eval.h"
 
 namespace fploc::eval {
 
 namespace {
-std::string esc(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '<') o += "&lt;";
-    else if (c == '>') o += "&gt;";
-    else if (c == '&') o += "&amp;";
-    else o += c;
-  }
-  return o;
-}
+std::string esc(const std::string& s) { return xml_text(s); }
 
 // The "jet" colour map (evo's default for the error colouring): 0 blue .. 0.5 green .. 1 red.
 std::string jet(double v) {

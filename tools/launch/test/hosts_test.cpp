@@ -18,13 +18,13 @@ namespace {
 struct FakeSsh {
   fs::path dir = fs::temp_directory_path() / ("fploc-hosts-" + std::to_string(::getpid()));
   std::string old_path = getenv("PATH") ? getenv("PATH") : "";
-  // The fake: logs "start ADDRESS" / "end ADDRESS" (the address is the argument before "--"), takes 1 s, and
+  // The fake: logs "start ADDRESS" / "end ADDRESS" (the address is the argument before "--"), takes 2 s, and
   // fails as ssh does for a host that does not answer.
   FakeSsh() {
     fs::create_directories(dir);
     const fs::path ssh = dir / "ssh";
     std::ofstream(ssh) << "#!/bin/sh\nprev=\nfor a; do [ \"$a\" = -- ] && addr=$prev; prev=$a; done\n"
-                          "echo \"start $addr\" >> '" << (dir / "log").string() << "'\nsleep 1\n"
+                          "echo \"start $addr\" >> '" << (dir / "log").string() << "'\nsleep 2\n"
                           "echo \"end $addr\" >> '" << (dir / "log").string() << "'\n"
                           "echo \"ssh: connect to host $addr port 22: No route to host\" >&2\nexit 255\n";
     ::chmod(ssh.c_str(), 0755);

@@ -18,4 +18,7 @@ std::string printable(std::string_view s);
 // error instead of its output). Every tool and node that prints or writes JSON uses this.
 std::string json_text(const nlohmann::json& j, int indent = -1);
 
+// s as XML character data or an attribute value (SVG text and titles): &, <, > and " as entities.
+std::string xml_text(std::string_view s);
+
 }  // namespace fploc
