@@ -52,7 +52,7 @@ class Os1ImuSource : public ImuSource {
       pcap_port_ = opt.imu_port();  // 0: any port, IMU packets recognised by size
       std::string err;
       const double rate = opt.pcap_rate() == 0 ? 1.0 : opt.pcap_rate();
-      if (!replay_.open(ctx.resolve_path(opt.pcap()), rate, opt.pcap_loop(), &err)) throw std::runtime_error("imu_driver: " + err);
+      if (!replay_.open(ctx.resolve_path(opt.pcap()), rate, opt.pcap_loop(), &err)) throw fploc::rt::SetupMayPass("imu_driver: " + err);
       ctx.every(0.002, [this] {
         const bool more = replay_.poll([this](uint16_t p, const uint8_t* d, size_t n) {
           if (pcap_port_ == 0 || p == pcap_port_) on_datagram(d, n, pcap_port_ == 0);

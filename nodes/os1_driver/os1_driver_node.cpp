@@ -83,7 +83,7 @@ class Os1DriverNode : public fploc::rt::Node {
     if (pcap_mode_) {
       std::string err;
       const double rate = opt.pcap_rate() == 0 ? 1.0 : opt.pcap_rate();
-      if (!replay_.open(ctx.resolve_path(opt.pcap()), rate, opt.pcap_loop(), &err)) throw std::runtime_error("os1_driver: " + err);
+      if (!replay_.open(ctx.resolve_path(opt.pcap()), rate, opt.pcap_loop(), &err)) throw fploc::rt::SetupMayPass("os1_driver: " + err);
       // Looping: the capture starts over with the same frame ids; never treat them as late packets.
       replay_.set_on_restart([this] {
         assembler_->resync(frames_);

@@ -554,6 +554,13 @@ int node_main(int argc, char** argv) {
     try {
       JoinBeats join{setup_done, loading_beats};
       node->setup(ctx);
+    } catch (const SetupMayPass& e) {
+      std::cerr << "[" << instance << "] setup failed (may pass; restarted by the launcher's policy): " << e.what()
+                << std::endl;
+      auto s = make_status(ctx, executable, "dead", 0, 0, restarts);
+      s.last_error = std::string("setup failed: ") + e.what();
+      bus.lcm().publish(telemetry, &s);
+      return 1;
     } catch (const std::exception& e) {
       std::cerr << "[" << instance << "] setup failed: " << e.what() << std::endl;
       auto s = make_status(ctx, executable, "dead", 0, 0, restarts);

@@ -300,9 +300,10 @@ bool Supervisor::on_exit(pid_t pid, const ExitStatus& st, double t) {
       wait_for_host(i, how, t - n.started_at, t);
       return true;
     }
-    // A set-up that failed (a configuration error) fails again on every restart: said once, no restart, and
-    // the launch stops (it would run on without the node, the graph not being the one that was asked for).
-    if (st.exited && st.code == fploc::rt::kSetupFailedExitCode && !n.hung) {
+    // A set-up that failed at the node's first start (a configuration error) fails again on every restart: said
+    // once, no restart, and the launch stops (it would run on without the node, the graph not being the one that
+    // was asked for). A node that ran before goes by its restart policy.
+    if (st.exited && st.code == fploc::rt::kSetupFailedExitCode && !n.hung && n.restarts == 0) {
       fx_.log("node '" + n.policy.name + "' failed at set-up (" + how +
               ": a configuration error, see its 'setup failed' line): not restarted; stopping the launch");
       n.state = State::Dead;

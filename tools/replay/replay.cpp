@@ -255,11 +255,16 @@ int main(int argc, char** argv) {
     }
     // The estimate's status (pose_t.status 0 OK, 1 POOR, 2 LOST) on the pose channel of the main pose logger
     // (FPLOC_POSE when there is none), for the summary line: a run that was LOST throughout said only "done".
-    std::string pose_channel = "FPLOC_POSE";
+    // The main logger as --out chooses it: the first whose pose input is FPLOC_POSE, else the first with a connected
+    // pose input.
+    std::string pose_channel;
     for (const auto& n : g.graph.node())
       if (!n.disabled() && type_from_executable(n.executable()) == "pose_logger")
         for (const auto& in : n.input())
-          if (in.port() == "pose" && (pose_channel == "FPLOC_POSE" || in.channel() == "FPLOC_POSE")) pose_channel = in.channel();
+          if (in.port() == "pose" && !in.channel().empty() && (pose_channel.empty() || in.channel() == "FPLOC_POSE") &&
+              pose_channel != "FPLOC_POSE")
+            pose_channel = in.channel();
+    if (pose_channel.empty()) pose_channel = "FPLOC_POSE";
     pose_channel = fploc::rt::robot_channel(fploc::rt::robot_of(&g.graph), pose_channel);
     int64_t status_count[4] = {0, 0, 0, 0};  // OK, POOR, LOST, other
     bus.lcm().subscribeFunction(pose_channel, +[](const lcm::ReceiveBuffer* rb, const std::string&, int64_t* count) {

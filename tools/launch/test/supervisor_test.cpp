@@ -635,6 +635,21 @@ TEST(Supervisor, ASetupFailureIsNotRestartedAndStopsTheLaunch) {
   EXPECT_EQ(w.logs.back(), "all nodes stopped; dead during the run: 'matcher' (exit code 1)");
 }
 
+// Only the first start's set-up failure stops the launch: a node that ran, crashed and then fails at set-up goes by
+// its restart policy (the set-up may have failed on something the crash left behind).
+TEST(Supervisor, ASetupFailureAfterARestartGoesByThePolicy) {
+  FakeWorld w;
+  Supervisor s({node("matcher"), node("b")}, {}, w);
+  s.start_all(0);
+  s.on_exit(s.pid(0), code(1), 5.0);  // a crash after running
+  for (double t = 5.1; t < 8 && w.starts.size() < 3; t += 0.1) s.tick(t);
+  ASSERT_EQ(w.starts.size(), 3u) << "the crashed node was not restarted";
+  s.on_exit(s.pid(0), code(fploc::rt::kSetupFailedExitCode), 8.2);
+  EXPECT_FALSE(s.shutting_down()) << "a restart's set-up failure stopped the launch";
+  for (double t = 8.3; t < 15 && w.starts.size() < 4; t += 0.1) s.tick(t);
+  EXPECT_EQ(w.starts.size(), 4u) << "not restarted by the policy";
+}
+
 // A control request for a name that is not in the graph is refused naming the graph's nodes.
 TEST(Control, UnknownNodeIsRefusedListingTheNodes) {
   fploc::Graph g;

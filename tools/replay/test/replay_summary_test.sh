@@ -29,6 +29,17 @@ assert p["ok"] > 0.8 * n, f"from the true start most poses should be OK: {p}"
 PY
 grep -q "outside its plan's extent" "$T/err" && fail "warning for a start inside the plan"
 
+# Several pose loggers (graphs/amcl.pbtxt, lidar2d.pbtxt): the summary counts the main one's channel (FPLOC_POSE,
+# as --out chooses), whatever the order of the others; a logger whose pose input is not connected counts for none.
+{ cat "$R/graphs/replay.pbtxt"
+  printf 'node {\n  name: "frame_logger"\n  executable: "fploc-pose-logger"\n  input { port: "pose" channel: "FPLOC_FRAME_POSE" }\n  pose_logger { file: "f.tum" }\n}\n'
+  printf 'node {\n  name: "idle_logger"\n  executable: "fploc-pose-logger"\n  input { port: "pose" channel: "" }\n  pose_logger { file: "i.tum" }\n}\n'
+} | sed "s#\.\./data/#$R/data/#g" > "$T/multi.pbtxt"
+"$BIN/fploc-replay" --graph "$T/multi.pbtxt" --log "$T/log.lcm" --out "$T/m.tum" \
+  --set matcher.initial_pose.x="$X" --set matcher.initial_pose.y="$Y" --set matcher.initial_pose.yaw="$YAW" > /dev/null 2> "$T/err" ||
+  fail "replay with three pose loggers"
+grep -qE '^fploc replay: [0-9]+ poses on FPLOC_POSE: ' "$T/err" || fail "the summary is not FPLOC_POSE's: $(grep 'poses on' "$T/err")"
+
 # From (40, 40), far outside the 16 x 12.5 m room: a warning naming the node, and the summary says LOST.
 "$BIN/fploc-replay" --graph "$R/graphs/replay.pbtxt" --log "$T/log.lcm" --out "$T/b.tum" \
   --set matcher.initial_pose.x=40 --set matcher.initial_pose.y=40 > /dev/null 2> "$T/err" || true

@@ -27,6 +27,7 @@
 #include <chrono>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -91,6 +92,13 @@ class Publisher {
 };
 
 class Bus;  // LCM instance shared by all nodes of a process
+
+// Thrown from Node::setup() for a failure that may pass by itself (a UDP port still held, an interface without
+// its address yet at boot): the process exits 1 and the launcher restarts it by the node's restart policy. Any
+// other exception from setup() is a configuration error (exit kSetupFailedExitCode, restart.h).
+struct SetupMayPass : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 class Context {
  public:

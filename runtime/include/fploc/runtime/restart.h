@@ -10,6 +10,8 @@ namespace fploc::rt {
 // A node whose setup() failed (its options, plan, files: "[NAME] setup failed: ..." on stderr and a "dead"
 // heartbeat) exits with this code (sysexits' EX_CONFIG). `fploc launch` does not restart it: the same
 // set-up would fail again. It says so once and stops the launch (docs/notes/launch-check.md).
+// Only at a node's first start: a node that ran and then fails at set-up on a restart goes by the restart policy.
+// A set-up failure that may pass (a socket not open yet at boot) throws SetupMayPass: exit 1, restarted as a crash.
 constexpr int kSetupFailedExitCode = 78;
 
 struct RestartDecision {
