@@ -25,6 +25,7 @@ struct Ctx {
   std::set<std::string> written;  // files some node writes at run time (metadata_out)
   int node = 0;
   std::string field;              // top-level options field name (for the line)
+  bool remote = false;            // the node runs on another host: the folders it writes to are that host's
 };
 
 std::string resolve(const fploc::rt::LoadedGraph& g, const std::string& p) {
@@ -120,7 +121,7 @@ void walk(Ctx& c, const std::string& prefix, const Message& m) {
     if (v.empty()) continue;
     const std::string path = resolve(c.g, v);
     if (const Written w = written_kind(d, f); w != Written::kNo) {
-      check_output_folder(c, name, w == Written::kGraphRelative ? path : v);
+      if (!c.remote) check_output_folder(c, name, w == Written::kGraphRelative ? path : v);
       continue;
     }
     if (f->name() == "metadata") {
@@ -175,6 +176,7 @@ void check_option_files(const fploc::rt::LoadedGraph& g, std::vector<fploc::rt::
     auto opts = fploc::rt::node_options(n);
     if (!opts) continue;
     c.node = i;
+    c.remote = !n.host().empty();
     c.field = fploc::rt::node_options_field(n);
     walk(c, c.field, *opts);
   }

@@ -38,7 +38,8 @@ namespace {
 void usage() {
   std::cerr << "usage: fploc map diff --graph GRAPH --log LOG.lcm --out DIFF.json|DIFF.dxf [--out ...] [--json]\n"
                "       [--features-channel C] [--pose-channel C] [--all (every element in the JSON, also those seen)]\n"
-               "       [--plan PLAN [--floor NAME]] (the plan to diff against; default: the graph's plan_diff node's plan)\n"
+               "       [--plan PLAN [--floor NAME]] (the plan to diff against, read as it is: every layer, the file's own\n"
+               "       units; default: the graph's plan_diff node's plan with its layers and units)\n"
                "       [--set NODE.field=value ...] (the graph's node options, as for fploc replay: e.g.\n"
                "        plan_diff.plan.file=PLAN; a matcher's plan is not the diff's plan)\n"
                "       [--poses FILE.tum] (place each scan with these poses, e.g. the ground truth, not the localizer's)\n";

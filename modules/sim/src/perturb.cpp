@@ -644,6 +644,8 @@ WorldEdit load_world_file(const std::string& path, const FloorPlan& plan, const 
           m["id"].get<size_t>() >= base.elements.size() || base.elements[m["id"].get<size_t>()].kind != ElementKind::kSegment)
         throw std::runtime_error(where + ".id: expected the id of a segment");
       const size_t id = m["id"].get<size_t>();
+      if (w.elements[id].change == ElementChange::kMoved)
+        throw std::runtime_error(where + ".id: element " + std::to_string(id) + " is moved twice (one entry per element)");
       const double off = read_required_num(m, "offset_m", where);
       shift[id] = off * left_normal(cur[id].a, cur[id].b);
       w.elements[id].change = ElementChange::kMoved;

@@ -249,6 +249,8 @@ TEST(WorldFile, UnknownOrMissingKeysInEntriesAreErrors) {
   EXPECT_NE(person.find("world.people[0].sped: unknown key (allowed: path, speed)"), std::string::npos) << person;
   const std::string missing = error_of("world_nooff.json", R"({"world": {"move": [{"id": 12}]}})");
   EXPECT_NE(missing.find("world_nooff.json: world.move[0].offset_m: missing"), std::string::npos) << missing;
+  const std::string twice = error_of("world_twice.json", R"({"world": {"move": [{"id": 12, "offset_m": 0.1}, {"id": 12, "offset_m": 0.2}]}})");
+  EXPECT_NE(twice.find("world.move[1].id: element 12 is moved twice"), std::string::npos) << twice;
   const std::string top = error_of("world_top.json", R"({"world": {"windows": []}})");
   EXPECT_NE(top.find("world.windows: unknown key (allowed: plan, remove, glass, move, add, doors, shelves, people)"),
             std::string::npos) << top;

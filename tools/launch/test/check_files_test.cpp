@@ -80,6 +80,16 @@ TEST(CheckFiles, OutputFolderMustExist) {
   EXPECT_NE(e[1].message.find((d.p / "no-dir").string()), std::string::npos) << e[1].str();
 }
 
+// A node on another host writes into that host's folders: not checked here.
+TEST(CheckFiles, ARemoteNodesOutputFoldersAreNotCheckedHere) {
+  Dir d;
+  auto e = check(d, "host { name: \"robot\" address: \"10.0.0.2\" }\n"
+                    "node { name: \"log\" executable: \"x\" host: \"robot\" pose_logger { file: \"/data-on-robot/p.tum\" } }\n"
+                    "node { name: \"here\" executable: \"y\" pose_logger { file: \"/nonexistent-fploc/p.tum\" } }\n");
+  ASSERT_EQ(e.size(), 1u) << (e.empty() ? "" : e[0].str());
+  EXPECT_NE(e[0].message.find("node 'here'"), std::string::npos) << e[0].str();
+}
+
 // Names the node checks at start (matcher::lookup_names, the map builder's own list) and a plan it needs.
 TEST(CheckFiles, UnknownLookupAndMissingPlanAreOptionErrors) {
   Dir d;
