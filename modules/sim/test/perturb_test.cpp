@@ -204,16 +204,19 @@ TEST(WorldFile, ReadsEveryKind) {
   EXPECT_EQ(w.people.size(), 1u);
 }
 
+// The error loading a world file of this text gives ("no error" when it loads).
+static std::string world_file_error(const FloorPlan& plan, const std::string& name, const std::string& text) {
+  try {
+    load_world_file(tmp_file(name, text), plan);
+  } catch (const std::runtime_error& e) {
+    return std::string(e.what());
+  }
+  return std::string("no error");
+}
+
 TEST(WorldFile, BadInputIsOneClearError) {
   const FloorPlan plan = demo_room_plan();
-  auto error_of = [&](const std::string& name, const std::string& text) {
-    try {
-      load_world_file(tmp_file(name, text), plan);
-    } catch (const std::runtime_error& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
+  auto error_of = [&](const std::string& name, const std::string& text) { return world_file_error(plan, name, text); };
   const std::string syntax = error_of("world_syntax.json", "{\"world\": {\"remove\": [2,, 3]}}");
   EXPECT_NE(syntax.find("world_syntax.json: byte 25: JSON syntax error"), std::string::npos) << syntax;
   const std::string field = error_of("world_field.json", R"({"world": {"doors": [{"a": [0, 1], "b": [0, "x"]}]}})");
@@ -229,14 +232,7 @@ TEST(WorldFile, BadInputIsOneClearError) {
 // key, with the keys allowed there.
 TEST(WorldFile, UnknownOrMissingKeysInEntriesAreErrors) {
   const FloorPlan plan = demo_room_plan();
-  auto error_of = [&](const std::string& name, const std::string& text) {
-    try {
-      load_world_file(tmp_file(name, text), plan);
-    } catch (const std::runtime_error& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
+  auto error_of = [&](const std::string& name, const std::string& text) { return world_file_error(plan, name, text); };
   const std::string move = error_of("world_mv.json", R"({"world": {"move": [{"id": 12, "offset": 0.2}]}})");
   EXPECT_NE(move.find("world_mv.json: world.move[0].offset: unknown key (allowed: id, offset_m)"), std::string::npos) << move;
   const std::string door = error_of("world_door.json", R"({"world": {"doors": [{"a": [0, 5.75], "b": [0, 6.75], "closed": true}]}})");
