@@ -72,6 +72,19 @@ node { name: "l3" executable: "fploc-log" }
   for (size_t i = 1; i < e.size(); ++i) EXPECT_LE(e[i - 1].line, e[i].line);  // sorted by line
 }
 
+// A queue policy is for inputs (which messages a node takes); on an output it is one error at its line.
+TEST(Validate, AQueuePolicyOnAnOutputIsAnError) {
+  const auto e = check(R"(node { name: "s" executable: "fploc-src"
+  output { port: "out" channel: "P" queue: LATEST }
+}
+node { name: "l" executable: "fploc-log" input { port: "pose" channel: "P" queue: LATEST } pose_logger { file: "x" } }
+)");
+  const std::string s = all(e);
+  ASSERT_EQ(e.size(), 1u) << s;
+  EXPECT_NE(s.find("g.pbtxt:2: node 's': output port 'out' has a queue policy (queue applies to inputs only)"),
+            std::string::npos) << s;
+}
+
 TEST(Validate, TypeMismatchAndExternalProducers) {
   auto e = check(R"(node { name: "s" executable: "fploc-src" output { port: "out" channel: "OS1_SCAN" } }
 node { name: "seg" executable: "fploc-seg" }
