@@ -485,7 +485,8 @@ int main(int argc, char** argv) {
     const Kind k = kind_of(c);
     // tf for the mounts whatever --start and --topics keep (a latched /tf_static is recorded at the start).
     if (mount_tf && (k == Kind::kOusterPackets || k == Kind::kCloud) && survey.topics.empty()) mount_tf = false;
-    if (mount_tf && k == Kind::kTf && decode_tf(m.data, m.size, c.encoding, mount_ts, &err))
+    bool tf_decoded = false;  // mount_ts holds this message's transforms (the TUM output takes them too)
+    if (mount_tf && k == Kind::kTf && (tf_decoded = decode_tf(m.data, m.size, c.encoding, mount_ts, &err)))
       for (const auto& t : mount_ts) survey.tf.add(t);
     if (start >= 0 && rel < start) continue;
     if (!wanted.empty() && !wanted.count(c.topic)) continue;
@@ -628,9 +629,8 @@ int main(int argc, char** argv) {
       }
       case Kind::kTf: {
         if (tum_out.empty() || tf_parent.empty()) { ++skipped_types[c.type]; break; }
-        std::vector<Transform> ts;
-        if (!decode_tf(m.data, m.size, c.encoding, ts, &err)) { bad(c, err); break; }
-        for (const auto& t : ts) tum.tf(t);
+        if (!tf_decoded && !decode_tf(m.data, m.size, c.encoding, mount_ts, &err)) { bad(c, err); break; }
+        for (const auto& t : mount_ts) tum.tf(t);
         ++written["(tf " + c.topic + ")"];
         break;
       }
