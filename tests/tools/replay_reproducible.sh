@@ -14,8 +14,12 @@ r=list(map(float,open('$W/gt.tum').readline().split()))
 qx,qy,qz,qw=r[4:8]
 print(repr(r[1]),repr(r[2]),repr(math.atan2(2*(qw*qz+qx*qy),1-2*(qy*qy+qz*qz))))")
 source "$ROOT/tests/support/paper_replay.sh"
+# Run b records two channels with a regular expression; the wrong-plan run below gives a comma list, which matches
+# no channel: the replay must say so (it wrote an empty file without a word).
 for run in a b; do
-  paper_replay "$W/log.lcm" "$W/$run" \
+  rec=()
+  [ "$run" = b ] && rec=(--record "$W/b-rec.lcm" --record-channels 'FPLOC_POSE|FPLOC_FRAME_POSE')
+  paper_replay "$W/log.lcm" "$W/$run" "${rec[@]}" \
     --set matcher.initial_pose.x="$X" --set matcher.initial_pose.y="$Y" --set matcher.initial_pose.yaw="$YAW" \
     --set odometry.initial_pose.x="$X" --set odometry.initial_pose.y="$Y" --set odometry.initial_pose.yaw="$YAW" \
     --set odometry_map.initial_pose.x="$X" --set odometry_map.initial_pose.y="$Y" --set odometry_map.initial_pose.yaw="$YAW"
@@ -45,7 +49,13 @@ done
   --set matcher.plan.file="$ROOT/data/plans/corridor.json" --set optimizer.plan.file="$ROOT/data/plans/corridor.json" \
   --set matcher.initial_pose.x="$X" --set matcher.initial_pose.y="$Y" --set matcher.initial_pose.yaw="$YAW" \
   --set sfr_logger.file="$W/bad-sfr.tum" --set wo_logger.file="$W/bad-wo.tum" --set odom_logger.file="$W/bad-odom.tum" \
-  --set odom_map_logger.file="$W/bad-odom_map.tum" >"$W/bad.json" 2>"$W/bad.err" || { cat "$W/bad.err" >&2; exit 1; }
+  --set odom_map_logger.file="$W/bad-odom_map.tum" --record "$W/bad-rec.lcm" --record-channels 'FPLOC_POSE,FPLOC_FRAME_POSE' \
+  >"$W/bad.json" 2>"$W/bad.err" || { cat "$W/bad.err" >&2; exit 1; }
+if grep -q "record" "$W/b.err" || [ ! -s "$W/b-rec.lcm" ]; then
+  echo "FAIL: --record-channels 'FPLOC_POSE|FPLOC_FRAME_POSE' recorded nothing or warned" >&2; cat "$W/b.err" >&2; fail=1
+fi
+grep -q "warning: --record $W/bad-rec.lcm is empty: --record-channels 'FPLOC_POSE,FPLOC_FRAME_POSE' matched none of the channels of the run (.*FPLOC_FRAME_POSE.*); it is a regular expression" "$W/bad.err" \
+  || { echo "FAIL: no warning for a --record-channels that matched nothing" >&2; cat "$W/bad.err" >&2; fail=1; }
 python3 - "$W/bad.json" "$W/bad-sfr.tum" <<'PY' || fail=1
 import json, math, sys
 rep = json.loads(open(sys.argv[1]).read().strip().splitlines()[-1])

@@ -236,22 +236,36 @@ int main(int argc, char** argv) {
     }
     int64_t published = 0, t_first = -1, t_last = -1;
     std::unique_ptr<lcm::LogFile> rec;
+    // What --record wrote, and every channel published during the replay (a pattern that matched none of them is
+    // said at the end: it is a regular expression, and "A,B" matches no channel).
+    struct Recorded {
+      lcm::LogFile* file = nullptr;
+      int64_t* t = nullptr;
+      int64_t written = 0;
+      std::map<std::string, int64_t> channels;
+    } recorded;
     if (!record.empty()) {
       rec = std::make_unique<lcm::LogFile>(record, "w");
       if (!rec->good()) {
         std::cerr << "fploc replay: cannot write the record log '" << record << "'\n";
         return 1;
       }
+      recorded.file = rec.get();
+      recorded.t = &t_last;
       bus.lcm().subscribeFunction(record_channels, +[](const lcm::ReceiveBuffer* rb, const std::string& channel,
-                                                       std::pair<lcm::LogFile*, int64_t*>* ctx) {
+                                                       Recorded* ctx) {
         lcm::LogEvent ev;
         ev.eventnum = 0;
-        ev.timestamp = *ctx->second;
+        ev.timestamp = *ctx->t;
         ev.channel = channel;
         ev.datalen = int32_t(rb->data_size);
         ev.data = rb->data;
-        ctx->first->writeEvent(&ev);
-      }, new std::pair<lcm::LogFile*, int64_t*>(rec.get(), &t_last));
+        ctx->file->writeEvent(&ev);
+        ++ctx->written;
+      }, &recorded);
+      bus.lcm().subscribeFunction(".*", +[](const lcm::ReceiveBuffer*, const std::string& channel, Recorded* ctx) {
+        ++ctx->channels[channel];
+      }, &recorded);
     }
     // The estimate's status (pose_t.status 0 OK, 1 POOR, 2 LOST) on the pose channel of the main pose logger
     // (FPLOC_POSE when there is none), for the summary line: a run that was LOST throughout said only "done".
@@ -323,6 +337,14 @@ int main(int argc, char** argv) {
               << status_count[1] << " POOR, " << status_count[2] << " LOST"
               << (status_count[3] ? ", " + std::to_string(status_count[3]) + " other status" : std::string())
               << (poses > 0 && status_count[2] == poses ? " (every pose LOST: no estimate of the run)" : "") << "\n";
+    if (rec && recorded.written == 0) {
+      std::string seen;
+      for (const auto& [c, k] : recorded.channels) seen += (seen.empty() ? "" : ", ") + fploc::printable(c);
+      std::cerr << "fploc replay: warning: --record " << record << " is empty: --record-channels '"
+                << fploc::printable(record_channels) << "' matched none of the channels of the run ("
+                << (seen.empty() ? "none" : seen) << "); it is a regular expression (LCM's), so join names with '|', "
+                << "e.g. 'FPLOC_POSE|FPLOC_FEATURES'\n";
+    }
     if (json) {
       nlohmann::json j{{"log_events", events},
                        {"events_fed", published},
