@@ -58,7 +58,12 @@ FitComparison compare_fits(const matcher::NearestLookup& lookup, const FeatureFr
     c.rival_inliers += at_rival;
     if (at_rival && !at_fix) {
       ++c.gained;
-      if (er >= 0) c.gained_structure = std::max(c.gained_structure, ++gained_on[er]);
+      // A drawn face that another drawn wall hides from the rival's sensor (a thick wall's outer face seen from inside
+      // the room) is not what the sensor saw: it explains nothing.
+      if (seen_through_plan(g, sensor, pr, inlier_m))
+        ++c.gained_hidden;
+      else if (er >= 0)
+        c.gained_structure = std::max(c.gained_structure, ++gained_on[er]);
     }
     if (at_fix && !at_rival) {
       ++c.lost;

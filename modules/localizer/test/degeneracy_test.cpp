@@ -685,6 +685,31 @@ TEST(Degeneracy, SeenThroughThePlanOnlyBeyondADrawnWall) {
   EXPECT_EQ(fwd.lost_behind, 21);
 }
 
+// A thick wall drawn with both faces (inner x = 2, outer x = 2.25), built 0.2 m in from where the plan draws it: its
+// points (x = 1.8) are off the plan at the fix. A second fit 0.2 m on puts them on the inner face (structure it
+// explains); one 0.45 m on puts them on the outer face, which the inner face hides from that fit's sensor: no
+// structure (it was counted as such, and a room with a moved wall was published POOR for 25 s at its right pose).
+TEST(Degeneracy, AFaceHiddenBehindADrawnWallExplainsNothing) {
+  FloorPlan p;
+  p.elements.push_back(Element::segment({2, -1}, {2, 1}));
+  p.elements.push_back(Element::segment({2.25, -1}, {2.25, 1}));
+  auto map = make_localization_map(p, "brute-force");
+  FeatureFrame f;
+  for (int i = -10; i <= 10; ++i) {
+    Feature2 q;
+    q.p = Eigen::Vector2d(1.8, 0.08 * i);
+    f.points.push_back(q);
+  }
+  const FitComparison inner = compare_fits(*map.lookup, f, Pose2{0, 0, 0}, Pose2{0.2, 0, 0}, 0.1);
+  EXPECT_EQ(inner.gained, 21);
+  EXPECT_EQ(inner.gained_hidden, 0);
+  EXPECT_EQ(inner.gained_structure, 21);
+  const FitComparison outer = compare_fits(*map.lookup, f, Pose2{0, 0, 0}, Pose2{0.45, 0, 0}, 0.1);
+  EXPECT_EQ(outer.gained, 21);
+  EXPECT_EQ(outer.gained_hidden, 21);
+  EXPECT_EQ(outer.gained_structure, 0);
+}
+
 // As fins_corridor, the fins 0.7 m deep and every third left out (the view repeats every 4.5 m; one period on, 1.5 m,
 // a look-alike that explains ~10 % fewer points).
 FloorPlan fins_corridor_thirds() {
