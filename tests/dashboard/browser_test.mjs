@@ -2,7 +2,8 @@
 // fploc-dashboard fed by fake publishers over LCM (inside the network namespace ctest gives us).
 // Checks: the page loads, the trail grows, every node is in the table, a killed node turns red and
 // green again after restart, a launcher "restarting" report turns a node red, the page reconnects by
-// itself after a server restart. Measures pose->browser latency, the dashboard's CPU with two
+// itself after a server restart, a pose lagging the sensor is said ("pose N s behind the sensor") and the text
+// goes when it catches up. Measures pose->browser latency, the dashboard's CPU with two
 // browsers attached at 10 Hz and the push rate. Writes dashboard.png + dashboard_browser.json.
 import { chromium } from 'playwright-core';
 import { spawn } from 'node:child_process';
@@ -214,6 +215,22 @@ try {
   await sleep(1500);
   const r1 = await page.evaluate(() => window.__fploc.trail.length);
   check(r1 > r0 && (await page.evaluate(() => document.getElementById('banner').classList.contains('hidden'))), `trail grows again, banner gone (${r0} -> ${r1})`);
+
+  // A pose that falls behind the sensor (the sim fake restarted with its pose stamps lagging from 1 s on, 0.75 s per
+  // s, for 7 s: at most 5.25 s, then caught up): the top bar says "pose N s behind the sensor" (red) once the lag
+  // passes 3 s (shown rounded: "3.0" for 3.04 s), and the text goes when the pose catches up.
+  {
+    await stop(fakes.sim);
+    fakes.sim = startFake('sim', ['--sim', '--rate', '10', '--pose-lag-at', '1', '--pose-lag-for', '7']);
+    const bar = () => page.evaluate(() => { const e = document.getElementById('latency'); return { text: e.textContent, stale: e.classList.contains('stale') }; });
+    let seen = null;
+    const tBehind = await waitFor(async () => { const b = await bar(); if (/pose \d+\.\d s behind the sensor/.test(b.text) && b.stale) seen = b.text; return seen !== null; }, 10000, 100);
+    const lag = seen ? Number(seen.match(/pose (\d+\.\d) s behind/)[1]) : NaN;
+    check(tBehind >= 0 && lag >= 3 && lag <= 5.3, `a lagging pose: "${seen ?? (await bar()).text}" in the top bar, red (after ${tBehind} ms)`);
+    let after = null;
+    const tCaught = await waitFor(async () => { const b = await bar(); after = b; return !b.text.includes('behind the sensor') && !b.stale; }, 8000, 100);
+    check(tBehind >= 0 && tCaught >= 0, `and gone when it catches up (after ${tCaught} ms: "${after?.text}")`);
+  }
 
   check(pageErrors.length === 0, `no errors in the page${pageErrors.length ? ': ' + pageErrors.slice(0, 3).join(' | ') : ''}`);
   writeFileSync(join(OUT, 'dashboard_browser.json'), JSON.stringify({ ...results, failures }, null, 2));

@@ -76,6 +76,10 @@ int main(int argc, char** argv) {
   std::string name = "fake", url, state = "running", reporter = "node";
   bool sim = false, once = false;
   double rate = 10, duration = 0;
+  // --pose-lag-at S --pose-lag-for D: from S s after the start, for D s, the pose falls behind the sensor (its stamp
+  // advances at a quarter of the sensor's pace: 0.75 s behind per second, a localizer slower than its input), then
+  // catches up at once (a node that keeps only the newest input). Ground truth and the frame stay at sensor time.
+  double lag_at = 0, lag_for = 0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -87,9 +91,11 @@ int main(int argc, char** argv) {
     else if (a == "--reporter") reporter = next();
     else if (a == "--once") once = true;
     else if (a == "--lcm-url") url = next();
+    else if (a == "--pose-lag-at") lag_at = std::stod(next());
+    else if (a == "--pose-lag-for") lag_for = std::stod(next());
     else {
       std::cerr << "usage: fploc-dashboard-fake --name NAME [--sim] [--rate HZ] [--duration S] [--state S] "
-                   "[--reporter R] [--once] [--lcm-url URL]\n";
+                   "[--reporter R] [--once] [--lcm-url URL] [--pose-lag-at S --pose-lag-for D]\n";
       return 2;
     }
   }
@@ -200,8 +206,9 @@ int main(int argc, char** argv) {
       fp.floor = "0";
       lc.publish("FPLOC_FRAME_POSE", &fp);
 
+      const double lag_s = lag_for > 0 && t >= lag_at && t < lag_at + lag_for ? 0.75 * (t - lag_at) : 0.0;
       fploc::pose_t p{};
-      p.utime = ut;
+      p.utime = ut - int64_t(lag_s * 1e6);
       p.seq = seq;
       p.keyframe = (seq % 5) == 0;
       p.status = poor(seq) ? 1 : 0;  // POOR for 3 s of every 10 (the status row names the reason: telemetry detail)

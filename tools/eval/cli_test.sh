@@ -59,4 +59,20 @@ grep -q "per-pose noise (if white) gt xy not resolvable (negative variance estim
 grep -q "gt -[0-9]" "$T/hat.err" && { cat "$T/hat.err"; fail "--hat: a negative noise level printed"; }
 grep -q '"gt":{[^}]*"pose_sigma_xy_m":-[0-9][^}]*"xy_resolvable":false' "$T/hat.json" || { cat "$T/hat.json"; fail "--hat: JSON gt.xy_resolvable"; }
 grep -q '"est":{[^}]*"xy_resolvable":true' "$T/hat.json" || { cat "$T/hat.json"; fail "--hat: JSON est.xy_resolvable"; }
+# --hat with a NaN variance (a third trajectory with coordinates of 1e200: the differences' squares overflow) says
+# "not computed (... NaN)" and why, never "negative" (it printed "xy not resolvable (negative variance estimate)" and
+# the negative-variance warning); the JSON's sigma is null and xy_resolvable false.
+awk 'BEGIN { for (i = 0; i < 50; ++i) printf "%.3f %g 0 0 0 0 0 1\n", 0.1 * i, (i % 2 ? 1e200 : -1e200) }' > "$T/hbig.tum"
+"$EVAL" --gt "$T/hgt.tum" --est "$T/hest.tum" --hat "$T/hbig.tum" --json > "$T/hat.json" 2> "$T/hat.err" || { cat "$T/hat.err"; fail "--hat 1e200"; }
+grep -q "per-pose noise (if white) gt xy not computed (the variance estimate is NaN) / " "$T/hat.err" || { cat "$T/hat.err"; fail "--hat: NaN variance not said"; }
+grep -q "a variance estimate is NaN: " "$T/hat.err" || { cat "$T/hat.err"; fail "--hat: no NaN warning"; }
+grep -qi "negative" "$T/hat.err" && { cat "$T/hat.err"; fail "--hat: a NaN variance called negative"; }
+grep -q '"gt":{[^}]*"pose_sigma_xy_m":null[^}]*"xy_resolvable":false' "$T/hat.json" || { cat "$T/hat.json"; fail "--hat: JSON gt NaN"; }
+# A constant difference (a stationary third trajectory against the straight constant-speed gt) is 0, not a
+# rounding residue called a negative variance (-1.7e-9 m).
+awk 'BEGIN { for (i = 0; i < 50; ++i) printf "%.3f 5 5 0 0 0 0 1\n", 0.1 * i }' > "$T/hstill.tum"
+awk 'BEGIN { for (i = 0; i < 50; ++i) printf "%.3f %.6f 0.3 0 0 0 0 1\n", 0.1 * i, 0.1 * i + 0.3 }' > "$T/hoff.tum"
+awk 'BEGIN { for (i = 0; i < 50; ++i) printf "%.3f %.6f 0 0 0 0 0 1\n", 0.1 * i, 0.1 * i }' > "$T/hline.tum"
+"$EVAL" --gt "$T/hline.tum" --est "$T/hoff.tum" --hat "$T/hstill.tum" > /dev/null 2> "$T/hat.err" || { cat "$T/hat.err"; fail "--hat constant"; }
+grep -q "per-pose noise (if white) gt 0 m / 0 deg, est 0 m / 0 deg, $T/hstill.tum 0 m / 0 deg" "$T/hat.err" || { cat "$T/hat.err"; fail "--hat: a constant difference is not 0"; }
 echo OK

@@ -353,12 +353,14 @@ int main(int argc, char** argv) {
       }
       // A negative variance estimate (the hat's assumptions fail: correlated errors, too few increments) is no
       // noise level: the JSON keeps the signed value under its key and says so in xy_resolvable / yaw_resolvable;
-      // the text says "not resolvable".
+      // the text says "not resolvable". A NaN estimate (an input whose increments overflow a double, e.g. coordinates
+      // of 1e200) is no number at all: the JSON's value is null, *_resolvable false, and the text says "NaN", not
+      // "negative".
       auto src = [&](const eval::HatSource& s) {
-        return nlohmann::json{{"increment_sigma_xy_m", eval::signed_sqrt(s.increment_var_xy_m2)},
-                              {"increment_sigma_yaw_rad", eval::signed_sqrt(s.increment_var_yaw_rad2)},
-                              {"pose_sigma_xy_m", s.pose_sigma_xy_m},
-                              {"pose_sigma_yaw_rad", s.pose_sigma_yaw_rad},
+        return nlohmann::json{{"increment_sigma_xy_m", num(eval::signed_sqrt(s.increment_var_xy_m2))},
+                              {"increment_sigma_yaw_rad", num(eval::signed_sqrt(s.increment_var_yaw_rad2))},
+                              {"pose_sigma_xy_m", num(s.pose_sigma_xy_m)},
+                              {"pose_sigma_yaw_rad", num(s.pose_sigma_yaw_rad)},
                               {"xy_resolvable", s.increment_var_xy_m2 >= 0},
                               {"yaw_resolvable", s.increment_var_yaw_rad2 >= 0}};
       };
@@ -366,20 +368,28 @@ int main(int argc, char** argv) {
                   {"gt", src(h.ref)}, {"est", src(h.est)}, {"third", src(h.third)}};
       auto noise = [](const eval::HatSource& s) {
         std::ostringstream o;
-        if (s.increment_var_xy_m2 >= 0) o << s.pose_sigma_xy_m << " m";
-        else o << "xy not resolvable (negative variance estimate)";
+        auto part = [&](const char* what, double var, double shown, const char* unit) {
+          if (std::isnan(var)) o << what << " not computed (the variance estimate is NaN)";
+          else if (var >= 0) o << shown << " " << unit;
+          else o << what << " not resolvable (negative variance estimate)";
+        };
+        part("xy", s.increment_var_xy_m2, s.pose_sigma_xy_m, "m");
         o << " / ";
-        if (s.increment_var_yaw_rad2 >= 0) o << s.pose_sigma_yaw_rad * 180 / M_PI << " deg";
-        else o << "yaw not resolvable (negative variance estimate)";
+        part("yaw", s.increment_var_yaw_rad2, s.pose_sigma_yaw_rad * 180 / M_PI, "deg");
         return o.str();
       };
       std::cerr << "fploc eval: three-cornered hat over " << h.increments << " increments (lag " << hat_lag
                 << "): per-pose noise (if white) gt " << noise(h.ref) << ", est " << noise(h.est) << ", " << hat_path
                 << " " << noise(h.third) << "\n";
-      if (h.ref.increment_var_xy_m2 < 0 || h.est.increment_var_xy_m2 < 0 || h.third.increment_var_xy_m2 < 0 ||
-          h.ref.increment_var_yaw_rad2 < 0 || h.est.increment_var_yaw_rad2 < 0 || h.third.increment_var_yaw_rad2 < 0)
+      bool negative = false, nan = false;
+      for (const eval::HatSource* s : {&h.ref, &h.est, &h.third})
+        for (const double v : {s->increment_var_xy_m2, s->increment_var_yaw_rad2}) negative |= v < 0, nan |= std::isnan(v);
+      if (negative)
         std::cerr << "fploc eval: a negative variance estimate: the hat's assumptions fail (errors correlated between "
                      "two of the trajectories, or too few increments)\n";
+      if (nan)
+        std::cerr << "fploc eval: a variance estimate is NaN: the increments' differences overflow a double (coordinates "
+                     "far too large, another unit or a corrupt file?)\n";
     }
     std::cerr << "fploc eval: " << pairs.size() << " associated poses (gt " << gt.size() << ", est " << est.size()
               << "); ATE rmse " << a.trans.rmse << " m, mean " << a.trans.mean << " m, max " << a.trans.max

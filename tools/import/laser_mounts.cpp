@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 namespace fploc::import {
 
@@ -32,25 +33,31 @@ LaserMount laser_mount(const TfTree& tree, const std::string& base, const std::s
     return m;
   }
   m.found = true;
-  double n = 0, sx = 0, sy = 0, sz = 0, sc = 0, ss = 0, snz = 0;
+  // The mean over the recording's time, not over tf's samples: each sample time of the path's edges weighs half the
+  // time to its neighbours (the trapezoid rule over the interpolated transform), so a stretch where tf published
+  // often, a value re-published many times or a static edge's extra stamps do not outweigh a long one sampled rarely.
+  std::vector<int64_t> times;
+  for (const int64_t t : p->times_ns)
+    if (t >= p->start_ns) times.push_back(t);
+  if (times.empty()) times.push_back(p->start_ns);  // every edge static
+  double wsum = 0, sx = 0, sy = 0, sz = 0, sc = 0, ss = 0, snz = 0;
   m.tilt_min_deg = 180;
   m.tilt_max_deg = 0;
-  auto sample = [&](int64_t t) {
-    const Eigen::Isometry3d T = TfTree::at(*p, t);
+  for (size_t k = 0; k < times.size(); ++k) {
+    const double w = times.size() == 1 ? 1.0
+                                       : 0.5 * double((k + 1 < times.size() ? times[k + 1] : times[k]) -
+                                                      (k > 0 ? times[k - 1] : times[k]));
+    const Eigen::Isometry3d T = TfTree::at(*p, times[k]);
     const Eigen::Matrix3d R = T.linear();
     const double nz = R(2, 2);  // the scan plane's normal (the laser's z axis) on the base's z axis
     const double tilt = std::acos(std::min(1.0, std::abs(nz))) * 180 / M_PI;
     m.tilt_min_deg = std::min(m.tilt_min_deg, tilt);
     m.tilt_max_deg = std::max(m.tilt_max_deg, tilt);
-    sx += T.translation().x(), sy += T.translation().y(), sz += T.translation().z();
-    sc += R(0, 0), ss += R(1, 0), snz += nz;
-    ++n;
-  };
-  bool any = false;
-  for (const int64_t t : p->times_ns)
-    if (t >= p->start_ns) sample(t), any = true;
-  if (!any) sample(p->start_ns);  // every edge static
-  m.x_m = sx / n, m.y_m = sy / n, m.z_m = sz / n;
+    sx += w * T.translation().x(), sy += w * T.translation().y(), sz += w * T.translation().z();
+    sc += w * R(0, 0), ss += w * R(1, 0), snz += w * nz;
+    wsum += w;
+  }
+  m.x_m = sx / wsum, m.y_m = sy / wsum, m.z_m = sz / wsum;
   m.yaw_deg = std::atan2(ss, sc) * 180 / M_PI;
   m.upside_down = snz < 0;
   return m;

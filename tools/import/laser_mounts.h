@@ -13,8 +13,8 @@ struct LaserMount {
   std::string topic, frame, base;
   bool found = false;  // tf connects base and frame
   std::string why;     // when not found
-  double x_m = 0, y_m = 0, z_m = 0, yaw_deg = 0;  // the mean mount (yaw: the laser's x axis in the base plane)
-  bool upside_down = false;                        // the scan plane's normal points down
+  double x_m = 0, y_m = 0, z_m = 0, yaw_deg = 0;  // the mount's mean over time (yaw: the laser's x axis in the base plane)
+  bool upside_down = false;                        // the scan plane's normal points down (on time average)
   double tilt_min_deg = 0, tilt_max_deg = 0;       // the scan plane's angle to the base plane over the recording
   static constexpr double kLevelDeg = 3;           // a scan plane within this of the base plane is level
   bool level() const { return found && tilt_max_deg <= kLevelDeg; }
@@ -27,7 +27,8 @@ struct LaserMount {
 std::string robot_frame(const TfTree& tree, const std::string& preferred);
 
 // The mount of the laser whose scans are in `frame`, over every sample of the tf edges between it and `base`
-// (tree sorted).
+// (tree sorted): the tilt's range over the samples, the mean weighted by time (each sample half the time to its
+// neighbours), from the first time every edge has a sample to the last sample.
 LaserMount laser_mount(const TfTree& tree, const std::string& base, const std::string& topic, const std::string& frame);
 
 }  // namespace fploc::import

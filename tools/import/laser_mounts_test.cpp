@@ -57,3 +57,40 @@ TEST(LaserMount, ComposedThroughTheTreeLevelTiltingAndUpsideDown) {
   EXPECT_NE(lost.why.find("no tf frame 'no_such_frame'"), std::string::npos) << lost.why;
   EXPECT_FALSE(laser_mount(tree, "base_link", "/y", "").found);
 }
+
+// The mean mount is a mean over time, not over tf samples: a stretch where tf was published densely must not
+// outweigh a longer one sampled rarely (it was weighted per sample: 0.216 m here instead of 0.37 m).
+TEST(LaserMount, MeanWeighsTimeNotSamplesUnevenSpacing) {
+  TfTree tree;
+  const auto id = Eigen::Quaterniond::Identity();
+  for (int k = 0; k <= 100; ++k) tree.add(tf("base_link", "laser", k * 10'000'000LL, {0.2, 0, 0.3}, id));  // 0..1 s, 100 Hz
+  for (int k = 2; k <= 10; ++k) tree.add(tf("base_link", "laser", k * 1'000'000'000LL, {0.4, 0, 0.3}, id));  // 2..10 s, 1 Hz
+  tree.sort();
+  const auto m = laser_mount(tree, "base_link", "/scan", "laser");
+  ASSERT_TRUE(m.found) << m.why;
+  // 0.2 m for 1 s, 0.2 -> 0.4 m interpolated over 1 s, 0.4 m for 8 s.
+  EXPECT_NEAR(m.x_m, (0.2 * 1 + 0.3 * 1 + 0.4 * 8) / 10, 1e-9);
+  EXPECT_NEAR(m.z_m, 0.3, 1e-12);
+}
+
+// fploc import keeps tf every 100 ms at most and not a value published again unchanged: a mount that held one value
+// for 9 s (re-published at 50 Hz, as a static transform sent on /tf is) and then jittered for 1 s is still 9 s of the
+// first value, through a static edge also re-published at 50 Hz. Before, the held value was one sample against the
+// jitter's ten (0.475 m), and with the repeats dropped it blended into the next value over the whole 9 s.
+TEST(LaserMount, AValuePublishedAgainAndAgainKeepsItsTime) {
+  TfTree tree(100'000'000);
+  const auto id = Eigen::Quaterniond::Identity();
+  for (int k = 0; k < 500; ++k) {  // 0 .. 9.98 s at 50 Hz
+    const int64_t t = k * 20'000'000LL;
+    tree.add(tf("base_link", "mount", t, {0.1, 0, 0.2}, id));
+    const double x = k < 450 ? 0.1 : 0.4 + (k % 2 ? 0.001 : -0.001);  // from 9 s: 0.4 m, jittering
+    tree.add(tf("mount", "laser", t, {x, 0, 0.1}, id));
+  }
+  tree.sort();
+  const auto m = laser_mount(tree, "base_link", "/scan", "laser");
+  ASSERT_TRUE(m.found) << m.why;
+  // 0.2 m in base_link for 8.98 s, then 0.5 m (+- 1 mm) for 1 s: about 0.23 m.
+  EXPECT_NEAR(m.x_m, (0.2 * 8.98 + 0.35 * 0.02 + 0.5 * 0.98) / 9.98, 0.002);
+  EXPECT_NEAR(m.z_m, 0.3, 1e-12);
+  EXPECT_TRUE(m.level());
+}

@@ -20,17 +20,30 @@ void TfTree::add(const rec::Transform& t) {
   const Sample smp{t.header.stamp_ns, Eigen::Vector3d(t.t[0], t.t[1], t.t[2]),
                    Eigen::Quaterniond(t.q[3], t.q[0], t.q[1], t.q[2]).normalized()};
   if (gap_ns_ > 0 && !e.samples.empty()) {
-    const Sample& last = e.samples.back();
+    const Sample last = e.samples.back();
+    if (smp.p == last.p && smp.q.coeffs() == last.q.coeffs()) {  // unchanged: held until then
+      e.held_until_ns = std::max(e.held_until_ns, smp.t_ns);
+      return;
+    }
     if (std::abs(smp.t_ns - last.t_ns) < gap_ns_) return;
-    if (smp.p == last.p && smp.q.coeffs() == last.q.coeffs()) return;  // unchanged
+    // The last value held until it was last published: a sample of it there, so that it does not blend into this
+    // one over the whole time it held.
+    if (e.held_until_ns > last.t_ns && e.held_until_ns < smp.t_ns) e.samples.push_back({e.held_until_ns, last.p, last.q});
+    e.held_until_ns = INT64_MIN;
   }
   e.parent = bare(t.header.frame_id);
   e.samples.push_back(smp);
 }
 
 void TfTree::sort() {
-  for (auto& [c, e] : edges_)
+  for (auto& [c, e] : edges_) {
+    if (!e.samples.empty() && e.held_until_ns > e.samples.back().t_ns) {
+      const Sample last = e.samples.back();
+      e.samples.push_back({e.held_until_ns, last.p, last.q});
+    }
+    e.held_until_ns = INT64_MIN;
     std::stable_sort(e.samples.begin(), e.samples.end(), [](const Sample& a, const Sample& b) { return a.t_ns < b.t_ns; });
+  }
 }
 
 bool TfTree::has(const std::string& frame) const { return frames().count(bare(frame)) > 0; }

@@ -4,6 +4,7 @@
 // span its nearest sample holds (a single sample = a static edge). Frame names: a leading '/' is ignored.
 #pragma once
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <set>
@@ -24,6 +25,9 @@ class TfTree {
   struct Edge {
     std::string parent;
     std::vector<Sample> samples;  // by time once sorted
+    // With a sample gap: the newest time the last kept value was published again (repeats are not kept, but how long a
+    // value held is: kept as a sample of that value at this time when the value changes, and by sort()).
+    int64_t held_until_ns = INT64_MIN;
   };
   // The edges between two frames: from each up to their first common ancestor.
   struct Path {
@@ -33,10 +37,13 @@ class TfTree {
   };
 
   // min_sample_gap_ns > 0: an edge keeps a sample only that long after its last one, and only when it differs from
-  // it (bounded memory over long recordings, for uses that do not need every stamp).
+  // it (bounded memory over long recordings, for uses that do not need every stamp). A value published again and
+  // again is kept as two samples, its first and its last time before it changed (or the last time, at sort()): the
+  // edge holds it all that time, not drifting towards the next value from its first stamp on.
   explicit TfTree(int64_t min_sample_gap_ns = 0) : gap_ns_(min_sample_gap_ns) {}
   void add(const rec::Transform& t);
-  // Sorts each edge's samples by time (call after the last add, before path/at).
+  // Sorts each edge's samples by time (call after the last add, before path/at); with a sample gap, first keeps each
+  // edge's last value until the last time it was published.
   void sort();
   bool has(const std::string& frame) const;
   std::set<std::string> frames() const;

@@ -46,6 +46,45 @@ grep -q '>2 m</text>' "$T/d.svg" || fail "no 2 m scale bar (plan 10 m wide)"
 grep -q "FPLOC-MOVED" "$T/d.svg" && fail "a legend line for a layer the drawing does not have"
 "$MAP" render --plan "$T/d.json" --fields none --out "$T/d.png" 2> "$T/err" || fail "render png --fields none"
 grep -q "scale bar (bottom left) 2 m" "$T/err" || fail "png scale bar not reported: $(cat "$T/err")"
+# Plan coordinates (the pictures had a scale bar but nothing to read a start pose off): a grid every metre, its ticks
+# and labels in margins below and left of the plan. PNG: the ticks under the plan are a metre apart, the FPLOC-MISSING
+# wall x = 0 is over the tick labelled 0 and the FPLOC-NEW segment starts (x = 3) three ticks right of it. SVG: the
+# grid's labels are at their plan coordinates ("3" at x = 3 below the plan, "8" at y = 8 left of it).
+PYLIB="$(cd "$(dirname "$0")/../pylib" && pwd)"
+python3 - "$T/d.svg" "$T/d.png" "$T/err" "$PYLIB" <<'PY' || fail "no plan coordinates on the picture"
+import re, sys
+sys.path.insert(0, sys.argv[4])
+from png_read import read_png
+svg, err = open(sys.argv[1]).read(), open(sys.argv[3]).read()
+m = re.search(r"grid every (\S+) m, labelled left \((\d+) px\) and below \((\d+) px\)", err)
+assert m, err
+step, L, B = float(m.group(1)), int(m.group(2)), int(m.group(3))
+band = int(re.search(r"legend above the plan \((\d+) px\)", err).group(1))
+assert step == 1, step
+w, h, px = read_png(sys.argv[2])
+bottom = h - B  # the first row below the plan
+ink = lambda c: max(c) < 90
+ticks = [x for x in range(L, w) if ink(px(x, bottom + 1)) and not ink(px(x - 1, bottom + 1))]
+gaps = [b - a for a, b in zip(ticks, ticks[1:])]
+assert len(ticks) >= 8 and max(gaps) - min(gaps) <= 1, ("ticks", ticks)
+def cols(rgb):
+    return [x for x in range(L, w) for y in range(band, bottom) if px(x, y) == rgb]
+red = cols((214, 39, 40)); green = cols((44, 160, 44))
+wall = (min(red) + max(red)) / 2
+zero = min(range(len(ticks)), key=lambda k: abs(ticks[k] - wall))
+assert abs(ticks[zero] - wall) <= 2, ("the wall x = 0 is not over a tick", wall, ticks)
+assert abs(ticks[zero + 3] - min(green) - 1.5) <= 3, ("the segment from x = 3 does not start 3 ticks right of x = 0", min(green), ticks)
+# The labels under the plan: ink below the ticks of x = 0 and x = 3.
+for k in (zero, zero + 3):
+    assert sum(ink(px(x, y)) for x in range(ticks[k] - 8, ticks[k] + 8) for y in range(bottom + 3, h)) > 5, ("no label", k)
+labels = re.search(r'<g class="grid-labels"[^>]*>(.*?)</g>', svg, re.S)
+assert labels, "SVG: no grid labels"
+assert re.search(r'<text x="3" y="[^"]*" text-anchor="middle">3</text>', labels.group(1)), labels.group(1)
+y8 = re.search(r'<text x="[^"]*" y="([^"]*)" text-anchor="end">8</text>', labels.group(1))
+assert y8 and abs(float(y8.group(1)) + 8) < 0.5, labels.group(1)
+assert '<line x1="0" y1=' in re.search(r'<g class="grid"[^>]*>(.*?)</g>', svg, re.S).group(1), "SVG: no grid line x = 0"
+print(f"coordinates: grid {step} m, ticks every {gaps[0]} px, wall x = 0 at column {wall}, the NEW segment from {min(green)}")
+PY
 # The legend sits in a band above the plan, not over its top-left walls (the trial: the SVG's legend box covered
 # them). SVG: the white box ends above the plan's top (y 8, -8 in SVG's downward y) and the view starts above it;
 # PNG: the band's height is said, the legend's swatch is in it, and the FPLOC-MISSING wall x = 0, y 0..8 is drawn

@@ -177,7 +177,8 @@ int main(int argc, char** argv) {
 
   PlanArgs r_plan;
   RenderArgs r;
-  auto* render = app.add_subcommand("render", "SVG/PNG of the plan and the leaf fields coloured by nearest element");
+  auto* render = app.add_subcommand("render", "SVG/PNG of the plan and the leaf fields coloured by nearest element, with a "
+                                     "scale bar and a grid in plan metres labelled along the left and bottom edges");
   r_plan.add(render);
   render->add_option("--map", r.map, "a built .fpmap (default: build a paper-mode field)");
   render->add_option("--depth", r.depth, "depth when building (default 5, like the paper's Fig. 2)");

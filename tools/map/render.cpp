@@ -117,9 +117,16 @@ void write_svg(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
   const int legend_lines = (diff_count[0] > 0) + (diff_count[1] > 0) + (diff_count[2] > 0) + int(conns.size());
   const double fs = std::min(W, H0) / 60;
   const double band = legend_lines > 0 ? 1.4 * fs * legend_lines + fs : 0.0;
-  const double H = H0 + band, top = -(b.max.y() + pad) - band;  // the view's top edge (SVG y, downwards)
-  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << int(width * H / W)
-    << "\" viewBox=\"" << b.min.x() - pad << " " << top << " " << W << " " << H << "\">\n"
+  // Plan coordinates: a light grid in metres under the plan, labelled in margins left of (y) and below (x) it
+  // (fploc/floorplan/png.h's rule for the step, at the picture's scale).
+  const double ppm = width / W;  // about: the margins widen the view a little
+  const PlanGrid grid = plan_grid(b.min.x() - pad, b.min.y() - pad, b.max.x() + pad, b.max.y() + pad, ppm,
+                                  std::max(1, int(std::lround(0.8 * fs * ppm))));
+  const double gfs = 0.8 * fs, left = grid.left_px / ppm, below = grid.bottom_px / ppm;
+  const double H = H0 + band + below, top = -(b.max.y() + pad) - band;  // the view's top edge (SVG y, downwards)
+  const double VW = W + left, vx0 = b.min.x() - pad - left;
+  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << int(width * H / VW)
+    << "\" viewBox=\"" << vx0 << " " << top << " " << VW << " " << H << "\">\n"
     << "<g transform=\"scale(1,-1)\">\n<g stroke=\"#00000030\" stroke-width=\"" << sw * 0.5 << "\">\n";
   if (f) f->for_each_leaf([&](const Box2& box, int, const uint32_t* ids, int n) {
     if (box.max.x() < b.min.x() - pad || box.min.x() > b.max.x() + pad || box.max.y() < b.min.y() - pad ||
@@ -132,6 +139,23 @@ void write_svg(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
     s << "<rect x=\"" << box.min.x() << "\" y=\"" << box.min.y() << "\" width=\"" << box.size().x() << "\" height=\""
       << box.size().y() << "\" fill=\"" << buf << "\"/>\n";
   });
+  s << "</g>\n";
+  // The grid (x = 0 and y = 0 darker, the origin ringed when in view).
+  const double gx0 = b.min.x() - pad, gx1 = b.max.x() + pad, gy0 = b.min.y() - pad, gy1 = b.max.y() + pad;
+  std::vector<double> gxs, gys;
+  for (double k = std::ceil(gx0 / grid.step_m); k * grid.step_m <= gx1; k += 1) gxs.push_back(k * grid.step_m + 0.0);
+  for (double k = std::ceil(gy0 / grid.step_m); k * grid.step_m <= gy1; k += 1) gys.push_back(k * grid.step_m + 0.0);
+  const auto axis = [&](double v) { return std::abs(v) < 1e-9 * grid.step_m; };
+  s << "<g class=\"grid\" stroke=\"#3c5a96\" stroke-width=\"" << sw << "\">\n";
+  for (double x : gxs)
+    s << "<line x1=\"" << x << "\" y1=\"" << gy0 << "\" x2=\"" << x << "\" y2=\"" << gy1 << "\" stroke-opacity=\""
+      << (axis(x) ? 0.5 : 0.2) << "\"/>\n";
+  for (double y : gys)
+    s << "<line x1=\"" << gx0 << "\" y1=\"" << y << "\" x2=\"" << gx1 << "\" y2=\"" << y << "\" stroke-opacity=\""
+      << (axis(y) ? 0.5 : 0.2) << "\"/>\n";
+  if (gx0 <= 0 && 0 <= gx1 && gy0 <= 0 && 0 <= gy1)
+    s << "<circle cx=\"0\" cy=\"0\" r=\"" << 5 / ppm << "\" fill=\"none\" stroke-opacity=\"0.9\" stroke-width=\"" << 2 / ppm
+      << "\"/>\n";
   s << "</g>\n<g fill=\"none\" stroke=\"#000\" stroke-width=\"" << sw * 2 << "\">\n";
   for (const auto& e : plan.elements) {
     const LayerStyle* st = style_of(plan, e);
@@ -172,6 +196,31 @@ void write_svg(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
   s << "<g font-family=\"sans-serif\" font-size=\"" << fs << "\">\n<line x1=\"" << x0 << "\" y1=\"" << ybar << "\" x2=\""
     << x0 + bar << "\" y2=\"" << ybar << "\" stroke=\"#000\" stroke-width=\"" << fs / 4 << "\"/>\n<text x=\"" << x0
     << "\" y=\"" << ybar - fs / 2 << "\">" << bar << " m</text>\n";
+  // Tick labels in the margins (upright): x below the plan, y left of it, "m" in the corner; the scale bar's corner
+  // keeps no x label under it.
+  const double tick = std::max(3.0, gfs * ppm / 3) / ppm, ybottom = -gy0;
+  s << "<g class=\"grid-labels\" font-size=\"" << gfs << "\" fill=\"#282828\">\n";
+  s << "<text x=\"" << gx0 - tick - 0.1 * gfs << "\" y=\"" << ybottom + tick + gfs << "\" text-anchor=\"end\">m</text>\n";
+  double right = gx0 - tick;
+  for (double x : gxs) {
+    const std::string t = grid.label(x);
+    const double half = 0.3 * gfs * double(t.size());
+    if (x - half < right + 0.5 * gfs) continue;
+    s << "<line x1=\"" << x << "\" y1=\"" << ybottom << "\" x2=\"" << x << "\" y2=\"" << ybottom + tick
+      << "\" stroke=\"#282828\" stroke-width=\"" << sw << "\"/><text x=\"" << x << "\" y=\"" << ybottom + tick + gfs
+      << "\" text-anchor=\"middle\">" << t << "</text>\n";
+    right = x + half;
+  }
+  double topmost = ybottom + tick;
+  for (double y : gys) {
+    const double base = -y + 0.35 * gfs;
+    if (base > topmost - 1.2 * gfs) continue;
+    s << "<line x1=\"" << gx0 - tick << "\" y1=\"" << -y << "\" x2=\"" << gx0 << "\" y2=\"" << -y
+      << "\" stroke=\"#282828\" stroke-width=\"" << sw << "\"/><text x=\"" << gx0 - tick - 0.1 * gfs << "\" y=\"" << base
+      << "\" text-anchor=\"end\">" << grid.label(y) << "</text>\n";
+    topmost = base - 0.7 * gfs;
+  }
+  s << "</g>\n";
   double yl = top + 1.5 * fs;
   if (legend_lines > 0)  // a white ground for the legend
     s << "<rect x=\"" << x0 - fs / 2 << "\" y=\"" << yl - 1.2 * fs << "\" width=\"" << 22 * fs << "\" height=\""
@@ -199,9 +248,18 @@ void write_png(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
   const Box2 b = drawn_bounds(plan, conns);
   const double pad = 0.02 * b.size().maxCoeff() + 0.1;
   const double W = b.size().x() + 2 * pad, H = b.size().y() + 2 * pad;
-  const int w = std::max(16, width), h = std::max(16, int(std::ceil(w * H / W)));
+  // Plan coordinates (fploc/floorplan/png.h): a light grid in metres under the plan, labelled in margins left of and
+  // below it; the picture is `width` wide with them.
+  const int fs = std::clamp(width / 60, 12, 24);
+  const PlanGrid grid = plan_grid(b.min.x() - pad, b.min.y() - pad, b.max.x() + pad, b.max.y() + pad,
+                                  std::max(16, width) / W, std::max(11, fs * 4 / 5));
+  const int w = std::max(16, width - grid.left_px), h = std::max(16, int(std::ceil(w * H / W)));
   const double px = W / w;
-  std::vector<uint8_t> img(size_t(w) * h * 3, 255);
+  RgbImage plan_img(w, h);
+  std::vector<uint8_t>& img = plan_img.px;
+  PlanArea area;
+  area.x1 = w, area.y1 = h;
+  area.ux = 1 / px, area.vy = -1 / px, area.ox = -(b.min.x() - pad) / px, area.oy = (b.max.y() + pad) / px;
   if (f) {
     std::vector<int64_t> leaf_key(size_t(w) * h, -1);
     for (int j = 0; j < h; ++j)
@@ -225,6 +283,7 @@ void write_png(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
           for (int q = 0; q < 3; ++q) img[k * 3 + q] = uint8_t(img[k * 3 + q] * 0.8);
       }
   }
+  draw_plan_grid_lines(plan_img, area, grid);
   // The elements, sampled every quarter pixel along them (1.5 px wide; the plan-change layers 3 px, in colour).
   auto dot = [&](const Eigen::Vector2d& p, const uint8_t rgb[3], double r_px) {
     const double ci = (p.x() - (b.min.x() - pad)) / px - 0.5, cj = ((b.max.y() + pad) - p.y()) / px - 0.5;
@@ -273,7 +332,6 @@ void write_png(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
   for (double x = 0; x <= bar; x += px / 4) dot(Eigen::Vector2d(b.min.x() - pad + 10 * px + x, b.min.y() - pad + 10 * px), black, 1.5);
   // Legend (in a band above the plan, as in the SVG: over the plan it hid the top-left walls): the plan-change
   // layers present and the floor's connections.
-  const int fs = std::clamp(w / 60, 12, 24);
   std::vector<std::pair<const uint8_t*, std::string>> legend;
   int diff_count[3] = {0, 0, 0};
   for (const auto& e : plan.elements)
@@ -284,11 +342,18 @@ void write_png(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
                                                   "): " + kDiffLayers[k].label);
   for (const auto& c : conns) legend.emplace_back(style_of(c.kind).rgb, legend_text(c, floor));
   const int band = legend.empty() ? 0 : fs / 2 + int(legend.size()) * (fs * 3 / 2) + fs / 2;
-  RgbImage pic(w, h + band);
-  std::copy(img.begin(), img.end(), pic.px.begin() + std::ptrdiff_t(size_t(band) * size_t(w) * 3));
+  const int L = grid.left_px;
+  RgbImage pic(L + w, band + h + grid.bottom_px);
+  for (int j = 0; j < h; ++j)
+    std::copy_n(img.begin() + std::ptrdiff_t(size_t(j) * w * 3), size_t(w) * 3,
+                pic.px.begin() + std::ptrdiff_t((size_t(band + j) * pic.w + L) * 3));
+  PlanArea shown = area;
+  shown.x0 = L, shown.y0 = band, shown.x1 = L + w, shown.y1 = band + h;
+  shown.ox += L, shown.oy += band;
+  draw_plan_grid_labels(pic, shown, grid);
   char bar_text[32];
   std::snprintf(bar_text, sizeof bar_text, "%g m", bar);
-  draw_text(pic, 10, pic.h - 10 - fs / 2 - 2, bar_text, fs, black);
+  draw_text(pic, L + 10, band + h - 10 - fs / 2 - 2, bar_text, fs, black);
   if (!legend.empty()) {
     const int lh = fs * 3 / 2, sw = 2 * fs, x0 = fs / 2;
     int tw = 0;
@@ -302,8 +367,10 @@ void write_png(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
     }
   }
   pic.write_png(out);
-  std::cerr << "fploc map render: " << w << " x " << pic.h << " px, " << px << " m per pixel; scale bar (bottom left) " << bar
-            << " m" << (band ? "; legend above the plan (" + std::to_string(band) + " px)" : std::string()) << "\n";
+  std::cerr << "fploc map render: " << pic.w << " x " << pic.h << " px, " << px << " m per pixel; scale bar (bottom left) " << bar
+            << " m" << (band ? "; legend above the plan (" + std::to_string(band) + " px)" : std::string())
+            << "; grid every " << grid.step_m << " m, labelled left (" << L << " px) and below (" << grid.bottom_px
+            << " px)\n";
 }
 
 }  // namespace

@@ -65,7 +65,9 @@ double scale_bar_m(double max_m) {
 // trajectories on top (colours in order: green, blue, orange, magenta), `scale` pixels per cell. crop_margin_m
 // >= 0: only the box around the occupied cells and the trajectories (crop_to_tracks: the trajectories alone), that
 // much wider on each side (a log's map is mostly the free space its longest beams swept). A scale bar in metres
-// (bottom left) and, with `labels` (one per trajectory), a legend of the trajectories' colours (top left).
+// (bottom left) and, with `labels` (one per trajectory), a legend of the trajectories' colours (top left). Plan
+// coordinates: a light grid in metres (1, 2 or 5 x 10^k) under the map's lines, x = 0 and y = 0 darker, the origin
+// ringed, labelled in margins left of (y) and below (x) the map.
 void write_png(const std::string& out, const fploc::OccupancyGrid& g, const fploc::FloorPlan& plan,
                const std::vector<std::vector<Eigen::Vector2d>>& tracks, const std::vector<std::string>& labels, int scale,
                double crop_margin_m, bool crop_to_tracks) {
@@ -94,9 +96,6 @@ void write_png(const std::string& out, const fploc::OccupancyGrid& g, const fplo
   };
   static const uint8_t red[3] = {220, 0, 0}, black[3] = {0, 0, 0}, white[3] = {255, 255, 255};
   static const uint8_t cols[4][3] = {{0, 170, 0}, {0, 60, 255}, {255, 140, 0}, {200, 0, 200}};
-  for (const auto& e : plan.elements) line(e.a, e.b, red, 0);
-  for (size_t t = 0; t < tracks.size(); ++t)
-    for (size_t k = 1; k < tracks[t].size(); ++k) line(tracks[t][k - 1], tracks[t][k], cols[t % 4], 1);
   // The box in pixels: occupied cells (unless crop_to_tracks) and trajectory points, widened by the margin, clamped
   // to the image; the whole grid without a margin or with nothing to frame.
   int cx0 = 0, cy0 = 0, cx1 = W, cy1 = H;
@@ -126,35 +125,68 @@ void write_png(const std::string& out, const fploc::OccupancyGrid& g, const fplo
       cx1 = std::min(W, int(x1 + m) + scale), cy1 = std::min(H, int(y1 + m) + scale);
     }
   }
-  fploc::RgbImage img(cx1 - cx0, cy1 - cy0);
-  for (int y = 0; y < img.h; ++y)
-    std::copy_n(full.px.begin() + (size_t(cy0 + y) * W + cx0) * 3, size_t(img.w) * 3, img.px.begin() + size_t(y) * img.w * 3);
+  // Plan coordinates (fploc/floorplan/png.h): a light grid in metres under the segments and trajectories, labelled
+  // in margins left of and below the map.
+  const int fs = std::clamp(std::min(cx1 - cx0, cy1 - cy0) / 30, 12, 28), pad = fs / 2;
+  const double k = scale / g.resolution;
+  fploc::PlanArea area;  // the full picture
+  area.x1 = W, area.y1 = H;
+  area.ux = k * c, area.vx = k * s, area.uy = k * s, area.vy = -k * c;
+  area.ox = -k * (c * g.origin_x + s * g.origin_y), area.oy = H + k * (-s * g.origin_x + c * g.origin_y);
+  double bx0 = 1e300, by0 = 1e300, bx1 = -1e300, by1 = -1e300;  // the crop in plan metres
+  for (int cc : {cx0, cx1})
+    for (int rr : {cy0, cy1}) {
+      double x, y;
+      area.to_m(cc, rr, &x, &y);
+      bx0 = std::min(bx0, x), by0 = std::min(by0, y), bx1 = std::max(bx1, x), by1 = std::max(by1, y);
+    }
+  const fploc::PlanGrid grid = fploc::plan_grid(bx0, by0, bx1, by1, k, std::max(11, fs * 4 / 5));
+  fploc::draw_plan_grid_lines(full, area, grid);
+  for (const auto& e : plan.elements) line(e.a, e.b, red, 0);
+  for (size_t t = 0; t < tracks.size(); ++t)
+    for (size_t q = 1; q < tracks[t].size(); ++q) line(tracks[t][q - 1], tracks[t][q], cols[t % 4], 1);
+  const int L = grid.left_px, B = grid.bottom_px;
+  fploc::RgbImage pic(cx1 - cx0 + L, cy1 - cy0 + B);
+  for (int y = 0; y < cy1 - cy0; ++y)
+    std::copy_n(full.px.begin() + (size_t(cy0 + y) * W + cx0) * 3, size_t(cx1 - cx0) * 3,
+                pic.px.begin() + (size_t(y) * pic.w + L) * 3);
+  fploc::PlanArea shown = area;  // the crop, moved right of the y labels' margin
+  shown.x0 = L, shown.y0 = 0, shown.x1 = L + cx1 - cx0, shown.y1 = cy1 - cy0;
+  shown.ox += L - cx0, shown.oy -= cy0;
+  fploc::draw_plan_grid_labels(pic, shown, grid);
+  // The map part of the picture (scale bar and legend are placed in it).
+  struct Sub {
+    fploc::RgbImage& im;
+    int x0, w, h;
+  } img{pic, L, cx1 - cx0, cy1 - cy0};
   // Scale bar (bottom left, on a white ground): 1, 2 or 5 x 10^k m, at most a third of the width.
-  const int fs = std::clamp(std::min(img.w, img.h) / 30, 12, 28), pad = fs / 2;
   const double m_per_px = g.resolution / scale, bar_m = scale_bar_m(img.w / 3.0 * m_per_px);
   const int bar_px = int(std::lround(bar_m / m_per_px));
   char bar_text[32];
   std::snprintf(bar_text, sizeof bar_text, "%g m", bar_m);
-  const int bx = pad, by = img.h - pad;
-  img.fill_rect(bx - pad / 2, by - 2 * fs - pad / 2, bx + std::max(bar_px, fploc::text_width(bar_text, fs)) + pad / 2,
+  const int bx = img.x0 + pad, by = img.h - pad;
+  pic.fill_rect(bx - pad / 2, by - 2 * fs - pad / 2, bx + std::max(bar_px, fploc::text_width(bar_text, fs)) + pad / 2,
                 by + pad / 2, white, 0.85);
-  img.fill_rect(bx, by - fs / 4, bx + bar_px, by, black);
-  for (int k : {0, bar_px - 2}) img.fill_rect(bx + k, by - fs / 2, bx + k + 2, by, black);  // end ticks
-  fploc::draw_text(img, bx, by - fs / 2 - 3, bar_text, fs, black);
+  pic.fill_rect(bx, by - fs / 4, bx + bar_px, by, black);
+  for (int q : {0, bar_px - 2}) pic.fill_rect(bx + q, by - fs / 2, bx + q + 2, by, black);  // end ticks
+  fploc::draw_text(pic, bx, by - fs / 2 - 3, bar_text, fs, black);
   // Legend (top left): a swatch and the name of each trajectory.
   if (!labels.empty()) {
     const size_t n = std::min(labels.size(), tracks.size());
     int tw = 0;
     for (size_t t = 0; t < n; ++t) tw = std::max(tw, fploc::text_width(labels[t], fs));
-    const int lh = fs * 3 / 2, sw = 2 * fs;
-    img.fill_rect(pad / 2, pad / 2, pad + sw + pad + tw + pad, pad + int(n) * lh + pad / 2, white, 0.85);
+    const int lh = fs * 3 / 2, sw = 2 * fs, x0 = img.x0;
+    pic.fill_rect(x0 + pad / 2, pad / 2, x0 + pad + sw + pad + tw + pad, pad + int(n) * lh + pad / 2, white, 0.85);
     for (size_t t = 0; t < n; ++t) {
       const int y = pad + int(t) * lh + lh / 2;
-      img.fill_rect(pad, y - 2, pad + sw, y + 2, cols[t % 4]);
-      fploc::draw_text(img, pad + sw + pad, y + fs * 2 / 5, labels[t], fs, black);
+      pic.fill_rect(x0 + pad, y - 2, x0 + pad + sw, y + 2, cols[t % 4]);
+      fploc::draw_text(pic, x0 + pad + sw + pad, y + fs * 2 / 5, labels[t], fs, black);
     }
   }
-  img.write_png(out);
+  pic.write_png(out);
+  std::cerr << "fploc occupancy: " << out << ": " << pic.w << " x " << pic.h << " px, the map " << img.w << " x "
+            << img.h << " px at " << L << ", 0 showing x " << bx0 + 0.0 << " .. " << bx1 + 0.0 << ", y " << by0 + 0.0 << " .. " << by1 + 0.0
+            << " m; grid every " << grid.step_m << " m, labelled left (" << L << " px) and below (" << B << " px)\n";
 }
 }  // namespace
 
@@ -173,7 +205,8 @@ int main(int argc, char** argv) {
   app.add_option("--out", out, "write the plan (.json or .csv)");
   app.add_option("--compare", compare, "another plan: two-way distances to the vectorised plan");
   app.add_flag("--json", json, "JSON on stdout");
-  app.add_option("--png", png_out, "picture: grid, segments (red), --tum trajectories (green, blue, orange, magenta)");
+  app.add_option("--png", png_out, "picture: grid, segments (red), --tum trajectories (green, blue, orange, magenta), a scale "
+                 "bar and plan coordinates (a grid in metres labelled along the left and bottom edges)");
   app.add_option("--scale", scale, "PNG pixels per cell (1)")->check(CLI::Range(1, 16));
   app.add_option("--tum", tums, "trajectory (TUM) to draw on the PNG; repeatable");
   app.add_option("--label", labels, "PNG legend: the name of each --tum trajectory, in their order; repeatable (default: no legend)");

@@ -37,7 +37,7 @@ PY
 printf '0 1.0 1.0 0 0 0 0 1\n1 4.0 2.0 0 0 0 0 1\n' > "$T/t.tum"
 printf '0 1.2 1.2 0 0 0 0 1\n1 3.8 1.8 0 0 0 0 1\n' > "$T/e.tum"
 "$OCC" "$T/m0.05/map.yaml" --png "$T/legend.png" --scale 2 --crop-margin 1 --crop-to tracks --tum "$T/t.tum" \
-  --label reference --tum "$T/e.tum" --label fploc 2>/dev/null || fail "png --crop-to tracks --label"
+  --label reference --tum "$T/e.tum" --label fploc 2> "$T/legend.err" || fail "png --crop-to tracks --label"
 if "$OCC" "$T/m0.05/map.yaml" --png "$T/n.png" --tum "$T/t.tum" --label a --label b 2> "$T/err"; then fail "2 labels for 1 track"; fi
 # Trajectories wholly off the map frame nothing: an error, not a 20-px strip at the edge (or the whole grid).
 printf '0 1000.0 1000.0 0 0 0 0 1\n1 1001.0 1000.0 0 0 0 0 1\n' > "$T/far.tum"
@@ -48,23 +48,48 @@ if "$OCC" "$T/m0.05/map.yaml" --crop-to tracks --png "$T/n.png" 2> "$T/err"; the
 if "$OCC" "$T/m0.05/map.yaml" --tum "$T/t.tum" --label a 2> "$T/err"; then fail "--tum/--label without --png"; fi
 grep -q "give --png" "$T/err" || fail "--label without --png: $(cat "$T/err")"
 PYLIB="$(cd "$(dirname "$0")/../pylib" && pwd)"
-python3 - "$T/legend.png" "$PYLIB" <<'PY' || fail "legend, scale bar or crop"
-import sys
+# Plan coordinates: a grid every 2 m (40 px per metre, labels 11 px: 1 m would put them closer than 5 of their
+# size), labelled in margins left of and below the map; the tick of x = 4 and the tick of y = 2 meet at the end of
+# the reference track, (4, 2), drawn where the map says it is (the pictures had a scale bar but no coordinates).
+python3 - "$T/legend.png" "$PYLIB" "$T/legend.err" <<'PY' || fail "legend, scale bar, crop or coordinates"
+import re, sys
 sys.path.insert(0, sys.argv[2])
 from png_read import read_png
-w, h, px = read_png(sys.argv[1])
-print(f"legend png {w}x{h}")
+W, H, px = read_png(sys.argv[1])
+m = re.search(r"the map (\d+) x (\d+) px at (\d+), 0 showing x (\S+) \.\. (\S+), y (\S+) \.\. (\S+) m; grid every (\S+) m, "
+              r"labelled left \((\d+) px\) and below \((\d+) px\)", open(sys.argv[3]).read())
+assert m, open(sys.argv[3]).read()
+w, h, L, ax0, ax1, ay0, ay1, step, L2, B = (float(v) for v in m.groups())
+w, h, L, B = int(w), int(h), int(L), int(B)
+print(f"legend png {W}x{H}: the map {w}x{h} at x {ax0} .. {ax1}, y {ay0} .. {ay1} m, margins {L} / {B} px, grid {step} m")
 assert abs(w - 200) <= 4 and abs(h - 120) <= 4, (w, h)
+assert (W, H) == (w + L, h + B) and L2 == L and L > 0 and B > 0, (W, H, w, h, L, B)
+assert step == 2, step
 # Legend: a swatch per track in its colour (reference green, fploc blue), each followed by dark text on a light ground.
 fs = max(12, min(28, min(w, h) // 30)); pad, lh, sw = fs // 2, fs * 3 // 2, 2 * fs
 for t, col in enumerate(((0, 170, 0), (0, 60, 255))):
     y = pad + t * lh + lh // 2
-    assert all(px(x, y) == col for x in range(pad, pad + sw)), (t, [px(x, y) for x in range(pad, pad + sw)])
-    text = [(x, yy) for x in range(pad + sw + pad, w // 2) for yy in range(y - lh // 2, y + lh // 2) if max(px(x, yy)) < 80]
+    assert all(px(L + x, y) == col for x in range(pad, pad + sw)), (t, [px(L + x, y) for x in range(pad, pad + sw)])
+    text = [(x, yy) for x in range(L + pad + sw + pad, L + w // 2) for yy in range(y - lh // 2, y + lh // 2) if max(px(x, yy)) < 80]
     assert len(text) > 20, (t, len(text))
-# Scale bar: a black bar 1 m (40 px) long just above the bottom, its length printed above it.
-bar = [x for x in range(w) if px(x, h - pad - 2) == (0, 0, 0)]
+# Scale bar: a black bar 1 m (40 px) long just above the map's bottom, its length printed above it.
+bar = [x for x in range(W) if px(x, h - pad - 2) == (0, 0, 0)]
 assert bar and bar[-1] - bar[0] + 1 == 40, bar
+# Ticks: dark marks just outside the map, below it at the columns of x = 2 and 4, left of it at the row of y = 2,
+# each with its label's ink beside it.
+ink = lambda c: max(c) < 90
+col = {x: L + (x - ax0) / (ax1 - ax0) * w for x in (2.0, 4.0)}
+row = {y: (ay1 - y) / (ay1 - ay0) * h for y in (2.0,)}
+for x, c in col.items():
+    assert any(ink(px(cc, h + 1)) for cc in range(int(c) - 1, int(c) + 2)), ("no tick below x", x, c)
+    assert sum(ink(px(cc, yy)) for cc in range(int(c) - 8, int(c) + 8) for yy in range(h + 4, H)) > 5, ("no label for x", x)
+for y, r in row.items():
+    assert any(ink(px(L - 2, rr)) for rr in range(int(r) - 1, int(r) + 2)), ("no tick left of y", y, r)
+    assert sum(ink(px(cc, rr)) for cc in range(0, L - 4) for rr in range(int(r) - 8, int(r) + 8)) > 5, ("no label for y", y)
+# The reference track ends at (4, 2): green where the two ticks' lines meet.
+green = [(cc, rr) for cc in range(int(col[4.0]) - 3, int(col[4.0]) + 4) for rr in range(int(row[2.0]) - 3, int(row[2.0]) + 4)
+         if px(cc, rr) == (0, 170, 0)]
+assert green, ("the track's end (4, 2) is not at the ticks of x = 4 and y = 2", col[4.0], row[2.0])
 PY
 # A corrupt YAML: one clear error naming file and field, exit 1.
 printf 'image: map.pgm\nresolution: -1\norigin: [0, 0, 0]\n' > "$T/bad.yaml"

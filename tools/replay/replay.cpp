@@ -25,6 +25,7 @@
 #include <fploc/pose_t.hpp>
 
 #include "fploc/core/text_out.h"
+#include "fploc/floorplan/building.h"
 #include "fploc/floorplan/io.h"
 #include "fploc/runtime/robot.h"
 #include "fploc/runtime/bus.h"
@@ -162,7 +163,11 @@ int main(int argc, char** argv) {
   }
 
   // A start pose outside the plan it is to be found in (a typo, the wrong plan, another frame): the run would
-  // go on LOST from the first scan. One warning per node, the replay still runs.
+  // go on LOST from the first scan. One warning per node, the replay still runs. A node that ignores its
+  // initial_pose option (the matcher's wait_for_initial_pose: it waits for a pose on its initial_pose port; amcl's
+  // global_localization) is not warned about it. A building (.pbtxt, .ifc) is checked on the floor the node starts
+  // on (plan.floor; "" = the first floor listed, IFC: the lowest storey), and the warning names it and any other
+  // floor whose plan holds the pose (the start pose has no z: plan.floor picks the floor).
   for (const auto& n : g.graph.node()) {
     if (n.disabled() || !find_registration(type_from_executable(n.executable()))) continue;
     const auto opts = node_options(n);
@@ -174,6 +179,11 @@ int main(int argc, char** argv) {
     if (!pf || !ipf || pf->type() != google::protobuf::FieldDescriptor::TYPE_MESSAGE ||
         ipf->type() != google::protobuf::FieldDescriptor::TYPE_MESSAGE || !r->HasField(*opts, ipf))
       continue;
+    const auto set_flag = [&](const char* name) {
+      const auto* f = d->FindFieldByName(name);
+      return f && f->type() == google::protobuf::FieldDescriptor::TYPE_BOOL && !f->is_repeated() && r->GetBool(*opts, f);
+    };
+    if (set_flag("wait_for_initial_pose") || set_flag("global_localization")) continue;
     const auto& plan = r->GetMessage(*opts, pf);
     const auto& ip = r->GetMessage(*opts, ipf);
     const auto* ipd = ip.GetDescriptor();
@@ -187,19 +197,49 @@ int main(int argc, char** argv) {
                                  ? file
                                  : (std::filesystem::path(g.dir) / file).lexically_normal().string();
     const double x = ip.GetReflection()->GetDouble(ip, fx), y = ip.GetReflection()->GetDouble(ip, fy);
+    const auto inside = [&](const fploc::Box2& box) {
+      return box.empty() || (x >= box.min.x() && x <= box.max.x() && y >= box.min.y() && y <= box.max.y());
+    };
     try {
       const auto* pd = plan.GetDescriptor();
       const auto* pr = plan.GetReflection();
-      std::vector<std::string> layers;
+      fploc::PlanLoadOptions lo;
       for (int k = 0; k < pr->FieldSize(plan, pd->FindFieldByName("layers")); ++k)
-        layers.push_back(pr->GetRepeatedString(plan, pd->FindFieldByName("layers"), k));
-      const auto box = fploc::load_floor_plan(path, layers, pr->GetString(plan, pd->FindFieldByName("units")),
-                                              pr->GetString(plan, pd->FindFieldByName("floor")))
-                           .bounds();
-      if (!box.empty() && (x < box.min.x() || x > box.max.x() || y < box.min.y() || y > box.max.y()))
+        lo.layer_globs.push_back(pr->GetRepeatedString(plan, pd->FindFieldByName("layers"), k));
+      lo.units_override = pr->GetString(plan, pd->FindFieldByName("units"));
+      lo.quiet = true;
+      const std::string floor = pr->GetString(plan, pd->FindFieldByName("floor"));
+      fploc::Box2 box;
+      std::string where = path;        // the plan (and floor) checked
+      std::vector<std::string> also;   // other floors whose plan holds the pose
+      if (fploc::is_building_file(path)) {
+        fploc::BuildingLoadOptions bo;
+        bo.quiet = true;
+        const fploc::Building b = fploc::load_building(path, bo);
+        const std::string start = b.floor(floor).name;  // throws naming the floors
+        for (const auto& f : b.floors) {
+          const fploc::Box2 fb = fploc::load_floor_plan(b, f.name, lo).bounds();
+          if (f.name == start) box = fb;
+          else if (!fb.empty() && inside(fb)) also.push_back(f.name);
+        }
+        where = "floor '" + start + "' of " + path;
+      } else {
+        box = fploc::load_floor_plan(path, lo).bounds();
+      }
+      if (!inside(box)) {
         std::cerr << "fploc replay: warning: " << n.name() << "'s initial pose (" << x << ", " << y
                   << ") lies outside its plan's extent (x " << box.min.x() << " .. " << box.max.x() << ", y "
-                  << box.min.y() << " .. " << box.max.y() << " m, " << path << ")\n";
+                  << box.min.y() << " .. " << box.max.y() << " m, " << where << ")";
+        if (also.size() == 1)
+          std::cerr << "; it lies inside floor '" << also[0] << "' (--set " << n.name() << ".plan.floor=" << also[0]
+                    << " to start there)";
+        else if (!also.empty()) {
+          std::cerr << "; it lies inside floors";
+          for (size_t k = 0; k < also.size(); ++k) std::cerr << (k ? ", '" : " '") << also[k] << "'";
+          std::cerr << " (--set " << n.name() << ".plan.floor=NAME to start on one)";
+        }
+        std::cerr << "\n";
+      }
     } catch (const std::exception&) {
       // the node says what is wrong with its plan when it loads it
     }

@@ -1,8 +1,10 @@
 #include "fploc/eval/reference_noise.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include "fploc/eval/eval.h"
 
@@ -32,17 +34,27 @@ HatResult three_cornered_hat(const Trajectory& ref, const Trajectory& est, const
                              int lag, double est_offset) {
   if (lag < 1) throw std::invalid_argument("three-cornered hat: lag must be >= 1");
   const auto pe = partner_of_ref(ref, est, max_dt, est_offset), pt = partner_of_ref(ref, third, max_dt, 0);
-  // Differences of the increments, accumulated for the three pairs: sums of squares and sums (for the mean).
+  // Differences of the increments for the three pairs, kept: the variances are taken about the mean (two passes).
+  // The one-pass sum-of-squares formula left a rounding residue of either sign where a difference is constant (a
+  // stationary third trajectory against a straight constant-speed reference: 0 in exact arithmetic), printed as a
+  // "negative variance" (-1.7e-9 m).
   struct Acc {
-    double s[3] = {0, 0, 0}, ss = 0, ssyaw = 0;  // x, y, yaw sums; sum of x^2 + y^2; sum of yaw^2
-    void add(const Pose2& a, const Pose2& b) {
-      const double dx = a.x - b.x, dy = a.y - b.y, dyaw = wrap_angle(a.yaw - b.yaw);
-      s[0] += dx, s[1] += dy, s[2] += dyaw;
-      ss += dx * dx + dy * dy;
-      ssyaw += dyaw * dyaw;
+    std::vector<std::array<double, 3>> d;  // x, y, yaw
+    void add(const Pose2& a, const Pose2& b) { d.push_back({a.x - b.x, a.y - b.y, wrap_angle(a.yaw - b.yaw)}); }
+    // The variance of components [k0, k1] summed, about their means; *ms: their mean square (the scale the sums'
+    // rounding is relative to).
+    double var(int k0, int k1, double* ms) const {
+      const double n = double(d.size());
+      double v = 0, q = 0;
+      for (int k = k0; k <= k1; ++k) {
+        double mean = 0;
+        for (const auto& x : d) mean += x[size_t(k)];
+        mean /= n;
+        for (const auto& x : d) v += (x[size_t(k)] - mean) * (x[size_t(k)] - mean), q += x[size_t(k)] * x[size_t(k)];
+      }
+      *ms = q / n;
+      return v / (n - 1);
     }
-    double var_xy(size_t n) const { return (ss - (s[0] * s[0] + s[1] * s[1]) / double(n)) / double(n - 1); }
-    double var_yaw(size_t n) const { return (ssyaw - s[2] * s[2] / double(n)) / double(n - 1); }
   } re, rt, et;
   HatResult r;
   for (size_t i = 0; i + size_t(lag) < ref.size(); ++i) {
@@ -59,9 +71,22 @@ HatResult three_cornered_hat(const Trajectory& ref, const Trajectory& est, const
   if (r.increments < 3)
     throw std::invalid_argument("three-cornered hat: " + std::to_string(r.increments) +
                                 " increments with all three trajectories (need >= 3; check the time stamps)");
-  const size_t n = r.increments;
-  const auto xy = split(re.var_xy(n), rt.var_xy(n), et.var_xy(n));
-  const auto yaw = split(re.var_yaw(n), rt.var_yaw(n), et.var_yaw(n));
+  // The hat's estimates, an estimate within the sums' rounding (1e-12 of the largest mean square of the differences)
+  // being 0: no noise measurable, neither positive nor negative. A pair's variance that overflowed (inf, NaN) leaves
+  // none of the three separable: all NaN.
+  auto hat = [&](int k0, int k1) {
+    double m[3];
+    const double ab = re.var(k0, k1, &m[0]), ac = rt.var(k0, k1, &m[1]), bc = et.var(k0, k1, &m[2]);
+    if (!std::isfinite(ab) || !std::isfinite(ac) || !std::isfinite(bc) || !std::isfinite(m[0] + m[1] + m[2]))
+      return std::array<double, 3>{NAN, NAN, NAN};
+    auto v = split(ab, ac, bc);
+    const double tiny = 1e-12 * std::max({m[0], m[1], m[2]});
+    for (double& x : v)
+      if (std::abs(x) <= tiny) x = 0;
+    return v;
+  };
+  const auto xy = hat(0, 1);
+  const auto yaw = hat(2, 2);
   HatSource* src[3] = {&r.ref, &r.est, &r.third};
   for (int k = 0; k < 3; ++k) {
     src[k]->increment_var_xy_m2 = xy[size_t(k)];

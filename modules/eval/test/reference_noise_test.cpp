@@ -124,3 +124,37 @@ TEST(ReferenceNoise, AssociatesByTimeWithGapsOffsetsAndOtherRates) {
   // Without the offset the estimate matches nothing.
   EXPECT_THROW(three_cornered_hat(ref, gapped, third, 0.02, 1, 0), std::invalid_argument);
 }
+
+// A difference that is constant (here a stationary third trajectory against a straight constant-speed reference, and
+// an estimate offset from the reference) has variance 0. The one-pass sum-of-squares formula left a rounding
+// residue of either sign, and `fploc eval --hat` said "gt xy not resolvable (negative variance estimate)" for -1.7e-9 m.
+TEST(ReferenceNoise, AConstantDifferenceIsZeroNotARoundingResidue) {
+  Trajectory ref, est, third;
+  for (int i = 0; i < 50; ++i) {
+    const double t = 0.1 * i;
+    ref.push_back(StampedPose::from_rpy(t, Eigen::Vector3d(0.1 * i, 0, 0), 0, 0, 0));
+    est.push_back(StampedPose::from_rpy(t, Eigen::Vector3d(0.1 * i + 0.3, 0.2, 0), 0, 0, 0));
+    third.push_back(StampedPose::from_rpy(t, Eigen::Vector3d(5, 5, 0), 0, 0, 0.4));
+  }
+  const HatResult h = three_cornered_hat(ref, est, third);
+  for (const HatSource* s : {&h.ref, &h.est, &h.third}) {
+    EXPECT_EQ(s->increment_var_xy_m2, 0.0);
+    EXPECT_EQ(s->increment_var_yaw_rad2, 0.0);
+    EXPECT_EQ(s->pose_sigma_xy_m, 0.0);
+  }
+}
+
+// Coordinates far too large (1e200: another unit, a corrupt file) overflow the differences' squares: no source's xy
+// variance can be separated, all three are NaN (not a finite value of either sign); yaw is still estimated.
+TEST(ReferenceNoise, OverflowingDifferencesAreNaN) {
+  const auto t = truth(60);
+  const Trajectory ref = noisy(t, 0.01, 0.002, 1), est = noisy(t, 0.02, 0.002, 2);
+  Trajectory third = noisy(t, 0.01, 0.002, 3);
+  for (size_t i = 0; i < third.size(); ++i) third[i].p.x() = i % 2 ? 1e200 : -1e200;
+  const HatResult h = three_cornered_hat(ref, est, third);
+  for (const HatSource* s : {&h.ref, &h.est, &h.third}) {
+    EXPECT_TRUE(std::isnan(s->increment_var_xy_m2)) << s->increment_var_xy_m2;
+    EXPECT_TRUE(std::isnan(s->pose_sigma_xy_m));
+    EXPECT_TRUE(std::isfinite(s->increment_var_yaw_rad2));
+  }
+}

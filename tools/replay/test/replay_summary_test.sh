@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `fploc replay` ends with one line counting the poses OK / POOR / LOST on the pose channel (JSON "poses"), and
 # warns when a node's initial pose lies outside its plan's extent (a run started there was LOST throughout and
-# said only "N node errors"). fploc replay runs over memq:// (no network).
+# said only "N node errors"): not for a matcher that waits for its initial pose, and in a building on the floor the
+# node starts on. fploc replay runs over memq:// (no network).
 set -uo pipefail
 BIN="${FPLOC_BUILD_DIR:?}/bin"; R="${FPLOC_ROOT:?}"
 T="$(mktemp -d)"; trap 'rm -rf "$T"' EXIT
@@ -47,6 +48,23 @@ grep -qE "^fploc replay: warning: matcher's initial pose \(40, 40\) lies outside
   fail "no warning for an initial pose outside the plan"
 
 grep -E '^fploc replay: [0-9]+ poses on FPLOC_POSE' "$T/err"
+# A matcher that waits for its initial pose (wait_for_initial_pose) ignores the configured one: no warning about it
+# (it was warned about).
+"$BIN/fploc-replay" --graph "$R/graphs/replay.pbtxt" --log "$T/log.lcm" --out "$T/w.tum" \
+  --set matcher.wait_for_initial_pose=true --set matcher.initial_pose.x=40 --set matcher.initial_pose.y=40 > /dev/null 2> "$T/err" || true
+grep -q "initial pose (40, 40) lies outside" "$T/err" && fail "warned about the initial pose of a matcher that waits for one"
+grep -qE '^fploc replay: [0-9]+ poses on FPLOC_POSE' "$T/err" || fail "replay with wait_for_initial_pose did not run"
+# A building: the floor the matcher starts on (plan.floor; unset: the first, 'ground' = the demo room) is checked, and
+# the warning names it and the floor whose plan holds the pose ('first' = the demo corridor, 25.8 m square about 0).
+B2="$R/data/buildings/two-floors.pbtxt"
+"$BIN/fploc-replay" --graph "$R/graphs/replay.pbtxt" --log "$T/log.lcm" --out "$T/f.tum" --set matcher.plan.file="$B2" \
+  --set matcher.initial_pose.x=-10 --set matcher.initial_pose.y=-10 > /dev/null 2> "$T/err" || true
+grep -qF "fploc replay: warning: matcher's initial pose (-10, -10) lies outside its plan's extent (x -2.25 .. 18.25, y -0.25 .. 12.75 m, floor 'ground' of $B2); it lies inside floor 'first' (--set matcher.plan.floor=first to start there)" "$T/err" ||
+  fail "building, no plan.floor: no warning naming floor 'ground' and 'first'"
+"$BIN/fploc-replay" --graph "$R/graphs/replay.pbtxt" --log "$T/log.lcm" --out "$T/f.tum" --set matcher.plan.file="$B2" \
+  --set matcher.plan.floor=first --set matcher.initial_pose.x=-10 --set matcher.initial_pose.y=-10 > /dev/null 2> "$T/err" || true
+grep -q "lies outside its plan's extent" "$T/err" && fail "building, plan.floor first: warned for a pose inside floor 'first'"
+grep -qE '^fploc replay: [0-9]+ poses on FPLOC_POSE' "$T/err" || fail "replay on floor 'first' did not run"
 # graphs/ndt.pbtxt's uncertainty file ("ndt.unc", relative) is written beside --out, not into the working directory.
 mkdir -p "$T/out" "$T/cwd"
 (cd "$T/cwd" && "$BIN/fploc-replay" --graph "$R/graphs/ndt.pbtxt" --log "$T/log.lcm" --out "$T/out/n.tum" \

@@ -11,7 +11,9 @@
 // from the same scans as the reference shares some of its error, which makes the reference look *less* noisy);
 // the per-pose noise is white, so an increment's variance is twice a pose's (check it with lag > 1: white
 // noise gives the same increment variance at every lag, a drift a growing one). A negative variance means
-// the assumptions fail (or too few increments); it is reported as is, not clipped.
+// the assumptions fail (or too few increments); it is reported as is, not clipped. An estimate within the rounding
+// of its sums (|v| <= 1e-12 of the mean square of the differences: e.g. a constant difference) is 0. NaN: the
+// differences overflow a double (coordinates of 1e200).
 #pragma once
 #include <string>
 
