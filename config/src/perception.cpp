@@ -35,6 +35,9 @@ feat::FeatureConfig config_of(const FeatureOptions& o) {
   if (given(o.min_group_points(), "features", "min_group_points")) c.min_group_points = o.min_group_points();
   if (given(o.line_max_rms_m(), "features", "line_max_rms_m")) c.line_max_rms_m = o.line_max_rms_m();
   if (given(o.column_front_m(), "features", "column_front_m")) c.column_front_m = o.column_front_m();
+  if (given(o.high_band_m(), "features", "high_band_m")) c.high_band_m = o.high_band_m();
+  if (given(o.high_min_points(), "features", "high_min_points")) c.high_min_points = o.high_min_points();
+  if (given(o.high_same_surface_m(), "features", "high_same_surface_m")) c.high_same_surface_m = o.high_same_surface_m();
   return c;
 }
 

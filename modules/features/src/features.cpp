@@ -131,6 +131,37 @@ FeatureStatus FeatureExtractor::extract(const seg::Segmentation& seg) {
       else if (r > b) b = r;
     }
   }
+  // Height as evidence (high_band_m): the low points of a frame with enough high ones, unless on a high surface.
+  low_.clear();
+  if (cfg_.high_band_m > 0 && std::isfinite(seg.z) && seg.z_sigma < kZUnknownFromSigmaM) {
+    const float band = float(cfg_.high_band_m - seg.z), same = float(cfg_.high_same_surface_m);
+    int width = std::max<int>(0, seg.width);
+    for (size_t i = 0; i < n; ++i) width = std::max(width, int(w.column[i]) + 1);
+    near_high_.assign(size_t(width), kInf);
+    low_.assign(n, 0);
+    int high = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3f q = R_ * Eigen::Vector3f(w.x[i], w.y[i], w.z[i]);
+      if (!(q.z() >= band)) {
+        low_[i] = 1;
+        continue;
+      }
+      const float r = std::sqrt(q.x() * q.x() + q.y() * q.y());
+      if (!std::isfinite(r)) continue;
+      ++high;
+      if (w.column[i] >= 0) near_high_[size_t(w.column[i])] = std::min(near_high_[size_t(w.column[i])], r);
+    }
+    if (high < cfg_.high_min_points) {
+      low_.clear();
+    } else if (same > 0) {
+      for (size_t i = 0; i < n; ++i) {
+        if (!low_[i] || w.column[i] < 0) continue;
+        const Eigen::Vector3f q = R_ * Eigen::Vector3f(w.x[i], w.y[i], w.z[i]);
+        const float r = std::sqrt(q.x() * q.x() + q.y() * q.y());
+        if (std::abs(r - near_high_[size_t(w.column[i])]) <= same) low_[i] = 0;
+      }
+    }
+  }
   for (size_t b = 0; b < n;) {
     const size_t e = run_end(w.ring.data(), b, n);
     if (w.ring[b] % ring_step_ == 0) ring(seg, b, e);
@@ -217,6 +248,10 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
       if (f > 0 && level_range_[i] < f - m - ratio * f) suppress(k, k);
     }
   }
+  // Low points of a frame with enough high ones (high_band_m): no features.
+  if (!low_.empty())
+    for (int k = 0; k < n; ++k)
+      if (low_[begin + size_t(k)]) suppress(k, k);
 
   // Per-sector selection (sectors split the ring's points evenly, as LOAM does): the sharpest corner
   // candidates that no earlier pick suppressed (the first index among equal q = c^2), then the smoothest surface

@@ -332,6 +332,9 @@ TEST(Features, ReferenceEqualWithOtherOptionsAndBeamCounts) {
   expect_same(s, cfg([](FeatureConfig& c) { c.column_front_m = 0.2; }), "column rule");
   expect_same(s, cfg([](FeatureConfig& c) { c.column_front_m = 0.05; c.column_front_ratio = 0; }), "column rule, tight");
   expect_same(s, cfg([](FeatureConfig& c) { c.min_group_points = 2; c.line_min_ratio = 1.0; c.line_max_rms_m = 1.0; }), "loose lines");
+  expect_same(s, cfg([](FeatureConfig& c) { c.high_band_m = 2.2; }), "high band");
+  expect_same(s, cfg([](FeatureConfig& c) { c.high_band_m = 2.2; c.high_same_surface_m = 0.15; }), "high band, same surface");
+  expect_same(s, cfg([](FeatureConfig& c) { c.high_band_m = 1.0; c.high_min_points = 1 << 30; }), "high band, too few");
 }
 
 // Hand-made rings: ties, gaps, occlusion steps at the ring ends, NaN and zero ranges, rings shorter than the
@@ -444,4 +447,61 @@ TEST(Features, APointInFrontOfTheWallAboveItIsNoFeature) {
   EXPECT_EQ(face_on, 0);
   EXPECT_GT(wall_on, 20);   // the wall above the cabinet is still seen
   EXPECT_GE(wall_on, wall_off);
+}
+
+// The same cabinet (2 m tall, 0.45 m deep, 5.5 m away) with the height rule (high_band_m 2.2 m): the wall above the
+// cabinet stands high, the face does not. With high_same_surface_m the wall's low points beside the cabinet (their
+// column's high point on the same surface) stay features, the face's do not (its column's high point lies 0.45 m
+// beyond it); without it every low point goes. Without the rule the face gives features as if it were a wall.
+TEST(Features, ALowPointOffTheHighSurfaceOfItsColumnIsNoFeature) {
+  synth::Room room;
+  room.boxes.push_back({{7.55, -2.0, 0.0}, {8.0, 2.0, 2.0}, synth::kClutter});
+  const synth::SensorPose pose{2.0, 0.0, 1.2, 0.5 * kDeg, -0.5 * kDeg, 0.1};
+  const auto s = synth::render(room, pose, synth::os1_like_beams(), 1024, 0.005, 0.01, 31);
+  seg::RingSegmenter sg(seg::SegmenterConfig{});
+  const auto seg = sg.process(s.scan);
+  ASSERT_EQ(seg.status, seg::SegStatus::kOk);
+  ASSERT_LT(seg.z_sigma, kZUnknownFromSigmaM);
+  ASSERT_NEAR(seg.z, 1.2, 0.05);
+  struct Count { int face = 0, wall_low = 0, wall_high = 0, beside_low = 0, all = 0; };
+  auto count = [&](const FeatureConfig& cfg) {
+    FeatureExtractor fx(cfg);
+    const FeatureFrame& f = fx.process(seg);
+    Count n;
+    const double c = std::cos(pose.yaw), sn = std::sin(pose.yaw);
+    for (size_t k = 0; k < f.points.size(); ++k) {
+      const auto& p = f.points[k];
+      const double wx = c * p.p.x() - sn * p.p.y() + pose.x, wy = sn * p.p.x() + c * p.p.y() + pose.y;
+      const size_t i = size_t(fx.source()[k]);
+      const Eigen::Vector3f q = Eigen::AngleAxisf(float(seg.pitch), Eigen::Vector3f::UnitY()) *
+                                Eigen::AngleAxisf(float(seg.roll), Eigen::Vector3f::UnitX()) *
+                                Eigen::Vector3f(seg.wall.x[i], seg.wall.y[i], seg.wall.z[i]);
+      const bool high = q.z() + seg.z >= 2.2;
+      ++n.all;
+      if (std::abs(wy) < 1.9) {
+        n.face += std::abs(wx - 7.55) < 0.1;
+        n.wall_low += std::abs(wx - 8.0) < 0.1 && !high;
+        n.wall_high += std::abs(wx - 8.0) < 0.1 && high;
+      } else if (std::abs(wy) > 2.1 && std::abs(wx - 8.0) < 0.1) {
+        n.beside_low += !high;
+      }
+    }
+    return n;
+  };
+  FeatureConfig drop, same;
+  drop.high_band_m = same.high_band_m = 2.2;
+  same.high_same_surface_m = 0.15;
+  const Count off = count(FeatureConfig{}), d = count(drop), sm = count(same);
+  EXPECT_GT(off.face, 40);       // the face is taken for a wall without the rule
+  EXPECT_GT(off.beside_low, 20);
+  EXPECT_EQ(d.face, 0);
+  EXPECT_EQ(d.wall_low + d.beside_low, 0);
+  EXPECT_GT(d.wall_high, 20);    // the wall above the cabinet is still seen
+  EXPECT_EQ(sm.face, 0);
+  EXPECT_GT(sm.beside_low, 20);  // the wall's low points beside the cabinet stay
+  EXPECT_GT(sm.all, d.all);
+  // Too few high points (a low room, the sensor near the ceiling): the rule stands aside.
+  FeatureConfig few = same;
+  few.high_min_points = 1 << 30;
+  EXPECT_EQ(count(few).all, off.all);
 }

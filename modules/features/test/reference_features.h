@@ -7,6 +7,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <map>
 #include <numeric>
 #include <vector>
 
@@ -85,6 +87,28 @@ inline Result extract(const seg::Segmentation& seg, const FeatureConfig& cfg = {
     const float f = v[v.size() - 2];
     return f > 0 && level_range(i) < f - float(cfg.column_front_m) - float(cfg.column_front_ratio) * f;
   };
+  // Height as evidence (high_band_m): a low point of a frame with enough high ones, unless its column holds a high
+  // point within high_same_surface_m of its levelled range.
+  std::vector<bool> low(N, false);
+  if (cfg.high_band_m > 0 && std::isfinite(seg.z) && seg.z_sigma < kZUnknownFromSigmaM) {
+    auto height = [&](size_t i) { return (Rot * Eigen::Vector3f(w.x[i], w.y[i], w.z[i])).z(); };
+    const float band = float(cfg.high_band_m - seg.z);
+    int high = 0;
+    for (size_t i = 0; i < N; ++i) high += height(i) >= band && std::isfinite(level_range(i));
+    std::map<int, float> nearest;  // per column: the nearest high point's levelled range
+    for (size_t i = 0; i < N; ++i)
+      if (height(i) >= band && std::isfinite(level_range(i)) && w.column[i] >= 0) {
+        auto it = nearest.emplace(w.column[i], level_range(i)).first;
+        it->second = std::min(it->second, level_range(i));
+      }
+    if (high >= cfg.high_min_points)
+      for (size_t i = 0; i < N; ++i) {
+        if (height(i) >= band) continue;
+        const auto it = nearest.find(w.column[i]);
+        low[i] = !(cfg.high_same_surface_m > 0 && w.column[i] >= 0 && it != nearest.end() &&
+                   std::abs(level_range(i) - it->second) <= float(cfg.high_same_surface_m));
+      }
+  }
   auto ring = [&](size_t begin, size_t end) {
     const int n = int(end - begin), hw = std::max(1, cfg.half_window);
     if (n < 2 * hw + 1) return;
@@ -101,7 +125,7 @@ inline Result extract(const seg::Segmentation& seg, const FeatureConfig& cfg = {
       const bool parallel = std::abs(R[i - 1] - r) > par * r && std::abs(R[i + 1] - r) > par * r;
       q[i] = smoothness_sq(X, Y, Z, i, hw);
       c[i] = std::sqrt(q[i]);
-      ok[i] = connected && in_range && !parallel && !in_front(begin + size_t(i));
+      ok[i] = connected && in_range && !parallel && !in_front(begin + size_t(i)) && !low[begin + size_t(i)];
     }
     for (int j = 0; j + 1 < n; ++j) {  // occlusion boundaries: clear hw points on the far side
       const float a = R[j], b = R[j + 1];

@@ -35,6 +35,17 @@ struct FeatureConfig {
   // from 7.8 cm to 7.3 m; docs/notes/realism.md, thirty-third round).
   double column_front_m = 0;
   double column_front_ratio = 0.02;
+  // Height as evidence (docs/notes/realism.md, fortieth round): a wall point at least high_band_m above the floor
+  // (the segmenter's sensor height z plus the point's levelled z) stands above furniture, people and cabinets, so it
+  // lies on a floor-to-ceiling wall or partition; a point below it may lie on anything. When a frame has at least
+  // high_min_points such high wall points (and its z is known), a low point is no feature unless its column holds a
+  // high point within high_same_surface_m of its levelled horizontal range (the same vertical surface); with
+  // high_same_surface_m = 0 no low point is. 0 = off (the default: at 2.2 m, same surface 0.15 m, the shelved corridors
+  // 4.7 / 11.8 / 18.9 -> 0.7 / 0.9 / 0.7 cm, but corridor s1 mixed 3 false-OK poses; with high_min_points 500 none, but
+  // LOST on s3 renovated and the crowd's POOR x3; docs/notes/realism.md, fortieth round).
+  double high_band_m = 0;
+  int high_min_points = 200;
+  double high_same_surface_m = 0;
   // PCA line groups.
   int min_group_points = 4;
   double line_max_rms_m = 0.03;     // sqrt(smallest eigenvalue) of the group's 2D covariance
@@ -87,6 +98,8 @@ class FeatureExtractor {
   std::vector<float> ring_w_;
   std::vector<float> far1_, far2_;            // per column: the farthest and second-farthest levelled range
   std::vector<float> level_range_;            // per wall point: its levelled horizontal range (column_front_m only)
+  std::vector<uint8_t> low_;                  // per wall point: below the high band and not on a high surface
+  std::vector<float> near_high_;              // per column: the nearest high point's levelled range
   std::vector<uint64_t> ring_brk_;
 };
 
