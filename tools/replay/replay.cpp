@@ -32,6 +32,7 @@
 #include "fploc/runtime/graph.h"
 #include "fploc/runtime/log_reader.h"
 #include "fploc/runtime/node.h"
+#include "fploc/tools/start_pose.h"
 #include "options/tools.pb.h"
 
 using namespace fploc::rt;
@@ -162,44 +163,14 @@ int main(int argc, char** argv) {
   }
 
   // A start pose outside the plan it is to be found in (a typo, the wrong plan, another frame): the run would
-  // go on LOST from the first scan. One warning per node, the replay still runs.
-  for (const auto& n : g.graph.node()) {
-    if (n.disabled() || !find_registration(type_from_executable(n.executable()))) continue;
-    const auto opts = node_options(n);
-    if (!opts) continue;
-    const auto* d = opts->GetDescriptor();
-    const auto* r = opts->GetReflection();
-    const auto* pf = d->FindFieldByName("plan");
-    const auto* ipf = d->FindFieldByName("initial_pose");
-    if (!pf || !ipf || pf->type() != google::protobuf::FieldDescriptor::TYPE_MESSAGE ||
-        ipf->type() != google::protobuf::FieldDescriptor::TYPE_MESSAGE || !r->HasField(*opts, ipf))
-      continue;
-    const auto& plan = r->GetMessage(*opts, pf);
-    const auto& ip = r->GetMessage(*opts, ipf);
-    const auto* ipd = ip.GetDescriptor();
-    const auto* fx = ipd->FindFieldByName("x");
-    const auto* fy = ipd->FindFieldByName("y");
-    const auto* ff = plan.GetDescriptor()->FindFieldByName("file");
-    if (!fx || !fy || !ff) continue;
-    const std::string file = plan.GetReflection()->GetString(plan, ff);
-    if (file.empty()) continue;
-    const std::string path = std::filesystem::path(file).is_absolute() || g.dir.empty()
-                                 ? file
-                                 : (std::filesystem::path(g.dir) / file).lexically_normal().string();
-    const double x = ip.GetReflection()->GetDouble(ip, fx), y = ip.GetReflection()->GetDouble(ip, fy);
+  // go on LOST from the first scan. One warning per node, the replay still runs (fploc/tools/start_pose.h, as
+  // `fploc node initial-pose`'s check).
+  for (const auto& sp : fploc::tools::start_plans(
+           g, [](const fploc::Node& n) { return find_registration(type_from_executable(n.executable())) != nullptr; })) {
+    if (!sp.has_initial_pose) continue;
     try {
-      const auto* pd = plan.GetDescriptor();
-      const auto* pr = plan.GetReflection();
-      std::vector<std::string> layers;
-      for (int k = 0; k < pr->FieldSize(plan, pd->FindFieldByName("layers")); ++k)
-        layers.push_back(pr->GetRepeatedString(plan, pd->FindFieldByName("layers"), k));
-      const auto box = fploc::load_floor_plan(path, layers, pr->GetString(plan, pd->FindFieldByName("units")),
-                                              pr->GetString(plan, pd->FindFieldByName("floor")))
-                           .bounds();
-      if (!box.empty() && (x < box.min.x() || x > box.max.x() || y < box.min.y() || y > box.max.y()))
-        std::cerr << "fploc replay: warning: " << n.name() << "'s initial pose (" << x << ", " << y
-                  << ") lies outside its plan's extent (x " << box.min.x() << " .. " << box.max.x() << ", y "
-                  << box.min.y() << " .. " << box.max.y() << " m, " << path << ")\n";
+      const auto c = fploc::tools::check_start_pose(sp, sp.x, sp.y);
+      if (!c.text.empty()) std::cerr << "fploc replay: warning: " << sp.node << "'s initial pose " << c.text << "\n";
     } catch (const std::exception&) {
       // the node says what is wrong with its plan when it loads it
     }
