@@ -59,20 +59,22 @@ function floorOfEstimateAt(trail) {
     return k >= 0 ? trail[k][3] : null;
   };
 }
-function drawOnShownFloor(c, v, trail, color, floorOf) {
+function drawOnShownFloor(c, v, trail, color, floorOf, width = 2) {
   const shown = floors.shown;
-  if (floors.floors.length < 2 || !shown) { v.polyline(c, trail, color, 2); return; }
+  if (floors.floors.length < 2 || !shown) { v.polyline(c, trail, color, width); return; }
   let run = [];
   for (const q of trail) {
     const f = floorOf(q);
     if (!f || f === shown) { run.push(q); continue; }
-    v.polyline(c, run, color, 2);
+    v.polyline(c, run, color, width);
     run = [];
   }
-  v.polyline(c, run, color, 2);
+  v.polyline(c, run, color, width);
 }
 map.layers.push((c, v) => {
-  drawOnShownFloor(c, v, S.gtTrail, COL.gt, floorOfEstimateAt(S.trail));
+  // The ground truth wide and underneath: where the estimate agrees with it (mm) it shows as a green band
+  // along the blue line instead of vanishing under it.
+  drawOnShownFloor(c, v, S.gtTrail, COL.gt, floorOfEstimateAt(S.trail), 6);
   drawOnShownFloor(c, v, S.trail, COL.est, (q) => q[3]);
   const f = S.features;
   // Project with the frame pose of the same scan when it is here (it arrives just after the features).

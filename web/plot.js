@@ -1,4 +1,5 @@
-// Small live line plot over a sliding time window (seconds); y range follows the data.
+// Small live line plot over a sliding time window (seconds); y range follows the data (from 0 with `zero` when
+// the data are >= 0).
 export class Plot {
   constructor(canvas, series, { window = 120, minSpan = 0, digits = 2, zero = false } = {}) {
     this.canvas = canvas; this.series = series; this.window = window; this.minSpan = minSpan;
@@ -40,10 +41,17 @@ export class Plot {
     const tmin = tmax - span;
     let lo = Infinity, hi = -Infinity;
     for (const d of this.data) for (const [t, v] of d) if (t >= tmin) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+    // zero: the axis includes 0; a quantity that cannot be negative (an error, a rate: all data >= 0) starts at
+    // exactly 0, with the minimum span and the margin added above only (no axis from -0.010 or -1.2).
     if (this.zero) lo = Math.min(lo, 0);
-    if (hi - lo < this.minSpan) { const m = (hi + lo) / 2; lo = m - this.minSpan / 2; hi = m + this.minSpan / 2; }
-    if (hi === lo) { hi += 1e-3; lo -= 1e-3; }
-    const pad = (hi - lo) * 0.08; lo -= pad; hi += pad;
+    const fromZero = this.zero && lo === 0;
+    if (hi - lo < this.minSpan) {
+      if (fromZero) hi = this.minSpan;
+      else { const m = (hi + lo) / 2; lo = m - this.minSpan / 2; hi = m + this.minSpan / 2; }
+    }
+    if (hi === lo) { hi += 1e-3; if (!fromZero) lo -= 1e-3; }
+    const pad = (hi - lo) * 0.08; if (!fromZero) lo -= pad; hi += pad;
+    this.axis = [lo, hi];  // (tests read the drawn range)
     const L = 44, R = 4, T = 15, B = 4;  // legend above the plot area
     const X = (t) => L + (t - tmin) / span * (w - L - R), Y = (v) => T + (hi - v) / (hi - lo) * (h - T - B);
     c.strokeStyle = '#e5e7eb'; c.lineWidth = 1; c.beginPath(); c.moveTo(L, T); c.lineTo(L, h - B); c.lineTo(w - R, h - B); c.stroke();

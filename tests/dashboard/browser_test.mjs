@@ -3,7 +3,7 @@
 // Checks: the page loads, the trail grows, every node is in the table, a killed node turns red and
 // green again after restart, a launcher "restarting" report turns a node red, the page reconnects by
 // itself after a server restart, a pose lagging the sensor is said ("pose N s behind the sensor") and the text
-// goes when it catches up. Measures pose->browser latency, the dashboard's CPU with two
+// goes when it catches up, the ATE and rate plots' axes start at 0. Measures pose->browser latency, the dashboard's CPU with two
 // browsers attached at 10 Hz and the push rate. Writes dashboard.png + dashboard_browser.json.
 import { chromium } from 'playwright-core';
 import { spawn } from 'node:child_process';
@@ -200,6 +200,15 @@ try {
     return { server: inRange.length, missing: miss.length, where: miss.map((e) => `${((e[0] - lo) / 1e6).toFixed(2)}/${((hi - lo) / 1e6).toFixed(2)} s`).join(' '), fills: window.__fploc.gapFills || 0 };
   });
   check(trailCheck.missing === 0, `page trail has every pose the server has (${trailCheck.server} poses, ${trailCheck.missing} missing ${trailCheck.where}, ${trailCheck.fills} gap fills)`);
+  // Plots of quantities that cannot be negative (ATE, horizontal error, frame and pose rates) have their axis
+  // from 0, not from a margin below it (a user trial read "ATE so far" from -0.010 and "frame rate" from -1.2).
+  const axes = await page.evaluate(() => Object.fromEntries(['ate', 'rate'].map((k) => {
+    const p = window.__fploc.plots[k];
+    return [k, { axis: p.axis ?? null, points: p.data.reduce((n, d) => n + d.length, 0) }];
+  })));
+  for (const [k, a] of Object.entries(axes))
+    check(a.points > 0 && a.axis && a.axis[0] === 0 && a.axis[1] > 0,
+      `plot '${k}' axis starts at 0 (${a.axis ? a.axis.map((v) => v.toFixed(4)).join(' .. ') : 'not drawn'}, ${a.points} points)`);
   await page.screenshot({ path: join(OUT, 'dashboard.png') });
   if (process.env.FPLOC_SCREENSHOT) copyFileSync(join(OUT, 'dashboard.png'), process.env.FPLOC_SCREENSHOT);
 

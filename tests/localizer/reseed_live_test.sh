@@ -3,7 +3,7 @@
 # the matcher node's `reseed` input), inside scripts/netns-run: `fploc launch` runs segmenter -> features ->
 # matcher -> optimizer -> pose loggers over real LCM, with no relocalizer; lcm-logplayer plays a simulated room;
 # the matcher waits for its initial pose (sent before the log plays); 4 s into the log an operator's pose 50 m off
-# (`fploc node initial-pose 40 40 0`) throws the matcher off the plan, and it goes LOST. The optimizer's dead reckoning still knows where the robot is: with the re-seed wired, the matcher
+# (`fploc node initial-pose 40 40 0 --force`: far outside the plan it is refused without) throws the matcher off the plan, and it goes LOST. The optimizer's dead reckoning still knows where the robot is: with the re-seed wired, the matcher
 # is started again at the optimizer's fit and every frame from 1 s after the wrong pose lies on the ground truth;
 # without it (the same graph, the two ports unconnected), the matcher stays lost to the end.
 source "$(dirname "${BASH_SOURCE[0]}")/../support/netns_test.sh"
@@ -51,7 +51,7 @@ G
   lcm-logplayer --lcm-url="$URL" -s 0.5 "$T/log.lcm" > "$d/player.txt" 2>&1 & pids+=($!)
   local pp=$!
   sleep 8
-  "$B/fploc-node" initial-pose 40 40 0 --graph "$d/g.pbtxt" 2>> "$d/ip.txt" || { cat "$d/ip.txt"; exit 1; }
+  "$B/fploc-node" initial-pose 40 40 0 --graph "$d/g.pbtxt" --force --no-wait 2>> "$d/ip.txt" || { cat "$d/ip.txt"; exit 1; }
   wait "$pp" || { echo "lcm-logplayer failed:"; cat "$d/player.txt"; exit 1; }
   sleep 1.5
   kill -INT "$lp"

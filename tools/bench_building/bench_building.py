@@ -43,7 +43,7 @@ BIN = os.environ.get("FPLOC_BIN") or os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(ROOT, "tools", "pylib"))
 import fploc_tools  # noqa: E402
 import lcm_log  # noqa: E402
-from fploc_tools import log, pct, read_tum, roll_pitch, yaw_of  # noqa: E402
+from fploc_tools import fmt_ms, fmt_num, log, pct, read_tum, roll_pitch, yaw_of  # noqa: E402
 
 SCENARIOS = ["building-areas-medium", "building-atrium-medium", "building-clutter-medium", "building-mixed-medium",
              "auto-loop-medium"]
@@ -330,27 +330,32 @@ def bench(a, work, plan, layers, scenario):
         row["plot"] = path
         plot_png(series, path[:-4] + ".png", title, marks=marks)
         row["plot_png"] = path[:-4] + ".png"
-    log(f"[{name}] ATE xy {100 * row.get('ate_xy_m', float('nan')):.2f} cm, z med/p99 "
-        f"{100 * row.get('z_err_median_m', float('nan')):.2f}/{100 * row.get('z_err_p99_m', float('nan')):.2f} cm, "
-        f"rp p99 {row.get('rp_err_p99_deg', float('nan')):.3f} deg, LOST {row['lost']}, "
+    log(f"[{name}] ATE xy {fmt_num(row.get('ate_xy_m'), 2, 100)} cm, z med/p99 "
+        f"{fmt_num(row.get('z_err_median_m'), 2, 100)}/{fmt_num(row.get('z_err_p99_m'), 2, 100)} cm, "
+        f"rp p99 {fmt_num(row.get('rp_err_p99_deg'), 3)} deg, LOST {row['lost']}, "
         f"NEES {fmt_num(row.get('nees_median'))}, false OK {row.get('false_ok', '-')}, ms/scan {fmt_ms(ms)}")
     if floors is not None:
-        log(f"[{name}] floors: " + (f"wrong-floor poses {floors['wrong_floor_poses']} ({floors['wrong_floor_after_3s']} later "
-            f"than 3 s after a change), recognised after {[c['recognised_after_s'] for c in floors['floor_changes']]} s, "
-            f"ATE after lift {floors['ate_after_lift_m']} m" if floors.get("floor_scored") else floors["floor_note"]))
+        log(f"[{name}] floors: {floors_summary(floors)}")
     return row
 
 
-def fmt_num(v, digits=2):
-    """A number for the text summary: 1.55, not 1.5474540577388338 ("-" when absent)."""
-    return "-" if v is None else f"{v:.{digits}f}" if isinstance(v, (int, float)) and math.isfinite(v) else str(v)
-
-
-def fmt_ms(ms):
-    """ms per scan per node for the text summary: "segmenter 1.2, features 0.8", not a Python dict."""
-    if isinstance(ms, dict):
-        return ", ".join(f"{k} {fmt_num(v, 1)}" for k, v in ms.items()) or "-"
-    return fmt_num(ms, 1)
+def floors_summary(floors):
+    """The floor rows of one run for the text summary: "no floor change in this run", "recognised after 1.20 s",
+    "not recognised", "-" for a value not measured (no Python None, [] or nan)."""
+    if not floors.get("floor_scored"):
+        return floors["floor_note"]
+    changes = floors.get("floor_changes") or []
+    wrong = (f"wrong-floor poses {floors['wrong_floor_poses']} ({floors['wrong_floor_after_3s']} later than 3 s after "
+             f"a change)")
+    if not changes:
+        return f"{wrong}, no floor change in this run"
+    rec = ", ".join(f"{c.get('how', 'change')} " + ("not recognised" if c.get("recognised_after_s") is None
+                                                     else f"recognised after {fmt_num(c['recognised_after_s'])} s")
+                    for c in changes)
+    lift = floors.get("ate_after_lift_m")
+    if lift is not None:
+        return f"{wrong}, {rec}, ATE after lift {fmt_num(lift, 3)} m"
+    return f"{wrong}, {rec}, ATE after lift " + ("- (no lift ride)" if not floors.get("lift_rides") else "- (not measured)")
 
 
 def main():
@@ -398,12 +403,12 @@ def main():
     # Per scenario, the floor rows beside z (stderr; the JSON has them all).
     log("scenario | z med/p99 cm | ATE xy cm | floor changes recognised after s | wrong floor (>3 s) | ATE 10 s after lift cm")
     for r in rows:
-        rec = ", ".join(f"{c['how']} {c['recognised_after_s']}" for c in r.get("floor_changes", [])) or "-"
-        lift = r.get("ate_after_lift_m")
-        log(f"{r['plan']}:{r['scenario']} | {100 * r.get('z_err_median_m', float('nan')):.2f}/"
-            f"{100 * r.get('z_err_p99_m', float('nan')):.2f} | {100 * r.get('ate_xy_m', float('nan')):.2f} | {rec} | "
+        rec = ", ".join(f"{c['how']} {fmt_num(c['recognised_after_s']) if c['recognised_after_s'] is not None else 'missed'}"
+                        for c in r.get("floor_changes", [])) or "-"
+        log(f"{r['plan']}:{r['scenario']} | {fmt_num(r.get('z_err_median_m'), 2, 100)}/"
+            f"{fmt_num(r.get('z_err_p99_m'), 2, 100)} | {fmt_num(r.get('ate_xy_m'), 2, 100)} | {rec} | "
             f"{r.get('wrong_floor_poses', '-')} ({r.get('wrong_floor_after_3s', '-')}) | "
-            f"{'-' if lift is None else f'{100 * lift:.2f}'}")
+            f"{fmt_num(r.get('ate_after_lift_m'), 2, 100)}")
     print(json.dumps({"rows": rows, "targets": TARGETS, "seed": a.seed, "graph": os.path.relpath(a.graph, ROOT),
                       "all_meet_targets": all(r.get("meets_targets") for r in rows)}, indent=1))
 

@@ -29,7 +29,7 @@ ROOT = os.environ.get("FPLOC_ROOT") or os.path.abspath(os.path.join(os.path.dirn
 BIN = os.environ.get("FPLOC_BIN") or os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(ROOT, "tools", "pylib"))
 import fploc_tools  # noqa: E402
-from fploc_tools import log, read_tum, yaw_of  # noqa: E402
+from fploc_tools import fmt_ms, fmt_num, log, read_tum, yaw_of  # noqa: E402
 
 
 def run(cmd):
@@ -188,9 +188,9 @@ class Bench:
                 "ate_local_map_m": res["odom_map"]["ate_rmse_m"] if res["odom_map"] else None,
                 "rpe_local_map_m": res["odom_map"]["rpe_mean_m"] if res["odom_map"] else None}
         log(f"[{scenario}] ATE sfr {fmt(row['ate_sfr_m'])} wo {fmt(row['ate_wo_m'])} odometry {fmt(base['ate_m'])} "
-            f"(local map {fmt(base['ate_local_map_m'])})  NEES wo {row['nees_wo_median']} false OK {row['false_ok_wo']} "
-            f"POOR {row['poor_wo']}  "
-            f"{hz} Hz (ms/scan {ms})")
+            f"(local map {fmt(base['ate_local_map_m'])})  NEES wo {fmt_num(row['nees_wo_median'])} false OK "
+            f"{fmt_num(row['false_ok_wo'], 0)} POOR {fmt_num(row['poor_wo'], 0)}  "
+            f"{fmt_num(hz, 1)} Hz (ms/scan {fmt_ms(ms)})")
         return row, base
 
     @staticmethod
@@ -247,7 +247,7 @@ class Bench:
             out.append(row)
             if sim:
                 self.drop(scenario, sim[0])
-            log(f"  ATE sfr {fmt(row['ate_sfr_m'])} wo {fmt(row['ate_wo_m'])} ({row['ratio_wo_to_clean']}x clean) {' '.join(info)}")
+            log(f"  ATE sfr {fmt(row['ate_sfr_m'])} wo {fmt(row['ate_wo_m'])} ({fmt_num(row['ratio_wo_to_clean'])}x clean) {' '.join(info)}")
         return out
 
 
@@ -271,7 +271,8 @@ def tail_ate(gt_path, est_path, skip_s):
 
 
 def fmt(v, scale=100.0, unit=" cm", digits=2):
-    return "-" if v is None else f"{v * scale:.{digits}f}{unit}"
+    t = fmt_num(v, digits, scale)
+    return t if t == "-" else t + unit
 
 
 def markdown(doc, argv=None):
@@ -310,7 +311,8 @@ def markdown(doc, argv=None):
         for r in doc["rows"]:
             n = lambda v: "-" if v is None else f"{v:.2f}"
             L.append(f"| {r['sequence']} | {r['speed']} | {n(r.get('nees_sfr_median'))} | {n(r.get('nees_wo_median'))} | "
-                     f"{r.get('false_ok_sfr')} / {r.get('false_ok_wo')} | {r.get('poor_sfr')} / {r.get('poor_wo')} |")
+                     f"{fmt_num(r.get('false_ok_sfr'), 0)} / {fmt_num(r.get('false_ok_wo'), 0)} | "
+                     f"{fmt_num(r.get('poor_sfr'), 0)} / {fmt_num(r.get('poor_wo'), 0)} |")
     if doc.get("lookups"):
         L.append("")
         L.append("| look-up | ATE SFR cm | ATE WO cm | matcher ms/scan | optimizer ms/scan | pipeline Hz |")

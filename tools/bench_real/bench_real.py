@@ -181,7 +181,7 @@ def markdown(doc, cmdline):
     for r in doc["rows"]:
         f, a, fl, n = r["fploc"], r["amcl"], r["floor"], r.get("reference_noise") or {}
         out.append(f"| {r['log']} | {r['start']} | {r['covered_scans']} | {cm(f['ate_m'])} | {cm(f['max_m'], 0)} | "
-                   f"{f['lost_pct']:.1f} % | {f.get('poor_pct', float('nan')):.1f} % | {f.get('false_ok_poses', '-')} | "
+                   f"{f['lost_pct']:.1f} % | {fploc_tools.fmt_num(f.get('poor_pct'), 1)} % | {f.get('false_ok_poses', '-')} | "
                    f"{f['ms_per_scan']:.1f} | {cm(a['ate_m'])} | {cm(a['max_m'], 0)} | {a['lost_pct']:.1f} % | "
                    f"{a['ms_per_scan']:.2f} | {'yes' if r['fploc_half_of_amcl'] else 'no'} | "
                    f"{cm(fl['ate_m'])} / {cm(fl.get('cauchy', {}).get('ate_m'))} | {cm(n.get('pose_sigma_xy_m'))} | "
@@ -196,7 +196,7 @@ def markdown(doc, cmdline):
         nees = lambda m, k="nees_median": "-" if m.get(k) is None else f"{m[k]:.1f}"
         out.append(f"| {r['log']} | {r['start']} | {nees(f)} | {nees(f, 'nees_median_with_reference_noise')} | "
                    f"{f.get('false_ok_poses', '-')} | {cm(pl['ate_m'])} | {pl['max_m'] * 100:.0f} | "
-                   f"{pl.get('poor_pct', float('nan')):.1f} % | {pl['lost_pct']:.1f} % | {pl.get('false_ok_poses', '-')} | "
+                   f"{fploc_tools.fmt_num(pl.get('poor_pct'), 1)} % | {pl['lost_pct']:.1f} % | {pl.get('false_ok_poses', '-')} | "
                    f"{nees(pl)} | {nees(pl, 'nees_median_with_reference_noise')} | {pl['ms_per_scan']:.1f} | {nees(a)} |")
     # Paths under the run's --out directory (a reader of the table has no copy of the runner's /tmp).
     rel = lambda f: os.path.join(os.path.basename(os.path.dirname(f)), os.path.basename(f))
@@ -340,11 +340,11 @@ def main():
                  "fploc_half_of_amcl": f["ate_m"] <= 0.5 * am["ate_m"], "plot": png, "plot_fploc": png_f}
             rows.append(r)
             print(f"{name:13s} {row:3s} split {r['split']['fraction']:.2f} scans {scans:5d} covered {len(keep):5d}  fploc ATE {f['ate_m']*100:8.1f} cm max {f['max_m']*100:8.1f} cm "
-                  f"LOST {f['lost_pct']:5.1f} % false OK {f.get('false_ok_poses', '-')} POOR {f.get('poor_pct', float('nan')):4.1f} % {fploc_ms:6.2f} ms | AMCL ATE {am['ate_m']*100:8.1f} cm max {am['max_m']*100:8.1f} cm "
+                  f"LOST {f['lost_pct']:5.1f} % false OK {f.get('false_ok_poses', '-')} POOR {fploc_tools.fmt_num(f.get('poor_pct'), 1):>4s} % {fploc_ms:6.2f} ms | AMCL ATE {am['ate_m']*100:8.1f} cm max {am['max_m']*100:8.1f} cm "
                   f"LOST {am['lost_pct']:5.1f} % {amcl_ms:6.2f} ms | other fploc ({'wo' if a.fploc == 'grid' else 'grid'}) "
                   f"ATE {(p if a.fploc == 'grid' else g)['ate_m']*100:8.1f} cm | all scans: fploc {f['all']['ate_m']*100:.1f} cm "
                   f"LOST {f['all']['lost_pct']:.1f} %, AMCL {am['all']['ate_m']*100:.1f} cm | floor {floor['ate_m']*100:.1f} cm (Cauchy fit {floor['cauchy']['ate_m']*100:.1f} cm) | reference noise {rnoise['pose_sigma_xy_m']*100:.1f} cm "
-                  f"(lag 2: {rnoise['lag2']['pose_sigma_xy_m']*100:.1f}), fploc less it {(f['ate_less_reference_noise_m'] if f['ate_less_reference_noise_m'] is not None else float('nan'))*100:.1f} cm", file=sys.stderr)
+                  f"(lag 2: {rnoise['lag2']['pose_sigma_xy_m']*100:.1f}), fploc less it {cm(f['ate_less_reference_noise_m'])} cm", file=sys.stderr)
     doc = {"bench": "real", "protocol": {"split": a.split, "scored": "scans covered by the map", "end": a.end, "resolution_m": a.resolution,
                                          "map": {**(map_used or {"min_hits": a.min_hits, "occupied_ratio": a.occupied_ratio,
                                                                   "hit_clearance_m": a.hit_clearance}),

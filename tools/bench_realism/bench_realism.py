@@ -643,11 +643,12 @@ class Bench:
 
 
 def fmt(v, nd=4):
-    return "-" if v is None else f"{v:.{nd}f}"
+    return fploc_tools.fmt_num(v, nd)
 
 
 def pct(v):
-    return "-" if v is None else f"{100 * v:.1f} %"
+    t = fploc_tools.fmt_num(v, 1, 100)
+    return t if t == "-" else t + " %"
 
 
 def svg_bars(rows, path, key="ate_m", title="horizontal ATE [cm]", scale=100.0):

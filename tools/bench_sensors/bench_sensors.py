@@ -26,7 +26,7 @@ ROOT = os.environ.get("FPLOC_ROOT") or os.path.abspath(os.path.join(os.path.dirn
 BIN = os.environ.get("FPLOC_BIN") or os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(ROOT, "tools", "pylib"))
 import fploc_tools  # noqa: E402
-from fploc_tools import log, pct, read_tum, yaw_of  # noqa: E402
+from fploc_tools import fmt_ms, fmt_num, log, pct, read_tum, yaw_of  # noqa: E402
 
 BEAMS = ["vlp16", "os1-32", "os1-64", "os1-128"]
 SCENARIOS = ["room-small-loop-medium", "corridor-loop-medium"]
@@ -91,8 +91,8 @@ def bench(a, work, beams, scenario):
     row.update(m or {"poses": 0})
     row["target_ate_xy_m"] = target_ate(beams)
     row["meets_targets"] = bool(m) and m["ate_xy_m"] <= target_ate(beams) and row["lost"] == 0
-    log(f"[{name}] ATE xy {100 * row.get('ate_xy_m', float('nan')):.2f} cm, z p99 "
-        f"{100 * row.get('z_err_p99_m', float('nan')):.2f} cm, LOST {row['lost']}, ms/scan {ms}")
+    log(f"[{name}] ATE xy {fmt_num(row.get('ate_xy_m'), 2, 100)} cm, z p99 "
+        f"{fmt_num(row.get('z_err_p99_m'), 2, 100)} cm, LOST {row['lost']}, ms/scan {fmt_ms(ms)}")
     return row
 
 

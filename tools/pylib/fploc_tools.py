@@ -12,6 +12,21 @@ def log(msg):
     print(msg, file=sys.stderr, flush=True)
 
 
+def fmt_num(v, digits=2, scale=1):
+    """A number for a text summary: 1.55, not 1.5474540577388338; "-" for a value not measured (None, NaN, inf),
+    never Python's None or nan. `scale` converts (100: metres to cm)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return "-" if v is None else str(v)
+    return f"{v * scale:.{digits}f}" if math.isfinite(v) else "-"
+
+
+def fmt_ms(ms):
+    """ms per scan per node for a text summary: "segmenter 1.2, features 0.8", not a Python dict."""
+    if isinstance(ms, dict):
+        return ", ".join(f"{k} {fmt_num(v, 1)}" for k, v in ms.items()) or "-"
+    return fmt_num(ms, 1)
+
+
 def run(cmd, who):
     """Runs cmd; on failure prints the end of its stderr and exits naming `who` and the program."""
     try:

@@ -33,6 +33,7 @@
 #include "fploc/runtime/graph.h"
 #include "fploc/runtime/log_reader.h"
 #include "fploc/runtime/node.h"
+#include "fploc/tools/start_pose.h"
 #include "options/tools.pb.h"
 
 using namespace fploc::rt;
@@ -163,83 +164,15 @@ int main(int argc, char** argv) {
   }
 
   // A start pose outside the plan it is to be found in (a typo, the wrong plan, another frame): the run would
-  // go on LOST from the first scan. One warning per node, the replay still runs. A node that ignores its
-  // initial_pose option (the matcher's wait_for_initial_pose: it waits for a pose on its initial_pose port; amcl's
-  // global_localization) is not warned about it. A building (.pbtxt, .ifc) is checked on the floor the node starts
-  // on (plan.floor; "" = the first floor listed, IFC: the lowest storey), and the warning names it and any other
-  // floor whose plan holds the pose (the start pose has no z: plan.floor picks the floor).
-  for (const auto& n : g.graph.node()) {
-    if (n.disabled() || !find_registration(type_from_executable(n.executable()))) continue;
-    const auto opts = node_options(n);
-    if (!opts) continue;
-    const auto* d = opts->GetDescriptor();
-    const auto* r = opts->GetReflection();
-    const auto* pf = d->FindFieldByName("plan");
-    const auto* ipf = d->FindFieldByName("initial_pose");
-    if (!pf || !ipf || pf->type() != google::protobuf::FieldDescriptor::TYPE_MESSAGE ||
-        ipf->type() != google::protobuf::FieldDescriptor::TYPE_MESSAGE || !r->HasField(*opts, ipf))
-      continue;
-    const auto set_flag = [&](const char* name) {
-      const auto* f = d->FindFieldByName(name);
-      return f && f->type() == google::protobuf::FieldDescriptor::TYPE_BOOL && !f->is_repeated() && r->GetBool(*opts, f);
-    };
-    if (set_flag("wait_for_initial_pose") || set_flag("global_localization")) continue;
-    const auto& plan = r->GetMessage(*opts, pf);
-    const auto& ip = r->GetMessage(*opts, ipf);
-    const auto* ipd = ip.GetDescriptor();
-    const auto* fx = ipd->FindFieldByName("x");
-    const auto* fy = ipd->FindFieldByName("y");
-    const auto* ff = plan.GetDescriptor()->FindFieldByName("file");
-    if (!fx || !fy || !ff) continue;
-    const std::string file = plan.GetReflection()->GetString(plan, ff);
-    if (file.empty()) continue;
-    const std::string path = std::filesystem::path(file).is_absolute() || g.dir.empty()
-                                 ? file
-                                 : (std::filesystem::path(g.dir) / file).lexically_normal().string();
-    const double x = ip.GetReflection()->GetDouble(ip, fx), y = ip.GetReflection()->GetDouble(ip, fy);
-    const auto inside = [&](const fploc::Box2& box) {
-      return box.empty() || (x >= box.min.x() && x <= box.max.x() && y >= box.min.y() && y <= box.max.y());
-    };
+  // go on LOST from the first scan. One warning per node, the replay still runs (fploc/tools/start_pose.h, as
+  // `fploc node initial-pose`'s check). A node that ignores its initial_pose option (wait_for_initial_pose,
+  // global_localization) is not warned about it; a building is checked on the floor the node starts on (plan.floor).
+  for (const auto& sp : fploc::tools::start_plans(
+           g, [](const fploc::Node& n) { return find_registration(type_from_executable(n.executable())) != nullptr; })) {
+    if (!sp.has_initial_pose || sp.ignores_initial_pose) continue;
     try {
-      const auto* pd = plan.GetDescriptor();
-      const auto* pr = plan.GetReflection();
-      fploc::PlanLoadOptions lo;
-      for (int k = 0; k < pr->FieldSize(plan, pd->FindFieldByName("layers")); ++k)
-        lo.layer_globs.push_back(pr->GetRepeatedString(plan, pd->FindFieldByName("layers"), k));
-      lo.units_override = pr->GetString(plan, pd->FindFieldByName("units"));
-      lo.quiet = true;
-      const std::string floor = pr->GetString(plan, pd->FindFieldByName("floor"));
-      fploc::Box2 box;
-      std::string where = path;        // the plan (and floor) checked
-      std::vector<std::string> also;   // other floors whose plan holds the pose
-      if (fploc::is_building_file(path)) {
-        fploc::BuildingLoadOptions bo;
-        bo.quiet = true;
-        const fploc::Building b = fploc::load_building(path, bo);
-        const std::string start = b.floor(floor).name;  // throws naming the floors
-        for (const auto& f : b.floors) {
-          const fploc::Box2 fb = fploc::load_floor_plan(b, f.name, lo).bounds();
-          if (f.name == start) box = fb;
-          else if (!fb.empty() && inside(fb)) also.push_back(f.name);
-        }
-        where = "floor '" + start + "' of " + path;
-      } else {
-        box = fploc::load_floor_plan(path, lo).bounds();
-      }
-      if (!inside(box)) {
-        std::cerr << "fploc replay: warning: " << n.name() << "'s initial pose (" << x << ", " << y
-                  << ") lies outside its plan's extent (x " << box.min.x() << " .. " << box.max.x() << ", y "
-                  << box.min.y() << " .. " << box.max.y() << " m, " << where << ")";
-        if (also.size() == 1)
-          std::cerr << "; it lies inside floor '" << also[0] << "' (--set " << n.name() << ".plan.floor=" << also[0]
-                    << " to start there)";
-        else if (!also.empty()) {
-          std::cerr << "; it lies inside floors";
-          for (size_t k = 0; k < also.size(); ++k) std::cerr << (k ? ", '" : " '") << also[k] << "'";
-          std::cerr << " (--set " << n.name() << ".plan.floor=NAME to start on one)";
-        }
-        std::cerr << "\n";
-      }
+      const auto c = fploc::tools::check_start_pose(sp, sp.x, sp.y);
+      if (!c.text.empty()) std::cerr << "fploc replay: warning: " << sp.node << "'s initial pose " << c.text << "\n";
     } catch (const std::exception&) {
       // the node says what is wrong with its plan when it loads it
     }

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # `fploc replay` ends with one line counting the poses OK / POOR / LOST on the pose channel (JSON "poses"), and
-# warns when a node's initial pose lies outside its plan's extent (a run started there was LOST throughout and
-# said only "N node errors"): not for a matcher that waits for its initial pose, and in a building on the floor the
-# node starts on. fploc replay runs over memq:// (no network).
+# warns when a node's initial pose lies outside its plan's extent or its drawn walls (a run started there was LOST
+# throughout and said only "N node errors"): not for a matcher that waits for its initial pose, and in a building on
+# the floor the node starts on. fploc replay runs over memq:// (no network).
 set -uo pipefail
 BIN="${FPLOC_BUILD_DIR:?}/bin"; R="${FPLOC_ROOT:?}"
 T="$(mktemp -d)"; trap 'rm -rf "$T"' EXIT
@@ -65,6 +65,12 @@ grep -qF "fploc replay: warning: matcher's initial pose (-10, -10) lies outside 
   --set matcher.plan.floor=first --set matcher.initial_pose.x=-10 --set matcher.initial_pose.y=-10 > /dev/null 2> "$T/err" || true
 grep -q "lies outside its plan's extent" "$T/err" && fail "building, plan.floor first: warned for a pose inside floor 'first'"
 grep -qE '^fploc replay: [0-9]+ poses on FPLOC_POSE' "$T/err" || fail "replay on floor 'first' did not run"
+# From (17, 11): within the plan's extent (the door leaves reach x 18.25) but outside the room's walls (x 16.25): the
+# same check as `fploc node initial-pose`'s (tools/start_pose), a warning.
+"$BIN/fploc-replay" --graph "$R/graphs/replay.pbtxt" --log "$T/log.lcm" --out "$T/c.tum" \
+  --set matcher.initial_pose.x=17 --set matcher.initial_pose.y=11 > /dev/null 2> "$T/err" || true
+grep -qE "^fploc replay: warning: matcher's initial pose \(17, 11\) lies within its plan's extent but not inside its drawn walls \(plan elements in [0-8] of 16 directions" "$T/err" ||
+  fail "no warning for an initial pose outside the walls"
 # graphs/ndt.pbtxt's uncertainty file ("ndt.unc", relative) is written beside --out, not into the working directory.
 mkdir -p "$T/out" "$T/cwd"
 (cd "$T/cwd" && "$BIN/fploc-replay" --graph "$R/graphs/ndt.pbtxt" --log "$T/log.lcm" --out "$T/out/n.tum" \
