@@ -60,6 +60,8 @@ laser2d::GridLocalizerConfig config_of(const Grid2dOptions& o) {
   if (o.global_after_lost_scans() < 0)
     throw OptionError("grid2d", "global_after_lost_scans", "must be >= 0 (0: never), got " + std::to_string(o.global_after_lost_scans()));
   c.global_after_lost_scans = o.global_after_lost_scans();
+  if (given(o.global_confirm_inlier_ratio(), "grid2d", "global_confirm_inlier_ratio"))
+    c.global_confirm_inlier_ratio = o.global_confirm_inlier_ratio();
   return c;
 }
 

@@ -84,9 +84,13 @@ int main(int argc, char** argv) {
   app.add_option("--laser-track-retry", c.laser_track_retry, "laser odometry: a failed tracking fit, a strong fit in the wheels' window");
   app.add_option("--global-candidates", c.global_candidates, "global: distinct places proposed per whole-map search");
   app.add_option("--global-max-hypotheses", c.global_max_hypotheses, "global: places tracked at most");
+  app.add_option("--global-sep", c.global_sep_xy_m, "global: the whole-map search's candidates are distinct beyond this [m]");
+  double global_sep_deg = -1;
+  app.add_option("--global-sep-deg", global_sep_deg, "global: ... or beyond this [deg]");
   app.add_option("--global-confirm-travel", c.global_confirm_travel_m, "global: travel [m] a place must have matched over");
   app.add_option("--global-confirm-inlier-ratio", c.global_confirm_inlier_ratio, "global: mean inlier share a place needs");
   app.add_option("--global-confirm-margin", c.global_confirm_margin, "global: mean inlier share over every other place still matching");
+  app.add_option("--global-confirm-outlier-ratio", c.global_confirm_outlier_ratio, "global: every other place leaves this many times the leader's unexplained share (0: off)");
   app.add_option("--global-after-lost", c.global_after_lost_scans, "kidnapped robot: whole-map search after this many LOST scans (0: never)");
   fploc::bench_real::add_fit_loss_option(app, c.fit_loss);
   app.add_option("--huber", c.huber_m, "scale of the map fit's robust loss [m]");
@@ -94,6 +98,7 @@ int main(int argc, char** argv) {
                  "redescending loss: Huber first when the prediction's sigma x/y exceeds this [m]");
   CLI11_PARSE(app, argc, argv);
   if (laser_sigma_yaw_deg >= 0) c.laser_sigma_yaw_rad = laser_sigma_yaw_deg * M_PI / 180;
+  if (global_sep_deg >= 0) c.global_sep_yaw_rad = global_sep_deg * M_PI / 180;
   namespace cm = fploc::carmen;
   namespace l2 = fploc::laser2d;
   try {
@@ -137,6 +142,15 @@ int main(int argc, char** argv) {
                       {"odom_bias_deg_per_m", r.odom_bias_rad_per_m * 180 / M_PI},
                       {"odom_turn_scale_error", r.odom_turn_scale_error}, {"odom_scale", r.odom_scale}});
       if (odom) rows.back().update({{"odom_x", odom->x}, {"odom_y", odom->y}, {"odom_yaw", odom->yaw}});
+      if (r.global) {
+        nlohmann::json pl = nlohmann::json::array();
+        for (const auto& q : r.places)
+          pl.push_back({{"id", q.id}, {"x", q.pose.x}, {"y", q.pose.y}, {"yaw", q.pose.yaw}, {"hits", q.hits},
+                        {"mean", q.mean_inlier_ratio}, {"min", q.min_inlier_ratio}, {"travel_m", q.travel_m},
+                        {"err_m", std::hypot(q.pose.x - s.pose.x, q.pose.y - s.pose.y)},
+                        {"err_yaw_deg", fploc::wrap_angle(q.pose.yaw - s.pose.theta) * 180 / M_PI}});
+        rows.back()["places"] = pl;
+      }
       if (r.laser_step)
         rows.back()["laser_increment"] = {r.laser_increment.x, r.laser_increment.y, r.laser_increment.yaw};
     }

@@ -84,11 +84,14 @@ struct GridLocalizer::Impl {
     double inlier_sum = 0;
     double travel_m = 0;  // the odometry's travel since it was proposed
     double last = 0;      // its latest fit's inlier share
+    double lowest = 1;    // its lowest fit's inlier share
+    int id = 0;
     double mean() const { return hits > 0 ? inlier_sum / hits : 0; }
   };
   std::vector<Hypothesis> hyps;
   // Global localization: searching the whole map (start_global, or LOST for global_after_lost_scans).
   bool global = false;
+  int next_place_id = 0;
   std::vector<uint8_t> free_cells;  // per cell of the field (row-major, row 0 bottom): 1 known free (set_free_space)
   Pose2 global_centre;              // the whole-map window: the free cells' (else the field's) world bounding box
   double global_half_m = 0;
@@ -151,6 +154,7 @@ struct GridLocalizer::Impl {
       ++h.hits;
       h.inlier_sum += f.inlier_ratio;
       h.last = f.inlier_ratio;
+      h.lowest = std::min(h.lowest, f.inlier_ratio);
       kept.push_back(h);
     }
     hyps = std::move(kept);
@@ -169,6 +173,8 @@ struct GridLocalizer::Impl {
     h.hits = 1;
     h.inlier_sum = f.inlier_ratio;
     h.last = f.inlier_ratio;
+    h.lowest = f.inlier_ratio;
+    h.id = next_place_id++;
     hyps.push_back(h);
   }
   // Global localization's scan: the hypotheses tracked, new ones from the whole-map search, and one taken when it
@@ -400,6 +406,8 @@ GridResult GridLocalizer::Impl::global_step(const std::vector<Eigen::Vector2d>& 
     win.prior_kappa = 0;  // no preference anywhere in the map
     SearchOptions so;
     so.keep = cfg.global_candidates;
+    so.sep_xy_m = cfg.global_sep_xy_m;
+    so.sep_yaw_rad = cfg.global_sep_yaw_rad;
     so.min_ratio = cfg.candidate_ratio;
     so.min_score = hypothesis_min_score();
     if (!free_cells.empty()) so.position_ok = [this](double x, double y) { return position_free(x, y); };
@@ -413,6 +421,7 @@ GridResult GridLocalizer::Impl::global_step(const std::vector<Eigen::Vector2d>& 
       add_hypothesis(fit(pts, c.pose, s0, y0, s0, y0, 1, cfg.min_inlier_ratio), so.sep_xy_m, so.sep_yaw_rad);
     }
   }
+  for (const auto& h : hyps) res.places.push_back({h.id, h.pose, h.hits, h.mean(), h.lowest, h.travel_m});
   // The leader: enough scans, travel and mean inlier share; the best mean of those. It is taken only when every
   // other hypothesis at another place has a mean lower by global_confirm_margin, whatever its number of scans.
   int lead = -1;
@@ -428,7 +437,9 @@ GridResult GridLocalizer::Impl::global_step(const std::vector<Eigen::Vector2d>& 
       const Hypothesis& h = hyps[i];
       const bool elsewhere = std::hypot(h.pose.x - l.pose.x, h.pose.y - l.pose.y) > cfg.rival_sep_xy_m ||
                              std::abs(wrap_angle(h.pose.yaw - l.pose.yaw)) > cfg.rival_sep_yaw_rad;
-      if (int(i) != lead && elsewhere && h.mean() > l.mean() - cfg.global_confirm_margin) lead = -1;
+      const bool close = h.mean() > l.mean() - cfg.global_confirm_margin ||
+                         1 - h.mean() < cfg.global_confirm_outlier_ratio * (1 - l.mean());
+      if (int(i) != lead && elsewhere && close) lead = -1;
     }
   }
   if (lead >= 0) {
