@@ -30,6 +30,8 @@ fploc blue, AMCL orange) and ROW-fploc.png (without AMCL).
 
   fploc bench real [--json] [--markdown FILE] [--logs intel,aces] [--split auto|F] [--end 0.6] [--out DIR] [--rows ref,off]
   fploc bench real --from-json RUN.json --markdown FILE     (the tables of an earlier run's JSON, nothing rerun)
+  fploc bench real --rows global [--global-every 50 --global-starts 5 --global-scans 300]   (global localization:
+      no start pose, started at several covered scans of each log; JSON "global_rows", see global_starts())
 """
 import argparse, json, math, os, subprocess, sys
 
