@@ -56,6 +56,12 @@ laser2d::GridLocalizerConfig config_of(const Grid2dOptions& o) {
   if (given(o.huber_m(), "grid2d", "huber_m")) c.huber_m = o.huber_m();
   if (given(o.huber_first_above_sigma_m(), "grid2d", "huber_first_above_sigma_m")) c.huber_first_above_sigma_m = o.huber_first_above_sigma_m();
   if (o.laser_conflict_inlier_ratio() != 0) c.laser_conflict_inlier_ratio = o.laser_conflict_inlier_ratio();
+  if (given(o.global_confirm_travel_m(), "grid2d", "global_confirm_travel_m")) c.global_confirm_travel_m = o.global_confirm_travel_m();
+  if (o.global_after_lost_scans() < 0)
+    throw OptionError("grid2d", "global_after_lost_scans", "must be >= 0 (0: never), got " + std::to_string(o.global_after_lost_scans()));
+  c.global_after_lost_scans = o.global_after_lost_scans();
+  if (given(o.global_confirm_inlier_ratio(), "grid2d", "global_confirm_inlier_ratio"))
+    c.global_confirm_inlier_ratio = o.global_confirm_inlier_ratio();
   return c;
 }
 

@@ -199,7 +199,9 @@ TEST(ConfigDefaults, Grid2d) {
          {"laser_map_scans", double(c.laser.map_scans)}, {"confirm_within_sigmas", c.confirm_within_sigmas},
          {"far_confirm_travel_m", c.far_confirm_travel_m}, {"huber_m", c.huber_m},
          {"huber_first_above_sigma_m", c.huber_first_above_sigma_m},
-         {"laser_conflict_inlier_ratio", c.laser_conflict_inlier_ratio}});
+         {"laser_conflict_inlier_ratio", c.laser_conflict_inlier_ratio},
+         {"global_confirm_travel_m", c.global_confirm_travel_m},
+         {"global_confirm_inlier_ratio", c.global_confirm_inlier_ratio}});
   EXPECT_EQ(c.fit_loss, fploc::laser2d::FitLoss::kHuber);
 }
 

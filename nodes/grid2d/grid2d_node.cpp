@@ -2,7 +2,7 @@
 // (pose_t on WHEEL_ODOM; optional) -> modules/laser2d GridLocalizer (scans matched directly to the distance
 // field of a map_server occupancy grid: correlative search around the odometry prediction, Ceres refinement)
 // -> pose_t (FPLOC_GRID_POSE) per scan: status OK / POOR (odometry prediction kept) / LOST, covariance
-// (x, y, yaw) from the fit. Odometry pairing: the latest odometry pose whose utime is not after the scan's
+// (x, y, yaw) from the fit. Without grid2d.initial_pose: global localization (LOST until one place dominates). Odometry pairing: the latest odometry pose whose utime is not after the scan's
 // (`fploc import-carmen` writes it with the scan's own utime, before the scan).
 #include <fploc/laser_scan_t.hpp>
 #include <fploc/pose_t.hpp>
@@ -52,12 +52,19 @@ class Grid2dNode : public fploc::rt::Node {
     mount_ = {o.mount_x_m(), o.mount_y_m(), o.mount_yaw_deg() * M_PI / 180};
     upside_down_ = o.upside_down();
     z_ = o.z_m();
-    const Pose2 p0{o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()};
-    loc_->set_initial_pose(p0);
+    loc_->set_free_space(g);  // where a whole-map search may place the robot (global start, kidnapped robot)
     std::cerr << "[" << ctx.name() << "] " << path << ": " << g.width << " x " << g.height << " cells at " << g.resolution
-              << " m, " << field->occupied_cells() << " occupied; initial pose " << p0.x << " " << p0.y << " " << p0.yaw
-              << " (+-" << 3 * c.initial_sigma_xy_m << " m, " << 3 * c.initial_sigma_yaw_rad * 180 / M_PI
-              << " deg searched); odometry " << (ctx.channel("odom").empty() ? "none" : ctx.channel("odom")) << "\n";
+              << " m, " << field->occupied_cells() << " occupied; ";
+    if (o.has_initial_pose()) {
+      const Pose2 p0{o.initial_pose().x(), o.initial_pose().y(), o.initial_pose().yaw()};
+      loc_->set_initial_pose(p0);
+      std::cerr << "initial pose " << p0.x << " " << p0.y << " " << p0.yaw << " (+-" << 3 * c.initial_sigma_xy_m << " m, "
+                << 3 * c.initial_sigma_yaw_rad * 180 / M_PI << " deg searched)";
+    } else {
+      loc_->start_global();
+      std::cerr << "no initial pose: global localization (the whole map searched; LOST until one place dominates)";
+    }
+    std::cerr << "; odometry " << (ctx.channel("odom").empty() ? "none" : ctx.channel("odom")) << "\n";
     out_ = ctx.advertise<fploc::pose_t>("pose");
     ctx.subscribe<fploc::laser_scan_t>("scan", [this](const fploc::laser_scan_t& m) { on_scan(m); });
     ctx.subscribe<fploc::pose_t>("odom", [this](const fploc::pose_t& m) { on_odom(m); });
@@ -109,6 +116,9 @@ class Grid2dNode : public fploc::rt::Node {
     if (r.status == l2::GridStatus::kOk)
       std::snprintf(why, sizeof why, "%smap fit, %d %% of %d returns within the inlier distance", r.reacquired ? "re-acquired: " : "",
                     pct, r.num_points);
+    else if (r.global)
+      std::snprintf(why, sizeof why, "global localization: %d place(s) of the whole map still match, none dominates yet "
+                    "(the leader: %d %% of %d returns inliers)", r.hypotheses, pct, r.num_points);
     else if (r.num_points < 10)
       std::snprintf(why, sizeof why, "%d returns in range, too few to fit; odometry prediction kept", r.num_points);
     else
@@ -118,7 +128,8 @@ class Grid2dNode : public fploc::rt::Node {
                     r.status == l2::GridStatus::kLost ? "; re-acquiring" : "; odometry prediction kept");
     const std::string line = "scan " + std::to_string(seq_) + ": " + names[int(r.status)] + ": " + why;
     bool printed = false;
-    if (r.status == l2::GridStatus::kLost) printed = ctx_->error("LOST at scan " + std::to_string(seq_) + ": " + why);
+    // (Searching the whole map is what a start without a pose does, not an error.)
+    if (r.status == l2::GridStatus::kLost && !r.global) printed = ctx_->error("LOST at scan " + std::to_string(seq_) + ": " + why);
     ctx_->status_changed(line, true, !printed);
   }
 

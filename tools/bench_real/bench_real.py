@@ -30,6 +30,8 @@ fploc blue, AMCL orange) and ROW-fploc.png (without AMCL).
 
   fploc bench real [--json] [--markdown FILE] [--logs intel,aces] [--split auto|F] [--end 0.6] [--out DIR] [--rows ref,off]
   fploc bench real --from-json RUN.json --markdown FILE     (the tables of an earlier run's JSON, nothing rerun)
+  fploc bench real --rows global [--global-every 50 --global-starts 5 --global-scans 300]   (global localization:
+      no start pose, started at several covered scans of each log; JSON "global_rows", see global_starts())
 """
 import argparse, json, math, os, subprocess, sys
 
@@ -160,6 +162,88 @@ def score(gt_path, est_path, lost_m, keep=None, status_path=None, ref_noise=None
     return out
 
 
+def global_starts(src, plan, imp, a, d):
+    """--rows global: global localization (no start pose: fploc-grid2d's GridLocalizer::start_global, the whole map
+    searched) started at every --global-every-th covered scan of the localized part (at most --global-starts), each
+    run in-process by fploc-real-track (the node's computation without LCM: a replay per start would run the whole
+    graph each time) over --global-scans scans. Per start: the scans and the reference's metres until the first OK
+    pose, whether that pose is within FALSE_OK_M / 5 deg of the reference (locked), the OK poses farther than
+    FALSE_OK_M off (wrong OK) over the whole run, and the ATE over the covered scans from the lock on, beside the
+    ATE of the tracker started at the first scan's reference pose (fploc-real-track --start ref, one run) over the
+    same scans."""
+    first, end = imp["first_scan"], imp["end_scan"]
+    covered = [first + i for i, c in enumerate(imp["coverage"]) if c >= imp["coverage_ratio"]]
+    starts = covered[::a.global_every][:a.global_starts]
+    track = os.path.join(BIN, "fploc-real-track")
+    last = min(end, max(starts) + a.global_scans) if starts else first
+    ref_rows = json.loads(run([track, src, "--map", plan, "--first-scan", str(first), "--end-scan", str(last),
+                               "--start", "ref"]).stdout)["scans"]
+    ref_err = {r["scan"]: r["err_m"] for r in ref_rows}
+    cov = set(covered)
+    out = []
+    for s0 in starts:
+        e0 = min(end, s0 + a.global_scans)
+        j = json.loads(run([track, src, "--map", plan, "--first-scan", str(s0), "--end-scan", str(e0), "--start", "global"]).stdout)
+        rows = j["scans"]
+        with open(os.path.join(d, f"global-{s0}.json"), "w") as f:
+            json.dump(j, f)
+        lock = next((i for i, r in enumerate(rows) if r["status"] == 0), None)
+        travel = 0.0
+        for i in range(1, (lock if lock is not None else len(rows) - 1) + 1):
+            travel += math.hypot(rows[i]["ref_x"] - rows[i - 1]["ref_x"], rows[i]["ref_y"] - rows[i - 1]["ref_y"])
+        wrong = [r["scan"] for r in rows if r["status"] == 0 and r["err_m"] > FALSE_OK_M]
+        after = [r for r in rows[lock:] if r["scan"] in cov] if lock is not None else []
+        rmse = lambda v: math.sqrt(sum(e * e for e in v) / len(v)) if v else None
+        pre = rows[:lock] if lock is not None else rows
+        out.append({"first_scan": s0, "end_scan": e0, "scans": len(rows), "locked": lock is not None,
+                    "lock_scan": rows[lock]["scan"] if lock is not None else None,
+                    "scans_to_lock": lock + 1 if lock is not None else None, "metres_to_lock": travel,
+                    "lock_err_m": rows[lock]["err_m"] if lock is not None else None,
+                    "lock_err_deg": abs(rows[lock]["err_yaw_deg"]) if lock is not None else None,
+                    "locked_correctly": lock is not None and rows[lock]["err_m"] <= FALSE_OK_M and abs(rows[lock]["err_yaw_deg"]) <= 5,
+                    "wrong_ok_poses": len(wrong), "wrong_ok_scans": wrong[:20],
+                    "ok_pct": 100.0 * sum(r["status"] == 0 for r in rows) / max(1, len(rows)),
+                    "ate_after_lock_m": rmse([r["err_m"] for r in after]),
+                    "ref_ate_same_scans_m": rmse([ref_err[r["scan"]] for r in after if r["scan"] in ref_err]),
+                    "covered_scans_after_lock": len(after),
+                    "ms_per_scan_before_lock": sum(r["ms"] for r in pre) / max(1, len(pre)),
+                    "ms_per_scan": j["ms_per_scan"], "max_hypotheses": max((r["hypotheses"] for r in rows), default=0)})
+    locked = [o for o in out if o["locked"]]
+    med = lambda v: sorted(v)[len(v) // 2] if v else None
+    pooled = lambda k, n: (math.sqrt(sum(o[k] ** 2 * o[n] for o in locked if o[k] is not None) /
+                                     max(1, sum(o[n] for o in locked if o[k] is not None)))
+                           if any(o[k] is not None for o in locked) else None)
+    summary = {"starts": len(out), "locked": len(locked), "locked_correctly": sum(o["locked_correctly"] for o in out),
+               "locked_correctly_pct": 100.0 * sum(o["locked_correctly"] for o in out) / max(1, len(out)),
+               "scans_to_lock_median": med([o["scans_to_lock"] for o in locked]),
+               "scans_to_lock_max": max((o["scans_to_lock"] for o in locked), default=None),
+               "metres_to_lock_median": med([o["metres_to_lock"] for o in locked]),
+               "metres_to_lock_max": max((o["metres_to_lock"] for o in locked), default=None),
+               "wrong_ok_poses": sum(o["wrong_ok_poses"] for o in out),
+               "ate_after_lock_m": pooled("ate_after_lock_m", "covered_scans_after_lock"),
+               "ref_ate_same_scans_m": pooled("ref_ate_same_scans_m", "covered_scans_after_lock"),
+               "ms_per_scan_before_lock": sum(o["ms_per_scan_before_lock"] for o in out) / max(1, len(out))}
+    return {"log": os.path.basename(src).replace("-corrected.log.gz", ""), "start": "global",
+            "global_every": a.global_every, "global_scans": a.global_scans, "summary": summary, "starts": out}
+
+
+def global_markdown(rows):
+    out = ["", "Global localization (`--rows global`: no start pose, the whole map searched; fploc-real-track per start): "
+           "starts = every Nth covered scan; locked = the first OK pose within 0.3 m / 5 deg of the reference; scans and "
+           "metres (the reference's path) until the first OK pose; wrong OK = OK poses more than 0.3 m off; ATE after the "
+           "lock over the covered scans, and the tracker started at the reference pose over the same scans.", "",
+           "| log | starts | locked correctly | scans to lock (median / max) | metres to lock (median / max) | wrong OK | "
+           "ATE after lock | ref-start ATE, same scans | ms per scan before lock |", "|" + "---|" * 9]
+    for r in rows:
+        g = r["summary"]
+        n = lambda v, f="{:.0f}": "-" if v is None else f.format(v)
+        out.append(f"| {r['log']} | {g['starts']} | {g['locked_correctly']} / {g['starts']} | {n(g['scans_to_lock_median'])} / "
+                   f"{n(g['scans_to_lock_max'])} | {n(g['metres_to_lock_median'], '{:.1f}')} / {n(g['metres_to_lock_max'], '{:.1f}')} | "
+                   f"{g['wrong_ok_poses']} | {cm(g['ate_after_lock_m'])} | {cm(g['ref_ate_same_scans_m'])} | "
+                   f"{g['ms_per_scan_before_lock']:.0f} |")
+    return "\n".join(out) + "\n"
+
+
 def cm(v, digits=1):
     return "-" if v is None or not math.isfinite(v) else f"{v * 100:.{digits}f}"
 
@@ -202,6 +286,8 @@ def markdown(doc, cmdline):
     rel = lambda f: os.path.join(os.path.basename(os.path.dirname(f)), os.path.basename(f))
     out += ["", "Plots, under the run's `--out` directory (reference green, fploc blue, AMCL orange; `-fploc.png` without AMCL):", ""]
     out += [f"- {r['log']} {r['start']}: `{rel(r['plot'])}`, `{rel(r['plot_fploc'])}`" for r in doc["rows"]]
+    if doc.get("global_rows"):
+        out.append(global_markdown(doc["global_rows"]))
     return "\n".join(out) + "\n"
 
 
@@ -217,7 +303,12 @@ def main():
     ap.add_argument("--end", type=float, default=1.0, help="localize up to this fraction of the log's scans (a short test run; above the split) (default: %(default)s)")
     ap.add_argument("--resolution", type=float, default=0.05, help="map cell size [m] (default: %(default)s)")
     ap.add_argument("--rows", default="ref,off",
-                    help="starts to run: ref (the reference pose of the first scan), off (1 m / 10 deg off it) (default: %(default)s)")
+                    help="starts to run: ref (the reference pose of the first scan), off (1 m / 10 deg off it), global (no "
+                         "start pose: global localization started at several scans, see --global-*; JSON global_rows) "
+                         "(default: %(default)s)")
+    ap.add_argument("--global-every", type=int, default=50, help="global: a start at every this-many-th covered scan (default: %(default)s)")
+    ap.add_argument("--global-starts", type=int, default=5, help="global: at most this many starts per log (default: %(default)s)")
+    ap.add_argument("--global-scans", type=int, default=300, help="global: scans run from each start (default: %(default)s)")
     # The map of the first part: a cell is occupied with >= min_hits hits and hits >= occupied_ratio of hits +
     # pass-throughs, and a beam marks nothing within hit_clearance of its hit free. The bench uses fploc
     # import-carmen's defaults (modules/carmen carmen.h GridConfig: 1 / 0.1 / 0.1 m); these options override them.
@@ -264,7 +355,11 @@ def main():
         if v is not None:
             map_opts += [opt, str(v)]
     map_used = None
-    rows = []
+    rows, grows = [], []
+    row_kinds = a.rows.split(",")
+    bad = [r for r in row_kinds if r not in ("ref", "off", "global")]
+    if bad:
+        raise SystemExit(f"fploc bench real: --rows: unknown row kind '{bad[0]}' (use ref, off, global)")
     for name in a.logs.split(","):
         src = os.path.join(radish, f"{name}-corrected.log.gz")
         d = os.path.join(a.out, name)
@@ -296,7 +391,15 @@ def main():
         # The same with the fit's Cauchy loss (GridLocalizerConfig::fit_loss): Huber's constant pull of returns on
         # structure the map lacks biases the fit, so the Huber floor is partly the objective's, not the map's.
         floor["cauchy"] = floor_of("cauchy")
-        for row in a.rows.split(","):
+        if "global" in row_kinds:
+            g = global_starts(src, plan, imp, a, d)
+            grows.append(g)
+            gs = g["summary"]
+            print(f"{name:13s} global starts {gs['starts']} locked correctly {gs['locked_correctly']} scans to lock median "
+                  f"{gs['scans_to_lock_median']} max {gs['scans_to_lock_max']} wrong OK {gs['wrong_ok_poses']} ATE after lock "
+                  f"{cm(gs['ate_after_lock_m'])} cm (ref start {cm(gs['ref_ate_same_scans_m'])} cm) "
+                  f"{gs['ms_per_scan_before_lock']:.0f} ms/scan before lock", file=sys.stderr)
+        for row in [r for r in row_kinds if r != "global"]:
             x, y, yaw = t0
             if row == "off":  # 1 m off (along the heading's left diagonal) and 10 degrees
                 x += math.cos(yaw + math.pi / 4)
@@ -350,6 +453,8 @@ def main():
                                                                   "hit_clearance_m": a.hit_clearance}),
                                                  "refine_map_poses": a.refine_map_poses},
                                          "lost_m": a.lost_m, "graph": a.graph}, "rows": rows}
+    if grows:
+        doc["global_rows"] = grows
     if a.json:
         print(json.dumps(doc, indent=1))
     if a.markdown:

@@ -1,9 +1,10 @@
-// fploc-real-track LOG[.gz] --map MAP.yaml --first-scan S [--end-scan E] [--start ref|off] : fploc-grid2d's
+// fploc-real-track LOG[.gz] --map MAP.yaml --first-scan S [--end-scan E] [--start ref|off|global] : fploc-grid2d's
 // tracker (modules/laser2d GridLocalizer, the node's own point extraction and odometry pairing) run in-process
 // over scans [S, E) of a CARMEN log, without LCM: per scan the estimate, the reference, the status, the fit's
 // inlier share and the CPU time of the update, as JSON. The bench's numbers come from `fploc replay` of the
 // lidar2d graph (fploc bench real); this is the same computation for looking at one log's errors scan by scan
-// (tools/bench_real/plot_errors.py) and for profiling.
+// (tools/bench_real/plot_errors.py), for profiling, and for `fploc bench real --rows global` (global starts at
+// many scans of a log: a replay per start would cost a whole graph run each).
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
@@ -36,8 +37,9 @@ int main(int argc, char** argv) {
   app.add_option("--map", map_path, "map_server occupancy map (.yaml)")->required();
   app.add_option("--first-scan", first, "first scan index")->required();
   app.add_option("--end-scan", end, "end scan index (exclusive; 0 = the log's end)");
-  app.add_option("--start", start, "ref: the reference pose of the first scan; off: 1 m / 10 deg off (as the bench)")
-      ->check(CLI::IsMember({"ref", "off"}));
+  app.add_option("--start", start, "ref: the reference pose of the first scan; off: 1 m / 10 deg off (as the bench); "
+                                   "global: no pose, the whole map searched (GridLocalizer::start_global)")
+      ->check(CLI::IsMember({"ref", "off", "global"}));
   std::vector<double> start_pose;
   app.add_option("--start-pose", start_pose, "X Y YAW: start here instead (e.g. the bench's start as read back from TUM)")
       ->expected(3);
@@ -80,23 +82,40 @@ int main(int argc, char** argv) {
   app.add_option("--laser-min-inlier-ratio", c.laser.min_inlier_ratio, "laser odometry: share of the scan the local map must explain");
   app.add_option("--laser-wide-retry", c.laser_wide_retry, "laser odometry: re-acquiring, a strong fit in the wheels' window");
   app.add_option("--laser-track-retry", c.laser_track_retry, "laser odometry: a failed tracking fit, a strong fit in the wheels' window");
+  app.add_option("--global-candidates", c.global_candidates, "global: distinct places proposed per whole-map search");
+  app.add_option("--global-max-hypotheses", c.global_max_hypotheses, "global: places tracked at most");
+  app.add_option("--global-sep", c.global_sep_xy_m, "global: the whole-map search's candidates are distinct beyond this [m]");
+  double global_sep_deg = -1;
+  app.add_option("--global-sep-deg", global_sep_deg, "global: ... or beyond this [deg]");
+  app.add_option("--global-confirm-travel", c.global_confirm_travel_m, "global: travel [m] a place must have matched over");
+  app.add_option("--global-confirm-inlier-ratio", c.global_confirm_inlier_ratio, "global: mean inlier share a place needs");
+  app.add_option("--global-confirm-margin", c.global_confirm_margin, "global: mean inlier share over every other place still matching");
+  app.add_option("--global-confirm-outlier-ratio", c.global_confirm_outlier_ratio, "global: every other place leaves this many times the leader's unexplained share (0: off)");
+  app.add_option("--global-after-lost", c.global_after_lost_scans, "kidnapped robot: whole-map search after this many LOST scans (0: never)");
   fploc::bench_real::add_fit_loss_option(app, c.fit_loss);
   app.add_option("--huber", c.huber_m, "scale of the map fit's robust loss [m]");
   app.add_option("--huber-first-above", c.huber_first_above_sigma_m,
                  "redescending loss: Huber first when the prediction's sigma x/y exceeds this [m]");
   CLI11_PARSE(app, argc, argv);
   if (laser_sigma_yaw_deg >= 0) c.laser_sigma_yaw_rad = laser_sigma_yaw_deg * M_PI / 180;
+  if (global_sep_deg >= 0) c.global_sep_yaw_rad = global_sep_deg * M_PI / 180;
   namespace cm = fploc::carmen;
   namespace l2 = fploc::laser2d;
   try {
     const fploc::bench_real::LogScans scans = fploc::bench_real::load_log_scans(log_path, first, end, c.max_range_m);
     const cm::Log& log = scans.log;
     end = scans.end;
-    const auto field = std::make_shared<fploc::DistanceField>(fploc::read_occupancy_map(map_path), c.field_max_m);
+    const fploc::OccupancyGrid grid = fploc::read_occupancy_map(map_path);
+    const auto field = std::make_shared<fploc::DistanceField>(grid, c.field_max_m);
     l2::GridLocalizer loc(field, c);
-    fploc::Pose2 p0 = fploc::bench_real::start_pose(log, first, start);
-    if (start_pose.size() == 3) p0 = {start_pose[0], start_pose[1], start_pose[2]};
-    loc.set_initial_pose(p0);
+    loc.set_free_space(grid);  // as fploc-grid2d
+    if (start == "global" && start_pose.empty()) {
+      loc.start_global();
+    } else {
+      fploc::Pose2 p0 = fploc::bench_real::start_pose(log, first, start == "global" ? "ref" : start);
+      if (start_pose.size() == 3) p0 = {start_pose[0], start_pose[1], start_pose[2]};
+      loc.set_initial_pose(p0);
+    }
     const double rmax = scans.max_range_m;
     nlohmann::json rows = nlohmann::json::array();
     double total_ms = 0;
@@ -118,11 +137,20 @@ int main(int argc, char** argv) {
                       {"cov", {r.covariance(0, 0), r.covariance(0, 1), r.covariance(0, 2), r.covariance(1, 1),
                                r.covariance(1, 2), r.covariance(2, 2)}},
                       {"rms_m", r.rms_m}, {"num_points", r.num_points},
-                      {"hypotheses", r.hypotheses}, {"ms", ms}, {"laser_step", r.laser_step},
+                      {"hypotheses", r.hypotheses}, {"global", r.global}, {"ms", ms}, {"laser_step", r.laser_step},
                       {"laser_inlier_ratio", r.laser_inlier_ratio}, {"wide_search", r.wide_search},
                       {"odom_bias_deg_per_m", r.odom_bias_rad_per_m * 180 / M_PI},
                       {"odom_turn_scale_error", r.odom_turn_scale_error}, {"odom_scale", r.odom_scale}});
       if (odom) rows.back().update({{"odom_x", odom->x}, {"odom_y", odom->y}, {"odom_yaw", odom->yaw}});
+      if (r.global) {
+        nlohmann::json pl = nlohmann::json::array();
+        for (const auto& q : r.places)
+          pl.push_back({{"id", q.id}, {"x", q.pose.x}, {"y", q.pose.y}, {"yaw", q.pose.yaw}, {"hits", q.hits},
+                        {"mean", q.mean_inlier_ratio}, {"min", q.min_inlier_ratio}, {"travel_m", q.travel_m},
+                        {"err_m", std::hypot(q.pose.x - s.pose.x, q.pose.y - s.pose.y)},
+                        {"err_yaw_deg", fploc::wrap_angle(q.pose.yaw - s.pose.theta) * 180 / M_PI}});
+        rows.back()["places"] = pl;
+      }
       if (r.laser_step)
         rows.back()["laser_increment"] = {r.laser_increment.x, r.laser_increment.y, r.laser_increment.yaw};
     }

@@ -147,7 +147,10 @@ struct Bnb {
     if (n.h == 0) {
       ++st.leaves;
       const double fit = exact_fit(pyr, s, n.y, n.di, n.dj);
-      offer(make_candidate(win, s, n.y, n.di, n.dj, fit, fit * prior_max(s, n.di, n.dj, 1, dyaw)));
+      const double sc = fit * prior_max(s, n.di, n.dj, 1, dyaw);
+      const SearchCandidate c = make_candidate(win, s, n.y, n.di, n.dj, fit, sc);
+      if (opt.position_ok && !opt.position_ok(c.pose.x, c.pose.y)) return;
+      offer(c);
       return;
     }
     const int c = 1 << (n.h - 1);

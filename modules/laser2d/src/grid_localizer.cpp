@@ -83,9 +83,19 @@ struct GridLocalizer::Impl {
     int hits = 0;
     double inlier_sum = 0;
     double travel_m = 0;  // the odometry's travel since it was proposed
+    double last = 0;      // its latest fit's inlier share
+    double lowest = 1;    // its lowest fit's inlier share
+    int id = 0;
     double mean() const { return hits > 0 ? inlier_sum / hits : 0; }
   };
   std::vector<Hypothesis> hyps;
+  // Global localization: searching the whole map (start_global, or LOST for global_after_lost_scans).
+  bool global = false;
+  int next_place_id = 0;
+  std::vector<uint8_t> free_cells;  // per cell of the field (row-major, row 0 bottom): 1 known free (set_free_space)
+  Pose2 global_centre;              // the whole-map window: the free cells' (else the field's) world bounding box
+  double global_half_m = 0;
+
 
   // One local fit: the search around pred (+-window_sigmas sigma, capped at max_xy / max_yaw), the refinement,
   // the inliers, the acceptance test and the covariance.
@@ -119,6 +129,58 @@ struct GridLocalizer::Impl {
     return r;
   }
 
+  // Every k-th point so that about 100 remain (the correlative search's points).
+  static std::vector<Eigen::Vector2d> search_points(const std::vector<Eigen::Vector2d>& pts) {
+    const size_t sk = std::max<size_t>(1, pts.size() / 100);
+    std::vector<Eigen::Vector2d> sp;
+    for (size_t i = 0; i < pts.size(); i += sk) sp.push_back(pts[i]);
+    return sp;
+  }
+  // The lowest score of a pose with min_inlier_ratio of the points within inlier_m: nothing below it can become a
+  // hypothesis (prunes most of a wide search where the map does not explain the scan).
+  double hypothesis_min_score() const {
+    const double r = cfg.inlier_m / cfg.score_sigma_m;
+    return cfg.min_inlier_ratio * std::exp(-0.5 * r * r);
+  }
+  // Each hypothesis refitted around its odometry-propagated pose; dropped at its first failed fit.
+  void track_hypotheses(const std::vector<Eigen::Vector2d>& pts) {
+    std::vector<Hypothesis> kept;
+    for (auto& h : hyps) {
+      const Fit f = fit(pts, h.pose, h.sxy, h.syaw, cfg.max_window_xy_m, cfg.max_window_yaw_rad, 1, cfg.min_inlier_ratio);
+      if (!f.accepted || f.inlier_ratio < cfg.min_inlier_ratio) continue;
+      h.pose = f.est;
+      h.sxy = std::sqrt(std::max(f.cov(0, 0), f.cov(1, 1)));
+      h.syaw = std::sqrt(f.cov(2, 2));
+      ++h.hits;
+      h.inlier_sum += f.inlier_ratio;
+      h.last = f.inlier_ratio;
+      h.lowest = std::min(h.lowest, f.inlier_ratio);
+      kept.push_back(h);
+    }
+    hyps = std::move(kept);
+  }
+  // A refined search candidate becomes a new hypothesis when it fits (accepted, >= min_inlier_ratio) and no
+  // hypothesis is already there (within sep_xy and sep_yaw).
+  void add_hypothesis(const Fit& f, double sep_xy, double sep_yaw) {
+    if (!f.accepted || f.inlier_ratio < cfg.min_inlier_ratio) return;
+    for (const auto& h : hyps)
+      if (std::hypot(h.pose.x - f.est.x, h.pose.y - f.est.y) < sep_xy && std::abs(wrap_angle(h.pose.yaw - f.est.yaw)) < sep_yaw)
+        return;
+    Hypothesis h;
+    h.pose = f.est;
+    h.sxy = std::sqrt(std::max(f.cov(0, 0), f.cov(1, 1)));
+    h.syaw = std::sqrt(f.cov(2, 2));
+    h.hits = 1;
+    h.inlier_sum = f.inlier_ratio;
+    h.last = f.inlier_ratio;
+    h.lowest = f.inlier_ratio;
+    h.id = next_place_id++;
+    hyps.push_back(h);
+  }
+  // Global localization's scan: the hypotheses tracked, new ones from the whole-map search, and one taken when it
+  // dominates (GridLocalizerConfig::global_*); else LOST at the leading hypothesis.
+  GridResult global_step(const std::vector<Eigen::Vector2d>& pts, GridResult res);
+
   // On a laser step: the fit in the window the wheels' model would have grown since the last fit (the laser
   // steps' own window can be too small: a laser increment wrong by more than its sigma, or a pose the last fits
   // left further off than their covariance says). Only an unrivalled fit that explains almost the whole scan
@@ -141,6 +203,30 @@ struct GridLocalizer::Impl {
     cfg = c;
     calib = OdometryCalibration(c.calibration);
     laser = LaserOdometry(c.laser);
+    // The whole-map window without a free-space mask: the field's corners.
+    std::vector<Eigen::Vector2d> corners;
+    for (int j : {0, df->height() - 1})
+      for (int i : {0, df->width() - 1}) corners.push_back(cell_world(i, j));
+    set_global_window(corners);
+  }
+  Eigen::Vector2d cell_world(int i, int j) const {
+    const double lx = (i + 0.5) * df->resolution(), ly = (j + 0.5) * df->resolution();
+    const double c = std::cos(df->origin_yaw()), s = std::sin(df->origin_yaw());
+    return {df->origin_x() + c * lx - s * ly, df->origin_y() + s * lx + c * ly};
+  }
+  // The square window (the search's shape) covering these world points.
+  void set_global_window(const std::vector<Eigen::Vector2d>& p) {
+    if (p.empty()) return;
+    Eigen::Vector2d lo = p.front(), hi = p.front();
+    for (const auto& q : p) lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+    global_centre = {0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), 0};
+    global_half_m = 0.5 * std::max(hi.x() - lo.x(), hi.y() - lo.y()) + df->resolution();
+  }
+  bool position_free(double x, double y) const {
+    const Eigen::Vector2d c = df->to_cell({x, y});
+    const long i = std::lround(c.x()), j = std::lround(c.y());
+    if (i < 0 || j < 0 || i >= df->width() || j >= df->height()) return false;
+    return free_cells[size_t(j) * size_t(df->width()) + size_t(i)] != 0;
   }
 };
 
@@ -170,7 +256,38 @@ void GridLocalizer::set_initial_pose(const Pose2& pose) {
   impl_->reconfirming = false;  // the pose given is taken as it is
   impl_->recent_inliers.clear();
   impl_->first = true;
+  impl_->global = false;
+  impl_->hyps.clear();
   have_pose_ = true;
+}
+
+void GridLocalizer::set_free_space(const OccupancyGrid& g) {
+  Impl& m = *impl_;
+  const DistanceField& d = *m.df;
+  if (g.width != d.width() || g.height != d.height() || std::abs(g.resolution - d.resolution()) > 1e-9 ||
+      std::abs(g.origin_x - d.origin_x()) > 1e-9 || std::abs(g.origin_y - d.origin_y()) > 1e-9 ||
+      std::abs(g.origin_yaw - d.origin_yaw()) > 1e-9 || g.data.size() != size_t(g.width) * size_t(g.height))
+    throw std::invalid_argument("grid localizer: free space: " + (g.source.empty() ? std::string("the grid") : g.source) +
+                                " is not the grid of the distance field (size, resolution or origin differ)");
+  m.free_cells.assign(g.data.size(), 0);
+  std::vector<Eigen::Vector2d> corners;
+  int lo_i = g.width, lo_j = g.height, hi_i = -1, hi_j = -1;
+  for (int j = 0; j < g.height; ++j)
+    for (int i = 0; i < g.width; ++i)
+      if (g.at(i, j) >= 0 && !g.occupied(i, j)) {
+        m.free_cells[size_t(j) * size_t(g.width) + size_t(i)] = 1;
+        lo_i = std::min(lo_i, i), hi_i = std::max(hi_i, i), lo_j = std::min(lo_j, j), hi_j = std::max(hi_j, j);
+      }
+  if (hi_i < 0) throw std::invalid_argument("grid localizer: free space: " + (g.source.empty() ? std::string("the grid") : g.source) +
+                                            " has no known-free cell");
+  for (int j : {lo_j, hi_j})
+    for (int i : {lo_i, hi_i}) corners.push_back(m.cell_world(i, j));
+  m.set_global_window(corners);
+}
+
+void GridLocalizer::start_global() {
+  set_initial_pose(impl_->global_centre);
+  impl_->global = true;
 }
 
 std::vector<Eigen::Vector2d> scan_points(const std::vector<float>& ranges, double angle_min, double increment,
@@ -273,6 +390,88 @@ GridLocalizer::Impl::Fit GridLocalizer::Impl::fit(const std::vector<Eigen::Vecto
   // Covariance from the Jacobian at the solution (loss applied).
   f.cov = detail::covariance_of(*problem, Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal());
   return f;
+}
+
+GridResult GridLocalizer::Impl::global_step(const std::vector<Eigen::Vector2d>& pts, GridResult res) {
+  res.global = true;
+  res.search_xy_m = global_half_m;
+  res.search_yaw_rad = M_PI;
+  if (pts.size() >= 10) {
+    track_hypotheses(pts);
+    SearchWindow win;
+    win.center = global_centre;
+    win.xy_m = global_half_m;
+    win.yaw_rad = M_PI;
+    win.yaw_step_rad = cfg.search_yaw_step_rad;
+    win.prior_kappa = 0;  // no preference anywhere in the map
+    SearchOptions so;
+    so.keep = cfg.global_candidates;
+    so.sep_xy_m = cfg.global_sep_xy_m;
+    so.sep_yaw_rad = cfg.global_sep_yaw_rad;
+    so.min_ratio = cfg.candidate_ratio;
+    so.min_score = hypothesis_min_score();
+    if (!free_cells.empty()) so.position_ok = [this](double x, double y) { return position_free(x, y); };
+    SearchStats st;
+    const std::vector<SearchCandidate> cands = correlative_search(*df, *pyramid, search_points(pts), win, so, &st);
+    res.wide_search = true;
+    res.candidates = int(st.leaves);
+    res.score = cands.empty() ? 0 : cands.front().score;
+    for (const auto& c : cands) {
+      const double s0 = 2 * df->resolution(), y0 = 2 * cfg.search_yaw_step_rad;
+      add_hypothesis(fit(pts, c.pose, s0, y0, s0, y0, 1, cfg.min_inlier_ratio), so.sep_xy_m, so.sep_yaw_rad);
+    }
+  }
+  for (const auto& h : hyps) res.places.push_back({h.id, h.pose, h.hits, h.mean(), h.lowest, h.travel_m});
+  // The leader: enough scans, travel and mean inlier share; the best mean of those. It is taken only when every
+  // other hypothesis at another place has a mean lower by global_confirm_margin, whatever its number of scans.
+  int lead = -1;
+  for (size_t i = 0; i < hyps.size(); ++i) {
+    const Hypothesis& h = hyps[i];
+    if (h.hits >= cfg.confirm_scans && h.travel_m >= cfg.global_confirm_travel_m &&
+        h.mean() >= cfg.global_confirm_inlier_ratio && (lead < 0 || h.mean() > hyps[size_t(lead)].mean()))
+      lead = int(i);
+  }
+  if (lead >= 0) {
+    const Hypothesis& l = hyps[size_t(lead)];
+    for (size_t i = 0; i < hyps.size() && lead >= 0; ++i) {
+      const Hypothesis& h = hyps[i];
+      const bool elsewhere = std::hypot(h.pose.x - l.pose.x, h.pose.y - l.pose.y) > cfg.rival_sep_xy_m ||
+                             std::abs(wrap_angle(h.pose.yaw - l.pose.yaw)) > cfg.rival_sep_yaw_rad;
+      const bool close = h.mean() > l.mean() - cfg.global_confirm_margin ||
+                         1 - h.mean() < cfg.global_confirm_outlier_ratio * (1 - l.mean());
+      if (int(i) != lead && elsewhere && close) lead = -1;
+    }
+  }
+  if (lead >= 0) {
+    const Hypothesis h = hyps[size_t(lead)];
+    hyps.clear();
+    global = false;
+    pose = h.pose;
+    sxy = h.sxy;
+    syaw = h.syaw;
+    poor_run = 0;
+    search_moved_m = -1;
+    res.pose = h.pose;
+    res.status = GridStatus::kOk;
+    res.covariance = Eigen::Vector3d(h.sxy * h.sxy, h.sxy * h.sxy, h.syaw * h.syaw).asDiagonal();
+    res.inlier_ratio = h.last;
+    res.hypotheses = 0;
+    res.reacquired = true;
+    return res;
+  }
+  std::sort(hyps.begin(), hyps.end(), [](const auto& a, const auto& b) {
+    return a.hits != b.hits ? a.hits > b.hits : a.mean() > b.mean();
+  });
+  if (int(hyps.size()) > cfg.global_max_hypotheses) hyps.resize(size_t(std::max(0, cfg.global_max_hypotheses)));
+  // Not localized: LOST, at the leading hypothesis (else where the search is centred), with the whole map's spread.
+  if (!hyps.empty()) pose = hyps.front().pose;
+  ++poor_run;
+  res.pose = pose;
+  res.status = GridStatus::kLost;
+  res.inlier_ratio = hyps.empty() ? 0 : hyps.front().last;
+  res.hypotheses = int(hyps.size());
+  res.covariance = Eigen::Vector3d(global_half_m * global_half_m, global_half_m * global_half_m, M_PI * M_PI).asDiagonal();
+  return res;
 }
 
 GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points, const std::optional<Pose2>& odom) {
@@ -400,6 +599,11 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
   if (odom) m.last_odom = odom;
 
   res.num_points = int(pts.size());
+  // Global localization: from start_global, or a kidnapped robot (LOST for global_after_lost_scans scans).
+  if (!m.global && cfg_.reacquire && cfg_.global_after_lost_scans > 0 &&
+      m.poor_run >= cfg_.lost_after + cfg_.global_after_lost_scans)
+    m.global = true;
+  if (m.global) return m.global_step(pts, res);
   auto keep_prediction = [&]() {
     m.pose = pred;
     m.sxy = sxy;
@@ -465,19 +669,7 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
           (!cfg_.weak_follow_step_only || (one_step && unrivalled)))
         pred = f.est;
     }
-    std::vector<Impl::Hypothesis> kept;
-    for (auto& h : m.hyps) {
-      const Impl::Fit f = m.fit(pts, h.pose, h.sxy, h.syaw, cfg_.max_window_xy_m, cfg_.max_window_yaw_rad, 1,
-                                cfg_.min_inlier_ratio);
-      if (!f.accepted || f.inlier_ratio < cfg_.min_inlier_ratio) continue;
-      h.pose = f.est;
-      h.sxy = std::sqrt(std::max(f.cov(0, 0), f.cov(1, 1)));
-      h.syaw = std::sqrt(f.cov(2, 2));
-      ++h.hits;
-      h.inlier_sum += f.inlier_ratio;
-      kept.push_back(h);
-    }
-    m.hyps = std::move(kept);
+    m.track_hypotheses(pts);
     // POOR: +-window_sigmas sigma of the dead-reckoned pose; LOST: the whole re-acquisition window (a LOST
     // tracker's own uncertainty is no longer to be trusted: it may have been confirmed at a wrong place).
     const bool lost = m.poor_run >= cfg_.lost_after;
@@ -514,11 +706,8 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
       so.min_ratio = cfg_.candidate_ratio;
       // A pose with min_inlier_ratio of the points within inlier_m scores at least this much: nothing below it
       // can become a hypothesis (prunes most of a wide search where the map does not explain the scan).
-      so.min_score = cfg_.min_inlier_ratio *
-                     std::exp(-0.5 * (cfg_.inlier_m / cfg_.score_sigma_m) * (cfg_.inlier_m / cfg_.score_sigma_m));
-      const size_t sk = std::max<size_t>(1, pts.size() / 100);
-      std::vector<Eigen::Vector2d> sp;
-      for (size_t i = 0; i < pts.size(); i += sk) sp.push_back(pts[i]);
+      so.min_score = m.hypothesis_min_score();
+      const std::vector<Eigen::Vector2d> sp = Impl::search_points(pts);
       // A strong fit (>= reacquire_strong_ratio) within the dead-reckoned window (not yet LOST) that no other
       // candidate comes close to (confirm_margin) ends POOR at once: the map explains the scan almost
       // entirely there and nowhere else nearby (csail: a 30 deg odometry turn error beyond the tracking window).
@@ -535,19 +724,7 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
             runner_up = std::max(runner_up, f.inlier_ratio);
           }
         }
-        if (!f.accepted || f.inlier_ratio < cfg_.min_inlier_ratio) continue;
-        bool dup = false;
-        for (const auto& h : m.hyps)
-          dup = dup || (std::hypot(h.pose.x - f.est.x, h.pose.y - f.est.y) < so.sep_xy_m &&
-                        std::abs(wrap_angle(h.pose.yaw - f.est.yaw)) < so.sep_yaw_rad);
-        if (dup) continue;
-        Impl::Hypothesis h;
-        h.pose = f.est;
-        h.sxy = std::sqrt(std::max(f.cov(0, 0), f.cov(1, 1)));
-        h.syaw = std::sqrt(f.cov(2, 2));
-        h.hits = 1;
-        h.inlier_sum = f.inlier_ratio;
-        m.hyps.push_back(h);
+        m.add_hypothesis(f, so.sep_xy_m, so.sep_yaw_rad);
       }
       if (strong && strong->inlier_ratio >= cfg_.reacquire_strong_ratio &&
           runner_up < strong->inlier_ratio - cfg_.confirm_margin) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <functional>
 #include <iostream>
 #include <random>
@@ -714,4 +715,108 @@ TEST(FieldFit, RedescendingLossesPullLessTowardsUnmappedStructure) {
   EXPECT_GT(huber, 0.01);
   EXPECT_LT(cauchy, 0.6 * huber);
   EXPECT_LT(tukey, 0.1 * huber);
+}
+
+// Global localization (start_global: no start pose). On the irregular room the whole-map search proposes
+// several places, the odometry and each place's own fit keep only the right one, and it is taken: the first OK
+// pose is the truth's and no pose is published OK anywhere else. On a room with point symmetry (every pose has a
+// twin rotated 180 degrees about the centre that sees the same scan) no place can dominate: nothing is OK. The
+// control run (the rival rules off: global_confirm_margin -1, global_confirm_outlier_ratio 0) does publish OK there
+// (at whichever twin leads by chance): the symmetric case fails without the rules.
+namespace {
+
+// A 12 x 8 m room symmetric about its centre (5.5, 3.5): every cell drawn is drawn with its point mirror.
+OccupancyGrid make_symmetric_room() {
+  OccupancyGrid g = l2::test::blank_grid(300, 200);  // x -1 .. 14, y -1 .. 9: the centre is the cell corner (130, 90)
+  auto occ = [&](double x, double y) {
+    int i, j;
+    if (!l2::test::cell_of(g, x, y, &i, &j)) return;
+    g.data[size_t(j) * g.width + i] = 100;
+    g.data[size_t(179 - j) * g.width + size_t(259 - i)] = 100;
+  };
+  for (double t = -0.5; t <= 11.5; t += 0.02) occ(t, -0.5);
+  for (double t = -0.5; t <= 7.5; t += 0.02) occ(-0.5, t);
+  for (double t = 4.0; t <= 7.5; t += 0.02) occ(3.5, t);      // an inner wall from the top wall (and its mirror)
+  for (double t = 0.0; t <= 1.5; t += 0.02) occ(t, 5.0);      // an alcove on the left
+  for (double a = 0; a < 2 * M_PI; a += 0.05) occ(6.5 + 0.2 * std::cos(a), 5.0 + 0.2 * std::sin(a));  // a pillar
+  return g;
+}
+
+std::vector<Pose2> symmetric_room_path() {
+  std::vector<Pose2> t;
+  auto add_line = [&](Pose2 a, Pose2 b, int n) {
+    for (int k = 0; k < n; ++k) {
+      const double s = double(k) / n;
+      t.push_back({a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), a.yaw + s * fploc::wrap_angle(b.yaw - a.yaw)});
+    }
+  };
+  add_line({1, 1, 0}, {6, 1, 0}, 7);
+  add_line({6, 1, 0}, {6, 3.5, M_PI / 2}, 4);
+  add_line({6, 3.5, M_PI / 2}, {9, 3.5, 0}, 4);
+  add_line({9, 3.5, 0}, {10, 6, M_PI / 2}, 4);
+  add_line({10, 6, M_PI / 2}, {5, 6, M_PI}, 7);
+  return t;
+}
+
+struct GlobalRun {
+  int ok = 0, wrong_ok = 0, first_ok = -1;
+  double first_ok_err_m = 0, first_ok_err_deg = 0, last_err_m = 0;
+  int max_hypotheses = 0;
+};
+
+GlobalRun global_run(const OccupancyGrid& g, const std::vector<Pose2>& truth, l2::GridLocalizerConfig c) {
+  l2::GridLocalizer loc(std::make_shared<fploc::DistanceField>(g, 1.0), c);
+  loc.set_free_space(g);
+  loc.start_global();
+  const auto odo = odometry(truth);
+  std::mt19937 rng(5);
+  GlobalRun r;
+  for (size_t k = 0; k < truth.size(); ++k) {
+    const auto res = loc.update(cast(g, truth[k], rng), odo[k]);
+    const double e = std::hypot(res.pose.x - truth[k].x, res.pose.y - truth[k].y);
+    const double ey = std::abs(fploc::wrap_angle(res.pose.yaw - truth[k].yaw)) * 180 / M_PI;
+    r.max_hypotheses = std::max(r.max_hypotheses, res.hypotheses);
+    if (res.status != l2::GridStatus::kOk) {
+      EXPECT_TRUE(res.status == l2::GridStatus::kLost || res.status == l2::GridStatus::kPoor);
+      continue;
+    }
+    ++r.ok;
+    r.wrong_ok += e > 0.3;
+    if (r.first_ok < 0) r.first_ok = int(k), r.first_ok_err_m = e, r.first_ok_err_deg = ey;
+    r.last_err_m = e;
+  }
+  return r;
+}
+
+}  // namespace
+
+TEST(GridLocalizer, GlobalStartLocksOnAnAsymmetricRoom) {
+  const auto lap = trajectory();
+  const GlobalRun r = global_run(make_room(), lap, {});
+  std::cout << "first OK at scan " << r.first_ok << " (" << r.first_ok_err_m << " m, " << r.first_ok_err_deg
+            << " deg off), " << r.ok << " OK of " << lap.size() << ", at most " << r.max_hypotheses << " places\n";
+  ASSERT_GE(r.first_ok, 0) << "never locked";
+  EXPECT_LE(r.first_ok, 12);  // 5 scans and 1 m at least; the room tells its places apart within a few more
+  EXPECT_LT(r.first_ok_err_m, 0.3);
+  EXPECT_LT(r.first_ok_err_deg, 5.0);
+  EXPECT_EQ(r.wrong_ok, 0);
+  EXPECT_LT(r.last_err_m, 0.05);
+  EXPECT_GE(r.ok, int(lap.size()) - r.first_ok - 2);
+  EXPECT_GE(r.max_hypotheses, 2);  // it did have rivals to rule out
+}
+
+TEST(GridLocalizer, GlobalStartStaysLostOnASymmetricRoom) {
+  const OccupancyGrid g = make_symmetric_room();
+  const auto path = symmetric_room_path();
+  const GlobalRun r = global_run(g, path, {});
+  EXPECT_EQ(r.ok, 0) << "first OK at scan " << r.first_ok << ", " << r.first_ok_err_m << " m off";
+  EXPECT_GE(r.max_hypotheses, 2);
+  // Control: without the rival rule one of the twins is taken.
+  l2::GridLocalizerConfig weak;
+  weak.global_confirm_margin = -1;
+  weak.global_confirm_outlier_ratio = 0;
+  const GlobalRun w = global_run(g, path, weak);
+  std::cout << "symmetric room: " << r.ok << " OK (at most " << r.max_hypotheses << " places); control: first OK at scan "
+            << w.first_ok << ", " << w.first_ok_err_m << " m off, " << w.wrong_ok << " wrong OK of " << w.ok << "\n";
+  EXPECT_GT(w.ok, 0) << "the control never locked: the symmetric room does not test the rule";
 }

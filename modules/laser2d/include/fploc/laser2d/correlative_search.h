@@ -10,6 +10,7 @@
 #pragma once
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -61,6 +62,9 @@ struct SearchOptions {
   double sep_xy_m = 0.3, sep_yaw_rad = 10 * M_PI / 180;  // distinct: farther apart than either
   double min_ratio = 0.0;          // prune blocks whose bound < min_ratio * best (0: only the K-th best prunes)
   double min_score = 0.0;          // prune blocks whose bound < this (candidates below it are of no use)
+  // Where a candidate may stand (e.g. a known-free cell of the map, for a search over the whole map); empty: anywhere.
+  // Asked of each leaf that would be kept (its position in world coordinates).
+  std::function<bool(double x, double y)> position_ok;
 };
 
 struct SearchStats {

@@ -16,7 +16,8 @@
 //     next search window widens (recovery after a stretch the map does not explain); LOST after lost_after
 //     POOR scans in a row, until a scan matches again.
 // The first scan is searched over the initial pose's uncertainty (initial_sigma_*), e.g. a start 1 m / 10 deg
-// off. Transport-free: nodes/grid2d wraps it.
+// off; without a start pose (start_global) the whole map is searched and several places tracked until one
+// dominates (global_*). Transport-free: nodes/grid2d wraps it.
 #pragma once
 #include <Eigen/Core>
 #include <memory>
@@ -26,6 +27,7 @@
 
 #include "fploc/core/pose.h"
 #include "fploc/floorplan/distance_field.h"
+#include "fploc/floorplan/occupancy.h"
 #include "fploc/laser2d/laser_odometry.h"
 #include "fploc/laser2d/odometry_calibration.h"
 
@@ -224,9 +226,43 @@ struct GridLocalizerConfig {
   // off 7.4/7.2, 5.9/6.0, 5.9/5.9, 5.0/3.4, 8.8/7.1 with 3 false OK; 0.6: 6.1/6.1, 6.2/6.3, 5.9/5.9, 5.0/3.4,
   // 7.9/7.1, none; 0.7 and 0.8 none either (docs/notes/real2d.md, sixteenth pass). <= 0: off.
   double laser_conflict_inlier_ratio = 0.6;
+  // Global localization (start_global(): no start pose; and a kidnapped robot with global_after_lost_scans): every
+  // scan is searched over the whole map (every known-free cell of set_free_space()'s grid, every yaw; the same
+  // branch-and-bound search) for up to global_candidates distinct places; each that fits (>= min_inlier_ratio)
+  // becomes a hypothesis tracked as the re-acquisition's are (the odometry, laser or wheels, and its own local fit;
+  // dropped at its first failed fit). Nothing is published OK until one hypothesis dominates: it has matched
+  // confirm_scans scans in a row over at least global_confirm_travel_m of travel (odometry) with a mean inlier share
+  // of at least global_confirm_inlier_ratio, and every other hypothesis alive at another place (rival_sep_*) has a
+  // mean lower by global_confirm_margin, however few scans it has matched (a place proposed late in a symmetric
+  // building has not had the time to match as many). There is no dead-reckoned pose to gate on: a building whose
+  // places look alike stays LOST until the robot has seen what tells them apart.
+  int global_candidates = 8;
+  int global_max_hypotheses = 16;
+  double global_sep_xy_m = 0.3;  // the whole-map search's candidates are distinct when farther apart than this, or
+  double global_sep_yaw_rad = 10.0 * M_PI / 180;  // than this in yaw
+  double global_confirm_travel_m = 1.0;
+  double global_confirm_inlier_ratio = 0.8;
+  double global_confirm_margin = 0.1;
+  // ... and leaves at least global_confirm_outlier_ratio times the leader's unexplained share of the scan
+  // unexplained: a lead of 0.83 over 0.72 is no lead (aces: a corridor seen 180 degrees turned, the right place
+  // the one the map covers in part), one of 1.0 over 0.88 is (0 of the scan unexplained against 12 %).
+  // docs/notes/real2d.md, fortieth round. 0: off.
+  double global_confirm_outlier_ratio = 2.0;
+  // Kidnapped robot: after this many scans LOST (beyond lost_after), re-acquisition searches the whole map with the
+  // global rule above instead of the window around the dead-reckoned pose (needs set_free_space()). 0: never.
+  int global_after_lost_scans = 0;
 };
 
 enum class GridStatus { kOk = 0, kPoor = 1, kLost = 2, kNotInitialised = 3 };
+
+// A place global localization tracks (GridResult::places): its pose after this scan, the scans it has matched in a
+// row since it was proposed, their mean and lowest inlier share, and the odometry's travel since then.
+struct GridPlace {
+  int id = 0;
+  Pose2 pose;
+  int hits = 0;
+  double mean_inlier_ratio = 0, min_inlier_ratio = 0, travel_m = 0;
+};
 
 struct GridResult {
   Pose2 pose;
@@ -242,6 +278,8 @@ struct GridResult {
   int refined = 0;  // candidates refined
   int hypotheses = 0;      // re-acquisition hypotheses tracked after this scan (while LOST)
   bool reacquired = false;  // this scan ended LOST with a confirmed hypothesis
+  bool global = false;      // searching the whole map (start_global, or LOST for global_after_lost_scans): not OK
+  std::vector<GridPlace> places;  // while global: the places tracked after this scan (before one is taken)
   bool laser_step = false;  // the prediction came from the laser odometry (else the wheels)
   double laser_inlier_ratio = 0;  // the laser odometry's match (0 when it did not match)
   Pose2 laser_increment;          // its increment since the previous scan (on laser steps)
@@ -256,6 +294,12 @@ class GridLocalizer {
   ~GridLocalizer();
   // (Re)start: the next scan is searched around `pose` with the initial uncertainty.
   void set_initial_pose(const Pose2& pose);
+  // The map's known-free cells (a cell with a value that is not occupied), where a whole-map search may place
+  // the robot: the occupancy grid the distance field was built from (same size, resolution and origin; throws
+  // std::invalid_argument otherwise). Without it a whole-map search spans the field and places the robot anywhere.
+  void set_free_space(const OccupancyGrid& grid);
+  // (Re)start without a pose: global localization (the config's global_*): not OK until one place dominates.
+  void start_global();
   bool initialised() const { return have_pose_; }
   // points: the scan's returns in the robot frame; odom: the wheel odometry pose at the scan's time (any
   // frame; only increments are used).
