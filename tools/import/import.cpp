@@ -736,7 +736,9 @@ int main(int argc, char** argv) {
     }
     for (const auto& [t, s] : cloud_info)
       j["clouds"][t] = {{"mode", decode_ouster ? "scans" : "clouds"}, {"ring_source", s.ring_source}, {"time_source", s.time_source}, {"points", s.points}, {"kept", s.kept},
-                        {"collisions", s.collisions}, {"max_azimuth_error_deg", s.max_azimuth_error_deg}};
+                        {"collisions", s.collisions}, {"max_azimuth_error_deg", s.max_azimuth_error_deg},
+                        {"column_source", s.column_source}, {"zero_range", s.zero_range}, {"not_finite", s.not_finite},
+                        {"too_far", s.too_far}};
     for (const auto& lm : mounts) {
       nlohmann::json l = {{"frame", lm.frame}, {"channel", topic_channel.count(lm.topic) ? topic_channel[lm.topic] : ""},
                           {"mount_found", lm.found}};
@@ -771,10 +773,28 @@ int main(int argc, char** argv) {
       std::printf("  ouster: %s, %dx%d (%s), %llu lidar + %llu imu packets -> %zu frames\n", printable(ouster.info()->sensor_name()).c_str(),
                   ouster.info()->pixels_per_column, ouster.info()->columns_per_frame, os1::to_string(ouster.info()->profile),
                   (unsigned long long)ouster.lidar_packets, (unsigned long long)ouster.imu_packets, frames_total);
-    for (const auto& [t, s] : cloud_info)
-      std::printf("  cloud %s: rings from %s, times from %s, %llu/%llu points kept, %llu collisions%s\n", printable(t).c_str(), s.ring_source.c_str(),
-                  s.time_source.c_str(), (unsigned long long)s.kept, (unsigned long long)s.points, (unsigned long long)s.collisions,
-                  decode_ouster ? "" : " (first cloud)");
+    for (const auto& [t, s] : cloud_info) {
+      // What became of the points, in words: the range image holds one point per pixel (ring, column).
+      std::string lost;
+      auto add = [&](uint64_t n, const char* what) {
+        if (n) lost += (lost.empty() ? "" : ", ") + std::to_string(n) + " " + what;
+      };
+      add(s.zero_range, "without a return (range 0)");
+      add(s.not_finite, "with a NaN/inf coordinate");
+      add(s.too_far, "beyond 2000 m");
+      add(s.collisions, s.collisions == 1 ? "in a pixel another point holds (a collision: the nearer of the two kept)"
+                                          : "in a pixel another point holds (collisions: the nearer of two kept)");
+      std::printf("  cloud %s%s: rings from %s, columns from %s, times from %s; %llu/%llu points kept in the range image%s%s%s\n",
+                  printable(t).c_str(), decode_ouster ? "" : " (first cloud)", s.ring_source.c_str(),
+                  s.column_source == "organised" ? "the organised cloud's columns (one point per pixel)" : "the azimuths",
+                  s.time_source.c_str(), (unsigned long long)s.kept, (unsigned long long)s.points, lost.empty() ? "" : " (not kept: ",
+                  lost.c_str(), lost.empty() ? "" : ")");
+      if (s.collisions)
+        std::printf("          a collision loses the farther of two points that fall in one pixel: %.2f %% of the points here%s\n",
+                    100.0 * double(s.collisions) / double(std::max<uint64_t>(1, s.points)),
+                    s.collisions * 100 < s.points ? " (a few lost points: harmless for the localization)"
+                                                  : " (many: give --columns W, or --rings N, to match the sensor)");
+    }
     if (!decode_ouster && !cloud_info.empty())
       std::printf("  clouds written as they are (point_cloud2_t); the cloud-to-scan node converts them on replay\n"
                   "          (--set cloud_to_scan.rings=N / cloud_to_scan.columns=W there; --decode converts here)\n");
