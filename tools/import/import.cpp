@@ -1,5 +1,6 @@
 // fploc import RECORDING [--list] [--json] [--out LOG.lcm] [--topics T,...] [--start S] [--end S] ...
-// ROS 1 bags (2.0; none/bz2/lz4 chunks) and ROS 2 MCAP (none/zstd/lz4 chunks, CDR) -> an LCM log that
+// ROS 1 bags (2.0; none/bz2/lz4 chunks), ROS 2 MCAP (none/zstd/lz4 chunks, CDR) and ROS 2 rosbag2 sqlite3 bags (.db3
+// files or the bag folder, CDR) -> an LCM log that
 // fploc replay and lcm-logplayer play:
 //   ouster_ros/PacketMsg (+ the std_msgs/String metadata topic) -> the packets as they are: os1_packet_t on
 //       OS1_LIDAR_PACKETS / OS1_IMU_PACKETS, os1_metadata_t on OS1_METADATA, decoded on replay by the OS-1
@@ -158,13 +159,13 @@ bool survey_lasers(const std::string& path, const std::set<std::string>& wanted,
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"fploc import: ROS 1 bags and ROS 2 MCAP recordings -> LCM log (and a TUM trajectory)"};
+  CLI::App app{"fploc import: ROS 1 bags, ROS 2 MCAP and sqlite3 (.db3) recordings -> LCM log (and a TUM trajectory)"};
   std::string path, out, tum_out, tf_parent, tf_child, odom_topic, metadata_file;
   std::vector<std::string> topics, channels;
   bool list = false, json = false, quiet = false, decode_ouster = false;
   double start = -1, end = -1;
   CloudOptions cloud_opt;
-  app.add_option("recording", path, "ROS 1 bag (.bag) or MCAP (.mcap) file")->required();
+  app.add_option("recording", path, "ROS 1 bag (.bag), MCAP (.mcap), ROS 2 sqlite3 bag (.db3 file or rosbag2 bag folder)")->required();
   app.footer("Exit status: 0 everything imported; 1 the file is damaged or cut short, or Ouster lidar packets could not be\n"
              "written or have no usable metadata (the log holds everything before the damage); 2 bad arguments; 3 single messages did not decode\n"
              "and were skipped (the log holds all the others; stderr names each topic, the count and where the first is).");
