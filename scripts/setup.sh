@@ -10,6 +10,7 @@ PKGS=(
   libfreetype-dev fonts-dejavu-core   # text in PNG pictures (legends, scale bars: modules/floorplan/src/text.cpp)
   nlohmann-json3-dev libyaml-dev libpng-dev libcli11-dev libcpp-httplib-dev libssl-dev libpcap-dev libnanoflann-dev
   libbz2-dev liblz4-dev libzstd-dev zlib1g-dev libisal-dev lz4
+  libsqlite3-dev   # ROS 2 rosbag2 sqlite3 bags (.db3): modules/recording/src/db3_reader.cpp
   python3
   libboost-dev openssh-client openssh-server
   python3-ezdxf   # tests: `fploc map diff` DXF read back by a CAD library (ezdxf, strict read + audit)

@@ -1,5 +1,6 @@
 // fploc import RECORDING [--list] [--json] [--out LOG.lcm] [--topics T,...] [--start S] [--end S] ...
-// ROS 1 bags (2.0; none/bz2/lz4 chunks) and ROS 2 MCAP (none/zstd/lz4 chunks, CDR) -> an LCM log that
+// ROS 1 bags (2.0; none/bz2/lz4 chunks), ROS 2 MCAP (none/zstd/lz4 chunks, CDR) and ROS 2 rosbag2 sqlite3 bags (.db3
+// files or the bag folder, CDR) -> an LCM log that
 // fploc replay and lcm-logplayer play:
 //   ouster_ros/PacketMsg (+ the std_msgs/String metadata topic) -> the packets as they are: os1_packet_t on
 //       OS1_LIDAR_PACKETS / OS1_IMU_PACKETS, os1_metadata_t on OS1_METADATA, decoded on replay by the OS-1
@@ -158,13 +159,13 @@ bool survey_lasers(const std::string& path, const std::set<std::string>& wanted,
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"fploc import: ROS 1 bags and ROS 2 MCAP recordings -> LCM log (and a TUM trajectory)"};
+  CLI::App app{"fploc import: ROS 1 bags, ROS 2 MCAP and sqlite3 (.db3) recordings -> LCM log (and a TUM trajectory)"};
   std::string path, out, tum_out, tf_parent, tf_child, odom_topic, metadata_file;
   std::vector<std::string> topics, channels;
   bool list = false, json = false, quiet = false, decode_ouster = false;
   double start = -1, end = -1;
   CloudOptions cloud_opt;
-  app.add_option("recording", path, "ROS 1 bag (.bag) or MCAP (.mcap) file")->required();
+  app.add_option("recording", path, "ROS 1 bag (.bag), MCAP (.mcap), ROS 2 sqlite3 bag (.db3 file or rosbag2 bag folder)")->required();
   app.footer("Exit status: 0 everything imported; 1 the file is damaged or cut short, or Ouster lidar packets could not be\n"
              "written or have no usable metadata (the log holds everything before the damage); 2 bad arguments; 3 single messages did not decode\n"
              "and were skipped (the log holds all the others; stderr names each topic, the count and where the first is).");
@@ -736,7 +737,9 @@ int main(int argc, char** argv) {
     }
     for (const auto& [t, s] : cloud_info)
       j["clouds"][t] = {{"mode", decode_ouster ? "scans" : "clouds"}, {"ring_source", s.ring_source}, {"time_source", s.time_source}, {"points", s.points}, {"kept", s.kept},
-                        {"collisions", s.collisions}, {"max_azimuth_error_deg", s.max_azimuth_error_deg}};
+                        {"collisions", s.collisions}, {"max_azimuth_error_deg", s.max_azimuth_error_deg},
+                        {"column_source", s.column_source}, {"zero_range", s.zero_range}, {"not_finite", s.not_finite},
+                        {"too_far", s.too_far}};
     for (const auto& lm : mounts) {
       nlohmann::json l = {{"frame", lm.frame}, {"channel", topic_channel.count(lm.topic) ? topic_channel[lm.topic] : ""},
                           {"mount_found", lm.found}};
@@ -771,10 +774,28 @@ int main(int argc, char** argv) {
       std::printf("  ouster: %s, %dx%d (%s), %llu lidar + %llu imu packets -> %zu frames\n", printable(ouster.info()->sensor_name()).c_str(),
                   ouster.info()->pixels_per_column, ouster.info()->columns_per_frame, os1::to_string(ouster.info()->profile),
                   (unsigned long long)ouster.lidar_packets, (unsigned long long)ouster.imu_packets, frames_total);
-    for (const auto& [t, s] : cloud_info)
-      std::printf("  cloud %s: rings from %s, times from %s, %llu/%llu points kept, %llu collisions%s\n", printable(t).c_str(), s.ring_source.c_str(),
-                  s.time_source.c_str(), (unsigned long long)s.kept, (unsigned long long)s.points, (unsigned long long)s.collisions,
-                  decode_ouster ? "" : " (first cloud)");
+    for (const auto& [t, s] : cloud_info) {
+      // What became of the points, in words: the range image holds one point per pixel (ring, column).
+      std::string lost;
+      auto add = [&](uint64_t n, const char* what) {
+        if (n) lost += (lost.empty() ? "" : ", ") + std::to_string(n) + " " + what;
+      };
+      add(s.zero_range, "without a return (range 0)");
+      add(s.not_finite, "with a NaN/inf coordinate");
+      add(s.too_far, "beyond 2000 m");
+      add(s.collisions, s.collisions == 1 ? "in a pixel another point holds (a collision: the nearer of the two kept)"
+                                          : "in a pixel another point holds (collisions: the nearer of two kept)");
+      std::printf("  cloud %s%s: rings from %s, columns from %s, times from %s; %llu/%llu points kept in the range image%s%s%s\n",
+                  printable(t).c_str(), decode_ouster ? "" : " (first cloud)", s.ring_source.c_str(),
+                  s.column_source == "organised" ? "the organised cloud's columns (one point per pixel)" : "the azimuths",
+                  s.time_source.c_str(), (unsigned long long)s.kept, (unsigned long long)s.points, lost.empty() ? "" : " (not kept: ",
+                  lost.c_str(), lost.empty() ? "" : ")");
+      if (s.collisions)
+        std::printf("          a collision loses the farther of two points that fall in one pixel: %.2f %% of the points here%s\n",
+                    100.0 * double(s.collisions) / double(std::max<uint64_t>(1, s.points)),
+                    s.collisions * 100 < s.points ? " (a few lost points: harmless for the localization)"
+                                                  : " (many: give --columns W, or --rings N, to match the sensor)");
+    }
     if (!decode_ouster && !cloud_info.empty())
       std::printf("  clouds written as they are (point_cloud2_t); the cloud-to-scan node converts them on replay\n"
                   "          (--set cloud_to_scan.rings=N / cloud_to_scan.columns=W there; --decode converts here)\n");

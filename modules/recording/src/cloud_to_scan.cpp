@@ -106,6 +106,7 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
     float az, el, sn;  // azimuth, elevation (approximate: for clustering), sin(elevation) (exact)
     uint32_t r_mm;
     int ring;
+    uint32_t row, col;  // where it is in the cloud
     float inten;
     double t;
   };
@@ -126,9 +127,11 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
       const double r = std::sqrt(x * x + y * y + z * z);
       if (!std::isfinite(r) || r < 1e-3 || r > 2000.0) {
         ++s.no_return;
+        ++(!std::isfinite(r) ? s.not_finite : r < 1e-3 ? s.zero_range : s.too_far);
         continue;
       }
       P q;
+      q.row = row, q.col = k;
       q.az = fast_atan2(float(y), float(x));
       q.el = need_el ? fast_atan2(float(z), float(std::sqrt(x * x + y * y))) : 0.f;
       q.sn = float(z / r);
@@ -225,26 +228,79 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
   }
   W = std::clamp(W, 8, 16384);
 
+  // An organised cloud (one ring per row, W its width): each point's column in the cloud, shifted per ring by the
+  // rounded median of (azimuth column - cloud column), is its pixel, one point per pixel, when every point of the ring
+  // lies within a column of that shift. Binning by azimuth instead puts two neighbours of a ring whose azimuths
+  // straddle a column edge (a beam azimuth offset near half a column, a motion-compensated cloud) into one pixel.
+  const double col = 2.0 * M_PI / W;
+  auto az_col = [&](const P& q) {  // the point's column (not rounded) in the Ouster convention
+    const double a = q.az < 0 ? q.az + 2.0 * M_PI : q.az;
+    return (2.0 * M_PI - a) / col;
+  };
+  auto wrap = [&](double d) {  // into [-W/2, W/2)
+    d = std::fmod(d, double(W));
+    if (d < -0.5 * W) d += W;
+    if (d >= 0.5 * W) d -= W;
+    return d;
+  };
+  std::vector<int> shift(size_t(nrings), 0);
+  std::vector<double> ring_az_deg(size_t(nrings), 0.0);
+  bool organised = c.height > 1 && int(c.height) == nrings && W == int(c.width);
+  if (organised) {
+    std::vector<std::vector<double>> d(static_cast<size_t>(nrings));
+    std::vector<int64_t> row_of(size_t(nrings), -1);
+    for (size_t i = 0; i < pts.size() && organised; ++i) {
+      auto& r = row_of[size_t(ring_of[i])];
+      if (r < 0) r = pts[i].row;
+      organised = r == int64_t(pts[i].row);  // a ring spread over rows: not organised by ring
+      d[size_t(ring_of[i])].push_back(wrap(az_col(pts[i]) - pts[i].col));
+    }
+    std::vector<double> off(size_t(nrings), 0.0);
+    for (int u = 0; u < nrings && organised; ++u) {
+      auto& v = d[size_t(u)];
+      if (v.empty()) continue;
+      const double d0 = v[0];
+      for (auto& x : v) x = wrap(x - d0);
+      std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+      const double med = v[v.size() / 2];
+      double sum = 0, lo = 1e300, hi = -1e300;
+      for (double x : v) sum += x - med, lo = std::min(lo, x - med), hi = std::max(hi, x - med);
+      if (hi - lo > 2.0) organised = false;  // not within a column of one shift
+      const double mean = med + sum / double(v.size());
+      shift[size_t(u)] = int(std::lround(d0 + med));
+      off[size_t(u)] = wrap(d0 + mean - shift[size_t(u)]);  // the ring's mean offset from its pixels (columns)
+      ring_az_deg[size_t(u)] = off[size_t(u)] * col * 180.0 / M_PI;
+    }
+  }
+  s.column_source = organised ? "organised" : "azimuth";
+
   out.resize(nrings, W);
   out.column_utime.assign(size_t(W), INT64_MAX);
   out.beams = BeamIntrinsics{};
   out.beams.altitude_deg = alt;
-  out.beams.azimuth_deg.assign(size_t(nrings), 0.0);
+  out.beams.azimuth_deg = organised ? ring_az_deg : std::vector<double>(size_t(nrings), 0.0);
   out.beams.pixel_shift_by_row.assign(size_t(nrings), 0);
   out.beams.beam_offset_mm = 0.0;
   out.beams.lidar_to_sensor = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
   out.missing_columns = 0;
   out.status = ScanStatus::kOk;
   double t0 = 1e300, max_err = s.max_azimuth_error_deg;  // (a local: kept in a register)
-  const double col = 2.0 * M_PI / W;
   for (size_t i = 0; i < pts.size(); ++i) {
     const P& q = pts[i];
-    double a = q.az < 0 ? q.az + 2.0 * M_PI : q.az;
-    const double fv = (2.0 * M_PI - a) / col;
-    const int64_t fr = fv >= 0.0 && fv < 1e15 ? round_nonneg(fv) : std::llround(fv);
-    int v = int(fr % W);
-    if (v < 0) v += W;
-    max_err = std::max(max_err, std::abs(fv - double(fr)) * col * 180.0 / M_PI);
+    const double fv = az_col(q);
+    int v;
+    if (organised) {
+      const int u = ring_of[i];
+      v = int((int64_t(q.col) + shift[size_t(u)]) % W);
+      if (v < 0) v += W;
+      // Its azimuth against the pixel's in the model (the column's angle and the ring's beam azimuth).
+      max_err = std::max(max_err, std::abs(wrap(fv - v) - ring_az_deg[size_t(u)] / (col * 180.0 / M_PI)) * col * 180.0 / M_PI);
+    } else {
+      const int64_t fr = fv >= 0.0 && fv < 1e15 ? round_nonneg(fv) : std::llround(fv);
+      v = int(fr % W);
+      if (v < 0) v += W;
+      max_err = std::max(max_err, std::abs(fv - double(fr)) * col * 180.0 / M_PI);
+    }
     const size_t k = size_t(ring_of[i]) * W + v;
     if (out.range_mm[k] != 0) {
       ++s.collisions;

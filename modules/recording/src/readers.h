@@ -135,4 +135,12 @@ class McapReader : public FileReader {
   std::map<uint16_t, std::pair<std::string, std::string>> schemas_;  // id -> (name, encoding)
 };
 
+// rosbag2 sqlite3 (db3_reader.cpp): one .db3 in memory, .db3 files read in the given order, a bag folder.
+// nullptr with *err when the first file cannot be read (not SQLite, no topics/messages table, damaged schema).
+std::unique_ptr<Recording> open_db3_memory(const uint8_t* data, size_t size, const std::string& name, std::string* err);
+std::unique_ptr<Recording> open_db3_files(const std::vector<std::string>& files, const std::string& name, std::string* err);
+std::unique_ptr<Recording> open_bag_folder(const std::string& dir, std::string* err, size_t read_bytes);
+bool is_zstd_file(const uint8_t* d, size_t n);
+std::string zstd_file_error(const std::string& name);
+
 }  // namespace fploc::rec

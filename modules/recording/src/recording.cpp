@@ -79,7 +79,9 @@ void FileBytes::read_ahead(size_t pos) {
 }
 
 namespace {
-std::unique_ptr<Recording> by_magic(std::unique_ptr<FileBytes> f, const std::string& name, std::string* err) {
+// path: the file (empty: the bytes are the caller's memory).
+std::unique_ptr<Recording> by_magic(std::unique_ptr<FileBytes> f, const std::string& name, std::string* err,
+                                    const std::string& path = "") {
   const uint8_t* d = f->data();
   const size_t n = f->size();
   if (n == 0) {
@@ -103,15 +105,23 @@ std::unique_ptr<Recording> by_magic(std::unique_ptr<FileBytes> f, const std::str
     }
     return std::make_unique<BagReader>(std::move(f), name);
   }
-  *err = name + ": neither a ROS 1 bag (#ROSBAG V2.0) nor an MCAP file";
+  if (n >= 16 && std::memcmp(d, "SQLite format 3", 16) == 0)  // (the 16th byte is the NUL)
+    return path.empty() ? open_db3_memory(d, n, name, err) : open_db3_files({path}, name, err);
+  if (is_zstd_file(d, n)) {
+    *err = zstd_file_error(name);
+    return nullptr;
+  }
+  *err = name + ": neither a ROS 1 bag (#ROSBAG V2.0), an MCAP file nor a ROS 2 rosbag2 sqlite3 file (.db3)";
   return nullptr;
 }
 }  // namespace
 
 std::unique_ptr<Recording> open_recording(const std::string& path, std::string* err, size_t read_bytes) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) return open_bag_folder(path, err, read_bytes);
   auto f = std::make_unique<FileBytes>();
   if (!f->map(path, err, read_bytes)) return nullptr;
-  return by_magic(std::move(f), path, err);
+  return by_magic(std::move(f), path, err, path);
 }
 
 std::unique_ptr<Recording> open_recording_memory(const uint8_t* data, size_t size, const std::string& name,

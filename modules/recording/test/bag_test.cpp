@@ -348,5 +348,5 @@ TEST(Bag, NotABag) {
   // A directory given as the recording: said so (it was "mmap: No such device").
   const std::string dir = ::testing::TempDir();
   EXPECT_FALSE(open_recording(dir, &err));
-  EXPECT_EQ(err, dir + ": is a directory");
+  EXPECT_EQ(err.rfind(dir + ": is a directory", 0), 0u) << err;
 }

@@ -2,7 +2,9 @@
 // Rows are rings sorted top beam first, with the ring's mean elevation as beam altitude; columns are
 // azimuth bins in the Ouster convention (measurement id v at encoder angle 2*pi*(1 - v/W)), so the
 // existing XYZ model (azimuth 0, beam offset 0, identity lidar_to_sensor) gives each point back to
-// within half a column in azimuth. Recognised fields (Ouster, Velodyne, Hesai, Robosense, Livox drivers):
+// within half a column in azimuth. An organised cloud (height = rings) whose rows each keep their column to within a
+// column of a fixed shift maps one point to one pixel: its columns are taken, the ring's mean azimuth offset from
+// them is the ring's beam azimuth (no collision where its azimuths straddle a column edge). Recognised fields (Ouster, Velodyne, Hesai, Robosense, Livox drivers):
 //   x y z (FLOAT32/64), intensity|reflectivity|signal, ring|channel|line (ring index),
 //   t (UINT32 ns from the header stamp: Ouster), time (FLOAT32 s from the stamp: Velodyne),
 //   timestamp (FLOAT64: absolute s for Hesai/Robosense, absolute ns when > 1e15 for Livox),
@@ -25,10 +27,18 @@ struct CloudOptions {
 };
 
 struct CloudStats {
+  // points = kept + no_return + collisions. no_return = zero_range + not_finite + too_far: points without a return
+  // (the driver's x = y = z = 0, range < 1 mm), with a NaN/inf coordinate, or beyond 2000 m. A collision is a point
+  // whose pixel of the range image (ring, column) another point already holds: the nearer of the two is kept.
   uint64_t points = 0, kept = 0, no_return = 0, collisions = 0;
+  uint64_t zero_range = 0, not_finite = 0, too_far = 0;
   std::string ring_source;     // "field 'ring'" or "elevation"
+  // "organised" (an organised cloud, one ring per row: each point's column in the cloud is its column in the image,
+  // shifted per ring; the ring's mean azimuth offset from its column becomes its beam azimuth) or "azimuth" (the
+  // column from the point's azimuth).
+  std::string column_source;
   std::string time_source;     // "field 't'" ... or "header stamp"
-  double max_azimuth_error_deg = 0;  // worst |point azimuth - its column's azimuth|
+  double max_azimuth_error_deg = 0;  // worst |point azimuth - its pixel's azimuth in the scan's beam model|
 };
 
 // Returns false with *err on a cloud it cannot turn into a range image (no x/y/z, bad sizes, ...).

@@ -1,4 +1,4 @@
-// ROS recordings (ROS 1 bag format 2.0, ROS 2 MCAP) read as one stream of raw messages in file order.
+// ROS recordings (ROS 1 bag format 2.0, ROS 2 MCAP, ROS 2 rosbag2 sqlite3 .db3) read as one stream of raw messages in file order.
 // No transport, no ROS: a Connection says what a topic carries (type, encoding), a RawMessage points at
 // its serialized bytes. Readers never throw on bad input: the first problem stops the stream with ONE
 // error naming the file, the byte offset and the record; everything delivered before it stays valid.
@@ -31,10 +31,12 @@ struct RawMessage {
   bool in_chunk = false;
   uint64_t chunk_at = 0;
   uint64_t offset = 0;
+  bool row = false;  // a rosbag2 .db3's message: offset is its id in the messages table
 };
 
-// "byte N" or "chunk at byte N, record at chunk offset K".
+// "byte N", "chunk at byte N, record at chunk offset K" or (.db3) "message id N".
 inline std::string where(const RawMessage& m) {
+  if (m.row) return "message id " + std::to_string(m.offset);
   return m.in_chunk ? "chunk at byte " + std::to_string(m.chunk_at) + ", record at chunk offset " + std::to_string(m.offset)
                     : "byte " + std::to_string(m.offset);
 }
@@ -55,7 +57,7 @@ class Recording {
   // Bytes of the file consumed so far (progress), and its size.
   virtual uint64_t position() const = 0;
   uint64_t size() const { return size_; }
-  const std::string& format() const { return format_; }  // "bag 2.0" or "mcap"
+  const std::string& format() const { return format_; }  // "bag 2.0", "mcap" or "rosbag2 sqlite3"
   // True when [p, p + n) lies in the recording's mapped (or borrowed) bytes, which stay valid and
   // unchanged until the Recording is destroyed: not a decompressed copy, and not the bytes of a file's
   // sequential reads (FileBytes::seq(), reused), which is where a file's records are read from.
@@ -113,7 +115,8 @@ class FileBytes {
   std::unique_ptr<ReadWindow> window_;  // set when the file is mapped
 };
 
-// Opens a bag or an MCAP file by its magic bytes. Returns nullptr with *err set when the file cannot be
+// Opens a bag, an MCAP file or a rosbag2 .db3 (SQLite) file by its magic bytes, or a rosbag2 bag folder
+// (metadata.yaml + NAME_N.db3 files, read one after the other; a folder of one .mcap opens that file). Returns nullptr with *err set when the file cannot be
 // read or is neither; a reader is returned even when its stream ends early (its error() says why).
 // read_bytes: FileBytes::map's (0: the default).
 std::unique_ptr<Recording> open_recording(const std::string& path, std::string* err, size_t read_bytes = 0);
