@@ -38,6 +38,7 @@ feat::FeatureConfig config_of(const FeatureOptions& o) {
   if (given(o.high_band_m(), "features", "high_band_m")) c.high_band_m = o.high_band_m();
   if (given(o.high_min_points(), "features", "high_min_points")) c.high_min_points = o.high_min_points();
   if (given(o.high_same_surface_m(), "features", "high_same_surface_m")) c.high_same_surface_m = o.high_same_surface_m();
+  c.high_keep_unseen = o.high_keep_unseen();
   return c;
 }
 

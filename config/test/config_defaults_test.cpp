@@ -150,7 +150,8 @@ TEST(ConfigDefaults, Perception) {
          {"surface_threshold", f.surface_threshold}, {"max_range_m", f.max_range_m}, {"min_range_m", f.min_range_m},
          {"half_window", f.half_window}, {"min_group_points", f.min_group_points}, {"line_max_rms_m", f.line_max_rms_m},
          {"column_front_m", f.column_front_m}, {"high_band_m", f.high_band_m}, {"high_min_points", f.high_min_points},
-         {"high_same_surface_m", f.high_same_surface_m}});
+         {"high_same_surface_m", f.high_same_surface_m},
+         {"high_keep_unseen", f.high_keep_unseen}});
 }
 
 TEST(ConfigDefaults, Relocalizer) {

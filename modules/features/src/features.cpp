@@ -153,12 +153,17 @@ FeatureStatus FeatureExtractor::extract(const seg::Segmentation& seg) {
     }
     if (high < cfg_.high_min_points) {
       low_.clear();
-    } else if (same > 0) {
+    } else if (same > 0 || cfg_.high_keep_unseen) {
       for (size_t i = 0; i < n; ++i) {
         if (!low_[i] || w.column[i] < 0) continue;
+        const float h = near_high_[size_t(w.column[i])];
+        if (h == kInf) {
+          if (cfg_.high_keep_unseen) low_[i] = 0;
+          continue;
+        }
         const Eigen::Vector3f q = R_ * Eigen::Vector3f(w.x[i], w.y[i], w.z[i]);
         const float r = std::sqrt(q.x() * q.x() + q.y() * q.y());
-        if (std::abs(r - near_high_[size_t(w.column[i])]) <= same) low_[i] = 0;
+        if (std::abs(r - h) <= same) low_[i] = 0;
       }
     }
   }

@@ -335,6 +335,9 @@ TEST(Features, ReferenceEqualWithOtherOptionsAndBeamCounts) {
   expect_same(s, cfg([](FeatureConfig& c) { c.high_band_m = 2.2; }), "high band");
   expect_same(s, cfg([](FeatureConfig& c) { c.high_band_m = 2.2; c.high_same_surface_m = 0.15; }), "high band, same surface");
   expect_same(s, cfg([](FeatureConfig& c) { c.high_band_m = 1.0; c.high_min_points = 1 << 30; }), "high band, too few");
+  expect_same(s, cfg([](FeatureConfig& c) { c.high_band_m = 2.2; c.high_same_surface_m = 0.15; c.high_keep_unseen = true; }),
+              "high band, same surface, unseen kept");
+  expect_same(s, cfg([](FeatureConfig& c) { c.high_band_m = 2.0; c.high_keep_unseen = true; }), "high band, unseen kept");
 }
 
 // Hand-made rings: ties, gaps, occlusion steps at the ring ends, NaN and zero ranges, rings shorter than the
@@ -504,4 +507,44 @@ TEST(Features, ALowPointOffTheHighSurfaceOfItsColumnIsNoFeature) {
   FeatureConfig few = same;
   few.high_min_points = 1 << 30;
   EXPECT_EQ(count(few).all, off.all);
+}
+
+// Per column: a low point whose column holds no high point at all (a wall within ~3 m of a 1.2 m sensor: its upper
+// part is above the top beam) stays with high_keep_unseen; the cabinet face, with the wall standing high behind it,
+// still goes.
+TEST(Features, ALowPointWhoseColumnHoldsNoHighPointStaysWithKeepUnseen) {
+  synth::Room room;
+  room.boxes.push_back({{7.55, -2.0, 0.0}, {8.0, 2.0, 2.0}, synth::kClutter});
+  const synth::SensorPose pose{2.0, 4.0, 1.2, 0.5 * kDeg, -0.5 * kDeg, 0.1};
+  const auto s = synth::render(room, pose, synth::os1_like_beams(), 1024, 0.005, 0.01, 37);
+  seg::RingSegmenter sg(seg::SegmenterConfig{});
+  const auto seg = sg.process(s.scan);
+  ASSERT_EQ(seg.status, seg::SegStatus::kOk);
+  ASSERT_LT(seg.z_sigma, kZUnknownFromSigmaM);
+  ASSERT_NEAR(seg.z, 1.2, 0.05);
+  struct Count { int near = 0, face = 0, all = 0; };
+  auto count = [&](const FeatureConfig& cfg) {
+    FeatureExtractor fx(cfg);
+    const FeatureFrame& f = fx.process(seg);
+    Count n;
+    const double c = std::cos(pose.yaw), sn = std::sin(pose.yaw);
+    for (const auto& p : f.points) {
+      const double wx = c * p.p.x() - sn * p.p.y() + pose.x, wy = sn * p.p.x() + c * p.p.y() + pose.y;
+      ++n.all;
+      n.near += std::abs(wy - 6.0) < 0.1 && std::hypot(wx - pose.x, wy - pose.y) < 3.0;  // the wall 2 m away
+      n.face += std::abs(wx - 7.55) < 0.1 && std::abs(wy) < 1.9;
+    }
+    return n;
+  };
+  FeatureConfig same, keep;
+  same.high_band_m = keep.high_band_m = 2.2;
+  same.high_same_surface_m = keep.high_same_surface_m = 0.15;
+  keep.high_keep_unseen = true;
+  const Count off = count(FeatureConfig{}), sm = count(same), kp = count(keep);
+  EXPECT_GT(off.near, 40);
+  EXPECT_GT(off.face, 20);
+  EXPECT_EQ(sm.near, 0);                 // no high point behind it, yet dropped without high_keep_unseen
+  EXPECT_GE(kp.near, off.near * 9 / 10);  // kept with it
+  EXPECT_EQ(kp.face, 0);                  // the face still goes: the wall stands high behind it
+  EXPECT_GT(kp.all, sm.all);
 }

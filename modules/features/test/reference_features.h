@@ -105,6 +105,7 @@ inline Result extract(const seg::Segmentation& seg, const FeatureConfig& cfg = {
       for (size_t i = 0; i < N; ++i) {
         if (height(i) >= band) continue;
         const auto it = nearest.find(w.column[i]);
+        if (w.column[i] >= 0 && it == nearest.end() && cfg.high_keep_unseen) continue;  // no high point: kept
         low[i] = !(cfg.high_same_surface_m > 0 && w.column[i] >= 0 && it != nearest.end() &&
                    std::abs(level_range(i) - it->second) <= float(cfg.high_same_surface_m));
       }

@@ -40,12 +40,15 @@ struct FeatureConfig {
   // lies on a floor-to-ceiling wall or partition; a point below it may lie on anything. When a frame has at least
   // high_min_points such high wall points (and its z is known), a low point is no feature unless its column holds a
   // high point within high_same_surface_m of its levelled horizontal range (the same vertical surface); with
-  // high_same_surface_m = 0 no low point is. 0 = off (the default: at 2.2 m, same surface 0.15 m, the shelved corridors
+  // high_same_surface_m = 0 no low point is. With high_keep_unseen a low point whose column holds no high point at all
+  // (a wall within ~3 m, whose upper part is above the beams) stays too: only high evidence against a point removes
+  // it. 0 = off (the default: at 2.2 m, same surface 0.15 m, the shelved corridors
   // 4.7 / 11.8 / 18.9 -> 0.7 / 0.9 / 0.7 cm, but corridor s1 mixed 3 false-OK poses; with high_min_points 500 none, but
   // LOST on s3 renovated and the crowd's POOR x3; docs/notes/realism.md, fortieth round).
   double high_band_m = 0;
   int high_min_points = 200;
   double high_same_surface_m = 0;
+  bool high_keep_unseen = false;
   // PCA line groups.
   int min_group_points = 4;
   double line_max_rms_m = 0.03;     // sqrt(smallest eigenvalue) of the group's 2D covariance
