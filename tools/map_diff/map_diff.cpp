@@ -6,7 +6,7 @@
 // the graph's plan_diff node (or, without one, the plan of its matcher); --plan FILE [--floor NAME] names the plan
 // instead. The first line on stderr says which plan and where it came from; a matcher / optimizer of the graph with
 // another plan, and a run in which no plan element was seen, are warned about (the wrong plan, most likely).
-// Writes JSON and/or DXF (layers FPLOC-MISSING, FPLOC-MOVED, FPLOC-NEW, FPLOC-PLAN) by the --out extension; --json
+// Writes JSON and/or DXF (layers FPLOC-MISSING, FPLOC-MOVED, FPLOC-NEW, FPLOC-LOW, FPLOC-PLAN) by the --out extension; --json
 // prints the JSON diff on stdout; --all lists every element (also those seen where expected); --set
 // NODE.field=value as for fploc replay (the plan_diff node's options: plan_diff.plan.file=PLAN, ...). The summary
 // on stderr: counts (with missing parts), the drawing scale, then one line per missing / moved element, missing
@@ -273,7 +273,7 @@ int main(int argc, char** argv) {
     if (po.new_min_height_m > 0 && n_seg == 0)
       preface << "fploc map diff: " << log_path << " has no " << seg_ch << " (segments_t): the heights of new structure "
               << "were not checked (a new run may be furniture); record them too (`fploc replay ... --record LOG.lcm "
-              << "--record-channels '^FPLOC_'`: the default leaves FPLOC_SEGMENTS out)\n";
+              << "--record-channels 'FPLOC_.*'`: the default leaves FPLOC_SEGMENTS out)\n";
     std::cerr << preface.str();
     const auto r = diff.result();
     for (const auto& o : outs) {

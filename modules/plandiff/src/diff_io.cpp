@@ -130,7 +130,7 @@ void write_text(const Diff& d, const FloorPlan& plan, std::ostream& out) {
     o << "  low structure (not a wall): " << std::setprecision(2) << n.length() << " m, " << xy(n.a) << "-" << xy(n.b)
       << ", top " << n.top_m << " m\n";
   if (d.height_frames == 0 && !d.added.empty())
-    o << "  (heights not checked: no 3D wall points (FPLOC_SEGMENTS) came with the scans; a new run may be furniture)\n";
+    o << "  (heights not checked: no 3D wall points (FPLOC_SEGMENTS) came with the scans, or the check is off; a new run may be furniture)\n";
   out << o.str();
 }
 
