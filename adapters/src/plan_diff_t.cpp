@@ -1,10 +1,29 @@
 #include "fploc/adapters/plan_diff_t.h"
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
 namespace fploc::adapters {
+
+plandiff::PlanDiff::Heights heights_of(const segments_t& m) {
+  plandiff::PlanDiff::Heights h;
+  h.sensor_z = m.z;
+  const size_t n = size_t(std::max(0, m.num_points));
+  if (m.status != 0 || !std::isfinite(m.roll) || !std::isfinite(m.pitch) || !std::isfinite(m.z) ||
+      m.x.size() < n || m.y.size() < n || m.z_pts.size() < n)
+    return h;
+  const Eigen::Matrix3f R = (Eigen::AngleAxisf(float(m.pitch), Eigen::Vector3f::UnitY()) *
+                             Eigen::AngleAxisf(float(m.roll), Eigen::Vector3f::UnitX()))
+                                .toRotationMatrix();
+  h.points.reserve(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3f p(m.x[i], m.y[i], m.z_pts[i]);
+    if (p.allFinite()) h.points.push_back(R * p);
+  }
+  return h;
+}
 
 plan_diff_t to_msg(const plandiff::Diff& r, const FloorPlan& plan, int64_t utime, int64_t seq) {
   using plandiff::Status;
@@ -43,6 +62,7 @@ plan_diff_t to_msg(const plandiff::Diff& r, const FloorPlan& plan, int64_t utime
     }
   }
   for (const auto& n : r.added) item(PlanDiffKind::kNew, n.extends, false, n.a.x(), n.a.y(), n.b.x(), n.b.y(), n.rms_m, 0);
+  for (const auto& n : r.low) item(PlanDiffKind::kLow, n.extends, false, n.a.x(), n.a.y(), n.b.x(), n.b.y(), n.top_m, 0);
   for (const auto& m : r.missing_parts)
     item(PlanDiffKind::kMissingPart, m.element, false, m.a.x(), m.a.y(), m.b.x(), m.b.y(), 0,
          m.expected ? double(m.seen) / double(m.expected) : 0.0);

@@ -7,12 +7,12 @@
 namespace fploc::dashboard {
 
 std::string plan_diff_json(const fploc::plan_diff_t& m) {
-  static const char* kinds[] = {"?", "missing", "moved", "new", "missing"};  // 4: a missing part
+  static const char* kinds[] = {"?", "missing", "moved", "new", "missing", "low"};  // 4: a missing part; 5: low structure
   auto r4 = [](double v) { return std::isfinite(v) ? std::round(v * 1e4) / 1e4 : 0.0; };
   nlohmann::json items = nlohmann::json::array();
   for (int i = 0; i < m.num_items; ++i) {
     const int k = m.kind[size_t(i)];
-    items.push_back({{"kind", kinds[k >= 1 && k <= 4 ? k : 0]},
+    items.push_back({{"kind", kinds[k >= 1 && k <= 5 ? k : 0]},
                      {"element", m.element[size_t(i)]},
                      {"circle", bool(m.circle[size_t(i)])},
                      {"x0", r4(m.x0[size_t(i)])},

@@ -3,9 +3,13 @@
 // shipped graphs) and fed to modules/plandiff; the flagged elements and the new structure found so far are
 // published on FPLOC_PLAN_DIFF (plan_diff_t) at publish_hz of sensor time, so a composed replay is
 // deterministic. With out_json / out_dxf set, the final diff is written at shutdown.
+// Optional input `segments` (FPLOC_SEGMENTS, unconnected by default): the segmenter's 3D wall points of the same scan
+// (utime), which tell a new wall from furniture (plandiff::Options::new_min_height_m); without it new runs are not
+// told by height.
 #include <fploc/features_t.hpp>
 #include <fploc/plan_diff_t.hpp>
 #include <fploc/pose_t.hpp>
+#include <fploc/segments_t.hpp>
 
 #include <cmath>
 #include <deque>
@@ -33,6 +37,7 @@ class PlanDiffNode : public fploc::rt::Node {
             "plan-change detection: missing / moved plan elements and new structure -> FPLOC_PLAN_DIFF",
             {fploc::rt::input<fploc::features_t>("features", "FPLOC_FEATURES"),
              fploc::rt::input<fploc::pose_t>("pose", "FPLOC_POSE_LATEST"),
+             fploc::rt::input<fploc::segments_t>("segments", ""),
              fploc::rt::output<fploc::plan_diff_t>("diff", "FPLOC_PLAN_DIFF")}};
   }
 
@@ -54,6 +59,11 @@ class PlanDiffNode : public fploc::rt::Node {
       features_.push_back(fploc::adapters::from_msg(m));
       while (features_.size() > 30) features_.pop_front();
     });
+    if (!ctx.channel("segments").empty())
+      ctx.subscribe<fploc::segments_t>("segments", [this](const fploc::segments_t& m) {
+        heights_.emplace_back(m.utime, fploc::adapters::heights_of(m));
+        while (heights_.size() > 30) heights_.pop_front();
+      });
     ctx.subscribe<fploc::pose_t>("pose", [this](const fploc::pose_t& m) { on_pose(m); });
   }
 
@@ -87,7 +97,10 @@ class PlanDiffNode : public fploc::rt::Node {
     pts.reserve(f->points.size());
     for (const auto& p : f->points) pts.emplace_back(float(p.p.x()), float(p.p.y()));
     const Eigen::Matrix3d cov = fploc::adapters::xy_yaw_covariance(m);
-    diff_->add_frame(x.x, x.y, x.yaw, pts, &cov, m.status == 0);  // POOR: scale only, no change evidence
+    const fploc::plandiff::PlanDiff::Heights* h = nullptr;
+    for (const auto& [t, hh] : heights_)
+      if (t == m.utime) h = &hh;
+    diff_->add_frame(x.x, x.y, x.yaw, pts, &cov, m.status == 0, h);  // POOR: scale only, no change evidence
     if (last_publish_ == 0 || m.utime - last_publish_ >= publish_us_) {
       last_publish_ = m.utime;
       publish(m.utime);
@@ -100,6 +113,7 @@ class PlanDiffNode : public fploc::rt::Node {
   fploc::FloorPlan plan_;
   std::unique_ptr<fploc::plandiff::PlanDiff> diff_;
   std::deque<fploc::FeatureFrame> features_;
+  std::deque<std::pair<int64_t, fploc::plandiff::PlanDiff::Heights>> heights_;
   fploc::rt::Publisher<fploc::plan_diff_t> out_;
   int64_t publish_us_ = 1000000, frame_us_ = 0, last_publish_ = 0, last_frame_ = 0, seq_ = 0;
   std::string out_json_, out_dxf_;

@@ -516,6 +516,8 @@ class Bench:
             main_sets += [f"{n}.{k}" for n in ("matcher", "optimizer") for k in ("plan_diff_weight=1", "plan_diff_scale=true")]
             main_sets += [f"plan_diff.frame_hz={self.a.scale_frame_hz}"]
         cmd = [os.path.join(BIN, "fploc-replay"), "--graph", graph, "--log", logf, "--record", rec, "--json"]
+        if self.a.diff_heights:  # the segmenter's 3D points too: the diff tells new walls from furniture by height
+            cmd += ["--record-channels", "FPLOC_.*"]
         for s in main_sets:
             cmd += ["--set", s]
         log(f"[{fam}] replaying fploc + AMCL + plan diff ...")
@@ -757,6 +759,9 @@ def main():
                     help="fploc and fploc+downweight without the online drawing-scale correction (plan_diff_scale)")
     ap.add_argument("--scale-frame-hz", type=float, default=2.0,
                     help="scans per second the live plan diff of the fploc row uses for its scale estimate (2)")
+    ap.add_argument("--diff-heights", action="store_true",
+                    help="record FPLOC_SEGMENTS with the fploc run (~0.5 MB per scan) so the plan diff checks the height "
+                         "of new structure (plan_diff.new_min_height_m); without it new runs are not told by height")
     ap.add_argument("--diff-truth-poses", action="store_true",
                     help="also run the change detector with the ground-truth poses (detection[].truth_poses)")
     a = ap.parse_args()

@@ -44,7 +44,7 @@ void colour(uint32_t id, uint8_t rgb[3]) {
 }
 
 // A plan element's line colour: the plan-change layers of `fploc map diff` (FPLOC-MISSING red, FPLOC-MOVED orange,
-// FPLOC-NEW green), every other layer black.
+// FPLOC-NEW green, FPLOC-LOW cyan: low structure, not a wall), every other layer black.
 struct LayerStyle {
   const char* prefix;
   const char* svg;
@@ -53,7 +53,8 @@ struct LayerStyle {
 };
 const LayerStyle kDiffLayers[] = {{"FPLOC-MISSING", "#d62728", {214, 39, 40}, "in the plan, not seen"},
                                   {"FPLOC-MOVED", "#ff7f0e", {255, 127, 14}, "seen offset"},
-                                  {"FPLOC-NEW", "#2ca02c", {44, 160, 44}, "seen, not in the plan"}};
+                                  {"FPLOC-NEW", "#2ca02c", {44, 160, 44}, "seen, not in the plan"},
+                                  {"FPLOC-LOW", "#17becf", {23, 190, 207}, "seen only low (furniture), not a wall"}};
 const LayerStyle* style_of(const FloorPlan& plan, const Element& e) {
   if (e.layer < 0 || e.layer >= int(plan.layers.size())) return nullptr;
   for (const auto& st : kDiffLayers)

@@ -6,7 +6,7 @@
 // the graph's plan_diff node (or, without one, the plan of its matcher); --plan FILE [--floor NAME] names the plan
 // instead. The first line on stderr says which plan and where it came from; a matcher / optimizer of the graph with
 // another plan, and a run in which no plan element was seen, are warned about (the wrong plan, most likely).
-// Writes JSON and/or DXF (layers FPLOC-MISSING, FPLOC-MOVED, FPLOC-NEW, FPLOC-PLAN) by the --out extension; --json
+// Writes JSON and/or DXF (layers FPLOC-MISSING, FPLOC-MOVED, FPLOC-NEW, FPLOC-LOW, FPLOC-PLAN) by the --out extension; --json
 // prints the JSON diff on stdout; --all lists every element (also those seen where expected); --set
 // NODE.field=value as for fploc replay (the plan_diff node's options: plan_diff.plan.file=PLAN, ...). The summary
 // on stderr: counts (with missing parts), the drawing scale, then one line per missing / moved element, missing
@@ -14,6 +14,8 @@
 // --poses FILE.tum (diagnostic): each scan placed with the pose of FILE nearest its time (within 5 ms; e.g. the
 // simulator's ground truth) instead of the localizer's, no covariance: what the detector finds with good poses.
 #include <fploc/features_t.hpp>
+#include <fploc/segments_t.hpp>
+#include "fploc/adapters/plan_diff_t.h"
 #include <fploc/pose_t.hpp>
 #include <lcm/lcm-cpp.hpp>
 
@@ -110,6 +112,7 @@ int main(int argc, char** argv) {
     const fploc::PlanSource* src = nullptr;
     std::string src_what;  // where the plan comes from, said on the first line
     fploc::plandiff::Options po;
+    std::string seg_ch = "FPLOC_SEGMENTS";  // the 3D wall points: how tall new structure is (when the log has them)
     for (const auto& n : g.graph.node()) {
       if (n.has_plan_diff() && !node) {
         node = &n;
@@ -119,6 +122,7 @@ int main(int argc, char** argv) {
         for (const auto& in : n.input()) {
           if (in.port() == "features" && feat_ch.empty()) feat_ch = in.channel();
           if (in.port() == "pose" && pose_ch.empty()) pose_ch = in.channel();
+          if (in.port() == "segments" && !in.channel().empty()) seg_ch = in.channel();
         }
       }
     }
@@ -191,10 +195,24 @@ int main(int argc, char** argv) {
     fploc::rt::LogReader log(log_path);
     if (!log.good()) throw std::runtime_error(log_path + ": cannot read the LCM log");
     std::map<int64_t, fploc::features_t> feats;
-    int64_t events = 0, n_feat = 0, n_pose = 0, used = 0, bad = 0;
+    std::map<int64_t, fploc::plandiff::PlanDiff::Heights> heights;  // by utime, as the features
+    auto heights_at = [&](int64_t utime) -> const fploc::plandiff::PlanDiff::Heights* {
+      const auto it = heights.find(utime);
+      return it == heights.end() ? nullptr : &it->second;
+    };
+    int64_t events = 0, n_feat = 0, n_pose = 0, n_seg = 0, used = 0, bad = 0;
     while (const lcm::LogEvent* ev = log.next()) {
       ++events;
-      if (ev->channel == feat_ch) {
+      if (ev->channel == seg_ch && po.new_min_height_m > 0) {
+        fploc::segments_t sg;
+        if (sg.decode(ev->data, 0, ev->datalen) < 0) {
+          if (bad++ == 0) std::cerr << "fploc map diff: " << log_path << ": event " << events << " on " << seg_ch << " does not decode as segments_t (skipped)\n";
+          continue;
+        }
+        ++n_seg;
+        heights[sg.utime] = fploc::adapters::heights_of(sg);
+        while (heights.size() > 50) heights.erase(heights.begin());
+      } else if (ev->channel == feat_ch) {
         fploc::features_t f;
         if (f.decode(ev->data, 0, ev->datalen) < 0) {
           if (bad++ == 0) std::cerr << "fploc map diff: " << log_path << ": event " << events << " on " << feat_ch << " does not decode as features_t (skipped)\n";
@@ -211,7 +229,7 @@ int main(int argc, char** argv) {
           }
           std::vector<Eigen::Vector2f> pts;
           for (int i = 0; i < f.num_points; ++i) pts.emplace_back(f.x[size_t(i)], f.y[size_t(i)]);
-          diff.add_frame(g->p.x(), g->p.y(), g->rpy().z(), pts);
+          diff.add_frame(g->p.x(), g->p.y(), g->rpy().z(), pts, nullptr, true, heights_at(f.utime));
           ++used;
           continue;
         }
@@ -234,7 +252,7 @@ int main(int argc, char** argv) {
         const int ix[3] = {0, 1, 5};
         for (int r = 0; r < 3; ++r)
           for (int c = 0; c < 3; ++c) cov(r, c) = p.covariance[ix[r] * 6 + ix[c]];
-        diff.add_frame(p.position[0], p.position[1], yaw, pts, &cov, p.status == 0);  // POOR: no change evidence
+        diff.add_frame(p.position[0], p.position[1], yaw, pts, &cov, p.status == 0, heights_at(p.utime));  // POOR: no change evidence
         ++used;
       }
     }
@@ -252,6 +270,10 @@ int main(int argc, char** argv) {
     if (used == 0)
       throw std::runtime_error(log_path + ": no " + pose_ch + " pose has the utime of a " + feat_ch + " scan (" +
                                std::to_string(n_feat) + " scans, " + std::to_string(n_pose) + " poses)");
+    if (po.new_min_height_m > 0 && n_seg == 0)
+      preface << "fploc map diff: " << log_path << " has no " << seg_ch << " (segments_t): the heights of new structure "
+              << "were not checked (a new run may be furniture); record them too (`fploc replay ... --record LOG.lcm "
+              << "--record-channels 'FPLOC_.*'`: the default leaves FPLOC_SEGMENTS out)\n";
     std::cerr << preface.str();
     const auto r = diff.result();
     for (const auto& o : outs) {

@@ -16,7 +16,7 @@ grep -q '"summary"' "$T/diff.json"
 # (missing / moved elements, missing parts, new runs) as many as the JSON has.
 head -1 "$T/main.err" | grep -q "^fploc map diff: the plan: $R/data/plans/room.json, from the graph's plan_diff node 'plan_diff' (plan.file)$" ||
   { echo "first line:"; cat "$T/main.err"; exit 1; }
-grep -q " scans of $T/run.lcm against .* new, [0-9]* missing parts\?; drawing scale " "$T/main.err" || { cat "$T/main.err"; exit 1; }
+grep -q " scans of $T/run.lcm against .* new, [0-9]* low, [0-9]* missing parts\?; drawing scale " "$T/main.err" || { cat "$T/main.err"; exit 1; }
 flagged=$(/usr/bin/python3 -c '
 import json, sys
 d = json.load(open(sys.argv[1]))

@@ -20,6 +20,7 @@ void write_json(const Diff& d, const FloorPlan& plan, std::ostream& out, bool al
                   {"moved", d.count(Status::kMoved)},
                   {"unobserved", d.count(Status::kUnobserved)},
                   {"new", d.added.size()},
+                  {"low", d.low.size()},
                   {"missing_parts", d.missing_parts.size()}};
   j["scale"] = {{"error", d.scale_error}, {"sigma", d.scale_sigma}, {"points", d.scale_points}};
   auto& el = j["elements"] = nlohmann::json::array();
@@ -46,10 +47,21 @@ void write_json(const Diff& d, const FloorPlan& plan, std::ostream& out, bool al
     }
     el.push_back(o);
   }
-  auto& nw = j["new"] = nlohmann::json::array();
-  for (const auto& n : d.added)
-    nw.push_back({{"a", {n.a.x(), n.a.y()}}, {"b", {n.b.x(), n.b.y()}}, {"length_m", n.length()}, {"cells", n.cells},
-                  {"min_frames", n.min_frames}, {"rms_m", n.rms_m}, {"extends", n.extends}});
+  // Heights: checked when some evidence scan came with the segmenter's 3D points (else every run is a new wall,
+  // "height": "unknown").
+  j["heights_checked"] = d.height_frames > 0;
+  j["height_frames"] = d.height_frames;
+  auto runs = [](const std::vector<NewStructure>& v) {
+    nlohmann::json a = nlohmann::json::array();
+    for (const auto& n : v)
+      a.push_back({{"a", {n.a.x(), n.a.y()}}, {"b", {n.b.x(), n.b.y()}}, {"length_m", n.length()}, {"cells", n.cells},
+                   {"min_frames", n.min_frames}, {"rms_m", n.rms_m}, {"extends", n.extends},
+                   {"height", height_name(n.height)},
+                   {"top_m", std::isfinite(n.top_m) ? nlohmann::json(n.top_m) : nlohmann::json(nullptr)}});
+    return a;
+  };
+  j["new"] = runs(d.added);
+  j["low"] = runs(d.low);
   auto& rf = j["refined"] = nlohmann::json::array();
   for (const auto& r : d.refined)
     rf.push_back({{"id", r.element}, {"offset_a", r.offset_a}, {"offset_b", r.offset_b}, {"frames", r.frames}});
@@ -76,7 +88,8 @@ void write_text(const Diff& d, const FloorPlan& plan, std::ostream& out) {
   o << std::fixed;
   const size_t parts = d.missing_parts.size();
   o << d.count(Status::kSeen) << " seen, " << d.count(Status::kMissing) << " missing, " << d.count(Status::kMoved)
-    << " moved, " << d.count(Status::kUnobserved) << " unobserved, " << d.added.size() << " new, " << parts
+    << " moved, " << d.count(Status::kUnobserved) << " unobserved, " << d.added.size() << " new, " << d.low.size()
+    << " low, " << parts
     << (parts == 1 ? " missing part" : " missing parts") << "; drawing scale ";
   if (d.scale_points > 0)
     o << std::showpos << std::setprecision(2) << 100 * d.scale_error << std::noshowpos << " % +- " << 100 * d.scale_sigma
@@ -109,8 +122,15 @@ void write_text(const Diff& d, const FloorPlan& plan, std::ostream& out) {
   for (const auto& n : d.added) {
     o << "  new: " << std::setprecision(2) << n.length() << " m, " << xy(n.a) << "-" << xy(n.b);
     if (n.extends >= 0) o << ", extends element " << n.extends;
+    if (std::isfinite(n.top_m)) o << ", top " << std::setprecision(2) << n.top_m << " m";
+    if (d.height_frames > 0 && n.height == Height::kUnknown) o << ", height not told";
     o << "\n";
   }
+  for (const auto& n : d.low)
+    o << "  low structure (not a wall): " << std::setprecision(2) << n.length() << " m, " << xy(n.a) << "-" << xy(n.b)
+      << ", top " << n.top_m << " m\n";
+  if (d.height_frames == 0 && !d.added.empty())
+    o << "  (heights not checked: no 3D wall points (FPLOC_SEGMENTS) came with the scans, or the check is off; a new run may be furniture)\n";
   out << o.str();
 }
 
@@ -155,7 +175,7 @@ void write_dxf(const Diff& d, const FloorPlan& plan, std::ostream& o) {
     const char* name;
     int color;
   };
-  const L layers[] = {{"0", 7}, {"FPLOC-PLAN", 8}, {"FPLOC-MISSING", 1}, {"FPLOC-MOVED", 2}, {"FPLOC-NEW", 3}};
+  const L layers[] = {{"0", 7}, {"FPLOC-PLAN", 8}, {"FPLOC-MISSING", 1}, {"FPLOC-MOVED", 2}, {"FPLOC-NEW", 3}, {"FPLOC-LOW", 4}};
   pair(o, 0, "SECTION");
   pair(o, 2, "HEADER");
   pair(o, 9, "$ACADVER");
@@ -205,6 +225,7 @@ void write_dxf(const Diff& d, const FloorPlan& plan, std::ostream& o) {
   }
   for (const auto& m : d.missing_parts) entity(o, Element::segment(m.a, m.b), "FPLOC-MISSING");
   for (const auto& n : d.added) entity(o, Element::segment(n.a, n.b), "FPLOC-NEW");
+  for (const auto& n : d.low) entity(o, Element::segment(n.a, n.b), "FPLOC-LOW");
   pair(o, 0, "ENDSEC");
   pair(o, 0, "EOF");
 }

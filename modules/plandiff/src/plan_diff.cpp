@@ -79,6 +79,15 @@ const char* status_name(Status s) {
   return "?";
 }
 
+const char* height_name(Height h) {
+  switch (h) {
+    case Height::kUnknown: return "unknown";
+    case Height::kTall: return "tall";
+    case Height::kLow: return "low";
+  }
+  return "?";
+}
+
 int Diff::count(Status s) const {
   return int(std::count_if(elements.begin(), elements.end(), [s](const ElementDiff& e) { return e.status == s; }));
 }
@@ -252,7 +261,7 @@ bool PlanDiff::plan_blocks(const V2& o, const V2& q, int skip) const {
 }
 
 void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen::Vector2f>& points,
-                         const Eigen::Matrix3d* pose_cov, bool pose_ok) {
+                         const Eigen::Matrix3d* pose_cov, bool pose_ok, const Heights* heights) {
   // A pose that is not finite is no registered scan (its points all fell into one "new" cell at INT_MIN).
   if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(yaw)) return;
   const int frame = frames_++;
@@ -275,6 +284,34 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
   auto bin_of = [&](const V2& d) {
     int b = int(std::floor((std::atan2(d.y(), d.x()) + M_PI) / bin_w));
     return ((b % nb) + nb) % nb;
+  };
+  // Heights: the highest 3D wall point of this scan in each new-structure cell (above the floor), and how high the
+  // scan's beams reach: the steepest upward elevation of any of its wall points (a wall's top ring).
+  std::unordered_map<int64_t, float> top_here;
+  double tan_up = -kInf;
+  const bool use_heights = heights && evidence && o_.new_min_height_m > 0 && !heights->points.empty();
+  if (use_heights) {
+    ++height_frames_;
+    for (const auto& q : heights->points) {
+      const double rxy = std::hypot(double(q.x()), double(q.y()));
+      if (!(rxy >= o_.min_range_m && rxy <= o_.max_range_m) || !std::isfinite(q.z())) continue;
+      tan_up = std::max(tan_up, double(q.z()) / rxy);
+      const V2 w = s + V2(c * q.x() - sn * q.y(), sn * q.x() + c * q.y());
+      const float h = float(heights->sensor_z + q.z());
+      float& t = top_here.try_emplace(cell_key(int(std::floor(w.x() / o_.new_cell_m)), int(std::floor(w.y() / o_.new_cell_m))),
+                                      -1.0f).first->second;
+      t = std::max(t, h);
+    }
+  }
+  // The highest point of this scan within a cell of the new-structure cell (ix, iy) (-1: none).
+  auto top_near = [&](int ix, int iy) {
+    float t = -1;
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy) {
+        const auto it = top_here.find(cell_key(ix + dx, iy + dy));
+        if (it != top_here.end()) t = std::max(t, it->second);
+      }
+    return t;
   };
   struct Obs {
     float range;
@@ -385,6 +422,18 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
         cell.last_frame = frame;
         ++cell.frames;
         if (cell.hit_frames.size() < kMaxHitFrames) cell.hit_frames.push_back(frame);
+        if (use_heights) {
+          const float t = top_near(ix, iy);
+          cell.top_m = std::max(cell.top_m, t);
+          if (t >= o_.new_min_height_m) ++cell.tall_frames;
+          // Could this scan tell whether the structure there rises above new_min_height_m: its highest beam at this
+          // range passes above it, or the structure's top was seen (its points end well below the highest beam: the
+          // beams above it passed over; margin for the rings' spacing)?
+          if (std::isfinite(tan_up)) {
+            const double reach = heights->sensor_z + r * tan_up;
+            if (reach >= o_.new_min_height_m + 0.1 || (t >= 0 && t < reach - (0.15 + 0.05 * r))) ++cell.checkable_frames;
+          }
+        }
       }
       ++cell.points;
       Cell& vc = view_[cell_key(int(std::floor(p.x() / o_.new_view_cell_m)), int(std::floor(p.y() / o_.new_view_cell_m)))];
@@ -542,6 +591,7 @@ Diff PlanDiff::result() const {
   Diff d;
   d.frames = frames_;
   d.evidence_frames = evidence_frames_;
+  d.height_frames = height_frames_;
   d.refined = refine_.result({o_.refine_obs_sigma_m, o_.refine_prior_m, o_.refine_min_info, o_.refine_ends, o_.min_frames});
   const DrawingScale::Estimate scale = scale_.estimate(frames_, o_.min_frames);
   d.scale_error = scale.error;
@@ -642,6 +692,7 @@ Diff PlanDiff::result() const {
   std::vector<V2> pts;
   std::vector<int> pf;
   std::vector<const std::vector<int>*> ph;
+  std::vector<const Cell*> pc;
   for (const auto& [k, c] : cells_) {
     if (c.frames < o_.new_min_frames) continue;
     const int ix = int(k >> 32), iy = int(int32_t(uint32_t(k & 0xffffffff)));
@@ -653,6 +704,7 @@ Diff PlanDiff::result() const {
     pts.emplace_back((ix + 0.5) * o_.new_cell_m, (iy + 0.5) * o_.new_cell_m);
     pf.push_back(c.frames);
     ph.push_back(&c.hit_frames);
+    pc.push_back(&c);
   }
   // Deterministic order (the hash map's is not).
   std::vector<size_t> order(pts.size());
@@ -663,7 +715,8 @@ Diff PlanDiff::result() const {
   std::vector<V2> P;
   std::vector<int> F;
   std::vector<const std::vector<int>*> H;
-  for (size_t i : order) P.push_back(pts[i]), F.push_back(pf[i]), H.push_back(ph[i]);
+  std::vector<const Cell*> CL;
+  for (size_t i : order) P.push_back(pts[i]), F.push_back(pf[i]), H.push_back(ph[i]), CL.push_back(pc[i]);
   // Was a run seen at once? Frames whose cells of the run cover, without a gap wider than new_max_gap_m, a stretch
   // >= `span` along v (new_min_span_m): >= new_min_frames of them and >= new_min_span_share of the frames that hit
   // the run. Two people pacing along one line are a gap apart, but for the moments they pass each other.
@@ -765,7 +818,26 @@ Diff PlanDiff::result() const {
         ns.cells = n;
         ns.min_frames = fmin;
         ns.rms_m = std::sqrt(ss / n);
-        d.added.push_back(ns);
+        // How tall: the share of its cells with points above new_min_height_m (a wall, a partition), else low when
+        // most of its cells were in view from where the beams reached that high (a table, a cabinet).
+        if (height_frames_ > 0) {
+          int tall = 0, checkable = 0;
+          std::vector<float> tops;
+          for (size_t j = s0; j < k; ++j) {
+            const Cell& cl = *CL[on[j].second];
+            if (cl.tall_frames >= o_.new_tall_min_frames) ++tall;
+            if (cl.checkable_frames >= o_.new_min_frames) ++checkable;
+            if (cl.top_m >= 0) tops.push_back(cl.top_m);
+          }
+          if (!tops.empty()) {  // the 90th percentile of its cells' highest points: one stray point is not its top
+            const size_t q = std::min(tops.size() - 1, size_t(0.9 * double(tops.size())));
+            std::nth_element(tops.begin(), tops.begin() + long(q), tops.end());
+            ns.top_m = tops[q];
+          }
+          if (tall >= o_.new_tall_share * n) ns.height = Height::kTall;
+          else if (checkable >= o_.new_low_checkable_share * n) ns.height = Height::kLow;
+        }
+        (ns.height == Height::kLow ? d.low : d.added).push_back(ns);
       }
       s0 = k;
     }

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <tuple>
 
 #include "fploc/floorplan/io.h"
 #include "fploc/plandiff/plan_diff.h"
@@ -609,4 +610,107 @@ TEST(PlanDiff, FarClusterIgnoresPointsWithoutALine) {
   EXPECT_EQ(e.status, plandiff::Status::kMoved) << "offset " << e.offset_m << " halves " << e.half_offset_m[0] << " "
                                                 << e.half_offset_m[1] << " spread " << e.offset_spread_m;
   EXPECT_NEAR(e.offset_m, -0.15, 0.03);
+}
+
+namespace {
+// A scan of a world of vertical faces (segment, top height above the floor) by a 3D LiDAR at sensor_z: every 0.5 deg
+// of bearing, the nearest face per elevation (32 rings over +-22.5 deg) that the ring hits below its top (the floor
+// is 0, the ceiling 3 m). The 2D points: the nearest such hit per bearing (levelled, sensor frame); the 3D ones: every
+// ring's hit, z from the sensor.
+struct Scan3 {
+  std::vector<Eigen::Vector2f> pts2;
+  plandiff::PlanDiff::Heights h;
+};
+Scan3 cast3d(const std::vector<std::tuple<V2, V2, double>>& world, const V2& o, double yaw, double sensor_z) {
+  Scan3 s;
+  s.h.sensor_z = sensor_z;
+  for (int i = 0; i < 720; ++i) {
+    const double a = i * M_PI / 360;
+    const V2 d(std::cos(a), std::sin(a));
+    std::vector<std::pair<double, double>> hits;  // (range, top)
+    for (const auto& [p, q, top] : world) {
+      const V2 e = q - p;
+      const double den = d.x() * e.y() - d.y() * e.x();
+      if (std::abs(den) < 1e-12) continue;
+      const V2 w = p - o;
+      const double t = (w.x() * e.y() - w.y() * e.x()) / den, u = (w.x() * d.y() - w.y() * d.x()) / den;
+      if (t > 0.05 && t < 12 && u >= 0 && u <= 1) hits.push_back({t, top});
+    }
+    std::sort(hits.begin(), hits.end());
+    const double rel = a - yaw;
+    double nearest = -1;
+    for (int ring = 0; ring < 32; ++ring) {
+      const double el = (-22.5 + 45.0 * ring / 31) * M_PI / 180;
+      for (const auto& [t, top] : hits) {
+        const double z = sensor_z + t * std::tan(el);
+        if (z < 0 || z > 3.0) break;  // floor / ceiling first
+        if (z > top) continue;        // over this face
+        s.h.points.emplace_back(float(t * std::cos(rel)), float(t * std::sin(rel)), float(z - sensor_z));
+        if (nearest < 0 || t < nearest) nearest = t;
+        break;
+      }
+    }
+    if (nearest > 0) s.pts2.emplace_back(float(nearest * std::cos(rel)), float(nearest * std::sin(rel)));
+  }
+  return s;
+}
+}  // namespace
+
+// Height evidence for new structure: in a 10 x 8 m room (3 m walls) a low box (1.6 x 0.6 m, 0.75 m tall: a table)
+// and a tall partition (2.4 m long, 2.7 m tall), neither in the plan, scanned from a loop around them at 1.2 m.
+// With the scans' heights the partition is a new wall and the box low structure (its top ~0.75 m); without heights
+// both are new walls (as before), and with the gate off (new_min_height_m 0) the box is a new wall again.
+TEST(PlanDiff, ALowBoxIsNoNewWall) {
+  FloorPlan plan;
+  const V2 c[4] = {{0, 0}, {10, 0}, {10, 8}, {0, 8}};
+  std::vector<std::tuple<V2, V2, double>> world;
+  for (int k = 0; k < 4; ++k) {
+    plan.elements.push_back(Element::segment(c[k], c[(k + 1) % 4]));
+    world.push_back({c[k], c[(k + 1) % 4], 3.0});
+  }
+  const V2 b[4] = {{6.5, 5.2}, {8.1, 5.2}, {8.1, 5.8}, {6.5, 5.8}};  // the box
+  for (int k = 0; k < 4; ++k) world.push_back({b[k], b[(k + 1) % 4], 0.75});
+  world.push_back({V2(2.0, 2.5), V2(2.0, 4.9), 2.7});  // the partition
+  auto run = [&](bool heights, const plandiff::Options& o) {
+    plandiff::PlanDiff d(plan, o);
+    for (int f = 0; f < 120; ++f) {
+      const double a = 2 * M_PI * f / 120;
+      const V2 s = V2(5, 4) + V2(3.2 * std::cos(a), 2.2 * std::sin(a));
+      const double yaw = 0.1 + 0.07 * f;
+      const Scan3 sc = cast3d(world, s, yaw, 1.2);
+      d.add_frame(s.x(), s.y(), yaw, sc.pts2, nullptr, true, heights ? &sc.h : nullptr);
+    }
+    return d.result();
+  };
+  auto near_box = [](const plandiff::NewStructure& n) { return 0.5 * (n.a + n.b).x() > 6 && 0.5 * (n.a + n.b).y() > 5; };
+  auto near_partition = [](const plandiff::NewStructure& n) {
+    return std::abs(n.a.x() - 2.0) < 0.1 && std::abs(n.b.x() - 2.0) < 0.1 && n.length() > 1.8;
+  };
+  auto count = [](const std::vector<plandiff::NewStructure>& v, auto pred) {
+    return std::count_if(v.begin(), v.end(), pred);
+  };
+  const plandiff::Diff with = run(true, {});
+  EXPECT_GT(with.height_frames, 100);
+  EXPECT_EQ(count(with.added, near_box), 0) << "the box reported as a new wall";
+  EXPECT_GE(count(with.low, near_box), 1) << "the box not reported as low structure";
+  EXPECT_EQ(count(with.added, near_partition), 1);
+  for (const auto& n : with.added)
+    if (near_partition(n)) {
+      EXPECT_EQ(n.height, plandiff::Height::kTall);
+      EXPECT_GT(n.top_m, 2.5);
+    }
+  for (const auto& n : with.low)
+    if (near_box(n)) EXPECT_NEAR(n.top_m, 0.75, 0.1);
+  // Without heights: both new walls, height unknown (as before).
+  const plandiff::Diff without = run(false, {});
+  EXPECT_EQ(without.height_frames, 0);
+  EXPECT_GE(count(without.added, near_box), 1);
+  EXPECT_EQ(count(without.added, near_partition), 1);
+  EXPECT_TRUE(without.low.empty());
+  // The gate off: the box is a new wall again (this test fails without the rule).
+  plandiff::Options off;
+  off.new_min_height_m = 0;
+  const plandiff::Diff gate_off = run(true, off);
+  EXPECT_GE(count(gate_off.added, near_box), 1);
+  EXPECT_TRUE(gate_off.low.empty());
 }

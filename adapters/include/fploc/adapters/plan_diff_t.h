@@ -3,6 +3,7 @@
 #pragma once
 
 #include <fploc/plan_diff_t.hpp>
+#include <fploc/segments_t.hpp>
 
 #include <cstdint>
 #include <vector>
@@ -15,7 +16,14 @@
 namespace fploc::adapters {
 
 // Item kinds in plan_diff_t.kind.
-enum class PlanDiffKind : int8_t { kMissing = 1, kMoved = 2, kNew = 3, kMissingPart = 4 };
+// kLow: new straight structure seen only below plandiff::Options::new_min_height_m (furniture); its offset_m is the
+// highest point seen on it above the floor (NaN: none).
+enum class PlanDiffKind : int8_t { kMissing = 1, kMoved = 2, kNew = 3, kMissingPart = 4, kLow = 5 };
+
+// The segmenter's wall points of a scan (FPLOC_SEGMENTS) levelled with its roll / pitch (as the features are:
+// Ry(pitch) Rx(roll) p), and the sensor's height above the floor: how tall the new structure is. Empty points when
+// the message is not OK or its attitude / height is not finite.
+plandiff::PlanDiff::Heights heights_of(const segments_t& m);
 
 plan_diff_t to_msg(const plandiff::Diff& d, const FloorPlan& plan, int64_t utime, int64_t seq);
 

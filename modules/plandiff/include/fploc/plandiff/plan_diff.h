@@ -23,6 +23,7 @@
 #include <Eigen/Dense>
 #include <cstdint>
 #include <iosfwd>
+#include <limits>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -90,6 +91,17 @@ struct Options {
   double new_min_hit_ratio = 0.3;   // ... and whose view cell was hit in this share of the scans that had it
   double new_view_cell_m = 0.25;    // in view (nothing measured in front) is static structure
   double new_min_length_m = 0.8;    // shortest new wall reported
+  // Height of new structure (add_frame's `heights`: the segmenter's 3D wall points). A new run is a wall only when
+  // >= new_tall_share of its cells held points >= new_min_height_m above the floor in >= new_tall_min_frames scans;
+  // a run whose cells were hit, in >= new_min_frames scans each, from where the sensor's highest beam passed above
+  // new_min_height_m there (its range times the scan's steepest upward wall point) or above the structure's top (its
+  // points there end >= 0.15 m + 5 % of the range below that beam), and that is not tall, is
+  // low structure (Diff::low: a table, a cabinet, a bench), with the highest point seen on it. Runs that could not
+  // be told (no heights, or never seen from far enough) stay new walls (NewStructure::height kUnknown). 0: off.
+  double new_min_height_m = 1.8;
+  int new_tall_min_frames = 2;
+  double new_tall_share = 0.3;
+  double new_low_checkable_share = 0.5;  // ... of its cells checkable for a run to be called low
   // A new wall is seen at once: its cells hit in one scan cover >= new_min_span_m of it without a gap wider than
   // new_max_gap_m (or 0.8 of its length, if shorter), in >= new_min_frames scans and in >= new_min_span_share of the
   // scans that hit it. A person pacing back and forth along a line leaves a straight trail
@@ -147,8 +159,13 @@ struct ElementDiff {
   double seen_ratio() const { return probes_expected ? double(probes_seen) / double(probes_expected) : 0.0; }
 };
 
+enum class Height : uint8_t { kUnknown = 0, kTall = 1, kLow = 2 };
+const char* height_name(Height h);  // "unknown", "tall", "low"
+
 struct NewStructure {
   Eigen::Vector2d a, b;
+  Height height = Height::kUnknown;  // Options::new_min_height_m
+  double top_m = std::numeric_limits<double>::quiet_NaN();  // highest point seen on it above the floor (NaN: none)
   int extends = -1;           // the plan segment this run continues beyond its drawn end (-1: none)
   int cells = 0;
   int min_frames = 0;         // frames that hit its least-seen cell
@@ -167,7 +184,9 @@ struct MissingPart {
 
 struct Diff {
   std::vector<ElementDiff> elements;  // one per plan element
-  std::vector<NewStructure> added;
+  std::vector<NewStructure> added;    // new walls: tall, or height not told
+  std::vector<NewStructure> low;      // new straight structure seen only below Options::new_min_height_m
+  int height_frames = 0;              // evidence scans that came with heights (0: heights not checked)
   std::vector<MissingPart> missing_parts;
   int frames = 0;
   int evidence_frames = 0;  // of them, those whose pose was good enough for change evidence (Options::max_pose_sigma_m)
@@ -187,8 +206,14 @@ class PlanDiff {
   // the pose's x, y, yaw covariance (the localizer's, optional: see Options::moved_pose_covariance); pose_ok: the
   // localizer's status is OK (false: POOR; see Options::max_pose_sigma_m). A pose that is not finite is ignored
   // (no frame).
+  // heights (optional): the scan's wall points in the gravity-levelled sensor frame (x, y as the 2D points; z up
+  // from the sensor) and the sensor's height above the floor: how tall the new structure is (Options::new_min_height_m).
+  struct Heights {
+    std::vector<Eigen::Vector3f> points;
+    double sensor_z = 0;
+  };
   void add_frame(double x, double y, double yaw, const std::vector<Eigen::Vector2f>& points,
-                 const Eigen::Matrix3d* pose_cov = nullptr, bool pose_ok = true);
+                 const Eigen::Matrix3d* pose_cov = nullptr, bool pose_ok = true, const Heights* heights = nullptr);
   int evidence_frames() const { return evidence_frames_; }
   Diff result() const;
   int frames() const { return frames_; }
@@ -211,6 +236,8 @@ class PlanDiff {
   };
   struct Cell {
     int frames = 0, last_frame = -1, points = 0, in_view = 0;
+    int tall_frames = 0, checkable_frames = 0;  // new-structure cells: scans with a point >= new_min_height_m there /
+    float top_m = -1;                           // that could have seen one; the highest point seen there
     std::vector<int> hit_frames;  // new-structure cells: the frames that hit it (the first kMaxHitFrames)
   };
   static constexpr size_t kMaxHitFrames = 256;
@@ -235,6 +262,7 @@ class PlanDiff {
   std::unordered_map<int64_t, Cell> view_;   // new_view_cell_m: hit in how many of the scans that saw it
   int frames_ = 0;
   int evidence_frames_ = 0;  // of them, those that gave change evidence
+  int height_frames_ = 0;    // evidence frames with heights
   DrawingScale scale_;
   WallRefinement refine_;
   // Uniform grid of elements (1 m cells, bounding boxes grown by assoc_m) for the point association.
@@ -244,22 +272,24 @@ class PlanDiff {
   std::vector<std::vector<int>> grid_;
 };
 
-// {"frames", "evidence_frames", "summary": {"seen", "missing", "moved", "unobserved", "new", "missing_parts"}, "scale": {"error", "sigma", "points"},
+// {"frames", "evidence_frames", "summary": {"seen", "missing", "moved", "unobserved", "new", "low", "missing_parts"}, "scale": {"error", "sigma", "points"},
 //  "elements": [{"id", "status",
 //  "offset_m", "offset_spread_m", "offset_sigma_m", "seen_ratio", "frames_expected", "frames_with_points", "a", "b" | "c", "r"}],
-//  "new": [{"a", "b", "length_m", "cells", "min_frames", "rms_m", "extends"}],
+//  "heights_checked", "height_frames",
+//  "new": [{"a", "b", "length_m", "cells", "min_frames", "rms_m", "extends", "height", "top_m"}], "low": [same],
 //  "missing_parts": [{"id", "a", "b", "length_m", "seen_ratio", "through_ratio"}],
 //  "refined": [{"id", "offset_a", "offset_b", "frames"}]}   (elements: only those not
 //  "seen" unless all_elements)
 void write_json(const Diff& d, const FloorPlan& plan, std::ostream& out, bool all_elements = false);
-// For people: one summary line ("26 seen, 2 missing, 0 moved, 16 unobserved, 4 new, 1 missing part; drawing scale
+// For people: one summary line ("26 seen, 2 missing, 0 moved, 16 unobserved, 4 new, 0 low, 1 missing part; drawing scale
 // +0.48 % +- 0.05 % (N points)" or "drawing scale: too little to tell"), then one line per flagged item: each
 // missing / moved element (id, layer, verdict, offset, length, where), each missing part, each new run. The
 // caller prefixes the first line (fploc map diff: "N scans of LOG against PLAN: ").
 void write_text(const Diff& d, const FloorPlan& plan, std::ostream& out);
 // ASCII DXF (AC1009, $INSUNITS 6 = metres) with a LAYER table: FPLOC-PLAN (the plan, grey),
 // FPLOC-MISSING (red: missing elements and missing parts where the plan has them), FPLOC-MOVED (yellow: moved elements
-// where they were seen), FPLOC-NEW (green: new structure). LINE and CIRCLE entities only.
+// where they were seen), FPLOC-NEW (green: new structure), FPLOC-LOW (cyan: new straight structure seen only below
+// Options::new_min_height_m: furniture). LINE and CIRCLE entities only.
 void write_dxf(const Diff& d, const FloorPlan& plan, std::ostream& out);
 
 }  // namespace fploc::plandiff
