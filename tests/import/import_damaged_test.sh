@@ -8,22 +8,7 @@ HERE="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 SHARED="${FPLOC_SHARED_DIR:-$HERE/../../../shared}/data"
 T="$(mktemp -d)"; trap 'rm -rf "$T"' EXIT
 python3 "$HERE/make_damaged.py" "$T" || { echo "FAIL: make_damaged.py"; exit 1; }
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
-# run NAME EXPECTED_RC ARGS...: stdout -> $T/NAME.out, stderr -> $T/NAME.err
-run() {
-  local name="$1" want="$2"; shift 2
-  "$I" "$@" > "$T/$name.out" 2> "$T/$name.err"; local rc=$?
-  [ "$rc" = "$want" ] || { fail "$name: exit $rc, expected $want"; sed 's/^/    /' "$T/$name.err" | head -5; }
-}
-# jcheck NAME PYTHON_EXPR: $T/NAME.out is a JSON document and the expression over j holds
-jcheck() {
-  python3 - "$T/$1.out" "$2" 2>/dev/null <<'PY' || fail "$1: $2"
-import json, sys
-j = json.load(open(sys.argv[1], encoding="utf-8"))
-sys.exit(0 if eval(sys.argv[2]) else 1)
-PY
-}
+source "$HERE/../support/import_checks.sh"
 # flip SRC DST OFFSET BYTE: a copy of SRC with one byte replaced
 flip() { python3 -c "import sys; d = bytearray(open(sys.argv[1], 'rb').read()); d[int(sys.argv[3])] = int(sys.argv[4], 0); open(sys.argv[2], 'wb').write(d)" "$@"; }
 

@@ -9,26 +9,7 @@ set -uo pipefail
 I="${FPLOC_BUILD_DIR:?}/bin/fploc-import"
 HERE="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 T="$(mktemp -d)"; trap 'rm -rf "$T"' EXIT
-fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
-# run NAME EXPECTED_RC ARGS...: stdout -> $T/NAME.out, stderr -> $T/NAME.err
-run() {
-  local name="$1" want="$2"; shift 2
-  "$I" "$@" > "$T/$name.out" 2> "$T/$name.err"; local rc=$?
-  [ "$rc" = "$want" ] || { fail "$name: exit $rc, expected $want"; sed 's/^/    /' "$T/$name.err" | head -5; }
-}
-# err NAME TEXT: stderr of NAME is exactly one line holding TEXT
-err() {
-  [ "$(wc -l < "$T/$1.err")" = 1 ] || fail "$1: $(wc -l < "$T/$1.err") stderr lines, expected 1"
-  grep -qF -- "$2" "$T/$1.err" || { fail "$1: stderr lacks '$2'"; sed 's/^/    /' "$T/$1.err"; }
-}
-jcheck() {
-  python3 - "$T/$1.out" "$2" <<'PY' || fail "$1: $2"
-import json, sys
-j = json.load(open(sys.argv[1], encoding="utf-8"))
-sys.exit(0 if eval(sys.argv[2]) else 1)
-PY
-}
+source "$HERE/../support/import_checks.sh"
 
 if [ -d "$HERE/node_modules/@mcap/core" ] && command -v node > /dev/null; then
   (cd "$HERE" && node write_mcap.js "$T/u.mcap" none unchunked && node write_mcap.js "$T/z.mcap" zstd chunked) || fail "write_mcap.js"

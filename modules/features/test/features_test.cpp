@@ -452,20 +452,30 @@ TEST(Features, APointInFrontOfTheWallAboveItIsNoFeature) {
   EXPECT_GE(wall_on, wall_off);
 }
 
+namespace {
+// The room of the height-rule tests: a 2 m cabinet (0.45 m deep) before the wall at x = 8, rendered from `pose` with
+// OS-1-like beams and segmented; the sensor's height above the floor known.
+seg::Segmentation cabinet_room_segments(const synth::SensorPose& pose, uint32_t seed) {
+  synth::Room room;
+  room.boxes.push_back({{7.55, -2.0, 0.0}, {8.0, 2.0, 2.0}, synth::kClutter});
+  const auto s = synth::render(room, pose, synth::os1_like_beams(), 1024, 0.005, 0.01, seed);
+  seg::RingSegmenter sg(seg::SegmenterConfig{});
+  seg::Segmentation seg = sg.process(s.scan);
+  EXPECT_EQ(seg.status, seg::SegStatus::kOk);
+  EXPECT_LT(seg.z_sigma, kZUnknownFromSigmaM);
+  EXPECT_NEAR(seg.z, 1.2, 0.05);
+  return seg;
+}
+}  // namespace
+
 // The same cabinet (2 m tall, 0.45 m deep, 5.5 m away) with the height rule (high_band_m 2.2 m): the wall above the
 // cabinet stands high, the face does not. With high_same_surface_m the wall's low points beside the cabinet (their
 // column's high point on the same surface) stay features, the face's do not (its column's high point lies 0.45 m
 // beyond it); without it every low point goes. Without the rule the face gives features as if it were a wall.
 TEST(Features, ALowPointOffTheHighSurfaceOfItsColumnIsNoFeature) {
-  synth::Room room;
-  room.boxes.push_back({{7.55, -2.0, 0.0}, {8.0, 2.0, 2.0}, synth::kClutter});
   const synth::SensorPose pose{2.0, 0.0, 1.2, 0.5 * kDeg, -0.5 * kDeg, 0.1};
-  const auto s = synth::render(room, pose, synth::os1_like_beams(), 1024, 0.005, 0.01, 31);
-  seg::RingSegmenter sg(seg::SegmenterConfig{});
-  const auto seg = sg.process(s.scan);
-  ASSERT_EQ(seg.status, seg::SegStatus::kOk);
-  ASSERT_LT(seg.z_sigma, kZUnknownFromSigmaM);
-  ASSERT_NEAR(seg.z, 1.2, 0.05);
+  const auto seg = cabinet_room_segments(pose, 31);
+  if (HasFailure()) return;
   struct Count { int face = 0, wall_low = 0, wall_high = 0, beside_low = 0, all = 0; };
   auto count = [&](const FeatureConfig& cfg) {
     FeatureExtractor fx(cfg);
@@ -513,15 +523,9 @@ TEST(Features, ALowPointOffTheHighSurfaceOfItsColumnIsNoFeature) {
 // part is above the top beam) stays with high_keep_unseen; the cabinet face, with the wall standing high behind it,
 // still goes.
 TEST(Features, ALowPointWhoseColumnHoldsNoHighPointStaysWithKeepUnseen) {
-  synth::Room room;
-  room.boxes.push_back({{7.55, -2.0, 0.0}, {8.0, 2.0, 2.0}, synth::kClutter});
   const synth::SensorPose pose{2.0, 4.0, 1.2, 0.5 * kDeg, -0.5 * kDeg, 0.1};
-  const auto s = synth::render(room, pose, synth::os1_like_beams(), 1024, 0.005, 0.01, 37);
-  seg::RingSegmenter sg(seg::SegmenterConfig{});
-  const auto seg = sg.process(s.scan);
-  ASSERT_EQ(seg.status, seg::SegStatus::kOk);
-  ASSERT_LT(seg.z_sigma, kZUnknownFromSigmaM);
-  ASSERT_NEAR(seg.z, 1.2, 0.05);
+  const auto seg = cabinet_room_segments(pose, 37);
+  if (HasFailure()) return;
   struct Count { int near = 0, face = 0, all = 0; };
   auto count = [&](const FeatureConfig& cfg) {
     FeatureExtractor fx(cfg);
