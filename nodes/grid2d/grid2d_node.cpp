@@ -52,7 +52,9 @@ class Grid2dNode : public fploc::rt::Node {
     mount_ = {o.mount_x_m(), o.mount_y_m(), o.mount_yaw_deg() * M_PI / 180};
     upside_down_ = o.upside_down();
     z_ = o.z_m();
-    loc_->set_free_space(g);  // where a whole-map search may place the robot (global start, kidnapped robot)
+    // Where a whole-map search may place the robot (a global start, a kidnapped robot): not needed otherwise (a map
+    // without a known-free cell works from a given start pose).
+    if (!o.has_initial_pose() || c.global_after_lost_scans > 0) loc_->set_free_space(g);
     std::cerr << "[" << ctx.name() << "] " << path << ": " << g.width << " x " << g.height << " cells at " << g.resolution
               << " m, " << field->occupied_cells() << " occupied; ";
     if (o.has_initial_pose()) {

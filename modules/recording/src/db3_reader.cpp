@@ -143,7 +143,7 @@ class Db3Reader : public Recording {
         m.row = true;
         if (message_zstd_) {
           // "message" compression: each blob one zstd frame; its size from the frame header.
-          const unsigned long long n = m.size >= 18 ? frame_size(m.data, m.size) : ~0ULL;
+          const unsigned long long n = frame_size(m.data, m.size);  // a few bytes' frame is 14 B: no minimum
           if (n == ~0ULL) return stop("message id " + std::to_string(id) + ": not a zstd frame with its size (the bag says "
                                       "'message' compression with zstd)");
           const std::string e = decompress("zstd", m.data, m.size, size_t(n), buf_);
@@ -157,8 +157,8 @@ class Db3Reader : public Recording {
         close();
         continue;
       }
-      return stop(sql_error("reading the messages table after " + std::to_string(rows_) + " of " + std::to_string(rows_total_) +
-                            " messages"));
+      return stop(sql_error("reading the messages table after " + std::to_string(rows_) +
+                            (rows_total_ ? " of " + std::to_string(rows_total_) : std::string()) + " messages"));
     }
     return false;
   }
@@ -283,9 +283,9 @@ class Db3Reader : public Recording {
     if (sqlite3_prepare_v2(db_, "SELECT count(*) FROM messages", -1, &s, nullptr) != SQLITE_OK)
       return stop(sql_error("counting the messages"));
     rc = sqlite3_step(s);
-    if (rc == SQLITE_ROW) rows_total_ = uint64_t(std::max<sqlite3_int64>(0, sqlite3_column_int64(s, 0)));
+    // Only for the progress line: a count that fails (an index page beyond a cut) must not stop the rows before it.
+    rows_total_ = rc == SQLITE_ROW ? uint64_t(std::max<sqlite3_int64>(0, sqlite3_column_int64(s, 0))) : 0;
     sqlite3_finalize(s);
-    if (rc != SQLITE_ROW) return stop(sql_error("counting the messages"));
     // rosbag2's order: timestamp, then id.
     if (sqlite3_prepare_v2(db_, "SELECT topic_id, timestamp, data, id FROM messages ORDER BY timestamp, id", -1, &stmt_,
                            nullptr) != SQLITE_OK)

@@ -68,14 +68,15 @@ StartPoseCheck check_start_pose(const StartPlan& plan, double x, double y) {
     bo.quiet = true;
     const Building b = load_building(plan.path, bo);
     c.floor = b.floor(plan.load.floor).name;  // throws naming the floors
+    c.where = locate_in_plan(load_floor_plan(b, c.floor, plan.load), {x, y});
     for (const auto& f : b.floors) {
-      const FloorPlan fp = load_floor_plan(b, f.name, plan.load);
-      if (f.name == c.floor) {
-        c.where = locate_in_plan(fp, {x, y});
-      } else {
-        const Box2 fb = fp.bounds();
-        if (!fb.empty() && x >= fb.min.x() && x <= fb.max.x() && y >= fb.min.y() && y <= fb.max.y())
-          c.other_floors.push_back(f.name);
+      if (f.name == c.floor) continue;
+      // Another floor holds the pose inside its drawn walls; one the node's layers/units cannot load is no answer
+      // (and no reason to skip the check of its own floor).
+      try {
+        const PlanPosition o = locate_in_plan(load_floor_plan(b, f.name, plan.load), {x, y});
+        if (o.inside_extent() && o.enclosed()) c.other_floors.push_back(f.name);
+      } catch (const std::exception&) {
       }
     }
     where = "floor '" + c.floor + "' of " + plan.path;
