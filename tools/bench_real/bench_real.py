@@ -304,7 +304,7 @@ def main():
     ap.add_argument("--resolution", type=float, default=0.05, help="map cell size [m] (default: %(default)s)")
     ap.add_argument("--rows", default="ref,off",
                     help="starts to run: ref (the reference pose of the first scan), off (1 m / 10 deg off it), global (no "
-                         "start pose: global localization started at several scans, see --global-*; JSON global_rows) "
+                         "start pose: global localization started at several scans, as the global-* options below say; JSON global_rows) "
                          "(default: %(default)s)")
     ap.add_argument("--global-every", type=int, default=50, help="global: a start at every this-many-th covered scan (default: %(default)s)")
     ap.add_argument("--global-starts", type=int, default=5, help="global: at most this many starts per log (default: %(default)s)")
