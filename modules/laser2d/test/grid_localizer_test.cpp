@@ -52,15 +52,18 @@ std::vector<Eigen::Vector2d> cast(const OccupancyGrid& g, const Pose2& p, std::m
   return l2::scan_points(r, -M_PI / 2, M_PI / 180, 0.1, 30);
 }
 
+// n poses from a towards b (b itself not included), the yaw turned the short way.
+void append_line(std::vector<Pose2>& t, Pose2 a, Pose2 b, int n) {
+  for (int k = 0; k < n; ++k) {
+    const double s = double(k) / n;
+    t.push_back({a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), a.yaw + s * fploc::wrap_angle(b.yaw - a.yaw)});
+  }
+}
+
 // A loop through the room: 1 m steps and turns, as the Radish logs' scan spacing.
 std::vector<Pose2> trajectory() {
   std::vector<Pose2> t;
-  auto add_line = [&](Pose2 a, Pose2 b, int n) {
-    for (int k = 0; k < n; ++k) {
-      const double s = double(k) / n;
-      t.push_back({a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), a.yaw + s * fploc::wrap_angle(b.yaw - a.yaw)});
-    }
-  };
+  auto add_line = [&](Pose2 a, Pose2 b, int n) { append_line(t, a, b, n); };
   add_line({1, 1, 0}, {7, 1.2, 0}, 8);
   add_line({7, 1.2, 0}, {7, 2.5, M_PI / 2}, 3);
   add_line({7, 2.5, M_PI / 2}, {11, 3, 0.2}, 5);
@@ -744,12 +747,7 @@ OccupancyGrid make_symmetric_room() {
 
 std::vector<Pose2> symmetric_room_path() {
   std::vector<Pose2> t;
-  auto add_line = [&](Pose2 a, Pose2 b, int n) {
-    for (int k = 0; k < n; ++k) {
-      const double s = double(k) / n;
-      t.push_back({a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), a.yaw + s * fploc::wrap_angle(b.yaw - a.yaw)});
-    }
-  };
+  auto add_line = [&](Pose2 a, Pose2 b, int n) { append_line(t, a, b, n); };
   add_line({1, 1, 0}, {6, 1, 0}, 7);
   add_line({6, 1, 0}, {6, 3.5, M_PI / 2}, 4);
   add_line({6, 3.5, M_PI / 2}, {9, 3.5, 0}, 4);
