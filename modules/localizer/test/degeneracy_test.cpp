@@ -656,6 +656,19 @@ TEST(Degeneracy, ShelvesAcrossACorridorEndAreNoEndWall) {
   }
 }
 
+namespace {
+// 21 points 8 cm apart along y at x (sensor frame): a wall seen side-on.
+FeatureFrame points_along_y(double x) {
+  FeatureFrame f;
+  for (int i = -10; i <= 10; ++i) {
+    Feature2 q;
+    q.p = Eigen::Vector2d(x, 0.08 * i);
+    f.points.push_back(q);
+  }
+  return f;
+}
+}  // namespace
+
 TEST(Degeneracy, SeenThroughThePlanOnlyBeyondADrawnWall) {
   FloorPlan p;
   p.elements.push_back(Element::segment({2, -1}, {2, 1}));
@@ -669,12 +682,7 @@ TEST(Degeneracy, SeenThroughThePlanOnlyBeyondADrawnWall) {
   EXPECT_FALSE(seen_through_plan(g, {0, 0}, {0, 5}, 0.1));
   // Point by point: the fix on the wall, a second fit 0.5 m back explains nothing more and loses the wall in front of it;
   // one 0.5 m forward puts the wall's points behind it.
-  FeatureFrame f;
-  for (int i = -10; i <= 10; ++i) {
-    Feature2 q;
-    q.p = Eigen::Vector2d(2.0, 0.08 * i);
-    f.points.push_back(q);
-  }
+  const FeatureFrame f = points_along_y(2.0);
   const FitComparison back = compare_fits(*map.lookup, f, Pose2{0, 0, 0}, Pose2{-0.5, 0, 0}, 0.1);
   EXPECT_EQ(back.fix_inliers, 21);
   EXPECT_EQ(back.gained, 0);
@@ -694,12 +702,7 @@ TEST(Degeneracy, AFaceHiddenBehindADrawnWallExplainsNothing) {
   p.elements.push_back(Element::segment({2, -1}, {2, 1}));
   p.elements.push_back(Element::segment({2.25, -1}, {2.25, 1}));
   auto map = make_localization_map(p, "brute-force");
-  FeatureFrame f;
-  for (int i = -10; i <= 10; ++i) {
-    Feature2 q;
-    q.p = Eigen::Vector2d(1.8, 0.08 * i);
-    f.points.push_back(q);
-  }
+  const FeatureFrame f = points_along_y(1.8);
   const FitComparison inner = compare_fits(*map.lookup, f, Pose2{0, 0, 0}, Pose2{0.2, 0, 0}, 0.1);
   EXPECT_EQ(inner.gained, 21);
   EXPECT_EQ(inner.gained_hidden, 0);
