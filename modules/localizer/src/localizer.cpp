@@ -442,7 +442,8 @@ bool Localizer::check_rival(const FeatureFrame& f, const Pose2& fix, const DeadR
   if (!rival) return false;
   rival_offset_ = between(fix, *rival);
   // Its points on drawn faces that other drawn walls hide from its sensor (a thick wall's outer face) are no inliers.
-  const int hidden = compare_fits(lookup_, f, fix, *rival, mc.inlier_m, stride).gained_hidden;
+  // (cmp already compares this rival when it explains the scan otherwise.)
+  const int hidden = otherwise ? cmp.gained_hidden : compare_fits(lookup_, f, fix, *rival, mc.inlier_m, stride).gained_hidden;
   const double share = double(rival_inliers - hidden) / double(std::max(1, own));
   if (share < rival_ratio && !otherwise) return false;
   if (dr && u.dead_reckoning_gate_sigma > 0 && !uncertainty_.off_dead_reckoning) {
