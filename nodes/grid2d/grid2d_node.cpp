@@ -1,7 +1,7 @@
 // fploc-grid2d: the 2D LiDAR mode's localizer on a raster map. laser_scan_t (LASER_SCAN) + wheel odometry
 // (pose_t on WHEEL_ODOM; optional) -> modules/laser2d GridLocalizer (scans matched directly to the distance
 // field of a map_server occupancy grid: correlative search around the odometry prediction, Ceres refinement)
-// -> pose_t (FPLOC_GRID_POSE) per scan: status OK / POOR (odometry prediction kept) / LOST, covariance
+// -> pose_t (FPLOC_GRID_POSE) per scan: status OK / POOR (odometry prediction kept) / LOST / 3 = no estimate (global search), covariance
 // (x, y, yaw) from the fit. Without grid2d.initial_pose: global localization (LOST until one place dominates). Odometry pairing: the latest odometry pose whose utime is not after the scan's
 // (`fploc import-carmen` writes it with the scan's own utime, before the scan).
 #include <fploc/laser_scan_t.hpp>
@@ -33,7 +33,11 @@ class Grid2dNode : public fploc::rt::Node {
             "2D LiDAR scans + wheel odometry -> localization on an occupancy grid's distance field (pose_t)",
             {fploc::rt::input<fploc::laser_scan_t>("scan", "LASER_SCAN"),
              fploc::rt::input<fploc::pose_t>("odom", "WHEEL_ODOM"),  // "" = no odometry (previous pose predicts)
-             fploc::rt::output<fploc::pose_t>("pose", "FPLOC_GRID_POSE")}};
+             fploc::rt::output<fploc::pose_t>("pose", "FPLOC_GRID_POSE"),
+             // Optional: the pose of each global lock (the first OK scan after a whole-map search), once, with its
+             // covariance: wired to the matcher's initial_pose port (FPLOC_INITIAL_POSE) in graphs/lidar2d.pbtxt, so
+             // the plan pipeline starts where grid2d found the robot. "" = not published.
+             fploc::rt::output<fploc::pose_t>("lock", "")}};
   }
 
   void setup(fploc::rt::Context& ctx) override {
@@ -68,6 +72,7 @@ class Grid2dNode : public fploc::rt::Node {
     }
     std::cerr << "; odometry " << (ctx.channel("odom").empty() ? "none" : ctx.channel("odom")) << "\n";
     out_ = ctx.advertise<fploc::pose_t>("pose");
+    if (!ctx.channel("lock").empty()) lock_ = ctx.advertise<fploc::pose_t>("lock");
     ctx.subscribe<fploc::laser_scan_t>("scan", [this](const fploc::laser_scan_t& m) { on_scan(m); });
     ctx.subscribe<fploc::pose_t>("odom", [this](const fploc::pose_t& m) { on_odom(m); });
   }
@@ -101,8 +106,25 @@ class Grid2dNode : public fploc::rt::Node {
                 << int(r.status) << " inl " << r.inlier_ratio << " n " << r.num_points << " win " << r.search_xy_m << " m "
                 << r.search_yaw_rad * 180 / M_PI << " deg score " << r.score << "\n";
     say_status(r, c);
-    out_.publish(fploc::adapters::make_pose_msg(m.utime, seq_++, r.pose, 0, 0, z_, r.covariance, 0.01, 0.01,
-                                                int8_t(r.status), true, true, floor_.index, floor_.name));
+    // While the whole map is searched there is no estimate: the pose is a placeholder (the map's centre), published
+    // with status 3 (NOT_INITIALISED, "no estimate", as frame_pose_t's) so that loggers and scores leave it out.
+    const int8_t status = r.global && r.status != l2::GridStatus::kOk ? int8_t(l2::GridStatus::kNotInitialised) : int8_t(r.status);
+    const auto msg = fploc::adapters::make_pose_msg(m.utime, seq_++, r.pose, 0, 0, z_, r.covariance, 0.01, 0.01, status,
+                                                    true, true, floor_.index, floor_.name);
+    out_.publish(msg);
+    if (r.global) searching_ = true;
+    if (searching_ && r.status == l2::GridStatus::kOk) {
+      searching_ = false;
+      if (!ctx_->channel("lock").empty()) {
+        // Its position searched within 3 sigma by the matcher: at least 0.5 m (the scan it registers next may be the
+        // next one, up to a metre on: the lock is taken where the plan pipeline then searches, not a fit's centimetres).
+        auto seed = msg;
+        for (int i : {0, 7}) seed.covariance[i] = std::max(seed.covariance[i], 0.25);
+        lock_.publish(seed);
+        std::cerr << "[" << ctx_->name() << "] scan " << seq_ - 1 << ": global lock at " << r.pose.x << " " << r.pose.y << " "
+                  << r.pose.yaw << " published on " << ctx_->channel("lock") << "\n";
+      }
+    }
   }
 
   // Each change of status (OK / POOR / LOST) with its reason (Context::status_changed: on stderr, the first 200, and
@@ -139,7 +161,8 @@ class Grid2dNode : public fploc::rt::Node {
   l2::GridStatus said_status_ = l2::GridStatus::kNotInitialised;  // the first scan's status is said too
   int bad_run_ = 0;
   std::unique_ptr<l2::GridLocalizer> loc_;
-  fploc::rt::Publisher<fploc::pose_t> out_;
+  fploc::rt::Publisher<fploc::pose_t> out_, lock_;
+  bool searching_ = false;  // a whole-map search has not locked yet
   std::optional<Pose2> odom_;
   int64_t odom_utime_ = 0;
   Pose2 mount_;

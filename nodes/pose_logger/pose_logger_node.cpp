@@ -3,6 +3,7 @@
 // its optional `ground_truth` port, to record the simulator's truth of a live run) becomes one TUM line (core `tum_line`, so the
 // formatting is deterministic). Each line is handed to the kernel with a single write(2) as soon as the
 // pose arrives: nothing is buffered in the process, so no processed pose is lost on SIGINT or a crash.
+// A pose_t or frame_pose_t with status 3 (NOT_INITIALISED: no estimate yet, e.g. grid2d's global search) is not written.
 // With `uncertainty_file`, each pose_t / frame_pose_t also gives one line "t status xx xy xyaw yy yyaw yawyaw"
 // (its status and x/y/yaw covariance, modules/eval/uncertainty.h) for `fploc eval --uncertainty`.
 // With `floor_file`, each pose_t / frame_pose_t also gives one line "t floor_index floor" (the floor it is on).
@@ -105,6 +106,7 @@ class PoseLoggerNode : public fploc::rt::Node {
 
   void on_pose(const fploc::pose_t& m) {
     if (final_only_ && !m.final_estimate) return;
+    if (m.status == 3) return;  // no estimate yet (grid2d searching the whole map: its pose is a placeholder)
     if (!write_pose(m.utime, m.seq, m.position, m.orientation, "pose")) return;
     write_floor(m.utime, m.floor_index, m.floor);
     if (unc_fd_ < 0) return;

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include <fploc/frame_pose_t.hpp>
 #include <fploc/pose_t.hpp>
 
 #include "fploc/core/text_out.h"
@@ -259,6 +260,41 @@ int main(int argc, char** argv) {
       if (p.decode(rb->data, 0, int(rb->data_size)) < 0) return;
       ++count[p.status >= 0 && p.status <= 2 ? p.status : 3];
     }, status_count);
+    // Every channel a pose logger of the graph logs (pose_t on `pose`, frame_pose_t on `frame_pose`): its statuses
+    // too (the main one above is also among them), so that a run where one estimate locked and another did not says so.
+    struct Logged {
+      std::string channel, logger;
+      bool frame = false;
+      int64_t count[4] = {0, 0, 0, 0};  // OK, POOR, LOST, 3 = no estimate yet / other
+    };
+    std::vector<std::unique_ptr<Logged>> logged;
+    for (const auto& n : g.graph.node()) {
+      if (n.disabled() || type_from_executable(n.executable()) != "pose_logger") continue;
+      for (const auto& in : n.input()) {
+        if (in.channel().empty() || (in.port() != "pose" && in.port() != "frame_pose")) continue;
+        const std::string ch = fploc::rt::robot_channel(fploc::rt::robot_of(&g.graph), in.channel());
+        bool seen = false;
+        for (const auto& l : logged) seen = seen || l->channel == ch;
+        if (seen) continue;
+        auto l = std::make_unique<Logged>();
+        l->channel = ch;
+        l->logger = n.name();
+        l->frame = in.port() == "frame_pose";
+        if (l->frame)
+          bus.lcm().subscribeFunction(ch, +[](const lcm::ReceiveBuffer* rb, const std::string&, Logged* c) {
+            fploc::frame_pose_t p;
+            if (p.decode(rb->data, 0, int(rb->data_size)) < 0) return;
+            ++c->count[p.status >= 0 && p.status <= 2 ? p.status : 3];
+          }, l.get());
+        else
+          bus.lcm().subscribeFunction(ch, +[](const lcm::ReceiveBuffer* rb, const std::string&, Logged* c) {
+            fploc::pose_t p;
+            if (p.decode(rb->data, 0, int(rb->data_size)) < 0) return;
+            ++c->count[p.status >= 0 && p.status <= 2 ? p.status : 3];
+          }, l.get());
+        logged.push_back(std::move(l));
+      }
+    }
     std::map<std::string, int64_t> per_channel;
     std::map<std::string, int64_t> log_channels;  // every channel of the log (an error names them when none is fed)
     const double w0 = now_s();
@@ -310,6 +346,17 @@ int main(int argc, char** argv) {
               << status_count[1] << " POOR, " << status_count[2] << " LOST"
               << (status_count[3] ? ", " + std::to_string(status_count[3]) + " other status" : std::string())
               << (poses > 0 && status_count[2] == poses ? " (every pose LOST: no estimate of the run)" : "") << "\n";
+    nlohmann::json logged_json = nlohmann::json::array();
+    for (const auto& l : logged) {
+      const int64_t n = l->count[0] + l->count[1] + l->count[2] + l->count[3];
+      logged_json.push_back({{"channel", l->channel}, {"logger", l->logger}, {"poses", n}, {"ok", l->count[0]},
+                             {"poor", l->count[1]}, {"lost", l->count[2]}, {"no_estimate", l->count[3]}});
+      if (l->channel == pose_channel) continue;  // said above
+      std::cerr << "fploc replay: " << n << " poses on " << l->channel << " (" << l->logger << "): " << l->count[0] << " OK, "
+                << l->count[1] << " POOR, " << l->count[2] << " LOST"
+                << (l->count[3] ? ", " + std::to_string(l->count[3]) + " no estimate yet (not logged)" : std::string())
+                << (n > 0 && l->count[2] + l->count[3] == n ? " (no estimate of the run)" : "") << "\n";
+    }
     if (rec && recorded.written == 0) {
       std::string seen;
       for (const auto& [c, k] : recorded.channels) seen += (seen.empty() ? "" : ", ") + fploc::printable(c);
@@ -329,7 +376,8 @@ int main(int argc, char** argv) {
                        {"handler_cpu_ms", total_cpu_ms},
                        {"nodes", nodes},
                        {"poses", {{"channel", pose_channel}, {"ok", status_count[0]}, {"poor", status_count[1]},
-                                  {"lost", status_count[2]}}}};
+                                  {"lost", status_count[2]}}},
+                       {"pose_channels", logged_json}};
       if (!out.empty()) j["out"] = out;
       std::cout << fploc::json_text(j) << std::endl;
     }
