@@ -132,6 +132,7 @@ int main(int argc, char** argv) {
 
   // Localizing nodes left on the graph's own plan (no --set NODE.plan.file=): one line naming it, so a log is not
   // localized against the demo room's plan unawares.
+  std::string own_plans;  // "matcher, optimizer -> PLAN; ...": said again after the run of a log not the simulator's
   {
     std::map<std::string, std::vector<std::string>> by_plan;  // plan file -> nodes
     for (const auto& n : g.graph.node()) {
@@ -161,6 +162,11 @@ int main(int argc, char** argv) {
         sep = "; ";
       }
       std::cerr << "\n";
+      for (const auto& [file, names] : by_plan) {
+        std::string ns;
+        for (const auto& x : names) ns += (ns.empty() ? "" : ", ") + x;
+        own_plans += (own_plans.empty() ? "" : "; ") + ns + " -> " + file;
+      }
     }
   }
 
@@ -357,6 +363,17 @@ int main(int argc, char** argv) {
                 << (l->count[3] ? ", " + std::to_string(l->count[3]) + " no estimate yet (not logged)" : std::string())
                 << (n > 0 && l->count[2] + l->count[3] == n ? " (no estimate of the run)" : "") << "\n";
     }
+    // A log that is not the simulator's (no ground truth in it: a real recording, an import) localized against the
+    // graph's own plan, which for the shipped graphs is a demo plan (data/plans/): its poses are no estimate of where
+    // that robot was. Said last, where the summary is read (the start's "own plan" line scrolls away).
+    const std::string truth = fploc::rt::robot_channel(fploc::rt::robot_of(&g.graph), "FPLOC_GROUND_TRUTH");
+    if (!own_plans.empty() && published > 0 && !log_channels.count(truth)) {
+      std::cerr << "fploc replay: WARNING: " << log_path << " has no " << truth << " (not a simulator log: a recording "
+                << "or an import), yet it was localized against the graph's own plan (" << own_plans << "), a demo plan "
+                << "unless this log was made there. Its poses are then no estimate: pass the log's map or plan to each "
+                << "node, --set NODE.plan.file=PLAN (and NODE.initial_pose.x/y/yaw; fploc occupancy MAP --png OUT --pose "
+                << "X,Y,YAW --scan LOG draws a scan at a guess).\n";
+    }
     if (rec && recorded.written == 0) {
       std::string seen;
       for (const auto& [c, k] : recorded.channels) seen += (seen.empty() ? "" : ", ") + fploc::printable(c);
@@ -377,7 +394,9 @@ int main(int argc, char** argv) {
                        {"nodes", nodes},
                        {"poses", {{"channel", pose_channel}, {"ok", status_count[0]}, {"poor", status_count[1]},
                                   {"lost", status_count[2]}}},
-                       {"pose_channels", logged_json}};
+                       {"pose_channels", logged_json},
+                       {"own_plan_without_truth", !own_plans.empty() && published > 0 && !log_channels.count(
+                           fploc::rt::robot_channel(fploc::rt::robot_of(&g.graph), "FPLOC_GROUND_TRUTH"))}};
       if (!out.empty()) j["out"] = out;
       std::cout << fploc::json_text(j) << std::endl;
     }

@@ -79,3 +79,36 @@ mkdir -p "$T/out" "$T/cwd"
 [ -s "$T/out/ndt.unc" ] || fail "ndt.unc not written beside --out ($(ls "$T/out" "$T/cwd" | tr '\n' ' '))"
 [ -e "$T/cwd/ndt.unc" ] && fail "ndt.unc written into the working directory"
 echo OK
+
+# A log that is not the simulator's (no FPLOC_GROUND_TRUTH: here the sim's log without it, as an import would be)
+# replayed on the graph's own (demo) plan: a WARNING as the last word (JSON own_plan_without_truth); the sim's log
+# itself, or a plan given with --set, none.
+python3 - "$T/log.lcm" "$T/notruth.lcm" <<'PY' || exit 1
+import struct, sys
+src, dst = open(sys.argv[1], "rb").read(), open(sys.argv[2], "wb")
+o = kept = 0
+while o + 28 <= len(src):
+    sync, num, ts, cl, dl = struct.unpack(">IqqII", src[o:o + 28])
+    assert sync == 0xEDA1DA01
+    ch = src[o + 28:o + 28 + cl]
+    end = o + 28 + cl + dl
+    if ch != b"FPLOC_GROUND_TRUTH":
+        dst.write(struct.pack(">IqqII", sync, kept, ts, cl, dl) + src[o + 28:end]); kept += 1
+    o = end
+PY
+"$BIN/fploc-replay" --graph "$R/graphs/replay.pbtxt" --log "$T/notruth.lcm" --out "$T/n.tum" --json > "$T/n.json" 2> "$T/err" ||
+  fail "replay of a log without truth: exit $?"
+tail -1 "$T/err" | grep -q "^fploc replay: WARNING: .*notruth.lcm has no FPLOC_GROUND_TRUTH (not a simulator log.*the graph's own plan (.*room.json).*--set NODE.plan.file=PLAN" ||
+  fail "no demo-plan warning as the last line"
+python3 -c "import json,sys; assert json.load(open(sys.argv[1]))['own_plan_without_truth'] is True" "$T/n.json" || fail "JSON own_plan_without_truth"
+"$BIN/fploc-replay" --graph "$R/graphs/replay.pbtxt" --log "$T/log.lcm" --out "$T/s.tum" --json > "$T/s.json" 2> "$T/err" ||
+  fail "replay of the sim log: exit $?"
+grep -q "WARNING: .*not a simulator log" "$T/err" && fail "demo-plan warning for the simulator's own log"
+python3 -c "import json,sys; assert json.load(open(sys.argv[1]))['own_plan_without_truth'] is False" "$T/s.json" || fail "JSON own_plan_without_truth (sim)"
+sets=""
+for n in matcher relocalizer optimizer; do sets="$sets --set $n.plan.file=$R/data/plans/room.json"; done
+# shellcheck disable=SC2086
+"$BIN/fploc-replay" --graph "$R/graphs/replay.pbtxt" --log "$T/notruth.lcm" --out "$T/g.tum" $sets > /dev/null 2> "$T/err" ||
+  fail "replay with the plans given: exit $?"
+grep -q "WARNING: .*not a simulator log" "$T/err" && fail "demo-plan warning with every plan given ($sets)"
+echo "demo-plan warning: OK"
