@@ -125,6 +125,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   if (!cfg_.imu_attitude || !fusion_.has_gyro()) return;
   if (!g.found || lower_.n < 100) {  // (the followed surface is kept for up to 1 s)
     kink_quiet_left_ = 0;
+    kink_armed_ = false;
     return;
   }
   const Eigen::Vector3d up = g.coeffs.head<3>();  // the ground's normal points up (into the room)
@@ -147,22 +148,64 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   // and its distance, the ring fit's plus the difference of the two at the last split (they differ by a few
   // millimetres: the surface's own fit has fewer returns and a tighter cut-off), kept for the rate.
   const double d_followed = g.coeffs[3] + kink_d_offset_;
-  if (kink_quiet_left_ > 0 && carried && t - follow_t_ < kFollowRateMaxDtUs && !ground_attitude &&
+  // A recheck: a scan that would be skipped but for the count (kink_recheck_scans) running out.
+  bool recheck = false;
+  if (carried && t - follow_t_ < kFollowRateMaxDtUs && !ground_attitude &&
       angle(up, prev) < kQuietOffDeg * k::kDeg && std::abs(d_followed - follow_.d) < kQuietStepM) {
     FollowRate next = follow_;
     next.update(t, d_followed, true);
     // The sweep's translation: its rate too low to be corrected, or the tilt it would correct (the last split's
     // measured tilt per unit rate, the same returns seen) within half of kSweepSkewDeg.
     if (!next.stands_out() || kink_skew_per_rate_ * std::abs(next.rate) < 0.5 * k::kSweepSkewDeg * k::kDeg) {
-      follow_ = next;
-      follow_up_ = prev;
-      follow_t_ = t;
-      --kink_quiet_left_;
-      ++kink_skipped_;
-      return;
+      if (kink_quiet_left_ > 0) {
+        follow_ = next;
+        follow_up_ = prev;
+        follow_t_ = t;
+        --kink_quiet_left_;
+        ++kink_skipped_;
+        return;
+      }
+      recheck = kink_armed_;
     }
   }
   kink_quiet_left_ = 0;
+  kink_armed_ = false;
+  // A recheck runs on every kink_recheck_stride-th of the returns near the ring fit (SegmenterConfig): kept when
+  // it finds the one surface again (the ring fit on it, nothing to correct: the scan's planes as they are, the
+  // skipping re-armed), else undone and the split run on all of them, which decides every other outcome.
+  const int stride = std::max(cfg_.kink_recheck_stride, 1);
+  if (recheck && stride > 1) {
+    const FollowRate follow0 = follow_;
+    const Eigen::Vector3d up0 = follow_up_;
+    const int64_t t0 = follow_t_;
+    const double skew0 = kink_skew_per_rate_, offset0 = kink_d_offset_;
+    const Plane g0 = g;
+    const size_t text0 = out_.status_text.size();
+    if (split_ground(t, scan, up, prev, ground_attitude, stride)) {
+      ++kink_thinned_;
+      return;
+    }
+    follow_ = follow0;
+    follow_up_ = up0;
+    follow_t_ = t0;
+    kink_skew_per_rate_ = skew0;
+    kink_d_offset_ = offset0;
+    kink_quiet_left_ = 0;
+    kink_armed_ = false;
+    g = g0;
+    out_.status_text.resize(text0);
+  }
+  split_ground(t, scan, up, prev, ground_attitude, 1);
+}
+
+bool Segmenter::split_ground(int64_t t, const Scan& scan, const Eigen::Vector3d& up, Eigen::Vector3d prev,
+                             bool ground_attitude, int stride) {
+  Plane& g = out_.ground;
+  const auto angle = [](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+    return std::acos(std::clamp(u.dot(v), -1.0, 1.0));
+  };
+  // (a thinned recheck's counts: its sectors' returns are 1 / stride of theirs)
+  const double min_points = double(kMinSectorPoints) / stride;
   const Eigen::Vector3f n0 = g.coeffs.head<3>().cast<float>();
   const float d0 = float(g.coeffs[3]);
   const Eigen::Vector3d ref = -g.coeffs[3] * up;  // numerics: moments relative to the point under the sensor
@@ -176,8 +219,20 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   std::array<int32_t, kSectors> count{};  // returns per sector
   kink_index_.resize(((lower_.n + 7) & ~size_t(7)) + 8);
   kink_sector_.resize(kink_index_.size());
-  const size_t near = kink::cells(lower_.x.data(), lower_.y.data(), lower_.z.data(), lower_.n, n0, d0,
-                                  kink_index_.data(), kink_sector_.data(), count);
+  size_t near = kink::cells(lower_.x.data(), lower_.y.data(), lower_.z.data(), lower_.n, n0, d0,
+                            kink_index_.data(), kink_sector_.data(), count);
+  if (stride > 1) {  // every stride-th return, in order
+    int32_t* ix = kink_index_.data();
+    int16_t* sc = kink_sector_.data();
+    count.fill(0);
+    size_t m = 0;
+    for (size_t k = 0; k < near; k += size_t(stride), ++m) {
+      ix[m] = ix[k];
+      sc[m] = sc[k];
+      ++count[size_t(sc[m])];
+    }
+    near = m;
+  }
   const int32_t* index = kink_index_.data();
   const int16_t* sector = kink_sector_.data();
   // The points grouped by sector (relative to ref), each sector's block padded to a multiple of kPad with a
@@ -229,7 +284,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     }
     for (int s = 0; s < kSectors; ++s) {
       Eigen::Vector3d ev;
-      ok[s] = sm[s].w >= (last ? kMinSectorPoints : 0.25 * kMinSectorPoints) && sm[s].plane(ref, -up, spl[s], &ev);
+      ok[s] = sm[s].w >= (last ? min_points : 0.25 * min_points) && sm[s].plane(ref, -up, spl[s], &ev);
       if (ok[s] && last) {
         // One surface: a sector seeing only a strip (one ring's arc, a wall's foot) has no second in-plane
         // direction; its rms must be that of one surface.
@@ -260,7 +315,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   };
   gather(prev, F);
   bool same_surface = true;  // F is the surface followed in the last scan
-  if (F.sectors < 2 || F.m.w < 4 * kMinSectorPoints) {
+  if (F.sectors < 2 || F.m.w < 4 * min_points) {
     // The surface seen before has left the view (past a ramp's head): the surface of the largest sector, if
     // others agree with it.
     same_surface = false;
@@ -273,9 +328,9 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
       gather(prev, F);
     }
   }
-  if (F.sectors < 2 || F.m.w < 4 * kMinSectorPoints || !F.m.plane(ref, -up, F.pl)) {
+  if (F.sectors < 2 || F.m.w < 4 * min_points || !F.m.plane(ref, -up, F.pl)) {
     follow_.ok = false;
-    return;  // the ring fit as it is
+    return false;  // the ring fit as it is
   }
   // F's plane from its returns, each weighed by its distance to that plane (Tukey, the cut-off shrinking). A
   // sector the kink line passes through (the level floor and the ramp's first metre behind the robot, the
@@ -307,7 +362,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     Eigen::Vector4d pl = F.pl;
     for (const float c : kRefineCutM) {
       const detail::Moments m = moments_near(near_x_.data(), near_y_.data(), near_z_.data(), near_x_.size(), pl, ref, c, false);
-      if (m.w < 2 * kMinSectorPoints || !m.plane(ref, -up, pl)) break;
+      if (m.w < 2 * min_points || !m.plane(ref, -up, pl)) break;
       F.pl = pl;
     }
   }
@@ -355,7 +410,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     }
     const detail::Moments m0 = detail::Moments::of_points(ax, ay, az, m), m1 = detail::Moments::of_points(bx, by, bz, m);
     Eigen::Vector4d p0, p1;
-    if (m0.w < 4 * kMinSectorPoints || !m0.plane(ref, -up, p0) || !m1.plane(ref, -up, p1)) return 0.0;
+    if (m0.w < 4 * min_points || !m0.plane(ref, -up, p0) || !m1.plane(ref, -up, p1)) return 0.0;
     const Eigen::Vector3d nc = (pl.head<3>() + p1.head<3>() - p0.head<3>()).normalized();
     *out = Eigen::Vector4d(nc.x(), nc.y(), nc.z(), pl[3] + p1[3] - p0[3]);
     return angle(nc, pl.head<3>());
@@ -379,7 +434,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     if (ok[s] && angle(spl[s].head<3>(), F.pl.head<3>()) > std::max(far, 3 * ssig[s])) far = angle(spl[s].head<3>(), F.pl.head<3>()), seed = s;
   if (seed >= 0) {
     gather(spl[seed].head<3>(), O);
-    if (O.m.w < 4 * kMinSectorPoints || !O.m.plane(ref, -up, O.pl)) O.sectors = 0;
+    if (O.m.w < 4 * min_points || !O.m.plane(ref, -up, O.pl)) O.sectors = 0;
   }
   const double off_fit = angle(F.pl.head<3>(), up);
   if (O.sectors == 0 && off_fit < k::kKinkFitOffDeg * k::kDeg && !ground_attitude) {
@@ -390,8 +445,10 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
     const double skew = sweep_deskewed ? sweep_corrected(g.coeffs, [](int16_t) { return true; }, follow_.rate, &gc) : 0.0;
     // The ring fit as it is, well within the kink's threshold of the followed surface: the next scans may skip
     // the split while that holds (see the top).
-    if (!sweep_deskewed && off_fit < kQuietOffDeg * k::kDeg) {
+    const bool quiet = !sweep_deskewed && off_fit < kQuietOffDeg * k::kDeg;
+    if (quiet) {
       kink_quiet_left_ = std::max(cfg_.kink_recheck_scans, 1) - 1;
+      kink_armed_ = true;
       // The tilt the sweep's translation gives the followed surface's fit per unit of rate (as measured, or at
       // kQuietRefRateMs: linear for the millimetres to centimetres involved), for the skipped scans' rates.
       Eigen::Vector4d unused;
@@ -407,7 +464,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
                     follow_.rate, skew / k::kDeg);
       out_.note(buf);
     }
-    return;
+    return quiet;  // (quiet: no sweep correction, the planes as they are)
   }
   // The surface under the robot: the one on the sensor's side of the line where the two planes meet. Each
   // group's sectors lie on one side of that line (the other plane is below them: its height of them has one
@@ -434,7 +491,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
   Plane followed = g;
   followed.coeffs = F.pl;
   quality(lower_, followed);
-  if (followed.inliers < scale_.min_plane_inliers) return;  // too little of it: the ring fit as it is
+  if (followed.inliers < scale_.min_plane_inliers) return false;  // too little of it: the ring fit as it is
   // The height is the distance to the surface under the robot. Where the ground gives the attitude (no
   // ceiling, or one that disagrees with the ring fit: AttitudeHeight then takes the ground), the followed
   // surface replaces the ring fit, so that GravityFusion sees one surface (its own rotation) or a clean step
@@ -466,6 +523,7 @@ void Segmenter::split_ground_at_kink(int64_t t, const Scan& scan) {
                   follow_.rate, sweep_skew / k::kDeg);
     out_.status_text += buf;
   }
+  return false;
 }
 
 }  // namespace fploc::seg

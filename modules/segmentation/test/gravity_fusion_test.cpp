@@ -48,6 +48,7 @@ struct Result {
   bool said_two_surfaces = false;
   std::vector<Eigen::Vector4d> zrp;  // per scan: z, roll, pitch, the ground's distance above the surface under it
   int64_t kink_skipped = 0;          // scans whose ground-at-a-kink split was skipped
+  int64_t kink_thinned = 0;          // rechecks settled on the thinned returns (kink_recheck_stride)
 };
 
 // Drives the trajectory pose(t) (t in s) for n scans of 0.1 s. The IMU (100 Hz, or 1 kHz with column times)
@@ -136,6 +137,7 @@ Result drive(const synth::Room& room, const std::function<SensorPose(double)>& p
                   out.status_text.c_str());
   }
   r.kink_skipped = seg.kink_splits_skipped();
+  r.kink_thinned = seg.kink_rechecks_thinned();
   return r;
 }
 
@@ -202,12 +204,13 @@ TEST(GravityFusion, GroundAtTheRampsFootAndHeadIsTheSurfaceUnderTheRobot) {
 // While one surface is followed steadily (the level floor, then the ramp, then the landing, each under the ceiling
 // that gives the attitude), the ground-at-a-kink split is skipped on up to kink_recheck_scans - 1 scans in a row;
 // approaching, crossing and leaving the ramp's foot and head it runs on every scan. The outputs are those of the
-// split run on every scan (kink_recheck_scans = 1): z within 1 mm, roll/pitch within 0.01 deg, the ground's
+// split run on every scan on every return (kink_recheck_scans = 1, kink_recheck_stride = 1): z within 1 mm, roll/pitch within 0.01 deg, the ground's
 // distance to the surface under the robot within 1 mm.
 TEST(GravityFusion, KinkSplitIsSkippedOnlyWhileOneSurfaceIsFollowed) {
   const auto room = ramp_hall();
   SegmenterConfig every;
   every.kink_recheck_scans = 1;
+  every.kink_recheck_stride = 1;  // (the split on every scan, on every return)
   const auto run = [&](const SegmenterConfig& cfg) {
     return drive(room, [&](double t) { return ramp_pose(room, t); }, wobbly_acc, 310, true, 1, 11,
                  [&](double t) { return on_ramp(room, t); }, Eigen::Vector3d::Zero(), cfg);
@@ -233,6 +236,13 @@ TEST(GravityFusion, KinkSplitIsSkippedOnlyWhileOneSurfaceIsFollowed) {
   EXPECT_LT(drp, 0.01 * kDeg);
   EXPECT_LT(dd, 0.001);
   EXPECT_TRUE(b.said_two_surfaces);
+  // The default's rechecks run on every second return near the ring fit (kink_recheck_stride 2): most of them
+  // settled so (the outputs above within the same bounds of the split on every scan); with stride 1 none.
+  EXPECT_GT(b.kink_thinned, 5);
+  EXPECT_EQ(a.kink_thinned, 0);
+  EXPECT_EQ(c.kink_thinned > 0, true);
+  std::printf("rechecks settled on every second return: %lld (kink_recheck_scans 4: %lld)\n", (long long)b.kink_thinned,
+              (long long)c.kink_thinned);
   EXPECT_LT(b.max_kink_z_err, 0.02);
 }
 

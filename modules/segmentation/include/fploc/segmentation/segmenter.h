@@ -60,6 +60,8 @@ class Segmenter {
   const Eigen::Vector3d& gyro_bias() const { return deskew_.bias(); }  // rad/s, perpendicular-to-gravity part
   // Scans whose ground-at-a-kink split was skipped, one surface followed steadily (SegmenterConfig::kink_recheck_scans).
   int64_t kink_splits_skipped() const { return kink_skipped_; }
+  // Rechecks of a steadily followed surface that the thinned returns settled (SegmenterConfig::kink_recheck_stride).
+  int64_t kink_rechecks_thinned() const { return kink_thinned_; }
   // Plane fits that refined last frame's plane without the start search (SegmenterConfig::start_recheck_scans).
   int64_t steady_plane_fits() const { return fit_->steady_fits(); }
   // Last scan's points per pixel (row-major like the scan, de-skewed when last().deskewed; NaN where there
@@ -76,6 +78,11 @@ class Segmenter {
   // above the one under the robot (ground_kink.cpp). t: the planes' time (mid-sweep).
   // scan: its column times (the sweep's translation, which the gyro de-skew leaves in the points).
   void split_ground_at_kink(int64_t t, const Scan& scan);
+  // The split itself on every stride-th return near the ring fit (up: the ring fit's normal, prev: the followed
+  // surface carried to t); true when it found the one surface again and re-armed the skipping (the planes
+  // unchanged).
+  bool split_ground(int64_t t, const Scan& scan, const Eigen::Vector3d& up, Eigen::Vector3d prev, bool ground_attitude,
+                    int stride);
   // No ground found: the ground fitted around gravity as the gyro carries it to t, the planes' time (segmenter.cpp).
   void refit_ground_around_gravity(int64_t t);
   void select_walls(const Scan& scan, const Eigen::Vector3d& up);
@@ -140,6 +147,8 @@ class Segmenter {
   double kink_skew_per_rate_ = 0;   // the last split's sweep tilt of the followed surface per m/s of the rate [rad s/m]
   double kink_d_offset_ = 0;         // the last split's followed surface's distance - the ring fit's [m]
   int64_t kink_skipped_ = 0;
+  bool kink_armed_ = false;     // the last split re-armed the skipping (the next one that runs while quiet: a recheck)
+  int64_t kink_thinned_ = 0;    // rechecks kept from the thinned returns (kink_recheck_stride)
   // ground_kink.cpp's scratch, kept from scan to scan: the lower candidates near the ring fit's plane (their
   // indices and sectors), and the sectors' points grouped (sector by sector, relative to the plane's reference
   // point), the followed surface's.

@@ -26,6 +26,11 @@ struct SegmenterConfig {
   // 8: a second surface that comes into view without moving the ring fit is split off at most 0.7 s (10 Hz) later;
   // the ring fit itself leaving the followed surface (a kink under the robot) ends the skipping on that scan.
   int kink_recheck_scans = 8;
+  // The recheck at the end of those scans (the surface still followed steadily) runs on every
+  // kink_recheck_stride-th of the returns near the ring fit, its sectors' minimum counts divided by it; when it
+  // finds the one surface again (the planes as they are) that stands, else it is undone and the split runs on
+  // every return, which decides every other outcome (1: every return always).
+  int kink_recheck_stride = 2;
   // The plane fits' start (ring_plane_fit.cpp): the seeds, the seed regression, the seed triplets and last frame's
   // plane scored on a subsample, the best refined, then last frame's plane refined too. While a plane is followed
   // steadily (the last search's start was last frame's plane, or the refinement from it joined the best start's)
