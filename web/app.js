@@ -91,6 +91,8 @@ map.layers.push((c, v) => {
       matched += near[k];
     }
     S.featuresMatched = n ? matched / n : null;
+    // What was drawn, for the browser test: the scan, its points on the plan and which of them count as matched.
+    S.featuresDrawn = { scan_seq: f.scan_seq, wx, wy, near };
     for (const kind of ['s', 'c']) {
       for (const m of [1, 0]) {
         c.beginPath();

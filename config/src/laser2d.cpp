@@ -62,6 +62,8 @@ laser2d::GridLocalizerConfig config_of(const Grid2dOptions& o) {
   c.global_after_lost_scans = o.global_after_lost_scans();
   if (given(o.global_confirm_inlier_ratio(), "grid2d", "global_confirm_inlier_ratio"))
     c.global_confirm_inlier_ratio = o.global_confirm_inlier_ratio();
+  if (o.global_budget_s() < 0) c.global_budget_s = 0;  // no budget
+  else if (o.global_budget_s() > 0) c.global_budget_s = o.global_budget_s();
   return c;
 }
 

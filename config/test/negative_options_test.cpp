@@ -27,7 +27,7 @@ const std::set<std::string> kSigned = {
     "matcher.plan_diff_weight", "matcher.as_built_loss_scale_m", "optimizer.max_points",
     "optimizer.keyframe_interval_s", "optimizer.max_final_delay_s", "optimizer.plan_diff_weight",
     "optimizer.as_built_loss_scale_m", "grid2d.confirm_within_sigmas", "grid2d.far_confirm_travel_m",
-    "grid2d.laser_conflict_inlier_ratio", "grid2d.mount_x_m", "grid2d.mount_y_m", "grid2d.mount_yaw_deg", "grid2d.z_m",
+    "grid2d.laser_conflict_inlier_ratio", "grid2d.global_budget_s", "grid2d.mount_x_m", "grid2d.mount_y_m", "grid2d.mount_yaw_deg", "grid2d.z_m",
     "laser2d.mount_x_m", "laser2d.mount_y_m", "laser2d.mount_yaw_deg", "laser2d.z_m",
 };
 

@@ -39,6 +39,20 @@ class CloudToScanNode : public fploc::rt::Node {
       ctx_->error("cloud seq " + std::to_string(m.seq) + " from " + m.source + ": " + err);
       return;
     }
+    // An organised cloud with stray points (binned by azimuth, the rest keeps its columns): said when it starts or
+    // its count of rings binned whole changes, not for every cloud.
+    const int strays = stats.stray_points || stats.relabelled_points ? 1 + stats.azimuth_rings : 0;
+    if (strays != last_strays_) {
+      last_strays_ = strays;
+      if (strays)
+        ctx_->status_changed("cloud seq " + std::to_string(m.seq) + " from " + m.source + ": organised, " +
+                             std::to_string(stats.stray_points) + " stray points binned by azimuth (off their ring's row "
+                             "or more than a column off its shift; " + std::to_string(stats.azimuth_rings) +
+                             " rings whole), " + std::to_string(stats.relabelled_points) +
+                             " points with a ring value no row has taken as their row's ring");
+      else
+        ctx_->status_changed("cloud seq " + std::to_string(m.seq) + " from " + m.source + ": no stray points", false);
+    }
     // As `fploc import --decode` names and numbers them.
     scan_.seq = m.seq;
     scan_.frame_id = int32_t(m.seq & 0xFFFF);
@@ -48,6 +62,7 @@ class CloudToScanNode : public fploc::rt::Node {
   }
 
   fploc::rt::Context* ctx_ = nullptr;
+  int last_strays_ = 0;  // 0: the last cloud had no stray points; else 1 + its rings binned by azimuth whole
   fploc::rec::CloudOptions opt_;
   fploc::rec::PointCloud2 cloud_;
   fploc::Scan scan_;  // buffers reused from cloud to cloud

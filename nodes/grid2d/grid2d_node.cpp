@@ -100,12 +100,13 @@ class Grid2dNode : public fploc::rt::Node {
     const auto pts = l2::scan_points(m.ranges, m.angle_min, m.angle_increment, rmin, rmax, mount_, upside_down_);
     std::optional<Pose2> odom;
     if (odom_ && odom_utime_ <= m.utime) odom = odom_;
-    const l2::GridResult r = loc_->update(pts, odom);
+    const l2::GridResult r = loc_->update(pts, odom, double(m.utime) * 1e-6);
     if (debug_)
       std::cerr << "[grid2d] " << seq_ << " " << r.pose.x << " " << r.pose.y << " " << r.pose.yaw * 180 / M_PI << " status "
                 << int(r.status) << " inl " << r.inlier_ratio << " n " << r.num_points << " win " << r.search_xy_m << " m "
                 << r.search_yaw_rad * 180 / M_PI << " deg score " << r.score << "\n";
     say_status(r, c);
+    say_global(r, c);
     // While the whole map is searched there is no estimate: the pose is a placeholder (the map's centre), published
     // with status 3 (NOT_INITIALISED, "no estimate", as frame_pose_t's) so that loggers and scores leave it out.
     const int8_t status = r.global && r.status != l2::GridStatus::kOk ? int8_t(l2::GridStatus::kNotInitialised) : int8_t(r.status);
@@ -157,7 +158,44 @@ class Grid2dNode : public fploc::rt::Node {
     ctx_->status_changed(line, true, !printed);
   }
 
+  // Global localization: its progress in telemetry's detail on every scan (and on stderr every 30 s of sensor time),
+  // and once, when it runs out of global_budget_s, that it gave up (an error: the node will not localize by itself).
+  void say_global(const l2::GridResult& r, const l2::GridLocalizerConfig& c) {
+    char line[400];
+    if (r.global_gave_up) {
+      if (said_gave_up_) return;
+      said_gave_up_ = true;
+      std::snprintf(line, sizeof line,
+                    "global localization gave up after %.1f s of sensor time (grid2d.global_budget_s %.0f s): no place of "
+                    "the whole map dominated (%zu still matched); LOST until restarted with grid2d.initial_pose "
+                    "(or a longer budget)", r.global_elapsed_s, c.global_budget_s, r.places.size());
+      const bool printed = ctx_->error("scan " + std::to_string(seq_) + ": " + line);
+      ctx_->status_changed("scan " + std::to_string(seq_) + ": LOST: " + line, true, !printed);
+      return;
+    }
+    if (!r.global) return;
+    said_gave_up_ = false;
+    const l2::GridPlace* lead = r.places.empty() ? nullptr : &r.places.front();
+    char budget[64] = "no budget";
+    if (c.global_budget_s > 0) std::snprintf(budget, sizeof budget, "budget %.0f s", c.global_budget_s);
+    if (lead)
+      std::snprintf(line, sizeof line, "global localization: %.1f s searched (%s), %zu place(s) tracked; the leader "
+                    "(%.2f, %.2f, %.0f deg) matched %d scan(s), %.0f %% inliers on average, over %.1f m",
+                    r.global_elapsed_s, budget, r.places.size(), lead->pose.x, lead->pose.y, lead->pose.yaw * 180 / M_PI,
+                    lead->hits, 100 * lead->mean_inlier_ratio, lead->travel_m);
+    else
+      std::snprintf(line, sizeof line, "global localization: %.1f s searched (%s), no place of the whole map matches yet",
+                    r.global_elapsed_s, budget);
+    ctx_->set_detail(line);
+    if (r.global_elapsed_s >= next_progress_s_) {
+      next_progress_s_ = r.global_elapsed_s + 30;
+      std::cerr << "[" << ctx_->name() << "] scan " << seq_ << ": " << line << "\n";
+    }
+  }
+
   fploc::rt::Context* ctx_ = nullptr;
+  bool said_gave_up_ = false;
+  double next_progress_s_ = 30;  // the first progress line after 30 s (the status line says the start)
   l2::GridStatus said_status_ = l2::GridStatus::kNotInitialised;  // the first scan's status is said too
   int bad_run_ = 0;
   std::unique_ptr<l2::GridLocalizer> loc_;

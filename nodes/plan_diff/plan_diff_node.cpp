@@ -3,9 +3,10 @@
 // shipped graphs) and fed to modules/plandiff; the flagged elements and the new structure found so far are
 // published on FPLOC_PLAN_DIFF (plan_diff_t) at publish_hz of sensor time, so a composed replay is
 // deterministic. With out_json / out_dxf set, the final diff is written at shutdown.
-// Optional input `segments` (FPLOC_SEGMENTS, unconnected by default): the segmenter's 3D wall points of the same scan
-// (utime), which tell a new wall from furniture (plandiff::Options::new_min_height_m); without it new runs are not
-// told by height.
+// Optional input `segments` (FPLOC_SEGMENTS; connected in graphs/realism*.pbtxt, unconnected by default): the
+// segmenter's 3D wall points of the same scan (utime), which tell a new wall from furniture
+// (plandiff::Options::new_min_height_m); without it new runs are not told by height. Only the scans it will use
+// are read (frame_hz), and none with new_min_height_m 0.
 #include <fploc/features_t.hpp>
 #include <fploc/plan_diff_t.hpp>
 #include <fploc/pose_t.hpp>
@@ -59,8 +60,10 @@ class PlanDiffNode : public fploc::rt::Node {
       features_.push_back(fploc::adapters::from_msg(m));
       while (features_.size() > 30) features_.pop_front();
     });
-    if (!ctx.channel("segments").empty())
+    if (!ctx.channel("segments").empty() && ps.diff.new_min_height_m > 0)
       ctx.subscribe<fploc::segments_t>("segments", [this](const fploc::segments_t& m) {
+        // A scan frame_hz leaves out (last_frame_ only grows) needs no heights.
+        if (frame_us_ > 0 && last_frame_ != 0 && m.utime - last_frame_ < frame_us_) return;
         heights_.emplace_back(m.utime, fploc::adapters::heights_of(m));
         while (heights_.size() > 30) heights_.pop_front();
       });

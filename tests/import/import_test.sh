@@ -192,7 +192,7 @@ for c in none bz2 lz4; do
   # Its /os/metadata is not a full sensor metadata: those 3 messages are skipped, exit 3.
   rc=0; "$B/fploc-import" "$T/py_$c.bag" --out "$T/py_$c.lcm" --tum-out "$T/py.tum" --json > "$T/py_$c.json" 2>/dev/null || rc=$?
   [ "$rc" = 3 ] || { echo "py_$c.bag: exit $rc, expected 3 (metadata messages skipped)"; exit 1; }
-  check "$T/py_$c.json" "j['not_decoded']['/os/metadata']['count']==3 and j['written']['POINT_CLOUD']==3 and j['replay_graph']=='graphs/replay-clouds.pbtxt' and j['clouds']['/points']['mode']=='clouds' and j['written']['LASER_SCAN']==3 and j['written']['OS1_IMU']==3 and j['written']['OS1_IMU_PACKETS']==3 and j['written']['(tum /odom)']==3 and j['clouds']['/points']['kept']==24"
+  check "$T/py_$c.json" "j['not_decoded']['/os/metadata']['count']==3 and j['written']['POINT_CLOUD']==3 and j['replay_graph']=='graphs/replay-clouds.pbtxt' and j['clouds']['/points']['mode']=='clouds' and j['written']['LASER_SCAN']==3 and j['written']['OS1_IMU']==3 and j['written']['OS1_IMU_PACKETS']==3 and j['written']['(tum /odom)']==3 and j['clouds']['/points']['kept']==24 and j['clouds']['/points']['stray_points']==0 and j['clouds']['/points']['clouds_with_stray_points']==0"
 done
 # MCAP from the MCAP project's writer (zstd chunks): PointCloud2 (Velodyne + Hesai layouts), Imu,
 # LaserScan -> LCM; tf -> TUM.

@@ -442,6 +442,18 @@ int main(int argc, char** argv) {
   std::map<std::string, int64_t> seq;
   CloudStats cstats;
   std::map<std::string, CloudStats> cloud_info;
+  // Per topic, the converted clouds organised but with stray points (binned by azimuth) or relabelled ones.
+  struct StrayTally { uint64_t clouds = 0, with = 0, stray = 0, relabelled = 0; int rings = 0; };
+  std::map<std::string, StrayTally> stray_tally;
+  auto tally = [&](const std::string& topic, const CloudStats& st) {
+    auto& t = stray_tally[topic];
+    ++t.clouds;
+    if (!st.stray_points && !st.relabelled_points) return;
+    ++t.with;
+    t.stray += st.stray_points;
+    t.relabelled += st.relabelled_points;
+    t.rings = std::max(t.rings, st.azimuth_rings);
+  };
   int64_t first_ns = INT64_MIN;
   const auto t_start = std::chrono::steady_clock::now();
   auto last_progress = t_start;
@@ -558,6 +570,7 @@ int main(int argc, char** argv) {
           const std::string& ch = channel_for(c, k);
           if (!cloud_info.count(c.topic)) {
             if (!cloud_to_scan(pc, cloud_opt, cloud_scan, &cstats, &err)) cloud_check_error[c.topic] = err;
+            else tally(c.topic, cstats);
             cloud_info[c.topic] = cstats;
           }
           if (!out.empty()) {
@@ -576,6 +589,7 @@ int main(int argc, char** argv) {
         s.frame_id = int32_t(s.seq & 0xFFFF);
         s.sensor = "PointCloud2 " + c.topic + " (" + std::to_string(s.height) + " rings)";
         cloud_info[c.topic] = cstats;
+        tally(c.topic, cstats);
         if (!out.empty())
           if (uint8_t* p = lcm_log.begin_event(ch, m.time_ns / 1000, fploc::import::encoded_scan_size(s)))
             fploc::import::encode_scan(s, p);
@@ -710,6 +724,17 @@ int main(int argc, char** argv) {
   if (main_laser && main_laser->found && !main_laser->level())
     warnings.push_back("LASER_SCAN (" + printable(main_laser->topic) + ") " + main_laser->describe() +
                        "; give a level laser with --channel TOPIC=LASER_SCAN");
+  for (const auto& [t, tl] : stray_tally)
+    if (tl.with) {
+      std::string w = "cloud " + printable(t) + ": " + std::to_string(tl.with) + " of " + std::to_string(tl.clouds) +
+                      (decode_ouster ? " clouds" : " cloud (the first)") + " organised with stray points: " +
+                      std::to_string(tl.stray) + " points binned by azimuth (off their ring's row, more than a column "
+                      "off its shift" + (tl.rings ? ", or of a ring binned whole: up to " + std::to_string(tl.rings) +
+                      (tl.rings == 1 ? " ring" : " rings") + " a cloud" : std::string()) + ")";
+      if (tl.relabelled)
+        w += ", " + std::to_string(tl.relabelled) + " points with a ring value no row has taken as their row's ring";
+      warnings.push_back(w + "; the other points keep their columns");
+    }
 
   if (json) {
     nlohmann::json j;
@@ -739,7 +764,9 @@ int main(int argc, char** argv) {
       j["clouds"][t] = {{"mode", decode_ouster ? "scans" : "clouds"}, {"ring_source", s.ring_source}, {"time_source", s.time_source}, {"points", s.points}, {"kept", s.kept},
                         {"collisions", s.collisions}, {"max_azimuth_error_deg", s.max_azimuth_error_deg},
                         {"column_source", s.column_source}, {"zero_range", s.zero_range}, {"not_finite", s.not_finite},
-                        {"too_far", s.too_far}};
+                        {"too_far", s.too_far}, {"stray_points", s.stray_points}, {"azimuth_rings", s.azimuth_rings},
+                        {"relabelled_points", s.relabelled_points},
+                        {"clouds_with_stray_points", stray_tally.count(t) ? stray_tally[t].with : 0}};
     for (const auto& lm : mounts) {
       nlohmann::json l = {{"frame", lm.frame}, {"channel", topic_channel.count(lm.topic) ? topic_channel[lm.topic] : ""},
                           {"mount_found", lm.found}};

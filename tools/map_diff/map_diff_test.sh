@@ -29,6 +29,16 @@ grep -q '^  element [0-9]* ([a-z]*): \(missing\|moved\).*, length [0-9.]* m, ' "
 grep -q "plan_diff.plan.file=PLAN" "$T/help" && grep -q -- "--plan PLAN" "$T/help" && ! grep -q "e.g. matcher.plan.file" "$T/help" ||
   { cat "$T/help"; exit 1; }
 test -s "$T/node.json"   # the node wrote its own diff at shutdown
+# The shipped graph's plan_diff node reads the segmenter's 3D wall points (FPLOC_SEGMENTS): it told new structure by
+# height. The recorded log leaves FPLOC_SEGMENTS out (--record's default): the offline diff still runs, says that the
+# heights were not checked, and its JSON says so.
+/usr/bin/python3 -c '
+import json, sys
+n, d = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+assert n["heights_checked"] and n["height_frames"] > 0, ("node", n["heights_checked"], n["height_frames"])
+assert not d["heights_checked"] and d["height_frames"] == 0, ("map diff", d["heights_checked"])' "$T/node.json" "$T/diff.json"
+grep -q "^fploc map diff: $T/run.lcm has no FPLOC_SEGMENTS (segments_t): the heights of new structure were not checked" "$T/main.err" ||
+  { cat "$T/main.err"; exit 1; }
 for l in FPLOC-MISSING FPLOC-MOVED FPLOC-NEW; do grep -qx "$l" "$T/diff.dxf"; done
 "$B/fploc-map" render --plan "$T/diff.dxf" --out "$T/diff.svg" 2>/dev/null
 test -s "$T/diff.svg"

@@ -91,6 +91,9 @@ struct GridLocalizer::Impl {
   std::vector<Hypothesis> hyps;
   // Global localization: searching the whole map (start_global, or LOST for global_after_lost_scans).
   bool global = false;
+  bool gave_up = false;                 // the whole-map search ran out of global_budget_s
+  double stamp = std::numeric_limits<double>::quiet_NaN();     // this scan's time (NaN: not given)
+  double global_t0 = std::numeric_limits<double>::quiet_NaN();  // the whole-map search's first stamped scan
   int next_place_id = 0;
   std::vector<uint8_t> free_cells;  // per cell of the field (row-major, row 0 bottom): 1 known free (set_free_space)
   Pose2 global_centre;              // the whole-map window: the free cells' (else the field's) world bounding box
@@ -180,6 +183,18 @@ struct GridLocalizer::Impl {
   // Global localization's scan: the hypotheses tracked, new ones from the whole-map search, and one taken when it
   // dominates (GridLocalizerConfig::global_*); else LOST at the leading hypothesis.
   GridResult global_step(const std::vector<Eigen::Vector2d>& pts, GridResult res);
+  // LOST after the whole-map search gave up: where it was, with the whole map's spread.
+  GridResult gave_up_result(GridResult res) {
+    ++poor_run;
+    res.global = false;
+    res.global_gave_up = true;
+    if (std::isfinite(stamp) && std::isfinite(global_t0)) res.global_elapsed_s = stamp - global_t0;
+    res.pose = pose;
+    res.status = GridStatus::kLost;
+    res.hypotheses = 0;
+    res.covariance = Eigen::Vector3d(global_half_m * global_half_m, global_half_m * global_half_m, M_PI * M_PI).asDiagonal();
+    return res;
+  }
 
   // On a laser step: the fit in the window the wheels' model would have grown since the last fit (the laser
   // steps' own window can be too small: a laser increment wrong by more than its sigma, or a pose the last fits
@@ -257,6 +272,7 @@ void GridLocalizer::set_initial_pose(const Pose2& pose) {
   impl_->recent_inliers.clear();
   impl_->first = true;
   impl_->global = false;
+  impl_->gave_up = false;
   impl_->hyps.clear();
   have_pose_ = true;
 }
@@ -288,6 +304,7 @@ void GridLocalizer::set_free_space(const OccupancyGrid& g) {
 void GridLocalizer::start_global() {
   set_initial_pose(impl_->global_centre);
   impl_->global = true;
+  impl_->global_t0 = std::numeric_limits<double>::quiet_NaN();
 }
 
 std::vector<Eigen::Vector2d> scan_points(const std::vector<float>& ranges, double angle_min, double increment,
@@ -396,6 +413,18 @@ GridResult GridLocalizer::Impl::global_step(const std::vector<Eigen::Vector2d>& 
   res.global = true;
   res.search_xy_m = global_half_m;
   res.search_yaw_rad = M_PI;
+  if (std::isfinite(stamp)) {
+    if (!std::isfinite(global_t0)) global_t0 = stamp;
+    res.global_elapsed_s = stamp - global_t0;
+  }
+  // Out of budget: give up before this scan's search (LOST, no whole-map search until a new start).
+  if (cfg.global_budget_s > 0 && res.global_elapsed_s > cfg.global_budget_s) {
+    global = false;
+    gave_up = true;
+    for (const auto& h : hyps) res.places.push_back({h.id, h.pose, h.hits, h.mean(), h.lowest, h.travel_m});
+    hyps.clear();
+    return gave_up_result(res);
+  }
   if (pts.size() >= 10) {
     track_hypotheses(pts);
     SearchWindow win;
@@ -475,7 +504,13 @@ GridResult GridLocalizer::Impl::global_step(const std::vector<Eigen::Vector2d>& 
 }
 
 GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points, const std::optional<Pose2>& odom) {
+  return update(points, odom, std::numeric_limits<double>::quiet_NaN());
+}
+
+GridResult GridLocalizer::update(const std::vector<Eigen::Vector2d>& points, const std::optional<Pose2>& odom,
+                                 double stamp_s) {
   Impl& m = *impl_;
+  m.stamp = stamp_s;
   m.raw_inc.reset();
   GridResult res = step(points, odom);
   // Calibration: a pair of consecutive good fits (>= min_inlier_ratio, from tracking; a confirmed
@@ -600,9 +635,12 @@ GridResult GridLocalizer::step(const std::vector<Eigen::Vector2d>& points_in, co
 
   res.num_points = int(pts.size());
   // Global localization: from start_global, or a kidnapped robot (LOST for global_after_lost_scans scans).
+  if (m.gave_up) return m.gave_up_result(res);
   if (!m.global && cfg_.reacquire && cfg_.global_after_lost_scans > 0 &&
-      m.poor_run >= cfg_.lost_after + cfg_.global_after_lost_scans)
+      m.poor_run >= cfg_.lost_after + cfg_.global_after_lost_scans) {
     m.global = true;
+    m.global_t0 = std::numeric_limits<double>::quiet_NaN();
+  }
   if (m.global) return m.global_step(pts, res);
   auto keep_prediction = [&]() {
     m.pose = pred;

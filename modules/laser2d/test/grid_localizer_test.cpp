@@ -818,3 +818,54 @@ TEST(GridLocalizer, GlobalStartStaysLostOnASymmetricRoom) {
             << w.first_ok << ", " << w.first_ok_err_m << " m off, " << w.wrong_ok << " wrong OK of " << w.ok << "\n";
   EXPECT_GT(w.ok, 0) << "the control never locked: the symmetric room does not test the rule";
 }
+
+// The whole-map search's time budget (global_budget_s, in the scans' time): on the symmetric room no place can be
+// taken, so without a budget every scan searches the whole map for ever. With 10 s (scans 1 s apart) the search runs
+// while the elapsed time is within the budget (telemetry: global_elapsed_s), then gives up: LOST, global_gave_up, no
+// whole-map search on later scans; a given pose starts tracking again. Scans without a stamp, or budget 0: no budget.
+TEST(GridLocalizer, GlobalSearchGivesUpAfterItsBudget) {
+  const OccupancyGrid g = make_symmetric_room();
+  std::vector<Pose2> path = symmetric_room_path();
+  const auto back = symmetric_room_path();
+  path.insert(path.end(), back.rbegin(), back.rend());  // there and back: 2 x 26 scans
+  const auto odo = odometry(path);
+  auto run = [&](double budget_s, bool stamps, int* searched, int* gave_up_at) {
+    l2::GridLocalizerConfig c;
+    c.global_budget_s = budget_s;
+    l2::GridLocalizer loc(std::make_shared<fploc::DistanceField>(g, 1.0), c);
+    loc.set_free_space(g);
+    loc.start_global();
+    std::mt19937 rng(5);
+    *searched = 0;
+    *gave_up_at = -1;
+    for (size_t k = 0; k < path.size(); ++k) {
+      const auto pts = cast(g, path[k], rng);
+      const auto res = stamps ? loc.update(pts, odo[k], 1000.0 + double(k)) : loc.update(pts, odo[k]);
+      EXPECT_NE(res.status, l2::GridStatus::kOk) << k;
+      *searched += res.wide_search;
+      if (res.global) EXPECT_NEAR(res.global_elapsed_s, stamps ? double(k) : 0.0, 1e-9) << k;
+      if (res.global_gave_up && *gave_up_at < 0) *gave_up_at = int(k);
+      if (*gave_up_at >= 0) {
+        EXPECT_TRUE(res.global_gave_up) << k;  // it stays given up
+        EXPECT_FALSE(res.global) << k;
+        EXPECT_EQ(res.status, l2::GridStatus::kLost) << k;
+        EXPECT_EQ(res.hypotheses, 0) << k;
+      }
+    }
+    // A given pose: tracking again.
+    loc.set_initial_pose(path.back());
+    const auto res = loc.update(cast(g, path.back(), rng), odo.back(), 2000.0);
+    EXPECT_FALSE(res.global_gave_up);
+    EXPECT_EQ(res.status, l2::GridStatus::kOk);
+  };
+  int searched = 0, gave_up_at = 0;
+  run(10.0, true, &searched, &gave_up_at);
+  EXPECT_EQ(gave_up_at, 11);  // elapsed 11 s > 10 s: no search on that scan
+  EXPECT_EQ(searched, 11);
+  run(0.0, true, &searched, &gave_up_at);  // no budget: every scan searched
+  EXPECT_EQ(gave_up_at, -1);
+  EXPECT_EQ(searched, int(path.size()));
+  run(10.0, false, &searched, &gave_up_at);  // no stamps: no budget
+  EXPECT_EQ(gave_up_at, -1);
+  EXPECT_EQ(searched, int(path.size()));
+}

@@ -163,6 +163,28 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
   std::vector<double> alt;
   if (gr.ok() && opt.rings == 0) {
     s.ring_source = "field '" + ring_name + "'";
+    // An organised cloud (most rows each the row of one ring value): a point whose ring value has no row of its own
+    // (one bad value, a ring the driver mislabelled) is a point of its row's ring, the row being its beam.
+    if (c.height > 1 && c.height <= 1024) {
+      std::vector<uint32_t> cnt(size_t(1024) * c.height, 0), tot(1024, 0);
+      for (const auto& q : pts) ++cnt[size_t(q.ring) * c.height + q.row], ++tot[size_t(q.ring)];
+      std::vector<int> owner(c.height, -1);
+      for (int ring = 0; ring < 1024; ++ring) {
+        if (!tot[size_t(ring)]) continue;
+        const uint32_t* row = &cnt[size_t(ring) * c.height];
+        const uint32_t best = uint32_t(std::max_element(row, row + c.height) - row);
+        if (2 * uint64_t(row[best]) < tot[size_t(ring)]) continue;  // no row holds half of it
+        int& o = owner[best];
+        if (o < 0 || cnt[size_t(o) * c.height + best] < row[best]) o = ring;
+      }
+      std::vector<uint8_t> has_row(1024, 0);
+      uint32_t rows_owned = 0;
+      for (int o : owner)
+        if (o >= 0) has_row[size_t(o)] = 1, ++rows_owned;
+      if (2 * rows_owned > c.height)
+        for (auto& q : pts)
+          if (!has_row[size_t(q.ring)] && owner[q.row] >= 0) q.ring = owner[q.row], ++s.relabelled_points;
+    }
     std::vector<std::pair<double, int>> acc(1024, {0.0, 0});
     for (const auto& q : pts) {
       auto& a = acc[size_t(q.ring)];
@@ -216,9 +238,29 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
       alt.push_back(cnt[size_t(r)] ? std::asin(std::clamp(sum[size_t(r)] / cnt[size_t(r)], -1.0, 1.0)) * 180.0 / M_PI : 0.0);
   }
 
+  // Each ring's row in an organised cloud: the row holding at least half of its points, unless another ring holds
+  // more there. Rows that are rings for most of the cloud make it organised (W its width).
+  std::vector<int64_t> ring_row(size_t(nrings), -1);
+  uint32_t rows_owned = 0;
+  if (c.height > 1 && c.height <= 1024) {
+    std::vector<uint32_t> cnt(size_t(nrings) * c.height, 0), tot(size_t(nrings), 0);
+    for (size_t i = 0; i < pts.size(); ++i) ++cnt[size_t(ring_of[i]) * c.height + pts[i].row], ++tot[size_t(ring_of[i])];
+    std::vector<int> owner(c.height, -1);
+    for (int u = 0; u < nrings; ++u) {
+      if (!tot[size_t(u)]) continue;
+      const uint32_t* row = &cnt[size_t(u) * c.height];
+      const uint32_t best = uint32_t(std::max_element(row, row + c.height) - row);
+      if (2 * uint64_t(row[best]) < tot[size_t(u)]) continue;
+      int& o = owner[best];
+      if (o < 0 || cnt[size_t(o) * c.height + best] < row[best]) o = u;
+    }
+    for (uint32_t r = 0; r < c.height; ++r)
+      if (owner[r] >= 0) ring_row[size_t(owner[r])] = r, ++rows_owned;
+  }
+  const bool rows_are_rings = c.height > 1 && 2 * rows_owned > c.height;
   int W = opt.columns;
   if (W <= 0) {
-    if (c.height > 1 && int(c.height) == nrings) {
+    if (c.height > 1 && (int(c.height) == nrings || rows_are_rings)) {
       W = int(c.width);
     } else {
       std::vector<int> per(size_t(nrings), 0);
@@ -228,10 +270,13 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
   }
   W = std::clamp(W, 8, 16384);
 
-  // An organised cloud (one ring per row, W its width): each point's column in the cloud, shifted per ring by the
-  // rounded median of (azimuth column - cloud column), is its pixel, one point per pixel, when every point of the ring
-  // lies within a column of that shift. Binning by azimuth instead puts two neighbours of a ring whose azimuths
-  // straddle a column edge (a beam azimuth offset near half a column, a motion-compensated cloud) into one pixel.
+  // An organised cloud (a ring per row, W its width): each point's column in the cloud, shifted per ring by the
+  // rounded median of (azimuth column - cloud column), is its pixel, one point per pixel. Binning by azimuth instead
+  // puts two neighbours of a ring whose azimuths straddle a column edge (a beam azimuth offset near half a column, a
+  // motion-compensated cloud) into one pixel. A ring whose points all lie within a column of its shift is taken
+  // whole; otherwise only its points within a column of the shift are, and the others (off their ring's row, more
+  // than a column off) are binned by azimuth: stray points. A ring without a row of its own, or with more than half
+  // of its points stray, is binned by azimuth whole. One bad ring or point does not demote the cloud.
   const double col = 2.0 * M_PI / W;
   auto az_col = [&](const P& q) {  // the point's column (not rounded) in the Ouster convention
     const double a = q.az < 0 ? q.az + 2.0 * M_PI : q.az;
@@ -244,32 +289,54 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
     return d;
   };
   std::vector<int> shift(size_t(nrings), 0);
-  std::vector<double> ring_az_deg(size_t(nrings), 0.0);
-  bool organised = c.height > 1 && int(c.height) == nrings && W == int(c.width);
+  std::vector<double> ring_az_deg(size_t(nrings), 0.0), off(size_t(nrings), 0.0);
+  static thread_local std::vector<uint8_t> by_col;  // 1: the point's pixel from its column in the cloud
+  by_col.assign(pts.size(), 0);
+  bool organised = c.height > 1 && W == int(c.width) && (int(c.height) == nrings || rows_are_rings);
   if (organised) {
-    std::vector<std::vector<double>> d(static_cast<size_t>(nrings));
-    std::vector<int64_t> row_of(size_t(nrings), -1);
-    for (size_t i = 0; i < pts.size() && organised; ++i) {
-      auto& r = row_of[size_t(ring_of[i])];
-      if (r < 0) r = pts[i].row;
-      organised = r == int64_t(pts[i].row);  // a ring spread over rows: not organised by ring
-      d[size_t(ring_of[i])].push_back(wrap(az_col(pts[i]) - pts[i].col));
+    std::vector<std::vector<uint32_t>> members(static_cast<size_t>(nrings));  // the points in their ring's row
+    for (size_t i = 0; i < pts.size(); ++i) {
+      const int u = ring_of[i];
+      if (ring_row[size_t(u)] == int64_t(pts[i].row)) members[size_t(u)].push_back(uint32_t(i));
     }
-    std::vector<double> off(size_t(nrings), 0.0);
-    for (int u = 0; u < nrings && organised; ++u) {
-      auto& v = d[size_t(u)];
-      if (v.empty()) continue;
-      const double d0 = v[0];
-      for (auto& x : v) x = wrap(x - d0);
+    std::vector<double> d, v;
+    int rings_by_col = 0;
+    for (int u = 0; u < nrings; ++u) {
+      const auto& m = members[size_t(u)];
+      if (m.empty()) continue;
+      d.clear();
+      for (uint32_t i : m) d.push_back(wrap(az_col(pts[i]) - pts[i].col));
+      const double d0 = d[0];
+      for (auto& x : d) x = wrap(x - d0);
+      v = d;
       std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
       const double med = v[v.size() / 2];
-      double sum = 0, lo = 1e300, hi = -1e300;
-      for (double x : v) sum += x - med, lo = std::min(lo, x - med), hi = std::max(hi, x - med);
-      if (hi - lo > 2.0) organised = false;  // not within a column of one shift
-      const double mean = med + sum / double(v.size());
+      double lo = 1e300, hi = -1e300;
+      for (double x : d) lo = std::min(lo, x - med), hi = std::max(hi, x - med);
+      const bool whole = hi - lo <= 2.0;  // every point within a column of one shift
+      double sum = 0;
+      size_t kept = 0;
+      for (size_t j = 0; j < m.size(); ++j)
+        if (whole || std::abs(d[j] - med) <= 1.0) sum += d[j] - med, ++kept;
+      if (2 * kept <= m.size()) continue;  // mostly stray: the ring by azimuth
+      for (size_t j = 0; j < m.size(); ++j)
+        if (whole || std::abs(d[j] - med) <= 1.0) by_col[m[j]] = 1;
+      ++rings_by_col;
+      const double mean = med + sum / double(kept);
       shift[size_t(u)] = int(std::lround(d0 + med));
       off[size_t(u)] = wrap(d0 + mean - shift[size_t(u)]);  // the ring's mean offset from its pixels (columns)
       ring_az_deg[size_t(u)] = off[size_t(u)] * col * 180.0 / M_PI;
+    }
+    organised = rings_by_col > 0;
+    if (organised) {
+      std::vector<uint8_t> ring_by_col(size_t(nrings), 0);
+      for (size_t i = 0; i < pts.size(); ++i) {
+        if (by_col[i]) ring_by_col[size_t(ring_of[i])] = 1;
+        else ++s.stray_points;
+      }
+      for (int u = 0; u < nrings; ++u) s.azimuth_rings += !ring_by_col[size_t(u)];
+    } else {
+      std::fill(by_col.begin(), by_col.end(), 0);
     }
   }
   s.column_source = organised ? "organised" : "azimuth";
@@ -289,17 +356,19 @@ bool cloud_to_scan(const PointCloud2& c, const CloudOptions& opt, Scan& out, Clo
     const P& q = pts[i];
     const double fv = az_col(q);
     int v;
-    if (organised) {
+    if (by_col[i]) {
       const int u = ring_of[i];
       v = int((int64_t(q.col) + shift[size_t(u)]) % W);
       if (v < 0) v += W;
       // Its azimuth against the pixel's in the model (the column's angle and the ring's beam azimuth).
-      max_err = std::max(max_err, std::abs(wrap(fv - v) - ring_az_deg[size_t(u)] / (col * 180.0 / M_PI)) * col * 180.0 / M_PI);
+      max_err = std::max(max_err, std::abs(wrap(fv - v) - off[size_t(u)]) * col * 180.0 / M_PI);
     } else {
-      const int64_t fr = fv >= 0.0 && fv < 1e15 ? round_nonneg(fv) : std::llround(fv);
+      // By azimuth: the pixel whose azimuth in the model (with the ring's beam azimuth) is nearest.
+      const double fa = fv - off[size_t(ring_of[i])];
+      const int64_t fr = fa >= 0.0 && fa < 1e15 ? round_nonneg(fa) : std::llround(fa);
       v = int(fr % W);
       if (v < 0) v += W;
-      max_err = std::max(max_err, std::abs(fv - double(fr)) * col * 180.0 / M_PI);
+      max_err = std::max(max_err, std::abs(fa - double(fr)) * col * 180.0 / M_PI);
     }
     const size_t k = size_t(ring_of[i]) * W + v;
     if (out.range_mm[k] != 0) {

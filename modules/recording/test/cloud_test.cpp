@@ -143,13 +143,94 @@ TEST(Cloud, OrganisedCloudOnePointPerPixel) {
     for (size_t i = 0; i < got.size(); ++i) worst = std::max(worst, std::abs(std::remainder(got[i] - want[i], 2.0 * M_PI)));
     EXPECT_LT(worst, 0.1 * colw) << "ring " << u;
   }
-  // The same points with one row's columns out of order: not organised by column; binned by azimuth, as before.
+  // The same points with one row's columns out of order: that ring is not organised by column and is binned by
+  // azimuth (collisions); the other 63 keep their columns, one point per pixel.
   for (int k = 0; k < W / 2; ++k) std::swap_ranges(buf.data() + size_t(k) * L.step, buf.data() + size_t(k + 1) * L.step,
                                                    buf.data() + size_t(W - 1 - k) * L.step);
   std::swap_ranges(buf.data(), buf.data() + 20 * L.step, buf.data() + 200 * L.step);
   ASSERT_TRUE(cloud_to_scan(c, CloudOptions{}, s, &st, &err)) << err;
-  EXPECT_EQ(st.column_source, "azimuth");
+  EXPECT_EQ(st.column_source, "organised");
+  EXPECT_EQ(st.azimuth_rings, 1);
+  EXPECT_EQ(st.stray_points, uint64_t(W));
   EXPECT_GT(st.collisions, 0u);
+  for (int u = 1; u < R; ++u)
+    for (int v = 0; v < W; ++v) ASSERT_GT(s.range(u, v), 0) << u << " " << v;
+}
+
+namespace {
+// An organised 64 x 512 cloud as above (rings half a column off their columns, jitter 0.05 column), ring field u16.
+struct Organised {
+  static constexpr int R = 64, W = 512, step = 48;
+  std::vector<uint8_t> buf = std::vector<uint8_t>(size_t(R) * W * step, 0);
+  PointCloud2 c;
+  Organised() {
+    const double colw = 2.0 * M_PI / W;
+    for (int r = 0; r < R; ++r)
+      for (int k = 0; k < W; ++k) set(r, k, r, (r % 2 ? -0.49 : 0.47) + 0.05 * std::sin(k * 12.9898 + r * 78.233), colw);
+    c.fields = {{"x", 0, 7, 1}, {"y", 4, 7, 1}, {"z", 8, 7, 1}, {"ring", 26, 4, 1}};
+    c.point_step = step;
+    c.height = R, c.width = W, c.row_step = W * step;
+    c.data = buf.data(), c.data_size = buf.size();
+  }
+  // The point in row r, column k: ring value `ring`, `off` columns off the column's azimuth.
+  void set(int r, int k, int ring, double off, double colw = 2.0 * M_PI / W) {
+    const double az = std::remainder(-colw * k + M_PI - off * colw, 2.0 * M_PI);
+    const double el = (16.6 - 33.2 * r / (R - 1)) * M_PI / 180.0;
+    const float xyz[3] = {float(5.0 * std::cos(az)), float(5.0 * std::sin(az)), float(5.0 * std::tan(el))};
+    uint8_t* p = buf.data() + (size_t(r) * W + k) * step;
+    std::memcpy(p, xyz, 12);
+    const uint16_t rv = uint16_t(ring);
+    std::memcpy(p + 26, &rv, 2);
+  }
+};
+}  // namespace
+
+// One bad ring or point of an organised cloud no longer demotes the whole cloud to azimuth binning (where the
+// half-column offsets cost collisions in every ring): only the stray points are binned by azimuth.
+TEST(Cloud, OrganisedCloudStrayPointsAndRing) {
+  Scan s;
+  CloudStats st;
+  std::string err;
+  {  // Three points of ring 10 five columns off their ring's shift (a glitch): those three binned by azimuth.
+    Organised o;
+    for (int k : {7, 100, 300}) o.set(10, k, 10, 5.3);
+    ASSERT_TRUE(cloud_to_scan(o.c, CloudOptions{}, s, &st, &err)) << err;
+    EXPECT_EQ(st.column_source, "organised");
+    EXPECT_EQ(st.stray_points, 3u);
+    EXPECT_EQ(st.azimuth_rings, 0);
+    EXPECT_EQ(st.relabelled_points, 0u);
+    EXPECT_EQ(s.height, Organised::R);
+    EXPECT_LE(st.collisions, 3u);  // at most the strays, each in a pixel of its ring another point holds
+    EXPECT_GE(st.kept, uint64_t(Organised::R) * Organised::W - 3);
+    for (int u = 0; u < Organised::R; ++u) {
+      if (u == 10) continue;
+      for (int v = 0; v < Organised::W; ++v) ASSERT_GT(s.range(u, v), 0) << u << " " << v;
+    }
+  }
+  {  // One point with a ring value no row has (64 in a 64-row cloud): a point of its row's ring, where it lies.
+    Organised o;
+    o.set(20, 33, 64, (20 % 2 ? -0.49 : 0.47));
+    ASSERT_TRUE(cloud_to_scan(o.c, CloudOptions{}, s, &st, &err)) << err;
+    EXPECT_EQ(st.column_source, "organised");
+    EXPECT_EQ(st.relabelled_points, 1u);
+    EXPECT_EQ(st.stray_points, 0u);
+    EXPECT_EQ(s.height, Organised::R);
+    EXPECT_EQ(st.collisions, 0u);
+    EXPECT_EQ(st.kept, uint64_t(Organised::R) * Organised::W);
+  }
+  {  // A ring whose points are shuffled along its row (a scrambled ring): that ring by azimuth, the others organised.
+    Organised o;
+    const double colw = 2.0 * M_PI / Organised::W;
+    for (int k = 0; k < Organised::W; ++k) o.set(5, k, 5, 0.47 + double((k * 37) % 101), colw);
+    ASSERT_TRUE(cloud_to_scan(o.c, CloudOptions{}, s, &st, &err)) << err;
+    EXPECT_EQ(st.column_source, "organised");
+    EXPECT_EQ(st.azimuth_rings, 1);
+    EXPECT_EQ(st.stray_points, uint64_t(Organised::W));
+    for (int u = 0; u < Organised::R; ++u) {
+      if (u == 5) continue;
+      for (int v = 0; v < Organised::W; ++v) ASSERT_GT(s.range(u, v), 0) << u << " " << v;
+    }
+  }
 }
 
 TEST(Cloud, NoRingFieldGivenRingCountUnevenBeams) {

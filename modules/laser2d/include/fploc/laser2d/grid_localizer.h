@@ -251,6 +251,11 @@ struct GridLocalizerConfig {
   // Kidnapped robot: after this many scans LOST (beyond lost_after), re-acquisition searches the whole map with the
   // global rule above instead of the window around the dead-reckoned pose (needs set_free_space()). 0: never.
   int global_after_lost_scans = 0;
+  // A whole-map search (start_global, a kidnapped robot) that has taken no place after this much sensor time (the
+  // scans' stamps: update(points, odom, stamp_s)) gives up: LOST with GridResult::global_gave_up, no whole-map search
+  // on later scans (each costs the whole map's branch-and-bound) until set_initial_pose or start_global. A search
+  // whose scans carry no stamp has no budget. 0: no budget.
+  double global_budget_s = 300;
 };
 
 enum class GridStatus { kOk = 0, kPoor = 1, kLost = 2, kNotInitialised = 3 };
@@ -280,6 +285,8 @@ struct GridResult {
   bool reacquired = false;  // this scan ended LOST with a confirmed hypothesis
   bool global = false;      // searching the whole map (start_global, or LOST for global_after_lost_scans): not OK
   std::vector<GridPlace> places;  // while global: the places tracked after this scan (before one is taken)
+  double global_elapsed_s = 0;    // while global (or gave up): sensor time since the whole-map search started
+  bool global_gave_up = false;    // the whole-map search ran out of global_budget_s without taking a place: LOST
   bool laser_step = false;  // the prediction came from the laser odometry (else the wheels)
   double laser_inlier_ratio = 0;  // the laser odometry's match (0 when it did not match)
   Pose2 laser_increment;          // its increment since the previous scan (on laser steps)
@@ -304,6 +311,8 @@ class GridLocalizer {
   // points: the scan's returns in the robot frame; odom: the wheel odometry pose at the scan's time (any
   // frame; only increments are used).
   GridResult update(const std::vector<Eigen::Vector2d>& points, const std::optional<Pose2>& odom);
+  // ... with the scan's time [s] (any epoch, increasing): what global_budget_s is counted in.
+  GridResult update(const std::vector<Eigen::Vector2d>& points, const std::optional<Pose2>& odom, double stamp_s);
   const GridLocalizerConfig& config() const { return cfg_; }
 
  private:

@@ -37,6 +37,12 @@ struct CloudStats {
   // shifted per ring; the ring's mean azimuth offset from its column becomes its beam azimuth) or "azimuth" (the
   // column from the point's azimuth).
   std::string column_source;
+  // Of an organised cloud: points binned by azimuth (off their ring's row, more than a column off the ring's shift,
+  // or of a ring binned by azimuth whole), such rings (no row of their own, most points stray), and points whose ring
+  // value has no row of its own, taken as points of their row's ring.
+  uint64_t stray_points = 0;
+  int azimuth_rings = 0;
+  uint64_t relabelled_points = 0;
   std::string time_source;     // "field 't'" ... or "header stamp"
   double max_azimuth_error_deg = 0;  // worst |point azimuth - its pixel's azimuth in the scan's beam model|
 };
