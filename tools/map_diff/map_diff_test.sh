@@ -51,6 +51,9 @@ if "$B/fploc-map-diff" --graph "$R/graphs/realism.pbtxt" --log "$T/sim.lcm" --ou
   echo "expected an error for a log without features"; exit 1
 fi
 grep -q "no FPLOC_FEATURES (features_t) events" "$T/err" || { cat "$T/err"; exit 1; }
+# ... whose advice, followed, records what the diff reads: FPLOC_SEGMENTS too (the heights of new structure; --record
+# leaves it out by default, and the advice without --record-channels gave "heights were not checked").
+grep -qF -- "--record LOG.lcm --record-channels 'FPLOC_.*'" "$T/err" || { cat "$T/err"; exit 1; }
 test "$(wc -l < "$T/err")" -eq 1 || { cat "$T/err"; exit 1; }
 # The run's --set reaches the diff (a run replayed with --set matcher.plan.file=PLAN was diffed against the graph
 # file's plan): the plan named by --set is the one diffed against; a --set naming no node is one error, exit 2.
