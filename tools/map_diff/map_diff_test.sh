@@ -30,8 +30,17 @@ grep -q "plan_diff.plan.file=PLAN" "$T/help" && grep -q -- "--plan PLAN" "$T/hel
   { cat "$T/help"; exit 1; }
 test -s "$T/node.json"   # the node wrote its own diff at shutdown
 for l in FPLOC-MISSING FPLOC-MOVED FPLOC-NEW; do grep -qx "$l" "$T/diff.dxf"; done
-"$B/fploc-map" render --plan "$T/diff.dxf" --out "$T/diff.svg" 2>/dev/null
+"$B/fploc-map" render --plan "$T/diff.dxf" --out "$T/diff.svg" 2> "$T/render.err"
 test -s "$T/diff.svg"
+# Drawn readably by default: lines only (the coloured leaf fields hid the coloured lines), every change layer of the
+# drawing in the legend (FPLOC-LOW was left out), the labels' TEXT entities read past (ignored).
+grep -q "a plan-change drawing (FPLOC-\* layers): lines only" "$T/render.err" && ! grep -q "leaf fields, " "$T/render.err" &&
+  grep -q "ignored: TEXT [0-9]" "$T/render.err" || { cat "$T/render.err"; exit 1; }
+for l in MISSING MOVED NEW LOW; do
+  n=$(/usr/bin/python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); l = sys.argv[2]
+print(len(d["new"]) if l == "NEW" else len(d["low"]) if l == "LOW" else sum(e["status"] == l.lower() for e in d["elements"]) + (len(d["missing_parts"]) if l == "MISSING" else 0))' "$T/diff.json" $l)
+  if [ "$n" -gt 0 ]; then grep -q ">FPLOC-$l ($n): " "$T/diff.svg" || { echo "legend: no FPLOC-$l ($n)"; exit 1; }; fi
+done
 # A CAD library reads it strictly, its audit finds nothing, the layers are there (Debian's python3-ezdxf).
 if /usr/bin/python3 -c "import ezdxf" 2>/dev/null; then
   /usr/bin/python3 - "$T/diff.dxf" <<'PY'
@@ -42,6 +51,9 @@ assert not a.errors, [str(e.message) for e in a.errors]
 names = {l.dxf.name for l in doc.layers}
 assert {"FPLOC-MISSING", "FPLOC-MOVED", "FPLOC-NEW", "FPLOC-PLAN"} <= names, names
 assert any(e.dxf.layer == "FPLOC-PLAN" for e in doc.modelspace())
+# Each change's label is a TEXT entity on its layer.
+texts = [e for e in doc.modelspace() if e.dxftype() == "TEXT"]
+assert texts and all(t.dxf.layer.startswith("FPLOC-") and t.dxf.text for t in texts), [t.dxf.text for t in texts]
 PY
 else
   echo "map diff: python3-ezdxf not installed (scripts/setup.sh installs it): CAD read-back skipped"
