@@ -161,7 +161,7 @@ node {
 // demo-building.pbtxt did, so two users' building demos wrote the same files).
 TEST(Graph, DemoGraphsWriteUnderFplocDemoDir) {
   ::setenv("FPLOC_DEMO_DIR", "/home/u/demo", 1);
-  for (const char* name : {"demo.pbtxt", "demo-building.pbtxt"}) {
+  for (const char* name : {"demo.pbtxt", "demo-building.pbtxt", "multihost.pbtxt"}) {  // multihost: hard-coded /tmp too
     LoadedGraph g;
     std::vector<GraphError> errors;
     ASSERT_TRUE(load_graph(std::string(FPLOC_SOURCE_DIR) + "/graphs/" + name, g, errors))
