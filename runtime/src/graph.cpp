@@ -151,8 +151,11 @@ bool parse_graph_text(const std::string& text, const std::string& name, LoadedGr
   parser.WriteLocationsTo(out.tree.get());
   parser.AllowUnknownField(true);
   const bool ok = parser.ParseFromString(text, &out.graph);
-  if (!ok || collector.count) return false;
-  const size_t before = errors.size();
+  if (!ok) return false;
+  // A misspelt field (counted by the collector) still leaves the rest of the graph parsed, and the launcher's
+  // --check goes on checking it: its ${NAME:-default} values are expanded all the same (they were not, and
+  // --check said e.g. "pose_logger.file '${FPLOC_DEMO_DIR:-/tmp}/...' cannot be written" beside the one real error).
+  const size_t before = errors.size() - collector.count;
   // NaN and inf parse as numbers; in an option they are never meant (a NaN initial pose).
   std::vector<std::pair<std::string, int>> bad;
   const auto* node_field = fploc::Graph::descriptor()->FindFieldByName("node");

@@ -57,6 +57,21 @@ node {
   EXPECT_EQ(errors[0].str().rfind("t.pbtxt:5: ", 0), 0u);
 }
 
+// A misspelt field is the only error: the rest of the graph is still read as a launch would read it (its
+// ${NAME:-default} values expanded), so `fploc launch --check` does not add false errors about "${...}" folders.
+TEST(Graph, AMisspeltFieldLeavesTheRestExpanded) {
+  ::unsetenv("FPLOC_GRAPH_TEST_DIR");
+  const std::string text =
+      "node {\n  name: \"opt\"\n  optimizer { window: 10 windw: 3 }\n}\n"
+      "node {\n  name: \"log\"\n  pose_logger { file: \"${FPLOC_GRAPH_TEST_DIR:-/tmp}/p.tum\" }\n}\n";
+  LoadedGraph g;
+  std::vector<GraphError> errors;
+  EXPECT_FALSE(parse_graph_text(text, "t.pbtxt", g, errors));
+  ASSERT_EQ(errors.size(), 1u) << errors.back().str();
+  EXPECT_NE(errors[0].message.find("windw"), std::string::npos) << errors[0].str();
+  EXPECT_EQ(g.graph.node(1).pose_logger().file(), "/tmp/p.tum");
+}
+
 TEST(Graph, WrongValueTypeIsAnError) {
   LoadedGraph g;
   std::vector<GraphError> errors;
@@ -146,7 +161,7 @@ node {
 // demo-building.pbtxt did, so two users' building demos wrote the same files).
 TEST(Graph, DemoGraphsWriteUnderFplocDemoDir) {
   ::setenv("FPLOC_DEMO_DIR", "/home/u/demo", 1);
-  for (const char* name : {"demo.pbtxt", "demo-building.pbtxt"}) {
+  for (const char* name : {"demo.pbtxt", "demo-building.pbtxt", "multihost.pbtxt"}) {  // multihost: hard-coded /tmp too
     LoadedGraph g;
     std::vector<GraphError> errors;
     ASSERT_TRUE(load_graph(std::string(FPLOC_SOURCE_DIR) + "/graphs/" + name, g, errors))

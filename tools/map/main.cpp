@@ -185,9 +185,9 @@ int main(int argc, char** argv) {
   render->add_option("--out", r.out, "output .svg or .png")->required();
   render->add_option("--width", r.width, "image width in pixels (PNG) / user units (SVG)");
   render->add_option("--fields", r.fields, "nearest: the look-up's leaf fields coloured by their nearest element (as the "
-                     "paper's Fig. 2); none: the plan's lines only, without building the fields (fast on a large plan)")
-      ->check(CLI::IsMember({"nearest", "none"}))
-      ->capture_default_str();
+                     "paper's Fig. 2); none: the plan's lines only, without building the fields (fast on a large plan). Default: "
+                     "nearest, but none for a plan-change drawing of `fploc map diff` (a DXF with FPLOC-* layers)")
+      ->check(CLI::IsMember({"nearest", "none"}));
 
   PlanArgs p_plan;
   PgmArgs p;

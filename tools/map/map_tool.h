@@ -31,7 +31,9 @@ int cmd_validate(const FloorPlan& plan, const ValidateArgs& a, bool as_json);
 
 struct RenderArgs {
   std::string map, out;
-  std::string fields = "nearest";  // "nearest": the look-up's leaf fields coloured by nearest element; "none": lines only
+  // "nearest": the look-up's leaf fields coloured by nearest element; "none": lines only; "": nearest, but none for a
+  // plan-change drawing (FPLOC-* layers of `fploc map diff`: its coloured lines were lost on the coloured fields)
+  std::string fields;
   int depth = 5;
   int width = 1600;
   // A building floor's stairs, ramps and lifts (the building's connections from or to the floor), drawn over the

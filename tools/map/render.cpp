@@ -112,10 +112,11 @@ void write_svg(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
   const double sw = b.size().maxCoeff() / 1500.0;
   // The legend (plan-change layers, connections) goes in a band above the plan: drawn over it, it hid the plan's
   // top-left walls.
-  int diff_count[3] = {0, 0, 0};
+  int diff_count[std::size(kDiffLayers)] = {};
   for (const auto& e : plan.elements)
     if (const LayerStyle* st = style_of(plan, e)) ++diff_count[st - kDiffLayers];
-  const int legend_lines = (diff_count[0] > 0) + (diff_count[1] > 0) + (diff_count[2] > 0) + int(conns.size());
+  int legend_lines = int(conns.size());
+  for (const int n : diff_count) legend_lines += n > 0;
   const double fs = std::min(W, H0) / 60;
   const double band = legend_lines > 0 ? 1.4 * fs * legend_lines + fs : 0.0;
   // Plan coordinates: a light grid in metres under the plan, labelled in margins left of (y) and below (x) it
@@ -226,7 +227,7 @@ void write_svg(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
   if (legend_lines > 0)  // a white ground for the legend
     s << "<rect x=\"" << x0 - fs / 2 << "\" y=\"" << yl - 1.2 * fs << "\" width=\"" << 22 * fs << "\" height=\""
       << 1.4 * fs * legend_lines + 0.4 * fs << "\" fill=\"#ffffffd0\"/>\n";
-  for (int k = 0; k < 3; ++k)
+  for (size_t k = 0; k < std::size(kDiffLayers); ++k)  // FPLOC-LOW too (it was left out)
     if (diff_count[k] > 0) {
       s << "<line x1=\"" << x0 << "\" y1=\"" << yl - fs / 3 << "\" x2=\"" << x0 + 1.5 * fs << "\" y2=\"" << yl - fs / 3
         << "\" stroke=\"" << kDiffLayers[k].svg << "\" stroke-width=\"" << fs / 3 << "\"/><text x=\"" << x0 + 2 * fs << "\" y=\"" << yl
@@ -334,10 +335,10 @@ void write_png(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
   // Legend (in a band above the plan, as in the SVG: over the plan it hid the top-left walls): the plan-change
   // layers present and the floor's connections.
   std::vector<std::pair<const uint8_t*, std::string>> legend;
-  int diff_count[3] = {0, 0, 0};
+  int diff_count[std::size(kDiffLayers)] = {};
   for (const auto& e : plan.elements)
     if (const LayerStyle* st = style_of(plan, e)) ++diff_count[st - kDiffLayers];
-  for (int k = 0; k < 3; ++k)
+  for (size_t k = 0; k < std::size(kDiffLayers); ++k)  // FPLOC-LOW too (it was left out)
     if (diff_count[k] > 0)
       legend.emplace_back(kDiffLayers[k].rgb, std::string(kDiffLayers[k].prefix) + " (" + std::to_string(diff_count[k]) +
                                                   "): " + kDiffLayers[k].label);
@@ -377,9 +378,18 @@ void write_png(const FloorPlan& plan, const annf::Annf* f, const std::string& ou
 }  // namespace
 
 
-int cmd_render(const FloorPlan& plan, const RenderArgs& a) {
-  const std::string ext = lower_ext(a.out);
-  if (ext != ".svg" && ext != ".png") throw std::runtime_error(a.out + ": output must be .svg or .png");
+int cmd_render(const FloorPlan& plan, const RenderArgs& given) {
+  const std::string ext = lower_ext(given.out);
+  if (ext != ".svg" && ext != ".png") throw std::runtime_error(given.out + ": output must be .svg or .png");
+  RenderArgs a = given;
+  if (a.fields.empty()) {  // a plan-change drawing: its coloured lines alone (on the fields, green NEW sat on green cells)
+    const bool diff = std::any_of(plan.elements.begin(), plan.elements.end(),
+                                  [&](const Element& e) { return style_of(plan, e) != nullptr; });
+    a.fields = diff && a.map.empty() ? "none" : "nearest";
+    if (diff && a.map.empty())
+      std::cerr << "fploc map render: a plan-change drawing (FPLOC-* layers): lines only (--fields nearest adds the "
+                   "look-up's leaf fields)\n";
+  }
   std::optional<annf::Annf> f;
   if (!a.map.empty()) {
     f = annf::Annf::load(a.map);

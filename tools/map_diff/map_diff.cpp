@@ -261,7 +261,8 @@ int main(int argc, char** argv) {
     if (n_feat == 0)
       throw std::runtime_error(log_path + ": no " + feat_ch + " (features_t) events in " + std::to_string(events) +
                                " log events; record a run with them (lcm-logger during `fploc launch`, or `fploc replay --graph " +
-                               graph_path + " --log SIM.lcm --record LOG.lcm`)");
+                               graph_path + " --log SIM.lcm --record LOG.lcm --record-channels 'FPLOC_.*'`: --record's default leaves "
+                               "FPLOC_SEGMENTS out, and without it the heights of new structure are not checked)");
     if (!given.empty() && used == 0)
       throw std::runtime_error(poses_path + ": no pose within 5 ms of any of the " + std::to_string(n_feat) + " " +
                                feat_ch + " scans");

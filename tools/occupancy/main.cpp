@@ -377,6 +377,7 @@ int main(int argc, char** argv) {
     o.tolerance_cells = tol;
     fploc::VectoriseStats st;
     fploc::FloorPlan plan = fploc::vectorise_occupancy(g, o, &st);
+    fploc::require_occupied_cells(g, plan, map);  // it said "0 boundary cells -> 0 segments", exit 0
     plan.source = map;
     nlohmann::json j = {{"map", map}, {"width", g.width}, {"height", g.height}, {"resolution_m", g.resolution},
                         {"origin", {g.origin_x, g.origin_y, g.origin_yaw}}, {"occupied_cells", st.occupied_cells},

@@ -17,4 +17,12 @@ grep -v '^resolution:' "$T/m/map.yaml" > "$T/m/nores.yaml"
 "$OCC" "$T/m/nores.yaml" > /dev/null 2> "$T/err" && fail "a missing resolution was accepted"
 [ "$(grep -c . "$T/err")" = 1 ] || fail "not exactly one error line"
 grep -qF "$T/m/nores.yaml: resolution: missing" "$T/err" || fail "the error does not name the file and the key"
+# An all-free map: one error naming the YAML and its own occupied_thresh, exit 1 (it was exit 0 with "0 boundary cells
+# -> 0 segments", while replay said "occupied_thresh 0.995000", a threshold the YAML does not have).
+printf 'P5\n8 8\n255\n' > "$T/m/free.pgm"; head -c 64 /dev/zero | tr '\0' '\376' >> "$T/m/free.pgm"
+sed 's/^image:.*/image: free.pgm/' "$T/m/map.yaml" > "$T/m/free.yaml"
+"$OCC" "$T/m/free.yaml" > /dev/null 2> "$T/err" && fail "an all-free map was accepted"
+[ "$(grep -c . "$T/err")" = 1 ] || fail "not exactly one error line"
+grep -qF "$T/m/free.yaml: image: no occupied cells (no pixel above occupied_thresh 0.65 of the YAML)" "$T/err" ||
+  fail "the error does not name the file and the YAML's occupied_thresh"
 echo OK

@@ -337,6 +337,7 @@ OccupancyGrid occupancy_from_image(const GrayImage& img, const MapYaml& y, const
   g.origin_yaw = y.origin_yaw;
   // trinary / scale: only the 100s are occupied (scale's 1..99 lie between the thresholds); raw: the percentage.
   g.occupied_thresh = y.mode == OccupancyMode::kRaw ? y.occupied_thresh : 0.995;
+  g.yaml_occupied_thresh = y.occupied_thresh;
   g.source = source;
   g.data.assign(size_t(g.width) * g.height, -1);
   for (int row = 0; row < img.height; ++row)
@@ -486,11 +487,20 @@ FloorPlan vectorise_occupancy(const OccupancyGrid& g, const VectoriseOptions& o,
   return plan;
 }
 
+void require_occupied_cells(const OccupancyGrid& g, const FloorPlan& vectorised, const std::string& yaml_path) {
+  if (!vectorised.elements.empty()) return;
+  // The YAML's threshold, not the grid's internal one (trinary / scale keep only the 100s: 0.995, which the user
+  // never wrote and the message used to show).
+  std::ostringstream t;
+  t << g.yaml_occupied_thresh;
+  fail(yaml_path + ": image: no occupied cells (no pixel above occupied_thresh " + t.str() +
+       " of the YAML): an all-free or all-unknown map has no walls to localize against");
+}
+
 FloorPlan load_occupancy_plan(const std::string& yaml_path, VectoriseStats* stats) {
   const OccupancyGrid g = read_occupancy_map(yaml_path);
   FloorPlan plan = vectorise_occupancy(g, {}, stats);
-  if (plan.elements.empty())
-    fail(yaml_path + ": image: no occupied cells (occupied_thresh " + std::to_string(g.occupied_thresh) + ")");
+  require_occupied_cells(g, plan, yaml_path);
   plan.source = yaml_path;
   return plan;
 }

@@ -1,4 +1,5 @@
 // JSON and DXF output of a plan diff.
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <nlohmann/json.hpp>
@@ -168,6 +169,25 @@ void entity(std::ostream& o, const Element& e, const char* layer, const Eigen::V
   }
 }
 
+// A change's label as a DXF TEXT entity (R12: insertion point, height, value) on the change's layer, beside the
+// middle of its line: CAD programs show it, the project's reader ignores it (it reads geometry only). `at`: the
+// line's middle; the text sits a little above it, `h` metres high.
+void label(std::ostream& o, const std::string& text, const char* layer, const Eigen::Vector2d& at, double h) {
+  pair(o, 0, "TEXT");
+  pair(o, 8, layer);
+  num(o, 10, at.x());
+  num(o, 20, at.y() + 0.3 * h);
+  num(o, 30, 0);
+  num(o, 40, h);
+  pair(o, 1, text);
+}
+
+std::string metres(double v, int digits, bool sign = false) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << (sign ? std::showpos : std::noshowpos) << v << std::noshowpos << " m";
+  return s.str();
+}
+
 }  // namespace
 
 void write_dxf(const Diff& d, const FloorPlan& plan, std::ostream& o) {
@@ -226,6 +246,30 @@ void write_dxf(const Diff& d, const FloorPlan& plan, std::ostream& o) {
   for (const auto& m : d.missing_parts) entity(o, Element::segment(m.a, m.b), "FPLOC-MISSING");
   for (const auto& n : d.added) entity(o, Element::segment(n.a, n.b), "FPLOC-NEW");
   for (const auto& n : d.low) entity(o, Element::segment(n.a, n.b), "FPLOC-LOW");
+  // Each change's label (what the terminal and the JSON say: "moved +0.115 m", "missing 7.50 m"), a text height of
+  // 1/80 of the plan's larger side (0.15 m to 1 m).
+  const double h = std::clamp(plan.bounds().size().maxCoeff() / 80, 0.15, 1.0);
+  auto length = [](const Element& e) { return e.kind == ElementKind::kSegment ? (e.b - e.a).norm() : 2 * M_PI * e.r; };
+  for (const auto& e : d.elements) {
+    if (e.status != Status::kMissing && e.status != Status::kMoved) continue;
+    if (e.id < 0 || size_t(e.id) >= plan.elements.size()) continue;
+    const Element& p = plan.elements[size_t(e.id)];
+    Eigen::Vector2d mid = p.kind == ElementKind::kSegment ? Eigen::Vector2d(0.5 * (p.a + p.b)) : Eigen::Vector2d(p.c + Eigen::Vector2d(0, p.r));
+    if (e.status == Status::kMoved && p.kind == ElementKind::kSegment) {
+      const Eigen::Vector2d u = (p.b - p.a).normalized();
+      mid += e.offset_m * Eigen::Vector2d(-u.y(), u.x());
+    }
+    const std::string id = "element " + std::to_string(e.id) + ": ";
+    if (e.status == Status::kMoved) label(o, id + "moved " + metres(e.offset_m, 3, true), "FPLOC-MOVED", mid, h);
+    else label(o, id + "missing " + metres(length(p), 2), "FPLOC-MISSING", mid, h);
+  }
+  for (const auto& m : d.missing_parts)
+    label(o, "element " + std::to_string(m.element) + ": missing part " + metres(m.length(), 2), "FPLOC-MISSING",
+          0.5 * (m.a + m.b), h);
+  for (const auto& n : d.added) label(o, "new " + metres(n.length(), 2), "FPLOC-NEW", 0.5 * (n.a + n.b), h);
+  for (const auto& n : d.low)
+    label(o, "low " + metres(n.length(), 2) + (std::isfinite(n.top_m) ? ", top " + metres(n.top_m, 2) : std::string()),
+          "FPLOC-LOW", 0.5 * (n.a + n.b), h);
   pair(o, 0, "ENDSEC");
   pair(o, 0, "EOF");
 }

@@ -541,7 +541,13 @@ void PlanDiff::add_frame(double x, double y, double yaw, const std::vector<Eigen
           break;
         }
     if (!seen) {
-      if (min_range[size_t(b)] < r - o_.occlusion_margin_m) continue;  // something unmapped in front
+      // Something unmapped in front (new structure observed in this scan): in the probe's bearing bin or either
+      // neighbour, as `seen` looks (a sparse scan's points on a new partition fell in the neighbours only, and the
+      // wall behind it counted as expected but unseen: "missing").
+      bool hidden = false;
+      for (int db = -1; db <= 1 && !hidden; ++db)
+        hidden = min_range[size_t(((b + db) % nb + nb) % nb)] < r - o_.occlusion_margin_m;
+      if (hidden) continue;
       if (plan_blocks(s, pr.p - 0.03 * d / r, pr.element)) continue;  // another plan element in front
     } else if (plan_blocks(s, pr.p - 0.03 * d / r, pr.element)) {
       continue;

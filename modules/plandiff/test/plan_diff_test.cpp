@@ -319,6 +319,17 @@ TEST(PlanDiff, DxfHasTheLayersAndLoadsBack) {
   const FloorPlan back = load_floor_plan(path, {"FPLOC-MISSING", "FPLOC-MOVED", "FPLOC-NEW"});
   EXPECT_EQ(back.elements.size(), size_t(r.diff.count(plandiff::Status::kMissing) + r.diff.count(plandiff::Status::kMoved)) +
                                       r.diff.added.size() + r.diff.missing_parts.size());
+  // Each change carries its label as a TEXT entity on its layer (the figures were only in the terminal and the
+  // JSON); the reader above took the file with them (it ignores text).
+  const size_t changes = size_t(r.diff.count(plandiff::Status::kMissing) + r.diff.count(plandiff::Status::kMoved)) +
+                         r.diff.added.size() + r.diff.missing_parts.size() + r.diff.low.size();
+  ASSERT_GT(changes, 0u);
+  size_t texts = 0;
+  for (size_t at = text.find("\n0\nTEXT\n8\nFPLOC-"); at != std::string::npos; at = text.find("\n0\nTEXT\n8\nFPLOC-", at + 1)) ++texts;
+  EXPECT_EQ(texts, changes);
+  for (const auto& e : r.diff.elements)
+    if (e.status == plandiff::Status::kMoved)
+      EXPECT_NE(text.find("1\nelement " + std::to_string(e.id) + ": moved "), std::string::npos) << e.id;
   std::ostringstream js;
   plandiff::write_json(r.diff, r.plan, js);
   EXPECT_NE(js.str().find("\"missing\""), std::string::npos);

@@ -47,6 +47,14 @@ check_file 's#window: 10 alpha#window: -3 alpha#'
 line="$(grep -n 'window: -3' "$T/g.pbtxt" | cut -d: -f1)"
 echo "$out" | grep -qxF "$T/g.pbtxt:$line: node 'optimizer': optimizer.window: must be > 0 (0 = the default), got -3" ||
   fail "optimizer window -3: no error at line $line"
+# One misspelt field: that one error and no other (the parse stopped before the ${FPLOC_DEMO_DIR:-/tmp} values were
+# expanded, and three output files were said to be in a folder '.../${FPLOC_DEMO_DIR:-/tmp}' that does not exist).
+check_file 's#window: 10 alpha#window: 10 windw: 3 alpha#'
+[ "$rc" = 1 ] || fail "optimizer windw: exit $rc, expected 1"
+line="$(grep -n 'windw: 3' "$T/g.pbtxt" | cut -d: -f1)"
+echo "$out" | grep -qF "$T/g.pbtxt:$line: Message type \"fploc.OptimizerOptions\" has no field named \"windw\"" ||
+  fail "optimizer windw: no error at line $line"
+[ "$(echo "$out" | grep -c "^$T/g.pbtxt:[0-9]*: ")" = 1 ] || fail "optimizer windw: not exactly one error"
 # A matcher without a plan.
 check_file '/^  matcher {/ s#plan { file: "[^"]*" } ##'
 [ "$rc" = 1 ] || fail "matcher without plan: exit $rc, expected 1"

@@ -63,6 +63,7 @@ struct OccupancyGrid {
   double resolution = 0;
   double origin_x = 0, origin_y = 0, origin_yaw = 0;
   double occupied_thresh = 0.65;
+  double yaml_occupied_thresh = 0.65;  // the YAML's occupied_thresh (occupied_thresh is 0.995 for trinary / scale)
   // ROS nav_msgs/OccupancyGrid layout: row 0 is the BOTTOM row (y = origin); -1 unknown, 0..100 occupancy.
   std::vector<int8_t> data;
   std::string source;
@@ -92,6 +93,9 @@ struct VectoriseStats {
 FloorPlan vectorise_occupancy(const OccupancyGrid& g, const VectoriseOptions& o = {}, VectoriseStats* stats = nullptr);
 
 // YAML path -> plan (what load_floor_plan does for .yaml / .yml); elements on layer "occupied".
+// An occupancy map with no occupied cell (nothing to localize against): throws "YAML: image 'IMG': no occupied cells
+// (...occupied_thresh T of the YAML...)", the same words from `fploc occupancy`, replay and `fploc launch --check`.
+void require_occupied_cells(const OccupancyGrid& g, const FloorPlan& vectorised, const std::string& yaml_path);
 FloorPlan load_occupancy_plan(const std::string& yaml_path, VectoriseStats* stats = nullptr);
 
 }  // namespace fploc
