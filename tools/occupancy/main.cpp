@@ -20,6 +20,7 @@
 
 #include <fploc/laser_scan_t.hpp>
 #include <lcm/lcm-cpp.hpp>
+#include "fploc/runtime/log_reader.h"
 
 #include "fploc/core/text_out.h"
 #include "fploc/floorplan/distance_field.h"
@@ -245,12 +246,12 @@ fploc::OccupancyGrid grown_to(const fploc::OccupancyGrid& g, const std::vector<E
 std::vector<Eigen::Vector2d> scan_at_pose(const std::string& log_path, const std::string& channel, double at_s,
                                           const fploc::Pose2& pose, const fploc::Pose2& mount, bool upside_down,
                                           const fploc::OccupancyGrid& g, nlohmann::json* j) {
-  lcm::LogFile log(log_path, "r");
+  fploc::rt::LogReader log(log_path);  // guards against a cut or damaged event (liblcm would read past the file)
   if (!log.good()) throw std::runtime_error("--scan " + log_path + ": cannot read the LCM log");
   int64_t first = -1, count = 0;
   double last_s = 0;
   std::map<std::string, int64_t> channels;
-  while (const lcm::LogEvent* ev = log.readNextEvent()) {
+  while (const lcm::LogEvent* ev = log.next()) {
     ++channels[ev->channel];
     if (ev->channel != channel) continue;
     fploc::laser_scan_t m;
@@ -281,6 +282,7 @@ std::vector<Eigen::Vector2d> scan_at_pose(const std::string& log_path, const std
     return out;
   }
   if (count == 0) {
+    if (!log.problem().empty()) throw std::runtime_error("--scan " + log.problem());
     std::string have;
     for (const auto& [c, k] : channels) have += (have.empty() ? "" : ", ") + c + " (" + std::to_string(k) + ")";
     throw std::runtime_error("--scan " + log_path + ": no " + channel + " event (the log holds " +

@@ -45,4 +45,14 @@ grep -q "expected X,Y,YAW" "$T/err" || fail "bad --pose: no reason"
 if "$OCC" "$T/map/map.yaml" --png "$T/x.png" --pose "$X,$Y,$YAW" --scan "$T/rest.lcm" --scan-channel NOPE 2> "$T/err"; then fail "no such channel accepted"; fi
 grep -q "no NOPE event (the log holds LASER_SCAN" "$T/err" || fail "missing channel: not named"
 if "$OCC" "$T/map/map.yaml" --png "$T/x.png" --scan "$T/rest.lcm" 2> "$T/err"; then fail "--scan without --pose accepted"; fi
+# A log whose first event's data length is damaged (0x7fffffff): one error naming the file and the event's byte
+# offset (liblcm alone would allocate and read 2 GB), not a crash and not "no LASER_SCAN event".
+python3 - "$T/rest.lcm" "$T/damaged.lcm" <<'PY'
+import sys
+b = bytearray(open(sys.argv[1], 'rb').read()[:4096])
+b[24:28] = (0x7fffffff).to_bytes(4, 'big')
+open(sys.argv[2], 'wb').write(b)
+PY
+if "$OCC" "$T/map/map.yaml" --png "$T/x.png" --pose "$X,$Y,$YAW" --scan "$T/damaged.lcm" 2> "$T/err"; then fail "a damaged log accepted"; fi
+grep -q -- "--scan $T/damaged.lcm: event 1 at byte 0" "$T/err" || fail "damaged log: not named with the event's offset"
 echo OK
