@@ -16,6 +16,7 @@
 // Last, the ratio again with the two lines alternated in blocks (alternated_ratio), the figure least moved by the
 // machine's load changing during the run, with received inputs and, for comparison, read from the pools.
 //   build/bin/perception_ratio_bench [--benchmark_repetitions=N] [--alternate=BLOCKS (40; 0: none)] [--renew]
+//                                    [--definitions=N (the IMU line reset vs renewed, alternated: N x 144 frames each)]
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -289,6 +290,42 @@ void alternated_ratio(int blocks, bool received, bool renew) {
       renew ? ", a new segmenter at each restart" : "", blocks, kFrames, q(d, 0.5), q(s, 0.5), q(r, 0.5), q(r, 0.25), q(r, 0.75), received ? " (target <= 2x)" : "");
 }
 
+// The IMU line's two definitions in one run (--definitions=BLOCKS): blocks of 48 frames of the line with its
+// segmenter reset at the sequence's restart and of the line with a new segmenter there, in turn (each restart
+// falls in every third block of each); their CPU time per frame over the whole run (the restarts included) and its
+// ratio. The machine's load changing during the run falls on both alike.
+void definitions_ratio(int triples) {
+  const auto& f = frames();
+  ImuLine reset(f, true, false), renew(f, true, true);
+  constexpr int kFrames = 48;  // (three blocks: the sequence's 144 frames, one restart of each line)
+  double tr = 0, tn = 0;
+  std::vector<double> r;
+  for (int k = 0; k < triples; ++k) {
+    double br = 0, bn = 0;
+    for (int b = 0; b < 3; ++b)
+      for (ImuLine* line : {&reset, &renew}) {
+        double& busy = line == &reset ? br : bn;
+        for (int i = 0; i < kFrames; ++i) {
+          if (line->at_wrap()) line->wrap();
+          line->receive();
+          const double t0 = thread_cpu_us();
+          line->frame();
+          busy += thread_cpu_us() - t0;
+        }
+      }
+    tr += br;
+    tn += bn;
+    r.push_back(br / bn);
+  }
+  std::sort(r.begin(), r.end());
+  const auto q = [&](double p) { return r[size_t(p * double(r.size() - 1) + 0.5)]; };
+  std::printf(
+      "the IMU line's two definitions alternated, %d x 3 blocks of %d frames: the segmenter reset at the restart %.1f "
+      "us, a new segmenter there %.1f us per frame (means); reset / new %.4f, per 144 frames: median %.4f, quartiles "
+      "%.4f - %.4f\n",
+      triples, kFrames, tr / (3 * triples * kFrames), tn / (3 * triples * kFrames), tr / tn, q(0.5), q(0.25), q(0.75));
+}
+
 class RatioReporter : public benchmark::ConsoleReporter {
  public:
   void ReportRuns(const std::vector<Run>& runs) override {
@@ -303,11 +340,14 @@ class RatioReporter : public benchmark::ConsoleReporter {
 
 int main(int argc, char** argv) {
   int alternate_blocks = 40;  // --alternate=N: blocks of the alternated ratio (0: none)
+  int definitions = 0;        // --definitions=N: the IMU line's two definitions alternated, N x 3 blocks (0: none)
   bool renew = false;         // --renew: the alternated ratio with a new segmenter at each restart (before the 42nd round)
   for (int i = 1; i < argc; ++i) {
-    const bool alt = std::strncmp(argv[i], "--alternate=", 12) == 0, rn = std::strcmp(argv[i], "--renew") == 0;
-    if (!alt && !rn) continue;
+    const bool alt = std::strncmp(argv[i], "--alternate=", 12) == 0, rn = std::strcmp(argv[i], "--renew") == 0,
+               def = std::strncmp(argv[i], "--definitions=", 14) == 0;
+    if (!alt && !rn && !def) continue;
     if (alt) alternate_blocks = std::atoi(argv[i] + 12);
+    if (def) definitions = std::atoi(argv[i] + 14);
     if (rn) renew = true;
     for (int j = i; j + 1 < argc; ++j) argv[j] = argv[j + 1];
     --argc;
@@ -333,5 +373,6 @@ int main(int argc, char** argv) {
     alternated_ratio(alternate_blocks, true, renew);
     alternated_ratio(alternate_blocks, false, renew);
   }
+  if (definitions > 0) definitions_ratio(definitions);
   return 0;
 }
