@@ -393,7 +393,10 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
   {
     // (through plain pointers and a local rotation: a store of a kind, an int8_t, may alias anything, so the arrays'
     // and the rotation's members were loaded again after each pick's)
-    const Eigen::Matrix3f R = R_;
+    // The rotation's first two rows as scalars: (R p).x() and .y() written out as Eigen sums them (its 3-term
+    // redux: a0 + (a1 + a2)), the same floats bit for bit (the ReferenceEqual* tests, whose reference computes R p
+    // with Eigen); Eigen's 3x3 product was an out-of-line call per pick here, and z was computed for nothing.
+    const float r00 = R_(0, 0), r01 = R_(0, 1), r02 = R_(0, 2), r10 = R_(1, 0), r11 = R_(1, 1), r12 = R_(1, 2);
     const int* const sel = sel_.data();
     const float *const wx = w.x.data(), *const wy = w.y.data(), *const wz = w.z.data();
     const float* const wt = has_t ? w.t.data() : nullptr;
@@ -403,9 +406,9 @@ void FeatureExtractor::ring(const seg::Segmentation& seg, size_t begin, size_t e
     for (size_t k = 0; k < m; ++k) {
       const int code = sel[k];
       const size_t src = begin + size_t(code >> 1), o = o0 + k;
-      const Eigen::Vector3f q = R * Eigen::Vector3f(wx[src], wy[src], wz[src]);
-      ox[o] = q.x();
-      oy[o] = q.y();
+      const float px = wx[src], py = wy[src], pz = wz[src];
+      ox[o] = r00 * px + (r01 * py + r02 * pz);
+      oy[o] = r10 * px + (r11 * py + r12 * pz);
       okind[o] = code & 1 ? kCorner : kSurface;
       ogroup[o] = -1;  // (unclassified until a line group takes it, below)
       ot[o] = wt ? wt[src] : 0.f;

@@ -5,7 +5,8 @@
 // extracted (the perception front end's work). Prints both and their ratio (CPU time per frame).
 // The pipeline's segmenter also takes the IMU (graphs/paper.pbtxt: gyro de-skew, gravity fusion, the ground at a
 // kink): BM_SegmenterPlusFeaturesImu runs it so, on 144 consecutive frames of the same sequence with each sweep's
-// IMU samples fed before its scan, and its ratio is printed beside the one without the IMU.
+// IMU samples fed before its scan, the segmenter reset when the sequence starts again, and its ratio is printed
+// beside the one without the IMU (and BM_SegmenterPlusFeaturesImuNew's: a new segmenter at each restart).
 // Each iteration's input arrives as in the pipeline: copied, outside the timing, into one receive buffer that is
 // reused (a socket's receive leaves the packets, LCM's decode the scan, in the caches). Before the thirty-first
 // round the lines read their inputs straight from the pools (24 frames' packets, 19 MB; 144 scans, 66 MB), so the
@@ -14,7 +15,8 @@
 // arithmetic, take the same time either way (docs/notes/perception.md, thirty-first round).
 // Last, the ratio again with the two lines alternated in blocks (alternated_ratio), the figure least moved by the
 // machine's load changing during the run, with received inputs and, for comparison, read from the pools.
-//   build/bin/perception_ratio_bench [--benchmark_repetitions=N] [--alternate=BLOCKS (40; 0: none)]
+//   build/bin/perception_ratio_bench [--benchmark_repetitions=N] [--alternate=BLOCKS (40; 0: none)] [--renew]
+//                                    [--definitions=N (the IMU line reset vs renewed, alternated: N x 144 frames each)]
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -122,13 +124,22 @@ class DecodeLine {
 
 // The pipeline's perception on one frame of the consecutive sequence: the sweep's IMU samples into the segmenter
 // (as the segmenter node gives them, before the scan), the scan segmented, its features extracted. At the
-// sequence's wrap a new segmenter, built by `wrap()` (outside any timing).
+// sequence's wrap (time going back to its start; outside any timing) the segmenter starts again: reset (the
+// pipeline's case, since the forty-second round: a pipeline's segmenter lives for the whole run and would be
+// reset on a time jump; Segmenter::reset gives a new segmenter's outputs bit for bit, its scratch arrays kept),
+// or, with `renew`, replaced by a new one (the definition before: its first scans' allocations and page faults,
+// once in a pipeline's run, every 144 frames here; docs/notes/perception.md, forty-second round).
 class ImuLine {
  public:
-  ImuLine(const Frames& f, bool received) : f_(f), scans_(pool(f), received) { wrap(); }
+  ImuLine(const Frames& f, bool received, bool renew = false) : f_(f), scans_(pool(f), received), renew_(renew) {
+    sg_ = std::make_unique<seg::RingSegmenter>(seg::SegmenterConfig{});
+  }
   bool at_wrap() const { return scans_.count() == f_.consecutive.size(); }
   void wrap() {
-    sg_ = std::make_unique<seg::RingSegmenter>(seg::SegmenterConfig{});
+    if (renew_)
+      sg_ = std::make_unique<seg::RingSegmenter>(seg::SegmenterConfig{});
+    else
+      sg_->reset();
     scans_.restart();
   }
   const Scan& receive() {
@@ -150,6 +161,7 @@ class ImuLine {
   Inputs<Scan> scans_;
   const bench::ImuFrame* imu_ = nullptr;
   const Scan* scan_ = nullptr;
+  bool renew_;
   std::unique_ptr<seg::RingSegmenter> sg_;
   feat::FeatureExtractor fx_;
 };
@@ -181,9 +193,10 @@ void BM_SegmenterPlusFeatures(benchmark::State& st) {
 }
 BENCHMARK(BM_SegmenterPlusFeatures)->Unit(benchmark::kMicrosecond);
 
-// As in the pipeline: the segmenter with the IMU, then the features (ImuLine).
-void BM_SegmenterPlusFeaturesImu(benchmark::State& st) {
-  ImuLine line(frames(), true);
+// As in the pipeline: the segmenter with the IMU, then the features (ImuLine; the segmenter reset at the
+// sequence's restart). ...New: a new segmenter at each restart (the line's definition before the 42nd round).
+void imu_line(benchmark::State& st, bool renew) {
+  ImuLine line(frames(), true, renew);
   for (auto _ : st) {
     st.PauseTiming();
     if (line.at_wrap()) line.wrap();
@@ -192,7 +205,10 @@ void BM_SegmenterPlusFeaturesImu(benchmark::State& st) {
     line.frame();
   }
 }
+void BM_SegmenterPlusFeaturesImu(benchmark::State& st) { imu_line(st, false); }
 BENCHMARK(BM_SegmenterPlusFeaturesImu)->Unit(benchmark::kMicrosecond);
+void BM_SegmenterPlusFeaturesImuNew(benchmark::State& st) { imu_line(st, true); }
+BENCHMARK(BM_SegmenterPlusFeaturesImuNew)->Unit(benchmark::kMicrosecond);
 
 // The two stages alone (breakdown; not part of the ratio): the segmenter, and the features of segmentations
 // computed once before the timing.
@@ -234,11 +250,11 @@ double thread_cpu_us() {
   return t.tv_sec * 1e6 + t.tv_nsec * 1e-3;
 }
 
-void alternated_ratio(int blocks, bool received) {
+void alternated_ratio(int blocks, bool received, bool renew) {
   const auto& f = frames();
   DecodeLine decode(f);
   Inputs<FramePackets> packets(f.packets, received);
-  ImuLine imu(f, received);
+  ImuLine imu(f, received, renew);
   constexpr int kFrames = 48;
   for (int i = 0; i < 2 * kFrames; ++i) decode.frame(packets.next());  // warm both lines: a new segmenter's first
   for (int i = 0; i < kFrames; ++i) imu.receive(), imu.frame();         // scans are slower than the steady ones
@@ -268,10 +284,46 @@ void alternated_ratio(int blocks, bool received) {
     return v[size_t(p * double(v.size() - 1) + 0.5)];
   };
   std::printf(
-      "alternated, %s, %d blocks of %d frames: decode + XYZ %.0f us, segmenter + features with the IMU %.0f us "
+      "alternated, %s%s, %d blocks of %d frames: decode + XYZ %.0f us, segmenter + features with the IMU %.0f us "
       "(medians); ratio per block: median %.2fx, quartiles %.2fx - %.2fx%s\n",
       received ? "inputs received (as in the pipeline)" : "inputs read from the pools (before the 31st round)",
-      blocks, kFrames, q(d, 0.5), q(s, 0.5), q(r, 0.5), q(r, 0.25), q(r, 0.75), received ? " (target <= 2x)" : "");
+      renew ? ", a new segmenter at each restart" : "", blocks, kFrames, q(d, 0.5), q(s, 0.5), q(r, 0.5), q(r, 0.25), q(r, 0.75), received ? " (target <= 2x)" : "");
+}
+
+// The IMU line's two definitions in one run (--definitions=BLOCKS): blocks of 48 frames of the line with its
+// segmenter reset at the sequence's restart and of the line with a new segmenter there, in turn (each restart
+// falls in every third block of each); their CPU time per frame over the whole run (the restarts included) and its
+// ratio. The machine's load changing during the run falls on both alike.
+void definitions_ratio(int triples) {
+  const auto& f = frames();
+  ImuLine reset(f, true, false), renew(f, true, true);
+  constexpr int kFrames = 48;  // (three blocks: the sequence's 144 frames, one restart of each line)
+  double tr = 0, tn = 0;
+  std::vector<double> r;
+  for (int k = 0; k < triples; ++k) {
+    double br = 0, bn = 0;
+    for (int b = 0; b < 3; ++b)
+      for (ImuLine* line : {&reset, &renew}) {
+        double& busy = line == &reset ? br : bn;
+        for (int i = 0; i < kFrames; ++i) {
+          if (line->at_wrap()) line->wrap();
+          line->receive();
+          const double t0 = thread_cpu_us();
+          line->frame();
+          busy += thread_cpu_us() - t0;
+        }
+      }
+    tr += br;
+    tn += bn;
+    r.push_back(br / bn);
+  }
+  std::sort(r.begin(), r.end());
+  const auto q = [&](double p) { return r[size_t(p * double(r.size() - 1) + 0.5)]; };
+  std::printf(
+      "the IMU line's two definitions alternated, %d x 3 blocks of %d frames: the segmenter reset at the restart %.1f "
+      "us, a new segmenter there %.1f us per frame (means); reset / new %.4f, per 144 frames: median %.4f, quartiles "
+      "%.4f - %.4f\n",
+      triples, kFrames, tr / (3 * triples * kFrames), tn / (3 * triples * kFrames), tr / tn, q(0.5), q(0.25), q(0.75));
 }
 
 class RatioReporter : public benchmark::ConsoleReporter {
@@ -288,29 +340,39 @@ class RatioReporter : public benchmark::ConsoleReporter {
 
 int main(int argc, char** argv) {
   int alternate_blocks = 40;  // --alternate=N: blocks of the alternated ratio (0: none)
-  for (int i = 1; i < argc; ++i)
-    if (std::strncmp(argv[i], "--alternate=", 12) == 0) {
-      alternate_blocks = std::atoi(argv[i] + 12);
-      for (int j = i; j + 1 < argc; ++j) argv[j] = argv[j + 1];
-      --argc;
-      --i;
-    }
+  int definitions = 0;        // --definitions=N: the IMU line's two definitions alternated, N x 3 blocks (0: none)
+  bool renew = false;         // --renew: the alternated ratio with a new segmenter at each restart (before the 42nd round)
+  for (int i = 1; i < argc; ++i) {
+    const bool alt = std::strncmp(argv[i], "--alternate=", 12) == 0, rn = std::strcmp(argv[i], "--renew") == 0,
+               def = std::strncmp(argv[i], "--definitions=", 14) == 0;
+    if (!alt && !rn && !def) continue;
+    if (alt) alternate_blocks = std::atoi(argv[i] + 12);
+    if (def) definitions = std::atoi(argv[i] + 14);
+    if (rn) renew = true;
+    for (int j = i; j + 1 < argc; ++j) argv[j] = argv[j + 1];
+    --argc;
+    --i;
+  }
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   RatioReporter rep;
   benchmark::RunSpecifiedBenchmarks(&rep);
   benchmark::Shutdown();
   const double d = rep.cpu_["BM_DecodeAndXyz"], s = rep.cpu_["BM_SegmenterPlusFeatures"],
-               si = rep.cpu_["BM_SegmenterPlusFeaturesImu"];
+               si = rep.cpu_["BM_SegmenterPlusFeaturesImu"], sn = rep.cpu_["BM_SegmenterPlusFeaturesImuNew"];
   if (d > 0 && s > 0)
     std::cout << "segmenter + features / (decode + XYZ) on the same frames: " << s << " us / " << d
               << " us = " << s / d << "x (target <= 2x)\n";
   if (d > 0 && si > 0)
     std::cout << "with the IMU, as in the pipeline (consecutive frames of the same sequence): " << si << " us / " << d
               << " us = " << si / d << "x (target <= 2x)\n";
+  if (d > 0 && sn > 0)
+    std::cout << "with the IMU, a new segmenter at each restart of the sequence (the definition before the 42nd round): "
+              << sn << " us / " << d << " us = " << sn / d << "x\n";
   if (alternate_blocks > 0) {
-    alternated_ratio(alternate_blocks, true);
-    alternated_ratio(alternate_blocks, false);
+    alternated_ratio(alternate_blocks, true, renew);
+    alternated_ratio(alternate_blocks, false, renew);
   }
+  if (definitions > 0) definitions_ratio(definitions);
   return 0;
 }

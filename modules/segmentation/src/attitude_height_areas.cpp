@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <utility>
+
 #include "fploc/segmentation/attitude_height.h"
 #include "segmenter_constants.h"
 
@@ -22,6 +24,12 @@ void AttitudeHeight::set_areas(const AreaCeilingMap& map) {
   areas_.finish();
   area_h_.reset(areas_, cfg_.room_height_window);
   have_areas_ = true;
+}
+
+void AttitudeHeight::reset() {
+  AttitudeHeight fresh(cfg_);
+  if (have_areas_) fresh.set_areas(areas_);
+  *this = std::move(fresh);
 }
 
 void AttitudeHeight::set_plan_pose(const PlanPose& pose) {

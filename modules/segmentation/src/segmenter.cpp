@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "segmenter_constants.h"
 
@@ -33,6 +35,51 @@ void roll_pitch_from_up(const Eigen::Vector3d& u, double& roll, double& pitch) {
 Segmenter::Segmenter(SegmenterConfig cfg, std::unique_ptr<PlaneFit> fit)
     : cfg_(cfg), fit_(std::move(fit)), deskew_(cfg.deskew_gyro), height_(cfg) {}
 Segmenter::~Segmenter() = default;
+
+void Segmenter::reset() {
+  fit_->reset();
+  deskew_ = GyroDeskew(cfg_.deskew_gyro);
+  fusion_ = GravityFusion();
+  height_.reset();
+  {  // the last output as a new segmenter's, its arrays' capacity kept
+    WallPoints wall = std::move(out_.wall);
+    std::vector<uint8_t> label = std::move(out_.label);
+    std::string text = std::move(out_.status_text);
+    wall.clear();
+    label.clear();
+    text.clear();
+    out_ = Segmentation{};
+    out_.wall = std::move(wall);
+    out_.label = std::move(label);
+    out_.status_text = std::move(text);
+  }
+  have_prev_ceiling_ = have_prev_ground_ = false;
+  prev_ceiling_.setZero();
+  prev_ground_.setZero();
+  follow_up_ = Eigen::Vector3d::UnitZ();
+  follow_t_ = 0;
+  follow_ = FollowRate{};
+  kink_quiet_left_ = 0;
+  kink_skew_per_rate_ = 0;
+  kink_d_offset_ = 0;
+  kink_skipped_ = 0;
+  kink_armed_ = false;
+  kink_thinned_ = 0;
+  accel_sum_.setZero();
+  accel_sq_ = 0;
+  accel_n_ = 0;
+  imu_trusted_ = false;
+  imu_up_ = Eigen::Vector3d::UnitZ();
+  have_imu_ = false;
+  have_prev_mid_z_ = false;
+  prev_mid_t_ = 0;
+  prev_mid_z_ = 0;
+  accel_this_scan_ = false;
+  accel_mean_.setZero();
+  // Kept: what depends only on the beam pattern and the configuration (lut_ and what is built with it in
+  // prepare(): ring_order_, scale_, lut_soa_, row_z_, row_set_, row_ring_), and every per-scan scratch array
+  // (written before it is read on each scan).
+}
 
 void Segmenter::add_accel(const Eigen::Vector3d& a) {
   if (!a.allFinite() || a.norm() < 1.0) return;

@@ -51,6 +51,33 @@ struct Result {
   int64_t kink_thinned = 0;          // rechecks settled on the thinned returns (kink_recheck_stride)
 };
 
+// Everything a segmentation says, as text (floats in hex: bit for bit), its wall points and labels hashed.
+std::string digest(const Segmentation& s) {
+  uint64_t h = 1469598103934665603ull;  // FNV-1a over the arrays' bytes
+  const auto hash = [&](const auto& v) {
+    const auto* b = reinterpret_cast<const unsigned char*>(v.data());
+    for (size_t i = 0; i < v.size() * sizeof(v[0]); ++i) h = (h ^ b[i]) * 1099511628211ull;
+    h = (h ^ v.size()) * 1099511628211ull;
+  };
+  const auto& w = s.wall;
+  hash(w.x), hash(w.y), hash(w.z), hash(w.range), hash(w.t), hash(w.ring), hash(w.column), hash(s.label);
+  std::string out;
+  char buf[160];
+  const auto plane = [&](const Plane& p) {
+    std::snprintf(buf, sizeof buf, "[%a %a %a %a %d %d %d %a %a %a %a] ", p.coeffs[0], p.coeffs[1], p.coeffs[2], p.coeffs[3],
+                  int(p.found), p.inliers, p.beyond, p.rms_m, p.tilt_sigma, p.d_sigma, p.under_m);
+    out += buf;
+  };
+  std::snprintf(buf, sizeof buf, "%lld %lld %d %a %a %a %a %a %d %d %d %a %d %d %016llx ", (long long)s.utime,
+                (long long)s.seq, int(s.status), s.roll, s.pitch, s.z, s.roll_pitch_sigma, s.z_sigma,
+                int(s.attitude_source), int(s.z_source), int(s.deskewed), s.attitude_t, s.height, s.width,
+                (unsigned long long)h);
+  out += buf;
+  plane(s.ceiling);
+  plane(s.ground);
+  return out + s.status_text;
+}
+
 // Drives the trajectory pose(t) (t in s) for n scans of 0.1 s. The IMU (100 Hz, or 1 kHz with column times)
 // is differentiated from pose(t) (the gyro averaged over each sample's interval) (+ linear acceleration `acc(t)` along the sensor's x, noise, gyro bias).
 // With `blocks` > 1 each scan is rendered in that many column blocks, each at its block's mid time, and
@@ -58,8 +85,10 @@ struct Result {
 Result drive(const synth::Room& room, const std::function<SensorPose(double)>& pose_at,
              const std::function<double(double)>& acc, int n, bool imu, int blocks, uint32_t seed,
              const std::function<bool(double)>& on_ramp, const Eigen::Vector3d& acc_bias = Eigen::Vector3d::Zero(),
-             const SegmenterConfig& cfg = SegmenterConfig{}) {
-  RingSegmenter seg(cfg);
+             const SegmenterConfig& cfg = SegmenterConfig{}, RingSegmenter* use = nullptr,
+             std::vector<std::string>* digests = nullptr) {
+  RingSegmenter own(cfg);
+  RingSegmenter& seg = use ? *use : own;  // (use: a segmenter that may have run before)
   const auto beams = synth::os1_like_beams();
   std::mt19937 rng(seed);
   std::normal_distribution<double> gauss(0.0, 1.0);
@@ -104,6 +133,7 @@ Result drive(const synth::Room& room, const std::function<SensorPose(double)>& p
     }
     scan.utime = utime;
     const auto& out = seg.process(scan);
+    if (digests) digests->push_back(digest(out));
     const SensorPose truth = pose_at(t0);  // the pose's time: utime
     const double err = std::max(std::abs(out.roll - truth.roll), std::abs(out.pitch - truth.pitch));
     const bool ramp = on_ramp(t0);
@@ -244,6 +274,47 @@ TEST(GravityFusion, KinkSplitIsSkippedOnlyWhileOneSurfaceIsFollowed) {
   std::printf("rechecks settled on every second return: %lld (kink_recheck_scans 4: %lld)\n", (long long)b.kink_thinned,
               (long long)c.kink_thinned);
   EXPECT_LT(b.max_kink_z_err, 0.02);
+}
+
+// Segmenter::reset: a segmenter that has run the whole ramp hall (the ramp found, the surface at the kinks followed,
+// the gyro bias and the fusion's slope learned, the split's skipping armed), reset, then given the first 120 scans
+// (60 with column times, after 150) again (time going back to the start, as a log replayed or the perception
+// benchmark's sequence at its restart) says exactly what a new segmenter says on them: every output bit for bit (digest: the planes, attitude, height,
+// sigmas, sources, status text, the wall points), and the same diagnostics counters. Seen to fail with the plane
+// fit's steady state or have_prev_ceiling_ left as they were (scan 0 differs; the steady fits' count).
+// (A few members reset() resets only for clarity: after a time jump back they are written before being read.)
+TEST(GravityFusion, ResetGivesANewSegmentersOutputs) {
+  const auto room = ramp_hall();
+  const auto pose = [&](double t) { return ramp_pose(room, t); };
+  const auto ramp = [&](double t) { return on_ramp(room, t); };
+  for (const int blocks : {1, 4}) {  // (4: column times and the gyro de-skew, the sweep's translation)
+    // (with column times: onto the ramp and back, fewer scans: each is rendered four times)
+    const int first = blocks == 1 ? 310 : 150, again = blocks == 1 ? 120 : 60;
+    SCOPED_TRACE("blocks " + std::to_string(blocks));
+    RingSegmenter used{SegmenterConfig{}};
+    used.set_keep_labels(true);
+    drive(room, pose, wobbly_acc, first, true, blocks, 11, ramp, Eigen::Vector3d::Zero(), SegmenterConfig{}, &used);
+    EXPECT_GT(used.kink_splits_skipped(), 0);
+    used.reset();
+    EXPECT_EQ(used.kink_splits_skipped(), 0);
+    EXPECT_EQ(used.kink_rechecks_thinned(), 0);
+    EXPECT_EQ(used.steady_plane_fits(), 0);
+    EXPECT_EQ(used.room_height(), 0.0);
+    RingSegmenter fresh{SegmenterConfig{}};
+    fresh.set_keep_labels(true);
+    std::vector<std::string> a, b;
+    const Result ra = drive(room, pose, wobbly_acc, again, true, blocks, 12, ramp, Eigen::Vector3d::Zero(), SegmenterConfig{},
+                            &used, &a);
+    const Result rb = drive(room, pose, wobbly_acc, again, true, blocks, 12, ramp, Eigen::Vector3d::Zero(), SegmenterConfig{},
+                            &fresh, &b);
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t k = 0; k < a.size(); ++k) ASSERT_EQ(a[k], b[k]) << "scan " << k;
+    EXPECT_EQ(ra.kink_skipped, rb.kink_skipped);
+    EXPECT_EQ(ra.kink_thinned, rb.kink_thinned);
+    EXPECT_EQ(used.steady_plane_fits(), fresh.steady_plane_fits());
+    EXPECT_EQ(used.gyro_bias(), fresh.gyro_bias());
+    EXPECT_EQ(used.room_height(), fresh.room_height());
+  }
 }
 
 // Off the ramp's head onto a landing under a sloped roof (8.5 deg, the demo building's lobby): the ground

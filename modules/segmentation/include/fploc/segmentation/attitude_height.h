@@ -42,6 +42,9 @@ class AttitudeHeight {
   void set_areas(const AreaCeilingMap& map);
   // The sensor's pose in the plan frame (the localizer's latest); the next scans extrapolate from the last two.
   void set_plan_pose(const PlanPose& pose);
+  // Everything learned from the scans and poses as after construction (then set_areas with the areas given,
+  // if any: their learned heights start anew); the configuration and the areas kept (Segmenter::reset).
+  void reset();
   bool has_areas() const { return have_areas_; }
   const AreaHeights& area_heights() const { return area_h_; }
   // A scan whose planes could not be fitted at all (bad or empty input): the predicted estimate.

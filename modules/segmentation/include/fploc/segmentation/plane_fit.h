@@ -27,6 +27,8 @@ class PlaneFit {
                    Eigen::Vector4d& plane) = 0;
   // Fits that refined last frame's plane without searching for a start (diagnostics, tests).
   virtual int64_t steady_fits() const { return 0; }
+  // What one fit carries to the next (and the diagnostics) as after construction; scratch kept (Segmenter::reset).
+  virtual void reset() {}
 };
 
 // The paper's fit: max-range seeds on the top K_r rings, linear regression, IRLS (Tukey), see
@@ -93,6 +95,10 @@ class RingPlaneFit : public PlaneFit {
  public:
   // Fits that refined last frame's plane alone (diagnostics, tests).
   int64_t steady_fits() const override { return steady_fits_; }
+  void reset() override {
+    steady_[0] = steady_[1] = Steady{};
+    steady_fits_ = 0;
+  }
 };
 
 }  // namespace fploc::seg

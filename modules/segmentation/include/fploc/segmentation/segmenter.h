@@ -36,6 +36,15 @@ class Segmenter {
 
   // Segments one scan. Never throws on bad data: the status says what was wrong.
   const Segmentation& process(const Scan& scan);
+  // Starts again as a new segmenter (a time jump: a log or a simulated sequence played again from its start).
+  // Everything carried from scan to scan -- the planes followed, the IMU samples and gyro bias, the gravity
+  // fusion, attitude and height, the surface followed at a kink, the diagnostics counters, the last output --
+  // as after construction; the configuration, set_keep_labels, the areas given (set_areas; their learned heights
+  // start anew) and the scratch arrays with their capacity (the look-up table of the last beam pattern, the
+  // candidates, the wall points, the kink split's cells) kept. The next scans' outputs are a new segmenter's, bit
+  // for bit (segmentation_gravity_fusion_test: ResetGivesANewSegmentersOutputs), without its first scans'
+  // allocations and page faults. A member added below that is carried from scan to scan must be reset there.
+  void reset();
   const Segmentation& last() const { return out_; }
 
   // IMU accelerometer sample (specific force, m/s^2) in the sensor frame; averaged until the next scan.
