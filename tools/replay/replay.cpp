@@ -50,6 +50,22 @@ void usage() {
                "                    [--record OUT.lcm [--record-channels REGEX]]\n"
                "  runs the graph's nodes in one process over memq://, lock-step on the log's events\n";
 }
+// The shipped graph that reads a log whose channels another graph left unread ("" when none is known).
+std::string graph_for_channels(const std::map<std::string, int64_t>& channels) {
+  for (const auto& [c, k] : channels) {
+    const std::string bare = c.substr(c.find('/') == std::string::npos ? 0 : c.rfind('/') + 1);  // robot R/...
+    if (bare == "OS1_LIDAR_PACKETS" || bare == "OS1_IMU_PACKETS")
+      return "The log holds Ouster packets: replay it with --graph graphs/replay-packets.pbtxt (its drivers decode them), "
+             "or import the bag again with `fploc import --decode` for graphs/replay.pbtxt";
+    if (bare.rfind("POINT_CLOUD", 0) == 0)
+      return "The log holds point clouds (point_cloud2_t): replay it with --graph graphs/replay-clouds.pbtxt (its "
+             "cloud_to_scan node makes the scans), or import the bag again with `fploc import --decode` for "
+             "graphs/replay.pbtxt";
+    if (bare == "LASER_SCAN")
+      return "The log holds a 2D laser (laser_scan_t): replay it with --graph graphs/lidar2d.pbtxt";
+  }
+  return "";
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -381,6 +397,25 @@ int main(int argc, char** argv) {
               << status_count[1] << " POOR, " << status_count[2] << " LOST"
               << (status_count[3] ? ", " + std::to_string(status_count[3]) + " other status" : std::string())
               << (poses > 0 && status_count[2] == poses ? " (every pose LOST: no estimate of the run)" : "") << "\n";
+    // Some of the graph's inputs got nothing while the log holds channels the graph does not read: a point-cloud log
+    // through graphs/replay.pbtxt fed its IMU and no scan, and said only "0 poses".
+    if (published > 0) {
+      std::string starved, unread;
+      std::map<std::string, int64_t> unread_channels;
+      for (const auto& c : external)
+        if (!per_channel.count(c)) starved += (starved.empty() ? "" : ", ") + c;
+      for (const auto& [c, k] : log_channels)
+        if (!ext.count(c) && c != fploc::rt::robot_channel(fploc::rt::robot_of(&g.graph), "FPLOC_GROUND_TRUTH")) {
+          unread += (unread.empty() ? "" : ", ") + fploc::printable(c) + " (" + std::to_string(k) + ")";
+          unread_channels[c] = k;
+        }
+      if (!starved.empty() && !unread.empty()) {
+        std::cerr << "fploc replay: warning: " << log_path << " has no event on " << starved << ", which " << graph_path
+                  << " reads; the log's channels it does not read: " << unread;
+        if (const std::string hint = graph_for_channels(unread_channels); !hint.empty()) std::cerr << ". " << hint;
+        std::cerr << "\n";
+      }
+    }
     nlohmann::json logged_json = nlohmann::json::array();
     for (const auto& l : logged) {
       const int64_t n = l->count[0] + l->count[1] + l->count[2] + l->count[3];
@@ -436,14 +471,7 @@ int main(int argc, char** argv) {
       for (const auto& c : external) want += (want.empty() ? "" : ", ") + c;
       std::cerr << "fploc replay: no event of " << log_path << " is on an input channel of " << graph_path
                 << ": the log holds " << have << "; the graph reads " << (want.empty() ? "nothing from outside" : want);
-      bool packets = false;
-      for (const auto& [c, k] : log_channels) {
-        const std::string bare = c.substr(c.find('/') == std::string::npos ? 0 : c.rfind('/') + 1);  // robot R/...
-        packets |= bare == "OS1_LIDAR_PACKETS" || bare == "OS1_IMU_PACKETS";
-      }
-      if (packets)
-        std::cerr << ". The log holds Ouster packets: replay it with --graph graphs/replay-packets.pbtxt (its drivers "
-                     "decode them), or import the bag again with `fploc import --decode` for graphs/replay.pbtxt";
+      if (const std::string hint = graph_for_channels(log_channels); !hint.empty()) std::cerr << ". " << hint;
       std::cerr << "\n";
       return 1;
     }
