@@ -841,8 +841,10 @@ int main(int argc, char** argv) {
       const std::vector<std::string> pose_nodes = lidar2d ? std::vector<std::string>{"matcher", "grid2d", "amcl"}
                                                           : std::vector<std::string>{"matcher"};
       std::string est = std::filesystem::path(out).replace_extension("").string() + "-poses.tum";
-      std::printf("  replay (PLAN: your plan; X Y: the start in it [m], YAW [rad]):\n"
-                  "    bin/fploc replay --graph %s --log %s --out %s \\\n     ", replay_graph.c_str(), printable(out).c_str(), printable(est).c_str());
+      // Without a start (not for lidar2d: grid2d searches by itself without grid2d.initial_pose), the relocalizer searches.
+      std::printf("  replay (PLAN: your plan; X Y: the start in it [m], YAW [rad]%s):\n"
+                  "    bin/fploc replay --graph %s --log %s --out %s \\\n     ", lidar2d ? "" : "; no start known: --set matcher.wait_for_initial_pose=true instead, the relocalizer searches the plan",
+                  replay_graph.c_str(), printable(out).c_str(), printable(est).c_str());
       for (const auto& n : plan_nodes) std::printf(" --set %s.plan.file=PLAN", n.c_str());
       std::printf(" \\\n     ");
       for (const auto& n : pose_nodes)
