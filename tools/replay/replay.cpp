@@ -203,8 +203,11 @@ int main(int argc, char** argv) {
         if (b.node != sp.node || !b.has_initial_pose || b.path == sp.path) continue;
         std::string how = "give the start in it: --set " + sp.node + ".initial_pose.x=X --set " + sp.node +
                           ".initial_pose.y=Y --set " + sp.node + ".initial_pose.yaw=YAW (radians)";
+        bool relocalizer = false;  // wait_for_initial_pose helps only where a relocalizer sends the start
         for (const auto& n : g.graph.node())
-          if (n.name() == sp.node)
+          relocalizer |= !n.disabled() && type_from_executable(n.executable()) == "relocalizer";
+        for (const auto& n : g.graph.node())
+          if (n.name() == sp.node && relocalizer)
             if (const auto o = node_options(n); o && o->GetDescriptor()->FindFieldByName("wait_for_initial_pose"))
               how += ", or let the relocalizer search the plan: --set " + sp.node + ".wait_for_initial_pose=true";
         char xy[96];
