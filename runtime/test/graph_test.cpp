@@ -1,10 +1,12 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "fploc/runtime/graph.h"
 #include "fploc/runtime/bus.h"
 #include "fploc/runtime/node.h"
+#include "fploc/runtime/cli_numbers.h"
 
 using namespace fploc::rt;
 
@@ -268,4 +270,28 @@ node {
   // An error names the override as given.
   EXPECT_FALSE(apply_node_overrides(g.graph, {"nonode.plan.file=x.dxf"}, {}, err));
   EXPECT_NE(err.find("nonode.plan.file=x.dxf"), std::string::npos) << err;
+}
+
+// A typo'd option of a CLI11 main (fploc map render --layer Walls): CLI11 said "The following arguments were not
+// expected: Walls --layer" without naming the command. Now one line naming the command and the option.
+TEST(CliMessages, ATypoedOptionIsNamedWithItsCommand) {
+  const auto error_of = [](std::vector<std::string> args) {
+    CLI::App app{"t"};
+    std::string plan, layers;
+    auto* render = app.add_subcommand("render", "r");
+    render->add_option("--plan", plan)->required();
+    render->add_option("--layers", layers);
+    std::reverse(args.begin(), args.end());
+    try {
+      app.parse(args);
+    } catch (const CLI::ParseError& e) {
+      return cli_error_text(app, e, "fploc map");
+    }
+    return std::string("parsed");
+  };
+  EXPECT_EQ(error_of({"render", "--plan", "p.dxf", "--layer", "Walls"}),
+            "fploc map: unknown option '--layer' (fploc map --help lists the options)");
+  EXPECT_EQ(error_of({"render", "--plan", "p.dxf", "extra1", "extra2"}),
+            "fploc map: unexpected argument 'extra1' (fploc map --help lists the options)");
+  EXPECT_EQ(error_of({"render", "--plan"}).rfind("fploc map: --plan: 1 required TEXT missing", 0), 0u);
 }

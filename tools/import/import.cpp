@@ -46,6 +46,7 @@
 #include "laser_mounts.h"
 #include "tf_tree.h"
 #include "tum_track.h"
+#include "fploc/runtime/cli_numbers.h"
 
 using namespace fploc;
 using namespace fploc::rec;
@@ -160,6 +161,7 @@ bool survey_lasers(const std::string& path, const std::set<std::string>& wanted,
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc import: ROS 1 bags, ROS 2 MCAP and sqlite3 (.db3) recordings -> LCM log (and a TUM trajectory)"};
+  fploc::rt::install_cli_messages(app, "fploc import");
   std::string path, out, tum_out, tf_parent, tf_child, odom_topic, metadata_file;
   std::vector<std::string> topics, channels;
   bool list = false, json = false, quiet = false, decode_ouster = false;

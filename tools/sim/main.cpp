@@ -42,6 +42,7 @@ using fploc::rt::write_event;
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc sim: simulate an OS-1-64 + IMU sequence into an LCM log and a TUM ground truth"};
+  fploc::rt::install_cli_messages(app, "fploc sim");
   std::string plan_file, scenario, out, gt, units, metadata, beams, demo_dir, floor, world_file, perturb, truth, gt_floors,
       demo_building_dir, ceilings_building;
   std::vector<std::string> layers, gaps;
