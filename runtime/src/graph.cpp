@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <type_traits>
 
@@ -303,27 +304,52 @@ nlohmann::json describe(const Descriptor* d, int depth) {
 }
 }  // namespace
 
+bool is_path_option(const std::string& field) {
+  // The string options the nodes read or write as files (Context::resolve_path, or opened as given).
+  static const std::set<std::string> kPaths = {"file",         "metadata",    "pcap",       "world",
+                                               "metadata_out", "web_root",    "graph",      "serial_device",
+                                               "stats_file",   "out_json",    "out_dxf",    "uncertainty_file",
+                                               "floor_file"};
+  return kPaths.count(field) > 0;
+}
+
+std::string command_line_path_override(const std::string& set, const std::string& cwd) {
+  const auto eq = set.find('=');
+  if (eq == std::string::npos) return set;
+  const std::string path = set.substr(0, eq), value = set.substr(eq + 1);
+  const auto dot = path.rfind('.');
+  const std::string leaf = dot == std::string::npos ? path : path.substr(dot + 1);
+  if (value.empty() || value.front() == '"' || !is_path_option(leaf) || std::filesystem::path(value).is_absolute())
+    return set;
+  return path + "=" + (std::filesystem::path(cwd) / value).lexically_normal().string();
+}
+
 bool apply_node_overrides(fploc::Graph& graph, const std::vector<std::string>& sets,
                           const std::function<std::string(const fploc::Node&)>& default_field, std::string& error) {
-  for (const auto& s : sets) {
+  // A path given on the command line is relative to the working directory, as every other path of the command
+  // (a graph's own paths are relative to its folder: `--set matcher.plan.file=my.dxf` looked in graphs/).
+  std::error_code ec;
+  const std::string cwd = std::filesystem::current_path(ec).string();
+  for (const auto& given : sets) {
+    const std::string s = ec ? given : command_line_path_override(given, cwd);
     const auto dot = s.find('.');
     fploc::Node* target = nullptr;
     for (int i = 0; dot != std::string::npos && i < graph.node_size(); ++i)
       if (graph.node(i).name() == s.substr(0, dot)) target = graph.mutable_node(i);
     if (!target) {
-      error = "--set " + s + ": expected NODE.field=value with a node of the graph";
+      error = "--set " + given + ": expected NODE.field=value with a node of the graph";
       return false;
     }
     std::string field = node_options_field(*target);
     if (field.empty() && default_field) field = default_field(*target);
     const FieldDescriptor* fd = field.empty() ? nullptr : fploc::Node::descriptor()->FindFieldByName(field);
     if (!fd || !fd->message_type()) {
-      error = "--set " + s + ": node '" + target->name() + "' takes no options";
+      error = "--set " + given + ": node '" + target->name() + "' takes no options";
       return false;
     }
     Message* opts = target->GetReflection()->MutableMessage(target, fd);
     if (!apply_overrides(*opts, {s.substr(dot + 1)}, error)) {
-      error = "--set " + s + " (node '" + target->name() + "'): " + error;
+      error = "--set " + given + " (node '" + target->name() + "'): " + error;
       return false;
     }
   }

@@ -1,8 +1,12 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
+
 #include "fploc/runtime/graph.h"
 #include "fploc/runtime/bus.h"
 #include "fploc/runtime/node.h"
+#include "fploc/runtime/cli_numbers.h"
 
 using namespace fploc::rt;
 
@@ -227,4 +231,67 @@ TEST(Context, StatusChangesArePrintedTwoHundredTimesAndKeptInTheDetail) {
   EXPECT_EQ(said.find("scan 201"), std::string::npos);
   EXPECT_EQ(said.find("further changes"), said.rfind("further changes")) << "marked once";
   EXPECT_EQ(ctx.stats().detail, "scan 399: POOR") << "the detail follows every change";
+}
+
+// `fploc replay --set matcher.plan.file=my.dxf` run in the folder holding my.dxf: the path is the working directory's,
+// as every other path on the command line; it was resolved against the graph's folder (graphs/my.dxf: cannot open).
+// Only file options change; names (plan.floor, lookup) and absolute paths stay as given.
+TEST(Overrides, CommandLinePathsAreRelativeToTheWorkingDirectory) {
+  const std::string text = R"pb(name: "t"
+lcm_url: "memq://"
+node {
+  name: "matcher"
+  executable: "fploc-matcher"
+  matcher { plan { file: "../data/plans/room.json" } }
+}
+node {
+  name: "log"
+  executable: "fploc-pose-logger"
+  pose_logger { file: "out.tum" }
+}
+)pb";
+  LoadedGraph g;
+  std::vector<GraphError> errors;
+  ASSERT_TRUE(parse_graph_text(text, "/somewhere/graphs/t.pbtxt", g, errors));
+  std::string err;
+  ASSERT_TRUE(apply_node_overrides(g.graph,
+                                   {"matcher.plan.file=plans/my.dxf", "matcher.plan.floor=first", "matcher.lookup=kdtree",
+                                    "log.file=/abs/est.tum"},
+                                   {}, err))
+      << err;
+  const std::string cwd = std::filesystem::current_path().string();
+  EXPECT_EQ(g.graph.node(0).matcher().plan().file(), (std::filesystem::path(cwd) / "plans/my.dxf").string());
+  EXPECT_EQ(g.graph.node(0).matcher().plan().floor(), "first");
+  EXPECT_EQ(g.graph.node(0).matcher().lookup(), "kdtree");
+  EXPECT_EQ(g.graph.node(1).pose_logger().file(), "/abs/est.tum");
+  EXPECT_EQ(command_line_path_override("n.metadata=../os1.json", "/w/run"), "n.metadata=/w/os1.json");
+  EXPECT_EQ(command_line_path_override("n.plan.units=mm", "/w"), "n.plan.units=mm");
+  EXPECT_EQ(command_line_path_override("n.plan.file=", "/w"), "n.plan.file=");
+  // An error names the override as given.
+  EXPECT_FALSE(apply_node_overrides(g.graph, {"nonode.plan.file=x.dxf"}, {}, err));
+  EXPECT_NE(err.find("nonode.plan.file=x.dxf"), std::string::npos) << err;
+}
+
+// A typo'd option of a CLI11 main (fploc map render --layer Walls): CLI11 said "The following arguments were not
+// expected: Walls --layer" without naming the command. Now one line naming the command and the option.
+TEST(CliMessages, ATypoedOptionIsNamedWithItsCommand) {
+  const auto error_of = [](std::vector<std::string> args) {
+    CLI::App app{"t"};
+    std::string plan, layers;
+    auto* render = app.add_subcommand("render", "r");
+    render->add_option("--plan", plan)->required();
+    render->add_option("--layers", layers);
+    std::reverse(args.begin(), args.end());
+    try {
+      app.parse(args);
+    } catch (const CLI::ParseError& e) {
+      return cli_error_text(app, e, "fploc map");
+    }
+    return std::string("parsed");
+  };
+  EXPECT_EQ(error_of({"render", "--plan", "p.dxf", "--layer", "Walls"}),
+            "fploc map: unknown option '--layer' (fploc map --help lists the options)");
+  EXPECT_EQ(error_of({"render", "--plan", "p.dxf", "extra1", "extra2"}),
+            "fploc map: unexpected argument 'extra1' (fploc map --help lists the options)");
+  EXPECT_EQ(error_of({"render", "--plan"}).rfind("fploc map: --plan: 1 required TEXT missing", 0), 0u);
 }

@@ -23,6 +23,7 @@
 #include "fploc/segmentation/ransac_segmenter.h"
 #include "fploc/segmentation/segmenter.h"
 #include "fploc/sim/simulator.h"
+#include "fploc/runtime/cli_numbers.h"
 
 namespace {
 
@@ -199,6 +200,7 @@ std::string shared_dir() {
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc bench perception: segmentation and feature accuracy/speed on a simulated sequence"};
+  fploc::rt::install_cli_messages(app, "fploc bench perception");
   std::string plan_file, units, scenario, beams;
   std::vector<std::string> layers;
   uint64_t seed = 0;

@@ -48,6 +48,7 @@ void quat_of_yaw(double yaw, double q[4]) {
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc import-carmen: CARMEN log (Radish) -> LCM log (laser_scan_t + odometry) + reference TUM"};
+  fploc::rt::install_cli_messages(app, "fploc import-carmen");
   std::string in, out, tum, odom_tum, map_dir;
   double begin = 0, end = 1, map_begin = 0, map_end = 0.5, resolution = 0.05;
   bool json = false;

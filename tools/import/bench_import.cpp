@@ -36,6 +36,7 @@
 #include "fploc/recording/bag_writer.h"
 #include "fploc/recording/mcap_writer.h"
 #include "fploc/recording/recording.h"
+#include "fploc/runtime/cli_numbers.h"
 
 using namespace fploc::rec;
 namespace fs = std::filesystem;
@@ -204,6 +205,7 @@ double median(std::vector<double> v) {
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc bench import: import speed against cat of the same file (ratio)"};
+  fploc::rt::install_cli_messages(app, "fploc bench import");
   int size_mb = 1024, runs = 3;
   std::string kind = "all", compression = "none", keep, format = "bag";
   bool json = false;

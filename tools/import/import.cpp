@@ -46,6 +46,7 @@
 #include "laser_mounts.h"
 #include "tf_tree.h"
 #include "tum_track.h"
+#include "fploc/runtime/cli_numbers.h"
 
 using namespace fploc;
 using namespace fploc::rec;
@@ -160,6 +161,7 @@ bool survey_lasers(const std::string& path, const std::set<std::string>& wanted,
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc import: ROS 1 bags, ROS 2 MCAP and sqlite3 (.db3) recordings -> LCM log (and a TUM trajectory)"};
+  fploc::rt::install_cli_messages(app, "fploc import");
   std::string path, out, tum_out, tf_parent, tf_child, odom_topic, metadata_file;
   std::vector<std::string> topics, channels;
   bool list = false, json = false, quiet = false, decode_ouster = false;
@@ -841,8 +843,10 @@ int main(int argc, char** argv) {
       const std::vector<std::string> pose_nodes = lidar2d ? std::vector<std::string>{"matcher", "grid2d", "amcl"}
                                                           : std::vector<std::string>{"matcher"};
       std::string est = std::filesystem::path(out).replace_extension("").string() + "-poses.tum";
-      std::printf("  replay (PLAN: your plan; X Y: the start in it [m], YAW [rad]):\n"
-                  "    bin/fploc replay --graph %s --log %s --out %s \\\n     ", replay_graph.c_str(), printable(out).c_str(), printable(est).c_str());
+      // Without a start (not for lidar2d: grid2d searches by itself without grid2d.initial_pose), the relocalizer searches.
+      std::printf("  replay (PLAN: your plan; X Y: the start in it [m], YAW [rad]%s):\n"
+                  "    bin/fploc replay --graph %s --log %s --out %s \\\n     ", lidar2d ? "" : "; no start known: --set matcher.wait_for_initial_pose=true instead, the relocalizer searches the plan",
+                  replay_graph.c_str(), printable(out).c_str(), printable(est).c_str());
       for (const auto& n : plan_nodes) std::printf(" --set %s.plan.file=PLAN", n.c_str());
       std::printf(" \\\n     ");
       for (const auto& n : pose_nodes)

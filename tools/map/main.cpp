@@ -131,6 +131,7 @@ int cmd_build(const PlanArgs& pa, const AnnfArgs& aa, const std::string& out, bo
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc map: floor plans and the ANNF"};
+  fploc::rt::install_cli_messages(app, "fploc map");
   app.require_subcommand(1);
   // `fploc map diff` is its own program (fploc-map-diff): the launcher script finds it before this one.
   app.footer("Also: diff (plan changes seen in a recorded run: fploc map diff --help)");

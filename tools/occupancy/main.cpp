@@ -28,6 +28,7 @@
 #include "fploc/floorplan/io.h"
 #include "fploc/floorplan/occupancy.h"
 #include "fploc/floorplan/png.h"
+#include "fploc/runtime/cli_numbers.h"
 
 namespace {
 // Largest distance from points sampled every `step` along a's elements to plan b (brute force).
@@ -296,6 +297,7 @@ std::vector<Eigen::Vector2d> scan_at_pose(const std::string& log_path, const std
 
 int main(int argc, char** argv) {
   CLI::App app{"occupancy map (map_server YAML + PGM/PNG) -> vectorised plan"};
+  fploc::rt::install_cli_messages(app, "fploc occupancy");
   std::string map, out, compare;
   double tol = 0.5;
   bool json = false;

@@ -11,9 +11,11 @@
 
 #include "fploc/core/text_out.h"
 #include "fploc/os1/sensor_config.h"
+#include "fploc/runtime/cli_numbers.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc os1 configure: set a live Ouster sensor up over its HTTP API (firmware 2.1+)"};
+  fploc::rt::install_cli_messages(app, "fploc os1 configure");
   std::string host, metadata_out;
   fploc::os1::SensorConfigRequest req;
   bool as_json = false, alerts_only = false;

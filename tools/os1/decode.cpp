@@ -27,6 +27,7 @@
 #include "fploc/os1/pcap.h"
 #ifdef FPLOC_HAVE_PCL
 #include "pcd_writer.h"
+#include "fploc/runtime/cli_numbers.h"
 #endif
 
 using namespace fploc;
@@ -164,6 +165,7 @@ json compare_digest(const json& ours, const json& ref) {
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc os1 decode: decode an Ouster pcap (legacy / RNG19 / RNG15 low-data-rate profiles) with its metadata JSON"};
+  fploc::rt::install_cli_messages(app, "fploc os1 decode");
   std::string pcap_path, meta_path, pcd_dir, digest_path;
   bool as_json = false;
   int lidar_port = 0, imu_port = 0;

@@ -12,9 +12,11 @@
 
 #include "fploc/os1/packet.h"
 #include "fploc/os1/source.h"
+#include "fploc/runtime/cli_numbers.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc os1 send: replay an Ouster pcap as UDP packets (to a driver under test)"};
+  fploc::rt::install_cli_messages(app, "fploc os1 send");
   std::string pcap, host = "127.0.0.1";
   int lidar_port = 7502, imu_port = 7503, loops = 1;
   double rate = 1.0;

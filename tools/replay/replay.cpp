@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <cstdio>
 #include <cstring>
 #include <iostream>
 #include <map>
@@ -48,6 +49,22 @@ void usage() {
                "                    [--robot R]   (the log's channels are R/...; default: the graph's robot, else $FPLOC_ROBOT)\n"
                "                    [--record OUT.lcm [--record-channels REGEX]]\n"
                "  runs the graph's nodes in one process over memq://, lock-step on the log's events\n";
+}
+// The shipped graph that reads a log whose channels another graph left unread ("" when none is known).
+std::string graph_for_channels(const std::map<std::string, int64_t>& channels) {
+  for (const auto& [c, k] : channels) {
+    const std::string bare = c.substr(c.find('/') == std::string::npos ? 0 : c.rfind('/') + 1);  // robot R/...
+    if (bare == "OS1_LIDAR_PACKETS" || bare == "OS1_IMU_PACKETS")
+      return "The log holds Ouster packets: replay it with --graph graphs/replay-packets.pbtxt (its drivers decode them), "
+             "or import the bag again with `fploc import --decode` for graphs/replay.pbtxt";
+    if (bare.rfind("POINT_CLOUD", 0) == 0)
+      return "The log holds point clouds (point_cloud2_t): replay it with --graph graphs/replay-clouds.pbtxt (its "
+             "cloud_to_scan node makes the scans), or import the bag again with `fploc import --decode` for "
+             "graphs/replay.pbtxt";
+    if (bare == "LASER_SCAN")
+      return "The log holds a 2D laser (laser_scan_t): replay it with --graph graphs/lidar2d.pbtxt";
+  }
+  return "";
 }
 }  // namespace
 
@@ -121,6 +138,7 @@ int main(int argc, char** argv) {
       if (loggers.size() > 1) std::cerr << "fploc replay: " << n->name() << " -> " << file << "\n";
     }
   }
+  const LoadedGraph as_written = g;  // before --set: which start pose belongs to which plan
   std::string set_error;
   if (!apply_node_overrides(g.graph, sets, [](const fploc::Node& n) {
         const auto* reg = find_registration(type_from_executable(n.executable()));
@@ -166,6 +184,36 @@ int main(int argc, char** argv) {
         std::string ns;
         for (const auto& x : names) ns += (ns.empty() ? "" : ", ") + x;
         own_plans += (own_plans.empty() ? "" : "; ") + ns + " -> " + file;
+      }
+    }
+  }
+
+  // A start pose written in the graph for the graph's own plan, kept with another plan given by --set (the demo room's
+  // start in the user's building: the first scans were matched there, published POOR 2.8 m off, then LOST and
+  // relocalized). One warning per node, saying how to give the start or let the relocalizer search.
+  {
+    const auto keep = [](const fploc::Node& n) { return find_registration(type_from_executable(n.executable())) != nullptr; };
+    const auto before = fploc::tools::start_plans(as_written, keep);
+    for (const auto& sp : fploc::tools::start_plans(g, keep)) {
+      if (!sp.has_initial_pose || sp.ignores_initial_pose) continue;
+      bool pose_given = false;
+      for (const auto& kv : sets) pose_given |= kv.rfind(sp.node + ".initial_pose", 0) == 0;
+      if (pose_given) continue;
+      for (const auto& b : before) {
+        if (b.node != sp.node || !b.has_initial_pose || b.path == sp.path) continue;
+        std::string how = "give the start in it: --set " + sp.node + ".initial_pose.x=X --set " + sp.node +
+                          ".initial_pose.y=Y --set " + sp.node + ".initial_pose.yaw=YAW (radians)";
+        bool relocalizer = false;  // wait_for_initial_pose helps only where a relocalizer sends the start
+        for (const auto& n : g.graph.node())
+          relocalizer |= !n.disabled() && type_from_executable(n.executable()) == "relocalizer";
+        for (const auto& n : g.graph.node())
+          if (n.name() == sp.node && relocalizer)
+            if (const auto o = node_options(n); o && o->GetDescriptor()->FindFieldByName("wait_for_initial_pose"))
+              how += ", or let the relocalizer search the plan: --set " + sp.node + ".wait_for_initial_pose=true";
+        char xy[96];
+        std::snprintf(xy, sizeof xy, "(%.2f, %.2f)", sp.x, sp.y);
+        std::cerr << "fploc replay: warning: " << sp.node << "'s initial pose " << xy << " is the graph's, written for "
+                  << b.path << ", but its plan is now " << sp.path << ": " << how << "\n";
       }
     }
   }
@@ -352,6 +400,25 @@ int main(int argc, char** argv) {
               << status_count[1] << " POOR, " << status_count[2] << " LOST"
               << (status_count[3] ? ", " + std::to_string(status_count[3]) + " other status" : std::string())
               << (poses > 0 && status_count[2] == poses ? " (every pose LOST: no estimate of the run)" : "") << "\n";
+    // Some of the graph's inputs got nothing while the log holds channels the graph does not read: a point-cloud log
+    // through graphs/replay.pbtxt fed its IMU and no scan, and said only "0 poses".
+    if (published > 0) {
+      std::string starved, unread;
+      std::map<std::string, int64_t> unread_channels;
+      for (const auto& c : external)
+        if (!per_channel.count(c)) starved += (starved.empty() ? "" : ", ") + c;
+      for (const auto& [c, k] : log_channels)
+        if (!ext.count(c) && c != fploc::rt::robot_channel(fploc::rt::robot_of(&g.graph), "FPLOC_GROUND_TRUTH")) {
+          unread += (unread.empty() ? "" : ", ") + fploc::printable(c) + " (" + std::to_string(k) + ")";
+          unread_channels[c] = k;
+        }
+      if (!starved.empty() && !unread.empty()) {
+        std::cerr << "fploc replay: warning: " << log_path << " has no event on " << starved << ", which " << graph_path
+                  << " reads; the log's channels it does not read: " << unread;
+        if (const std::string hint = graph_for_channels(unread_channels); !hint.empty()) std::cerr << ". " << hint;
+        std::cerr << "\n";
+      }
+    }
     nlohmann::json logged_json = nlohmann::json::array();
     for (const auto& l : logged) {
       const int64_t n = l->count[0] + l->count[1] + l->count[2] + l->count[3];
@@ -407,14 +474,7 @@ int main(int argc, char** argv) {
       for (const auto& c : external) want += (want.empty() ? "" : ", ") + c;
       std::cerr << "fploc replay: no event of " << log_path << " is on an input channel of " << graph_path
                 << ": the log holds " << have << "; the graph reads " << (want.empty() ? "nothing from outside" : want);
-      bool packets = false;
-      for (const auto& [c, k] : log_channels) {
-        const std::string bare = c.substr(c.find('/') == std::string::npos ? 0 : c.rfind('/') + 1);  // robot R/...
-        packets |= bare == "OS1_LIDAR_PACKETS" || bare == "OS1_IMU_PACKETS";
-      }
-      if (packets)
-        std::cerr << ". The log holds Ouster packets: replay it with --graph graphs/replay-packets.pbtxt (its drivers "
-                     "decode them), or import the bag again with `fploc import --decode` for graphs/replay.pbtxt";
+      if (const std::string hint = graph_for_channels(log_channels); !hint.empty()) std::cerr << ". " << hint;
       std::cerr << "\n";
       return 1;
     }

@@ -42,6 +42,7 @@ using fploc::rt::write_event;
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc sim: simulate an OS-1-64 + IMU sequence into an LCM log and a TUM ground truth"};
+  fploc::rt::install_cli_messages(app, "fploc sim");
   std::string plan_file, scenario, out, gt, units, metadata, beams, demo_dir, floor, world_file, perturb, truth, gt_floors,
       demo_building_dir, ceilings_building;
   std::vector<std::string> layers, gaps;
@@ -214,6 +215,10 @@ int main(int argc, char** argv) {
         write_event(log, ut, "OS1_IMU", m, buf);
       }
     };
+    // The frames written (--duration cuts the path short): the progress counted against the whole path's frames
+    // ("frame 600/6015", then "wrote 600 scans").
+    int to_write = 0;
+    while (to_write < sim.num_frames() && sim.frame_time(to_write) + period <= t_end + 1e-9) ++to_write;
     for (int k = 0; k < sim.num_frames(); ++k) {
       const double ts = sim.frame_time(k);
       if (ts + period > t_end + 1e-9) break;
@@ -242,7 +247,7 @@ int main(int argc, char** argv) {
         write_event(log, int64_t(std::llround(t_pub * 1e6)), "OS1_SCAN", sm, buf);
       }
       ++frames;
-      if (frames % 100 == 0) std::cerr << "\r  frame " << frames << "/" << sim.num_frames() << std::flush;
+      if (frames % 100 == 0) std::cerr << "\r  frame " << frames << "/" << to_write << std::flush;
     }
     flush_imu(t_end);
     std::cerr << "\n";

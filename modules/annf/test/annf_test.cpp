@@ -316,3 +316,23 @@ TEST(Annf, FastAndGeneralPathsAgreeWithBruteForce) {
     }
   }
 }
+
+// A drawing in mm read as metres (the Barcelona pavilion's DXF with $INSUNITS 0: 52 x 23 km) built 33 million root
+// fields for minutes in the matcher, silent after the loader's warning. Now one error naming the plan, its extents and
+// the units; a large real site (the synthetic plan x 50: 600 x 400 m) still builds.
+TEST(Annf, APlanInTheWrongUnitsIsRefused) {
+  FloorPlan mm = synthetic();
+  scale_plan(mm, 1000);
+  mm.source = "plan_mm.dxf";
+  try {
+    (void)Annf::build(mm, AnnfOptions{});
+    FAIL() << "a 12 x 8 km plan was built";
+  } catch (const std::runtime_error& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("plan_mm.dxf: plan of 12000 x 8000 m is too large"), std::string::npos) << w;
+    EXPECT_NE(w.find("check the units"), std::string::npos) << w;
+  }
+  FloorPlan site = synthetic();
+  scale_plan(site, 50);
+  EXPECT_NO_THROW((void)Annf::build(site, AnnfOptions{}));
+}

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -161,6 +162,16 @@ AutoLoopResult plan_auto_loop(const FloorPlan& plan, const AutoLoopConfig& cfg) 
   const Box2 b = plan.bounds();
   const double ext = std::max(b.size().x(), b.size().y());
   const double res = cfg.resolution_m > 0 ? cfg.resolution_m : std::clamp(ext / 1000.0, 0.05, 0.2);
+  // A plan in the wrong units (a mm drawing read as metres: 52 x 23 km) asked for 3e10 cells: "fploc sim: std::bad_alloc".
+  const double cells = (b.size().x() / res + 4 / res + 1) * (b.size().y() / res + 4 / res + 1);
+  if (cells > 5e7) {
+    std::ostringstream m;
+    m << "auto-loop: " << (plan.source.empty() ? std::string("the plan") : plan.source) << " is " << std::fixed
+      << std::setprecision(0) << b.size().x() << " x " << b.size().y() << " m, too large to plan a path on ("
+      << std::setprecision(2) << cells / 1e6 << " million cells of " << res
+      << " m); check the units (a drawing in mm or cm read as metres: --units mm)";
+    throw std::runtime_error(m.str());
+  }
   const Grid g = distance_grid(plan, res, 2.0);
   const double dmin = cfg.clearance_m + 0.15 + res;
   std::vector<double> offsets;

@@ -92,3 +92,19 @@ TEST(DemoPlans, ShippedFilesMatchCode) {
   const Box2 b = demo_room_plan().bounds();
   EXPECT_GT(b.size().x() * b.size().y(), 200.0);
 }
+
+// `fploc sim --plan mm.dxf --scenario auto-loop-medium` on a drawing in mm read as metres said only
+// "fploc sim: std::bad_alloc" (a 3e10-cell grid); now one error naming the plan, its size and the units.
+TEST(AutoLoop, APlanInTheWrongUnitsIsRefused) {
+  FloorPlan mm = demo_room_plan();
+  scale_plan(mm, 1000);
+  mm.source = "room_mm.dxf";
+  try {
+    (void)plan_auto_loop(mm, AutoLoopConfig{});
+    FAIL() << "planned a loop on a 20 km room";
+  } catch (const std::exception& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("auto-loop: room_mm.dxf is 20500 x 13000 m, too large to plan a path on"), std::string::npos) << w;
+    EXPECT_NE(w.find("check the units"), std::string::npos) << w;
+  }
+}

@@ -112,3 +112,19 @@ for n in matcher relocalizer optimizer; do sets="$sets --set $n.plan.file=$R/dat
   fail "replay with the plans given: exit $?"
 grep -q "WARNING: .*not a simulator log" "$T/err" && fail "demo-plan warning with every plan given ($sets)"
 echo "demo-plan warning: OK"
+grep -q "initial pose .* is the graph's" "$T/err" && fail "start-pose warning with the graph's own plan given by --set"
+
+# Another plan by --set, the graph's start pose (the demo room's) left as written: one warning saying how to give the
+# start or let the relocalizer search; none once the start is given. The plan path is relative to the working directory.
+cp "$R/data/plans/corridor.json" "$T/my-plan.json"
+(cd "$T" && "$BIN/fploc-replay" --graph "$R/graphs/replay.pbtxt" --log "$T/log.lcm" --out "$T/h.tum" --set matcher.plan.file=my-plan.json \
+  --set optimizer.plan.file=my-plan.json --set relocalizer.plan.file=my-plan.json > /dev/null 2> "$T/err") ||
+  fail "replay with a plan relative to the working directory: exit $?"
+grep -qF "fploc replay: warning: matcher's initial pose (5.80, 3.23) is the graph's, written for $R/data/plans/room.json, but its plan is now $T/my-plan.json: give the start in it: --set matcher.initial_pose.x=X" "$T/err" ||
+  fail "no warning about the graph's start pose kept with another plan"
+grep -q "wait_for_initial_pose=true" "$T/err" || fail "the warning does not say how to let the relocalizer search"
+(cd "$T" && "$BIN/fploc-replay" --graph "$R/graphs/replay.pbtxt" --log "$T/log.lcm" --out "$T/h.tum" --set matcher.plan.file=my-plan.json \
+  --set optimizer.plan.file=my-plan.json --set relocalizer.plan.file=my-plan.json --set matcher.initial_pose.x=1 \
+  --set matcher.initial_pose.y=1 --set matcher.initial_pose.yaw=0 > /dev/null 2> "$T/err") || fail "replay with its start: exit $?"
+grep -q "is the graph's, written for" "$T/err" && fail "start-pose warning with the start given"
+echo "start pose with another plan: OK"

@@ -49,8 +49,15 @@ bool apply_overrides(google::protobuf::Message& opts, const std::vector<std::str
 // Applies "NODE.path.to.field=value" overrides to the options of the graph's nodes (fploc launch/replay
 // --set). `default_field(node)` names the options field of a node whose graph entry has no options block
 // (from its executable's spec; "" = takes none). Returns false and sets `error` naming the override.
+// A relative path given for a file option (is_path_option: plan.file, metadata, pcap, world, ...) is taken
+// relative to the working directory, as any path on a command line (the graph's own are relative to its folder).
 bool apply_node_overrides(fploc::Graph& graph, const std::vector<std::string>& sets,
                           const std::function<std::string(const fploc::Node&)>& default_field, std::string& error);
+
+// The string option names that are files (the last component of an override's field path).
+bool is_path_option(const std::string& field);
+// "NODE.a.file=rel" -> "NODE.a.file=CWD/rel" for a path option with a relative value; anything else unchanged.
+std::string command_line_path_override(const std::string& set, const std::string& cwd);
 
 // JSON schema-ish description of a message type (fields, types, nested messages), for --describe.
 std::string describe_message_json(const google::protobuf::Descriptor* d);

@@ -42,6 +42,10 @@ namespace fploc::annf {
 
 enum class AnnfMode : uint8_t { kPaper = 0, kExact = 1 };
 
+// Annf::build refuses a plan needing more root fields than this (a 6 x 6 km floor at the default 6 m root): a plan
+// that large is a drawing read in the wrong units, and its build ran for many minutes.
+inline constexpr double kMaxRootFields = 1e6;
+
 // Readings of the paper's stopping rules and candidate choice: the enumerators (and their names for
 // the command line) are in the bench-only header fploc/annf/ablation.h; the localizer uses the
 // defaults below. The value 2 is kChildLeafOrdered.
