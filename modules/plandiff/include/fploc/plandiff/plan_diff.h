@@ -251,6 +251,9 @@ class PlanDiff {
   bool extends_beyond_end(const Eigen::Vector2d& p) const;
   int extended_element(const Eigen::Vector2d& a, const Eigen::Vector2d& b) const;
   bool plan_blocks(const Eigen::Vector2d& o, const Eigen::Vector2d& q, int skip) const;
+  // A probe's look from s is blocked by another plan element: at the probe, or (segments) at either end of the
+  // stretch of the element it stands for (probe_step_m).
+  bool stretch_blocked(const Eigen::Vector2d& s, const Probe& pr) const;
   void cells_of(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, std::vector<int>& out) const;
 
   FloorPlan plan_;
