@@ -10,6 +10,17 @@ printf '0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n2 2 0 0 0 0 0 1\n' > "$T/gt.tum"
 printf '0 0 0.1 0 0 0 0 1\n1 1 0.1 0 0 0 0 1\n2 2 0.1 0 0 0 0 1\n' > "$T/est.tum"
 "$EVAL" --gt "$T/gt.tum" --est "$T/est.tum" --json > "$T/ok.json" 2>/dev/null || fail "good input"
 grep -q "\"ate_rmse_m\":0.1," "$T/ok.json" || fail "no ate in $(cat "$T/ok.json")"
+# The horizontal ATE beside the 3D one (what a floor plan constrains): est2 is off by 5 cm in y and 10-20 cm in z.
+printf '0 0 0 0 0 0 0 1\n1 1 0.05 0.1 0 0 0 1\n2 2 0 0.2 0 0 0 1\n' > "$T/est2.tum"
+"$EVAL" --gt "$T/gt.tum" --est "$T/est2.tum" --json > "$T/xy.json" 2> "$T/xy.err" || fail "good input (xy)"
+python3 - "$T/xy.json" "$T/ok.json" <<'PY' || fail "horizontal ATE: $(cat "$T/xy.json")"
+import json, math, sys
+a, b = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+assert abs(a["ate_xy_rmse_m"] - math.sqrt(0.05 ** 2 / 3)) < 1e-9, a
+assert abs(a["ate_xy_max_m"] - 0.05) < 1e-9 and abs(a["ate_max_m"] - 0.2) < 1e-9, a
+assert abs(b["ate_xy_rmse_m"] - 0.1) < 1e-9 and b["ate_rmse_m"] == 0.1, b
+PY
+grep -q "(horizontal: rmse 0.0288675 m, max 0.05 m)" "$T/xy.err" || fail "horizontal ATE text: $(cat "$T/xy.err")"
 for bad in "--delta 1x" "--offset nan" "--max-dt inf" "--false-ok-m -nan" "--offset 0.5s"; do
   set -- $bad
   rc=0

@@ -309,6 +309,8 @@ int main(int argc, char** argv) {
                      {"ate_mean_m", num(a.trans.mean)},
                      {"ate_median_m", num(a.trans.median)},
                      {"ate_max_m", num(a.trans.max)},
+                     {"ate_xy_rmse_m", num(a.trans_xy.rmse)},
+                     {"ate_xy_max_m", num(a.trans_xy.max)},
                      {"rpe_mean_m", num(r.trans.mean)},
                      {"rpe_rmse_m", num(r.trans.rmse)},
                      {"rpe_rot_mean_deg", num(r.rot_deg.mean)},
@@ -393,7 +395,7 @@ int main(int argc, char** argv) {
     }
     std::cerr << "fploc eval: " << pairs.size() << " associated poses (gt " << gt.size() << ", est " << est.size()
               << "); ATE rmse " << a.trans.rmse << " m, mean " << a.trans.mean << " m, max " << a.trans.max
-              << " m; RPE/" << delta << unit << " mean " << r.trans.mean << " m, " << r.rot_deg.mean << " deg ("
+              << " m (horizontal: rmse " << a.trans_xy.rmse << " m, max " << a.trans_xy.max << " m); RPE/" << delta << unit << " mean " << r.trans.mean << " m, " << r.rot_deg.mean << " deg ("
               << r.trans.n << " pairs)\n";
     if (r.trans.n == 0) std::cerr << "fploc eval: warning: no pose pair " << delta << unit << " apart: RPE is 0\n";
     if (json) std::cout << fploc::json_text(j) << std::endl;

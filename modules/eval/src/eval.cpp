@@ -100,8 +100,15 @@ Ate ate(const Trajectory& gt, const Trajectory& est, const Pairs& pairs, Align m
   Ate r;
   r.S = align(gt, est, pairs, mode);
   r.errors.reserve(pairs.size());
-  for (const auto& [g, e] : pairs) r.errors.push_back((gt[g].p - r.S * est[e].p).norm());
+  std::vector<double> xy;
+  xy.reserve(pairs.size());
+  for (const auto& [g, e] : pairs) {
+    const Eigen::Vector3d d = gt[g].p - r.S * est[e].p;
+    r.errors.push_back(d.norm());
+    xy.push_back(d.head<2>().norm());
+  }
   r.trans = summarize(r.errors);
+  r.trans_xy = summarize(xy);
   return r;
 }
 

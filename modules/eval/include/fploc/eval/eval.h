@@ -36,6 +36,7 @@ Eigen::Isometry3d align(const Trajectory& gt, const Trajectory& est, const Pairs
 
 struct Ate {
   Stats trans;                 // metres
+  Stats trans_xy;              // metres, horizontal (x, y) only: what a floor plan constrains
   Eigen::Isometry3d S = Eigen::Isometry3d::Identity();
   std::vector<double> errors;  // per pair
 };
