@@ -6,7 +6,7 @@
 #include "fploc/runtime/graph.h"
 #include "fploc/runtime/bus.h"
 #include "fploc/runtime/node.h"
-#include "fploc/runtime/cli_numbers.h"
+#include "fploc/runtime/cli_messages.h"
 
 using namespace fploc::rt;
 

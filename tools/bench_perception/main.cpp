@@ -23,7 +23,7 @@
 #include "fploc/segmentation/ransac_segmenter.h"
 #include "fploc/segmentation/segmenter.h"
 #include "fploc/sim/simulator.h"
-#include "fploc/runtime/cli_numbers.h"
+#include "fploc/runtime/cli_messages.h"
 
 namespace {
 

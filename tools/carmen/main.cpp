@@ -26,6 +26,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fploc/core/text_out.h"
+#include "fploc/runtime/cli_messages.h"
 #include "fploc/runtime/cli_numbers.h"
 #include "fploc/carmen/carmen.h"
 #include "fploc/carmen/coverage.h"

@@ -36,7 +36,7 @@
 #include "fploc/recording/bag_writer.h"
 #include "fploc/recording/mcap_writer.h"
 #include "fploc/recording/recording.h"
-#include "fploc/runtime/cli_numbers.h"
+#include "fploc/runtime/cli_messages.h"
 
 using namespace fploc::rec;
 namespace fs = std::filesystem;

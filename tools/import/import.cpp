@@ -46,7 +46,7 @@
 #include "laser_mounts.h"
 #include "tf_tree.h"
 #include "tum_track.h"
-#include "fploc/runtime/cli_numbers.h"
+#include "fploc/runtime/cli_messages.h"
 
 using namespace fploc;
 using namespace fploc::rec;

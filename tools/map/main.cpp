@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "fploc/core/text_out.h"
+#include "fploc/runtime/cli_messages.h"
 #include "fploc/runtime/cli_numbers.h"
 #include "fploc/annf/ablation.h"
 #include "fploc/annf/annf.h"

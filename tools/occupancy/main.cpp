@@ -28,7 +28,7 @@
 #include "fploc/floorplan/io.h"
 #include "fploc/floorplan/occupancy.h"
 #include "fploc/floorplan/png.h"
-#include "fploc/runtime/cli_numbers.h"
+#include "fploc/runtime/cli_messages.h"
 
 namespace {
 // Largest distance from points sampled every `step` along a's elements to plan b (brute force).

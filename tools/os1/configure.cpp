@@ -11,7 +11,7 @@
 
 #include "fploc/core/text_out.h"
 #include "fploc/os1/sensor_config.h"
-#include "fploc/runtime/cli_numbers.h"
+#include "fploc/runtime/cli_messages.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc os1 configure: set a live Ouster sensor up over its HTTP API (firmware 2.1+)"};

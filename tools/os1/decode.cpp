@@ -27,7 +27,7 @@
 #include "fploc/os1/pcap.h"
 #ifdef FPLOC_HAVE_PCL
 #include "pcd_writer.h"
-#include "fploc/runtime/cli_numbers.h"
+#include "fploc/runtime/cli_messages.h"
 #endif
 
 using namespace fploc;

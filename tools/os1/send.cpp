@@ -12,7 +12,7 @@
 
 #include "fploc/os1/packet.h"
 #include "fploc/os1/source.h"
-#include "fploc/runtime/cli_numbers.h"
+#include "fploc/runtime/cli_messages.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"fploc os1 send: replay an Ouster pcap as UDP packets (to a driver under test)"};

@@ -193,6 +193,15 @@ int main(int argc, char** argv) {
   // relocalized). One warning per node, saying how to give the start or let the relocalizer search.
   {
     const auto keep = [](const fploc::Node& n) { return find_registration(type_from_executable(n.executable())) != nullptr; };
+    // wait_for_initial_pose helps only where a relocalizer sends the start, to a node that has the option.
+    bool relocalizer = false;
+    for (const auto& n : g.graph.node()) relocalizer |= !n.disabled() && type_from_executable(n.executable()) == "relocalizer";
+    auto can_wait = [&](const std::string& node) {
+      for (const auto& n : g.graph.node())
+        if (n.name() == node)
+          if (const auto o = node_options(n); o && o->GetDescriptor()->FindFieldByName("wait_for_initial_pose")) return true;
+      return false;
+    };
     const auto before = fploc::tools::start_plans(as_written, keep);
     for (const auto& sp : fploc::tools::start_plans(g, keep)) {
       if (!sp.has_initial_pose || sp.ignores_initial_pose) continue;
@@ -203,13 +212,8 @@ int main(int argc, char** argv) {
         if (b.node != sp.node || !b.has_initial_pose || b.path == sp.path) continue;
         std::string how = "give the start in it: --set " + sp.node + ".initial_pose.x=X --set " + sp.node +
                           ".initial_pose.y=Y --set " + sp.node + ".initial_pose.yaw=YAW (radians)";
-        bool relocalizer = false;  // wait_for_initial_pose helps only where a relocalizer sends the start
-        for (const auto& n : g.graph.node())
-          relocalizer |= !n.disabled() && type_from_executable(n.executable()) == "relocalizer";
-        for (const auto& n : g.graph.node())
-          if (n.name() == sp.node && relocalizer)
-            if (const auto o = node_options(n); o && o->GetDescriptor()->FindFieldByName("wait_for_initial_pose"))
-              how += ", or let the relocalizer search the plan: --set " + sp.node + ".wait_for_initial_pose=true";
+        if (relocalizer && can_wait(sp.node))
+          how += ", or let the relocalizer search the plan: --set " + sp.node + ".wait_for_initial_pose=true";
         char xy[96];
         std::snprintf(xy, sizeof xy, "(%.2f, %.2f)", sp.x, sp.y);
         std::cerr << "fploc replay: warning: " << sp.node << "'s initial pose " << xy << " is the graph's, written for "

@@ -20,6 +20,7 @@
 #include <cstdio>
 
 #include "fploc/core/text_out.h"
+#include "fploc/runtime/cli_messages.h"
 #include "fploc/runtime/cli_numbers.h"
 #include "fploc/floorplan/building.h"
 #include "fploc/floorplan/io.h"
